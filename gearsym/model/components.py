@@ -1,0 +1,144 @@
+"""Drivetrain components, joined at their flanges (bodies) like Modelica Rotational.
+
+Bodies carry a rotation angle psi (the angle left after the steady rotation is
+removed). Couplings join two bodies: a :class:`Mesh` along the line of action,
+a :class:`Shaft` in torsion. :class:`Torque` acts on one body.
+
+Sign conventions (those of the paper's Eqs. 1 and 8):
+
+* mesh deflection ``delta = r_a*psi_a - r_b*psi_b`` (the two angles of an
+  external pair are counted in opposite senses, so rigid rolling is delta = 0);
+* shaft twist ``theta = psi_b - psi_a``;
+* a torque with ``load=True`` is a resisting torque M: it enters as -M (the
+  paper's M2 and M3); otherwise it drives (+M, the paper's M1).
+
+Every quantity is a number, a parameter name or a SymPy formula (see
+:mod:`gearsym.model.expressions`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional, Union
+
+from .expressions import ExprLike
+from .stiffness import rectangular_mesh_stiffness
+
+
+@dataclass(eq=False)
+class Body:
+    """A rotating inertia (base class of :class:`Gear` and :class:`Disk`)."""
+
+    name: str
+    inertia: ExprLike
+
+    @property
+    def radius(self) -> Optional[ExprLike]:
+        return None
+
+
+@dataclass(eq=False)
+class Gear(Body):
+    """A gear wheel: moment of inertia and base-circle radius."""
+
+    base_radius: ExprLike = "r"
+
+    @property
+    def radius(self) -> ExprLike:
+        return self.base_radius
+
+
+@dataclass(eq=False)
+class Disk(Body):
+    """A disk (flywheel, rotor, load inertia): moment of inertia only."""
+
+
+BodyRef = Union[Body, str]
+
+
+@dataclass(eq=False)
+class Mesh:
+    """A gear mesh between two gears, acting along the line of action.
+
+    Elastic force ``stiffness * variation(phi) * g(delta, backlash)``, damping force
+    ``damping * d(delta)/dt``; ``phi = order * omega * t + phase`` is the mesh phase.
+
+    * ``variation``: dimensionless, 2*pi-periodic in ``phi`` (default: the documented
+      smoothed rectangular wave, :func:`rectangular_mesh_stiffness`).
+    * ``coordinate``: name of the relative coordinate (the mesh deflection).
+    * ``function``: name under which the nondimensional stiffness k(tau) appears.
+    * ``damping_group``: name of the damping ratio group (the paper's zeta).
+    * ``backlash``: the clearance eta; 0 gives a linear mesh.
+    """
+
+    name: str
+    gear_a: BodyRef
+    gear_b: BodyRef
+    stiffness: ExprLike = "kZ"
+    damping: ExprLike = "cZ"
+    backlash: ExprLike = "eta"
+    variation: ExprLike = field(default_factory=rectangular_mesh_stiffness)
+    order: ExprLike = 1
+    phase: ExprLike = 0
+    coordinate: Optional[str] = None
+    function: Optional[str] = None
+    damping_group: Optional[str] = None
+    stiffness_group: Optional[str] = None
+
+    @property
+    def ends(self) -> tuple[BodyRef, BodyRef]:
+        return (self.gear_a, self.gear_b)
+
+
+@dataclass(eq=False)
+class Shaft:
+    """A torsional shaft from body ``a`` to body ``b`` (twist ``psi_b - psi_a``).
+
+    Its relative coordinate is the twist scaled to a length,
+    ``x = radius * (psi_b - psi_a)`` as the paper's ``x2 = r2 (psi3 - psi2)``;
+    ``radius`` defaults to the base radius of ``a`` (or of ``b`` if ``a`` is a disk).
+    ``forced=False`` (the paper's choice) makes the reduction require that no
+    constant torque loads the twist: that is the torque-balance condition of Eq. 10.
+    """
+
+    name: str
+    a: BodyRef
+    b: BodyRef
+    stiffness: ExprLike = "kS"
+    damping: ExprLike = 0
+    coordinate: Optional[str] = None
+    radius: Optional[ExprLike] = None
+    forced: bool = False
+
+    @property
+    def ends(self) -> tuple[BodyRef, BodyRef]:
+        return (self.a, self.b)
+
+
+@dataclass(eq=False)
+class Harmonic:
+    """One harmonic ``amplitude * cos(order * omega * t + phase)`` of a torque.
+
+    ``group`` names the nondimensional forcing group it ends up in (the paper's
+    B1 for the excitation, D for the weak resonant term); harmonics of the same
+    order and phase on different bodies add up into one group.
+    """
+
+    amplitude: ExprLike
+    phase: ExprLike = 0
+    order: int = 1
+    group: Optional[str] = None
+
+
+@dataclass(eq=False)
+class Torque:
+    """An external torque ``mean + sum(harmonics)`` on one body (see ``load`` above)."""
+
+    name: str
+    on: BodyRef
+    mean: ExprLike = 0
+    harmonics: tuple[Harmonic, ...] = ()
+    load: bool = False
+
+
+Coupling = Union[Mesh, Shaft]
+Component = Union[Body, Mesh, Shaft, Torque]

@@ -1,0 +1,69 @@
+"""Turning what a user writes (a name, a number, a formula) into SymPy expressions.
+
+Every name in a formula becomes the canonical parameter symbol, except the
+reserved ``t``, ``tau`` and ``phi``; calls of functions SymPy does not know are
+rejected with the name of the component that used them.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Union
+
+import re
+
+import sympy as sp
+from sympy.core.function import AppliedUndef
+from sympy.parsing.sympy_parser import parse_expr, standard_transformations
+
+from ..errors import ModelError
+from ..symbols import RESERVED, parameter_symbol
+
+ExprLike = Union[str, int, float, sp.Expr]
+_NAME = re.compile(r"\b([A-Za-z_][A-Za-z_0-9]*)\b(\s*\()?")
+
+
+def to_expr(value: ExprLike, where: str, extra: Mapping[str, sp.Expr] | None = None) -> sp.Expr:
+    """Parse ``value`` into a SymPy expression of canonical symbols.
+
+    ``extra`` maps further names (e.g. a function already declared) to objects.
+    """
+    if isinstance(value, bool) or value is None:
+        raise ModelError(f"expected a number, a parameter name or a formula, got {value!r}", where)
+    if isinstance(value, (int, float)):
+        return sp.nsimplify(value) if isinstance(value, int) else sp.Float(value)
+    if isinstance(value, str):
+        # a name is a function only where it is called: 'beta', 'zeta', 'gamma', 'E', 'I'
+        # would otherwise be SymPy's special functions and constants, not parameters
+        names = {m.group(1) for m in _NAME.finditer(value) if not m.group(2)}
+        local = {n: sp.Symbol(n) for n in names if n != "pi"}
+        try:
+            expr = parse_expr(value, local_dict=local, transformations=standard_transformations, evaluate=True)
+        except Exception as exc:  # SyntaxError, TokenError, ...
+            raise ModelError(f"cannot read the formula {value!r}: {exc}", where) from None
+    elif isinstance(value, sp.Basic):
+        expr = value
+    else:
+        raise ModelError(f"expected a number, a parameter name or a formula, got {type(value).__name__}", where)
+    return canonicalize(expr, where, extra)
+
+
+def canonicalize(expr: sp.Expr, where: str, extra: Mapping[str, sp.Expr] | None = None) -> sp.Expr:
+    """Replace every symbol by its canonical twin (same name, same assumptions everywhere)."""
+    extra = dict(extra or {})
+    unknown_calls = sorted({type(f).__name__ for f in expr.atoms(AppliedUndef)} - set(extra))
+    if unknown_calls:
+        raise ModelError(
+            f"unknown function(s) {', '.join(unknown_calls)} in {expr}; use SymPy functions "
+            "such as cos, sin, exp, Abs, Piecewise",
+            where,
+        )
+    mapping = {}
+    for s in expr.free_symbols:
+        name = s.name
+        mapping[s] = extra.get(name) or RESERVED.get(name) or parameter_symbol(name)
+    return expr.xreplace(mapping)
+
+
+def parameter_names(expr: sp.Expr) -> set[str]:
+    """Names of the parameters in ``expr`` (everything but the reserved time/phase symbols)."""
+    return {s.name for s in expr.free_symbols if s.name not in RESERVED}

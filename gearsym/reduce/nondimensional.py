@@ -1,0 +1,353 @@
+"""Coefficient groups, conditions and the nondimensional form in tau = omega t.
+
+From a :class:`~gearsym.reduce.reduction.Reduction` (row i holds
+``-factor_ic * law_c`` and forcing terms), this module names the groups the
+paper names and writes Eqs. 2, 6 and 9:
+
+* a mesh's own-row factor m (r1^2/I1 + r2^2/I2 for a pair) is absorbed into
+  its stiffness and damping: ``k(tau) g = m kZ g`` (Eq. 4), ``2 zeta = m cZ`` (Eq. 3);
+  in the other rows it leaves ``beta = factor / m`` (the paper's beta3);
+* a shaft's factor in every row is a group ``beta`` multiplying ``kS x``
+  (the paper's beta1, beta2);
+* the forcing of each row, grouped by harmonic, gives B0, B1, D, ...;
+  the constant forcing of an unforced shaft row must vanish: the torque-balance
+  condition of Eq. 10;
+* time is measured in units of 1/omega_n, omega_n^2 = m kZ of the first mesh,
+  so that its mean stiffness is 1 (the paper's convention; a condition too).
+
+Groups are numbered shafts first, then meshes, as in the paper's Eq. 10.
+"""
+from __future__ import annotations
+
+import functools
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Optional
+
+import sympy as sp
+
+from ..backlash import g
+from ..errors import ModelError, UnknownParameterError
+from ..model.drivetrain import Drivetrain, ResolvedCoupling
+from ..model.expressions import ExprLike, parameter_names, to_expr
+from ..model.stiffness import check_periodic
+from ..symbols import omega, parameter_symbol, phi, t, tau
+from ..system import FirstOrderSystem
+from .reduction import Reduction, reduce_drivetrain
+
+
+@dataclass(frozen=True)
+class Group:
+    """A coefficient group: a new symbol standing for a combination of component parameters.
+
+    ``free`` groups (zeta, B0, ...) are parameters of the nondimensional model
+    with their own values; ``derived`` groups (beta) are evaluated from their
+    definition, so the inertias and radii behind them stay declared parameters.
+    """
+
+    name: str
+    definition: sp.Expr
+    kind: str  # "free" | "derived"
+    description: str
+
+    @property
+    def symbol(self) -> sp.Symbol:
+        return parameter_symbol(self.name)
+
+
+@dataclass(frozen=True)
+class Condition:
+    """An equation the reduction requires or assumes, with the reason."""
+
+    equation: sp.Eq
+    description: str
+
+
+@dataclass(frozen=True)
+class StiffnessFunction:
+    """The nondimensional mesh stiffness k(tau) of one mesh."""
+
+    name: str
+    mesh: str
+    definition: sp.Expr  # m * kZ(t): the group, in the declared parameters
+    expression: sp.Expr  # its value as a function of tau (replaceable)
+
+    @property
+    def applied(self) -> sp.Expr:
+        return sp.Function(self.name, real=True)(tau)
+
+
+@dataclass
+class NondimensionalModel:
+    """A drivetrain reduced to relative coordinates and written in tau = omega t."""
+
+    reduction: Reduction
+    groups: list[Group] = field(default_factory=list)
+    conditions: list[Condition] = field(default_factory=list)
+    functions: list[StiffnessFunction] = field(default_factory=list)
+    _row_lhs: list[sp.Expr] = field(default_factory=list)  # sum of terms besides x''
+    _row_rhs: list[sp.Expr] = field(default_factory=list)  # forcing numerators (over omega^2)
+
+    @property
+    def name(self) -> str:
+        return self.reduction.drivetrain.name
+
+    @property
+    def drivetrain(self) -> Drivetrain:
+        return self.reduction.drivetrain
+
+    @property
+    def coordinates(self):
+        return self.reduction.coordinates
+
+    def group(self, name: str) -> Group:
+        for gr in self.groups:
+            if gr.name == name:
+                return gr
+        raise UnknownParameterError(name, [gr.name for gr in self.groups], f"{self.name} groups")
+
+    # ------------------------------------------------------------- equations
+    @cached_property
+    def equations(self) -> list[sp.Eq]:
+        """Second-order equations in tau, in the paper's layout (x'' + ... = (...)/omega^2)."""
+        out = []
+        for c, lhs, rhs in zip(self.coordinates, self._row_lhs, self._row_rhs):
+            out.append(sp.Eq(sp.diff(c.of(tau), tau, 2) + lhs, rhs / omega**2 if rhs != 0 else sp.S.Zero))
+        return out
+
+    @cached_property
+    def states(self) -> tuple[sp.Symbol, ...]:
+        out = []
+        for c in self.coordinates:
+            out += [sp.Symbol(c.name, real=True), sp.Symbol(c.velocity_name, real=True)]
+        return tuple(out)
+
+    def _to_state_symbols(self, expr: sp.Expr) -> sp.Expr:
+        sub = {}
+        for c in self.coordinates:
+            sub[sp.Derivative(c.of(tau), tau)] = sp.Symbol(c.velocity_name, real=True)
+        expr = expr.xreplace(sub)
+        return expr.xreplace({c.of(tau): sp.Symbol(c.name, real=True) for c in self.coordinates})
+
+    @cached_property
+    def rhs(self) -> tuple[sp.Expr, ...]:
+        """First-order right-hand side d(x, v)/dtau, with groups and k(tau) as symbols."""
+        out = []
+        for c, eq in zip(self.coordinates, self.equations):
+            out.append(sp.Symbol(c.velocity_name, real=True))
+            out.append(self._to_state_symbols(eq.rhs - (eq.lhs - sp.diff(c.of(tau), tau, 2))))
+        return tuple(out)
+
+    @cached_property
+    def period(self) -> sp.Expr:
+        """The forcing period in tau: 2 pi / gcd of all mesh and torque frequencies."""
+        freqs = [sp.nsimplify(rc.mesh_phase.coeff(omega * t)) for rc in self.reduction.resolved.couplings if rc.kind == "mesh"]
+        freqs += [sp.Integer(f.order) for f in self.reduction.resolved.forcing if f.order]
+        return 2 * sp.pi / functools.reduce(sp.gcd, freqs, sp.S.Zero) if freqs else 2 * sp.pi
+
+    # ------------------------------------------------------------- parameters
+    @cached_property
+    def parameter_names(self) -> list[str]:
+        """Parameters of the nondimensional model: omega, free groups, then the rest by name."""
+        expr_syms = set()
+        for f in self._substituted_rhs(None):
+            expr_syms |= parameter_names(f)
+        expr_syms -= {s.name for s in self.states}
+        free = [gr.name for gr in self.groups if gr.kind == "free" and gr.name in expr_syms]
+        rest = sorted(expr_syms - set(free) - {"omega"})
+        return ["omega"] + free + rest
+
+    @cached_property
+    def defaults(self) -> dict[str, float]:
+        """Declared default of every parameter; errors name what is missing or unknown."""
+        declared = self.drivetrain.defaults
+        allowed = set(self.parameter_names) | {f.name for f in self.functions}
+        for name in declared:
+            if name in allowed:
+                continue
+            absorbed = [gr.name for gr in self.groups if name in parameter_names(gr.definition) and gr.kind == "free"]
+            absorbed += [f.name for f in self.functions if name in parameter_names(f.definition)]
+            if absorbed:
+                raise ModelError(
+                    f"{name!r} is not a parameter of the reduced model: it only enters through "
+                    f"{', '.join(absorbed)}; set those instead",
+                    f"{self.name}: set_defaults",
+                )
+            raise UnknownParameterError(name, allowed, f"{self.name}: set_defaults")
+        out, missing = {}, []
+        for name in self.parameter_names:
+            if name not in declared:
+                missing.append(name)
+                continue
+            value = to_expr(declared[name], f"default of {name}")
+            if not value.is_number:
+                raise ModelError(f"the default must be a number, got {value}", f"parameter {name!r}")
+            out[name] = float(value)
+        if missing:
+            hints = []
+            for name in missing:
+                gr = next((gr for gr in self.groups if gr.name == name), None)
+                hints.append(f"{name} ({gr.description}: {gr.definition})" if gr else name)
+            raise ModelError(
+                "parameters without a default value: " + "; ".join(hints)
+                + f". Add them with model.set_defaults({missing[0]}=...)",
+                self.name,
+            )
+        return out
+
+    def _substituted_rhs(self, functions: Optional[Mapping[str, sp.Expr]]) -> list[sp.Expr]:
+        fsub = {}
+        for sf in self.functions:
+            expr = sf.expression if functions is None or sf.name not in functions else functions[sf.name]
+            fsub[sf.applied] = expr
+        gsub = {gr.symbol: gr.definition for gr in self.groups if gr.kind == "derived"}
+        return [f.xreplace(fsub).xreplace(gsub) for f in self.rhs]
+
+    def system(self, **settings: ExprLike) -> FirstOrderSystem:
+        """The first-order system for the engine.
+
+        ``settings`` override parameter values (``omega=1.2``) or replace a mesh
+        stiffness function by a formula in tau (``k="1 + 0.2*cos(tau)"``).
+        """
+        fnames = {f.name for f in self.functions}
+        functions, values = {}, {}
+        for key, value in settings.items():
+            if key in fnames:
+                expr = to_expr(value, f"stiffness function {key}")
+                check_periodic(expr, tau, f"stiffness function {key}", period=self.period)
+                functions[key] = expr
+            elif key in self.parameter_names:
+                values[key] = value
+            else:
+                raise UnknownParameterError(key, set(self.parameter_names) | fnames, self.name)
+        rhs = self._substituted_rhs(functions)
+        names = set()
+        for f in rhs:
+            names |= parameter_names(f)
+        names -= {s.name for s in self.states}
+        defaults = self.defaults
+        params = {}
+        for name in self.parameter_names + sorted(names - set(self.parameter_names)):
+            if name in names or name == "omega":
+                if name not in defaults and name not in values:
+                    raise ModelError(f"parameter {name!r} (used by a replaced function) needs a value: pass {name}=...", self.name)
+                params[name] = float(values.get(name, defaults.get(name, 0.0)))
+        descriptions = dict(self.drivetrain.descriptions)
+        for gr in self.groups:
+            descriptions.setdefault(gr.name, gr.description)
+        return FirstOrderSystem(self.name, tau, self.states, tuple(rhs), params, self.period, descriptions)
+
+
+# ============================================================================ construction
+def _coordinate_suffix(red: Reduction, row: int) -> str:
+    return "" if row == 0 else f"_{red.coordinates[row].name}"
+
+
+def nondimensionalize(red: Reduction) -> NondimensionalModel:
+    """Name the coefficient groups of ``red`` and write its equations in tau."""
+    nd = NondimensionalModel(red)
+    n = len(red.coordinates)
+    lhs = [sp.S.Zero] * n
+    rhs = [sp.S.Zero] * n
+    meshes = [rc for rc in red.resolved.couplings if rc.kind == "mesh"]
+    shafts = [rc for rc in red.resolved.couplings if rc.kind == "shaft"]
+    reference = meshes[0] if meshes else None
+    betas: dict[sp.Expr, sp.Expr] = {}
+
+    def beta(definition: sp.Expr, description: str) -> sp.Expr:
+        if definition.is_number:
+            return definition
+        for known, sym in betas.items():
+            if sp.simplify(known - definition) == 0:
+                return sym
+        gr = Group(f"beta_{len(betas) + 1}", definition, "derived", description)
+        nd.groups.append(gr)
+        betas[definition] = gr.symbol
+        return gr.symbol
+
+    def own_factor(rc: ResolvedCoupling) -> sp.Expr:
+        row = red.coordinates.index(red.coordinate_of(rc))
+        return next(ct.factor for ct in red.row_terms(row) if ct.coupling is rc)
+
+    # shafts: beta * (kS x + cS x') in every row they reach
+    for rc in shafts:
+        x = red.coordinate_of(rc).of(tau)
+        for ct in (ct for ct in red.coupling_terms if ct.coupling is rc):
+            b = beta(sp.expand(ct.factor), f"coupling of shaft {rc.name!r} into {red.coordinates[ct.row].name}")
+            lhs[ct.row] += b * rc.stiffness * x / omega**2 + b * rc.damping * sp.diff(x, tau) / omega
+    # meshes: own row absorbs the factor; other rows get beta * (own-row terms)
+    own_terms = {}
+    for rc in meshes:
+        cx = red.coordinate_of(rc)
+        suffix = "" if rc is reference else f"_{cx.name}"
+        m = sp.expand(own_factor(rc))
+        x = cx.of(tau)
+        comp = rc.component
+        fname = comp.function or ("k" if rc is reference else f"k{suffix}")
+        varied = rc.variation.subs(phi, sp.expand(rc.mesh_phase.subs(t, tau / omega)))
+        if rc is reference:
+            nd.conditions.append(Condition(
+                sp.Eq(m * rc.stiffness, 1),
+                f"time unit: t is measured in units of 1/omega_n with omega_n^2 = {rc.stiffness} ({m}), "
+                f"so the mean of {fname}(tau) is the mean of the declared stiffness variation (the paper's convention)",
+            ))
+            expression = varied
+        else:
+            K = Group(comp.stiffness_group or f"K{suffix}", m * rc.stiffness, "free",
+                      f"mean stiffness of mesh {rc.name!r} relative to the first mesh")
+            nd.groups.append(K)
+            expression = K.symbol * varied
+        kfun = StiffnessFunction(fname, rc.name, m * red.resolved.stiffness_at(rc).subs(t, tau / omega), expression)
+        nd.functions.append(kfun)
+        terms = kfun.applied * g(x, rc.backlash) / omega**2
+        if rc.damping != 0:
+            zeta = Group(comp.damping_group or f"zeta{suffix}", m * rc.damping / 2, "free",
+                         f"damping ratio of mesh {rc.name!r}")
+            nd.groups.append(zeta)
+            terms = 2 * zeta.symbol * sp.diff(x, tau) / omega + terms
+        own_terms[rc] = terms
+    for rc in meshes:
+        m = own_factor(rc)
+        for ct in (ct for ct in red.coupling_terms if ct.coupling is rc):
+            if ct.factor == m and red.coordinates[ct.row] is red.coordinate_of(rc):
+                lhs[ct.row] += own_terms[rc]
+            else:
+                b = beta(sp.expand(ct.factor) / sp.expand(m), f"share of mesh {rc.name!r} force in {red.coordinates[ct.row].name}")
+                lhs[ct.row] += sp.expand(b * own_terms[rc])
+    # forcing: group each row's terms by harmonic
+    for row, cx in enumerate(red.coordinates):
+        by_key: dict = {}
+        for ft in red.row_forcing(row):
+            by_key.setdefault(ft.key, []).append(ft)
+        used_names: set[str] = {gr.name for gr in nd.groups}
+        for (order, phase), terms in by_key.items():
+            definition = sp.expand(sp.Add(*(ft.coefficient for ft in terms)))
+            if definition == 0:
+                continue
+            if order == 0 and cx.kind == "shaft" and not cx.coupling.component.forced:
+                nd.conditions.append(Condition(
+                    sp.Eq(0, definition),
+                    f"torque balance: no constant torque may load the twist {cx.name} of shaft "
+                    f"{cx.coupling.name!r} (declare Shaft(..., forced=True) to keep it as forcing)",
+                ))
+                continue
+            hint = next((ft.source.group for ft in terms if ft.source.group), None)
+            base = "B0" if order == 0 else (hint or f"B{order}")
+            name = base + _coordinate_suffix(red, row) if (row != 0 and not hint) else base
+            k = 2
+            while name in used_names:
+                name, k = f"{base}_{k}", k + 1
+            used_names.add(name)
+            what = "constant forcing" if order == 0 else f"forcing amplitude of cos({order}*tau + {phase})"
+            gr = Group(name, definition, "free", f"{what} of {cx.name}")
+            nd.groups.append(gr)
+            timefn = sp.S.One if order == 0 else sp.cos(order * tau + phase)
+            rhs[row] += gr.symbol * timefn
+    nd._row_lhs, nd._row_rhs = lhs, rhs
+    return nd
+
+
+def reduce(model: Drivetrain) -> NondimensionalModel:
+    """Derive the equations of motion, reduce them and write the nondimensional form."""
+    return nondimensionalize(reduce_drivetrain(model))
