@@ -32,6 +32,7 @@ class FirstOrderSystem:
     parameters: Mapping[str, float]
     period: sp.Expr = sp.S.One
     descriptions: Mapping[str, str] = field(default_factory=dict)
+    title: str = ""
 
     def __post_init__(self):
         if len(self.states) != len(self.rhs):
@@ -57,13 +58,14 @@ class FirstOrderSystem:
         time: str = "t",
         period: ExprLike = 1,
         descriptions: Mapping[str, str] | None = None,
+        title: str = "",
     ) -> "FirstOrderSystem":
         """Declare an ODE from strings, e.g. Lorenz: states ['x','y','z'], rhs ['sigma*(y-x)', ...]."""
         state_syms = tuple(sp.Symbol(s, real=True) for s in states)
         time_sym = sp.Symbol(time, real=True)
         extra = {s.name: s for s in state_syms} | {time: time_sym}
         exprs = tuple(to_expr(f, f"{name}: d{s}/d{time}", extra) for f, s in zip(rhs, states))
-        return cls(name, time_sym, state_syms, exprs, dict(parameters), to_expr(period, name), dict(descriptions or {}))
+        return cls(name, time_sym, state_syms, exprs, dict(parameters), to_expr(period, name), dict(descriptions or {}), title)
 
     @property
     def dimension(self) -> int:

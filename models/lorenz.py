@@ -13,4 +13,5 @@ model = FirstOrderSystem.from_equations(
     time="t",
     period=1,
     descriptions={"sigma": "Prandtl number", "rho": "Rayleigh number ratio", "beta": "geometric factor"},
+    title="Lorenz system: a check of the engine against published Lyapunov exponents",
 )

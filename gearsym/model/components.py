@@ -13,7 +13,8 @@ Sign conventions (those of the paper's Eqs. 1 and 8):
   paper's M2 and M3); otherwise it drives (+M, the paper's M1).
 
 Every quantity is a number, a parameter name or a SymPy formula (see
-:mod:`gearsym.model.expressions`).
+:mod:`gearsym.model.expressions`). Components are frozen: a change after
+declaring means declaring again, so nothing derived from them goes stale.
 """
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ from .expressions import ExprLike
 from .stiffness import rectangular_mesh_stiffness
 
 
-@dataclass(eq=False)
+@dataclass(eq=False, frozen=True)
 class Body:
     """A rotating inertia (base class of :class:`Gear` and :class:`Disk`)."""
 
@@ -36,7 +37,7 @@ class Body:
         return None
 
 
-@dataclass(eq=False)
+@dataclass(eq=False, frozen=True)
 class Gear(Body):
     """A gear wheel: moment of inertia and base-circle radius."""
 
@@ -47,7 +48,7 @@ class Gear(Body):
         return self.base_radius
 
 
-@dataclass(eq=False)
+@dataclass(eq=False, frozen=True)
 class Disk(Body):
     """A disk (flywheel, rotor, load inertia): moment of inertia only."""
 
@@ -55,7 +56,7 @@ class Disk(Body):
 BodyRef = Union[Body, str]
 
 
-@dataclass(eq=False)
+@dataclass(eq=False, frozen=True)
 class Mesh:
     """A gear mesh between two gears, acting along the line of action.
 
@@ -89,7 +90,7 @@ class Mesh:
         return (self.gear_a, self.gear_b)
 
 
-@dataclass(eq=False)
+@dataclass(eq=False, frozen=True)
 class Shaft:
     """A torsional shaft from body ``a`` to body ``b`` (twist ``psi_b - psi_a``).
 
@@ -114,7 +115,7 @@ class Shaft:
         return (self.a, self.b)
 
 
-@dataclass(eq=False)
+@dataclass(eq=False, frozen=True)
 class Harmonic:
     """One harmonic ``amplitude * cos(order * omega * t + phase)`` of a torque.
 
@@ -129,7 +130,7 @@ class Harmonic:
     group: Optional[str] = None
 
 
-@dataclass(eq=False)
+@dataclass(eq=False, frozen=True)
 class Torque:
     """An external torque ``mean + sum(harmonics)`` on one body (see ``load`` above)."""
 

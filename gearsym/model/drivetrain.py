@@ -15,7 +15,7 @@ import sympy as sp
 
 from ..backlash import G
 from ..errors import ModelError, suggest
-from ..symbols import omega, phi, t
+from ..symbols import omega, parameter_symbol, phi, t
 from .components import Body, BodyRef, Coupling, Disk, Gear, Harmonic, Mesh, Shaft, Torque
 from .expressions import ExprLike, parameter_names, to_expr
 from .stiffness import check_periodic
@@ -81,11 +81,16 @@ class Drivetrain:
         self.torques: list[Torque] = []
         self._defaults: dict[str, ExprLike] = {}
         self._descriptions: dict[str, str] = {}
+        self.version = 0  # bumped by every change, so derived results can be cached safely
+
+    def _changed(self) -> None:
+        self.version += 1
+        self.__dict__.pop("resolved", None)
 
     # ----------------------------------------------------------------- declaring
     def add(self, component):
         """Add a component; returns it, so ``g1 = model.add(Gear(...))`` reads naturally."""
-        self.__dict__.pop("resolved", None)  # a new component invalidates the cached view
+        self._changed()
         names = {c.name for c in (*self.bodies, *self.couplings, *self.torques)}
         if not getattr(component, "name", None) or not isinstance(component.name, str):
             raise ModelError("every component needs a name (a non-empty string)", repr(component))
@@ -106,12 +111,13 @@ class Drivetrain:
 
     def set_defaults(self, **values: ExprLike) -> "Drivetrain":
         """Default values of the model's parameters (checked against the reduced model's parameters)."""
-        self.__dict__.pop("resolved", None)
+        self._changed()
         self._defaults.update(values)
         return self
 
     def describe(self, **descriptions: str) -> "Drivetrain":
         """One-line descriptions of parameters, shown in the derivation docs."""
+        self._changed()
         self._descriptions.update(descriptions)
         return self
 
@@ -166,18 +172,20 @@ class ResolvedDrivetrain:
         for name in parameter_names(expr):
             if name not in self.model._defaults:
                 return None
-            subs[sp.Symbol(name, real=True)] = to_expr(self.model._defaults[name], f"default of {name}")
+            subs[parameter_symbol(name)] = to_expr(self.model._defaults[name], f"default of {name}")
         try:
             return float(expr.xreplace(subs))
         except TypeError:
             return None
 
-    def _positive(self, value: ExprLike, what: str, where: str) -> sp.Expr:
+    def _positive(self, value: ExprLike, what: str, where: str, allow_zero: bool = False) -> sp.Expr:
+        """Parse ``value`` and reject a non-positive number or default (negative only, with allow_zero)."""
         expr = to_expr(value, where)
-        num = self._default_value(expr)
-        if (expr.is_number and not expr.is_positive) or (num is not None and num <= 0):
+        num = float(expr) if expr.is_number else self._default_value(expr)
+        if num is not None and (num < 0 or (num == 0 and not allow_zero)):
             shown = expr if expr.is_number else f"{expr} = {num:g} (its default)"
-            raise ModelError(f"{what} must be positive, got {shown}", where)
+            must = "must not be negative" if allow_zero else "must be positive"
+            raise ModelError(f"{what} {must}, got {shown}", where)
         return expr
 
     def body(self, ref: BodyRef, where: str) -> ResolvedBody:
@@ -228,15 +236,15 @@ class ResolvedDrivetrain:
             if variation.free_symbols & {t}:
                 raise ModelError("the stiffness variation must be written in the mesh phase phi, not in t", where)
             defaults = {
-                sp.Symbol(nm, real=True): self._default_value(sp.Symbol(nm, real=True))
+                parameter_symbol(nm): self._default_value(parameter_symbol(nm))
                 for nm in parameter_names(variation)
             }
             check_periodic(variation, phi, where, {k: v for k, v in defaults.items() if v is not None})
             return ResolvedCoupling(
                 component=c, kind=kind, a=a, b=b, row=tuple(row), scale=sp.S.One,
                 stiffness=self._positive(c.stiffness, "the mesh stiffness", where),
-                damping=to_expr(c.damping, where),
-                backlash=to_expr(c.backlash, where),
+                damping=self._positive(c.damping, "the mesh damping", where, allow_zero=True),
+                backlash=self._positive(c.backlash, "the backlash", where, allow_zero=True),
                 variation=variation,
                 mesh_phase=order * omega * t + to_expr(c.phase, where),
             )
@@ -255,8 +263,8 @@ class ResolvedDrivetrain:
             )
         return ResolvedCoupling(
             component=c, kind=kind, a=a, b=b, row=tuple(row), scale=scale,
-            stiffness=self._positive(c.stiffness, "the shaft stiffness", where),
-            damping=to_expr(c.damping, where),
+            stiffness=self._positive(c.stiffness, "the shaft stiffness", where, allow_zero=True),
+            damping=self._positive(c.damping, "the shaft damping", where, allow_zero=True),
             backlash=sp.S.Zero, variation=sp.S.One, mesh_phase=sp.S.Zero,
         )
 
@@ -303,8 +311,10 @@ class ResolvedDrivetrain:
         """
         if rc.kind == "shaft":
             return rc.stiffness
-        name = rc.stiffness.name if isinstance(rc.stiffness, sp.Symbol) else f"k_{rc.name}"
-        return sp.Function(name, real=True)(t)
+        shared = sum(1 for other in self.couplings if other.kind == "mesh" and other.stiffness == rc.stiffness) > 1
+        plain = isinstance(rc.stiffness, sp.Symbol) and not shared
+        base = rc.stiffness.name if isinstance(rc.stiffness, sp.Symbol) else "kZ"
+        return sp.Function(base if plain else f"{base}_{rc.name}", real=True)(t)
 
     def stiffness_definition(self, rc: ResolvedCoupling) -> sp.Expr:
         """kZ(t) = kZ * k(phi(t)) with the declared variation k and mesh phase phi."""

@@ -64,29 +64,34 @@ def check_periodic(
     values: Mapping[sp.Symbol, float] | None = None,
     period: sp.Expr = 2 * sp.pi,
 ) -> None:
-    """Raise ModelError unless ``expr`` is ``period``-periodic in ``variable``.
+    """Raise ModelError unless ``expr`` is ``period``-periodic in ``variable`` for every parameter value.
 
-    First symbolically (shift and simplify); if SymPy cannot decide, numerically
-    at 24 points with the other symbols set to ``values`` (or to generic numbers).
+    First symbolically (shift and simplify). If SymPy cannot decide, numerically
+    at 24 phases, with the other symbols at ``values`` and at three random
+    parameter sets: a period that holds only at the defaults (``cos(w*phi)`` with
+    w = 1) would break as soon as w is changed at run time, so it is rejected.
     """
     if variable not in expr.free_symbols:
         return
     diff = sp.simplify(expr.subs(variable, variable + period) - expr)
     if diff == 0:
         return
-    others = sorted(diff.free_symbols - {variable}, key=lambda s: s.name)
+    others = sorted((expr.free_symbols | diff.free_symbols) - {variable}, key=lambda s: s.name)
     rng = np.random.default_rng(12345)
-    subs = {s: (values or {}).get(s, float(rng.uniform(0.3, 1.7))) for s in others}
-    f = sp.lambdify(variable, diff.subs(subs).rewrite(sp.Piecewise), "numpy")
-    scale = sp.lambdify(variable, expr.subs(subs).rewrite(sp.Piecewise), "numpy")
-    xs = np.linspace(0.0, 2 * np.pi, 24, endpoint=False) + 0.137
-    err = np.max(np.abs(np.asarray(f(xs), dtype=float) * np.ones_like(xs)))
-    ref = max(1.0, float(np.max(np.abs(np.asarray(scale(xs), dtype=float) * np.ones_like(xs)))))
-    if not np.isfinite(err) or err > 1e-9 * ref:
-        raise ModelError(
-            f"the mesh stiffness {expr} is not 2*pi-periodic in the mesh phase {variable} "
-            f"(k({variable}+2*pi) - k({variable}) reaches {err:.3g}). Write it with whole "
-            f"multiples of {variable}, e.g. 1 + 0.2*cos({variable}), and set the mesh "
-            "frequency with the mesh's `order`.",
-            where,
-        )
+    trials = [{s: (values or {}).get(s, 1.0) for s in others}]
+    trials += [{s: float(rng.uniform(0.3, 1.7)) for s in others} for _ in range(3)]
+    xs = np.linspace(0.0, float(period), 24, endpoint=False) + 0.137
+    for subs in trials:
+        f = sp.lambdify(variable, diff.subs(subs).rewrite(sp.Piecewise), "numpy")
+        scale = sp.lambdify(variable, expr.subs(subs).rewrite(sp.Piecewise), "numpy")
+        err = float(np.max(np.abs(np.asarray(f(xs), dtype=float) * np.ones_like(xs))))
+        ref = max(1.0, float(np.max(np.abs(np.asarray(scale(xs), dtype=float) * np.ones_like(xs)))))
+        if not np.isfinite(err) or err > 1e-9 * ref:
+            at = ", ".join(f"{k}={v:.3g}" for k, v in subs.items())
+            raise ModelError(
+                f"the mesh stiffness {expr} is not {period}-periodic in {variable}"
+                f"{' at ' + at if at else ''} (the shift by one period changes it by up to {err:.3g}). "
+                f"Write it with whole multiples of the mesh phase, e.g. 1 + 0.2*cos({variable}), "
+                "and set a mesh's frequency with its `order`, not with a parameter.",
+                where,
+            )

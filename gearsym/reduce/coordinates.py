@@ -65,11 +65,17 @@ def relative_coordinates(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.M
     """One coordinate per coupling, and the transform T (q = T psi)."""
     jac = deflection_matrix(rd)
     n_bodies, n_couplings = len(rd.bodies), len(rd.couplings)
-    rank = generic_rank(jac)
-    if rank < n_couplings:
+    if generic_rank(jac) < n_couplings:
+        # name the couplings that close a loop: those adding no independent deflection
+        closing, kept = [], []
+        for i, rc in enumerate(rd.couplings):
+            if generic_rank(jac.extract(kept + [i], list(range(n_bodies)))) > len(kept):
+                kept.append(i)
+            else:
+                closing.append(rc.name)
         raise ModelError(
-            f"the couplings form a closed kinematic loop ({n_couplings} couplings but only {rank} independent "
-            "deflections); loops (e.g. planetary sets) are not supported yet: remove a redundant coupling",
+            f"coupling(s) {', '.join(map(repr, closing))} close a kinematic loop with the couplings declared "
+            "before them; loops (e.g. planetary sets) are not supported yet: remove the redundant coupling",
             rd.model.name,
         )
     single = n_couplings == 1

@@ -26,6 +26,7 @@ from functools import cached_property
 from typing import Optional
 
 import sympy as sp
+from sympy.core.function import AppliedUndef
 
 from ..backlash import g
 from ..errors import ModelError, UnknownParameterError
@@ -62,6 +63,7 @@ class Condition:
 
     equation: sp.Eq
     description: str
+    kind: str  # "time_unit" | "torque_balance"
 
 
 @dataclass(frozen=True)
@@ -72,6 +74,7 @@ class StiffnessFunction:
     mesh: str
     definition: sp.Expr  # m * kZ(t): the group, in the declared parameters
     expression: sp.Expr  # its value as a function of tau (replaceable)
+    period: sp.Expr  # 2 pi / mesh order: a replacement must keep it
 
     @property
     def applied(self) -> sp.Expr:
@@ -158,16 +161,30 @@ class NondimensionalModel:
         rest = sorted(expr_syms - set(free) - {"omega"})
         return ["omega"] + free + rest
 
-    @cached_property
+    def _absorbing(self, name: str) -> list[str]:
+        """Groups and functions that absorb the component parameter ``name``."""
+        out = [gr.name for gr in self.groups if gr.kind == "free" and name in parameter_names(gr.definition)]
+        for f in self.functions:
+            # the definition holds kZ(t) as a function; the mean stiffness kZ is a symbol of the mesh
+            names = parameter_names(f.definition) | parameter_names(self._mesh(f).stiffness)
+            names |= {type(a).__name__ for a in f.definition.atoms(AppliedUndef)}
+            if name in names:
+                out.append(f.name)
+        return out
+
+    def _mesh(self, f: StiffnessFunction) -> ResolvedCoupling:
+        return next(rc for rc in self.reduction.resolved.couplings if rc.name == f.mesh)
+
+    @property
     def defaults(self) -> dict[str, float]:
         """Declared default of every parameter; errors name what is missing or unknown."""
         declared = self.drivetrain.defaults
-        allowed = set(self.parameter_names) | {f.name for f in self.functions}
+        fnames = {f.name for f in self.functions}
+        allowed = set(self.parameter_names) | fnames
         for name in declared:
             if name in allowed:
                 continue
-            absorbed = [gr.name for gr in self.groups if name in parameter_names(gr.definition) and gr.kind == "free"]
-            absorbed += [f.name for f in self.functions if name in parameter_names(f.definition)]
+            absorbed = self._absorbing(name)
             if absorbed:
                 raise ModelError(
                     f"{name!r} is not a parameter of the reduced model: it only enters through "
@@ -180,10 +197,7 @@ class NondimensionalModel:
             if name not in declared:
                 missing.append(name)
                 continue
-            value = to_expr(declared[name], f"default of {name}")
-            if not value.is_number:
-                raise ModelError(f"the default must be a number, got {value}", f"parameter {name!r}")
-            out[name] = float(value)
+            out[name] = self._number(name, declared[name], "default")
         if missing:
             hints = []
             for name in missing:
@@ -195,6 +209,43 @@ class NondimensionalModel:
                 self.name,
             )
         return out
+
+    @cached_property
+    def _constraints(self) -> dict[str, tuple[bool, str]]:
+        """name -> (zero allowed, what it is) for parameters that have a physical sign."""
+        rd = self.reduction.resolved
+        out: dict[str, tuple[bool, str]] = {"omega": (False, "the forcing frequency")}
+        for rb in rd.bodies:
+            for value, what in ((rb.inertia, "an inertia"), (rb.radius, "a radius")):
+                if isinstance(value, sp.Symbol):
+                    out[value.name] = (False, what)
+        for rc in rd.couplings:
+            for value, what in ((rc.backlash, "a backlash"), (rc.damping, "a damping"), (rc.stiffness, "a stiffness")):
+                if isinstance(value, sp.Symbol):
+                    out.setdefault(value.name, (True, what))
+        for gr in self.groups:
+            if gr.name.startswith("zeta") or gr.description.startswith("damping ratio"):
+                out[gr.name] = (True, "a damping ratio")
+            elif gr.description.startswith("mean stiffness"):
+                out[gr.name] = (False, "a relative mesh stiffness")
+        return out
+
+    def _number(self, name: str, value: ExprLike, what: str) -> float:
+        expr = to_expr(value, f"{what} of {name}")
+        if not expr.is_number:
+            raise ModelError(f"the {what} must be a number, got {value!r}", f"parameter {name!r}")
+        number = float(expr)
+        zero_ok, meaning = self._constraints.get(name, (True, None))
+        if meaning and (number < 0 or (number == 0 and not zero_ok)):
+            must = "must not be negative" if zero_ok else "must be positive"
+            raise ModelError(f"is {meaning} and {must}, got {number:g}", f"parameter {name!r}")
+        return number
+
+    def _function_expr(self, f: StiffnessFunction, value: ExprLike) -> sp.Expr:
+        where = f"stiffness function {f.name} (mesh {f.mesh!r})"
+        expr = to_expr(value, where)
+        check_periodic(expr, tau, where, period=f.period)
+        return expr
 
     def _substituted_rhs(self, functions: Optional[Mapping[str, sp.Expr]]) -> list[sp.Expr]:
         fsub = {}
@@ -208,35 +259,40 @@ class NondimensionalModel:
         """The first-order system for the engine.
 
         ``settings`` override parameter values (``omega=1.2``) or replace a mesh
-        stiffness function by a formula in tau (``k="1 + 0.2*cos(tau)"``).
+        stiffness function by a formula in tau (``k="1 + a*cos(tau)"``, then
+        ``a=0.3`` gives the new parameter its value). A default for a function
+        name in ``set_defaults`` replaces it the same way.
         """
-        fnames = {f.name for f in self.functions}
-        functions, values = {}, {}
-        for key, value in settings.items():
-            if key in fnames:
-                expr = to_expr(value, f"stiffness function {key}")
-                check_periodic(expr, tau, f"stiffness function {key}", period=self.period)
-                functions[key] = expr
-            elif key in self.parameter_names:
-                values[key] = value
-            else:
-                raise UnknownParameterError(key, set(self.parameter_names) | fnames, self.name)
+        declared = self.drivetrain.defaults
+        functions = {f.name: self._function_expr(f, declared[f.name]) for f in self.functions if f.name in declared}
+        for f in self.functions:
+            if f.name in settings:
+                functions[f.name] = self._function_expr(f, settings[f.name])
         rhs = self._substituted_rhs(functions)
-        names = set()
-        for f in rhs:
-            names |= parameter_names(f)
-        names -= {s.name for s in self.states}
+        used = set()
+        for expr in rhs:
+            used |= parameter_names(expr)
+        used -= {s.name for s in self.states}
+        fnames = {f.name for f in self.functions}
+        for key in settings:
+            if key not in fnames and key not in used and key not in self.parameter_names:
+                raise UnknownParameterError(key, set(self.parameter_names) | fnames | used, self.name)
         defaults = self.defaults
+        names = [n for n in self.parameter_names if n in used or n == "omega"]
+        names += sorted(used - set(names))
         params = {}
-        for name in self.parameter_names + sorted(names - set(self.parameter_names)):
-            if name in names or name == "omega":
-                if name not in defaults and name not in values:
-                    raise ModelError(f"parameter {name!r} (used by a replaced function) needs a value: pass {name}=...", self.name)
-                params[name] = float(values.get(name, defaults.get(name, 0.0)))
+        for name in names:
+            if name in settings:
+                params[name] = self._number(name, settings[name], "value")
+            elif name in defaults:
+                params[name] = defaults[name]
+            else:
+                raise ModelError(f"parameter {name!r} of a replaced stiffness function needs a value: pass {name}=...", self.name)
         descriptions = dict(self.drivetrain.descriptions)
         for gr in self.groups:
             descriptions.setdefault(gr.name, gr.description)
-        return FirstOrderSystem(self.name, tau, self.states, tuple(rhs), params, self.period, descriptions)
+        return FirstOrderSystem(self.name, tau, self.states, tuple(rhs), params, self.period, descriptions,
+                                self.drivetrain.title)
 
 
 # ============================================================================ construction
@@ -289,8 +345,10 @@ def nondimensionalize(red: Reduction) -> NondimensionalModel:
         if rc is reference:
             nd.conditions.append(Condition(
                 sp.Eq(m * rc.stiffness, 1),
-                f"time unit: t is measured in units of 1/omega_n with omega_n^2 = {rc.stiffness} ({m}), "
-                f"so the mean of {fname}(tau) is the mean of the declared stiffness variation (the paper's convention)",
+                f"time unit: t is measured in units of 1/omega_n, omega_n^2 being the left-hand side (the mean "
+                f"stiffness of mesh {rc.name!r} per unit effective mass), so {fname}(tau) has the mean of the "
+                "declared stiffness variation (the paper's convention)",
+                "time_unit",
             ))
             expression = varied
         else:
@@ -298,7 +356,9 @@ def nondimensionalize(red: Reduction) -> NondimensionalModel:
                       f"mean stiffness of mesh {rc.name!r} relative to the first mesh")
             nd.groups.append(K)
             expression = K.symbol * varied
-        kfun = StiffnessFunction(fname, rc.name, m * red.resolved.stiffness_at(rc).subs(t, tau / omega), expression)
+        order = sp.nsimplify(rc.mesh_phase.coeff(omega * t))
+        kfun = StiffnessFunction(fname, rc.name, m * red.resolved.stiffness_at(rc).subs(t, tau / omega),
+                                 expression, 2 * sp.pi / order)
         nd.functions.append(kfun)
         terms = kfun.applied * g(x, rc.backlash) / omega**2
         if rc.damping != 0:
@@ -330,24 +390,47 @@ def nondimensionalize(red: Reduction) -> NondimensionalModel:
                     sp.Eq(0, definition),
                     f"torque balance: no constant torque may load the twist {cx.name} of shaft "
                     f"{cx.coupling.name!r} (declare Shaft(..., forced=True) to keep it as forcing)",
+                    "torque_balance",
                 ))
                 continue
-            hint = next((ft.source.group for ft in terms if ft.source.group), None)
-            base = "B0" if order == 0 else (hint or f"B{order}")
-            name = base + _coordinate_suffix(red, row) if (row != 0 and not hint) else base
-            k = 2
-            while name in used_names:
-                name, k = f"{base}_{k}", k + 1
+            hints = sorted({ft.source.group for ft in terms if ft.source.group})
+            torques = ", ".join(sorted({repr(ft.source.torque.name) for ft in terms}))
+            if len(hints) > 1:
+                raise ModelError(
+                    f"harmonics of the same order and phase are named differently ({', '.join(hints)}); "
+                    "they add up into one group, so give them one name", f"Torque {torques}",
+                )
+            base = "B0" if order == 0 else (hints[0] if hints else f"B{order}")
+            name = base + _coordinate_suffix(red, row)
+            if name in used_names and not hints and order > 0:
+                # an unnamed second harmonic of the same order: name it after its phase
+                tag = phase.name if isinstance(phase, sp.Symbol) else str(len(used_names))
+                name = f"B{order}_{tag}" + _coordinate_suffix(red, row)
+            if name in used_names:
+                raise ModelError(
+                    f"the forcing group of {cx.name} from cos({order}*tau + {phase}) would be named {name!r}, "
+                    "which another group already has; give the harmonic a distinct Harmonic(..., group=...) name",
+                    f"Torque {torques}",
+                )
             used_names.add(name)
-            what = "constant forcing" if order == 0 else f"forcing amplitude of cos({order}*tau + {phase})"
+            what = "constant forcing" if order == 0 else f"forcing amplitude of {sp.cos(order * tau + phase)}"
             gr = Group(name, definition, "free", f"{what} of {cx.name}")
             nd.groups.append(gr)
             timefn = sp.S.One if order == 0 else sp.cos(order * tau + phase)
             rhs[row] += gr.symbol * timefn
     nd._row_lhs, nd._row_rhs = lhs, rhs
+    nd.groups.sort(key=lambda gr: gr.kind == "derived")  # stable: free groups first, betas in their order
     return nd
 
 
 def reduce(model: Drivetrain) -> NondimensionalModel:
-    """Derive the equations of motion, reduce them and write the nondimensional form."""
-    return nondimensionalize(reduce_drivetrain(model))
+    """Derive the equations of motion, reduce them and write the nondimensional form.
+
+    The result is cached on the drivetrain until it changes (add, set_defaults, describe).
+    """
+    cached = model.__dict__.get("_reduced")
+    if cached is not None and cached[0] == model.version:
+        return cached[1]
+    nd = nondimensionalize(reduce_drivetrain(model))
+    model.__dict__["_reduced"] = (model.version, nd)
+    return nd
