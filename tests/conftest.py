@@ -1,0 +1,90 @@
+"""Shared, cached helpers for the gearsym correctness tests (imported as `conftest`).
+
+Reductions take seconds each, so every shipped model is reduced at most once
+per test session. The model objects returned by ``gearsym.load_model`` are
+module-level singletons shared by all tests: tests must never mutate them
+(``set_defaults``, ``add``); build a fresh drivetrain instead (``fresh_one_stage``).
+"""
+from __future__ import annotations
+
+import functools
+import sys
+
+import sympy as sp
+
+import gearsym
+from gearsym.symbols import parameter_symbol, t
+
+GEAR_MODELS = ("one_stage", "one_stage_resonant", "flexible_shaft", "two_stage")
+
+
+@functools.cache
+def load(name: str):
+    if name == "rich":
+        return rich_model()
+    if name == "idler":
+        return idler_model()
+    return gearsym.load_model(name)
+
+
+def idler_model() -> gearsym.Drivetrain:
+    """Three gears in a chain (1-2, 2-3) with two backlash meshes: no shaft, two mesh coordinates."""
+    from gearsym import Drivetrain, Gear, Harmonic, Mesh, Torque
+
+    m = Drivetrain("idler")
+    a = m.add(Gear("g1", inertia="I1", base_radius="r1"))
+    b = m.add(Gear("g2", inertia="I2", base_radius="r2"))
+    c = m.add(Gear("g3", inertia="I3", base_radius="r3"))
+    m.add(Mesh("m1", a, b, variation="1 + kv*cos(phi)", coordinate="x1"))
+    m.add(Mesh("m2", b, c, stiffness="kZ2", damping="cZ2", backlash="eta2", variation="1 + kv*cos(phi)",
+               phase="ph2", coordinate="x2"))
+    m.add(Torque("T1", on=a, mean="M1", harmonics=(Harmonic("M1a"),)))
+    m.add(Torque("T3", on=c, mean="M3", load=True))
+    return m
+
+
+def rich_model() -> gearsym.Drivetrain:
+    """An inline drivetrain with what the shipped models lack: shaft damping, a forced shaft
+    declared disk-first, a mesh phase and a custom variation, harmonics of two orders on
+    several bodies, a load torque with harmonics."""
+    from gearsym import Disk, Drivetrain, Gear, Harmonic, Mesh, Shaft, Torque
+
+    m = Drivetrain("rich")
+    a = m.add(Gear("gear1", inertia="I1", base_radius="r1"))
+    b = m.add(Gear("gear2", inertia="I2", base_radius="r2"))
+    d = m.add(Disk("disk3", inertia="I3"))
+    m.add(Mesh("mesh", a, b, variation="1 + kv*cos(phi) + kw*sin(2*phi)", phase="ph", coordinate="x1"))
+    m.add(Shaft("shaft", d, b, stiffness="kS", damping="cS", forced=True, coordinate="x2"))
+    m.add(Torque("M1", on=a, mean="M1", harmonics=(Harmonic("M1a", phase="Theta", group="B1"),)))
+    m.add(Torque("M2", on=b, mean="M2", load=True,
+                 harmonics=(Harmonic("M2a", phase="Theta"), Harmonic("M2b", order=2))))
+    m.add(Torque("M3", on=d, mean="M3", load=True, harmonics=(Harmonic("M3a", phase="Theta2"),)))
+    m.set_defaults(omega=1.5, zeta=0.08, eta=1.0, kv=0.2, kw=0.05, ph=0.3, kS=0.5, cS=0.02,
+                   I1=1.0, I2=2.0, I3=0.5, r1=1.0, r2=1.5, Theta=0.0, Theta2=0.4,
+                   B0=1.0, B1=2.0, B2=0.5, B0_x2=0.1, B1_x2=0.2, B2_x2=0.3, B1_Theta2_x2=0.1)
+    return m
+
+
+@functools.cache
+def reduced(name: str) -> gearsym.NondimensionalModel:
+    return gearsym.reduce(load(name))
+
+
+def fresh_one_stage(name: str = "one_stage", resonant: bool = False) -> gearsym.Drivetrain:
+    """A new, unshared one-stage drivetrain built by the shipped model's own builder."""
+    load("one_stage")  # makes the ``models`` package importable and imports models.one_stage
+    return sys.modules["models.one_stage"].build(name, resonant=resonant)
+
+
+def P(name: str) -> sp.Symbol:
+    """The canonical parameter symbol."""
+    return parameter_symbol(name)
+
+
+def psi(i: int) -> sp.Expr:
+    """The paper's psi_i(t), typed independently of the library."""
+    return sp.Function(f"psi_{i}", real=True)(t)
+
+
+def coord(name: str, time: sp.Symbol) -> sp.Expr:
+    return sp.Function(name, real=True)(time)
