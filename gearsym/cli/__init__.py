@@ -1,0 +1,48 @@
+"""The ``gearsym`` command line.
+
+Each subcommand lives in its own module, which defines ``NAME``, ``HELP``,
+``add_arguments(parser)`` and ``run(args) -> int`` (the exit status). Adding
+a subcommand (``compile``, ``lyap``, ``sweep``, ...) means writing such a
+module and listing it in :data:`COMMANDS`; :func:`main` does the rest,
+including turning every :class:`~gearsym.errors.GearsymError` into a one-line
+message and exit status 2 (a user's mistake, not a crash: no traceback).
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from types import ModuleType
+
+from .. import __version__
+from ..errors import GearsymError
+from . import derive, docs, list_models
+
+#: the subcommand modules, in the order ``gearsym --help`` lists them
+COMMANDS: tuple[ModuleType, ...] = (list_models, derive, docs)
+
+#: exit status of a GearsymError (argparse uses the same for bad arguments)
+USAGE_ERROR = 2
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="gearsym", description="Symbolic drivetrain models, reduced and nondimensionalised automatically."
+    )
+    parser.add_argument("--version", action="version", version=f"gearsym {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for module in COMMANDS:
+        command = sub.add_parser(module.NAME, help=module.HELP, description=module.HELP)
+        module.add_arguments(command)
+        command.set_defaults(run=module.run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run ``gearsym`` with ``argv`` (default: the process arguments); returns the exit status."""
+    args = build_parser().parse_args(argv)
+    try:
+        return args.run(args)
+    except GearsymError as exc:
+        print(f"gearsym: error: {exc}", file=sys.stderr)
+        return USAGE_ERROR

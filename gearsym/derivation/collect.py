@@ -1,0 +1,149 @@
+"""Collecting the derivation of a model into a :class:`~gearsym.derivation.records.Derivation`.
+
+This is the one place that walks the pipeline (declaration -> Lagrangian ->
+equations of motion -> reduction -> groups -> tau-form -> first-order
+system) and keeps what each step produced. Every expression comes from the
+core API, so the docs cannot drift from the code; the only things computed
+here are the derived groups' values at the defaults and, for parameters the
+model does not describe, a description of their role in the components.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Union
+
+import sympy as sp
+
+from ..model.drivetrain import Drivetrain, ResolvedDrivetrain
+from ..reduce.nondimensional import NondimensionalModel, reduce
+from ..registry import Model, load_model
+from ..symbols import parameter_symbol
+from ..system import FirstOrderSystem
+from .notes import default_wave_amplitude, paper_notes
+from .records import (
+    BodyRecord, ConditionRecord, CoordinateRecord, CouplingRecord, Derivation, FunctionRecord, GroupRecord,
+    Mechanics, ParameterRecord, TorqueRecord,
+)
+
+ModelRef = Union[str, Path, Model, NondimensionalModel]
+
+
+def derive(ref: ModelRef) -> Derivation:
+    """The structured derivation of a model given by name, path, model object or reduced model.
+
+    Reducing a drivetrain takes seconds; pass a :class:`NondimensionalModel`
+    (``gearsym.reduce(model)``) to reuse one already reduced.
+    """
+    if isinstance(ref, NondimensionalModel):
+        return _derive_reduced(ref)
+    model = load_model(ref)
+    if isinstance(model, Drivetrain):
+        return _derive_reduced(reduce(model))
+    return _derive_first_order(model)
+
+
+def _parameters(system: FirstOrderSystem, roles: Mapping[str, str] | None = None) -> tuple[ParameterRecord, ...]:
+    """Parameters in the system's order; a description the model does not give is its role, if known."""
+    roles = roles or {}
+    return tuple(
+        ParameterRecord(name, float(value), system.descriptions.get(name) or roles.get(name, ""))
+        for name, value in system.parameters.items()
+    )
+
+
+def _roles(rd: ResolvedDrivetrain) -> dict[str, str]:
+    """What each parameter declared as a bare name is in the drivetrain (the docs' fallback descriptions)."""
+    roles: dict[str, str] = {"omega": "forcing frequency (tau = omega t)"}
+
+    def put(expr: sp.Expr, text: str) -> None:
+        if isinstance(expr, sp.Symbol):
+            roles.setdefault(expr.name, text)
+
+    for rb in rd.bodies:
+        put(rb.inertia, f"moment of inertia of {rb.body.name!r}")
+        if rb.radius is not None:
+            put(rb.radius, f"base radius of {rb.body.name!r}")
+    for rc in rd.couplings:
+        put(rc.stiffness, f"{'mean mesh' if rc.kind == 'mesh' else 'torsional'} stiffness of {rc.kind} {rc.name!r}")
+        put(rc.damping, f"damping of {rc.kind} {rc.name!r}")
+        if rc.kind == "mesh":
+            put(rc.backlash, f"backlash (clearance) of mesh {rc.name!r}")
+            amplitude = default_wave_amplitude(rc.variation)
+            if amplitude is not None:
+                put(parameter_symbol(amplitude), f"relative amplitude of the stiffness variation of mesh {rc.name!r}")
+    for f in rd.forcing:
+        if f.order:
+            put(f.phase, f"phase of the order-{f.order} harmonic of torque {f.torque.name!r}")
+    return roles
+
+
+def _derive_first_order(system: FirstOrderSystem) -> Derivation:
+    return Derivation(
+        model=system.name, title=system.title or system.name, description="", time=system.time, states=tuple(system.states),
+        rhs=tuple(system.rhs), parameters=_parameters(system), period=system.period, mechanics=None, notes=(),
+    )
+
+
+def _value(expr: sp.Expr, values: dict[str, float]) -> float | None:
+    """``expr`` at the parameter values, or None if it does not evaluate to a number."""
+    result = expr.xreplace({parameter_symbol(n): sp.Float(v) for n, v in values.items()})
+    return float(result) if result.is_number else None
+
+
+def _components(
+    rd: ResolvedDrivetrain, coordinates: Mapping[str, str]
+) -> tuple[tuple[BodyRecord, ...], tuple[CouplingRecord, ...], tuple[TorqueRecord, ...]]:
+    """The component tables; ``coordinates`` maps a coupling's name to its coordinate's."""
+    bodies = tuple(
+        BodyRecord(rb.body.name, type(rb.body).__name__, rb.inertia, rb.radius, rb.angle) for rb in rd.bodies
+    )
+    couplings = []
+    for rc in rd.couplings:
+        in_time = sp.Eq(rd.stiffness_at(rc), rd.stiffness_definition(rc)) if rc.kind == "mesh" else None
+        couplings.append(CouplingRecord(
+            rc.name, rc.kind, (rc.a.body.name, rc.b.body.name), coordinates[rc.name], rc.stiffness, rc.damping,
+            rc.backlash, rc.variation, rc.mesh_phase, in_time,
+        ))
+    torques = []
+    for tq in rd.model.torques:
+        terms = tuple(f.amplitude * f.time_function for f in rd.forcing if f.torque is tq)
+        on = tq.on if isinstance(tq.on, str) else tq.on.name
+        torques.append(TorqueRecord(tq.name, on, tq.load, terms))
+    return bodies, tuple(couplings), tuple(torques)
+
+
+def _derive_reduced(nd: NondimensionalModel) -> Derivation:
+    red, rd, model = nd.reduction, nd.reduction.resolved, nd.drivetrain
+    system = nd.system()
+    values = dict(system.parameters)
+    groups = tuple(
+        GroupRecord(gr.name, gr.definition, gr.kind, gr.description,
+                    _value(gr.definition, values) if gr.kind == "derived" else values.get(gr.name))
+        for gr in nd.groups
+    )
+    bodies, couplings, torques = _components(rd, {c.coupling.name: c.name for c in red.coordinates})
+    kinetic, potential, dissipation = model.form_lagrangian()
+    mechanics = Mechanics(
+        bodies=bodies, couplings=couplings, torques=torques,
+        kinetic_energy=kinetic, potential_energy=potential, dissipation=dissipation,
+        generalized_forces=tuple(rd.generalized_forces),
+        equations_of_motion=tuple(model.form_eoms()),
+        rigid_modes=tuple(red.rigid_modes),
+        rigid_body_equations=tuple(red.rigid_body_equations),
+        coordinates=tuple(
+            CoordinateRecord(c.name, c.velocity_name, c.kind, c.coupling.name, c.definition) for c in red.coordinates
+        ),
+        transform=red.transform,
+        reduced_equations=tuple(red.equations),
+        groups=groups,
+        conditions=tuple(ConditionRecord(c.equation, c.description) for c in nd.conditions),
+        functions=tuple(FunctionRecord(f.name, f.mesh, f.definition, f.expression) for f in nd.functions),
+        equations=tuple(nd.equations),
+        engine_rhs=tuple(system.rhs),
+    )
+    return Derivation(
+        model=model.name, title=model.title, description=model.description, time=system.time,
+        states=tuple(nd.states), rhs=tuple(nd.rhs), parameters=_parameters(system, _roles(rd)), period=nd.period,
+        mechanics=mechanics, notes=paper_notes(nd, groups, values),
+    )
