@@ -202,3 +202,48 @@ def test_errors_are_value_errors_and_carry_the_component():
         m.form_eoms()
     assert isinstance(err.value, gearsym.GearsymError)
     assert err.value.component == "Mesh 'selfmesh'"
+
+
+# ---------------------------------------------------------------------------- physical signs
+@pytest.mark.parametrize("field, value, what", [
+    ("backlash", -1, "backlash must not be negative"),
+    ("damping", "-0.1", "mesh damping must not be negative"),
+])
+def test_negative_mesh_property(field, value, what):
+    m, a, b = pair()
+    m.add(Mesh("mesh", a, b, **{field: value}))
+    with pytest.raises(ModelError, match=rf"Mesh 'mesh'.*{what}"):
+        m.form_eoms()
+
+
+def test_negative_backlash_via_default():
+    m = fresh_one_stage()
+    m.set_defaults(eta=-1)
+    with pytest.raises(ModelError, match=r"Mesh 'mesh'.*backlash must not be negative.*eta = -1"):
+        m.form_eoms()
+
+
+def test_negative_shaft_stiffness():
+    m, a, b = pair()
+    d = m.add(Disk("disk", inertia="I3"))
+    m.add(Mesh("mesh", a, b))
+    m.add(Shaft("shaft", b, d, stiffness=-0.1))
+    with pytest.raises(ModelError, match=r"Shaft 'shaft'.*shaft stiffness must not be negative"):
+        m.form_eoms()
+
+
+@pytest.mark.parametrize("setting, message", [
+    (dict(omega=0), r"'omega'.*forcing frequency and must be positive"),
+    (dict(zeta=-0.1), r"'zeta'.*damping ratio and must not be negative"),
+    (dict(eta=-2), r"'eta'.*backlash and must not be negative"),
+    (dict(omega="fast"), r"'omega'.*must be a number"),
+])
+def test_run_time_values_are_checked(setting, message):
+    nd = gearsym.reduce(fresh_one_stage())
+    with pytest.raises(ModelError, match=message):
+        nd.system(**setting)
+
+
+def test_run_time_value_given_as_formula_string():
+    nd = gearsym.reduce(fresh_one_stage())
+    assert nd.system(omega="3/2").parameters["omega"] == 1.5

@@ -51,6 +51,7 @@ class Group:
     definition: sp.Expr
     kind: str  # "free" | "derived"
     description: str
+    role: str  # "coupling" (beta), "damping" (zeta), "stiffness" (K), "forcing" (B0, B1, D)
 
     @property
     def symbol(self) -> sp.Symbol:
@@ -224,9 +225,9 @@ class NondimensionalModel:
                 if isinstance(value, sp.Symbol):
                     out.setdefault(value.name, (True, what))
         for gr in self.groups:
-            if gr.name.startswith("zeta") or gr.description.startswith("damping ratio"):
+            if gr.role == "damping":
                 out[gr.name] = (True, "a damping ratio")
-            elif gr.description.startswith("mean stiffness"):
+            elif gr.role == "stiffness":
                 out[gr.name] = (False, "a relative mesh stiffness")
         return out
 
@@ -317,7 +318,7 @@ def nondimensionalize(red: Reduction) -> NondimensionalModel:
         for known, sym in betas.items():
             if sp.simplify(known - definition) == 0:
                 return sym
-        gr = Group(f"beta_{len(betas) + 1}", definition, "derived", description)
+        gr = Group(f"beta_{len(betas) + 1}", definition, "derived", description, "coupling")
         nd.groups.append(gr)
         betas[definition] = gr.symbol
         return gr.symbol
@@ -353,7 +354,7 @@ def nondimensionalize(red: Reduction) -> NondimensionalModel:
             expression = varied
         else:
             K = Group(comp.stiffness_group or f"K{suffix}", m * rc.stiffness, "free",
-                      f"mean stiffness of mesh {rc.name!r} relative to the first mesh")
+                      f"mean stiffness of mesh {rc.name!r} relative to the first mesh", "stiffness")
             nd.groups.append(K)
             expression = K.symbol * varied
         order = sp.nsimplify(rc.mesh_phase.coeff(omega * t))
@@ -363,7 +364,7 @@ def nondimensionalize(red: Reduction) -> NondimensionalModel:
         terms = kfun.applied * g(x, rc.backlash) / omega**2
         if rc.damping != 0:
             zeta = Group(comp.damping_group or f"zeta{suffix}", m * rc.damping / 2, "free",
-                         f"damping ratio of mesh {rc.name!r}")
+                         f"damping ratio of mesh {rc.name!r}", "damping")
             nd.groups.append(zeta)
             terms = 2 * zeta.symbol * sp.diff(x, tau) / omega + terms
         own_terms[rc] = terms
@@ -414,7 +415,7 @@ def nondimensionalize(red: Reduction) -> NondimensionalModel:
                 )
             used_names.add(name)
             what = "constant forcing" if order == 0 else f"forcing amplitude of {sp.cos(order * tau + phase)}"
-            gr = Group(name, definition, "free", f"{what} of {cx.name}")
+            gr = Group(name, definition, "free", f"{what} of {cx.name}", "forcing")
             nd.groups.append(gr)
             timefn = sp.S.One if order == 0 else sp.cos(order * tau + phase)
             rhs[row] += gr.symbol * timefn

@@ -18,7 +18,7 @@ import sympy as sp
 from ..backlash import g
 from ..errors import GearsymError
 from ..model.drivetrain import Drivetrain, ResolvedCoupling, ResolvedDrivetrain, ResolvedForcing
-from ..symbols import omega, t
+from ..symbols import t
 from .coordinates import Coordinate, angle_symbols, relative_coordinates, rigid_body_modes, to_symbols
 
 
@@ -169,5 +169,4 @@ def reduce_drivetrain(model: Drivetrain) -> Reduction:
         direct = _simplify_backlash_args(to_symbols(direct, rd, p, pd).xreplace(to_q)).xreplace(back)
         if sp.simplify(sp.expand(direct - eq.rhs)) != 0:
             raise ReductionError(f"reduced equation of {coords[i].name} does not match T M^-1 Q")
-    _ = omega  # omega appears through the time functions
     return red
