@@ -17,7 +17,7 @@ from ..backlash import G
 from ..errors import ModelError, suggest
 from ..symbols import omega, parameter_symbol, phi, t
 from .components import Body, BodyRef, Coupling, Disk, Gear, Harmonic, Mesh, Shaft, Torque
-from .expressions import ExprLike, parameter_names, to_expr
+from .expressions import ExprLike, parameter_names, sign_violation, to_expr
 from .stiffness import check_periodic
 
 
@@ -45,6 +45,7 @@ class ResolvedCoupling:
     backlash: sp.Expr  # eta (0 for shafts)
     variation: sp.Expr  # k(phi) shape (1 for shafts)
     mesh_phase: sp.Expr  # phi as a function of t (0 for shafts)
+    order: sp.Expr = sp.S.Zero  # mesh frequency / forcing frequency (0 for shafts)
 
     @property
     def name(self) -> str:
@@ -182,9 +183,9 @@ class ResolvedDrivetrain:
         """Parse ``value`` and reject a non-positive number or default (negative only, with allow_zero)."""
         expr = to_expr(value, where)
         num = float(expr) if expr.is_number else self._default_value(expr)
-        if num is not None and (num < 0 or (num == 0 and not allow_zero)):
+        must = sign_violation(num, allow_zero) if num is not None else None
+        if must:
             shown = expr if expr.is_number else f"{expr} = {num:g} (its default)"
-            must = "must not be negative" if allow_zero else "must be positive"
             raise ModelError(f"{what} {must}, got {shown}", where)
         return expr
 
@@ -247,6 +248,7 @@ class ResolvedDrivetrain:
                 backlash=self._positive(c.backlash, "the backlash", where, allow_zero=True),
                 variation=variation,
                 mesh_phase=order * omega * t + to_expr(c.phase, where),
+                order=order,
             )
         row[a.index], row[b.index] = sp.S.NegativeOne, sp.S.One
         if c.radius is not None:

@@ -31,7 +31,7 @@ from sympy.core.function import AppliedUndef
 from ..backlash import g
 from ..errors import ModelError, UnknownParameterError
 from ..model.drivetrain import Drivetrain, ResolvedCoupling
-from ..model.expressions import ExprLike, parameter_names, to_expr
+from ..model.expressions import ExprLike, parameter_names, sign_violation, to_expr
 from ..model.stiffness import check_periodic
 from ..symbols import omega, parameter_symbol, phi, t, tau
 from ..system import FirstOrderSystem
@@ -146,7 +146,7 @@ class NondimensionalModel:
     @cached_property
     def period(self) -> sp.Expr:
         """The forcing period in tau: 2 pi / gcd of all mesh and torque frequencies."""
-        freqs = [sp.nsimplify(rc.mesh_phase.coeff(omega * t)) for rc in self.reduction.resolved.couplings if rc.kind == "mesh"]
+        freqs = [rc.order for rc in self.reduction.resolved.couplings if rc.kind == "mesh"]
         freqs += [sp.Integer(f.order) for f in self.reduction.resolved.forcing if f.order]
         return 2 * sp.pi / functools.reduce(sp.gcd, freqs, sp.S.Zero) if freqs else 2 * sp.pi
 
@@ -237,8 +237,8 @@ class NondimensionalModel:
             raise ModelError(f"the {what} must be a number, got {value!r}", f"parameter {name!r}")
         number = float(expr)
         zero_ok, meaning = self._constraints.get(name, (True, None))
-        if meaning and (number < 0 or (number == 0 and not zero_ok)):
-            must = "must not be negative" if zero_ok else "must be positive"
+        must = sign_violation(number, zero_ok) if meaning else None
+        if must:
             raise ModelError(f"is {meaning} and {must}, got {number:g}", f"parameter {name!r}")
         return number
 
@@ -357,9 +357,8 @@ def nondimensionalize(red: Reduction) -> NondimensionalModel:
                       f"mean stiffness of mesh {rc.name!r} relative to the first mesh", "stiffness")
             nd.groups.append(K)
             expression = K.symbol * varied
-        order = sp.nsimplify(rc.mesh_phase.coeff(omega * t))
         kfun = StiffnessFunction(fname, rc.name, m * red.resolved.stiffness_at(rc).subs(t, tau / omega),
-                                 expression, 2 * sp.pi / order)
+                                 expression, 2 * sp.pi / rc.order)
         nd.functions.append(kfun)
         terms = kfun.applied * g(x, rc.backlash) / omega**2
         if rc.damping != 0:
@@ -407,17 +406,17 @@ def nondimensionalize(red: Reduction) -> NondimensionalModel:
                 # an unnamed second harmonic of the same order: name it after its phase
                 tag = phase.name if isinstance(phase, sp.Symbol) else str(len(used_names))
                 name = f"B{order}_{tag}" + _coordinate_suffix(red, row)
+            timefn = sp.S.One if order == 0 else sp.cos(order * tau + phase)
             if name in used_names:
                 raise ModelError(
-                    f"the forcing group of {cx.name} from cos({order}*tau + {phase}) would be named {name!r}, "
+                    f"the forcing group of {cx.name} from {timefn} would be named {name!r}, "
                     "which another group already has; give the harmonic a distinct Harmonic(..., group=...) name",
                     f"Torque {torques}",
                 )
             used_names.add(name)
-            what = "constant forcing" if order == 0 else f"forcing amplitude of {sp.cos(order * tau + phase)}"
+            what = "constant forcing" if order == 0 else f"forcing amplitude of {timefn}"
             gr = Group(name, definition, "free", f"{what} of {cx.name}", "forcing")
             nd.groups.append(gr)
-            timefn = sp.S.One if order == 0 else sp.cos(order * tau + phase)
             rhs[row] += gr.symbol * timefn
     nd._row_lhs, nd._row_rhs = lhs, rhs
     nd.groups.sort(key=lambda gr: gr.kind == "derived")  # stable: free groups first, betas in their order
