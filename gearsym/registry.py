@@ -67,3 +67,35 @@ def _with_models_importable(action):
     finally:
         if added:
             sys.path.remove(root)
+
+
+def system_for(ref, **settings) -> FirstOrderSystem:
+    """The first-order system of a model with ``settings`` applied.
+
+    ``settings`` give parameter values (``omega=1.5``) or, for a drivetrain, a
+    new mesh stiffness as a formula in tau (``k="1 + 0.2*cos(tau)"``). Strings
+    that read as numbers are numbers.
+    """
+    from .reduce import NondimensionalModel, reduce
+
+    model = ref if isinstance(ref, NondimensionalModel) else load_model(ref)
+    settings = {k: _maybe_number(v) for k, v in settings.items()}
+    if isinstance(model, FirstOrderSystem):
+        for key, value in settings.items():
+            if not isinstance(value, (int, float)):
+                raise GearsymError(
+                    f"{model.name}: {key}={value!r} is not a number; only drivetrain models accept a formula "
+                    "(a new mesh stiffness function)"
+                )
+        return model.with_values(**settings)
+    nd = model if isinstance(model, NondimensionalModel) else reduce(model)
+    return nd.system(**settings)
+
+
+def _maybe_number(value):
+    if isinstance(value, str):
+        try:
+            return float(value)
+        except ValueError:
+            return value.strip()
+    return value

@@ -23,6 +23,9 @@ class FirstOrderSystem:
 
     ``period`` is the forcing period in ``time`` (2*pi for the gear models):
     the unit of stroboscopic sampling and of tangent-space re-orthonormalisation.
+    ``coordinates`` names the states whose vibration amplitude is reported (the
+    relative coordinates of a drivetrain); empty means every state. ``initial``
+    is the default initial state (states not named start at 0).
     """
 
     name: str
@@ -33,6 +36,8 @@ class FirstOrderSystem:
     period: sp.Expr = sp.S.One
     descriptions: Mapping[str, str] = field(default_factory=dict)
     title: str = ""
+    coordinates: tuple[str, ...] = ()
+    initial: Mapping[str, float] = field(default_factory=dict)
 
     def __post_init__(self):
         if len(self.states) != len(self.rhs):
@@ -44,6 +49,14 @@ class FirstOrderSystem:
             for s in f.free_symbols:
                 if s.name not in known:
                     raise UnknownParameterError(s.name, set(self.parameters), f"{self.name}: d{self.states[i].name}/d{self.time.name}")
+        bad = set(self.initial) - {s.name for s in self.states}
+        if bad:
+            raise ModelError(f"the initial state names {sorted(bad)}, which are not states "
+                             f"({', '.join(s.name for s in self.states)})", self.name)
+        unknown = set(self.coordinates) - {s.name for s in self.states}
+        if unknown:
+            raise ModelError(f"coordinates {sorted(unknown)} are not states ({', '.join(s.name for s in self.states)})",
+                             self.name)
         clash = {s.name for s in self.states} & set(self.parameters)
         if clash:
             raise ModelError(f"names used both as state and parameter: {sorted(clash)}", self.name)
@@ -59,13 +72,15 @@ class FirstOrderSystem:
         period: ExprLike = 1,
         descriptions: Mapping[str, str] | None = None,
         title: str = "",
+        initial: Mapping[str, float] | None = None,
     ) -> "FirstOrderSystem":
         """Declare an ODE from strings, e.g. Lorenz: states ['x','y','z'], rhs ['sigma*(y-x)', ...]."""
         state_syms = tuple(sp.Symbol(s, real=True) for s in states)
         time_sym = sp.Symbol(time, real=True)
         extra = {s.name: s for s in state_syms} | {time: time_sym}
         exprs = tuple(to_expr(f, f"{name}: d{s}/d{time}", extra) for f, s in zip(rhs, states))
-        return cls(name, time_sym, state_syms, exprs, dict(parameters), to_expr(period, name), dict(descriptions or {}), title)
+        return cls(name, time_sym, state_syms, exprs, dict(parameters), to_expr(period, name),
+                   dict(descriptions or {}), title, initial=dict(initial or {}))
 
     @property
     def dimension(self) -> int:
@@ -81,6 +96,15 @@ class FirstOrderSystem:
             if k not in self.parameters:
                 raise UnknownParameterError(k, self.parameters, self.name)
         return replace(self, parameters={**self.parameters, **{k: float(v) for k, v in values.items()}})
+
+    @property
+    def observed(self) -> tuple[str, ...]:
+        """The states whose amplitude is reported: ``coordinates``, or every state."""
+        return self.coordinates or tuple(s.name for s in self.states)
+
+    @property
+    def initial_vector(self) -> tuple[float, ...]:
+        return tuple(float(self.initial.get(s.name, 0.0)) for s in self.states)
 
     def jacobian(self) -> sp.Matrix:
         """Exact Jacobian d rhs / d y."""

@@ -18,6 +18,7 @@ model.add(Torque("M1", on=g1, mean="M1", harmonics=(Harmonic("M1a", phase="Theta
 model.add(Torque("M2", on=g2, mean="M2", load=True))
 model.add(Torque("M3", on=d3, mean="M3", load=True))
 model.set_defaults(**PAPER_VALUES, kS=0.1, k_a=0.2, I1=1.0, I2=1.0, I3=1.0, r1=1.0, r2=1.0)
+model.set_initial_state(x1=-2.0, v1=-0.5)  # the paper's start
 model.describe(
     kS="torsional stiffness of the shaft (the paper's coupling; 0, 0.1, 1.0 in Fig. 6)",
     I1="inertia of gear 1 (not given in the paper)",

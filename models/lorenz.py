@@ -12,6 +12,7 @@ model = FirstOrderSystem.from_equations(
     parameters={"sigma": 10.0, "rho": 28.0, "beta": 8.0 / 3.0},
     time="t",
     period=1,
+    initial={"x": 1.0, "y": 1.0, "z": 1.0},
     descriptions={"sigma": "Prandtl number", "rho": "Rayleigh number ratio", "beta": "geometric factor"},
     title="Lorenz system: a check of the engine against published Lyapunov exponents",
 )

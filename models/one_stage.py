@@ -22,6 +22,7 @@ def build(name: str = "one_stage", resonant: bool = False) -> Drivetrain:
     m.add(Torque("M1", on=g1, mean="M1", harmonics=tuple(harmonics)))
     m.add(Torque("M2", on=g2, mean="M2", load=True))
     m.set_defaults(**PAPER_VALUES, k_a=0.2)
+    m.set_initial_state(x=-2.0, v=-0.5)  # the paper's start
     if resonant:
         m.set_defaults(D=2.0, Theta_p=0.1)
     m.describe(

@@ -30,6 +30,7 @@ model.set_defaults(
     eta=10.0, eta2=10.0, kS=1.0, k_a=0.2, k_a2=0.2,
     I1=1.0, I2=4.0, I3=1.0, I4=9.0, r1=1.0, r2=2.0, r3=1.0, r4=3.0,
 )
+model.set_initial_state(x1=-2.0, v1=-0.5, x3=-2.0, v3=-0.5)
 model.describe(
     K2="mean stiffness of the second mesh relative to the first",
     kS="torsional stiffness of the intermediate shaft",

@@ -88,3 +88,22 @@ def psi(i: int) -> sp.Expr:
 
 def coord(name: str, time: sp.Symbol) -> sp.Expr:
     return sp.Function(name, real=True)(time)
+
+
+# --------------------------------------------------------------------------- compiled engine
+import pytest  # noqa: E402
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _private_library_cache(tmp_path_factory):
+    """Compiled libraries go to a fresh cache per session: the tests compile for real and see cache hits
+    they caused themselves, never a stale library from an earlier checkout."""
+    import os
+
+    old = os.environ.get("GEARSYM_CACHE")
+    os.environ["GEARSYM_CACHE"] = str(tmp_path_factory.mktemp("gearsym-cache"))
+    yield
+    if old is None:
+        os.environ.pop("GEARSYM_CACHE", None)
+    else:
+        os.environ["GEARSYM_CACHE"] = old

@@ -82,6 +82,7 @@ class Drivetrain:
         self.torques: list[Torque] = []
         self._defaults: dict[str, ExprLike] = {}
         self._descriptions: dict[str, str] = {}
+        self._initial: dict[str, float] = {}
         self.version = 0  # bumped by every change, so derived results can be cached safely
 
     def _changed(self) -> None:
@@ -115,6 +116,15 @@ class Drivetrain:
         self._changed()
         self._defaults.update(values)
         return self
+
+    def set_initial_state(self, **values: float) -> "Drivetrain":
+        """Default initial state of the reduced model (e.g. the paper's x=-2, v=-0.5); others start at 0."""
+        self._initial.update({k: float(v) for k, v in values.items()})
+        return self
+
+    @property
+    def initial_state(self) -> dict[str, float]:
+        return dict(self._initial)
 
     def describe(self, **descriptions: str) -> "Drivetrain":
         """One-line descriptions of parameters, shown in the derivation docs."""

@@ -231,6 +231,10 @@ class NondimensionalModel:
                 out[gr.name] = (False, "a relative mesh stiffness")
         return out
 
+    def check_value(self, name: str, value: ExprLike) -> float:
+        """``value`` as a float, if it is a number with the sign parameter ``name`` must have."""
+        return self._number(name, value, "value")
+
     def _number(self, name: str, value: ExprLike, what: str) -> float:
         expr = to_expr(value, f"{what} of {name}")
         if not expr.is_number:
@@ -293,7 +297,8 @@ class NondimensionalModel:
         for gr in self.groups:
             descriptions.setdefault(gr.name, gr.description)
         return FirstOrderSystem(self.name, tau, self.states, tuple(rhs), params, self.period, descriptions,
-                                self.drivetrain.title)
+                                self.drivetrain.title, tuple(c.name for c in self.coordinates),
+                                self.drivetrain.initial_state)
 
 
 # ============================================================================ construction

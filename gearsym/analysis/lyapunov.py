@@ -1,0 +1,114 @@
+"""The Lyapunov spectrum at one parameter point.
+
+Exponents come from the exact variational equations integrated with the
+state (:mod:`gearsym.codegen.functions`) and Gram-Schmidt once per forcing
+period: lambda_i = sum of log stretches / time, over the periods after the
+transient. Exponents are per unit of the model's time (tau for the gear
+models). The paper's criterion for chaos is lambda_1 > 0 (it prints "> 1").
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..codegen.compiled import CompiledModel, compile_model
+from ..errors import GearsymError
+from .statistics import batch_means_stderr
+
+
+@dataclass(frozen=True)
+class LyapunovSpectrum:
+    """All n exponents at one point, with what the run saw along the way."""
+
+    model: str
+    parameters: dict[str, float]
+    exponents: np.ndarray  # descending, per unit time
+    stderr: np.ndarray  # batch-means standard error of each exponent
+    history: np.ndarray  # (measured periods, n): running estimates after each period
+    amplitude: dict[str, float]  # A = (max - min)/2 of each relative coordinate over the measured periods
+    final_state: dict[str, float]
+    strobe: np.ndarray  # (n, measured periods): stroboscopic (Poincare) samples
+    periods: int
+    discard: int
+    steps_per_period: int
+    period: float
+    backend: str
+    info: dict = field(default_factory=dict)
+
+    @property
+    def sum(self) -> float:
+        return float(np.sum(self.exponents))
+
+    def as_dict(self) -> dict:
+        """JSON-ready: the keys of ``gearsym lyap --format json``."""
+        return {
+            "model": self.model,
+            "parameters": self.parameters,
+            "exponents": [float(x) for x in self.exponents],
+            "stderr": [float(x) for x in self.stderr],
+            "sum": self.sum,
+            "amplitude": self.amplitude,
+            "final_state": self.final_state,
+            "periods": self.periods,
+            "discard": self.discard,
+            "steps_per_period": self.steps_per_period,
+            "period": self.period,
+            "backend": self.backend,
+        }
+
+
+def lyapunov_spectrum(
+    model,
+    *,
+    periods: int = 400,
+    discard: int = 100,
+    y0=None,
+    steps_per_period: int = 200,
+    backend: str = "auto",
+    **settings,
+) -> LyapunovSpectrum:
+    """Full Lyapunov spectrum of ``model`` at the point given by ``settings``.
+
+    ``model`` is anything :func:`~gearsym.codegen.compile_model` takes (name,
+    path, Drivetrain, FirstOrderSystem) or a prebuilt :class:`CompiledModel`,
+    in which case ``settings`` may only change parameter values and nothing is
+    rebuilt (the low-level call for sweeps). ``y0`` is the initial state
+    (sequence or mapping; default: the model's declared initial state).
+    """
+    if not isinstance(periods, int) or not isinstance(discard, int) or discard < 0 or periods <= discard:
+        raise GearsymError(f"need 0 <= discard < periods (integers), got periods={periods}, discard={discard}")
+    if isinstance(model, CompiledModel):
+        compiled, values = model, settings
+    else:
+        compiled = compile_model(model, steps_per_period=steps_per_period, backend=backend, **settings)
+        values = {}
+    p = compiled.parameter_vector(values)
+    inputs = compiled.prepare(p)
+    run = compiled.tangent_run(y0, periods, inputs)
+
+    measured = run.log_stretch[:, discard:] / inputs.period  # per unit time, each period
+    count = measured.shape[1]
+    exponents = measured.mean(axis=1)
+    stderr = batch_means_stderr(measured)
+    history = np.cumsum(measured, axis=1).T / np.arange(1, count + 1)[:, None]
+    order = np.argsort(-exponents, kind="stable")
+    low = run.low[:, discard:].min(axis=1)
+    high = run.high[:, discard:].max(axis=1)
+    final = run.strobe[:, -1]
+    return LyapunovSpectrum(
+        model=compiled.name,
+        parameters=dict(zip(compiled.parameter_names, map(float, p))),
+        exponents=exponents[order],
+        stderr=stderr[order],
+        history=history[:, order],
+        amplitude={name: float((h - lo) / 2) for name, lo, h in zip(compiled.observed, low, high)},
+        final_state=dict(zip(compiled.state_names, map(float, final))),
+        strobe=run.strobe[:, discard:],
+        periods=periods,
+        discard=discard,
+        steps_per_period=compiled.steps_per_period,
+        period=inputs.period,
+        backend=compiled.backend,
+        info={"Q": run.Q},
+    )

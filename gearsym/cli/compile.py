@@ -1,0 +1,54 @@
+"""``gearsym compile MODEL``: write generated/<model>/ (C and manifest) and compile it into the cache."""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from ..codegen.compiled import BACKENDS
+from ..codegen.generated import DEFAULT_DIR, generate_model
+from ..registry import available_models
+from .settings import add_set_argument, parse_settings
+
+NAME = "compile"
+HELP = "generate the model's C code into generated/<model>/ and compile it (cached)"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("models", nargs="*", metavar="MODEL", help="model names or model file paths")
+    parser.add_argument("--all", action="store_true", help="every model of `gearsym list`")
+    add_set_argument(parser)
+    parser.add_argument("--steps-per-period", type=int, default=200, help="RK4 steps per period (default 200)")
+    parser.add_argument("--out", type=Path, default=DEFAULT_DIR, metavar="DIR",
+                        help="where <model>/ is written (default: generated/ of the repository)")
+    parser.add_argument("--no-compile", action="store_true", help="write the C only")
+    parser.add_argument("--check", action="store_true",
+                        help="write nothing; exit 1 and name the files that differ from what would be written")
+
+
+def run(args: argparse.Namespace) -> int:
+    if bool(args.all) == bool(args.models):
+        print("gearsym compile: error: give model names or --all (not both)", file=sys.stderr)
+        return 2
+    refs = available_models() if args.all else args.models
+    settings = parse_settings(args.set)
+    stale = []
+    for ref in refs:
+        report = generate_model(ref, args.out, steps_per_period=args.steps_per_period, check=args.check,
+                                compile=not (args.no_compile or args.check), **settings)
+        if args.check:
+            stale += report.stale
+            continue
+        line = f"{report.name}: {report.source} ({report.size / 1024:.0f} KiB, hash {report.hash[:12]})"
+        if report.library:
+            how = f"compiled in {report.compile_seconds:.1f} s" if report.compile_seconds else "cached"
+            line += f"; library {report.library} ({how})"
+        print(line)
+    if args.check:
+        for path in stale:
+            print(f"out of date: {path}", file=sys.stderr)
+        if stale:
+            print("run `gearsym compile --all` and commit generated/", file=sys.stderr)
+            return 1
+        print(f"generated code up to date ({len(refs)} models)")
+    return 0

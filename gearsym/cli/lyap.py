@@ -1,0 +1,46 @@
+"""``gearsym lyap MODEL``: the Lyapunov spectrum, amplitudes and final state at one point."""
+from __future__ import annotations
+
+import argparse
+import json
+
+from ..analysis import lyapunov_spectrum
+from ..codegen.compiled import BACKENDS
+from .settings import add_set_argument, parse_settings, parse_state
+
+NAME = "lyap"
+HELP = "Lyapunov spectrum (all exponents, per unit time) at one parameter point"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("model", help="a model name (see `gearsym list`) or the path of a model file")
+    add_set_argument(parser)
+    parser.add_argument("--periods", type=int, default=400, help="forcing periods in all (default 400)")
+    parser.add_argument("--discard", type=int, default=100, help="transient periods left out (default 100)")
+    parser.add_argument("--steps-per-period", type=int, default=200, help="RK4 steps per period (default 200)")
+    parser.add_argument("--y0", metavar="x=-2,v=-0.5", help="initial state (default: the model's)")
+    parser.add_argument("--backend", choices=BACKENDS, default="auto",
+                        help="compiled C, CasADi in-process, or auto (compiled when a C compiler exists)")
+    parser.add_argument("--format", choices=("text", "json"), default="text")
+
+
+def run(args: argparse.Namespace) -> int:
+    result = lyapunov_spectrum(
+        args.model, periods=args.periods, discard=args.discard, steps_per_period=args.steps_per_period,
+        y0=parse_state(args.y0), backend=args.backend, **parse_settings(args.set),
+    )
+    if args.format == "json":
+        print(json.dumps(result.as_dict(), indent=2))
+        return 0
+    print(f"{result.model}: {result.periods} periods ({result.discard} discarded), "
+          f"{result.steps_per_period} RK4 steps/period, {result.backend}")
+    changed = ", ".join(f"{k}={v:g}" for k, v in result.parameters.items())
+    print(f"parameters: {changed}")
+    print("Lyapunov exponents (per unit time, +- standard error):")
+    for i, (lam, err) in enumerate(zip(result.exponents, result.stderr), 1):
+        print(f"  lambda_{i} = {lam:+.6f} +- {err:.6f}")
+    print(f"  sum      = {result.sum:+.6f}")
+    for name, a in result.amplitude.items():
+        print(f"amplitude A_{name} = {a:.6g}")
+    print("final state: " + ", ".join(f"{k}={v:.6g}" for k, v in result.final_state.items()))
+    return 0

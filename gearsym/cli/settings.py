@@ -1,0 +1,43 @@
+"""Parsing ``--set NAME=VALUE`` and ``--y0 x=-2,v=-0.5`` (shared by the subcommands)."""
+from __future__ import annotations
+
+import argparse
+
+from ..errors import GearsymError
+
+
+def add_set_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--set", action="append", default=[], metavar="NAME=VALUE",
+        help="a parameter value (omega=1.5) or a new mesh stiffness formula in tau "
+             "(\"k=1+0.2*cos(tau)\"); repeat for several",
+    )
+
+
+def parse_settings(pairs: list[str]) -> dict[str, str]:
+    settings = {}
+    for pair in pairs:
+        name, sep, value = pair.partition("=")
+        name, value = name.strip(), value.strip()
+        if not sep or not name or not value:
+            raise GearsymError(f"--set {pair!r}: expected NAME=VALUE, e.g. --set omega=1.5 or --set \"k=1+0.2*cos(tau)\"")
+        if name in settings:
+            raise GearsymError(f"--set gives {name} twice")
+        settings[name] = value
+    return settings
+
+
+def parse_state(text: str | None) -> dict[str, float] | None:
+    """``x=-2,v=-0.5`` -> {'x': -2.0, 'v': -0.5}; states not named start at 0."""
+    if not text:
+        return None
+    state = {}
+    for item in text.split(","):
+        name, sep, value = item.partition("=")
+        try:
+            state[name.strip()] = float(value)
+        except ValueError:
+            raise GearsymError(f"--y0 {text!r}: expected NAME=NUMBER pairs separated by commas, e.g. x=-2,v=-0.5") from None
+        if not sep:
+            raise GearsymError(f"--y0 {text!r}: expected NAME=NUMBER pairs separated by commas, e.g. x=-2,v=-0.5")
+    return state

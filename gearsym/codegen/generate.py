@@ -1,0 +1,103 @@
+"""C source and manifest for one model, byte for byte the same for the same model.
+
+The hash that names the code is computed from the symbolic model and the loop
+options (not from parameter values, which are runtime inputs), so a cache can
+be consulted before any CasADi graph is built.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import casadi as ca
+import sympy as sp
+
+from ..system import FirstOrderSystem
+from .functions import LoopOptions, ModelFunctions
+
+#: bump when the generated code changes for the same model and options
+CODEGEN_VERSION = 1
+
+
+def code_hash(system: FirstOrderSystem, options: LoopOptions) -> str:
+    """SHA-256 of everything that determines the C: model equations, names, loop options, versions."""
+    description = {
+        "codegen": CODEGEN_VERSION,
+        "casadi": ca.__version__,
+        "name": system.name,
+        "time": system.time.name,
+        "states": [s.name for s in system.states],
+        "rhs": [sp.srepr(f) for f in system.rhs],
+        "parameters": list(system.parameters),
+        "period": sp.srepr(system.period),
+        "observed": list(system.observed),
+        "options": asdict(options),
+    }
+    return hashlib.sha256(json.dumps(description, sort_keys=True).encode()).hexdigest()
+
+
+def manifest(mf: ModelFunctions, digest: str) -> dict:
+    s = mf.system
+    return {
+        "model": s.name,
+        "hash": digest,
+        "casadi_version": ca.__version__,
+        "codegen_version": CODEGEN_VERSION,
+        "options": asdict(mf.options),
+        "time": s.time.name,
+        "period": str(s.period),
+        "states": [x.name for x in s.states],
+        "observed": list(s.observed),
+        "parameters": list(s.parameters),
+        "equations": {f"d{x.name}/d{s.time.name}": str(f) for x, f in zip(s.states, s.rhs)},
+        "tables": {str(k): str(v) for k, v in mf.split.tables},
+        "constants": {str(k): str(v) for k, v in mf.split.constants},
+        "functions": {name: str(f) for name, f in mf.functions.items()},
+    }
+
+
+@dataclass(frozen=True)
+class GeneratedCode:
+    directory: Path
+    source: Path
+    manifest: Path
+    hash: str
+
+
+def write_code(mf: ModelFunctions, directory: Path, digest: str) -> GeneratedCode:
+    """Write ``<model>.c`` and ``manifest.json`` into ``directory`` (atomically: no half-written files)."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    name = mf.system.name
+    with tempfile.TemporaryDirectory(dir=directory) as tmp:
+        gen = ca.CodeGenerator(f"{name}.c", {"with_header": False, "verbose": False, "prefix": ""})
+        for f in mf.functions.values():
+            gen.add(f)
+        cwd = os.getcwd()
+        try:  # CasADi writes into the working directory
+            os.chdir(tmp)
+            gen.generate()
+        finally:
+            os.chdir(cwd)
+        os.replace(Path(tmp) / f"{name}.c", directory / f"{name}.c")
+    text = json.dumps(manifest(mf, digest), indent=2, sort_keys=True) + "\n"
+    _write_atomic(directory / "manifest.json", text)
+    return GeneratedCode(directory, directory / f"{name}.c", directory / "manifest.json", digest)
+
+
+def read_manifest(directory: Path) -> dict | None:
+    path = Path(directory) / "manifest.json"
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)

@@ -1,0 +1,49 @@
+"""The committed ``generated/<model>/`` folders: write them, or check them byte for byte."""
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..registry import REPO_ROOT
+from .compiler import compile_library
+from .functions import LoopOptions, build_functions
+from .generate import code_hash, write_code
+
+DEFAULT_DIR = REPO_ROOT / "generated"
+
+
+@dataclass
+class GenerateReport:
+    name: str
+    source: Path
+    hash: str
+    size: int
+    library: Path | None = None
+    compile_seconds: float = 0.0
+    stale: list[Path] = field(default_factory=list)
+
+
+def generate_model(ref, out: Path = DEFAULT_DIR, *, steps_per_period: int = 200, check: bool = False,
+                   compile: bool = True, **settings) -> GenerateReport:
+    """Write ``out/<model>/<model>.c`` and ``manifest.json``; with ``check``, compare instead of writing."""
+    from ..registry import system_for
+
+    system = system_for(ref, **settings)
+    options = LoopOptions(steps_per_period=steps_per_period)
+    digest = code_hash(system, options)
+    target = Path(out) / system.name
+    mf = build_functions(system, options)
+    if check:
+        with tempfile.TemporaryDirectory() as tmp:
+            fresh = write_code(mf, Path(tmp) / system.name, digest)
+            stale = [target / p.name for p in (fresh.source, fresh.manifest)
+                     if not (target / p.name).is_file() or (target / p.name).read_bytes() != p.read_bytes()]
+            return GenerateReport(system.name, target / fresh.source.name, digest, fresh.source.stat().st_size,
+                                  stale=stale)
+    code = write_code(mf, target, digest)
+    report = GenerateReport(system.name, code.source, digest, code.source.stat().st_size)
+    if compile:
+        lib = compile_library(code.source, system.name)
+        report.library, report.compile_seconds = lib.path, lib.seconds if lib.compiled else 0.0
+    return report

@@ -1,0 +1,97 @@
+"""Split the right-hand side into a state part, periodic tables of time, and constants.
+
+In the gear models time enters only through k(tau) and the forcing, both
+periodic with the forcing period. With a fixed step the RK4 stage times repeat
+every period, so those parts are evaluated once per run at the 2N+1 half-step
+times and looked up: the inner loop does no sin/cos at all. Likewise every
+combination of parameters alone (-2 zeta/omega, kS beta1/omega^2) is evaluated
+once per run, not at every stage.
+
+A maximal state-free subexpression becomes a *table* entry if it depends on
+time, else a *constant*. The state-free factors of a product and terms of a sum
+are grouped first, so ``-2*zeta*v/omega`` is one constant times ``v``.
+"""
+from __future__ import annotations
+
+import math
+import random
+from dataclasses import dataclass
+
+import sympy as sp
+
+from ..errors import ModelError
+from ..system import FirstOrderSystem
+
+
+@dataclass(frozen=True)
+class SplitRHS:
+    """``rhs`` in the states, ``table_i`` (functions of time) and ``const_i`` (functions of parameters)."""
+
+    rhs: tuple[sp.Expr, ...]
+    tables: tuple[tuple[sp.Symbol, sp.Expr], ...]
+    constants: tuple[tuple[sp.Symbol, sp.Expr], ...]
+
+
+def split_rhs(system: FirstOrderSystem) -> SplitRHS:
+    time = system.time
+    states = set(system.states)
+    tables: dict[sp.Expr, sp.Symbol] = {}
+    constants: dict[sp.Expr, sp.Symbol] = {}
+
+    def entry(e: sp.Expr) -> sp.Expr:
+        if e.is_Number:
+            return e
+        book, prefix = (tables, "table") if time in e.free_symbols else (constants, "const")
+        if e not in book:
+            book[e] = sp.Symbol(f"{prefix}_{len(book)}", real=True)
+        return book[e]
+
+    def state_free(e: sp.Expr) -> bool:
+        return not (e.free_symbols & states)
+
+    def visit(e: sp.Expr) -> sp.Expr:
+        if e in states:
+            return e
+        if state_free(e):
+            return entry(e)
+        if e.is_Add or e.is_Mul:
+            fixed = [a for a in e.args if state_free(a)]
+            rest = [visit(a) for a in e.args if not state_free(a)]
+            if fixed:
+                rest.append(entry(e.func(*fixed)))
+            return e.func(*rest)
+        if e.is_Pow and e.exp.is_Integer:  # keep integer powers for the code generator
+            return sp.Pow(visit(e.base), e.exp)
+        return e.func(*(visit(a) for a in e.args))
+
+    rhs = tuple(visit(f) for f in system.rhs)
+    split = SplitRHS(rhs, tuple((s, e) for e, s in tables.items()), tuple((s, e) for e, s in constants.items()))
+    _check_periodic(system, split)
+    return split
+
+
+def _check_periodic(system: FirstOrderSystem, split: SplitRHS) -> None:
+    """The tables repeat every period only if time enters periodically: check at the defaults."""
+    values = {k: float(v) for k, v in system.parameters.items()}
+
+    def numeric(expr: sp.Expr) -> sp.Expr:
+        return expr.subs({s: values[s.name] for s in expr.free_symbols if s.name in values})
+
+    period = numeric(system.period)
+    if not (period.is_number and float(period) > 0 and math.isfinite(float(period))):
+        raise ModelError(f"the forcing period {system.period} must be a positive, finite function of parameters",
+                         system.name)
+    period = float(period)
+    rng = random.Random(0)
+    for _, expr in split.tables:
+        f = sp.lambdify(system.time, numeric(expr), "math")
+        for _ in range(4):
+            t0 = rng.uniform(0, period)
+            a, b = f(t0), f(t0 + period)
+            if not abs(a - b) <= 1e-9 * (1 + abs(a)):
+                raise ModelError(
+                    f"time enters the right-hand side through {expr}, which is not periodic with the "
+                    f"declared period {system.period} ({a:.6g} at {system.time}={t0:.4g}, {b:.6g} one period "
+                    "later). The engine repeats one sampled period: declare the true forcing period.",
+                    system.name,
+                )

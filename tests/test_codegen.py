@@ -1,0 +1,176 @@
+"""Code generation: translation, splitting, determinism, the committed generated/, cache, fallback."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import casadi as ca
+import numpy as np
+import pytest
+import sympy as sp
+
+import gearsym.codegen.compiled as compiled_module
+import gearsym.codegen.compiler as compiler
+from gearsym import FirstOrderSystem, ModelError, UnknownParameterError
+from gearsym.backlash import G, g, g_slope
+from gearsym.codegen import CompilerError, compile_model
+from gearsym.codegen.generated import generate_model
+from gearsym.codegen.time_tables import split_rhs
+from gearsym.codegen.translate import to_casadi
+from gearsym.registry import REPO_ROOT, available_models, system_for
+
+
+# ------------------------------------------------------------------ SymPy -> CasADi
+@pytest.mark.parametrize("x", [5.0, 0.0, -0.5, -9.99, -10.0, -12.5])
+def test_backlash_translation_matches_sympy_on_every_branch(x):
+    xs, es = sp.Symbol("x", real=True), sp.Symbol("eta", real=True)
+    X, E = ca.SX.sym("x"), ca.SX.sym("eta")
+    exprs = [g(xs, es), g_slope(xs, es), G(xs, es), sp.Piecewise((xs**2, xs > 1), (sp.cos(xs), True))]
+    f = ca.Function("f", [X, E], to_casadi(exprs, {xs: X, es: E}))
+    for expr, value in zip(exprs, f(x, 10.0)):
+        expected = float(expr.subs({xs: x, es: 10.0}).rewrite(sp.Piecewise))
+        assert float(value) == pytest.approx(expected, abs=1e-15)
+
+
+def test_casadi_jacobian_of_backlash_is_the_slope():
+    X, E = ca.SX.sym("x"), ca.SX.sym("eta")
+    xs, es = sp.Symbol("x", real=True), sp.Symbol("eta", real=True)
+    (gx,) = to_casadi([g(xs, es)], {xs: X, es: E})
+    slope = ca.Function("s", [X, E], [ca.jacobian(gx, X)])
+    assert [float(slope(x, 10.0)) for x in (3.0, -4.0, -11.0)] == [1.0, 0.0, 1.0]
+
+
+def test_untranslatable_function_is_a_clear_error():
+    xs = sp.Symbol("x", real=True)
+    with pytest.raises(ModelError, match="cannot generate code for besselj"):
+        to_casadi([sp.besselj(0, xs)], {xs: ca.SX.sym("x")}, "m")
+
+
+# ------------------------------------------------------------------ tables and constants
+def test_split_puts_all_time_dependence_into_tables_and_parameters_into_constants():
+    system = system_for("flexible_shaft")
+    split = split_rhs(system)
+    states = set(system.states)
+    for f in split.rhs:
+        assert system.time not in f.free_symbols
+        assert all(s in states or s.name.startswith(("table_", "const_")) for s in f.free_symbols)
+    # substituting the entries back gives the model's rhs exactly
+    back = {sym: expr for sym, expr in split.tables + split.constants}
+    for f, original in zip(split.rhs, system.rhs):
+        assert sp.simplify(f.xreplace(back) - original) == 0
+
+
+def test_time_dependence_that_is_not_periodic_is_rejected():
+    bad = FirstOrderSystem.from_equations("drift", ["x"], ["-x + t"], {}, time="t", period=1)
+    with pytest.raises(ModelError, match="not periodic with the declared period"):
+        compile_model(bad, backend="in-process")
+
+
+# ------------------------------------------------------------------ generated/ is what the models give
+@pytest.mark.parametrize("name", available_models())
+def test_committed_generated_code_is_regenerated_byte_for_byte(name):
+    report = generate_model(name, REPO_ROOT / "generated", check=True)
+    assert report.stale == [], f"stale: {report.stale}; run `gearsym compile --all` and commit generated/"
+
+
+def test_generated_code_does_not_depend_on_the_hash_seed(tmp_path):
+    script = ("import sys; from gearsym.codegen.generated import generate_model; "
+              "generate_model('one_stage', sys.argv[1], compile=False)")
+    for seed in ("1", "2"):
+        env = {**os.environ, "PYTHONHASHSEED": seed}
+        subprocess.run([sys.executable, "-c", script, str(tmp_path / seed)], check=True, env=env)
+    for fname in ("one_stage.c", "manifest.json"):
+        assert (tmp_path / "1" / "one_stage" / fname).read_bytes() == (tmp_path / "2" / "one_stage" / fname).read_bytes()
+
+
+def test_manifest_records_hash_options_and_casadi_version():
+    import json
+    manifest = json.loads((REPO_ROOT / "generated" / "flexible_shaft" / "manifest.json").read_text())
+    assert manifest["casadi_version"] == ca.__version__
+    assert manifest["options"]["steps_per_period"] == 200
+    assert manifest["states"] == ["x1", "v1", "x2", "v2"]
+    assert len(manifest["hash"]) == 64
+    assert "omega" in manifest["parameters"] and "kS" in manifest["parameters"]
+
+
+# ------------------------------------------------------------------ compiled == in-process
+def test_compiled_and_in_process_agree():
+    compiled = compile_model("flexible_shaft", backend="compiled")
+    inproc = compile_model("flexible_shaft", backend="in-process")
+    assert compiled.backend == "compiled" and inproc.backend == "in-process"
+    for cm_pair_p in ({"omega": 0.2}, {"omega": 1.7, "kS": 1.0}):
+        runs = []
+        for cm in (compiled, inproc):
+            inputs = cm.prepare(cm.parameter_vector(cm_pair_p))
+            runs.append(cm.tangent_run(None, 60, inputs))
+        a, b = runs
+        assert np.max(np.abs(a.strobe - b.strobe)) < 1e-12
+        assert np.max(np.abs(a.log_stretch - b.log_stretch)) < 1e-12
+        assert np.max(np.abs(a.low - b.low)) < 1e-12
+    y, p = np.array([0.3, -0.2, 1.1, 0.4]), compiled.parameter_vector(omega=1.3)
+    assert compiled.rhs(0.7, y, p) == pytest.approx(inproc.rhs(0.7, y, p), abs=1e-14)
+    assert compiled.jacobian(0.7, y, p) == pytest.approx(inproc.jacobian(0.7, y, p), abs=1e-14)
+
+
+def test_chunks_and_single_periods_give_the_same_run():
+    cm = compile_model("one_stage")
+    inputs = cm.prepare(cm.parameter_vector(omega=0.8))
+    whole = cm.tangent_run(None, 53, inputs)  # one chunk of 50 and three single periods
+    first = cm.tangent_run(None, 3, inputs)
+    rest = cm.tangent_run(first.strobe[:, -1], 50, inputs, Q0=first.Q)
+    assert whole.strobe.shape == (2, 53)
+    assert np.array_equal(whole.strobe, np.hstack([first.strobe, rest.strobe]))
+    assert np.array_equal(whole.log_stretch, np.hstack([first.log_stretch, rest.log_stretch]))
+
+
+# ------------------------------------------------------------------ parameters are inputs; cache
+def test_changing_parameters_never_rebuilds(monkeypatch):
+    cm = compile_model("one_stage")
+    calls = []
+    monkeypatch.setattr(compiled_module, "build_functions", lambda *a, **k: calls.append(1))
+    monkeypatch.setattr(compiled_module, "compile_library", lambda *a, **k: calls.append(1))
+    again = compile_model("one_stage", omega=0.7, zeta=0.05)
+    assert calls == [] and again.functions is cm.functions
+    assert again.parameter_vector()[list(again.parameter_names).index("omega")] == 0.7
+
+
+def test_library_cache_survives_a_new_process_and_misses_on_a_new_model(monkeypatch):
+    compile_model("lorenz")
+    monkeypatch.setattr(compiled_module, "_LOADED", {})  # as in a fresh process
+    again = compile_model("lorenz")
+    assert "compile" not in again.timings and again.library.is_file()
+    other = compile_model("lorenz", steps_per_period=100)
+    assert other.hash != again.hash and other.library != again.library
+
+
+def test_unknown_or_unphysical_parameter_values_are_rejected():
+    cm = compile_model("one_stage")
+    with pytest.raises(UnknownParameterError, match="Did you mean 'omega'"):
+        cm.parameter_vector(omgea=1.0)
+    with pytest.raises(ModelError, match="zeta"):
+        cm.parameter_vector(zeta=-0.1)
+
+
+def test_without_a_compiler_auto_falls_back_and_compiled_explains(monkeypatch, capsys):
+    monkeypatch.setenv("CC", "no-such-compiler-gearsym")
+    compiler.find_compiler.cache_clear()
+    monkeypatch.setattr(compiled_module, "_WARNED", set())
+    try:
+        cm = compile_model("lorenz", backend="auto", steps_per_period=100)
+        assert cm.backend == "in-process"
+        assert "no C compiler found" in capsys.readouterr().err
+        from gearsym.analysis import lyapunov_spectrum
+        assert lyapunov_spectrum(cm, periods=20, discard=5).sum == pytest.approx(-13.6667, abs=1e-3)
+        monkeypatch.setattr(compiled_module, "_LOADED", {})
+        with pytest.raises(CompilerError, match="apt install gcc"):
+            compile_model("lorenz", backend="compiled", steps_per_period=100)
+    finally:
+        compiler.find_compiler.cache_clear()
+
+
+def test_a_failing_compiler_reports_its_output(monkeypatch, tmp_path):
+    src = tmp_path / "broken.c"
+    src.write_text("this is not C\n")
+    with pytest.raises(CompilerError, match="compiling .*broken.c failed"):
+        compiler.compile_library(src, "broken")

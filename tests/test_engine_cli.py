@@ -1,0 +1,84 @@
+"""``gearsym lyap`` and ``gearsym compile``."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from gearsym.cli import main
+
+
+def run(capsys, *argv: str) -> tuple[int, str, str]:
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_lyap_json_has_the_documented_keys(capsys):
+    code, out, _ = run(capsys, "lyap", "flexible_shaft", "--set", "omega=1.5", "--set", "kS=0.1", "--periods", "200",
+                       "--discard", "50", "--steps-per-period", "200", "--format", "json")
+    assert code == 0
+    data = json.loads(out)
+    assert len(data["exponents"]) == 4 and len(data["stderr"]) == 4
+    assert data["exponents"] == sorted(data["exponents"], reverse=True)
+    assert sum(data["exponents"]) == pytest.approx(-2 * 0.08 / 1.5, abs=1e-3)
+    assert set(data["amplitude"]) == {"x1", "x2"} and all(a > 0 for a in data["amplitude"].values())
+    assert set(data["final_state"]) == {"x1", "v1", "x2", "v2"}
+    assert data["parameters"]["kS"] == 0.1 and data["periods"] == 200 and data["discard"] == 50
+
+
+def test_lyap_accepts_a_new_stiffness_formula(capsys):
+    code, out, _ = run(capsys, "lyap", "one_stage", "--set", "k=1+0.3*cos(tau)", "--set", "omega=0.5",
+                       "--periods", "60", "--discard", "20", "--format", "json")
+    assert code == 0
+    data = json.loads(out)
+    assert sum(data["exponents"]) == pytest.approx(-2 * 0.08 / 0.5, abs=1e-3)
+    assert "k_a" not in data["parameters"]  # the default k(tau) and its amplitude are gone
+
+
+def test_lyap_text_output_and_initial_state(capsys):
+    code, out, _ = run(capsys, "lyap", "lorenz", "--periods", "30", "--discard", "10", "--y0", "x=1,y=2,z=20")
+    assert code == 0
+    assert "lambda_1" in out and "lambda_3" in out and "final state: x=" in out
+
+
+@pytest.mark.parametrize("argv,message", [
+    (["lyap", "one_stage", "--set", "omgea=1.5"], "Did you mean 'omega'"),
+    (["lyap", "one_stage", "--set", "omega"], "expected NAME=VALUE"),
+    (["lyap", "one_stage", "--set", "zeta=-1"], "zeta"),
+    (["lyap", "one_stage", "--periods", "10", "--discard", "10"], "discard < periods"),
+    (["lyap", "one_stage", "--y0", "x:1"], "NAME=NUMBER"),
+    (["lyap", "one_stage", "--y0", "q=1"], "unknown states"),
+    (["lyap", "lorenz", "--set", "rho=1+x"], "only drivetrain models accept a formula"),
+    (["lyap", "nosuchmodel"], "unknown model"),
+])
+def test_lyap_errors_are_one_line_messages(capsys, argv, message):
+    code, _, err = run(capsys, *argv)
+    assert code == 2
+    assert message in err and "Traceback" not in err
+
+
+def test_compile_check_reports_up_to_date(capsys):
+    code, out, _ = run(capsys, "compile", "--all", "--check")
+    assert code == 0 and "up to date (5 models)" in out
+
+
+def test_compile_writes_source_manifest_and_library(capsys, tmp_path):
+    code, out, _ = run(capsys, "compile", "one_stage", "--out", str(tmp_path))
+    assert code == 0
+    assert (tmp_path / "one_stage" / "one_stage.c").is_file() and (tmp_path / "one_stage" / "manifest.json").is_file()
+    assert "library" in out
+    code, out, _ = run(capsys, "compile", "one_stage", "--out", str(tmp_path))
+    assert "(cached)" in out  # the same source is never compiled twice
+
+
+def test_compile_check_detects_a_hand_edited_file(capsys, tmp_path):
+    run(capsys, "compile", "lorenz", "--out", str(tmp_path), "--no-compile")
+    source = tmp_path / "lorenz" / "lorenz.c"
+    source.write_text(source.read_text().replace("casadi_real", "double", 1))
+    code, _, err = run(capsys, "compile", "lorenz", "--out", str(tmp_path), "--check")
+    assert code == 1 and "lorenz.c" in err

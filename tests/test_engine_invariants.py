@@ -1,0 +1,130 @@
+"""The compiled engine against invariants, published values and an independent implementation."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import sympy as sp
+
+from gearsym.analysis import lyapunov_spectrum, phase_trajectory, poincare_samples
+from gearsym.codegen import compile_model
+from gearsym.registry import system_for
+
+
+# ------------------------------------------------------------------ sum of exponents = mean trace
+@pytest.mark.parametrize("name", ["one_stage", "one_stage_resonant", "flexible_shaft", "two_stage"])
+def test_trace_of_jacobian_is_minus_two_zeta_over_omega(name):
+    system = system_for(name)
+    trace = sp.simplify(system.jacobian().trace())
+    zeta, omega = sp.Symbol("zeta", real=True), sp.Symbol("omega", positive=True)
+    if name == "two_stage":  # a second damped mesh adds its own term
+        zeta2 = sp.Symbol("zeta2", real=True)
+        assert sp.simplify(trace - (-2 * zeta / omega - 2 * zeta2 / omega)) == 0
+    else:
+        assert sp.simplify(trace - (-2 * zeta / omega)) == 0
+
+
+@pytest.mark.parametrize("name,settings", [
+    ("one_stage", {"omega": 1.5}),            # the paper's point
+    ("one_stage", {"omega": 1.2}),            # chaotic: the sum holds all the same
+    ("one_stage_resonant", {"omega": 1.36}),
+    ("flexible_shaft", {"omega": 1.5, "kS": 0.1}),
+    ("flexible_shaft", {"omega": 0.9, "kS": 1.0}),
+])
+def test_exponents_sum_to_mean_trace(name, settings):
+    result = lyapunov_spectrum(name, periods=300, discard=100, **settings)
+    expected = -2 * result.parameters["zeta"] / result.parameters["omega"]
+    assert len(result.exponents) == len(result.final_state)
+    assert abs(result.sum - expected) < 1e-3
+    assert np.all(np.diff(result.exponents) <= 0), "exponents must be listed in descending order"
+
+
+def test_trace_error_shrinks_with_more_steps():
+    """RK4's tangent map has det = exp(trace * h) + O(h^5): the error of the sum falls ~ h^4."""
+    errors = []
+    for steps in (100, 200, 400):
+        r = lyapunov_spectrum("one_stage", omega=0.2, periods=120, discard=20, steps_per_period=steps)
+        errors.append(abs(r.sum + 2 * 0.08 / 0.2))
+    assert errors[0] > 4 * errors[1] > 16 * errors[2] > 0
+    assert errors[1] < 1e-3
+
+
+# ------------------------------------------------------------------ published values
+def test_lorenz_published_exponents():
+    """Lorenz sigma=10, rho=28, beta=8/3: 0.9056, 0, -14.5723 (sum exactly -(sigma + 1 + beta))."""
+    r = lyapunov_spectrum("lorenz", periods=3100, discard=100)
+    assert r.exponents == pytest.approx([0.9056, 0.0, -14.5723], abs=0.02)
+    assert r.sum == pytest.approx(-(10 + 1 + 8 / 3), abs=1e-4)  # RK4 at h = 0.005: ~6e-6
+    assert np.all(r.stderr < 0.02)
+
+
+# ------------------------------------------------------------------ an independent implementation
+def _numpy_reference(omega, periods, discard, steps, zeta=0.08, B0=1.0, B1=4.0, eta=10.0, a=0.2):
+    """Eq. 2 with k(tau) = 1 + a cos(tau), typed from the paper: plain NumPy RK4 on the state and
+    its 2x2 tangent matrix, Gram-Schmidt (QR) once per period."""
+    def g(x):
+        return x if x >= 0 else (x + eta if x <= -eta else 0.0)
+
+    def dg(x):
+        return 1.0 if (x >= 0 or x <= -eta) else 0.0
+
+    def f(tau, y, Q):
+        x, v = y
+        k = 1 + a * np.cos(tau)
+        dy = np.array([v, -2 * zeta / omega * v - k * g(x) / omega**2 + (B0 + B1 * np.cos(tau)) / omega**2])
+        J = np.array([[0.0, 1.0], [-k * dg(x) / omega**2, -2 * zeta / omega]])
+        return dy, J @ Q
+
+    h = 2 * np.pi / steps
+    y, Q = np.array([-2.0, -0.5]), np.eye(2)
+    logs, lo, hi = [], np.inf, -np.inf
+    for period in range(periods):
+        for i in range(steps):
+            tau = i * h
+            k1, K1 = f(tau, y, Q)
+            k2, K2 = f(tau + h / 2, y + h / 2 * k1, Q + h / 2 * K1)
+            k3, K3 = f(tau + h / 2, y + h / 2 * k2, Q + h / 2 * K2)
+            k4, K4 = f(tau + h, y + h * k3, Q + h * K3)
+            y = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            Q = Q + h / 6 * (K1 + 2 * K2 + 2 * K3 + K4)
+            if period >= discard:
+                lo, hi = min(lo, y[0]), max(hi, y[0])
+        q, r = np.linalg.qr(Q)
+        signs = np.sign(np.diag(r))
+        Q = q * signs
+        logs.append(np.log(np.abs(np.diag(r))))
+    lam = np.array(logs[discard:]).sum(axis=0) / ((periods - discard) * 2 * np.pi)
+    return lam, y, (hi - lo) / 2
+
+
+@pytest.mark.parametrize("omega", [0.5, 1.6])
+def test_one_stage_agrees_with_independent_numpy_rk4(omega):
+    periods, discard, steps = 60, 20, 200
+    ref_lam, ref_y, ref_amp = _numpy_reference(omega, periods, discard, steps)
+    assert ref_lam[0] < -1e-3, "the comparison point must be periodic (errors do not grow)"
+    r = lyapunov_spectrum("one_stage", k="1 + 0.2*cos(tau)", omega=omega, periods=periods, discard=discard,
+                          steps_per_period=steps)
+    assert r.exponents == pytest.approx(np.sort(ref_lam)[::-1], abs=1e-9)
+    assert [r.final_state["x"], r.final_state["v"]] == pytest.approx(ref_y, abs=1e-9)
+    assert r.amplitude["x"] == pytest.approx(ref_amp, abs=1e-9)
+
+
+# ------------------------------------------------------------------ the analyses agree with each other
+def test_strobe_samples_agree_between_tangent_orbit_and_trajectory_runs():
+    cm = compile_model("one_stage")
+    lyap = lyapunov_spectrum(cm, periods=30, discard=10, omega=0.8)
+    orbit = poincare_samples(cm, periods=20, discard=10, omega=0.8)
+    traj = phase_trajectory(cm, periods=20, discard=10, omega=0.8)
+    assert orbit.strobe == pytest.approx(lyap.strobe, abs=1e-12)
+    assert traj.strobe[:, 1:] == pytest.approx(orbit.strobe, abs=1e-12)
+    assert traj.states.shape == (2, 20 * 200 + 1)
+    assert traj.time[0] == pytest.approx(10 * 2 * np.pi)
+    assert orbit.amplitude["x"] == pytest.approx(lyap.amplitude["x"], abs=1e-12)
+    x = traj["x"]
+    assert (x.max() - x.min()) / 2 == pytest.approx(orbit.amplitude["x"], abs=1e-12)
+
+
+def test_history_converges_to_the_exponents():
+    r = lyapunov_spectrum("flexible_shaft", periods=200, discard=50, omega=1.5)
+    assert r.history.shape == (150, 4)
+    assert r.history[-1] == pytest.approx(r.exponents, abs=1e-12)
+    assert r.strobe.shape == (4, 150)
