@@ -21,6 +21,7 @@ from ..system import FirstOrderSystem
 from .compiler import CompilerError, cache_dir, compile_library, find_compiler, NO_COMPILER_HINT
 from .functions import LoopOptions, build_functions
 from .generate import code_hash, read_manifest, write_code
+from .native import NativeFunction, load_native
 
 BACKENDS = ("auto", "compiled", "in-process")
 
@@ -34,10 +35,18 @@ class RunInputs:
     """What the loops need for one parameter point, computed once: tables of time and constants."""
 
     p: np.ndarray
-    table: ca.DM
-    constants: ca.DM
+    table: np.ndarray  # column-major (3 * table entries, steps per period)
+    constants: np.ndarray
     period: float
     t0: float
+
+    @property
+    def table_dm(self) -> ca.DM:
+        return ca.DM(self.table)
+
+    @property
+    def constants_dm(self) -> ca.DM:
+        return ca.DM(self.constants)
 
 
 @dataclass(frozen=True)
@@ -63,6 +72,7 @@ class CompiledModel:
     library: Path | None = None
     timings: dict[str, float] = field(default_factory=dict)
     check: Callable[[str, float], float] | None = None
+    native: Mapping[str, NativeFunction] | None = None  # the same functions, called without CasADi
 
     # ---------------------------------------------------------------- names
     @property
@@ -104,13 +114,17 @@ class CompiledModel:
         if p.shape != (len(self.parameter_names),):
             raise GearsymError(f"{self.name}: expected {len(self.parameter_names)} parameter values "
                                f"({', '.join(self.parameter_names)}), got shape {p.shape}")
-        c, period = self.functions["constants"](p)
-        period = float(period)
+        if self.native:
+            c, period = self.native["constants"](p)
+            (table,) = self.native["table"](np.array([float(t0)]), p)
+        else:
+            c, period = (np.array(v) for v in self.functions["constants"](p))
+            table = np.asfortranarray(np.array(self.functions["table"](t0, p)))
+        period = float(period.reshape(-1)[0])
         if not (np.isfinite(period) and period > 0):
             raise ModelError(f"the forcing period is {period} at these parameter values; it must be positive",
                              self.name)
-        table = self.functions["table"](t0, p)
-        return RunInputs(p, table, c, period, float(t0))
+        return RunInputs(p, table, c.reshape(-1), period, float(t0))
 
     def initial_state(self, y0=None) -> np.ndarray:
         if y0 is None:
@@ -130,39 +144,78 @@ class CompiledModel:
     # ---------------------------------------------------------------- runs
     def tangent_run(self, y0, periods: int, inputs: RunInputs, Q0=None) -> TangentRun:
         """``periods`` forcing periods of the state and n tangent vectors, re-orthonormalised every period."""
+        n, m = self.dimension, len(self.observed)
+        y = self.initial_state(y0)
+        Q = np.asfortranarray(np.eye(n) if Q0 is None else np.asarray(Q0, dtype=float))
+        if Q.shape != (n, n):
+            raise GearsymError(f"{self.name}: tangent vectors must be a {n}x{n} matrix, got {Q.shape}")
+        schedule = self._schedule(periods, "lyapunov")
+        if self.native:
+            strobe, logs = (np.empty((n, periods), order="F") for _ in range(2))
+            low, high = (np.empty((m, periods), order="F") for _ in range(2))
+            Q = self._native_loop(schedule, y, [Q, np.empty_like(Q)], inputs, strobe, [strobe, logs, low, high])
+        else:
+            yd, Qd, parts = ca.DM(y), ca.DM(Q), []
+            for fname, count in schedule:
+                f = self.functions[fname]
+                for _ in range(count):
+                    out, Qd, logs, low, high = f(yd, Qd, inputs.table_dm, inputs.constants_dm)
+                    yd = out[:, -1]
+                    parts.append((out, logs, low, high))
+            strobe, logs, low, high = (_hcat([p[i] for p in parts], rows) for i, rows in enumerate((n, n, m, m)))
+            Q = np.array(Qd)
+        self._check_finite(strobe, logs, inputs)
+        return TangentRun(strobe, logs, low, high, Q)
+
+    def _native_loop(self, schedule, y, Qs, inputs: RunInputs, strobe, outputs) -> np.ndarray | None:
+        """Chunk after chunk, writing straight into ``outputs`` (column-major, one column per period).
+
+        The start state of each chunk is read where the previous chunk wrote its last period; with
+        tangent vectors (``Qs``: two n x n buffers), Q ping-pongs between the two.
+        """
         n = self.dimension
-        y = ca.DM(self.initial_state(y0))
-        Q = ca.DM(np.eye(n) if Q0 is None else np.asarray(Q0, dtype=float))
-        parts = []
-        for fname, count in self._schedule(periods, "lyapunov"):
-            f = self.functions[fname]
+        table = np.asfortranarray(inputs.table)
+        shared = [table.ctypes.data, inputs.constants.ctypes.data]
+        y_addr, col, stride = y.ctypes.data, 0, [o.shape[0] * 8 for o in outputs]
+        for fname, count in schedule:
+            f, width = self.native[fname], (self.options.chunk_periods if fname.endswith("chunk") else 1)
             for _ in range(count):
-                strobe, Q, logs, low, high = f(y, Q, inputs.table, inputs.constants)
-                y = strobe[:, -1]
-                parts.append((strobe, logs, low, high))
-        strobe, logs, low, high = (_hcat([p[i] for p in parts], rows) for i, rows in
-                                   enumerate((n, n, len(self.observed), len(self.observed))))
-        return TangentRun(strobe, logs, low, high, np.array(Q))
+                at = [o.ctypes.data + col * s for o, s in zip(outputs, stride)]
+                if Qs:
+                    f.call([y_addr, Qs[0].ctypes.data, *shared], [at[0], Qs[1].ctypes.data, *at[1:]])
+                    Qs.reverse()
+                else:
+                    f.call([y_addr, *shared], at)
+                col += width
+                y_addr = strobe.ctypes.data + (col - 1) * n * 8
+        return Qs[0] if Qs else None
 
     def orbit_run(self, y0, periods: int, inputs: RunInputs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The state after each of ``periods`` periods (stroboscopic samples), with each period's min and max."""
-        y = ca.DM(self.initial_state(y0))
-        parts = []
-        for fname, count in self._schedule(periods, "orbit"):
-            f = self.functions[fname]
-            for _ in range(count):
-                strobe, low, high = f(y, inputs.table, inputs.constants)
-                y = strobe[:, -1]
-                parts.append((strobe, low, high))
-        m = len(self.observed)
-        return tuple(_hcat([p[i] for p in parts], rows) for i, rows in enumerate((self.dimension, m, m)))
+        y, n, m = self.initial_state(y0), self.dimension, len(self.observed)
+        schedule = self._schedule(periods, "orbit")
+        if self.native:
+            strobe = np.empty((n, periods), order="F")
+            low, high = (np.empty((m, periods), order="F") for _ in range(2))
+            self._native_loop(schedule, y, [], inputs, strobe, [strobe, low, high])
+        else:
+            yd, parts = ca.DM(y), []
+            for fname, count in schedule:
+                f = self.functions[fname]
+                for _ in range(count):
+                    out, low, high = f(yd, inputs.table_dm, inputs.constants_dm)
+                    yd = out[:, -1]
+                    parts.append((out, low, high))
+            strobe, low, high = (_hcat([p[i] for p in parts], rows) for i, rows in enumerate((n, m, m)))
+        self._check_finite(strobe, strobe, inputs)
+        return strobe, low, high
 
     def trajectory(self, y0, periods: int, inputs: RunInputs) -> tuple[np.ndarray, np.ndarray]:
         """Every RK4 step of ``periods`` periods: times (steps,) and states (n, steps), the start included."""
         y = ca.DM(self.initial_state(y0))
         cols = [np.array(y)]
         for _ in range(periods):
-            states = self.functions["trajectory"](y, inputs.table, inputs.constants)
+            states = self.functions["trajectory"](y, inputs.table_dm, inputs.constants_dm)
             cols.append(np.array(states))
             y = states[:, -1]
         states = np.hstack(cols)
@@ -175,11 +228,27 @@ class CompiledModel:
     def jacobian(self, t: float, y, p) -> np.ndarray:
         return np.array(self.functions["jacobian"](t, y, p))
 
+    def _check_finite(self, strobe: np.ndarray, logs: np.ndarray, inputs: RunInputs) -> None:
+        bad = ~(np.isfinite(strobe).all(axis=0) & np.isfinite(logs).all(axis=0))
+        if bad.any():
+            k = int(np.argmax(bad))
+            values = ", ".join(f"{n}={v:g}" for n, v in zip(self.parameter_names, inputs.p))
+            raise GearsymError(
+                f"{self.name}: the solution became non-finite in period {k + 1} ({values}). The orbit diverges "
+                f"or the step T/{self.steps_per_period} is too large for it: try more --steps-per-period, "
+                "another initial state or other parameter values."
+            )
+
     def _schedule(self, periods: int, kind: str) -> list[tuple[str, int]]:
         if periods < 0:
             raise GearsymError(f"the number of periods must not be negative, got {periods}")
         chunks, rest = divmod(int(periods), self.options.chunk_periods)
         return [(f"{kind}_chunk", chunks), (f"{kind}_period", rest)]
+
+
+def _native_copy(base: CompiledModel):
+    """Fresh work arrays for another CompiledModel object (so two objects may run in two threads)."""
+    return load_native(base.library, dict(base.functions)) if base.native else None
 
 
 def _generated_dir() -> Path:
@@ -241,7 +310,8 @@ def compile_model(
     key = (digest, backend)
     if key in _LOADED:  # same code: reuse the loaded functions, with these parameter values
         base = _LOADED[key]
-        return CompiledModel(system, options, digest, base.functions, backend, base.library, dict(base.timings), check)
+        return CompiledModel(system, options, digest, base.functions, backend, base.library, dict(base.timings), check,
+                             _native_copy(base))
 
     code_dir = cache_dir() / "code" / f"{system.name}-{digest[:16]}"
     committed = _generated_dir() / system.name
@@ -263,12 +333,13 @@ def compile_model(
             write_code(mf, code_dir, digest)
             timings["generate"] = time.perf_counter() - t
         if verbose:
-            print(f"gearsym: compiling {system.name} ({source})", file=sys.stderr)
+            print(f"gearsym: compiling {system.name} if not cached ({source})", file=sys.stderr)
         lib = compile_library(source, system.name)
         if lib.compiled:
             timings["compile"] = lib.seconds
         library = lib.path
         functions = {name: ca.external(name, str(lib.path)) for name in FUNCTION_NAMES}
-    compiled = CompiledModel(system, options, digest, functions, backend, library, timings, check)
+    native = load_native(library, functions) if library else None
+    compiled = CompiledModel(system, options, digest, functions, backend, library, timings, check, native)
     _LOADED[key] = compiled
     return compiled
