@@ -512,7 +512,7 @@ def main(argv=None) -> int:
         print(f"  {k:62s} {v:8.3f} s")
     if gearsym_timings:
         comp = gearsym_timings.get("compile")
-        print(f"  gearsym timings: " + ", ".join(f"{k} {v:.3f} s" for k, v in gearsym_timings.items())
+        print("  gearsym timings: " + ", ".join(f"{k} {v:.3f} s" for k, v in gearsym_timings.items())
               + ("" if comp else "   (library from the cache: no first-time compile in this run)"))
     print()
     print(f"sweep time, seconds, {args.repeats} interleaved repetition(s)")
@@ -536,7 +536,7 @@ def main(argv=None) -> int:
             print(f"  {tag:{W}s} {r['min_over_min']:8.3f} {r['median_over_median']:8.3f} {r['paired_median']:8.3f}{star}")
     print()
     print("correctness (first repetition; exponents in Gram-Schmidt order, vs the reference build)")
-    print(f"  runs deterministic across repetitions: "
+    print("  runs deterministic across repetitions: "
           + ", ".join(f"{k}: {'yes' if v else 'NO'}" for k, v in deterministic.items()))
     print(f"  yardstick builds bit-identical to each other: {'yes' if builds_identical else 'no'}"
           + ("" if builds_identical else "  (expected: builds with FMA round differently)"))

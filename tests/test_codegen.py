@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-import gearsym.codegen.compiled as compiled_module
+import gearsym.codegen.build as build_module
 import gearsym.codegen.compiler as compiler
 from gearsym import FirstOrderSystem, ModelError, UnknownParameterError
 from gearsym.backlash import G, g, g_slope
@@ -128,8 +128,8 @@ def test_chunks_and_single_periods_give_the_same_run():
 def test_changing_parameters_never_rebuilds(monkeypatch):
     cm = compile_model("one_stage")
     calls = []
-    monkeypatch.setattr(compiled_module, "build_functions", lambda *a, **k: calls.append(1))
-    monkeypatch.setattr(compiled_module, "compile_library", lambda *a, **k: calls.append(1))
+    monkeypatch.setattr(build_module, "build_functions", lambda *a, **k: calls.append(1))
+    monkeypatch.setattr(build_module, "compile_library", lambda *a, **k: calls.append(1))
     again = compile_model("one_stage", omega=0.7, zeta=0.05)
     assert calls == [] and again.functions is cm.functions
     assert again.parameter_vector()[list(again.parameter_names).index("omega")] == 0.7
@@ -137,7 +137,7 @@ def test_changing_parameters_never_rebuilds(monkeypatch):
 
 def test_library_cache_survives_a_new_process_and_misses_on_a_new_model(monkeypatch):
     compile_model("lorenz")
-    monkeypatch.setattr(compiled_module, "_LOADED", {})  # as in a fresh process
+    monkeypatch.setattr(build_module, "_LOADED", {})  # as in a fresh process
     again = compile_model("lorenz")
     assert "compile" not in again.timings and again.library.is_file()
     other = compile_model("lorenz", steps_per_period=100)
@@ -155,14 +155,14 @@ def test_unknown_or_unphysical_parameter_values_are_rejected():
 def test_without_a_compiler_auto_falls_back_and_compiled_explains(monkeypatch, capsys):
     monkeypatch.setenv("CC", "no-such-compiler-gearsym")
     compiler.find_compiler.cache_clear()
-    monkeypatch.setattr(compiled_module, "_WARNED", set())
+    monkeypatch.setattr(build_module, "_WARNED", set())
     try:
         cm = compile_model("lorenz", backend="auto", steps_per_period=100)
         assert cm.backend == "in-process"
         assert "no C compiler found" in capsys.readouterr().err
         from gearsym.analysis import lyapunov_spectrum
         assert lyapunov_spectrum(cm, periods=20, discard=5).sum == pytest.approx(-13.6667, abs=1e-3)
-        monkeypatch.setattr(compiled_module, "_LOADED", {})
+        monkeypatch.setattr(build_module, "_LOADED", {})
         with pytest.raises(CompilerError, match="apt install gcc"):
             compile_model("lorenz", backend="compiled", steps_per_period=100)
     finally:

@@ -2,11 +2,7 @@
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 
-import numpy as np
 import pytest
 
 from gearsym.cli import main
@@ -82,3 +78,11 @@ def test_compile_check_detects_a_hand_edited_file(capsys, tmp_path):
     source.write_text(source.read_text().replace("casadi_real", "double", 1))
     code, _, err = run(capsys, "compile", "lorenz", "--out", str(tmp_path), "--check")
     assert code == 1 and "lorenz.c" in err
+
+
+def test_lyap_plot_writes_a_png(capsys, tmp_path):
+    out = tmp_path / "fig" / "point.png"
+    code, _, err = run(capsys, "lyap", "one_stage", "--set", "omega=1.2", "--periods", "60", "--discard", "20",
+                       "--plot", str(out))
+    assert code == 0 and f"wrote {out}" in err
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and out.stat().st_size > 20_000

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..codegen.compiled import CompiledModel, compile_model
+from ..codegen import CompiledModel, compile_model
 from ..errors import GearsymError
 from .statistics import batch_means_stderr
 

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..codegen.compiled import CompiledModel, compile_model
+from ..codegen import CompiledModel, compile_model
 from ..errors import GearsymError
 
 

@@ -5,7 +5,6 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..codegen.compiled import BACKENDS
 from ..codegen.generated import DEFAULT_DIR, generate_model
 from ..registry import available_models
 from .settings import add_set_argument, parse_settings

@@ -3,9 +3,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
+from pathlib import Path
 
-from ..analysis import lyapunov_spectrum
-from ..codegen.compiled import BACKENDS
+from ..analysis import lyapunov_spectrum, phase_trajectory
+from ..codegen import BACKENDS, compile_model
 from .settings import add_set_argument, parse_settings, parse_state
 
 NAME = "lyap"
@@ -22,20 +24,28 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--backend", choices=BACKENDS, default="auto",
                         help="compiled C, CasADi in-process, or auto (compiled when a C compiler exists)")
     parser.add_argument("--format", choices=("text", "json"), default="text")
+    parser.add_argument("--plot", type=Path, metavar="FILE.png",
+                        help="also draw the exponents' convergence and the phase portrait with the Poincare points")
 
 
 def run(args: argparse.Namespace) -> int:
-    result = lyapunov_spectrum(
-        args.model, periods=args.periods, discard=args.discard, steps_per_period=args.steps_per_period,
-        y0=parse_state(args.y0), backend=args.backend, **parse_settings(args.set),
-    )
+    compiled = compile_model(args.model, steps_per_period=args.steps_per_period, backend=args.backend,
+                             verbose=True, **parse_settings(args.set))
+    result = lyapunov_spectrum(compiled, periods=args.periods, discard=args.discard, y0=parse_state(args.y0))
+    if args.plot:
+        from ..figures import plot_point  # matplotlib only when asked for
+
+        shown = min(30, result.periods - result.discard)
+        trajectory = phase_trajectory(compiled, periods=shown, discard=result.periods - shown,
+                                      y0=parse_state(args.y0))
+        plot_point(result, trajectory, args.plot)
+        print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     if args.format == "json":
         print(json.dumps(result.as_dict(), indent=2))
         return 0
     print(f"{result.model}: {result.periods} periods ({result.discard} discarded), "
           f"{result.steps_per_period} RK4 steps/period, {result.backend}")
-    changed = ", ".join(f"{k}={v:g}" for k, v in result.parameters.items())
-    print(f"parameters: {changed}")
+    print("parameters: " + ", ".join(f"{k}={v:g}" for k, v in result.parameters.items()))
     print("Lyapunov exponents (per unit time, +- standard error):")
     for i, (lam, err) in enumerate(zip(result.exponents, result.stderr), 1):
         print(f"  lambda_{i} = {lam:+.6f} +- {err:.6f}")

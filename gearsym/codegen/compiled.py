@@ -1,16 +1,15 @@
 """A model's loops, compiled (or evaluated in-process), behind one small object.
 
-:func:`compile_model` is the high-level entry (a model name and settings in,
-a :class:`CompiledModel` out, from the cache when it can); the analyses in
-:mod:`gearsym.analysis` take a ``CompiledModel`` so that a sweep builds it once
-and only changes the parameter vector.
+A :class:`CompiledModel` is built by :func:`gearsym.codegen.build.compile_model`;
+the analyses in :mod:`gearsym.analysis` take one, so that a sweep builds it
+once and only changes the parameter vector (the low-level call), or build it
+from a model name themselves (the high-level call).
 """
 from __future__ import annotations
 
-import sys
-import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import casadi as ca
@@ -18,16 +17,8 @@ import numpy as np
 
 from ..errors import GearsymError, ModelError, UnknownParameterError
 from ..system import FirstOrderSystem
-from .compiler import CompilerError, cache_dir, compile_library, find_compiler, NO_COMPILER_HINT
-from .functions import LoopOptions, build_functions
-from .generate import code_hash, read_manifest, write_code
-from .native import NativeFunction, load_native
-
-BACKENDS = ("auto", "compiled", "in-process")
-
-#: every function the generated library exports
-FUNCTION_NAMES = ("rhs", "jacobian", "constants", "table", "lyapunov_chunk", "lyapunov_period",
-                  "orbit_chunk", "orbit_period", "trajectory")
+from .functions import LoopOptions
+from .native import NativeFunction
 
 
 @dataclass(frozen=True)
@@ -40,11 +31,11 @@ class RunInputs:
     period: float
     t0: float
 
-    @property
-    def table_dm(self) -> ca.DM:
+    @cached_property
+    def table_dm(self) -> ca.DM:  # for the in-process backend
         return ca.DM(self.table)
 
-    @property
+    @cached_property
     def constants_dm(self) -> ca.DM:
         return ca.DM(self.constants)
 
@@ -246,100 +237,5 @@ class CompiledModel:
         return [(f"{kind}_chunk", chunks), (f"{kind}_period", rest)]
 
 
-def _native_copy(base: CompiledModel):
-    """Fresh work arrays for another CompiledModel object (so two objects may run in two threads)."""
-    return load_native(base.library, dict(base.functions)) if base.native else None
-
-
-def _generated_dir() -> Path:
-    from ..registry import REPO_ROOT
-    return REPO_ROOT / "generated"
-
-
 def _hcat(blocks, rows: int) -> np.ndarray:
     return np.hstack([np.array(b) for b in blocks]) if blocks else np.zeros((rows, 0))
-
-
-# ============================================================================ building
-_LOADED: dict[tuple, CompiledModel] = {}
-_WARNED = set()
-
-
-def compile_model(
-    model,
-    *,
-    steps_per_period: int = 200,
-    backend: str = "auto",
-    chunk_periods: int = 50,
-    verbose: bool = False,
-    **settings,
-) -> CompiledModel:
-    """Generate, compile (or take from the cache) and load a model's functions.
-
-    ``model`` is a model name, a path, a Drivetrain, a NondimensionalModel or a
-    FirstOrderSystem; ``settings`` give parameter values or replace a mesh
-    stiffness (``k="1 + 0.2*cos(tau)"``). Parameter values never change the
-    code; they become the defaults of the returned object.
-    ``backend``: "compiled" (fail without a C compiler), "in-process" (CasADi's
-    virtual machine) or "auto" (compiled if a compiler exists, else in-process
-    with a warning).
-    """
-    from ..reduce import NondimensionalModel, reduce
-    from ..registry import load_model, system_for
-
-    if backend not in BACKENDS:
-        raise GearsymError(f"unknown backend {backend!r}; choose one of {', '.join(BACKENDS)}")
-    start = time.perf_counter()
-    loaded = model if isinstance(model, (FirstOrderSystem, NondimensionalModel)) else load_model(model)
-    check = None
-    if isinstance(loaded, FirstOrderSystem):
-        system = system_for(loaded, **settings)
-    else:
-        nd = loaded if isinstance(loaded, NondimensionalModel) else reduce(loaded)
-        system = system_for(nd, **settings)
-        check = nd.check_value
-    options = LoopOptions(steps_per_period=steps_per_period, chunk_periods=chunk_periods)
-    digest = code_hash(system, options)
-    timings = {"symbolic": time.perf_counter() - start}
-
-    if backend == "auto":
-        backend = "compiled" if find_compiler() else "in-process"
-        if backend == "in-process" and "no-cc" not in _WARNED:
-            _WARNED.add("no-cc")
-            print(f"gearsym: warning: {NO_COMPILER_HINT.format(what='$CC, cc, gcc, clang')}", file=sys.stderr)
-    key = (digest, backend)
-    if key in _LOADED:  # same code: reuse the loaded functions, with these parameter values
-        base = _LOADED[key]
-        return CompiledModel(system, options, digest, base.functions, backend, base.library, dict(base.timings), check,
-                             _native_copy(base))
-
-    code_dir = cache_dir() / "code" / f"{system.name}-{digest[:16]}"
-    committed = _generated_dir() / system.name
-    if (read_manifest(committed) or {}).get("hash") == digest:
-        code_dir = committed  # the committed C of this very model: no need to generate it again
-    library = None
-    if backend == "in-process":
-        t = time.perf_counter()
-        functions = build_functions(system, options).functions
-        timings["build"] = time.perf_counter() - t
-    else:
-        manifest = read_manifest(code_dir)
-        source = code_dir / f"{system.name}.c"
-        if not (manifest and manifest.get("hash") == digest and source.is_file()):
-            t = time.perf_counter()
-            mf = build_functions(system, options)
-            timings["build"] = time.perf_counter() - t
-            t = time.perf_counter()
-            write_code(mf, code_dir, digest)
-            timings["generate"] = time.perf_counter() - t
-        if verbose:
-            print(f"gearsym: compiling {system.name} if not cached ({source})", file=sys.stderr)
-        lib = compile_library(source, system.name)
-        if lib.compiled:
-            timings["compile"] = lib.seconds
-        library = lib.path
-        functions = {name: ca.external(name, str(lib.path)) for name in FUNCTION_NAMES}
-    native = load_native(library, functions) if library else None
-    compiled = CompiledModel(system, options, digest, functions, backend, library, timings, check, native)
-    _LOADED[key] = compiled
-    return compiled

@@ -92,8 +92,12 @@ class Library:
     seconds: float
 
 
-def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple[str, ...] | None = None) -> Library:
-    """The shared library of ``source`` for this machine: from the cache, or compiled into it."""
+def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple[str, ...] | None = None,
+                    announce=None) -> Library:
+    """The shared library of ``source`` for this machine: from the cache, or compiled into it.
+
+    ``announce(message)`` is called before an actual compilation (a few seconds), not on a cache hit.
+    """
     cc = cc or find_compiler()
     if cc is None:
         raise CompilerError(NO_COMPILER_HINT.format(what="$CC, cc, gcc, clang"))
@@ -103,6 +107,8 @@ def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple
     if target.is_file():
         return Library(target, False, 0.0)
     target.parent.mkdir(parents=True, exist_ok=True)
+    if announce:
+        announce(f"compiling {name} ({' '.join(flags)}; once: cached in {target.parent})")
     start = time.perf_counter()
     with tempfile.TemporaryDirectory(dir=target.parent) as tmp:
         out = Path(tmp) / target.name

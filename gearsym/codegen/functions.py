@@ -23,7 +23,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import casadi as ca
-import sympy as sp
 
 from ..errors import ModelError
 from ..system import FirstOrderSystem

@@ -1,0 +1,124 @@
+"""Building a :class:`CompiledModel`: from the process, the library cache, or from scratch.
+
+Order of preference, cheapest first: a model already loaded in this process
+(same code hash and backend); a compiled library in the cache; the committed
+C in ``generated/<model>/`` if its manifest carries this model's hash; newly
+generated C in the cache. Parameter values never enter the hash, so they
+never cause any of this.
+"""
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import casadi as ca
+
+from ..errors import GearsymError
+from ..system import FirstOrderSystem
+from .compiled import CompiledModel
+from .compiler import NO_COMPILER_HINT, cache_dir, compile_library, find_compiler
+from .functions import LoopOptions, build_functions
+from .generate import code_hash, read_manifest, write_code
+from .native import load_native
+
+BACKENDS = ("auto", "compiled", "in-process")
+
+#: every function the generated library exports
+FUNCTION_NAMES = ("rhs", "jacobian", "constants", "table", "lyapunov_chunk", "lyapunov_period",
+                  "orbit_chunk", "orbit_period", "trajectory")
+
+_LOADED: dict[tuple, CompiledModel] = {}
+_WARNED = set()
+
+
+def compile_model(
+    model,
+    *,
+    steps_per_period: int = 200,
+    backend: str = "auto",
+    chunk_periods: int = 50,
+    verbose: bool = False,
+    **settings,
+) -> CompiledModel:
+    """Generate, compile (or take from the cache) and load a model's functions.
+
+    ``model`` is a model name, a path, a Drivetrain, a NondimensionalModel or a
+    FirstOrderSystem; ``settings`` give parameter values or replace a mesh
+    stiffness (``k="1 + 0.2*cos(tau)"``). Parameter values never change the
+    code; they become the defaults of the returned object.
+    ``backend``: "compiled" (fail without a C compiler), "in-process" (CasADi's
+    virtual machine) or "auto" (compiled if a compiler exists, else in-process
+    with a warning). ``verbose`` says on stderr when it compiles (seconds, once).
+    """
+    from ..reduce import NondimensionalModel, reduce
+    from ..registry import load_model, system_for
+
+    if backend not in BACKENDS:
+        raise GearsymError(f"unknown backend {backend!r}; choose one of {', '.join(BACKENDS)}")
+    start = time.perf_counter()
+    loaded = model if isinstance(model, (FirstOrderSystem, NondimensionalModel)) else load_model(model)
+    check = None
+    if isinstance(loaded, FirstOrderSystem):
+        system = system_for(loaded, **settings)
+    else:
+        nd = loaded if isinstance(loaded, NondimensionalModel) else reduce(loaded)
+        system = system_for(nd, **settings)
+        check = nd.check_value
+    options = LoopOptions(steps_per_period=steps_per_period, chunk_periods=chunk_periods)
+    digest = code_hash(system, options)
+    timings = {"symbolic": time.perf_counter() - start}
+
+    if backend == "auto":
+        backend = "compiled" if find_compiler() else "in-process"
+        if backend == "in-process" and "no-cc" not in _WARNED:
+            _WARNED.add("no-cc")
+            print(f"gearsym: warning: {NO_COMPILER_HINT.format(what='$CC, cc, gcc, clang')}", file=sys.stderr)
+    key = (digest, backend)
+    if key in _LOADED:  # same code: reuse the loaded functions, with these parameter values
+        base = _LOADED[key]
+        return CompiledModel(system, options, digest, base.functions, backend, base.library, dict(base.timings), check,
+                             _native_copy(base))
+
+    code_dir = cache_dir() / "code" / f"{system.name}-{digest[:16]}"
+    committed = _generated_dir() / system.name
+    if (read_manifest(committed) or {}).get("hash") == digest:
+        code_dir = committed  # the committed C of this very model: no need to generate it again
+    library = None
+    if backend == "in-process":
+        t = time.perf_counter()
+        functions = build_functions(system, options).functions
+        timings["build"] = time.perf_counter() - t
+    else:
+        manifest = read_manifest(code_dir)
+        source = code_dir / f"{system.name}.c"
+        if not (manifest and manifest.get("hash") == digest and source.is_file()):
+            t = time.perf_counter()
+            mf = build_functions(system, options)
+            timings["build"] = time.perf_counter() - t
+            t = time.perf_counter()
+            write_code(mf, code_dir, digest)
+            timings["generate"] = time.perf_counter() - t
+        lib = compile_library(source, system.name, announce=_to_stderr if verbose else None)
+        if lib.compiled:
+            timings["compile"] = lib.seconds
+        library = lib.path
+        functions = {name: ca.external(name, str(lib.path)) for name in FUNCTION_NAMES}
+    native = load_native(library, functions) if library else None
+    compiled = CompiledModel(system, options, digest, functions, backend, library, timings, check, native)
+    _LOADED[key] = compiled
+    return compiled
+
+
+def _to_stderr(message: str) -> None:
+    print(f"gearsym: {message}", file=sys.stderr, flush=True)
+
+
+def _native_copy(base: CompiledModel):
+    """Fresh work arrays for another CompiledModel object (so two objects may run in two threads)."""
+    return load_native(base.library, dict(base.functions)) if base.native else None
+
+
+def _generated_dir() -> Path:
+    from ..registry import REPO_ROOT  # registry imports the model layer; keep codegen importable alone
+    return REPO_ROOT / "generated"
