@@ -40,6 +40,18 @@ class LyapunovSpectrum:
     def sum(self) -> float:
         return float(np.sum(self.exponents))
 
+    @property
+    def kaplan_yorke_dimension(self) -> float:
+        """D_KY = j + (lambda_1 + ... + lambda_j) / |lambda_(j+1)|, j the largest with a non-negative partial sum."""
+        partial = np.cumsum(self.exponents)
+        nonneg = np.nonzero(partial >= 0)[0]
+        if nonneg.size == 0:
+            return 0.0
+        j = int(nonneg[-1]) + 1
+        if j == len(self.exponents):
+            return float(j)
+        return j + float(partial[j - 1]) / abs(float(self.exponents[j]))
+
     def as_dict(self) -> dict:
         """JSON-ready: the keys of ``gearsym lyap --format json``."""
         return {
@@ -48,6 +60,7 @@ class LyapunovSpectrum:
             "exponents": [float(x) for x in self.exponents],
             "stderr": [float(x) for x in self.stderr],
             "sum": self.sum,
+            "kaplan_yorke_dimension": self.kaplan_yorke_dimension,
             "amplitude": self.amplitude,
             "final_state": self.final_state,
             "periods": self.periods,

@@ -5,11 +5,13 @@ Layering (the CasADi pitfall: a loop Function called on SX symbols is inlined,
 and 80 000 inlined RK4 steps crash the C compiler):
 
 * SX, straight-line code with common subexpressions removed: ``rhs``,
-  ``jacobian``, a *block* of a few RK4 steps of the state and its tangent
-  matrix, the Gram-Schmidt re-orthonormalisation;
-* MX, loops that stay loops in C: one forcing period is ``mapaccum`` over the
-  blocks plus Gram-Schmidt, and a *chunk* of periods is ``mapaccum`` over
-  periods. A run is a few chunk calls; nothing per step or period is Python.
+  ``jacobian``, one RK4 step of the state and its tangent matrix (a *block*),
+  the Gram-Schmidt re-orthonormalisation;
+* MX, which calls those functions instead of inlining them: one forcing
+  period calls the block N times and then Gram-Schmidt; a *chunk* calls the
+  period 50 times. Shared inputs (tables, constants) reach every call by
+  pointer (``mapaccum`` would copy them into each iteration: 16 % of the time,
+  measured). A run is a few chunk calls; nothing per step or period is Python.
 
 Tangent vectors follow the exact variational equations Q' = J(t, y) Q,
 integrated by the same RK4 as the state (RK4 of the augmented system), so the
@@ -69,59 +71,119 @@ class ModelFunctions:
 
 
 def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions()) -> ModelFunctions:
+    """Every function the engine generates for ``system`` (see the module docstring)."""
     split = split_rhs(system)
+    sym = _Symbols(system, split)
     n, m, nc = system.dimension, len(split.tables), len(split.constants)
-    params = list(system.parameters)
-    observed = [i for i, s in enumerate(system.states) if s.name in system.observed]
-    N = options.steps_per_period
-    K = options.block(n)
+    N, K = options.steps_per_period, options.block(n)
     where = system.name
-    opts = {"cse": True}
-
-    t = ca.SX.sym("t")
-    y = ca.SX.sym("y", n)
-    p = ca.SX.sym("p", len(params))
-    T = ca.SX.sym("T", m)
-    c = ca.SX.sym("c", nc)
-    symbols = {system.time: t}
-    symbols.update({s: y[i] for i, s in enumerate(system.states)})
-    symbols.update({sym: T[i] for i, (sym, _) in enumerate(split.tables)})
-    symbols.update({sym: c[i] for i, (sym, _) in enumerate(split.constants)})
-    by_name = {name: p[j] for j, name in enumerate(params)}
-    for expr in list(system.rhs) + [system.period]:
-        for s in expr.free_symbols:
-            if s not in symbols and s.name in by_name:
-                symbols[s] = by_name[s.name]
 
     # rhs and Jacobian in the user's terms (time, state, parameters)
-    f_user = ca.vertcat(*to_casadi(system.rhs, symbols, where))
-    rhs = ca.Function("rhs", [t, y, p], [f_user], ["t", "y", "p"], ["dy"], opts)
-    jacobian = ca.Function("jacobian", [t, y, p], [ca.densify(ca.jacobian(f_user, y))], ["t", "y", "p"], ["J"], opts)
+    f_user = ca.vertcat(*to_casadi(system.rhs, sym.outer, where))
+    rhs = ca.Function("rhs", [sym.t, sym.y, sym.p], [f_user], ["t", "y", "p"], ["dy"], _OPTS)
+    jacobian = ca.Function("jacobian", [sym.t, sym.y, sym.p], [ca.densify(ca.jacobian(f_user, sym.y))],
+                           ["t", "y", "p"], ["J"], _OPTS)
 
-    # what the loops need once per run: constants (and the step), tables of time
-    period_expr, h_expr = to_casadi([system.period, system.period / N], symbols, where)
-    if ca.depends_on(period_expr, ca.vertcat(t, y)):
+    # what the loops need once per run: constants (then the step h), tables of time
+    period_expr, h_expr = to_casadi([system.period, system.period / N], sym.outer, where)
+    if ca.depends_on(period_expr, ca.vertcat(sym.t, sym.y)):
         raise ModelError(f"the forcing period {system.period} may depend on parameters only", where)
-    const_values = to_casadi([e for _, e in split.constants], symbols, where)
-    constants = ca.Function("constants", [p], [ca.vertcat(*const_values, h_expr), period_expr], ["p"],
-                            ["c", "period"], opts)
-    table_values = to_casadi([e for _, e in split.tables], symbols, where)
-    table_point = ca.Function("table_point", [t, p], [ca.vertcat(*table_values) if m else ca.SX(0, 1)], opts)
+    const_values = to_casadi([e for _, e in split.constants], sym.outer, where)
+    constants = ca.Function("constants", [sym.p], [ca.vertcat(*const_values, h_expr), period_expr], ["p"],
+                            ["c", "period"], _OPTS)
+    table_values = to_casadi([e for _, e in split.tables], sym.outer, where)
+    table_point = ca.Function("table_point", [sym.t, sym.p], [ca.vertcat(*table_values) if m else ca.SX(0, 1)],
+                              _OPTS)
 
-    # the loop body sees states, table values and constants only
-    ch = ca.SX.sym("c", nc + 1)  # constants, then the step h
+    tangent_block, state_block, state_step = _rk4_functions(sym, split, K, where)
+    gram_schmidt = _gram_schmidt(n)
+
+    # MX loops over the SX functions
+    Ym, Qm, Cm = ca.MX.sym("y", n), ca.MX.sym("Q", n, n), ca.MX.sym("c", nc + 1)
+    Tm = ca.MX.sym("T", 3 * m, N)
+    obs0 = ca.vertcat(*[Ym[j] for j in sym.observed])
+    blocks = [Tm[:, b * K:(b + 1) * K] for b in range(N // K)]
+
+    yk, Qk, lk, hk = Ym, Qm, obs0, obs0
+    for Tb in blocks:
+        yk, Qk, lk, hk = tangent_block(yk, Qk, lk, hk, Tb, Cm)
+    Qn, logr = gram_schmidt(Qk)
+    lyapunov_period = ca.Function("lyapunov_period", [Ym, Qm, Tm, Cm], [yk, Qn, logr, lk, hk],
+                                  ["y0", "Q0", "table", "c"], ["strobe", "Q", "log_stretch", "low", "high"])
+    yk, Qk, rows = Ym, Qm, []
+    for _ in range(options.chunk_periods):
+        yk, Qk, logr, lk, hk = lyapunov_period(yk, Qk, Tm, Cm)
+        rows.append((yk, logr, lk, hk))
+    strobe, logr, low, high = (ca.horzcat(*col) for col in zip(*rows))
+    lyapunov_chunk = ca.Function("lyapunov_chunk", [Ym, Qm, Tm, Cm], [strobe, Qk, logr, low, high],
+                                 ["y0", "Q0", "table", "c"], ["strobe", "Q", "log_stretch", "low", "high"])
+
+    yk, lk, hk = Ym, obs0, obs0
+    for Tb in blocks:
+        yk, lk, hk = state_block(yk, lk, hk, Tb, Cm)
+    orbit_period = ca.Function("orbit_period", [Ym, Tm, Cm], [yk, lk, hk], ["y0", "table", "c"],
+                               ["strobe", "low", "high"])
+    yk, rows = Ym, []
+    for _ in range(options.chunk_periods):
+        yk, lk, hk = orbit_period(yk, Tm, Cm)
+        rows.append((yk, lk, hk))
+    orbit_chunk = ca.Function("orbit_chunk", [Ym, Tm, Cm], [ca.horzcat(*col) for col in zip(*rows)],
+                              ["y0", "table", "c"], ["strobe", "low", "high"])
+
+    # every step of one period, for phase portraits
+    Yt = state_step.mapaccum("steps", N, 1)(Ym, Tm, Cm)
+    trajectory = ca.Function("trajectory", [Ym, Tm, Cm], [Yt], ["y0", "table", "c"], ["states"])
+
+    table = _table_function(constants, table_point, len(sym.params), nc, m, N)
+    functions = {f.name(): f for f in (rhs, jacobian, constants, table, lyapunov_chunk, lyapunov_period,
+                                       orbit_chunk, orbit_period, trajectory)}
+    return ModelFunctions(system, options, split, functions)
+
+
+_OPTS = {"cse": True}
+
+
+class _Symbols:
+    """The SX symbols of one model and the SymPy -> SX maps of the outer functions and the loop body."""
+
+    def __init__(self, system: FirstOrderSystem, split: SplitRHS):
+        n, m, nc = system.dimension, len(split.tables), len(split.constants)
+        self.params = list(system.parameters)
+        self.observed = [i for i, s in enumerate(system.states) if s.name in system.observed]
+        self.t = ca.SX.sym("t")
+        self.y = ca.SX.sym("y", n)
+        self.p = ca.SX.sym("p", len(self.params))
+        self.T = ca.SX.sym("T", m)
+        c = ca.SX.sym("c", nc)
+        outer = {system.time: self.t}
+        outer.update({s: self.y[i] for i, s in enumerate(system.states)})
+        outer.update({s: self.T[i] for i, (s, _) in enumerate(split.tables)})
+        outer.update({s: c[i] for i, (s, _) in enumerate(split.constants)})
+        by_name = {name: self.p[j] for j, name in enumerate(self.params)}
+        for expr in list(system.rhs) + [system.period]:
+            for s in expr.free_symbols:
+                if s not in outer and s.name in by_name:
+                    outer[s] = by_name[s.name]
+        self.outer = outer
+        # the loop body sees states, table values and constants only; ch = (constants, h)
+        self.ch = ca.SX.sym("c", nc + 1)
+        self.inner = {**outer, **{s: self.ch[i] for i, (s, _) in enumerate(split.constants)}}
+
+
+def _rk4_functions(sym: _Symbols, split: SplitRHS, K: int, where: str):
+    """K RK4 steps with tangent (``tangent_block``), without (``state_block``), and one plain step."""
+    n, m, nc = sym.y.numel(), len(split.tables), sym.ch.numel() - 1
+    y, T, ch = sym.y, sym.T, sym.ch
     h = ch[nc]
-    inner = {**symbols, **{sym: ch[i] for i, (sym, _) in enumerate(split.constants)}}
-    f_tab = ca.vertcat(*to_casadi(split.rhs, inner, where))
+    f_tab = ca.vertcat(*to_casadi(split.rhs, sym.inner, where))
     f_of = ca.Function("f_tab", [y, T, ch], [f_tab])
     J_of = ca.Function("J_tab", [y, T, ch], [ca.jacobian(f_tab, y)])
-
     Q = ca.SX.sym("Q", n, n)
-    lo = ca.SX.sym("lo", len(observed))
-    hi = ca.SX.sym("hi", len(observed))
+    lo = ca.SX.sym("lo", len(sym.observed))
+    hi = ca.SX.sym("hi", len(sym.observed))
     Tk = ca.SX.sym("Tk", 3 * m, K)
 
-    def rk4(yk, Qk, Ta, Tb, Tc):
+    def rk4(yk, Qk, Ta, Tb, Tc):  # Ta, Tb, Tc: table values at t, t + h/2, t + h
         k1 = f_of(yk, Ta, ch)
         y2 = yk + h / 2 * k1
         k2 = f_of(y2, Tb, ch)
@@ -143,19 +205,23 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
         for i in range(K):
             col = Tk[:, i]
             yk, Qk = rk4(yk, Qk, col[:m], col[m:2 * m], col[2 * m:])
-            obs = ca.vertcat(*[yk[j] for j in observed])
+            obs = ca.vertcat(*[yk[j] for j in sym.observed])
             lk, hk = select_min(obs, lk), select_max(obs, hk)
         return yk, Qk, lk, hk
 
     yb, Qb, lb, hb = block(True)
-    tangent_block = ca.Function("tangent_block", [y, Q, lo, hi, Tk, ch], [yb, Qb, lb, hb], opts)
+    tangent_block = ca.Function("tangent_block", [y, Q, lo, hi, Tk, ch], [yb, Qb, lb, hb], _OPTS)
     yb, _, lb, hb = block(False)
-    state_block = ca.Function("state_block", [y, lo, hi, Tk, ch], [yb, lb, hb], opts)
+    state_block = ca.Function("state_block", [y, lo, hi, Tk, ch], [yb, lb, hb], _OPTS)
     col = ca.SX.sym("Ti", 3 * m)
     y_next, _ = rk4(y, None, col[:m], col[m:2 * m], col[2 * m:])
-    state_step = ca.Function("state_step", [y, col, ch], [y_next], opts)
+    state_step = ca.Function("state_step", [y, col, ch], [y_next], _OPTS)
+    return tangent_block, state_block, state_step
 
-    # modified Gram-Schmidt: orthonormal columns and the log of each stretch
+
+def _gram_schmidt(n: int) -> ca.Function:
+    """Modified Gram-Schmidt: orthonormal columns and the log of each column's stretch."""
+    Q = ca.SX.sym("Q", n, n)
     cols, logs = [], []
     for j in range(n):
         v = Q[:, j]
@@ -164,57 +230,18 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
         norm = ca.norm_2(v)
         cols.append(v / norm)
         logs.append(ca.log(norm))
-    gram_schmidt = ca.Function("gram_schmidt", [Q], [ca.horzcat(*cols), ca.vertcat(*logs)], opts)
+    return ca.Function("gram_schmidt", [Q], [ca.horzcat(*cols), ca.vertcat(*logs)], _OPTS)
 
-    # --- MX loops: calls, not inlined code, and shared inputs passed by pointer
-    blocks, C = N // K, options.chunk_periods
-    Ym, Qm, Cm = ca.MX.sym("y", n), ca.MX.sym("Q", n, n), ca.MX.sym("c", nc + 1)
-    Tm = ca.MX.sym("T", 3 * m, N)
-    obs0 = ca.vertcat(*[Ym[j] for j in observed])
 
-    yk, Qk, lk, hk = Ym, Qm, obs0, obs0
-    for b in range(blocks):
-        yk, Qk, lk, hk = tangent_block(yk, Qk, lk, hk, Tm[:, b * K:(b + 1) * K], Cm)
-    Qn, logr = gram_schmidt(Qk)
-    period = ca.Function("lyapunov_period", [Ym, Qm, Tm, Cm], [yk, Qn, logr, lk, hk],
-                         ["y0", "Q0", "table", "c"], ["strobe", "Q", "log_stretch", "low", "high"])
-    lyapunov_period = period
-    yk, Qk, outs = Ym, Qm, []
-    for _ in range(C):
-        yk, Qk, logr, lk, hk = period(yk, Qk, Tm, Cm)
-        outs.append((yk, logr, lk, hk))
-    lyapunov_chunk = ca.Function(
-        "lyapunov_chunk", [Ym, Qm, Tm, Cm], [ca.horzcat(*col) for col in zip(*outs)][:1] + [Qk] +
-        [ca.horzcat(*col) for col in zip(*outs)][1:],
-        ["y0", "Q0", "table", "c"], ["strobe", "Q", "log_stretch", "low", "high"])
-
-    yk, lk, hk = Ym, obs0, obs0
-    for b in range(blocks):
-        yk, lk, hk = state_block(yk, lk, hk, Tm[:, b * K:(b + 1) * K], Cm)
-    period = ca.Function("orbit_period", [Ym, Tm, Cm], [yk, lk, hk], ["y0", "table", "c"], ["strobe", "low", "high"])
-    orbit_period = period
-    yk, outs = Ym, []
-    for _ in range(C):
-        yk, lk, hk = period(yk, Tm, Cm)
-        outs.append((yk, lk, hk))
-    orbit_chunk = ca.Function("orbit_chunk", [Ym, Tm, Cm], [ca.horzcat(*col) for col in zip(*outs)],
-                              ["y0", "table", "c"], ["strobe", "low", "high"])
-
-    # every step of one period, for phase portraits
-    Yt = state_step.mapaccum("steps", N, 1)(Ym, Tm, Cm)
-    trajectory = ca.Function("trajectory", [Ym, Tm, Cm], [Yt], ["y0", "table", "c"], ["states"])
-
-    # the tables at the 2N+1 half-step times of the period starting at t0
-    t0, Pm = ca.MX.sym("t0"), ca.MX.sym("p", len(params))
+def _table_function(constants: ca.Function, table_point: ca.Function, n_params: int, nc: int, m: int,
+                    N: int) -> ca.Function:
+    """The tables at the 2N+1 half-step times of the period starting at t0, one column per step."""
+    t0, p = ca.MX.sym("t0"), ca.MX.sym("p", n_params)
     if m:
-        hm = constants(Pm)[0][nc]
-        times = t0 + ca.DM(list(range(2 * N + 1))).T * (hm / 2)
-        vals = table_point.map(2 * N + 1)(times, Pm)
+        h = constants(p)[0][nc]
+        times = t0 + ca.DM(list(range(2 * N + 1))).T * (h / 2)
+        vals = table_point.map(2 * N + 1)(times, p)
         tab = ca.vertcat(vals[:, 0:2 * N:2], vals[:, 1:2 * N:2], vals[:, 2:2 * N + 1:2])
     else:
         tab = ca.MX(0, N)
-    table = ca.Function("table", [t0, Pm], [tab], ["t0", "p"], ["table"])
-
-    functions = {f.name(): f for f in (rhs, jacobian, constants, table, lyapunov_chunk, lyapunov_period,
-                                       orbit_chunk, orbit_period, trajectory)}
-    return ModelFunctions(system, options, split, functions)
+    return ca.Function("table", [t0, p], [tab], ["t0", "p"], ["table"])
