@@ -12,7 +12,7 @@ import sympy as sp
 
 import gearsym.codegen.build as build_module
 import gearsym.codegen.compiler as compiler
-from gearsym import FirstOrderSystem, ModelError, UnknownParameterError
+from gearsym import FirstOrderSystem, GearsymError, ModelError, UnknownParameterError
 from gearsym.backlash import G, g, g_slope
 from gearsym.codegen import CompilerError, compile_model
 from gearsym.codegen.generated import generate_model
@@ -174,3 +174,123 @@ def test_a_failing_compiler_reports_its_output(monkeypatch, tmp_path):
     src.write_text("this is not C\n")
     with pytest.raises(CompilerError, match="compiling .*broken.c failed"):
         compiler.compile_library(src, "broken")
+
+
+# ------------------------------------------------------------------ what the split must get right, end to end
+def _numpy_orbit(system, p, y0, t0, periods, steps):
+    """Plain NumPy RK4 of the state from the SymPy equations (lambdify): the reference for the split."""
+    import math
+    names = list(system.parameters)
+    args = (system.time, *system.states, *[sp.Symbol(n, real=True) for n in names])
+    f = sp.lambdify(args, [e.subs({s: sp.Symbol(s.name, real=True) for s in e.free_symbols
+                                   if s.name in names}) for e in system.rhs], "math")
+    period = float(system.period.subs({sp.Symbol(n, real=True): v for n, v in zip(names, p)}))
+    h = period / steps
+    y, out = np.array(y0, dtype=float), []
+    for k in range(periods):
+        for i in range(steps):
+            t = t0 + k * period + i * h
+
+            def F(tt, yy):
+                return np.array(f(tt, *yy, *p), dtype=float)
+
+            k1 = F(t, y)
+            k2 = F(t + h / 2, y + h / 2 * k1)
+            k3 = F(t + h / 2, y + h / 2 * k2)
+            k4 = F(t + h, y + h * k3)
+            y = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        out.append(y.copy())
+    assert math.isfinite(period)
+    return np.array(out).T
+
+
+@pytest.mark.parametrize("backend", ["compiled", "in-process"])
+def test_piecewise_min_max_powers_and_time_conditions_survive_the_split(backend):
+    system = FirstOrderSystem.from_equations(
+        "odd", ["x", "v"],
+        ["v", "-d*v - Piecewise((x**3, x > 0), (x, True)) + 0.1*Max(x, -1) + 0.01*Abs(x)**a "
+              "+ F*cos(t) + Piecewise((0.3, sin(t) > 0), (0, True)) + Piecewise((-x, x > 2), (0.1*sin(2*t), True))"],
+        {"d": 0.3, "a": 1.5, "F": 0.4}, time="t", period="2*pi", initial={"x": 0.5})
+    cm = compile_model(system, backend=backend, steps_per_period=100)
+    p = cm.parameter_vector(F=0.5)
+    inputs = cm.prepare(p, t0=0.7)
+    strobe, _, _ = cm.orbit_run([0.5, 0.1], 4, inputs)
+    reference = _numpy_orbit(system, p, [0.5, 0.1], 0.7, 4, 100)
+    assert strobe == pytest.approx(reference, abs=1e-9)
+
+
+def test_time_inside_a_function_of_the_state_is_explained():
+    system = FirstOrderSystem.from_equations("slip", ["x"], ["-x + sin(x - t)"], {}, time="t", period="2*pi")
+    with pytest.raises(ModelError, match="keep time out of functions of the state"):
+        compile_model(system, backend="in-process")
+
+
+def test_periodicity_is_checked_at_the_values_of_each_run():
+    system = FirstOrderSystem.from_equations("forced", ["x"], ["-x + cos(w*t)"], {"w": 1.0}, time="t",
+                                             period="2*pi")
+    cm = compile_model(system)
+    cm.prepare(cm.parameter_vector(w=2.0))  # still 2 pi periodic
+    with pytest.raises(ModelError, match="not periodic .* at w=1.5"):
+        cm.prepare(cm.parameter_vector(w=1.5))
+
+
+def test_generated_names_never_clash_with_user_names():
+    system = FirstOrderSystem.from_equations("clash", ["x"], ["-const_0*x + table_0*cos(t)"],
+                                             {"const_0": 0.5, "table_0": 1.0}, time="t", period="2*pi")
+    cm = compile_model(system, steps_per_period=50)
+    r = cm.tangent_run([1.0], 3, cm.prepare())
+    assert r.log_stretch.sum() / (3 * 2 * np.pi) == pytest.approx(-0.5, abs=1e-6)
+
+
+# ------------------------------------------------------------------ the native calls and their inputs
+def test_initial_state_may_be_any_array_view_and_Q0_is_not_changed():
+    cm = compile_model("flexible_shaft")
+    inputs = cm.prepare(cm.parameter_vector(omega=0.8))
+    y = np.array([-2.0, -0.5, 0.0, 0.0])
+    base = cm.tangent_run(y, 7, inputs)
+    strided = np.zeros((4, 3), order="C")
+    strided[:, 1] = y
+    assert np.array_equal(cm.tangent_run(strided[:, 1], 7, inputs).strobe, base.strobe)
+    assert np.array_equal(cm.tangent_run(y[::-1][::-1], 7, inputs).strobe, base.strobe)
+    Q0 = np.asfortranarray(base.Q)
+    kept = Q0.copy()
+    again = cm.tangent_run(base.strobe[:, -1], 3, inputs, Q0=Q0)
+    assert np.array_equal(Q0, kept) and again.Q is not Q0
+
+
+def test_inputs_prepared_for_another_model_are_refused():
+    one, two = compile_model("one_stage"), compile_model("flexible_shaft")
+    with pytest.raises(GearsymError, match="prepared by another model"):
+        two.tangent_run(None, 2, one.prepare())
+
+
+def test_non_finite_values_and_formulas_on_a_built_model_are_refused():
+    cm = compile_model("one_stage")
+    with pytest.raises(GearsymError, match="finite"):
+        cm.parameter_vector(B0=float("inf"))
+    with pytest.raises(GearsymError, match="finite"):
+        cm.initial_state([np.nan, 0.0])
+    with pytest.raises(GearsymError, match="compile_model"):
+        cm.parameter_vector(k="1 + 0.3*cos(tau)")
+    with pytest.raises(GearsymError, match="whole number"):
+        cm.tangent_run(None, 2.5, cm.prepare())
+
+
+def test_a_diverging_orbit_names_the_period_and_the_values():
+    from gearsym.analysis import lyapunov_spectrum
+    with pytest.raises(GearsymError, match=r"non-finite in period 1 \(sigma=1000"):
+        lyapunov_spectrum("lorenz", sigma=1000, periods=10, discard=2)
+
+
+def test_a_stiffness_formula_may_not_use_the_state():
+    with pytest.raises(ModelError, match="uses the state"):
+        system_for("one_stage", k="1 + 0.1*x")
+
+
+def test_editing_the_code_generator_changes_the_hash(monkeypatch):
+    import gearsym.codegen.generate as generate
+    from gearsym.codegen import LoopOptions, code_hash
+    system = system_for("one_stage")
+    before = code_hash(system, LoopOptions())
+    monkeypatch.setattr(generate, "_generator_digest", lambda: "edited")
+    assert code_hash(system, LoopOptions()) != before

@@ -49,6 +49,8 @@ def test_lyap_text_output_and_initial_state(capsys):
     (["lyap", "one_stage", "--periods", "10", "--discard", "10"], "discard < periods"),
     (["lyap", "one_stage", "--y0", "x:1"], "NAME=NUMBER"),
     (["lyap", "one_stage", "--y0", "q=1"], "unknown states"),
+    (["lyap", "one_stage", "--y0", "x=1,x=2"], "gives x twice"),
+    (["lyap", "one_stage", "--set", "omega=1e400"], "finite"),
     (["lyap", "lorenz", "--set", "rho=1+x"], "only drivetrain models accept a formula"),
     (["lyap", "nosuchmodel"], "unknown model"),
 ])

@@ -144,8 +144,22 @@ def test_strobe_samples_agree_between_tangent_orbit_and_trajectory_runs():
     assert (x.max() - x.min()) / 2 == pytest.approx(orbit.amplitude["x"], abs=1e-12)
 
 
-def test_history_converges_to_the_exponents():
-    r = lyapunov_spectrum("flexible_shaft", periods=200, discard=50, omega=1.5)
-    assert r.history.shape == (150, 4)
+def test_history_and_initial_state():
+    cm = compile_model("flexible_shaft")
+    y0 = np.array([-1.0, 0.2, 0.5, 0.0])
+    r = lyapunov_spectrum(cm, periods=200, discard=50, omega=1.5, y0=y0)
+    assert r.history.shape == (150, 4) and r.strobe.shape == (4, 150)
     assert r.history[-1] == pytest.approx(r.exponents, abs=1e-12)
-    assert r.strobe.shape == (4, 150)
+    # the first running estimate is the first measured period's stretch, from the run's own data
+    run = cm.tangent_run(y0, 200, cm.prepare(cm.parameter_vector(omega=1.5)))
+    first = np.sort(run.log_stretch[:, 50] / (2 * np.pi))[::-1]
+    assert np.sort(r.history[0])[::-1] == pytest.approx(first, abs=1e-12)
+    assert r.strobe[:, -1] == pytest.approx(run.strobe[:, -1], abs=0)
+    other = lyapunov_spectrum(cm, periods=200, discard=50, omega=1.5)  # the model's own start
+    assert not np.allclose(other.strobe[:, :5], r.strobe[:, :5])
+
+
+def test_too_few_periods_for_an_error_give_null_in_json():
+    r = lyapunov_spectrum("lorenz", periods=101, discard=100)
+    assert np.all(np.isnan(r.stderr))
+    assert r.as_dict()["stderr"] == [None, None, None]

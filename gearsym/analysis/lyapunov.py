@@ -8,6 +8,7 @@ models). The paper's criterion for chaos is lambda_1 > 0 (it prints "> 1").
 """
 from __future__ import annotations
 
+import operator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -57,10 +58,10 @@ class LyapunovSpectrum:
         return {
             "model": self.model,
             "parameters": self.parameters,
-            "exponents": [float(x) for x in self.exponents],
-            "stderr": [float(x) for x in self.stderr],
+            "exponents": [_json_number(x) for x in self.exponents],
+            "stderr": [_json_number(x) for x in self.stderr],  # null with too few periods to estimate it
             "sum": self.sum,
-            "kaplan_yorke_dimension": self.kaplan_yorke_dimension,
+            "kaplan_yorke_dimension": _json_number(self.kaplan_yorke_dimension),
             "amplitude": self.amplitude,
             "final_state": self.final_state,
             "periods": self.periods,
@@ -69,6 +70,23 @@ class LyapunovSpectrum:
             "period": self.period,
             "backend": self.backend,
         }
+
+
+def _json_number(x) -> float | None:
+    """JSON has no NaN or infinity: those become null."""
+    x = float(x)
+    return x if np.isfinite(x) else None
+
+
+def whole_number(value, what: str) -> int:
+    """``value`` as a non-negative int (any integer type), or a clear error."""
+    try:
+        count = operator.index(value)
+    except TypeError:
+        raise GearsymError(f"{what} must be a whole number, got {value!r}") from None
+    if count < 0:
+        raise GearsymError(f"{what} must not be negative, got {count}")
+    return count
 
 
 def lyapunov_spectrum(
@@ -89,8 +107,9 @@ def lyapunov_spectrum(
     rebuilt (the low-level call for sweeps). ``y0`` is the initial state
     (sequence or mapping; default: the model's declared initial state).
     """
-    if not isinstance(periods, int) or not isinstance(discard, int) or discard < 0 or periods <= discard:
-        raise GearsymError(f"need 0 <= discard < periods (integers), got periods={periods}, discard={discard}")
+    periods, discard = whole_number(periods, "periods"), whole_number(discard, "discard")
+    if periods <= discard:
+        raise GearsymError(f"need 0 <= discard < periods, got periods={periods}, discard={discard}")
     if isinstance(model, CompiledModel):
         compiled, values = model, settings
     else:

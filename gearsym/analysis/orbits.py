@@ -7,6 +7,7 @@ import numpy as np
 
 from ..codegen import CompiledModel, compile_model
 from ..errors import GearsymError
+from .lyapunov import whole_number
 
 
 @dataclass(frozen=True)
@@ -44,8 +45,9 @@ def _compiled(model, settings, steps_per_period, backend) -> tuple[CompiledModel
 def poincare_samples(model, *, periods: int = 200, discard: int = 100, y0=None, t0: float = 0.0,
                      steps_per_period: int = 200, backend: str = "auto", **settings) -> Orbit:
     """Stroboscopic samples after ``discard`` transient periods (no tangent vectors: cheaper)."""
-    if discard < 0 or periods < 1:
-        raise GearsymError(f"need periods >= 1 and discard >= 0, got periods={periods}, discard={discard}")
+    periods, discard = whole_number(periods, "periods"), whole_number(discard, "discard")
+    if periods < 1:
+        raise GearsymError(f"need at least one period of samples, got periods={periods}")
     compiled, values = _compiled(model, settings, steps_per_period, backend)
     inputs = compiled.prepare(compiled.parameter_vector(values), t0=t0)
     strobe, low, high = compiled.orbit_run(y0, discard + periods, inputs)
@@ -58,6 +60,7 @@ def poincare_samples(model, *, periods: int = 200, discard: int = 100, y0=None, 
 def phase_trajectory(model, *, periods: int = 20, discard: int = 100, y0=None, steps_per_period: int = 200,
                      backend: str = "auto", **settings) -> Trajectory:
     """The trajectory over ``periods`` periods after ``discard`` transient ones, at every step."""
+    periods, discard = whole_number(periods, "periods"), whole_number(discard, "discard")
     compiled, values = _compiled(model, settings, steps_per_period, backend)
     inputs = compiled.prepare(compiled.parameter_vector(values))
     start = compiled.initial_state(y0)

@@ -9,14 +9,13 @@ def batch_means_stderr(samples: np.ndarray, batches: int = 10) -> np.ndarray:
 
     Consecutive per-period stretches are correlated, so the naive sigma/sqrt(M)
     is too small; the means of ``batches`` contiguous batches are nearly
-    independent, and their spread gives an honest error. NaN with fewer than
-    two batches' worth of samples.
+    independent, and their spread gives an honest error (batches differ in size
+    by at most one sample, so every sample counts). NaN with fewer than two samples.
     """
     samples = np.atleast_2d(samples)
     m = samples.shape[1]
     b = min(batches, m)
     if b < 2:
         return np.full(samples.shape[0], np.nan)
-    size = m // b
-    means = samples[:, : b * size].reshape(samples.shape[0], b, size).mean(axis=2)
+    means = np.stack([part.mean(axis=1) for part in np.array_split(samples, b, axis=1)], axis=1)
     return means.std(axis=1, ddof=1) / np.sqrt(b)

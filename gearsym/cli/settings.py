@@ -32,12 +32,15 @@ def parse_state(text: str | None) -> dict[str, float] | None:
     if not text:
         return None
     state = {}
+    usage = f"--y0 {text!r}: expected NAME=NUMBER pairs separated by commas, e.g. x=-2,v=-0.5"
     for item in text.split(","):
-        name, sep, value = item.partition("=")
+        name, sep, value = (part.strip() for part in item.partition("="))
+        if not sep or not name:
+            raise GearsymError(usage)
+        if name in state:
+            raise GearsymError(f"--y0 gives {name} twice")
         try:
-            state[name.strip()] = float(value)
+            state[name] = float(value)
         except ValueError:
-            raise GearsymError(f"--y0 {text!r}: expected NAME=NUMBER pairs separated by commas, e.g. x=-2,v=-0.5") from None
-        if not sep:
-            raise GearsymError(f"--y0 {text!r}: expected NAME=NUMBER pairs separated by commas, e.g. x=-2,v=-0.5")
+            raise GearsymError(usage) from None
     return state

@@ -17,7 +17,7 @@ import casadi as ca
 from ..errors import GearsymError
 from ..system import FirstOrderSystem
 from .compiled import CompiledModel
-from .compiler import NO_COMPILER_HINT, cache_dir, compile_library, find_compiler
+from .compiler import FALLBACK_NOTE, cache_dir, compile_library, compilers_looked_for, find_compiler
 from .functions import LoopOptions, build_functions
 from .generate import code_hash, read_manifest, write_code
 from .native import load_native
@@ -25,7 +25,7 @@ from .native import load_native
 BACKENDS = ("auto", "compiled", "in-process")
 
 #: every function the generated library exports
-FUNCTION_NAMES = ("rhs", "jacobian", "constants", "table", "lyapunov_chunk", "lyapunov_period",
+FUNCTION_NAMES = ("rhs", "jacobian", "constants", "table", "table_point", "lyapunov_chunk", "lyapunov_period",
                   "orbit_chunk", "orbit_period", "trajectory")
 
 _LOADED: dict[tuple, CompiledModel] = {}
@@ -73,7 +73,7 @@ def compile_model(
         backend = "compiled" if find_compiler() else "in-process"
         if backend == "in-process" and "no-cc" not in _WARNED:
             _WARNED.add("no-cc")
-            print(f"gearsym: warning: {NO_COMPILER_HINT.format(what='$CC, cc, gcc, clang')}", file=sys.stderr)
+            print(f"gearsym: warning: {FALLBACK_NOTE.format(what=compilers_looked_for())}", file=sys.stderr)
     key = (digest, backend)
     if key in _LOADED:  # same code: reuse the loaded functions, with these parameter values
         base = _LOADED[key]

@@ -7,6 +7,7 @@ from a model name themselves (the high-level call).
 """
 from __future__ import annotations
 
+import operator
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -30,6 +31,7 @@ class RunInputs:
     constants: np.ndarray
     period: float
     t0: float
+    model_hash: str  # the code these inputs were prepared for (the loops read them by raw pointer)
 
     @cached_property
     def table_dm(self) -> ca.DM:  # for the in-process backend
@@ -96,8 +98,21 @@ class CompiledModel:
         merged = dict(self.system.parameters)
         for name, value in {**(values or {}), **more}.items():
             if name not in merged:
+                if isinstance(value, str):
+                    raise GearsymError(
+                        f"{self.name}: {name}={value!r} would change the model's equations; a compiled model "
+                        f"only takes parameter values. Build a new one: compile_model(model, {name}=...)")
                 raise UnknownParameterError(name, merged, self.name)
-            merged[name] = self.check(name, value) if self.check else float(value)
+            try:
+                merged[name] = self.check(name, value) if self.check else float(value)
+            except (TypeError, ValueError) as exc:
+                if isinstance(exc, GearsymError):
+                    raise
+                raise GearsymError(f"{self.name}: {name} must be a number, got {value!r}") from None
+        bad = [n for n, v in merged.items() if not np.isfinite(v)]
+        if bad:
+            raise GearsymError(f"{self.name}: parameter values must be finite numbers: "
+                               + ", ".join(f"{n}={merged[n]}" for n in bad))
         return np.array([merged[n] for n in self.parameter_names], dtype=float)
 
     def prepare(self, p: np.ndarray | Mapping[str, float] | None = None, t0: float = 0.0) -> RunInputs:
@@ -115,7 +130,31 @@ class CompiledModel:
         if not (np.isfinite(period) and period > 0):
             raise ModelError(f"the forcing period is {period} at these parameter values; it must be positive",
                              self.name)
-        return RunInputs(p, table, c.reshape(-1), period, float(t0))
+        self._check_periodic(p, float(t0), period)
+        return RunInputs(p, np.asfortranarray(table, dtype=np.float64), np.ascontiguousarray(c.reshape(-1)),
+                         period, float(t0), self.hash)
+
+    def _check_periodic(self, p: np.ndarray, t0: float, period: float) -> None:
+        """The loops repeat one sampled period; at other parameter values than the defaults
+        (checked when the code was generated) the time dependence must still repeat."""
+        points = (t0 + 0.37 * period, t0 + 1.37 * period)
+        if self.native:
+            a, b = (self.native["table_point"](np.array([t]), p)[0].reshape(-1) for t in points)
+        else:
+            a, b = (np.array(self.functions["table_point"](t, p)).reshape(-1) for t in points)
+        off = np.nonzero(~(np.abs(a - b) <= 1e-9 * (1 + np.abs(a))))[0]
+        if off.size:
+            from .time_tables import NotPeriodicError, split_rhs
+
+            i = int(off[0])
+            expr = split_rhs(self.system).tables[i][1]
+            values = ", ".join(f"{n}={v:g}" for n, v in zip(self.parameter_names, p))
+            raise NotPeriodicError(self.system, expr, points[0], float(a[i]), float(b[i]), f"at {values}")
+
+    def _check_inputs(self, inputs: RunInputs) -> None:
+        if inputs.model_hash != self.hash:
+            raise GearsymError(f"{self.name}: these run inputs were prepared by another model "
+                               "(a different code hash); call prepare() on this one")
 
     def initial_state(self, y0=None) -> np.ndarray:
         if y0 is None:
@@ -126,18 +165,21 @@ class CompiledModel:
                 raise GearsymError(f"{self.name}: unknown states {sorted(unknown)} in the initial state; "
                                    f"states are {', '.join(self.state_names)}")
             return np.array([float(y0.get(s, 0.0)) for s in self.state_names])
-        y = np.asarray(y0, dtype=float).reshape(-1)
+        y = np.array(y0, dtype=np.float64).reshape(-1)  # a contiguous copy: the C loop reads it by address
         if y.shape != (self.dimension,):
             raise GearsymError(f"{self.name}: the initial state needs {self.dimension} values "
                                f"({', '.join(self.state_names)}), got {y.size}")
+        if not np.all(np.isfinite(y)):
+            raise GearsymError(f"{self.name}: the initial state must be finite, got {y}")
         return y
 
     # ---------------------------------------------------------------- runs
     def tangent_run(self, y0, periods: int, inputs: RunInputs, Q0=None) -> TangentRun:
         """``periods`` forcing periods of the state and n tangent vectors, re-orthonormalised every period."""
+        self._check_inputs(inputs)
         n, m = self.dimension, len(self.observed)
         y = self.initial_state(y0)
-        Q = np.asfortranarray(np.eye(n) if Q0 is None else np.asarray(Q0, dtype=float))
+        Q = np.array(np.eye(n) if Q0 is None else Q0, dtype=np.float64, order="F")  # a copy: written in place
         if Q.shape != (n, n):
             raise GearsymError(f"{self.name}: tangent vectors must be a {n}x{n} matrix, got {Q.shape}")
         schedule = self._schedule(periods, "lyapunov")
@@ -183,6 +225,7 @@ class CompiledModel:
 
     def orbit_run(self, y0, periods: int, inputs: RunInputs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The state after each of ``periods`` periods (stroboscopic samples), with each period's min and max."""
+        self._check_inputs(inputs)
         y, n, m = self.initial_state(y0), self.dimension, len(self.observed)
         schedule = self._schedule(periods, "orbit")
         if self.native:
@@ -203,6 +246,8 @@ class CompiledModel:
 
     def trajectory(self, y0, periods: int, inputs: RunInputs) -> tuple[np.ndarray, np.ndarray]:
         """Every RK4 step of ``periods`` periods: times (steps,) and states (n, steps), the start included."""
+        self._check_inputs(inputs)
+        _count(periods, "periods")
         y = ca.DM(self.initial_state(y0))
         cols = [np.array(y)]
         for _ in range(periods):
@@ -231,10 +276,19 @@ class CompiledModel:
             )
 
     def _schedule(self, periods: int, kind: str) -> list[tuple[str, int]]:
-        if periods < 0:
-            raise GearsymError(f"the number of periods must not be negative, got {periods}")
-        chunks, rest = divmod(int(periods), self.options.chunk_periods)
+        chunks, rest = divmod(_count(periods, "periods"), self.options.chunk_periods)
         return [(f"{kind}_chunk", chunks), (f"{kind}_period", rest)]
+
+
+def _count(value, what: str, minimum: int = 0) -> int:
+    """A whole number of periods (any integer type), at least ``minimum``."""
+    try:
+        count = operator.index(value)
+    except TypeError:
+        raise GearsymError(f"{what} must be a whole number, got {value!r}") from None
+    if count < minimum:
+        raise GearsymError(f"{what} must be at least {minimum}, got {count}")
+    return count
 
 
 def _hcat(blocks, rows: int) -> np.ndarray:

@@ -61,11 +61,18 @@ def find_compiler() -> str | None:
     return None
 
 
-NO_COMPILER_HINT = (
-    "no C compiler found (looked for {what}). gearsym falls back to CasADi's in-process evaluation, "
-    "which gives the same results about 10x slower. To compile: install one (Debian/Ubuntu: "
-    "`apt install gcc`; macOS: `xcode-select --install`) or point $CC at it."
-)
+def compilers_looked_for() -> str:
+    env = os.environ.get("CC")
+    return f"$CC={env!r}" if env else "cc, gcc, clang on PATH"
+
+
+#: what to do without a compiler; the first sentence depends on the backend asked for
+INSTALL_HINT = ("To compile: install one (Debian/Ubuntu: `apt install gcc`; macOS: `xcode-select --install`) "
+                "or point $CC at it.")
+FALLBACK_NOTE = ("no C compiler found (looked for {what}). gearsym falls back to CasADi's in-process "
+                 "evaluation, which gives the same results about 10x slower. " + INSTALL_HINT)
+REQUIRED_NOTE = ("no C compiler found (looked for {what}), and the compiled backend was asked for. "
+                 + INSTALL_HINT + " Or choose the in-process backend (same results, about 10x slower).")
 
 
 @lru_cache(maxsize=None)
@@ -100,7 +107,7 @@ def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple
     """
     cc = cc or find_compiler()
     if cc is None:
-        raise CompilerError(NO_COMPILER_HINT.format(what="$CC, cc, gcc, clang"))
+        raise CompilerError(REQUIRED_NOTE.format(what=compilers_looked_for()))
     flags = compile_flags() if flags is None else tuple(flags)
     digest = hashlib.sha256(Path(source).read_bytes()).hexdigest()[:16]
     target = cache_dir() / "lib" / f"{name}-{digest}-{_machine_key(cc, flags)}.so"

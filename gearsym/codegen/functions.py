@@ -93,7 +93,7 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
                             ["c", "period"], _OPTS)
     table_values = to_casadi([e for _, e in split.tables], sym.outer, where)
     table_point = ca.Function("table_point", [sym.t, sym.p], [ca.vertcat(*table_values) if m else ca.SX(0, 1)],
-                              _OPTS)
+                              ["t", "p"], ["values"], _OPTS)
 
     tangent_block, state_block, state_step = _rk4_functions(sym, split, K, where)
     gram_schmidt = _gram_schmidt(n)
@@ -135,8 +135,8 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
     trajectory = ca.Function("trajectory", [Ym, Tm, Cm], [Yt], ["y0", "table", "c"], ["states"])
 
     table = _table_function(constants, table_point, len(sym.params), nc, m, N)
-    functions = {f.name(): f for f in (rhs, jacobian, constants, table, lyapunov_chunk, lyapunov_period,
-                                       orbit_chunk, orbit_period, trajectory)}
+    functions = {f.name(): f for f in (rhs, jacobian, constants, table, table_point, lyapunov_chunk,
+                                       lyapunov_period, orbit_chunk, orbit_period, trajectory)}
     return ModelFunctions(system, options, split, functions)
 
 

@@ -22,11 +22,25 @@ from .functions import LoopOptions, ModelFunctions
 #: bump when the generated code changes for the same model and options
 CODEGEN_VERSION = 1
 
+#: the modules whose text determines the generated C; their bytes are part of the hash, so an edit
+#: can never leave a stale library or committed C in use (the tests then ask to regenerate)
+_GENERATOR_SOURCES = ("translate.py", "time_tables.py", "functions.py", "generate.py")
+
+
+def _generator_digest() -> str:
+    here = Path(__file__).resolve().parent
+    digest = hashlib.sha256()
+    for name in _GENERATOR_SOURCES:
+        digest.update((here / name).read_bytes())
+    digest.update((here.parent / "backlash.py").read_bytes())
+    return digest.hexdigest()
+
 
 def code_hash(system: FirstOrderSystem, options: LoopOptions) -> str:
     """SHA-256 of everything that determines the C: model equations, names, loop options, versions."""
     description = {
         "codegen": CODEGEN_VERSION,
+        "generator": _generator_digest(),
         "casadi": ca.__version__,
         "name": system.name,
         "time": system.time.name,
@@ -98,6 +112,7 @@ def read_manifest(directory: Path) -> dict | None:
 
 
 def _write_atomic(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name + ".", suffix=".tmp")
+    with os.fdopen(fd, "w") as f:
+        f.write(text)
     os.replace(tmp, path)

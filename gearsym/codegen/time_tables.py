@@ -42,18 +42,30 @@ def split_rhs(system: FirstOrderSystem) -> SplitRHS:
         if e.is_Number:
             return e
         book, prefix = (tables, "table") if time in e.free_symbols else (constants, "const")
-        if e not in book:
-            book[e] = sp.Symbol(f"{prefix}_{len(book)}", real=True)
+        if e not in book:  # a Dummy: never equal to a user's symbol of the same name
+            book[e] = sp.Dummy(f"{prefix}_{len(book)}", real=True)
         return book[e]
 
     def state_free(e: sp.Expr) -> bool:
         return not (e.free_symbols & states)
+
+    def condition(c):
+        """A Piecewise condition: state-free ones become a 0/1 table entry or constant compared with 1/2."""
+        if c in (sp.true, sp.false):
+            return c
+        if state_free(c):
+            return sp.StrictGreaterThan(entry(sp.Piecewise((1, c), (0, True))), sp.S.Half)
+        if isinstance(c, sp.core.relational.Relational):
+            return c.func(visit(c.lhs), visit(c.rhs))
+        return c.func(*(condition(a) for a in c.args))  # And, Or, Not
 
     def visit(e: sp.Expr) -> sp.Expr:
         if e in states:
             return e
         if state_free(e):
             return entry(e)
+        if isinstance(e, sp.Piecewise):
+            return sp.Piecewise(*((visit(value), condition(cond)) for value, cond in e.args))
         if e.is_Add or e.is_Mul:
             fixed = [a for a in e.args if state_free(a)]
             rest = [visit(a) for a in e.args if not state_free(a)]
@@ -68,6 +80,17 @@ def split_rhs(system: FirstOrderSystem) -> SplitRHS:
     split = SplitRHS(rhs, tuple((s, e) for e, s in tables.items()), tuple((s, e) for e, s in constants.items()))
     _check_periodic(system, split)
     return split
+
+
+class NotPeriodicError(ModelError):
+    def __init__(self, system: FirstOrderSystem, expr, t0: float, a: float, b: float, where: str = "at the defaults"):
+        super().__init__(
+            f"time enters the right-hand side through {expr}, which is not periodic with the declared period "
+            f"{system.period} {where} ({a:.6g} at {system.time}={t0:.4g}, {b:.6g} one period later). The engine "
+            "samples one period and repeats it: declare the true forcing period, and keep time out of functions "
+            "of the state (write sin(x - t) as sin(x)cos(t) - cos(x)sin(t)).",
+            system.name,
+        )
 
 
 def _check_periodic(system: FirstOrderSystem, split: SplitRHS) -> None:
@@ -89,9 +112,4 @@ def _check_periodic(system: FirstOrderSystem, split: SplitRHS) -> None:
             t0 = rng.uniform(0, period)
             a, b = f(t0), f(t0 + period)
             if not abs(a - b) <= 1e-9 * (1 + abs(a)):
-                raise ModelError(
-                    f"time enters the right-hand side through {expr}, which is not periodic with the "
-                    f"declared period {system.period} ({a:.6g} at {system.time}={t0:.4g}, {b:.6g} one period "
-                    "later). The engine repeats one sampled period: declare the true forcing period.",
-                    system.name,
-                )
+                raise NotPeriodicError(system, expr, t0, a, b)

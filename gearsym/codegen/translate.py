@@ -103,8 +103,9 @@ class _Translator:
                 out = v if out is None else ca.if_else(self(cond), v, out)
             return out
         if isinstance(e, sp.Heaviside):
-            return e.args[0] >= 0 if len(e.args) == 1 else ca.if_else(self(e.args[0]) == 0, self(e.args[1]),
-                                                                      self(e.args[0]) > 0)
+            x = self(e.args[0])
+            at_zero = self(e.args[1]) if len(e.args) > 1 else ca.SX(0.5)
+            return ca.if_else(x == 0, at_zero, ca.if_else(x > 0, 1, 0))
         if isinstance(e, (sp.Min, sp.Max)):
             op = ca.fmin if isinstance(e, sp.Min) else ca.fmax
             out = self(e.args[0])

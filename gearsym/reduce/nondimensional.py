@@ -249,6 +249,10 @@ class NondimensionalModel:
     def _function_expr(self, f: StiffnessFunction, value: ExprLike) -> sp.Expr:
         where = f"stiffness function {f.name} (mesh {f.mesh!r})"
         expr = to_expr(value, where)
+        used_states = sorted({st.name for st in self.states} & {sym.name for sym in expr.free_symbols})
+        if used_states:
+            raise ModelError(f"a mesh stiffness is a function of tau and parameters, but {value!r} uses the "
+                             f"state(s) {', '.join(used_states)}; rename the parameter", where)
         check_periodic(expr, tau, where, period=f.period)
         return expr
 

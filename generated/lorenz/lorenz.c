@@ -38,6 +38,7 @@ extern "C" {
 #define casadi_f13 CASADI_PREFIX(f13)
 #define casadi_f14 CASADI_PREFIX(f14)
 #define casadi_f15 CASADI_PREFIX(f15)
+#define casadi_f16 CASADI_PREFIX(f16)
 #define casadi_f2 CASADI_PREFIX(f2)
 #define casadi_f3 CASADI_PREFIX(f3)
 #define casadi_f4 CASADI_PREFIX(f4)
@@ -53,6 +54,7 @@ extern "C" {
 #define casadi_s4 CASADI_PREFIX(s4)
 #define casadi_s5 CASADI_PREFIX(s5)
 #define casadi_s6 CASADI_PREFIX(s6)
+#define casadi_s7 CASADI_PREFIX(s7)
 #define casadi_sq CASADI_PREFIX(sq)
 #define casadi_zeros CASADI_PREFIX(zeros)
 
@@ -98,8 +100,9 @@ static const casadi_int casadi_s1[3] = {3, 1, 1};
 static const casadi_int casadi_s2[3] = {3, 3, 1};
 static const casadi_int casadi_s3[3] = {4, 1, 1};
 static const casadi_int casadi_s4[3] = {0, 200, 1};
-static const casadi_int casadi_s5[3] = {3, 50, 1};
-static const casadi_int casadi_s6[3] = {3, 200, 1};
+static const casadi_int casadi_s5[3] = {0, 1, 1};
+static const casadi_int casadi_s6[3] = {3, 50, 1};
+static const casadi_int casadi_s7[3] = {3, 200, 1};
 
 static const casadi_real casadi_zeros[400] = 
   {0.};
@@ -472,8 +475,86 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
   return 0;
 }
 
+/* table_point:(t,p[3])->(values[0]) */
+static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table_point(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f4(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int table_point_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void table_point_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void table_point_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void table_point_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int table_point_n_in(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_int table_point_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real table_point_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_point_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_point_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "values";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_point_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s1;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_point_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s5;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int table_point_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 2;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table_point_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 2*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
 /* tangent_block:(i0[3],i1[3x3],i2[3],i3[3],i4[0],i5[4])->(o0[3],o1[3x3],o2[3],o3[3]) */
-static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
@@ -481,112 +562,112 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a01=arg[5]? arg[5][3] : 0;
   a02=6.;
   a02=(a01/a02);
-  a03=arg[5]? arg[5][0] : 0;
-  a04=arg[0]? arg[0][1] : 0;
-  a05=(a04-a00);
-  a05=(a03*a05);
+  a03=arg[0]? arg[0][1] : 0;
+  a04=(a03-a00);
+  a05=arg[5]? arg[5][0] : 0;
+  a04=(a04*a05);
   a06=2.;
   a06=(a01/a06);
   a07=arg[5]? arg[5][1] : 0;
   a08=arg[0]? arg[0][2] : 0;
   a09=(a07-a08);
   a10=(a00*a09);
-  a10=(a10-a04);
+  a10=(a10-a03);
   a11=(a06*a10);
-  a11=(a04+a11);
-  a12=(a06*a05);
+  a11=(a03+a11);
+  a12=(a06*a04);
   a12=(a00+a12);
   a13=(a11-a12);
-  a13=(a03*a13);
+  a13=(a13*a05);
   a14=(2.*a13);
-  a05=(a05+a14);
-  a14=arg[5]? arg[5][2] : 0;
-  a15=(a14*a08);
-  a16=(a00*a04);
-  a15=(a15+a16);
-  a16=(a06*a15);
+  a04=(a04+a14);
+  a14=(a00*a03);
+  a15=arg[5]? arg[5][2] : 0;
+  a16=(a08*a15);
+  a14=(a14+a16);
+  a16=(a06*a14);
   a16=(a08+a16);
   a17=(a07-a16);
   a18=(a12*a17);
   a18=(a18-a11);
   a19=(a06*a18);
-  a19=(a04+a19);
+  a19=(a03+a19);
   a13=(a06*a13);
   a13=(a00+a13);
   a20=(a19-a13);
-  a20=(a03*a20);
+  a20=(a20*a05);
   a21=(2.*a20);
-  a05=(a05+a21);
-  a16=(a14*a16);
+  a04=(a04+a21);
   a21=(a12*a11);
-  a16=(a16+a21);
-  a21=(a06*a16);
-  a21=(a08+a21);
-  a22=(a07-a21);
+  a16=(a16*a15);
+  a21=(a21+a16);
+  a16=(a06*a21);
+  a16=(a08+a16);
+  a22=(a07-a16);
   a23=(a13*a22);
   a23=(a23-a19);
   a24=(a01*a23);
-  a24=(a04+a24);
+  a24=(a03+a24);
   a20=(a01*a20);
   a20=(a00+a20);
   a25=(a24-a20);
-  a25=(a03*a25);
-  a05=(a05+a25);
-  a05=(a02*a05);
-  a05=(a00+a05);
-  if (res[0]!=0) res[0][0]=a05;
+  a25=(a25*a05);
+  a04=(a04+a25);
+  a04=(a02*a04);
+  a04=(a00+a04);
+  if (res[0]!=0) res[0][0]=a04;
   a18=(2.*a18);
   a10=(a10+a18);
   a23=(2.*a23);
   a10=(a10+a23);
-  a21=(a14*a21);
   a23=(a13*a19);
-  a21=(a21+a23);
-  a23=(a01*a21);
-  a23=(a08+a23);
-  a07=(a07-a23);
+  a16=(a16*a15);
+  a23=(a23+a16);
+  a16=(a01*a23);
+  a16=(a08+a16);
+  a07=(a07-a16);
   a18=(a20*a07);
   a18=(a18-a24);
   a10=(a10+a18);
   a10=(a02*a10);
-  a10=(a04+a10);
+  a10=(a03+a10);
   if (res[0]!=0) res[0][1]=a10;
-  a16=(2.*a16);
-  a15=(a15+a16);
   a21=(2.*a21);
-  a15=(a15+a21);
-  a23=(a14*a23);
-  a21=(a20*a24);
-  a23=(a23+a21);
-  a15=(a15+a23);
-  a15=(a02*a15);
-  a08=(a08+a15);
+  a14=(a14+a21);
+  a23=(2.*a23);
+  a14=(a14+a23);
+  a23=(a20*a24);
+  a16=(a16*a15);
+  a23=(a23+a16);
+  a14=(a14+a23);
+  a14=(a02*a14);
+  a08=(a08+a14);
   if (res[0]!=0) res[0][2]=a08;
-  a15=arg[1]? arg[1][0] : 0;
+  a14=arg[1]? arg[1][0] : 0;
   a23=arg[1]? arg[1][1] : 0;
-  a21=(a03*a23);
-  a16=(a03*a15);
-  a21=(a21-a16);
-  a16=(a09*a15);
-  a16=(a16-a23);
+  a16=(a05*a23);
+  a21=(a05*a14);
+  a16=(a16-a21);
+  a21=(a09*a14);
+  a21=(a21-a23);
   a18=arg[1]? arg[1][2] : 0;
   a25=(a00*a18);
-  a16=(a16-a25);
-  a25=(a06*a16);
+  a21=(a21-a25);
+  a25=(a06*a21);
   a25=(a23+a25);
-  a26=(a03*a25);
-  a27=(a06*a21);
-  a27=(a15+a27);
-  a28=(a03*a27);
+  a26=(a05*a25);
+  a27=(a06*a16);
+  a27=(a14+a27);
+  a28=(a05*a27);
   a26=(a26-a28);
   a28=(2.*a26);
-  a21=(a21+a28);
+  a16=(a16+a28);
   a28=(a17*a27);
   a28=(a28-a25);
-  a29=(a04*a15);
+  a29=(a03*a14);
   a30=(a00*a23);
   a29=(a29+a30);
-  a30=(a14*a18);
+  a30=(a15*a18);
   a29=(a29+a30);
   a30=(a06*a29);
   a30=(a18+a30);
@@ -594,19 +675,19 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a28=(a28-a31);
   a31=(a06*a28);
   a31=(a23+a31);
-  a32=(a03*a31);
+  a32=(a05*a31);
   a26=(a06*a26);
-  a26=(a15+a26);
-  a33=(a03*a26);
+  a26=(a14+a26);
+  a33=(a05*a26);
   a32=(a32-a33);
   a33=(2.*a32);
-  a21=(a21+a33);
+  a16=(a16+a33);
   a33=(a22*a26);
   a33=(a33-a31);
   a27=(a11*a27);
   a25=(a12*a25);
   a27=(a27+a25);
-  a30=(a14*a30);
+  a30=(a15*a30);
   a27=(a27+a30);
   a30=(a06*a27);
   a30=(a18+a30);
@@ -614,33 +695,33 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a33=(a33-a25);
   a25=(a01*a33);
   a25=(a23+a25);
-  a34=(a03*a25);
+  a34=(a05*a25);
   a32=(a01*a32);
-  a32=(a15+a32);
-  a35=(a03*a32);
+  a32=(a14+a32);
+  a35=(a05*a32);
   a34=(a34-a35);
-  a21=(a21+a34);
-  a21=(a02*a21);
-  a15=(a15+a21);
-  if (res[1]!=0) res[1][0]=a15;
+  a16=(a16+a34);
+  a16=(a02*a16);
+  a14=(a14+a16);
+  if (res[1]!=0) res[1][0]=a14;
   a28=(2.*a28);
-  a16=(a16+a28);
+  a21=(a21+a28);
   a33=(2.*a33);
-  a16=(a16+a33);
+  a21=(a21+a33);
   a33=(a07*a32);
   a33=(a33-a25);
   a26=(a19*a26);
   a31=(a13*a31);
   a26=(a26+a31);
-  a30=(a14*a30);
+  a30=(a15*a30);
   a26=(a26+a30);
   a30=(a01*a26);
   a30=(a18+a30);
   a31=(a20*a30);
   a33=(a33-a31);
-  a16=(a16+a33);
-  a16=(a02*a16);
-  a23=(a23+a16);
+  a21=(a21+a33);
+  a21=(a02*a21);
+  a23=(a23+a21);
   if (res[1]!=0) res[1][1]=a23;
   a27=(2.*a27);
   a29=(a29+a27);
@@ -649,7 +730,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a32=(a24*a32);
   a25=(a20*a25);
   a32=(a32+a25);
-  a30=(a14*a30);
+  a30=(a15*a30);
   a32=(a32+a30);
   a29=(a29+a32);
   a29=(a02*a29);
@@ -657,8 +738,8 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   if (res[1]!=0) res[1][2]=a18;
   a18=arg[1]? arg[1][3] : 0;
   a29=arg[1]? arg[1][4] : 0;
-  a32=(a03*a29);
-  a30=(a03*a18);
+  a32=(a05*a29);
+  a30=(a05*a18);
   a32=(a32-a30);
   a30=(a09*a18);
   a30=(a30-a29);
@@ -667,71 +748,71 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a30=(a30-a26);
   a26=(a06*a30);
   a26=(a29+a26);
-  a27=(a03*a26);
+  a27=(a05*a26);
   a23=(a06*a32);
   a23=(a18+a23);
-  a16=(a03*a23);
-  a27=(a27-a16);
-  a16=(2.*a27);
-  a32=(a32+a16);
-  a16=(a17*a23);
-  a16=(a16-a26);
-  a33=(a04*a18);
+  a21=(a05*a23);
+  a27=(a27-a21);
+  a21=(2.*a27);
+  a32=(a32+a21);
+  a21=(a17*a23);
+  a21=(a21-a26);
+  a33=(a03*a18);
   a31=(a00*a29);
   a33=(a33+a31);
-  a31=(a14*a25);
+  a31=(a15*a25);
   a33=(a33+a31);
   a31=(a06*a33);
   a31=(a25+a31);
   a28=(a12*a31);
-  a16=(a16-a28);
-  a28=(a06*a16);
+  a21=(a21-a28);
+  a28=(a06*a21);
   a28=(a29+a28);
-  a15=(a03*a28);
+  a14=(a05*a28);
   a27=(a06*a27);
   a27=(a18+a27);
-  a21=(a03*a27);
-  a15=(a15-a21);
-  a21=(2.*a15);
-  a32=(a32+a21);
-  a21=(a22*a27);
-  a21=(a21-a28);
+  a16=(a05*a27);
+  a14=(a14-a16);
+  a16=(2.*a14);
+  a32=(a32+a16);
+  a16=(a22*a27);
+  a16=(a16-a28);
   a23=(a11*a23);
   a26=(a12*a26);
   a23=(a23+a26);
-  a31=(a14*a31);
+  a31=(a15*a31);
   a23=(a23+a31);
   a31=(a06*a23);
   a31=(a25+a31);
   a26=(a13*a31);
-  a21=(a21-a26);
-  a26=(a01*a21);
+  a16=(a16-a26);
+  a26=(a01*a16);
   a26=(a29+a26);
-  a34=(a03*a26);
-  a15=(a01*a15);
-  a15=(a18+a15);
-  a35=(a03*a15);
+  a34=(a05*a26);
+  a14=(a01*a14);
+  a14=(a18+a14);
+  a35=(a05*a14);
   a34=(a34-a35);
   a32=(a32+a34);
   a32=(a02*a32);
   a18=(a18+a32);
   if (res[1]!=0) res[1][3]=a18;
-  a16=(2.*a16);
-  a30=(a30+a16);
   a21=(2.*a21);
   a30=(a30+a21);
-  a21=(a07*a15);
-  a21=(a21-a26);
+  a16=(2.*a16);
+  a30=(a30+a16);
+  a16=(a07*a14);
+  a16=(a16-a26);
   a27=(a19*a27);
   a28=(a13*a28);
   a27=(a27+a28);
-  a31=(a14*a31);
+  a31=(a15*a31);
   a27=(a27+a31);
   a31=(a01*a27);
   a31=(a25+a31);
   a28=(a20*a31);
-  a21=(a21-a28);
-  a30=(a30+a21);
+  a16=(a16-a28);
+  a30=(a30+a16);
   a30=(a02*a30);
   a29=(a29+a30);
   if (res[1]!=0) res[1][4]=a29;
@@ -739,20 +820,20 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a33=(a33+a23);
   a27=(2.*a27);
   a33=(a33+a27);
-  a15=(a24*a15);
+  a14=(a24*a14);
   a26=(a20*a26);
-  a15=(a15+a26);
-  a31=(a14*a31);
-  a15=(a15+a31);
-  a33=(a33+a15);
+  a14=(a14+a26);
+  a31=(a15*a31);
+  a14=(a14+a31);
+  a33=(a33+a14);
   a33=(a02*a33);
   a25=(a25+a33);
   if (res[1]!=0) res[1][5]=a25;
   a25=arg[1]? arg[1][6] : 0;
   a33=arg[1]? arg[1][7] : 0;
-  a15=(a03*a33);
-  a31=(a03*a25);
-  a15=(a15-a31);
+  a14=(a05*a33);
+  a31=(a05*a25);
+  a14=(a14-a31);
   a09=(a09*a25);
   a09=(a09-a33);
   a31=arg[1]? arg[1][8] : 0;
@@ -760,39 +841,39 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a09=(a09-a26);
   a26=(a06*a09);
   a26=(a33+a26);
-  a27=(a03*a26);
-  a23=(a06*a15);
+  a27=(a05*a26);
+  a23=(a06*a14);
   a23=(a25+a23);
-  a29=(a03*a23);
+  a29=(a05*a23);
   a27=(a27-a29);
   a29=(2.*a27);
-  a15=(a15+a29);
+  a14=(a14+a29);
   a17=(a17*a23);
   a17=(a17-a26);
-  a04=(a04*a25);
+  a03=(a03*a25);
   a00=(a00*a33);
-  a04=(a04+a00);
-  a00=(a14*a31);
-  a04=(a04+a00);
-  a00=(a06*a04);
+  a03=(a03+a00);
+  a00=(a15*a31);
+  a03=(a03+a00);
+  a00=(a06*a03);
   a00=(a31+a00);
   a29=(a12*a00);
   a17=(a17-a29);
   a29=(a06*a17);
   a29=(a33+a29);
-  a30=(a03*a29);
+  a30=(a05*a29);
   a27=(a06*a27);
   a27=(a25+a27);
-  a21=(a03*a27);
-  a30=(a30-a21);
-  a21=(2.*a30);
-  a15=(a15+a21);
+  a16=(a05*a27);
+  a30=(a30-a16);
+  a16=(2.*a30);
+  a14=(a14+a16);
   a22=(a22*a27);
   a22=(a22-a29);
   a11=(a11*a23);
   a12=(a12*a26);
   a11=(a11+a12);
-  a00=(a14*a00);
+  a00=(a15*a00);
   a11=(a11+a00);
   a06=(a06*a11);
   a06=(a31+a06);
@@ -800,14 +881,14 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a22=(a22-a00);
   a00=(a01*a22);
   a00=(a33+a00);
-  a12=(a03*a00);
+  a12=(a05*a00);
   a30=(a01*a30);
   a30=(a25+a30);
-  a03=(a03*a30);
-  a12=(a12-a03);
-  a15=(a15+a12);
-  a15=(a02*a15);
-  a25=(a25+a15);
+  a05=(a05*a30);
+  a12=(a12-a05);
+  a14=(a14+a12);
+  a14=(a02*a14);
+  a25=(a25+a14);
   if (res[1]!=0) res[1][6]=a25;
   a17=(2.*a17);
   a09=(a09+a17);
@@ -818,7 +899,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a19=(a19*a27);
   a13=(a13*a29);
   a19=(a19+a13);
-  a06=(a14*a06);
+  a06=(a15*a06);
   a19=(a19+a06);
   a01=(a01*a19);
   a01=(a31+a01);
@@ -829,51 +910,51 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a33=(a33+a09);
   if (res[1]!=0) res[1][7]=a33;
   a11=(2.*a11);
-  a04=(a04+a11);
+  a03=(a03+a11);
   a19=(2.*a19);
-  a04=(a04+a19);
+  a03=(a03+a19);
   a24=(a24*a30);
   a20=(a20*a00);
   a24=(a24+a20);
-  a14=(a14*a01);
-  a24=(a24+a14);
-  a04=(a04+a24);
-  a02=(a02*a04);
+  a15=(a15*a01);
+  a24=(a24+a15);
+  a03=(a03+a24);
+  a02=(a02*a03);
   a31=(a31+a02);
   if (res[1]!=0) res[1][8]=a31;
   a31=arg[2]? arg[2][0] : 0;
-  a02=(a05<a31);
-  a04=(a02?a05:0);
+  a02=(a04<a31);
+  a03=(a02?a04:0);
   a02=(!a02);
   a02=(a02?a31:0);
-  a04=(a04+a02);
-  if (res[2]!=0) res[2][0]=a04;
-  a04=arg[2]? arg[2][1] : 0;
-  a02=(a10<a04);
+  a03=(a03+a02);
+  if (res[2]!=0) res[2][0]=a03;
+  a03=arg[2]? arg[2][1] : 0;
+  a02=(a10<a03);
   a31=(a02?a10:0);
   a02=(!a02);
-  a02=(a02?a04:0);
+  a02=(a02?a03:0);
   a31=(a31+a02);
   if (res[2]!=0) res[2][1]=a31;
   a31=arg[2]? arg[2][2] : 0;
   a02=(a08<a31);
-  a04=(a02?a08:0);
+  a03=(a02?a08:0);
   a02=(!a02);
   a02=(a02?a31:0);
-  a04=(a04+a02);
-  if (res[2]!=0) res[2][2]=a04;
-  a04=arg[3]? arg[3][0] : 0;
-  a02=(a04<a05);
-  a05=(a02?a05:0);
+  a03=(a03+a02);
+  if (res[2]!=0) res[2][2]=a03;
+  a03=arg[3]? arg[3][0] : 0;
+  a02=(a03<a04);
+  a04=(a02?a04:0);
   a02=(!a02);
-  a02=(a02?a04:0);
-  a05=(a05+a02);
-  if (res[3]!=0) res[3][0]=a05;
-  a05=arg[3]? arg[3][1] : 0;
-  a02=(a05<a10);
+  a02=(a02?a03:0);
+  a04=(a04+a02);
+  if (res[3]!=0) res[3][0]=a04;
+  a04=arg[3]? arg[3][1] : 0;
+  a02=(a04<a10);
   a10=(a02?a10:0);
   a02=(!a02);
-  a02=(a02?a05:0);
+  a02=(a02?a04:0);
   a10=(a10+a02);
   if (res[3]!=0) res[3][1]=a10;
   a10=arg[3]? arg[3][2] : 0;
@@ -887,7 +968,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 }
 
 /* gram_schmidt:(i0[3x3])->(o0[3x3],o1[3]) */
-static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12;
   a00=arg[0]? arg[0][0] : 0;
@@ -978,7 +1059,7 @@ static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 }
 
 /* lyapunov_period:(y0[3],Q0[3x3],table[0x200],c[4])->(strobe[3],Q[3x3],log_stretch[3],low[3],high[3]) */
-static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real **res1=res+5, *rr, *w00=w+36, *w01=w+39, w02, w03, w04, *w05=w+48, *w07=w+51, *w08=w+55, *w09=w+58, *w10=w+67;
   casadi_real *w11=w+70, *w12=w+73;
   const casadi_real **arg1=arg+4, *cs, *wr01;
@@ -1002,7 +1083,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1013,7 +1094,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1024,7 +1105,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1035,7 +1116,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1046,7 +1127,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1057,7 +1138,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1068,7 +1149,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1079,7 +1160,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1090,7 +1171,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1101,7 +1182,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1112,7 +1193,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1123,7 +1204,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1134,7 +1215,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1145,7 +1226,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1156,7 +1237,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1167,7 +1248,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1178,7 +1259,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1189,7 +1270,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1200,7 +1281,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1211,7 +1292,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1222,7 +1303,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1233,7 +1314,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1244,7 +1325,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1255,7 +1336,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1266,7 +1347,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1277,7 +1358,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1288,7 +1369,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1299,7 +1380,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1310,7 +1391,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1321,7 +1402,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1332,7 +1413,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1343,7 +1424,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1354,7 +1435,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1365,7 +1446,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1376,7 +1457,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1387,7 +1468,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1398,7 +1479,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1409,7 +1490,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1420,7 +1501,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1431,7 +1512,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1442,7 +1523,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1453,7 +1534,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1464,7 +1545,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1475,7 +1556,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1486,7 +1567,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1497,7 +1578,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1508,7 +1589,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1519,7 +1600,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1530,7 +1611,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1541,7 +1622,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1552,7 +1633,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1563,7 +1644,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1574,7 +1655,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1585,7 +1666,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1596,7 +1677,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1607,7 +1688,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1618,7 +1699,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1629,7 +1710,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1640,7 +1721,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1651,7 +1732,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1662,7 +1743,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1673,7 +1754,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1684,7 +1765,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1695,7 +1776,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1706,7 +1787,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1717,7 +1798,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1728,7 +1809,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1739,7 +1820,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1750,7 +1831,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1761,7 +1842,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1772,7 +1853,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1783,7 +1864,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1794,7 +1875,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1805,7 +1886,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1816,7 +1897,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1827,7 +1908,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1838,7 +1919,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1849,7 +1930,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1860,7 +1941,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1871,7 +1952,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1882,7 +1963,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1893,7 +1974,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1904,7 +1985,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1915,7 +1996,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1926,7 +2007,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1937,7 +2018,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1948,7 +2029,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1959,7 +2040,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1970,7 +2051,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1981,7 +2062,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1992,7 +2073,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2003,7 +2084,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2014,7 +2095,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2025,7 +2106,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2036,7 +2117,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2047,7 +2128,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2058,7 +2139,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2069,7 +2150,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2080,7 +2161,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2091,7 +2172,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2102,7 +2183,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2113,7 +2194,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2124,7 +2205,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2135,7 +2216,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2146,7 +2227,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2157,7 +2238,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2168,7 +2249,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2179,7 +2260,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2190,7 +2271,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2201,7 +2282,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2212,7 +2293,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2223,7 +2304,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2234,7 +2315,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2245,7 +2326,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2256,7 +2337,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2267,7 +2348,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2278,7 +2359,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2289,7 +2370,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2300,7 +2381,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2311,7 +2392,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2322,7 +2403,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2333,7 +2414,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2344,7 +2425,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2355,7 +2436,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2366,7 +2447,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2377,7 +2458,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2388,7 +2469,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2399,7 +2480,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2410,7 +2491,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2421,7 +2502,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2432,7 +2513,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2443,7 +2524,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2454,7 +2535,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2465,7 +2546,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2476,7 +2557,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2487,7 +2568,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2498,7 +2579,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2509,7 +2590,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2520,7 +2601,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2531,7 +2612,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2542,7 +2623,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2553,7 +2634,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2564,7 +2645,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2575,7 +2656,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2586,7 +2667,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2597,7 +2678,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2608,7 +2689,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2619,7 +2700,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2630,7 +2711,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2641,7 +2722,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2652,7 +2733,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2663,7 +2744,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2674,7 +2755,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2685,7 +2766,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2696,7 +2777,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2707,7 +2788,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2718,7 +2799,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2729,7 +2810,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2740,7 +2821,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2751,7 +2832,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2762,7 +2843,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2773,7 +2854,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2784,7 +2865,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2795,7 +2876,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2806,7 +2887,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2817,7 +2898,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2828,7 +2909,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2839,7 +2920,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2850,7 +2931,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2861,7 +2942,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2872,7 +2953,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2883,7 +2964,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2894,7 +2975,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2905,7 +2986,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2916,7 +2997,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2927,7 +3008,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2938,7 +3019,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2949,7 +3030,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2960,7 +3041,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2971,7 +3052,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2982,7 +3063,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2993,7 +3074,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3004,7 +3085,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3015,7 +3096,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3026,7 +3107,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3037,7 +3118,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3048,7 +3129,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3059,7 +3140,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3070,7 +3151,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3081,7 +3162,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3092,7 +3173,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3103,7 +3184,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3114,7 +3195,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3125,7 +3206,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3136,7 +3217,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3147,7 +3228,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3158,7 +3239,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3169,7 +3250,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3180,7 +3261,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3191,12 +3272,12 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w00, 3, res[0]);
   arg1[0]=w01;
   res1[0]=w09;
   res1[1]=w00;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w09, 9, res[1]);
   casadi_copy(w00, 3, res[2]);
   casadi_copy(w05, 3, res[3]);
@@ -3205,7 +3286,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 }
 
 /* lyapunov_chunk:(y0[3],Q0[3x3],table[0x200],c[4])->(strobe[3x50],Q[3x3],log_stretch[3x50],low[3x50],high[3x50]) */
-static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real **res1=res+5, *rr, *w000=w+79, *w001=w+82, w002, w003, w004, *w005=w+91, *w007=w+94, *w008=w+98, *w009=w+101, *w010=w+110;
   casadi_real *w011=w+113, *w012=w+116, *w013=w+119, *w014=w+122, *w015=w+125, *w016=w+128, *w017=w+131, *w018=w+134, *w019=w+137, *w020=w+140, *w021=w+143, *w022=w+146;
   casadi_real *w023=w+149, *w024=w+152, *w025=w+155, *w026=w+158, *w027=w+161, *w028=w+164, *w029=w+167, *w030=w+170, *w031=w+173, *w032=w+176, *w033=w+179, *w034=w+182;
@@ -3241,7 +3322,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3252,7 +3333,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3263,7 +3344,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3274,7 +3355,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3285,7 +3366,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3296,7 +3377,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3307,7 +3388,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3318,7 +3399,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3329,7 +3410,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3340,7 +3421,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3351,7 +3432,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3362,7 +3443,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3373,7 +3454,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3384,7 +3465,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3395,7 +3476,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3406,7 +3487,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3417,7 +3498,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3428,7 +3509,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3439,7 +3520,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3450,7 +3531,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3461,7 +3542,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3472,7 +3553,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3483,7 +3564,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3494,7 +3575,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3505,7 +3586,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3516,7 +3597,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3527,7 +3608,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3538,7 +3619,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3549,7 +3630,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3560,7 +3641,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3571,7 +3652,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3582,7 +3663,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3593,7 +3674,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3604,7 +3685,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3615,7 +3696,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3626,7 +3707,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3637,7 +3718,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3648,7 +3729,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3659,7 +3740,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3670,7 +3751,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3681,7 +3762,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3692,7 +3773,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3703,7 +3784,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3714,7 +3795,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3725,7 +3806,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3736,7 +3817,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3747,7 +3828,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3758,7 +3839,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3769,7 +3850,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3780,7 +3861,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3791,7 +3872,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3802,7 +3883,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3813,7 +3894,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3824,7 +3905,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3835,7 +3916,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3846,7 +3927,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3857,7 +3938,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3868,7 +3949,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3879,7 +3960,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3890,7 +3971,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3901,7 +3982,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3912,7 +3993,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3923,7 +4004,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3934,7 +4015,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3945,7 +4026,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3956,7 +4037,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3967,7 +4048,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3978,7 +4059,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3989,7 +4070,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4000,7 +4081,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4011,7 +4092,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4022,7 +4103,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4033,7 +4114,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4044,7 +4125,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4055,7 +4136,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4066,7 +4147,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4077,7 +4158,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4088,7 +4169,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4099,7 +4180,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4110,7 +4191,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4121,7 +4202,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4132,7 +4213,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4143,7 +4224,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4154,7 +4235,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4165,7 +4246,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4176,7 +4257,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4187,7 +4268,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4198,7 +4279,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4209,7 +4290,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4220,7 +4301,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4231,7 +4312,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4242,7 +4323,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4253,7 +4334,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4264,7 +4345,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4275,7 +4356,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4286,7 +4367,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4297,7 +4378,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4308,7 +4389,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4319,7 +4400,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4330,7 +4411,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4341,7 +4422,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4352,7 +4433,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4363,7 +4444,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4374,7 +4455,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4385,7 +4466,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4396,7 +4477,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4407,7 +4488,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4418,7 +4499,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4429,7 +4510,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4440,7 +4521,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4451,7 +4532,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4462,7 +4543,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4473,7 +4554,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4484,7 +4565,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4495,7 +4576,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4506,7 +4587,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4517,7 +4598,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4528,7 +4609,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4539,7 +4620,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4550,7 +4631,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4561,7 +4642,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4572,7 +4653,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4583,7 +4664,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4594,7 +4675,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4605,7 +4686,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4616,7 +4697,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4627,7 +4708,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4638,7 +4719,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4649,7 +4730,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4660,7 +4741,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4671,7 +4752,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4682,7 +4763,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4693,7 +4774,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4704,7 +4785,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4715,7 +4796,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4726,7 +4807,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4737,7 +4818,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4748,7 +4829,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4759,7 +4840,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4770,7 +4851,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4781,7 +4862,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4792,7 +4873,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4803,7 +4884,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4814,7 +4895,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4825,7 +4906,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4836,7 +4917,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4847,7 +4928,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4858,7 +4939,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4869,7 +4950,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4880,7 +4961,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4891,7 +4972,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4902,7 +4983,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4913,7 +4994,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4924,7 +5005,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4935,7 +5016,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4946,7 +5027,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4957,7 +5038,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4968,7 +5049,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4979,7 +5060,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4990,7 +5071,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5001,7 +5082,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5012,7 +5093,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5023,7 +5104,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5034,7 +5115,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5045,7 +5126,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5056,7 +5137,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5067,7 +5148,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5078,7 +5159,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5089,7 +5170,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5100,7 +5181,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5111,7 +5192,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5122,7 +5203,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5133,7 +5214,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5144,7 +5225,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5155,7 +5236,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5166,7 +5247,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5177,7 +5258,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5188,7 +5269,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5199,7 +5280,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5210,7 +5291,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5221,7 +5302,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5232,7 +5313,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5243,7 +5324,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5254,7 +5335,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5265,7 +5346,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5276,7 +5357,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5287,7 +5368,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5298,7 +5379,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5309,7 +5390,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5320,7 +5401,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5331,7 +5412,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5342,7 +5423,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5353,7 +5434,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5364,7 +5445,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5375,7 +5456,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5386,7 +5467,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5397,7 +5478,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5408,7 +5489,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5419,7 +5500,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5430,12 +5511,12 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w000, 3, res[0]);
   arg1[0]=w001;
   res1[0]=w009;
   res1[1]=w008;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w009;
   arg1[2]=0;
@@ -5445,7 +5526,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w011;
   res1[3]=w013;
   res1[4]=w014;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+3);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5456,7 +5537,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w015;
   res1[3]=w016;
   res1[4]=w017;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+6);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5467,7 +5548,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w018;
   res1[3]=w019;
   res1[4]=w020;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+9);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5478,7 +5559,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w021;
   res1[3]=w022;
   res1[4]=w023;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+12);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5489,7 +5570,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w024;
   res1[3]=w025;
   res1[4]=w026;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+15);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5500,7 +5581,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w027;
   res1[3]=w028;
   res1[4]=w029;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+18);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5511,7 +5592,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w030;
   res1[3]=w031;
   res1[4]=w032;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+21);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5522,7 +5603,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w033;
   res1[3]=w034;
   res1[4]=w035;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+24);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5533,7 +5614,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w036;
   res1[3]=w037;
   res1[4]=w038;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+27);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5544,7 +5625,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w039;
   res1[3]=w040;
   res1[4]=w041;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+30);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5555,7 +5636,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w042;
   res1[3]=w043;
   res1[4]=w044;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+33);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5566,7 +5647,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w045;
   res1[3]=w046;
   res1[4]=w047;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+36);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5577,7 +5658,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w048;
   res1[3]=w049;
   res1[4]=w050;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+39);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5588,7 +5669,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w051;
   res1[3]=w052;
   res1[4]=w053;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+42);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5599,7 +5680,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w054;
   res1[3]=w055;
   res1[4]=w056;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+45);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5610,7 +5691,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w057;
   res1[3]=w058;
   res1[4]=w059;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+48);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5621,7 +5702,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w060;
   res1[3]=w061;
   res1[4]=w062;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+51);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5632,7 +5713,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w063;
   res1[3]=w064;
   res1[4]=w065;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+54);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5643,7 +5724,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w066;
   res1[3]=w067;
   res1[4]=w068;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+57);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5654,7 +5735,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w069;
   res1[3]=w070;
   res1[4]=w071;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+60);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5665,7 +5746,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w072;
   res1[3]=w073;
   res1[4]=w074;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+63);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5676,7 +5757,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w075;
   res1[3]=w076;
   res1[4]=w077;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+66);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5687,7 +5768,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w078;
   res1[3]=w079;
   res1[4]=w080;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+69);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5698,7 +5779,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w081;
   res1[3]=w082;
   res1[4]=w083;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+72);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5709,7 +5790,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w084;
   res1[3]=w085;
   res1[4]=w086;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+75);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5720,7 +5801,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w087;
   res1[3]=w088;
   res1[4]=w089;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+78);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5731,7 +5812,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w090;
   res1[3]=w091;
   res1[4]=w092;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+81);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5742,7 +5823,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w093;
   res1[3]=w094;
   res1[4]=w095;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+84);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5753,7 +5834,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w096;
   res1[3]=w097;
   res1[4]=w098;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+87);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5764,7 +5845,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w099;
   res1[3]=w100;
   res1[4]=w101;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+90);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5775,7 +5856,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w102;
   res1[3]=w103;
   res1[4]=w104;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+93);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5786,7 +5867,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w105;
   res1[3]=w106;
   res1[4]=w107;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+96);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5797,7 +5878,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w108;
   res1[3]=w109;
   res1[4]=w110;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+99);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5808,7 +5889,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w111;
   res1[3]=w112;
   res1[4]=w113;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+102);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5819,7 +5900,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w114;
   res1[3]=w115;
   res1[4]=w116;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+105);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5830,7 +5911,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w117;
   res1[3]=w118;
   res1[4]=w119;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+108);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5841,7 +5922,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w120;
   res1[3]=w121;
   res1[4]=w122;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+111);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5852,7 +5933,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w123;
   res1[3]=w124;
   res1[4]=w125;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+114);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5863,7 +5944,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w126;
   res1[3]=w127;
   res1[4]=w128;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+117);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5874,7 +5955,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w129;
   res1[3]=w130;
   res1[4]=w131;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+120);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5885,7 +5966,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w132;
   res1[3]=w133;
   res1[4]=w134;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+123);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5896,7 +5977,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w135;
   res1[3]=w136;
   res1[4]=w137;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+126);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5907,7 +5988,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w138;
   res1[3]=w139;
   res1[4]=w140;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+129);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5918,7 +5999,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w141;
   res1[3]=w142;
   res1[4]=w143;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+132);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5929,7 +6010,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w144;
   res1[3]=w145;
   res1[4]=w146;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+135);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5940,7 +6021,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w147;
   res1[3]=w148;
   res1[4]=w149;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+138);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5951,7 +6032,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w150;
   res1[3]=w151;
   res1[4]=w152;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+141);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5962,7 +6043,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w153;
   res1[3]=w154;
   res1[4]=w155;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+144);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5973,7 +6054,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w156;
   res1[3]=w157;
   res1[4]=w158;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+147);
   casadi_copy(w001, 9, res[1]);
   casadi_copy(w008, 3, res[2]);
@@ -6130,7 +6211,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_chunk(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f4(arg, res, iw, w, mem);
+  return casadi_f5(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_chunk_checkout(void) {
@@ -6189,11 +6270,11 @@ CASADI_SYMBOL_EXPORT const casadi_int* lyapunov_chunk_sparsity_in(casadi_int i) 
 
 CASADI_SYMBOL_EXPORT const casadi_int* lyapunov_chunk_sparsity_out(casadi_int i) {
   switch (i) {
-    case 0: return casadi_s5;
+    case 0: return casadi_s6;
     case 1: return casadi_s2;
-    case 2: return casadi_s5;
-    case 3: return casadi_s5;
-    case 4: return casadi_s5;
+    case 2: return casadi_s6;
+    case 3: return casadi_s6;
+    case 4: return casadi_s6;
     default: return 0;
   }
 }
@@ -6215,7 +6296,7 @@ CASADI_SYMBOL_EXPORT int lyapunov_chunk_work_bytes(casadi_int *sz_arg, casadi_in
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f7(arg, res, iw, w, mem);
+  return casadi_f8(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period_checkout(void) {
@@ -6300,141 +6381,141 @@ CASADI_SYMBOL_EXPORT int lyapunov_period_work_bytes(casadi_int *sz_arg, casadi_i
 }
 
 /* state_block:(i0[3],i1[3],i2[3],i3[0],i4[4])->(o0[3],o1[3],o2[3]) */
-static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19;
   a00=arg[0]? arg[0][0] : 0;
   a01=arg[4]? arg[4][3] : 0;
   a02=6.;
   a02=(a01/a02);
-  a03=arg[4]? arg[4][0] : 0;
-  a04=arg[0]? arg[0][1] : 0;
-  a05=(a04-a00);
-  a05=(a03*a05);
+  a03=arg[0]? arg[0][1] : 0;
+  a04=(a03-a00);
+  a05=arg[4]? arg[4][0] : 0;
+  a04=(a04*a05);
   a06=2.;
   a06=(a01/a06);
   a07=arg[4]? arg[4][1] : 0;
   a08=arg[0]? arg[0][2] : 0;
   a09=(a07-a08);
   a09=(a00*a09);
-  a09=(a09-a04);
+  a09=(a09-a03);
   a10=(a06*a09);
-  a10=(a04+a10);
-  a11=(a06*a05);
+  a10=(a03+a10);
+  a11=(a06*a04);
   a11=(a00+a11);
   a12=(a10-a11);
-  a12=(a03*a12);
+  a12=(a12*a05);
   a13=(2.*a12);
-  a05=(a05+a13);
-  a13=arg[4]? arg[4][2] : 0;
-  a14=(a13*a08);
-  a15=(a00*a04);
-  a14=(a14+a15);
-  a15=(a06*a14);
+  a04=(a04+a13);
+  a13=(a00*a03);
+  a14=arg[4]? arg[4][2] : 0;
+  a15=(a08*a14);
+  a13=(a13+a15);
+  a15=(a06*a13);
   a15=(a08+a15);
   a16=(a07-a15);
   a16=(a11*a16);
   a16=(a16-a10);
   a17=(a06*a16);
-  a17=(a04+a17);
+  a17=(a03+a17);
   a12=(a06*a12);
   a12=(a00+a12);
   a18=(a17-a12);
-  a18=(a03*a18);
+  a18=(a18*a05);
   a19=(2.*a18);
-  a05=(a05+a19);
-  a15=(a13*a15);
+  a04=(a04+a19);
   a11=(a11*a10);
-  a15=(a15+a11);
-  a06=(a06*a15);
+  a15=(a15*a14);
+  a11=(a11+a15);
+  a06=(a06*a11);
   a06=(a08+a06);
-  a11=(a07-a06);
-  a11=(a12*a11);
-  a11=(a11-a17);
-  a10=(a01*a11);
-  a10=(a04+a10);
+  a15=(a07-a06);
+  a15=(a12*a15);
+  a15=(a15-a17);
+  a10=(a01*a15);
+  a10=(a03+a10);
   a18=(a01*a18);
   a18=(a00+a18);
   a19=(a10-a18);
-  a03=(a03*a19);
-  a05=(a05+a03);
-  a05=(a02*a05);
-  a00=(a00+a05);
+  a19=(a19*a05);
+  a04=(a04+a19);
+  a04=(a02*a04);
+  a00=(a00+a04);
   if (res[0]!=0) res[0][0]=a00;
   a16=(2.*a16);
   a09=(a09+a16);
-  a11=(2.*a11);
-  a09=(a09+a11);
-  a06=(a13*a06);
+  a15=(2.*a15);
+  a09=(a09+a15);
   a12=(a12*a17);
-  a06=(a06+a12);
-  a01=(a01*a06);
+  a06=(a06*a14);
+  a12=(a12+a06);
+  a01=(a01*a12);
   a01=(a08+a01);
   a07=(a07-a01);
   a07=(a18*a07);
   a07=(a07-a10);
   a09=(a09+a07);
   a09=(a02*a09);
-  a04=(a04+a09);
-  if (res[0]!=0) res[0][1]=a04;
-  a15=(2.*a15);
-  a14=(a14+a15);
-  a06=(2.*a06);
-  a14=(a14+a06);
-  a13=(a13*a01);
+  a03=(a03+a09);
+  if (res[0]!=0) res[0][1]=a03;
+  a11=(2.*a11);
+  a13=(a13+a11);
+  a12=(2.*a12);
+  a13=(a13+a12);
   a18=(a18*a10);
+  a01=(a01*a14);
+  a18=(a18+a01);
   a13=(a13+a18);
-  a14=(a14+a13);
-  a02=(a02*a14);
+  a02=(a02*a13);
   a08=(a08+a02);
   if (res[0]!=0) res[0][2]=a08;
   a02=arg[1]? arg[1][0] : 0;
-  a14=(a00<a02);
-  a13=(a14?a00:0);
-  a14=(!a14);
-  a14=(a14?a02:0);
-  a13=(a13+a14);
-  if (res[1]!=0) res[1][0]=a13;
-  a13=arg[1]? arg[1][1] : 0;
-  a14=(a04<a13);
-  a02=(a14?a04:0);
-  a14=(!a14);
-  a14=(a14?a13:0);
-  a02=(a02+a14);
+  a13=(a00<a02);
+  a18=(a13?a00:0);
+  a13=(!a13);
+  a13=(a13?a02:0);
+  a18=(a18+a13);
+  if (res[1]!=0) res[1][0]=a18;
+  a18=arg[1]? arg[1][1] : 0;
+  a13=(a03<a18);
+  a02=(a13?a03:0);
+  a13=(!a13);
+  a13=(a13?a18:0);
+  a02=(a02+a13);
   if (res[1]!=0) res[1][1]=a02;
   a02=arg[1]? arg[1][2] : 0;
-  a14=(a08<a02);
-  a13=(a14?a08:0);
-  a14=(!a14);
-  a14=(a14?a02:0);
-  a13=(a13+a14);
-  if (res[1]!=0) res[1][2]=a13;
-  a13=arg[2]? arg[2][0] : 0;
-  a14=(a13<a00);
-  a00=(a14?a00:0);
-  a14=(!a14);
-  a14=(a14?a13:0);
-  a00=(a00+a14);
+  a13=(a08<a02);
+  a18=(a13?a08:0);
+  a13=(!a13);
+  a13=(a13?a02:0);
+  a18=(a18+a13);
+  if (res[1]!=0) res[1][2]=a18;
+  a18=arg[2]? arg[2][0] : 0;
+  a13=(a18<a00);
+  a00=(a13?a00:0);
+  a13=(!a13);
+  a13=(a13?a18:0);
+  a00=(a00+a13);
   if (res[2]!=0) res[2][0]=a00;
   a00=arg[2]? arg[2][1] : 0;
-  a14=(a00<a04);
-  a04=(a14?a04:0);
-  a14=(!a14);
-  a14=(a14?a00:0);
-  a04=(a04+a14);
-  if (res[2]!=0) res[2][1]=a04;
-  a04=arg[2]? arg[2][2] : 0;
-  a14=(a04<a08);
-  a08=(a14?a08:0);
-  a14=(!a14);
-  a14=(a14?a04:0);
-  a08=(a08+a14);
+  a13=(a00<a03);
+  a03=(a13?a03:0);
+  a13=(!a13);
+  a13=(a13?a00:0);
+  a03=(a03+a13);
+  if (res[2]!=0) res[2][1]=a03;
+  a03=arg[2]? arg[2][2] : 0;
+  a13=(a03<a08);
+  a08=(a13?a08:0);
+  a13=(!a13);
+  a13=(a13?a03:0);
+  a08=(a08+a13);
   if (res[2]!=0) res[2][2]=a08;
   return 0;
 }
 
 /* orbit_period:(y0[3],table[0x200],c[4])->(strobe[3],low[3],high[3]) */
-static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real **res1=res+3, *rr, *w00=w+20, w01, w02, w03, *w04=w+23, *w06=w+26, *w07=w+30, *w08=w+33, *w09=w+36, *w10=w+39;
   const casadi_real **arg1=arg+3, *cs;
   casadi_copy(arg[0], 3, w00);
@@ -6454,7 +6535,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6463,7 +6544,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6472,7 +6553,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6481,7 +6562,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6490,7 +6571,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6499,7 +6580,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6508,7 +6589,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6517,7 +6598,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6526,7 +6607,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6535,7 +6616,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6544,7 +6625,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6553,7 +6634,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6562,7 +6643,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6571,7 +6652,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6580,7 +6661,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6589,7 +6670,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6598,7 +6679,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6607,7 +6688,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6616,7 +6697,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6625,7 +6706,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6634,7 +6715,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6643,7 +6724,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6652,7 +6733,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6661,7 +6742,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6670,7 +6751,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6679,7 +6760,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6688,7 +6769,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6697,7 +6778,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6706,7 +6787,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6715,7 +6796,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6724,7 +6805,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6733,7 +6814,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6742,7 +6823,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6751,7 +6832,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6760,7 +6841,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6769,7 +6850,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6778,7 +6859,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6787,7 +6868,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6796,7 +6877,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6805,7 +6886,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6814,7 +6895,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6823,7 +6904,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6832,7 +6913,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6841,7 +6922,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6850,7 +6931,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6859,7 +6940,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6868,7 +6949,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6877,7 +6958,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6886,7 +6967,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6895,7 +6976,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6904,7 +6985,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6913,7 +6994,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6922,7 +7003,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6931,7 +7012,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6940,7 +7021,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6949,7 +7030,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6958,7 +7039,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6967,7 +7048,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6976,7 +7057,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6985,7 +7066,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6994,7 +7075,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7003,7 +7084,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7012,7 +7093,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7021,7 +7102,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7030,7 +7111,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7039,7 +7120,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7048,7 +7129,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7057,7 +7138,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7066,7 +7147,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7075,7 +7156,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7084,7 +7165,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7093,7 +7174,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7102,7 +7183,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7111,7 +7192,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7120,7 +7201,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7129,7 +7210,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7138,7 +7219,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7147,7 +7228,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7156,7 +7237,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7165,7 +7246,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7174,7 +7255,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7183,7 +7264,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7192,7 +7273,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7201,7 +7282,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7210,7 +7291,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7219,7 +7300,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7228,7 +7309,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7237,7 +7318,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7246,7 +7327,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7255,7 +7336,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7264,7 +7345,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7273,7 +7354,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7282,7 +7363,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7291,7 +7372,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7300,7 +7381,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7309,7 +7390,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7318,7 +7399,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7327,7 +7408,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7336,7 +7417,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7345,7 +7426,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7354,7 +7435,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7363,7 +7444,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7372,7 +7453,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7381,7 +7462,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7390,7 +7471,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7399,7 +7480,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7408,7 +7489,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7417,7 +7498,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7426,7 +7507,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7435,7 +7516,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7444,7 +7525,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7453,7 +7534,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7462,7 +7543,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7471,7 +7552,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7480,7 +7561,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7489,7 +7570,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7498,7 +7579,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7507,7 +7588,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7516,7 +7597,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7525,7 +7606,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7534,7 +7615,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7543,7 +7624,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7552,7 +7633,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7561,7 +7642,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7570,7 +7651,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7579,7 +7660,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7588,7 +7669,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7597,7 +7678,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7606,7 +7687,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7615,7 +7696,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7624,7 +7705,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7633,7 +7714,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7642,7 +7723,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7651,7 +7732,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7660,7 +7741,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7669,7 +7750,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7678,7 +7759,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7687,7 +7768,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7696,7 +7777,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7705,7 +7786,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7714,7 +7795,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7723,7 +7804,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7732,7 +7813,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7741,7 +7822,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7750,7 +7831,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7759,7 +7840,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7768,7 +7849,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7777,7 +7858,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7786,7 +7867,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7795,7 +7876,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7804,7 +7885,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7813,7 +7894,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7822,7 +7903,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7831,7 +7912,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7840,7 +7921,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7849,7 +7930,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7858,7 +7939,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7867,7 +7948,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7876,7 +7957,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7885,7 +7966,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7894,7 +7975,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7903,7 +7984,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7912,7 +7993,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7921,7 +8002,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7930,7 +8011,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7939,7 +8020,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7948,7 +8029,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7957,7 +8038,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7966,7 +8047,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7975,7 +8056,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7984,7 +8065,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7993,7 +8074,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8002,7 +8083,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8011,7 +8092,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8020,7 +8101,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8029,7 +8110,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8038,7 +8119,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8047,7 +8128,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8056,7 +8137,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8065,7 +8146,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8074,7 +8155,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8083,7 +8164,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8092,7 +8173,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8101,7 +8182,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8110,7 +8191,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8119,7 +8200,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8128,7 +8209,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8137,7 +8218,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8146,7 +8227,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8155,7 +8236,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8164,7 +8245,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8173,7 +8254,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8182,7 +8263,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8191,7 +8272,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8200,7 +8281,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8209,7 +8290,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8218,7 +8299,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8227,7 +8308,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8236,7 +8317,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8245,7 +8326,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w00, 3, res[0]);
   casadi_copy(w04, 3, res[1]);
   casadi_copy(w10, 3, res[2]);
@@ -8253,7 +8334,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 /* orbit_chunk:(y0[3],table[0x200],c[4])->(strobe[3x50],low[3x50],high[3x50]) */
-static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real **res1=res+3, *rr, *w000=w+45, w001, w002, w003, *w004=w+48, *w006=w+51, *w007=w+55, *w008=w+58, *w009=w+61, *w010=w+64;
   casadi_real *w011=w+67, *w012=w+70, *w013=w+73, *w014=w+76, *w015=w+79, *w016=w+82, *w017=w+85, *w018=w+88, *w019=w+91, *w020=w+94, *w021=w+97, *w022=w+100;
   casadi_real *w023=w+103, *w024=w+106, *w025=w+109, *w026=w+112, *w027=w+115, *w028=w+118, *w029=w+121, *w030=w+124, *w031=w+127, *w032=w+130, *w033=w+133, *w034=w+136;
@@ -8281,7 +8362,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8290,7 +8371,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8299,7 +8380,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8308,7 +8389,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8317,7 +8398,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8326,7 +8407,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8335,7 +8416,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8344,7 +8425,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8353,7 +8434,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8362,7 +8443,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8371,7 +8452,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8380,7 +8461,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8389,7 +8470,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8398,7 +8479,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8407,7 +8488,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8416,7 +8497,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8425,7 +8506,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8434,7 +8515,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8443,7 +8524,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8452,7 +8533,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8461,7 +8542,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8470,7 +8551,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8479,7 +8560,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8488,7 +8569,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8497,7 +8578,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8506,7 +8587,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8515,7 +8596,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8524,7 +8605,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8533,7 +8614,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8542,7 +8623,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8551,7 +8632,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8560,7 +8641,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8569,7 +8650,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8578,7 +8659,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8587,7 +8668,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8596,7 +8677,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8605,7 +8686,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8614,7 +8695,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8623,7 +8704,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8632,7 +8713,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8641,7 +8722,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8650,7 +8731,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8659,7 +8740,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8668,7 +8749,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8677,7 +8758,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8686,7 +8767,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8695,7 +8776,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8704,7 +8785,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8713,7 +8794,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8722,7 +8803,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8731,7 +8812,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8740,7 +8821,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8749,7 +8830,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8758,7 +8839,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8767,7 +8848,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8776,7 +8857,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8785,7 +8866,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8794,7 +8875,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8803,7 +8884,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8812,7 +8893,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8821,7 +8902,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8830,7 +8911,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8839,7 +8920,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8848,7 +8929,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8857,7 +8938,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8866,7 +8947,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8875,7 +8956,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8884,7 +8965,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8893,7 +8974,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8902,7 +8983,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8911,7 +8992,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8920,7 +9001,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8929,7 +9010,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8938,7 +9019,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8947,7 +9028,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8956,7 +9037,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8965,7 +9046,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8974,7 +9055,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8983,7 +9064,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8992,7 +9073,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9001,7 +9082,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9010,7 +9091,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9019,7 +9100,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9028,7 +9109,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9037,7 +9118,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9046,7 +9127,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9055,7 +9136,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9064,7 +9145,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9073,7 +9154,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9082,7 +9163,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9091,7 +9172,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9100,7 +9181,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9109,7 +9190,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9118,7 +9199,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9127,7 +9208,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9136,7 +9217,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9145,7 +9226,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9154,7 +9235,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9163,7 +9244,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9172,7 +9253,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9181,7 +9262,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9190,7 +9271,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9199,7 +9280,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9208,7 +9289,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9217,7 +9298,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9226,7 +9307,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9235,7 +9316,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9244,7 +9325,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9253,7 +9334,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9262,7 +9343,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9271,7 +9352,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9280,7 +9361,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9289,7 +9370,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9298,7 +9379,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9307,7 +9388,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9316,7 +9397,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9325,7 +9406,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9334,7 +9415,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9343,7 +9424,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9352,7 +9433,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9361,7 +9442,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9370,7 +9451,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9379,7 +9460,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9388,7 +9469,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9397,7 +9478,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9406,7 +9487,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9415,7 +9496,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9424,7 +9505,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9433,7 +9514,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9442,7 +9523,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9451,7 +9532,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9460,7 +9541,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9469,7 +9550,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9478,7 +9559,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9487,7 +9568,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9496,7 +9577,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9505,7 +9586,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9514,7 +9595,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9523,7 +9604,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9532,7 +9613,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9541,7 +9622,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9550,7 +9631,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9559,7 +9640,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9568,7 +9649,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9577,7 +9658,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9586,7 +9667,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9595,7 +9676,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9604,7 +9685,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9613,7 +9694,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9622,7 +9703,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9631,7 +9712,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9640,7 +9721,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9649,7 +9730,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9658,7 +9739,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9667,7 +9748,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9676,7 +9757,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9685,7 +9766,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9694,7 +9775,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9703,7 +9784,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9712,7 +9793,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9721,7 +9802,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9730,7 +9811,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9739,7 +9820,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9748,7 +9829,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9757,7 +9838,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9766,7 +9847,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9775,7 +9856,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9784,7 +9865,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9793,7 +9874,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9802,7 +9883,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9811,7 +9892,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9820,7 +9901,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9829,7 +9910,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9838,7 +9919,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9847,7 +9928,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9856,7 +9937,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9865,7 +9946,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9874,7 +9955,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9883,7 +9964,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9892,7 +9973,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9901,7 +9982,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9910,7 +9991,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9919,7 +10000,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9928,7 +10009,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9937,7 +10018,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9946,7 +10027,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9955,7 +10036,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9964,7 +10045,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9973,7 +10054,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9982,7 +10063,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9991,7 +10072,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -10000,7 +10081,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -10009,7 +10090,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -10018,7 +10099,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -10027,7 +10108,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -10036,7 +10117,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -10045,7 +10126,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -10054,7 +10135,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -10063,7 +10144,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -10072,7 +10153,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w000, 3, res[0]);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10080,7 +10161,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+3);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10088,7 +10169,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w011;
   res1[2]=w012;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+6);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10096,7 +10177,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w013;
   res1[2]=w014;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+9);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10104,7 +10185,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w015;
   res1[2]=w016;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+12);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10112,7 +10193,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w017;
   res1[2]=w018;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+15);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10120,7 +10201,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w019;
   res1[2]=w020;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+18);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10128,7 +10209,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w021;
   res1[2]=w022;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+21);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10136,7 +10217,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w023;
   res1[2]=w024;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+24);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10144,7 +10225,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w025;
   res1[2]=w026;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+27);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10152,7 +10233,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w027;
   res1[2]=w028;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+30);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10160,7 +10241,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w029;
   res1[2]=w030;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+33);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10168,7 +10249,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w031;
   res1[2]=w032;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+36);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10176,7 +10257,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w033;
   res1[2]=w034;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+39);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10184,7 +10265,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w035;
   res1[2]=w036;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+42);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10192,7 +10273,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w037;
   res1[2]=w038;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+45);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10200,7 +10281,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w039;
   res1[2]=w040;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+48);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10208,7 +10289,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w041;
   res1[2]=w042;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+51);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10216,7 +10297,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w043;
   res1[2]=w044;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+54);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10224,7 +10305,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w045;
   res1[2]=w046;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+57);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10232,7 +10313,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w047;
   res1[2]=w048;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+60);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10240,7 +10321,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w049;
   res1[2]=w050;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+63);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10248,7 +10329,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w051;
   res1[2]=w052;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+66);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10256,7 +10337,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w053;
   res1[2]=w054;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+69);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10264,7 +10345,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w055;
   res1[2]=w056;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+72);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10272,7 +10353,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w057;
   res1[2]=w058;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+75);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10280,7 +10361,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w059;
   res1[2]=w060;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+78);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10288,7 +10369,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w061;
   res1[2]=w062;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+81);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10296,7 +10377,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w063;
   res1[2]=w064;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+84);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10304,7 +10385,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w065;
   res1[2]=w066;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+87);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10312,7 +10393,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w067;
   res1[2]=w068;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+90);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10320,7 +10401,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w069;
   res1[2]=w070;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+93);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10328,7 +10409,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w071;
   res1[2]=w072;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+96);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10336,7 +10417,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w073;
   res1[2]=w074;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+99);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10344,7 +10425,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w075;
   res1[2]=w076;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+102);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10352,7 +10433,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w077;
   res1[2]=w078;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+105);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10360,7 +10441,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w079;
   res1[2]=w080;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+108);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10368,7 +10449,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w081;
   res1[2]=w082;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+111);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10376,7 +10457,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w083;
   res1[2]=w084;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+114);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10384,7 +10465,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w085;
   res1[2]=w086;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+117);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10392,7 +10473,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w087;
   res1[2]=w088;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+120);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10400,7 +10481,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w089;
   res1[2]=w090;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+123);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10408,7 +10489,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w091;
   res1[2]=w092;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+126);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10416,7 +10497,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w093;
   res1[2]=w094;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+129);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10424,7 +10505,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w095;
   res1[2]=w096;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+132);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10432,7 +10513,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w097;
   res1[2]=w098;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+135);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10440,7 +10521,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w099;
   res1[2]=w100;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+138);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10448,7 +10529,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w101;
   res1[2]=w102;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+141);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10456,7 +10537,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w103;
   res1[2]=w104;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+144);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10464,7 +10545,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w105;
   res1[2]=w106;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+147);
   casadi_copy(w004, 3, res[1]);
   if (res[1]) casadi_copy(w008, 3, res[1]+3);
@@ -10570,7 +10651,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 }
 
 CASADI_SYMBOL_EXPORT int orbit_chunk(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f8(arg, res, iw, w, mem);
+  return casadi_f9(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int orbit_chunk_checkout(void) {
@@ -10625,9 +10706,9 @@ CASADI_SYMBOL_EXPORT const casadi_int* orbit_chunk_sparsity_in(casadi_int i) {
 
 CASADI_SYMBOL_EXPORT const casadi_int* orbit_chunk_sparsity_out(casadi_int i) {
   switch (i) {
-    case 0: return casadi_s5;
-    case 1: return casadi_s5;
-    case 2: return casadi_s5;
+    case 0: return casadi_s6;
+    case 1: return casadi_s6;
+    case 2: return casadi_s6;
     default: return 0;
   }
 }
@@ -10649,7 +10730,7 @@ CASADI_SYMBOL_EXPORT int orbit_chunk_work_bytes(casadi_int *sz_arg, casadi_int* 
 }
 
 CASADI_SYMBOL_EXPORT int orbit_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f10(arg, res, iw, w, mem);
+  return casadi_f11(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int orbit_period_checkout(void) {
@@ -10728,99 +10809,99 @@ CASADI_SYMBOL_EXPORT int orbit_period_work_bytes(casadi_int *sz_arg, casadi_int*
 }
 
 /* state_step:(i0[3],i1[0],i2[4])->(o0[3]) */
-static int casadi_f15(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f16(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19;
   a00=arg[0]? arg[0][0] : 0;
   a01=arg[2]? arg[2][3] : 0;
   a02=6.;
   a02=(a01/a02);
-  a03=arg[2]? arg[2][0] : 0;
-  a04=arg[0]? arg[0][1] : 0;
-  a05=(a04-a00);
-  a05=(a03*a05);
+  a03=arg[0]? arg[0][1] : 0;
+  a04=(a03-a00);
+  a05=arg[2]? arg[2][0] : 0;
+  a04=(a04*a05);
   a06=2.;
   a06=(a01/a06);
   a07=arg[2]? arg[2][1] : 0;
   a08=arg[0]? arg[0][2] : 0;
   a09=(a07-a08);
   a09=(a00*a09);
-  a09=(a09-a04);
+  a09=(a09-a03);
   a10=(a06*a09);
-  a10=(a04+a10);
-  a11=(a06*a05);
+  a10=(a03+a10);
+  a11=(a06*a04);
   a11=(a00+a11);
   a12=(a10-a11);
-  a12=(a03*a12);
+  a12=(a12*a05);
   a13=(2.*a12);
-  a05=(a05+a13);
-  a13=arg[2]? arg[2][2] : 0;
-  a14=(a13*a08);
-  a15=(a00*a04);
-  a14=(a14+a15);
-  a15=(a06*a14);
+  a04=(a04+a13);
+  a13=(a00*a03);
+  a14=arg[2]? arg[2][2] : 0;
+  a15=(a08*a14);
+  a13=(a13+a15);
+  a15=(a06*a13);
   a15=(a08+a15);
   a16=(a07-a15);
   a16=(a11*a16);
   a16=(a16-a10);
   a17=(a06*a16);
-  a17=(a04+a17);
+  a17=(a03+a17);
   a12=(a06*a12);
   a12=(a00+a12);
   a18=(a17-a12);
-  a18=(a03*a18);
+  a18=(a18*a05);
   a19=(2.*a18);
-  a05=(a05+a19);
-  a15=(a13*a15);
+  a04=(a04+a19);
   a11=(a11*a10);
-  a15=(a15+a11);
-  a06=(a06*a15);
+  a15=(a15*a14);
+  a11=(a11+a15);
+  a06=(a06*a11);
   a06=(a08+a06);
-  a11=(a07-a06);
-  a11=(a12*a11);
-  a11=(a11-a17);
-  a10=(a01*a11);
-  a10=(a04+a10);
+  a15=(a07-a06);
+  a15=(a12*a15);
+  a15=(a15-a17);
+  a10=(a01*a15);
+  a10=(a03+a10);
   a18=(a01*a18);
   a18=(a00+a18);
   a19=(a10-a18);
-  a03=(a03*a19);
-  a05=(a05+a03);
-  a05=(a02*a05);
-  a00=(a00+a05);
+  a19=(a19*a05);
+  a04=(a04+a19);
+  a04=(a02*a04);
+  a00=(a00+a04);
   if (res[0]!=0) res[0][0]=a00;
   a16=(2.*a16);
   a09=(a09+a16);
-  a11=(2.*a11);
-  a09=(a09+a11);
-  a06=(a13*a06);
+  a15=(2.*a15);
+  a09=(a09+a15);
   a12=(a12*a17);
-  a06=(a06+a12);
-  a01=(a01*a06);
+  a06=(a06*a14);
+  a12=(a12+a06);
+  a01=(a01*a12);
   a01=(a08+a01);
   a07=(a07-a01);
   a07=(a18*a07);
   a07=(a07-a10);
   a09=(a09+a07);
   a09=(a02*a09);
-  a04=(a04+a09);
-  if (res[0]!=0) res[0][1]=a04;
-  a15=(2.*a15);
-  a14=(a14+a15);
-  a06=(2.*a06);
-  a14=(a14+a06);
-  a13=(a13*a01);
+  a03=(a03+a09);
+  if (res[0]!=0) res[0][1]=a03;
+  a11=(2.*a11);
+  a13=(a13+a11);
+  a12=(2.*a12);
+  a13=(a13+a12);
   a18=(a18*a10);
+  a01=(a01*a14);
+  a18=(a18+a01);
   a13=(a13+a18);
-  a14=(a14+a13);
-  a02=(a02*a14);
+  a02=(a02*a13);
   a08=(a08+a02);
   if (res[0]!=0) res[0][2]=a08;
   return 0;
 }
 
 /* state_step_acc10:(i0[3],i1[0x10],i2[4x10])->(o0[3x10]) */
-static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f15(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real **res1=res+1, *w0=w+20, *w2=w+23, *w3=w+27;
   const casadi_real **arg1=arg+3;
   casadi_copy(arg[0], 3, w0);
@@ -10829,76 +10910,76 @@ static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w3, 3, res[0]);
   casadi_copy(arg[2] ? arg[2]+4 : 0, 4, w2);
   arg1[0]=w3;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w0;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w0, 3, res[0]+3);
   casadi_copy(arg[2] ? arg[2]+8 : 0, 4, w2);
   arg1[0]=w0;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 3, res[0]+6);
   casadi_copy(arg[2] ? arg[2]+12 : 0, 4, w2);
   arg1[0]=w3;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w0;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w0, 3, res[0]+9);
   casadi_copy(arg[2] ? arg[2]+16 : 0, 4, w2);
   arg1[0]=w0;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 3, res[0]+12);
   casadi_copy(arg[2] ? arg[2]+20 : 0, 4, w2);
   arg1[0]=w3;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w0;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w0, 3, res[0]+15);
   casadi_copy(arg[2] ? arg[2]+24 : 0, 4, w2);
   arg1[0]=w0;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 3, res[0]+18);
   casadi_copy(arg[2] ? arg[2]+28 : 0, 4, w2);
   arg1[0]=w3;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w0;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w0, 3, res[0]+21);
   casadi_copy(arg[2] ? arg[2]+32 : 0, 4, w2);
   arg1[0]=w0;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 3, res[0]+24);
   casadi_copy(arg[2] ? arg[2]+36 : 0, 4, w2);
   arg1[0]=w3;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w0;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w0, 3, res[0]+27);
   return 0;
 }
 
 /* state_step_acc10_acc10:(i0[3],i1[0x100],i2[4x100])->(o0[3x100]) */
-static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real **res1=res+1, *w0=w+30, *w3=w+33;
   const casadi_real **arg1=arg+3, *wr2;
   casadi_copy(arg[0], 3, w0);
@@ -10907,7 +10988,7 @@ static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w3, 30, res[0]);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+40 : casadi_zeros;
@@ -10915,7 +10996,7 @@ static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+30);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+80 : casadi_zeros;
@@ -10923,7 +11004,7 @@ static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+60);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+120 : casadi_zeros;
@@ -10931,7 +11012,7 @@ static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+90);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+160 : casadi_zeros;
@@ -10939,7 +11020,7 @@ static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+120);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+200 : casadi_zeros;
@@ -10947,7 +11028,7 @@ static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+150);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+240 : casadi_zeros;
@@ -10955,7 +11036,7 @@ static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+180);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+280 : casadi_zeros;
@@ -10963,7 +11044,7 @@ static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+210);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+320 : casadi_zeros;
@@ -10971,7 +11052,7 @@ static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+240);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+360 : casadi_zeros;
@@ -10979,13 +11060,13 @@ static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+270);
   return 0;
 }
 
 /* steps:(i0[3],i1[0x200],i2[4x200])->(o0[3x200]) */
-static int casadi_f12(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real **res1=res+1, *w0=w+103, *w3=w+106;
   const casadi_real **arg1=arg+3, *wr2;
   casadi_copy(arg[0], 3, w0);
@@ -10994,7 +11075,7 @@ static int casadi_f12(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f13(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w3, 300, res[0]);
   casadi_copy(w3+297, 3, w0);
   wr2 = arg[2] ? arg[2]+400 : casadi_zeros;
@@ -11002,13 +11083,13 @@ static int casadi_f12(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f13(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 300, res[0]+300);
   return 0;
 }
 
 /* trajectory:(y0[3],table[0x200],c[4])->(states[3x200]) */
-static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f12(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_int i;
   casadi_real **res1=res+1, *w0=w+806, *w2=w+809, *w3=w+813, *w4=w+1613;
   const casadi_real **arg1=arg+3;
@@ -11021,13 +11102,13 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=w3;
   res1[0]=w4;
-  if (casadi_f12(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f13(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w4, 600, res[0]);
   return 0;
 }
 
 CASADI_SYMBOL_EXPORT int trajectory(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f11(arg, res, iw, w, mem);
+  return casadi_f12(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int trajectory_checkout(void) {
@@ -11080,7 +11161,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* trajectory_sparsity_in(casadi_int i) {
 
 CASADI_SYMBOL_EXPORT const casadi_int* trajectory_sparsity_out(casadi_int i) {
   switch (i) {
-    case 0: return casadi_s6;
+    case 0: return casadi_s7;
     default: return 0;
   }
 }

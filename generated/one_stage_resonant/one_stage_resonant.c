@@ -551,7 +551,7 @@ CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz
   return 0;
 }
 
-/* table_point:(i0,i1[9])->(o0[2]) */
+/* table_point:(t,p[9])->(values[2]) */
 static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a0, a1, a2, a3, a4, a5;
   a0=1.;
@@ -614,7 +614,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   return 0;
 }
 
-/* map401_table_point:(i0[1x401],i1[9x401])->(o0[2x401]) */
+/* map401_table_point:(t[1x401],p[9x401])->(values[2x401]) */
 static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_int i;
   casadi_real* *res1;
@@ -745,10 +745,84 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
   return 0;
 }
 
+CASADI_SYMBOL_EXPORT int table_point(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f5(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int table_point_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void table_point_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void table_point_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void table_point_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int table_point_n_in(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_int table_point_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real table_point_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_point_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_point_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "values";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_point_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_point_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s1;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int table_point_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 2;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table_point_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 2*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
 /* tangent_block:(i0[2],i1[2x2],i2,i3,i4[6],i5[3])->(o0[2],o1[2x2],o2,o3) */
 static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+  casadi_real a24;
   a00=arg[0]? arg[0][0] : 0;
   a01=arg[5]? arg[5][2] : 0;
   a02=6.;
@@ -756,10 +830,8 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a03=arg[0]? arg[0][1] : 0;
   a04=2.;
   a04=(a01/a04);
-  a05=arg[4]? arg[4][1] : 0;
-  a06=arg[5]? arg[5][1] : 0;
-  a07=(a06*a03);
-  a05=(a05+a07);
+  a05=arg[5]? arg[5][1] : 0;
+  a06=(a03*a05);
   a07=arg[4]? arg[4][0] : 0;
   a08=0.;
   a09=(a08<=a00);
@@ -771,167 +843,169 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a14=(a13?a14:0);
   a10=(a10+a14);
   a10=(a07*a10);
-  a05=(a05+a10);
-  a10=(a04*a05);
+  a06=(a06+a10);
+  a10=arg[4]? arg[4][1] : 0;
+  a06=(a06+a10);
+  a10=(a04*a06);
   a10=(a03+a10);
   a14=(2.*a10);
   a14=(a03+a14);
-  a15=arg[4]? arg[4][3] : 0;
-  a16=(a06*a10);
-  a16=(a15+a16);
-  a17=arg[4]? arg[4][2] : 0;
-  a18=(a04*a03);
-  a18=(a00+a18);
-  a19=(a08<=a18);
-  a20=(a19?a18:0);
-  a21=(a18<=a12);
-  a18=(a18+a11);
-  a18=(a21?a18:0);
-  a20=(a20+a18);
-  a20=(a17*a20);
-  a16=(a16+a20);
-  a20=(a04*a16);
-  a20=(a03+a20);
-  a18=(2.*a20);
-  a14=(a14+a18);
-  a18=(a06*a20);
-  a15=(a15+a18);
+  a15=(a10*a05);
+  a16=arg[4]? arg[4][2] : 0;
+  a17=(a04*a03);
+  a17=(a00+a17);
+  a18=(a08<=a17);
+  a19=(a18?a17:0);
+  a20=(a17<=a12);
+  a17=(a17+a11);
+  a17=(a20?a17:0);
+  a19=(a19+a17);
+  a19=(a16*a19);
+  a15=(a15+a19);
+  a19=arg[4]? arg[4][3] : 0;
+  a15=(a15+a19);
+  a17=(a04*a15);
+  a17=(a03+a17);
+  a21=(2.*a17);
+  a14=(a14+a21);
+  a21=(a17*a05);
   a10=(a04*a10);
   a10=(a00+a10);
-  a18=(a08<=a10);
-  a22=(a18?a10:0);
-  a23=(a10<=a12);
+  a22=(a08<=a10);
+  a23=(a22?a10:0);
+  a24=(a10<=a12);
   a10=(a10+a11);
-  a10=(a23?a10:0);
-  a22=(a22+a10);
-  a22=(a17*a22);
-  a15=(a15+a22);
-  a22=(a01*a15);
-  a22=(a03+a22);
-  a14=(a14+a22);
+  a10=(a24?a10:0);
+  a23=(a23+a10);
+  a23=(a16*a23);
+  a21=(a21+a23);
+  a21=(a21+a19);
+  a19=(a01*a21);
+  a19=(a03+a19);
+  a14=(a14+a19);
   a14=(a02*a14);
   a14=(a00+a14);
   if (res[0]!=0) res[0][0]=a14;
-  a16=(2.*a16);
-  a05=(a05+a16);
   a15=(2.*a15);
-  a05=(a05+a15);
-  a15=arg[4]? arg[4][5] : 0;
-  a22=(a06*a22);
-  a15=(a15+a22);
-  a22=arg[4]? arg[4][4] : 0;
-  a20=(a01*a20);
-  a00=(a00+a20);
+  a06=(a06+a15);
+  a21=(2.*a21);
+  a06=(a06+a21);
+  a19=(a19*a05);
+  a21=arg[4]? arg[4][4] : 0;
+  a17=(a01*a17);
+  a00=(a00+a17);
   a08=(a08<=a00);
-  a20=(a08?a00:0);
+  a17=(a08?a00:0);
   a12=(a00<=a12);
   a00=(a00+a11);
   a00=(a12?a00:0);
-  a20=(a20+a00);
-  a20=(a22*a20);
-  a15=(a15+a20);
-  a05=(a05+a15);
-  a05=(a02*a05);
-  a03=(a03+a05);
+  a17=(a17+a00);
+  a17=(a21*a17);
+  a19=(a19+a17);
+  a17=arg[4]? arg[4][5] : 0;
+  a19=(a19+a17);
+  a06=(a06+a19);
+  a06=(a02*a06);
+  a03=(a03+a06);
   if (res[0]!=0) res[0][1]=a03;
   a03=arg[1]? arg[1][0] : 0;
-  a05=arg[1]? arg[1][1] : 0;
-  a15=1.;
-  a09=(a09?a15:0);
-  a13=(a13?a15:0);
+  a06=arg[1]? arg[1][1] : 0;
+  a19=1.;
+  a09=(a09?a19:0);
+  a13=(a13?a19:0);
   a09=(a09+a13);
   a07=(a07*a09);
   a09=(a07*a03);
-  a13=(a06*a05);
+  a13=(a05*a06);
   a09=(a09+a13);
   a13=(a04*a09);
-  a13=(a05+a13);
-  a20=(2.*a13);
-  a20=(a05+a20);
-  a19=(a19?a15:0);
-  a21=(a21?a15:0);
-  a19=(a19+a21);
-  a19=(a17*a19);
-  a21=(a04*a05);
-  a21=(a03+a21);
-  a21=(a19*a21);
-  a00=(a06*a13);
-  a21=(a21+a00);
-  a00=(a04*a21);
-  a00=(a05+a00);
+  a13=(a06+a13);
+  a17=(2.*a13);
+  a17=(a06+a17);
+  a18=(a18?a19:0);
+  a20=(a20?a19:0);
+  a18=(a18+a20);
+  a18=(a16*a18);
+  a20=(a04*a06);
+  a20=(a03+a20);
+  a20=(a18*a20);
+  a00=(a05*a13);
+  a20=(a20+a00);
+  a00=(a04*a20);
+  a00=(a06+a00);
   a11=(2.*a00);
-  a20=(a20+a11);
-  a18=(a18?a15:0);
-  a23=(a23?a15:0);
-  a18=(a18+a23);
-  a17=(a17*a18);
+  a17=(a17+a11);
+  a22=(a22?a19:0);
+  a24=(a24?a19:0);
+  a22=(a22+a24);
+  a16=(a16*a22);
   a13=(a04*a13);
   a13=(a03+a13);
-  a13=(a17*a13);
-  a18=(a06*a00);
-  a13=(a13+a18);
-  a18=(a01*a13);
-  a18=(a05+a18);
-  a20=(a20+a18);
-  a20=(a02*a20);
-  a20=(a03+a20);
-  if (res[1]!=0) res[1][0]=a20;
-  a21=(2.*a21);
-  a09=(a09+a21);
+  a13=(a16*a13);
+  a22=(a05*a00);
+  a13=(a13+a22);
+  a22=(a01*a13);
+  a22=(a06+a22);
+  a17=(a17+a22);
+  a17=(a02*a17);
+  a17=(a03+a17);
+  if (res[1]!=0) res[1][0]=a17;
+  a20=(2.*a20);
+  a09=(a09+a20);
   a13=(2.*a13);
   a09=(a09+a13);
-  a08=(a08?a15:0);
-  a12=(a12?a15:0);
+  a08=(a08?a19:0);
+  a12=(a12?a19:0);
   a08=(a08+a12);
-  a22=(a22*a08);
+  a21=(a21*a08);
   a00=(a01*a00);
   a03=(a03+a00);
-  a03=(a22*a03);
-  a18=(a06*a18);
-  a03=(a03+a18);
+  a03=(a21*a03);
+  a22=(a05*a22);
+  a03=(a03+a22);
   a09=(a09+a03);
   a09=(a02*a09);
-  a05=(a05+a09);
-  if (res[1]!=0) res[1][1]=a05;
-  a05=arg[1]? arg[1][2] : 0;
+  a06=(a06+a09);
+  if (res[1]!=0) res[1][1]=a06;
+  a06=arg[1]? arg[1][2] : 0;
   a09=arg[1]? arg[1][3] : 0;
-  a07=(a07*a05);
-  a03=(a06*a09);
+  a07=(a07*a06);
+  a03=(a05*a09);
   a07=(a07+a03);
   a03=(a04*a07);
   a03=(a09+a03);
-  a18=(2.*a03);
-  a18=(a09+a18);
+  a22=(2.*a03);
+  a22=(a09+a22);
   a00=(a04*a09);
-  a00=(a05+a00);
-  a19=(a19*a00);
-  a00=(a06*a03);
-  a19=(a19+a00);
-  a00=(a04*a19);
+  a00=(a06+a00);
+  a18=(a18*a00);
+  a00=(a05*a03);
+  a18=(a18+a00);
+  a00=(a04*a18);
   a00=(a09+a00);
   a08=(2.*a00);
-  a18=(a18+a08);
+  a22=(a22+a08);
   a04=(a04*a03);
-  a04=(a05+a04);
-  a17=(a17*a04);
-  a04=(a06*a00);
-  a17=(a17+a04);
-  a04=(a01*a17);
+  a04=(a06+a04);
+  a16=(a16*a04);
+  a04=(a05*a00);
+  a16=(a16+a04);
+  a04=(a01*a16);
   a04=(a09+a04);
-  a18=(a18+a04);
-  a18=(a02*a18);
-  a18=(a05+a18);
-  if (res[1]!=0) res[1][2]=a18;
-  a19=(2.*a19);
-  a07=(a07+a19);
-  a17=(2.*a17);
-  a07=(a07+a17);
+  a22=(a22+a04);
+  a22=(a02*a22);
+  a22=(a06+a22);
+  if (res[1]!=0) res[1][2]=a22;
+  a18=(2.*a18);
+  a07=(a07+a18);
+  a16=(2.*a16);
+  a07=(a07+a16);
   a01=(a01*a00);
-  a05=(a05+a01);
-  a22=(a22*a05);
-  a06=(a06*a04);
-  a22=(a22+a06);
-  a07=(a07+a22);
+  a06=(a06+a01);
+  a21=(a21*a06);
+  a05=(a05*a04);
+  a21=(a21+a05);
+  a07=(a07+a21);
   a02=(a02*a07);
   a09=(a09+a02);
   if (res[1]!=0) res[1][3]=a09;
@@ -991,7 +1065,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 
 /* lyapunov_period:(y0[2],Q0[2x2],table[6x200],c[3])->(strobe[2],Q[2x2],log_stretch[2],low,high) */
 static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real **res1=res+5, *rr, *w00=w+24, *w01=w+26, w02, *w05=w+30, *w06=w+33, *w07=w+35, w08, w09, w10;
+  casadi_real **res1=res+5, *rr, *w00=w+25, *w01=w+27, w02, *w05=w+31, *w06=w+34, *w07=w+36, w08, w09, w10;
   const casadi_real **arg1=arg+4, *cs, *wr03, *wr04;
   casadi_copy(arg[0], 2, w00);
   casadi_copy(arg[1], 4, w01);
@@ -3412,19 +3486,19 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 
 /* lyapunov_chunk:(y0[2],Q0[2x2],table[6x200],c[3])->(strobe[2x50],Q[2x2],log_stretch[2x50],low[1x50],high[1x50]) */
 static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real **res1=res+5, *rr, *w000=w+1249, *w001=w+1251, w002, *w005=w+1255, *w006=w+1258, *w007=w+1260, w008, w009, w010, *w011=w+1264;
-  casadi_real *w012=w+1266, *w013=w+1268, w014, w015, *w016=w+1270, w017, w018, *w019=w+1272, w020, w021, *w022=w+1274, w023;
-  casadi_real w024, *w025=w+1276, w026, w027, *w028=w+1278, w029, w030, *w031=w+1280, w032, w033, *w034=w+1282, w035;
-  casadi_real w036, *w037=w+1284, w038, w039, *w040=w+1286, w041, w042, *w043=w+1288, w044, w045, *w046=w+1290, w047;
-  casadi_real w048, *w049=w+1292, w050, w051, *w052=w+1294, w053, w054, *w055=w+1296, w056, w057, *w058=w+1298, w059;
-  casadi_real w060, *w061=w+1300, w062, w063, *w064=w+1302, w065, w066, *w067=w+1304, w068, w069, *w070=w+1306, w071;
-  casadi_real w072, *w073=w+1308, w074, w075, *w076=w+1310, w077, w078, *w079=w+1312, w080, w081, *w082=w+1314, w083;
-  casadi_real w084, *w085=w+1316, w086, w087, *w088=w+1318, w089, w090, *w091=w+1320, w092, w093, *w094=w+1322, w095;
-  casadi_real w096, *w097=w+1324, w098, w099, *w100=w+1326, w101, w102, *w103=w+1328, w104, w105, *w106=w+1330, w107;
-  casadi_real w108, *w109=w+1332, w110, w111, *w112=w+1334, w113, w114, *w115=w+1336, w116, w117, *w118=w+1338, w119;
-  casadi_real w120, *w121=w+1340, w122, w123, *w124=w+1342, w125, w126, *w127=w+1344, w128, w129, *w130=w+1346, w131;
-  casadi_real w132, *w133=w+1348, w134, w135, *w136=w+1350, w137, w138, *w139=w+1352, w140, w141, *w142=w+1354, w143;
-  casadi_real w144, *w145=w+1356, w146, w147, *w148=w+1358, w149, w150, *w151=w+1360, w152, w153, *w154=w+1362, w155;
+  casadi_real **res1=res+5, *rr, *w000=w+1250, *w001=w+1252, w002, *w005=w+1256, *w006=w+1259, *w007=w+1261, w008, w009, w010, *w011=w+1265;
+  casadi_real *w012=w+1267, *w013=w+1269, w014, w015, *w016=w+1271, w017, w018, *w019=w+1273, w020, w021, *w022=w+1275, w023;
+  casadi_real w024, *w025=w+1277, w026, w027, *w028=w+1279, w029, w030, *w031=w+1281, w032, w033, *w034=w+1283, w035;
+  casadi_real w036, *w037=w+1285, w038, w039, *w040=w+1287, w041, w042, *w043=w+1289, w044, w045, *w046=w+1291, w047;
+  casadi_real w048, *w049=w+1293, w050, w051, *w052=w+1295, w053, w054, *w055=w+1297, w056, w057, *w058=w+1299, w059;
+  casadi_real w060, *w061=w+1301, w062, w063, *w064=w+1303, w065, w066, *w067=w+1305, w068, w069, *w070=w+1307, w071;
+  casadi_real w072, *w073=w+1309, w074, w075, *w076=w+1311, w077, w078, *w079=w+1313, w080, w081, *w082=w+1315, w083;
+  casadi_real w084, *w085=w+1317, w086, w087, *w088=w+1319, w089, w090, *w091=w+1321, w092, w093, *w094=w+1323, w095;
+  casadi_real w096, *w097=w+1325, w098, w099, *w100=w+1327, w101, w102, *w103=w+1329, w104, w105, *w106=w+1331, w107;
+  casadi_real w108, *w109=w+1333, w110, w111, *w112=w+1335, w113, w114, *w115=w+1337, w116, w117, *w118=w+1339, w119;
+  casadi_real w120, *w121=w+1341, w122, w123, *w124=w+1343, w125, w126, *w127=w+1345, w128, w129, *w130=w+1347, w131;
+  casadi_real w132, *w133=w+1349, w134, w135, *w136=w+1351, w137, w138, *w139=w+1353, w140, w141, *w142=w+1355, w143;
+  casadi_real w144, *w145=w+1357, w146, w147, *w148=w+1359, w149, w150, *w151=w+1361, w152, w153, *w154=w+1363, w155;
   casadi_real w156;
   const casadi_real **arg1=arg+4, *cs, *wr003, *wr004;
   casadi_copy(arg[0], 2, w000);
@@ -6603,7 +6677,7 @@ CASADI_SYMBOL_EXPORT int lyapunov_chunk_work(casadi_int *sz_arg, casadi_int* sz_
   if (sz_arg) *sz_arg = 14;
   if (sz_res) *sz_res = 14;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 1364;
+  if (sz_w) *sz_w = 1365;
   return 0;
 }
 
@@ -6611,7 +6685,7 @@ CASADI_SYMBOL_EXPORT int lyapunov_chunk_work_bytes(casadi_int *sz_arg, casadi_in
   if (sz_arg) *sz_arg = 14*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 14*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 1364*sizeof(casadi_real);
+  if (sz_w) *sz_w = 1365*sizeof(casadi_real);
   return 0;
 }
 
@@ -6688,7 +6762,7 @@ CASADI_SYMBOL_EXPORT int lyapunov_period_work(casadi_int *sz_arg, casadi_int* sz
   if (sz_arg) *sz_arg = 10;
   if (sz_res) *sz_res = 9;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 39;
+  if (sz_w) *sz_w = 40;
   return 0;
 }
 
@@ -6696,7 +6770,7 @@ CASADI_SYMBOL_EXPORT int lyapunov_period_work_bytes(casadi_int *sz_arg, casadi_i
   if (sz_arg) *sz_arg = 10*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 9*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 39*sizeof(casadi_real);
+  if (sz_w) *sz_w = 40*sizeof(casadi_real);
   return 0;
 }
 
@@ -6711,10 +6785,8 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   a03=arg[0]? arg[0][1] : 0;
   a04=2.;
   a04=(a01/a04);
-  a05=arg[3]? arg[3][1] : 0;
-  a06=arg[4]? arg[4][1] : 0;
-  a07=(a06*a03);
-  a05=(a05+a07);
+  a05=arg[4]? arg[4][1] : 0;
+  a06=(a03*a05);
   a07=arg[3]? arg[3][0] : 0;
   a08=0.;
   a09=(a08<=a00);
@@ -6726,31 +6798,32 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   a12=(a12?a13:0);
   a09=(a09+a12);
   a07=(a07*a09);
-  a05=(a05+a07);
-  a07=(a04*a05);
+  a06=(a06+a07);
+  a07=arg[3]? arg[3][1] : 0;
+  a06=(a06+a07);
+  a07=(a04*a06);
   a07=(a03+a07);
   a09=(2.*a07);
   a09=(a03+a09);
-  a12=arg[3]? arg[3][3] : 0;
-  a13=(a06*a07);
-  a13=(a12+a13);
-  a14=arg[3]? arg[3][2] : 0;
-  a15=(a04*a03);
-  a15=(a00+a15);
-  a16=(a08<=a15);
-  a16=(a16?a15:0);
-  a17=(a15<=a11);
-  a15=(a15+a10);
-  a17=(a17?a15:0);
-  a16=(a16+a17);
-  a16=(a14*a16);
-  a13=(a13+a16);
-  a16=(a04*a13);
+  a12=(a07*a05);
+  a13=arg[3]? arg[3][2] : 0;
+  a14=(a04*a03);
+  a14=(a00+a14);
+  a15=(a08<=a14);
+  a15=(a15?a14:0);
+  a16=(a14<=a11);
+  a14=(a14+a10);
+  a16=(a16?a14:0);
+  a15=(a15+a16);
+  a15=(a13*a15);
+  a12=(a12+a15);
+  a15=arg[3]? arg[3][3] : 0;
+  a12=(a12+a15);
+  a16=(a04*a12);
   a16=(a03+a16);
-  a17=(2.*a16);
-  a09=(a09+a17);
-  a17=(a06*a16);
-  a12=(a12+a17);
+  a14=(2.*a16);
+  a09=(a09+a14);
+  a14=(a16*a05);
   a04=(a04*a07);
   a04=(a00+a04);
   a07=(a08<=a04);
@@ -6759,22 +6832,21 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   a04=(a04+a10);
   a17=(a17?a04:0);
   a07=(a07+a17);
-  a14=(a14*a07);
-  a12=(a12+a14);
-  a14=(a01*a12);
-  a14=(a03+a14);
-  a09=(a09+a14);
+  a13=(a13*a07);
+  a14=(a14+a13);
+  a14=(a14+a15);
+  a15=(a01*a14);
+  a15=(a03+a15);
+  a09=(a09+a15);
   a09=(a02*a09);
   a09=(a00+a09);
   if (res[0]!=0) res[0][0]=a09;
-  a13=(2.*a13);
-  a05=(a05+a13);
   a12=(2.*a12);
-  a05=(a05+a12);
-  a12=arg[3]? arg[3][5] : 0;
-  a06=(a06*a14);
-  a12=(a12+a06);
-  a06=arg[3]? arg[3][4] : 0;
+  a06=(a06+a12);
+  a14=(2.*a14);
+  a06=(a06+a14);
+  a15=(a15*a05);
+  a05=arg[3]? arg[3][4] : 0;
   a01=(a01*a16);
   a00=(a00+a01);
   a08=(a08<=a00);
@@ -6783,24 +6855,26 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   a00=(a00+a10);
   a11=(a11?a00:0);
   a08=(a08+a11);
-  a06=(a06*a08);
-  a12=(a12+a06);
-  a05=(a05+a12);
-  a02=(a02*a05);
+  a05=(a05*a08);
+  a15=(a15+a05);
+  a05=arg[3]? arg[3][5] : 0;
+  a15=(a15+a05);
+  a06=(a06+a15);
+  a02=(a02*a06);
   a03=(a03+a02);
   if (res[0]!=0) res[0][1]=a03;
   a03=arg[1]? arg[1][0] : 0;
   a02=(a09<a03);
-  a05=(a02?a09:0);
+  a06=(a02?a09:0);
   a02=(!a02);
   a02=(a02?a03:0);
-  a05=(a05+a02);
-  if (res[1]!=0) res[1][0]=a05;
-  a05=arg[2]? arg[2][0] : 0;
-  a02=(a05<a09);
+  a06=(a06+a02);
+  if (res[1]!=0) res[1][0]=a06;
+  a06=arg[2]? arg[2][0] : 0;
+  a02=(a06<a09);
   a09=(a02?a09:0);
   a02=(!a02);
-  a02=(a02?a05:0);
+  a02=(a02?a06:0);
   a09=(a09+a02);
   if (res[2]!=0) res[2][0]=a09;
   return 0;
@@ -11501,10 +11575,8 @@ static int casadi_f17(const casadi_real** arg, casadi_real** res, casadi_int* iw
   a03=arg[0]? arg[0][1] : 0;
   a04=2.;
   a04=(a01/a04);
-  a05=arg[1]? arg[1][1] : 0;
-  a06=arg[2]? arg[2][1] : 0;
-  a07=(a06*a03);
-  a05=(a05+a07);
+  a05=arg[2]? arg[2][1] : 0;
+  a06=(a03*a05);
   a07=arg[1]? arg[1][0] : 0;
   a08=0.;
   a09=(a08<=a00);
@@ -11516,31 +11588,32 @@ static int casadi_f17(const casadi_real** arg, casadi_real** res, casadi_int* iw
   a12=(a12?a13:0);
   a09=(a09+a12);
   a07=(a07*a09);
-  a05=(a05+a07);
-  a07=(a04*a05);
+  a06=(a06+a07);
+  a07=arg[1]? arg[1][1] : 0;
+  a06=(a06+a07);
+  a07=(a04*a06);
   a07=(a03+a07);
   a09=(2.*a07);
   a09=(a03+a09);
-  a12=arg[1]? arg[1][3] : 0;
-  a13=(a06*a07);
-  a13=(a12+a13);
-  a14=arg[1]? arg[1][2] : 0;
-  a15=(a04*a03);
-  a15=(a00+a15);
-  a16=(a08<=a15);
-  a16=(a16?a15:0);
-  a17=(a15<=a11);
-  a15=(a15+a10);
-  a17=(a17?a15:0);
-  a16=(a16+a17);
-  a16=(a14*a16);
-  a13=(a13+a16);
-  a16=(a04*a13);
+  a12=(a07*a05);
+  a13=arg[1]? arg[1][2] : 0;
+  a14=(a04*a03);
+  a14=(a00+a14);
+  a15=(a08<=a14);
+  a15=(a15?a14:0);
+  a16=(a14<=a11);
+  a14=(a14+a10);
+  a16=(a16?a14:0);
+  a15=(a15+a16);
+  a15=(a13*a15);
+  a12=(a12+a15);
+  a15=arg[1]? arg[1][3] : 0;
+  a12=(a12+a15);
+  a16=(a04*a12);
   a16=(a03+a16);
-  a17=(2.*a16);
-  a09=(a09+a17);
-  a17=(a06*a16);
-  a12=(a12+a17);
+  a14=(2.*a16);
+  a09=(a09+a14);
+  a14=(a16*a05);
   a04=(a04*a07);
   a04=(a00+a04);
   a07=(a08<=a04);
@@ -11549,22 +11622,21 @@ static int casadi_f17(const casadi_real** arg, casadi_real** res, casadi_int* iw
   a04=(a04+a10);
   a17=(a17?a04:0);
   a07=(a07+a17);
-  a14=(a14*a07);
-  a12=(a12+a14);
-  a14=(a01*a12);
-  a14=(a03+a14);
-  a09=(a09+a14);
+  a13=(a13*a07);
+  a14=(a14+a13);
+  a14=(a14+a15);
+  a15=(a01*a14);
+  a15=(a03+a15);
+  a09=(a09+a15);
   a09=(a02*a09);
   a09=(a00+a09);
   if (res[0]!=0) res[0][0]=a09;
-  a13=(2.*a13);
-  a05=(a05+a13);
   a12=(2.*a12);
-  a05=(a05+a12);
-  a12=arg[1]? arg[1][5] : 0;
-  a06=(a06*a14);
-  a12=(a12+a06);
-  a06=arg[1]? arg[1][4] : 0;
+  a06=(a06+a12);
+  a14=(2.*a14);
+  a06=(a06+a14);
+  a15=(a15*a05);
+  a05=arg[1]? arg[1][4] : 0;
   a01=(a01*a16);
   a00=(a00+a01);
   a08=(a08<=a00);
@@ -11573,10 +11645,12 @@ static int casadi_f17(const casadi_real** arg, casadi_real** res, casadi_int* iw
   a00=(a00+a10);
   a11=(a11?a00:0);
   a08=(a08+a11);
-  a06=(a06*a08);
-  a12=(a12+a06);
-  a05=(a05+a12);
-  a02=(a02*a05);
+  a05=(a05*a08);
+  a15=(a15+a05);
+  a05=arg[1]? arg[1][5] : 0;
+  a15=(a15+a05);
+  a06=(a06+a15);
+  a02=(a02*a06);
   a03=(a03+a02);
   if (res[0]!=0) res[0][1]=a03;
   return 0;
