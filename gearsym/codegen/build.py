@@ -25,7 +25,7 @@ from .native import load_native
 BACKENDS = ("auto", "compiled", "in-process")
 
 #: every function the generated library exports
-FUNCTION_NAMES = ("rhs", "jacobian", "constants", "table", "table_point", "lyapunov_chunk", "lyapunov_period",
+FUNCTION_NAMES = ("rhs", "jacobian", "constants", "table", "lyapunov_chunk", "lyapunov_period",
                   "orbit_chunk", "orbit_period", "trajectory")
 
 _LOADED: dict[tuple, CompiledModel] = {}

@@ -122,26 +122,23 @@ class CompiledModel:
                                f"({', '.join(self.parameter_names)}), got shape {p.shape}")
         if self.native:
             c, period = self.native["constants"](p)
-            (table,) = self.native["table"](np.array([float(t0)]), p)
+            table, probe = self.native["table"](np.array([float(t0)]), p)
         else:
             c, period = (np.array(v) for v in self.functions["constants"](p))
-            table = np.asfortranarray(np.array(self.functions["table"](t0, p)))
+            table, probe = (np.asfortranarray(np.array(v)) for v in self.functions["table"](t0, p))
         period = float(period.reshape(-1)[0])
         if not (np.isfinite(period) and period > 0):
             raise ModelError(f"the forcing period is {period} at these parameter values; it must be positive",
                              self.name)
-        self._check_periodic(p, float(t0), period)
+        self._check_periodic(p, float(t0), period, probe)
         return RunInputs(p, np.asfortranarray(table, dtype=np.float64), np.ascontiguousarray(c.reshape(-1)),
                          period, float(t0), self.hash)
 
-    def _check_periodic(self, p: np.ndarray, t0: float, period: float) -> None:
+    def _check_periodic(self, p: np.ndarray, t0: float, period: float, probe: np.ndarray) -> None:
         """The loops repeat one sampled period; at other parameter values than the defaults
-        (checked when the code was generated) the time dependence must still repeat."""
-        points = (t0 + 0.37 * period, t0 + 1.37 * period)
-        if self.native:
-            a, b = (self.native["table_point"](np.array([t]), p)[0].reshape(-1) for t in points)
-        else:
-            a, b = (np.array(self.functions["table_point"](t, p)).reshape(-1) for t in points)
+        (checked when the code was generated) the time dependence must still repeat.
+        ``probe`` holds the tables at t0 + 0.37 T and one period later."""
+        a, b = probe[:, 0], probe[:, 1]
         off = np.nonzero(~(np.abs(a - b) <= 1e-9 * (1 + np.abs(a))))[0]
         if off.size:
             from .time_tables import NotPeriodicError, split_rhs
@@ -149,7 +146,7 @@ class CompiledModel:
             i = int(off[0])
             expr = split_rhs(self.system).tables[i][1]
             values = ", ".join(f"{n}={v:g}" for n, v in zip(self.parameter_names, p))
-            raise NotPeriodicError(self.system, expr, points[0], float(a[i]), float(b[i]), f"at {values}")
+            raise NotPeriodicError(self.system, expr, t0 + 0.37 * period, float(a[i]), float(b[i]), f"at {values}")
 
     def _check_inputs(self, inputs: RunInputs) -> None:
         if inputs.model_hash != self.hash:
@@ -207,20 +204,22 @@ class CompiledModel:
         tangent vectors (``Qs``: two n x n buffers), Q ping-pongs between the two.
         """
         n = self.dimension
-        table = np.asfortranarray(inputs.table)
-        shared = [table.ctypes.data, inputs.constants.ctypes.data]
-        y_addr, col, stride = y.ctypes.data, 0, [o.shape[0] * 8 for o in outputs]
+        shared = [inputs.table.ctypes.data, inputs.constants.ctypes.data]  # RunInputs keeps both contiguous
+        bases, strides = [o.ctypes.data for o in outputs], [o.shape[0] * 8 for o in outputs]
+        Q_addr = [q.ctypes.data for q in Qs]
+        y_addr, col, strobe_base = y.ctypes.data, 0, strobe.ctypes.data
         for fname, count in schedule:
             f, width = self.native[fname], (self.options.chunk_periods if fname.endswith("chunk") else 1)
             for _ in range(count):
-                at = [o.ctypes.data + col * s for o, s in zip(outputs, stride)]
+                at = [b + col * s for b, s in zip(bases, strides)]
                 if Qs:
-                    f.call([y_addr, Qs[0].ctypes.data, *shared], [at[0], Qs[1].ctypes.data, *at[1:]])
+                    f.call([y_addr, Q_addr[0], *shared], [at[0], Q_addr[1], *at[1:]])
+                    Q_addr.reverse()
                     Qs.reverse()
                 else:
                     f.call([y_addr, *shared], at)
                 col += width
-                y_addr = strobe.ctypes.data + (col - 1) * n * 8
+                y_addr = strobe_base + (col - 1) * n * 8
         return Qs[0] if Qs else None
 
     def orbit_run(self, y0, periods: int, inputs: RunInputs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -236,10 +236,13 @@ class NondimensionalModel:
         return self._number(name, value, "value")
 
     def _number(self, name: str, value: ExprLike, what: str) -> float:
-        expr = to_expr(value, f"{what} of {name}")
-        if not expr.is_number:
-            raise ModelError(f"the {what} must be a number, got {value!r}", f"parameter {name!r}")
-        number = float(expr)
+        if isinstance(value, (int, float)) and not isinstance(value, bool):  # sweeps: no parsing per point
+            number = float(value)
+        else:
+            expr = to_expr(value, f"{what} of {name}")
+            if not expr.is_number:
+                raise ModelError(f"the {what} must be a number, got {value!r}", f"parameter {name!r}")
+            number = float(expr)
         zero_ok, meaning = self._constraints.get(name, (True, None))
         must = sign_violation(number, zero_ok) if meaning else None
         if must:

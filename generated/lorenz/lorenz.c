@@ -38,7 +38,6 @@ extern "C" {
 #define casadi_f13 CASADI_PREFIX(f13)
 #define casadi_f14 CASADI_PREFIX(f14)
 #define casadi_f15 CASADI_PREFIX(f15)
-#define casadi_f16 CASADI_PREFIX(f16)
 #define casadi_f2 CASADI_PREFIX(f2)
 #define casadi_f3 CASADI_PREFIX(f3)
 #define casadi_f4 CASADI_PREFIX(f4)
@@ -100,7 +99,7 @@ static const casadi_int casadi_s1[3] = {3, 1, 1};
 static const casadi_int casadi_s2[3] = {3, 3, 1};
 static const casadi_int casadi_s3[3] = {4, 1, 1};
 static const casadi_int casadi_s4[3] = {0, 200, 1};
-static const casadi_int casadi_s5[3] = {0, 1, 1};
+static const casadi_int casadi_s5[3] = {0, 2, 1};
 static const casadi_int casadi_s6[3] = {3, 50, 1};
 static const casadi_int casadi_s7[3] = {3, 200, 1};
 
@@ -397,7 +396,7 @@ CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz
   return 0;
 }
 
-/* table:(t0,p[3])->(table[0x200]) */
+/* table:(t0,p[3])->(table[0x200],probe[0x2]) */
 static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   return 0;
 }
@@ -421,7 +420,7 @@ CASADI_SYMBOL_EXPORT void table_decref(void) {
 
 CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
 
-CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 1;}
+CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
 
 CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
   switch (i) {
@@ -440,6 +439,7 @@ CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
 CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
   switch (i) {
     case 0: return "table";
+    case 1: return "probe";
     default: return 0;
   }
 }
@@ -455,13 +455,14 @@ CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
 CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
   switch (i) {
     case 0: return casadi_s4;
+    case 1: return casadi_s5;
     default: return 0;
   }
 }
 
 CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 2;
-  if (sz_res) *sz_res = 1;
+  if (sz_res) *sz_res = 2;
   if (sz_iw) *sz_iw = 0;
   if (sz_w) *sz_w = 0;
   return 0;
@@ -469,92 +470,14 @@ CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casa
 
 CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 2*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* table_point:(t,p[3])->(values[0]) */
-static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table_point(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f4(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int table_point_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void table_point_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void table_point_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void table_point_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int table_point_n_in(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_int table_point_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real table_point_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_point_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_point_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "values";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_point_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s1;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_point_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s5;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int table_point_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 2;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table_point_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 2*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_res) *sz_res = 2*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
   if (sz_w) *sz_w = 0*sizeof(casadi_real);
   return 0;
 }
 
 /* tangent_block:(i0[3],i1[3x3],i2[3],i3[3],i4[0],i5[4])->(o0[3],o1[3x3],o2[3],o3[3]) */
-static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
@@ -968,7 +891,7 @@ static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 }
 
 /* gram_schmidt:(i0[3x3])->(o0[3x3],o1[3]) */
-static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12;
   a00=arg[0]? arg[0][0] : 0;
@@ -1059,7 +982,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 }
 
 /* lyapunov_period:(y0[3],Q0[3x3],table[0x200],c[4])->(strobe[3],Q[3x3],log_stretch[3],low[3],high[3]) */
-static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real **res1=res+5, *rr, *w00=w+36, *w01=w+39, w02, w03, w04, *w05=w+48, *w07=w+51, *w08=w+55, *w09=w+58, *w10=w+67;
   casadi_real *w11=w+70, *w12=w+73;
   const casadi_real **arg1=arg+4, *cs, *wr01;
@@ -1083,7 +1006,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1094,7 +1017,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1105,7 +1028,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1116,7 +1039,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1127,7 +1050,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1138,7 +1061,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1149,7 +1072,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1160,7 +1083,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1171,7 +1094,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1182,7 +1105,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1193,7 +1116,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1204,7 +1127,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1215,7 +1138,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1226,7 +1149,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1237,7 +1160,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1248,7 +1171,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1259,7 +1182,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1270,7 +1193,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1281,7 +1204,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1292,7 +1215,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1303,7 +1226,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1314,7 +1237,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1325,7 +1248,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1336,7 +1259,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1347,7 +1270,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1358,7 +1281,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1369,7 +1292,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1380,7 +1303,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1391,7 +1314,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1402,7 +1325,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1413,7 +1336,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1424,7 +1347,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1435,7 +1358,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1446,7 +1369,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1457,7 +1380,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1468,7 +1391,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1479,7 +1402,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1490,7 +1413,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1501,7 +1424,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1512,7 +1435,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1523,7 +1446,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1534,7 +1457,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1545,7 +1468,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1556,7 +1479,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1567,7 +1490,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1578,7 +1501,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1589,7 +1512,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1600,7 +1523,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1611,7 +1534,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1622,7 +1545,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1633,7 +1556,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1644,7 +1567,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1655,7 +1578,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1666,7 +1589,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1677,7 +1600,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1688,7 +1611,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1699,7 +1622,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1710,7 +1633,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1721,7 +1644,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1732,7 +1655,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1743,7 +1666,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1754,7 +1677,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1765,7 +1688,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1776,7 +1699,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1787,7 +1710,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1798,7 +1721,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1809,7 +1732,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1820,7 +1743,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1831,7 +1754,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1842,7 +1765,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1853,7 +1776,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1864,7 +1787,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1875,7 +1798,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1886,7 +1809,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1897,7 +1820,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1908,7 +1831,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1919,7 +1842,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1930,7 +1853,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1941,7 +1864,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1952,7 +1875,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1963,7 +1886,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1974,7 +1897,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -1985,7 +1908,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -1996,7 +1919,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2007,7 +1930,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2018,7 +1941,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2029,7 +1952,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2040,7 +1963,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2051,7 +1974,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2062,7 +1985,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2073,7 +1996,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2084,7 +2007,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2095,7 +2018,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2106,7 +2029,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2117,7 +2040,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2128,7 +2051,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2139,7 +2062,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2150,7 +2073,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2161,7 +2084,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2172,7 +2095,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2183,7 +2106,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2194,7 +2117,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2205,7 +2128,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2216,7 +2139,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2227,7 +2150,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2238,7 +2161,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2249,7 +2172,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2260,7 +2183,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2271,7 +2194,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2282,7 +2205,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2293,7 +2216,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2304,7 +2227,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2315,7 +2238,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2326,7 +2249,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2337,7 +2260,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2348,7 +2271,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2359,7 +2282,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2370,7 +2293,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2381,7 +2304,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2392,7 +2315,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2403,7 +2326,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2414,7 +2337,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2425,7 +2348,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2436,7 +2359,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2447,7 +2370,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2458,7 +2381,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2469,7 +2392,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2480,7 +2403,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2491,7 +2414,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2502,7 +2425,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2513,7 +2436,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2524,7 +2447,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2535,7 +2458,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2546,7 +2469,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2557,7 +2480,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2568,7 +2491,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2579,7 +2502,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2590,7 +2513,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2601,7 +2524,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2612,7 +2535,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2623,7 +2546,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2634,7 +2557,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2645,7 +2568,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2656,7 +2579,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2667,7 +2590,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2678,7 +2601,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2689,7 +2612,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2700,7 +2623,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2711,7 +2634,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2722,7 +2645,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2733,7 +2656,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2744,7 +2667,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2755,7 +2678,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2766,7 +2689,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2777,7 +2700,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2788,7 +2711,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2799,7 +2722,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2810,7 +2733,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2821,7 +2744,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2832,7 +2755,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2843,7 +2766,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2854,7 +2777,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2865,7 +2788,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2876,7 +2799,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2887,7 +2810,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2898,7 +2821,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2909,7 +2832,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2920,7 +2843,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2931,7 +2854,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2942,7 +2865,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2953,7 +2876,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2964,7 +2887,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2975,7 +2898,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -2986,7 +2909,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -2997,7 +2920,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3008,7 +2931,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3019,7 +2942,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3030,7 +2953,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3041,7 +2964,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3052,7 +2975,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3063,7 +2986,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3074,7 +2997,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3085,7 +3008,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3096,7 +3019,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3107,7 +3030,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3118,7 +3041,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3129,7 +3052,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3140,7 +3063,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3151,7 +3074,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3162,7 +3085,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3173,7 +3096,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3184,7 +3107,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3195,7 +3118,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3206,7 +3129,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3217,7 +3140,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3228,7 +3151,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3239,7 +3162,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3250,7 +3173,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w01;
   arg1[2]=w05;
@@ -3261,7 +3184,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w09;
   res1[2]=w10;
   res1[3]=w11;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w08;
   arg1[1]=w09;
   arg1[2]=w10;
@@ -3272,12 +3195,12 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w01;
   res1[2]=w05;
   res1[3]=w12;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w00, 3, res[0]);
   arg1[0]=w01;
   res1[0]=w09;
   res1[1]=w00;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w09, 9, res[1]);
   casadi_copy(w00, 3, res[2]);
   casadi_copy(w05, 3, res[3]);
@@ -3286,7 +3209,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 }
 
 /* lyapunov_chunk:(y0[3],Q0[3x3],table[0x200],c[4])->(strobe[3x50],Q[3x3],log_stretch[3x50],low[3x50],high[3x50]) */
-static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real **res1=res+5, *rr, *w000=w+79, *w001=w+82, w002, w003, w004, *w005=w+91, *w007=w+94, *w008=w+98, *w009=w+101, *w010=w+110;
   casadi_real *w011=w+113, *w012=w+116, *w013=w+119, *w014=w+122, *w015=w+125, *w016=w+128, *w017=w+131, *w018=w+134, *w019=w+137, *w020=w+140, *w021=w+143, *w022=w+146;
   casadi_real *w023=w+149, *w024=w+152, *w025=w+155, *w026=w+158, *w027=w+161, *w028=w+164, *w029=w+167, *w030=w+170, *w031=w+173, *w032=w+176, *w033=w+179, *w034=w+182;
@@ -3322,7 +3245,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3333,7 +3256,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3344,7 +3267,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3355,7 +3278,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3366,7 +3289,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3377,7 +3300,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3388,7 +3311,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3399,7 +3322,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3410,7 +3333,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3421,7 +3344,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3432,7 +3355,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3443,7 +3366,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3454,7 +3377,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3465,7 +3388,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3476,7 +3399,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3487,7 +3410,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3498,7 +3421,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3509,7 +3432,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3520,7 +3443,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3531,7 +3454,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3542,7 +3465,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3553,7 +3476,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3564,7 +3487,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3575,7 +3498,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3586,7 +3509,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3597,7 +3520,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3608,7 +3531,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3619,7 +3542,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3630,7 +3553,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3641,7 +3564,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3652,7 +3575,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3663,7 +3586,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3674,7 +3597,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3685,7 +3608,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3696,7 +3619,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3707,7 +3630,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3718,7 +3641,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3729,7 +3652,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3740,7 +3663,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3751,7 +3674,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3762,7 +3685,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3773,7 +3696,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3784,7 +3707,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3795,7 +3718,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3806,7 +3729,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3817,7 +3740,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3828,7 +3751,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3839,7 +3762,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3850,7 +3773,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3861,7 +3784,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3872,7 +3795,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3883,7 +3806,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3894,7 +3817,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3905,7 +3828,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3916,7 +3839,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3927,7 +3850,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3938,7 +3861,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3949,7 +3872,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3960,7 +3883,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3971,7 +3894,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -3982,7 +3905,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -3993,7 +3916,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4004,7 +3927,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4015,7 +3938,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4026,7 +3949,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4037,7 +3960,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4048,7 +3971,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4059,7 +3982,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4070,7 +3993,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4081,7 +4004,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4092,7 +4015,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4103,7 +4026,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4114,7 +4037,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4125,7 +4048,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4136,7 +4059,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4147,7 +4070,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4158,7 +4081,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4169,7 +4092,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4180,7 +4103,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4191,7 +4114,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4202,7 +4125,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4213,7 +4136,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4224,7 +4147,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4235,7 +4158,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4246,7 +4169,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4257,7 +4180,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4268,7 +4191,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4279,7 +4202,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4290,7 +4213,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4301,7 +4224,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4312,7 +4235,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4323,7 +4246,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4334,7 +4257,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4345,7 +4268,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4356,7 +4279,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4367,7 +4290,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4378,7 +4301,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4389,7 +4312,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4400,7 +4323,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4411,7 +4334,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4422,7 +4345,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4433,7 +4356,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4444,7 +4367,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4455,7 +4378,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4466,7 +4389,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4477,7 +4400,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4488,7 +4411,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4499,7 +4422,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4510,7 +4433,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4521,7 +4444,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4532,7 +4455,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4543,7 +4466,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4554,7 +4477,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4565,7 +4488,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4576,7 +4499,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4587,7 +4510,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4598,7 +4521,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4609,7 +4532,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4620,7 +4543,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4631,7 +4554,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4642,7 +4565,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4653,7 +4576,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4664,7 +4587,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4675,7 +4598,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4686,7 +4609,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4697,7 +4620,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4708,7 +4631,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4719,7 +4642,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4730,7 +4653,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4741,7 +4664,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4752,7 +4675,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4763,7 +4686,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4774,7 +4697,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4785,7 +4708,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4796,7 +4719,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4807,7 +4730,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4818,7 +4741,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4829,7 +4752,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4840,7 +4763,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4851,7 +4774,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4862,7 +4785,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4873,7 +4796,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4884,7 +4807,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4895,7 +4818,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4906,7 +4829,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4917,7 +4840,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4928,7 +4851,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4939,7 +4862,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4950,7 +4873,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4961,7 +4884,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4972,7 +4895,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -4983,7 +4906,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -4994,7 +4917,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5005,7 +4928,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5016,7 +4939,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5027,7 +4950,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5038,7 +4961,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5049,7 +4972,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5060,7 +4983,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5071,7 +4994,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5082,7 +5005,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5093,7 +5016,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5104,7 +5027,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5115,7 +5038,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5126,7 +5049,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5137,7 +5060,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5148,7 +5071,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5159,7 +5082,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5170,7 +5093,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5181,7 +5104,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5192,7 +5115,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5203,7 +5126,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5214,7 +5137,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5225,7 +5148,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5236,7 +5159,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5247,7 +5170,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5258,7 +5181,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5269,7 +5192,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5280,7 +5203,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5291,7 +5214,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5302,7 +5225,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5313,7 +5236,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5324,7 +5247,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5335,7 +5258,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5346,7 +5269,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5357,7 +5280,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5368,7 +5291,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5379,7 +5302,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5390,7 +5313,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5401,7 +5324,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5412,7 +5335,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5423,7 +5346,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5434,7 +5357,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5445,7 +5368,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5456,7 +5379,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5467,7 +5390,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5478,7 +5401,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5489,7 +5412,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w001;
   arg1[2]=w005;
@@ -5500,7 +5423,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w009;
   res1[2]=w010;
   res1[3]=w011;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w008;
   arg1[1]=w009;
   arg1[2]=w010;
@@ -5511,12 +5434,12 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[1]=w001;
   res1[2]=w005;
   res1[3]=w012;
-  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w000, 3, res[0]);
   arg1[0]=w001;
   res1[0]=w009;
   res1[1]=w008;
-  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f6(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w009;
   arg1[2]=0;
@@ -5526,7 +5449,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w011;
   res1[3]=w013;
   res1[4]=w014;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+3);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5537,7 +5460,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w015;
   res1[3]=w016;
   res1[4]=w017;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+6);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5548,7 +5471,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w018;
   res1[3]=w019;
   res1[4]=w020;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+9);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5559,7 +5482,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w021;
   res1[3]=w022;
   res1[4]=w023;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+12);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5570,7 +5493,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w024;
   res1[3]=w025;
   res1[4]=w026;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+15);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5581,7 +5504,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w027;
   res1[3]=w028;
   res1[4]=w029;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+18);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5592,7 +5515,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w030;
   res1[3]=w031;
   res1[4]=w032;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+21);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5603,7 +5526,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w033;
   res1[3]=w034;
   res1[4]=w035;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+24);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5614,7 +5537,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w036;
   res1[3]=w037;
   res1[4]=w038;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+27);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5625,7 +5548,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w039;
   res1[3]=w040;
   res1[4]=w041;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+30);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5636,7 +5559,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w042;
   res1[3]=w043;
   res1[4]=w044;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+33);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5647,7 +5570,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w045;
   res1[3]=w046;
   res1[4]=w047;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+36);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5658,7 +5581,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w048;
   res1[3]=w049;
   res1[4]=w050;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+39);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5669,7 +5592,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w051;
   res1[3]=w052;
   res1[4]=w053;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+42);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5680,7 +5603,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w054;
   res1[3]=w055;
   res1[4]=w056;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+45);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5691,7 +5614,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w057;
   res1[3]=w058;
   res1[4]=w059;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+48);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5702,7 +5625,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w060;
   res1[3]=w061;
   res1[4]=w062;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+51);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5713,7 +5636,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w063;
   res1[3]=w064;
   res1[4]=w065;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+54);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5724,7 +5647,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w066;
   res1[3]=w067;
   res1[4]=w068;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+57);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5735,7 +5658,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w069;
   res1[3]=w070;
   res1[4]=w071;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+60);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5746,7 +5669,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w072;
   res1[3]=w073;
   res1[4]=w074;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+63);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5757,7 +5680,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w075;
   res1[3]=w076;
   res1[4]=w077;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+66);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5768,7 +5691,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w078;
   res1[3]=w079;
   res1[4]=w080;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+69);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5779,7 +5702,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w081;
   res1[3]=w082;
   res1[4]=w083;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+72);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5790,7 +5713,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w084;
   res1[3]=w085;
   res1[4]=w086;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+75);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5801,7 +5724,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w087;
   res1[3]=w088;
   res1[4]=w089;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+78);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5812,7 +5735,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w090;
   res1[3]=w091;
   res1[4]=w092;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+81);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5823,7 +5746,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w093;
   res1[3]=w094;
   res1[4]=w095;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+84);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5834,7 +5757,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w096;
   res1[3]=w097;
   res1[4]=w098;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+87);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5845,7 +5768,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w099;
   res1[3]=w100;
   res1[4]=w101;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+90);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5856,7 +5779,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w102;
   res1[3]=w103;
   res1[4]=w104;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+93);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5867,7 +5790,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w105;
   res1[3]=w106;
   res1[4]=w107;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+96);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5878,7 +5801,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w108;
   res1[3]=w109;
   res1[4]=w110;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+99);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5889,7 +5812,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w111;
   res1[3]=w112;
   res1[4]=w113;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+102);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5900,7 +5823,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w114;
   res1[3]=w115;
   res1[4]=w116;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+105);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5911,7 +5834,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w117;
   res1[3]=w118;
   res1[4]=w119;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+108);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5922,7 +5845,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w120;
   res1[3]=w121;
   res1[4]=w122;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+111);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5933,7 +5856,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w123;
   res1[3]=w124;
   res1[4]=w125;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+114);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5944,7 +5867,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w126;
   res1[3]=w127;
   res1[4]=w128;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+117);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5955,7 +5878,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w129;
   res1[3]=w130;
   res1[4]=w131;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+120);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5966,7 +5889,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w132;
   res1[3]=w133;
   res1[4]=w134;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+123);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5977,7 +5900,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w135;
   res1[3]=w136;
   res1[4]=w137;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+126);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -5988,7 +5911,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w138;
   res1[3]=w139;
   res1[4]=w140;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+129);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -5999,7 +5922,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w141;
   res1[3]=w142;
   res1[4]=w143;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+132);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -6010,7 +5933,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w144;
   res1[3]=w145;
   res1[4]=w146;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+135);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -6021,7 +5944,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w147;
   res1[3]=w148;
   res1[4]=w149;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+138);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -6032,7 +5955,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w150;
   res1[3]=w151;
   res1[4]=w152;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+141);
   arg1[0]=w010;
   arg1[1]=w001;
@@ -6043,7 +5966,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w153;
   res1[3]=w154;
   res1[4]=w155;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+144);
   arg1[0]=w000;
   arg1[1]=w009;
@@ -6054,7 +5977,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[2]=w156;
   res1[3]=w157;
   res1[4]=w158;
-  if (casadi_f8(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f7(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w010, 3, res[0]+147);
   casadi_copy(w001, 9, res[1]);
   casadi_copy(w008, 3, res[2]);
@@ -6211,7 +6134,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_chunk(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f5(arg, res, iw, w, mem);
+  return casadi_f4(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_chunk_checkout(void) {
@@ -6296,7 +6219,7 @@ CASADI_SYMBOL_EXPORT int lyapunov_chunk_work_bytes(casadi_int *sz_arg, casadi_in
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f8(arg, res, iw, w, mem);
+  return casadi_f7(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period_checkout(void) {
@@ -6381,7 +6304,7 @@ CASADI_SYMBOL_EXPORT int lyapunov_period_work_bytes(casadi_int *sz_arg, casadi_i
 }
 
 /* state_block:(i0[3],i1[3],i2[3],i3[0],i4[4])->(o0[3],o1[3],o2[3]) */
-static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19;
   a00=arg[0]? arg[0][0] : 0;
@@ -6515,7 +6438,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 /* orbit_period:(y0[3],table[0x200],c[4])->(strobe[3],low[3],high[3]) */
-static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real **res1=res+3, *rr, *w00=w+20, w01, w02, w03, *w04=w+23, *w06=w+26, *w07=w+30, *w08=w+33, *w09=w+36, *w10=w+39;
   const casadi_real **arg1=arg+3, *cs;
   casadi_copy(arg[0], 3, w00);
@@ -6535,7 +6458,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6544,7 +6467,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6553,7 +6476,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6562,7 +6485,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6571,7 +6494,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6580,7 +6503,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6589,7 +6512,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6598,7 +6521,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6607,7 +6530,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6616,7 +6539,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6625,7 +6548,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6634,7 +6557,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6643,7 +6566,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6652,7 +6575,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6661,7 +6584,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6670,7 +6593,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6679,7 +6602,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6688,7 +6611,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6697,7 +6620,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6706,7 +6629,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6715,7 +6638,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6724,7 +6647,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6733,7 +6656,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6742,7 +6665,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6751,7 +6674,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6760,7 +6683,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6769,7 +6692,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6778,7 +6701,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6787,7 +6710,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6796,7 +6719,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6805,7 +6728,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6814,7 +6737,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6823,7 +6746,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6832,7 +6755,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6841,7 +6764,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6850,7 +6773,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6859,7 +6782,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6868,7 +6791,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6877,7 +6800,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6886,7 +6809,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6895,7 +6818,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6904,7 +6827,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6913,7 +6836,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6922,7 +6845,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6931,7 +6854,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6940,7 +6863,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6949,7 +6872,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6958,7 +6881,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6967,7 +6890,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6976,7 +6899,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -6985,7 +6908,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -6994,7 +6917,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7003,7 +6926,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7012,7 +6935,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7021,7 +6944,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7030,7 +6953,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7039,7 +6962,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7048,7 +6971,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7057,7 +6980,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7066,7 +6989,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7075,7 +6998,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7084,7 +7007,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7093,7 +7016,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7102,7 +7025,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7111,7 +7034,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7120,7 +7043,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7129,7 +7052,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7138,7 +7061,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7147,7 +7070,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7156,7 +7079,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7165,7 +7088,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7174,7 +7097,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7183,7 +7106,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7192,7 +7115,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7201,7 +7124,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7210,7 +7133,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7219,7 +7142,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7228,7 +7151,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7237,7 +7160,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7246,7 +7169,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7255,7 +7178,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7264,7 +7187,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7273,7 +7196,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7282,7 +7205,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7291,7 +7214,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7300,7 +7223,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7309,7 +7232,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7318,7 +7241,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7327,7 +7250,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7336,7 +7259,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7345,7 +7268,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7354,7 +7277,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7363,7 +7286,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7372,7 +7295,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7381,7 +7304,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7390,7 +7313,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7399,7 +7322,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7408,7 +7331,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7417,7 +7340,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7426,7 +7349,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7435,7 +7358,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7444,7 +7367,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7453,7 +7376,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7462,7 +7385,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7471,7 +7394,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7480,7 +7403,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7489,7 +7412,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7498,7 +7421,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7507,7 +7430,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7516,7 +7439,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7525,7 +7448,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7534,7 +7457,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7543,7 +7466,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7552,7 +7475,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7561,7 +7484,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7570,7 +7493,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7579,7 +7502,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7588,7 +7511,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7597,7 +7520,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7606,7 +7529,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7615,7 +7538,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7624,7 +7547,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7633,7 +7556,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7642,7 +7565,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7651,7 +7574,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7660,7 +7583,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7669,7 +7592,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7678,7 +7601,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7687,7 +7610,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7696,7 +7619,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7705,7 +7628,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7714,7 +7637,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7723,7 +7646,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7732,7 +7655,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7741,7 +7664,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7750,7 +7673,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7759,7 +7682,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7768,7 +7691,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7777,7 +7700,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7786,7 +7709,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7795,7 +7718,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7804,7 +7727,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7813,7 +7736,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7822,7 +7745,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7831,7 +7754,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7840,7 +7763,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7849,7 +7772,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7858,7 +7781,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7867,7 +7790,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7876,7 +7799,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7885,7 +7808,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7894,7 +7817,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7903,7 +7826,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7912,7 +7835,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7921,7 +7844,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7930,7 +7853,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7939,7 +7862,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7948,7 +7871,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7957,7 +7880,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7966,7 +7889,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7975,7 +7898,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -7984,7 +7907,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -7993,7 +7916,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8002,7 +7925,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8011,7 +7934,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8020,7 +7943,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8029,7 +7952,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8038,7 +7961,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8047,7 +7970,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8056,7 +7979,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8065,7 +7988,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8074,7 +7997,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8083,7 +8006,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8092,7 +8015,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8101,7 +8024,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8110,7 +8033,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8119,7 +8042,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8128,7 +8051,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8137,7 +8060,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8146,7 +8069,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8155,7 +8078,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8164,7 +8087,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8173,7 +8096,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8182,7 +8105,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8191,7 +8114,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8200,7 +8123,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8209,7 +8132,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8218,7 +8141,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8227,7 +8150,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8236,7 +8159,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8245,7 +8168,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8254,7 +8177,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8263,7 +8186,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8272,7 +8195,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8281,7 +8204,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8290,7 +8213,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8299,7 +8222,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8308,7 +8231,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w00;
   arg1[1]=w04;
   arg1[2]=w10;
@@ -8317,7 +8240,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w07;
   res1[1]=w08;
   res1[2]=w09;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w07;
   arg1[1]=w08;
   arg1[2]=w09;
@@ -8326,7 +8249,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
   res1[0]=w00;
   res1[1]=w04;
   res1[2]=w10;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w00, 3, res[0]);
   casadi_copy(w04, 3, res[1]);
   casadi_copy(w10, 3, res[2]);
@@ -8334,7 +8257,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 /* orbit_chunk:(y0[3],table[0x200],c[4])->(strobe[3x50],low[3x50],high[3x50]) */
-static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real **res1=res+3, *rr, *w000=w+45, w001, w002, w003, *w004=w+48, *w006=w+51, *w007=w+55, *w008=w+58, *w009=w+61, *w010=w+64;
   casadi_real *w011=w+67, *w012=w+70, *w013=w+73, *w014=w+76, *w015=w+79, *w016=w+82, *w017=w+85, *w018=w+88, *w019=w+91, *w020=w+94, *w021=w+97, *w022=w+100;
   casadi_real *w023=w+103, *w024=w+106, *w025=w+109, *w026=w+112, *w027=w+115, *w028=w+118, *w029=w+121, *w030=w+124, *w031=w+127, *w032=w+130, *w033=w+133, *w034=w+136;
@@ -8362,7 +8285,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8371,7 +8294,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8380,7 +8303,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8389,7 +8312,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8398,7 +8321,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8407,7 +8330,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8416,7 +8339,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8425,7 +8348,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8434,7 +8357,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8443,7 +8366,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8452,7 +8375,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8461,7 +8384,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8470,7 +8393,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8479,7 +8402,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8488,7 +8411,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8497,7 +8420,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8506,7 +8429,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8515,7 +8438,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8524,7 +8447,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8533,7 +8456,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8542,7 +8465,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8551,7 +8474,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8560,7 +8483,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8569,7 +8492,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8578,7 +8501,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8587,7 +8510,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8596,7 +8519,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8605,7 +8528,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8614,7 +8537,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8623,7 +8546,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8632,7 +8555,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8641,7 +8564,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8650,7 +8573,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8659,7 +8582,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8668,7 +8591,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8677,7 +8600,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8686,7 +8609,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8695,7 +8618,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8704,7 +8627,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8713,7 +8636,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8722,7 +8645,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8731,7 +8654,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8740,7 +8663,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8749,7 +8672,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8758,7 +8681,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8767,7 +8690,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8776,7 +8699,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8785,7 +8708,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8794,7 +8717,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8803,7 +8726,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8812,7 +8735,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8821,7 +8744,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8830,7 +8753,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8839,7 +8762,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8848,7 +8771,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8857,7 +8780,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8866,7 +8789,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8875,7 +8798,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8884,7 +8807,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8893,7 +8816,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8902,7 +8825,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8911,7 +8834,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8920,7 +8843,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8929,7 +8852,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8938,7 +8861,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8947,7 +8870,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8956,7 +8879,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8965,7 +8888,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8974,7 +8897,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -8983,7 +8906,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -8992,7 +8915,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9001,7 +8924,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9010,7 +8933,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9019,7 +8942,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9028,7 +8951,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9037,7 +8960,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9046,7 +8969,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9055,7 +8978,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9064,7 +8987,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9073,7 +8996,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9082,7 +9005,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9091,7 +9014,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9100,7 +9023,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9109,7 +9032,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9118,7 +9041,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9127,7 +9050,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9136,7 +9059,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9145,7 +9068,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9154,7 +9077,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9163,7 +9086,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9172,7 +9095,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9181,7 +9104,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9190,7 +9113,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9199,7 +9122,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9208,7 +9131,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9217,7 +9140,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9226,7 +9149,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9235,7 +9158,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9244,7 +9167,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9253,7 +9176,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9262,7 +9185,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9271,7 +9194,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9280,7 +9203,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9289,7 +9212,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9298,7 +9221,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9307,7 +9230,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9316,7 +9239,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9325,7 +9248,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9334,7 +9257,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9343,7 +9266,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9352,7 +9275,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9361,7 +9284,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9370,7 +9293,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9379,7 +9302,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9388,7 +9311,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9397,7 +9320,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9406,7 +9329,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9415,7 +9338,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9424,7 +9347,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9433,7 +9356,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9442,7 +9365,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9451,7 +9374,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9460,7 +9383,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9469,7 +9392,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9478,7 +9401,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9487,7 +9410,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9496,7 +9419,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9505,7 +9428,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9514,7 +9437,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9523,7 +9446,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9532,7 +9455,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9541,7 +9464,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9550,7 +9473,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9559,7 +9482,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9568,7 +9491,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9577,7 +9500,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9586,7 +9509,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9595,7 +9518,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9604,7 +9527,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9613,7 +9536,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9622,7 +9545,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9631,7 +9554,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9640,7 +9563,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9649,7 +9572,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9658,7 +9581,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9667,7 +9590,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9676,7 +9599,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9685,7 +9608,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9694,7 +9617,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9703,7 +9626,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9712,7 +9635,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9721,7 +9644,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9730,7 +9653,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9739,7 +9662,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9748,7 +9671,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9757,7 +9680,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9766,7 +9689,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9775,7 +9698,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9784,7 +9707,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9793,7 +9716,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9802,7 +9725,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9811,7 +9734,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9820,7 +9743,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9829,7 +9752,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9838,7 +9761,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9847,7 +9770,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9856,7 +9779,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9865,7 +9788,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9874,7 +9797,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9883,7 +9806,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9892,7 +9815,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9901,7 +9824,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9910,7 +9833,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9919,7 +9842,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9928,7 +9851,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9937,7 +9860,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9946,7 +9869,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9955,7 +9878,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9964,7 +9887,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9973,7 +9896,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -9982,7 +9905,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -9991,7 +9914,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -10000,7 +9923,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -10009,7 +9932,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -10018,7 +9941,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -10027,7 +9950,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -10036,7 +9959,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -10045,7 +9968,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -10054,7 +9977,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -10063,7 +9986,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -10072,7 +9995,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -10081,7 +10004,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -10090,7 +10013,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -10099,7 +10022,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -10108,7 +10031,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -10117,7 +10040,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -10126,7 +10049,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -10135,7 +10058,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w000;
   arg1[1]=w004;
   arg1[2]=w010;
@@ -10144,7 +10067,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   arg1[0]=w007;
   arg1[1]=w008;
   arg1[2]=w009;
@@ -10153,7 +10076,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w004;
   res1[2]=w010;
-  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f9(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w000, 3, res[0]);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10161,7 +10084,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w008;
   res1[2]=w009;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+3);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10169,7 +10092,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w011;
   res1[2]=w012;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+6);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10177,7 +10100,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w013;
   res1[2]=w014;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+9);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10185,7 +10108,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w015;
   res1[2]=w016;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+12);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10193,7 +10116,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w017;
   res1[2]=w018;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+15);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10201,7 +10124,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w019;
   res1[2]=w020;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+18);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10209,7 +10132,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w021;
   res1[2]=w022;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+21);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10217,7 +10140,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w023;
   res1[2]=w024;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+24);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10225,7 +10148,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w025;
   res1[2]=w026;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+27);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10233,7 +10156,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w027;
   res1[2]=w028;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+30);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10241,7 +10164,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w029;
   res1[2]=w030;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+33);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10249,7 +10172,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w031;
   res1[2]=w032;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+36);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10257,7 +10180,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w033;
   res1[2]=w034;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+39);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10265,7 +10188,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w035;
   res1[2]=w036;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+42);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10273,7 +10196,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w037;
   res1[2]=w038;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+45);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10281,7 +10204,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w039;
   res1[2]=w040;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+48);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10289,7 +10212,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w041;
   res1[2]=w042;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+51);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10297,7 +10220,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w043;
   res1[2]=w044;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+54);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10305,7 +10228,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w045;
   res1[2]=w046;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+57);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10313,7 +10236,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w047;
   res1[2]=w048;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+60);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10321,7 +10244,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w049;
   res1[2]=w050;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+63);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10329,7 +10252,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w051;
   res1[2]=w052;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+66);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10337,7 +10260,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w053;
   res1[2]=w054;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+69);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10345,7 +10268,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w055;
   res1[2]=w056;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+72);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10353,7 +10276,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w057;
   res1[2]=w058;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+75);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10361,7 +10284,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w059;
   res1[2]=w060;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+78);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10369,7 +10292,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w061;
   res1[2]=w062;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+81);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10377,7 +10300,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w063;
   res1[2]=w064;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+84);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10385,7 +10308,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w065;
   res1[2]=w066;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+87);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10393,7 +10316,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w067;
   res1[2]=w068;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+90);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10401,7 +10324,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w069;
   res1[2]=w070;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+93);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10409,7 +10332,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w071;
   res1[2]=w072;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+96);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10417,7 +10340,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w073;
   res1[2]=w074;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+99);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10425,7 +10348,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w075;
   res1[2]=w076;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+102);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10433,7 +10356,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w077;
   res1[2]=w078;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+105);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10441,7 +10364,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w079;
   res1[2]=w080;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+108);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10449,7 +10372,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w081;
   res1[2]=w082;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+111);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10457,7 +10380,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w083;
   res1[2]=w084;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+114);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10465,7 +10388,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w085;
   res1[2]=w086;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+117);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10473,7 +10396,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w087;
   res1[2]=w088;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+120);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10481,7 +10404,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w089;
   res1[2]=w090;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+123);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10489,7 +10412,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w091;
   res1[2]=w092;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+126);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10497,7 +10420,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w093;
   res1[2]=w094;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+129);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10505,7 +10428,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w095;
   res1[2]=w096;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+132);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10513,7 +10436,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w097;
   res1[2]=w098;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+135);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10521,7 +10444,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w099;
   res1[2]=w100;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+138);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10529,7 +10452,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w101;
   res1[2]=w102;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+141);
   arg1[0]=w007;
   arg1[1]=0;
@@ -10537,7 +10460,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w000;
   res1[1]=w103;
   res1[2]=w104;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w000, 3, res[0]+144);
   arg1[0]=w000;
   arg1[1]=0;
@@ -10545,7 +10468,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   res1[0]=w007;
   res1[1]=w105;
   res1[2]=w106;
-  if (casadi_f11(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f10(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w007, 3, res[0]+147);
   casadi_copy(w004, 3, res[1]);
   if (res[1]) casadi_copy(w008, 3, res[1]+3);
@@ -10651,7 +10574,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 }
 
 CASADI_SYMBOL_EXPORT int orbit_chunk(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f9(arg, res, iw, w, mem);
+  return casadi_f8(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int orbit_chunk_checkout(void) {
@@ -10730,7 +10653,7 @@ CASADI_SYMBOL_EXPORT int orbit_chunk_work_bytes(casadi_int *sz_arg, casadi_int* 
 }
 
 CASADI_SYMBOL_EXPORT int orbit_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f11(arg, res, iw, w, mem);
+  return casadi_f10(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int orbit_period_checkout(void) {
@@ -10809,7 +10732,7 @@ CASADI_SYMBOL_EXPORT int orbit_period_work_bytes(casadi_int *sz_arg, casadi_int*
 }
 
 /* state_step:(i0[3],i1[0],i2[4])->(o0[3]) */
-static int casadi_f16(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f15(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19;
   a00=arg[0]? arg[0][0] : 0;
@@ -10901,7 +10824,7 @@ static int casadi_f16(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 /* state_step_acc10:(i0[3],i1[0x10],i2[4x10])->(o0[3x10]) */
-static int casadi_f15(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real **res1=res+1, *w0=w+20, *w2=w+23, *w3=w+27;
   const casadi_real **arg1=arg+3;
   casadi_copy(arg[0], 3, w0);
@@ -10910,76 +10833,76 @@ static int casadi_f15(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w3;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w3, 3, res[0]);
   casadi_copy(arg[2] ? arg[2]+4 : 0, 4, w2);
   arg1[0]=w3;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w0;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w0, 3, res[0]+3);
   casadi_copy(arg[2] ? arg[2]+8 : 0, 4, w2);
   arg1[0]=w0;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w3;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 3, res[0]+6);
   casadi_copy(arg[2] ? arg[2]+12 : 0, 4, w2);
   arg1[0]=w3;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w0;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w0, 3, res[0]+9);
   casadi_copy(arg[2] ? arg[2]+16 : 0, 4, w2);
   arg1[0]=w0;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w3;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 3, res[0]+12);
   casadi_copy(arg[2] ? arg[2]+20 : 0, 4, w2);
   arg1[0]=w3;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w0;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w0, 3, res[0]+15);
   casadi_copy(arg[2] ? arg[2]+24 : 0, 4, w2);
   arg1[0]=w0;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w3;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 3, res[0]+18);
   casadi_copy(arg[2] ? arg[2]+28 : 0, 4, w2);
   arg1[0]=w3;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w0;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w0, 3, res[0]+21);
   casadi_copy(arg[2] ? arg[2]+32 : 0, 4, w2);
   arg1[0]=w0;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w3;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 3, res[0]+24);
   casadi_copy(arg[2] ? arg[2]+36 : 0, 4, w2);
   arg1[0]=w3;
   arg1[1]=0;
   arg1[2]=w2;
   res1[0]=w0;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w0, 3, res[0]+27);
   return 0;
 }
 
 /* state_step_acc10_acc10:(i0[3],i1[0x100],i2[4x100])->(o0[3x100]) */
-static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real **res1=res+1, *w0=w+30, *w3=w+33;
   const casadi_real **arg1=arg+3, *wr2;
   casadi_copy(arg[0], 3, w0);
@@ -10988,7 +10911,7 @@ static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w3, 30, res[0]);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+40 : casadi_zeros;
@@ -10996,7 +10919,7 @@ static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+30);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+80 : casadi_zeros;
@@ -11004,7 +10927,7 @@ static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+60);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+120 : casadi_zeros;
@@ -11012,7 +10935,7 @@ static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+90);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+160 : casadi_zeros;
@@ -11020,7 +10943,7 @@ static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+120);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+200 : casadi_zeros;
@@ -11028,7 +10951,7 @@ static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+150);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+240 : casadi_zeros;
@@ -11036,7 +10959,7 @@ static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+180);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+280 : casadi_zeros;
@@ -11044,7 +10967,7 @@ static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+210);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+320 : casadi_zeros;
@@ -11052,7 +10975,7 @@ static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+240);
   casadi_copy(w3+27, 3, w0);
   wr2 = arg[2] ? arg[2]+360 : casadi_zeros;
@@ -11060,13 +10983,13 @@ static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 30, res[0]+270);
   return 0;
 }
 
 /* steps:(i0[3],i1[0x200],i2[4x200])->(o0[3x200]) */
-static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f12(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real **res1=res+1, *w0=w+103, *w3=w+106;
   const casadi_real **arg1=arg+3, *wr2;
   casadi_copy(arg[0], 3, w0);
@@ -11075,7 +10998,7 @@ static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f13(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w3, 300, res[0]);
   casadi_copy(w3+297, 3, w0);
   wr2 = arg[2] ? arg[2]+400 : casadi_zeros;
@@ -11083,13 +11006,13 @@ static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=wr2;
   res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f13(arg1, res1, iw, w, 0)) return 1;
   if (res[0]) casadi_copy(w3, 300, res[0]+300);
   return 0;
 }
 
 /* trajectory:(y0[3],table[0x200],c[4])->(states[3x200]) */
-static int casadi_f12(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_int i;
   casadi_real **res1=res+1, *w0=w+806, *w2=w+809, *w3=w+813, *w4=w+1613;
   const casadi_real **arg1=arg+3;
@@ -11102,13 +11025,13 @@ static int casadi_f12(const casadi_real** arg, casadi_real** res, casadi_int* iw
   arg1[1]=0;
   arg1[2]=w3;
   res1[0]=w4;
-  if (casadi_f13(arg1, res1, iw, w, 0)) return 1;
+  if (casadi_f12(arg1, res1, iw, w, 0)) return 1;
   casadi_copy(w4, 600, res[0]);
   return 0;
 }
 
 CASADI_SYMBOL_EXPORT int trajectory(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f12(arg, res, iw, w, mem);
+  return casadi_f11(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int trajectory_checkout(void) {

@@ -632,43 +632,59 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   return 0;
 }
 
-/* table:(t0,p[9])->(table[6x200]) */
+/* table:(t0,p[9])->(table[6x200],probe[2x2]) */
 static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_int i, j;
-  casadi_real **res1=res+1, *rr, w00, *w01=w+6, *w03=w+407, w04, w05, *w06=w+410, *w07=w+4019, *w08=w+4821, *w09=w+5221, *w10=w+5621;
-  casadi_real *w11=w+6021, *w12=w+6421, *w13=w+7621;
+  casadi_real **res1=res+2, *rr, w00, *w01=w+6, *w03=w+407, w04, w05, w06, *w07=w+410, *w08=w+4019, *w09=w+4821, *w10=w+5221;
+  casadi_real *w11=w+5621, *w12=w+6021, *w13=w+6421, *w14=w+7621, *w15=w+8821;
   const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
   w00 = arg[0] ? arg[0][0] : 0;
   wr01 = casadi_c0;
   wr02 = arg[1] ? arg[1] : casadi_zeros;
   arg1[0]=wr02;
   res1[0]=w03;
-  res1[1]=0;
+  res1[1]=(&w04);
   if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
-  for (rr=(&w04), cs=w03+2; cs!=w03+3; cs+=1) *rr++ = *cs;
-  w05 = 2.;
-  w04 /= w05;
-  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w04);
+  for (rr=(&w05), cs=w03+2; cs!=w03+3; cs+=1) *rr++ = *cs;
+  w06 = 2.;
+  w05 /= w06;
+  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w05);
   for (i=0, rr=w01, cs=w01; i<401; ++i) (*rr++)  = (w00+(*cs++));
   for (i=0;i<401;++i) {
-    casadi_copy(wr02, 9, w06+ i*9);
+    casadi_copy(wr02, 9, w07+ i*9);
   }
   arg1[0]=w01;
-  arg1[1]=w06;
-  res1[0]=w07;
+  arg1[1]=w07;
+  res1[0]=w08;
   if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
-  for (rr=w08, cs=w07+0; cs!=w07+800; cs+=4) for (ct=cs+0; ct!=cs+2; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w09, cs=w08; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
-  for (rr=w08, cs=w07+0; cs!=w07+800; cs+=4) for (ct=cs+2; ct!=cs+4; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w10, cs=w08; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
-  for (rr=w08, cs=w07+0; cs!=w07+800; cs+=4) for (ct=cs+4; ct!=cs+6; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w11, cs=w08; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
-  rr=w12;
-  for (i=0, cs=w09; i<400; ++i) *rr++ = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+0; ct!=cs+2; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w10, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+2; ct!=cs+4; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w11, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+4; ct!=cs+6; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w12, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
+  rr=w13;
   for (i=0, cs=w10; i<400; ++i) *rr++ = *cs++;
   for (i=0, cs=w11; i<400; ++i) *rr++ = *cs++;
-  for (i=0, rr=w13, cs=w12; i<6; ++i) for (j=0; j<200; ++j) rr[i+j*6] = *cs++;
-  casadi_copy(w13, 1200, res[0]);
+  for (i=0, cs=w12; i<400; ++i) *rr++ = *cs++;
+  for (i=0, rr=w14, cs=w13; i<6; ++i) for (j=0; j<200; ++j) rr[i+j*6] = *cs++;
+  casadi_copy(w14, 1200, res[0]);
+  w05 = 3.7000000000000000e-01;
+  w05 *= w04;
+  w05  = (w00+w05);
+  arg1[0]=(&w05);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  casadi_copy(w15, 2, res[1]);
+  w05 = 1.3700000000000001e+00;
+  w05 *= w04;
+  w00 += w05;
+  arg1[0]=(&w00);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (res[1]) casadi_copy(w15, 2, res[1]+2);
   return 0;
 }
 
@@ -691,7 +707,7 @@ CASADI_SYMBOL_EXPORT void table_decref(void) {
 
 CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
 
-CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 1;}
+CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
 
 CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
   switch (i) {
@@ -710,6 +726,7 @@ CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
 CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
   switch (i) {
     case 0: return "table";
+    case 1: return "probe";
     default: return 0;
   }
 }
@@ -725,96 +742,24 @@ CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
 CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
   switch (i) {
     case 0: return casadi_s5;
+    case 1: return casadi_s3;
     default: return 0;
   }
 }
 
 CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 6;
-  if (sz_res) *sz_res = 3;
+  if (sz_res) *sz_res = 4;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 8821;
+  if (sz_w) *sz_w = 8823;
   return 0;
 }
 
 CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 3*sizeof(casadi_real*);
+  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 8821*sizeof(casadi_real);
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table_point(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f5(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int table_point_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void table_point_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void table_point_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void table_point_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int table_point_n_in(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_int table_point_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real table_point_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_point_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_point_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "values";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_point_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_point_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s1;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int table_point_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 2;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table_point_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 2*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  if (sz_w) *sz_w = 8823*sizeof(casadi_real);
   return 0;
 }
 

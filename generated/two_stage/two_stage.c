@@ -106,7 +106,7 @@ static const casadi_int casadi_s2[3] = {21, 1, 1};
 static const casadi_int casadi_s3[3] = {6, 6, 1};
 static const casadi_int casadi_s4[3] = {11, 1, 1};
 static const casadi_int casadi_s5[3] = {15, 200, 1};
-static const casadi_int casadi_s6[3] = {5, 1, 1};
+static const casadi_int casadi_s6[3] = {5, 2, 1};
 static const casadi_int casadi_s7[3] = {6, 50, 1};
 static const casadi_int casadi_s8[3] = {3, 50, 1};
 static const casadi_int casadi_s9[3] = {3, 1, 1};
@@ -983,43 +983,59 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   return 0;
 }
 
-/* table:(t0,p[21])->(table[15x200]) */
+/* table:(t0,p[21])->(table[15x200],probe[5x2]) */
 static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_int i, j;
-  casadi_real **res1=res+1, *rr, w00, *w01=w+18, *w03=w+419, w04, w05, *w06=w+430, *w07=w+8851, *w08=w+10856, *w09=w+11856, *w10=w+12856;
-  casadi_real *w11=w+13856, *w12=w+14856, *w13=w+17856;
+  casadi_real **res1=res+2, *rr, w00, *w01=w+18, *w03=w+419, w04, w05, w06, *w07=w+430, *w08=w+8851, *w09=w+10856, *w10=w+11856;
+  casadi_real *w11=w+12856, *w12=w+13856, *w13=w+14856, *w14=w+17856, *w15=w+20856;
   const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
   w00 = arg[0] ? arg[0][0] : 0;
   wr01 = casadi_c0;
   wr02 = arg[1] ? arg[1] : casadi_zeros;
   arg1[0]=wr02;
   res1[0]=w03;
-  res1[1]=0;
+  res1[1]=(&w04);
   if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
-  for (rr=(&w04), cs=w03+10; cs!=w03+11; cs+=1) *rr++ = *cs;
-  w05 = 2.;
-  w04 /= w05;
-  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w04);
+  for (rr=(&w05), cs=w03+10; cs!=w03+11; cs+=1) *rr++ = *cs;
+  w06 = 2.;
+  w05 /= w06;
+  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w05);
   for (i=0, rr=w01, cs=w01; i<401; ++i) (*rr++)  = (w00+(*cs++));
   for (i=0;i<401;++i) {
-    casadi_copy(wr02, 21, w06+ i*21);
+    casadi_copy(wr02, 21, w07+ i*21);
   }
   arg1[0]=w01;
-  arg1[1]=w06;
-  res1[0]=w07;
+  arg1[1]=w07;
+  res1[0]=w08;
   if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
-  for (rr=w08, cs=w07+0; cs!=w07+2000; cs+=10) for (ct=cs+0; ct!=cs+5; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w09, cs=w08; i<200; ++i) for (j=0; j<5; ++j) rr[i+j*200] = *cs++;
-  for (rr=w08, cs=w07+0; cs!=w07+2000; cs+=10) for (ct=cs+5; ct!=cs+10; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w10, cs=w08; i<200; ++i) for (j=0; j<5; ++j) rr[i+j*200] = *cs++;
-  for (rr=w08, cs=w07+0; cs!=w07+2000; cs+=10) for (ct=cs+10; ct!=cs+15; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w11, cs=w08; i<200; ++i) for (j=0; j<5; ++j) rr[i+j*200] = *cs++;
-  rr=w12;
-  for (i=0, cs=w09; i<1000; ++i) *rr++ = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+2000; cs+=10) for (ct=cs+0; ct!=cs+5; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w10, cs=w09; i<200; ++i) for (j=0; j<5; ++j) rr[i+j*200] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+2000; cs+=10) for (ct=cs+5; ct!=cs+10; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w11, cs=w09; i<200; ++i) for (j=0; j<5; ++j) rr[i+j*200] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+2000; cs+=10) for (ct=cs+10; ct!=cs+15; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w12, cs=w09; i<200; ++i) for (j=0; j<5; ++j) rr[i+j*200] = *cs++;
+  rr=w13;
   for (i=0, cs=w10; i<1000; ++i) *rr++ = *cs++;
   for (i=0, cs=w11; i<1000; ++i) *rr++ = *cs++;
-  for (i=0, rr=w13, cs=w12; i<15; ++i) for (j=0; j<200; ++j) rr[i+j*15] = *cs++;
-  casadi_copy(w13, 3000, res[0]);
+  for (i=0, cs=w12; i<1000; ++i) *rr++ = *cs++;
+  for (i=0, rr=w14, cs=w13; i<15; ++i) for (j=0; j<200; ++j) rr[i+j*15] = *cs++;
+  casadi_copy(w14, 3000, res[0]);
+  w05 = 3.7000000000000000e-01;
+  w05 *= w04;
+  w05  = (w00+w05);
+  arg1[0]=(&w05);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  casadi_copy(w15, 5, res[1]);
+  w05 = 1.3700000000000001e+00;
+  w05 *= w04;
+  w00 += w05;
+  arg1[0]=(&w00);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (res[1]) casadi_copy(w15, 5, res[1]+5);
   return 0;
 }
 
@@ -1042,7 +1058,7 @@ CASADI_SYMBOL_EXPORT void table_decref(void) {
 
 CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
 
-CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 1;}
+CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
 
 CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
   switch (i) {
@@ -1061,6 +1077,7 @@ CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
 CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
   switch (i) {
     case 0: return "table";
+    case 1: return "probe";
     default: return 0;
   }
 }
@@ -1076,96 +1093,24 @@ CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
 CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
   switch (i) {
     case 0: return casadi_s5;
+    case 1: return casadi_s6;
     default: return 0;
   }
 }
 
 CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 6;
-  if (sz_res) *sz_res = 3;
+  if (sz_res) *sz_res = 4;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 20856;
+  if (sz_w) *sz_w = 20861;
   return 0;
 }
 
 CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
   if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 3*sizeof(casadi_real*);
+  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 20856*sizeof(casadi_real);
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table_point(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f5(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int table_point_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void table_point_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void table_point_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void table_point_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int table_point_n_in(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_int table_point_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real table_point_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_point_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_point_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "values";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_point_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_point_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s6;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int table_point_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 2;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table_point_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 2*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  if (sz_w) *sz_w = 20861*sizeof(casadi_real);
   return 0;
 }
 
