@@ -70,6 +70,10 @@ def test_time_dependence_that_is_not_periodic_is_rejected():
 # ------------------------------------------------------------------ generated/ is what the models give
 @pytest.mark.parametrize("name", available_models())
 def test_committed_generated_code_is_regenerated_byte_for_byte(name):
+    import json
+    made_with = json.loads((REPO_ROOT / "generated" / name / "manifest.json").read_text())["casadi_version"]
+    assert made_with == ca.__version__, (f"generated/ was made with CasADi {made_with}, this is {ca.__version__}: "
+                                         "install the pinned version (pyproject.toml) or regenerate")
     report = generate_model(name, REPO_ROOT / "generated", check=True)
     assert report.stale == [], f"stale: {report.stale}; run `gearsym compile --all` and commit generated/"
 
