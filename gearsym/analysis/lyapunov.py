@@ -8,13 +8,14 @@ models). The paper's criterion for chaos is lambda_1 > 0 (it prints "> 1").
 """
 from __future__ import annotations
 
-import operator
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..codegen import CompiledModel, compile_model
+from ..checks import whole_number
 from ..errors import GearsymError
+from .orbits import amplitudes
 from .statistics import batch_means_stderr
 
 
@@ -78,17 +79,6 @@ def _json_number(x) -> float | None:
     return x if np.isfinite(x) else None
 
 
-def whole_number(value, what: str) -> int:
-    """``value`` as a non-negative int (any integer type), or a clear error."""
-    try:
-        count = operator.index(value)
-    except TypeError:
-        raise GearsymError(f"{what} must be a whole number, got {value!r}") from None
-    if count < 0:
-        raise GearsymError(f"{what} must not be negative, got {count}")
-    return count
-
-
 def lyapunov_spectrum(
     model,
     *,
@@ -125,8 +115,6 @@ def lyapunov_spectrum(
     stderr = batch_means_stderr(measured)
     history = np.cumsum(measured, axis=1).T / np.arange(1, count + 1)[:, None]
     order = np.argsort(-exponents, kind="stable")
-    low = run.low[:, discard:].min(axis=1)
-    high = run.high[:, discard:].max(axis=1)
     final = run.strobe[:, -1]
     return LyapunovSpectrum(
         model=compiled.name,
@@ -134,7 +122,7 @@ def lyapunov_spectrum(
         exponents=exponents[order],
         stderr=stderr[order],
         history=history[:, order],
-        amplitude={name: float((h - lo) / 2) for name, lo, h in zip(compiled.observed, low, high)},
+        amplitude=amplitudes(compiled.observed, run.low[:, discard:], run.high[:, discard:]),
         final_state=dict(zip(compiled.state_names, map(float, final))),
         strobe=run.strobe[:, discard:],
         periods=periods,

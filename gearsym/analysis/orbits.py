@@ -6,8 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..codegen import CompiledModel, compile_model
-from ..errors import GearsymError
-from .lyapunov import whole_number
+from ..checks import whole_number
 
 
 @dataclass(frozen=True)
@@ -36,6 +35,11 @@ class Trajectory:
         return self.states[self.state_names.index(name)]
 
 
+def amplitudes(names, low: np.ndarray, high: np.ndarray) -> dict[str, float]:
+    """A = (max - min)/2 of each observed state, from per-period minima and maxima (observed x periods)."""
+    return {n: float((h - lo) / 2) for n, lo, h in zip(names, low.min(axis=1), high.max(axis=1))}
+
+
 def _compiled(model, settings, steps_per_period, backend) -> tuple[CompiledModel, dict]:
     if isinstance(model, CompiledModel):
         return model, settings
@@ -45,15 +49,12 @@ def _compiled(model, settings, steps_per_period, backend) -> tuple[CompiledModel
 def poincare_samples(model, *, periods: int = 200, discard: int = 100, y0=None, t0: float = 0.0,
                      steps_per_period: int = 200, backend: str = "auto", **settings) -> Orbit:
     """Stroboscopic samples after ``discard`` transient periods (no tangent vectors: cheaper)."""
-    periods, discard = whole_number(periods, "periods"), whole_number(discard, "discard")
-    if periods < 1:
-        raise GearsymError(f"need at least one period of samples, got periods={periods}")
+    periods, discard = whole_number(periods, "periods", 1), whole_number(discard, "discard")
     compiled, values = _compiled(model, settings, steps_per_period, backend)
     inputs = compiled.prepare(compiled.parameter_vector(values), t0=t0)
     strobe, low, high = compiled.orbit_run(y0, discard + periods, inputs)
-    low, high = low[:, discard:].min(axis=1), high[:, discard:].max(axis=1)
     return Orbit(compiled.name, compiled.state_names, strobe[:, discard:],
-                 {n: float((h - lo) / 2) for n, lo, h in zip(compiled.observed, low, high)},
+                 amplitudes(compiled.observed, low[:, discard:], high[:, discard:]),
                  dict(zip(compiled.state_names, map(float, strobe[:, -1]))), inputs.period)
 
 

@@ -7,7 +7,6 @@ from a model name themselves (the high-level call).
 """
 from __future__ import annotations
 
-import operator
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -16,6 +15,7 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
+from ..checks import whole_number
 from ..errors import GearsymError, ModelError, UnknownParameterError
 from ..system import FirstOrderSystem
 from .functions import LoopOptions
@@ -246,7 +246,7 @@ class CompiledModel:
     def trajectory(self, y0, periods: int, inputs: RunInputs) -> tuple[np.ndarray, np.ndarray]:
         """Every RK4 step of ``periods`` periods: times (steps,) and states (n, steps), the start included."""
         self._check_inputs(inputs)
-        _count(periods, "periods")
+        whole_number(periods, "periods")
         y = ca.DM(self.initial_state(y0))
         cols = [np.array(y)]
         for _ in range(periods):
@@ -275,19 +275,8 @@ class CompiledModel:
             )
 
     def _schedule(self, periods: int, kind: str) -> list[tuple[str, int]]:
-        chunks, rest = divmod(_count(periods, "periods"), self.options.chunk_periods)
+        chunks, rest = divmod(whole_number(periods, "periods"), self.options.chunk_periods)
         return [(f"{kind}_chunk", chunks), (f"{kind}_period", rest)]
-
-
-def _count(value, what: str, minimum: int = 0) -> int:
-    """A whole number of periods (any integer type), at least ``minimum``."""
-    try:
-        count = operator.index(value)
-    except TypeError:
-        raise GearsymError(f"{what} must be a whole number, got {value!r}") from None
-    if count < minimum:
-        raise GearsymError(f"{what} must be at least {minimum}, got {count}")
-    return count
 
 
 def _hcat(blocks, rows: int) -> np.ndarray:
