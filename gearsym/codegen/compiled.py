@@ -117,9 +117,9 @@ class CompiledModel:
 
     def prepare(self, p: np.ndarray | Mapping[str, float] | None = None, t0: float = 0.0) -> RunInputs:
         p = self.parameter_vector(p) if p is None or isinstance(p, Mapping) else np.asarray(p, dtype=float)
-        if p.shape != (len(self.parameter_names),):
-            raise GearsymError(f"{self.name}: expected {len(self.parameter_names)} parameter values "
-                               f"({', '.join(self.parameter_names)}), got shape {p.shape}")
+        if p.shape != (len(self.parameter_names),) or not np.all(np.isfinite(p)):
+            raise GearsymError(f"{self.name}: expected {len(self.parameter_names)} finite parameter values "
+                               f"({', '.join(self.parameter_names)}), got {p}")
         if self.native:
             c, period = self.native["constants"](p)
             table, probe = self.native["table"](np.array([float(t0)]), p)
@@ -161,7 +161,7 @@ class CompiledModel:
             if unknown:
                 raise GearsymError(f"{self.name}: unknown states {sorted(unknown)} in the initial state; "
                                    f"states are {', '.join(self.state_names)}")
-            return np.array([float(y0.get(s, 0.0)) for s in self.state_names])
+            y0 = [float(y0.get(s, 0.0)) for s in self.state_names]
         y = np.array(y0, dtype=np.float64).reshape(-1)  # a contiguous copy: the C loop reads it by address
         if y.shape != (self.dimension,):
             raise GearsymError(f"{self.name}: the initial state needs {self.dimension} values "
