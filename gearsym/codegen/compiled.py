@@ -125,7 +125,7 @@ class CompiledModel:
             table, probe = self.native["table"](np.array([float(t0)]), p)
         else:
             c, period = (np.array(v) for v in self.functions["constants"](p))
-            table, probe = (np.asfortranarray(np.array(v)) for v in self.functions["table"](t0, p))
+            table, probe = (np.array(v) for v in self.functions["table"](t0, p))
         period = float(period.reshape(-1)[0])
         if not (np.isfinite(period) and period > 0):
             raise ModelError(f"the forcing period is {period} at these parameter values; it must be positive",
@@ -185,16 +185,8 @@ class CompiledModel:
             low, high = (np.empty((m, periods), order="F") for _ in range(2))
             Q = self._native_loop(schedule, y, [Q, np.empty_like(Q)], inputs, strobe, [strobe, logs, low, high])
         else:
-            yd, Qd, parts = ca.DM(y), ca.DM(Q), []
-            for fname, count in schedule:
-                f = self.functions[fname]
-                for _ in range(count):
-                    out, Qd, logs, low, high = f(yd, Qd, inputs.table_dm, inputs.constants_dm)
-                    yd = out[:, -1]
-                    parts.append((out, logs, low, high))
-            strobe, logs, low, high = (_hcat([p[i] for p in parts], rows) for i, rows in enumerate((n, n, m, m)))
-            Q = np.array(Qd)
-        self._check_finite(strobe, logs, inputs)
+            (strobe, logs, low, high), Q = self._casadi_loop(schedule, y, Q, inputs, (n, n, m, m))
+        self._check_finite(inputs, strobe, logs)
         return TangentRun(strobe, logs, low, high, Q)
 
     def _native_loop(self, schedule, y, Qs, inputs: RunInputs, strobe, outputs) -> np.ndarray | None:
@@ -222,6 +214,22 @@ class CompiledModel:
                 y_addr = strobe_base + (col - 1) * n * 8
         return Qs[0] if Qs else None
 
+    def _casadi_loop(self, schedule, y, Q, inputs: RunInputs, rows: tuple[int, ...]):
+        """The in-process twin of ``_native_loop``: the same chunks through CasADi's calls, outputs stacked
+        per period (``rows``: their heights, for an empty run). ``Q`` None: no tangent vectors."""
+        yd, Qd, parts = ca.DM(y), (None if Q is None else ca.DM(Q)), []
+        for fname, count in schedule:
+            f = self.functions[fname]
+            for _ in range(count):
+                if Qd is None:
+                    out, *rest = f(yd, inputs.table_dm, inputs.constants_dm)
+                else:
+                    out, Qd, *rest = f(yd, Qd, inputs.table_dm, inputs.constants_dm)
+                yd = out[:, -1]
+                parts.append((out, *rest))
+        stacked = [_hcat([p[i] for p in parts], r) for i, r in enumerate(rows)]
+        return stacked, (None if Qd is None else np.array(Qd))
+
     def orbit_run(self, y0, periods: int, inputs: RunInputs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The state after each of ``periods`` periods (stroboscopic samples), with each period's min and max."""
         self._check_inputs(inputs)
@@ -232,15 +240,8 @@ class CompiledModel:
             low, high = (np.empty((m, periods), order="F") for _ in range(2))
             self._native_loop(schedule, y, [], inputs, strobe, [strobe, low, high])
         else:
-            yd, parts = ca.DM(y), []
-            for fname, count in schedule:
-                f = self.functions[fname]
-                for _ in range(count):
-                    out, low, high = f(yd, inputs.table_dm, inputs.constants_dm)
-                    yd = out[:, -1]
-                    parts.append((out, low, high))
-            strobe, low, high = (_hcat([p[i] for p in parts], rows) for i, rows in enumerate((n, m, m)))
-        self._check_finite(strobe, strobe, inputs)
+            (strobe, low, high), _ = self._casadi_loop(schedule, y, None, inputs, (n, m, m))
+        self._check_finite(inputs, strobe)
         return strobe, low, high
 
     def trajectory(self, y0, periods: int, inputs: RunInputs) -> tuple[np.ndarray, np.ndarray]:
@@ -263,8 +264,8 @@ class CompiledModel:
     def jacobian(self, t: float, y, p) -> np.ndarray:
         return np.array(self.functions["jacobian"](t, y, p))
 
-    def _check_finite(self, strobe: np.ndarray, logs: np.ndarray, inputs: RunInputs) -> None:
-        bad = ~(np.isfinite(strobe).all(axis=0) & np.isfinite(logs).all(axis=0))
+    def _check_finite(self, inputs: RunInputs, *per_period: np.ndarray) -> None:
+        bad = ~np.logical_and.reduce([np.isfinite(a).all(axis=0) for a in per_period])
         if bad.any():
             k = int(np.argmax(bad))
             values = ", ".join(f"{n}={v:g}" for n, v in zip(self.parameter_names, inputs.p))
