@@ -98,6 +98,11 @@ class FirstOrderSystem:
         return replace(self, parameters={**self.parameters, **{k: float(v) for k, v in values.items()}})
 
     @property
+    def autonomous(self) -> bool:
+        """True if time does not appear in the right-hand side (Lorenz); then one Lyapunov exponent is zero."""
+        return all(self.time not in f.free_symbols for f in self.rhs)
+
+    @property
     def observed(self) -> tuple[str, ...]:
         """The states whose amplitude is reported: ``coordinates``, or every state."""
         return self.coordinates or tuple(s.name for s in self.states)

@@ -12,10 +12,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..codegen import CompiledModel, compile_model
+from ..codegen import compiled_and_values
 from ..checks import whole_number
 from ..errors import GearsymError
 from .orbits import amplitudes
+from .regime import classify_regime
 from .statistics import batch_means_stderr
 
 
@@ -36,7 +37,18 @@ class LyapunovSpectrum:
     steps_per_period: int
     period: float
     backend: str
+    autonomous: bool = False  # time-free equations: one exponent is zero along the flow
     info: dict = field(default_factory=dict)
+
+    @property
+    def measured_time(self) -> float:
+        """The time the exponents are averaged over (after the transient)."""
+        return (self.periods - self.discard) * self.period
+
+    @property
+    def regime(self) -> str:
+        """periodic, quasi-periodic, chaotic or hyperchaotic (see :mod:`gearsym.analysis.regime`)."""
+        return classify_regime(self.exponents, self.stderr, self.measured_time, self.autonomous)
 
     @property
     def sum(self) -> float:
@@ -63,6 +75,7 @@ class LyapunovSpectrum:
             "stderr": [_json_number(x) for x in self.stderr],  # null with too few periods to estimate it
             "sum": self.sum,
             "kaplan_yorke_dimension": _json_number(self.kaplan_yorke_dimension),
+            "regime": self.regime,
             "amplitude": self.amplitude,
             "final_state": self.final_state,
             "periods": self.periods,
@@ -100,11 +113,7 @@ def lyapunov_spectrum(
     periods, discard = whole_number(periods, "periods"), whole_number(discard, "discard")
     if periods <= discard:
         raise GearsymError(f"need 0 <= discard < periods, got periods={periods}, discard={discard}")
-    if isinstance(model, CompiledModel):
-        compiled, values = model, settings
-    else:
-        compiled = compile_model(model, steps_per_period=steps_per_period, backend=backend, **settings)
-        values = {}
+    compiled, values = compiled_and_values(model, settings, steps_per_period=steps_per_period, backend=backend)
     p = compiled.parameter_vector(values)
     inputs = compiled.prepare(p)
     run = compiled.tangent_run(y0, periods, inputs)
@@ -130,5 +139,6 @@ def lyapunov_spectrum(
         steps_per_period=compiled.steps_per_period,
         period=inputs.period,
         backend=compiled.backend,
+        autonomous=compiled.system.autonomous,
         info={"Q": run.Q},
     )

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..codegen import CompiledModel, compile_model
+from ..codegen import compiled_and_values
 from ..checks import whole_number
 
 
@@ -40,17 +40,11 @@ def amplitudes(names, low: np.ndarray, high: np.ndarray) -> dict[str, float]:
     return {n: float((h - lo) / 2) for n, lo, h in zip(names, low.min(axis=1), high.max(axis=1))}
 
 
-def _compiled(model, settings, steps_per_period, backend) -> tuple[CompiledModel, dict]:
-    if isinstance(model, CompiledModel):
-        return model, settings
-    return compile_model(model, steps_per_period=steps_per_period, backend=backend, **settings), {}
-
-
 def poincare_samples(model, *, periods: int = 200, discard: int = 100, y0=None, t0: float = 0.0,
                      steps_per_period: int = 200, backend: str = "auto", **settings) -> Orbit:
     """Stroboscopic samples after ``discard`` transient periods (no tangent vectors: cheaper)."""
     periods, discard = whole_number(periods, "periods", 1), whole_number(discard, "discard")
-    compiled, values = _compiled(model, settings, steps_per_period, backend)
+    compiled, values = compiled_and_values(model, settings, steps_per_period=steps_per_period, backend=backend)
     inputs = compiled.prepare(compiled.parameter_vector(values), t0=t0)
     strobe, low, high = compiled.orbit_run(y0, discard + periods, inputs)
     return Orbit(compiled.name, compiled.state_names, strobe[:, discard:],
@@ -62,7 +56,7 @@ def phase_trajectory(model, *, periods: int = 20, discard: int = 100, y0=None, s
                      backend: str = "auto", **settings) -> Trajectory:
     """The trajectory over ``periods`` periods after ``discard`` transient ones, at every step."""
     periods, discard = whole_number(periods, "periods"), whole_number(discard, "discard")
-    compiled, values = _compiled(model, settings, steps_per_period, backend)
+    compiled, values = compiled_and_values(model, settings, steps_per_period=steps_per_period, backend=backend)
     inputs = compiled.prepare(compiled.parameter_vector(values))
     start = compiled.initial_state(y0)
     if discard:

@@ -5,11 +5,11 @@ constants) -> ``functions`` (RK4 with exact variational equations, loops in
 MX) -> ``generate`` (deterministic C and manifest) -> ``compiler`` (cached
 shared libraries) -> ``compiled`` (the :class:`CompiledModel` the analyses use).
 """
-from .build import BACKENDS, compile_model
+from .build import BACKENDS, compiled_and_values, compile_model
 from .compiled import CompiledModel, RunInputs, TangentRun
 from .compiler import CompilerError, cache_dir
 from .functions import LoopOptions, build_functions
 from .generate import code_hash, write_code
 
-__all__ = ["BACKENDS", "CompiledModel", "CompilerError", "LoopOptions", "RunInputs", "TangentRun", "build_functions",
+__all__ = ["BACKENDS", "CompiledModel", "compiled_and_values", "CompilerError", "LoopOptions", "RunInputs", "TangentRun", "build_functions",
            "cache_dir", "code_hash", "compile_model", "write_code"]

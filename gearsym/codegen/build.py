@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import casadi as ca
@@ -77,8 +78,7 @@ def compile_model(
     key = (digest, backend)
     if key in _LOADED:  # same code: reuse the loaded functions, with these parameter values
         base = _LOADED[key]
-        return CompiledModel(system, options, digest, base.functions, backend, base.library, dict(base.timings), check,
-                             _native_copy(base))
+        return replace(base.clone(), system=system, check=check)
 
     code_dir = cache_dir() / "code" / f"{system.name}-{digest[:16]}"
     committed = _generated_dir() / system.name
@@ -110,13 +110,18 @@ def compile_model(
     return compiled
 
 
+def compiled_and_values(model, settings: dict, *, steps_per_period: int = 200, backend: str = "auto",
+                        verbose: bool = False) -> tuple[CompiledModel, dict]:
+    """The two ways into every analysis: a prebuilt CompiledModel with ``settings`` as parameter values
+    (the low-level call, nothing rebuilt), or a model compiled with ``settings`` as its defaults."""
+    if isinstance(model, CompiledModel):
+        return model, dict(settings)
+    return compile_model(model, steps_per_period=steps_per_period, backend=backend, verbose=verbose,
+                         **settings), {}
+
+
 def _to_stderr(message: str) -> None:
     print(f"gearsym: {message}", file=sys.stderr, flush=True)
-
-
-def _native_copy(base: CompiledModel):
-    """Fresh work arrays for another CompiledModel object (so two objects may run in two threads)."""
-    return load_native(base.library, dict(base.functions)) if base.native else None
 
 
 def _generated_dir() -> Path:

@@ -8,7 +8,7 @@ from a model name themselves (the high-level call).
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
 
@@ -66,6 +66,14 @@ class CompiledModel:
     timings: dict[str, float] = field(default_factory=dict)
     check: Callable[[str, float], float] | None = None
     native: Mapping[str, NativeFunction] | None = None  # the same functions, called without CasADi
+
+    def clone(self) -> "CompiledModel":
+        """The same functions with work arrays of its own: one clone per thread runs in parallel
+        (the native calls release the GIL; the generated functions keep no other state)."""
+        from .native import load_native
+
+        native = load_native(self.library, dict(self.functions)) if self.native else None
+        return replace(self, native=native, timings=dict(self.timings))
 
     # ---------------------------------------------------------------- names
     @property

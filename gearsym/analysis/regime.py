@@ -1,0 +1,67 @@
+"""Naming the motion at a parameter point from its Lyapunov spectrum and the spectrum's errors.
+
+For a periodically forced system (the gear models) the n exponents are those of
+the stroboscopic map, so
+
+=================  ==================================================
+periodic           every exponent below zero (a period-k orbit)
+quasi-periodic     the largest is zero, the rest below
+chaotic            exactly one above zero
+hyperchaotic       two or more above zero (the paper's kS = 0.1 case)
+=================  ==================================================
+
+An autonomous system (Lorenz) always has a zero exponent along the flow; it is
+left out first (``equilibrium`` when there is none: every exponent negative).
+
+"Zero" is decided with the measurement's own uncertainty: an exponent counts
+as zero when |lambda| <= max(3 stderr, 5 / measured time). The second term is
+the finite-time bias of a zero exponent, which decays only like 1/T (a bounded
+tangent vector stretch over time T). So a point on a bifurcation, where lambda_1
+passes through zero, is reported quasi-periodic: the spectrum cannot tell the two apart.
+"""
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+REGIMES = ("periodic", "quasi-periodic", "chaotic", "hyperchaotic")
+EQUILIBRIUM = "equilibrium"  # autonomous systems only
+
+#: an exponent within this many standard errors of zero counts as zero
+ZERO_SIGMAS = 3.0
+#: ... or within this many units of 1/(measured time): a zero exponent's finite-time bias
+ZERO_BIAS = 5.0
+
+
+def zero_band(stderr: Sequence[float], measured_time: float) -> np.ndarray:
+    """Half-width of the band around zero, per exponent (NaN errors: the bias term alone)."""
+    err = np.nan_to_num(np.asarray(stderr, dtype=float), nan=0.0)
+    return np.maximum(ZERO_SIGMAS * err, ZERO_BIAS / float(measured_time))
+
+
+def classify_regime(exponents: Sequence[float], stderr: Sequence[float], measured_time: float,
+                    autonomous: bool = False) -> str:
+    """The regime name for one spectrum; ``measured_time`` is the time the exponents were averaged over."""
+    lam = np.asarray(exponents, dtype=float)
+    band = zero_band(stderr, measured_time)
+    if lam.shape != band.shape or lam.ndim != 1 or lam.size == 0:
+        raise ValueError(f"need one standard error per exponent, got {lam.shape} and {band.shape}")
+    if not (np.isfinite(lam).all() and measured_time > 0):
+        raise ValueError("exponents must be finite and the measured time positive")
+    if autonomous:
+        flow = int(np.argmin(np.abs(lam) / band))  # the exponent along the flow: the one nearest zero
+        if abs(lam[flow]) > band[flow]:
+            return EQUILIBRIUM if (lam < 0).all() else _by_signs(lam, band)
+        lam, band = np.delete(lam, flow), np.delete(band, flow)
+    return _by_signs(lam, band)
+
+
+def _by_signs(lam: np.ndarray, band: np.ndarray) -> str:
+    positive = int(np.sum(lam > band))
+    if positive >= 2:
+        return "hyperchaotic"
+    if positive == 1:
+        return "chaotic"
+    return "quasi-periodic" if np.any(np.abs(lam) <= band) else "periodic"
+
