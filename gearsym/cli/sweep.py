@@ -1,0 +1,70 @@
+"""``gearsym sweep MODEL --param omega=0.1:2.0:0.01``: Lyapunov spectra and amplitudes over a grid."""
+from __future__ import annotations
+
+import argparse
+import sys
+from collections import Counter
+from pathlib import Path
+
+from ..codegen import BACKENDS
+from ..sweep import DIRECTIONS, MODES, POINCARE_SAMPLES, run_sweep
+from .settings import add_set_argument, parse_settings, parse_state
+
+NAME = "sweep"
+HELP = "Lyapunov spectra, amplitudes and regimes over a 1-D or 2-D parameter grid (resumable)"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("model", help="a model name (see `gearsym list`) or the path of a model file")
+    parser.add_argument("--param", action="append", required=True, metavar="NAME=VALUES",
+                        help="a swept parameter: START:STOP:STEP (stop included), V1,V2,... or one value; "
+                             "repeat for a 2-D grid (a continuation follows the first)")
+    add_set_argument(parser)
+    parser.add_argument("--mode", choices=MODES, default="continuation",
+                        help="continuation: each point starts from the last state of the previous one (the "
+                             "paper's procedure); independent: every point from the initial state, in parallel")
+    parser.add_argument("--direction", choices=DIRECTIONS, default="up",
+                        help="continuation along the first parameter: ascending, descending, or up then down "
+                             "(shows hysteresis)")
+    parser.add_argument("--periods", type=int, default=400, help="forcing periods per point (default 400)")
+    parser.add_argument("--discard", type=int, default=100, help="transient periods left out (default 100)")
+    parser.add_argument("--steps-per-period", type=int, default=200, help="RK4 steps per period (default 200)")
+    parser.add_argument("--y0", metavar="x=-2,v=-0.5", help="initial state (default: the model's)")
+    parser.add_argument("--jobs", type=int, default=0, help="threads (default 0: every core)")
+    parser.add_argument("--out", type=Path, required=True, metavar="FILE.csv",
+                        help="the table; FILE.json (record, jumps) and FILE.poincare.csv are written beside it. "
+                             "If they exist, the same command resumes them")
+    parser.add_argument("--overwrite", action="store_true", help="start again instead of resuming")
+    parser.add_argument("--poincare", type=int, default=POINCARE_SAMPLES, metavar="K",
+                        help=f"stroboscopic samples kept per point, for bifurcation diagrams (default {POINCARE_SAMPLES})")
+    parser.add_argument("--backend", choices=BACKENDS, default="auto")
+    parser.add_argument("--plot", type=Path, metavar="FILE.png",
+                        help="draw amplitudes, exponents, regimes and the bifurcation diagram")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def run(args: argparse.Namespace) -> int:
+    try:
+        result = run_sweep(args.model, args.param, mode=args.mode, direction=args.direction, periods=args.periods,
+                           discard=args.discard, steps_per_period=args.steps_per_period, y0=parse_state(args.y0),
+                           jobs=args.jobs, out=args.out, overwrite=args.overwrite, poincare=args.poincare,
+                           progress=not args.quiet, backend=args.backend, **parse_settings(args.set))
+    except KeyboardInterrupt as exc:
+        print(f"gearsym: {exc}", file=sys.stderr)
+        return 130
+    regimes = Counter(result["regime"].tolist())
+    print(f"{result.model}: {len(result)} points -> {args.out} (+ .json, .poincare.csv)")
+    print("regimes: " + ", ".join(f"{k} {v}" for k, v in sorted(regimes.items())))
+    findings = result.findings()
+    for j in findings["jumps"]:
+        print(f"jump in A_{j['coordinate']} ({j['direction']}): {j['from']:g} -> {j['to']:g}, "
+              f"A {j['A_before']:.4g} -> {j['A_after']:.4g}")
+    for h in findings["hysteresis"]:
+        print(f"hysteresis in A_{h['coordinate']}: up and down differ for {result.axes[0].name} in "
+              f"[{h['from']:g}, {h['to']:g}]")
+    if args.plot:
+        from ..figures.sweep import plot_sweep  # matplotlib only when asked for
+
+        plot_sweep(result, args.plot)
+        print(f"gearsym: wrote {args.plot}", file=sys.stderr)
+    return 0

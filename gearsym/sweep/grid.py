@@ -1,0 +1,129 @@
+"""What a sweep visits: axes of parameter values, and the order of the points.
+
+``omega=0.1:2.0:0.01`` is a range (stop included), ``kS=0,0.1,1.0`` a list,
+``D=2`` a single value. Ranges are counted in decimal arithmetic, so
+0.1:2.0:0.01 gives exactly 0.1, 0.11, ... 2.0 as written (not 0.30000000000000004),
+and the same command always visits the same floats.
+
+The first axis is the one a continuation follows; every combination of the
+other axes is a separate continuation line, started afresh from the initial
+state. ``up`` follows the first axis in ascending order, ``down`` descending,
+``both`` up and then back down from where the up run ended (the down run
+shows hysteresis).
+"""
+from __future__ import annotations
+
+import itertools
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
+from decimal import Decimal, InvalidOperation
+
+from ..errors import GearsymError
+
+MODES = ("continuation", "independent")
+DIRECTIONS = ("up", "down", "both")
+INDEPENDENT = "independent"  # the direction column of independent points
+MAX_POINTS = 1_000_000
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One swept parameter and its values (distinct; ascending for ranges and lists alike)."""
+
+    name: str
+    values: tuple[float, ...]
+    spec: str  # as written, for the record
+
+    def __post_init__(self):
+        if not self.values:
+            raise GearsymError(f"--param {self.spec!r}: no values")
+        if len(set(self.values)) != len(self.values):
+            raise GearsymError(f"--param {self.spec!r}: values repeat")
+
+
+def parse_axis(text: str) -> Axis:
+    """``NAME=START:STOP:STEP``, ``NAME=V1,V2,...`` or ``NAME=VALUE``."""
+    usage = (f"--param {text!r}: expected NAME=START:STOP:STEP (e.g. omega=0.1:2.0:0.01), "
+             "NAME=V1,V2,... (e.g. kS=0,0.1,1.0) or NAME=VALUE")
+    name, sep, body = (part.strip() for part in text.partition("="))
+    if not sep or not name or not body:
+        raise GearsymError(usage)
+    try:
+        if ":" in body:
+            parts = [Decimal(p) for p in body.split(":")]
+            if len(parts) != 3:
+                raise GearsymError(usage)
+            values = _range(text, *parts)
+        else:
+            values = [Decimal(p) for p in body.split(",")]
+    except InvalidOperation:
+        raise GearsymError(usage) from None
+    if not all(v.is_finite() for v in values):
+        raise GearsymError(f"--param {text!r}: values must be finite numbers")
+    return Axis(name, tuple(sorted(float(v) for v in values)), text)
+
+
+def _range(text: str, start: Decimal, stop: Decimal, step: Decimal) -> list[Decimal]:
+    if not (start.is_finite() and stop.is_finite() and step.is_finite()):
+        raise GearsymError(f"--param {text!r}: start, stop and step must be finite")
+    if step == 0 or (stop - start) * step < 0:
+        raise GearsymError(f"--param {text!r}: the step must be nonzero and lead from start to stop")
+    count = int((stop - start) / step) + 1  # stop included when the steps land on it
+    if count > MAX_POINTS:
+        raise GearsymError(f"--param {text!r}: {count} values; that many points is surely a typo in the step")
+    return [start + i * step for i in range(count)]
+
+
+def axes_from(spec: Mapping[str, Sequence[float]] | Sequence[Axis | str]) -> tuple[Axis, ...]:
+    """Axes from a mapping {name: values}, from Axis objects or from --param strings."""
+    if isinstance(spec, Mapping):
+        axes = tuple(Axis(n, tuple(sorted(float(v) for v in vals)), f"{n}={','.join(map(repr, vals))}")
+                     for n, vals in spec.items())
+    else:
+        axes = tuple(a if isinstance(a, Axis) else parse_axis(a) for a in spec)
+    if not axes:
+        raise GearsymError("a sweep needs at least one --param NAME=VALUES")
+    names = [a.name for a in axes]
+    if len(set(names)) != len(names):
+        raise GearsymError(f"a parameter is swept twice: {', '.join(names)}")
+    return axes
+
+
+@dataclass(frozen=True)
+class Point:
+    """One point of the plan: the run direction and the values of the swept parameters (axis order)."""
+
+    direction: str
+    values: tuple[float, ...]
+
+    @property
+    def key(self) -> tuple:
+        return (self.direction, self.values)
+
+
+def plan(axes: Sequence[Axis], mode: str, direction: str) -> list[list[Point]]:
+    """The tasks of a sweep, each a list of points run in order (state handed on in a continuation).
+
+    Independent mode: one task per point. Continuation: one task per line (a
+    combination of the other axes), up and/or down along the first axis.
+    """
+    if mode not in MODES:
+        raise GearsymError(f"unknown mode {mode!r}; choose {' or '.join(MODES)}")
+    if direction not in DIRECTIONS:
+        raise GearsymError(f"unknown direction {direction!r}; choose one of {', '.join(DIRECTIONS)}")
+    first, others = axes[0], [a.values for a in axes[1:]]
+    tasks = []
+    for rest in itertools.product(*others):
+        if mode == INDEPENDENT:
+            tasks.extend([Point(INDEPENDENT, (v, *rest))] for v in first.values)
+            continue
+        up = [Point("up", (v, *rest)) for v in first.values]
+        down = [Point("down", (v, *rest)) for v in reversed(first.values)]
+        tasks.append({"up": up, "down": down, "both": up + down}[direction])
+    if sum(map(len, tasks)) > MAX_POINTS:
+        raise GearsymError(f"the sweep has {sum(map(len, tasks))} points; more than {MAX_POINTS} is surely a typo")
+    return tasks
+
+
+def points(tasks: Sequence[Sequence[Point]]) -> Iterator[Point]:
+    return itertools.chain.from_iterable(tasks)

@@ -1,0 +1,125 @@
+"""A finished sweep as arrays, with what the paper looks for in it: jumps and hysteresis."""
+from __future__ import annotations
+
+import csv
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.jumps import find_jumps, hysteresis_intervals
+from ..errors import GearsymError
+from .grid import INDEPENDENT, Axis
+from .store import sidecar
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """Columns of the sweep table (numbers as float arrays, ``direction``/``regime`` as str arrays),
+    plus the Poincare samples (``strobe``: the same columns, one row per sample)."""
+
+    model: str
+    axes: tuple[Axis, ...]
+    mode: str
+    columns: dict[str, np.ndarray]
+    strobe: dict[str, np.ndarray]
+    record: dict
+    path: Path | None = None
+
+    TEXT = ("direction", "regime")
+
+    @classmethod
+    def from_rows(cls, model, axes, mode, names: Sequence[str], rows: Sequence[dict], strobe_rows: Sequence[dict],
+                  record: dict, path: Path | None = None) -> "SweepResult":
+        return cls(model, tuple(axes), mode, _columns(names, rows), _columns(_keys(strobe_rows), strobe_rows),
+                   record, path)
+
+    def __len__(self) -> int:
+        return len(self.columns["direction"])
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        try:
+            return self.columns[name]
+        except KeyError:
+            raise GearsymError(f"the sweep has no column {name!r}; it has {', '.join(self.columns)}") from None
+
+    @property
+    def coordinates(self) -> list[str]:
+        return [c[2:] for c in self.columns if c.startswith("A_")]
+
+    @property
+    def exponent_count(self) -> int:
+        return sum(c.startswith("lambda_") for c in self.columns)
+
+    def lines(self) -> list[tuple[str, dict[str, float], np.ndarray]]:
+        """(direction, values of the other axes, row indices in run order) for each run along the first axis."""
+        others = [a.name for a in self.axes[1:]]
+        groups: dict[tuple, list[int]] = {}
+        for i in range(len(self)):
+            key = (str(self["direction"][i]), tuple(float(self[n][i]) for n in others))
+            groups.setdefault(key, []).append(i)
+        return [(d, dict(zip(others, vals)), np.array(idx)) for (d, vals), idx in groups.items()]
+
+    def findings(self) -> dict:
+        """Jumps of every amplitude along every continuation run, and hysteresis where up and down both ran."""
+        first = self.axes[0].name
+        jumps, hysteresis = [], []
+        if self.mode == INDEPENDENT:
+            return {"jumps": jumps, "hysteresis": hysteresis}
+        runs = self.lines()
+        for direction, fixed, idx in runs:
+            for c in self.coordinates:
+                for j in find_jumps(self[first][idx], self[f"A_{c}"][idx]):
+                    jumps.append({"coordinate": c, "direction": direction, **fixed, **j.as_dict()})
+        by_fixed: dict[tuple, dict[str, np.ndarray]] = {}
+        for direction, fixed, idx in runs:
+            by_fixed.setdefault(tuple(fixed.items()), {})[direction] = idx
+        for fixed, pair in by_fixed.items():
+            if {"up", "down"} <= set(pair):
+                up, down = pair["up"], pair["down"][::-1]  # both ascending in the first axis
+                for c in self.coordinates:
+                    for lo, hi in hysteresis_intervals(self[first][up], self[f"A_{c}"][up], self[f"A_{c}"][down]):
+                        hysteresis.append({"coordinate": c, **dict(fixed), "from": lo, "to": hi})
+        return {"jumps": jumps, "hysteresis": hysteresis}
+
+
+def _keys(rows: Sequence[dict]) -> list[str]:
+    return list(rows[0]) if rows else []
+
+
+def _columns(names: Sequence[str], rows: Sequence[dict]) -> dict[str, np.ndarray]:
+    out = {}
+    for name in names:
+        values = [r[name] for r in rows]
+        out[name] = np.array(values, dtype=str) if name in SweepResult.TEXT else np.array(values, dtype=float)
+    return out
+
+
+def read_sweep(path: str | Path) -> SweepResult:
+    """A sweep written by :func:`~gearsym.sweep.run_sweep` (complete or not), from its CSV and JSON record."""
+    path = Path(path)
+    meta = sidecar(path, ".json")
+    for p in (path, meta):
+        if not p.is_file():
+            raise GearsymError(f"{p}: no such file; a sweep is written by `gearsym sweep ... --out {path.name}`")
+    try:
+        record = json.loads(meta.read_text())["sweep"]
+        axes = tuple(Axis(n, tuple(v), f"{n}=...") for n, v in record["axes"].items())
+    except (json.JSONDecodeError, KeyError, TypeError, AttributeError) as exc:
+        raise GearsymError(f"{meta}: not a gearsym sweep record ({exc})") from None
+
+    def rows_of(p: Path) -> tuple[list[str], list[dict]]:
+        if not p.is_file():
+            return [], []
+        with open(p, newline="") as f:
+            reader = csv.DictReader(f)
+            return list(reader.fieldnames or []), list(reader)
+
+    names, rows = rows_of(path)
+    _, strobe_rows = rows_of(sidecar(path, ".poincare.csv"))
+    try:
+        return SweepResult.from_rows(record["model"], axes, record["mode"], names, rows, strobe_rows, record, path)
+    except ValueError as exc:
+        raise GearsymError(f"{path}: a value is not a number ({exc})") from None

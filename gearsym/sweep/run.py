@@ -1,0 +1,258 @@
+"""Running a sweep: the Lyapunov spectrum and amplitudes at every point of a grid.
+
+The model is compiled once; every point only changes the parameter vector
+(the low-level call of :func:`~gearsym.analysis.lyapunov_spectrum`). Tasks
+(single points, or whole continuation lines) run on ``jobs`` threads, each with
+its own clone of the compiled model: the native loops release the GIL, so the
+threads use all cores without a process per core paying the symbolic
+reduction again. Threads hand finished points to the main thread, which alone
+writes the files and moves the progress bar.
+"""
+from __future__ import annotations
+
+import os
+import queue
+import sys
+import threading
+import time
+from collections.abc import Callable, Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from .. import __version__
+from ..analysis.lyapunov import lyapunov_spectrum
+from ..checks import whole_number
+from ..codegen import CompiledModel, compiled_and_values
+from ..errors import GearsymError, UnknownParameterError
+from .grid import INDEPENDENT, Axis, Point, axes_from, plan, points
+from .result import SweepResult
+from .store import SweepStore, number
+
+#: stroboscopic samples kept per point for bifurcation diagrams
+POINCARE_SAMPLES = 50
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a sweep: the finished points are on disk; the same command resumes."""
+
+    def __init__(self, done: int, planned: int, path: Path | None):
+        self.done, self.planned, self.path = done, planned, path
+        where = f" in {path}; run the same command again to resume" if path else ""
+        super().__init__(f"interrupted: kept {done} of {planned} points{where}")
+
+
+def run_sweep(
+    model,
+    axes: Mapping[str, Sequence[float]] | Sequence[Axis | str],
+    *,
+    mode: str = "continuation",
+    direction: str = "up",
+    periods: int = 400,
+    discard: int = 100,
+    steps_per_period: int = 200,
+    y0=None,
+    jobs: int = 0,
+    out: str | Path | None = None,
+    overwrite: bool = False,
+    poincare: int = POINCARE_SAMPLES,
+    progress: bool = True,
+    backend: str = "auto",
+    on_point: Callable[[dict], None] | None = None,
+    **settings,
+) -> SweepResult:
+    """Sweep ``model`` over ``axes`` (``{"omega": values}`` or ``["omega=0.1:2.0:0.01", ...]``).
+
+    ``mode="continuation"`` hands each point's final state to the next along
+    the first axis (the paper's procedure), ``"independent"`` starts every
+    point from ``y0`` (default: the model's declared initial state).
+    ``out``: write ``out`` (CSV), its ``.json`` record and ``.poincare.csv``
+    as points finish, resuming if they exist. ``jobs``: threads (0 = every
+    core). ``on_point(row)`` is called in the main thread after each point is
+    stored. ``settings`` fix other parameters (or a stiffness formula) for
+    the whole sweep. ``model`` may also be a prebuilt :class:`CompiledModel`.
+    """
+    periods, discard = whole_number(periods, "periods", 1), whole_number(discard, "discard")
+    if periods <= discard:
+        raise GearsymError(f"need 0 <= discard < periods, got periods={periods}, discard={discard}")
+    poincare = min(whole_number(poincare, "poincare samples"), periods - discard)
+    jobs = whole_number(jobs, "jobs") or os.cpu_count() or 1
+    if mode == INDEPENDENT and direction != "up":
+        raise GearsymError(f"--direction {direction} applies to a continuation; independent points have no direction")
+    axes = axes_from(axes)
+    compiled, values = compiled_and_values(model, settings, steps_per_period=steps_per_period, backend=backend,
+                                           verbose=progress)
+    for axis in axes:
+        if axis.name not in compiled.parameter_names:
+            raise UnknownParameterError(axis.name, compiled.parameter_names, f"{compiled.name}: --param")
+        if axis.name in settings:
+            raise GearsymError(f"{axis.name} is both swept (--param) and fixed (--set); drop one")
+        for v in axis.values:
+            compiled.parameter_vector(values, **{axis.name: v})  # every value checked before any work
+    base = dict(zip(compiled.parameter_names, map(float, compiled.parameter_vector(values))))
+    start = compiled.initial_state(y0)
+    tasks = plan(axes, mode, direction)
+    planned = [p for p in points(tasks)]
+
+    names = [a.name for a in axes]
+    n = compiled.dimension
+    columns = [*names, "direction", *(f"A_{c}" for c in compiled.observed),
+               *(f"lambda_{i}" for i in range(1, n + 1)), *(f"stderr_{i}" for i in range(1, n + 1)),
+               "regime", *(f"final_{s}" for s in compiled.state_names)]
+    strobe_columns = [*names, "direction", "sample", *compiled.state_names]
+    record = {
+        "model": compiled.name, "model_hash": compiled.hash, "backend": compiled.backend,
+        "settings": {k: str(v) for k, v in settings.items()}, "parameters": base,
+        "axes": {a.name: list(a.values) for a in axes}, "mode": mode, "direction": direction,
+        "periods": periods, "discard": discard, "steps_per_period": compiled.steps_per_period,
+        "initial_state": dict(zip(compiled.state_names, map(float, start))), "poincare_samples": poincare,
+    }
+    run = _Run(compiled, base, names, start, periods, discard, poincare, columns, strobe_columns)
+    store = SweepStore(out, columns, strobe_columns, [*names, "direction"], record) if out else None
+    try:  # the files stay locked against a second writer until this sweep returns or fails
+        done, strobes = store.open(overwrite) if store else ({}, {})
+        unknown = set(done) - {p.key for p in planned}
+        if unknown:
+            raise GearsymError(f"{out}: holds points this sweep does not plan, e.g. {sorted(unknown)[0]}; "
+                               "pass --overwrite or choose another --out")
+        todo = [run.remaining(task, done) for task in tasks]
+        todo = [t for t in todo if t[0]]
+        t_start = time.perf_counter()
+        bar = _progress(len(planned), len(done), compiled.name, progress)
+        already = len(done)
+        try:
+            for row, strobe_rows in _execute(run, todo, jobs):
+                done[run.key(row)], strobes[run.key(row)] = row, strobe_rows
+                if store:
+                    store.append(row, strobe_rows)
+                bar.update(1)
+                if on_point:
+                    on_point(row)
+        except KeyboardInterrupt:
+            bar.close()
+            if store:
+                store.close()
+                store.write_record(status="interrupted", points={"planned": len(planned), "done": len(done)})
+            raise SweepInterrupted(len(done), len(planned), store.path if store else None) from None
+        except BaseException:
+            bar.close()
+            raise
+        bar.close()
+        rows = [done[p.key] for p in planned]
+        strobe_rows = [r for p in planned for r in strobes.get(p.key, [])]
+        result = SweepResult.from_rows(compiled.name, axes, mode, columns, rows, strobe_rows, record,
+                                       path=store.path if store else None)
+        if store:
+            store.finish(rows, strobe_rows)
+            store.write_record(status="complete",
+                               points={"planned": len(planned), "done": len(done), "computed": len(done) - already},
+                               seconds=round(time.perf_counter() - t_start, 3), gearsym=__version__,
+                               **result.findings())
+        return result
+    finally:
+        if store:
+            store.release()
+
+
+class _Run:
+    """What every point of one sweep shares, and how a point becomes a row."""
+
+    def __init__(self, compiled, base, names, start, periods, discard, poincare, columns, strobe_columns):
+        self.compiled, self.base, self.names, self.start = compiled, base, names, start
+        self.periods, self.discard, self.poincare = periods, discard, poincare
+        self.columns, self.strobe_columns = columns, strobe_columns
+
+    def key(self, row: dict) -> tuple:
+        return (row["direction"], tuple(float(row[n]) for n in self.names))
+
+    def remaining(self, task: list[Point], done: dict) -> tuple[list[Point], np.ndarray]:
+        """The points of a task still to run, and the state to start from (a continuation's last done point)."""
+        finished = [p.key in done for p in task]
+        count = sum(finished)
+        if not all(finished[:count]) or any(finished[count:]):
+            raise GearsymError("the sweep file holds points of a continuation line out of order (not its first "
+                               "points), so it cannot be resumed: pass --overwrite to start again")
+        if count and task[0].direction != INDEPENDENT:
+            last = done[task[count - 1].key]
+            state = np.array([float(last[f"final_{s}"]) for s in self.compiled.state_names])
+        else:
+            state = self.start
+        return task[count:], state
+
+    def point(self, compiled: CompiledModel, point: Point, y0: np.ndarray) -> tuple[dict, list[dict], np.ndarray]:
+        values = {**self.base, **dict(zip(self.names, point.values))}
+        try:
+            spectrum = lyapunov_spectrum(compiled, periods=self.periods, discard=self.discard, y0=y0, **values)
+        except GearsymError as exc:
+            where = ", ".join(f"{n}={v:g}" for n, v in zip(self.names, point.values))
+            raise GearsymError(f"at {where} ({point.direction}): {exc}") from None
+        n = compiled.dimension
+        row = {**{n_: number(v) for n_, v in zip(self.names, point.values)}, "direction": point.direction}
+        row.update({f"A_{c}": number(a) for c, a in spectrum.amplitude.items()})
+        row.update({f"lambda_{i + 1}": number(x) for i, x in enumerate(spectrum.exponents)})
+        row.update({f"stderr_{i + 1}": number(x) for i, x in enumerate(spectrum.stderr)})
+        row["regime"] = spectrum.regime
+        row.update({f"final_{s}": number(v) for s, v in spectrum.final_state.items()})
+        strobe = spectrum.strobe[:, spectrum.strobe.shape[1] - self.poincare:] if self.poincare else np.zeros((n, 0))
+        strobe_rows = [{**{k: row[k] for k in (*self.names, "direction")}, "sample": str(j),
+                        **{s: number(v) for s, v in zip(compiled.state_names, col)}}
+                       for j, col in enumerate(strobe.T)]
+        final = np.array([spectrum.final_state[s] for s in compiled.state_names])
+        return row, strobe_rows, final
+
+
+def _execute(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], jobs: int):
+    """Yield (row, Poincare rows) as points finish; tasks run on up to ``jobs`` threads."""
+    if not tasks:
+        return
+    if jobs == 1 or len(tasks) == 1:  # no threads: simplest, and Ctrl-C stops at once
+        for task, state in tasks:
+            for point in task:
+                row, strobe_rows, final = run.point(run.compiled, point, state)
+                if point.direction != INDEPENDENT:
+                    state = final
+                yield row, strobe_rows
+        return
+    results: queue.Queue = queue.Queue()
+    stop = threading.Event()
+    local = threading.local()
+
+    def work(task, state):
+        compiled = getattr(local, "compiled", None)
+        if compiled is None:
+            compiled = local.compiled = run.compiled.clone()
+        for point in task:
+            if stop.is_set():
+                return
+            row, strobe_rows, final = run.point(compiled, point, state)
+            if point.direction != INDEPENDENT:
+                state = final
+            results.put((row, strobe_rows))
+
+    pool = ThreadPoolExecutor(max_workers=min(jobs, len(tasks)), thread_name_prefix="gearsym-sweep")
+    futures = [pool.submit(work, task, state) for task, state in tasks]
+    try:
+        pending = sum(len(t) for t, _ in tasks)
+        while pending:
+            try:
+                item = results.get(timeout=0.2)
+            except queue.Empty:
+                failed = next((f for f in futures if f.done() and f.exception()), None)
+                if failed:
+                    raise failed.exception()
+                continue
+            pending -= 1
+            yield item
+    finally:
+        stop.set()  # on an error or Ctrl-C: threads stop after their current point
+        pool.shutdown(wait=True, cancel_futures=True)  # points finished meanwhile are redone on resume
+
+
+def _progress(total: int, done: int, name: str, enabled: bool):
+    """A tqdm bar on stderr: points done, rate and time left (updated less often off a terminal)."""
+    from tqdm import tqdm
+
+    tty = sys.stderr.isatty()
+    return tqdm(total=total, initial=done, desc=f"{name} sweep", unit="pt", disable=not enabled,
+                mininterval=0.2 if tty else 10.0, file=sys.stderr, dynamic_ncols=True)

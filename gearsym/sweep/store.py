@@ -1,0 +1,186 @@
+"""A sweep on disk: rows appended as points finish, so an interrupted sweep keeps them and resumes.
+
+Three files share a stem: ``FILE.csv`` (one row per point), ``FILE.json``
+(how the sweep was made and, at the end, what it found) and
+``FILE.poincare.csv`` (the last stroboscopic samples of every point, for
+bifurcation diagrams). Rows are flushed one by one; a row cut off by a kill
+is dropped when the sweep resumes. Running the same command again resumes:
+the record in ``FILE.json`` must match the new command (else the error says
+what differs). When every point is done, both CSV files are rewritten in the
+plan's order, so the result does not depend on which thread finished first or
+on where the sweep was interrupted. Floats are written with ``repr``, which
+reads back to the same bits: a continuation resumed from a row continues
+exactly where it stopped.
+"""
+from __future__ import annotations
+
+import csv
+import fcntl
+import io
+import json
+import os
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+
+from ..errors import GearsymError
+
+
+def number(x: float) -> str:
+    return repr(float(x))
+
+
+def sidecar(path: Path, suffix: str) -> Path:
+    return path.with_name(path.stem + suffix)
+
+
+class SweepStore:
+    """The CSV, Poincare CSV and JSON record of one sweep."""
+
+    def __init__(self, path: str | Path, columns: Sequence[str], strobe_columns: Sequence[str],
+                 key_columns: Sequence[str], record: dict):
+        self.path = Path(path)
+        if self.path.suffix.lower() != ".csv":
+            raise GearsymError(f"--out {self.path}: the sweep is written as CSV; name the file *.csv")
+        self.meta_path = sidecar(self.path, ".json")
+        self.strobe_path = sidecar(self.path, ".poincare.csv")
+        self.columns, self.strobe_columns = list(columns), list(strobe_columns)
+        self.key_columns = list(key_columns)  # the swept parameters, then "direction"
+        self.record = record
+        self._files: list = []
+
+    # ------------------------------------------------------------ opening
+    def open(self, overwrite: bool = False) -> tuple[dict[tuple, dict], dict[tuple, list[dict]]]:
+        """Start the files, or resume them: returns the rows already done (and their Poincare rows) by key."""
+        self._lock()
+        done, strobes = {}, {}
+        if overwrite:
+            for p in (self.path, self.meta_path, self.strobe_path):
+                p.unlink(missing_ok=True)
+        elif self.path.exists():
+            self._check_record()
+            done = self._read(self.path, self.columns)
+            strobes = {}
+            if self.strobe_path.exists():
+                for row in self._read_rows(self.strobe_path, self.strobe_columns):
+                    strobes.setdefault(self.key(row), []).append(row)
+            strobes = {k: v for k, v in strobes.items() if k in done}  # written before their main row
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._write_table(self.path, self.columns, done.values())  # drops a row cut off mid-write
+        self._write_table(self.strobe_path, self.strobe_columns, (r for rows in strobes.values() for r in rows))
+        self.write_record(status="running")
+        self._files = [open(p, "a", newline="") for p in (self.strobe_path, self.path)]
+        return done, strobes
+
+    def key(self, row: dict) -> tuple:
+        *params, direction = self.key_columns
+        try:
+            return (row[direction], tuple(float(row[p]) for p in params))
+        except ValueError as exc:
+            raise GearsymError(f"{self.path}: a swept parameter is not a number: {exc}") from None
+
+    def _check_record(self) -> None:
+        if not self.meta_path.exists():
+            raise GearsymError(f"{self.path} exists but {self.meta_path.name} (the record of how it was made) "
+                               "does not, so it cannot be resumed: pass --overwrite or choose another --out")
+        try:
+            old = json.loads(self.meta_path.read_text())["sweep"]
+        except (json.JSONDecodeError, KeyError, TypeError) as exc:
+            raise GearsymError(f"{self.meta_path}: not a gearsym sweep record ({exc}); pass --overwrite "
+                               "or choose another --out") from None
+        new = json.loads(json.dumps(self.record))  # compare as JSON sees them
+        differ = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
+        if differ:
+            detail = "; ".join(f"{k}: {_short(old.get(k))} before, {_short(new.get(k))} now" for k in differ)
+            raise GearsymError(f"{self.path} was written by a different sweep ({detail}). To resume it, repeat "
+                               "the command it came from; to start again pass --overwrite, or choose another --out")
+
+    def _read(self, path: Path, columns: list[str]) -> dict[tuple, dict]:
+        rows = {}
+        for row in self._read_rows(path, columns):
+            key = self.key(row)
+            if key in rows:
+                raise GearsymError(f"{path}: the point {key} appears twice; pass --overwrite to start again")
+            rows[key] = row
+        return rows
+
+    def _read_rows(self, path: Path, columns: list[str]) -> list[dict]:
+        text = path.read_text()
+        if text and not text.endswith("\n"):
+            text = text[: text.rfind("\n") + 1]  # the last row was cut off mid-write: it is redone
+        reader = csv.reader(io.StringIO(text))
+        header = next(reader, None)
+        if header is None:
+            return []
+        if header != columns:
+            raise GearsymError(f"{path}: its columns ({', '.join(header)}) are not this sweep's "
+                               f"({', '.join(columns)}); pass --overwrite or choose another --out")
+        rows = []
+        for line, fields in enumerate(reader, start=2):
+            if len(fields) != len(columns):
+                raise GearsymError(f"{path}, row {line}: {len(fields)} fields, expected {len(columns)}; "
+                                   "the file was edited or damaged: fix the row or pass --overwrite")
+            rows.append(dict(zip(columns, fields)))
+        return rows
+
+    # ------------------------------------------------------------ writing
+    def append(self, row: dict, strobe_rows: Iterable[dict]) -> None:
+        """One finished point: its Poincare rows first, then its row (whose presence marks it done)."""
+        strobe_file, main_file = self._files
+        csv.DictWriter(strobe_file, self.strobe_columns, lineterminator="\n").writerows(strobe_rows)
+        strobe_file.flush()
+        csv.DictWriter(main_file, self.columns, lineterminator="\n").writerow(row)
+        main_file.flush()
+
+    def close(self) -> None:
+        for f in self._files:
+            f.close()
+        self._files = []
+
+    def _lock(self) -> None:
+        """One writer per sweep file: a second process on the same --out would interleave rows.
+        An flock is released by the kernel when its process dies, so no stale lock survives a kill."""
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        lock = open(sidecar(self.path, ".lock"), "a+")
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            lock.close()
+            raise GearsymError(f"another gearsym process is writing {self.path}; wait for it to finish "
+                               "(or stop it), or choose another --out") from None
+        self._lock_file = lock
+
+    def release(self) -> None:
+        """Close the files and let another process have them."""
+        self.close()
+        lock = getattr(self, "_lock_file", None)
+        if lock is not None:
+            lock.close()
+            self._lock_file = None
+
+    def finish(self, rows: Iterable[dict], strobe_rows: Iterable[dict]) -> None:
+        """All points done: both tables rewritten in plan order (the lock is kept until ``release``)."""
+        self.close()
+        self._write_table(self.path, self.columns, rows)
+        self._write_table(self.strobe_path, self.strobe_columns, strobe_rows)
+
+    def write_record(self, **extra) -> None:
+        _atomic_write(self.meta_path, json.dumps({"sweep": self.record, **extra}, indent=2) + "\n")
+
+    @staticmethod
+    def _write_table(path: Path, columns: list[str], rows: Iterable[dict]) -> None:
+        buffer = io.StringIO()
+        writer = csv.DictWriter(buffer, columns, lineterminator="\n")
+        writer.writeheader()
+        writer.writerows(rows)
+        _atomic_write(path, buffer.getvalue())
+
+
+def _atomic_write(path: Path, text: str) -> None:
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def _short(value) -> str:
+    text = json.dumps(value)
+    return text if len(text) <= 60 else text[:57] + "..."

@@ -1,0 +1,182 @@
+"""Sweeps: the grid, continuation hand-over, resume after an interruption, threads, and the CLI."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gearsym.analysis import lyapunov_spectrum
+from gearsym.cli import main
+from gearsym.codegen import compile_model
+from gearsym.errors import GearsymError
+from gearsym.sweep import SweepInterrupted, parse_axis, read_sweep, run_sweep
+
+SHORT = dict(periods=60, discard=20, progress=False)
+
+
+@pytest.fixture(scope="module")
+def one_stage():
+    return compile_model("one_stage")
+
+
+# ------------------------------------------------------------------ grid
+def test_ranges_are_counted_in_decimal_and_include_stop():
+    axis = parse_axis("omega=0.1:2.0:0.01")
+    assert len(axis.values) == 191 and axis.values[0] == 0.1 and axis.values[-1] == 2.0
+    assert 0.3 in axis.values and 1.36 in axis.values  # not 0.30000000000000004
+    assert parse_axis("kS=1.0,0,0.1").values == (0.0, 0.1, 1.0)
+    assert parse_axis("D=2").values == (2.0,)
+
+
+@pytest.mark.parametrize("text, words", [
+    ("omega", "NAME=START:STOP:STEP"), ("omega=1:2", "NAME=START:STOP:STEP"), ("omega=a,b", "NAME=V1"),
+    ("omega=1:2:0", "step must be nonzero"), ("omega=2:1:0.1", "lead from start to stop"),
+    ("kS=0,0.1,0", "repeat"), ("omega=0:1e9:1e-9", "typo"),
+])
+def test_bad_axes_say_what_is_expected(text, words):
+    with pytest.raises(GearsymError, match=words):
+        parse_axis(text)
+
+
+def test_unknown_or_doubly_given_parameters_are_refused(one_stage):
+    with pytest.raises(GearsymError, match="unknown parameter 'omgea'.*omega"):
+        run_sweep(one_stage, ["omgea=1,2"], **SHORT)
+    with pytest.raises(GearsymError, match="both swept"):
+        run_sweep("one_stage", ["omega=1,2"], omega=1.5, **SHORT)
+    with pytest.raises(GearsymError, match="must be positive|must not be negative"):
+        run_sweep(one_stage, ["zeta=-1,0.1"], **SHORT)
+
+
+# ------------------------------------------------------------------ what a point is
+def test_continuation_hands_the_final_state_on(one_stage):
+    result = run_sweep(one_stage, {"omega": [1.0, 1.1, 1.2]}, **SHORT)
+    state = None
+    for i, w in enumerate((1.0, 1.1, 1.2)):
+        direct = lyapunov_spectrum(one_stage, periods=60, discard=20, y0=state, omega=w)
+        assert result["lambda_1"][i] == direct.exponents[0] and result["A_x"][i] == direct.amplitude["x"]
+        assert result["final_x"][i] == direct.final_state["x"]
+        state = [direct.final_state["x"], direct.final_state["v"]]
+    from_default = lyapunov_spectrum(one_stage, periods=60, discard=20, omega=1.2)
+    assert result["final_x"][2] != from_default.final_state["x"]  # it did not restart
+
+
+def test_independent_points_start_from_the_initial_state(one_stage):
+    result = run_sweep(one_stage, {"omega": [1.0, 1.2]}, mode="independent", y0=[-1.0, 0.3], **SHORT)
+    direct = lyapunov_spectrum(one_stage, periods=60, discard=20, y0=[-1.0, 0.3], omega=1.2)
+    assert result["lambda_1"][1] == direct.exponents[0] and set(result["direction"]) == {"independent"}
+
+
+def test_both_directions_go_up_then_back_down_from_where_up_ended(one_stage):
+    result = run_sweep(one_stage, {"omega": [1.0, 1.1, 1.2]}, direction="both", **SHORT)
+    assert result["direction"].tolist() == ["up"] * 3 + ["down"] * 3
+    assert result["omega"].tolist() == [1.0, 1.1, 1.2, 1.2, 1.1, 1.0]
+    top = [result["final_x"][2], result["final_v"][2]]
+    down = lyapunov_spectrum(one_stage, periods=60, discard=20, y0=top, omega=1.2)
+    assert result["final_x"][3] == down.final_state["x"]
+
+
+def test_regime_column_names_the_motion(one_stage):
+    result = run_sweep(one_stage, {"omega": [1.2, 1.6]}, mode="independent", periods=400, discard=100,
+                       progress=False)
+    assert result["regime"].tolist() == ["chaotic", "periodic"]
+
+
+# ------------------------------------------------------------------ files, resume, threads
+def _interrupt_after(count):
+    seen = []
+
+    def on_point(row):
+        seen.append(row)
+        if len(seen) == count:
+            raise KeyboardInterrupt
+
+    return on_point
+
+
+@pytest.mark.parametrize("mode, jobs", [("continuation", 2), ("independent", 2), ("continuation", 1)])
+def test_an_interrupted_sweep_resumes_to_the_same_files(tmp_path, one_stage, mode, jobs):
+    axes = ["omega=0.9:1.3:0.1", "B1=3.5,4"]
+    whole = run_sweep(one_stage, axes, mode=mode, jobs=jobs, out=tmp_path / "whole.csv", **SHORT)
+    assert len(whole) == 10
+    part = tmp_path / "part.csv"
+    with pytest.raises(SweepInterrupted) as info:
+        run_sweep(one_stage, axes, mode=mode, jobs=jobs, out=part, on_point=_interrupt_after(4), **SHORT)
+    assert info.value.done >= 4 and "run the same command again" in str(info.value)
+    kept = part.read_text().splitlines()
+    assert len(kept) - 1 == info.value.done  # every finished point is on disk
+    part.write_text(part.read_text() + kept[-1][:10])  # as if killed while writing a row
+    resumed = run_sweep(one_stage, axes, mode=mode, jobs=jobs, out=part, **SHORT)
+    assert part.read_bytes() == (tmp_path / "whole.csv").read_bytes()
+    assert (tmp_path / "part.poincare.csv").read_bytes() == (tmp_path / "whole.poincare.csv").read_bytes()
+    assert np.array_equal(resumed["lambda_1"], whole["lambda_1"])
+    again = run_sweep(one_stage, axes, mode=mode, jobs=jobs, out=part, on_point=_interrupt_after(1), **SHORT)
+    assert len(again) == 10  # complete: nothing left to run, nothing recomputed
+
+
+def test_threads_do_not_change_a_single_bit(tmp_path, one_stage):
+    axes = ["omega=0.9:1.4:0.1", "B1=3.5,4"]
+    for jobs in (1, 2):
+        run_sweep(one_stage, axes, mode="independent", jobs=jobs, out=tmp_path / f"j{jobs}.csv", **SHORT)
+    assert (tmp_path / "j1.csv").read_bytes() == (tmp_path / "j2.csv").read_bytes()
+
+
+def test_resuming_with_other_options_says_what_differs(tmp_path, one_stage):
+    out = tmp_path / "s.csv"
+    run_sweep(one_stage, ["omega=1,1.1"], out=out, **SHORT)
+    with pytest.raises(GearsymError, match="different sweep.*periods: 60 before, 80 now.*--overwrite"):
+        run_sweep(one_stage, ["omega=1,1.1"], out=out, periods=80, discard=20, progress=False)
+    run_sweep(one_stage, ["omega=1,1.1"], out=out, periods=80, discard=20, progress=False, overwrite=True)
+    assert read_sweep(out).record["periods"] == 80
+
+
+def test_a_damaged_sweep_file_is_named_with_its_row(tmp_path, one_stage):
+    out = tmp_path / "s.csv"
+    run_sweep(one_stage, ["omega=1:1.3:0.1"], out=out, **SHORT)
+    lines = out.read_text().splitlines()
+    lines[2] = lines[2].rsplit(",", 3)[0]
+    out.write_text("\n".join(lines) + "\n")
+    with pytest.raises(GearsymError, match=r"s.csv, row 3: .* fields"):
+        run_sweep(one_stage, ["omega=1:1.3:0.1"], out=out, **SHORT)
+    (tmp_path / "s.json").unlink()
+    with pytest.raises(GearsymError, match="cannot be resumed"):
+        run_sweep(one_stage, ["omega=1:1.3:0.1"], out=out, **SHORT)
+
+
+def test_the_record_lists_jumps_and_the_table_has_the_documented_columns(tmp_path):
+    out = tmp_path / "f.csv"
+    result = run_sweep("flexible_shaft", ["omega=1.4,1.5", "kS=0.1"], out=out, poincare=5, **SHORT)
+    assert out.read_text().splitlines()[0] == (
+        "omega,kS,direction,A_x1,A_x2,lambda_1,lambda_2,lambda_3,lambda_4,stderr_1,stderr_2,stderr_3,stderr_4,"
+        "regime,final_x1,final_v1,final_x2,final_v2")
+    assert len(result.strobe["x1"]) == 2 * 5
+    record = read_sweep(out).record
+    assert record["parameters"]["kS"] == 0.1 and record["model_hash"] == compile_model("flexible_shaft").hash
+
+
+# ------------------------------------------------------------------ command line
+def test_sweep_command(tmp_path, capsys):
+    out = tmp_path / "s.csv"
+    code = main(["sweep", "one_stage_resonant", "--param", "omega=1.3:1.4:0.05", "--direction", "both",
+                 "--periods", "60", "--discard", "20", "--out", str(out), "--plot", str(tmp_path / "s.png"),
+                 "--quiet"])
+    text, err = capsys.readouterr()
+    assert code == 0 and "6 points" in text and "regimes:" in text
+    assert (tmp_path / "s.png").stat().st_size > 10_000 and (tmp_path / "s.json").exists()
+    code = main(["sweep", "one_stage", "--param", "omega=1,2", "--set", "zetta=1", "--out", str(out), "--quiet"])
+    assert code == 2 and "unknown parameter 'zetta'" in capsys.readouterr().err
+
+
+def test_a_second_writer_on_the_same_file_is_refused(tmp_path, one_stage):
+    import fcntl
+
+    out = tmp_path / "s.csv"
+    with open(tmp_path / "s.lock", "a") as held:  # as another process running this sweep holds it
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        with pytest.raises(GearsymError, match="another gearsym process is writing"):
+            run_sweep(one_stage, ["omega=1,1.1"], out=out, **SHORT)
+    run_sweep(one_stage, ["omega=1,1.1"], out=out, **SHORT)  # free again
+    run_sweep(one_stage, ["omega=1,1.1"], out=out, **SHORT)  # and released by the sweep itself
+
+
+def test_independent_points_have_no_direction(one_stage):
+    with pytest.raises(GearsymError, match="applies to a continuation"):
+        run_sweep(one_stage, ["omega=1,1.1"], mode="independent", direction="both", **SHORT)
