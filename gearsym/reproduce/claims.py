@@ -87,7 +87,7 @@ def chaos_d0(c: Computed, study: dict) -> dict:
     chaotic = np.isin(r["regime"][idx], CHAOTIC)
     verdict = (AGREES if min(w.values()) >= 0.5 else PARTLY if max(w.values()) >= 0.5 or min(w.values()) >= 0.2
                else DISAGREES)
-    return _claim("chaos-D0", "3b", "D = 0 (curve '1') is chaotic (lambda_1 > 0) near omega = 1.0 and in "
+    return _claim("chaos-D0", "3b", "D = 0 (curve '1') is chaotic (λ₁ > 0) near ω = 1.0 and in "
                   "[1.24, 1.62].",
                   f"chaotic at {_pct(w['near_1'])} of the points in [{NEAR_ONE[0]}, {NEAR_ONE[1]}] and "
                   f"{_pct(w['band'])} in [{CHAOS_BAND[0]}, {CHAOS_BAND[1]}]; chaotic intervals: "
@@ -129,7 +129,7 @@ def jumps_d2(c: Computed, study: dict) -> dict:
     listing = "; ".join(f"{j['from']:.2f}->{j['to']:.2f} (A {j['A_before']:.2f}->{j['A_after']:.2f})" for j in up)
     hyst = "; ".join(f"[{h['from']:.2f}, {h['to']:.2f}]" for h in findings["hysteresis"]) or "none"
     verdict = AGREES if len(matched) == len(PAPER_JUMPS) else PARTLY if matched else DISAGREES
-    return _claim("jumps-D2", "3a", "The amplitude with D = 2 jumps near omega = 1.36 and 1.70.",
+    return _claim("jumps-D2", "3a", "The amplitude with D = 2 jumps near ω = 1.36 and 1.70.",
                   f"jumps on the way up: {listing or 'none'}; matched within +-{JUMP_TOLERANCE}: "
                   f"{', '.join(map(str, matched)) or 'none'}; hysteresis (up and down differ): {hyst}",
                   verdict, {"jumps_up": up, "matched": matched, "hysteresis": findings["hysteresis"]})
@@ -138,7 +138,7 @@ def jumps_d2(c: Computed, study: dict) -> dict:
 # ------------------------------------------------------------------ Fig. 4: coexisting attractors
 def _attractor_summary(s) -> str:
     return ", ".join(f"'{a.paper_label}' {a.description} ({len(a.members)}/{len(s.results)} starts, "
-                     f"lambda_1 {a.lambda1:+.3f})" for a in s.attractors)
+                     f"λ₁ {a.lambda1:+.3f})" for a in s.attractors)
 
 
 def _kinds(s) -> tuple[bool, bool]:
@@ -149,7 +149,7 @@ def coexistence_15(c: Computed, study: dict) -> dict:
     found = {m: c.attractors[(m, 1.5)] for m in ("one_stage", "one_stage_resonant")}
     both = [all(_kinds(s)) for s in found.values()]
     verdict = AGREES if all(both) else PARTLY if any(both) else DISAGREES
-    return _claim("attractors-1.5", "4a", "At omega = 1.5 a regular ('1') and a chaotic ('2') attractor coexist, "
+    return _claim("attractors-1.5", "4a", "At ω = 1.5 a regular ('1') and a chaotic ('2') attractor coexist, "
                   "for D = 0 and D = 2 alike.",
                   f"D = 0: {_attractor_summary(found['one_stage'])}. D = 2: "
                   f"{_attractor_summary(found['one_stage_resonant'])}",
@@ -160,7 +160,7 @@ def coexistence_16(c: Computed, study: dict) -> dict:
     d0, d2 = c.attractors[("one_stage", 1.6)], c.attractors[("one_stage_resonant", 1.6)]
     parts = [not _kinds(d0)[0], _kinds(d2)[0], _kinds(d2)[1]]
     verdict = AGREES if all(parts) else PARTLY if any(parts) else DISAGREES
-    return _claim("attractors-1.6", "4b", "At omega = 1.6 the regular attractor of D = 0 is gone; with D = 2 it "
+    return _claim("attractors-1.6", "4b", "At ω = 1.6 the regular attractor of D = 0 is gone; with D = 2 it "
                   "remains, and a chaotic attractor appears beside it.",
                   f"D = 0: {_attractor_summary(d0)}. D = 2: {_attractor_summary(d2)}",
                   verdict, {"one_stage": d0.as_dict() | {"initial_conditions": None},
@@ -198,7 +198,7 @@ def chaos_ks01(c: Computed, study: dict) -> dict:
     s0, s1 = _flex_window_stats(r, kS=0.0), _flex_window_stats(r, kS=0.1)
     kept = s1["chaotic"] / s0["chaotic"] if s0["chaotic"] else float("nan")
     return _claim("chaos-kS0.1", "6b", "The weak shaft (kS = 0.1, curve '2') does not reduce the chaos of kS = 0 "
-                  "near omega = 1.0 and in [1.24, 1.62].",
+                  "near ω = 1.0 and in [1.24, 1.62].",
                   f"chaotic in those windows at {_pct(s1['chaotic'])} of the points for kS = 0.1, against "
                   f"{_pct(s0['chaotic'])} for kS = 0 (ratio {kept:.2f})",
                   _grade(kept, 0.8, 0.5), {"kS=0": s0, "kS=0.1": s1, "kept": kept}, study.get("chaos-kS0.1", ""))
@@ -207,7 +207,7 @@ def chaos_ks01(c: Computed, study: dict) -> dict:
 def tamed_ks1(c: Computed, study: dict) -> dict:
     s = _flex_window_stats(c.sweeps["fig6"], kS=1.0)
     return _claim("tamed-kS1", "6b", "The stiff shaft (kS = 1.0) tames the chaos in those regions.",
-                  f"regular at {_pct(s['regular'])} of the points near omega = 1.0 and in [1.24, 1.62]",
+                  f"regular at {_pct(s['regular'])} of the points near ω = 1.0 and in [1.24, 1.62]",
                   _grade(s["regular"], 0.8, 0.5), s, study.get("tamed-kS1", ""))
 
 
@@ -236,7 +236,7 @@ def single_ks1(c: Computed, study: dict) -> dict:
                   _grade(share, 0.8, 0.5), {"chaotic_points": int(chaotic.sum()), "single_share": share})
 
 
-# ------------------------------------------------------------------ Fig. 7: portraits at omega = 1.5
+# ------------------------------------------------------------------ Fig. 7: portraits at ω = 1.5
 def portraits(c: Computed, study: dict) -> dict:
     by = {p.letter: p for p in c.portraits}
     reg = {k: by[k].spectrum.regime for k in "abc"}
@@ -244,7 +244,7 @@ def portraits(c: Computed, study: dict) -> dict:
     period1 = bool(np.all(np.abs(strobe - strobe[:, -1:]) <= 1e-4 * (1 + np.abs(strobe[:, -1:]))))
     parts = [reg["a"] in CHAOTIC, reg["b"] in REGULAR and period1, reg["c"] == "hyperchaotic"]
     lam = {k: ", ".join(f"{x:+.3f}" for x in by[k].spectrum.exponents) for k in "abc"}
-    return _claim("portraits-1.5", "7", "At omega = 1.5 from the paper's start: kS = 0 chaotic (a), kS = 1.0 regular "
+    return _claim("portraits-1.5", "7", "At ω = 1.5 from the paper's start: kS = 0 chaotic (a), kS = 1.0 regular "
                   "and synchronised with the excitation (b), kS = 0.1 hyperchaotic (c, d).",
                   f"(a) kS = 0: {reg['a']} ({lam['a']}); (b) kS = 1.0: {reg['b']}"
                   f"{', period 1' if period1 else ''} ({lam['b']}); (c) kS = 0.1: {reg['c']} ({lam['c']})",

@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 from pathlib import Path
 
 #: Why a claim comes out as it does, where the numbers alone do not say it. Written by a person
@@ -92,7 +93,7 @@ def render(record: dict, figures_dir: str = "figures") -> str:
     ]
     for c in main["claims"]:
         verdicts = [VERDICT_MARK[c["verdict"]]] + [VERDICT_MARK[o[c["id"]]["verdict"]] for o in by_id]
-        lines.append(f"| [{c['id']}](#{c['id']}) | {c['figure']} | {c['paper']} | " + " | ".join(verdicts) + " |")
+        lines.append(f"| [{c['id']}](#{_anchor(c['id'])}) | {c['figure']} | {c['paper']} | " + " | ".join(verdicts) + " |")
     lines.append("")
     for s in record["scenarios"]:
         counts = {v: sum(c["verdict"] == v for c in s["claims"]) for v in VERDICT_MARK}
@@ -131,6 +132,11 @@ def render(record: dict, figures_dir: str = "figures") -> str:
     lines += _study(main, figures_dir)
     lines += _method(record)
     return "\n".join(lines).rstrip() + "\n"
+
+
+def _anchor(heading: str) -> str:
+    """The id GitHub gives a heading: lower case, punctuation dropped, spaces to hyphens."""
+    return re.sub(r"[^\w\- ]", "", heading.lower()).replace(" ", "-")
 
 
 def _values_text(scenario: dict) -> str:
