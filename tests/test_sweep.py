@@ -1,6 +1,8 @@
 """Sweeps: the grid, continuation hand-over, resume after an interruption, threads, and the CLI."""
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -141,7 +143,7 @@ def test_a_damaged_sweep_file_is_named_with_its_row(tmp_path, one_stage):
         run_sweep(one_stage, ["omega=1:1.3:0.1"], out=out, **SHORT)
 
 
-def test_the_record_lists_jumps_and_the_table_has_the_documented_columns(tmp_path):
+def test_the_table_has_the_documented_columns(tmp_path):
     out = tmp_path / "f.csv"
     result = run_sweep("flexible_shaft", ["omega=1.4,1.5", "kS=0.1"], out=out, poincare=5, **SHORT)
     assert out.read_text().splitlines()[0] == (
@@ -150,6 +152,61 @@ def test_the_record_lists_jumps_and_the_table_has_the_documented_columns(tmp_pat
     assert len(result.strobe["x1"]) == 2 * 5
     record = read_sweep(out).record
     assert record["parameters"]["kS"] == 0.1 and record["model_hash"] == compile_model("flexible_shaft").hash
+
+
+def test_the_record_lists_the_jumps_and_hysteresis_found(tmp_path, one_stage):
+    """one_stage falls off its resonance peak between omega 0.88 and 0.9 going up, and
+    earlier going down (the up and down branches coexist there)."""
+    out = tmp_path / "j.csv"
+    result = run_sweep(one_stage, ["omega=0.8:1.0:0.01"], direction="both", out=out, progress=False)
+    record = json.loads((tmp_path / "j.json").read_text())
+    assert record["status"] == "complete" and record["jumps"] == json.loads(json.dumps(result.findings()["jumps"]))
+    up = [j for j in record["jumps"] if j["direction"] == "up"]
+    assert any(j["from"] <= 0.89 <= j["to"] and j["A_after"] < j["A_before"] / 1.5 for j in up)
+    assert record["hysteresis"] and all(h["from"] <= h["to"] for h in record["hysteresis"])
+
+
+def test_continuation_lines_on_threads_do_not_change_a_single_bit(tmp_path, one_stage):
+    axes = ["omega=0.9:1.3:0.1", "B1=3.5,4"]
+    for jobs in (1, 2):
+        run_sweep(one_stage, axes, direction="both", jobs=jobs, out=tmp_path / f"c{jobs}.csv", **SHORT)
+    assert (tmp_path / "c1.csv").read_bytes() == (tmp_path / "c2.csv").read_bytes()
+
+
+def test_resume_in_the_down_half_after_a_kill_mid_row(tmp_path, one_stage):
+    axes = ["omega=0.9:1.3:0.1"]
+    run_sweep(one_stage, axes, direction="both", out=tmp_path / "whole.csv", **SHORT)
+    part = tmp_path / "part.csv"
+    with pytest.raises(SweepInterrupted):
+        run_sweep(one_stage, axes, direction="both", out=part, on_point=_interrupt_after(7), **SHORT)
+    whole_rows = (tmp_path / "whole.csv").read_text().splitlines()
+    part.write_text(part.read_text() + whole_rows[8][:15])  # the 8th point (going down) cut while written
+    strobe = tmp_path / "part.poincare.csv"
+    strobe.write_text(strobe.read_text() + "1.0,down,0,0.12")  # and its Poincare rows
+    partial = read_sweep(part)  # reading an interrupted sweep leaves the cut row out ...
+    assert len(partial) == 7 and partial["direction"].tolist() == ["up"] * 5 + ["down"] * 2
+    assert partial.findings()["hysteresis"] is not None  # ... and compares only what both runs have
+    run_sweep(one_stage, axes, direction="both", out=part, **SHORT)
+    assert part.read_bytes() == (tmp_path / "whole.csv").read_bytes()
+    assert strobe.read_bytes() == (tmp_path / "whole.poincare.csv").read_bytes()
+
+
+def test_a_sweep_that_finished_no_point_starts_again_with_new_options(tmp_path, one_stage):
+    out = tmp_path / "s.csv"
+    with pytest.raises(SweepInterrupted):
+        run_sweep(one_stage, ["omega=1,1.1"], out=out, on_point=_interrupt_after(1), **SHORT)
+    out.write_text(out.read_text().splitlines()[0] + "\n")  # as if stopped before the first point was written
+    result = run_sweep(one_stage, ["omega=1,1.1"], out=out, periods=80, discard=20, progress=False)
+    assert len(result) == 2 and read_sweep(out).record["periods"] == 80
+
+
+def test_missing_poincare_samples_are_not_silently_dropped(tmp_path, one_stage):
+    out = tmp_path / "s.csv"
+    with pytest.raises(SweepInterrupted):
+        run_sweep(one_stage, ["omega=1:1.3:0.1"], out=out, on_point=_interrupt_after(2), **SHORT)
+    (tmp_path / "s.poincare.csv").unlink()
+    with pytest.raises(GearsymError, match="lacks the Poincare samples of 2 finished points"):
+        run_sweep(one_stage, ["omega=1:1.3:0.1"], out=out, **SHORT)
 
 
 # ------------------------------------------------------------------ command line
@@ -169,7 +226,7 @@ def test_a_second_writer_on_the_same_file_is_refused(tmp_path, one_stage):
     import fcntl
 
     out = tmp_path / "s.csv"
-    with open(tmp_path / "s.lock", "a") as held:  # as another process running this sweep holds it
+    with open(tmp_path / "s.csv.lock", "a") as held:  # as another process running this sweep holds it
         fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
         with pytest.raises(GearsymError, match="another gearsym process is writing"):
             run_sweep(one_stage, ["omega=1,1.1"], out=out, **SHORT)

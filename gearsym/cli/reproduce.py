@@ -28,7 +28,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         reproduce(args.out, doc, quick=args.quick, jobs=args.jobs, progress=not args.quiet, data=args.data)
     except KeyboardInterrupt as exc:
-        print(f"gearsym: {exc or 'interrupted'}; run the same command again to resume", file=sys.stderr)
+        print(f"gearsym: {exc}" if str(exc) else "gearsym: interrupted; run the same command again to resume",
+              file=sys.stderr)
         return 130
     print(f"wrote {doc} and the figures in {args.out}")
     return 0

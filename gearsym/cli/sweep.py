@@ -49,8 +49,9 @@ def run(args: argparse.Namespace) -> int:
                            discard=args.discard, steps_per_period=args.steps_per_period, y0=parse_state(args.y0),
                            jobs=args.jobs, out=args.out, overwrite=args.overwrite, poincare=args.poincare,
                            progress=not args.quiet, backend=args.backend, **parse_settings(args.set))
-    except KeyboardInterrupt as exc:
-        print(f"gearsym: {exc}", file=sys.stderr)
+    except KeyboardInterrupt as exc:  # SweepInterrupted says how many points were kept
+        print(f"gearsym: {exc}" if str(exc) else "gearsym: interrupted before any point was finished",
+              file=sys.stderr)
         return 130
     regimes = Counter(result["regime"].tolist())
     print(f"{result.model}: {len(result)} points -> {args.out} (+ .json, .poincare.csv)")

@@ -109,7 +109,8 @@ def plot_map(ax, result: SweepResult, column: str = "lambda_1", *, direction: st
         mesh = ax.pcolormesh(_edges(xs), _edges(ys), grid, cmap=cmap, norm=BoundaryNorm(np.arange(-0.5, 4), 4))
     elif column.startswith("lambda_"):
         grid[iy, ix] = result[column][keep]
-        span = float(np.nanmax(np.abs(grid))) or 1.0
+        finite = np.abs(grid[np.isfinite(grid)])
+        span = float(finite.max()) if finite.size and finite.max() > 0 else 1.0
         mesh = ax.pcolormesh(_edges(xs), _edges(ys), grid, cmap="RdBu_r", norm=TwoSlopeNorm(0.0, -span, span))
         if len(xs) > 1 and len(ys) > 1:
             ax.contour(xs, ys, grid, levels=[0.0], colors="k", linewidths=0.6)
@@ -149,7 +150,7 @@ def plot_sweep(result: SweepResult, path: str | Path) -> Path:
     title = f"{result.model}: " + ", ".join(f"{a.name} {a.values[0]:g}..{a.values[-1]:g}" for a in result.axes)
     if len(result.axes) >= 2:
         fig, axs = plt.subplots(1, 3, figsize=(15, 4.2), constrained_layout=True)
-        direction = None if result.mode == "independent" else "up"
+        direction = None if result.mode == "independent" else ("down" if result.record.get("direction") == "down" else "up")
         for ax, column, label in zip(axs, ("lambda_1", "regime", f"A_{result.coordinates[0]}"),
                                      (r"$\lambda_1$", "regime", f"A ({result.coordinates[0]})")):
             mesh = plot_map(ax, result, column, direction=direction)
@@ -158,7 +159,7 @@ def plot_sweep(result: SweepResult, path: str | Path) -> Path:
             else:
                 cbar = fig.colorbar(mesh, ax=ax, ticks=range(4))
                 cbar.ax.set_yticklabels(REGIMES, fontsize=7)
-        axs[1].set_title(title + (" (up)" if direction else ""), fontsize=9)
+        axs[1].set_title(title + (f" ({direction})" if direction else ""), fontsize=9)
     else:
         fig, axs = plt.subplots(4, 1, figsize=(8, 9.5), sharex=True, constrained_layout=True,
                                 gridspec_kw={"height_ratios": [3, 3, 3, 1]})

@@ -44,9 +44,10 @@ def record_of(computed: list[Computed]) -> dict:
     return _plain({"run": run, "scenarios": [scenario_record(c) for c in computed]})
 
 
-def reproduce(out: str | Path = "docs/figures", doc: str | Path | None = "docs/reproduction.md", *,
+def reproduce(out: str | Path = "docs/figures", doc: str | Path | None = None, *,
               quick: bool = False, jobs: int = 0, progress: bool = True, data: str | Path | None = None) -> dict:
-    """Compute everything, draw the figures into ``out``, write ``out/claims.json`` and ``doc``.
+    """Compute everything, draw the figures into ``out``, write ``out/claims.json`` and ``doc``
+    (default: ``reproduction.md`` beside ``out``, i.e. docs/reproduction.md for docs/figures).
 
     Sweep data go to ``data`` (default ``out/data``), which is also the cache a
     rerun reads and the place an interrupted run resumes from. Returns the record.
@@ -60,7 +61,7 @@ def reproduce(out: str | Path = "docs/figures", doc: str | Path | None = "docs/r
         computed.append(compute(plan, data / scenario.name, jobs=jobs, progress=progress))
         draw_all(computed[-1], out, "" if i == 0 else f"-{scenario.name}")
     record = record_of(computed)
-    write(record, out / "claims.json", Path(doc) if doc else out / "reproduction.md")
+    write(record, out / "claims.json", Path(doc) if doc else out.parent / "reproduction.md")
     if progress:
         for s in record["scenarios"]:
             verdicts = [c["verdict"] for c in s["claims"]]

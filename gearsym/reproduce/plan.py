@@ -111,6 +111,9 @@ def paper_plan(quick: bool = False, scenario: Scenario = CALIBRATED, study: bool
         SweepJob("study_inertia", "flexible_shaft",
                  (study_omega, "I2=0.5,2,8" if quick else "I2=0.5,1,2,4,8"), settings={"kS": 0.1},
                  title="the inertia I2 of gear 2 (sets beta_1 = 1/I2, beta_2, beta_3), kS = 0.1"),
+        SweepJob("study_inertia_kS0", "flexible_shaft",  # the baseline of "kS = 0.1 keeps the chaos of kS = 0"
+                 (study_omega, "I2=0.5,2,8" if quick else "I2=0.5,1,2,4,8"), settings={"kS": 0.0},
+                 title="the same at kS = 0"),
     )
     sweeps = tuple(replace(job, settings={**_unswept(scenario.settings(job.model), job.params), **job.settings})
                    for job in sweeps + (studies if study else ()))

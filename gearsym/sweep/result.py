@@ -12,7 +12,7 @@ import numpy as np
 from ..analysis.jumps import find_jumps, hysteresis_intervals
 from ..errors import GearsymError
 from .grid import INDEPENDENT, Axis
-from .store import sidecar
+from .store import read_rows, sidecar
 
 
 @dataclass(frozen=True)
@@ -78,11 +78,18 @@ class SweepResult:
             by_fixed.setdefault(tuple(fixed.items()), {})[direction] = idx
         for fixed, pair in by_fixed.items():
             if {"up", "down"} <= set(pair):
-                up, down = pair["up"], pair["down"][::-1]  # both ascending in the first axis
+                common = np.intersect1d(self[first][pair["up"]], self[first][pair["down"]])  # all, unless interrupted
+                up, down = (_ascending_on(self[first], pair[d], common) for d in ("up", "down"))
                 for c in self.coordinates:
                     for lo, hi in hysteresis_intervals(self[first][up], self[f"A_{c}"][up], self[f"A_{c}"][down]):
                         hysteresis.append({"coordinate": c, **dict(fixed), "from": lo, "to": hi})
         return {"jumps": jumps, "hysteresis": hysteresis}
+
+
+def _ascending_on(values: np.ndarray, idx: np.ndarray, common: np.ndarray) -> np.ndarray:
+    """The rows of ``idx`` whose first-axis value is in ``common``, in ascending order of it."""
+    keep = idx[np.isin(values[idx], common)]
+    return keep[np.argsort(values[keep], kind="stable")]
 
 
 def _keys(rows: Sequence[dict]) -> list[str]:
@@ -110,16 +117,11 @@ def read_sweep(path: str | Path) -> SweepResult:
     except (json.JSONDecodeError, KeyError, TypeError, AttributeError) as exc:
         raise GearsymError(f"{meta}: not a gearsym sweep record ({exc})") from None
 
-    def rows_of(p: Path) -> tuple[list[str], list[dict]]:
-        if not p.is_file():
-            return [], []
-        with open(p, newline="") as f:
-            reader = csv.DictReader(f)
-            return list(reader.fieldnames or []), list(reader)
-
-    names, rows = rows_of(path)
-    _, strobe_rows = rows_of(sidecar(path, ".poincare.csv"))
+    rows = read_rows(path)
+    names = list(rows[0]) if rows else next(csv.reader(path.read_text().splitlines()), [])
+    strobe_path = sidecar(path, ".poincare.csv")
+    strobe_rows = read_rows(strobe_path) if strobe_path.is_file() else []
     try:
         return SweepResult.from_rows(record["model"], axes, record["mode"], names, rows, strobe_rows, record, path)
-    except ValueError as exc:
+    except (ValueError, TypeError) as exc:
         raise GearsymError(f"{path}: a value is not a number ({exc})") from None

@@ -123,9 +123,9 @@ def run_sweep(
         already = len(done)
         try:
             for row, strobe_rows in _execute(run, todo, jobs):
-                done[run.key(row)], strobes[run.key(row)] = row, strobe_rows
                 if store:
                     store.append(row, strobe_rows)
+                done[run.key(row)], strobes[run.key(row)] = row, strobe_rows  # counted once it is on disk
                 bar.update(1)
                 if on_point:
                     on_point(row)
@@ -144,11 +144,14 @@ def run_sweep(
         result = SweepResult.from_rows(compiled.name, axes, mode, columns, rows, strobe_rows, record,
                                        path=store.path if store else None)
         if store:
+            computed = len(done) - already
+            seconds = round(time.perf_counter() - t_start, 3)
+            if not computed:  # a rerun of a finished sweep: keep the time it took
+                seconds = store.previous_record().get("seconds", seconds)
             store.finish(rows, strobe_rows)
             store.write_record(status="complete",
-                               points={"planned": len(planned), "done": len(done), "computed": len(done) - already},
-                               seconds=round(time.perf_counter() - t_start, 3), gearsym=__version__,
-                               **result.findings())
+                               points={"planned": len(planned), "done": len(done), "computed": computed},
+                               seconds=seconds, gearsym=__version__, **result.findings())
         return result
     finally:
         if store:

@@ -56,14 +56,19 @@ class SweepStore:
         if overwrite:
             for p in (self.path, self.meta_path, self.strobe_path):
                 p.unlink(missing_ok=True)
-        elif self.path.exists():
-            self._check_record()
+        elif self.path.exists() and (read_rows(self.path) if self.meta_path.exists() else True):
+            self._check_record()  # (a file with no finished point is simply started again)
             done = self._read(self.path, self.columns)
             strobes = {}
             if self.strobe_path.exists():
                 for row in self._read_rows(self.strobe_path, self.strobe_columns):
                     strobes.setdefault(self.key(row), []).append(row)
             strobes = {k: v for k, v in strobes.items() if k in done}  # written before their main row
+            lacking = [k for k in done if k not in strobes]
+            if self.record.get("poincare_samples") and lacking:
+                raise GearsymError(f"{self.strobe_path} lacks the Poincare samples of {len(lacking)} finished "
+                                   "points (deleted or damaged?), so the sweep cannot be resumed whole: pass "
+                                   "--overwrite to start again")
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._write_table(self.path, self.columns, done.values())  # drops a row cut off mid-write
         self._write_table(self.strobe_path, self.strobe_columns, (r for rows in strobes.values() for r in rows))
@@ -104,23 +109,7 @@ class SweepStore:
         return rows
 
     def _read_rows(self, path: Path, columns: list[str]) -> list[dict]:
-        text = path.read_text()
-        if text and not text.endswith("\n"):
-            text = text[: text.rfind("\n") + 1]  # the last row was cut off mid-write: it is redone
-        reader = csv.reader(io.StringIO(text))
-        header = next(reader, None)
-        if header is None:
-            return []
-        if header != columns:
-            raise GearsymError(f"{path}: its columns ({', '.join(header)}) are not this sweep's "
-                               f"({', '.join(columns)}); pass --overwrite or choose another --out")
-        rows = []
-        for line, fields in enumerate(reader, start=2):
-            if len(fields) != len(columns):
-                raise GearsymError(f"{path}, row {line}: {len(fields)} fields, expected {len(columns)}; "
-                                   "the file was edited or damaged: fix the row or pass --overwrite")
-            rows.append(dict(zip(columns, fields)))
-        return rows
+        return read_rows(path, columns)
 
     # ------------------------------------------------------------ writing
     def append(self, row: dict, strobe_rows: Iterable[dict]) -> None:
@@ -140,7 +129,7 @@ class SweepStore:
         """One writer per sweep file: a second process on the same --out would interleave rows.
         An flock is released by the kernel when its process dies, so no stale lock survives a kill."""
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        lock = open(sidecar(self.path, ".lock"), "a+")
+        lock = open(self.path.with_name(self.path.name + ".lock"), "a+")
         try:
             fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
@@ -166,6 +155,13 @@ class SweepStore:
     def write_record(self, **extra) -> None:
         _atomic_write(self.meta_path, json.dumps({"sweep": self.record, **extra}, indent=2) + "\n")
 
+    def previous_record(self) -> dict:
+        """What the last run wrote beside the sweep record (status, points, seconds, ...), or {}."""
+        try:
+            return {k: v for k, v in json.loads(self.meta_path.read_text()).items() if k != "sweep"}
+        except (OSError, json.JSONDecodeError, AttributeError):
+            return {}
+
     @staticmethod
     def _write_table(path: Path, columns: list[str], rows: Iterable[dict]) -> None:
         buffer = io.StringIO()
@@ -173,6 +169,29 @@ class SweepStore:
         writer.writeheader()
         writer.writerows(rows)
         _atomic_write(path, buffer.getvalue())
+
+
+def read_rows(path: Path, columns: list[str] | None = None) -> list[dict]:
+    """The rows of a sweep table; a last row cut off mid-write is left out (a resume redoes it).
+    ``columns``: the header it must have (default: whatever it has)."""
+    text = path.read_text()
+    if text and not text.endswith("\n"):
+        text = text[: text.rfind("\n") + 1]
+    reader = csv.reader(io.StringIO(text))
+    header = next(reader, None)
+    if header is None:
+        return []
+    columns = header if columns is None else columns
+    if header != columns:
+        raise GearsymError(f"{path}: its columns ({', '.join(header)}) are not this sweep's "
+                           f"({', '.join(columns)}); pass --overwrite or choose another --out")
+    rows = []
+    for line, fields in enumerate(reader, start=2):
+        if len(fields) != len(columns):
+            raise GearsymError(f"{path}, row {line}: {len(fields)} fields, expected {len(columns)}; "
+                               "the file was edited or damaged: fix the row or pass --overwrite")
+        rows.append(dict(zip(columns, fields)))
+    return rows
 
 
 def _atomic_write(path: Path, text: str) -> None:
