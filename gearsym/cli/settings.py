@@ -29,18 +29,21 @@ def parse_settings(pairs: list[str]) -> dict[str, str]:
 
 def parse_state(text: str | None) -> dict[str, float] | None:
     """``x=-2,v=-0.5`` -> {'x': -2.0, 'v': -0.5}; states not named start at 0."""
-    if not text:
-        return None
-    state = {}
-    usage = f"--y0 {text!r}: expected NAME=NUMBER pairs separated by commas, e.g. x=-2,v=-0.5"
+    return parse_numbers(text, "--y0", "x=-2,v=-0.5") if text else None
+
+
+def parse_numbers(text: str, option: str, example: str) -> dict[str, float]:
+    """``NAME=NUMBER,NAME=NUMBER`` -> a dict, with an error that shows ``option`` and an ``example``."""
+    usage = f"{option} {text!r}: expected NAME=NUMBER pairs separated by commas, e.g. {option} {example}"
+    numbers = {}
     for item in text.split(","):
         name, sep, value = (part.strip() for part in item.partition("="))
         if not sep or not name:
             raise GearsymError(usage)
-        if name in state:
-            raise GearsymError(f"--y0 gives {name} twice")
+        if name in numbers:
+            raise GearsymError(f"{option} {text!r} gives {name} twice")
         try:
-            state[name] = float(value)
+            numbers[name] = float(value)
         except ValueError:
-            raise GearsymError(usage) from None
-    return state
+            raise GearsymError(f"{usage} ({name}={value!r} is not a number)") from None
+    return numbers

@@ -1,0 +1,491 @@
+"""Measured time series: the tidy CSV files of issue 5, read and checked against a model.
+
+One row per sample. The columns, in any order:
+
+* the time: ``tau``, the model's own (nondimensional) time, or ``t``, physical time, with a
+  time scale given to :func:`load_measurements` (tau = time_scale * t; ``gearsym derive MODEL``
+  shows the model's time unit). A model whose own time is ``t`` (Lorenz) reads ``t`` as is.
+* one column per measured state, named as in the model: ``x`` for ``one_stage``, ``x1`` and
+  ``x2`` for ``flexible_shaft``; velocity columns (``v``, ``v1``, ...) are optional. At least
+  one state is needed; states that were not measured are left out.
+* optionally ``record``: a label (any text) that separates several runs in one file. The rows of
+  a record are together and in time order. Without the column the file is one record, ``1``.
+* any number of operating conditions: columns named as model parameters (``omega``, ``B1``),
+  constant within a record. They override the model's defaults for that record.
+
+Every sample of a record must be finite, the time strictly increasing and evenly spaced (within
+``spacing_tolerance`` of the record's median step), with at least ``min_samples_per_period``
+samples per forcing period and at least ``min_periods`` whole forcing periods. The forcing
+period is the compiled model's, at the record's parameter values (2*pi in tau for the gear
+models). A file that breaks a rule gets a :class:`DataError` naming the file, the line (as a
+text editor numbers it: the header is line 1) and the column.
+
+The forcing phase of a measurement is the model's tau: data whose clock does not start at a
+known phase of the excitation need the phase (``Theta``) fitted, which is the fitting layer's job.
+"""
+from __future__ import annotations
+
+import csv
+import math
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Union
+
+import numpy as np
+
+from ..checks import whole_number
+from ..codegen import CompiledModel, compiled_and_values
+from ..errors import GearsymError, suggest
+
+RECORD = "record"
+PHYSICAL_TIME = "t"
+#: default minimum number of samples per forcing period
+MIN_SAMPLES_PER_PERIOD = 20
+#: default minimum number of whole forcing periods per record
+MIN_PERIODS = 3
+#: default relative tolerance on the sample step (0.1 % of the median step)
+SPACING_TOLERANCE = 1e-3
+#: rounding allowance at window edges, as a fraction of a sample step
+_EDGE = 1e-6
+
+PathLike = Union[str, Path]
+
+
+class DataError(GearsymError):
+    """A measured-data file that cannot be used; says where: ``source``, ``line`` and ``column``."""
+
+    def __init__(self, message: str, source: PathLike, line: int | None = None, column: str | None = None):
+        self.source, self.line, self.column = Path(source), line, column
+        where = str(source) + (f", line {line}" if line else "") + (f", column {column!r}" if column else "")
+        super().__init__(f"{where}: {message}")
+
+
+# --------------------------------------------------------------------------- the result
+@dataclass(frozen=True, eq=False)
+class Record:
+    """One run at fixed operating conditions: evenly spaced samples of some of the model's states.
+
+    ``tau`` is the model's time; ``observed`` maps state names to arrays like ``tau``;
+    ``conditions`` the parameter values this record sets (the rest are the model's);
+    ``period`` the forcing period in tau; ``step`` the sample step (the median, in tau);
+    ``line_numbers`` the line of each sample in its file; ``origin`` the time at which
+    forcing-period windows start (the first sample, kept by the parts of a split so that their
+    windows stay those of the whole record); ``time_scale`` the factor from the file's ``t`` to
+    tau (1 for a file in tau).
+    """
+
+    source: Path
+    record: str
+    tau: np.ndarray
+    observed: Mapping[str, np.ndarray]
+    conditions: Mapping[str, float]
+    period: float
+    step: float
+    line_numbers: np.ndarray
+    origin: float
+    time_scale: float = 1.0
+
+    @property
+    def label(self) -> str:
+        return f"{self.source.name} record {self.record}"
+
+    @property
+    def lines(self) -> tuple[int, int]:
+        """The first and last line of the record in its file."""
+        return int(self.line_numbers[0]), int(self.line_numbers[-1])
+
+    @property
+    def samples(self) -> int:
+        return int(self.tau.size)
+
+    @property
+    def samples_per_period(self) -> float:
+        return self.period / self.step
+
+    @property
+    def periods(self) -> float:
+        """The length covered, in forcing periods (each sample counts one step)."""
+        return self.samples * self.step / self.period
+
+    def __getitem__(self, state: str) -> np.ndarray:
+        return self.observed[state]
+
+    def windows(self) -> tuple["Window", ...]:
+        """The whole forcing periods [origin + k T, origin + (k+1) T) the record covers, in order.
+
+        Each sample belongs to at most one window; a window holds every sample in its period
+        (so with an integer number of samples per period, windows are blocks of that many).
+        Samples after the last whole period belong to none.
+        """
+        h, T, tol = self.step, self.period, _EDGE * self.step
+        first = math.floor((self.tau[0] - h + tol - self.origin) / T) + 1
+        last = math.floor((self.tau[-1] + h + tol - self.origin) / T) - 1
+        out = []
+        for k in range(first, last + 1):
+            start = self.origin + k * T
+            lo, hi = np.searchsorted(self.tau, [start - tol, start + T - tol], side="left")
+            out.append(Window(self, k, start, slice(int(lo), int(hi))))
+        return tuple(out)
+
+    def part(self, start: float = -math.inf, stop: float = math.inf) -> "Record":
+        """The samples with start <= tau < stop (same origin, so the same windows)."""
+        lo, hi = (int(i) for i in np.searchsorted(self.tau, [start, stop], side="left"))
+        if hi <= lo:
+            raise GearsymError(f"{self.label}: no samples with {start:g} <= tau < {stop:g}")
+        return replace(self, tau=self.tau[lo:hi], observed={k: v[lo:hi] for k, v in self.observed.items()},
+                       line_numbers=self.line_numbers[lo:hi])
+
+    def split(self, held_out: float = 0.25) -> tuple["Record", "Record"]:
+        """(train, held-out) by time: the last ``held_out`` of the record's whole forcing periods
+        (rounded, at least one) and anything after them are held out; the rest is for training."""
+        if not 0 < held_out < 1:
+            raise GearsymError(f"held_out must be a fraction between 0 and 1, got {held_out!r}")
+        windows = self.windows()
+        if len(windows) < 2:
+            raise GearsymError(f"{self.label}: {len(windows)} whole forcing period(s); at least 2 are needed to "
+                               "hold one out")
+        kept = len(windows) - min(len(windows) - 1, max(1, round(held_out * len(windows))))
+        cut = windows[kept].start - _EDGE * self.step
+        return self.part(stop=cut), self.part(start=cut)
+
+
+@dataclass(frozen=True, eq=False)
+class Window:
+    """The samples of one forcing period [start, start + period) of a record: one multiple-shooting
+    interval (``start`` is the node's time, the record's origin plus ``index`` periods)."""
+
+    record: Record
+    index: int
+    start: float
+    rows: slice
+
+    @property
+    def stop(self) -> float:
+        return self.start + self.record.period
+
+    @property
+    def tau(self) -> np.ndarray:
+        return self.record.tau[self.rows]
+
+    @property
+    def observed(self) -> dict[str, np.ndarray]:
+        return {k: v[self.rows] for k, v in self.record.observed.items()}
+
+    @property
+    def conditions(self) -> Mapping[str, float]:
+        return self.record.conditions
+
+
+@dataclass(frozen=True, eq=False)
+class Measurements:
+    """Records of one model, from one or more files.
+
+    ``defaults`` are the model's parameter values (with any settings given when loading),
+    which each record's ``conditions`` override: :meth:`parameters`.
+    """
+
+    model: str
+    states: tuple[str, ...]
+    defaults: Mapping[str, float]
+    records: tuple[Record, ...]
+
+    def __len__(self) -> int:
+        return len(self.records)
+
+    def __iter__(self) -> Iterator[Record]:
+        return iter(self.records)
+
+    def __getitem__(self, index: int) -> Record:
+        return self.records[index]
+
+    @property
+    def observed(self) -> tuple[str, ...]:
+        """The states measured in at least one record, in the model's order."""
+        seen = {name for r in self.records for name in r.observed}
+        return tuple(s for s in self.states if s in seen)
+
+    @property
+    def sources(self) -> tuple[Path, ...]:
+        return tuple(dict.fromkeys(r.source for r in self.records))
+
+    def find(self, record: str, source: PathLike | None = None) -> Record:
+        """The record with this id (in ``source``, needed when several files use the id)."""
+        hits = [r for r in self.records if r.record == str(record)
+                and (source is None or r.source == Path(source) or r.source.name == str(source))]
+        if len(hits) != 1:
+            ids = ", ".join(f"{r.source.name}:{r.record}" for r in self.records)
+            what = "no" if not hits else "more than one"
+            raise GearsymError(f"{what} record {record!r}{'' if source is None else f' in {source}'}; records: {ids}")
+        return hits[0]
+
+    def parameters(self, record: Record) -> dict[str, float]:
+        """Every parameter value of a record: the defaults, overridden by its conditions."""
+        return {**self.defaults, **record.conditions}
+
+    def windows(self) -> tuple[Window, ...]:
+        """The one-forcing-period windows of every record, record after record."""
+        return tuple(w for r in self.records for w in r.windows())
+
+    def split(self, held_out: float = 0.25) -> tuple["Measurements", "Measurements"]:
+        """(train, held-out): every record split by time (:meth:`Record.split`)."""
+        parts = [r.split(held_out) for r in self.records]
+        return (replace(self, records=tuple(p[0] for p in parts)),
+                replace(self, records=tuple(p[1] for p in parts)))
+
+
+# --------------------------------------------------------------------------- reading
+def load_measurements(
+    paths: PathLike | Sequence[PathLike],
+    model,
+    *,
+    time_scale: float | None = None,
+    min_samples_per_period: float = MIN_SAMPLES_PER_PERIOD,
+    min_periods: int = MIN_PERIODS,
+    spacing_tolerance: float = SPACING_TOLERANCE,
+    **settings,
+) -> Measurements:
+    """Read and check measured-data files (one path or several) for ``model``.
+
+    ``model`` is a model name, path or object (compiled with ``settings`` as its defaults) or a
+    :class:`~gearsym.codegen.CompiledModel` (``settings`` then are parameter values). Records
+    are identified per file (two files may both have a record ``1``). ``time_scale`` converts a
+    ``t`` column: tau = time_scale * t; files with a ``tau`` column ignore it.
+    """
+    compiled, values = compiled_and_values(model, dict(settings))
+    defaults = dict(zip(compiled.parameter_names, map(float, compiled.parameter_vector(values))))
+    rules = _Rules(_positive(min_samples_per_period, "min_samples_per_period"),
+                   whole_number(min_periods, "min_periods", 1), _positive(spacing_tolerance, "spacing_tolerance"))
+    if time_scale is not None:
+        time_scale = _positive(time_scale, "time_scale (tau = time_scale * t)")
+    files = [paths] if isinstance(paths, (str, Path)) else list(paths)
+    if not files:
+        raise GearsymError("no measurement files given")
+    twice = [p for i, p in enumerate(files) if Path(p).resolve() in {Path(q).resolve() for q in files[:i]}]
+    if twice:
+        raise GearsymError(f"{twice[0]} is given twice")
+    records = tuple(r for path in files for r in _read_file(Path(path), compiled, defaults, time_scale, rules))
+    return Measurements(compiled.name, compiled.state_names, defaults, records)
+
+
+def _positive(value, what: str) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        number = math.nan
+    if not (math.isfinite(number) and number > 0):
+        raise GearsymError(f"{what} must be a positive number, got {value!r}")
+    return number
+
+
+@dataclass(frozen=True)
+class _Rules:
+    min_samples_per_period: float
+    min_periods: int
+    spacing_tolerance: float
+
+
+@dataclass(frozen=True)
+class _Layout:
+    """What each column of a file is."""
+
+    time: str
+    scale: float
+    record: str | None
+    states: tuple[str, ...]
+    conditions: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class _Rows:
+    """The data rows of one record: their line numbers, record id and numeric cells by column."""
+
+    record: str
+    lines: np.ndarray
+    values: dict[str, np.ndarray]
+
+
+def _read_file(path: Path, compiled: CompiledModel, defaults: dict, time_scale, rules: _Rules) -> list[Record]:
+    header_line, header, rows = _read_csv(path)
+    layout = _layout(path, header_line, header, compiled, time_scale)
+    return [_record(path, group, layout, compiled, defaults, rules) for group in _group(path, header, rows, layout)]
+
+
+def _read_csv(path: Path) -> tuple[int, list[str], list[tuple[int, list[str]]]]:
+    """The header (its line number and names) and the non-blank rows with their line numbers."""
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise DataError("no such file", path) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DataError(f"cannot read it as UTF-8 text ({exc})", path) from None
+    reader = csv.reader(text.splitlines())
+    header_line, header, rows = 0, None, []
+    for cells in reader:
+        if not any(c.strip() for c in cells):
+            continue
+        if header is None:
+            header_line, header = reader.line_num, [c.strip() for c in cells]
+            continue
+        if len(cells) != len(header):
+            raise DataError(f"{len(cells)} cells, but the header (line {header_line}) names {len(header)} columns",
+                            path, reader.line_num)
+        rows.append((reader.line_num, cells))
+    if header is None:
+        raise DataError("the file is empty; expected a header line naming the columns, e.g. tau,x", path)
+    return header_line, header, rows
+
+
+def _layout(path: Path, line: int, header: list[str], compiled: CompiledModel, time_scale) -> _Layout:
+    states, parameters = compiled.state_names, compiled.parameter_names
+    own_time = compiled.system.time.name
+    times = [own_time] + ([PHYSICAL_TIME] if own_time != PHYSICAL_TIME else [])
+    for i, name in enumerate(header):
+        if not name:
+            raise DataError(f"column {i + 1} has no name", path, line)
+        if header.index(name) != i:
+            raise DataError("the column appears twice", path, line, name)
+    known = [*times, RECORD, *states, *parameters]
+    for name in header:
+        if name not in known:
+            raise DataError(
+                f"unknown column.{suggest(name, known)} A column is the time ({' or '.join(times)}), "
+                f"{RECORD}, a state of {compiled.name} ({', '.join(states)}) or one of its parameters as an "
+                f"operating condition ({', '.join(parameters)})", path, line, name)
+    given = [t for t in times if t in header]
+    if not given:
+        raise DataError(f"no time column: name it {own_time} (the model's time)"
+                        + (f" or {PHYSICAL_TIME} (physical time, with a time scale)" if len(times) > 1 else ""),
+                        path, line)
+    if len(given) > 1:
+        raise DataError(f"both {own_time} and {PHYSICAL_TIME} columns; keep one", path, line, PHYSICAL_TIME)
+    scale = 1.0
+    if given[0] == PHYSICAL_TIME and own_time != PHYSICAL_TIME:
+        if time_scale is None:
+            raise DataError(
+                f"the time is t (physical time) but no time scale was given: pass time_scale=... "
+                f"({own_time} = time_scale * t; `gearsym derive {compiled.name}` shows the time unit), or give "
+                f"the model's time as a {own_time} column", path, line, PHYSICAL_TIME)
+        scale = float(time_scale)
+    measured = tuple(s for s in states if s in header)
+    if not measured:
+        raise DataError(f"no measured state: name at least one column as a state of {compiled.name} "
+                        f"({', '.join(states)})", path, line)
+    conditions = tuple(p for p in parameters if p in header)
+    return _Layout(given[0], scale, RECORD if RECORD in header else None, measured, conditions)
+
+
+def _group(path: Path, header: list[str], rows, layout: _Layout) -> list[_Rows]:
+    """Numbers parsed (every bad cell reported where it is) and rows grouped by record."""
+    numeric = [layout.time, *layout.states, *layout.conditions]
+    index = {name: header.index(name) for name in header}
+    ids, lines, table = [], [], np.empty((len(rows), len(numeric)))
+    for r, (line, cells) in enumerate(rows):
+        if layout.record:
+            ids.append(cells[index[RECORD]].strip())
+            if not ids[-1]:
+                raise DataError("empty record id", path, line, RECORD)
+        lines.append(line)
+        for c, name in enumerate(numeric):
+            table[r, c] = _number(cells[index[name]], path, line, name)
+    groups, order = {}, []
+    for r, rid in enumerate(ids or ["1"] * len(rows)):
+        if rid not in groups:
+            groups[rid] = [r]
+            order.append(rid)
+        elif groups[rid][-1] != r - 1:
+            raise DataError(f"record {rid} appears again after other records (it started on line "
+                            f"{lines[groups[rid][0]]}); the rows of a record must be together, or give the second "
+                            "run another record id", path, lines[r], RECORD)
+        else:
+            groups[rid].append(r)
+    if not order:
+        raise DataError("no data rows below the header", path)
+    return [_Rows(rid, np.array(lines)[groups[rid]], {name: table[groups[rid], c] for c, name in enumerate(numeric)})
+            for rid in order]
+
+
+def _number(text: str, path: Path, line: int, column: str) -> float:
+    cell = text.strip()
+    if not cell:
+        raise DataError("empty cell; every sample needs a value (drop the row or fill the gap, keeping the "
+                        "time evenly spaced)", path, line, column)
+    try:
+        value = float(cell)
+    except ValueError:
+        raise DataError(f"{cell!r} is not a number", path, line, column) from None
+    if not math.isfinite(value):
+        raise DataError(f"{cell!r}: every value must be a finite number", path, line, column)
+    return value
+
+
+def _record(path: Path, rows: _Rows, layout: _Layout, compiled: CompiledModel, defaults: dict,
+            rules: _Rules) -> Record:
+    lines, where = rows.lines, f"record {rows.record}"
+    conditions = {name: _condition(path, rows, name, compiled) for name in layout.conditions}
+    try:
+        period = compiled.prepare({**defaults, **conditions}).period
+    except GearsymError as exc:
+        raise DataError(f"{where}: at its conditions: {exc}", path, int(lines[0])) from None
+    step = _check_time(path, rows.values[layout.time], lines, layout.time, where, rules)
+    tau = rows.values[layout.time] * layout.scale
+    record = Record(path, rows.record, tau, {s: rows.values[s] for s in layout.states}, conditions, period,
+                    step * layout.scale, lines, float(tau[0]), layout.scale)
+    _check_length(record, layout, rules)
+    return record
+
+
+def _condition(path: Path, rows: _Rows, name: str, compiled: CompiledModel) -> float:
+    """The value of an operating condition in a record: constant, and valid for the model."""
+    column, lines = rows.values[name], rows.lines
+    changed = np.nonzero(column != column[0])[0]
+    if changed.size:
+        i = int(changed[0])
+        raise DataError(f"{name} varies within record {rows.record} ({float(column[0])!r} on line {lines[0]}, "
+                        f"{float(column[i])!r} here); an operating condition is constant within a record: start a "
+                        "new record where it changes", path, int(lines[i]), name)
+    try:
+        vector = compiled.parameter_vector({name: float(column[0])})
+    except GearsymError as exc:
+        raise DataError(f"record {rows.record}: {exc}", path, int(lines[0]), name) from None
+    return float(vector[compiled.parameter_names.index(name)])
+
+
+def _check_time(path: Path, time: np.ndarray, lines: np.ndarray, column: str, where: str, rules: _Rules) -> float:
+    """The record's median step, after checking that time increases strictly and evenly."""
+    if time.size < 2:
+        raise DataError(f"{where} has a single sample; a fit needs at least {rules.min_periods} forcing periods "
+                        f"of {rules.min_samples_per_period:g} samples or more", path, int(lines[0]), column)
+    steps = np.diff(time)
+    back = np.nonzero(steps <= 0)[0]
+    if back.size:
+        i = int(back[0]) + 1
+        raise DataError(f"the time does not increase within {where}: {float(time[i])!r} after "
+                        f"{float(time[i - 1])!r} on line {lines[i - 1]}; sort the rows by time, or start a new "
+                        f"record with the {RECORD} column", path, int(lines[i]), column)
+    step = float(np.median(steps))
+    uneven = np.nonzero(np.abs(steps - step) > rules.spacing_tolerance * step)[0]
+    if uneven.size:
+        i = int(uneven[0]) + 1
+        raise DataError(f"the samples of {where} are not evenly spaced: the step from line {lines[i - 1]} is "
+                        f"{float(steps[i - 1])!r}, the median step {step!r} (tolerance "
+                        f"{rules.spacing_tolerance:.3g} of the step); resample the record to a uniform time grid "
+                        "or split it where samples are missing", path, int(lines[i]), column)
+    return step
+
+
+def _check_length(record: Record, layout: _Layout, rules: _Rules) -> None:
+    where = f"record {record.record} (lines {record.lines[0]}-{record.lines[1]})"
+    scaled = f" with time_scale={layout.scale:g}" if layout.time == PHYSICAL_TIME and layout.scale != 1 else ""
+    if record.samples_per_period < rules.min_samples_per_period * (1 - 1e-9):
+        raise DataError(
+            f"{where} has {record.samples_per_period:.3g} samples per forcing period (period {record.period:.6g} "
+            f"in the model's time, step {record.step:.6g}{scaled}); at least {rules.min_samples_per_period:g} are "
+            "needed: sample faster" + (", or check the time scale" if scaled else ""),
+            record.source, record.lines[0], layout.time)
+    whole = len(record.windows())
+    if whole < rules.min_periods:
+        raise DataError(
+            f"{where} is too short to fit: it covers {record.periods:.3g} forcing periods ({whole} whole), at "
+            f"least {rules.min_periods} whole periods are needed: record a longer run",
+            record.source, record.lines[0], layout.time)
