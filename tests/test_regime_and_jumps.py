@@ -77,3 +77,11 @@ def test_hysteresis_is_where_up_and_down_differ():
     down = smooth(OMEGA) + np.where(OMEGA > 1.3, -2.0, 0.0)  # down falls off at 1.3
     assert hysteresis_intervals(OMEGA, up, down) == [(1.31, 1.5)]
     assert hysteresis_intervals(OMEGA, up, up) == []
+
+
+def test_a_tiny_step_on_a_flat_curve_is_not_a_jump():
+    """Numerical wobble: the step stands out from its neighbours, but is nothing next to A itself."""
+    a = 10 + 1e-9 * np.random.default_rng(2).normal(size=OMEGA.size) + np.where(OMEGA > 1.0, 1e-6, 0.0)
+    assert find_jumps(OMEGA, a) == []
+    up, down = a.copy(), a + 1e-6
+    assert hysteresis_intervals(OMEGA, up, down) == []
