@@ -1,7 +1,10 @@
 """Small argument checks shared by the engine and the analyses."""
 from __future__ import annotations
 
+import math
 import operator
+
+import numpy as np
 
 from .errors import GearsymError
 
@@ -15,3 +18,22 @@ def whole_number(value, what: str, minimum: int = 0) -> int:
     if count < minimum:
         raise GearsymError(f"{what} must be at least {minimum}, got {count}")
     return count
+
+
+def json_safe(x):
+    """JSON-safe: numpy scalars to Python, NaN and infinities to None, tuples to lists."""
+    if isinstance(x, dict):
+        return {str(k): json_safe(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [json_safe(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return [json_safe(v) for v in x.tolist()]
+    if isinstance(x, (np.bool_, bool)):
+        return bool(x)
+    if isinstance(x, (np.integer, int)):
+        return int(x)
+    if isinstance(x, (np.floating, float)):
+        return float(x) if math.isfinite(x) else None
+    if isinstance(x, np.str_):
+        return str(x)
+    return x

@@ -16,10 +16,10 @@ from types import ModuleType
 
 from .. import __version__
 from ..errors import GearsymError
-from . import compile, derive, docs, list_models, lyap, poincare, reproduce, simulate, sweep
+from . import compile, derive, docs, explain, list_models, lyap, poincare, reproduce, simulate, sweep
 
 #: the subcommand modules, in the order ``gearsym --help`` lists them
-COMMANDS: tuple[ModuleType, ...] = (list_models, derive, docs, compile, lyap, sweep, poincare, reproduce, simulate)
+COMMANDS: tuple[ModuleType, ...] = (list_models, derive, docs, compile, lyap, sweep, poincare, reproduce, simulate, explain)
 
 #: exit status of a GearsymError (argparse uses the same for bad arguments)
 USAGE_ERROR = 2

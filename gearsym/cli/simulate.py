@@ -33,6 +33,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--y0", metavar="x=-2,v=-0.5", help="initial state of every record (default: the model's)")
     parser.add_argument("--backend", choices=BACKENDS, default="auto",
                         help="compiled C, CasADi in-process, or auto (compiled when a C compiler exists)")
+    parser.add_argument("--effect", action="append", default=[], metavar="NAME",
+                        help="simulate the model with an effect of the library added (coulomb_friction, "
+                             "cubic_stiffness, mesh_stiffness_harmonic, transmission_error, coast_side_stiffness); "
+                             "set its strength with --set, e.g. --effect cubic_stiffness --set k3=0.02")
     parser.add_argument("--out", type=Path, required=True, metavar="FILE.csv", help="where to write the measurements")
 
 
@@ -40,7 +44,9 @@ def run(args: argparse.Namespace) -> int:
     records = [parse_conditions(text) for text in args.record]
     settings = parse_settings(args.set)
     steps = steps_for(args.samples_per_period, args.steps_per_period)
-    compiled = compile_model(args.model, steps_per_period=steps, backend=args.backend, verbose=True, **settings)
+    model = _with_effects(args.model, args.effect, settings) if args.effect else args.model
+    compiled = compile_model(model, steps_per_period=steps, backend=args.backend, verbose=True,
+                             **({} if args.effect else settings))
     table = simulate_measurements(compiled, periods=args.periods, discard=args.discard,
                                   samples_per_period=args.samples_per_period,
                                   noise=args.noise, seed=args.seed, records=records or None,
@@ -52,6 +58,16 @@ def run(args: argparse.Namespace) -> int:
           f"noise {args.noise:g}{conditions}; columns {', '.join(table.columns)}")
     print(f"wrote {args.out}")
     return 0
+
+
+def _with_effects(model: str, effects: list[str], settings: dict):
+    """The model's equations with ``effects`` added; ``settings`` set the model's and the effects' parameters."""
+    from ..fit.effects import augment, effect
+    from ..registry import system_for
+
+    own = {p for e in map(effect, effects) for p in e.parameters}
+    base = system_for(model, **{k: v for k, v in settings.items() if k not in own})
+    return augment(base, effects, values={k: v for k, v in settings.items() if k in own})
 
 
 def parse_conditions(text: str) -> dict[str, float]:

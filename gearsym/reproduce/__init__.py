@@ -6,13 +6,11 @@ portraits) -> :mod:`.claims` (each claim measured and judged) ->
 """
 from __future__ import annotations
 
-import math
 import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
+from ..checks import json_safe
 from .claims import evaluate
 from .compute import Computed, compute
 from .figures import draw_all
@@ -41,7 +39,7 @@ def record_of(computed: list[Computed]) -> dict:
     """The JSON record behind the report: run options, then each scenario's values, claims and study."""
     first = next(iter(computed[0].sweeps.values())).record
     run = {"periods": first["periods"], "discard": first["discard"], "steps_per_period": first["steps_per_period"]}
-    return _plain({"run": run, "scenarios": [scenario_record(c) for c in computed]})
+    return json_safe({"run": run, "scenarios": [scenario_record(c) for c in computed]})
 
 
 def reproduce(out: str | Path = "docs/figures", doc: str | Path | None = None, *,
@@ -69,22 +67,3 @@ def reproduce(out: str | Path = "docs/figures", doc: str | Path | None = None, *
             print(f"gearsym: {s['label']}: {summary}", file=sys.stderr)
         print(f"gearsym: reproduced in {time.perf_counter() - start:.0f} s", file=sys.stderr)
     return record
-
-
-def _plain(x):
-    """JSON-safe: numpy scalars to Python, NaN and infinities to None, tuples to lists."""
-    if isinstance(x, dict):
-        return {str(k): _plain(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_plain(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return [_plain(v) for v in x.tolist()]
-    if isinstance(x, (np.bool_, bool)):
-        return bool(x)
-    if isinstance(x, (np.integer, int)):
-        return int(x)
-    if isinstance(x, (np.floating, float)):
-        return float(x) if math.isfinite(x) else None
-    if isinstance(x, np.str_):
-        return str(x)
-    return x

@@ -1,0 +1,31 @@
+"""The data loop: fit a model to measured windows, find the effect its residual says is missing,
+add it to the symbolic model, and report the held-out error before and after.
+
+:mod:`.shooting` (multiple-shooting fit) -> :mod:`.prediction` (held-out error) ->
+:mod:`.explain` (forward selection over :mod:`.effects`) -> :mod:`.report`.
+"""
+from .effects import EFFECTS, Effect, augment, effect_terms
+from .explain import Explanation, explain
+from .prediction import Prediction, predict_ahead
+from .shooting import Fit, Segment, fit_windows
+
+__all__ = ["EFFECTS", "Effect", "Explanation", "Fit", "Prediction", "Segment", "augment", "effect_terms", "explain",
+           "explain_files", "fit_windows", "predict_ahead"]
+
+
+def explain_files(paths, model, fit, *, out=None, time_scale=None, held_out: float = 0.25, candidates=None,
+                  progress=None, **settings):
+    """The whole loop from files: load ``paths`` for ``model`` (settings fix parameter values), explain,
+    and with ``out`` write the report there. Returns the report's dict (the keys of report.json)."""
+    from ..codegen import compile_model
+    from ..data import load_measurements
+    from .report import write_report
+
+    compiled = compile_model(model, **settings)
+    measurements = load_measurements(paths, compiled, time_scale=time_scale)
+    ex = explain(compiled.system, measurements, fit, held_out=held_out, candidates=candidates, progress=progress)
+    if out is not None:
+        return write_report(ex, compiled.system, out, measurements.sources)
+    from ..checks import json_safe
+
+    return json_safe(ex.as_dict())
