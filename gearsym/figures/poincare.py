@@ -24,6 +24,7 @@ import numpy as np  # noqa: E402
 from ..analysis.attractors import Attractor, AttractorSet  # noqa: E402
 from ..analysis.orbits import Trajectory, phase_trajectory, poincare_samples  # noqa: E402
 from ..errors import GearsymError  # noqa: E402
+from .save import save_figure  # noqa: E402
 
 #: how parameter names are written in titles and labels
 SYMBOLS = {"omega": "ω", "zeta": "ζ", "eta": "η", "Theta": "Θ", "Theta_p": "Θ'", "kS": "$k_S$", "k_a": "$k_a$"}
@@ -97,7 +98,7 @@ def plot_attractors(sets: AttractorSet | Sequence[AttractorSet | Sequence[Attrac
             ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), frameon=False, handletextpad=0.3,
                       fontsize=7.5, markerscale=1.0)
         fig.supxlabel(_caption(panels), fontsize=7, color="0.35")
-        return _save(fig, path)
+        return save_figure(fig, path, dpi=150)
 
 
 def _panels(sets) -> list[list[AttractorSet]]:
@@ -282,12 +283,6 @@ def plot_phase_portraits(panels: Sequence[PhasePanel], path: str | Path, columns
             ax.set_title(panel.title)
             ax.text(0.02, 0.97, f"({chr(ord('a') + k)})", transform=ax.transAxes, ha="left", va="top",
                     fontsize=11, fontweight="bold")
-        return _save(fig, path)
+        return save_figure(fig, path, dpi=150)
 
 
-def _save(fig, path: str | Path) -> Path:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
-    return path

@@ -17,6 +17,7 @@ import numpy as np  # noqa: E402
 
 from ..analysis.lyapunov import LyapunovSpectrum  # noqa: E402
 from ..analysis.orbits import Trajectory  # noqa: E402
+from .save import save_figure  # noqa: E402
 
 
 def plot_point(spectrum: LyapunovSpectrum, trajectory: Trajectory, path: str | Path,
@@ -49,8 +50,4 @@ def plot_point(spectrum: LyapunovSpectrum, trajectory: Trajectory, path: str | P
 
     shown = ", ".join(f"{k}={v:g}" for k, v in spectrum.parameters.items())
     fig.suptitle(f"{spectrum.model}: {shown}", fontsize=9)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=120)

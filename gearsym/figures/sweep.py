@@ -18,6 +18,7 @@ from matplotlib.colors import BoundaryNorm, ListedColormap, TwoSlopeNorm  # noqa
 
 from ..analysis.regime import REGIMES  # noqa: E402
 from ..sweep.result import SweepResult  # noqa: E402
+from .save import save_figure  # noqa: E402
 
 REGIME_COLORS = {"periodic": "#4c72b0", "quasi-periodic": "#55a868", "chaotic": "#dd8452",
                  "hyperchaotic": "#c44e52", "equilibrium": "#8172b3"}
@@ -173,8 +174,4 @@ def plot_sweep(result: SweepResult, path: str | Path) -> Path:
         axs[1].legend(unique.values(), unique.keys(), fontsize=7, ncol=4)
         axs[3].set_xlabel(_axis_label(result.axes[0].name))
         axs[0].set_title(title, fontsize=9)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=120)

@@ -12,6 +12,7 @@ import numpy as np  # noqa: E402
 import sympy as sp  # noqa: E402
 
 from ..checks import json_safe  # noqa: E402
+from ..figures.save import save_figure  # noqa: E402
 from ..system import FirstOrderSystem  # noqa: E402
 from .effects import EFFECTS, augment, effect_terms, mesh_term  # noqa: E402
 from .explain import Candidate, Explanation  # noqa: E402
@@ -131,8 +132,7 @@ def _residual_figure(ex: Explanation, path: Path) -> None:
     axs[0].set_ylabel("held-out residual")
     axs[3].set_xlim(0, 8)
     axs[3].legend(fontsize=8)
-    fig.savefig(path, dpi=100, metadata={"Software": None})
-    plt.close(fig)
+    save_figure(fig, path, dpi=100)
 
 
 def _prediction_figure(ex: Explanation, path: Path) -> None:
@@ -150,8 +150,7 @@ def _prediction_figure(ex: Explanation, path: Path) -> None:
     ax.set_xlabel("held-out sample (one period ahead of each estimated start)")
     ax.set_ylabel(coordinate)
     ax.legend(fontsize=8)
-    fig.savefig(path, dpi=100, metadata={"Software": None})
-    plt.close(fig)
+    save_figure(fig, path, dpi=100)
 
 
 __all__ = ["derived_model_page", "report_page", "write_report"]

@@ -14,18 +14,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..figures.save import save_figure  # noqa: E402
 from ..figures.sweep import plot_amplitude, plot_bifurcation, plot_exponents, plot_map, plot_regime_strip  # noqa: E402
 from .compute import Computed  # noqa: E402
 from .plan import CHAOS_BAND, NEAR_ONE, PAPER_JUMPS  # noqa: E402
 
 CURVE_COLORS = ("C0", "C3", "C2")
+DPI = 110
 
 
-def _save(fig, path: Path) -> Path:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110, metadata={"Software": None})  # no version string: same bytes on any matplotlib
-    plt.close(fig)
-    return path
 
 
 def _paper_chaos(ax) -> None:
@@ -59,7 +56,7 @@ def figure3(c: Computed, out: Path, suffix: str = "") -> Path:
         ax.legend(fontsize=8, loc="upper right")
         _letter(ax, letter)
     b.set_title("grey: the paper's chaotic regions for D = 0", fontsize=8)
-    return _save(fig, out / f"fig3{suffix}.png")
+    return save_figure(fig, out / f"fig3{suffix}.png", DPI)
 
 
 def figure6(c: Computed, out: Path, suffix: str = "") -> Path:
@@ -81,7 +78,7 @@ def figure6(c: Computed, out: Path, suffix: str = "") -> Path:
         _finish_omega(ax)
         ax.legend(fontsize=8, loc="upper right")
         _letter(ax, letter)
-    return _save(fig, out / f"fig6{suffix}.png")
+    return save_figure(fig, out / f"fig6{suffix}.png", DPI)
 
 
 def _clip_peak(ax, x: np.ndarray, y: np.ndarray) -> None:
@@ -123,7 +120,7 @@ def hysteresis(c: Computed, out: Path, suffix: str = "") -> Path:
         axs[1, col].set_title("bifurcation diagram: x at t = kT (up)", fontsize=9)
         plot_regime_strip(axs[2, col], r)
         _finish_omega(axs[2, col])
-    return _save(fig, out / f"hysteresis{suffix}.png")
+    return save_figure(fig, out / f"hysteresis{suffix}.png", DPI)
 
 
 def study(c: Computed, out: Path, suffix: str = "") -> Path:
@@ -143,7 +140,7 @@ def study(c: Computed, out: Path, suffix: str = "") -> Path:
             for lo, hi in (NEAR_ONE, CHAOS_BAND):
                 ax.axvline(lo, color="k", ls=":", lw=0.7)
                 ax.axvline(hi, color="k", ls=":", lw=0.7)
-    return _save(fig, out / f"study{suffix}.png")
+    return save_figure(fig, out / f"study{suffix}.png", DPI)
 
 
 def draw_all(c: Computed, out: str | Path, suffix: str = "") -> list[Path]:
