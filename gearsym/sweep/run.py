@@ -28,7 +28,7 @@ from ..codegen import CompiledModel, compiled_and_values
 from ..errors import GearsymError, UnknownParameterError
 from .grid import INDEPENDENT, Axis, Point, axes_from, plan, points
 from .result import SweepResult
-from .store import SweepStore, number
+from .store import SweepStore, number, row_key
 
 #: stroboscopic samples kept per point for bifurcation diagrams
 POINCARE_SAMPLES = 50
@@ -125,7 +125,8 @@ def run_sweep(
             for row, strobe_rows in _execute(run, todo, jobs):
                 if store:
                     store.append(row, strobe_rows)
-                done[run.key(row)], strobes[run.key(row)] = row, strobe_rows  # counted once it is on disk
+                key = row_key(row, names)
+                done[key], strobes[key] = row, strobe_rows  # counted once it is on disk
                 bar.update(1)
                 if on_point:
                     on_point(row)
@@ -166,9 +167,6 @@ class _Run:
         self.periods, self.discard, self.poincare = periods, discard, poincare
         self.columns, self.strobe_columns = columns, strobe_columns
 
-    def key(self, row: dict) -> tuple:
-        return (row["direction"], tuple(float(row[n]) for n in self.names))
-
     def remaining(self, task: list[Point], done: dict) -> tuple[list[Point], np.ndarray]:
         """The points of a task still to run, and the state to start from (a continuation's last done point)."""
         finished = [p.key in done for p in task]
@@ -204,6 +202,14 @@ class _Run:
         final = np.array([spectrum.final_state[s] for s in compiled.state_names])
         return row, strobe_rows, final
 
+    def task(self, compiled: CompiledModel, points: list[Point], state: np.ndarray):
+        """Yield (row, Poincare rows) point after point; a continuation hands each final state on."""
+        for point in points:
+            row, strobe_rows, final = self.point(compiled, point, state)
+            if point.direction != INDEPENDENT:
+                state = final
+            yield row, strobe_rows
+
 
 def _execute(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], jobs: int):
     """Yield (row, Poincare rows) as points finish; tasks run on up to ``jobs`` threads."""
@@ -211,11 +217,7 @@ def _execute(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], jobs: int):
         return
     if jobs == 1 or len(tasks) == 1:  # no threads: simplest, and Ctrl-C stops at once
         for task, state in tasks:
-            for point in task:
-                row, strobe_rows, final = run.point(run.compiled, point, state)
-                if point.direction != INDEPENDENT:
-                    state = final
-                yield row, strobe_rows
+            yield from run.task(run.compiled, task, state)
         return
     results: queue.Queue = queue.Queue()
     stop = threading.Event()
@@ -225,13 +227,12 @@ def _execute(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], jobs: int):
         compiled = getattr(local, "compiled", None)
         if compiled is None:
             compiled = local.compiled = run.compiled.clone()
-        for point in task:
-            if stop.is_set():
+        if stop.is_set():
+            return
+        for item in run.task(compiled, task, state):
+            results.put(item)
+            if stop.is_set():  # checked before the next point is computed
                 return
-            row, strobe_rows, final = run.point(compiled, point, state)
-            if point.direction != INDEPENDENT:
-                state = final
-            results.put((row, strobe_rows))
 
     pool = ThreadPoolExecutor(max_workers=min(jobs, len(tasks)), thread_name_prefix="gearsym-sweep")
     futures = [pool.submit(work, task, state) for task, state in tasks]

@@ -61,7 +61,7 @@ class SweepStore:
             done = self._read(self.path, self.columns)
             strobes = {}
             if self.strobe_path.exists():
-                for row in self._read_rows(self.strobe_path, self.strobe_columns):
+                for row in read_rows(self.strobe_path, self.strobe_columns):
                     strobes.setdefault(self.key(row), []).append(row)
             strobes = {k: v for k, v in strobes.items() if k in done}  # written before their main row
             lacking = [k for k in done if k not in strobes]
@@ -77,9 +77,8 @@ class SweepStore:
         return done, strobes
 
     def key(self, row: dict) -> tuple:
-        *params, direction = self.key_columns
         try:
-            return (row[direction], tuple(float(row[p]) for p in params))
+            return row_key(row, self.key_columns[:-1])
         except ValueError as exc:
             raise GearsymError(f"{self.path}: a swept parameter is not a number: {exc}") from None
 
@@ -101,15 +100,13 @@ class SweepStore:
 
     def _read(self, path: Path, columns: list[str]) -> dict[tuple, dict]:
         rows = {}
-        for row in self._read_rows(path, columns):
+        for row in read_rows(path, columns):
             key = self.key(row)
             if key in rows:
                 raise GearsymError(f"{path}: the point {key} appears twice; pass --overwrite to start again")
             rows[key] = row
         return rows
 
-    def _read_rows(self, path: Path, columns: list[str]) -> list[dict]:
-        return read_rows(path, columns)
 
     # ------------------------------------------------------------ writing
     def append(self, row: dict, strobe_rows: Iterable[dict]) -> None:
@@ -169,6 +166,11 @@ class SweepStore:
         writer.writeheader()
         writer.writerows(rows)
         _atomic_write(path, buffer.getvalue())
+
+
+def row_key(row: dict, params) -> tuple:
+    """A point's identity in a table row: its direction and swept values (the same as ``Point.key``)."""
+    return (row["direction"], tuple(float(row[p]) for p in params))
 
 
 def read_rows(path: Path, columns: list[str] | None = None) -> list[dict]:
