@@ -224,16 +224,13 @@ def tamed_ks1(c: Computed, study: dict) -> dict:
 def hyperchaos_ks01(c: Computed, study: dict) -> dict:
     r = c.sweeps["fig6"]
     idx = _line(r, kS=0.1)
-    regime = r["regime"][idx]
-    chaotic = np.isin(regime, CHAOTIC)
-    share = _fraction(regime[chaotic] == "hyperchaotic") if chaotic.any() else float("nan")
+    whole = _whole_line(r, minimum=1, kS=0.1)
     return _claim("hyperchaos-kS0.1", "6c", "For kS = 0.1 most chaotic regions have two positive exponents "
                   "(hyperchaos).",
-                  f"{int(chaotic.sum())} chaotic points over the whole sweep, {_pct(share)} of them with two "
-                  f"positive exponents; hyperchaotic at "
-                  f"{_fmt_intervals(intervals(r['omega'][idx], regime == 'hyperchaotic'))}",
-                  _grade(share, 0.5, 0.2), {"chaotic_points": int(chaotic.sum()), "hyper_share": share},
-                  study.get("hyperchaos-kS0.1", ""))
+                  f"{whole['chaotic_points']} chaotic points over the whole sweep, {_pct(whole['hyper_share'])} of "
+                  f"them with two positive exponents; hyperchaotic at "
+                  f"{_fmt_intervals(intervals(r['omega'][idx], r['regime'][idx] == 'hyperchaotic'))}",
+                  _grade(whole["hyper_share"], 0.5, 0.2), whole, study.get("hyperchaos-kS0.1", ""))
 
 
 def single_ks1(c: Computed, study: dict) -> dict:
@@ -273,11 +270,12 @@ CHECKS: tuple[Callable[[Computed, dict], dict], ...] = (
 MIN_CHAOTIC = 5
 
 
-def _whole_line(r: SweepResult, **fixed) -> dict[str, float]:
-    """Chaotic points over the whole line, and the hyperchaotic share of them (the hyperchaos claim's measure)."""
+def _whole_line(r: SweepResult, minimum: int = MIN_CHAOTIC, **fixed) -> dict[str, float]:
+    """Chaotic points over the whole line, and the hyperchaotic share of them (the hyperchaos claim's
+    measure); the share is NaN with fewer than ``minimum`` chaotic points."""
     regime = r["regime"][_line(r, **fixed)]
     chaotic = np.isin(regime, CHAOTIC)
-    share = _fraction(regime[chaotic] == "hyperchaotic") if chaotic.sum() >= MIN_CHAOTIC else float("nan")
+    share = _fraction(regime[chaotic] == "hyperchaotic") if chaotic.sum() >= max(minimum, 1) else float("nan")
     return {"chaotic_points": int(chaotic.sum()), "hyper_share": share}
 
 
