@@ -88,8 +88,8 @@ def segments_of(system: FirstOrderSystem, measurements: Measurements) -> tuple[l
         values = {**system.parameters, **measurements.parameters(r)}
         for w in r.windows():
             segments.append(Segment(w.tau, w.observed, values, f"{r.label} period {w.index}"))
-            keys.append((id(r.source), r.record, w.index))
-    return segments, [(f"{k[0]}:{k[1]}", k[2]) for k in keys]
+            keys.append(((str(r.source), r.record), w.index))  # (which record, which period)
+    return segments, keys
 
 
 def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[str], *,
@@ -100,13 +100,13 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
     while they lower the held-out error; see the module docstring."""
     if not fit:
         raise GearsymError("name the parameters to fit, e.g. --fit zeta,B1")
-    library = [effect(c) for c in (candidates if candidates is not None else list(EFFECTS))]
+    library = {e.name: e for e in map(effect, candidates if candidates is not None else list(EFFECTS))}
     train, test = measurements.split(held_out)
     say = progress or (lambda message: None)
 
     def evaluate(effects: tuple[str, ...], guess: dict) -> Candidate:
-        model = augment(system, [effect(e) if e in EFFECTS else _find(library, e) for e in effects])
-        names = list(fit) + [p for e in effects for p in _find(library, e).fitted]
+        model = augment(system, [library[e] for e in effects])
+        names = list(fit) + [p for e in effects for p in library[e].fitted]
         seg_train, _ = segments_of(model, train)
         seg_test, keys = segments_of(model, test)
         result = fit_windows(model, seg_train, names, guess=guess)
@@ -118,7 +118,7 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
     tried, current = [base], base
     while len(current.effects) < max_effects:
         round_ = [evaluate(current.effects + (c.name,), dict(current.fit.estimates))
-                  for c in library if c.name not in current.effects]
+                  for c in library.values() if c.name not in current.effects]
         tried.extend(round_)
         if not round_:
             break
@@ -128,10 +128,6 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
         current = best
     correlation = _lag1(current.prediction)
     return Explanation(base, current, tried, bool(correlation > max_correlation), correlation, tuple(fit), held_out)
-
-
-def _find(library: Sequence[Effect], name: str) -> Effect:
-    return next(e for e in library if e.name == name)
 
 
 def _lag1(prediction: Prediction) -> float:

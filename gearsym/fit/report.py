@@ -27,7 +27,7 @@ def write_report(ex: Explanation, system: FirstOrderSystem, out: str | Path, sou
     _residual_figure(ex, out / "residuals.png")
     _prediction_figure(ex, out / "prediction.png")
     derived = augment(system, ex.effects) if ex.effects else system
-    (out / "derived_model.md").write_text(derived_model_page(system, ex.effects))
+    (out / "derived_model.md").write_text(derived_model_page(system, derived, ex.effects))
     (out / "report.md").write_text(report_page(ex, system, derived, data, sources))
     return data
 
@@ -82,8 +82,8 @@ def report_page(ex: Explanation, system: FirstOrderSystem, derived: FirstOrderSy
     return "\n".join(lines)
 
 
-def derived_model_page(system: FirstOrderSystem, effects) -> str:
-    derived = augment(system, effects) if effects else system
+def derived_model_page(system: FirstOrderSystem, derived: FirstOrderSystem, effects) -> str:
+    """The equations of ``derived`` (``system`` with ``effects`` added) and the terms that were added."""
     lines = [f"# `{derived.name}`", "", "<!-- written by `gearsym explain` -->", "",
              f"{derived.title or derived.name}. Equations in the paper's τ-form:", ""]
     for s, f in zip(derived.states, derived.rhs):

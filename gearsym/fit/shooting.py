@@ -54,9 +54,6 @@ class Fit:
     iterations: int
     info: dict = field(default_factory=dict)
 
-    def parameters(self, base: Mapping[str, float]) -> dict[str, float]:
-        return {**base, **self.estimates}
-
 
 class _Model:
     """The model's equations in CasADi, and a window integrator for a given number of samples."""
