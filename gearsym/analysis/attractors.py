@@ -31,10 +31,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..checks import whole_number
+from ..checks import json_safe, whole_number
 from ..codegen import CompiledModel, compiled_and_values
 from ..errors import GearsymError, suggest
-from .lyapunov import LyapunovSpectrum, _json_number, lyapunov_spectrum
+from .lyapunov import LyapunovSpectrum, lyapunov_spectrum
 from .regime import classify_regime
 
 #: the box initial states are drawn from, for every state the caller does not name
@@ -75,8 +75,8 @@ class InitialConditionResult:
             "index": self.index,
             "initial_state": self.initial_state,
             "attractor": self.attractor,
-            "exponents": [_json_number(x) for x in self.exponents],
-            "stderr": [_json_number(x) for x in self.stderr],
+            "exponents": json_safe(self.exponents),
+            "stderr": json_safe(self.stderr),
             "regime": self.regime,
             "amplitude": self.amplitude,
             "final_state": self.final_state,
@@ -132,8 +132,8 @@ class Attractor:
             "regime": self.regime,
             "paper_label": self.paper_label,
             "period": self.period,
-            "exponents": [_json_number(x) for x in self.exponents],
-            "stderr": [_json_number(x) for x in self.stderr],
+            "exponents": json_safe(self.exponents),
+            "stderr": json_safe(self.stderr),
             "amplitude": self.amplitude,
             "centroid": self.centroid,
             "point_count": int(self.points.shape[1]),

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..codegen import compiled_and_values
-from ..checks import whole_number
+from ..checks import json_safe, whole_number
 from ..errors import GearsymError
 from .orbits import amplitudes
 from .regime import classify_regime
@@ -71,10 +71,10 @@ class LyapunovSpectrum:
         return {
             "model": self.model,
             "parameters": self.parameters,
-            "exponents": [_json_number(x) for x in self.exponents],
-            "stderr": [_json_number(x) for x in self.stderr],  # null with too few periods to estimate it
+            "exponents": json_safe(self.exponents),
+            "stderr": json_safe(self.stderr),  # null with too few periods to estimate it
             "sum": self.sum,
-            "kaplan_yorke_dimension": _json_number(self.kaplan_yorke_dimension),
+            "kaplan_yorke_dimension": json_safe(self.kaplan_yorke_dimension),
             "regime": self.regime,
             "amplitude": self.amplitude,
             "final_state": self.final_state,
@@ -84,12 +84,6 @@ class LyapunovSpectrum:
             "period": self.period,
             "backend": self.backend,
         }
-
-
-def _json_number(x) -> float | None:
-    """JSON has no NaN or infinity: those become null."""
-    x = float(x)
-    return x if np.isfinite(x) else None
 
 
 def lyapunov_spectrum(
