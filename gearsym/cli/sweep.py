@@ -30,7 +30,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--discard", type=int, default=100, help="transient periods left out (default 100)")
     parser.add_argument("--steps-per-period", type=int, default=200, help="RK4 steps per period (default 200)")
     parser.add_argument("--y0", metavar="x=-2,v=-0.5", help="initial state (default: the model's)")
-    parser.add_argument("--jobs", type=int, default=0, help="threads (default 0: every core)")
+    parser.add_argument("--jobs", type=int, default=0,
+                        help="threads (default 0: every core); with --dask, worker processes")
+    cluster = parser.add_mutually_exclusive_group()
+    cluster.add_argument("--dask", action="store_true",
+                         help='run the points on a Dask cluster of --jobs processes started on this machine for '
+                              'this sweep (needs pip install "gearsym[distributed]")')
+    cluster.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                         help="run the points on the Dask cluster of this scheduler (`dask scheduler`, "
+                              "`dask worker tcp://HOST:PORT`; every worker needs gearsym)")
     parser.add_argument("--out", type=Path, required=True, metavar="FILE.csv",
                         help="the table; FILE.json (record, jumps) and FILE.poincare.csv are written beside it. "
                              "If they exist, the same command resumes them")
@@ -48,7 +56,8 @@ def run(args: argparse.Namespace) -> int:
         result = run_sweep(args.model, args.param, mode=args.mode, direction=args.direction, periods=args.periods,
                            discard=args.discard, steps_per_period=args.steps_per_period, y0=parse_state(args.y0),
                            jobs=args.jobs, out=args.out, overwrite=args.overwrite, poincare=args.poincare,
-                           progress=not args.quiet, backend=args.backend, **parse_settings(args.set))
+                           progress=not args.quiet, backend=args.backend,
+                           scheduler="local" if args.dask else args.scheduler, **parse_settings(args.set))
     except KeyboardInterrupt as exc:  # SweepInterrupted says how many points were kept
         print(f"gearsym: {exc}" if str(exc) else "gearsym: interrupted before any point was finished",
               file=sys.stderr)

@@ -80,10 +80,7 @@ def compile_model(
         base = _LOADED[key]
         return replace(base.clone(), system=system, check=check)
 
-    code_dir = cache_dir() / "code" / f"{system.name}-{digest[:16]}"
-    committed = _generated_dir() / system.name
-    if (read_manifest(committed) or {}).get("hash") == digest:
-        code_dir = committed  # the committed C of this very model: no need to generate it again
+    code_dir = code_directory(system.name, digest)
     library = None
     if backend == "in-process":
         t = time.perf_counter()
@@ -118,6 +115,15 @@ def compiled_and_values(model, settings: dict, *, steps_per_period: int = 200, b
         return model, dict(settings)
     return compile_model(model, steps_per_period=steps_per_period, backend=backend, verbose=verbose,
                          **settings), {}
+
+
+def code_directory(name: str, digest: str) -> Path:
+    """Where the C of the code ``digest`` is: the committed ``generated/<model>/`` if its manifest carries
+    this hash (no need to generate it again), else the cache."""
+    committed = _generated_dir() / name
+    if (read_manifest(committed) or {}).get("hash") == digest:
+        return committed
+    return cache_dir() / "code" / f"{name}-{digest[:16]}"
 
 
 def _to_stderr(message: str) -> None:

@@ -81,15 +81,28 @@ def _machine_key(cc: str, flags: tuple[str, ...]) -> str:
         version = subprocess.run([*shlex.split(cc), "--version"], capture_output=True, text=True, timeout=30).stdout
     except (OSError, subprocess.SubprocessError):
         version = ""
-    cpu = ""
-    if "-march=native" in flags or "-mtune=native" in flags:
-        try:
-            info = Path("/proc/cpuinfo").read_text()
-            cpu = next((line for line in info.splitlines() if line.startswith("flags")), "")
-            cpu += next((line for line in info.splitlines() if line.startswith("model name")), "")
-        except OSError:
-            cpu = platform.processor()
-    return hashlib.sha256("\n".join([version, " ".join(flags), platform.machine(), cpu]).encode()).hexdigest()[:12]
+    return hashlib.sha256("\n".join([version, " ".join(flags), platform.machine(), _cpu(flags)]).encode()
+                          ).hexdigest()[:12]
+
+
+def _cpu(flags: tuple[str, ...]) -> str:
+    """The CPU a library built with ``flags`` is specific to ('' unless the flags say native)."""
+    if "-march=native" not in flags and "-mtune=native" not in flags:
+        return ""
+    try:
+        info = Path("/proc/cpuinfo").read_text()
+        cpu = next((line for line in info.splitlines() if line.startswith("flags")), "")
+        return cpu + next((line for line in info.splitlines() if line.startswith("model name")), "")
+    except OSError:
+        return platform.processor()
+
+
+def binary_key(flags: tuple[str, ...]) -> str:
+    """Whether a library built here with ``flags`` runs on another machine with the same results to the bit:
+    same system, architecture, C library (its libm evaluates sin, cos, exp) and, for native flags, CPU.
+    Not the compiler: it made the bytes, which travel as they are."""
+    parts = [platform.system(), platform.machine(), " ".join(platform.libc_ver()), " ".join(flags), _cpu(flags)]
+    return hashlib.sha256("\n".join(parts).encode()).hexdigest()[:12]
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,9 @@ The model is compiled once; every point only changes the parameter vector
 its own clone of the compiled model: the native loops release the GIL, so the
 threads use all cores without a process per core paying the symbolic
 reduction again. Threads hand finished points to the main thread, which alone
-writes the files and moves the progress bar.
+writes the files and moves the progress bar. With ``scheduler`` the tasks run
+on a Dask cluster instead (:mod:`gearsym.sweep.distributed`); the main thread
+still writes everything.
 """
 from __future__ import annotations
 
@@ -60,6 +62,7 @@ def run_sweep(
     progress: bool = True,
     backend: str = "auto",
     on_point: Callable[[dict], None] | None = None,
+    scheduler=None,
     **settings,
 ) -> SweepResult:
     """Sweep ``model`` over ``axes`` (``{"omega": values}`` or ``["omega=0.1:2.0:0.01", ...]``).
@@ -72,11 +75,21 @@ def run_sweep(
     core). ``on_point(row)`` is called in the main thread after each point is
     stored. ``settings`` fix other parameters (or a stiffness formula) for
     the whole sweep. ``model`` may also be a prebuilt :class:`CompiledModel`.
+    ``scheduler``: run the points on Dask (the ``distributed`` extra) instead of
+    threads: ``"local"`` starts a cluster of ``jobs`` single-threaded worker
+    processes on this machine for this sweep, ``"tcp://HOST:PORT"`` uses the
+    cluster of that scheduler, a ``distributed.Client`` its cluster. The files
+    are the same, byte for byte, as long as the workers run the client's library
+    (see :mod:`gearsym.codegen.portable`).
     """
     periods, discard = whole_number(periods, "periods", 1), whole_number(discard, "discard")
     if periods <= discard:
         raise GearsymError(f"need 0 <= discard < periods, got periods={periods}, discard={discard}")
     poincare = min(whole_number(poincare, "poincare samples"), periods - discard)
+    if scheduler is not None:
+        from .distributed import check_scheduler
+
+        check_scheduler(scheduler, whole_number(jobs, "jobs"))  # no Dask, a bad address: said before any work
     jobs = whole_number(jobs, "jobs") or os.cpu_count() or 1
     if mode == INDEPENDENT and direction != "up":
         raise GearsymError(f"--direction {direction} applies to a continuation; independent points have no direction")
@@ -121,8 +134,10 @@ def run_sweep(
         t_start = time.perf_counter()
         bar = _progress(len(planned), len(done), compiled.name, progress)
         already = len(done)
+        ran: dict = {}  # where the points ran, for the record (Dask only)
+        finished = _execute(run, todo, jobs) if scheduler is None else _execute_dask(run, todo, scheduler, jobs, ran)
         try:
-            for row, strobe_rows in _execute(run, todo, jobs):
+            for row, strobe_rows in finished:
                 if store:
                     store.append(row, strobe_rows)
                 key = row_key(row, names)
@@ -131,12 +146,15 @@ def run_sweep(
                 if on_point:
                     on_point(row)
         except KeyboardInterrupt:
+            finished.close()  # now, not when the traceback lets go of it: threads stop, cluster tasks are cancelled
             bar.close()
             if store:
                 store.close()
-                store.write_record(status="interrupted", points={"planned": len(planned), "done": len(done)})
+                store.write_record(status="interrupted", points={"planned": len(planned), "done": len(done)},
+                                   **({"dask": ran} if ran else {}))
             raise SweepInterrupted(len(done), len(planned), store.path if store else None) from None
         except BaseException:
+            finished.close()
             bar.close()
             raise
         bar.close()
@@ -146,13 +164,14 @@ def run_sweep(
                                        path=store.path if store else None)
         if store:
             computed = len(done) - already
-            seconds = round(time.perf_counter() - t_start, 3)
-            if not computed:  # a rerun of a finished sweep: keep the time it took
-                seconds = store.previous_record().get("seconds", seconds)
+            timing = {"seconds": round(time.perf_counter() - t_start, 3), **({"dask": ran} if ran else {})}
+            if not computed:  # a rerun of a finished sweep: keep the time it took, and where
+                previous = store.previous_record()
+                timing = {k: previous[k] for k in ("seconds", "dask") if k in previous} or timing
             store.finish(rows, strobe_rows)
             store.write_record(status="complete",
                                points={"planned": len(planned), "done": len(done), "computed": computed},
-                               seconds=seconds, gearsym=__version__, **result.findings())
+                               **timing, gearsym=__version__, **result.findings())
         return result
     finally:
         if store:
@@ -167,6 +186,14 @@ class _Run:
         self.periods, self.discard, self.poincare = periods, discard, poincare
         self.columns, self.strobe_columns = columns, strobe_columns
 
+    def __getstate__(self) -> dict:  # sent to Dask workers without the compiled model: each loads its own
+        return {**self.__dict__, "compiled": None}
+
+    @staticmethod
+    def final_state(row: dict, state_names) -> np.ndarray:
+        """The state a point ended in, read back from its row (``repr`` floats: the same bits)."""
+        return np.array([float(row[f"final_{s}"]) for s in state_names])
+
     def remaining(self, task: list[Point], done: dict) -> tuple[list[Point], np.ndarray]:
         """The points of a task still to run, and the state to start from (a continuation's last done point)."""
         finished = [p.key in done for p in task]
@@ -175,8 +202,7 @@ class _Run:
             raise GearsymError("the sweep file holds points of a continuation line out of order (not its first "
                                "points), so it cannot be resumed: pass --overwrite to start again")
         if count and task[0].direction != INDEPENDENT:
-            last = done[task[count - 1].key]
-            state = np.array([float(last[f"final_{s}"]) for s in self.compiled.state_names])
+            state = self.final_state(done[task[count - 1].key], self.compiled.state_names)
         else:
             state = self.start
         return task[count:], state
@@ -251,6 +277,19 @@ def _execute(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], jobs: int):
     finally:
         stop.set()  # on an error or Ctrl-C: threads stop after their current point
         pool.shutdown(wait=True, cancel_futures=True)  # points finished meanwhile are redone on resume
+
+
+def _execute_dask(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], scheduler, workers: int, ran: dict):
+    """``_execute`` on a Dask cluster, connected (or started) only if there is something to compute;
+    ``ran`` is filled with where it ran."""
+    if not tasks:
+        return
+    from .distributed import connect, execute_dask
+
+    if scheduler == "local":
+        ran["scheduler"] = "local"  # not the cluster's passing port
+    with connect(scheduler, workers) as client:
+        yield from execute_dask(run, tasks, client, ran)
 
 
 def _progress(total: int, done: int, name: str, enabled: bool):
