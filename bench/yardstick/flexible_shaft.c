@@ -45,7 +45,8 @@
  *
  * Output (stdout, after the timed sweep): CSV
  *   omega,lambda_1,lambda_2,lambda_3,lambda_4,A_x1,A_x2,seconds
- * with the exponents in Gram-Schmidt column order, then "# total_seconds=...".
+ * with the exponents in Gram-Schmidt column order, then one "# y_end=x1,v1,x2,v2"
+ * line per point (its final state) and "# total_seconds=...".
  *
  * Build: gcc -O3 -std=c99 -Wall -Wextra -o flexible_shaft flexible_shaft.c -lm
  */
@@ -187,6 +188,7 @@ typedef struct {
     double omega;
     double lambda[4];
     double amp[2];
+    double y_end[4]; /* final state (the next point's start) */
     double seconds;
 } Result;
 
@@ -255,6 +257,7 @@ static void run_point(double omega, const Params *p, int N, int P, int D,
     }
 
     memcpy(y, s, 4 * sizeof(double));
+    memcpy(res->y_end, s, 4 * sizeof(double));
     res->omega = omega;
     for (int j = 0; j < 4; j++) res->lambda[j] = sumlog[j] / ((P - D) * T);
     res->amp[0] = 0.5 * (xmax[0] - xmin[0]);
@@ -385,6 +388,9 @@ int main(int argc, char **argv)
         printf("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", res[i].omega,
                res[i].lambda[0], res[i].lambda[1], res[i].lambda[2], res[i].lambda[3],
                res[i].amp[0], res[i].amp[1], res[i].seconds);
+    for (int i = 0; i < npts; i++)
+        printf("# y_end=%.17g,%.17g,%.17g,%.17g\n", res[i].y_end[0], res[i].y_end[1],
+               res[i].y_end[2], res[i].y_end[3]);
     printf("# variant=%s steps=%d periods=%d discard=%d points=%d\n",
            use_table ? "table" : "direct", N, P, D, npts);
     printf("# total_seconds=%.17g\n", total);
