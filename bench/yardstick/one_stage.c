@@ -97,6 +97,12 @@ static inline void rhs(const double *restrict s, double kw, double fw,
     const double x = s[0], v = s[1];
 
     /* Backlash and its slope; at x = -eta both branches give g = 0. */
+#ifdef BACKLASH_SELECT
+    /* Profiling variant (bench/speed/profile.py): the branch-free selects CasADi generates for g and
+     * g', (c ? a : 0) + (d ? b : 0), instead of the branches below. */
+    const double g = ((x >= 0.0) ? x : 0.0) + ((x <= -c->eta) ? x + c->eta : 0.0);
+    const double gp = ((x >= 0.0) ? 1.0 : 0.0) + ((x <= -c->eta) ? 1.0 : 0.0);
+#else
     double g, gp;
     if (x >= 0.0) {
         g = x;
@@ -108,6 +114,7 @@ static inline void rhs(const double *restrict s, double kw, double fw,
         g = 0.0;
         gp = 0.0;
     }
+#endif
 
     ds[0] = v;
     ds[1] = -c->c1 * v + fw - kw * g;

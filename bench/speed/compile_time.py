@@ -1,0 +1,50 @@
+"""Compile time per model, from an empty cache, and proof that an unchanged model is not compiled again.
+
+Each model is loaded twice in fresh Python processes sharing one empty
+temporary cache (``GEARSYM_CACHE``): the first process compiles the C (the
+committed ``generated/`` source when its hash matches, so the C is not even
+regenerated), the second must find the library and compile nothing. The
+times are gearsym's own (``CompiledModel.timings``): ``symbolic`` (loading and
+reducing the model), ``build``/``generate`` (CasADi functions and C, only if the
+committed C did not match) and ``compile`` (the C compiler).
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+from .machine import REPO
+
+_PROBE = ("import json, sys; from gearsym.codegen import compile_model; "
+          "cm = compile_model(sys.argv[1], backend='compiled'); "
+          "print(json.dumps({'timings': cm.timings, 'library': str(cm.library)}))")
+
+
+def _load(model: str, cache: str) -> dict:
+    env = {**os.environ, "GEARSYM_CACHE": cache}
+    t = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-c", _PROBE, model], capture_output=True, text=True, env=env, cwd=REPO)
+    wall = time.perf_counter() - t
+    if proc.returncode != 0:
+        raise RuntimeError(f"loading {model} failed:\n{proc.stderr[-2000:]}")
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    out["process_seconds"] = wall
+    return out
+
+
+def measure(models: list[str]) -> dict:
+    out = {}
+    with tempfile.TemporaryDirectory(prefix="gearsym-cache-") as cache:
+        for model in models:
+            first, second = _load(model, cache), _load(model, cache)
+            out[model] = {
+                "first": first["timings"], "first_process_seconds": first["process_seconds"],
+                "second": second["timings"], "second_process_seconds": second["process_seconds"],
+                "recompiled": "compile" in second["timings"],
+                "same_library": first["library"] == second["library"],
+            }
+    return out

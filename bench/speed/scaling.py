@@ -1,0 +1,76 @@
+"""Every core, and beyond: the same sweep on 1 thread, on all threads, and on a local Dask cluster.
+
+Workloads (flexible-shaft model, 400 periods, 100 discarded):
+
+* ``independent``: the 191 omegas, every point from the initial state;
+* ``map``: a 2-D map omega = 0.1:2.0:0.02 x kS in {0, 0.05, 0.1, 1.0}, independent points;
+* ``lines``: the same map as four continuation lines (one task per kS).
+
+Each runs through :func:`gearsym.sweep.run_sweep` on a prebuilt compiled model,
+interleaved over repetitions; the results of every configuration are compared
+with the single-thread run bit for bit (repr of every number in every row).
+The Dask cluster is started once, outside the timings; its start-up is reported.
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+import time
+from collections.abc import Callable
+
+WORKLOADS = {
+    "independent": ({"omega": "0.1:2.0:0.01"}, "independent"),
+    "map": ({"omega": "0.1:2.0:0.02", "kS": "0,0.05,0.1,1.0"}, "independent"),
+    "lines": ({"omega": "0.1:2.0:0.02", "kS": "0,0.05,0.1,1.0"}, "continuation"),
+}
+
+
+def _rows(result) -> list[tuple]:
+    names = list(result.columns)
+    return [tuple(repr(result.columns[n][i].item()) for n in names) for i in range(len(result))]
+
+
+def measure(compiled, periods: int, discard: int, repeats: int, dask: bool = True, workloads=None,
+            log: Callable[[str], None] = lambda s: print(s, file=sys.stderr, flush=True)) -> dict:
+    from gearsym.sweep import run_sweep
+
+    cores = os.cpu_count() or 1
+    configs: dict[str, dict] = {"1 thread": {"jobs": 1}, f"{cores} threads": {"jobs": cores}}
+    out: dict = {"cores": cores, "periods": periods, "discard": discard, "workloads": {}}
+    stack = contextlib.ExitStack()
+    if dask:
+        try:
+            from gearsym.sweep.distributed import connect
+
+            t = time.perf_counter()
+            client = stack.enter_context(connect("local", cores))  # the cluster `gearsym sweep --dask` starts
+            client.wait_for_workers(cores)
+            out["dask_startup_seconds"] = time.perf_counter() - t
+            configs[f"Dask LocalCluster, {cores} workers"] = {"scheduler": client}
+        except Exception as exc:  # the extra is optional: report why it is missing, keep the thread numbers
+            out["dask"] = str(exc)
+    try:
+        for name in workloads or WORKLOADS:
+            axes, mode = WORKLOADS[name]
+            spec = [f"{k}={v}" for k, v in axes.items()]
+            entry = {"axes": axes, "mode": mode, "seconds": {c: [] for c in configs}, "identical": {}}
+            baseline = None
+            for rep in range(repeats + 1):  # repetition 0 warms up (and ships the library to the workers)
+                for label, kw in configs.items():
+                    t = time.perf_counter()
+                    res = run_sweep(compiled, spec, mode=mode, periods=periods, discard=discard, progress=False, **kw)
+                    seconds = time.perf_counter() - t
+                    rows = _rows(res)
+                    if baseline is None:
+                        baseline, entry["points"] = rows, len(rows)
+                    entry["identical"][label] = entry["identical"].get(label, True) and rows == baseline
+                    if rep:
+                        entry["seconds"][label].append(seconds)
+                if rep:
+                    log(f"    {name} repetition {rep}/{repeats}: " + ", ".join(
+                        f"{label} {entry['seconds'][label][-1]:.3f} s" for label in configs))
+            out["workloads"][name] = entry
+    finally:
+        stack.close()
+    return out

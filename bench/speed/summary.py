@@ -1,0 +1,166 @@
+"""Errors, ratios and verdicts: pure functions of the raw measurements (so the tests can recompute them).
+
+Conventions:
+
+* a tool's time for the per-point task is the sum over the omegas of the
+  median over repetitions of its time at that point; ratios divide such sums
+  measured in the same run; "per point" is that sum over the number of points;
+* the C reference is the fastest of the C builds (smallest sum of medians);
+* a tool's error is the largest |lambda_i - reference_i| over the sorted
+  exponents, over the points whose reference converged (periodic points);
+  chaotic points are reported separately (~1e-2 is the floor there);
+* "at equal accuracy": an adaptive tool is taken at the loosest tolerance of
+  its ladder whose error is no larger than gearsym's at 200 steps per period
+  (so it is at least as accurate; the ladder steps by 100x, so its time is
+  an upper bound); if none reaches it, its most accurate run is used and
+  marked so.
+"""
+from __future__ import annotations
+
+import statistics
+
+TARGETS = {
+    "gearsym_vs_c": 1.0,  # gearsym time / hand-written C time, at most
+    "threads_speedup": 1.8,  # 1 thread / all threads, independent sweep on 2 cores, at least
+    "jitcode_ratio": 100.0,  # JiTCODE time / gearsym time at equal accuracy, at least
+    "scipy_ratio": 1000.0,  # SciPy time / gearsym time at equal accuracy, at least
+    "compile_seconds": 10.0,  # per model, at most
+}
+GEARSYM = "gearsym"
+ADAPTIVE = ("JiTCODE", "SciPy RK45")
+
+
+def point_time(record: dict, stat=statistics.median) -> float:
+    return sum(stat(p["seconds"]) for p in record["points"].values())
+
+
+def errors(record: dict, reference: dict) -> dict:
+    """Largest exponent error over converged (periodic) and over chaotic points."""
+    periodic, chaotic = [], []
+    for key, ref in reference.items():
+        got = record["points"][key]["exponents"]
+        err = max(abs(a - b) for a, b in zip(got, ref["reference"]))
+        (periodic if ref["converged"] else chaotic).append(err)
+    return {"periodic": max(periodic) if periodic else None, "chaotic": max(chaotic) if chaotic else None}
+
+
+def sum_rule(record: dict, reference: dict, zeta: float) -> float:
+    """Largest |sum of exponents + 2 zeta/omega| (the exact mean trace of the Jacobian) over the points."""
+    return max(abs(record["points"][k]["sum"] + 2 * zeta / ref["omega"]) for k, ref in reference.items())
+
+
+def _c_labels(records: dict) -> list[str]:
+    return [label for label in records if label.startswith("C ")]
+
+
+def _row(record: dict, reference: dict, zeta: float, c_time: float, g_time: float, setting: str) -> dict:
+    t = point_time(record)
+    return {"setting": setting, "accuracy": record["accuracy"], "seconds": t, "seconds_min": point_time(record, min),
+            "per_point": t / len(record["points"]), "vs_c": t / c_time, "vs_gearsym": t / g_time,
+            "errors": errors(record, reference), "sum_rule": sum_rule(record, reference, zeta),
+            "setup_seconds": record["setup_seconds"], "setup_note": record["setup_note"]}
+
+
+def summarise_model(raw: dict, zeta: float) -> dict:
+    reference, fixed = raw["reference"], raw["fixed"]
+    c_ref = min(_c_labels(fixed), key=lambda label: point_time(fixed[label]))
+    c_time, g_time = point_time(fixed[c_ref]), point_time(fixed[GEARSYM])
+    tools = {label: _row(record, reference, zeta, c_time, g_time, "200")
+             for label, record in fixed.items()}
+    precision = {}
+    for tool, by_setting in raw.get("precision", {}).items():
+        rows = [_row(record, reference, zeta, c_time, g_time, setting) for setting, record in by_setting.items()]
+        base = raw.get("precision_base", {}).get(tool)  # the 200-step run of a fixed-step tool
+        if base:
+            rows.insert(0, dict(tools[base], setting="200"))
+        precision[tool] = rows
+    target = tools[GEARSYM]["errors"]["periodic"]
+    equal = {}
+    for tool in ADAPTIVE:
+        rows = precision.get(tool)
+        if not rows:
+            continue
+        good = [r for r in rows if target is None or (r["errors"]["periodic"] or 0.0) <= target]
+        pick = max(good, key=lambda r: r["errors"]["periodic"] or 0.0) if good else \
+            min(rows, key=lambda r: r["errors"]["periodic"] or 0.0)
+        equal[tool] = {"setting": pick["setting"], "reached": bool(good), "vs_gearsym": pick["vs_gearsym"],
+                       "vs_c": pick["vs_c"], "error": pick["errors"]["periodic"], "per_point": pick["per_point"]}
+    periodic = [ref["omega"] for ref in reference.values() if ref["converged"]]
+    return {"c_reference": c_ref, "gearsym_error": target, "tools": tools, "precision": precision,
+            "equal_accuracy": equal, "periodic_omegas": periodic,
+            "chaotic_omegas": [ref["omega"] for ref in reference.values() if not ref["converged"]],
+            "sweep": summarise_sweep(raw.get("sweep", {}))}
+
+
+def summarise_sweep(sweep: dict) -> dict:
+    if not sweep:
+        return {}
+    finest = min(r["every"] for r in sweep.values())  # 1 in the real run; coarser only in --quick
+    full = {label: r for label, r in sweep.items() if r["every"] == finest}
+    c_ref = min(_c_labels(full), key=lambda label: statistics.median(full[label]["seconds"]))
+    c_per_point = statistics.median(full[c_ref]["seconds"]) / full[c_ref]["points"]
+    g = sweep[GEARSYM]
+    g_per_point = statistics.median(g["seconds"]) / g["points"]
+    ref_lams = full[c_ref]["exponents"]
+    out = {"c_reference": c_ref, "tools": {}}
+    for label, r in sweep.items():
+        per_point = statistics.median(r["seconds"]) / r["points"]
+        agree = None
+        if r["every"] == finest:
+            diffs = [max(abs(a - b) for a, b in zip(x, y)) for x, y in zip(r["exponents"], ref_lams)]
+            agree = {"1e-9": sum(d <= 1e-9 for d in diffs), "1e-2": sum(d <= 1e-2 for d in diffs),
+                     "points": len(diffs)}
+        out["tools"][label] = {
+            "points": r["points"], "every": r["every"], "accuracy": r["accuracy"], "repeats": len(r["seconds"]),
+            "seconds_min": min(r["seconds"]), "seconds_median": statistics.median(r["seconds"]),
+            "per_point": per_point, "vs_c": per_point / c_per_point, "vs_gearsym": per_point / g_per_point,
+            "agree_with_c": agree}
+    return out
+
+
+def summarise_scaling(scaling: dict) -> dict:
+    out = {}
+    for name, w in scaling.get("workloads", {}).items():
+        labels = list(w["seconds"])
+        one = statistics.median(w["seconds"][labels[0]])
+        out[name] = {label: {"median": statistics.median(s), "min": min(s), "speedup": one / statistics.median(s),
+                             "identical": w["identical"][label]} for label, s in w["seconds"].items()}
+    return out
+
+
+def verdicts(models: dict, scaling: dict, compile_times: dict) -> list[dict]:
+    """One line per target of the issue: measured value, target, met or not."""
+    rows = []
+    for model, s in models.items():
+        ratio = s["tools"][GEARSYM]["vs_c"]
+        rows.append({"what": f"gearsym / hand-written C, per point, {model}", "value": ratio,
+                     "target": f"<= {TARGETS['gearsym_vs_c']}", "met": ratio <= TARGETS["gearsym_vs_c"]})
+        sweep = s["sweep"].get("tools", {}).get(GEARSYM)
+        if sweep:
+            rows.append({"what": f"gearsym / hand-written C, 191-point sweep, {model}", "value": sweep["vs_c"],
+                         "target": f"<= {TARGETS['gearsym_vs_c']}", "met": sweep["vs_c"] <= TARGETS["gearsym_vs_c"]})
+        for tool, key in zip(ADAPTIVE, ("jitcode_ratio", "scipy_ratio")):
+            eq = s["equal_accuracy"].get(tool)
+            if eq:
+                rows.append({"what": f"{tool} / gearsym at equal accuracy, {model}", "value": eq["vs_gearsym"],
+                             "target": f">= {TARGETS[key]:g}", "met": eq["vs_gearsym"] >= TARGETS[key]})
+    ind = scaling.get("independent")
+    if ind:
+        label = [k for k in ind if k.endswith("threads")][0]
+        rows.append({"what": f"independent sweep, {label} vs 1 thread", "value": ind[label]["speedup"],
+                     "target": f">= {TARGETS['threads_speedup']}",
+                     "met": ind[label]["speedup"] >= TARGETS["threads_speedup"]})
+    if compile_times:
+        worst = max(c["first"].get("compile", 0.0) for c in compile_times.values())
+        rows.append({"what": "C compile time, slowest model (s)", "value": worst,
+                     "target": f"<= {TARGETS['compile_seconds']:g}", "met": worst <= TARGETS["compile_seconds"]})
+        again = sum(c["recompiled"] for c in compile_times.values())
+        rows.append({"what": "models compiled again when unchanged", "value": again, "target": "0",
+                     "met": again == 0})
+    return rows
+
+
+def summarise(raw: dict) -> dict:
+    models = {m: summarise_model(r, r["zeta"]) for m, r in raw["models"].items()}
+    scaling = summarise_scaling(raw.get("scaling", {}))
+    return {"models": models, "scaling": scaling, "verdicts": verdicts(models, scaling, raw.get("compile", {}))}
