@@ -298,3 +298,49 @@ def test_editing_the_code_generator_changes_the_hash(monkeypatch):
     before = code_hash(system, LoopOptions())
     monkeypatch.setattr(generate, "_generator_digest", lambda: "edited")
     assert code_hash(system, LoopOptions()) != before
+
+
+# ------------------------------------------------------------------ long periods: bounded code
+def _period_run(options, monkeypatch=None, segment=None):
+    import gearsym.codegen.functions as functions
+
+    if segment is not None:
+        monkeypatch.setattr(functions, "SEGMENT_STEPS", segment)
+    mf = functions.build_functions(system_for("one_stage"), options)
+    p = np.array([1.5, 0.08, 1.0, 4.0, 0.0, 10.0, 0.2])
+    c, _ = mf.functions["constants"](p)
+    table, _ = mf.functions["table"](0.0, p)
+    y, Q = ca.DM([-2.0, -0.5]), ca.DM.eye(2)
+    out = []
+    for _ in range(3):
+        y, Q, logs, low, high = mf.functions["lyapunov_period"](y, Q, table, c)
+        out.append(np.concatenate([np.array(v).ravel() for v in (y, Q, logs, low, high)]))
+    return mf, np.array(out)
+
+
+@pytest.mark.parametrize("steps", [400, 450])  # whole segments; and a remainder segment
+def test_long_periods_run_in_segments_with_the_same_bits(monkeypatch, steps):
+    from gearsym.codegen.functions import LoopOptions
+
+    options = LoopOptions(steps_per_period=steps, chunk_periods=1)
+    segmented, a = _period_run(options)
+    _, b = _period_run(options, monkeypatch, segment=10_000)  # everything written out in one function
+    assert np.array_equal(a, b)
+    period = segmented.functions["lyapunov_period"]
+    names = {period.instruction_MX(i).which_function().name() for i in range(period.n_instructions())
+             if period.instruction_id(i) == ca.OP_CALL}
+    assert "tangent_segment_200" in names
+    assert ("tangent_segment_50" in names) == (steps == 450)
+
+
+def test_generated_code_size_does_not_grow_with_the_steps_per_period(tmp_path):
+    from gearsym.codegen.functions import LoopOptions, build_functions
+    from gearsym.codegen.generate import code_hash, write_code
+
+    system = system_for("one_stage")
+    sizes = {}
+    for steps in (200, 3200):
+        options = LoopOptions(steps_per_period=steps)
+        write_code(build_functions(system, options), tmp_path / str(steps), code_hash(system, options))
+        sizes[steps] = (tmp_path / str(steps) / "one_stage.c").stat().st_size
+    assert sizes[3200] < 1.5 * sizes[200], sizes  # written out, 3200 steps were 16x the code (24 s of gcc)

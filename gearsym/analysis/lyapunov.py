@@ -94,6 +94,7 @@ def lyapunov_spectrum(
     y0=None,
     steps_per_period: int = 200,
     backend: str = "auto",
+    locate_crossings: bool = False,
     **settings,
 ) -> LyapunovSpectrum:
     """Full Lyapunov spectrum of ``model`` at the point given by ``settings``.
@@ -103,11 +104,14 @@ def lyapunov_spectrum(
     in which case ``settings`` may only change parameter values and nothing is
     rebuilt (the low-level call for sweeps). ``y0`` is the initial state
     (sequence or mapping; default: the model's declared initial state).
+    ``locate_crossings``: split RK4 steps at backlash crossings (4th order exponents; ignored for a
+    prebuilt model, which has its own).
     """
     periods, discard = whole_number(periods, "periods"), whole_number(discard, "discard")
     if periods <= discard:
         raise GearsymError(f"need 0 <= discard < periods, got periods={periods}, discard={discard}")
-    compiled, values = compiled_and_values(model, settings, steps_per_period=steps_per_period, backend=backend)
+    compiled, values = compiled_and_values(model, settings, steps_per_period=steps_per_period, backend=backend,
+                                           locate_crossings=locate_crossings)
     p = compiled.parameter_vector(values)
     inputs = compiled.prepare(p)
     run = compiled.tangent_run(y0, periods, inputs)

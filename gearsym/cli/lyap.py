@@ -20,6 +20,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--periods", type=int, default=400, help="forcing periods in all (default 400)")
     parser.add_argument("--discard", type=int, default=100, help="transient periods left out (default 100)")
     parser.add_argument("--steps-per-period", type=int, default=200, help="RK4 steps per period (default 200)")
+    parser.add_argument("--locate-crossings", action="store_true",
+                        help="split RK4 steps where the backlash switches (4th order exponents; see docs/engine.md)")
     parser.add_argument("--y0", metavar="x=-2,v=-0.5", help="initial state (default: the model's)")
     parser.add_argument("--backend", choices=BACKENDS, default="auto",
                         help="compiled C, CasADi in-process, or auto (compiled when a C compiler exists)")
@@ -30,7 +32,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     compiled = compile_model(args.model, steps_per_period=args.steps_per_period, backend=args.backend,
-                             verbose=True, **parse_settings(args.set))
+                             locate_crossings=args.locate_crossings, verbose=True, **parse_settings(args.set))
     result = lyapunov_spectrum(compiled, periods=args.periods, discard=args.discard, y0=parse_state(args.y0))
     if args.plot:
         from ..figures import plot_point  # matplotlib only when asked for
@@ -44,7 +46,8 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(result.as_dict(), indent=2))
         return 0
     print(f"{result.model}: {result.periods} periods ({result.discard} discarded), "
-          f"{result.steps_per_period} RK4 steps/period, {result.backend}")
+          f"{result.steps_per_period} RK4 steps/period{', crossings located' if args.locate_crossings else ''}, "
+          f"{result.backend}")
     print("parameters: " + ", ".join(f"{k}={v:g}" for k, v in result.parameters.items()))
     print("Lyapunov exponents (per unit time, +- standard error):")
     for i, (lam, err) in enumerate(zip(result.exponents, result.stderr), 1):

@@ -29,6 +29,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--periods", type=int, default=400, help="forcing periods per point (default 400)")
     parser.add_argument("--discard", type=int, default=100, help="transient periods left out (default 100)")
     parser.add_argument("--steps-per-period", type=int, default=200, help="RK4 steps per period (default 200)")
+    parser.add_argument("--locate-crossings", action="store_true",
+                        help="split RK4 steps where the backlash switches (4th order exponents; see docs/engine.md)")
     parser.add_argument("--y0", metavar="x=-2,v=-0.5", help="initial state (default: the model's)")
     parser.add_argument("--jobs", type=int, default=0,
                         help="threads (default 0: every core); with --dask, worker processes")
@@ -56,7 +58,7 @@ def run(args: argparse.Namespace) -> int:
         result = run_sweep(args.model, args.param, mode=args.mode, direction=args.direction, periods=args.periods,
                            discard=args.discard, steps_per_period=args.steps_per_period, y0=parse_state(args.y0),
                            jobs=args.jobs, out=args.out, overwrite=args.overwrite, poincare=args.poincare,
-                           progress=not args.quiet, backend=args.backend,
+                           progress=not args.quiet, backend=args.backend, locate_crossings=args.locate_crossings,
                            scheduler="local" if args.dask else args.scheduler, **parse_settings(args.set))
     except KeyboardInterrupt as exc:  # SweepInterrupted says how many points were kept
         print(f"gearsym: {exc}" if str(exc) else "gearsym: interrupted before any point was finished",

@@ -39,6 +39,7 @@ def compile_model(
     steps_per_period: int = 200,
     backend: str = "auto",
     chunk_periods: int = 50,
+    locate_crossings: bool = False,
     verbose: bool = False,
     **settings,
 ) -> CompiledModel:
@@ -51,6 +52,8 @@ def compile_model(
     ``backend``: "compiled" (fail without a C compiler), "in-process" (CasADi's
     virtual machine) or "auto" (compiled if a compiler exists, else in-process
     with a warning). ``verbose`` says on stderr when it compiles (seconds, once).
+    ``locate_crossings``: split each RK4 step that crosses a backlash switching surface at the crossing
+    (4th order Lyapunov exponents instead of 1st; see :mod:`gearsym.codegen.functions`).
     """
     from ..reduce import NondimensionalModel, reduce
     from ..registry import load_model, system_for
@@ -66,7 +69,8 @@ def compile_model(
         nd = loaded if isinstance(loaded, NondimensionalModel) else reduce(loaded)
         system = system_for(nd, **settings)
         check = nd.check_value
-    options = LoopOptions(steps_per_period=steps_per_period, chunk_periods=chunk_periods)
+    options = LoopOptions(steps_per_period=steps_per_period, chunk_periods=chunk_periods,
+                          locate_crossings=bool(locate_crossings))
     digest = code_hash(system, options)
     timings = {"symbolic": time.perf_counter() - start}
 
@@ -108,13 +112,13 @@ def compile_model(
 
 
 def compiled_and_values(model, settings: dict, *, steps_per_period: int = 200, backend: str = "auto",
-                        verbose: bool = False) -> tuple[CompiledModel, dict]:
+                        verbose: bool = False, locate_crossings: bool = False) -> tuple[CompiledModel, dict]:
     """The two ways into every analysis: a prebuilt CompiledModel with ``settings`` as parameter values
     (the low-level call, nothing rebuilt), or a model compiled with ``settings`` as its defaults."""
     if isinstance(model, CompiledModel):
         return model, dict(settings)
     return compile_model(model, steps_per_period=steps_per_period, backend=backend, verbose=verbose,
-                         **settings), {}
+                         locate_crossings=locate_crossings, **settings), {}
 
 
 def code_directory(name: str, digest: str) -> Path:

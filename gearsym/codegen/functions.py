@@ -19,13 +19,20 @@ tangent map is the exact derivative of the discrete flow.
 
 Parameters are an input vector ``p`` in ``system.parameters`` order: changing
 a value never regenerates or recompiles anything.
+
+``LoopOptions(locate_crossings=True)`` makes every step that crosses a backlash
+switching surface split there, so that RK4 sees a smooth right-hand side on
+both substeps (see ``_crossing_steps``); the split runs only on crossing steps,
+behind a real ``if`` in the C (a CasADi ``Switch``).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import casadi as ca
+import sympy as sp
 
+from ..backlash import G, g, g_slope
 from ..errors import ModelError
 from ..system import FirstOrderSystem
 from .time_tables import SplitRHS, split_rhs
@@ -39,6 +46,7 @@ class LoopOptions:
     steps_per_period: int = 200
     chunk_periods: int = 50  # periods per compiled call
     block_steps: int = 0  # RK4 steps unrolled per SX block; 0 chooses
+    locate_crossings: bool = False  # split steps at backlash switching surfaces (4th order exponents)
 
     def __post_init__(self):
         if self.steps_per_period < 1:
@@ -52,6 +60,8 @@ class LoopOptions:
         One, measured: the call costs little next to a tangent step, and longer
         straight-line blocks run slower (register pressure) and compile slower.
         """
+        if self.locate_crossings:  # the crossing test and its branch are per step
+            return 1
         target = self.block_steps or 1
         return max(d for d in range(1, target + 1) if self.steps_per_period % d == 0)
 
@@ -95,18 +105,19 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
     table_point = ca.Function("table_point", [sym.t, sym.p], [ca.vertcat(*table_values) if m else ca.SX(0, 1)],
                               ["t", "p"], ["values"], _OPTS)
 
-    tangent_block, state_block, state_step = _rk4_functions(sym, split, K, where)
+    switching = _switching(system, split) if options.locate_crossings else None
+    if switching is None or not switching.surfaces:  # nothing switches (Lorenz): the plain loops
+        tangent_block, state_block, state_step = _rk4_functions(sym, split, K, where)
+    else:
+        tangent_block, state_block, state_step = _crossing_steps(sym, split, switching, where)
     gram_schmidt = _gram_schmidt(n)
 
     # MX loops over the SX functions
     Ym, Qm, Cm = ca.MX.sym("y", n), ca.MX.sym("Q", n, n), ca.MX.sym("c", nc + 1)
     Tm = ca.MX.sym("T", 3 * m, N)
     obs0 = ca.vertcat(*[Ym[j] for j in sym.observed])
-    blocks = [Tm[:, b * K:(b + 1) * K] for b in range(N // K)]
 
-    yk, Qk, lk, hk = Ym, Qm, obs0, obs0
-    for Tb in blocks:
-        yk, Qk, lk, hk = tangent_block(yk, Qk, lk, hk, Tb, Cm)
+    yk, Qk, lk, hk = _over_period(tangent_block, [Ym, Qm, obs0, obs0], Tm, Cm, K, "tangent")
     Qn, logr = gram_schmidt(Qk)
     lyapunov_period = ca.Function("lyapunov_period", [Ym, Qm, Tm, Cm], [yk, Qn, logr, lk, hk],
                                   ["y0", "Q0", "table", "c"], ["strobe", "Q", "log_stretch", "low", "high"])
@@ -118,9 +129,7 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
     lyapunov_chunk = ca.Function("lyapunov_chunk", [Ym, Qm, Tm, Cm], [strobe, Qk, logr, low, high],
                                  ["y0", "Q0", "table", "c"], ["strobe", "Q", "log_stretch", "low", "high"])
 
-    yk, lk, hk = Ym, obs0, obs0
-    for Tb in blocks:
-        yk, lk, hk = state_block(yk, lk, hk, Tb, Cm)
+    yk, lk, hk = _over_period(state_block, [Ym, obs0, obs0], Tm, Cm, K, "state")
     orbit_period = ca.Function("orbit_period", [Ym, Tm, Cm], [yk, lk, hk], ["y0", "table", "c"],
                                ["strobe", "low", "high"])
     yk, rows = Ym, []
@@ -141,6 +150,34 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
 
 
 _OPTS = {"cse": True}
+
+#: RK4 steps written out in one function. A period of more steps calls such a segment repeatedly, so the
+#: C (and its compile time) stays the size of a 200-step period whatever ``steps_per_period`` is (3200 steps
+#: written out took 24 s to compile). The default period is one segment: its C is what it always was.
+SEGMENT_STEPS = 200
+
+
+def _over_period(block, carry: list, T: ca.MX, C: ca.MX, K: int, name: str) -> list:
+    """``block(*carry, T[:, K columns], C)`` applied along all columns of the table ``T``: written out up to
+    SEGMENT_STEPS steps, beyond that through segment functions (full ones, then one for the rest)."""
+    blocks, per = T.size2() // K, max(1, SEGMENT_STEPS // K)
+    if blocks <= per:
+        for b in range(blocks):
+            carry = list(block(*carry, T[:, b * K:(b + 1) * K], C))
+        return carry
+
+    def segment(count: int) -> ca.Function:
+        args = [ca.MX.sym(f"x{i}", c.sparsity()) for i, c in enumerate(carry)]
+        Ts, Cs = ca.MX.sym("T", T.size1(), count * K), ca.MX.sym("c", C.sparsity())
+        return ca.Function(f"{name}_segment_{count * K}", [*args, Ts, Cs],
+                           _over_period(block, args, Ts, Cs, K, name))
+
+    full, (whole, rest) = segment(per), divmod(blocks, per)
+    for i in range(whole):
+        carry = list(full(*carry, T[:, i * per * K:(i + 1) * per * K], C))
+    if rest:
+        carry = list(segment(rest)(*carry, T[:, whole * per * K:], C))
+    return carry
 
 
 class _Symbols:
@@ -184,21 +221,7 @@ def _rk4_functions(sym: _Symbols, split: SplitRHS, K: int, where: str):
     Tk = ca.SX.sym("Tk", 3 * m, K)
 
     def rk4(yk, Qk, Ta, Tb, Tc):  # Ta, Tb, Tc: table values at t, t + h/2, t + h
-        k1 = f_of(yk, Ta, ch)
-        y2 = yk + h / 2 * k1
-        k2 = f_of(y2, Tb, ch)
-        y3 = yk + h / 2 * k2
-        k3 = f_of(y3, Tb, ch)
-        y4 = yk + h * k3
-        k4 = f_of(y4, Tc, ch)
-        y_next = yk + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        if Qk is None:
-            return y_next, None
-        K1 = ca.mtimes(J_of(yk, Ta, ch), Qk)
-        K2 = ca.mtimes(J_of(y2, Tb, ch), Qk + h / 2 * K1)
-        K3 = ca.mtimes(J_of(y3, Tb, ch), Qk + h / 2 * K2)
-        K4 = ca.mtimes(J_of(y4, Tc, ch), Qk + h * K3)
-        return y_next, Qk + h / 6 * (K1 + 2 * K2 + 2 * K3 + K4)
+        return _rk4(lambda x, T: f_of(x, T, ch), lambda x, T: J_of(x, T, ch), yk, Qk, h, Ta, Tb, Tc)
 
     def block(with_tangent: bool):
         yk, Qk, lk, hk = y, (Q if with_tangent else None), lo, hi
@@ -217,6 +240,225 @@ def _rk4_functions(sym: _Symbols, split: SplitRHS, K: int, where: str):
     y_next, _ = rk4(y, None, col[:m], col[m:2 * m], col[2 * m:])
     state_step = ca.Function("state_step", [y, col, ch], [y_next], _OPTS)
     return tangent_block, state_block, state_step
+
+
+def _rk4(f, J, yk, Qk, h, Ta, Tb, Tc):
+    """One RK4 step of length h of y' = f(y, T) and, unless ``Qk`` is None, of Q' = J(y, T) Q.
+    Ta, Tb, Tc: the table values at the start, middle and end of the step."""
+    k1 = f(yk, Ta)
+    y2 = yk + h / 2 * k1
+    k2 = f(y2, Tb)
+    y3 = yk + h / 2 * k2
+    k3 = f(y3, Tb)
+    y4 = yk + h * k3
+    k4 = f(y4, Tc)
+    y_next = yk + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    if Qk is None:
+        return y_next, None
+    K1 = ca.mtimes(J(yk, Ta), Qk)
+    K2 = ca.mtimes(J(y2, Tb), Qk + h / 2 * K1)
+    K3 = ca.mtimes(J(y3, Tb), Qk + h / 2 * K2)
+    K4 = ca.mtimes(J(y4, Tc), Qk + h * K3)
+    return y_next, Qk + h / 6 * (K1 + 2 * K2 + 2 * K3 + K4)
+
+
+@dataclass(frozen=True)
+class _Switching:
+    """The switching surfaces of a model's backlash, in the loop's symbols (states, tables, constants).
+
+    Every application g(x, eta) (likewise g_slope, G) has two surfaces, s = x and s = -(x + eta), oriented
+    so that the side [s >= 0] is the indicator of its branch: x >= 0 (one flank in contact) and x <= -eta
+    (the other). ``rhs`` is ``split.rhs`` with each indicator replaced by a symbol of ``sides``: with the
+    sides held fixed it is the smooth extension of one branch across its surfaces.
+    """
+
+    surfaces: tuple[sp.Expr, ...]
+    sides: tuple[sp.Dummy, ...]
+    rhs: tuple[sp.Expr, ...]
+
+
+_OTHER_SWITCHES = (sp.Piecewise, sp.Heaviside, sp.Min, sp.Max, sp.Abs, sp.sign, sp.floor, sp.ceiling)
+
+
+def _switching(system: FirstOrderSystem, split: SplitRHS) -> _Switching:
+    """The backlash switching surfaces of ``split.rhs``, derived from the expressions, in a fixed order
+    (SymPy's canonical argument order) so that the same model always gives the same C."""
+    states = set(system.states)
+    surfaces: list[sp.Expr] = []
+    sides: list[sp.Dummy] = []
+
+    def side(s: sp.Expr) -> sp.Dummy:
+        if s not in surfaces:
+            surfaces.append(s)
+            sides.append(sp.Dummy(f"side_{len(sides)}", real=True))
+        return sides[surfaces.index(s)]
+
+    def freeze(e: sp.Expr) -> sp.Expr:
+        if isinstance(e, (g, g_slope, G)):
+            x, eta = e.args
+            if any(isinstance(a, (g, g_slope, G)) for arg in e.args for a in sp.preorder_traversal(arg)):
+                raise ModelError(f"locate_crossings: nested backlash in {e} is not supported", system.name)
+            on, off = side(x), side(-(x + eta))
+            if isinstance(e, g):
+                return on * x + off * (x + eta)
+            if isinstance(e, g_slope):
+                return on + off
+            return on * x**2 / 2 + off * (x + eta) ** 2 / 2
+        if isinstance(e, _OTHER_SWITCHES) and e.free_symbols & states:
+            raise ModelError(
+                f"locate_crossings locates the backlash g(x, eta) only; {e} switches on the state too and its "
+                "crossings would not be located (use the plain loops, locate_crossings=False)", system.name)
+        if not e.args or isinstance(e, sp.Symbol):
+            return e
+        return e.func(*(freeze(a) for a in e.args))
+
+    rhs = tuple(freeze(f) for f in split.rhs)
+    return _Switching(tuple(surfaces), tuple(sides), rhs)
+
+
+def _crossing_steps(sym: _Symbols, split: SplitRHS, switching: _Switching, where: str):
+    """``tangent_block``, ``state_block`` and ``state_step`` (one step each) that split a step at a crossing.
+
+    The right-hand side is continuous across a backlash surface but its slope jumps, so plain RK4 over a
+    crossing step is only first order for the tangent map (and the exponents). Here each step is:
+
+    1. *try* (SX, every step): the plain RK4 step y0 -> y1 and a flag: does some surface s change side
+       between y0 and y1? (A crossing and return within one step is not seen: it stays a plain step.)
+    2. a CasADi ``Switch`` (a C ``if``): no crossing, keep y1; a crossing, the *split* (SX):
+
+       * the sides at y0 (mode A) are frozen: RK4 of the smooth extension of mode A over the whole step
+         gives s at the end, and a cubic Hermite of s over the step (values and slopes h ds/dt at both
+         ends) locates theta in [0, 1] by Newton from the linear estimate (``_NEWTON`` iterations,
+         clamped). The extension is smooth, so theta is O(h^4) accurate; the earliest surface wins;
+         surfaces that the extension does not cross are left alone;
+       * RK4 of mode A over theta h, then of mode B (mode A with the crossed surface(s) flipped) over
+         (1 - theta) h, the tangent Q along. Each substep sees one smooth right-hand side: with every
+         stage evaluated on the frozen mode, stages that overshoot the surface stay on the branch they
+         belong to, which is what makes the step 4th order again.
+       * the tables at the substeps' stage times come from the quadratic through Ta, Tb, Tc (t, t + h/2,
+         t + h): O(h^3) in the coefficients over O(1) split steps per period, 4th order overall.
+
+    No saltation matrix: f is continuous across the surface (g is), so the tangent map is continuous
+    there; only J jumps, and each substep integrates J of its own mode. Two *different* surfaces crossed in
+    one step: the earliest is split at; the other is integrated on the extension of its old side for the
+    rest of that step (like a plain step, first order there). The min/max of the observed states are
+    taken after the step, as in the plain loops.
+    """
+    n, m, nc = sym.y.numel(), len(split.tables), sym.ch.numel() - 1
+    y, T, ch = sym.y, sym.T, sym.ch
+    h = ch[nc]
+    f_tab = ca.vertcat(*to_casadi(split.rhs, sym.inner, where))
+    f_of = ca.Function("f_tab", [y, T, ch], [f_tab])
+    J_of = ca.Function("J_tab", [y, T, ch], [ca.jacobian(f_tab, y)])
+    ns = len(switching.surfaces)
+    sides = ca.SX.sym("side", ns)
+    frozen = {**sym.inner, **{d: sides[i] for i, d in enumerate(switching.sides)}}
+    fz = ca.vertcat(*to_casadi(switching.rhs, frozen, where))
+    fz_of = ca.Function("f_mode", [y, T, ch, sides], [fz])
+    Jz_of = ca.Function("J_mode", [y, T, ch, sides], [ca.jacobian(fz, y)])
+    s_expr = ca.vertcat(*to_casadi(switching.surfaces, sym.inner, where))
+    s_of = ca.Function("s", [y, T, ch], [s_expr])
+    ydot, Tdot = ca.SX.sym("ydot", n), ca.SX.sym("Tdot", m)
+    sdot_of = ca.Function("s_dot", [y, T, ch, ydot, Tdot],
+                          [ca.jtimes(s_expr, ca.vertcat(y, T), ca.vertcat(ydot, Tdot))])
+
+    col = ca.SX.sym("Ti", 3 * m)
+    Ta, Tb, Tc = col[:m], col[m:2 * m], col[2 * m:]
+    Q = ca.SX.sym("Q", n, n)
+    y1 = ca.SX.sym("y1", n)
+    Q1 = ca.SX.sym("Q1", n, n)
+    lo = ca.SX.sym("lo", len(sym.observed))
+    hi = ca.SX.sym("hi", len(sym.observed))
+
+    def side(s):
+        return s >= 0
+
+    def plain(with_tangent: bool):
+        yn, Qn = _rk4(lambda x, Tx: f_of(x, Tx, ch), lambda x, Tx: J_of(x, Tx, ch), y,
+                      Q if with_tangent else None, h, Ta, Tb, Tc)
+        flag = ca.sum1(side(s_of(y, Ta, ch)) != side(s_of(yn, Tc, ch))) > 0
+        return yn, Qn, flag
+
+    def table_at(theta):  # the quadratic through Ta, Tb, Tc, at t + theta h
+        return Ta + theta * (4 * Tb - 3 * Ta - Tc) + theta * theta * (2 * Ta - 4 * Tb + 2 * Tc)
+
+    def split_step(with_tangent: bool):
+        def f_mode(mode):
+            return lambda x, Tx: fz_of(x, Tx, ch, mode)
+
+        def J_mode(mode):
+            return lambda x, Tx: Jz_of(x, Tx, ch, mode)
+
+        mode_a = side(s_of(y, Ta, ch))
+        y_ext, _ = _rk4(f_mode(mode_a), None, y, None, h, Ta, Tb, Tc)
+        s0, s1 = s_of(y, Ta, ch), s_of(y_ext, Tc, ch)
+        d0 = sdot_of(y, Ta, ch, h * fz_of(y, Ta, ch, mode_a), 4 * Tb - 3 * Ta - Tc)
+        d1 = sdot_of(y_ext, Tc, ch, h * fz_of(y_ext, Tc, ch, mode_a), Ta - 4 * Tb + 3 * Tc)
+        crossed = side(s1) != mode_a
+        theta = s0 / ca.if_else(crossed, s0 - s1, 1)  # the secant, then Newton on the cubic Hermite
+        for _ in range(_NEWTON):
+            t2 = theta * theta
+            t3 = t2 * theta
+            p = (2 * t3 - 3 * t2 + 1) * s0 + (t3 - 2 * t2 + theta) * d0 + (3 * t2 - 2 * t3) * s1 + (t3 - t2) * d1
+            dp = (6 * t2 - 6 * theta) * (s0 - s1) + (3 * t2 - 4 * theta + 1) * d0 + (3 * t2 - 2 * theta) * d1
+            theta = _clamp01(theta - p / ca.if_else(dp == 0, 1, dp))
+        theta = ca.if_else(crossed, theta, 2)  # 2: not crossed in this step
+        first = theta[0]
+        for i in range(1, ns):
+            first = ca.if_else(theta[i] < first, theta[i], first)
+        flip = ca.logic_and(crossed, theta <= first)
+        mode_b = ca.if_else(flip, 1 - mode_a, mode_a)
+        first = ca.if_else(first > 1, 1, first)
+        Tm = table_at(first)
+        y_c, Q_c = _rk4(f_mode(mode_a), J_mode(mode_a), y, Q if with_tangent else None, first * h,
+                        Ta, table_at(first / 2), Tm)
+        return _rk4(f_mode(mode_b), J_mode(mode_b), y_c, Q_c, (1 - first) * h, Tm, table_at((1 + first) / 2), Tc)
+
+    def extremes(yn):
+        obs = ca.vertcat(*[yn[j] for j in sym.observed])
+        return select_min(obs, lo), select_max(obs, hi)
+
+    # with tangent vectors: try, then Switch(keep | split), emitted straight into the caller's MX graph
+    # (a Function around the two calls would copy its inputs once more at every step)
+    yn, Qn, flag = plain(True)
+    tangent_try = ca.Function("tangent_try", [y, Q, col, ch], [yn, Qn, flag], _OPTS)
+    ys, Qs = split_step(True)
+    inputs = [y, Q, lo, hi, y1, Q1, col, ch]
+    keep = ca.Function("tangent_keep", inputs, [y1, Q1, *extremes(y1)], _OPTS)
+    cross = ca.Function("tangent_split", inputs, [ys, Qs, *extremes(ys)], _OPTS)
+    tangent_switch = ca.Function.if_else("tangent_switch", cross, keep)
+
+    def tangent_block(yk, Qk, lk, hk, Tk, c):
+        y_try, Q_try, crossing = tangent_try(yk, Qk, Tk, c)
+        return tangent_switch(crossing, yk, Qk, lk, hk, y_try, Q_try, Tk, c)
+
+    # the state alone: the same stepping (orbit loops and trajectory)
+    yn, _, flag = plain(False)
+    state_try = ca.Function("state_try", [y, col, ch], [yn, flag], _OPTS)
+    ys, _ = split_step(False)
+    inputs = [y, lo, hi, y1, col, ch]
+    keep = ca.Function("state_keep", inputs, [y1, *extremes(y1)], _OPTS)
+    cross = ca.Function("state_split", inputs, [ys, *extremes(ys)], _OPTS)
+    state_switch = ca.Function.if_else("state_switch", cross, keep)
+
+    def state_block(yk, lk, hk, Tk, c):
+        y_try, crossing = state_try(yk, Tk, c)
+        return state_switch(crossing, yk, lk, hk, y_try, Tk, c)
+
+    keep = ca.Function("step_keep", [y, y1, col, ch], [y1], _OPTS)
+    cross = ca.Function("step_split", [y, y1, col, ch], [ys], _OPTS)
+    step_switch = ca.Function.if_else("step_switch", cross, keep)
+    Ym, Ti, Cm = ca.MX.sym("y", n), ca.MX.sym("Ti", 3 * m), ca.MX.sym("c", nc + 1)
+    y_try, crossing = state_try(Ym, Ti, Cm)
+    state_step = ca.Function("state_step", [Ym, Ti, Cm], [step_switch(crossing, Ym, y_try, Ti, Cm)])
+    return tangent_block, state_block, state_step
+
+
+_NEWTON = 4  # Newton iterations on the Hermite cubic from the secant (the error squares at each one)
+
+
+def _clamp01(x):
+    return ca.if_else(x < 0, 0, ca.if_else(x > 1, 1, x))
 
 
 def _gram_schmidt(n: int) -> ca.Function:

@@ -63,6 +63,7 @@ def run_sweep(
     backend: str = "auto",
     on_point: Callable[[dict], None] | None = None,
     scheduler=None,
+    locate_crossings: bool = False,
     **settings,
 ) -> SweepResult:
     """Sweep ``model`` over ``axes`` (``{"omega": values}`` or ``["omega=0.1:2.0:0.01", ...]``).
@@ -80,7 +81,8 @@ def run_sweep(
     processes on this machine for this sweep, ``"tcp://HOST:PORT"`` uses the
     cluster of that scheduler, a ``distributed.Client`` its cluster. The files
     are the same, byte for byte, as long as the workers run the client's library
-    (see :mod:`gearsym.codegen.portable`).
+    (see :mod:`gearsym.codegen.portable`). ``locate_crossings``: split RK4 steps at backlash crossings
+    (see :func:`~gearsym.codegen.compile_model`; ignored for a prebuilt model).
     """
     periods, discard = whole_number(periods, "periods", 1), whole_number(discard, "discard")
     if periods <= discard:
@@ -95,7 +97,7 @@ def run_sweep(
         raise GearsymError(f"--direction {direction} applies to a continuation; independent points have no direction")
     axes = axes_from(axes)
     compiled, values = compiled_and_values(model, settings, steps_per_period=steps_per_period, backend=backend,
-                                           verbose=progress)
+                                           verbose=progress, locate_crossings=locate_crossings)
     for axis in axes:
         if axis.name not in compiled.parameter_names:
             raise UnknownParameterError(axis.name, compiled.parameter_names, f"{compiled.name}: --param")
@@ -121,6 +123,8 @@ def run_sweep(
         "periods": periods, "discard": discard, "steps_per_period": compiled.steps_per_period,
         "initial_state": dict(zip(compiled.state_names, map(float, start))), "poincare_samples": poincare,
     }
+    if compiled.options.locate_crossings:  # (only then: records of earlier sweeps still match)
+        record["locate_crossings"] = True
     run = _Run(compiled, base, names, start, periods, discard, poincare, columns, strobe_columns)
     store = SweepStore(out, columns, strobe_columns, [*names, "direction"], record) if out else None
     try:  # the files stay locked against a second writer until this sweep returns or fails

@@ -1,0 +1,168 @@
+"""Steps split at backlash crossings (``locate_crossings``): 4th order exponents, checked against DOP853.
+
+Plain RK4 with a fixed step is only first order for the exponents of the gear models: the slope of
+the backlash g jumps, so the variational equations have a discontinuous right-hand side and the
+error jumps about with the step count. The order tests use the in-process backend (no compile of
+the 3200-step loops); the DOP853 comparison and the sum rule use the compiled library at 200 steps.
+"""
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+import sympy as sp
+from scipy.integrate import solve_ivp
+
+from gearsym import FirstOrderSystem, ModelError
+from gearsym.backlash import g
+from gearsym.codegen import compile_model
+from gearsym.codegen.functions import LoopOptions, build_functions
+from gearsym.codegen.generate import code_hash, write_code
+from gearsym.registry import REPO_ROOT, system_for
+from gearsym.symbols import parameter_symbol
+
+PERIODS, DISCARD = 80, 30
+STEPS = (100, 200, 400, 800)
+REFERENCE_STEPS = 1600
+
+
+def exponents(model, steps: int, locate: bool, periods: int = PERIODS, discard: int = DISCARD,
+              backend: str = "in-process", **values) -> np.ndarray:
+    cm = compile_model(model, steps_per_period=steps, locate_crossings=locate, backend=backend)
+    inputs = cm.prepare(cm.parameter_vector(values))
+    run = cm.tangent_run(None, periods, inputs)
+    return np.sort(run.log_stretch[:, discard:].mean(axis=1) / inputs.period)[::-1]
+
+
+def errors(model, locate: bool, **values) -> list[float]:
+    reference = exponents(model, REFERENCE_STEPS, locate, **values)
+    return [float(np.abs(exponents(model, n, locate, **values) - reference).max()) for n in STEPS]
+
+
+@pytest.mark.parametrize("model, omega", [("one_stage", 1.5), ("one_stage", 1.8), ("flexible_shaft", 1.8)])
+def test_exponents_converge_at_fourth_order_with_crossings_located(model, omega):
+    located = errors(model, True, omega=omega)
+    ratios = [a / b for a, b in zip(located, located[1:])]
+    assert all(r >= 8 for r in ratios), (located, ratios)  # 4th order: 16 per halving (measured 13-16)
+    assert located[1] < 1e-8, located  # 200 steps per period
+    plain = errors(model, False, omega=omega)
+    assert not all(a / b >= 8 for a, b in zip(plain, plain[1:])), plain  # plain RK4 is not (first order)
+    assert plain[1] > 10 * located[1]
+
+
+def test_time_dependent_switching_surface_converges_at_fourth_order():
+    """A surface that moves with time (g(x - sin(t)/2, eta)): the crossing's slope includes dT/dt."""
+    t, x, v = sp.symbols("t x v", real=True)
+    eta = parameter_symbol("eta")
+    rhs = (v, -(1 + sp.Rational(3, 10) * sp.cos(t)) * g(x - sp.sin(t) / 2, eta) - v / 10 + 2 * sp.cos(t))
+    system = FirstOrderSystem("moving_kink", t, (x, v), rhs, {"eta": 1.0}, 2 * sp.pi, initial={"x": 0.3})
+    reference = exponents(system, 1600, True, periods=40, discard=20)
+    errs = [float(np.abs(exponents(system, n, True, periods=40, discard=20) - reference).max())
+            for n in (100, 200, 400)]
+    assert all(a / b >= 8 for a, b in zip(errs, errs[1:])), errs
+
+
+# ---------------------------------------------------------------- an independent reference: DOP853
+ZETA, B0, B1, THETA, ETA, K_A = 0.08, 1.0, 4.0, 0.0, 10.0, 0.2
+HARMONICS = ((1, 1.18003861468), (2, -0.336894506314), (3, -0.195632837787), (4, 0.192724343884),
+             (6, -0.0605674179821), (7, 0.0148837545288))
+
+
+def dop853_exponents(omega: float, periods: int, discard: int) -> np.ndarray:
+    """The one-stage model (Eq. 2) and its variational equations typed in NumPy, DOP853 at 1e-11,
+    modified Gram-Schmidt every period."""
+
+    def f(tau, u):
+        x, v = u[0], u[1]
+        k = 1 + K_A * sum(c * np.cos(j * tau) for j, c in HARMONICS)
+        gx = x if x >= 0 else (x + ETA if x <= -ETA else 0.0)
+        slope = 1.0 if (x >= 0 or x <= -ETA) else 0.0
+        a = -2 * ZETA / omega * v + (B0 + B1 * np.cos(tau + THETA)) / omega**2 - k * gx / omega**2
+        J = np.array([[0.0, 1.0], [-k * slope / omega**2, -2 * ZETA / omega]])
+        return np.concatenate(([v, a], (J @ u[2:].reshape(2, 2)).ravel()))
+
+    period, y, Q, logs = 2 * np.pi, np.array([-2.0, -0.5]), np.eye(2), []
+    for k in range(periods):
+        sol = solve_ivp(f, (k * period, (k + 1) * period), np.concatenate((y, Q.ravel())), method="DOP853",
+                        rtol=1e-11, atol=1e-11)
+        u = sol.y[:, -1]
+        y, M = u[:2], u[2:].reshape(2, 2)
+        q1 = M[:, 0] / np.linalg.norm(M[:, 0])
+        w = M[:, 1] - (q1 @ M[:, 1]) * q1
+        logs.append([np.log(np.linalg.norm(M[:, 0])), np.log(np.linalg.norm(w))])
+        Q = np.column_stack((q1, w / np.linalg.norm(w)))
+    return np.sort(np.mean(logs[discard:], axis=0) / period)[::-1]
+
+
+@pytest.fixture(scope="module")
+def at_200_steps():
+    """one_stage at omega = 1.5 (a periodic orbit), 200 steps per period: plain, and located (compiled)."""
+    return {locate: exponents("one_stage", 200, locate, periods=60, discard=20,
+                              backend="auto" if locate else "in-process", omega=1.5)
+            for locate in (False, True)}
+
+
+def test_agrees_with_dop853_where_plain_rk4_does_not(at_200_steps):
+    reference = dop853_exponents(1.5, 60, 20)
+    located = np.abs(at_200_steps[True] - reference).max()
+    plain = np.abs(at_200_steps[False] - reference).max()
+    assert located <= 1e-6, located  # measured 4.5e-9
+    assert plain >= 1e-4, plain  # measured 1.0e-3
+
+
+def test_sum_rule_holds_with_crossings_located(at_200_steps):
+    assert abs(at_200_steps[True].sum() + 2 * ZETA / 1.5) < 1e-9  # trace of J = -2 zeta / omega
+
+
+def test_compiled_and_in_process_agree_and_every_loop_steps_the_same_way():
+    compiled = compile_model("one_stage", locate_crossings=True, backend="auto")
+    in_process = compile_model("one_stage", locate_crossings=True, backend="in-process")
+    runs = []
+    for cm in (compiled, in_process):
+        inputs = cm.prepare(cm.parameter_vector(omega=1.5))
+        tangent = cm.tangent_run(None, 12, inputs)
+        strobe, low, high = cm.orbit_run(None, 12, inputs)
+        _, states = cm.trajectory(None, 12, inputs)
+        np.testing.assert_array_equal(strobe, tangent.strobe)  # orbit loops split the same steps
+        np.testing.assert_array_equal(low, tangent.low)
+        np.testing.assert_array_equal(states[:, 200::200], strobe)  # and so does the trajectory
+        runs.append(tangent)
+    np.testing.assert_allclose(runs[0].log_stretch, runs[1].log_stretch, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(runs[0].strobe, runs[1].strobe, rtol=0, atol=1e-12)
+
+
+# ---------------------------------------------------------------- the option off, and what it does not handle
+def test_option_off_generates_the_committed_c_unchanged(tmp_path):
+    """locate_crossings=False (the default) adds nothing to the C: the loops are those of generated/."""
+    system = system_for("one_stage")
+    options = LoopOptions()
+    assert options == LoopOptions(locate_crossings=False)
+    fresh = write_code(build_functions(system, options), tmp_path, code_hash(system, options))
+    assert fresh.source.read_bytes() == (REPO_ROOT / "generated" / "one_stage" / "one_stage.c").read_bytes()
+    plain = compile_model("one_stage", backend="in-process")
+    assert plain.hash == compile_model("one_stage", locate_crossings=False, backend="in-process").hash
+    assert plain.options == options
+
+
+def test_split_runs_behind_a_real_branch_in_the_c(tmp_path):
+    system = system_for("one_stage")
+    options = LoopOptions(locate_crossings=True)
+    code = write_code(build_functions(system, options), tmp_path, code_hash(system, options))
+    text = code.source.read_text()
+    switch = re.search(r"/\* tangent_switch:.*?\n}\n", text, re.S).group(0)
+    assert re.search(r"\bif \(", switch) and "else" in switch
+
+
+def test_a_model_without_backlash_is_unchanged_and_other_switches_are_refused(tmp_path):
+    lorenz = system_for("lorenz")
+    texts = []
+    for locate in (False, True):
+        options = LoopOptions(locate_crossings=locate)
+        code = write_code(build_functions(lorenz, options), tmp_path / str(locate), code_hash(lorenz, options))
+        texts.append(code.source.read_bytes())
+    assert texts[0] == texts[1]
+    kinked = FirstOrderSystem.from_equations("abs_spring", ["x", "v"], ["v", "-Abs(x) - v/10 + cos(t)"], {},
+                                             time="t", period="2*pi")
+    with pytest.raises(ModelError, match="locates the backlash g"):
+        build_functions(kinked, LoopOptions(locate_crossings=True))
