@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import sympy as sp
 
@@ -97,7 +98,7 @@ class FirstOrderSystem:
                 raise UnknownParameterError(k, self.parameters, self.name)
         return replace(self, parameters={**self.parameters, **{k: float(v) for k, v in values.items()}})
 
-    @property
+    @cached_property  # asked at every point of a sweep; a walk over the SymPy trees each time
     def autonomous(self) -> bool:
         """True if time does not appear in the right-hand side (Lorenz); then one Lyapunov exponent is zero."""
         return all(self.time not in f.free_symbols for f in self.rhs)

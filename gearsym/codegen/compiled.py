@@ -84,11 +84,11 @@ class CompiledModel:
     def dimension(self) -> int:
         return self.system.dimension
 
-    @property
+    @cached_property  # read for every row a sweep writes
     def state_names(self) -> tuple[str, ...]:
         return tuple(s.name for s in self.system.states)
 
-    @property
+    @cached_property
     def observed(self) -> tuple[str, ...]:
         return tuple(s for s in self.state_names if s in self.system.observed)
 

@@ -226,8 +226,9 @@ class _Run:
         row["regime"] = spectrum.regime
         row.update({f"final_{s}": number(v) for s, v in spectrum.final_state.items()})
         strobe = spectrum.strobe[:, spectrum.strobe.shape[1] - self.poincare:] if self.poincare else np.zeros((n, 0))
-        strobe_rows = [{**{k: row[k] for k in (*self.names, "direction")}, "sample": str(j),
-                        **{s: number(v) for s, v in zip(compiled.state_names, col)}}
+        where = {k: row[k] for k in (*self.names, "direction")}
+        states = compiled.state_names
+        strobe_rows = [{**where, "sample": str(j), **dict(zip(states, map(number, col.tolist())))}
                        for j, col in enumerate(strobe.T)]
         final = np.array([spectrum.final_state[s] for s in compiled.state_names])
         return row, strobe_rows, final
