@@ -16,7 +16,7 @@ from pathlib import Path
 
 from . import compile_time, points, profile, reference, scaling, sweep
 from .machine import REPO, machine_info
-from .summary import summarise, summarise_model
+from .summary import CROSSINGS, summarise, summarise_model
 
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
@@ -25,7 +25,8 @@ MODELS = ("one_stage", "flexible_shaft")
 OMEGAS = (0.9, 1.2, 1.5, 1.8)
 C_FLAGS = (("-O3",), ("-O3", "-march=native"), ("-O3", "-march=native", "-mprefer-vector-width=128"))
 PRECISION_STEPS = (800, 3200)  # besides 200, timed with the rest
-PRECISION_TOLERANCES = (1e-4, 1e-6, 1e-8, 1e-10)
+CROSSING_STEPS = (100, 400)  # fourth order: coarser steps already reach the adaptive tools' accuracy
+PRECISION_TOLERANCES = (1e-4, 1e-6, 1e-8, 1e-10, 1e-11)
 DEFAULT_OUT = REPO / "bench" / "results" / "speed.json"
 
 
@@ -55,6 +56,7 @@ def run_model(model: str, args, log=log) -> dict:
 
     makers = {
         "gearsym": lambda acc: gearsym_tool.make(model, acc, **params),
+        CROSSINGS: lambda acc: gearsym_tool.make(model, acc, crossings=True, **params),
         "C": lambda acc: c_yardstick.make(model, acc, **params),  # the fastest build (see c_yardstick)
         "Numba RK4": lambda acc: numba_rk4.make(model, acc, **params),
         "JiTCODE": lambda acc: jitcode_lyap.make(model, acc, **params),
@@ -66,6 +68,7 @@ def run_model(model: str, args, log=log) -> dict:
     for flags in C_FLAGS:
         fixed["C " + " ".join(flags)] = c_yardstick.make(model, {"steps": steps}, flags=flags, **params)
     fixed["Numba RK4"] = makers["Numba RK4"]({"steps": steps})
+    fixed[CROSSINGS] = makers[CROSSINGS]({"steps": steps})
     for label, tool in fixed.items():
         log(f"  setup {label}: {tool.setup_seconds:.2f} s ({tool.setup_note})")
 
@@ -84,14 +87,16 @@ def run_model(model: str, args, log=log) -> dict:
 
     # work against precision: the fixed-step tools at finer steps, the adaptive ones along a tolerance ladder
     raw["precision_base"] = {"gearsym": "gearsym", "C": "C " + " ".join(c_yardstick.DEFAULT_FLAGS),
-                             "Numba RK4": "Numba RK4"}
+                             "Numba RK4": "Numba RK4", CROSSINGS: CROSSINGS}
     raw["precision"] = {}
     ladders = {"steps": PRECISION_STEPS[:1] if args.quick else PRECISION_STEPS,
+               "crossings": CROSSING_STEPS[:1] if args.quick else CROSSING_STEPS,
                "tol": PRECISION_TOLERANCES[1:3] if args.quick else PRECISION_TOLERANCES}
     for name, make in makers.items():
         adaptive = name in ("JiTCODE", "SciPy RK45")
+        steps_ladder = ladders["crossings"] if name == CROSSINGS else ladders["steps"]
         settings = [(f"{x:.0e}", tol(x)) for x in ladders["tol"]] if adaptive else \
-            [(str(x), {"steps": x}) for x in ladders["steps"]]
+            [(str(x), {"steps": x}) for x in steps_ladder]
         raw["precision"][name] = {}
         for key, acc in settings:
             t = time.perf_counter()
@@ -104,7 +109,7 @@ def run_model(model: str, args, log=log) -> dict:
         log(f"  191-point continuation sweep{' (every 10th point)' if args.quick else ''}, "
             f"{args.repeats} interleaved repetitions of the fixed-step tools")
         raw["sweep"] = sweep.time_sweeps(fixed, y0, P, D, args.repeats, every=every, log=log)
-        equal = summarise_model(raw, zeta)["equal_accuracy"]
+        equal = summarise_model(raw, zeta)["equal_accuracy"]["gearsym"]  # like for like with the sweep's gearsym
         for name in ("JiTCODE", "SciPy RK45"):
             tool_every = max(every, args.scipy_every) if name == "SciPy RK45" else every
             t = time.perf_counter()

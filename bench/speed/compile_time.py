@@ -6,7 +6,8 @@ committed ``generated/`` source when its hash matches, so the C is not even
 regenerated), the second must find the library and compile nothing. The
 times are gearsym's own (``CompiledModel.timings``): ``symbolic`` (loading and
 reducing the model), ``build``/``generate`` (CasADi functions and C, only if the
-committed C did not match) and ``compile`` (the C compiler).
+committed C did not match) and ``compile`` (the C compiler). A third process
+loads the model with ``locate_crossings`` (new C, generated and compiled).
 """
 from __future__ import annotations
 
@@ -20,14 +21,15 @@ import time
 from .machine import REPO
 
 _PROBE = ("import json, sys; from gearsym.codegen import compile_model; "
-          "cm = compile_model(sys.argv[1], backend='compiled'); "
+          "cm = compile_model(sys.argv[1], backend='compiled', locate_crossings=sys.argv[2] == 'on'); "
           "print(json.dumps({'timings': cm.timings, 'library': str(cm.library)}))")
 
 
-def _load(model: str, cache: str) -> dict:
+def _load(model: str, cache: str, crossings: bool = False) -> dict:
     env = {**os.environ, "GEARSYM_CACHE": cache}
     t = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-c", _PROBE, model], capture_output=True, text=True, env=env, cwd=REPO)
+    proc = subprocess.run([sys.executable, "-c", _PROBE, model, "on" if crossings else "off"], capture_output=True,
+                          text=True, env=env, cwd=REPO)
     wall = time.perf_counter() - t
     if proc.returncode != 0:
         raise RuntimeError(f"loading {model} failed:\n{proc.stderr[-2000:]}")
@@ -46,5 +48,6 @@ def measure(models: list[str]) -> dict:
                 "second": second["timings"], "second_process_seconds": second["process_seconds"],
                 "recompiled": "compile" in second["timings"],
                 "same_library": first["library"] == second["library"],
+                "crossings": _load(model, cache, crossings=True)["timings"],
             }
     return out

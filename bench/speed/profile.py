@@ -49,8 +49,8 @@ def measure(models, c_flags: dict, periods: int = 400, omega: float = 1.5, repea
         select = c_yardstick.make("one_stage", {"steps": STEPS}, flags=(*flags, "-DBACKLASH_SELECT"))
         times: dict[str, list[float]] = {"branch": [], "select": []}
         for _ in range(repeats):
-            times["branch"].append(branch.spectrum(omega, None, periods, 100).seconds)
-            times["select"].append(select.spectrum(omega, None, periods, 100).seconds)
+            times["branch"].append(branch.spectrum(omega, None, periods, periods // 4).seconds)
+            times["select"].append(select.spectrum(omega, None, periods, periods // 4).seconds)
         b, s = statistics.median(times["branch"]), statistics.median(times["select"])
         out["backlash_select"] = {"branch_ms": b * 1e3, "select_ms": s * 1e3, "ratio": s / b, "flags": list(flags)}
         log(f"    one_stage C, backlash as selects / as branches: {s / b:.2f}")

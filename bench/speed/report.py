@@ -68,9 +68,9 @@ def _precision_table(s: dict) -> list[str]:
     lines = ["| tool | setting | ms per point | × gearsym (200 steps) | error, periodic points | "
              "error, chaotic points | setup (s) |", "|---|---|---|---|---|---|---|"]
     for tool, rows in s["precision"].items():
-        pick = s["equal_accuracy"].get(tool, {}).get("setting")
+        picks = {base: eq[tool]["setting"] for base, eq in s["equal_accuracy"].items() if tool in eq}
         for r in rows:
-            mark = " ← equal accuracy" if r["setting"] == pick else ""
+            mark = "".join(f" ← as accurate as {base}" for base, setting in picks.items() if setting == r["setting"])
             lines.append(f"| {tool} | {_accuracy(r['accuracy'])}{mark} | {_ms(r['per_point'])} | "
                          f"{_x(r['vs_gearsym'])} | {_e(r['errors']['periodic'])} | {_e(r['errors']['chaotic'])} | "
                          f"{r['setup_seconds']:.2f} ({r['setup_note']}) |")
@@ -129,13 +129,14 @@ def _compile_table(raw: dict) -> list[str]:
     comp = raw.get("compile")
     if not comp:
         return ["(not run)"]
-    lines = ["| model | symbolic (s) | C generated (s) | C compiled (s) | second load (s) | compiled again |",
-             "|---|---|---|---|---|---|"]
+    lines = ["| model | symbolic (s) | C generated (s) | C compiled (s) | second load (s) | compiled again "
+             "| with crossings located: generated + compiled (s) |", "|---|---|---|---|---|---|---|"]
     for model, c in comp.items():
-        f = c["first"]
+        f, x = c["first"], c.get("crossings", {})
         gen = f.get("build", 0.0) + f.get("generate", 0.0)
         lines.append(f"| {model} | {f.get('symbolic', 0.0):.2f} | {gen:.2f} | {f.get('compile', 0.0):.2f} | "
-                     f"{c['second_process_seconds']:.2f} | {'**yes**' if c['recompiled'] else 'no'} |")
+                     f"{c['second_process_seconds']:.2f} | {'**yes**' if c['recompiled'] else 'no'} | "
+                     f"{x.get('build', 0.0) + x.get('generate', 0.0):.2f} + {x.get('compile', 0.0):.2f} |")
     return lines
 
 
@@ -268,7 +269,7 @@ def figure(raw: dict, path: Path) -> Path:
     c_label = "C (fastest build)"
     labels: list[str] = []
     for s in summary["models"].values():
-        for label in [*s["tools"], *s["equal_accuracy"]]:
+        for label in [*s["tools"], *s["equal_accuracy"]["gearsym"]]:
             label = c_label if label == s["c_reference"] else label
             if label not in labels and not label.startswith("C "):
                 labels.append(label)
@@ -278,7 +279,7 @@ def figure(raw: dict, path: Path) -> Path:
         for label in labels:
             key = s["c_reference"] if label == c_label else label
             values.append(s["tools"][key]["vs_c"] if key in s["tools"] else
-                          s["equal_accuracy"].get(key, {}).get("vs_c", float("nan")))
+                          s["equal_accuracy"]["gearsym"].get(key, {}).get("vs_c", float("nan")))
         xs = [j + (i - (len(models) - 1) / 2) * width for j in range(len(labels))]
         ax.bar(xs, values, width, label=model)
     ax.set_yscale("log")

@@ -27,6 +27,8 @@ TARGETS = {
     "compile_seconds": 10.0,  # per model, at most
 }
 GEARSYM = "gearsym"
+CROSSINGS = "gearsym (crossings located)"  # the opt-in step that splits RK4 steps at the backlash kinks
+BASES = (GEARSYM, CROSSINGS)  # the gearsym runs the adaptive tools are matched against, when present
 ADAPTIVE = ("JiTCODE", "SciPy RK45")
 
 
@@ -74,8 +76,18 @@ def summarise_model(raw: dict, zeta: float) -> dict:
         if base:
             rows.insert(0, dict(tools[base], setting="200"))
         precision[tool] = rows
-    target = tools[GEARSYM]["errors"]["periodic"]
-    equal = {}
+    equal = {base: _equal_accuracy(precision, tools[base]) for base in BASES if base in tools}
+    periodic = [ref["omega"] for ref in reference.values() if ref["converged"]]
+    return {"c_reference": c_ref, "gearsym_error": tools[GEARSYM]["errors"]["periodic"], "tools": tools,
+            "precision": precision,
+            "equal_accuracy": equal, "periodic_omegas": periodic,
+            "chaotic_omegas": [ref["omega"] for ref in reference.values() if not ref["converged"]],
+            "sweep": summarise_sweep(raw.get("sweep", {}))}
+
+
+def _equal_accuracy(precision: dict, base: dict) -> dict:
+    """Each adaptive tool at the loosest tolerance at least as accurate as ``base``, timed against it."""
+    target, out = base["errors"]["periodic"], {}
     for tool in ADAPTIVE:
         rows = precision.get(tool)
         if not rows:
@@ -83,13 +95,10 @@ def summarise_model(raw: dict, zeta: float) -> dict:
         good = [r for r in rows if target is None or (r["errors"]["periodic"] or 0.0) <= target]
         pick = max(good, key=lambda r: r["errors"]["periodic"] or 0.0) if good else \
             min(rows, key=lambda r: r["errors"]["periodic"] or 0.0)
-        equal[tool] = {"setting": pick["setting"], "reached": bool(good), "vs_gearsym": pick["vs_gearsym"],
-                       "vs_c": pick["vs_c"], "error": pick["errors"]["periodic"], "per_point": pick["per_point"]}
-    periodic = [ref["omega"] for ref in reference.values() if ref["converged"]]
-    return {"c_reference": c_ref, "gearsym_error": target, "tools": tools, "precision": precision,
-            "equal_accuracy": equal, "periodic_omegas": periodic,
-            "chaotic_omegas": [ref["omega"] for ref in reference.values() if not ref["converged"]],
-            "sweep": summarise_sweep(raw.get("sweep", {}))}
+        out[tool] = {"setting": pick["setting"], "reached": bool(good), "error": pick["errors"]["periodic"],
+                     "per_point": pick["per_point"], "vs_c": pick["vs_c"],
+                     "vs_gearsym": pick["seconds"] / base["seconds"], "gearsym_error": target}
+    return out
 
 
 def summarise_sweep(sweep: dict) -> dict:
@@ -139,11 +148,14 @@ def verdicts(models: dict, scaling: dict, compile_times: dict) -> list[dict]:
         if sweep:
             rows.append({"what": f"gearsym / hand-written C, 191-point sweep, {model}", "value": sweep["vs_c"],
                          "target": f"<= {TARGETS['gearsym_vs_c']}", "met": sweep["vs_c"] <= TARGETS["gearsym_vs_c"]})
-        for tool, key in zip(ADAPTIVE, ("jitcode_ratio", "scipy_ratio")):
-            eq = s["equal_accuracy"].get(tool)
-            if eq:
-                rows.append({"what": f"{tool} / gearsym at equal accuracy, {model}", "value": eq["vs_gearsym"],
-                             "target": f">= {TARGETS[key]:g}", "met": eq["vs_gearsym"] >= TARGETS[key]})
+        for base, scheme in ((GEARSYM, "the paper's RK4"), (CROSSINGS, "crossings located")):
+            for tool, key in zip(ADAPTIVE, ("jitcode_ratio", "scipy_ratio")):
+                eq = s["equal_accuracy"].get(base, {}).get(tool)
+                if eq:
+                    bound = "" if eq["reached"] else " (no tolerance reached it: a lower bound)"
+                    rows.append({"what": f"{tool} / gearsym ({scheme}) at equal accuracy, {model}{bound}",
+                                 "value": eq["vs_gearsym"], "target": f">= {TARGETS[key]:g}",
+                                 "met": eq["vs_gearsym"] >= TARGETS[key]})
     ind = scaling.get("independent")
     if ind:
         label = [k for k in ind if k.endswith("threads")][0]
@@ -151,8 +163,9 @@ def verdicts(models: dict, scaling: dict, compile_times: dict) -> list[dict]:
                      "target": f">= {TARGETS['threads_speedup']}",
                      "met": ind[label]["speedup"] >= TARGETS["threads_speedup"]})
     if compile_times:
-        worst = max(c["first"].get("compile", 0.0) for c in compile_times.values())
-        rows.append({"what": "C compile time, slowest model (s)", "value": worst,
+        worst = max(max(c["first"].get("compile", 0.0), c.get("crossings", {}).get("compile", 0.0))
+                    for c in compile_times.values())
+        rows.append({"what": "C compile time, slowest model, either scheme (s)", "value": worst,
                      "target": f"<= {TARGETS['compile_seconds']:g}", "met": worst <= TARGETS["compile_seconds"]})
         again = sum(c["recompiled"] for c in compile_times.values())
         rows.append({"what": "models compiled again when unchanged", "value": again, "target": "0",
