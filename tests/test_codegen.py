@@ -318,9 +318,11 @@ def _period_run(options, monkeypatch=None, segment=None):
     return mf, np.array(out)
 
 
-@pytest.mark.parametrize("steps", [400, 450])  # whole segments; and a remainder segment
+@pytest.mark.parametrize("steps", [400, 410])  # whole segments; and a remainder segment
 def test_long_periods_run_in_segments_with_the_same_bits(monkeypatch, steps):
-    from gearsym.codegen.functions import LoopOptions
+    from gearsym.codegen.functions import SEGMENT_STEPS, LoopOptions
+
+    assert SEGMENT_STEPS == 50
 
     options = LoopOptions(steps_per_period=steps, chunk_periods=1)
     segmented, a = _period_run(options)
@@ -329,8 +331,8 @@ def test_long_periods_run_in_segments_with_the_same_bits(monkeypatch, steps):
     period = segmented.functions["lyapunov_period"]
     names = {period.instruction_MX(i).which_function().name() for i in range(period.n_instructions())
              if period.instruction_id(i) == ca.OP_CALL}
-    assert "tangent_segment_200" in names
-    assert ("tangent_segment_50" in names) == (steps == 450)
+    assert "tangent_segment_50" in names
+    assert ("tangent_segment_10" in names) == (steps == 410)
 
 
 def test_generated_code_size_does_not_grow_with_the_steps_per_period(tmp_path):
@@ -343,4 +345,6 @@ def test_generated_code_size_does_not_grow_with_the_steps_per_period(tmp_path):
         options = LoopOptions(steps_per_period=steps)
         write_code(build_functions(system, options), tmp_path / str(steps), code_hash(system, options))
         sizes[steps] = (tmp_path / str(steps) / "one_stage.c").stat().st_size
-    assert sizes[3200] < 1.5 * sizes[200], sizes  # written out, 3200 steps were 16x the code (24 s of gcc)
+    # written out, 3200 steps were 16x the code (24 s of gcc); what still grows is data (the 2N+1 sample
+    # times of the table function) and a few dozen segment calls
+    assert sizes[3200] < 2 * sizes[200], sizes

@@ -151,16 +151,17 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
 
 _OPTS = {"cse": True}
 
-#: RK4 steps written out in one function. A period of more steps calls such a segment repeatedly, so the
-#: C (and its compile time) stays the size of a 200-step period whatever ``steps_per_period`` is (3200 steps
-#: written out took 24 s to compile). The default period is one segment: its C is what it always was.
-SEGMENT_STEPS = 200
+#: RK4 steps written out in one function. A longer period calls such a segment repeatedly, so the C (and its
+#: compile time) stays the same size whatever ``steps_per_period`` is: 3200 steps written out took 24 s to
+#: compile. 50 rather than 200: the same speed and the same bits (measured), 2.4x less C.
+SEGMENT_STEPS = 50
 
 
-def _over_period(block, carry: list, T: ca.MX, C: ca.MX, K: int, name: str) -> list:
+def _over_period(block, carry: list, T: ca.MX, C: ca.MX, K: int, name: str, group: int = 0) -> list:
     """``block(*carry, T[:, K columns], C)`` applied along all columns of the table ``T``: written out up to
-    SEGMENT_STEPS steps, beyond that through segment functions (full ones, then one for the rest)."""
-    blocks, per = T.size2() // K, max(1, SEGMENT_STEPS // K)
+    ``group`` blocks (SEGMENT_STEPS steps), beyond that through segment functions of that many blocks (and
+    one for the rest), which are themselves grouped the same way: the code grows with log(steps)."""
+    blocks, per = T.size2() // K, group or max(2, SEGMENT_STEPS // K)
     if blocks <= per:
         for b in range(blocks):
             carry = list(block(*carry, T[:, b * K:(b + 1) * K], C))
@@ -170,11 +171,10 @@ def _over_period(block, carry: list, T: ca.MX, C: ca.MX, K: int, name: str) -> l
         args = [ca.MX.sym(f"x{i}", c.sparsity()) for i, c in enumerate(carry)]
         Ts, Cs = ca.MX.sym("T", T.size1(), count * K), ca.MX.sym("c", C.sparsity())
         return ca.Function(f"{name}_segment_{count * K}", [*args, Ts, Cs],
-                           _over_period(block, args, Ts, Cs, K, name))
+                           _over_period(block, args, Ts, Cs, K, name, per))
 
-    full, (whole, rest) = segment(per), divmod(blocks, per)
-    for i in range(whole):
-        carry = list(full(*carry, T[:, i * per * K:(i + 1) * per * K], C))
+    whole, rest = divmod(blocks, per)
+    carry = _over_period(segment(per), carry, T[:, :whole * per * K], C, per * K, name, per)
     if rest:
         carry = list(segment(rest)(*carry, T[:, whole * per * K:], C))
     return carry
