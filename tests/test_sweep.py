@@ -114,11 +114,25 @@ def test_an_interrupted_sweep_resumes_to_the_same_files(tmp_path, one_stage, mod
     assert len(again) == 10  # complete: nothing left to run, nothing recomputed
 
 
-def test_threads_do_not_change_a_single_bit(tmp_path, one_stage):
+@pytest.mark.parametrize("parallel", ["threads", "processes"])
+def test_threads_and_processes_do_not_change_a_single_bit(tmp_path, one_stage, parallel):
     axes = ["omega=0.9:1.4:0.1", "B1=3.5,4"]
     for jobs in (1, 2):
-        run_sweep(one_stage, axes, mode="independent", jobs=jobs, out=tmp_path / f"j{jobs}.csv", **SHORT)
-    assert (tmp_path / "j1.csv").read_bytes() == (tmp_path / "j2.csv").read_bytes()
+        run_sweep(one_stage, axes, mode="independent", jobs=jobs, out=tmp_path / f"j{jobs}.csv", parallel=parallel,
+                  **SHORT)
+    for name in ("j{}.csv", "j{}.poincare.csv"):
+        assert (tmp_path / name.format(1)).read_bytes() == (tmp_path / name.format(2)).read_bytes()
+
+
+def test_an_error_in_a_worker_process_names_the_point():
+    with pytest.raises(GearsymError, match=r"at sigma=1000 \(independent\): .*non-finite"):  # the orbit diverges
+        run_sweep("lorenz", ["sigma=10,1000"], mode="independent", jobs=2, parallel="processes", periods=10,
+                  discard=2, progress=False)
+
+
+def test_an_unknown_way_to_run_in_parallel_is_refused(one_stage):
+    with pytest.raises(GearsymError, match="parallel='gpu'.*processes, threads"):
+        run_sweep(one_stage, ["omega=1.1,1.2"], parallel="gpu", **SHORT)
 
 
 def test_resuming_with_other_options_says_what_differs(tmp_path, one_stage):
@@ -166,10 +180,12 @@ def test_the_record_lists_the_jumps_and_hysteresis_found(tmp_path, one_stage):
     assert record["hysteresis"] and all(h["from"] <= h["to"] for h in record["hysteresis"])
 
 
-def test_continuation_lines_on_threads_do_not_change_a_single_bit(tmp_path, one_stage):
+@pytest.mark.parametrize("parallel", ["threads", "processes"])
+def test_continuation_lines_in_parallel_do_not_change_a_single_bit(tmp_path, one_stage, parallel):
     axes = ["omega=0.9:1.3:0.1", "B1=3.5,4"]
     for jobs in (1, 2):
-        run_sweep(one_stage, axes, direction="both", jobs=jobs, out=tmp_path / f"c{jobs}.csv", **SHORT)
+        run_sweep(one_stage, axes, direction="both", jobs=jobs, out=tmp_path / f"c{jobs}.csv", parallel=parallel,
+                  **SHORT)
     assert (tmp_path / "c1.csv").read_bytes() == (tmp_path / "c2.csv").read_bytes()
 
 

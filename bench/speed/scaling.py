@@ -6,7 +6,8 @@ Workloads (flexible-shaft model, 400 periods, 100 discarded):
 * ``map``: a 2-D map omega = 0.1:2.0:0.02 x kS in {0, 0.05, 0.1, 1.0}, independent points;
 * ``lines``: the same map as four continuation lines (one task per kS).
 
-Each runs through :func:`gearsym.sweep.run_sweep` on a prebuilt compiled model,
+Each runs through :func:`gearsym.sweep.run_sweep` on a prebuilt compiled model
+(1 thread; every core as threads; every core as forked processes, the default),
 interleaved over repetitions; the results of every configuration are compared
 with the single-thread run bit for bit (repr of every number in every row).
 The Dask cluster is started once, outside the timings; its start-up is reported.
@@ -36,7 +37,9 @@ def measure(compiled, periods: int, discard: int, repeats: int, dask: bool = Tru
     from gearsym.sweep import run_sweep
 
     cores = os.cpu_count() or 1
-    configs: dict[str, dict] = {"1 thread": {"jobs": 1}, f"{cores} threads": {"jobs": cores}}
+    configs: dict[str, dict] = {"1 thread": {"jobs": 1},
+                                f"{cores} threads": {"jobs": cores, "parallel": "threads"},
+                                f"{cores} processes": {"jobs": cores, "parallel": "processes"}}  # the default
     out: dict = {"cores": cores, "periods": periods, "discard": discard, "workloads": {}}
     stack = contextlib.ExitStack()
     if dask:

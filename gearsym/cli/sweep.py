@@ -7,7 +7,7 @@ from collections import Counter
 from pathlib import Path
 
 from ..codegen import BACKENDS
-from ..sweep import DIRECTIONS, MODES, POINCARE_SAMPLES, run_sweep
+from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, run_sweep
 from .settings import add_set_argument, parse_settings, parse_state
 
 NAME = "sweep"
@@ -33,7 +33,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="split RK4 steps where the backlash switches (4th order exponents; see docs/engine.md)")
     parser.add_argument("--y0", metavar="x=-2,v=-0.5", help="initial state (default: the model's)")
     parser.add_argument("--jobs", type=int, default=0,
-                        help="threads (default 0: every core); with --dask, worker processes")
+                        help="processes or threads (default 0: every core); with --dask, worker processes")
+    parser.add_argument("--parallel", choices=PARALLEL, default="auto",
+                        help="how --jobs run on this machine: forked processes (auto, where the OS can fork) "
+                             "or threads")
     cluster = parser.add_mutually_exclusive_group()
     cluster.add_argument("--dask", action="store_true",
                          help='run the points on a Dask cluster of --jobs processes started on this machine for '
@@ -59,7 +62,8 @@ def run(args: argparse.Namespace) -> int:
                            discard=args.discard, steps_per_period=args.steps_per_period, y0=parse_state(args.y0),
                            jobs=args.jobs, out=args.out, overwrite=args.overwrite, poincare=args.poincare,
                            progress=not args.quiet, backend=args.backend, locate_crossings=args.locate_crossings,
-                           scheduler="local" if args.dask else args.scheduler, **parse_settings(args.set))
+                           scheduler="local" if args.dask else args.scheduler, parallel=args.parallel,
+                           **parse_settings(args.set))
     except KeyboardInterrupt as exc:  # SweepInterrupted says how many points were kept
         print(f"gearsym: {exc}" if str(exc) else "gearsym: interrupted before any point was finished",
               file=sys.stderr)

@@ -2,18 +2,21 @@
 
 The model is compiled once; every point only changes the parameter vector
 (the low-level call of :func:`~gearsym.analysis.lyapunov_spectrum`). Tasks
-(single points, or whole continuation lines) run on ``jobs`` threads, each with
-its own clone of the compiled model: the native loops release the GIL, so the
-threads use all cores without a process per core paying the symbolic
-reduction again. Threads hand finished points to the main thread, which alone
-writes the files and moves the progress bar. With ``scheduler`` the tasks run
-on a Dask cluster instead (:mod:`gearsym.sweep.distributed`); the main thread
-still writes everything.
+(single points, or whole continuation lines) run on ``jobs`` workers, each with
+its own clone of the compiled model: processes forked from this one where the
+OS can fork (they inherit the loaded model, so nothing is rebuilt, and they do
+not share Python's lock), else threads (the native loops release the GIL).
+Workers hand finished points to the main process, which alone writes the files
+and moves the progress bar. With ``scheduler`` the tasks run on a Dask cluster
+instead (:mod:`gearsym.sweep.distributed`); the main process still writes
+everything.
 """
 from __future__ import annotations
 
+import multiprocessing
 import os
 import queue
+import signal
 import sys
 import threading
 import time
@@ -34,6 +37,8 @@ from .store import SweepStore, number, row_key
 
 #: stroboscopic samples kept per point for bifurcation diagrams
 POINCARE_SAMPLES = 50
+#: ways to use more than one core of this machine (``run_sweep(parallel=...)``)
+PARALLEL = ("auto", "processes", "threads")
 
 
 class SweepInterrupted(KeyboardInterrupt):
@@ -64,6 +69,7 @@ def run_sweep(
     on_point: Callable[[dict], None] | None = None,
     scheduler=None,
     locate_crossings: bool = False,
+    parallel: str = "auto",
     **settings,
 ) -> SweepResult:
     """Sweep ``model`` over ``axes`` (``{"omega": values}`` or ``["omega=0.1:2.0:0.01", ...]``).
@@ -76,6 +82,10 @@ def run_sweep(
     core). ``on_point(row)`` is called in the main thread after each point is
     stored. ``settings`` fix other parameters (or a stiffness formula) for
     the whole sweep. ``model`` may also be a prebuilt :class:`CompiledModel`.
+    ``parallel``: how ``jobs`` > 1 run on this machine: ``"processes"`` (forked
+    from this one, so nothing is rebuilt; no lock shared between them, so the
+    Python around each point does not serialise them), ``"threads"``, or
+    ``"auto"``: processes where the OS can fork (Linux, macOS), else threads.
     ``scheduler``: run the points on Dask (the ``distributed`` extra) instead of
     threads: ``"local"`` starts a cluster of ``jobs`` single-threaded worker
     processes on this machine for this sweep, ``"tcp://HOST:PORT"`` uses the
@@ -93,6 +103,10 @@ def run_sweep(
 
         check_scheduler(scheduler, whole_number(jobs, "jobs"))  # no Dask, a bad address: said before any work
     jobs = whole_number(jobs, "jobs") or os.cpu_count() or 1
+    if parallel not in PARALLEL:
+        raise GearsymError(f"parallel={parallel!r}: choose one of {', '.join(PARALLEL)}")
+    if parallel == "auto":
+        parallel = "processes" if "fork" in multiprocessing.get_all_start_methods() else "threads"
     if mode == INDEPENDENT and direction != "up":
         raise GearsymError(f"--direction {direction} applies to a continuation; independent points have no direction")
     axes = axes_from(axes)
@@ -139,7 +153,12 @@ def run_sweep(
         bar = _progress(len(planned), len(done), compiled.name, progress)
         already = len(done)
         ran: dict = {}  # where the points ran, for the record (Dask only)
-        finished = _execute(run, todo, jobs) if scheduler is None else _execute_dask(run, todo, scheduler, jobs, ran)
+        if scheduler is not None:
+            finished = _execute_dask(run, todo, scheduler, jobs, ran)
+        elif parallel == "processes" and jobs > 1 and len(todo) > 1:
+            finished = _execute_processes(run, todo, jobs)
+        else:
+            finished = _execute(run, todo, jobs)
         try:
             for row, strobe_rows in finished:
                 if store:
@@ -282,6 +301,71 @@ def _execute(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], jobs: int):
     finally:
         stop.set()  # on an error or Ctrl-C: threads stop after their current point
         pool.shutdown(wait=True, cancel_futures=True)  # points finished meanwhile are redone on resume
+
+
+def _execute_processes(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], jobs: int):
+    """``_execute`` on ``jobs`` processes forked from this one (they inherit the loaded model: nothing is
+    rebuilt or shipped). Rows come back one by one through a queue, so the files, the progress bar and
+    Ctrl-C behave as with threads; the threads' shared lock, which serialises the Python around every
+    point (analysis, row formatting), is gone."""
+    global _FORKED
+    if not tasks:
+        return
+    ctx = multiprocessing.get_context("fork")
+    todo, done = ctx.Queue(), ctx.Queue()
+    workers = min(jobs, len(tasks))
+    for i in range(len(tasks)):
+        todo.put(i)
+    for _ in range(workers):
+        todo.put(None)
+    _FORKED = (run, tasks)  # what the children inherit
+    procs = [ctx.Process(target=_process_worker, args=(todo, done), daemon=True, name=f"gearsym-sweep-{k}")
+             for k in range(workers)]
+    try:
+        for proc in procs:
+            proc.start()
+        _FORKED = None
+        pending = sum(len(t) for t, _ in tasks)
+        while pending:
+            try:
+                kind, item = done.get(timeout=0.2)
+            except queue.Empty:
+                dead = next((p for p in procs if p.exitcode not in (None, 0)), None)
+                if dead is not None:
+                    raise GearsymError(f"a sweep worker process died (exit code {dead.exitcode}); the points "
+                                       "finished so far are kept: run the same command with --parallel threads "
+                                       "to resume")
+                continue
+            if kind == "error":
+                raise GearsymError(item)
+            pending -= 1
+            yield item
+    finally:
+        _FORKED = None
+        for proc in procs:  # on an error or Ctrl-C: stop at once; unfinished points are redone on resume
+            if proc.is_alive():
+                proc.terminate()
+        for proc in procs:
+            proc.join()
+        todo.close()
+        done.close()
+
+
+_FORKED = None  # (run, tasks) of the sweep being forked, read by _process_worker in the children
+
+
+def _process_worker(todo, done) -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle: it stops us
+    run, tasks = _FORKED
+    compiled = run.compiled.clone()  # work arrays of its own (the parent's are its own business)
+    while (index := todo.get()) is not None:
+        task, state = tasks[index]
+        try:
+            for item in run.task(compiled, task, state):
+                done.put(("row", item))
+        except Exception as exc:  # the message is what the parent reports
+            done.put(("error", str(exc)))
+            return
 
 
 def _execute_dask(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], scheduler, workers: int, ran: dict):
