@@ -303,7 +303,8 @@ def figure(raw: dict, path: Path) -> Path:
         ax.set_xticklabels(names)
         ax.set_ylabel("speed-up over 1 thread")
         ax.set_title("flexible_shaft sweeps on every core", fontsize=9)
-        ax.legend(fontsize=8)
+        ax.set_ylim(0, raw["scaling"]["cores"] * 1.25)
+        ax.legend(fontsize=7, loc="upper center", ncol=2)
     fig.tight_layout()
     return save_figure(fig, path, dpi=100)
 
