@@ -39,11 +39,8 @@ import dataclasses
 import datetime as _dt
 import json
 import math
-import os
-import platform
 import shlex
 import statistics
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -54,6 +51,7 @@ REPO = Path(__file__).resolve().parent.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
+from bench.speed.machine import machine_info  # noqa: E402
 from bench.yardstick import runner  # noqa: E402
 
 MODEL = "flexible_shaft"
@@ -91,55 +89,6 @@ class Sweep:
 
 FULL = Sweep(0.1, 2.0, 0.01, 400, 100, 200)
 QUICK = Sweep(0.1, 2.0, 0.1, 100, 25, 200)  # every 10th point, 100 periods
-
-
-# ============================================================================ machine
-def _run_text(cmd: list[str]) -> str:
-    try:
-        return subprocess.run(cmd, capture_output=True, text=True, timeout=30).stdout
-    except (OSError, subprocess.SubprocessError):
-        return ""
-
-
-def machine_info(cc: str) -> dict:
-    cpu = platform.processor()
-    flags = ""
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name") and cpu in ("", platform.machine()):
-                cpu = line.split(":", 1)[1].strip()
-            elif line.startswith("flags") and not flags:
-                flags = line.split(":", 1)[1]
-    except OSError:
-        pass
-    simd = [f for f in ("sse4_2", "avx", "avx2", "fma", "avx512f") if f in flags.split()]
-    try:
-        import casadi
-        casadi_version = casadi.__version__
-    except ImportError:  # pragma: no cover
-        casadi_version = None
-    commit = _run_text(["git", "-C", str(REPO), "rev-parse", "HEAD"]).strip() or None
-    dirty = bool(_run_text(["git", "-C", str(REPO), "status", "--porcelain", "--", "gearsym", "models"]).strip())
-    try:
-        load = os.getloadavg()
-    except OSError:
-        load = None
-    return {
-        "platform": platform.platform(),
-        "machine": platform.machine(),
-        "cpu_model": cpu,
-        "cpu_simd": simd,
-        "nproc": os.cpu_count(),
-        "loadavg_at_start": load,
-        "python": sys.version.split()[0],
-        "numpy": np.__version__,
-        "casadi": casadi_version,
-        "cc": cc,
-        "cc_version": _run_text([cc, "--version"]).splitlines()[0] if _run_text([cc, "--version"]) else None,
-        "gearsym_cflags": os.environ.get("GEARSYM_CFLAGS"),
-        "git_commit": commit,
-        "git_dirty_gearsym_or_models": dirty,
-    }
 
 
 # ============================================================================ gearsym

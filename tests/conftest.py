@@ -107,3 +107,15 @@ def _private_library_cache(tmp_path_factory):
         os.environ.pop("GEARSYM_CACHE", None)
     else:
         os.environ["GEARSYM_CACHE"] = old
+
+
+def interrupt_after(count):
+    """An ``on_point`` for sweeps that presses Ctrl-C once ``count`` points are stored."""
+    seen = []
+
+    def on_point(row):
+        seen.append(row)
+        if len(seen) == count:
+            raise KeyboardInterrupt
+
+    return on_point

@@ -20,6 +20,7 @@ from gearsym.codegen.portable import load_shipped, ship
 from gearsym.errors import GearsymError
 from gearsym.sweep import SweepInterrupted, read_sweep, run_sweep
 from gearsym.sweep import distributed as dsweep
+from conftest import interrupt_after
 
 distributed = pytest.importorskip("distributed")
 
@@ -78,17 +79,6 @@ def test_the_in_process_backend_runs_on_workers_too(tmp_path, cluster):
     _same_files(tmp_path / "one.csv", tmp_path / "dask.csv")
 
 
-def _interrupt_after(count):
-    seen = []
-
-    def on_point(row):
-        seen.append(row)
-        if len(seen) == count:
-            raise KeyboardInterrupt
-
-    return on_point
-
-
 def test_interrupted_on_the_cluster_cancels_its_tasks_and_resumes_to_the_same_files(tmp_path, cluster, one_stage,
                                                                                   monkeypatch):
     monkeypatch.setattr(dsweep, "POINTS_PER_TASK", 2)
@@ -96,7 +86,7 @@ def test_interrupted_on_the_cluster_cancels_its_tasks_and_resumes_to_the_same_fi
     run_sweep(one_stage, axes, jobs=1, out=tmp_path / "whole.csv", **SHORT)
     part = tmp_path / "part.csv"
     with pytest.raises(SweepInterrupted) as info:
-        run_sweep(one_stage, axes, scheduler=cluster, out=part, on_point=_interrupt_after(3), **SHORT)
+        run_sweep(one_stage, axes, scheduler=cluster, out=part, on_point=interrupt_after(3), **SHORT)
     assert len(part.read_text().splitlines()) - 1 == info.value.done >= 3
     deadline = time.monotonic() + 10
     while cluster.run_on_scheduler(lambda dask_scheduler: len(dask_scheduler.tasks)) and time.monotonic() < deadline:

@@ -11,6 +11,7 @@ from gearsym.cli import main
 from gearsym.codegen import compile_model
 from gearsym.errors import GearsymError
 from gearsym.sweep import SweepInterrupted, parse_axis, read_sweep, run_sweep
+from conftest import interrupt_after
 
 SHORT = dict(periods=60, discard=20, progress=False)
 
@@ -83,17 +84,6 @@ def test_regime_column_names_the_motion(one_stage):
 
 
 # ------------------------------------------------------------------ files, resume, threads
-def _interrupt_after(count):
-    seen = []
-
-    def on_point(row):
-        seen.append(row)
-        if len(seen) == count:
-            raise KeyboardInterrupt
-
-    return on_point
-
-
 @pytest.mark.parametrize("mode, jobs", [("continuation", 2), ("independent", 2), ("continuation", 1)])
 def test_an_interrupted_sweep_resumes_to_the_same_files(tmp_path, one_stage, mode, jobs):
     axes = ["omega=0.9:1.3:0.1", "B1=3.5,4"]
@@ -101,7 +91,7 @@ def test_an_interrupted_sweep_resumes_to_the_same_files(tmp_path, one_stage, mod
     assert len(whole) == 10
     part = tmp_path / "part.csv"
     with pytest.raises(SweepInterrupted) as info:
-        run_sweep(one_stage, axes, mode=mode, jobs=jobs, out=part, on_point=_interrupt_after(4), **SHORT)
+        run_sweep(one_stage, axes, mode=mode, jobs=jobs, out=part, on_point=interrupt_after(4), **SHORT)
     assert info.value.done >= 4 and "run the same command again" in str(info.value)
     kept = part.read_text().splitlines()
     assert len(kept) - 1 == info.value.done  # every finished point is on disk
@@ -110,7 +100,7 @@ def test_an_interrupted_sweep_resumes_to_the_same_files(tmp_path, one_stage, mod
     assert part.read_bytes() == (tmp_path / "whole.csv").read_bytes()
     assert (tmp_path / "part.poincare.csv").read_bytes() == (tmp_path / "whole.poincare.csv").read_bytes()
     assert np.array_equal(resumed["lambda_1"], whole["lambda_1"])
-    again = run_sweep(one_stage, axes, mode=mode, jobs=jobs, out=part, on_point=_interrupt_after(1), **SHORT)
+    again = run_sweep(one_stage, axes, mode=mode, jobs=jobs, out=part, on_point=interrupt_after(1), **SHORT)
     assert len(again) == 10  # complete: nothing left to run, nothing recomputed
 
 
@@ -194,7 +184,7 @@ def test_resume_in_the_down_half_after_a_kill_mid_row(tmp_path, one_stage):
     run_sweep(one_stage, axes, direction="both", out=tmp_path / "whole.csv", **SHORT)
     part = tmp_path / "part.csv"
     with pytest.raises(SweepInterrupted):
-        run_sweep(one_stage, axes, direction="both", out=part, on_point=_interrupt_after(7), **SHORT)
+        run_sweep(one_stage, axes, direction="both", out=part, on_point=interrupt_after(7), **SHORT)
     whole_rows = (tmp_path / "whole.csv").read_text().splitlines()
     part.write_text(part.read_text() + whole_rows[8][:15])  # the 8th point (going down) cut while written
     strobe = tmp_path / "part.poincare.csv"
@@ -210,7 +200,7 @@ def test_resume_in_the_down_half_after_a_kill_mid_row(tmp_path, one_stage):
 def test_a_sweep_that_finished_no_point_starts_again_with_new_options(tmp_path, one_stage):
     out = tmp_path / "s.csv"
     with pytest.raises(SweepInterrupted):
-        run_sweep(one_stage, ["omega=1,1.1"], out=out, on_point=_interrupt_after(1), **SHORT)
+        run_sweep(one_stage, ["omega=1,1.1"], out=out, on_point=interrupt_after(1), **SHORT)
     out.write_text(out.read_text().splitlines()[0] + "\n")  # as if stopped before the first point was written
     result = run_sweep(one_stage, ["omega=1,1.1"], out=out, periods=80, discard=20, progress=False)
     assert len(result) == 2 and read_sweep(out).record["periods"] == 80
@@ -219,7 +209,7 @@ def test_a_sweep_that_finished_no_point_starts_again_with_new_options(tmp_path, 
 def test_missing_poincare_samples_are_not_silently_dropped(tmp_path, one_stage):
     out = tmp_path / "s.csv"
     with pytest.raises(SweepInterrupted):
-        run_sweep(one_stage, ["omega=1:1.3:0.1"], out=out, on_point=_interrupt_after(2), **SHORT)
+        run_sweep(one_stage, ["omega=1:1.3:0.1"], out=out, on_point=interrupt_after(2), **SHORT)
     (tmp_path / "s.poincare.csv").unlink()
     with pytest.raises(GearsymError, match="lacks the Poincare samples of 2 finished points"):
         run_sweep(one_stage, ["omega=1:1.3:0.1"], out=out, **SHORT)

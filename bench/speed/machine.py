@@ -57,6 +57,7 @@ def machine_info(cc: str = "gcc") -> dict:
         "versions": {name: _version(name) for name in
                      ("numpy", "casadi", "sympy", "numba", "jitcode", "symengine", "scipy", "dask", "distributed")},
         "numpy": np.__version__,
+        "casadi": _version("casadi"),
         "cc": cc,
         "cc_version": cc_version[0] if cc_version else None,
         "gearsym_cflags": os.environ.get("GEARSYM_CFLAGS"),

@@ -207,14 +207,19 @@ class _Symbols:
         self.inner = {**outer, **{s: self.ch[i] for i, (s, _) in enumerate(split.constants)}}
 
 
+def _tabulated_rhs(sym: _Symbols, split: SplitRHS, where: str) -> tuple[ca.Function, ca.Function]:
+    """f and its Jacobian in the loop's terms (state, table values at the stage's time, constants and h)."""
+    f_tab = ca.vertcat(*to_casadi(split.rhs, sym.inner, where))
+    return (ca.Function("f_tab", [sym.y, sym.T, sym.ch], [f_tab]),
+            ca.Function("J_tab", [sym.y, sym.T, sym.ch], [ca.jacobian(f_tab, sym.y)]))
+
+
 def _rk4_functions(sym: _Symbols, split: SplitRHS, K: int, where: str):
     """K RK4 steps with tangent (``tangent_block``), without (``state_block``), and one plain step."""
     n, m, nc = sym.y.numel(), len(split.tables), sym.ch.numel() - 1
-    y, T, ch = sym.y, sym.T, sym.ch
+    y, ch = sym.y, sym.ch
     h = ch[nc]
-    f_tab = ca.vertcat(*to_casadi(split.rhs, sym.inner, where))
-    f_of = ca.Function("f_tab", [y, T, ch], [f_tab])
-    J_of = ca.Function("J_tab", [y, T, ch], [ca.jacobian(f_tab, y)])
+    f_of, J_of = _tabulated_rhs(sym, split, where)
     Q = ca.SX.sym("Q", n, n)
     lo = ca.SX.sym("lo", len(sym.observed))
     hi = ca.SX.sym("hi", len(sym.observed))
@@ -347,9 +352,7 @@ def _crossing_steps(sym: _Symbols, split: SplitRHS, switching: _Switching, where
     n, m, nc = sym.y.numel(), len(split.tables), sym.ch.numel() - 1
     y, T, ch = sym.y, sym.T, sym.ch
     h = ch[nc]
-    f_tab = ca.vertcat(*to_casadi(split.rhs, sym.inner, where))
-    f_of = ca.Function("f_tab", [y, T, ch], [f_tab])
-    J_of = ca.Function("J_tab", [y, T, ch], [ca.jacobian(f_tab, y)])
+    f_of, J_of = _tabulated_rhs(sym, split, where)
     ns = len(switching.surfaces)
     sides = ca.SX.sym("side", ns)
     frozen = {**sym.inner, **{d: sides[i] for i, d in enumerate(switching.sides)}}
