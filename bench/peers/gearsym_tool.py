@@ -20,12 +20,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .common import PointResult, default_state
+from .common import ContinuationSweep, PointResult, initial_state
 
 PATHS = ("loop", "lyapunov_spectrum")
 
 
-class GearsymTool:
+class GearsymTool(ContinuationSweep):  # sweep: the shared continuation over spectrum()
     def __init__(self, model: str, accuracy: dict | None = None, path: str = "loop", crossings: bool = False,
                  **params: float):
         from gearsym.codegen import compile_model
@@ -47,14 +47,11 @@ class GearsymTool:
         self.params = dict(params)
         self.compiled.parameter_vector(self.params)  # unknown names fail here, before any timing
         warm = self.compiled.prepare(self.compiled.parameter_vector(self.params, omega=1.0))
-        self.compiled.tangent_run(self._state(None), 2, warm)  # page in the library
-
-    def _state(self, y0) -> np.ndarray:
-        return np.array(default_state(self.model) if y0 is None else y0, dtype=float)
+        self.compiled.tangent_run(initial_state(model, None), 2, warm)  # page in the library
 
     def spectrum(self, omega: float, y0: Sequence[float] | None = None, periods: int = 400,
                  discard: int = 100) -> PointResult:
-        y = self._state(y0)
+        y = initial_state(self.model, y0)
         start = time.perf_counter()
         if self.path == "loop":
             cm = self.compiled
@@ -70,15 +67,6 @@ class GearsymTool:
             exponents = np.asarray(res.exponents)  # sorted: the analysis does not keep Gram-Schmidt order
             final = np.array([res.final_state[s] for s in self.compiled.state_names])
         return PointResult(exponents, final, time.perf_counter() - start)
-
-    def sweep(self, omegas: Sequence[float], y0: Sequence[float] | None = None, periods: int = 400,
-              discard: int = 100) -> list[PointResult]:
-        y, out = self._state(y0), []
-        for omega in omegas:
-            res = self.spectrum(omega, y, periods, discard)
-            out.append(res)
-            y = res.final_state
-        return out
 
 
 def make(model: str, accuracy: dict | None = None, crossings: bool = False, **params: float) -> GearsymTool:

@@ -127,6 +127,11 @@ def code_directory(name: str, digest: str) -> Path:
     committed = _generated_dir() / name
     if (read_manifest(committed) or {}).get("hash") == digest:
         return committed
+    return cached_code_directory(name, digest)
+
+
+def cached_code_directory(name: str, digest: str) -> Path:
+    """Where the cache keeps the C of the code ``digest`` when it is generated (or received) here."""
     return cache_dir() / "code" / f"{name}-{digest[:16]}"
 
 

@@ -16,6 +16,7 @@ from pathlib import Path
 import casadi as ca
 import sympy as sp
 
+from ..files import write_atomically
 from ..system import FirstOrderSystem
 from .functions import LoopOptions, ModelFunctions
 
@@ -99,7 +100,7 @@ def write_code(mf: ModelFunctions, directory: Path, digest: str) -> GeneratedCod
             os.chdir(cwd)
         os.replace(Path(tmp) / f"{name}.c", directory / f"{name}.c")
     text = json.dumps(manifest(mf, digest), indent=2, sort_keys=True) + "\n"
-    _write_atomic(directory / "manifest.json", text)
+    write_atomically(directory / "manifest.json", text)
     return GeneratedCode(directory, directory / f"{name}.c", directory / "manifest.json", digest)
 
 
@@ -109,10 +110,3 @@ def read_manifest(directory: Path) -> dict | None:
         return json.loads(path.read_text())
     except (OSError, ValueError):
         return None
-
-
-def _write_atomic(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name + ".", suffix=".tmp")
-    with os.fdopen(fd, "w") as f:
-        f.write(text)
-    os.replace(tmp, path)

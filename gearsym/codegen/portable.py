@@ -31,7 +31,6 @@ from __future__ import annotations
 import logging
 import os
 import socket
-import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,8 +38,9 @@ from pathlib import Path
 import casadi as ca
 
 from ..errors import GearsymError
+from ..files import write_atomically
 from ..system import FirstOrderSystem
-from .build import FUNCTION_NAMES, code_directory
+from .build import FUNCTION_NAMES, cached_code_directory, code_directory
 from .compiled import CompiledModel
 from .compiler import CompilerError, binary_key, cache_dir, compile_flags, compile_library
 from .functions import LoopOptions, build_functions
@@ -119,24 +119,15 @@ def _write_library(shipped: ShippedModel) -> Path:
     """The shipped bytes in this machine's cache, under the name compile_library gave them (atomically)."""
     target = cache_dir() / "lib" / shipped.library_name
     if not target.is_file():  # e.g. a worker on the client's machine sharing its cache has it already
-        target.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
-        with os.fdopen(fd, "wb") as f:
-            f.write(shipped.library)
-        os.replace(tmp, target)  # concurrent workers write the same bytes; the last rename wins
+        write_atomically(target, shipped.library)  # concurrent workers write the same bytes
     return target
 
 
 def _rebuild(shipped: ShippedModel, timings: dict) -> Path:
     """The shipped C compiled here (the library was built for another system, CPU or C library)."""
-    code_dir = cache_dir() / "code" / f"{shipped.name}-{shipped.hash[:16]}"
-    source = code_dir / f"{shipped.name}.c"
+    source = cached_code_directory(shipped.name, shipped.hash) / f"{shipped.name}.c"
     if not (source.is_file() and source.read_bytes() == shipped.source):
-        code_dir.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=code_dir, prefix=f".{source.name}.", suffix=".tmp")
-        with os.fdopen(fd, "wb") as f:
-            f.write(shipped.source)
-        os.replace(tmp, source)
+        write_atomically(source, shipped.source)
     try:
         lib = compile_library(source, shipped.name, flags=shipped.flags)
     except CompilerError as exc:

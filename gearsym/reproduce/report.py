@@ -12,6 +12,7 @@ import os
 import re
 from pathlib import Path
 
+from ..files import write_atomically
 from .claims import MIN_CHAOTIC
 
 #: Why a claim comes out as it does, where the numbers alone do not say it. Written by a person
@@ -190,14 +191,6 @@ def _method(record: dict) -> list[str]:
 
 
 def write(record: dict, json_path: Path, doc_path: Path) -> None:
-    json_path.parent.mkdir(parents=True, exist_ok=True)
-    _atomic(json_path, json.dumps(record, indent=1, sort_keys=False, allow_nan=False) + "\n")
+    write_atomically(json_path, json.dumps(record, indent=1, sort_keys=False, allow_nan=False) + "\n")
     figures_dir = os.path.relpath(json_path.parent, doc_path.parent).replace(os.sep, "/")
-    _atomic(doc_path, render(record, figures_dir))
-
-
-def _atomic(path: Path, text: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+    write_atomically(doc_path, render(record, figures_dir))

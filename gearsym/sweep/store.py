@@ -18,11 +18,11 @@ import csv
 import fcntl
 import io
 import json
-import os
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 from ..errors import GearsymError
+from ..files import write_atomically
 
 
 def number(x: float) -> str:
@@ -150,7 +150,7 @@ class SweepStore:
         self._write_table(self.strobe_path, self.strobe_columns, strobe_rows)
 
     def write_record(self, **extra) -> None:
-        _atomic_write(self.meta_path, json.dumps({"sweep": self.record, **extra}, indent=2) + "\n")
+        write_atomically(self.meta_path, json.dumps({"sweep": self.record, **extra}, indent=2) + "\n")
 
     def previous_record(self) -> dict:
         """What the last run wrote beside the sweep record (status, points, seconds, ...), or {}."""
@@ -165,7 +165,7 @@ class SweepStore:
         writer = csv.DictWriter(buffer, columns, lineterminator="\n")
         writer.writeheader()
         writer.writerows(rows)
-        _atomic_write(path, buffer.getvalue())
+        write_atomically(path, buffer.getvalue())
 
 
 def row_key(row: dict, params) -> tuple:
@@ -194,12 +194,6 @@ def read_rows(path: Path, columns: list[str] | None = None) -> list[dict]:
                                "the file was edited or damaged: fix the row or pass --overwrite")
         rows.append(dict(zip(columns, fields)))
     return rows
-
-
-def _atomic_write(path: Path, text: str) -> None:
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
 
 
 def _short(value) -> str:
