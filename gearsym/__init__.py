@@ -1,19 +1,84 @@
 """gearsym: symbolic drivetrain models, reduced and nondimensionalised automatically.
 
-Pipeline: ``gearsym.model`` (declare) -> ``gearsym.reduce`` (relative coordinates,
-groups, tau-form) -> ``gearsym.system`` (first-order ODE for the engine);
-``gearsym.derivation`` renders the derivation as text, LaTeX, JSON or Markdown.
+One flat public face; the stages behind it, each handing one type to the next:
+
+* declare: :class:`Drivetrain` from components (:class:`Gear`, :class:`Mesh`, ...), or a plain ODE as a
+  :class:`FirstOrderSystem`; ``load_model(name)`` reads one from ``models/`` or a file;
+* reduce: :func:`reduce` (Drivetrain -> :class:`NondimensionalModel`), whose ``.system(**values)`` is the
+  :class:`FirstOrderSystem` the engine takes; :func:`load` does name -> system in one call;
+* compile: :func:`compile_model` (FirstOrderSystem, :class:`Integration` -> :class:`CompiledModel`);
+* analyse: :func:`lyapunov_spectrum`, :func:`poincare_samples`, :func:`phase_trajectory`,
+  :func:`find_attractors`, :func:`run_sweep` (on a CompiledModel, or on a system, compiled first);
+* data: :func:`simulate_measurements`, :func:`load_measurements`, :func:`explain`;
+* document: :func:`derive` and :func:`render`.
+
+The verbs are imported on first use, so ``import gearsym`` stays cheap for a command that needs few of them.
 """
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
+
 from .errors import GearsymError, ModelError, UnknownParameterError
 from .model import Disk, Drivetrain, Gear, Harmonic, Mesh, Shaft, Torque, rectangular_mesh_stiffness
-from .reduce import NondimensionalModel, reduce
-from .registry import available_models, load_model
+from .options import Integration
 from .system import FirstOrderSystem
 
 __version__ = "0.1.0"
 
+#: public name -> the module that defines it (imported when the name is first used)
+_LAZY = {
+    "NondimensionalModel": "gearsym.reduce",
+    "reduce": "gearsym.reduce",
+    "available_models": "gearsym.registry",
+    "load": "gearsym.registry",
+    "load_model": "gearsym.registry",
+    "CompiledModel": "gearsym.codegen",
+    "compile_model": "gearsym.codegen",
+    "LyapunovSpectrum": "gearsym.analysis",
+    "lyapunov_spectrum": "gearsym.analysis",
+    "poincare_samples": "gearsym.analysis",
+    "phase_trajectory": "gearsym.analysis",
+    "find_attractors": "gearsym.analysis",
+    "classify_regime": "gearsym.analysis",
+    "run_sweep": "gearsym.sweep",
+    "read_sweep": "gearsym.sweep",
+    "Workers": "gearsym.sweep",
+    "SweepInterrupted": "gearsym.sweep",
+    "simulate_measurements": "gearsym.data",
+    "load_measurements": "gearsym.data",
+    "explain": "gearsym.fit",
+    "EFFECTS": "gearsym.fit",
+    "derive": "gearsym.derivation",
+    "render": "gearsym.derivation",
+}
+
 __all__ = [
-    "Disk", "Drivetrain", "FirstOrderSystem", "Gear", "GearsymError", "Harmonic", "Mesh", "ModelError",
-    "NondimensionalModel", "Shaft", "Torque", "UnknownParameterError", "available_models", "load_model",
-    "rectangular_mesh_stiffness", "reduce",
+    "Disk", "Drivetrain", "FirstOrderSystem", "Gear", "GearsymError", "Harmonic", "Integration", "Mesh",
+    "ModelError", "Shaft", "Torque", "UnknownParameterError", "rectangular_mesh_stiffness", *_LAZY,
 ]
+
+
+def __getattr__(name: str):
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'gearsym' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value  # once: later lookups do not come here
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
+
+
+if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
+    from .analysis import (LyapunovSpectrum, classify_regime, find_attractors, lyapunov_spectrum,
+                           phase_trajectory, poincare_samples)
+    from .codegen import CompiledModel, compile_model
+    from .data import load_measurements, simulate_measurements
+    from .derivation import derive, render
+    from .fit import EFFECTS, explain
+    from .reduce import NondimensionalModel, reduce
+    from .registry import available_models, load, load_model
+    from .sweep import SweepInterrupted, Workers, read_sweep, run_sweep

@@ -9,12 +9,10 @@ from typing import Union
 
 from .errors import GearsymError, ModelError, suggest
 from .model.drivetrain import Drivetrain
+from .paths import REPO_ROOT
 from .system import FirstOrderSystem
 
 Model = Union[Drivetrain, FirstOrderSystem]
-
-#: the repository checkout this package was installed from (editable installs)
-REPO_ROOT = Path(__file__).resolve().parent.parent
 
 
 def models_dir() -> Path:
@@ -69,27 +67,28 @@ def _with_models_importable(action):
             sys.path.remove(root)
 
 
-def system_for(ref, **settings) -> FirstOrderSystem:
-    """The first-order system of a model with ``settings`` applied.
+def load(ref, **values) -> FirstOrderSystem:
+    """The first-order system of a model, ready for the engine: the one place names and files are resolved.
 
-    ``settings`` give parameter values (``omega=1.5``) or, for a drivetrain, a
-    new mesh stiffness as a formula in tau (``k="1 + 0.2*cos(tau)"``). Strings
-    that read as numbers are numbers.
+    ``ref`` is a model name (``models/<name>.py``), the path of a model file, a Drivetrain, a reduced
+    NondimensionalModel or a FirstOrderSystem. ``values`` give parameter values (``omega=1.5``) or, for a
+    drivetrain, a new mesh stiffness as a formula in tau (``k="1 + 0.2*cos(tau)"``). Strings that read as
+    numbers are numbers.
     """
     from .reduce import NondimensionalModel, reduce
 
     model = ref if isinstance(ref, NondimensionalModel) else load_model(ref)
-    settings = {k: _maybe_number(v) for k, v in settings.items()}
+    values = {k: _maybe_number(v) for k, v in values.items()}
     if isinstance(model, FirstOrderSystem):
-        for key, value in settings.items():
+        for key, value in values.items():
             if not isinstance(value, (int, float)):
                 raise GearsymError(
                     f"{model.name}: {key}={value!r} is not a number; only drivetrain models accept a formula "
                     "(a new mesh stiffness function)"
                 )
-        return model.with_values(**settings)
+        return model.with_values(**values)
     nd = model if isinstance(model, NondimensionalModel) else reduce(model)
-    return nd.system(**settings)
+    return nd.system(**values)
 
 
 def _maybe_number(value):

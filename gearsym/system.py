@@ -7,15 +7,50 @@ The compiled engine takes nothing else, so it is one engine for both.
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 import sympy as sp
 
-from .errors import ModelError, UnknownParameterError
-from .model.expressions import ExprLike, to_expr
+from .errors import GearsymError, ModelError, UnknownParameterError
+from .model.expressions import ExprLike, sign_violation, to_expr
 from .symbols import parameter_symbol
+
+
+@dataclass(frozen=True)
+class Coupling:
+    """A mesh or shaft of a reduced drivetrain, as its first-order system carries it.
+
+    The reduction knows every coupling; the engine, the effects of the data loop and the reports read
+    it here instead of searching the equations. The coupling's *law* in its own coordinate ``x`` is, in
+    the tau-form, ``2 zeta v/omega + k(tau) g(x, eta)/omega^2`` for a mesh (``beta (kS x/omega^2 +
+    cS v/omega)`` for a shaft); it enters the velocity equation of each row in ``rows`` as
+    ``-factor * law``.
+    """
+
+    name: str  # the component ("mesh", "shaft")
+    kind: str  # "mesh" | "shaft"
+    coordinate: str  # the state of its relative coordinate (x1)
+    velocity: str  # the state of its rate (v1)
+    backlash: sp.Expr  # eta; 0 for a linear mesh and for every shaft
+    stiffness: sp.Expr  # the mesh stiffness k(tau) as the equations use it (for a shaft its kS)
+    order: sp.Expr = sp.S.Zero  # mesh frequency over forcing frequency (0 for shafts)
+    rows: tuple[tuple[int, sp.Expr], ...] = ()  # (index in rhs of a velocity equation, factor of the law)
+    contact: sp.Expr | None = None  # the argument of g: the coordinate (None), or it shifted by an effect
+
+    def __post_init__(self):
+        if self.contact is None:
+            object.__setattr__(self, "contact", sp.Symbol(self.coordinate, real=True))
+
+
+@dataclass(frozen=True)
+class Constraint:
+    """What a parameter is physically, and so which sign it must have."""
+
+    meaning: str  # "an inertia", "a damping ratio", ...
+    zero_allowed: bool = True
 
 
 @dataclass(frozen=True)
@@ -26,7 +61,9 @@ class FirstOrderSystem:
     the unit of stroboscopic sampling and of tangent-space re-orthonormalisation.
     ``coordinates`` names the states whose vibration amplitude is reported (the
     relative coordinates of a drivetrain); empty means every state. ``initial``
-    is the default initial state (states not named start at 0).
+    is the default initial state (states not named start at 0). A reduced
+    drivetrain also hands on its ``couplings`` and the ``constraints`` its
+    parameters' physical meaning puts on their values.
     """
 
     name: str
@@ -39,6 +76,8 @@ class FirstOrderSystem:
     title: str = ""
     coordinates: tuple[str, ...] = ()
     initial: Mapping[str, float] = field(default_factory=dict)
+    couplings: tuple[Coupling, ...] = ()
+    constraints: Mapping[str, Constraint] = field(default_factory=dict)
 
     def __post_init__(self):
         if len(self.states) != len(self.rhs):
@@ -61,6 +100,11 @@ class FirstOrderSystem:
         clash = {s.name for s in self.states} & set(self.parameters)
         if clash:
             raise ModelError(f"names used both as state and parameter: {sorted(clash)}", self.name)
+        names = {s.name for s in self.states}
+        for c in self.couplings:
+            if not {c.coordinate, c.velocity} <= names:
+                raise ModelError(f"coupling {c.name!r} acts on {c.coordinate}, {c.velocity}, which are not states",
+                                 self.name)
 
     @classmethod
     def from_equations(
@@ -92,11 +136,66 @@ class FirstOrderSystem:
         return tuple(parameter_symbol(n) for n in self.parameters)
 
     def with_values(self, **values: float) -> "FirstOrderSystem":
-        """The same system with some parameter values changed (names are checked)."""
+        """The same system with some parameter values changed (names and values are checked)."""
         for k in values:
             if k not in self.parameters:
                 raise UnknownParameterError(k, self.parameters, self.name)
-        return replace(self, parameters={**self.parameters, **{k: float(v) for k, v in values.items()}})
+        return replace(self, parameters={**self.parameters, **{k: self.check_value(k, v) for k, v in values.items()}})
+
+    def parameter_values(self, values: Mapping[str, float] | None = None) -> dict[str, float]:
+        """Every parameter's value: the system's own, with ``values`` overriding (names, signs and
+        finiteness checked)."""
+        merged = dict(self.parameters)
+        for name, value in (values or {}).items():
+            if name not in merged:
+                if isinstance(value, str):
+                    raise GearsymError(
+                        f"{self.name}: {name}={value!r} would change the model's equations; a system only takes "
+                        f"parameter values: load the model with it (gearsym.load(model, {name}=...))")
+                raise UnknownParameterError(name, merged, self.name)
+            merged[name] = self.check_value(name, value)
+        bad = [n for n, v in merged.items() if not math.isfinite(v)]
+        if bad:
+            raise GearsymError(f"{self.name}: parameter values must be finite numbers: "
+                               + ", ".join(f"{n}={merged[n]}" for n in bad))
+        return merged
+
+    def period_at(self, values: Mapping[str, float] | None = None) -> float:
+        """The forcing period (in the system's time) at these parameter values."""
+        merged = self.parameter_values(values)
+        period = self.period.xreplace({s: merged[s.name] for s in self.period.free_symbols if s.name in merged})
+        number = float(period) if period.is_number else math.nan
+        if not (math.isfinite(number) and number > 0):
+            raise ModelError(f"the forcing period {self.period} is {period} at these parameter values; it must be a "
+                             "positive number", self.name)
+        return number
+
+    @property
+    def state_names(self) -> tuple[str, ...]:
+        return tuple(s.name for s in self.states)
+
+    def check_value(self, name: str, value) -> float:
+        """``value`` as a float, if it is a finite number with the sign parameter ``name`` must have."""
+        if isinstance(value, str):
+            raise GearsymError(f"{self.name}: {name}={value!r} is not a number; a formula changes the equations: "
+                               f"give it when loading the model (gearsym.load(model, {name}=...))")
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            raise GearsymError(f"{self.name}: {name} must be a number, got {value!r}") from None
+        constraint = self.constraints.get(name)
+        must = sign_violation(number, constraint.zero_allowed) if constraint else None
+        if must:
+            raise ModelError(f"is {constraint.meaning} and {must}, got {number:g}", f"parameter {name!r}")
+        return number
+
+    def coupling(self, coordinate: str) -> Coupling:
+        """The coupling whose relative coordinate is ``coordinate``."""
+        for c in self.couplings:
+            if c.coordinate == coordinate:
+                return c
+        known = ", ".join(c.coordinate for c in self.couplings) or "none: not a reduced drivetrain"
+        raise ModelError(f"no coupling acts on {coordinate!r} (couplings act on: {known})", self.name)
 
     @cached_property  # asked at every point of a sweep; a walk over the SymPy trees each time
     def autonomous(self) -> bool:

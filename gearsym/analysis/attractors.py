@@ -32,7 +32,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..checks import json_safe, whole_number
-from ..codegen import CompiledModel, compiled_and_values
+from ..codegen import CompiledModel, engine_verb
+from ..options import Integration
 from ..errors import GearsymError, suggest
 from .lyapunov import LyapunovSpectrum, lyapunov_spectrum
 from .regime import classify_regime
@@ -51,6 +52,9 @@ MAX_POINTS = 400
 PERIOD_TOLERANCE = 1e-2
 #: the longest period (in forcing periods) reported; beyond it the period is None
 MAX_PERIOD = 64
+
+#: the run of each initial state when no options are given: a long transient before the runs are compared
+RUN = {"periods": 500, "discard": 300}
 
 #: the paper's labels in Fig. 4: '1' a regular attractor, '2' a chaotic one
 PAPER_LABELS = {"periodic": "1", "quasi-periodic": "1", "equilibrium": "1", "chaotic": "2", "hyperchaotic": "2"}
@@ -192,33 +196,32 @@ class AttractorSet:
 
 
 # ------------------------------------------------------------------------------------------ entry point
+@engine_verb(default=Integration(**RUN))
 def find_attractors(
-    model,
+    model: CompiledModel,
     *,
+    options: Integration | None = None,
     ics: int = 10,
     seed: int = 0,
     box: Mapping[str, tuple[float, float]] | None = None,
-    periods: int = 200,
-    discard: int = 300,
-    steps_per_period: int = 200,
-    backend: str = "auto",
     initial_states=None,
     merge_factor: float = MERGE_FACTOR,
     resolution: float = RESOLUTION,
     merge_floor: float = MERGE_FLOOR,
-    **settings,
+    **values: float,
 ) -> AttractorSet:
     """Run from many initial states and group the runs into distinct attractors.
 
-    ``model`` is anything :func:`~gearsym.codegen.compile_model` takes or a prebuilt
-    :class:`CompiledModel` (then ``settings`` are parameter values only), as for
+    ``model`` is a :class:`CompiledModel` (``values`` are parameter values) or a system, as for
     :func:`~gearsym.analysis.lyapunov_spectrum`. The ``ics`` initial states are
     drawn uniformly from ``box`` (state name -> (low, high); every state not named
     spans ``DEFAULT_BOX`` = [-5, 5]) with ``numpy.random.default_rng(seed)``, so a
     seed gives the same states every time; or ``initial_states`` (a sequence of
     mappings or of full state vectors) replaces the random draw, and then ``ics``,
-    ``seed`` and ``box`` are not used. Each run discards ``discard`` periods and
-    measures ``periods`` more (exponents and Poincare points).
+    ``seed`` and ``box`` are not used. Each run discards ``options.discard`` periods and
+    measures the rest (exponents and Poincare points); a system is compiled by default for ``RUN``
+    (500 periods, 300 discarded: a long transient, so that a run has settled on its attractor before
+    it is compared).
 
     Two runs are one attractor when their clouds of Poincare points are closer
     than ``merge_factor`` self distances plus ``resolution`` times the cloud's
@@ -227,12 +230,12 @@ def find_attractors(
     a slowly turning invariant circle and share no points within a short run.
     Attractors closer than that are not told apart.
     """
-    periods = whole_number(periods, "periods", 1)
-    discard = whole_number(discard, "discard")
+    options = model.run_options(options)
+    periods, discard = options.measured, options.discard
     for what, value in (("merge_factor", merge_factor), ("resolution", resolution), ("merge_floor", merge_floor)):
         if not (isinstance(value, numbers.Real) and np.isfinite(value) and value >= 0):
             raise GearsymError(f"{what} must be a finite number >= 0, got {value!r}")
-    compiled, values = compiled_and_values(model, settings, steps_per_period=steps_per_period, backend=backend)
+    compiled = model
     p = compiled.parameter_vector(values)  # checks the names and values once, before any run
 
     if initial_states is not None:
@@ -248,7 +251,7 @@ def find_attractors(
         starts = np.random.default_rng(seed).uniform(low, high, size=(ics, compiled.dimension))
         used_seed = seed
 
-    spectra = [_run(compiled, p, y0, i, periods, discard) for i, y0 in enumerate(starts)]
+    spectra = [_run(compiled, p, y0, i, options) for i, y0 in enumerate(starts)]
     clouds = [s.strobe for s in spectra]
     scale = _scales(clouds)
     groups = _group(clouds, scale, merge_factor, resolution, merge_floor)
@@ -289,11 +292,10 @@ def _explicit_states(compiled: CompiledModel, initial_states) -> np.ndarray:
     return np.array([compiled.initial_state(y0) for y0 in states])
 
 
-def _run(compiled: CompiledModel, p: np.ndarray, y0: np.ndarray, index: int, periods: int,
-         discard: int) -> LyapunovSpectrum:
+def _run(compiled: CompiledModel, p: np.ndarray, y0: np.ndarray, index: int,
+         options: Integration) -> LyapunovSpectrum:
     try:
-        return lyapunov_spectrum(compiled, periods=discard + periods, discard=discard, y0=y0,
-                                 **dict(zip(compiled.parameter_names, p)))
+        return lyapunov_spectrum(compiled, options=options, y0=y0, **dict(zip(compiled.parameter_names, p)))
     except GearsymError as exc:
         start = ", ".join(f"{n}={v:g}" for n, v in zip(compiled.state_names, y0))
         raise GearsymError(f"initial state #{index} ({start}): {exc}") from exc

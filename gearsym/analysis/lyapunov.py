@@ -12,9 +12,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..codegen import compiled_and_values
-from ..checks import json_safe, whole_number
-from ..errors import GearsymError
+from ..checks import json_safe
+from ..codegen import CompiledModel, engine_verb
+from ..options import Integration
 from .orbits import amplitudes
 from .regime import classify_regime
 from .statistics import batch_means_stderr
@@ -86,35 +86,22 @@ class LyapunovSpectrum:
         }
 
 
-def lyapunov_spectrum(
-    model,
-    *,
-    periods: int = 400,
-    discard: int = 100,
-    y0=None,
-    steps_per_period: int = 200,
-    backend: str = "auto",
-    locate_crossings: bool = False,
-    **settings,
-) -> LyapunovSpectrum:
-    """Full Lyapunov spectrum of ``model`` at the point given by ``settings``.
+@engine_verb
+def lyapunov_spectrum(model: CompiledModel, *, options: Integration | None = None, y0=None,
+                      **values: float) -> LyapunovSpectrum:
+    """Full Lyapunov spectrum of ``model`` at the parameter ``values`` (the model's own for the rest).
 
-    ``model`` is anything :func:`~gearsym.codegen.compile_model` takes (name,
-    path, Drivetrain, FirstOrderSystem) or a prebuilt :class:`CompiledModel`,
-    in which case ``settings`` may only change parameter values and nothing is
-    rebuilt (the low-level call for sweeps). ``y0`` is the initial state
-    (sequence or mapping; default: the model's declared initial state).
-    ``locate_crossings``: split RK4 steps at backlash crossings (4th order exponents; ignored for a
-    prebuilt model, which has its own).
+    ``model`` is a :class:`~gearsym.codegen.CompiledModel` (the low-level call: nothing is rebuilt, for
+    sweeps) or a :class:`~gearsym.system.FirstOrderSystem` (compiled first with ``options``).
+    ``options``: an :class:`~gearsym.options.Integration` (default: the compiled model's; the exponents
+    average over ``periods - discard`` periods). ``y0`` is the initial state (sequence or mapping;
+    default: the model's declared initial state).
     """
-    periods, discard = whole_number(periods, "periods"), whole_number(discard, "discard")
-    if periods <= discard:
-        raise GearsymError(f"need 0 <= discard < periods, got periods={periods}, discard={discard}")
-    compiled, values = compiled_and_values(model, settings, steps_per_period=steps_per_period, backend=backend,
-                                           locate_crossings=locate_crossings)
-    p = compiled.parameter_vector(values)
-    inputs = compiled.prepare(p)
-    run = compiled.tangent_run(y0, periods, inputs)
+    options = model.run_options(options)
+    p = model.parameter_vector(values)
+    inputs = model.prepare(p)
+    run = model.tangent_run(y0, options.periods, inputs)
+    discard = options.discard
 
     measured = run.log_stretch[:, discard:] / inputs.period  # per unit time, each period
     count = measured.shape[1]
@@ -124,19 +111,19 @@ def lyapunov_spectrum(
     order = np.argsort(-exponents, kind="stable")
     final = run.strobe[:, -1]
     return LyapunovSpectrum(
-        model=compiled.name,
-        parameters=dict(zip(compiled.parameter_names, map(float, p))),
+        model=model.name,
+        parameters=dict(zip(model.parameter_names, map(float, p))),
         exponents=exponents[order],
         stderr=stderr[order],
         history=history[:, order],
-        amplitude=amplitudes(compiled.observed, run.low[:, discard:], run.high[:, discard:]),
-        final_state=dict(zip(compiled.state_names, map(float, final))),
+        amplitude=amplitudes(model.observed, run.low[:, discard:], run.high[:, discard:]),
+        final_state=dict(zip(model.state_names, map(float, final))),
         strobe=run.strobe[:, discard:],
-        periods=periods,
+        periods=options.periods,
         discard=discard,
-        steps_per_period=compiled.steps_per_period,
+        steps_per_period=model.steps_per_period,
         period=inputs.period,
-        backend=compiled.backend,
-        autonomous=compiled.system.autonomous,
-        info={"Q": run.Q},
+        backend=model.backend,
+        autonomous=model.system.autonomous,
+        info={"Q": run.Q, "locate_crossings": model.options.locate_crossings},
     )

@@ -5,8 +5,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..codegen import compiled_and_values
-from ..checks import whole_number
+from ..codegen import CompiledModel, engine_verb
+from ..options import Integration
 
 
 @dataclass(frozen=True)
@@ -40,28 +40,29 @@ def amplitudes(names, low: np.ndarray, high: np.ndarray) -> dict[str, float]:
     return {n: float((h - lo) / 2) for n, lo, h in zip(names, low.min(axis=1), high.max(axis=1))}
 
 
-def poincare_samples(model, *, periods: int = 200, discard: int = 100, y0=None, t0: float = 0.0,
-                     steps_per_period: int = 200, backend: str = "auto", **settings) -> Orbit:
-    """Stroboscopic samples after ``discard`` transient periods (no tangent vectors: cheaper)."""
-    periods, discard = whole_number(periods, "periods", 1), whole_number(discard, "discard")
-    compiled, values = compiled_and_values(model, settings, steps_per_period=steps_per_period, backend=backend)
-    inputs = compiled.prepare(compiled.parameter_vector(values), t0=t0)
-    strobe, low, high = compiled.orbit_run(y0, discard + periods, inputs)
-    return Orbit(compiled.name, compiled.state_names, strobe[:, discard:],
-                 amplitudes(compiled.observed, low[:, discard:], high[:, discard:]),
-                 dict(zip(compiled.state_names, map(float, strobe[:, -1]))), inputs.period)
+@engine_verb
+def poincare_samples(model: CompiledModel, *, options: Integration | None = None, y0=None, t0: float = 0.0,
+                     **values: float) -> Orbit:
+    """Stroboscopic samples of the ``periods - discard`` periods after the transient (no tangent
+    vectors: cheaper than a spectrum). ``t0``: the phase of the section, t mod period = t0."""
+    options = model.run_options(options)
+    inputs = model.prepare(model.parameter_vector(values), t0=t0)
+    strobe, low, high = model.orbit_run(y0, options.periods, inputs)
+    d = options.discard
+    return Orbit(model.name, model.state_names, strobe[:, d:], amplitudes(model.observed, low[:, d:], high[:, d:]),
+                 dict(zip(model.state_names, map(float, strobe[:, -1]))), inputs.period)
 
 
-def phase_trajectory(model, *, periods: int = 20, discard: int = 100, y0=None, steps_per_period: int = 200,
-                     backend: str = "auto", **settings) -> Trajectory:
-    """The trajectory over ``periods`` periods after ``discard`` transient ones, at every step."""
-    periods, discard = whole_number(periods, "periods"), whole_number(discard, "discard")
-    compiled, values = compiled_and_values(model, settings, steps_per_period=steps_per_period, backend=backend)
-    inputs = compiled.prepare(compiled.parameter_vector(values))
-    start = compiled.initial_state(y0)
-    if discard:
-        strobe, _, _ = compiled.orbit_run(start, discard, inputs)
+@engine_verb
+def phase_trajectory(model: CompiledModel, *, options: Integration | None = None, y0=None,
+                     **values: float) -> Trajectory:
+    """The trajectory at every RK4 step over the ``periods - discard`` periods after the transient."""
+    options = model.run_options(options)
+    inputs = model.prepare(model.parameter_vector(values))
+    start = model.initial_state(y0)
+    if options.discard:
+        strobe, _, _ = model.orbit_run(start, options.discard, inputs)
         start = strobe[:, -1]
-    time, states = compiled.trajectory(start, periods, inputs)
-    time = time + discard * inputs.period
-    return Trajectory(compiled.name, compiled.state_names, time, states, states[:, ::compiled.steps_per_period])
+    time, states = model.trajectory(start, options.measured, inputs)
+    time = time + options.discard * inputs.period
+    return Trajectory(model.name, model.state_names, time, states, states[:, ::model.steps_per_period])

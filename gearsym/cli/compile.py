@@ -5,8 +5,10 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..codegen.generated import DEFAULT_DIR, generate_model
-from ..registry import available_models
+from ..codegen.generated import generate_model
+from ..paths import GENERATED_DIR
+from ..registry import available_models, load
+from .integration import add_integration_arguments, integration_from
 from .settings import add_set_argument, parse_settings
 
 NAME = "compile"
@@ -17,8 +19,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("models", nargs="*", metavar="MODEL", help="model names or model file paths")
     parser.add_argument("--all", action="store_true", help="every model of `gearsym list`")
     add_set_argument(parser)
-    parser.add_argument("--steps-per-period", type=int, default=200, help="RK4 steps per period (default 200)")
-    parser.add_argument("--out", type=Path, default=DEFAULT_DIR, metavar="DIR",
+    add_integration_arguments(parser, periods=None)
+    parser.add_argument("--out", type=Path, default=GENERATED_DIR, metavar="DIR",
                         help="where <model>/ is written (default: generated/ of the repository)")
     parser.add_argument("--no-compile", action="store_true", help="write the C only")
     parser.add_argument("--check", action="store_true",
@@ -33,8 +35,8 @@ def run(args: argparse.Namespace) -> int:
     settings = parse_settings(args.set)
     stale = []
     for ref in refs:
-        report = generate_model(ref, args.out, steps_per_period=args.steps_per_period, check=args.check,
-                                compile=not (args.no_compile or args.check), **settings)
+        report = generate_model(load(ref, **settings), args.out, integration_from(args), check=args.check,
+                                compile=not (args.no_compile or args.check))
         if args.check:
             stale += report.stale
             continue

@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 
 from ..derivation import derive, render
+from ..registry import load_model
 
 NAME = "derive"
 HELP = "print the reduced, nondimensional equations and coefficient groups of a model"
@@ -19,5 +20,5 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    print(render(derive(args.model), args.format, full=args.full), end="")
+    print(render(derive(load_model(args.model)), args.format, full=args.full), end="")
     return 0

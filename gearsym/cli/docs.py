@@ -10,11 +10,12 @@ import sys
 from pathlib import Path
 
 from ..derivation import derive, render
-from ..registry import REPO_ROOT, available_models
+from ..paths import DERIVATIONS_DIR
+from ..registry import available_models, load_model
 
 NAME = "docs"
 HELP = "write the Markdown derivation of models to DIR/<model>.md"
-DEFAULT_OUT = REPO_ROOT / "docs" / "derivations"
+DEFAULT_OUT = DERIVATIONS_DIR
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -28,7 +29,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def page(model: str) -> tuple[str, str]:
     """(model name, Markdown page) for a model reference."""
-    derivation = derive(model)
+    derivation = derive(load_model(model))
     return derivation.model, render(derivation, "markdown")
 
 

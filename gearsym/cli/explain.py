@@ -5,7 +5,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from .settings import add_set_argument, parse_settings
+from .integration import add_integration_arguments, integration_from, system_from
+from .settings import add_set_argument
 
 NAME = "explain"
 HELP = "fit a model to measured data, find the missing physical effect, add it, report the error before and after"
@@ -25,6 +26,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="fraction of each record (its last whole periods) held out for judging (default 0.25)")
     parser.add_argument("--effects", default=None, metavar="NAME,NAME",
                         help="candidate effects (default: the whole library)")
+    add_integration_arguments(parser, periods=None, steps_help="RK4 steps per forcing period between the samples "
+                                                               "(default 200; the fit's windows are plain RK4)")
     parser.add_argument("--quiet", action="store_true")
 
 
@@ -34,8 +37,9 @@ def run(args: argparse.Namespace) -> int:
     fit = [p.strip() for p in args.fit.split(",") if p.strip()]
     candidates = [e.strip() for e in args.effects.split(",")] if args.effects else None
     say = None if args.quiet else (lambda m: print(f"gearsym: {m}", file=sys.stderr, flush=True))
-    report = explain_files(args.data, args.model, fit, out=args.out, time_scale=args.time_scale,
-                           held_out=args.held_out, candidates=candidates, progress=say, **parse_settings(args.set))
+    report = explain_files(args.data, system_from(args), fit, out=args.out, time_scale=args.time_scale,
+                           held_out=args.held_out, candidates=candidates, progress=say,
+                           options=integration_from(args))
     added = ", ".join(report["effects"]) or "none"
     print(f"effects added: {added}; held-out error {report['error_before']:.4g} -> {report['error_after']:.4g}; "
           f"unexplained: {'yes' if report['unexplained'] else 'no'}")

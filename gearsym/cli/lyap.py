@@ -7,8 +7,8 @@ import sys
 from pathlib import Path
 
 from ..analysis import lyapunov_spectrum, phase_trajectory
-from ..codegen import BACKENDS, compile_model
-from .settings import add_set_argument, parse_settings, parse_state
+from .integration import add_integration_arguments, compiled_from
+from .settings import add_set_argument, parse_state
 
 NAME = "lyap"
 HELP = "Lyapunov spectrum (all exponents, per unit time) at one parameter point"
@@ -17,28 +17,21 @@ HELP = "Lyapunov spectrum (all exponents, per unit time) at one parameter point"
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("model", help="a model name (see `gearsym list`) or the path of a model file")
     add_set_argument(parser)
-    parser.add_argument("--periods", type=int, default=400, help="forcing periods in all (default 400)")
-    parser.add_argument("--discard", type=int, default=100, help="transient periods left out (default 100)")
-    parser.add_argument("--steps-per-period", type=int, default=200, help="RK4 steps per period (default 200)")
-    parser.add_argument("--locate-crossings", action="store_true",
-                        help="split RK4 steps where the backlash switches (4th order exponents; see docs/engine.md)")
+    add_integration_arguments(parser)
     parser.add_argument("--y0", metavar="x=-2,v=-0.5", help="initial state (default: the model's)")
-    parser.add_argument("--backend", choices=BACKENDS, default="auto",
-                        help="compiled C, CasADi in-process, or auto (compiled when a C compiler exists)")
     parser.add_argument("--format", choices=("text", "json"), default="text")
     parser.add_argument("--plot", type=Path, metavar="FILE.png",
                         help="also draw the exponents' convergence and the phase portrait with the Poincare points")
 
 
 def run(args: argparse.Namespace) -> int:
-    compiled = compile_model(args.model, steps_per_period=args.steps_per_period, backend=args.backend,
-                             locate_crossings=args.locate_crossings, verbose=True, **parse_settings(args.set))
-    result = lyapunov_spectrum(compiled, periods=args.periods, discard=args.discard, y0=parse_state(args.y0))
+    compiled = compiled_from(args)
+    result = lyapunov_spectrum(compiled, y0=parse_state(args.y0))
     if args.plot:
         from ..figures import plot_point  # matplotlib only when asked for
 
         shown = min(30, result.periods - result.discard)
-        trajectory = phase_trajectory(compiled, periods=shown, discard=result.periods - shown,
+        trajectory = phase_trajectory(compiled, options=compiled.integration.run(discard=result.periods - shown),
                                       y0=parse_state(args.y0))
         plot_point(result, trajectory, args.plot)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
@@ -46,7 +39,7 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(result.as_dict(), indent=2))
         return 0
     print(f"{result.model}: {result.periods} periods ({result.discard} discarded), "
-          f"{result.steps_per_period} RK4 steps/period{', crossings located' if args.locate_crossings else ''}, "
+          f"{result.steps_per_period} RK4 steps/period, {'plain RK4' if args.plain else 'crossings located'}, "
           f"{result.backend}")
     print("parameters: " + ", ".join(f"{k}={v:g}" for k, v in result.parameters.items()))
     print("Lyapunov exponents (per unit time, +- standard error):")

@@ -6,10 +6,10 @@ import json
 import sys
 from pathlib import Path
 
-from ..analysis.attractors import DEFAULT_BOX, AttractorSet, find_attractors
-from ..codegen import BACKENDS, compile_model
+from ..analysis.attractors import DEFAULT_BOX, RUN, AttractorSet, find_attractors
 from ..errors import GearsymError
-from .settings import add_set_argument, parse_settings
+from .integration import add_integration_arguments, compiled_from
+from .settings import add_set_argument
 
 NAME = "poincare"
 HELP = "Poincare maps from many random initial states, grouped into coexisting attractors"
@@ -23,12 +23,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--box", metavar="x=-5:5,v=-5:5",
                         help=f"where the initial states are drawn, per state (default {DEFAULT_BOX[0]:g}:"
                              f"{DEFAULT_BOX[1]:g} for every state not named)")
-    parser.add_argument("--periods", type=int, default=200,
-                        help="measured periods per run, after the discarded ones (default 200)")
-    parser.add_argument("--discard", type=int, default=300, help="transient periods left out (default 300)")
-    parser.add_argument("--steps-per-period", type=int, default=200, help="RK4 steps per period (default 200)")
-    parser.add_argument("--backend", choices=BACKENDS, default="auto",
-                        help="compiled C, CasADi in-process, or auto (compiled when a C compiler exists)")
+    add_integration_arguments(parser, **RUN)
     parser.add_argument("--format", choices=("text", "json"), default="text")
     parser.add_argument("--plot", type=Path, metavar="FILE.png",
                         help="also draw the Poincare points of every attractor")
@@ -56,10 +51,8 @@ def parse_box(text: str | None) -> dict[str, tuple[float, float]] | None:
 
 def run(args: argparse.Namespace) -> int:
     box = parse_box(args.box)
-    compiled = compile_model(args.model, steps_per_period=args.steps_per_period, backend=args.backend,
-                             verbose=True, **parse_settings(args.set))
-    found = find_attractors(compiled, ics=args.ics, seed=args.seed, box=box, periods=args.periods,
-                            discard=args.discard)
+    compiled = compiled_from(args)
+    found = find_attractors(compiled, ics=args.ics, seed=args.seed, box=box)
     if args.plot:
         from ..figures.poincare import plot_attractors  # matplotlib only when asked for
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..codegen import BACKENDS, compile_model
-from ..data.simulate import simulate_measurements, steps_for
+from ..data.simulate import RUN, simulate_measurements, steps_for
+from .integration import add_integration_arguments, compiled_from, integration_from
 from .settings import add_set_argument, parse_numbers, parse_settings, parse_state
 
 NAME = "simulate"
@@ -19,20 +19,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="one record and its operating conditions, written as columns of the file (repeat for "
                              "several records; default one record without conditions). --set values are the "
                              "simulated model and are not written")
-    parser.add_argument("--periods", type=int, default=40, help="forcing periods recorded per record (default 40)")
-    parser.add_argument("--discard", type=int, default=100, help="transient periods left out first (default 100)")
     parser.add_argument("--samples-per-period", type=int, default=50,
                         help="samples per forcing period (default 50); must divide the RK4 steps per period")
-    parser.add_argument("--steps-per-period", type=int, default=None,
-                        help="RK4 steps per period (default: the smallest multiple of the samples of at least 200)")
+    add_integration_arguments(parser, **RUN, steps_help="RK4 steps per period (default: the smallest multiple of the "
+                                                       "samples per period of at least 200)")
     parser.add_argument("--noise", type=float, default=0.0,
                         help="Gaussian noise, standard deviation relative to the clean signal's, per record and "
                              "column (0.01 = 1 %%; default 0)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the noise (default 0)")
     parser.add_argument("--velocities", action="store_true", help="also write the velocity states (v, v1, ...)")
     parser.add_argument("--y0", metavar="x=-2,v=-0.5", help="initial state of every record (default: the model's)")
-    parser.add_argument("--backend", choices=BACKENDS, default="auto",
-                        help="compiled C, CasADi in-process, or auto (compiled when a C compiler exists)")
     parser.add_argument("--effect", action="append", default=[], metavar="NAME",
                         help="simulate the model with an effect of the library added (coulomb_friction, "
                              "cubic_stiffness, mesh_stiffness_harmonic, transmission_error, coast_side_stiffness); "
@@ -42,19 +38,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     records = [parse_conditions(text) for text in args.record]
-    settings = parse_settings(args.set)
-    steps = steps_for(args.samples_per_period, args.steps_per_period)
-    model = _with_effects(args.model, args.effect, settings) if args.effect else args.model
-    compiled = compile_model(model, steps_per_period=steps, backend=args.backend, verbose=True,
-                             **({} if args.effect else settings))
-    table = simulate_measurements(compiled, periods=args.periods, discard=args.discard,
-                                  samples_per_period=args.samples_per_period,
+    options = integration_from(args, steps_for(args.samples_per_period, args.steps_per_period))
+    system = _with_effects(args.model, args.effect, parse_settings(args.set)) if args.effect else None
+    compiled = compiled_from(args, options, system)
+    table = simulate_measurements(compiled, samples_per_period=args.samples_per_period,
                                   noise=args.noise, seed=args.seed, records=records or None,
                                   y0=parse_state(args.y0), velocities=args.velocities, out=args.out)
     per_record = table.rows // table.records
     conditions = f"; conditions {', '.join(table.conditions)}" if table.conditions else ""
     print(f"{table.model}: {table.records} record(s) of {per_record} samples ({table.samples_per_period} per period, "
-          f"{args.periods} periods after {args.discard} discarded, {table.steps_per_period} RK4 steps/period), "
+          f"{options.measured} periods after {args.discard} discarded, {table.steps_per_period} RK4 steps/period), "
           f"noise {args.noise:g}{conditions}; columns {', '.join(table.columns)}")
     print(f"wrote {args.out}")
     return 0
@@ -63,10 +56,10 @@ def run(args: argparse.Namespace) -> int:
 def _with_effects(model: str, effects: list[str], settings: dict):
     """The model's equations with ``effects`` added; ``settings`` set the model's and the effects' parameters."""
     from ..fit.effects import augment, effect
-    from ..registry import system_for
+    from ..registry import load
 
     own = {p for e in map(effect, effects) for p in e.parameters}
-    base = system_for(model, **{k: v for k, v in settings.items() if k not in own})
+    base = load(model, **{k: v for k, v in settings.items() if k not in own})
     return augment(base, effects, values={k: v for k, v in settings.items() if k in own})
 
 

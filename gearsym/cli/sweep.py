@@ -6,9 +6,9 @@ import sys
 from collections import Counter
 from pathlib import Path
 
-from ..codegen import BACKENDS
-from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, run_sweep
-from .settings import add_set_argument, parse_settings, parse_state
+from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, Workers, run_sweep
+from .integration import add_integration_arguments, compiled_from
+from .settings import add_set_argument, parse_state
 
 NAME = "sweep"
 HELP = "Lyapunov spectra, amplitudes and regimes over a 1-D or 2-D parameter grid (resumable)"
@@ -26,11 +26,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--direction", choices=DIRECTIONS, default="up",
                         help="continuation along the first parameter: ascending, descending, or up then down "
                              "(shows hysteresis)")
-    parser.add_argument("--periods", type=int, default=400, help="forcing periods per point (default 400)")
-    parser.add_argument("--discard", type=int, default=100, help="transient periods left out (default 100)")
-    parser.add_argument("--steps-per-period", type=int, default=200, help="RK4 steps per period (default 200)")
-    parser.add_argument("--locate-crossings", action="store_true",
-                        help="split RK4 steps where the backlash switches (4th order exponents; see docs/engine.md)")
+    add_integration_arguments(parser)
     parser.add_argument("--y0", metavar="x=-2,v=-0.5", help="initial state (default: the model's)")
     parser.add_argument("--jobs", type=int, default=0,
                         help="processes or threads (default 0: every core); with --dask, worker processes")
@@ -50,7 +46,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--overwrite", action="store_true", help="start again instead of resuming")
     parser.add_argument("--poincare", type=int, default=POINCARE_SAMPLES, metavar="K",
                         help=f"stroboscopic samples kept per point, for bifurcation diagrams (default {POINCARE_SAMPLES})")
-    parser.add_argument("--backend", choices=BACKENDS, default="auto")
     parser.add_argument("--plot", type=Path, metavar="FILE.png",
                         help="draw amplitudes, exponents, regimes and the bifurcation diagram")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -58,12 +53,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     try:
-        result = run_sweep(args.model, args.param, mode=args.mode, direction=args.direction, periods=args.periods,
-                           discard=args.discard, steps_per_period=args.steps_per_period, y0=parse_state(args.y0),
-                           jobs=args.jobs, out=args.out, overwrite=args.overwrite, poincare=args.poincare,
-                           progress=not args.quiet, backend=args.backend, locate_crossings=args.locate_crossings,
-                           scheduler="local" if args.dask else args.scheduler, parallel=args.parallel,
-                           **parse_settings(args.set))
+        workers = Workers(args.jobs, args.parallel, "local" if args.dask else args.scheduler)
+        result = run_sweep(compiled_from(args), args.param, mode=args.mode, direction=args.direction,
+                           y0=parse_state(args.y0), out=args.out, overwrite=args.overwrite, poincare=args.poincare,
+                           workers=workers, progress=not args.quiet)
     except KeyboardInterrupt as exc:  # SweepInterrupted says how many points were kept
         print(f"gearsym: {exc}" if str(exc) else "gearsym: interrupted before any point was finished",
               file=sys.stderr)

@@ -1,13 +1,14 @@
 """A model's loops, compiled (or evaluated in-process), behind one small object.
 
-A :class:`CompiledModel` is built by :func:`gearsym.codegen.build.compile_model`;
-the analyses in :mod:`gearsym.analysis` take one, so that a sweep builds it
-once and only changes the parameter vector (the low-level call), or build it
-from a model name themselves (the high-level call).
+A :class:`CompiledModel` is built by :func:`gearsym.codegen.build.compile_model`
+from a :class:`~gearsym.system.FirstOrderSystem` and an
+:class:`~gearsym.options.Integration`; the analyses in :mod:`gearsym.analysis`
+take one, so that a sweep builds it once and only changes the parameter vector
+(the low-level call), or build it from a system themselves (the high-level call).
 """
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
@@ -16,7 +17,8 @@ import casadi as ca
 import numpy as np
 
 from ..checks import whole_number
-from ..errors import GearsymError, ModelError, UnknownParameterError
+from ..errors import GearsymError, ModelError
+from ..options import Integration
 from ..system import FirstOrderSystem
 from .functions import LoopOptions
 from .native import NativeFunction
@@ -64,8 +66,26 @@ class CompiledModel:
     backend: str  # "compiled" | "in-process"
     library: Path | None = None
     timings: dict[str, float] = field(default_factory=dict)
-    check: Callable[[str, float], float] | None = None
     native: Mapping[str, NativeFunction] | None = None  # the same functions, called without CasADi
+    integration: Integration = field(default_factory=Integration)  # the options it was compiled with
+
+    def run_options(self, options: Integration | None) -> Integration:
+        """The options a run on this model uses: its own, or ``options`` if they need the same code."""
+        if options is None:
+            return self.integration
+        if not isinstance(options, Integration):
+            raise GearsymError(f"options must be a gearsym.Integration, got {type(options).__name__}")
+        mine = self.integration
+        same = (options.steps_per_period == mine.steps_per_period
+                and options.locate_crossings == mine.locate_crossings
+                and options.backend in ("auto", self.backend))
+        if not same:
+            raise GearsymError(
+                f"{self.name}: this compiled model integrates with {mine.steps_per_period} steps per period, "
+                f"{'crossings located' if mine.locate_crossings else 'plain RK4'}, {self.backend}; the options ask "
+                f"for {options.steps_per_period}, {'crossings located' if options.locate_crossings else 'plain RK4'}"
+                f", {options.backend}: compile the system with these options (compile_model(system, options))")
+        return options
 
     def clone(self) -> "CompiledModel":
         """The same functions with work arrays of its own: one clone per thread runs in parallel
@@ -103,24 +123,7 @@ class CompiledModel:
     # ---------------------------------------------------------------- inputs
     def parameter_vector(self, values: Mapping[str, float] | None = None, **more: float) -> np.ndarray:
         """The model's parameter vector: its values, with ``values``/``more`` overriding (names checked)."""
-        merged = dict(self.system.parameters)
-        for name, value in {**(values or {}), **more}.items():
-            if name not in merged:
-                if isinstance(value, str):
-                    raise GearsymError(
-                        f"{self.name}: {name}={value!r} would change the model's equations; a compiled model "
-                        f"only takes parameter values. Build a new one: compile_model(model, {name}=...)")
-                raise UnknownParameterError(name, merged, self.name)
-            try:
-                merged[name] = self.check(name, value) if self.check else float(value)
-            except (TypeError, ValueError) as exc:
-                if isinstance(exc, GearsymError):
-                    raise
-                raise GearsymError(f"{self.name}: {name} must be a number, got {value!r}") from None
-        bad = [n for n, v in merged.items() if not np.isfinite(v)]
-        if bad:
-            raise GearsymError(f"{self.name}: parameter values must be finite numbers: "
-                               + ", ".join(f"{n}={merged[n]}" for n in bad))
+        merged = self.system.parameter_values({**(values or {}), **more})
         return np.array([merged[n] for n in self.parameter_names], dtype=float)
 
     def prepare(self, p: np.ndarray | Mapping[str, float] | None = None, t0: float = 0.0) -> RunInputs:

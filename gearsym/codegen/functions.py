@@ -34,6 +34,7 @@ import sympy as sp
 
 from ..backlash import G, g, g_slope
 from ..errors import ModelError
+from ..options import STEPS_PER_PERIOD, Integration
 from ..system import FirstOrderSystem
 from .time_tables import SplitRHS, split_rhs
 from .translate import select_max, select_min, to_casadi
@@ -43,10 +44,15 @@ from .translate import select_max, select_min, to_casadi
 class LoopOptions:
     """Structure of the generated loops (part of the model hash; values of parameters are not)."""
 
-    steps_per_period: int = 200
+    steps_per_period: int = STEPS_PER_PERIOD
     chunk_periods: int = 50  # periods per compiled call
     block_steps: int = 0  # RK4 steps unrolled per SX block; 0 chooses
     locate_crossings: bool = False  # split steps at backlash switching surfaces (4th order exponents)
+
+    @classmethod
+    def of(cls, options: Integration) -> "LoopOptions":
+        """The part of an :class:`~gearsym.options.Integration` that shapes the generated code."""
+        return cls(steps_per_period=options.steps_per_period, locate_crossings=options.locate_crossings)
 
     def __post_init__(self):
         if self.steps_per_period < 1:
@@ -89,7 +95,7 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
     where = system.name
 
     # rhs and Jacobian in the user's terms (time, state, parameters)
-    f_user = ca.vertcat(*to_casadi(system.rhs, sym.outer, where))
+    f_user = sym.base.rhs(system)
     rhs = ca.Function("rhs", [sym.t, sym.y, sym.p], [f_user], ["t", "y", "p"], ["dy"], _OPTS)
     jacobian = ca.Function("jacobian", [sym.t, sym.y, sym.p], [ca.densify(ca.jacobian(f_user, sym.y))],
                            ["t", "y", "p"], ["J"], _OPTS)
@@ -180,27 +186,47 @@ def _over_period(block, carry: list, T: ca.MX, C: ca.MX, K: int, name: str, grou
     return carry
 
 
+@dataclass(frozen=True)
+class SystemSymbols:
+    """SX symbols for a system's time, state and parameter vector, and the SymPy -> SX map of them: the one
+    map from a model's symbols to CasADi's, for the engine's functions and the fit's windows alike."""
+
+    t: ca.SX
+    y: ca.SX
+    p: ca.SX
+    mapping: dict
+
+    @classmethod
+    def of(cls, system: FirstOrderSystem) -> "SystemSymbols":
+        names = list(system.parameters)
+        t, y, p = ca.SX.sym("t"), ca.SX.sym("y", system.dimension), ca.SX.sym("p", len(names))
+        mapping = {system.time: t, **{s: y[i] for i, s in enumerate(system.states)}}
+        by_name = {name: p[j] for j, name in enumerate(names)}
+        for expr in list(system.rhs) + [system.period]:  # parameters by name, whatever their assumptions
+            for s in expr.free_symbols:
+                if s not in mapping and s.name in by_name:
+                    mapping[s] = by_name[s.name]
+        return cls(t, y, p, mapping)
+
+    def rhs(self, system: FirstOrderSystem) -> ca.SX:
+        """f(t, y, p), the right-hand side in these symbols."""
+        return ca.vertcat(*to_casadi(system.rhs, self.mapping, system.name))
+
+
 class _Symbols:
     """The SX symbols of one model and the SymPy -> SX maps of the outer functions and the loop body."""
 
     def __init__(self, system: FirstOrderSystem, split: SplitRHS):
-        n, m, nc = system.dimension, len(split.tables), len(split.constants)
+        m, nc = len(split.tables), len(split.constants)
+        base = self.base = SystemSymbols.of(system)
         self.params = list(system.parameters)
         self.observed = [i for i, s in enumerate(system.states) if s.name in system.observed]
-        self.t = ca.SX.sym("t")
-        self.y = ca.SX.sym("y", n)
-        self.p = ca.SX.sym("p", len(self.params))
+        self.t, self.y, self.p = base.t, base.y, base.p
         self.T = ca.SX.sym("T", m)
         c = ca.SX.sym("c", nc)
-        outer = {system.time: self.t}
-        outer.update({s: self.y[i] for i, s in enumerate(system.states)})
+        outer = dict(base.mapping)
         outer.update({s: self.T[i] for i, (s, _) in enumerate(split.tables)})
         outer.update({s: c[i] for i, (s, _) in enumerate(split.constants)})
-        by_name = {name: self.p[j] for j, name in enumerate(self.params)}
-        for expr in list(system.rhs) + [system.period]:
-            for s in expr.free_symbols:
-                if s not in outer and s.name in by_name:
-                    outer[s] = by_name[s.name]
         self.outer = outer
         # the loop body sees states, table values and constants only; ch = (constants, h)
         self.ch = ca.SX.sym("c", nc + 1)
@@ -226,7 +252,7 @@ def _rk4_functions(sym: _Symbols, split: SplitRHS, K: int, where: str):
     Tk = ca.SX.sym("Tk", 3 * m, K)
 
     def rk4(yk, Qk, Ta, Tb, Tc):  # Ta, Tb, Tc: table values at t, t + h/2, t + h
-        return _rk4(lambda x, T: f_of(x, T, ch), lambda x, T: J_of(x, T, ch), yk, Qk, h, Ta, Tb, Tc)
+        return rk4_step(lambda x, T: f_of(x, T, ch), lambda x, T: J_of(x, T, ch), yk, Qk, h, Ta, Tb, Tc)
 
     def block(with_tangent: bool):
         yk, Qk, lk, hk = y, (Q if with_tangent else None), lo, hi
@@ -247,9 +273,10 @@ def _rk4_functions(sym: _Symbols, split: SplitRHS, K: int, where: str):
     return tangent_block, state_block, state_step
 
 
-def _rk4(f, J, yk, Qk, h, Ta, Tb, Tc):
-    """One RK4 step of length h of y' = f(y, T) and, unless ``Qk`` is None, of Q' = J(y, T) Q.
-    Ta, Tb, Tc: the table values at the start, middle and end of the step."""
+def rk4_step(f, J, yk, Qk, h, Ta, Tb, Tc):
+    """One RK4 step of length h of y' = f(y, T) and, unless ``Qk`` is None, of Q' = J(y, T) Q: the one RK4 of
+    gearsym (the engine's loops and the fit's windows). Ta, Tb, Tc: what time-dependent values f needs at the
+    start, middle and end of the step (the engine's tables, or the time itself)."""
     k1 = f(yk, Ta)
     y2 = yk + h / 2 * k1
     k2 = f(y2, Tb)
@@ -377,7 +404,7 @@ def _crossing_steps(sym: _Symbols, split: SplitRHS, switching: _Switching, where
         return s >= 0
 
     def plain(with_tangent: bool):
-        yn, Qn = _rk4(lambda x, Tx: f_of(x, Tx, ch), lambda x, Tx: J_of(x, Tx, ch), y,
+        yn, Qn = rk4_step(lambda x, Tx: f_of(x, Tx, ch), lambda x, Tx: J_of(x, Tx, ch), y,
                       Q if with_tangent else None, h, Ta, Tb, Tc)
         flag = ca.sum1(side(s_of(y, Ta, ch)) != side(s_of(yn, Tc, ch))) > 0
         return yn, Qn, flag
@@ -393,7 +420,7 @@ def _crossing_steps(sym: _Symbols, split: SplitRHS, switching: _Switching, where
             return lambda x, Tx: Jz_of(x, Tx, ch, mode)
 
         mode_a = side(s_of(y, Ta, ch))
-        y_ext, _ = _rk4(f_mode(mode_a), None, y, None, h, Ta, Tb, Tc)
+        y_ext, _ = rk4_step(f_mode(mode_a), None, y, None, h, Ta, Tb, Tc)
         s0, s1 = s_of(y, Ta, ch), s_of(y_ext, Tc, ch)
         d0 = sdot_of(y, Ta, ch, h * fz_of(y, Ta, ch, mode_a), 4 * Tb - 3 * Ta - Tc)
         d1 = sdot_of(y_ext, Tc, ch, h * fz_of(y_ext, Tc, ch, mode_a), Ta - 4 * Tb + 3 * Tc)
@@ -413,9 +440,9 @@ def _crossing_steps(sym: _Symbols, split: SplitRHS, switching: _Switching, where
         mode_b = ca.if_else(flip, 1 - mode_a, mode_a)
         first = ca.if_else(first > 1, 1, first)
         Tm = table_at(first)
-        y_c, Q_c = _rk4(f_mode(mode_a), J_mode(mode_a), y, Q if with_tangent else None, first * h,
+        y_c, Q_c = rk4_step(f_mode(mode_a), J_mode(mode_a), y, Q if with_tangent else None, first * h,
                         Ta, table_at(first / 2), Tm)
-        return _rk4(f_mode(mode_b), J_mode(mode_b), y_c, Q_c, (1 - first) * h, Tm, table_at((1 + first) / 2), Tc)
+        return rk4_step(f_mode(mode_b), J_mode(mode_b), y_c, Q_c, (1 - first) * h, Tm, table_at((1 + first) / 2), Tc)
 
     def extremes(yn):
         obs = ca.vertcat(*[yn[j] for j in sym.observed])

@@ -5,12 +5,12 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..registry import REPO_ROOT
+from ..options import Integration
+from ..paths import GENERATED_DIR
+from ..system import FirstOrderSystem
 from .compiler import compile_library
 from .functions import LoopOptions, build_functions
 from .generate import code_hash, write_code
-
-DEFAULT_DIR = REPO_ROOT / "generated"
 
 
 @dataclass
@@ -24,16 +24,14 @@ class GenerateReport:
     stale: list[Path] = field(default_factory=list)
 
 
-def generate_model(ref, out: Path = DEFAULT_DIR, *, steps_per_period: int = 200, check: bool = False,
-                   compile: bool = True, **settings) -> GenerateReport:
-    """Write ``out/<model>/<model>.c`` and ``manifest.json``; with ``check``, compare instead of writing."""
-    from ..registry import system_for
-
-    system = system_for(ref, **settings)
-    options = LoopOptions(steps_per_period=steps_per_period)
-    digest = code_hash(system, options)
+def generate_model(system: FirstOrderSystem, out: Path = GENERATED_DIR, options: Integration = Integration(), *,
+                   check: bool = False, compile: bool = True) -> GenerateReport:
+    """Write ``out/<model>/<model>.c`` and ``manifest.json`` for ``system`` compiled with ``options``;
+    with ``check``, compare instead of writing."""
+    loops = LoopOptions.of(options)
+    digest = code_hash(system, loops)
     target = Path(out) / system.name
-    mf = build_functions(system, options)
+    mf = build_functions(system, loops)
     if check:
         with tempfile.TemporaryDirectory() as tmp:
             fresh = write_code(mf, Path(tmp) / system.name, digest)

@@ -22,9 +22,8 @@ that built it, and the generated C source (about 0.3 MB each way).
   KB). The worker's code hash must equal the shipped one, which proves it
   builds the same functions.
 
-Parameter checks (the reduction's ``check_value``) do not travel: a sweep
-checks every value on the client before any work, and the check returns the
-same float it is given.
+Parameter checks travel with the system (its ``constraints``); a sweep checks
+every value on the client before any work anyway.
 """
 from __future__ import annotations
 
@@ -39,6 +38,7 @@ import casadi as ca
 
 from ..errors import GearsymError
 from ..files import write_atomically
+from ..options import Integration
 from ..system import FirstOrderSystem
 from .build import FUNCTION_NAMES, cached_code_directory, code_directory
 from .compiled import CompiledModel
@@ -56,6 +56,7 @@ class ShippedModel:
 
     system: FirstOrderSystem
     options: LoopOptions
+    integration: Integration
     hash: str
     backend: str  # "compiled" | "in-process"
     versions: tuple[str, str]  # gearsym and casadi of the client
@@ -76,8 +77,8 @@ class ShippedModel:
 
 def ship(compiled: CompiledModel) -> ShippedModel:
     """``compiled`` packed for another process or machine (see the module docstring)."""
-    base = dict(system=compiled.system, options=compiled.options, hash=compiled.hash, backend=compiled.backend,
-                versions=_versions())
+    base = dict(system=compiled.system, options=compiled.options, integration=compiled.integration,
+                hash=compiled.hash, backend=compiled.backend, versions=_versions())
     if compiled.backend != "compiled":
         return ShippedModel(**base)
     name = compiled.name
@@ -103,7 +104,7 @@ def load_shipped(shipped: ShippedModel) -> CompiledModel:
                                "(the code hash differs); install the same gearsym on every worker")
         functions = build_functions(shipped.system, shipped.options).functions
         return CompiledModel(shipped.system, shipped.options, shipped.hash, functions, "in-process",
-                             timings={"load": time.perf_counter() - start})
+                             timings={"load": time.perf_counter() - start}, integration=shipped.integration)
     timings = {}
     if shipped.binary_key == binary_key(shipped.flags):
         path = _write_library(shipped)
@@ -112,7 +113,7 @@ def load_shipped(shipped: ShippedModel) -> CompiledModel:
     functions = {name: ca.external(name, str(path)) for name in FUNCTION_NAMES}
     timings["load"] = time.perf_counter() - start
     return CompiledModel(shipped.system, shipped.options, shipped.hash, functions, "compiled", path, timings,
-                         None, load_native(path, functions))
+                         load_native(path, functions), shipped.integration)
 
 
 def _write_library(shipped: ShippedModel) -> Path:

@@ -16,7 +16,7 @@ One row per sample. The columns, in any order:
 Every sample of a record must be finite, the time strictly increasing and evenly spaced (within
 ``spacing_tolerance`` of the record's median step), with at least ``min_samples_per_period``
 samples per forcing period and at least ``min_periods`` whole forcing periods. The forcing
-period is the compiled model's, at the record's parameter values (2*pi in tau for the gear
+period is the model's, at the record's parameter values (2*pi in tau for the gear
 models). A file that breaks a rule gets a :class:`DataError` naming the file, the line (as a
 text editor numbers it: the header is line 1) and the column.
 
@@ -35,8 +35,8 @@ from typing import Union
 import numpy as np
 
 from ..checks import whole_number
-from ..codegen import CompiledModel, compiled_and_values
 from ..errors import GearsymError, suggest
+from ..system import FirstOrderSystem
 
 RECORD = "record"
 PHYSICAL_TIME = "t"
@@ -237,23 +237,25 @@ class Measurements:
 # --------------------------------------------------------------------------- reading
 def load_measurements(
     paths: PathLike | Sequence[PathLike],
-    model,
+    system: FirstOrderSystem,
     *,
     time_scale: float | None = None,
     min_samples_per_period: float = MIN_SAMPLES_PER_PERIOD,
     min_periods: int = MIN_PERIODS,
     spacing_tolerance: float = SPACING_TOLERANCE,
-    **settings,
+    **values: float,
 ) -> Measurements:
-    """Read and check measured-data files (one path or several) for ``model``.
+    """Read and check measured-data files (one path or several) for a model.
 
-    ``model`` is a model name, path or object (compiled with ``settings`` as its defaults) or a
-    :class:`~gearsym.codegen.CompiledModel` (``settings`` then are parameter values). Records
+    ``system`` is the model's :class:`~gearsym.system.FirstOrderSystem` (``values``: parameter values that
+    hold for every record unless a record's conditions set them). Records
     are identified per file (two files may both have a record ``1``). ``time_scale`` converts a
     ``t`` column: tau = time_scale * t; files with a ``tau`` column ignore it.
     """
-    compiled, values = compiled_and_values(model, dict(settings))
-    defaults = dict(zip(compiled.parameter_names, map(float, compiled.parameter_vector(values))))
+    if not isinstance(system, FirstOrderSystem):
+        raise GearsymError(f"load_measurements takes the model's FirstOrderSystem, got {type(system).__name__}"
+                           + ("; resolve a name with gearsym.load(...)" if isinstance(system, str) else ""))
+    defaults = system.parameter_values(values)
     rules = _Rules(_positive(min_samples_per_period, "min_samples_per_period"),
                    whole_number(min_periods, "min_periods", 1), _positive(spacing_tolerance, "spacing_tolerance"))
     if time_scale is not None:
@@ -264,8 +266,8 @@ def load_measurements(
     twice = [p for i, p in enumerate(files) if Path(p).resolve() in {Path(q).resolve() for q in files[:i]}]
     if twice:
         raise GearsymError(f"{twice[0]} is given twice")
-    records = tuple(r for path in files for r in _read_file(Path(path), compiled, defaults, time_scale, rules))
-    return Measurements(compiled.name, compiled.state_names, defaults, records)
+    records = tuple(r for path in files for r in _read_file(Path(path), system, defaults, time_scale, rules))
+    return Measurements(system.name, system.state_names, defaults, records)
 
 
 def _positive(value, what: str) -> float:
@@ -305,10 +307,10 @@ class _Rows:
     values: dict[str, np.ndarray]
 
 
-def _read_file(path: Path, compiled: CompiledModel, defaults: dict, time_scale, rules: _Rules) -> list[Record]:
+def _read_file(path: Path, system: FirstOrderSystem, defaults: dict, time_scale, rules: _Rules) -> list[Record]:
     header_line, header, rows = _read_csv(path)
-    layout = _layout(path, header_line, header, compiled, time_scale)
-    return [_record(path, group, layout, compiled, defaults, rules) for group in _group(path, header, rows, layout)]
+    layout = _layout(path, header_line, header, system, time_scale)
+    return [_record(path, group, layout, system, defaults, rules) for group in _group(path, header, rows, layout)]
 
 
 def _read_csv(path: Path) -> tuple[int, list[str], list[tuple[int, list[str]]]]:
@@ -336,9 +338,9 @@ def _read_csv(path: Path) -> tuple[int, list[str], list[tuple[int, list[str]]]]:
     return header_line, header, rows
 
 
-def _layout(path: Path, line: int, header: list[str], compiled: CompiledModel, time_scale) -> _Layout:
-    states, parameters = compiled.state_names, compiled.parameter_names
-    own_time = compiled.system.time.name
+def _layout(path: Path, line: int, header: list[str], system: FirstOrderSystem, time_scale) -> _Layout:
+    states, parameters = system.state_names, tuple(system.parameters)
+    own_time = system.time.name
     times = [own_time] + ([PHYSICAL_TIME] if own_time != PHYSICAL_TIME else [])
     for i, name in enumerate(header):
         if not name:
@@ -350,7 +352,7 @@ def _layout(path: Path, line: int, header: list[str], compiled: CompiledModel, t
         if name not in known:
             raise DataError(
                 f"unknown column.{suggest(name, known)} A column is the time ({' or '.join(times)}), "
-                f"{RECORD}, a state of {compiled.name} ({', '.join(states)}) or one of its parameters as an "
+                f"{RECORD}, a state of {system.name} ({', '.join(states)}) or one of its parameters as an "
                 f"operating condition ({', '.join(parameters)})", path, line, name)
     given = [t for t in times if t in header]
     if not given:
@@ -364,12 +366,12 @@ def _layout(path: Path, line: int, header: list[str], compiled: CompiledModel, t
         if time_scale is None:
             raise DataError(
                 f"the time is t (physical time) but no time scale was given: pass time_scale=... "
-                f"({own_time} = time_scale * t; `gearsym derive {compiled.name}` shows the time unit), or give "
+                f"({own_time} = time_scale * t; `gearsym derive {system.name}` shows the time unit), or give "
                 f"the model's time as a {own_time} column", path, line, PHYSICAL_TIME)
         scale = float(time_scale)
     measured = tuple(s for s in states if s in header)
     if not measured:
-        raise DataError(f"no measured state: name at least one column as a state of {compiled.name} "
+        raise DataError(f"no measured state: name at least one column as a state of {system.name} "
                         f"({', '.join(states)})", path, line)
     conditions = tuple(p for p in parameters if p in header)
     return _Layout(given[0], scale, RECORD if RECORD in header else None, measured, conditions)
@@ -419,12 +421,12 @@ def _number(text: str, path: Path, line: int, column: str) -> float:
     return value
 
 
-def _record(path: Path, rows: _Rows, layout: _Layout, compiled: CompiledModel, defaults: dict,
+def _record(path: Path, rows: _Rows, layout: _Layout, system: FirstOrderSystem, defaults: dict,
             rules: _Rules) -> Record:
     lines, where = rows.lines, f"record {rows.record}"
-    conditions = {name: _condition(path, rows, name, compiled) for name in layout.conditions}
+    conditions = {name: _condition(path, rows, name, system) for name in layout.conditions}
     try:
-        period = compiled.prepare({**defaults, **conditions}).period
+        period = system.period_at({**defaults, **conditions})
     except GearsymError as exc:
         raise DataError(f"{where}: at its conditions: {exc}", path, int(lines[0])) from None
     step = _check_time(path, rows.values[layout.time], lines, layout.time, where, rules)
@@ -435,7 +437,7 @@ def _record(path: Path, rows: _Rows, layout: _Layout, compiled: CompiledModel, d
     return record
 
 
-def _condition(path: Path, rows: _Rows, name: str, compiled: CompiledModel) -> float:
+def _condition(path: Path, rows: _Rows, name: str, system: FirstOrderSystem) -> float:
     """The value of an operating condition in a record: constant, and valid for the model."""
     column, lines = rows.values[name], rows.lines
     changed = np.nonzero(column != column[0])[0]
@@ -445,10 +447,9 @@ def _condition(path: Path, rows: _Rows, name: str, compiled: CompiledModel) -> f
                         f"{float(column[i])!r} here); an operating condition is constant within a record: start a "
                         "new record where it changes", path, int(lines[i]), name)
     try:
-        vector = compiled.parameter_vector({name: float(column[0])})
+        return system.parameter_values({name: float(column[0])})[name]
     except GearsymError as exc:
         raise DataError(f"record {rows.record}: {exc}", path, int(lines[0]), name) from None
-    return float(vector[compiled.parameter_names.index(name)])
 
 
 def _check_time(path: Path, time: np.ndarray, lines: np.ndarray, column: str, where: str, rules: _Rules) -> float:

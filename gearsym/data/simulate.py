@@ -1,9 +1,9 @@
 """Synthetic measurements: a model run by the compiled engine, sampled evenly and given noise.
 
 Each record is one run at its operating conditions: ``discard`` forcing periods of transient
-from ``y0`` (the model's start by default), then ``periods`` periods sampled
-``samples_per_period`` times per period (the end point included, so a record has
-``periods * samples_per_period + 1`` rows). The samples are RK4 steps of the engine itself
+from ``y0`` (the model's start by default), then the other ``periods - discard`` periods
+sampled ``samples_per_period`` times per period (the end point included, so a record has
+``(periods - discard) * samples_per_period + 1`` rows). The samples are RK4 steps of the engine itself
 (:func:`~gearsym.analysis.phase_trajectory`), so the engine's steps per period is a multiple
 of ``samples_per_period``: by default the smallest multiple of at least 200.
 
@@ -15,8 +15,8 @@ standard deviation of the clean signal, per record and per state column (``noise
 of the signal's spread). The table keeps the clean signal and the standard deviations used.
 
 Which parameters appear in the file: only the operating conditions given per record
-(``records=[{"omega": 1.2}, ...]``, the ``--record`` option), as columns. ``settings`` are the
-simulated ("true") model, which a fit has to find: they are not written.
+(``records=[{"omega": 1.2}, ...]``, the ``--record`` option), as columns. Other parameter values
+are the simulated ("true") model, which a fit has to find: they are not written.
 """
 from __future__ import annotations
 
@@ -28,13 +28,14 @@ import numpy as np
 
 from ..analysis import phase_trajectory
 from ..checks import whole_number
-from ..codegen import CompiledModel, compiled_and_values
+from ..codegen import CompiledModel, compile_model, engine_verb
+from ..options import STEPS_PER_PERIOD, Integration
+from ..system import FirstOrderSystem
 from ..errors import GearsymError
 from .measurements import RECORD
 
-#: the engine's default steps per forcing period; simulations use the smallest multiple of the
-#: samples per period that is at least this
-DEFAULT_STEPS_PER_PERIOD = 200
+#: the run of each record when no options are given: 40 periods recorded after a transient of 100
+RUN = {"periods": 140, "discard": 100}
 
 
 @dataclass(frozen=True, eq=False)
@@ -79,77 +80,78 @@ class MeasurementTable:
         return np.nonzero(self.data[RECORD] == record)[0]
 
 
+@engine_verb
 def simulate_measurements(
-    model,
+    model: CompiledModel,
     *,
-    periods: int = 40,
-    discard: int = 100,
+    options: Integration | None = None,
     samples_per_period: int = 50,
     noise: float = 0.0,
     seed: int = 0,
     records: Sequence[Mapping[str, float]] | None = None,
     y0=None,
     velocities: bool = False,
-    steps_per_period: int | None = None,
-    backend: str = "auto",
     out: str | Path | None = None,
-    **settings,
+    **values: float,
 ) -> MeasurementTable:
-    """Simulate measurements of ``model`` (a name, path, model object or CompiledModel).
+    """Simulate measurements of ``model`` (a CompiledModel, or a FirstOrderSystem compiled first).
 
+    Each record discards ``options.discard`` periods and records the remaining ``periods - discard``
+    (a system is compiled by default for ``RUN``: 40 periods after 100). The engine's steps per period
+    must be a multiple of ``samples_per_period`` (the samples are RK4 steps); a system is compiled with
+    the smallest multiple of at least 200 unless the options say otherwise.
     ``records``: the operating conditions of each record (parameter values, written as columns);
     default one record without conditions. ``velocities``: also the states that are not
     coordinates (``v``, ``v1``, ...). ``out``: also write the table there (:func:`write_measurements`).
     """
-    periods = whole_number(periods, "periods", 1)
-    discard = whole_number(discard, "discard")
+    options = model.run_options(options)
     m = whole_number(samples_per_period, "samples_per_period", 1)
     seed = whole_number(seed, "seed")
     if not (np.isfinite(noise) and noise >= 0):
         raise GearsymError(f"noise must be a relative size of 0 or more (0.01 = 1 % of the signal), got {noise!r}")
-    steps = _steps_per_period(model, m, steps_per_period)
-    compiled, values = compiled_and_values(model, dict(settings), steps_per_period=steps, backend=backend)
+    steps_for(m, model.steps_per_period)
     runs = [dict(r) for r in records] if records else [{}]
-    condition_names = tuple(p for p in compiled.parameter_names if any(p in r for r in runs))
+    condition_names = tuple(p for p in model.parameter_names if any(p in r for r in runs))
     for run in runs:
-        compiled.parameter_vector({**values, **run})  # unknown names and bad values, before any run
-    states = compiled.observed + (tuple(s for s in compiled.state_names if s not in compiled.observed)
-                                  if velocities else ())
+        model.parameter_vector({**values, **run})  # unknown names and bad values, before any run
+    states = model.observed + (tuple(s for s in model.state_names if s not in model.observed)
+                               if velocities else ())
     rng = np.random.default_rng(seed)
-    pieces = [_simulate_record(compiled, i, {**values, **run}, condition_names, states, periods, discard, m, y0,
-                               noise, rng) for i, run in enumerate(runs, 1)]
+    pieces = [_simulate_record(model, options, i, {**values, **run}, condition_names, states, m, y0, noise, rng)
+              for i, run in enumerate(runs, 1)]
     columns = ("tau", RECORD, *condition_names, *states)
     table = MeasurementTable(
-        compiled.name, columns,
+        model.name, columns,
         {c: np.concatenate([p.data[c] for p in pieces]) for c in columns},
         {s: np.concatenate([p.clean[s] for p in pieces]) for s in states},
-        tuple(p.noise_std for p in pieces), tuple(p.parameters for p in pieces), m, steps)
+        tuple(p.noise_std for p in pieces), tuple(p.parameters for p in pieces), m, model.steps_per_period)
     if out is not None:
         write_measurements(table, out)
     return table
 
 
+@simulate_measurements.register
+def _on_system(system: FirstOrderSystem, *, options: Integration | None = None, samples_per_period: int = 50,
+               **kwargs) -> MeasurementTable:
+    """The high-level call: compiled with steps per period that the samples divide."""
+    if options is None:
+        options = Integration(**RUN, steps_per_period=steps_for(samples_per_period))
+    return simulate_measurements(compile_model(system, options), options=options,
+                                 samples_per_period=samples_per_period, **kwargs)
+
+
 def steps_for(samples_per_period: int, steps_per_period: int | None = None) -> int:
     """The engine's steps per period for sampling ``samples_per_period`` times a period: ``steps_per_period``
-    if given (checked to be a multiple), else the smallest multiple of at least 200."""
+    if given (checked to be a multiple), else the smallest multiple of at least the default steps."""
     samples = whole_number(samples_per_period, "samples_per_period", 1)
     if steps_per_period is None:
-        return samples * -(-DEFAULT_STEPS_PER_PERIOD // samples)
+        return samples * -(-STEPS_PER_PERIOD // samples)
     steps = whole_number(steps_per_period, "steps_per_period", 1)
     if steps % samples:
         raise GearsymError(f"samples_per_period={samples} must divide the engine's {steps} steps per period (the "
                            f"samples are RK4 steps): choose a divisor, or steps_per_period="
                            f"{samples * -(-steps // samples)}")
     return steps
-
-
-def _steps_per_period(model, samples: int, asked: int | None) -> int:
-    if not isinstance(model, CompiledModel):
-        return steps_for(samples, asked)
-    if asked is not None and asked != model.steps_per_period:
-        raise GearsymError(f"{model.name}: this compiled model takes {model.steps_per_period} steps per period, "
-                           f"not {asked}")
-    return steps_for(samples, model.steps_per_period)
 
 
 @dataclass(frozen=True)
@@ -160,9 +162,9 @@ class _Piece:
     parameters: dict[str, float]
 
 
-def _simulate_record(compiled: CompiledModel, record: int, parameters: dict, condition_names, states, periods: int,
-                     discard: int, samples: int, y0, noise: float, rng: np.random.Generator) -> _Piece:
-    trajectory = phase_trajectory(compiled, periods=periods, discard=discard, y0=y0, **parameters)
+def _simulate_record(compiled: CompiledModel, options: Integration, record: int, parameters: dict, condition_names,
+                     states, samples: int, y0, noise: float, rng: np.random.Generator) -> _Piece:
+    trajectory = phase_trajectory(compiled, options=options, y0=y0, **parameters)
     stride = compiled.steps_per_period // samples
     sampled = trajectory.states[:, ::stride]
     period = compiled.prepare(compiled.parameter_vector(parameters)).period

@@ -9,15 +9,15 @@ model does not describe, a description of their role in the components.
 """
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Union
 
 import sympy as sp
 
+from ..errors import GearsymError
 from ..model.drivetrain import Drivetrain, ResolvedDrivetrain
 from ..reduce.nondimensional import NondimensionalModel, reduce
-from ..registry import Model, load_model
 from ..symbols import parameter_symbol
 from ..system import FirstOrderSystem
 from .notes import default_wave_amplitude, paper_notes
@@ -26,21 +26,18 @@ from .records import (
     Mechanics, ParameterRecord, TorqueRecord,
 )
 
-ModelRef = Union[str, Path, Model, NondimensionalModel]
+@functools.singledispatch
+def derive(model) -> Derivation:
+    """The structured derivation of a declared model (``gearsym.load_model(name)``: a Drivetrain or a
+    FirstOrderSystem) or of a reduced one (a :class:`NondimensionalModel`, which saves reducing again)."""
+    hint = f"; for a name or file use derive(gearsym.load_model({model!r}))" if isinstance(model, (str, Path)) else ""
+    raise GearsymError(f"derive takes a Drivetrain, a NondimensionalModel or a FirstOrderSystem, got "
+                       f"{type(model).__name__}{hint}")
 
 
-def derive(ref: ModelRef) -> Derivation:
-    """The structured derivation of a model given by name, path, model object or reduced model.
-
-    Reducing a drivetrain takes seconds; pass a :class:`NondimensionalModel`
-    (``gearsym.reduce(model)``) to reuse one already reduced.
-    """
-    if isinstance(ref, NondimensionalModel):
-        return _derive_reduced(ref)
-    model = load_model(ref)
-    if isinstance(model, Drivetrain):
-        return _derive_reduced(reduce(model))
-    return _derive_first_order(model)
+@derive.register
+def _derive_drivetrain(model: Drivetrain) -> Derivation:
+    return _derive_reduced(reduce(model))
 
 
 def _parameters(system: FirstOrderSystem, roles: Mapping[str, str] | None = None) -> tuple[ParameterRecord, ...]:
@@ -78,6 +75,7 @@ def _roles(rd: ResolvedDrivetrain) -> dict[str, str]:
     return roles
 
 
+@derive.register
 def _derive_first_order(system: FirstOrderSystem) -> Derivation:
     return Derivation(
         model=system.name, title=system.title or system.name, description="", time=system.time, states=tuple(system.states),
@@ -113,6 +111,7 @@ def _components(
     return bodies, tuple(couplings), tuple(torques)
 
 
+@derive.register
 def _derive_reduced(nd: NondimensionalModel) -> Derivation:
     red, rd, model = nd.reduction, nd.reduction.resolved, nd.drivetrain
     system = nd.system()

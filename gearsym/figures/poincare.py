@@ -11,7 +11,7 @@ the last periods as a gray line, the Poincare points in black on top (Fig. 7 a-d
 """
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -216,38 +216,21 @@ class PhasePanel:
 
 def phase_panel(model, *, title: str | None = None, x: str | None = None, y: str | None = None,
                 periods: int = 30, discard: int = 300, poincare_periods: int = 400, y0=None,
-                steps_per_period: int = 200, backend: str = "auto", title_parameters: Sequence[str] = ("omega",),
-                **settings) -> PhasePanel:
+                title_parameters: Sequence[str] = ("omega",), **values) -> PhasePanel:
     """Compute one panel: ``periods`` periods of trajectory and ``poincare_periods`` Poincare points,
     both after the same ``discard`` transient periods from ``y0``.
 
-    ``model`` and ``settings`` as for :func:`~gearsym.analysis.phase_trajectory` (a name, or a
-    CompiledModel and parameter values). The default title lists ``title_parameters``
-    and every parameter given in ``settings``, e.g. 'ω=1.5, k_S=0.1'.
+    ``model`` is a compiled model (its scheme is used; ``values`` are parameter values). The default title
+    lists ``title_parameters`` and every parameter given in ``values``, e.g. 'ω=1.5, k_S=0.1'.
     """
-    trajectory = phase_trajectory(model, periods=periods, discard=discard, y0=y0, steps_per_period=steps_per_period,
-                                  backend=backend, **settings)
-    orbit = poincare_samples(model, periods=poincare_periods, discard=discard, y0=y0,
-                             steps_per_period=steps_per_period, backend=backend, **settings)
+    scheme = model.integration
+    trajectory = phase_trajectory(model, options=scheme.run(discard + periods, discard), y0=y0, **values)
+    orbit = poincare_samples(model, options=scheme.run(discard + poincare_periods, discard), y0=y0, **values)
     if title is None:
-        shown = dict.fromkeys([*title_parameters, *settings])
-        values = _parameter_values(model, settings)
-        title = ", ".join(parameter_text(k, values[k]) for k in shown if k in values)
+        shown = dict.fromkeys([*title_parameters, *values])
+        used = dict(zip(model.parameter_names, map(float, model.parameter_vector(values))))
+        title = ", ".join(parameter_text(k, used[k]) for k in shown if k in used)
     return PhasePanel(trajectory, orbit.strobe, title, x, y)
-
-
-def _parameter_values(model, settings: Mapping) -> dict[str, float]:
-    from ..codegen import CompiledModel
-
-    if isinstance(model, CompiledModel):
-        return dict(zip(model.parameter_names, map(float, model.parameter_vector(settings))))
-    out = {}
-    for k, v in settings.items():
-        try:
-            out[k] = float(v)
-        except (TypeError, ValueError):
-            continue  # a formula (k="1+0.2*cos(tau)"): not a number to show
-    return out
 
 
 def plot_phase_portraits(panels: Sequence[PhasePanel], path: str | Path, columns: int | None = None) -> Path:

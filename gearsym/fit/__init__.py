@@ -13,19 +13,19 @@ __all__ = ["EFFECTS", "Effect", "Explanation", "Fit", "Prediction", "Segment", "
            "explain_files", "fit_windows", "predict_ahead"]
 
 
-def explain_files(paths, model, fit, *, out=None, time_scale=None, held_out: float = 0.25, candidates=None,
-                  progress=None, **settings):
-    """The whole loop from files: load ``paths`` for ``model`` (settings fix parameter values), explain,
+def explain_files(paths, system, fit, *, out=None, time_scale=None, held_out: float = 0.25, candidates=None,
+                  progress=None, options=None, **values):
+    """The whole loop from files: load ``paths`` for ``system`` (``values`` fix parameter values), explain,
     and with ``out`` write the report there. Returns the report's dict (the keys of report.json)."""
-    from ..codegen import compile_model
     from ..data import load_measurements
     from .report import write_report
 
-    compiled = compile_model(model, **settings)
-    measurements = load_measurements(paths, compiled, time_scale=time_scale)
-    ex = explain(compiled.system, measurements, fit, held_out=held_out, candidates=candidates, progress=progress)
+    measurements = load_measurements(paths, system, time_scale=time_scale, **values)
+    system = system.with_values(**values)
+    ex = explain(system, measurements, fit, held_out=held_out, candidates=candidates, progress=progress,
+                 **({"options": options} if options else {}))
     if out is not None:
-        return write_report(ex, compiled.system, out, measurements.sources)
+        return write_report(ex, system, out, measurements.sources)
     from ..checks import json_safe
 
     return json_safe(ex.as_dict())

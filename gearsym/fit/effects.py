@@ -5,9 +5,9 @@ system in the paper's tau-form, where the mesh force enters the acceleration as
 
     dv/dtau = ... - k(tau) g(x, eta) / omega^2 + ...
 
-The library finds that mesh term in the equations (the coefficient of g(x, eta))
-and builds each effect from it, so the effects follow whatever k(tau) the model
-declares. Every effect adds parameters whose value 0 switches it off:
+The mesh term comes from the couplings the reduction hands on with the system
+(:class:`~gearsym.system.Coupling`), and each effect is built from it, so the
+effects follow whatever k(tau) the model declares. Every effect adds parameters whose value 0 switches it off:
 
 =========================  ===============================================================
 coulomb_friction           tooth friction, a force opposing the sliding velocity:
@@ -118,32 +118,23 @@ def effect(name: str | Effect) -> Effect:
 
 
 def mesh_term(system: FirstOrderSystem, coordinate: str | None = None) -> MeshTerm:
-    """Find the mesh force -k(tau) g(x, eta)/omega^2 of ``coordinate`` (default: the first with one)."""
-    names = [s.name for s in system.states]
-    for row, f in enumerate(system.rhs):
-        for term in sorted(f.atoms(g), key=sp.default_sort_key):
-            x = term.args[0]
-            if not (x.is_Symbol and x.name in names) or (coordinate and x.name != coordinate):
-                continue
-            coefficient = sp.expand(f).coeff(term)
-            if coefficient == 0 or coefficient.has(g):
-                continue
-            v = _velocity_of(system, x)
-            if v is None or system.rhs[names.index(v.name)] != f:
-                continue
-            omega = parameter_symbol("omega")
-            if omega not in f.free_symbols:
-                raise ModelError("the effects library needs the paper's tau-form (a parameter omega)", system.name)
-            return MeshTerm(system, x, v, row, term, sp.factor_terms(coefficient), omega)
-    where = f"coordinate {coordinate!r}" if coordinate else "any coordinate"
-    raise ModelError(f"no mesh force g(x, eta) acting on {where}; the effects act on a backlash mesh", system.name)
-
-
-def _velocity_of(system: FirstOrderSystem, x: sp.Symbol) -> sp.Symbol | None:
-    """The state v with dx/dtau = v."""
-    i = system.states.index(x)
-    rate = system.rhs[i]
-    return rate if rate.is_Symbol and rate in system.states else None
+    """The mesh force -k(tau) g(x, eta)/omega^2 of ``coordinate`` (default: the first mesh with backlash),
+    read from the couplings the reduction handed on with the system."""
+    meshes = [c for c in system.couplings if c.kind == "mesh" and c.backlash != 0]
+    chosen = [c for c in meshes if coordinate in (None, c.coordinate)]
+    if not chosen:
+        where = f"coordinate {coordinate!r}" if coordinate else "any coordinate"
+        known = f" (meshes with backlash act on {', '.join(c.coordinate for c in meshes)})" if meshes else ""
+        raise ModelError(f"no mesh force g(x, eta) acting on {where}{known}; the effects act on a backlash mesh "
+                         "of a reduced drivetrain", system.name)
+    mesh = chosen[0]
+    omega = parameter_symbol("omega")
+    if omega.name not in system.parameters:
+        raise ModelError("the effects library needs the paper's tau-form (a parameter omega)", system.name)
+    names = system.state_names
+    row = names.index(mesh.velocity)  # its own row, where the law enters with factor 1
+    x, v = system.states[names.index(mesh.coordinate)], system.states[row]
+    return MeshTerm(system, x, v, row, g(mesh.contact, mesh.backlash), -mesh.stiffness / omega**2, omega)
 
 
 def effect_terms(system: FirstOrderSystem, effects: Sequence[str | Effect], coordinate: str | None = None
@@ -171,10 +162,13 @@ def augment(system: FirstOrderSystem, effects: Sequence[str | Effect], coordinat
     rhs = list(system.rhs)
     f = rhs[m.row]
     parameters = dict(system.parameters)
+    couplings = list(system.couplings)
     for e in chosen:
         added, backlash = e.build(m)
         if backlash is not None:
             f = f.subs(m.backlash, backlash)
+            i = next(i for i, c in enumerate(couplings) if c.coordinate == m.x.name)
+            couplings[i] = replace(couplings[i], contact=backlash.args[0])  # the contact the mesh now has
         f = f + added
         clash = set(e.parameters) & set(system.parameters)
         if clash:
@@ -189,4 +183,5 @@ def augment(system: FirstOrderSystem, effects: Sequence[str | Effect], coordinat
     descriptions = {**system.descriptions, **{p: f"{e.name}: {e.description}" for e in chosen for p in e.parameters}}
     name = f"{system.name}_with_{'_and_'.join(e.name for e in chosen)}"  # a C identifier: the model may be compiled
     return replace(system, name=name, rhs=tuple(rhs), parameters=parameters, descriptions=descriptions,
-                   title=f"{system.title or system.name}, with {', '.join(e.name for e in chosen)}")
+                   title=f"{system.title or system.name}, with {', '.join(e.name for e in chosen)}",
+                   couplings=tuple(couplings))

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..data.measurements import Measurements
 from ..errors import GearsymError
+from ..options import Integration
 from ..system import FirstOrderSystem
 from .effects import EFFECTS, Effect, augment, effect
 from .prediction import Prediction, predict_ahead
@@ -95,7 +96,8 @@ def segments_of(system: FirstOrderSystem, measurements: Measurements) -> tuple[l
 def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[str], *,
             candidates: Sequence[str | Effect] | None = None, held_out: float = 0.25,
             min_gain: float = MIN_GAIN, max_effects: int = MAX_EFFECTS,
-            max_correlation: float = MAX_CORRELATION, progress=None) -> Explanation:
+            max_correlation: float = MAX_CORRELATION, progress=None,
+            options: Integration = Integration()) -> Explanation:
     """Fit ``fit`` on ``measurements``, then add effects from ``candidates`` (default: the whole library)
     while they lower the held-out error; see the module docstring."""
     if not fit:
@@ -109,8 +111,8 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
         names = list(fit) + [p for e in effects for p in library[e].fitted]
         seg_train, _ = segments_of(model, train)
         seg_test, keys = segments_of(model, test)
-        result = fit_windows(model, seg_train, names, guess=guess)
-        prediction = predict_ahead(model, seg_test, keys, result.estimates)
+        result = fit_windows(model, seg_train, names, guess=guess, options=options)
+        prediction = predict_ahead(model, seg_test, keys, result.estimates, options=options)
         say(f"{'+'.join(effects) or 'the model as declared'}: held-out error {prediction.error:.4g}")
         return Candidate(effects, result, prediction)
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..options import Integration
 from ..system import FirstOrderSystem
 from .shooting import Segment, fit_windows, simulate_segment
 
@@ -46,20 +47,21 @@ def pairs_of(segments: Sequence[Segment], keys: Sequence[tuple]) -> list[tuple[i
 
 
 def predict_ahead(system: FirstOrderSystem, segments: Sequence[Segment], keys: Sequence[tuple],
-                  estimates: Mapping[str, float], period: float = 2 * np.pi) -> Prediction:
+                  estimates: Mapping[str, float], period: float = 2 * np.pi,
+                  options: Integration = Integration()) -> Prediction:
     """One-forcing-period-ahead prediction of every held-out pair (see the module docstring)."""
     pairs = pairs_of(segments, keys)
     if not pairs:
         raise ValueError("the held-out part has no two consecutive whole forcing periods of one record")
     firsts = [segments[i] for i, _ in pairs]
     fixed = [Segment(s.tau, s.observed, {**s.parameters, **estimates}, s.label) for s in firsts]
-    starts = fit_windows(system, fixed, [], period=period).starts
+    starts = fit_windows(system, fixed, [], period=period, options=options).starts
     names = sorted({k for s in segments for k in s.observed})
     tau, measured, predicted, states = [], {k: [] for k in names}, {k: [] for k in names}, []
     state_names = [s.name for s in system.states]
     for (i, j), seg, start in zip(pairs, fixed, starts.T):
         samples = len(seg.tau)
-        Y = simulate_segment(system, seg, start, None, period, samples=2 * samples)[:, samples:]
+        Y = simulate_segment(system, seg, start, None, period, samples=2 * samples, options=options)[:, samples:]
         nxt = segments[j]
         tau.append(nxt.tau)
         states.append(Y)

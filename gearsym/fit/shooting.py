@@ -21,12 +21,11 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
-from ..codegen.translate import to_casadi
+from ..codegen.functions import SystemSymbols, rk4_step
 from ..errors import GearsymError
+from ..options import Integration
 from ..system import FirstOrderSystem
 
-#: RK4 steps per sample interval at least this fine: period / STEPS_PER_PERIOD
-STEPS_PER_PERIOD = 200
 
 
 @dataclass(frozen=True)
@@ -62,30 +61,27 @@ class _Model:
         self.system = system
         self.names = tuple(system.parameters)
         self.states = tuple(s.name for s in system.states)
-        t, y, p = ca.SX.sym("t"), ca.SX.sym("y", system.dimension), ca.SX.sym("p", len(self.names))
-        from ..symbols import parameter_symbol
-
-        mapping = {system.time: t, **{s: y[i] for i, s in enumerate(system.states)},
-                   **{parameter_symbol(n): p[j] for j, n in enumerate(self.names)}}
-        f = ca.vertcat(*to_casadi(system.rhs, mapping, system.name))
-        self.rhs = ca.Function("rhs", [t, y, p], [f])
+        sym = SystemSymbols.of(system)
+        self.rhs = ca.Function("rhs", [sym.t, sym.y, sym.p], [sym.rhs(system)])
         self._windows: dict[tuple[int, int], ca.Function] = {}
 
     def window(self, samples: int, substeps: int) -> ca.Function:
-        """(start state, first sample time, sample step, p) -> states at the ``samples`` sample times."""
+        """(start state, first sample time, sample step, p) -> states at the ``samples`` sample times,
+        ``substeps`` steps of the engine's RK4 between samples."""
         key = (samples, substeps)
         if key not in self._windows:
             n = self.system.dimension
             y0, t0, dt, p = ca.SX.sym("y0", n), ca.SX.sym("t0"), ca.SX.sym("dt"), ca.SX.sym("p", len(self.names))
             h = dt / substeps
             y, t, cols = y0, t0, [y0]
+
+            def f(x, time):
+                return self.rhs(time, x, p)
+
             for _ in range(samples - 1):
                 for _ in range(substeps):
-                    k1 = self.rhs(t, y, p)
-                    k2 = self.rhs(t + h / 2, y + h / 2 * k1, p)
-                    k3 = self.rhs(t + h / 2, y + h / 2 * k2, p)
-                    k4 = self.rhs(t + h, y + h * k3, p)
-                    y, t = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4), t + h
+                    y, _ = rk4_step(f, None, y, None, h, t, t + h / 2, t + h)
+                    t = t + h
                 cols.append(y)
             self._windows[key] = ca.Function(f"window{samples}", [y0, t0, dt, p], [ca.horzcat(*cols)])
         return self._windows[key]
@@ -102,20 +98,21 @@ def _model(system: FirstOrderSystem) -> _Model:
     return _MODELS[key]
 
 
-def substeps_for(step: float, period: float) -> int:
-    """RK4 steps per sample interval: at least STEPS_PER_PERIOD per forcing period."""
-    return max(1, int(np.ceil(STEPS_PER_PERIOD * step / period - 1e-9)))
+def substeps_for(step: float, period: float, options: Integration) -> int:
+    """RK4 steps per sample interval: at least the options' steps per forcing period."""
+    return max(1, int(np.ceil(options.steps_per_period * step / period - 1e-9)))
 
 
 def fit_windows(system: FirstOrderSystem, segments: Sequence[Segment], fit: Sequence[str], *,
                 guess: Mapping[str, float] | None = None, starts: np.ndarray | None = None,
-                period: float = 2 * np.pi, max_iterations: int = 200) -> Fit:
+                period: float = 2 * np.pi, max_iterations: int = 200, options: Integration = Integration()) -> Fit:
     """Estimate the parameters ``fit`` (and every window's start state) from ``segments``.
 
     ``guess``: starting values of the fitted parameters (default: the segments' own values).
     ``starts``: starting start states (n x windows; default from the data: the measured states at
     the first sample, a finite-difference rate for an unmeasured velocity, 0 otherwise).
     ``fit`` may be empty: then only the start states are fitted (the parameters are known).
+    ``options``: its steps per period set the RK4 steps between samples (the windows are plain RK4).
     """
     if not segments:
         raise GearsymError("nothing to fit: no whole forcing period in the data")
@@ -124,7 +121,7 @@ def fit_windows(system: FirstOrderSystem, segments: Sequence[Segment], fit: Sequ
     if unknown:
         raise GearsymError(f"cannot fit {', '.join(unknown)}: not parameters of {system.name} "
                            f"({', '.join(model.names)})")
-    problem = _Problem(model, segments, list(fit), period)
+    problem = _Problem(model, segments, list(fit), period, options)
     theta = np.array([(guess or {}).get(p, segments[0].parameters[p]) for p in fit], dtype=float)
     S = np.array(starts if starts is not None else _data_starts(model, segments), dtype=float)
     theta, S, J, r, iterations, converged = _levenberg_marquardt(problem, theta, S, max_iterations)
@@ -133,7 +130,7 @@ def fit_windows(system: FirstOrderSystem, segments: Sequence[Segment], fit: Sequ
     sigma2 = float(r @ r) / dof
     err = np.sqrt(np.maximum(np.diag(sigma2 * np.linalg.pinv(J.T @ J))[:m], 0.0))
     estimates = dict(zip(fit, map(float, theta)))
-    predicted, resid = _evaluate(model, segments, estimates, S, period)
+    predicted, resid = _evaluate(model, segments, estimates, S, period, options)
     return Fit(system, estimates, dict(zip(fit, map(float, err))), S, predicted, resid, float(np.sqrt(sigma2)),
                converged, iterations, {"residuals": int(r.size), "unknowns": int(J.shape[1])})
 
@@ -141,7 +138,8 @@ def fit_windows(system: FirstOrderSystem, segments: Sequence[Segment], fit: Sequ
 class _Problem:
     """Scaled residuals of every window and their exact Jacobian (CasADi forward derivatives)."""
 
-    def __init__(self, model: _Model, segments: Sequence[Segment], fit: list[str], period: float):
+    def __init__(self, model: _Model, segments: Sequence[Segment], fit: list[str], period: float,
+                 options: Integration):
         self.model, self.segments, self.fit = model, segments, fit
         self.index = [model.names.index(p) for p in fit]
         observed = sorted({k for s in segments for k in s.observed}, key=model.states.index)
@@ -151,7 +149,7 @@ class _Problem:
         for seg in segments:
             dt = float(np.median(np.diff(seg.tau)))
             rows = [model.states.index(k) for k in seg.observed]
-            f = _window_jacobian(model, len(seg.tau), substeps_for(dt, period))
+            f = _window_jacobian(model, len(seg.tau), substeps_for(dt, period, options))
             data = np.concatenate([seg.observed[k] / self.scale[k] for k in seg.observed])
             weights = np.concatenate([np.full(len(seg.tau), 1 / self.scale[k]) for k in seg.observed])
             base = np.array([seg.parameters[n] for n in model.names], dtype=float)
@@ -221,23 +219,24 @@ def _levenberg_marquardt(problem: _Problem, theta, S, max_iterations: int):
     return theta, S, J, r, iteration, converged
 
 
-def _evaluate(model: _Model, segments, estimates, starts, period):
+def _evaluate(model: _Model, segments, estimates, starts, period, options: Integration):
     predicted, resid = [], []
     for k, seg in enumerate(segments):
-        Y = simulate_segment(model.system, seg, starts[:, k], estimates, period)
+        Y = simulate_segment(model.system, seg, starts[:, k], estimates, period, options=options)
         predicted.append({name: Y[model.states.index(name)] for name in seg.observed})
         resid.append({name: seg.observed[name] - predicted[-1][name] for name in seg.observed})
     return predicted, resid
 
 
 def simulate_segment(system: FirstOrderSystem, seg: Segment, start, estimates: Mapping[str, float] | None = None,
-                     period: float = 2 * np.pi, samples: int | None = None) -> np.ndarray:
+                     period: float = 2 * np.pi, samples: int | None = None,
+                     options: Integration = Integration()) -> np.ndarray:
     """The states at ``seg``'s sample times (or ``samples`` of them) from ``start`` (n x samples)."""
     model = _model(system)
     values = {**seg.parameters, **(estimates or {})}
     dt = float(np.median(np.diff(seg.tau)))
     samples = samples or len(seg.tau)
-    out = model.window(samples, substeps_for(dt, period))(np.asarray(start, float), float(seg.tau[0]), dt,
+    out = model.window(samples, substeps_for(dt, period, options))(np.asarray(start, float), float(seg.tau[0]), dt,
                                                          [values[n] for n in model.names])
     return np.array(out)
 

@@ -34,7 +34,7 @@ from ..model.drivetrain import Drivetrain, ResolvedCoupling
 from ..model.expressions import ExprLike, parameter_names, sign_violation, to_expr
 from ..model.stiffness import check_periodic
 from ..symbols import omega, parameter_symbol, phi, t, tau
-from ..system import FirstOrderSystem
+from ..system import Constraint, Coupling, FirstOrderSystem
 from .reduction import Reduction, reduce_drivetrain
 
 
@@ -90,8 +90,9 @@ class NondimensionalModel:
     groups: list[Group] = field(default_factory=list)
     conditions: list[Condition] = field(default_factory=list)
     functions: list[StiffnessFunction] = field(default_factory=list)
-    _row_lhs: list[sp.Expr] = field(default_factory=list)  # sum of terms besides x''
-    _row_rhs: list[sp.Expr] = field(default_factory=list)  # forcing numerators (over omega^2)
+    row_lhs: list[sp.Expr] = field(default_factory=list)  # per coordinate: the sum of its terms besides x''
+    row_rhs: list[sp.Expr] = field(default_factory=list)  # per coordinate: its forcing numerator (over omega^2)
+    coupling_rows: dict[str, tuple[tuple[int, sp.Expr], ...]] = field(default_factory=dict)  # coupling -> (row, factor)
 
     @property
     def name(self) -> str:
@@ -116,7 +117,7 @@ class NondimensionalModel:
     def equations(self) -> list[sp.Eq]:
         """Second-order equations in tau, in the paper's layout (x'' + ... = (...)/omega^2)."""
         out = []
-        for c, lhs, rhs in zip(self.coordinates, self._row_lhs, self._row_rhs):
+        for c, lhs, rhs in zip(self.coordinates, self.row_lhs, self.row_rhs):
             out.append(sp.Eq(sp.diff(c.of(tau), tau, 2) + lhs, rhs / omega**2 if rhs != 0 else sp.S.Zero))
         return out
 
@@ -303,9 +304,25 @@ class NondimensionalModel:
         descriptions = dict(self.drivetrain.descriptions)
         for gr in self.groups:
             descriptions.setdefault(gr.name, gr.description)
+        constraints = {name: Constraint(meaning, zero_ok) for name, (zero_ok, meaning) in self._constraints.items()
+                       if name in params}
         return FirstOrderSystem(self.name, tau, self.states, tuple(rhs), params, self.period, descriptions,
                                 self.drivetrain.title, tuple(c.name for c in self.coordinates),
-                                self.drivetrain.initial_state)
+                                self.drivetrain.initial_state, self._system_couplings(functions), constraints)
+
+    def _system_couplings(self, functions: Mapping[str, sp.Expr]) -> tuple[Coupling, ...]:
+        """Every coupling as the first-order system carries it, in the system's own terms (stiffness
+        functions and derived groups written out, as in its right-hand side)."""
+        derived = {gr.symbol: gr.definition for gr in self.groups if gr.kind == "derived"}
+        own = {f.mesh: functions.get(f.name, f.expression) for f in self.functions}
+        out = []
+        for row, c in enumerate(self.coordinates):
+            rc = c.coupling
+            stiffness = own[rc.name] if rc.kind == "mesh" else rc.stiffness
+            rows = tuple((2 * r + 1, sp.sympify(factor).xreplace(derived)) for r, factor in self.coupling_rows[rc.name])
+            out.append(Coupling(rc.name, rc.kind, c.name, c.velocity_name, rc.backlash, stiffness.xreplace(derived),
+                                rc.order, rows))
+        return tuple(out)
 
 
 # ============================================================================ construction
@@ -313,50 +330,60 @@ def _coordinate_suffix(red: Reduction, row: int) -> str:
     return "" if row == 0 else f"_{red.coordinates[row].name}"
 
 
-def nondimensionalize(red: Reduction) -> NondimensionalModel:
-    """Name the coefficient groups of ``red`` and write its equations in tau."""
-    nd = NondimensionalModel(red)
-    n = len(red.coordinates)
-    lhs = [sp.S.Zero] * n
-    rhs = [sp.S.Zero] * n
-    meshes = [rc for rc in red.resolved.couplings if rc.kind == "mesh"]
-    shafts = [rc for rc in red.resolved.couplings if rc.kind == "shaft"]
-    reference = meshes[0] if meshes else None
-    betas: dict[sp.Expr, sp.Expr] = {}
+class _Assembly:
+    """The groups, conditions, stiffness functions and rows of a NondimensionalModel as they are named,
+    in the order the paper names them: shafts, then meshes, then the forcing of each row."""
 
-    def beta(definition: sp.Expr, description: str) -> sp.Expr:
+    def __init__(self, red: Reduction):
+        self.red = red
+        n = len(red.coordinates)
+        self.groups: list[Group] = []
+        self.conditions: list[Condition] = []
+        self.functions: list[StiffnessFunction] = []
+        self.lhs = [sp.S.Zero] * n  # sum of the terms besides x'' in each row
+        self.rhs = [sp.S.Zero] * n  # forcing numerators (over omega^2)
+        self.coupling_rows: dict[str, list[tuple[int, sp.Expr]]] = {}  # coupling -> (row, factor of its law)
+        self._betas: dict[sp.Expr, sp.Expr] = {}
+
+    def beta(self, definition: sp.Expr, description: str) -> sp.Expr:
+        """The group standing for ``definition`` (one per distinct value), or the number itself."""
         if definition.is_number:
             return definition
-        for known, sym in betas.items():
+        for known, sym in self._betas.items():
             if sp.simplify(known - definition) == 0:
                 return sym
-        gr = Group(f"beta_{len(betas) + 1}", definition, "derived", description, "coupling")
-        nd.groups.append(gr)
-        betas[definition] = gr.symbol
+        gr = Group(f"beta_{len(self._betas) + 1}", definition, "derived", description, "coupling")
+        self.groups.append(gr)
+        self._betas[definition] = gr.symbol
         return gr.symbol
 
-    def own_factor(rc: ResolvedCoupling) -> sp.Expr:
+    def own_factor(self, rc: ResolvedCoupling) -> sp.Expr:
+        red = self.red
         row = red.coordinates.index(red.coordinate_of(rc))
         return next(ct.factor for ct in red.row_terms(row) if ct.coupling is rc)
 
-    # shafts: beta * (kS x + cS x') in every row they reach
-    for rc in shafts:
+    def add_shaft(self, rc: ResolvedCoupling) -> None:
+        """beta * (kS x + cS x') in every row the shaft reaches."""
+        red = self.red
         x = red.coordinate_of(rc).of(tau)
         for ct in (ct for ct in red.coupling_terms if ct.coupling is rc):
-            b = beta(sp.expand(ct.factor), f"coupling of shaft {rc.name!r} into {red.coordinates[ct.row].name}")
-            lhs[ct.row] += b * rc.stiffness * x / omega**2 + b * rc.damping * sp.diff(x, tau) / omega
-    # meshes: own row absorbs the factor; other rows get beta * (own-row terms)
-    own_terms = {}
-    for rc in meshes:
+            b = self.beta(sp.expand(ct.factor), f"coupling of shaft {rc.name!r} into {red.coordinates[ct.row].name}")
+            self.lhs[ct.row] += b * rc.stiffness * x / omega**2 + b * rc.damping * sp.diff(x, tau) / omega
+            self.coupling_rows.setdefault(rc.name, []).append((ct.row, b))
+
+    def mesh_law(self, rc: ResolvedCoupling, reference: ResolvedCoupling) -> sp.Expr:
+        """The mesh's terms in its own row, ``2 zeta x'/omega + k(tau) g(x, eta)/omega^2``: the own-row
+        factor m is absorbed into its stiffness and damping, naming k(tau), zeta (and K for a second mesh)."""
+        red = self.red
         cx = red.coordinate_of(rc)
         suffix = "" if rc is reference else f"_{cx.name}"
-        m = sp.expand(own_factor(rc))
+        m = sp.expand(self.own_factor(rc))
         x = cx.of(tau)
         comp = rc.component
         fname = comp.function or ("k" if rc is reference else f"k{suffix}")
         varied = rc.variation.subs(phi, sp.expand(rc.mesh_phase.subs(t, tau / omega)))
         if rc is reference:
-            nd.conditions.append(Condition(
+            self.conditions.append(Condition(
                 sp.Eq(m * rc.stiffness, 1),
                 f"time unit: t is measured in units of 1/omega_n, omega_n^2 being the left-hand side (the mean "
                 f"stiffness of mesh {rc.name!r} per unit effective mass), so {fname}(tau) has the mean of the "
@@ -367,72 +394,103 @@ def nondimensionalize(red: Reduction) -> NondimensionalModel:
         else:
             K = Group(comp.stiffness_group or f"K{suffix}", m * rc.stiffness, "free",
                       f"mean stiffness of mesh {rc.name!r} relative to the first mesh", "stiffness")
-            nd.groups.append(K)
+            self.groups.append(K)
             expression = K.symbol * varied
         kfun = StiffnessFunction(fname, rc.name, m * red.resolved.stiffness_at(rc).subs(t, tau / omega),
                                  expression, 2 * sp.pi / rc.order)
-        nd.functions.append(kfun)
+        self.functions.append(kfun)
         terms = kfun.applied * g(x, rc.backlash) / omega**2
         if rc.damping != 0:
             zeta = Group(comp.damping_group or f"zeta{suffix}", m * rc.damping / 2, "free",
                          f"damping ratio of mesh {rc.name!r}", "damping")
-            nd.groups.append(zeta)
+            self.groups.append(zeta)
             terms = 2 * zeta.symbol * sp.diff(x, tau) / omega + terms
-        own_terms[rc] = terms
-    for rc in meshes:
-        m = own_factor(rc)
+        return terms
+
+    def add_mesh_rows(self, rc: ResolvedCoupling, law: sp.Expr) -> None:
+        """The law in its own row; in the other rows, times beta = factor / m (the paper's beta3)."""
+        red = self.red
+        m = self.own_factor(rc)
         for ct in (ct for ct in red.coupling_terms if ct.coupling is rc):
             if ct.factor == m and red.coordinates[ct.row] is red.coordinate_of(rc):
-                lhs[ct.row] += own_terms[rc]
+                self.lhs[ct.row] += law
+                self.coupling_rows.setdefault(rc.name, []).append((ct.row, sp.S.One))
             else:
-                b = beta(sp.expand(ct.factor) / sp.expand(m), f"share of mesh {rc.name!r} force in {red.coordinates[ct.row].name}")
-                lhs[ct.row] += sp.expand(b * own_terms[rc])
-    # forcing: group each row's terms by harmonic
-    for row, cx in enumerate(red.coordinates):
+                b = self.beta(sp.expand(ct.factor) / sp.expand(m),
+                              f"share of mesh {rc.name!r} force in {red.coordinates[ct.row].name}")
+                self.lhs[ct.row] += sp.expand(b * law)
+                self.coupling_rows.setdefault(rc.name, []).append((ct.row, b))
+
+    def add_forcing(self, row: int) -> None:
+        """The forcing of one row, grouped by harmonic into B0, B1, D, ...; an unforced shaft's constant
+        forcing becomes the torque-balance condition (Eq. 10)."""
+        red = self.red
+        cx = red.coordinates[row]
         by_key: dict = {}
         for ft in red.row_forcing(row):
             by_key.setdefault(ft.key, []).append(ft)
-        used_names: set[str] = {gr.name for gr in nd.groups}
+        used_names: set[str] = {gr.name for gr in self.groups}
         for (order, phase), terms in by_key.items():
             definition = sp.expand(sp.Add(*(ft.coefficient for ft in terms)))
             if definition == 0:
                 continue
             if order == 0 and cx.kind == "shaft" and not cx.coupling.component.forced:
-                nd.conditions.append(Condition(
+                self.conditions.append(Condition(
                     sp.Eq(0, definition),
                     f"torque balance: no constant torque may load the twist {cx.name} of shaft "
                     f"{cx.coupling.name!r} (declare Shaft(..., forced=True) to keep it as forcing)",
                     "torque_balance",
                 ))
                 continue
-            hints = sorted({ft.source.group for ft in terms if ft.source.group})
-            torques = ", ".join(sorted({repr(ft.source.torque.name) for ft in terms}))
-            if len(hints) > 1:
-                raise ModelError(
-                    f"harmonics of the same order and phase are named differently ({', '.join(hints)}); "
-                    "they add up into one group, so give them one name", f"Torque {torques}",
-                )
-            base = "B0" if order == 0 else (hints[0] if hints else f"B{order}")
-            name = base + _coordinate_suffix(red, row)
-            if name in used_names and not hints and order > 0:
-                # an unnamed second harmonic of the same order: name it after its phase
-                tag = phase.name if isinstance(phase, sp.Symbol) else str(len(used_names))
-                name = f"B{order}_{tag}" + _coordinate_suffix(red, row)
-            timefn = sp.S.One if order == 0 else sp.cos(order * tau + phase)
-            if name in used_names:
-                raise ModelError(
-                    f"the forcing group of {cx.name} from {timefn} would be named {name!r}, "
-                    "which another group already has; give the harmonic a distinct Harmonic(..., group=...) name",
-                    f"Torque {torques}",
-                )
+            name = self._forcing_name(row, order, phase, terms, used_names)
             used_names.add(name)
+            timefn = sp.S.One if order == 0 else sp.cos(order * tau + phase)
             what = "constant forcing" if order == 0 else f"forcing amplitude of {timefn}"
             gr = Group(name, definition, "free", f"{what} of {cx.name}", "forcing")
-            nd.groups.append(gr)
-            rhs[row] += gr.symbol * timefn
-    nd._row_lhs, nd._row_rhs = lhs, rhs
-    nd.groups.sort(key=lambda gr: gr.kind == "derived")  # stable: free groups first, betas in their order
-    return nd
+            self.groups.append(gr)
+            self.rhs[row] += gr.symbol * timefn
+
+    def _forcing_name(self, row: int, order, phase, terms, used_names: set[str]) -> str:
+        red = self.red
+        cx = red.coordinates[row]
+        hints = sorted({ft.source.group for ft in terms if ft.source.group})
+        torques = ", ".join(sorted({repr(ft.source.torque.name) for ft in terms}))
+        if len(hints) > 1:
+            raise ModelError(
+                f"harmonics of the same order and phase are named differently ({', '.join(hints)}); "
+                "they add up into one group, so give them one name", f"Torque {torques}",
+            )
+        base = "B0" if order == 0 else (hints[0] if hints else f"B{order}")
+        name = base + _coordinate_suffix(red, row)
+        if name in used_names and not hints and order > 0:
+            # an unnamed second harmonic of the same order: name it after its phase
+            tag = phase.name if isinstance(phase, sp.Symbol) else str(len(used_names))
+            name = f"B{order}_{tag}" + _coordinate_suffix(red, row)
+        if name in used_names:
+            timefn = sp.S.One if order == 0 else sp.cos(order * tau + phase)
+            raise ModelError(
+                f"the forcing group of {cx.name} from {timefn} would be named {name!r}, "
+                "which another group already has; give the harmonic a distinct Harmonic(..., group=...) name",
+                f"Torque {torques}",
+            )
+        return name
+
+
+def nondimensionalize(red: Reduction) -> NondimensionalModel:
+    """Name the coefficient groups of ``red`` and write its equations in tau."""
+    build = _Assembly(red)
+    meshes = [rc for rc in red.resolved.couplings if rc.kind == "mesh"]
+    for rc in red.resolved.couplings:
+        if rc.kind == "shaft":
+            build.add_shaft(rc)
+    laws = {rc.name: build.mesh_law(rc, meshes[0]) for rc in meshes}
+    for rc in meshes:
+        build.add_mesh_rows(rc, laws[rc.name])
+    for row in range(len(red.coordinates)):
+        build.add_forcing(row)
+    groups = sorted(build.groups, key=lambda gr: gr.kind == "derived")  # stable: free groups first, betas in order
+    return NondimensionalModel(red, groups, build.conditions, build.functions, build.lhs, build.rhs,
+                               {name: tuple(rows) for name, rows in build.coupling_rows.items()})
 
 
 def reduce(model: Drivetrain) -> NondimensionalModel:

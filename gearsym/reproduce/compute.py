@@ -13,7 +13,9 @@ from pathlib import Path
 from ..analysis import LyapunovSpectrum, Trajectory, lyapunov_spectrum, phase_trajectory
 from ..analysis.attractors import AttractorSet, find_attractors
 from ..codegen import compile_model
-from ..sweep import SweepResult, run_sweep
+from ..options import Integration
+from ..registry import load
+from ..sweep import SweepResult, Workers, run_sweep
 from .plan import Plan
 
 
@@ -36,30 +38,37 @@ class Computed:
 
 
 def compute(plan: Plan, data_dir: str | Path, *, jobs: int = 0, progress: bool = True) -> Computed:
+    """Every run of ``plan`` with the paper's scheme (plain RK4 at 200 steps per period), named explicitly
+    so that the reproduction stays like for like whatever the engine's default."""
     data_dir = Path(data_dir)
+    scheme = Integration.paper(periods=plan.periods, discard=plan.discard)
+    compiled = {name: compile_model(load(name), scheme)
+                for name in dict.fromkeys([j.model for j in plan.sweeps] + [j.model for j in plan.attractors]
+                                          + ([plan.portrait_model] if plan.portraits else []))}
     sweeps = {}
     for job in plan.sweeps:
         _say(progress, f"sweep {job.name}: {job.model} {' '.join(job.params)}"
              + "".join(f" {k}={v}" for k, v in job.settings.items()))
-        sweeps[job.name] = run_sweep(job.model, job.params, mode="continuation", direction=job.direction,
-                                     periods=plan.periods, discard=plan.discard, jobs=jobs,
-                                     out=data_dir / f"{job.name}.csv", poincare=job.poincare, progress=progress,
-                                     **job.settings)
+        sweeps[job.name] = run_sweep(compiled[job.model], job.params, mode="continuation", direction=job.direction,
+                                     workers=Workers(jobs), out=data_dir / f"{job.name}.csv", poincare=job.poincare,
+                                     progress=progress, **job.settings)
     attractors = {}
+    transient = scheme.run(plan.attractor_discard + plan.attractor_periods, plan.attractor_discard)
     for job in plan.attractors:
         _say(progress, f"attractors: {job.model} at omega={job.omega:g}, {job.ics} random initial states")
         attractors[(job.model, job.omega)] = find_attractors(
-            job.model, ics=job.ics, seed=job.seed, periods=plan.attractor_periods, discard=plan.attractor_discard,
+            compiled[job.model], options=transient, ics=job.ics, seed=job.seed,
             **plan.scenario.settings(job.model), omega=job.omega)
     portraits = []
     fixed = plan.scenario.settings(plan.portrait_model)
-    compiled = compile_model(plan.portrait_model, **fixed) if plan.portraits else None
+    shown = min(40, plan.periods - plan.discard)
     for job in plan.portraits:
-        values = {"omega": plan.portrait_omega, **job.settings}
-        spectrum = lyapunov_spectrum(compiled, periods=plan.periods, discard=plan.discard, **values)
-        trajectory = phase_trajectory(compiled, periods=min(40, plan.periods - plan.discard),
-                                      discard=plan.periods - min(40, plan.periods - plan.discard), **values)
-        portraits.append(Portrait(job.letter, values, job.x, job.y, spectrum, trajectory))
+        values = {"omega": plan.portrait_omega, **fixed, **job.settings}
+        model = compiled[plan.portrait_model]
+        spectrum = lyapunov_spectrum(model, **values)
+        trajectory = phase_trajectory(model, options=scheme.run(discard=plan.periods - shown), **values)
+        portraits.append(Portrait(job.letter, {"omega": plan.portrait_omega, **job.settings}, job.x, job.y,
+                                  spectrum, trajectory))
     return Computed(plan, sweeps, attractors, tuple(portraits))
 
 

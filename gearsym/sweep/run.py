@@ -22,6 +22,7 @@ import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -29,8 +30,9 @@ import numpy as np
 from .. import __version__
 from ..analysis.lyapunov import lyapunov_spectrum
 from ..checks import whole_number
-from ..codegen import CompiledModel, compiled_and_values
+from ..codegen import CompiledModel, engine_verb
 from ..errors import GearsymError, UnknownParameterError
+from ..options import Integration
 from .grid import INDEPENDENT, Axis, Point, axes_from, plan, points
 from .result import SweepResult
 from .store import SweepStore, number, row_key
@@ -50,163 +52,205 @@ class SweepInterrupted(KeyboardInterrupt):
         super().__init__(f"interrupted: kept {done} of {planned} points{where}")
 
 
+@dataclass(frozen=True)
+class Workers:
+    """Where a sweep's points run: ``jobs`` workers (0: one per core) on this machine, as forked
+    ``"processes"`` (nothing is rebuilt; no lock shared between them, so the Python around each point does
+    not serialise them), ``"threads"``, or ``"auto"`` (processes where the OS can fork: Linux, macOS); or,
+    with ``scheduler``, on Dask (the ``distributed`` extra): ``"local"`` starts a cluster of ``jobs``
+    single-threaded worker processes on this machine for this sweep, ``"tcp://HOST:PORT"`` uses the cluster
+    of that scheduler, a ``distributed.Client`` its cluster. The files are the same, byte for byte, however
+    the points run (on Dask as long as the workers run the client's library: see
+    :mod:`gearsym.codegen.portable`)."""
+
+    jobs: int = 0
+    parallel: str = "auto"
+    scheduler: object = None
+
+    def __post_init__(self):
+        whole_number(self.jobs, "jobs")
+        if self.parallel not in PARALLEL:
+            raise GearsymError(f"parallel={self.parallel!r}: choose one of {', '.join(PARALLEL)}")
+        if self.scheduler is not None:
+            from .distributed import check_scheduler
+
+            check_scheduler(self.scheduler, self.jobs)  # no Dask, a bad address: said before any work
+
+    @property
+    def count(self) -> int:
+        return self.jobs or os.cpu_count() or 1
+
+    @property
+    def mode(self) -> str:
+        """"processes" or "threads" (on this machine)."""
+        if self.parallel != "auto":
+            return self.parallel
+        return "processes" if "fork" in multiprocessing.get_all_start_methods() else "threads"
+
+
+@engine_verb
 def run_sweep(
-    model,
+    model: CompiledModel,
     axes: Mapping[str, Sequence[float]] | Sequence[Axis | str],
     *,
+    options: Integration | None = None,
     mode: str = "continuation",
     direction: str = "up",
-    periods: int = 400,
-    discard: int = 100,
-    steps_per_period: int = 200,
     y0=None,
-    jobs: int = 0,
     out: str | Path | None = None,
     overwrite: bool = False,
     poincare: int = POINCARE_SAMPLES,
+    workers: Workers = Workers(),
     progress: bool = True,
-    backend: str = "auto",
     on_point: Callable[[dict], None] | None = None,
-    scheduler=None,
-    locate_crossings: bool = False,
-    parallel: str = "auto",
-    **settings,
+    **values: float,
 ) -> SweepResult:
     """Sweep ``model`` over ``axes`` (``{"omega": values}`` or ``["omega=0.1:2.0:0.01", ...]``).
 
-    ``mode="continuation"`` hands each point's final state to the next along
-    the first axis (the paper's procedure), ``"independent"`` starts every
-    point from ``y0`` (default: the model's declared initial state).
-    ``out``: write ``out`` (CSV), its ``.json`` record and ``.poincare.csv``
-    as points finish, resuming if they exist. ``jobs``: threads (0 = every
-    core). ``on_point(row)`` is called in the main thread after each point is
-    stored. ``settings`` fix other parameters (or a stiffness formula) for
-    the whole sweep. ``model`` may also be a prebuilt :class:`CompiledModel`.
-    ``parallel``: how ``jobs`` > 1 run on this machine: ``"processes"`` (forked
-    from this one, so nothing is rebuilt; no lock shared between them, so the
-    Python around each point does not serialise them), ``"threads"``, or
-    ``"auto"``: processes where the OS can fork (Linux, macOS), else threads.
-    ``scheduler``: run the points on Dask (the ``distributed`` extra) instead of
-    threads: ``"local"`` starts a cluster of ``jobs`` single-threaded worker
-    processes on this machine for this sweep, ``"tcp://HOST:PORT"`` uses the
-    cluster of that scheduler, a ``distributed.Client`` its cluster. The files
-    are the same, byte for byte, as long as the workers run the client's library
-    (see :mod:`gearsym.codegen.portable`). ``locate_crossings``: split RK4 steps at backlash crossings
-    (see :func:`~gearsym.codegen.compile_model`; ignored for a prebuilt model).
+    ``model`` is a :class:`CompiledModel` (or a system, compiled first with ``options``); ``values`` fix
+    other parameters for the whole sweep; ``options`` (an :class:`~gearsym.options.Integration`) give the
+    periods per point and the scheme. ``mode="continuation"`` hands each point's final state to the next
+    along the first axis (the paper's procedure), ``"independent"`` starts every point from ``y0``
+    (default: the model's declared initial state). ``out``: write ``out`` (CSV), its ``.json`` record and
+    ``.poincare.csv`` as points finish, resuming if they exist. ``workers``: where the points run
+    (:class:`Workers`). ``on_point(row)`` is called in the main thread after each point is stored.
     """
-    periods, discard = whole_number(periods, "periods", 1), whole_number(discard, "discard")
-    if periods <= discard:
-        raise GearsymError(f"need 0 <= discard < periods, got periods={periods}, discard={discard}")
-    poincare = min(whole_number(poincare, "poincare samples"), periods - discard)
-    if scheduler is not None:
-        from .distributed import check_scheduler
-
-        check_scheduler(scheduler, whole_number(jobs, "jobs"))  # no Dask, a bad address: said before any work
-    jobs = whole_number(jobs, "jobs") or os.cpu_count() or 1
-    if parallel not in PARALLEL:
-        raise GearsymError(f"parallel={parallel!r}: choose one of {', '.join(PARALLEL)}")
-    if parallel == "auto":
-        parallel = "processes" if "fork" in multiprocessing.get_all_start_methods() else "threads"
-    if mode == INDEPENDENT and direction != "up":
-        raise GearsymError(f"--direction {direction} applies to a continuation; independent points have no direction")
-    axes = axes_from(axes)
-    compiled, values = compiled_and_values(model, settings, steps_per_period=steps_per_period, backend=backend,
-                                           verbose=progress, locate_crossings=locate_crossings)
-    for axis in axes:
-        if axis.name not in compiled.parameter_names:
-            raise UnknownParameterError(axis.name, compiled.parameter_names, f"{compiled.name}: --param")
-        if axis.name in settings:
-            raise GearsymError(f"{axis.name} is both swept (--param) and fixed (--set); drop one")
-        for v in axis.values:
-            compiled.parameter_vector(values, **{axis.name: v})  # every value checked before any work
-    base = dict(zip(compiled.parameter_names, map(float, compiled.parameter_vector(values))))
-    start = compiled.initial_state(y0)
-    tasks = plan(axes, mode, direction)
-    planned = [p for p in points(tasks)]
-
-    names = [a.name for a in axes]
-    n = compiled.dimension
-    columns = [*names, "direction", *(f"A_{c}" for c in compiled.observed),
-               *(f"lambda_{i}" for i in range(1, n + 1)), *(f"stderr_{i}" for i in range(1, n + 1)),
-               "regime", *(f"final_{s}" for s in compiled.state_names)]
-    strobe_columns = [*names, "direction", "sample", *compiled.state_names]
-    record = {
-        "model": compiled.name, "model_hash": compiled.hash, "backend": compiled.backend,
-        "settings": {k: str(v) for k, v in settings.items()}, "parameters": base,
-        "axes": {a.name: list(a.values) for a in axes}, "mode": mode, "direction": direction,
-        "periods": periods, "discard": discard, "steps_per_period": compiled.steps_per_period,
-        "initial_state": dict(zip(compiled.state_names, map(float, start))), "poincare_samples": poincare,
-    }
-    if compiled.options.locate_crossings:  # (only then: records of earlier sweeps still match)
-        record["locate_crossings"] = True
-    run = _Run(compiled, base, names, start, periods, discard, poincare, columns, strobe_columns)
-    store = SweepStore(out, columns, strobe_columns, [*names, "direction"], record) if out else None
+    options = model.run_options(options)
+    plan = _SweepPlan.make(model, axes, options, mode, direction, y0, poincare, values)
+    store = SweepStore(out, plan.columns, plan.strobe_columns, [*plan.names, "direction"], plan.record) \
+        if out else None
     try:  # the files stay locked against a second writer until this sweep returns or fails
         done, strobes = store.open(overwrite) if store else ({}, {})
-        unknown = set(done) - {p.key for p in planned}
+        unknown = set(done) - {p.key for p in plan.points}
         if unknown:
             raise GearsymError(f"{out}: holds points this sweep does not plan, e.g. {sorted(unknown)[0]}; "
                                "pass --overwrite or choose another --out")
-        todo = [run.remaining(task, done) for task in tasks]
-        todo = [t for t in todo if t[0]]
-        t_start = time.perf_counter()
-        bar = _progress(len(planned), len(done), compiled.name, progress)
-        already = len(done)
-        ran: dict = {}  # where the points ran, for the record (Dask only)
-        if scheduler is not None:
-            finished = _execute_dask(run, todo, scheduler, jobs, ran)
-        elif parallel == "processes" and jobs > 1 and len(todo) > 1:
-            finished = _execute_processes(run, todo, jobs)
-        else:
-            finished = _execute(run, todo, jobs)
-        try:
-            for row, strobe_rows in finished:
-                if store:
-                    store.append(row, strobe_rows)
-                key = row_key(row, names)
-                done[key], strobes[key] = row, strobe_rows  # counted once it is on disk
-                bar.update(1)
-                if on_point:
-                    on_point(row)
-        except KeyboardInterrupt:
-            finished.close()  # now, not when the traceback lets go of it: threads stop, cluster tasks are cancelled
-            bar.close()
-            if store:
-                store.close()
-                store.write_record(status="interrupted", points={"planned": len(planned), "done": len(done)},
-                                   **({"dask": ran} if ran else {}))
-            raise SweepInterrupted(len(done), len(planned), store.path if store else None) from None
-        except BaseException:
-            finished.close()
-            bar.close()
-            raise
-        bar.close()
-        rows = [done[p.key] for p in planned]
-        strobe_rows = [r for p in planned for r in strobes.get(p.key, [])]
-        result = SweepResult.from_rows(compiled.name, axes, mode, columns, rows, strobe_rows, record,
+        run = _Run(model, plan.base, plan.names, plan.start, options, plan.poincare, plan.columns,
+                   plan.strobe_columns)
+        todo = [t for t in (run.remaining(task, done) for task in plan.tasks) if t[0]]
+        t_start, already, ran = time.perf_counter(), len(done), {}  # ran: where the points ran (Dask only)
+        finished = _execute_on(workers, run, todo, ran)
+        _store_as_finished(finished, store, plan, done, strobes, progress, on_point, ran)
+        rows = [done[p.key] for p in plan.points]
+        strobe_rows = [r for p in plan.points for r in strobes.get(p.key, [])]
+        result = SweepResult.from_rows(model.name, plan.axes, mode, plan.columns, rows, strobe_rows, plan.record,
                                        path=store.path if store else None)
         if store:
-            computed = len(done) - already
-            timing = {"seconds": round(time.perf_counter() - t_start, 3), **({"dask": ran} if ran else {})}
-            if not computed:  # a rerun of a finished sweep: keep the time it took, and where
-                previous = store.previous_record()
-                timing = {k: previous[k] for k in ("seconds", "dask") if k in previous} or timing
-            store.finish(rows, strobe_rows)
-            store.write_record(status="complete",
-                               points={"planned": len(planned), "done": len(done), "computed": computed},
-                               **timing, gearsym=__version__, **result.findings())
+            _finish_files(store, result, rows, strobe_rows, len(done) - already, time.perf_counter() - t_start, ran)
         return result
     finally:
         if store:
             store.release()
 
 
+@dataclass(frozen=True)
+class _SweepPlan:
+    """Everything a sweep decides before its first point: the checked grid, the start, columns and record."""
+
+    axes: tuple[Axis, ...]
+    names: tuple[str, ...]
+    tasks: list
+    points: list[Point]
+    base: dict[str, float]
+    start: np.ndarray
+    poincare: int
+    columns: list[str]
+    strobe_columns: list[str]
+    record: dict
+
+    @classmethod
+    def make(cls, compiled: CompiledModel, axes, options: Integration, mode: str, direction: str, y0, poincare: int,
+             values: dict) -> "_SweepPlan":
+        poincare = min(whole_number(poincare, "poincare samples"), options.measured)
+        if mode == INDEPENDENT and direction != "up":
+            raise GearsymError(f"--direction {direction} applies to a continuation; independent points have no "
+                               "direction")
+        axes = tuple(axes_from(axes))
+        for axis in axes:
+            if axis.name not in compiled.parameter_names:
+                raise UnknownParameterError(axis.name, compiled.parameter_names, f"{compiled.name}: --param")
+            if axis.name in values:
+                raise GearsymError(f"{axis.name} is both swept (--param) and fixed (--set); drop one")
+            for v in axis.values:
+                compiled.parameter_vector(values, **{axis.name: v})  # every value checked before any work
+        base = dict(zip(compiled.parameter_names, map(float, compiled.parameter_vector(values))))
+        start = compiled.initial_state(y0)
+        tasks = plan(axes, mode, direction)
+        names = tuple(a.name for a in axes)
+        n = compiled.dimension
+        columns = [*names, "direction", *(f"A_{c}" for c in compiled.observed),
+                   *(f"lambda_{i}" for i in range(1, n + 1)), *(f"stderr_{i}" for i in range(1, n + 1)),
+                   "regime", *(f"final_{s}" for s in compiled.state_names)]
+        strobe_columns = [*names, "direction", "sample", *compiled.state_names]
+        record = {
+            "model": compiled.name, "model_hash": compiled.hash, "backend": compiled.backend,
+            "settings": {k: str(v) for k, v in values.items()}, "parameters": base,
+            "axes": {a.name: list(a.values) for a in axes}, "mode": mode, "direction": direction,
+            "periods": options.periods, "discard": options.discard, "steps_per_period": compiled.steps_per_period,
+            "initial_state": dict(zip(compiled.state_names, map(float, start))), "poincare_samples": poincare,
+        }
+        if compiled.options.locate_crossings:  # (only then: records of plain sweeps keep their keys)
+            record["locate_crossings"] = True
+        return cls(axes, names, tasks, list(points(tasks)), base, start, poincare, columns, strobe_columns, record)
+
+
+def _execute_on(workers: Workers, run: "_Run", todo: list, ran: dict):
+    """The rows of ``todo`` as they finish, from wherever ``workers`` says the points run."""
+    if workers.scheduler is not None:
+        return _execute_dask(run, todo, workers.scheduler, workers.jobs, ran)
+    if workers.mode == "processes" and workers.count > 1 and len(todo) > 1:
+        return _execute_processes(run, todo, workers.count)
+    return _execute(run, todo, workers.count)
+
+
+def _store_as_finished(finished, store: SweepStore | None, plan: _SweepPlan, done: dict, strobes: dict,
+                       progress: bool, on_point, ran: dict) -> None:
+    """Write each finished point (a point counts once it is on disk) and move the bar; on Ctrl-C keep what
+    is done, mark the record interrupted and say how to resume."""
+    bar = _progress(len(plan.points), len(done), plan.record["model"], progress)
+    try:
+        for row, strobe_rows in finished:
+            if store:
+                store.append(row, strobe_rows)
+            key = row_key(row, plan.names)
+            done[key], strobes[key] = row, strobe_rows
+            bar.update(1)
+            if on_point:
+                on_point(row)
+    except KeyboardInterrupt:
+        finished.close()  # now, not when the traceback lets go of it: workers stop, cluster tasks are cancelled
+        bar.close()
+        if store:
+            store.close()
+            store.write_record(status="interrupted", points={"planned": len(plan.points), "done": len(done)},
+                               **({"dask": ran} if ran else {}))
+        raise SweepInterrupted(len(done), len(plan.points), store.path if store else None) from None
+    except BaseException:
+        finished.close()
+        bar.close()
+        raise
+    bar.close()
+
+
+def _finish_files(store: SweepStore, result: SweepResult, rows, strobe_rows, computed: int, seconds: float,
+                  ran: dict) -> None:
+    """Both tables rewritten in the plan's order, and the record completed with what the sweep found."""
+    timing = {"seconds": round(seconds, 3), **({"dask": ran} if ran else {})}
+    if not computed:  # a rerun of a finished sweep: keep the time it took, and where
+        previous = store.previous_record()
+        timing = {k: previous[k] for k in ("seconds", "dask") if k in previous} or timing
+    store.finish(rows, strobe_rows)
+    store.write_record(status="complete",
+                       points={"planned": len(result), "done": len(rows), "computed": computed},
+                       **timing, gearsym=__version__, **result.findings())
+
+
 class _Run:
     """What every point of one sweep shares, and how a point becomes a row."""
 
-    def __init__(self, compiled, base, names, start, periods, discard, poincare, columns, strobe_columns):
+    def __init__(self, compiled, base, names, start, options, poincare, columns, strobe_columns):
         self.compiled, self.base, self.names, self.start = compiled, base, names, start
-        self.periods, self.discard, self.poincare = periods, discard, poincare
+        self.options, self.poincare = options, poincare
         self.columns, self.strobe_columns = columns, strobe_columns
 
     def __getstate__(self) -> dict:  # sent to Dask workers without the compiled model: each loads its own
@@ -233,7 +277,7 @@ class _Run:
     def point(self, compiled: CompiledModel, point: Point, y0: np.ndarray) -> tuple[dict, list[dict], np.ndarray]:
         values = {**self.base, **dict(zip(self.names, point.values))}
         try:
-            spectrum = lyapunov_spectrum(compiled, periods=self.periods, discard=self.discard, y0=y0, **values)
+            spectrum = lyapunov_spectrum(compiled, options=self.options, y0=y0, **values)
         except GearsymError as exc:
             where = ", ".join(f"{n}={v:g}" for n, v in zip(self.names, point.values))
             raise GearsymError(f"at {where} ({point.direction}): {exc}") from None

@@ -1,0 +1,48 @@
+"""The options every integrating command shares, declared once: the command-line face of
+:class:`~gearsym.options.Integration`, and the one way a command turns MODEL and --set into a compiled model."""
+from __future__ import annotations
+
+import argparse
+
+from ..options import BACKENDS, STEPS_PER_PERIOD, Integration
+from .settings import parse_settings
+
+
+def add_integration_arguments(parser: argparse.ArgumentParser, *, periods: int | None = 400, discard: int = 100,
+                              steps_help: str = f"RK4 steps per forcing period (default {STEPS_PER_PERIOD})") -> None:
+    """--periods, --discard (with this command's run length; none for ``periods=None``, a command whose runs
+    the data decide), --steps-per-period, --plain, --backend."""
+    group = parser.add_argument_group("integration (the same for every command that integrates)")
+    if periods is not None:
+        group.add_argument("--periods", type=int, default=periods,
+                           help=f"forcing periods in all, the discarded ones included (default {periods})")
+        group.add_argument("--discard", type=int, default=discard,
+                           help=f"transient periods left out of every result (default {discard})")
+    group.add_argument("--steps-per-period", type=int, default=None, help=steps_help)
+    group.add_argument("--plain", action="store_true",
+                       help="the paper's plain RK4: do not split the steps where the backlash switches (by default "
+                            "they are split, which keeps the exponents 4th order; see docs/engine.md)")
+    group.add_argument("--locate-crossings", action="store_true", help=argparse.SUPPRESS)  # the default now
+    group.add_argument("--backend", choices=BACKENDS, default="auto",
+                       help="compiled C, CasADi in-process, or auto (compiled when a C compiler exists)")
+
+
+def integration_from(args: argparse.Namespace, steps_per_period: int | None = None) -> Integration:
+    """The command's options; ``steps_per_period`` if the command chose them (else --steps-per-period)."""
+    run = {"periods": args.periods, "discard": args.discard} if hasattr(args, "periods") else {}
+    return Integration(**run, steps_per_period=steps_per_period or args.steps_per_period or STEPS_PER_PERIOD,
+                       locate_crossings=not args.plain, backend=args.backend)
+
+
+def system_from(args: argparse.Namespace):
+    """The system of the command's MODEL with its --set values (names and files are resolved here, at the edge)."""
+    from ..registry import load
+
+    return load(args.model, **parse_settings(args.set))
+
+
+def compiled_from(args: argparse.Namespace, options: Integration | None = None, system=None):
+    """The compiled model of the command's MODEL with its --set values (or of ``system``)."""
+    from ..codegen import compile_model
+
+    return compile_model(system or system_from(args), options or integration_from(args), verbose=True)
