@@ -6,7 +6,7 @@ import operator
 
 import numpy as np
 
-from .errors import GearsymError
+from .errors import GearsymError, suggest
 
 
 def whole_number(value, what: str, minimum: int = 0) -> int:
@@ -37,3 +37,16 @@ def json_safe(x):
     if isinstance(x, np.str_):
         return str(x)
     return x
+
+
+def chosen_coordinate(name: str | None, coordinates, plot) -> str | None:
+    """``--coordinate name`` checked: it chooses what ``--plot`` draws, so it needs ``plot``, and it must be one of
+    ``coordinates``. None stays None (the plot's default, the first coordinate)."""
+    if name is None:
+        return None
+    if not plot:
+        raise GearsymError(f"--coordinate {name} chooses what --plot draws; add --plot FILE.png")
+    if name not in coordinates:
+        raise GearsymError(f"--coordinate {name}: no such coordinate.{suggest(name, coordinates)} "
+                           f"The coordinates are {', '.join(coordinates)}")
+    return name

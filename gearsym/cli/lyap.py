@@ -7,6 +7,8 @@ import sys
 from pathlib import Path
 
 from ..analysis import lyapunov_spectrum, phase_trajectory
+from ..analysis.regime import describe_regime
+from ..checks import chosen_coordinate
 from ..codegen import BACKENDS, compile_model
 from .settings import add_set_argument, parse_settings, parse_state
 
@@ -28,11 +30,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--format", choices=("text", "json"), default="text")
     parser.add_argument("--plot", type=Path, metavar="FILE.png",
                         help="also draw the exponents' convergence and the phase portrait with the Poincare points")
+    parser.add_argument("--coordinate", metavar="NAME",
+                        help="the coordinate of the phase portrait (against the state after it; default the first)")
 
 
 def run(args: argparse.Namespace) -> int:
     compiled = compile_model(args.model, steps_per_period=args.steps_per_period, backend=args.backend,
                              locate_crossings=args.locate_crossings, verbose=True, **parse_settings(args.set))
+    coordinate = chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     result = lyapunov_spectrum(compiled, periods=args.periods, discard=args.discard, y0=parse_state(args.y0))
     if args.plot:
         from ..figures import plot_point  # matplotlib only when asked for
@@ -40,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
         shown = min(30, result.periods - result.discard)
         trajectory = phase_trajectory(compiled, periods=shown, discard=result.periods - shown,
                                       y0=parse_state(args.y0))
-        plot_point(result, trajectory, args.plot)
+        plot_point(result, trajectory, args.plot, x=coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     if args.format == "json":
         print(json.dumps(result.as_dict(), indent=2))
@@ -53,6 +58,8 @@ def run(args: argparse.Namespace) -> int:
     for i, (lam, err) in enumerate(zip(result.exponents, result.stderr), 1):
         print(f"  lambda_{i} = {lam:+.6f} +- {err:.6f}")
     print(f"  sum      = {result.sum:+.6f}")
+    print("regime: " + describe_regime(result.regime, result.exponents, result.stderr, result.measured_time,
+                                       result.autonomous))
     for name, a in result.amplitude.items():
         print(f"amplitude A_{name} = {a:.6g}")
     print("final state: " + ", ".join(f"{k}={v:.6g}" for k, v in result.final_state.items()))

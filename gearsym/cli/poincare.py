@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from ..analysis.attractors import DEFAULT_BOX, AttractorSet, find_attractors
+from ..checks import chosen_coordinate
 from ..codegen import BACKENDS, compile_model
 from ..errors import GearsymError
 from .settings import add_set_argument, parse_settings
@@ -32,6 +33,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--format", choices=("text", "json"), default="text")
     parser.add_argument("--plot", type=Path, metavar="FILE.png",
                         help="also draw the Poincare points of every attractor")
+    parser.add_argument("--coordinate", metavar="NAME",
+                        help="the coordinate --plot shows (against the state after it; default the first)")
 
 
 def parse_box(text: str | None) -> dict[str, tuple[float, float]] | None:
@@ -58,12 +61,13 @@ def run(args: argparse.Namespace) -> int:
     box = parse_box(args.box)
     compiled = compile_model(args.model, steps_per_period=args.steps_per_period, backend=args.backend,
                              verbose=True, **parse_settings(args.set))
+    coordinate = chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     found = find_attractors(compiled, ics=args.ics, seed=args.seed, box=box, periods=args.periods,
                             discard=args.discard)
     if args.plot:
         from ..figures.poincare import plot_attractors  # matplotlib only when asked for
 
-        plot_attractors(found, args.plot)
+        plot_attractors(found, args.plot, x=coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     if args.format == "json":
         print(json.dumps(found.as_dict(), indent=2))

@@ -6,8 +6,11 @@ import sys
 from collections import Counter
 from pathlib import Path
 
-from ..codegen import BACKENDS
+from ..checks import chosen_coordinate
+from ..codegen import BACKENDS, compile_model
 from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, run_sweep
+from ..sweep.report import findings_lines
+from ..sweep.store import sidecar
 from .settings import add_set_argument, parse_settings, parse_state
 
 NAME = "sweep"
@@ -53,17 +56,24 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--backend", choices=BACKENDS, default="auto")
     parser.add_argument("--plot", type=Path, metavar="FILE.png",
                         help="draw amplitudes, exponents, regimes and the bifurcation diagram")
+    parser.add_argument("--coordinate", metavar="NAME",
+                        help="the coordinate --plot shows (amplitude, bifurcation diagram; default the first)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
 def run(args: argparse.Namespace) -> int:
+    settings = parse_settings(args.set)
+    if args.coordinate:  # checked before any point runs (the model compiled here is reused by the sweep)
+        compiled = compile_model(args.model, steps_per_period=args.steps_per_period, backend=args.backend,
+                                 locate_crossings=args.locate_crossings, verbose=not args.quiet, **settings)
+        chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     try:
         result = run_sweep(args.model, args.param, mode=args.mode, direction=args.direction, periods=args.periods,
                            discard=args.discard, steps_per_period=args.steps_per_period, y0=parse_state(args.y0),
                            jobs=args.jobs, out=args.out, overwrite=args.overwrite, poincare=args.poincare,
                            progress=not args.quiet, backend=args.backend, locate_crossings=args.locate_crossings,
                            scheduler="local" if args.dask else args.scheduler, parallel=args.parallel,
-                           **parse_settings(args.set))
+                           **settings)
     except KeyboardInterrupt as exc:  # SweepInterrupted says how many points were kept
         print(f"gearsym: {exc}" if str(exc) else "gearsym: interrupted before any point was finished",
               file=sys.stderr)
@@ -71,16 +81,12 @@ def run(args: argparse.Namespace) -> int:
     regimes = Counter(result["regime"].tolist())
     print(f"{result.model}: {len(result)} points -> {args.out} (+ .json, .poincare.csv)")
     print("regimes: " + ", ".join(f"{k} {v}" for k, v in sorted(regimes.items())))
-    findings = result.findings()
-    for j in findings["jumps"]:
-        print(f"jump in A_{j['coordinate']} ({j['direction']}): {j['from']:g} -> {j['to']:g}, "
-              f"A {j['A_before']:.4g} -> {j['A_after']:.4g}")
-    for h in findings["hysteresis"]:
-        print(f"hysteresis in A_{h['coordinate']}: up and down differ for {result.axes[0].name} in "
-              f"[{h['from']:g}, {h['to']:g}]")
+    for line in findings_lines(result, sidecar(args.out, ".json")):
+        print(line)
     if args.plot:
         from ..figures.sweep import plot_sweep  # matplotlib only when asked for
 
-        plot_sweep(result, args.plot)
+        plot_sweep(result, args.plot, coordinate=args.coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     return 0
+

@@ -57,8 +57,8 @@ def compute(plan: Plan, data_dir: str | Path, *, jobs: int = 0, progress: bool =
     for job in plan.portraits:
         values = {"omega": plan.portrait_omega, **job.settings}
         spectrum = lyapunov_spectrum(compiled, periods=plan.periods, discard=plan.discard, **values)
-        trajectory = phase_trajectory(compiled, periods=min(40, plan.periods - plan.discard),
-                                      discard=plan.periods - min(40, plan.periods - plan.discard), **values)
+        shown = min(plan.portrait_window, plan.periods - plan.discard)  # the end of the same run
+        trajectory = phase_trajectory(compiled, periods=shown, discard=plan.periods - shown, **values)
         portraits.append(Portrait(job.letter, values, job.x, job.y, spectrum, trajectory))
     return Computed(plan, sweeps, attractors, tuple(portraits))
 
