@@ -7,7 +7,9 @@ import sys
 from pathlib import Path
 
 from ..analysis import lyapunov_spectrum, phase_trajectory
+from ..checks import check_run
 from ..codegen import BACKENDS, compile_model
+from ..outputs import check_figure
 from .settings import add_set_argument, parse_settings, parse_state
 
 NAME = "lyap"
@@ -31,6 +33,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_run(steps_per_period=args.steps_per_period, measured=args.periods - args.discard, discard=args.discard)
+    if args.plot:
+        check_figure(args.plot)
     compiled = compile_model(args.model, steps_per_period=args.steps_per_period, backend=args.backend,
                              locate_crossings=args.locate_crossings, verbose=True, **parse_settings(args.set))
     result = lyapunov_spectrum(compiled, periods=args.periods, discard=args.discard, y0=parse_state(args.y0))

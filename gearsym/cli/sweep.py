@@ -6,7 +6,9 @@ import sys
 from collections import Counter
 from pathlib import Path
 
+from ..checks import check_run
 from ..codegen import BACKENDS
+from ..outputs import check_figure, check_file
 from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, run_sweep
 from .settings import add_set_argument, parse_settings, parse_state
 
@@ -57,6 +59,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_run(steps_per_period=args.steps_per_period, measured=args.periods - args.discard, discard=args.discard)
+    check_file(args.out, (".csv",))
+    if args.plot:
+        check_figure(args.plot)
     try:
         result = run_sweep(args.model, args.param, mode=args.mode, direction=args.direction, periods=args.periods,
                            discard=args.discard, steps_per_period=args.steps_per_period, y0=parse_state(args.y0),
