@@ -58,6 +58,11 @@ def run(args: argparse.Namespace) -> int:
     for i, (lam, err) in enumerate(zip(result.exponents, result.stderr), 1):
         print(f"  lambda_{i} = {lam:+.6f} +- {err:.6f}")
     print(f"  sum      = {result.sum:+.6f}")
+    if result.at_rest:
+        print(f"regime: equilibrium, {'stable' if max(result.exponents) < 0 else 'unstable'} (the run never left a "
+              "fixed point: the exponents are the real parts of the Jacobian's eigenvalues there, "
+              + ", ".join(f"{e.real:.6g}{e.imag:+.6g}i" if e.imag else f"{e.real:.6g}" for e in result.eigenvalues)
+              + ")")
     for name, a in result.amplitude.items():
         print(f"amplitude A_{name} = {a:.6g}")
     print("final state: " + ", ".join(f"{k}={v:.6g}" for k, v in result.final_state.items()))
