@@ -10,12 +10,14 @@ message and exit status 2 (a user's mistake, not a crash: no traceback).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+import warnings
 from collections.abc import Sequence
 from types import ModuleType
 
 from .. import __version__
-from ..errors import GearsymError
+from ..errors import GearsymError, GearsymWarning
 from . import compile, derive, docs, explain, list_models, lyap, poincare, reproduce, simulate, sweep
 
 #: the subcommand modules, in the order ``gearsym --help`` lists them
@@ -23,6 +25,8 @@ COMMANDS: tuple[ModuleType, ...] = (list_models, derive, docs, compile, lyap, sw
 
 #: exit status of a GearsymError (argparse uses the same for bad arguments)
 USAGE_ERROR = 2
+#: exit status when the reader of stdout went away (`gearsym list | head -1`), as a shell reports SIGPIPE
+CLOSED_PIPE = 141
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -41,8 +45,24 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``gearsym`` with ``argv`` (default: the process arguments); returns the exit status."""
     args = build_parser().parse_args(argv)
-    try:
-        return args.run(args)
-    except GearsymError as exc:
-        print(f"gearsym: error: {exc}", file=sys.stderr)
-        return USAGE_ERROR
+    with warnings.catch_warnings():
+        warnings.simplefilter("default", GearsymWarning)
+        warnings.showwarning = _one_line
+        try:
+            status = args.run(args)
+            sys.stdout.flush()  # a closed pipe shows here rather than at the interpreter's exit
+            return status
+        except GearsymError as exc:
+            print(f"gearsym: error: {exc}", file=sys.stderr)
+            return USAGE_ERROR
+        except BrokenPipeError:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nobody reads the rest
+            return CLOSED_PIPE
+
+
+def _one_line(message, category, filename, lineno, file=None, line=None):
+    """Warnings of gearsym as one line on stderr, like its errors; others as Python prints them."""
+    if issubclass(category, GearsymWarning):
+        print(f"gearsym: warning: {message}", file=sys.stderr, flush=True)
+    else:
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))

@@ -5,8 +5,10 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..codegen.generated import DEFAULT_DIR, generate_model
-from ..registry import available_models
+from ..checks import check_run
+from ..codegen.generated import generate_model
+from ..outputs import check_folder
+from ..registry import available_models, output_root
 from .settings import add_set_argument, parse_settings
 
 NAME = "compile"
@@ -18,8 +20,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--all", action="store_true", help="every model of `gearsym list`")
     add_set_argument(parser)
     parser.add_argument("--steps-per-period", type=int, default=200, help="RK4 steps per period (default 200)")
-    parser.add_argument("--out", type=Path, default=DEFAULT_DIR, metavar="DIR",
-                        help="where <model>/ is written (default: generated/ of the repository)")
+    parser.add_argument("--out", type=Path, default=None, metavar="DIR",
+                        help="where <model>/ is written (default: generated/ of the repository for its own models, "
+                             "of the current directory for others)")
     parser.add_argument("--no-compile", action="store_true", help="write the C only")
     parser.add_argument("--check", action="store_true",
                         help="write nothing; exit 1 and name the files that differ from what would be written")
@@ -31,9 +34,13 @@ def run(args: argparse.Namespace) -> int:
         return 2
     refs = available_models() if args.all else args.models
     settings = parse_settings(args.set)
+    check_run(steps_per_period=args.steps_per_period)
+    outs = [args.out or output_root(ref) / "generated" for ref in refs]
+    for out in set(outs) if not args.check else ():
+        check_folder(out)
     stale = []
-    for ref in refs:
-        report = generate_model(ref, args.out, steps_per_period=args.steps_per_period, check=args.check,
+    for ref, out in zip(refs, outs):
+        report = generate_model(ref, out, steps_per_period=args.steps_per_period, check=args.check,
                                 compile=not (args.no_compile or args.check), **settings)
         if args.check:
             stale += report.stale

@@ -8,8 +8,9 @@ from pathlib import Path
 
 from ..analysis import lyapunov_spectrum, phase_trajectory
 from ..analysis.regime import describe_regime
-from ..checks import chosen_coordinate
+from ..checks import check_run, chosen_coordinate
 from ..codegen import BACKENDS, compile_model
+from ..outputs import check_figure
 from .settings import add_set_argument, parse_settings, parse_state
 
 NAME = "lyap"
@@ -35,6 +36,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_run(steps_per_period=args.steps_per_period, measured=args.periods - args.discard, discard=args.discard)
+    if args.plot:
+        check_figure(args.plot)
     compiled = compile_model(args.model, steps_per_period=args.steps_per_period, backend=args.backend,
                              locate_crossings=args.locate_crossings, verbose=True, **parse_settings(args.set))
     coordinate = chosen_coordinate(args.coordinate, compiled.observed, args.plot)
@@ -58,8 +62,14 @@ def run(args: argparse.Namespace) -> int:
     for i, (lam, err) in enumerate(zip(result.exponents, result.stderr), 1):
         print(f"  lambda_{i} = {lam:+.6f} +- {err:.6f}")
     print(f"  sum      = {result.sum:+.6f}")
-    print("regime: " + describe_regime(result.regime, result.exponents, result.stderr, result.measured_time,
-                                       result.autonomous))
+    if result.at_rest:
+        print(f"regime: equilibrium, {'stable' if max(result.exponents) < 0 else 'unstable'} (the run never left a "
+              "fixed point: the exponents are the real parts of the Jacobian's eigenvalues there, "
+              + ", ".join(f"{e.real:.6g}{e.imag:+.6g}i" if e.imag else f"{e.real:.6g}" for e in result.eigenvalues)
+              + ")")
+    else:
+        print("regime: " + describe_regime(result.regime, result.exponents, result.stderr, result.measured_time,
+                                           result.autonomous))
     for name, a in result.amplitude.items():
         print(f"amplitude A_{name} = {a:.6g}")
     print("final state: " + ", ".join(f"{k}={v:.6g}" for k, v in result.final_state.items()))

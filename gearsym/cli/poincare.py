@@ -7,9 +7,10 @@ import sys
 from pathlib import Path
 
 from ..analysis.attractors import DEFAULT_BOX, AttractorSet, find_attractors
-from ..checks import chosen_coordinate
+from ..checks import check_run, chosen_coordinate
 from ..codegen import BACKENDS, compile_model
 from ..errors import GearsymError
+from ..outputs import check_figure
 from .settings import add_set_argument, parse_settings
 
 NAME = "poincare"
@@ -58,6 +59,10 @@ def parse_box(text: str | None) -> dict[str, tuple[float, float]] | None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_run(steps_per_period=args.steps_per_period, measured=args.periods, discard=args.discard,
+              measured_is="--periods")
+    if args.plot:
+        check_figure(args.plot)
     box = parse_box(args.box)
     compiled = compile_model(args.model, steps_per_period=args.steps_per_period, backend=args.backend,
                              verbose=True, **parse_settings(args.set))

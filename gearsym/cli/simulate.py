@@ -4,8 +4,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..checks import check_run
 from ..codegen import BACKENDS, compile_model
 from ..data.simulate import simulate_measurements, steps_for
+from ..errors import GearsymError
+from ..outputs import check_file
 from .settings import add_set_argument, parse_numbers, parse_settings, parse_state
 
 NAME = "simulate"
@@ -44,6 +47,9 @@ def run(args: argparse.Namespace) -> int:
     records = [parse_conditions(text) for text in args.record]
     settings = parse_settings(args.set)
     steps = steps_for(args.samples_per_period, args.steps_per_period)
+    check_run(steps_per_period=steps)
+    check_file(args.out, (".csv",))
+    check_strengths(args.effect, settings)
     model = _with_effects(args.model, args.effect, settings) if args.effect else args.model
     compiled = compile_model(model, steps_per_period=steps, backend=args.backend, verbose=True,
                              **({} if args.effect else settings))
@@ -68,6 +74,24 @@ def _with_effects(model: str, effects: list[str], settings: dict):
     own = {p for e in map(effect, effects) for p in e.parameters}
     base = system_for(model, **{k: v for k, v in settings.items() if k not in own})
     return augment(base, effects, values={k: v for k, v in settings.items() if k in own})
+
+
+def check_strengths(effects: list[str], settings: dict) -> None:
+    """Every effect needs a strength other than 0 (its off value) among ``settings``."""
+    from ..fit.effects import effect
+
+    for e in map(effect, effects):
+        if not any(_nonzero(settings.get(p)) for p in e.fitted):
+            given = " and/or ".join(f"--set {p}=VALUE" for p in e.fitted)
+            raise GearsymError(f"--effect {e.name} needs its strength: {given} (the effect is off at 0, which "
+                               f"would simulate the model without it)")
+
+
+def _nonzero(value: str | None) -> bool:
+    try:
+        return value is not None and float(value) != 0.0
+    except ValueError:
+        raise GearsymError(f"an effect's strength must be a number, got {value!r}") from None
 
 
 def parse_conditions(text: str) -> dict[str, float]:

@@ -6,8 +6,9 @@ import sys
 from collections import Counter
 from pathlib import Path
 
-from ..checks import chosen_coordinate
+from ..checks import check_run, chosen_coordinate
 from ..codegen import BACKENDS, compile_model
+from ..outputs import check_figure, check_file
 from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, run_sweep
 from ..sweep.report import findings_lines
 from ..sweep.store import sidecar
@@ -62,6 +63,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_run(steps_per_period=args.steps_per_period, measured=args.periods - args.discard, discard=args.discard)
+    check_file(args.out, (".csv",))
+    if args.plot:
+        check_figure(args.plot)
     settings = parse_settings(args.set)
     if args.coordinate:  # checked before any point runs (the model compiled here is reused by the sweep)
         compiled = compile_model(args.model, steps_per_period=args.steps_per_period, backend=args.backend,

@@ -5,13 +5,10 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..registry import REPO_ROOT
+from ..registry import output_root
 from .compiler import compile_library
 from .functions import LoopOptions, build_functions
 from .generate import code_hash, write_code
-
-DEFAULT_DIR = REPO_ROOT / "generated"
-
 
 @dataclass
 class GenerateReport:
@@ -24,11 +21,13 @@ class GenerateReport:
     stale: list[Path] = field(default_factory=list)
 
 
-def generate_model(ref, out: Path = DEFAULT_DIR, *, steps_per_period: int = 200, check: bool = False,
+def generate_model(ref, out: Path | None = None, *, steps_per_period: int = 200, check: bool = False,
                    compile: bool = True, **settings) -> GenerateReport:
-    """Write ``out/<model>/<model>.c`` and ``manifest.json``; with ``check``, compare instead of writing."""
+    """Write ``out/<model>/<model>.c`` and ``manifest.json``; with ``check``, compare instead of writing.
+    ``out`` defaults to ``generated/`` of the repository for its own models, of the current directory for others."""
     from ..registry import system_for
 
+    out = output_root(ref) / "generated" if out is None else out
     system = system_for(ref, **settings)
     options = LoopOptions(steps_per_period=steps_per_period)
     digest = code_hash(system, options)

@@ -19,8 +19,11 @@ def explain_files(paths, model, fit, *, out=None, time_scale=None, held_out: flo
     and with ``out`` write the report there. Returns the report's dict (the keys of report.json)."""
     from ..codegen import compile_model
     from ..data import load_measurements
+    from ..outputs import check_folder
     from .report import write_report
 
+    if out is not None:
+        check_folder(out)
     compiled = compile_model(model, **settings)
     measurements = load_measurements(paths, compiled, time_scale=time_scale)
     ex = explain(compiled.system, measurements, fit, held_out=held_out, candidates=candidates, progress=progress)

@@ -10,7 +10,7 @@ paper names and writes Eqs. 2, 6 and 9:
 * a shaft's factor in every row is a group ``beta`` multiplying ``kS x``
   (the paper's beta1, beta2);
 * the forcing of each row, grouped by harmonic, gives B0, B1, D, ...;
-  the constant forcing of an unforced shaft row must vanish: the torque-balance
+  the constant forcing of a shaft declared forced=False must vanish: the torque-balance
   condition of Eq. 10;
 * time is measured in units of 1/omega_n, omega_n^2 = m kZ of the first mesh,
   so that its mean stiffness is 1 (the paper's convention; a condition too).
@@ -179,6 +179,16 @@ class NondimensionalModel:
     @property
     def defaults(self) -> dict[str, float]:
         """Declared default of every parameter; errors name what is missing or unknown."""
+        return self._defaults_except(())
+
+    @property
+    def declared_defaults(self) -> dict[str, float]:
+        """The parameters' declared defaults, checked; those without one are left out (no error)."""
+        return self._defaults_except(self.parameter_names, strict=False)
+
+    def _defaults_except(self, given, strict: bool = True) -> dict[str, float]:
+        """Declared defaults of the parameters; with ``strict``, an error names those that have none and are
+        not ``given`` (values passed instead)."""
         declared = self.drivetrain.defaults
         fnames = {f.name for f in self.functions}
         allowed = set(self.parameter_names) | fnames
@@ -193,20 +203,17 @@ class NondimensionalModel:
                     f"{self.name}: set_defaults",
                 )
             raise UnknownParameterError(name, allowed, f"{self.name}: set_defaults")
-        out, missing = {}, []
-        for name in self.parameter_names:
-            if name not in declared:
-                missing.append(name)
-                continue
-            out[name] = self._number(name, declared[name], "default")
-        if missing:
+        out = {name: self._number(name, declared[name], "default") for name in self.parameter_names
+               if name in declared}
+        missing = [name for name in self.parameter_names if name not in declared and name not in given]
+        if missing and strict:
             hints = []
             for name in missing:
                 gr = next((gr for gr in self.groups if gr.name == name), None)
                 hints.append(f"{name} ({gr.description}: {gr.definition})" if gr else name)
             raise ModelError(
                 "parameters without a default value: " + "; ".join(hints)
-                + f". Add them with model.set_defaults({missing[0]}=...)",
+                + f". Add them with model.set_defaults({missing[0]}=...) or pass them as values",
                 self.name,
             )
         return out
@@ -275,6 +282,27 @@ class NondimensionalModel:
         ``a=0.3`` gives the new parameter its value). A default for a function
         name in ``set_defaults`` replaces it the same way.
         """
+        rhs, names = self.engine_equations(**settings)
+        defaults = self._defaults_except(set(settings) | (set(self.parameter_names) - set(names)))
+        params = {}
+        for name in names:
+            if name in settings:
+                params[name] = self._number(name, settings[name], "value")
+            elif name in defaults:
+                params[name] = defaults[name]
+            else:
+                raise ModelError(f"parameter {name!r} of a replaced stiffness function needs a value: pass {name}=...", self.name)
+        descriptions = dict(self.drivetrain.descriptions)
+        for gr in self.groups:
+            descriptions.setdefault(gr.name, gr.description)
+        return FirstOrderSystem(self.name, tau, self.states, rhs, params, self.period, descriptions,
+                                self.drivetrain.title, tuple(c.name for c in self.coordinates),
+                                self.drivetrain.initial_state)
+
+    def engine_equations(self, **settings: ExprLike) -> tuple[tuple[sp.Expr, ...], list[str]]:
+        """The right-hand side :meth:`system` gives the engine (k(tau) written out, derived groups expanded)
+        and its parameters in order; symbolic, so no parameter needs a value. ``settings`` are checked
+        names; those naming a stiffness function replace it."""
         declared = self.drivetrain.defaults
         functions = {f.name: self._function_expr(f, declared[f.name]) for f in self.functions if f.name in declared}
         for f in self.functions:
@@ -289,23 +317,8 @@ class NondimensionalModel:
         for key in settings:
             if key not in fnames and key not in used and key not in self.parameter_names:
                 raise UnknownParameterError(key, set(self.parameter_names) | fnames | used, self.name)
-        defaults = self.defaults
         names = [n for n in self.parameter_names if n in used or n == "omega"]
-        names += sorted(used - set(names))
-        params = {}
-        for name in names:
-            if name in settings:
-                params[name] = self._number(name, settings[name], "value")
-            elif name in defaults:
-                params[name] = defaults[name]
-            else:
-                raise ModelError(f"parameter {name!r} of a replaced stiffness function needs a value: pass {name}=...", self.name)
-        descriptions = dict(self.drivetrain.descriptions)
-        for gr in self.groups:
-            descriptions.setdefault(gr.name, gr.description)
-        return FirstOrderSystem(self.name, tau, self.states, tuple(rhs), params, self.period, descriptions,
-                                self.drivetrain.title, tuple(c.name for c in self.coordinates),
-                                self.drivetrain.initial_state)
+        return tuple(rhs), names + sorted(used - set(names))
 
 
 # ============================================================================ construction
