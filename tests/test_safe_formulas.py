@@ -79,6 +79,8 @@ def test_the_set_error_names_the_option_and_what_was_refused(sandbox, capsys):
     ("x^2", r"'^' (write powers as **)"),
     ("2j", "imaginary"),
     ("x and y", "use And(a, b)"),
+    ("sin(x)(2)", "calls something other than a function by its name"),
+    ("(1 + x)(2)", "calls something other than a function by its name"),
 ])
 def test_a_formula_that_reaches_outside_the_grammar_is_refused_in_one_line(formula, refused, sandbox):
     with pytest.raises(ModelError) as err:

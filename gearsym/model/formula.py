@@ -150,7 +150,7 @@ class _Builder:
         if isinstance(base, sp.Rational) and isinstance(exponent, sp.Rational):
             bits = abs(exponent.p) * max(int(base.p).bit_length(), int(base.q).bit_length())
             if bits > MAX_EXACT_BITS:
-                raise self.refuse(f"asks for a power with more than {MAX_EXACT_BITS} bits, too large to compute exactly")
+                raise self.refuse(f"asks for a power of more than {MAX_EXACT_BITS} bits, too large to compute exactly")
         return base**exponent
 
     def compare(self, n: ast.Compare, depth: int) -> sp.Basic:
@@ -163,8 +163,10 @@ class _Builder:
         return parts[0] if len(parts) == 1 else sp.And(*parts)  # 0 < x < 1 reads as in mathematics
 
     def call(self, n: ast.Call, depth: int) -> sp.Basic:
+        if isinstance(n.func, ast.Attribute):
+            raise self.refuse(f"uses {_REFUSED_NODES[ast.Attribute]}, which is not allowed in a formula")
         if not isinstance(n.func, ast.Name):
-            return self.node(n.func, depth + 1)  # refuses attribute access, calls of calls, ...
+            raise self.refuse("calls something other than a function by its name")
         name = n.func.id
         if name.startswith("_"):
             raise self.refuse(f"calls {name!r}; a name in a formula must not start with '_'")
