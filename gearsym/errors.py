@@ -2,11 +2,21 @@
 from __future__ import annotations
 
 import difflib
+import warnings
 from collections.abc import Iterable
 
 
 class GearsymError(Exception):
     """Base class of every error gearsym raises on purpose."""
+
+
+class GearsymWarning(UserWarning):
+    """Something gearsym does that the user may not expect: the command line prints it as one line."""
+
+
+def warn(message: str) -> None:
+    """Say ``message`` as a :class:`GearsymWarning` (``gearsym: warning: ...`` on the command line)."""
+    warnings.warn(message, GearsymWarning, stacklevel=2)
 
 
 class ModelError(GearsymError, ValueError):

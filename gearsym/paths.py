@@ -11,5 +11,3 @@ from pathlib import Path
 REPO_ROOT = Path(__file__).resolve().parent.parent
 #: the committed C of the shipped models, one folder per model
 GENERATED_DIR = REPO_ROOT / "generated"
-#: the committed derivation pages of the shipped models
-DERIVATIONS_DIR = REPO_ROOT / "docs" / "derivations"

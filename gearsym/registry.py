@@ -4,6 +4,7 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import sys
+import traceback
 from pathlib import Path
 from typing import Union
 
@@ -19,6 +20,19 @@ def models_dir() -> Path:
     """``./models`` if the working directory has one, else the repository's ``models/``."""
     local = Path.cwd() / "models"
     return local if (local / "__init__.py").is_file() else REPO_ROOT / "models"
+
+
+def output_root(ref) -> Path:
+    """Where a model's derivation page (``docs/derivations/``) and C (``generated/``) go by default: the
+    repository for a model of its own ``models/``, else the current directory (a user's model must
+    not write into the installed tree)."""
+    shipped = (REPO_ROOT / "models").resolve()
+    if isinstance(ref, (str, Path)):
+        text = str(ref)
+        folder = Path(text).resolve().parent if text.endswith(".py") or "/" in text else models_dir().resolve()
+        if folder == shipped:
+            return REPO_ROOT
+    return Path.cwd()
 
 
 def available_models() -> list[str]:
@@ -37,7 +51,7 @@ def load_model(ref: Union[str, Path, Model]) -> Model:
             raise GearsymError(f"model file {ref} does not exist")
         spec = importlib.util.spec_from_file_location(f"gearsym_user_model_{path.stem}", path)
         module = importlib.util.module_from_spec(spec)
-        _with_models_importable(lambda: spec.loader.exec_module(module))
+        _with_models_importable(lambda: spec.loader.exec_module(module), path)
     else:
         names = available_models()
         if ref not in names:
@@ -54,14 +68,26 @@ def load_model(ref: Union[str, Path, Model]) -> Model:
     return model
 
 
-def _with_models_importable(action):
-    """Run ``action`` with the folder holding ``models/`` importable (model files import each other)."""
+def _with_models_importable(action, model_file: Path | None = None):
+    """Run ``action`` with the folder holding ``models/`` importable (model files import each other);
+    a model file that fails to run (a syntax error, a missing import, ...) is a one-line error naming
+    its file and line."""
     root = str(models_dir().parent)
+    folders = {models_dir().resolve()} | ({model_file.resolve().parent} if model_file else set())
     added = root not in sys.path
     if added:
         sys.path.insert(0, root)
     try:
         return action()
+    except GearsymError:
+        raise
+    except SyntaxError as exc:
+        raise GearsymError(f"{exc.filename}, line {exc.lineno}: {type(exc).__name__}: {exc.msg}") from None
+    except Exception as exc:
+        frames = traceback.extract_tb(exc.__traceback__)
+        models = [f for f in frames if not f.filename.startswith("<") and Path(f.filename).parent.resolve() in folders]
+        where = (models or frames)[-1]  # the model file's own line, not one in a library it called
+        raise GearsymError(f"{where.filename}, line {where.lineno}: {type(exc).__name__}: {exc}") from None
     finally:
         if added:
             sys.path.remove(root)

@@ -13,7 +13,7 @@ g1 = model.add(Gear("gear1", inertia="I1", base_radius="r1"))
 g2 = model.add(Gear("gear2", inertia="I2", base_radius="r2"))
 d3 = model.add(Disk("disk3", inertia="I3"))
 model.add(Mesh("mesh", g1, g2, stiffness="kZ", damping="cZ", backlash="eta", coordinate="x1"))
-model.add(Shaft("shaft", g2, d3, stiffness="kS", coordinate="x2"))
+model.add(Shaft("shaft", g2, d3, stiffness="kS", coordinate="x2", forced=False))  # the torque balance of Eq. 10
 model.add(Torque("M1", on=g1, mean="M1", harmonics=(Harmonic("M1a", phase="Theta", group="B1"),)))
 model.add(Torque("M2", on=g2, mean="M2", load=True))
 model.add(Torque("M3", on=d3, mean="M3", load=True))

@@ -150,17 +150,53 @@ def test_figures_are_written(duffing, tmp_path):
 
     weak = find_attractors(duffing, ics=6, seed=3, box=WELLS, periods=30, discard=100)
     strong = find_attractors(duffing, ics=6, seed=3, box=WELLS, periods=100, discard=100, g=0.3)
-    out = plot_attractors([[weak, strong], strong], tmp_path / "attractors.png", labels=["g=0.1", "g=0.3"])
+    out = tmp_path / "attractors.png"
+    plot_attractors([[weak, strong], strong], out, labels=["g=0.1", "g=0.3"])
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and out.stat().st_size > 20_000
-    panels = [phase_panel(duffing, periods=3, discard=50, poincare_periods=50, g=g, title_parameters=("w",))
-              for g in (0.1, 0.3)]
-    assert panels[1].title == "w=1.2, g=0.3" and panels[1].points.shape == (2, 50)
-    out = plot_phase_portraits([*panels, PhasePanel(panels[0].trajectory, x="v", y="x")], tmp_path / "phase.png")
+    panels = [phase_panel(duffing, periods=50, discard=50, g=g, title_parameters=("w",)) for g in (0.1, 0.3)]
+    assert panels[1].title == "w=1.2, g=0.3" and panels[1].points.shape == (2, 51)
+    out = tmp_path / "phase.png"
+    plot_phase_portraits([*panels, PhasePanel(panels[0].trajectory, x="v", y="x")], out)
     assert out.stat().st_size > 20_000
     with pytest.raises(GearsymError, match="no state 'q'"):
         plot_attractors(weak, tmp_path / "bad.png", x="q")
     with pytest.raises(GearsymError, match="2 overlaid sets but only 1 labels"):
         plot_attractors([[weak, strong]], tmp_path / "bad.png", labels=["one"])
+
+
+def test_an_attractor_is_drawn_by_its_regime_whatever_order_it_was_found_in(duffing):
+    """The same attractors, numbered the other way round (as another set of starts might find them),
+    get the same labels, marks and markers: the marker is the regime's, the mark the paper's class."""
+    import dataclasses
+
+    import matplotlib.pyplot as plt
+
+    from gearsym.figures.poincare import REGIME_MARKERS, plot_attractors
+
+    def renumbered(s):
+        flipped = [dataclasses.replace(a, number=len(s.attractors) + 1 - a.number) for a in s.attractors]
+        return dataclasses.replace(s, attractors=tuple(sorted(flipped, key=lambda a: a.number)))
+
+    weak = find_attractors(duffing, ics=6, seed=3, box=WELLS, periods=30, discard=100)  # two period-1 orbits
+    strong = find_attractors(duffing, ics=6, seed=3, box=WELLS, periods=60, discard=100, g=0.3)  # chaotic
+    assert len(weak) == 2 and {a.regime for a in weak} == {"periodic"} and not strong.attractors[0].regular
+    fig = plot_attractors([[weak, strong], [renumbered(weak), renumbered(strong)]])
+
+    def drawn(ax):
+        legend = ax.get_legend()
+        entries = sorted((t.get_text(), h.get_marker()) for t, h in zip(legend.get_texts(), legend.legend_handles))
+        marks = sorted((t.get_text(), t.xyann) for t in ax.texts if "mathbf" in t.get_text())  # text and place
+        return entries, marks
+
+    first, second = fig.axes[:2]
+    assert drawn(first) == drawn(second)
+    entries, marks = drawn(first)
+    for s in (weak, strong):
+        for a in s.attractors:
+            entry = next(e for e in entries if f"λ₁={a.lambda1:+.4f}" in e[0])
+            assert entry[1] == REGIME_MARKERS[a.regime] and f"'{a.paper_label}'" in entry[0]
+    assert sorted(m.split("}")[0][-1] for m, _ in marks) == sorted(a.paper_label for s in (weak, strong) for a in s)
+    plt.close(fig)
 
 
 # ------------------------------------------------------------------------------------------ command line
@@ -207,6 +243,29 @@ def test_cli_text_lists_attractors_and_runs_and_plots(capsys, tmp_path):
     assert code == 0 and f"wrote {plot}" in err and plot.stat().st_size > 20_000
     assert "attractor 1 ['" in out and "lambda_1 = " in out and "amplitude A_x = " in out and "centroid  x=" in out
     assert out.count("-> attractor") == 3
+
+
+def test_cli_plot_shows_the_coordinate_asked_for(capsys, tmp_path, monkeypatch):
+    import gearsym.figures.poincare as figures
+
+    drawn = []
+    real = figures.plot_attractors
+    monkeypatch.setattr(figures, "plot_attractors", lambda *a, **k: drawn.append((a, real(*a, **k))) or drawn[-1][1])
+    code, _, _ = run_cli(capsys, "flexible_shaft", "--ics", "2", "--periods", "20", "--discard", "10",
+                         "--plot", str(tmp_path / "p.png"), "--coordinate", "x2")
+    assert code == 0
+    (found, *_), fig = drawn[0]
+    ax = fig.axes[0]
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("x2", "v2")
+    ix = found.state_names.index("x2")
+    plotted = np.concatenate([line.get_xdata() for line in ax.lines])
+    assert plotted.size and np.isin(plotted, np.concatenate([a.points[ix] for a in found.attractors])).all()
+
+
+def test_cli_refuses_an_unknown_coordinate_before_any_run(capsys, tmp_path, monkeypatch):
+    monkeypatch.setattr(poincare, "find_attractors", lambda *a, **k: pytest.fail("the runs started"))
+    code, _, err = run_cli(capsys, "flexible_shaft", "--plot", str(tmp_path / "p.png"), "--coordinate", "x")
+    assert code == 2 and "--coordinate x: no such coordinate. Did you mean" in err and "are x1, x2" in err
 
 
 @pytest.mark.parametrize("argv,message", [

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
 from gearsym.cli import main
@@ -40,6 +41,46 @@ def test_lyap_text_output_and_initial_state(capsys):
     code, out, _ = run(capsys, "lyap", "lorenz", "--periods", "30", "--discard", "10", "--y0", "x=1,y=2,z=20")
     assert code == 0
     assert "lambda_1" in out and "lambda_3" in out and "final state: x=" in out
+
+
+
+def test_lyap_text_names_the_regime_and_what_it_means(capsys):
+    code, out, _ = run(capsys, "lyap", "one_stage", "--set", "omega=1.2", "--periods", "200", "--discard", "50")
+    assert code == 0 and "regime: chaotic: exactly one exponent above zero" in out
+    code, out, _ = run(capsys, "lyap", "lorenz", "--periods", "60", "--discard", "10", "--format", "json")
+    regime = json.loads(out)["regime"]
+    code, out, _ = run(capsys, "lyap", "lorenz", "--periods", "60", "--discard", "10")
+    line = next(line for line in out.splitlines() if line.startswith("regime:"))
+    assert line.startswith(f"regime: {regime}: lambda_") and "the exponent along the flow" in line
+    assert "autonomous" in line and "left out" in line
+
+
+def test_lyap_plot_shows_the_coordinate_asked_for(capsys, tmp_path, monkeypatch):
+    import gearsym.figures as figures
+
+    drawn = []
+    real = figures.plot_point
+    monkeypatch.setattr(figures, "plot_point", lambda *a, **k: drawn.append((a, real(*a, **k))) or drawn[-1][1])
+    code, _, _ = run(capsys, "lyap", "flexible_shaft", "--periods", "40", "--discard", "10", "--plot",
+                     str(tmp_path / "p.png"), "--coordinate", "x2")
+    assert code == 0
+    (spectrum, trajectory, *_), fig = drawn[0]
+    portrait = fig.axes[1]
+    trajectory_line, points = portrait.lines[:2]
+    assert np.array_equal(trajectory_line.get_xdata(), trajectory["x2"])
+    assert np.array_equal(trajectory_line.get_ydata(), trajectory["v2"])  # against the state after it
+    assert np.array_equal(points.get_xdata(), spectrum.strobe[trajectory.state_names.index("x2")])
+    assert (portrait.get_xlabel(), portrait.get_ylabel()) == ("x2", "v2")
+
+
+def test_lyap_refuses_an_unknown_coordinate_before_any_work(capsys, tmp_path, monkeypatch):
+    import gearsym.cli.lyap as lyap_command
+
+    monkeypatch.setattr(lyap_command, "lyapunov_spectrum", lambda *a, **k: pytest.fail("the spectrum ran"))
+    code, _, err = run(capsys, "lyap", "flexible_shaft", "--plot", str(tmp_path / "p.png"), "--coordinate", "v1")
+    assert code == 2 and "--coordinate v1: no such coordinate" in err and "x1, x2" in err
+    code, _, err = run(capsys, "lyap", "flexible_shaft", "--coordinate", "x2")
+    assert code == 2 and "add --plot" in err
 
 
 @pytest.mark.parametrize("argv,message", [

@@ -243,3 +243,74 @@ def test_a_second_writer_on_the_same_file_is_refused(tmp_path, one_stage):
 def test_independent_points_have_no_direction(one_stage):
     with pytest.raises(GearsymError, match="applies to a continuation"):
         run_sweep(one_stage, ["omega=1,1.1"], mode="independent", direction="both", **SHORT)
+
+
+# ------------------------------------------------------------------ what the command prints
+JUMPY = ["--param", "omega=0.8:1.0:0.01", "--param", "B1=3.5,4", "--direction", "both", "--periods", "60",
+         "--discard", "20", "--quiet"]  # one_stage falls off its resonance peak on every line
+
+
+def test_each_jump_of_a_2d_sweep_names_the_line_it_lies_on(tmp_path, capsys):
+    out = tmp_path / "s.csv"
+    assert main(["sweep", "one_stage", *JUMPY, "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    jumps = [line for line in text.splitlines() if line.startswith("jump in")]
+    record = json.loads((tmp_path / "s.json").read_text())
+    assert len(jumps) == len(record["jumps"]) >= 4
+    for line, j in zip(jumps, record["jumps"]):
+        assert line.startswith(f"jump in A_x ({j['direction']}, B1={j['B1']:g}): omega {j['from']:g} -> ")
+    assert {j["B1"] for j in record["jumps"]} == {3.5, 4.0}  # the record keeps the other parameter's value
+    intervals = [line for line in text.splitlines() if line.startswith("hysteresis in")]
+    assert intervals and all("(B1=" in line for line in intervals)
+
+
+def test_a_long_list_of_jumps_is_summarised_and_points_to_the_record(tmp_path, capsys, monkeypatch):
+    from gearsym.sweep import report
+
+    out = tmp_path / "s.csv"
+    main(["sweep", "one_stage", *JUMPY, "--out", str(out)])
+    jumps = json.loads((tmp_path / "s.json").read_text())["jumps"]
+    capsys.readouterr()
+    monkeypatch.setattr(report, "LISTED", 2)
+    monkeypatch.setattr(report, "LARGEST", 2)
+    assert main(["sweep", "one_stage", *JUMPY, "--out", str(out)]) == 0  # complete: only reads and reports
+    text = capsys.readouterr().out
+    assert f"{len(jumps)} jumps (A_x {len(jumps)}) on " in text
+    per_line = next(line for line in text.splitlines() if "per line:" in line)
+    for direction in ("up", "down"):
+        count = sum(j["direction"] == direction and j["B1"] == 3.5 for j in jumps)
+        assert f"{direction}, B1=3.5: {count}" in per_line
+    largest = sorted(jumps, key=lambda j: abs(j["A_after"] - j["A_before"]), reverse=True)[:2]
+    listed = [line.strip() for line in text.splitlines() if line.strip().startswith("jump in")]
+    assert len(listed) == 2 and all(f"A {j['A_before']:.4g} -> {j['A_after']:.4g}" in line
+                                    for line, j in zip(listed, largest))
+    assert f"{tmp_path / 's.json'} (\"jumps\")" in text
+
+
+def test_sweep_plot_shows_the_coordinate_asked_for(tmp_path, capsys, monkeypatch):
+    import gearsym.figures.sweep as sweep_figures
+
+    drawn = []
+    real = sweep_figures.plot_sweep
+    monkeypatch.setattr(sweep_figures, "plot_sweep", lambda *a, **k: drawn.append(real(*a, **k)) or drawn[-1])
+    out = tmp_path / "f.csv"
+    code = main(["sweep", "flexible_shaft", "--param", "omega=1.3:1.5:0.1", "--periods", "30", "--discard", "10",
+                 "--poincare", "5", "--out", str(out), "--plot", str(tmp_path / "f.png"), "--coordinate", "x2",
+                 "--quiet"])
+    assert code == 0
+    result = read_sweep(out)
+    amplitude, _, bifurcation, _ = drawn[0].axes[:4]
+    assert np.array_equal(amplitude.lines[0].get_ydata(), result["A_x2"])
+    assert np.array_equal(np.sort(bifurcation.lines[0].get_ydata()), np.sort(result.strobe["x2"]))
+    assert "x2" in bifurcation.get_title() and "x2" in amplitude.get_ylabel()
+
+
+def test_an_unknown_coordinate_is_refused_before_any_point_runs(tmp_path, capsys, monkeypatch):
+    import gearsym.cli.sweep as sweep_command
+
+    monkeypatch.setattr(sweep_command, "run_sweep", lambda *a, **k: pytest.fail("the sweep ran"))
+    argv = ["sweep", "flexible_shaft", "--param", "omega=1,2", "--out", str(tmp_path / "s.csv"), "--quiet"]
+    assert main([*argv, "--plot", str(tmp_path / "s.png"), "--coordinate", "x3"]) == 2
+    err = capsys.readouterr().err
+    assert "--coordinate x3: no such coordinate" in err and "x1, x2" in err and len(err.splitlines()) == 1
+    assert main([*argv, "--coordinate", "x2"]) == 2 and "add --plot" in capsys.readouterr().err

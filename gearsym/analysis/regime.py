@@ -50,11 +50,39 @@ def classify_regime(exponents: Sequence[float], stderr: Sequence[float], measure
     if not (np.isfinite(lam).all() and measured_time > 0):
         raise ValueError("exponents must be finite and the measured time positive")
     if autonomous:
-        flow = int(np.argmin(np.abs(lam) / band))  # the exponent along the flow: the one nearest zero
-        if abs(lam[flow]) > band[flow]:
+        flow = flow_exponent(lam, band)
+        if flow is None:
             return EQUILIBRIUM if (lam < 0).all() else _by_signs(lam, band)
         lam, band = np.delete(lam, flow), np.delete(band, flow)
     return _by_signs(lam, band)
+
+
+def flow_exponent(exponents: Sequence[float], band: Sequence[float]) -> int | None:
+    """An autonomous system's exponent along the flow (0-based): the one nearest zero, if it is zero."""
+    lam, band = np.asarray(exponents, dtype=float), np.asarray(band, dtype=float)
+    flow = int(np.argmin(np.abs(lam) / band))
+    return flow if abs(lam[flow]) <= band[flow] else None
+
+
+#: what each regime says about the exponents, for a forced system
+MEANING = {
+    "periodic": "every exponent below zero: a periodic orbit",
+    "quasi-periodic": "the largest exponent zero within its error, the rest below: a torus, or a bifurcation point",
+    "chaotic": "exactly one exponent above zero",
+    "hyperchaotic": "two or more exponents above zero",
+    EQUILIBRIUM: "every exponent below zero, none along a flow: the motion comes to rest at a fixed point",
+}
+
+
+def describe_regime(regime: str, exponents: Sequence[float], stderr: Sequence[float], measured_time: float,
+                    autonomous: bool = False) -> str:
+    """The regime and what it means, in one line ('zero' is the band of :func:`zero_band`)."""
+    meaning = MEANING.get(regime, regime)
+    flow = flow_exponent(exponents, zero_band(stderr, measured_time)) if autonomous else None
+    if flow is None:
+        return f"{regime}: {meaning}"
+    return (f"{regime}: lambda_{flow + 1} is the exponent along the flow (zero for every motion of an autonomous "
+            f"system that does not come to rest) and is left out; of the others, {meaning}")
 
 
 def _by_signs(lam: np.ndarray, band: np.ndarray) -> str:

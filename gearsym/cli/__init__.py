@@ -6,16 +6,24 @@ a subcommand (``compile``, ``lyap``, ``sweep``, ...) means writing such a
 module and listing it in :data:`COMMANDS`; :func:`main` does the rest,
 including turning every :class:`~gearsym.errors.GearsymError` into a one-line
 message and exit status 2 (a user's mistake, not a crash: no traceback).
+A plain ``kill`` (SIGTERM) is handled like Ctrl-C: a sweep keeps its finished
+points and says so, forked workers are stopped; the exit status is 130 after
+Ctrl-C, 143 after SIGTERM (128 + the signal, as a shell reports either).
 """
 from __future__ import annotations
 
 import argparse
+import os
+import signal
 import sys
-from collections.abc import Sequence
+import threading
+import warnings
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from types import ModuleType
 
 from .. import __version__
-from ..errors import GearsymError
+from ..errors import GearsymError, GearsymWarning
 from . import compile, derive, docs, explain, list_models, lyap, poincare, reproduce, simulate, sweep
 
 #: the subcommand modules, in the order ``gearsym --help`` lists them
@@ -23,6 +31,10 @@ COMMANDS: tuple[ModuleType, ...] = (list_models, derive, docs, compile, lyap, sw
 
 #: exit status of a GearsymError (argparse uses the same for bad arguments)
 USAGE_ERROR = 2
+#: exit status when the reader of stdout went away (`gearsym list | head -1`), as a shell reports SIGPIPE
+CLOSED_PIPE = 141
+#: exit status after Ctrl-C (commands return it); after SIGTERM :func:`main` makes it 128 + 15
+INTERRUPTED = 128 + signal.SIGINT
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -41,8 +53,49 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``gearsym`` with ``argv`` (default: the process arguments); returns the exit status."""
     args = build_parser().parse_args(argv)
+    with warnings.catch_warnings(), _sigterm_as_ctrl_c() as terminated:
+        warnings.simplefilter("default", GearsymWarning)
+        warnings.showwarning = _one_line
+        try:
+            status = args.run(args)
+            sys.stdout.flush()  # a closed pipe shows here rather than at the interpreter's exit
+        except GearsymError as exc:
+            print(f"gearsym: error: {exc}", file=sys.stderr)
+            return USAGE_ERROR
+        except BrokenPipeError:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nobody reads the rest
+            return CLOSED_PIPE
+        except KeyboardInterrupt:  # a command with nothing to keep, or to say about it
+            print("gearsym: interrupted", file=sys.stderr)
+            status = INTERRUPTED
+    return 128 + signal.SIGTERM if status == INTERRUPTED and terminated else status
+
+
+def _one_line(message, category, filename, lineno, file=None, line=None):
+    """Warnings of gearsym as one line on stderr, like its errors; others as Python prints them."""
+    if issubclass(category, GearsymWarning):
+        print(f"gearsym: warning: {message}", file=sys.stderr, flush=True)
+    else:
+        sys.stderr.write(warnings.formatwarning(message, category, filename, lineno, line))
+
+
+@contextmanager
+def _sigterm_as_ctrl_c() -> Iterator[list]:
+    """While running a command, SIGTERM raises KeyboardInterrupt in the main thread, so every cleanup written
+    for Ctrl-C runs (a sweep keeps its points, stops its workers, removes its lock). A second SIGTERM ends
+    the process at once (its forked workers end with it). Yields a list that is non-empty once it came."""
+    received: list = []
+    if threading.current_thread() is not threading.main_thread():  # (signal handlers live there only)
+        yield received
+        return
+
+    def interrupt(signum, frame):
+        received.append(signum)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, interrupt)
     try:
-        return args.run(args)
-    except GearsymError as exc:
-        print(f"gearsym: error: {exc}", file=sys.stderr)
-        return USAGE_ERROR
+        yield received
+    finally:
+        signal.signal(signal.SIGTERM, previous)

@@ -6,8 +6,8 @@ import sys
 from pathlib import Path
 
 from ..codegen.generated import generate_model
-from ..paths import GENERATED_DIR
-from ..registry import available_models, load
+from ..outputs import check_folder
+from ..registry import available_models, load, output_root
 from .integration import add_integration_arguments, integration_from
 from .settings import add_set_argument, parse_settings
 
@@ -20,8 +20,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--all", action="store_true", help="every model of `gearsym list`")
     add_set_argument(parser)
     add_integration_arguments(parser, periods=None)
-    parser.add_argument("--out", type=Path, default=GENERATED_DIR, metavar="DIR",
-                        help="where <model>/ is written (default: generated/ of the repository)")
+    parser.add_argument("--out", type=Path, default=None, metavar="DIR",
+                        help="where <model>/ is written (default: generated/ of the repository for its own models, "
+                             "of the current directory for others)")
     parser.add_argument("--no-compile", action="store_true", help="write the C only")
     parser.add_argument("--check", action="store_true",
                         help="write nothing; exit 1 and name the files that differ from what would be written")
@@ -33,9 +34,13 @@ def run(args: argparse.Namespace) -> int:
         return 2
     refs = available_models() if args.all else args.models
     settings = parse_settings(args.set)
+    options = integration_from(args)
+    outs = [args.out or output_root(ref) / "generated" for ref in refs]
+    for out in set(outs) if not args.check else ():
+        check_folder(out)
     stale = []
-    for ref in refs:
-        report = generate_model(load(ref, **settings), args.out, integration_from(args), check=args.check,
+    for ref, out in zip(refs, outs):
+        report = generate_model(load(ref, **settings), out, options, check=args.check,
                                 compile=not (args.no_compile or args.check))
         if args.check:
             stale += report.stale

@@ -10,19 +10,19 @@ import sys
 from pathlib import Path
 
 from ..derivation import derive, render
-from ..paths import DERIVATIONS_DIR
-from ..registry import available_models, load_model
+from ..outputs import check_folder
+from ..registry import available_models, load_model, output_root
 
 NAME = "docs"
 HELP = "write the Markdown derivation of models to DIR/<model>.md"
-DEFAULT_OUT = DERIVATIONS_DIR
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("models", nargs="*", metavar="MODEL", help="model names or model file paths")
     parser.add_argument("--all", action="store_true", help="every model of `gearsym list`")
-    parser.add_argument("--out", type=Path, default=DEFAULT_OUT, metavar="DIR",
-                        help="output folder (default: docs/derivations of the repository)")
+    parser.add_argument("--out", type=Path, default=None, metavar="DIR",
+                        help="output folder (default: docs/derivations/ of the repository for its own models, "
+                             "of the current directory for others)")
     parser.add_argument("--check", action="store_true",
                         help="write nothing; exit 1 and name the pages that differ from what would be written")
 
@@ -46,21 +46,24 @@ def run(args: argparse.Namespace) -> int:
         print("gearsym docs: error: give model names or --all (not both)", file=sys.stderr)
         return 2
     refs = available_models() if args.all else args.models
+    outs = [args.out or output_root(ref) / "docs" / "derivations" for ref in refs]
+    for out in set(outs) if not args.check else ():
+        check_folder(out)
     pages = [page(ref) for ref in refs]
     if args.check:
         stale = []
-        for name, text in pages:
-            path = args.out / f"{name}.md"
+        for (name, text), out in zip(pages, outs):
+            path = out / f"{name}.md"
             if not path.is_file() or path.read_bytes() != text.encode("utf-8"):
                 stale.append(path)
         for path in stale:
             print(f"gearsym docs: {shown(path)} is out of date; run `gearsym docs {path.stem}`", file=sys.stderr)
         if not stale:
-            print(f"{len(pages)} page(s) up to date in {shown(args.out)}")
+            print(f"{len(pages)} page(s) up to date in {', '.join(sorted(map(shown, set(outs))))}")
         return 1 if stale else 0
-    args.out.mkdir(parents=True, exist_ok=True)
-    for name, text in pages:
-        path = args.out / f"{name}.md"
+    for (name, text), out in zip(pages, outs):
+        path = out / f"{name}.md"
+        path.parent.mkdir(parents=True, exist_ok=True)
         path.write_bytes(text.encode("utf-8"))
         print(shown(path))
     return 0

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from ..checks import check_run
 from ..options import BACKENDS, STEPS_PER_PERIOD, Integration
 from .settings import parse_settings
 
@@ -27,11 +28,18 @@ def add_integration_arguments(parser: argparse.ArgumentParser, *, periods: int |
                        help="compiled C, CasADi in-process, or auto (compiled when a C compiler exists)")
 
 
-def integration_from(args: argparse.Namespace, steps_per_period: int | None = None) -> Integration:
-    """The command's options; ``steps_per_period`` if the command chose them (else --steps-per-period)."""
+def integration_from(args: argparse.Namespace, steps_per_period: int | None = None, *,
+                     exponents: bool = True) -> Integration:
+    """The command's options, checked before any work: ``steps_per_period`` if the command chose them (else
+    --steps-per-period); a run too coarse, or (for ``exponents``) too short to mean anything, is refused, and
+    one in the grey zone warned about."""
+    steps = steps_per_period or args.steps_per_period or STEPS_PER_PERIOD
     run = {"periods": args.periods, "discard": args.discard} if hasattr(args, "periods") else {}
-    return Integration(**run, steps_per_period=steps_per_period or args.steps_per_period or STEPS_PER_PERIOD,
-                       locate_crossings=not args.plain, backend=args.backend)
+    if exponents and run:
+        check_run(steps_per_period=steps, measured=args.periods - args.discard, discard=args.discard)
+    else:
+        check_run(steps_per_period=steps)
+    return Integration(**run, steps_per_period=steps, locate_crossings=not args.plain, backend=args.backend)
 
 
 def system_from(args: argparse.Namespace):

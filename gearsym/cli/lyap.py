@@ -7,6 +7,9 @@ import sys
 from pathlib import Path
 
 from ..analysis import lyapunov_spectrum, phase_trajectory
+from ..analysis.regime import describe_regime
+from ..checks import chosen_coordinate
+from ..outputs import check_figure
 from .integration import add_integration_arguments, compiled_from
 from .settings import add_set_argument, parse_state
 
@@ -22,10 +25,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--format", choices=("text", "json"), default="text")
     parser.add_argument("--plot", type=Path, metavar="FILE.png",
                         help="also draw the exponents' convergence and the phase portrait with the Poincare points")
+    parser.add_argument("--coordinate", metavar="NAME",
+                        help="the coordinate of the phase portrait (against the state after it; default the first)")
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.plot:
+        check_figure(args.plot)
     compiled = compiled_from(args)
+    coordinate = chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     result = lyapunov_spectrum(compiled, y0=parse_state(args.y0))
     if args.plot:
         from ..figures import plot_point  # matplotlib only when asked for
@@ -33,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
         shown = min(30, result.periods - result.discard)
         trajectory = phase_trajectory(compiled, options=compiled.integration.run(discard=result.periods - shown),
                                       y0=parse_state(args.y0))
-        plot_point(result, trajectory, args.plot)
+        plot_point(result, trajectory, args.plot, x=coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     if args.format == "json":
         print(json.dumps(result.as_dict(), indent=2))
@@ -46,6 +54,14 @@ def run(args: argparse.Namespace) -> int:
     for i, (lam, err) in enumerate(zip(result.exponents, result.stderr), 1):
         print(f"  lambda_{i} = {lam:+.6f} +- {err:.6f}")
     print(f"  sum      = {result.sum:+.6f}")
+    if result.at_rest:
+        print(f"regime: equilibrium, {'stable' if max(result.exponents) < 0 else 'unstable'} (the run never left a "
+              "fixed point: the exponents are the real parts of the Jacobian's eigenvalues there, "
+              + ", ".join(f"{e.real:.6g}{e.imag:+.6g}i" if e.imag else f"{e.real:.6g}" for e in result.eigenvalues)
+              + ")")
+    else:
+        print("regime: " + describe_regime(result.regime, result.exponents, result.stderr, result.measured_time,
+                                           result.autonomous))
     for name, a in result.amplitude.items():
         print(f"amplitude A_{name} = {a:.6g}")
     print("final state: " + ", ".join(f"{k}={v:.6g}" for k, v in result.final_state.items()))

@@ -7,7 +7,9 @@ import sys
 from pathlib import Path
 
 from ..analysis.attractors import DEFAULT_BOX, RUN, AttractorSet, find_attractors
+from ..checks import chosen_coordinate
 from ..errors import GearsymError
+from ..outputs import check_figure
 from .integration import add_integration_arguments, compiled_from
 from .settings import add_set_argument
 
@@ -27,6 +29,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--format", choices=("text", "json"), default="text")
     parser.add_argument("--plot", type=Path, metavar="FILE.png",
                         help="also draw the Poincare points of every attractor")
+    parser.add_argument("--coordinate", metavar="NAME",
+                        help="the coordinate --plot shows (against the state after it; default the first)")
 
 
 def parse_box(text: str | None) -> dict[str, tuple[float, float]] | None:
@@ -50,13 +54,16 @@ def parse_box(text: str | None) -> dict[str, tuple[float, float]] | None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.plot:
+        check_figure(args.plot)
     box = parse_box(args.box)
     compiled = compiled_from(args)
+    coordinate = chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     found = find_attractors(compiled, ics=args.ics, seed=args.seed, box=box)
     if args.plot:
         from ..figures.poincare import plot_attractors  # matplotlib only when asked for
 
-        plot_attractors(found, args.plot)
+        plot_attractors(found, args.plot, x=coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     if args.format == "json":
         print(json.dumps(found.as_dict(), indent=2))

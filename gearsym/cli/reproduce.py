@@ -22,9 +22,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..outputs import check_file, check_folder
     from ..reproduce import reproduce
 
     doc = args.doc or args.out.parent / "reproduction.md"
+    check_folder(args.out)
+    check_file(doc, (".md",), "--doc")
+    if args.data:
+        check_folder(args.data, "--data")
     try:
         reproduce(args.out, doc, quick=args.quick, jobs=args.jobs, progress=not args.quiet, data=args.data)
     except KeyboardInterrupt as exc:

@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 
 from ..errors import GearsymError
+from ..model.expressions import to_expr
 
 
 def add_set_argument(parser: argparse.ArgumentParser) -> None:
@@ -15,6 +16,7 @@ def add_set_argument(parser: argparse.ArgumentParser) -> None:
 
 
 def parse_settings(pairs: list[str]) -> dict[str, str]:
+    """``NAME=VALUE`` pairs; every value reads as a safe formula (checked here, before any work starts)."""
     settings = {}
     for pair in pairs:
         name, sep, value = pair.partition("=")
@@ -23,6 +25,7 @@ def parse_settings(pairs: list[str]) -> dict[str, str]:
             raise GearsymError(f"--set {pair!r}: expected NAME=VALUE, e.g. --set omega=1.5 or --set \"k=1+0.2*cos(tau)\"")
         if name in settings:
             raise GearsymError(f"--set gives {name} twice")
+        to_expr(value, f"--set {name}")
         settings[name] = value
     return settings
 

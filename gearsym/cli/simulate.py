@@ -5,6 +5,8 @@ import argparse
 from pathlib import Path
 
 from ..data.simulate import RUN, simulate_measurements, steps_for
+from ..errors import GearsymError
+from ..outputs import check_file
 from .integration import add_integration_arguments, compiled_from, integration_from
 from .settings import add_set_argument, parse_numbers, parse_settings, parse_state
 
@@ -38,8 +40,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     records = [parse_conditions(text) for text in args.record]
-    options = integration_from(args, steps_for(args.samples_per_period, args.steps_per_period))
-    system = _with_effects(args.model, args.effect, parse_settings(args.set)) if args.effect else None
+    settings = parse_settings(args.set)
+    options = integration_from(args, steps_for(args.samples_per_period, args.steps_per_period), exponents=False)
+    check_file(args.out, (".csv",))
+    check_strengths(args.effect, settings)
+    system = _with_effects(args.model, args.effect, settings) if args.effect else None
     compiled = compiled_from(args, options, system)
     table = simulate_measurements(compiled, samples_per_period=args.samples_per_period,
                                   noise=args.noise, seed=args.seed, records=records or None,
@@ -61,6 +66,24 @@ def _with_effects(model: str, effects: list[str], settings: dict):
     own = {p for e in map(effect, effects) for p in e.parameters}
     base = load(model, **{k: v for k, v in settings.items() if k not in own})
     return augment(base, effects, values={k: v for k, v in settings.items() if k in own})
+
+
+def check_strengths(effects: list[str], settings: dict) -> None:
+    """Every effect needs a strength other than 0 (its off value) among ``settings``."""
+    from ..fit.effects import effect
+
+    for e in map(effect, effects):
+        if not any(_nonzero(settings.get(p)) for p in e.fitted):
+            given = " and/or ".join(f"--set {p}=VALUE" for p in e.fitted)
+            raise GearsymError(f"--effect {e.name} needs its strength: {given} (the effect is off at 0, which "
+                               f"would simulate the model without it)")
+
+
+def _nonzero(value: str | None) -> bool:
+    try:
+        return value is not None and float(value) != 0.0
+    except ValueError:
+        raise GearsymError(f"an effect's strength must be a number, got {value!r}") from None
 
 
 def parse_conditions(text: str) -> dict[str, float]:

@@ -6,7 +6,11 @@ import sys
 from collections import Counter
 from pathlib import Path
 
+from ..checks import chosen_coordinate
+from ..outputs import check_figure, check_file
 from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, Workers, run_sweep
+from ..sweep.report import findings_lines
+from ..sweep.store import sidecar
 from .integration import add_integration_arguments, compiled_from
 from .settings import add_set_argument, parse_state
 
@@ -48,15 +52,22 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"stroboscopic samples kept per point, for bifurcation diagrams (default {POINCARE_SAMPLES})")
     parser.add_argument("--plot", type=Path, metavar="FILE.png",
                         help="draw amplitudes, exponents, regimes and the bifurcation diagram")
+    parser.add_argument("--coordinate", metavar="NAME",
+                        help="the coordinate --plot shows (amplitude, bifurcation diagram; default the first)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
 def run(args: argparse.Namespace) -> int:
+    check_file(args.out, (".csv",))
+    if args.plot:
+        check_figure(args.plot)
+    workers = Workers(args.jobs, args.parallel, "local" if args.dask else args.scheduler)
+    compiled = compiled_from(args)
+    chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     try:
-        workers = Workers(args.jobs, args.parallel, "local" if args.dask else args.scheduler)
-        result = run_sweep(compiled_from(args), args.param, mode=args.mode, direction=args.direction,
-                           y0=parse_state(args.y0), out=args.out, overwrite=args.overwrite, poincare=args.poincare,
-                           workers=workers, progress=not args.quiet)
+        result = run_sweep(compiled, args.param, mode=args.mode, direction=args.direction, y0=parse_state(args.y0),
+                           out=args.out, overwrite=args.overwrite, poincare=args.poincare, workers=workers,
+                           progress=not args.quiet)
     except KeyboardInterrupt as exc:  # SweepInterrupted says how many points were kept
         print(f"gearsym: {exc}" if str(exc) else "gearsym: interrupted before any point was finished",
               file=sys.stderr)
@@ -64,16 +75,12 @@ def run(args: argparse.Namespace) -> int:
     regimes = Counter(result["regime"].tolist())
     print(f"{result.model}: {len(result)} points -> {args.out} (+ .json, .poincare.csv)")
     print("regimes: " + ", ".join(f"{k} {v}" for k, v in sorted(regimes.items())))
-    findings = result.findings()
-    for j in findings["jumps"]:
-        print(f"jump in A_{j['coordinate']} ({j['direction']}): {j['from']:g} -> {j['to']:g}, "
-              f"A {j['A_before']:.4g} -> {j['A_after']:.4g}")
-    for h in findings["hysteresis"]:
-        print(f"hysteresis in A_{h['coordinate']}: up and down differ for {result.axes[0].name} in "
-              f"[{h['from']:g}, {h['to']:g}]")
+    for line in findings_lines(result, sidecar(args.out, ".json")):
+        print(line)
     if args.plot:
         from ..figures.sweep import plot_sweep  # matplotlib only when asked for
 
-        plot_sweep(result, args.plot)
+        plot_sweep(result, args.plot, coordinate=args.coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     return 0
+

@@ -17,7 +17,7 @@ import casadi as ca
 import numpy as np
 
 from ..checks import whole_number
-from ..errors import GearsymError, ModelError
+from ..errors import GearsymError, ModelError, warn
 from ..options import Integration
 from ..system import FirstOrderSystem
 from .functions import LoopOptions
@@ -172,6 +172,12 @@ class CompiledModel:
             if unknown:
                 raise GearsymError(f"{self.name}: unknown states {sorted(unknown)} in the initial state; "
                                    f"states are {', '.join(self.state_names)}")
+            declared = self.system.initial
+            zeroed = [s for s in self.state_names if s not in y0 and declared.get(s, 0.0) != 0.0]
+            if zeroed:
+                warn(f"{self.name}: the initial state does not name {', '.join(zeroed)}, so "
+                     f"{'they start' if len(zeroed) > 1 else 'it starts'} at 0, not at the model's "
+                     + ", ".join(f"{s}={declared[s]:g}" for s in zeroed) + "; name every state to choose")
             y0 = [float(y0.get(s, 0.0)) for s in self.state_names]
         y = np.array(y0, dtype=np.float64).reshape(-1)  # a contiguous copy: the C loop reads it by address
         if y.shape != (self.dimension,):

@@ -6,7 +6,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..options import Integration
-from ..paths import GENERATED_DIR
 from ..system import FirstOrderSystem
 from .compiler import compile_library
 from .functions import LoopOptions, build_functions
@@ -24,7 +23,7 @@ class GenerateReport:
     stale: list[Path] = field(default_factory=list)
 
 
-def generate_model(system: FirstOrderSystem, out: Path = GENERATED_DIR, options: Integration = Integration(), *,
+def generate_model(system: FirstOrderSystem, out: Path, options: Integration = Integration(), *,
                    check: bool = False, compile: bool = True) -> GenerateReport:
     """Write ``out/<model>/<model>.c`` and ``manifest.json`` for ``system`` compiled with ``options``;
     with ``check``, compare instead of writing."""

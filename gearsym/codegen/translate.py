@@ -10,6 +10,7 @@ slope (1 in contact, 0 in the gap) for the variational equations.
 """
 from __future__ import annotations
 
+import numbers
 from collections.abc import Mapping
 
 import casadi as ca
@@ -141,4 +142,15 @@ class _Translator:
 def to_casadi(exprs, symbols: Mapping[sp.Symbol, ca.SX], where: str = "") -> list[ca.SX]:
     """Translate SymPy expressions with ``symbols`` mapped to SX symbols (one memo for all)."""
     tr = _Translator(symbols, where)
-    return [tr(sp.sympify(e)) for e in exprs]
+    return [tr(_as_sympy(e, where)) for e in exprs]
+
+
+def _as_sympy(e, where: str) -> sp.Basic:
+    """SymPy objects and Python numbers only: a string would need parsing (gearsym.model.expressions.to_expr)."""
+    if isinstance(e, sp.Basic):
+        return e
+    if isinstance(e, numbers.Integral) and not isinstance(e, bool):
+        return sp.Integer(int(e))
+    if isinstance(e, numbers.Real):
+        return sp.Float(float(e))
+    raise ModelError(f"cannot generate code for {e!r} ({type(e).__name__}); expected a SymPy expression", where)

@@ -18,7 +18,7 @@ import sympy as sp
 from ..errors import GearsymError
 from ..model.drivetrain import Drivetrain, ResolvedDrivetrain
 from ..reduce.nondimensional import NondimensionalModel, reduce
-from ..symbols import parameter_symbol
+from ..symbols import parameter_symbol, tau
 from ..system import FirstOrderSystem
 from .notes import default_wave_amplitude, paper_notes
 from .records import (
@@ -40,12 +40,15 @@ def _derive_drivetrain(model: Drivetrain) -> Derivation:
     return _derive_reduced(reduce(model))
 
 
-def _parameters(system: FirstOrderSystem, roles: Mapping[str, str] | None = None) -> tuple[ParameterRecord, ...]:
-    """Parameters in the system's order; a description the model does not give is its role, if known."""
+def _parameters(names, values: Mapping[str, float], descriptions: Mapping[str, str],
+                roles: Mapping[str, str] | None = None) -> tuple[ParameterRecord, ...]:
+    """Parameters in the system's order with their defaults (None: no default); a description the model
+    does not give is its role, if known."""
     roles = roles or {}
     return tuple(
-        ParameterRecord(name, float(value), system.descriptions.get(name) or roles.get(name, ""))
-        for name, value in system.parameters.items()
+        ParameterRecord(name, float(values[name]) if name in values else None,
+                        descriptions.get(name) or roles.get(name, ""))
+        for name in names
     )
 
 
@@ -79,7 +82,8 @@ def _roles(rd: ResolvedDrivetrain) -> dict[str, str]:
 def _derive_first_order(system: FirstOrderSystem) -> Derivation:
     return Derivation(
         model=system.name, title=system.title or system.name, description="", time=system.time, states=tuple(system.states),
-        rhs=tuple(system.rhs), parameters=_parameters(system), period=system.period, mechanics=None, notes=(),
+        rhs=tuple(system.rhs), parameters=_parameters(system.parameters, system.parameters, system.descriptions),
+        period=system.period, mechanics=None, notes=(),
     )
 
 
@@ -114,8 +118,9 @@ def _components(
 @derive.register
 def _derive_reduced(nd: NondimensionalModel) -> Derivation:
     red, rd, model = nd.reduction, nd.reduction.resolved, nd.drivetrain
-    system = nd.system()
-    values = dict(system.parameters)
+    engine_rhs, names = nd.engine_equations()  # symbolic: no parameter needs a default
+    values = {n: v for n, v in nd.declared_defaults.items() if n in names}
+    descriptions = {gr.name: gr.description for gr in nd.groups} | dict(model.descriptions)
     groups = tuple(
         GroupRecord(gr.name, gr.definition, gr.kind, gr.description,
                     _value(gr.definition, values) if gr.kind == "derived" else values.get(gr.name))
@@ -139,10 +144,11 @@ def _derive_reduced(nd: NondimensionalModel) -> Derivation:
         conditions=tuple(ConditionRecord(c.equation, c.description) for c in nd.conditions),
         functions=tuple(FunctionRecord(f.name, f.mesh, f.definition, f.expression) for f in nd.functions),
         equations=tuple(nd.equations),
-        engine_rhs=tuple(system.rhs),
+        engine_rhs=engine_rhs,
     )
     return Derivation(
-        model=model.name, title=model.title, description=model.description, time=system.time,
-        states=tuple(nd.states), rhs=tuple(nd.rhs), parameters=_parameters(system, _roles(rd)), period=nd.period,
+        model=model.name, title=model.title, description=model.description, time=tau,
+        states=tuple(nd.states), rhs=tuple(nd.rhs), parameters=_parameters(names, values, descriptions, _roles(rd)),
+        period=nd.period,
         mechanics=mechanics, notes=paper_notes(nd, groups, values),
     )

@@ -152,7 +152,8 @@ def _parameters(d: Derivation) -> list[str]:
     out = _section("Parameters")
     out += ["Defaults declared in the model file."]
     out += table(["Parameter", "Symbol", "Default", "Description"], [
-        [f"`{p.name}`", inline(latex_name(p.name)), number(p.default), escape(p.description) or "—"]
+        [f"`{p.name}`", inline(latex_name(p.name)), number(p.default) if p.default is not None else "no default",
+         escape(p.description) or "—"]
         for p in d.parameters
     ])
     return out

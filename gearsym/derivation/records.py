@@ -105,7 +105,7 @@ class FunctionRecord:
 @dataclass(frozen=True)
 class ParameterRecord:
     name: str
-    default: float
+    default: Optional[float]  # None: the model declares no default (the equations need none)
     description: str
 
 

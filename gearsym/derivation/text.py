@@ -99,7 +99,8 @@ def render_text(d: Derivation, full: bool = False) -> str:
         ])
     width = max((len(p.name) for p in d.parameters), default=0)
     out += _section("Parameters (default, description)", [
-        f"{_INDENT}{p.name.ljust(width)}  {number(p.default):>14}  {p.description}".rstrip() for p in d.parameters
+        f"{_INDENT}{p.name.ljust(width)}  {number(p.default) if p.default is not None else 'no default':>14}  "
+        f"{p.description}".rstrip() for p in d.parameters
     ])
     out += ["", f"Period in {d.time}: {d.period}"]
     if full and d.notes:

@@ -4,10 +4,12 @@
 :func:`~gearsym.analysis.attractors.find_attractors` found, one panel per
 parameter point; several sets may share a panel (Fig. 4 overlays D = 0 in gray
 and D = 2 in black at one omega). Each attractor carries the paper's mark, '1'
-regular or '2' chaotic, and its number.
+regular or '2' chaotic, and the marker of its regime: the same kind of attractor
+looks the same in every panel, whatever order it was found in.
 
 :func:`plot_phase_portraits` draws a grid of phase portraits: every RK4 step of
-the last periods as a gray line, the Poincare points in black on top (Fig. 7 a-d).
+some periods as a gray line, the Poincare points of those periods in black on top
+(Fig. 7 a-d).
 """
 from __future__ import annotations
 
@@ -22,7 +24,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from ..analysis.attractors import Attractor, AttractorSet  # noqa: E402
-from ..analysis.orbits import Trajectory, phase_trajectory, poincare_samples  # noqa: E402
+from ..analysis.orbits import Trajectory, phase_trajectory  # noqa: E402
 from ..errors import GearsymError  # noqa: E402
 from .save import save_figure  # noqa: E402
 
@@ -30,10 +32,12 @@ from .save import save_figure  # noqa: E402
 SYMBOLS = {"omega": "ω", "zeta": "ζ", "eta": "η", "Theta": "Θ", "Theta_p": "Θ'", "kS": "$k_S$", "k_a": "$k_a$"}
 #: overlaid layers: gray first, then black, as the paper's Fig. 4; then colours
 LAYER_COLORS = ("0.55", "k", "C3", "C0", "C2", "C1")
-#: one set alone: a colour per attractor
-ATTRACTOR_COLORS = ("k", "C3", "C0", "C2", "C1", "C4", "C5", "C6")
-#: regular attractors: a marker per attractor number (chaotic ones are clouds of dots)
-MARKERS = ("o", "s", "^", "D", "v", "p", "h", "<", ">")
+#: one set alone: a colour per class of attractor, the paper's '1' (regular) and '2' (chaotic)
+CLASS_COLORS = {"1": "k", "2": "C3"}
+#: regular attractors: a marker per regime (chaotic ones are clouds of dots)
+REGIME_MARKERS = {"periodic": "o", "quasi-periodic": "s", "equilibrium": "D", "chaotic": ".", "hyperchaotic": "."}
+#: how captions write each marker
+MARKER_GLYPHS = {"o": "○", "s": "□", "D": "◇", ".": "·"}
 #: short forms of the regimes in the annotations
 SHORT = {"periodic": "P", "quasi-periodic": "QP", "chaotic": "chaotic", "hyperchaotic": "hyperchaotic",
          "equilibrium": "eq."}
@@ -49,16 +53,19 @@ def parameter_text(name: str, value: float) -> str:
 
 
 # ------------------------------------------------------------------------------------ Fig. 4: attractors
-def plot_attractors(sets: AttractorSet | Sequence[AttractorSet | Sequence[AttractorSet]], path: str | Path,
+def plot_attractors(sets: AttractorSet | Sequence[AttractorSet | Sequence[AttractorSet]], path: str | Path | None = None,
                     x: str | None = None, y: str | None = None, colors: Sequence[str] | None = None,
-                    labels: Sequence[str] | None = None) -> Path:
-    """Write the Poincare points of every attractor to ``path`` (PNG).
+                    labels: Sequence[str] | None = None):
+    """The Poincare points of every attractor, written to ``path`` (PNG) if given; returns the Figure.
 
     ``sets``: one AttractorSet (one panel), or a sequence whose items are panels;
     a panel is one AttractorSet or a sequence of them drawn on top of each other
     (layer 0 in gray, layer 1 in black, unless ``colors`` says otherwise;
     ``labels`` names the layers in the legend, default the model names).
-    ``x``/``y`` choose the state on each axis (default the first two states).
+    ``x``/``y`` choose the state on each axis (default the first state, and the state after ``x``).
+    An attractor is marked by its regime, not by the order it was found in: the paper's '1'
+    (regular) or '2' (chaotic), the marker of its regime (:data:`REGIME_MARKERS`), and, alone in
+    a panel, the colour of its class; so one kind of attractor looks the same in every panel.
     """
     panels = _panels(sets)
     layers = max(len(p) for p in panels)
@@ -67,7 +74,7 @@ def plot_attractors(sets: AttractorSet | Sequence[AttractorSet | Sequence[Attrac
         raise GearsymError(f"plot_attractors: {layers} overlaid sets but only {len(colors)} colors")
     if labels is not None and len(labels) < layers:
         raise GearsymError(f"plot_attractors: {layers} overlaid sets but only {len(labels)} labels")
-    x, y = _axes_names(panels[0][0].state_names, x, y)
+    x, y = phase_axes(panels[0][0].state_names, x, y)
     for panel in panels:
         for s in panel:
             missing = {x, y} - set(s.state_names)
@@ -83,9 +90,8 @@ def plot_attractors(sets: AttractorSet | Sequence[AttractorSet | Sequence[Attrac
             for layer, s in enumerate(panel):
                 name = labels[layer] if labels is not None else s.model
                 ix, iy = s.state_names.index(x), s.state_names.index(y)
-                for a in s.attractors:
-                    own = ATTRACTOR_COLORS[(a.number - 1) % len(ATTRACTOR_COLORS)]
-                    color = colors[layer] if len(panel) > 1 else own
+                for a in sorted(s.attractors, key=lambda a: (a.paper_label, -len(a.members))):
+                    color = colors[layer] if len(panel) > 1 else CLASS_COLORS[a.paper_label]
                     prefix = f"{name}: " if len(panel) > 1 else ""
                     _draw_attractor(ax, a, a.points[ix], a.points[iy], color, prefix, layer)
                     drawn.append((a, a.points[ix], a.points[iy], color))
@@ -98,7 +104,9 @@ def plot_attractors(sets: AttractorSet | Sequence[AttractorSet | Sequence[Attrac
             ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), frameon=False, handletextpad=0.3,
                       fontsize=7.5, markerscale=1.0)
         fig.supxlabel(_caption(panels), fontsize=7, color="0.35")
-        return save_figure(fig, path, dpi=150)
+        if path is not None:
+            save_figure(fig, path, dpi=150)
+        return fig
 
 
 def _panels(sets) -> list[list[AttractorSet]]:
@@ -111,18 +119,26 @@ def _panels(sets) -> list[list[AttractorSet]]:
     return panels
 
 
-def _axes_names(names: Sequence[str], x: str | None, y: str | None) -> tuple[str, str]:
+def phase_axes(names: Sequence[str], x: str | None = None, y: str | None = None) -> tuple[str, str]:
+    """The phase plane: ``x`` (default the first state) against ``y`` (default the state after ``x``,
+    its velocity in the gear models: x1 -> v1, x2 -> v2)."""
+    names = list(names)
     x = x or names[0]
-    y = y or names[min(1, len(names) - 1)]
-    return x, y
+    if y is None and x in names:
+        y = names[(names.index(x) + 1) % len(names)]
+    return x, y or names[min(1, len(names) - 1)]
+
+
+def attractor_kind(a: Attractor) -> str:
+    """'P6', 'QP', 'chaotic': the regime in a few letters, with the period of a periodic orbit."""
+    return f"P{a.period}" if a.regime == "periodic" and a.period else SHORT.get(a.regime, a.regime)
 
 
 def _draw_attractor(ax, a: Attractor, px: np.ndarray, py: np.ndarray, color: str, prefix: str, layer: int) -> None:
-    """Regular attractors (few points) as open circles, chaotic ones as a cloud of dots."""
-    kind = f"P{a.period}" if a.regime == "periodic" and a.period else SHORT.get(a.regime, a.regime)
-    label = f"{prefix}#{a.number} '{a.paper_label}' {kind}, λ₁={a.lambda1:+.4f} ({len(a.members)} ICs)"
-    if a.regular:
-        marker = MARKERS[(a.number - 1) % len(MARKERS)]
+    """Regular attractors (few points) as the marker of their regime, chaotic ones as a cloud of dots."""
+    label = f"{prefix}'{a.paper_label}' {attractor_kind(a)}, λ₁={a.lambda1:+.4f} ({len(a.members)} ICs)"
+    marker = REGIME_MARKERS.get(a.regime, ".")
+    if marker != ".":
         ax.plot(px, py, marker, ms=4.5, mfc="white" if layer == 0 else color, mec=color, mew=1.0, color=color,
                 label=label, zorder=4 + layer)
     else:
@@ -164,7 +180,7 @@ def _place_labels(ax, drawn) -> None:
         spot = spots[best]
         placed.append(spot + half * np.array([[-1, -1], [-1, 1], [1, -1], [1, 1], [0, 0]]))  # the text's box
         point = (x0 + anchor[0] * (x1 - x0), y0 + anchor[1] * (y1 - y0))
-        ax.annotate(f"$\\mathbf{{{a.paper_label}}}$ (#{a.number})", point, xytext=tuple(spot),
+        ax.annotate(f"$\\mathbf{{{a.paper_label}}}$ {attractor_kind(a)}", point, xytext=tuple(spot),
                     textcoords="axes fraction", ha="center", va="center", fontsize=9, color=_darker(color),
                     arrowprops=dict(arrowstyle="-", color=color, lw=0.6, shrinkA=4, shrinkB=2), zorder=10)
     ax.set_xlim(x0, x1)
@@ -198,43 +214,51 @@ def _common_title(panel: Sequence[AttractorSet]) -> str:
 def _caption(panels: Sequence[Sequence[AttractorSet]]) -> str:
     s = panels[0][0]
     origin = f"seed {s.seed}" if s.seed is not None else "given initial states"
+    regimes = {a.regime: None for panel in panels for s_ in panel for a in s_.attractors}
+    marks = ", ".join(f"{MARKER_GLYPHS[REGIME_MARKERS.get(r, '.')]} {r}" for r in sorted(regimes, key=_regime_order))
     return (f"{len(s.results)} initial states ({origin}), {s.periods} periods after {s.discard}; "
-            "'1' regular, '2' chaotic")
+            f"'1' regular, '2' chaotic; {marks}")
+
+
+def _regime_order(regime: str) -> int:
+    return list(REGIME_MARKERS).index(regime) if regime in REGIME_MARKERS else len(REGIME_MARKERS)
 
 
 # ------------------------------------------------------------------------------------ Fig. 7: phase portraits
 @dataclass(frozen=True)
 class PhasePanel:
-    """One phase portrait: the trajectory (gray line) and Poincare points (black) in the plane x-y."""
+    """One phase portrait in the plane x-y: the trajectory (gray line) and, in black, its own Poincare
+    points (the states at t = kT within the trajectory's time window, so both show the same motion)."""
 
     trajectory: Trajectory
-    points: np.ndarray | None = None  # (n, m) states; default the trajectory's own stroboscopic points
     title: str = ""
     x: str | None = None
     y: str | None = None
 
+    @property
+    def points(self) -> np.ndarray:
+        return self.trajectory.strobe
+
 
 def phase_panel(model, *, title: str | None = None, x: str | None = None, y: str | None = None,
-                periods: int = 30, discard: int = 300, poincare_periods: int = 400, y0=None,
-                title_parameters: Sequence[str] = ("omega",), **values) -> PhasePanel:
-    """Compute one panel: ``periods`` periods of trajectory and ``poincare_periods`` Poincare points,
-    both after the same ``discard`` transient periods from ``y0``.
+                periods: int = 100, discard: int = 300, y0=None, title_parameters: Sequence[str] = ("omega",),
+                **values) -> PhasePanel:
+    """Compute one panel: ``periods`` periods of trajectory after ``discard`` transient ones from ``y0``.
 
     ``model`` is a compiled model (its scheme is used; ``values`` are parameter values). The default title
     lists ``title_parameters`` and every parameter given in ``values``, e.g. 'ω=1.5, k_S=0.1'.
     """
-    scheme = model.integration
-    trajectory = phase_trajectory(model, options=scheme.run(discard + periods, discard), y0=y0, **values)
-    orbit = poincare_samples(model, options=scheme.run(discard + poincare_periods, discard), y0=y0, **values)
+    trajectory = phase_trajectory(model, options=model.integration.run(discard + periods, discard), y0=y0, **values)
     if title is None:
         shown = dict.fromkeys([*title_parameters, *values])
         used = dict(zip(model.parameter_names, map(float, model.parameter_vector(values))))
         title = ", ".join(parameter_text(k, used[k]) for k in shown if k in used)
-    return PhasePanel(trajectory, orbit.strobe, title, x, y)
+    return PhasePanel(trajectory, title, x, y)
 
 
-def plot_phase_portraits(panels: Sequence[PhasePanel], path: str | Path, columns: int | None = None) -> Path:
-    """Write a grid of phase portraits to ``path`` (PNG), captioned (a), (b), ... in order."""
+def plot_phase_portraits(panels: Sequence[PhasePanel], path: str | Path | None = None, columns: int | None = None):
+    """A grid of phase portraits, captioned (a), (b), ... in order, written to ``path`` (PNG) if given;
+    returns the Figure."""
     panels = list(panels)
     if not panels or not all(isinstance(p, PhasePanel) for p in panels):
         raise GearsymError("plot_phase_portraits needs a list of PhasePanel (see phase_panel)")
@@ -249,23 +273,33 @@ def plot_phase_portraits(panels: Sequence[PhasePanel], path: str | Path, columns
                 continue
             panel = panels[k]
             names = panel.trajectory.state_names
-            x, y = _axes_names(names, panel.x, panel.y)
+            x, y = phase_axes(names, panel.x, panel.y)
             for name in (x, y):
                 if name not in names:
                     raise GearsymError(f"phase portrait ({chr(ord('a') + k)}): no state {name!r}; "
                                        f"the states are {', '.join(names)}")
             ix, iy = names.index(x), names.index(y)
             traj = panel.trajectory.states
-            points = panel.trajectory.strobe if panel.points is None else panel.points
-            ax.plot(traj[ix], traj[iy], lw=0.45, color="0.6", rasterized=True, zorder=1)
+            points = panel.points
+            ax.plot(traj[ix], traj[iy], lw=0.4, color="0.6", rasterized=True, zorder=1)
             distinct = np.unique(np.round(points[[ix, iy]], 6), axis=1).shape[1]
-            ax.plot(points[ix], points[iy], "o" if distinct <= 50 else ".", ms=3.5 if distinct <= 50 else 2.4,
+            ax.plot(points[ix], points[iy], "o" if distinct <= 50 else ".", ms=3.5 if distinct <= 50 else 3.0,
                     color="k", mew=0, rasterized=True, zorder=2)  # a periodic orbit's few points must show
             ax.set_xlabel(x)
             ax.set_ylabel(y)
             ax.set_title(panel.title)
             ax.text(0.02, 0.97, f"({chr(ord('a') + k)})", transform=ax.transAxes, ha="left", va="top",
                     fontsize=11, fontweight="bold")
-        return save_figure(fig, path, dpi=150)
+        fig.supxlabel(_window_caption(panels), fontsize=7, color="0.35")
+        if path is not None:
+            save_figure(fig, path, dpi=150)
+        return fig
 
 
+def _window_caption(panels: Sequence[PhasePanel]) -> str:
+    windows = {(float(p.trajectory.time[0]), float(p.trajectory.time[-1]), p.points.shape[1] - 1) for p in panels}
+    if len(windows) == 1:
+        t0, t1, periods = windows.pop()
+        return (f"gray: the trajectory over t = {t0:.4g} .. {t1:.4g} ({periods} forcing periods, every RK4 step); "
+                "black: its Poincaré points (t = kT) in that window")
+    return "gray: each panel's trajectory; black: its Poincaré points (t = kT) in the same window"

@@ -2,8 +2,8 @@
 
 Left: the running estimate of every Lyapunov exponent over the measured
 periods, with the final value and its standard error. Right: the phase
-portrait of the first coordinate (the last periods, every RK4 step) with the
-stroboscopic Poincare points on top (the paper's Fig. 7 style).
+portrait of a coordinate against the state after it (the last periods, every RK4
+step) with the stroboscopic Poincare points of every measured period on top.
 """
 from __future__ import annotations
 
@@ -17,15 +17,16 @@ import numpy as np  # noqa: E402
 
 from ..analysis.lyapunov import LyapunovSpectrum  # noqa: E402
 from ..analysis.orbits import Trajectory  # noqa: E402
+from .poincare import phase_axes  # noqa: E402
 from .save import save_figure  # noqa: E402
 
 
-def plot_point(spectrum: LyapunovSpectrum, trajectory: Trajectory, path: str | Path,
-               x: str | None = None, y: str | None = None) -> Path:
-    """Write the two-panel figure to ``path`` (PNG); ``x``/``y`` choose the phase-plane axes."""
+def plot_point(spectrum: LyapunovSpectrum, trajectory: Trajectory, path: str | Path | None = None,
+               x: str | None = None, y: str | None = None):
+    """The two-panel figure, written to ``path`` (PNG) if given; returns the matplotlib Figure.
+    ``x``/``y`` choose the phase-plane axes (default the first state, and the state after ``x``)."""
     names = list(trajectory.state_names)
-    x = x or names[0]
-    y = y or names[min(1, len(names) - 1)]
+    x, y = phase_axes(names, x, y)
     fig, (ax_l, ax_p) = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)
 
     periods = np.arange(spectrum.discard + 1, spectrum.periods + 1)
@@ -40,14 +41,19 @@ def plot_point(spectrum: LyapunovSpectrum, trajectory: Trajectory, path: str | P
     ax_l.legend(fontsize=8, loc="best")
 
     ix, iy = names.index(x), names.index(y)
-    ax_p.plot(trajectory.states[ix], trajectory.states[iy], lw=0.5, color="0.55", label="trajectory")
+    shown = round((trajectory.time[-1] - trajectory.time[0]) / spectrum.period)
+    ax_p.plot(trajectory.states[ix], trajectory.states[iy], lw=0.5, color="0.55",
+              label=f"trajectory: the last {shown} periods")
     strobe = spectrum.strobe
-    ax_p.plot(strobe[ix], strobe[iy], ".", ms=4, color="C3", label=f"Poincaré points ({strobe.shape[1]})")
+    ax_p.plot(strobe[ix], strobe[iy], ".", ms=4, color="C3",
+              label=f"Poincaré points: all {strobe.shape[1]} measured periods")
     ax_p.set_xlabel(x)
     ax_p.set_ylabel(y)
     ax_p.set_title("phase portrait and stroboscopic section")
     ax_p.legend(fontsize=8, loc="best")
 
-    shown = ", ".join(f"{k}={v:g}" for k, v in spectrum.parameters.items())
-    fig.suptitle(f"{spectrum.model}: {shown}", fontsize=9)
-    return save_figure(fig, path, dpi=120)
+    values = ", ".join(f"{k}={v:g}" for k, v in spectrum.parameters.items())
+    fig.suptitle(f"{spectrum.model}: {values}\n{spectrum.regime}, λ₁ = {spectrum.exponents[0]:+.4f}", fontsize=9)
+    if path is not None:
+        save_figure(fig, path, dpi=120)
+    return fig

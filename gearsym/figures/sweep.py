@@ -7,6 +7,7 @@ one-call overview behind ``gearsym sweep --plot``.
 """
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import matplotlib
@@ -15,14 +16,18 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.colors import BoundaryNorm, ListedColormap, TwoSlopeNorm  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
 
 from ..analysis.regime import REGIMES  # noqa: E402
+from ..errors import GearsymError  # noqa: E402
 from ..sweep.result import SweepResult  # noqa: E402
 from .save import save_figure  # noqa: E402
 
 REGIME_COLORS = {"periodic": "#4c72b0", "quasi-periodic": "#55a868", "chaotic": "#dd8452",
                  "hyperchaotic": "#c44e52", "equilibrium": "#8172b3"}
 _LINESTYLE = {"up": "-", "down": "--", "independent": "-"}
+_STYLE_NAME = {"-": "solid", "--": "dashed"}
+_CONTINUATION = {"up": "continuation upward", "down": "continuation downward", "both": "continuation up, then down"}
 
 
 def _axis_label(name: str) -> str:
@@ -89,7 +94,7 @@ def plot_regime_strip(ax, result: SweepResult, *, direction: str | None = None, 
         width = np.min(np.diff(np.sort(xs))) if len(xs) > 1 else 1.0
         for xv, reg in zip(xs, result["regime"][idx]):
             ax.broken_barh([(xv - width / 2, width)], (row, 0.8), color=REGIME_COLORS.get(reg, "0.5"), lw=0)
-    ax.set_yticks([r + 0.4 for r in range(len(runs))], [_run_label(d, v) for d, v, _ in runs], fontsize=7)
+    ax.set_yticks([r + 0.4 for r in range(len(runs))], [_run_label(d, v, style=False) for d, v, _ in runs], fontsize=7)
     ax.set_ylim(0, max(len(runs), 1))
     handles = [plt.Rectangle((0, 0), 1, 1, color=REGIME_COLORS[r]) for r in REGIMES]
     ax.legend(handles, REGIMES, ncol=4, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.45), frameon=False)
@@ -140,38 +145,86 @@ def _geometric(v: np.ndarray) -> bool:
     return len(v) >= 3 and bool(np.all(v > 0)) and bool(np.allclose(np.diff(np.log(v)), np.log(v[1] / v[0])))
 
 
-def _run_label(direction: str, values: dict) -> str:
+def _run_label(direction: str, values: dict, style: bool = True) -> str:
+    """'up (solid), kS=0.1': the run, and how its curves are drawn."""
     fixed = ", ".join(f"{k}={v:g}" for k, v in values.items())
-    return ", ".join(p for p in (direction if direction != "independent" else "", fixed) if p) or "sweep"
+    run = "" if direction == "independent" else direction
+    if run and style:
+        run += f" ({_STYLE_NAME[_LINESTYLE[direction]]})"
+    return ", ".join(p for p in (run, fixed) if p) or "sweep"
 
 
-def plot_sweep(result: SweepResult, path: str | Path) -> Path:
-    """Overview PNG: for one swept parameter A, lambda_i, bifurcation diagram and regimes against it;
-    for two, maps of lambda_1, the regime and A over both."""
-    title = f"{result.model}: " + ", ".join(f"{a.name} {a.values[0]:g}..{a.values[-1]:g}" for a in result.axes)
+def _style_legend(result: SweepResult) -> list[Line2D]:
+    """Legend entries for the line styles of the directions in ``result`` (none for independent points)."""
+    directions = [d for d in dict.fromkeys(result["direction"].tolist()) if d in ("up", "down")]
+    return [Line2D([], [], color="0.3", lw=1.0, ls=_LINESTYLE[d], label=f"{_STYLE_NAME[_LINESTYLE[d]]}: {d}")
+            for d in directions]
+
+
+def fixed_parameters(result: SweepResult) -> str:
+    """The values of every parameter not swept: those the sweep set first, then the model's defaults."""
+    swept = {a.name for a in result.axes}
+    given = {k: v for k, v in result.record.get("settings", {}).items() if k not in swept}
+    defaults = {k: v for k, v in result.record.get("parameters", {}).items() if k not in swept and k not in given}
+    parts = [*(["set: " + ", ".join(f"{k}={v}" for k, v in given.items())] if given else []),
+             *(["defaults: " + ", ".join(f"{k}={v:g}" for k, v in defaults.items())] if defaults else [])]
+    return "; ".join(parts)
+
+
+def sweep_title(result: SweepResult, width: int = 110) -> str:
+    """The model, the swept ranges and the fixed parameters, wrapped to ``width`` characters."""
+    swept = ", ".join(f"{a.name} = {a.values[0]:g}..{a.values[-1]:g} ({len(a.values)} values)" for a in result.axes)
+    mode = ("independent points" if result.mode == "independent" else
+            _CONTINUATION.get(result.record.get("direction"), "continuation"))
+    return textwrap.fill(f"{result.model}: {swept}, {mode}. {fixed_parameters(result)}", width)
+
+
+def _shown_direction(result: SweepResult) -> str | None:
+    """The one run a panel that cannot overlay both shows: up if there is one (None: independent points)."""
+    if result.mode == "independent":
+        return None
+    directions = list(dict.fromkeys(result["direction"].tolist()))
+    return "up" if "up" in directions or not directions else directions[0]
+
+
+def plot_sweep(result: SweepResult, path: str | Path | None = None, coordinate: str | None = None):
+    """Overview, written to ``path`` (PNG) if given; returns the Figure. For one swept parameter: A of
+    ``coordinate`` (default the first), lambda_i, the bifurcation diagram of ``coordinate`` and the regimes
+    against it; for two, maps of lambda_1, the regime and A over both."""
+    coordinate = coordinate or result.coordinates[0]
+    if coordinate not in result.coordinates:
+        raise GearsymError(f"plot_sweep: no coordinate {coordinate!r}; the coordinates are "
+                           f"{', '.join(result.coordinates)}")
+    direction = _shown_direction(result)
+    run = f" ({direction})" if direction else ""
     if len(result.axes) >= 2:
-        fig, axs = plt.subplots(1, 3, figsize=(15, 4.2), constrained_layout=True)
-        direction = None if result.mode == "independent" else ("down" if result.record.get("direction") == "down" else "up")
-        for ax, column, label in zip(axs, ("lambda_1", "regime", f"A_{result.coordinates[0]}"),
-                                     (r"$\lambda_1$", "regime", f"A ({result.coordinates[0]})")):
+        fig, axs = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
+        over = f"over {result.axes[0].name} and {result.axes[1].name}"
+        for ax, column, label in zip(axs, ("lambda_1", "regime", f"A_{coordinate}"),
+                                     (r"$\lambda_1$", "regime", f"A ({coordinate})")):
             mesh = plot_map(ax, result, column, direction=direction)
+            ax.set_title(f"{label} {over}{run}", fontsize=9)
             if column != "regime":
                 fig.colorbar(mesh, ax=ax, label=label)
             else:
                 cbar = fig.colorbar(mesh, ax=ax, ticks=range(4))
                 cbar.ax.set_yticklabels(REGIMES, fontsize=7)
-        axs[1].set_title(title + (f" ({direction})" if direction else ""), fontsize=9)
+        fig.suptitle(sweep_title(result, 160), fontsize=9)
     else:
-        fig, axs = plt.subplots(4, 1, figsize=(8, 9.5), sharex=True, constrained_layout=True,
+        fig, axs = plt.subplots(4, 1, figsize=(8, 10), sharex=True, constrained_layout=True,
                                 gridspec_kw={"height_ratios": [3, 3, 3, 1]})
-        plot_amplitude(axs[0], result)
+        plot_amplitude(axs[0], result, coordinate)
         plot_exponents(axs[1], result, which=range(1, result.exponent_count + 1), direction=None)
-        plot_bifurcation(axs[2], result)
+        plot_bifurcation(axs[2], result, coordinate, direction=direction)
         plot_regime_strip(axs[3], result)
         axs[0].legend(fontsize=7)
         handles, labels = axs[1].get_legend_handles_labels()
-        unique = dict(zip(labels, handles))
-        axs[1].legend(unique.values(), unique.keys(), fontsize=7, ncol=4)
+        colours = [Line2D([], [], color=h.get_color(), lw=1.0, label=k) for k, h in dict(zip(labels, handles)).items()]
+        axs[1].legend(handles=[*colours, *_style_legend(result)], fontsize=7, ncol=4)
+        axs[2].set_title(f"bifurcation diagram: {coordinate} at t = kT"
+                         + (f", the {direction} run" if direction else ", independent points"), fontsize=9)
         axs[3].set_xlabel(_axis_label(result.axes[0].name))
-        axs[0].set_title(title, fontsize=9)
-    return save_figure(fig, path, dpi=120)
+        axs[0].set_title(sweep_title(result, 100), fontsize=8)
+    if path is not None:
+        save_figure(fig, path, dpi=120)
+    return fig

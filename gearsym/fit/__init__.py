@@ -18,8 +18,11 @@ def explain_files(paths, system, fit, *, out=None, time_scale=None, held_out: fl
     """The whole loop from files: load ``paths`` for ``system`` (``values`` fix parameter values), explain,
     and with ``out`` write the report there. Returns the report's dict (the keys of report.json)."""
     from ..data import load_measurements
+    from ..outputs import check_folder
     from .report import write_report
 
+    if out is not None:
+        check_folder(out)
     measurements = load_measurements(paths, system, time_scale=time_scale, **values)
     system = system.with_values(**values)
     ex = explain(system, measurements, fit, held_out=held_out, candidates=candidates, progress=progress,

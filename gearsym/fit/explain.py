@@ -102,6 +102,7 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
     while they lower the held-out error; see the module docstring."""
     if not fit:
         raise GearsymError("name the parameters to fit, e.g. --fit zeta,B1")
+    _check_one_value_each(measurements, fit)
     library = {e.name: e for e in map(effect, candidates if candidates is not None else list(EFFECTS))}
     train, test = measurements.split(held_out)
     say = progress or (lambda message: None)
@@ -130,6 +131,17 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
         current = best
     correlation = _lag1(current.prediction)
     return Explanation(base, current, tried, bool(correlation > max_correlation), correlation, tuple(fit), held_out)
+
+
+def _check_one_value_each(measurements: Measurements, fit: Sequence[str]) -> None:
+    """A fit estimates one value of each parameter for all records: refuse one the records set differently."""
+    for name in fit:
+        values = {r.conditions[name] for r in measurements if name in r.conditions}
+        if len(values) > 1:
+            shown = ", ".join(f"{v:g}" for v in sorted(values))
+            raise GearsymError(f"cannot fit {name}: the records set it to different values ({shown}) and a fit "
+                               f"estimates one value for all; leave it out of --fit, or explain one record (or "
+                               f"records of one {name}) at a time")
 
 
 def _lag1(prediction: Prediction) -> float:

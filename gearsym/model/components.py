@@ -97,8 +97,11 @@ class Shaft:
     Its relative coordinate is the twist scaled to a length,
     ``x = radius * (psi_b - psi_a)`` as the paper's ``x2 = r2 (psi3 - psi2)``;
     ``radius`` defaults to the base radius of ``a`` (or of ``b`` if ``a`` is a disk).
-    ``forced=False`` (the paper's choice) makes the reduction require that no
-    constant torque loads the twist: that is the torque-balance condition of Eq. 10.
+    A constant torque that loads the twist (a motor driving through the shaft)
+    stays in the equations as forcing, with the static twist it causes. ``forced=False``
+    is an assumption to declare (the paper's, for its flexible shaft): the reduction
+    then requires that no constant torque loads the twist and drops it, which is the
+    torque-balance condition of Eq. 10.
     """
 
     name: str
@@ -108,7 +111,7 @@ class Shaft:
     damping: ExprLike = 0
     coordinate: Optional[str] = None
     radius: Optional[ExprLike] = None
-    forced: bool = False
+    forced: bool = True
 
     @property
     def ends(self) -> tuple[BodyRef, BodyRef]:

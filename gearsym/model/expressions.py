@@ -1,45 +1,36 @@
 """Turning what a user writes (a name, a number, a formula) into SymPy expressions.
 
-Every name in a formula becomes the canonical parameter symbol, except the
-reserved ``t``, ``tau`` and ``phi``; calls of functions SymPy does not know are
-rejected with the name of the component that used them.
+Formula strings are read by :mod:`gearsym.model.formula`, which never runs
+them as Python. Every name in a formula becomes the canonical parameter symbol,
+except the reserved ``t``, ``tau`` and ``phi``; calls of functions outside the
+allowed ones are rejected with the name of the component that used them.
 """
 from __future__ import annotations
 
 from collections.abc import Mapping
 from typing import Union
 
-import re
-
 import sympy as sp
 from sympy.core.function import AppliedUndef
-from sympy.parsing.sympy_parser import parse_expr, standard_transformations
 
 from ..errors import ModelError
 from ..symbols import RESERVED, parameter_symbol
+from .formula import parse_formula
 
 ExprLike = Union[str, int, float, sp.Expr]
-_NAME = re.compile(r"\b([A-Za-z_][A-Za-z_0-9]*)\b(\s*\()?")
 
 
 def to_expr(value: ExprLike, where: str, extra: Mapping[str, sp.Expr] | None = None) -> sp.Expr:
     """Parse ``value`` into a SymPy expression of canonical symbols.
 
-    ``extra`` maps further names (e.g. a function already declared) to objects.
+    ``extra`` maps further names (the states and time of a first-order system) to their symbols.
     """
     if isinstance(value, bool) or value is None:
         raise ModelError(f"expected a number, a parameter name or a formula, got {value!r}", where)
     if isinstance(value, (int, float)):
         return sp.nsimplify(value) if isinstance(value, int) else sp.Float(value)
     if isinstance(value, str):
-        # a name is a function only where it is called: 'beta', 'zeta', 'gamma', 'E', 'I'
-        # would otherwise be SymPy's special functions and constants, not parameters
-        names = {m.group(1) for m in _NAME.finditer(value) if not m.group(2)}
-        local = {n: sp.Symbol(n) for n in names if n != "pi"}
-        try:
-            expr = parse_expr(value, local_dict=local, transformations=standard_transformations, evaluate=True)
-        except Exception as exc:  # SyntaxError, TokenError, ...
-            raise ModelError(f"cannot read the formula {value!r}: {exc}", where) from None
+        expr = parse_formula(value, where)
     elif isinstance(value, sp.Basic):
         expr = value
     else:

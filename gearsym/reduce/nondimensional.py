@@ -10,7 +10,7 @@ paper names and writes Eqs. 2, 6 and 9:
 * a shaft's factor in every row is a group ``beta`` multiplying ``kS x``
   (the paper's beta1, beta2);
 * the forcing of each row, grouped by harmonic, gives B0, B1, D, ...;
-  the constant forcing of an unforced shaft row must vanish: the torque-balance
+  the constant forcing of a shaft declared forced=False must vanish: the torque-balance
   condition of Eq. 10;
 * time is measured in units of 1/omega_n, omega_n^2 = m kZ of the first mesh,
   so that its mean stiffness is 1 (the paper's convention; a condition too).
@@ -180,6 +180,16 @@ class NondimensionalModel:
     @property
     def defaults(self) -> dict[str, float]:
         """Declared default of every parameter; errors name what is missing or unknown."""
+        return self._defaults_except(())
+
+    @property
+    def declared_defaults(self) -> dict[str, float]:
+        """The parameters' declared defaults, checked; those without one are left out (no error)."""
+        return self._defaults_except(self.parameter_names, strict=False)
+
+    def _defaults_except(self, given, strict: bool = True) -> dict[str, float]:
+        """Declared defaults of the parameters; with ``strict``, an error names those that have none and are
+        not ``given`` (values passed instead)."""
         declared = self.drivetrain.defaults
         fnames = {f.name for f in self.functions}
         allowed = set(self.parameter_names) | fnames
@@ -194,20 +204,17 @@ class NondimensionalModel:
                     f"{self.name}: set_defaults",
                 )
             raise UnknownParameterError(name, allowed, f"{self.name}: set_defaults")
-        out, missing = {}, []
-        for name in self.parameter_names:
-            if name not in declared:
-                missing.append(name)
-                continue
-            out[name] = self._number(name, declared[name], "default")
-        if missing:
+        out = {name: self._number(name, declared[name], "default") for name in self.parameter_names
+               if name in declared}
+        missing = [name for name in self.parameter_names if name not in declared and name not in given]
+        if missing and strict:
             hints = []
             for name in missing:
                 gr = next((gr for gr in self.groups if gr.name == name), None)
                 hints.append(f"{name} ({gr.description}: {gr.definition})" if gr else name)
             raise ModelError(
                 "parameters without a default value: " + "; ".join(hints)
-                + f". Add them with model.set_defaults({missing[0]}=...)",
+                + f". Add them with model.set_defaults({missing[0]}=...) or pass them as values",
                 self.name,
             )
         return out
@@ -276,23 +283,8 @@ class NondimensionalModel:
         ``a=0.3`` gives the new parameter its value). A default for a function
         name in ``set_defaults`` replaces it the same way.
         """
-        declared = self.drivetrain.defaults
-        functions = {f.name: self._function_expr(f, declared[f.name]) for f in self.functions if f.name in declared}
-        for f in self.functions:
-            if f.name in settings:
-                functions[f.name] = self._function_expr(f, settings[f.name])
-        rhs = self._substituted_rhs(functions)
-        used = set()
-        for expr in rhs:
-            used |= parameter_names(expr)
-        used -= {s.name for s in self.states}
-        fnames = {f.name for f in self.functions}
-        for key in settings:
-            if key not in fnames and key not in used and key not in self.parameter_names:
-                raise UnknownParameterError(key, set(self.parameter_names) | fnames | used, self.name)
-        defaults = self.defaults
-        names = [n for n in self.parameter_names if n in used or n == "omega"]
-        names += sorted(used - set(names))
+        rhs, names, functions = self._engine(settings)
+        defaults = self._defaults_except(set(settings) | (set(self.parameter_names) - set(names)))
         params = {}
         for name in names:
             if name in settings:
@@ -306,9 +298,35 @@ class NondimensionalModel:
             descriptions.setdefault(gr.name, gr.description)
         constraints = {name: Constraint(meaning, zero_ok) for name, (zero_ok, meaning) in self._constraints.items()
                        if name in params}
-        return FirstOrderSystem(self.name, tau, self.states, tuple(rhs), params, self.period, descriptions,
+        return FirstOrderSystem(self.name, tau, self.states, rhs, params, self.period, descriptions,
                                 self.drivetrain.title, tuple(c.name for c in self.coordinates),
                                 self.drivetrain.initial_state, self._system_couplings(functions), constraints)
+
+    def engine_equations(self, **settings: ExprLike) -> tuple[tuple[sp.Expr, ...], list[str]]:
+        """The right-hand side :meth:`system` gives the engine (k(tau) written out, derived groups expanded)
+        and its parameters in order; symbolic, so no parameter needs a value. ``settings`` are checked
+        names; those naming a stiffness function replace it."""
+        rhs, names, _ = self._engine(settings)
+        return rhs, names
+
+    def _engine(self, settings: Mapping[str, ExprLike]) -> tuple[tuple[sp.Expr, ...], list[str], dict]:
+        """:meth:`engine_equations`, and the stiffness functions written into them."""
+        declared = self.drivetrain.defaults
+        functions = {f.name: self._function_expr(f, declared[f.name]) for f in self.functions if f.name in declared}
+        for f in self.functions:
+            if f.name in settings:
+                functions[f.name] = self._function_expr(f, settings[f.name])
+        rhs = tuple(self._substituted_rhs(functions))
+        used = set()
+        for expr in rhs:
+            used |= parameter_names(expr)
+        used -= {s.name for s in self.states}
+        fnames = {f.name for f in self.functions}
+        for key in settings:
+            if key not in fnames and key not in used and key not in self.parameter_names:
+                raise UnknownParameterError(key, set(self.parameter_names) | fnames | used, self.name)
+        names = [n for n in self.parameter_names if n in used or n == "omega"]
+        return tuple(rhs), names + sorted(used - set(names)), functions
 
     def _system_couplings(self, functions: Mapping[str, sp.Expr]) -> tuple[Coupling, ...]:
         """Every coupling as the first-order system carries it, in the system's own terms (stiffness
@@ -316,10 +334,10 @@ class NondimensionalModel:
         derived = {gr.symbol: gr.definition for gr in self.groups if gr.kind == "derived"}
         own = {f.mesh: functions.get(f.name, f.expression) for f in self.functions}
         out = []
-        for row, c in enumerate(self.coordinates):
+        for c in self.coordinates:
             rc = c.coupling
             stiffness = own[rc.name] if rc.kind == "mesh" else rc.stiffness
-            rows = tuple((2 * r + 1, sp.sympify(factor).xreplace(derived)) for r, factor in self.coupling_rows[rc.name])
+            rows = tuple((2 * r + 1, factor.xreplace(derived)) for r, factor in self.coupling_rows[rc.name])
             out.append(Coupling(rc.name, rc.kind, c.name, c.velocity_name, rc.backlash, stiffness.xreplace(derived),
                                 rc.order, rows))
         return tuple(out)

@@ -14,11 +14,8 @@ from ..checks import json_safe
 from .claims import evaluate
 from .compute import Computed, compute
 from .figures import draw_all
-from .plan import SCENARIOS, Plan, Scenario, paper_plan
+from .plan import NOT_IN_PAPER, SCENARIOS, Plan, Scenario, paper_plan
 from .report import render, write
-
-#: parameters the paper does not give; their values are listed in the report
-NOT_IN_PAPER = ("k_a", "I1", "I2", "I3", "r1", "r2")
 
 __all__ = ["SCENARIOS", "Computed", "Plan", "Scenario", "compute", "evaluate", "paper_plan", "record_of", "render",
            "reproduce"]

@@ -61,12 +61,12 @@ def compute(plan: Plan, data_dir: str | Path, *, jobs: int = 0, progress: bool =
             **plan.scenario.settings(job.model), omega=job.omega)
     portraits = []
     fixed = plan.scenario.settings(plan.portrait_model)
-    shown = min(40, plan.periods - plan.discard)
+    shown = min(plan.portrait_window, plan.periods - plan.discard)
     for job in plan.portraits:
         values = {"omega": plan.portrait_omega, **fixed, **job.settings}
         model = compiled[plan.portrait_model]
         spectrum = lyapunov_spectrum(model, **values)
-        trajectory = phase_trajectory(model, options=scheme.run(discard=plan.periods - shown), **values)
+        trajectory = phase_trajectory(model, options=scheme.run(discard=plan.periods - shown), **values)  # its end
         portraits.append(Portrait(job.letter, {"omega": plan.portrait_omega, **job.settings}, job.x, job.y,
                                   spectrum, trajectory))
     return Computed(plan, sweeps, attractors, tuple(portraits))

@@ -2,10 +2,16 @@
 
 Panels follow the captions: curves labelled '1', '2', '3' as in the paper, the
 same axes and the same grids. The paper's claimed regions are shaded grey
-behind our curves, so that agreement can be seen, not only read.
+behind our curves, so that agreement can be seen, not only read. Every figure
+says at its top which parameter set it shows (:data:`~gearsym.reproduce.plan.SCENARIOS`:
+calibrated to the paper, or the models' defaults) with the values the paper leaves
+open, and the values it does give.
+
+Each ``figureN(c)`` returns a matplotlib Figure (tests read it); :func:`draw_all` writes them.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 
 import matplotlib
@@ -14,15 +20,48 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from ..figures.poincare import parameter_text  # noqa: E402
 from ..figures.save import save_figure  # noqa: E402
 from ..figures.sweep import plot_amplitude, plot_bifurcation, plot_exponents, plot_map, plot_regime_strip  # noqa: E402
 from .compute import Computed  # noqa: E402
-from .plan import CHAOS_BAND, NEAR_ONE, PAPER_JUMPS  # noqa: E402
+from .plan import CHAOS_BAND, NEAR_ONE, NOT_IN_PAPER, PAPER_JUMPS  # noqa: E402
 
 CURVE_COLORS = ("C0", "C3", "C2")
 DPI = 110
+#: the phase-plane figures carry many points: a finer raster
+FINE_DPI = 150
 
 
+def parameter_set(c: Computed, runs: Mapping[str, Mapping[str, float]], varied=()) -> str:
+    """Two lines for a figure's top: the parameter set with the values the paper leaves open, per model
+    (``runs``: model -> its parameter values), and the values the paper gives, except those ``varied``
+    along the figure's axes or between its curves."""
+    open_values: dict[str, list[str]] = {}
+    for model, values in runs.items():
+        if open_text(values, varied):
+            open_values.setdefault(open_text(values, varied), []).append(model)
+    if len(open_values) <= 1:
+        opened = "".join(open_values)
+    else:
+        opened = "; ".join(f"{' and '.join(models)}: {text}" for text, models in open_values.items())
+    return f"parameter set: {c.plan.scenario.label}" + (f" ({opened})" if opened else "") + "\n" + paper_text(runs, varied)
+
+
+def paper_text(runs: Mapping[str, Mapping[str, float]], varied=()) -> str:
+    """"the paper's values: ζ=0.08, ...": those of ``runs`` the paper gives, except those ``varied``."""
+    given: dict[str, float] = {}
+    for values in runs.values():
+        given.update({k: v for k, v in values.items() if k not in NOT_IN_PAPER and k not in varied})
+    return f"the paper's values: {', '.join(parameter_text(k, v) for k, v in given.items())}"
+
+
+def open_text(values: Mapping[str, float], varied=()) -> str:
+    """'k_a=0.05, I1=2, ...': the values of what the paper leaves open (except those ``varied``)."""
+    return ", ".join(parameter_text(k, values[k]) for k in NOT_IN_PAPER if k in values and k not in varied)
+
+
+def _sweep_parameters(c: Computed, *names: str) -> dict[str, dict[str, float]]:
+    return {c.sweeps[n].model: c.sweeps[n].record["parameters"] for n in names}
 
 
 def _paper_chaos(ax) -> None:
@@ -39,9 +78,9 @@ def _finish_omega(ax) -> None:
     ax.set_xlim(0.1, 2.0)
 
 
-def figure3(c: Computed, out: Path, suffix: str = "") -> Path:
+def figure3(c: Computed):
     d0, d2 = c.sweeps["fig3_D0"], c.sweeps["fig3_D2"]
-    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4.3), constrained_layout=True)
+    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4.8), constrained_layout=True)
     for ax in (a, b):
         _paper_chaos(ax)
     for (r, label), color in zip(((d0, "'1'  D = 0"), (d2, "'2'  D = 2")), CURVE_COLORS):
@@ -53,15 +92,17 @@ def figure3(c: Computed, out: Path, suffix: str = "") -> Path:
     a.set_ylabel(r"$A$")
     for ax, letter in ((a, "a"), (b, "b")):
         _finish_omega(ax)
-        ax.legend(fontsize=8, loc="upper right")
+        ax.legend(fontsize=8, loc="upper right", title="continuation up in ω", title_fontsize=8)
         _letter(ax, letter)
     b.set_title("grey: the paper's chaotic regions for D = 0", fontsize=8)
-    return save_figure(fig, out / f"fig3{suffix}.png", DPI)
+    fig.suptitle("Fig. 3: Eq. 2 (D = 0) and Eq. 6 (D = 2) — "
+                 + parameter_set(c, _sweep_parameters(c, "fig3_D0", "fig3_D2"), ("omega", "D")), fontsize=8)
+    return fig
 
 
-def figure6(c: Computed, out: Path, suffix: str = "") -> Path:
+def figure6(c: Computed):
     r = c.sweeps["fig6"]
-    fig, axs = plt.subplots(2, 2, figsize=(12, 8), constrained_layout=True)
+    fig, axs = plt.subplots(2, 2, figsize=(12, 8.4), constrained_layout=True)
     (a, b), (cc, d) = axs
     for ax in (a, b):
         _paper_chaos(ax)
@@ -76,9 +117,30 @@ def figure6(c: Computed, out: Path, suffix: str = "") -> Path:
     _clip_peak(a, r["omega"], r["A_x1"])
     for ax, letter in zip((a, b, cc, d), "abcd"):
         _finish_omega(ax)
-        ax.legend(fontsize=8, loc="upper right")
+        ax.legend(fontsize=8, loc="upper right", title="continuation up in ω", title_fontsize=8)
         _letter(ax, letter)
-    return save_figure(fig, out / f"fig6{suffix}.png", DPI)
+    for ax, ks in ((cc, 0.1), (d, 1.0)):
+        _zoom_near_zero(ax, r, kS=ks)
+    fig.suptitle("Fig. 6: Eq. 9, the flexible shaft — " + parameter_set(c, _sweep_parameters(c, "fig6"),
+                                                                        ("omega", "kS")), fontsize=8)
+    return fig
+
+
+def _zoom_near_zero(ax, r, **fixed) -> None:
+    """An inset on lambda_1 and lambda_2 near zero, where the main panel's scale (set by the most negative
+    exponents) draws them on top of each other: it shows whether lambda_2 is above zero too (hyperchaos)."""
+    inset = ax.inset_axes([0.36, 0.07, 0.62, 0.42])
+    plot_exponents(inset, r, which=(1, 2), direction="up", **fixed)
+    line = next(idx for d, values, idx in r.lines()
+                if d == "up" and all(np.isclose(values[k], v) for k, v in fixed.items()))
+    second = r["lambda_2"][line]
+    half = max(2.5 * float(np.max(np.abs(second[r["omega"][line] >= 0.5]), initial=0.0)), 0.01)
+    inset.set_ylim(-half, half)
+    inset.set_xlim(0.1, 2.0)
+    inset.set_ylabel("")
+    inset.tick_params(labelsize=7)
+    inset.set_title(r"zoom near zero: $\lambda_1$, $\lambda_2$", fontsize=7, pad=2)
+    inset.set_facecolor("white")
 
 
 def _clip_peak(ax, x: np.ndarray, y: np.ndarray) -> None:
@@ -92,24 +154,37 @@ def _clip_peak(ax, x: np.ndarray, y: np.ndarray) -> None:
                     fontsize=8, arrowprops={"arrowstyle": "->", "lw": 0.8})
 
 
-def figure4(c: Computed, out: Path, suffix: str = "") -> Path:
+def figure4(c: Computed):
     from ..figures.poincare import plot_attractors
 
     panels = [[c.attractors[("one_stage", omega)], c.attractors[("one_stage_resonant", omega)]] for omega in (1.5, 1.6)]
-    return plot_attractors(panels, out / f"fig4{suffix}.png", colors=["0.6", "k"], labels=["D = 0 (Eq. 2)", "D = 2 (Eq. 6)"])
+    fig = plot_attractors(panels, colors=["0.6", "k"], labels=["D = 0 (Eq. 2)", "D = 2 (Eq. 6)"])
+    runs = {s.model: s.parameters for panel in panels for s in panel}
+    fig.suptitle("Fig. 4: coexisting attractors — "
+                 + parameter_set(c, runs, ("omega", "D")), fontsize=8)
+    return fig
 
 
-def figure7(c: Computed, out: Path, suffix: str = "") -> Path:
+def figure7(c: Computed):
     from ..figures.poincare import PhasePanel, plot_phase_portraits
 
-    panels = [PhasePanel(p.trajectory, p.spectrum.strobe, f"ω = {p.settings['omega']:g}, $k_S$ = {p.settings['kS']:g}",
-                         p.x, p.y) for p in c.portraits]
-    return plot_phase_portraits(panels, out / f"fig7{suffix}.png")
+    panels = [PhasePanel(p.trajectory, _portrait_title(p), p.x, p.y) for p in c.portraits]
+    fig = plot_phase_portraits(panels)
+    runs = {c.plan.portrait_model: c.portraits[0].spectrum.parameters} if c.portraits else {}
+    fig.suptitle(f"Fig. 7: ω = {c.plan.portrait_omega:g}, from the paper's initial state — "
+                 + parameter_set(c, runs, ("omega", "kS")), fontsize=8)
+    return fig
 
 
-def hysteresis(c: Computed, out: Path, suffix: str = "") -> Path:
+def _portrait_title(p) -> str:
+    """'$k_S$ = 0: chaotic, λ₁ = +0.055': the setting, and the regime and λ₁ of the run drawn."""
+    lam = p.spectrum.exponents[0]
+    return f"$k_S$ = {p.settings['kS']:g}: {p.spectrum.regime}, λ₁ = {lam:+.4f}"
+
+
+def hysteresis(c: Computed):
     """Beyond the paper: up and down runs, and the bifurcation diagrams, of both one-stage models."""
-    fig, axs = plt.subplots(3, 2, figsize=(12, 9), sharex=True, constrained_layout=True,
+    fig, axs = plt.subplots(3, 2, figsize=(12, 9.5), sharex=True, constrained_layout=True,
                             gridspec_kw={"height_ratios": [3, 3, 1]})
     for col, (name, title) in enumerate((("fig3_D0", "D = 0 (Eq. 2)"), ("fig3_D2", "D = 2 (Eq. 6)"))):
         r = c.sweeps[name]
@@ -117,16 +192,18 @@ def hysteresis(c: Computed, out: Path, suffix: str = "") -> Path:
         axs[0, col].set_title(f"{title}: up (solid) and down (dashed)", fontsize=9)
         axs[0, col].legend(fontsize=8)
         plot_bifurcation(axs[1, col], r, direction="up")
-        axs[1, col].set_title("bifurcation diagram: x at t = kT (up)", fontsize=9)
+        axs[1, col].set_title("bifurcation diagram: x at t = kT, the up run", fontsize=9)
         plot_regime_strip(axs[2, col], r)
         _finish_omega(axs[2, col])
-    return save_figure(fig, out / f"hysteresis{suffix}.png", DPI)
+    fig.suptitle("Hysteresis: continuation up, then down in ω — "
+                 + parameter_set(c, _sweep_parameters(c, "fig3_D0", "fig3_D2"), ("omega", "D")), fontsize=8)
+    return fig
 
 
-def study(c: Computed, out: Path, suffix: str = "") -> Path:
+def study(c: Computed):
     """Beyond the paper: lambda_1 and the regime over omega and a parameter the paper leaves open."""
     names = ("study_kS", "study_ka", "study_inertia")
-    fig, axs = plt.subplots(len(names), 2, figsize=(13, 10.5), constrained_layout=True)
+    fig, axs = plt.subplots(len(names), 2, figsize=(13, 11), constrained_layout=True)
     for row, name in enumerate(names):
         r = c.sweeps[name]
         mesh = plot_map(axs[row, 0], r, "lambda_1", direction="up")
@@ -135,17 +212,25 @@ def study(c: Computed, out: Path, suffix: str = "") -> Path:
         bar = fig.colorbar(mesh, ax=axs[row, 1], ticks=range(4))
         bar.ax.set_yticklabels(["periodic", "quasi-per.", "chaotic", "hyperchaotic"], fontsize=7)
         job = c.plan.sweep(name)
-        axs[row, 0].set_title(f"{job.model}: {job.title}", fontsize=8)
+        fixed = open_text(r.record["parameters"], [a.name for a in r.axes])
+        axs[row, 0].set_title(f"{job.model}: {job.title}" + (f"; {fixed}" if fixed else ""), fontsize=8, loc="left")
         for ax in axs[row]:
             for lo, hi in (NEAR_ONE, CHAOS_BAND):
                 ax.axvline(lo, color="k", ls=":", lw=0.7)
                 ax.axvline(hi, color="k", ls=":", lw=0.7)
-    return save_figure(fig, out / f"study{suffix}.png", DPI)
+    swept = {a.name for n in names for a in c.sweeps[n].axes} | {"kS"}
+    fig.suptitle(f"Parameter study, continuation up in ω — parameter set: {c.plan.scenario.label} (the values each "
+                 f"row keeps fixed are in its title)\n{paper_text(_sweep_parameters(c, *names), swept)}", fontsize=8)
+    return fig
+
+
+#: the figures of one scenario: file stem -> (builder, dpi)
+FIGURES = {"fig3": (figure3, DPI), "fig4": (figure4, FINE_DPI), "fig6": (figure6, DPI), "fig7": (figure7, FINE_DPI),
+           "hysteresis": (hysteresis, DPI), "study": (study, DPI)}
 
 
 def draw_all(c: Computed, out: str | Path, suffix: str = "") -> list[Path]:
     """Every figure of one computed plan; ``suffix`` tells the file names of another scenario apart."""
     out = Path(out)
-    drawn = [figure3(c, out, suffix), figure4(c, out, suffix), figure6(c, out, suffix), figure7(c, out, suffix),
-             hysteresis(c, out, suffix)]
-    return drawn + ([study(c, out, suffix)] if "study_ka" in c.sweeps else [])
+    names = [n for n in FIGURES if n != "study" or "study_ka" in c.sweeps]
+    return [save_figure(FIGURES[n][0](c), out / f"{n}{suffix}.png", FIGURES[n][1]) for n in names]

@@ -13,6 +13,8 @@ PAPER_OMEGA = "omega=0.1:2.0:0.01"
 #: the paper's regions of chaos for D = 0 (Section 3): near omega = 1.0, and [1.24, 1.62]
 NEAR_ONE = (0.95, 1.05)
 CHAOS_BAND = (1.24, 1.62)
+#: parameters the paper does not give; their values are listed in the report and on every figure
+NOT_IN_PAPER = ("k_a", "I1", "I2", "I3", "r1", "r2")
 #: the paper's amplitude jumps for D = 2 (Fig. 3a), and how close a found jump must be
 PAPER_JUMPS = (1.36, 1.70)
 JUMP_TOLERANCE = 0.04
@@ -81,6 +83,7 @@ class Plan:
     portraits: tuple[PortraitJob, ...]
     portrait_model: str = "flexible_shaft"
     portrait_omega: float = 1.5
+    portrait_window: int = 100  # the last periods of each portrait's run drawn, with their Poincare points
     periods: int = 400
     discard: int = 100
     attractor_periods: int = 200

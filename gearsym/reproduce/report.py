@@ -56,11 +56,13 @@ FIGURES = {
                       "x = −2, v = −0.5 at ω = 0.1; '1' D = 0, '2' D = 2. Grey: the paper's chaotic regions for "
                       "D = 0; dotted: the paper's jumps."),
     "4": ("fig4.png", "Fig. 4: Poincaré maps from ten random starts at (a) ω = 1.5 and (b) ω = 1.6; grey D = 0, "
-                      "black D = 2; '1' marks a regular attractor, '2' a chaotic one."),
+                      "black D = 2; '1' marks a regular attractor, '2' a chaotic one, and the marker is the "
+                      "regime's in both panels."),
     "6": ("fig6.png", "Fig. 6: (a) amplitude of x₁ and (b) λ₁ for kS = 0, 0.1, 1.0 (curves '1', '2', '3'); "
-                      "(c), (d) the four exponents for kS = 0.1 and 1.0."),
-    "7": ("fig7.png", "Fig. 7: phase portraits (grey) and Poincaré points (black) at ω = 1.5: (a) kS = 0, "
-                      "(b) kS = 1.0, (c), (d) kS = 0.1 in the planes of x₁ and x₂."),
+                      "(c), (d) the four exponents for kS = 0.1 and 1.0, with insets on λ₁ and λ₂ near zero."),
+    "7": ("fig7.png", "Fig. 7: phase portraits (grey) and Poincaré points (black) of the last 100 periods of each "
+                      "run at ω = 1.5: (a) kS = 0, (b) kS = 1.0, (c), (d) kS = 0.1 in the planes of x₁ and x₂; "
+                      "each panel's title gives the regime and λ₁ of its run."),
 }
 
 

@@ -13,7 +13,9 @@ everything.
 """
 from __future__ import annotations
 
+import ctypes
 import multiprocessing
+import multiprocessing.connection
 import os
 import queue
 import signal
@@ -362,7 +364,7 @@ def _execute_processes(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], j
         todo.put(i)
     for _ in range(workers):
         todo.put(None)
-    _FORKED = (run, tasks)  # what the children inherit
+    _FORKED = (run, tasks, os.getpid())  # what the children inherit
     procs = [ctx.Process(target=_process_worker, args=(todo, done), daemon=True, name=f"gearsym-sweep-{k}")
              for k in range(workers)]
     try:
@@ -395,12 +397,14 @@ def _execute_processes(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], j
         done.close()
 
 
-_FORKED = None  # (run, tasks) of the sweep being forked, read by _process_worker in the children
+_FORKED = None  # (run, tasks, parent pid) of the sweep being forked, read by _process_worker in the children
 
 
 def _process_worker(todo, done) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle: it stops us
-    run, tasks = _FORKED
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # not the command line's handler: the parent's terminate() ends us
+    run, tasks, parent = _FORKED
+    _end_with_parent(parent)
     compiled = run.compiled.clone()  # work arrays of its own (the parent's are its own business)
     while (index := todo.get()) is not None:
         task, state = tasks[index]
@@ -410,6 +414,40 @@ def _process_worker(todo, done) -> None:
         except Exception as exc:  # the message is what the parent reports
             done.put(("error", str(exc)))
             return
+
+
+#: prctl's request for a signal when the parent ends (linux/prctl.h)
+_PR_SET_PDEATHSIG = 1
+
+
+def _end_with_parent(parent: int) -> None:
+    """Make this forked worker end when the sweep's process ``parent`` does, however it ends (``kill -9``
+    included): an orphan would compute on for nothing, holding the open files.
+
+    Where the kernel can do it (Linux), it does: at once, with nothing asked of the worker, whose thread
+    may be deep in a native loop. Elsewhere (macOS, the BSDs) a thread of the worker ends it when the
+    sentinel multiprocessing gives a forked child, a pipe whose write end the parent keeps, reads end of
+    file. (A sibling forked later inherits that write end too; it ends the same way, first.)"""
+    if _kernel_ends_orphans():
+        if os.getppid() != parent:  # it died before the request was made
+            os._exit(1)
+        return
+    sentinel = multiprocessing.parent_process().sentinel
+
+    def watch() -> None:
+        multiprocessing.connection.wait([sentinel])
+        os._exit(1)
+
+    threading.Thread(target=watch, name="gearsym-parent-watch", daemon=True).start()
+
+
+def _kernel_ends_orphans() -> bool:
+    """Ask the kernel to SIGKILL this process when the thread that forked it ends (Linux's
+    PR_SET_PDEATHSIG: here the thread running the sweep, which stops its workers before it returns);
+    False where it cannot."""
+    if not sys.platform.startswith("linux"):
+        return False
+    return ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0
 
 
 def _execute_dask(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], scheduler, workers: int, ran: dict):

@@ -18,6 +18,9 @@ import csv
 import fcntl
 import io
 import json
+import os
+import socket
+import time
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 
@@ -47,6 +50,7 @@ class SweepStore:
         self.key_columns = list(key_columns)  # the swept parameters, then "direction"
         self.record = record
         self._files: list = []
+        self._lock_fd: int | None = None
 
     # ------------------------------------------------------------ opening
     def open(self, overwrite: bool = False) -> tuple[dict[tuple, dict], dict[tuple, list[dict]]]:
@@ -123,25 +127,16 @@ class SweepStore:
         self._files = []
 
     def _lock(self) -> None:
-        """One writer per sweep file: a second process on the same --out would interleave rows.
-        An flock is released by the kernel when its process dies, so no stale lock survives a kill."""
+        """One writer per sweep file: a second process on the same --out would interleave rows."""
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        lock = open(self.path.with_name(self.path.name + ".lock"), "a+")
-        try:
-            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            lock.close()
-            raise GearsymError(f"another gearsym process is writing {self.path}; wait for it to finish "
-                               "(or stop it), or choose another --out") from None
-        self._lock_file = lock
+        self._lock_fd = take_lock(self.path)
 
     def release(self) -> None:
-        """Close the files and let another process have them."""
+        """Close the files, remove the lock file and let another process have the sweep."""
         self.close()
-        lock = getattr(self, "_lock_file", None)
-        if lock is not None:
-            lock.close()
-            self._lock_file = None
+        if self._lock_fd is not None:
+            release_lock(self.path, self._lock_fd)
+            self._lock_fd = None
 
     def finish(self, rows: Iterable[dict], strobe_rows: Iterable[dict]) -> None:
         """All points done: both tables rewritten in plan order (the lock is kept until ``release``)."""
@@ -194,6 +189,99 @@ def read_rows(path: Path, columns: list[str] | None = None) -> list[dict]:
                                "the file was edited or damaged: fix the row or pass --overwrite")
         rows.append(dict(zip(columns, fields)))
     return rows
+
+
+# ---------------------------------------------------------------- the writer's lock: FILE.csv.lock
+# An flock, which the kernel drops when the last descriptor of it closes: with its holder's death, so a lock
+# file whose holder is gone is simply taken over. Forked children inherit the descriptor and with it the lock
+# (sweep workers that outlived a killed parent kept it), so every fork closes it in the child. The file says
+# who holds it, for the message a second writer gets, and is removed when the sweep ends.
+_HELD_LOCKS: set[int] = set()  # descriptors of the locks this process holds
+
+
+def _close_inherited_locks() -> None:
+    for fd in _HELD_LOCKS:  # only this copy: the parent's lock stays (no LOCK_UN, which would drop it)
+        os.close(fd)
+    _HELD_LOCKS.clear()
+
+
+os.register_at_fork(after_in_child=_close_inherited_locks)
+
+
+def lock_path(path: Path) -> Path:
+    return path.with_name(path.name + ".lock")
+
+
+def take_lock(path: Path) -> int:
+    """Lock the sweep ``path`` against other writers (GearsymError naming the holder if one is alive);
+    returns the lock file's descriptor, for :func:`release_lock`."""
+    lock = lock_path(path)
+    while True:
+        fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            holder = _read_holder(fd)
+            os.close(fd)
+            raise GearsymError(_busy(path, holder)) from None
+        if _is_at(fd, lock):
+            break
+        os.close(fd)  # its holder removed the file as we locked it: lock the one now at the path
+    _HELD_LOCKS.add(fd)
+    holder = {"pid": os.getpid(), "host": socket.gethostname(), "started": time.strftime("%Y-%m-%d %H:%M:%S")}
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, (json.dumps(holder) + "\n").encode(), 0)
+    return fd
+
+
+def release_lock(path: Path, fd: int) -> None:
+    """Remove the lock file, while still holding it (whoever opened it meanwhile sees it gone), and unlock."""
+    lock = lock_path(path)
+    if _is_at(fd, lock):  # (not a file someone made after deleting ours)
+        lock.unlink(missing_ok=True)
+    _HELD_LOCKS.discard(fd)
+    os.close(fd)
+
+
+def _is_at(fd: int, path: Path) -> bool:
+    try:
+        return os.path.samestat(os.fstat(fd), os.stat(path))
+    except FileNotFoundError:
+        return False
+
+
+def _read_holder(fd: int) -> dict:
+    try:
+        holder = json.loads(os.pread(fd, 4096, 0))
+        return holder if isinstance(holder, dict) and isinstance(holder.get("pid"), int) else {}
+    except (OSError, ValueError):  # written by an older gearsym (empty), or not yet
+        return {}
+
+
+def _busy(path: Path, holder: dict) -> str:
+    """Who holds the lock of ``path``, as the one line a second writer gets."""
+    lock = lock_path(path)
+    find = f"`fuser -v {lock}` or `lsof {lock}` names it"
+    if not holder:
+        return f"another gearsym process is writing {path}; wait for it or stop it ({find}), or choose another --out"
+    pid, host = holder["pid"], holder.get("host")
+    here = host in (None, socket.gethostname())
+    if here and not _alive(pid):
+        return (f"{path} is locked by a process left behind by gearsym process {pid}, which has ended (a sweep "
+                f"worker of an older gearsym?): stop it ({find}), or choose another --out")
+    where = "" if here else f" on {host}"
+    return (f"{path} is being written by gearsym process {pid}{where} (started {holder.get('started', '?')}); "
+            f"wait for it or stop it{'' if where else f' (kill {pid})'}, or choose another --out")
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's
+        pass
+    return True
 
 
 def _short(value) -> str:

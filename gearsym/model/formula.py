@@ -1,0 +1,184 @@
+"""Reading a formula string into SymPy without running it as Python.
+
+SymPy's ``sympify``/``parse_expr`` evaluate their input, so a formula such as
+``__import__('os').system(...)`` would run. Here Python's ``ast`` only parses
+the text; the tree is then walked, every node checked against a short grammar,
+and the SymPy expression built node by node, so no string ever reaches SymPy.
+
+The grammar: numbers (``2``, ``0.5``, ``1e-3``), names (parameters, states, the
+time ``t``/``tau``/``phi``; ``pi`` is the constant), ``+ - * / **``, the
+comparisons ``< <= > >= == !=`` and ``True``/``False`` (for Piecewise
+conditions), and calls of the functions in :data:`FUNCTIONS` by plain name.
+``^`` is refused (in Python it is not a power). A name is a function only where
+it is called, so ``beta``, ``gamma``, ``E`` or ``I`` are parameters.
+"""
+from __future__ import annotations
+
+import ast
+import operator
+from collections.abc import Callable
+
+import sympy as sp
+
+from ..errors import ModelError
+
+#: functions a formula may call: those the code generator translates (``abs`` is Python's name of Abs)
+FUNCTIONS: dict[str, Callable] = {
+    "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "exp": sp.exp, "log": sp.log, "sqrt": sp.sqrt,
+    "sinh": sp.sinh, "cosh": sp.cosh, "tanh": sp.tanh, "asin": sp.asin, "acos": sp.acos, "atan": sp.atan,
+    "atan2": sp.atan2, "Abs": sp.Abs, "abs": sp.Abs, "sign": sp.sign, "floor": sp.floor, "ceiling": sp.ceiling,
+    "erf": sp.erf, "Min": sp.Min, "Max": sp.Max, "Heaviside": sp.Heaviside, "Piecewise": sp.Piecewise,
+    "And": sp.And, "Or": sp.Or, "Not": sp.Not,
+}
+GRAMMAR = ("a formula may use numbers, names of parameters and states, t, tau, phi, pi, + - * / **, "
+           f"comparisons, and the functions {', '.join(FUNCTIONS)}")
+MAX_LENGTH = 10_000
+MAX_DEPTH = 100
+#: an exact power a**b with more bits than this would take minutes and gigabytes to compute
+MAX_EXACT_BITS = 1_000_000
+
+_BINARY = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
+           ast.Pow: operator.pow}
+_COMPARE = {ast.Lt: operator.lt, ast.LtE: operator.le, ast.Gt: operator.gt, ast.GtE: operator.ge,
+            ast.Eq: sp.Eq, ast.NotEq: sp.Ne}
+_REFUSED_OPERATORS = {
+    ast.BitXor: "'^' (write powers as **)", ast.Mod: "'%'", ast.FloorDiv: "'//' (use floor(a/b))",
+    ast.MatMult: "'@'", ast.LShift: "'<<'", ast.RShift: "'>>'", ast.BitAnd: "'&' (use And(a, b))",
+    ast.BitOr: "'|' (use Or(a, b))", ast.Invert: "'~' (use Not(a))", ast.Not: "'not' (use Not(a))",
+    ast.And: "'and' (use And(a, b))", ast.Or: "'or' (use Or(a, b))",
+}
+_REFUSED_NODES = {
+    ast.Attribute: "attribute access (.)", ast.Subscript: "subscripts ([])", ast.Lambda: "lambda",
+    ast.Tuple: "a tuple (only a Piecewise takes (value, condition) pairs)", ast.List: "a list",
+    ast.Dict: "a dict", ast.Set: "a set", ast.ListComp: "a comprehension", ast.SetComp: "a comprehension",
+    ast.DictComp: "a comprehension", ast.GeneratorExp: "a comprehension", ast.JoinedStr: "an f-string",
+    ast.IfExp: "'if ... else' (use Piecewise)", ast.NamedExpr: "':='", ast.Starred: "'*' unpacking",
+}
+
+
+def parse_formula(text: str, where: str) -> sp.Basic:
+    """The SymPy expression of ``text``, with a plain ``Symbol`` for every name.
+
+    Anything outside the grammar raises a one-line :class:`ModelError` that
+    names ``where`` and what was refused.
+    """
+    return _Builder(text.strip(), where).build()
+
+
+class _Builder:
+    def __init__(self, text: str, where: str):
+        self.text, self.where = text, where
+        self.shown = repr(text if len(text) <= 60 else text[:57] + "...")
+
+    def refuse(self, what: str) -> ModelError:
+        return ModelError(f"the formula {self.shown} {what}; {GRAMMAR}", self.where)
+
+    def build(self) -> sp.Basic:
+        if not self.text:
+            raise ModelError("empty formula; give a number, a parameter name or a formula", self.where)
+        if len(self.text) > MAX_LENGTH:
+            raise self.refuse(f"has {len(self.text)} characters, more than the {MAX_LENGTH} a formula may have")
+        try:
+            tree = ast.parse(self.text, mode="eval")
+        except SyntaxError as exc:
+            if "nested parentheses" in str(exc):
+                raise self.refuse(f"is nested too deeply (more than {MAX_DEPTH} levels)") from None
+            raise self.refuse(f"is not a formula ({exc.msg})") from None
+        except (RecursionError, MemoryError):
+            raise self.refuse("is nested too deeply for Python's parser") from None
+        try:
+            return self.node(tree.body, 0)
+        except ModelError:
+            raise
+        except (TypeError, ValueError, ArithmeticError) as exc:  # SymPy refusing, e.g. sin(x, y) or (x < 1) + 1
+            raise self.refuse(f"cannot be built: {exc}") from None
+
+    def node(self, n: ast.AST, depth: int) -> sp.Basic:
+        if depth > MAX_DEPTH:
+            raise self.refuse(f"is nested too deeply (more than {MAX_DEPTH} levels)")
+        if isinstance(n, ast.Constant):
+            return self.constant(n)
+        if isinstance(n, ast.Name):
+            return self.name(n.id)
+        if isinstance(n, ast.BinOp) and type(n.op) in _BINARY:
+            return self.binary(n, depth)
+        if isinstance(n, ast.UnaryOp) and isinstance(n.op, (ast.UAdd, ast.USub)):
+            operand = self.node(n.operand, depth + 1)
+            return -operand if isinstance(n.op, ast.USub) else +operand
+        if isinstance(n, ast.Compare):
+            return self.compare(n, depth)
+        if isinstance(n, ast.Call):
+            return self.call(n, depth)
+        op = getattr(n, "op", None)
+        if type(op) in _REFUSED_OPERATORS:
+            raise self.refuse(f"uses the operator {_REFUSED_OPERATORS[type(op)]}, which is not allowed")
+        what = _REFUSED_NODES.get(type(n), type(n).__name__)
+        raise self.refuse(f"uses {what}, which is not allowed in a formula")
+
+    def constant(self, n: ast.Constant) -> sp.Basic:
+        value = n.value
+        if isinstance(value, bool):
+            return sp.true if value else sp.false
+        if isinstance(value, int):
+            return sp.Integer(value)
+        if isinstance(value, float):
+            # from the digits as written, as SymPy's parser did ('0.1' keeps the precision its digits give)
+            return sp.Float(ast.get_source_segment(self.text, n).replace("_", ""))
+        if isinstance(value, complex):
+            raise self.refuse("uses an imaginary number, which is not allowed")
+        raise self.refuse(f"uses the constant {value!r}; only numbers are allowed")
+
+    def name(self, name: str) -> sp.Basic:
+        if name.startswith("_"):
+            raise self.refuse(f"uses {name!r}; a name in a formula must not start with '_'")
+        return sp.pi if name == "pi" else sp.Symbol(name)
+
+    def binary(self, n: ast.BinOp, depth: int) -> sp.Basic:
+        if isinstance(n.op, ast.Pow):
+            return self.power(self.node(n.left, depth + 1), self.node(n.right, depth + 1))
+        # a+b+c+... nests to the left: walk that spine in a loop so that only real nesting counts as depth
+        spine = []
+        while isinstance(n, ast.BinOp) and type(n.op) in _BINARY and not isinstance(n.op, ast.Pow):
+            spine.append(n)
+            n = n.left
+        out = self.node(n, depth + 1)
+        for step in reversed(spine):
+            out = _BINARY[type(step.op)](out, self.node(step.right, depth + 1))
+        return out
+
+    def power(self, base: sp.Basic, exponent: sp.Basic) -> sp.Basic:
+        if isinstance(base, sp.Rational) and isinstance(exponent, sp.Rational):
+            bits = abs(exponent.p) * max(int(base.p).bit_length(), int(base.q).bit_length())
+            if bits > MAX_EXACT_BITS:
+                raise self.refuse(f"asks for a power of more than {MAX_EXACT_BITS} bits, too large to compute exactly")
+        return base**exponent
+
+    def compare(self, n: ast.Compare, depth: int) -> sp.Basic:
+        terms = [self.node(n.left, depth + 1)] + [self.node(c, depth + 1) for c in n.comparators]
+        parts = []
+        for op, left, right in zip(n.ops, terms, terms[1:]):
+            if type(op) not in _COMPARE:
+                raise self.refuse(f"uses the comparison {type(op).__name__}; use < <= > >= == !=")
+            parts.append(_COMPARE[type(op)](left, right))
+        return parts[0] if len(parts) == 1 else sp.And(*parts)  # 0 < x < 1 reads as in mathematics
+
+    def call(self, n: ast.Call, depth: int) -> sp.Basic:
+        if isinstance(n.func, ast.Attribute):
+            raise self.refuse(f"uses {_REFUSED_NODES[ast.Attribute]}, which is not allowed in a formula")
+        if not isinstance(n.func, ast.Name):
+            raise self.refuse("calls something other than a function by its name")
+        name = n.func.id
+        if name.startswith("_"):
+            raise self.refuse(f"calls {name!r}; a name in a formula must not start with '_'")
+        if name not in FUNCTIONS:
+            raise ModelError(f"unknown function {name}() in the formula {self.shown}; {GRAMMAR}", self.where)
+        if n.keywords:
+            raise self.refuse(f"gives {name}() a keyword argument; arguments are positional")
+        if name == "Piecewise":
+            return sp.Piecewise(*(self.pair(a, depth + 1) for a in n.args))
+        return FUNCTIONS[name](*(self.node(a, depth + 1) for a in n.args))
+
+    def pair(self, n: ast.AST, depth: int) -> tuple[sp.Basic, sp.Basic]:
+        if not (isinstance(n, ast.Tuple) and len(n.elts) == 2):
+            raise self.refuse("gives Piecewise an argument that is not a (value, condition) pair")
+        return self.node(n.elts[0], depth + 1), self.node(n.elts[1], depth + 1)
