@@ -376,55 +376,80 @@ def _crossing_steps(sym: _Symbols, split: SplitRHS, switching: _Switching, where
     rest of that step (like a plain step, first order there). The min/max of the observed states are
     taken after the step, as in the plain loops.
     """
-    n, m, nc = sym.y.numel(), len(split.tables), sym.ch.numel() - 1
-    y, T, ch = sym.y, sym.T, sym.ch
-    h = ch[nc]
-    f_of, J_of = _tabulated_rhs(sym, split, where)
-    ns = len(switching.surfaces)
-    sides = ca.SX.sym("side", ns)
-    frozen = {**sym.inner, **{d: sides[i] for i, d in enumerate(switching.sides)}}
-    fz = ca.vertcat(*to_casadi(switching.rhs, frozen, where))
-    fz_of = ca.Function("f_mode", [y, T, ch, sides], [fz])
-    Jz_of = ca.Function("J_mode", [y, T, ch, sides], [ca.jacobian(fz, y)])
-    s_expr = ca.vertcat(*to_casadi(switching.surfaces, sym.inner, where))
-    s_of = ca.Function("s", [y, T, ch], [s_expr])
-    ydot, Tdot = ca.SX.sym("ydot", n), ca.SX.sym("Tdot", m)
-    sdot_of = ca.Function("s_dot", [y, T, ch, ydot, Tdot],
-                          [ca.jtimes(s_expr, ca.vertcat(y, T), ca.vertcat(ydot, Tdot))])
+    step = _CrossingStep(sym, split, switching, where)
+    # with tangent vectors: try, then Switch(keep | split), emitted straight into the caller's MX graph
+    # (a Function around the two calls would copy its inputs once more at every step)
+    tangent_try, tangent_switch = step.switched("tangent", with_tangent=True)
 
-    col = ca.SX.sym("Ti", 3 * m)
-    Ta, Tb, Tc = col[:m], col[m:2 * m], col[2 * m:]
-    Q = ca.SX.sym("Q", n, n)
-    y1 = ca.SX.sym("y1", n)
-    Q1 = ca.SX.sym("Q1", n, n)
-    lo = ca.SX.sym("lo", len(sym.observed))
-    hi = ca.SX.sym("hi", len(sym.observed))
+    def tangent_block(yk, Qk, lk, hk, Tk, c):
+        y_try, Q_try, crossing = tangent_try(yk, Qk, Tk, c)
+        return tangent_switch(crossing, yk, Qk, lk, hk, y_try, Q_try, Tk, c)
 
+    # the state alone: the same stepping (orbit loops and trajectory)
+    state_try, state_switch = step.switched("state", with_tangent=False)
+
+    def state_block(yk, lk, hk, Tk, c):
+        y_try, crossing = state_try(yk, Tk, c)
+        return state_switch(crossing, yk, lk, hk, y_try, Tk, c)
+
+    return tangent_block, state_block, step.single(state_try)
+
+
+class _CrossingStep:
+    """The pieces of a crossing-located RK4 step (see :func:`_crossing_steps`): the frozen-mode right-hand
+    side and Jacobian, the surfaces and their rates, in the loop's symbols."""
+
+    def __init__(self, sym: _Symbols, split: SplitRHS, switching: _Switching, where: str):
+        n, m, nc = sym.y.numel(), len(split.tables), sym.ch.numel() - 1
+        self.sym, self.n, self.m, self.nc = sym, n, m, nc
+        y, T, ch = sym.y, sym.T, sym.ch
+        self.h = ch[nc]
+        self.f_of, self.J_of = _tabulated_rhs(sym, split, where)
+        self.surfaces = len(switching.surfaces)
+        sides = ca.SX.sym("side", self.surfaces)
+        frozen = {**sym.inner, **{d: sides[i] for i, d in enumerate(switching.sides)}}
+        fz = ca.vertcat(*to_casadi(switching.rhs, frozen, where))
+        self.fz_of = ca.Function("f_mode", [y, T, ch, sides], [fz])
+        self.Jz_of = ca.Function("J_mode", [y, T, ch, sides], [ca.jacobian(fz, y)])
+        s_expr = ca.vertcat(*to_casadi(switching.surfaces, sym.inner, where))
+        self.s_of = ca.Function("s", [y, T, ch], [s_expr])
+        ydot, Tdot = ca.SX.sym("ydot", n), ca.SX.sym("Tdot", m)
+        self.sdot_of = ca.Function("s_dot", [y, T, ch, ydot, Tdot],
+                                   [ca.jtimes(s_expr, ca.vertcat(y, T), ca.vertcat(ydot, Tdot))])
+        self.col = ca.SX.sym("Ti", 3 * m)
+        self.Ta, self.Tb, self.Tc = self.col[:m], self.col[m:2 * m], self.col[2 * m:]
+        self.Q = ca.SX.sym("Q", n, n)
+        self.y1 = ca.SX.sym("y1", n)
+        self.Q1 = ca.SX.sym("Q1", n, n)
+        self.lo = ca.SX.sym("lo", len(sym.observed))
+        self.hi = ca.SX.sym("hi", len(sym.observed))
+
+    @staticmethod
     def side(s):
         return s >= 0
 
-    def plain(with_tangent: bool):
-        yn, Qn = rk4_step(lambda x, Tx: f_of(x, Tx, ch), lambda x, Tx: J_of(x, Tx, ch), y,
-                      Q if with_tangent else None, h, Ta, Tb, Tc)
-        flag = ca.sum1(side(s_of(y, Ta, ch)) != side(s_of(yn, Tc, ch))) > 0
+    def plain(self, with_tangent: bool):
+        """The plain RK4 step, and whether some surface changed side over it."""
+        y, ch, Ta, Tc = self.sym.y, self.sym.ch, self.Ta, self.Tc
+        yn, Qn = rk4_step(lambda x, Tx: self.f_of(x, Tx, ch), lambda x, Tx: self.J_of(x, Tx, ch), y,
+                          self.Q if with_tangent else None, self.h, Ta, self.Tb, Tc)
+        flag = ca.sum1(self.side(self.s_of(y, Ta, ch)) != self.side(self.s_of(yn, Tc, ch))) > 0
         return yn, Qn, flag
 
-    def table_at(theta):  # the quadratic through Ta, Tb, Tc, at t + theta h
+    def table_at(self, theta):
+        """The quadratic through Ta, Tb, Tc, at t + theta h."""
+        Ta, Tb, Tc = self.Ta, self.Tb, self.Tc
         return Ta + theta * (4 * Tb - 3 * Ta - Tc) + theta * theta * (2 * Ta - 4 * Tb + 2 * Tc)
 
-    def split_step(with_tangent: bool):
-        def f_mode(mode):
-            return lambda x, Tx: fz_of(x, Tx, ch, mode)
-
-        def J_mode(mode):
-            return lambda x, Tx: Jz_of(x, Tx, ch, mode)
-
-        mode_a = side(s_of(y, Ta, ch))
-        y_ext, _ = rk4_step(f_mode(mode_a), None, y, None, h, Ta, Tb, Tc)
-        s0, s1 = s_of(y, Ta, ch), s_of(y_ext, Tc, ch)
-        d0 = sdot_of(y, Ta, ch, h * fz_of(y, Ta, ch, mode_a), 4 * Tb - 3 * Ta - Tc)
-        d1 = sdot_of(y_ext, Tc, ch, h * fz_of(y_ext, Tc, ch, mode_a), Ta - 4 * Tb + 3 * Tc)
-        crossed = side(s1) != mode_a
+    def crossing(self, mode_a):
+        """(theta, mode B): where in the step the earliest surface is crossed on the extension of mode A
+        (1: none), and the mode after it."""
+        y, ch, h, Ta, Tb, Tc = self.sym.y, self.sym.ch, self.h, self.Ta, self.Tb, self.Tc
+        y_ext, _ = rk4_step(lambda x, Tx: self.fz_of(x, Tx, ch, mode_a), None, y, None, h, Ta, Tb, Tc)
+        s0, s1 = self.s_of(y, Ta, ch), self.s_of(y_ext, Tc, ch)
+        d0 = self.sdot_of(y, Ta, ch, h * self.fz_of(y, Ta, ch, mode_a), 4 * Tb - 3 * Ta - Tc)
+        d1 = self.sdot_of(y_ext, Tc, ch, h * self.fz_of(y_ext, Tc, ch, mode_a), Ta - 4 * Tb + 3 * Tc)
+        crossed = self.side(s1) != mode_a
         theta = s0 / ca.if_else(crossed, s0 - s1, 1)  # the secant, then Newton on the cubic Hermite
         for _ in range(_NEWTON):
             t2 = theta * theta
@@ -434,54 +459,58 @@ def _crossing_steps(sym: _Symbols, split: SplitRHS, switching: _Switching, where
             theta = _clamp01(theta - p / ca.if_else(dp == 0, 1, dp))
         theta = ca.if_else(crossed, theta, 2)  # 2: not crossed in this step
         first = theta[0]
-        for i in range(1, ns):
+        for i in range(1, self.surfaces):
             first = ca.if_else(theta[i] < first, theta[i], first)
         flip = ca.logic_and(crossed, theta <= first)
-        mode_b = ca.if_else(flip, 1 - mode_a, mode_a)
-        first = ca.if_else(first > 1, 1, first)
-        Tm = table_at(first)
-        y_c, Q_c = rk4_step(f_mode(mode_a), J_mode(mode_a), y, Q if with_tangent else None, first * h,
-                        Ta, table_at(first / 2), Tm)
-        return rk4_step(f_mode(mode_b), J_mode(mode_b), y_c, Q_c, (1 - first) * h, Tm, table_at((1 + first) / 2), Tc)
+        return ca.if_else(first > 1, 1, first), ca.if_else(flip, 1 - mode_a, mode_a)
 
-    def extremes(yn):
-        obs = ca.vertcat(*[yn[j] for j in sym.observed])
-        return select_min(obs, lo), select_max(obs, hi)
+    def located(self, with_tangent: bool):
+        """RK4 of mode A up to the crossing, then of mode B over the rest of the step."""
+        y, ch, h, Ta, Tc = self.sym.y, self.sym.ch, self.h, self.Ta, self.Tc
 
-    # with tangent vectors: try, then Switch(keep | split), emitted straight into the caller's MX graph
-    # (a Function around the two calls would copy its inputs once more at every step)
-    yn, Qn, flag = plain(True)
-    tangent_try = ca.Function("tangent_try", [y, Q, col, ch], [yn, Qn, flag], _OPTS)
-    ys, Qs = split_step(True)
-    inputs = [y, Q, lo, hi, y1, Q1, col, ch]
-    keep = ca.Function("tangent_keep", inputs, [y1, Q1, *extremes(y1)], _OPTS)
-    cross = ca.Function("tangent_split", inputs, [ys, Qs, *extremes(ys)], _OPTS)
-    tangent_switch = ca.Function.if_else("tangent_switch", cross, keep)
+        def f_mode(mode):
+            return lambda x, Tx: self.fz_of(x, Tx, ch, mode)
 
-    def tangent_block(yk, Qk, lk, hk, Tk, c):
-        y_try, Q_try, crossing = tangent_try(yk, Qk, Tk, c)
-        return tangent_switch(crossing, yk, Qk, lk, hk, y_try, Q_try, Tk, c)
+        def J_mode(mode):
+            return lambda x, Tx: self.Jz_of(x, Tx, ch, mode)
 
-    # the state alone: the same stepping (orbit loops and trajectory)
-    yn, _, flag = plain(False)
-    state_try = ca.Function("state_try", [y, col, ch], [yn, flag], _OPTS)
-    ys, _ = split_step(False)
-    inputs = [y, lo, hi, y1, col, ch]
-    keep = ca.Function("state_keep", inputs, [y1, *extremes(y1)], _OPTS)
-    cross = ca.Function("state_split", inputs, [ys, *extremes(ys)], _OPTS)
-    state_switch = ca.Function.if_else("state_switch", cross, keep)
+        mode_a = self.side(self.s_of(y, Ta, ch))
+        first, mode_b = self.crossing(mode_a)
+        Tm = self.table_at(first)
+        y_c, Q_c = rk4_step(f_mode(mode_a), J_mode(mode_a), y, self.Q if with_tangent else None, first * h,
+                            Ta, self.table_at(first / 2), Tm)
+        return rk4_step(f_mode(mode_b), J_mode(mode_b), y_c, Q_c, (1 - first) * h, Tm, self.table_at((1 + first) / 2),
+                        Tc)
 
-    def state_block(yk, lk, hk, Tk, c):
-        y_try, crossing = state_try(yk, Tk, c)
-        return state_switch(crossing, yk, lk, hk, y_try, Tk, c)
+    def extremes(self, yn):
+        obs = ca.vertcat(*[yn[j] for j in self.sym.observed])
+        return select_min(obs, self.lo), select_max(obs, self.hi)
 
-    keep = ca.Function("step_keep", [y, y1, col, ch], [y1], _OPTS)
-    cross = ca.Function("step_split", [y, y1, col, ch], [ys], _OPTS)
-    step_switch = ca.Function.if_else("step_switch", cross, keep)
-    Ym, Ti, Cm = ca.MX.sym("y", n), ca.MX.sym("Ti", 3 * m), ca.MX.sym("c", nc + 1)
-    y_try, crossing = state_try(Ym, Ti, Cm)
-    state_step = ca.Function("state_step", [Ym, Ti, Cm], [step_switch(crossing, Ym, y_try, Ti, Cm)])
-    return tangent_block, state_block, state_step
+    def switched(self, kind: str, with_tangent: bool) -> tuple[ca.Function, ca.Function]:
+        """``{kind}_try`` (the plain step and its crossing flag) and ``{kind}_switch`` (keep the try, or
+        the located step), with or without tangent vectors."""
+        y, ch, col = self.sym.y, self.sym.ch, self.col
+        yn, Qn, flag = self.plain(with_tangent)
+        ys, Qs = self.located(with_tangent)
+        if with_tangent:
+            tried = ca.Function(f"{kind}_try", [y, self.Q, col, ch], [yn, Qn, flag], _OPTS)
+            inputs, kept, split = [y, self.Q, self.lo, self.hi, self.y1, self.Q1, col, ch], [self.y1, self.Q1], [ys, Qs]
+        else:
+            tried = ca.Function(f"{kind}_try", [y, col, ch], [yn, flag], _OPTS)
+            inputs, kept, split = [y, self.lo, self.hi, self.y1, col, ch], [self.y1], [ys]
+        keep = ca.Function(f"{kind}_keep", inputs, [*kept, *self.extremes(self.y1)], _OPTS)
+        cross = ca.Function(f"{kind}_split", inputs, [*split, *self.extremes(ys)], _OPTS)
+        return tried, ca.Function.if_else(f"{kind}_switch", cross, keep)
+
+    def single(self, state_try: ca.Function) -> ca.Function:
+        """One located step of the state (phase portraits), as an MX function."""
+        y, ch, col, n, m, nc = self.sym.y, self.sym.ch, self.col, self.n, self.m, self.nc
+        keep = ca.Function("step_keep", [y, self.y1, col, ch], [self.y1], _OPTS)
+        cross = ca.Function("step_split", [y, self.y1, col, ch], [self.located(False)[0]], _OPTS)
+        step_switch = ca.Function.if_else("step_switch", cross, keep)
+        Ym, Ti, Cm = ca.MX.sym("y", n), ca.MX.sym("Ti", 3 * m), ca.MX.sym("c", nc + 1)
+        y_try, crossing = state_try(Ym, Ti, Cm)
+        return ca.Function("state_step", [Ym, Ti, Cm], [step_switch(crossing, Ym, y_try, Ti, Cm)])
 
 
 _NEWTON = 4  # Newton iterations on the Hermite cubic from the secant (the error squares at each one)
