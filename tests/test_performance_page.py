@@ -66,6 +66,24 @@ def test_sum_rule_holds_for_every_tool(raw):
                 assert r["sum_rule"] < max(1e-6, 10 * r["accuracy"].get("rtol", 0.0)), r
 
 
+LIKE_FOR_LIKE = "gearsym (the paper's RK4) − hand-written C"
+
+
+def test_the_recorded_gearsym_rows_ran_the_c_programs_scheme(raw):
+    """The rows timed against the C are the same computation: the C's exponents to rounding, every model."""
+    rows = [v for v in summary.summarise(raw)["verdicts"] if v["what"].startswith(LIKE_FOR_LIKE)]
+    assert len(rows) == len(raw["models"]) and all(v["met"] for v in rows), rows
+
+
+def test_gearsym_rows_with_the_crossings_located_are_not_like_for_like_with_the_c(raw):
+    located = copy.deepcopy(raw)
+    for m in located["models"].values():
+        m["fixed"]["gearsym"] = m["fixed"]["gearsym (crossings located)"]
+    rows = [v for v in summary.summarise(located)["verdicts"] if v["what"].startswith(LIKE_FOR_LIKE)]
+    assert rows and not any(v["met"] for v in rows)
+    assert all(v["value"] > 1e-4 for v in rows)  # the plain scheme's error at the kinks, not rounding
+
+
 def _model(errors_by_setting: dict[str, float], gearsym_error: float) -> dict:
     """A synthetic record: one periodic point; gearsym and a C build at 200 steps, SciPy on a ladder."""
     ref = {"0.5": {"omega": 0.5, "reference": [0.0, -1.0], "converged": True}}

@@ -2,8 +2,8 @@
 
 Each module has ``make(model, accuracy=None, **params) -> Tool`` (see
 ``common.Tool``): ``c_yardstick`` (the hand-written C programs), ``numba_rk4``,
-``jitcode_lyap``, ``scipy_ivp``, and gearsym itself (``gearsym_tool``). ``python -m bench.peers.check`` checks
-that they agree.
+``jitcode_lyap``, ``scipy_ivp``, and gearsym itself (``gearsym_tool``, which also takes the ``scheme``: the
+paper's ``Integration.paper()`` or the crossings located). ``python -m bench.peers.check`` checks that they agree.
 """
 import importlib
 from types import ModuleType

@@ -12,7 +12,7 @@ import time
 
 import numpy as np
 
-from bench.peers.common import PointResult, check_periods, initial_state, model_params
+from bench.peers.common import PointResult, check_periods, fixed_step_accuracy, initial_state, model_params
 from bench.yardstick import runner
 
 # The fastest build found for both models (bench/README.md): on AVX-512 CPUs
@@ -28,11 +28,9 @@ class CYardstick:
     def __init__(self, model: str, accuracy: dict | None, flags: tuple[str, ...], cc: str,
                  variant: str, params: dict[str, float]):
         t0 = time.perf_counter()
-        if set(accuracy or {}) - {"steps"}:
-            raise ValueError(f"the C yardstick is fixed-step: accuracy takes only 'steps', got {accuracy}")
         self.model = model
         self.params = model_params(model, **params)
-        self.accuracy = {"steps": int((accuracy or {}).get("steps", 200))}
+        self.accuracy = fixed_step_accuracy(accuracy, "the C yardstick")
         self.flags, self.variant = tuple(flags), variant
         cached = runner.binary_path(cc, self.flags, model=model).exists()
         self.binary = runner.build(cc, self.flags, model=model)

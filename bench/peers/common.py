@@ -108,6 +108,13 @@ class Tool(Protocol):
     def sweep(self, omegas, y0=None, periods: int = 400, discard: int = 100) -> list[PointResult]: ...
 
 
+def fixed_step_accuracy(accuracy: dict | None, tool: str) -> dict:
+    """``{"steps": N}`` (default 200 steps per period) for a fixed-step tool; anything else is an error."""
+    if set(accuracy or {}) - {"steps"}:
+        raise ValueError(f"{tool} is fixed-step: accuracy takes only 'steps', got {accuracy}")
+    return {"steps": int((accuracy or {}).get("steps", 200))}
+
+
 def check_periods(periods: int, discard: int) -> None:
     if not 0 <= discard < periods:
         raise ValueError(f"need periods > discard >= 0, got periods={periods}, discard={discard}")

@@ -1,6 +1,15 @@
 """gearsym itself behind the peers' interface: the compiled model, built once, reused for every point.
 
-Two ways through gearsym are offered, because they differ in what the call does:
+The scheme is always named by the caller (``scheme=``, a :class:`gearsym.Integration`), because gearsym's
+default locates the backlash crossings and the hand-written C, Numba and the paper do not:
+
+* ``Integration.paper()``: the paper's plain RK4, the same numbers as the C yardstick to rounding (like for
+  like in every timing against it);
+* ``Integration(locate_crossings=True)``: RK4 steps that cross a backlash kink are split there, which
+  restores fourth order for the exponents (the plain scheme is first order at the kinks).
+
+``accuracy={"steps": N}`` sets the scheme's steps per period. Two ways through gearsym are offered, because
+they differ in what the call does:
 
 * ``path="loop"`` (default): the low-level call a sweep makes, ``prepare`` and
   ``tangent_run`` on the prebuilt :class:`~gearsym.codegen.CompiledModel`, the
@@ -8,40 +17,35 @@ Two ways through gearsym are offered, because they differ in what the call does:
 * ``path="lyapunov_spectrum"``: the high-level analysis on the same prebuilt
   model (sorted exponents, batch-means errors, history, amplitudes, regime),
   which is what ``gearsym sweep`` calls for every point.
-
-``crossings=True`` compiles the model with ``locate_crossings``: RK4 steps that
-cross a backlash kink are split there, which restores fourth order for the
-exponents (the plain scheme is first order at the kinks).
 """
 from __future__ import annotations
 
 import time
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 
-from .common import ContinuationSweep, PointResult, initial_state
+import gearsym
+from gearsym import Integration
+
+from .common import ContinuationSweep, PointResult, fixed_step_accuracy, initial_state
 
 PATHS = ("loop", "lyapunov_spectrum")
 
 
 class GearsymTool(ContinuationSweep):  # sweep: the shared continuation over spectrum()
-    def __init__(self, model: str, accuracy: dict | None = None, path: str = "loop", crossings: bool = False,
+    def __init__(self, model: str, accuracy: dict | None, *, scheme: Integration, path: str = "loop",
                  **params: float):
-        from gearsym.codegen import compile_model
-
         if path not in PATHS:
             raise ValueError(f"path must be one of {PATHS}, not {path!r}")
-        accuracy = dict(accuracy or {"steps": 200})
-        if set(accuracy) != {"steps"}:
-            raise ValueError(f"gearsym integrates with fixed steps: accuracy must be {{'steps': N}}, got {accuracy}")
-        self.model, self.path, self.accuracy = model, path, accuracy
+        self.model, self.path, self.accuracy = model, path, fixed_step_accuracy(accuracy, "gearsym")
         self.name = "gearsym" if path == "loop" else "gearsym (lyapunov_spectrum)"
-        if crossings:
+        if scheme.locate_crossings:
             self.name = "gearsym (crossings located)"
+        self.scheme = replace(scheme, steps_per_period=self.accuracy["steps"], backend="compiled")
         start = time.perf_counter()
-        extra = {"locate_crossings": True} if crossings else {}  # opt-in: RK4 steps split at the backlash kinks
-        self.compiled = compile_model(model, steps_per_period=int(accuracy["steps"]), backend="compiled", **extra)
+        self.compiled = gearsym.compile_model(gearsym.load(model), self.scheme)
         self.setup_seconds = time.perf_counter() - start
         self.setup_note = "compiled now" if "compile" in self.compiled.timings else "library from the cache"
         self.params = dict(params)
@@ -60,14 +64,13 @@ class GearsymTool(ContinuationSweep):  # sweep: the shared continuation over spe
             exponents = run.log_stretch[:, discard:].sum(axis=1) / ((periods - discard) * inputs.period)
             final = run.strobe[:, -1].copy()
         else:
-            from gearsym.analysis import lyapunov_spectrum
-
-            res = lyapunov_spectrum(self.compiled, periods=periods, discard=discard, y0=y, **self.params,
-                                    omega=omega)
+            res = gearsym.lyapunov_spectrum(self.compiled, options=self.scheme.run(periods, discard), y0=y,
+                                            **self.params, omega=omega)
             exponents = np.asarray(res.exponents)  # sorted: the analysis does not keep Gram-Schmidt order
             final = np.array([res.final_state[s] for s in self.compiled.state_names])
         return PointResult(exponents, final, time.perf_counter() - start)
 
 
-def make(model: str, accuracy: dict | None = None, crossings: bool = False, **params: float) -> GearsymTool:
-    return GearsymTool(model, accuracy, crossings=crossings, **params)
+def make(model: str, accuracy: dict | None = None, *, scheme: Integration, **params: float) -> GearsymTool:
+    """``scheme``: ``Integration.paper()`` (like the C) or ``Integration(locate_crossings=True)``; required."""
+    return GearsymTool(model, accuracy, scheme=scheme, **params)

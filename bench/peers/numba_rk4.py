@@ -16,7 +16,7 @@ import time
 import numpy as np
 from numba import njit
 
-from bench.peers.common import (ContinuationSweep, PointResult, Stopwatch, check_periods,
+from bench.peers.common import (ContinuationSweep, PointResult, Stopwatch, check_periods, fixed_step_accuracy,
                                 initial_state, model_params, shaft_constants)
 
 TWO_PI = 2.0 * math.pi
@@ -150,11 +150,9 @@ class NumbaRK4(ContinuationSweep):
 
     def __init__(self, model: str, accuracy: dict | None, params: dict[str, float]):
         t0 = time.perf_counter()
-        if set(accuracy or {}) - {"steps"}:
-            raise ValueError(f"Numba RK4 is fixed-step: accuracy takes only 'steps', got {accuracy}")
         self.model = model
         self.p = model_params(model, **params)
-        self.accuracy = {"steps": int((accuracy or {}).get("steps", 200))}
+        self.accuracy = fixed_step_accuracy(accuracy, "Numba RK4")
         self._point = _POINT[model]
         jitted = bool(self._point.signatures)
         self._run(1.0, initial_state(model, None), 2, 2, 1)  # triggers the JIT compile

@@ -1,9 +1,9 @@
 """Where the time per point goes, for the targets a run misses: cost per RK4 step and per point.
 
-* For gearsym and the fastest C build of each model: the time of a 1-period
-  point and of a 400-period point (interleaved, medians), giving the cost per
-  RK4 step (with its tangent vectors) and the fixed cost per point (tables,
-  constants, calls, exponents).
+* For gearsym (the paper's plain RK4, like the C) and the fastest C build of
+  each model: the time of a 1-period point and of a 400-period point
+  (interleaved, medians), giving the cost per RK4 step (with its tangent
+  vectors) and the fixed cost per point (tables, constants, calls, exponents).
 * The backlash as CasADi writes it: the one-stage C yardstick compiled with
   ``-DBACKLASH_SELECT``, which replaces its if/else for g and g' by the
   branch-free selects in gearsym's generated step, timed against the
@@ -25,11 +25,13 @@ def _median_seconds(tool, omega, periods, discard, repeats) -> float:
 def measure(models, c_flags: dict, periods: int = 400, omega: float = 1.5, repeats: int = 7,
             log: Callable[[str], None] = lambda s: print(s, file=sys.stderr, flush=True)) -> dict:
     """``c_flags[model]``: the flags of that model's fastest C build in this run."""
+    from gearsym import Integration
+
     from bench.peers import c_yardstick, gearsym_tool
 
     out: dict = {"omega": omega, "periods": periods, "steps_per_period": STEPS, "models": {}}
     for model in models:
-        tools = {"gearsym": gearsym_tool.make(model, {"steps": STEPS}),
+        tools = {"gearsym": gearsym_tool.make(model, {"steps": STEPS}, scheme=Integration.paper()),
                  "C": c_yardstick.make(model, {"steps": STEPS}, flags=tuple(c_flags[model]))}
         entry = {}
         for label, tool in tools.items():

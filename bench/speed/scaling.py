@@ -6,8 +6,9 @@ Workloads (flexible-shaft model, 400 periods, 100 discarded):
 * ``map``: a 2-D map omega = 0.1:2.0:0.02 x kS in {0, 0.05, 0.1, 1.0}, independent points;
 * ``lines``: the same map as four continuation lines (one task per kS).
 
-Each runs through :func:`gearsym.sweep.run_sweep` on a prebuilt compiled model
-(1 thread; every core as threads; every core as forked processes, the default),
+Each runs through :func:`gearsym.run_sweep` on a model compiled once with the scheme given (the paper's
+plain RK4 in ``python -m bench.speed``), on 1 thread, every core as threads and every core as forked
+processes (the default),
 interleaved over repetitions; the results of every configuration are compared
 with the single-thread run bit for bit (repr of every number in every row).
 The Dask cluster is started once, outside the timings; its start-up is reported.
@@ -19,6 +20,7 @@ import os
 import sys
 import time
 from collections.abc import Callable
+from dataclasses import replace
 
 WORKLOADS = {
     "independent": ({"omega": "0.1:2.0:0.01"}, "independent"),
@@ -32,15 +34,19 @@ def _rows(result) -> list[tuple]:
     return [tuple(repr(result.columns[n][i].item()) for n in names) for i in range(len(result))]
 
 
-def measure(compiled, periods: int, discard: int, repeats: int, dask: bool = True, workloads=None,
+def measure(model: str, scheme, repeats: int, dask: bool = True, workloads=None,
             log: Callable[[str], None] = lambda s: print(s, file=sys.stderr, flush=True)) -> dict:
-    from gearsym.sweep import run_sweep
+    """``scheme``: the :class:`gearsym.Integration` of every sweep (periods, discard, steps, crossings)."""
+    import gearsym
+    from gearsym import Workers
 
+    compiled = gearsym.compile_model(gearsym.load(model), replace(scheme, backend="compiled"))
     cores = os.cpu_count() or 1
-    configs: dict[str, dict] = {"1 thread": {"jobs": 1},
-                                f"{cores} threads": {"jobs": cores, "parallel": "threads"},
-                                f"{cores} processes": {"jobs": cores, "parallel": "processes"}}  # the default
-    out: dict = {"cores": cores, "periods": periods, "discard": discard, "workloads": {}}
+    configs: dict[str, Workers] = {"1 thread": Workers(jobs=1),
+                                   f"{cores} threads": Workers(jobs=cores, parallel="threads"),
+                                   f"{cores} processes": Workers(jobs=cores, parallel="processes")}  # the default
+    out: dict = {"cores": cores, "periods": scheme.periods, "discard": scheme.discard,
+                 "locate_crossings": scheme.locate_crossings, "workloads": {}}
     stack = contextlib.ExitStack()
     if dask:
         try:
@@ -50,7 +56,7 @@ def measure(compiled, periods: int, discard: int, repeats: int, dask: bool = Tru
             client = stack.enter_context(connect("local", cores))  # the cluster `gearsym sweep --dask` starts
             client.wait_for_workers(cores)
             out["dask_startup_seconds"] = time.perf_counter() - t
-            configs[f"Dask LocalCluster, {cores} workers"] = {"scheduler": client}
+            configs[f"Dask LocalCluster, {cores} workers"] = Workers(scheduler=client)
         except Exception as exc:  # the extra is optional: report why it is missing, keep the thread numbers
             out["dask"] = str(exc)
     try:
@@ -60,9 +66,9 @@ def measure(compiled, periods: int, discard: int, repeats: int, dask: bool = Tru
             entry = {"axes": axes, "mode": mode, "seconds": {c: [] for c in configs}, "identical": {}}
             baseline = None
             for rep in range(repeats + 1):  # repetition 0 warms up (and ships the library to the workers)
-                for label, kw in configs.items():
+                for label, workers in configs.items():
                     t = time.perf_counter()
-                    res = run_sweep(compiled, spec, mode=mode, periods=periods, discard=discard, progress=False, **kw)
+                    res = gearsym.run_sweep(compiled, spec, options=scheme, mode=mode, workers=workers, progress=False)
                     seconds = time.perf_counter() - t
                     rows = _rows(res)
                     if baseline is None:

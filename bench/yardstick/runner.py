@@ -48,10 +48,6 @@ MODELS: dict[str, ModelSpec] = {
 }
 DEFAULT_MODEL = "flexible_shaft"
 
-# Backwards compatible names (the flexible-shaft program was the only one).
-SOURCE = MODELS[DEFAULT_MODEL].source
-PARAMS = MODELS[DEFAULT_MODEL].params
-
 
 def _spec(model: str) -> ModelSpec:
     try:
