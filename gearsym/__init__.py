@@ -22,14 +22,15 @@ from typing import TYPE_CHECKING
 from .errors import GearsymError, ModelError, UnknownParameterError
 from .model import Disk, Drivetrain, Gear, Harmonic, Mesh, Shaft, Torque, rectangular_mesh_stiffness
 from .options import Integration
+# not lazy: gearsym.reduce is also a subpackage, and importing it (gearsym.load does) would bind the name
+# gearsym.reduce to the package, so that gearsym.reduce(drivetrain) called the module
+from .reduce import NondimensionalModel, reduce
 from .system import FirstOrderSystem
 
 __version__ = "0.1.0"
 
 #: public name -> the module that defines it (imported when the name is first used)
 _LAZY = {
-    "NondimensionalModel": "gearsym.reduce",
-    "reduce": "gearsym.reduce",
     "available_models": "gearsym.registry",
     "load": "gearsym.registry",
     "load_model": "gearsym.registry",
@@ -55,7 +56,8 @@ _LAZY = {
 
 __all__ = [
     "Disk", "Drivetrain", "FirstOrderSystem", "Gear", "GearsymError", "Harmonic", "Integration", "Mesh",
-    "ModelError", "Shaft", "Torque", "UnknownParameterError", "rectangular_mesh_stiffness", *_LAZY,
+    "ModelError", "NondimensionalModel", "Shaft", "Torque", "UnknownParameterError", "rectangular_mesh_stiffness",
+    "reduce", *_LAZY,
 ]
 
 
@@ -79,6 +81,5 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .data import load_measurements, simulate_measurements
     from .derivation import derive, render
     from .fit import EFFECTS, explain
-    from .reduce import NondimensionalModel, reduce
     from .registry import available_models, load, load_model
     from .sweep import SweepInterrupted, Workers, read_sweep, run_sweep

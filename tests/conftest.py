@@ -70,6 +70,27 @@ def reduced(name: str) -> gearsym.NondimensionalModel:
     return gearsym.reduce(load(name))
 
 
+def system(name: str, **values) -> gearsym.FirstOrderSystem:
+    """The engine's system of a shipped (or conftest) model, as ``gearsym.load(name, **values)`` gives it,
+    from the session's one reduction of the model."""
+    if not values:
+        return _default_system(name)
+    model = load(name)
+    return gearsym.load(reduced(name) if isinstance(model, gearsym.Drivetrain) else model, **values)
+
+
+@functools.cache
+def _default_system(name: str) -> gearsym.FirstOrderSystem:
+    model = load(name)
+    return gearsym.load(reduced(name) if isinstance(model, gearsym.Drivetrain) else model)
+
+
+@functools.cache
+def compiled(name: str, options: gearsym.Integration = gearsym.Integration()):
+    """The compiled model of ``name`` at its default values, with ``options`` (compiled once per session)."""
+    return gearsym.compile_model(system(name), options)
+
+
 def fresh_one_stage(name: str = "one_stage", resonant: bool = False) -> gearsym.Drivetrain:
     """A new, unshared one-stage drivetrain built by the shipped model's own builder."""
     load("one_stage")  # makes the ``models`` package importable and imports models.one_stage

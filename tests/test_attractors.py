@@ -16,11 +16,9 @@ import sys
 import numpy as np
 import pytest
 
-from gearsym import FirstOrderSystem, GearsymError
-from gearsym.analysis import lyapunov_spectrum
-from gearsym.analysis.attractors import cloud_distance, find_attractors, orbit_period, self_distance
+from gearsym import FirstOrderSystem, GearsymError, Integration, compile_model, find_attractors, lyapunov_spectrum
+from gearsym.analysis.attractors import cloud_distance, orbit_period, self_distance
 from gearsym.cli import poincare
-from gearsym.codegen import compile_model
 
 WELLS = {"x": (-2.0, 2.0), "v": (-1.0, 1.0)}
 
@@ -30,7 +28,12 @@ def duffing():
     system = FirstOrderSystem.from_equations(
         "two_well_duffing", ["x", "v"], ["v", "-d*v + x - x**3 + g*cos(w*t)"], {"d": 0.3, "g": 0.1, "w": 1.2},
         time="t", period="2*pi/w")
-    return compile_model(system, steps_per_period=100)
+    return compile_model(system, Integration(steps_per_period=100))
+
+
+def run(model, periods: int, discard: int) -> Integration:
+    """The model's scheme over ``periods`` forcing periods in all, the first ``discard`` left out."""
+    return model.integration.run(periods, discard)
 
 
 def side_of_each_run(found) -> list[int]:
@@ -45,7 +48,7 @@ def side_of_each_run(found) -> list[int]:
 
 # ------------------------------------------------------------------------------------------ grouping
 def test_weak_forcing_gives_one_period_one_orbit_per_well(duffing):
-    found = find_attractors(duffing, ics=12, seed=3, box=WELLS, periods=60, discard=150)
+    found = find_attractors(duffing, ics=12, seed=3, box=WELLS, options=run(duffing, 210, 150))
     assert len(found) == 2
     assert sorted(np.sign(a.centroid["x"]) for a in found) == [-1, 1]
     for a in found:
@@ -66,7 +69,7 @@ def test_weak_forcing_gives_one_period_one_orbit_per_well(duffing):
 def test_runs_on_one_chaotic_attractor_share_no_point_but_are_grouped(duffing, resolution):
     """With resolution 0 the self distance alone (the sampling's own resolution) must hold each attractor together."""
     more = {} if resolution is None else {"resolution": resolution}
-    found = find_attractors(duffing, ics=10, seed=1, box=WELLS, periods=300, discard=200, g=0.3, **more)
+    found = find_attractors(duffing, ics=10, seed=1, box=WELLS, options=run(duffing, 500, 200), g=0.3, **more)
     sides = side_of_each_run(found)
     assert set(sides) == {-1, 1}
     assert len(found) == 2
@@ -81,10 +84,11 @@ def test_runs_on_one_chaotic_attractor_share_no_point_but_are_grouped(duffing, r
 
 
 def test_a_period_two_orbit_reached_with_shifted_phase_is_one_attractor(duffing):
-    orbit = lyapunov_spectrum(duffing, periods=300, discard=260, y0={"x": 1.0}, g=0.28).strobe
+    orbit = lyapunov_spectrum(duffing, options=run(duffing, 300, 260), y0={"x": 1.0}, g=0.28).strobe
     step = lambda k: np.abs(orbit[:, k:] - orbit[:, :-k]).max()  # noqa: E731
     assert step(2) < 1e-8 < 1e-2 < step(1), "precondition: g=0.28 holds a period-2 orbit"
-    found = find_attractors(duffing, initial_states=[orbit[:, -1], orbit[:, -2]], periods=40, discard=10, g=0.28)
+    found = find_attractors(duffing, initial_states=[orbit[:, -1], orbit[:, -2]], options=run(duffing, 50, 10),
+                            g=0.28)
     one, two = (r.strobe for r in found.results)
     assert np.abs(one[:, 0] - two[:, 0]).max() > 1e-2  # the two runs are out of phase ...
     assert np.abs(one[:, 1:] - two[:, :-1]).max() < 1e-8  # ... by one period
@@ -94,9 +98,9 @@ def test_a_period_two_orbit_reached_with_shifted_phase_is_one_attractor(duffing)
 
 
 def test_the_same_seed_gives_the_same_runs_and_another_seed_other_starts(duffing):
-    a = find_attractors(duffing, ics=5, seed=7, box=WELLS, periods=20, discard=30)
-    b = find_attractors(duffing, ics=5, seed=7, box=WELLS, periods=20, discard=30)
-    c = find_attractors(duffing, ics=5, seed=8, box=WELLS, periods=20, discard=30)
+    a = find_attractors(duffing, ics=5, seed=7, box=WELLS, options=run(duffing, 50, 30))
+    b = find_attractors(duffing, ics=5, seed=7, box=WELLS, options=run(duffing, 50, 30))
+    c = find_attractors(duffing, ics=5, seed=8, box=WELLS, options=run(duffing, 50, 30))
     starts = lambda s: np.array([list(r.initial_state.values()) for r in s.results])  # noqa: E731
     assert np.array_equal(starts(a), starts(b)) and not np.allclose(starts(a), starts(c))
     assert np.array_equal(a.assignment, b.assignment)
@@ -136,20 +140,21 @@ def test_set_distances_ignore_order_and_see_a_missing_point():
     ({"initial_states": [[1.0, 2.0, 3.0]]}, "needs 2 values"),
     ({"initial_states": [{"q": 1.0}]}, "unknown states"),
     ({"periods": 0}, "periods"),
+    ({"periods": 5}, "discard=5.* must be shorter than the run"),
     ({"merge_factor": -1.0}, "merge_factor"),
     ({"gg": 0.2}, "Did you mean 'g'"),
 ])
 def test_bad_input_is_a_clear_error(duffing, kwargs, message):
     with pytest.raises(GearsymError, match=message):
-        find_attractors(duffing, periods=kwargs.pop("periods", 10), discard=5, **kwargs)
+        find_attractors(duffing, options=run(duffing, kwargs.pop("periods", 15), 5), **kwargs)
 
 
 # ------------------------------------------------------------------------------------------ figures
 def test_figures_are_written(duffing, tmp_path):
     from gearsym.figures.poincare import PhasePanel, phase_panel, plot_attractors, plot_phase_portraits
 
-    weak = find_attractors(duffing, ics=6, seed=3, box=WELLS, periods=30, discard=100)
-    strong = find_attractors(duffing, ics=6, seed=3, box=WELLS, periods=100, discard=100, g=0.3)
+    weak = find_attractors(duffing, ics=6, seed=3, box=WELLS, options=run(duffing, 130, 100))
+    strong = find_attractors(duffing, ics=6, seed=3, box=WELLS, options=run(duffing, 200, 100), g=0.3)
     out = tmp_path / "attractors.png"
     plot_attractors([[weak, strong], strong], out, labels=["g=0.1", "g=0.3"])
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and out.stat().st_size > 20_000
@@ -177,8 +182,8 @@ def test_an_attractor_is_drawn_by_its_regime_whatever_order_it_was_found_in(duff
         flipped = [dataclasses.replace(a, number=len(s.attractors) + 1 - a.number) for a in s.attractors]
         return dataclasses.replace(s, attractors=tuple(sorted(flipped, key=lambda a: a.number)))
 
-    weak = find_attractors(duffing, ics=6, seed=3, box=WELLS, periods=30, discard=100)  # two period-1 orbits
-    strong = find_attractors(duffing, ics=6, seed=3, box=WELLS, periods=60, discard=100, g=0.3)  # chaotic
+    weak = find_attractors(duffing, ics=6, seed=3, box=WELLS, options=run(duffing, 130, 100))  # two period-1 orbits
+    strong = find_attractors(duffing, ics=6, seed=3, box=WELLS, options=run(duffing, 160, 100), g=0.3)  # chaotic
     assert len(weak) == 2 and {a.regime for a in weak} == {"periodic"} and not strong.attractors[0].regular
     fig = plot_attractors([[weak, strong], [renumbered(weak), renumbered(strong)]])
 
@@ -218,7 +223,7 @@ def run_cli(capsys, *argv: str) -> tuple[int, str, str]:
     return code, out, err
 
 
-FAST = ("--set", "omega=1.6", "--ics", "3", "--periods", "30", "--discard", "40")
+FAST = ("--set", "omega=1.6", "--ics", "3", "--periods", "70", "--discard", "40")  # 30 measured periods
 
 
 def test_cli_json_partitions_the_initial_states(capsys):
@@ -251,7 +256,7 @@ def test_cli_plot_shows_the_coordinate_asked_for(capsys, tmp_path, monkeypatch):
     drawn = []
     real = figures.plot_attractors
     monkeypatch.setattr(figures, "plot_attractors", lambda *a, **k: drawn.append((a, real(*a, **k))) or drawn[-1][1])
-    code, _, _ = run_cli(capsys, "flexible_shaft", "--ics", "2", "--periods", "20", "--discard", "10",
+    code, _, _ = run_cli(capsys, "flexible_shaft", "--ics", "2", "--periods", "30", "--discard", "10",
                          "--plot", str(tmp_path / "p.png"), "--coordinate", "x2")
     assert code == 0
     (found, *_), fig = drawn[0]
@@ -277,5 +282,5 @@ def test_cli_refuses_an_unknown_coordinate_before_any_run(capsys, tmp_path, monk
     (["--set", "omgea=1.5"], "Did you mean 'omega'"),
 ])
 def test_cli_errors_are_one_line_messages(capsys, argv, message):
-    code, _, err = run_cli(capsys, "one_stage", "--periods", "10", "--discard", "5", *argv)
+    code, _, err = run_cli(capsys, "one_stage", "--periods", "15", "--discard", "5", *argv)
     assert code == 2 and message in err and "Traceback" not in err

@@ -12,8 +12,11 @@ from pathlib import Path
 
 import pytest
 
+import gearsym
 import gearsym.cli.compile
 import gearsym.cli.docs
+import gearsym.cli.explain
+import gearsym.cli.integration
 import gearsym.cli.lyap
 import gearsym.cli.poincare
 import gearsym.cli.simulate
@@ -21,9 +24,9 @@ import gearsym.cli.sweep
 import gearsym.codegen
 import gearsym.reproduce
 from gearsym.cli import main
-from gearsym.codegen import compile_model
+from conftest import compiled
 from gearsym.errors import GearsymError, GearsymWarning
-from gearsym.registry import REPO_ROOT
+from gearsym.paths import REPO_ROOT
 
 
 def run(capsys, *argv: str) -> tuple[int, str, str]:
@@ -38,11 +41,11 @@ def no_work(monkeypatch):
     def work(*args, **kwargs):
         raise AssertionError("the work started before the input was checked")
 
-    for module, name in ((gearsym.cli.lyap, "compile_model"), (gearsym.cli.poincare, "compile_model"),
-                         (gearsym.cli.simulate, "compile_model"), (gearsym.cli.sweep, "run_sweep"),
-                         (gearsym.codegen, "compile_model"), (gearsym.cli.simulate, "_with_effects"),
-                         (gearsym.cli.compile, "generate_model"), (gearsym.cli.docs, "page"),
-                         (sys.modules["gearsym.reproduce"], "reproduce")):
+    for module, name in ((gearsym.cli.integration, "system_from"), (gearsym.cli.explain, "system_from"),
+                         (gearsym.codegen, "compile_model"), (gearsym.cli.sweep, "run_sweep"),
+                         (gearsym.cli.simulate, "_with_effects"),
+                         (gearsym.cli.compile, "load"), (gearsym.cli.compile, "generate_model"),
+                         (gearsym.cli.docs, "page"), (sys.modules["gearsym.reproduce"], "reproduce")):
         monkeypatch.setattr(module, name, work)
 
 
@@ -136,7 +139,7 @@ def test_a_writable_output_leaves_nothing_behind_when_checked(tmp_path):
     (["lyap", "one_stage", "--periods", "5", "--discard", "0"], "5 measured periods"),
     (["sweep", "one_stage", "--param", "omega=1:1.2:0.1", "--out", "s.csv", "--periods", "105"],
      "5 measured periods"),
-    (["poincare", "one_stage", "--periods", "5"], "5 measured periods"),
+    (["poincare", "one_stage", "--periods", "305"], "5 measured periods"),  # --discard 300 by default
 ])
 def test_a_run_too_coarse_or_too_short_to_mean_anything_is_refused(capsys, no_work, tmp_path, monkeypatch, argv,
                                                                   message):
@@ -176,29 +179,25 @@ def test_simulating_an_effect_without_its_strength_is_refused(capsys, no_work, a
 
 
 def test_an_initial_state_that_leaves_out_a_state_says_it_starts_at_zero(capsys):
-    compiled = compile_model("one_stage")
+    model = compiled("one_stage")
     with pytest.warns(GearsymWarning, match=r"does not name v, so it starts at 0, not at the model's v=-0.5"):
-        assert list(compiled.initial_state({"x": 1.0})) == [1.0, 0.0]
+        assert list(model.initial_state({"x": 1.0})) == [1.0, 0.0]
     with warnings.catch_warnings():
         warnings.simplefilter("error", GearsymWarning)
-        compiled.initial_state({"x": 1.0, "v": 0.0})
+        model.initial_state({"x": 1.0, "v": 0.0})
     code, _, err = run(capsys, "lyap", "one_stage", "--y0", "x=1", "--periods", "60", "--discard", "10")
     assert code == 0 and "gearsym: warning: one_stage: the initial state does not name v" in err
 
 
 def test_fitting_a_parameter_the_records_set_differently_is_refused_before_fitting(tmp_path, monkeypatch):
-    from gearsym.data import load_measurements
-    from gearsym.data.simulate import simulate_measurements
-    from gearsym.fit import explain
-
-    compiled = compile_model("one_stage")
+    model = compiled("one_stage")
     path = tmp_path / "m.csv"
-    simulate_measurements(compiled, periods=4, discard=10, samples_per_period=20,
-                          records=[{"omega": 1.2}, {"omega": 1.6}], out=path)
-    measurements = load_measurements(path, compiled)
+    gearsym.simulate_measurements(model, options=model.integration.run(periods=14, discard=10), samples_per_period=20,
+                                  records=[{"omega": 1.2}, {"omega": 1.6}], out=path)
+    measurements = gearsym.load_measurements(path, model.system)
     monkeypatch.setattr(sys.modules["gearsym.fit.explain"], "fit_windows", lambda *a, **k: pytest.fail("fitted anyway"))
     with pytest.raises(GearsymError, match=r"cannot fit omega: the records set it to different values \(1.2, 1.6\)"):
-        explain(compiled.system, measurements, ["zeta", "omega"])
+        gearsym.explain(model.system, measurements, ["zeta", "omega"])
 
 
 # --------------------------------------------------------------------------- a closed stdout

@@ -1,7 +1,6 @@
 """The ``gearsym`` command line: list, derive, docs, and how errors are reported."""
 from __future__ import annotations
 
-import functools
 import json
 import os
 import subprocess
@@ -14,13 +13,20 @@ import gearsym.cli.docs
 from gearsym import available_models
 from gearsym.cli import COMMANDS, main
 from gearsym.derivation import derive
-from gearsym.registry import REPO_ROOT
+from gearsym.paths import REPO_ROOT
 
 
 @pytest.fixture(autouse=True, scope="module")
 def cached_derivations():
-    """The CLI derives (reduces) a model per call; reuse one derivation per model in this module."""
-    cached = functools.cache(derive)
+    """The CLI derives (reduces) a model per call; reuse one derivation per model in this module (the
+    declared models are shared objects, not hashable: keyed by identity, each kept alive by its entry)."""
+    derived = {}
+
+    def cached(model):
+        if id(model) not in derived:
+            derived[id(model)] = (model, derive(model))
+        return derived[id(model)][1]
+
     patch = pytest.MonkeyPatch()
     patch.setattr(gearsym.cli.derive, "derive", cached)
     patch.setattr(gearsym.cli.docs, "derive", cached)

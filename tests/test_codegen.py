@@ -10,15 +10,18 @@ import numpy as np
 import pytest
 import sympy as sp
 
+import gearsym
 import gearsym.codegen.build as build_module
 import gearsym.codegen.compiler as compiler
-from gearsym import FirstOrderSystem, GearsymError, ModelError, UnknownParameterError
+from conftest import system
+from gearsym import FirstOrderSystem, GearsymError, Integration, ModelError, UnknownParameterError, compile_model
 from gearsym.backlash import G, g, g_slope
-from gearsym.codegen import CompilerError, compile_model
+from gearsym.codegen import CompilerError
 from gearsym.codegen.generated import generate_model
 from gearsym.codegen.time_tables import split_rhs
 from gearsym.codegen.translate import to_casadi
-from gearsym.registry import REPO_ROOT, available_models, system_for
+from gearsym.paths import REPO_ROOT
+from gearsym.registry import available_models
 
 
 # ------------------------------------------------------------------ SymPy -> CasADi
@@ -49,22 +52,22 @@ def test_untranslatable_function_is_a_clear_error():
 
 # ------------------------------------------------------------------ tables and constants
 def test_split_puts_all_time_dependence_into_tables_and_parameters_into_constants():
-    system = system_for("flexible_shaft")
-    split = split_rhs(system)
-    states = set(system.states)
+    shaft = system("flexible_shaft")
+    split = split_rhs(shaft)
+    states = set(shaft.states)
     for f in split.rhs:
-        assert system.time not in f.free_symbols
+        assert shaft.time not in f.free_symbols
         assert all(s in states or s.name.startswith(("table_", "const_")) for s in f.free_symbols)
     # substituting the entries back gives the model's rhs exactly
     back = {sym: expr for sym, expr in split.tables + split.constants}
-    for f, original in zip(split.rhs, system.rhs):
+    for f, original in zip(split.rhs, shaft.rhs):
         assert sp.simplify(f.xreplace(back) - original) == 0
 
 
 def test_time_dependence_that_is_not_periodic_is_rejected():
     bad = FirstOrderSystem.from_equations("drift", ["x"], ["-x + t"], {}, time="t", period=1)
     with pytest.raises(ModelError, match="not periodic with the declared period"):
-        compile_model(bad, backend="in-process")
+        compile_model(bad, Integration(backend="in-process"))
 
 
 # ------------------------------------------------------------------ generated/ is what the models give
@@ -74,13 +77,13 @@ def test_committed_generated_code_is_regenerated_byte_for_byte(name):
     made_with = json.loads((REPO_ROOT / "generated" / name / "manifest.json").read_text())["casadi_version"]
     assert made_with == ca.__version__, (f"generated/ was made with CasADi {made_with}, this is {ca.__version__}: "
                                          "install the pinned version (pyproject.toml) or regenerate")
-    report = generate_model(name, REPO_ROOT / "generated", check=True)
+    report = generate_model(system(name), REPO_ROOT / "generated", check=True)  # the default: crossings located
     assert report.stale == [], f"stale: {report.stale}; run `gearsym compile --all` and commit generated/"
 
 
 def test_generated_code_does_not_depend_on_the_hash_seed(tmp_path):
-    script = ("import sys; from gearsym.codegen.generated import generate_model; "
-              "generate_model('one_stage', sys.argv[1], compile=False)")
+    script = ("import sys, gearsym; from gearsym.codegen.generated import generate_model; "
+              "generate_model(gearsym.load('one_stage'), sys.argv[1], compile=False)")
     for seed in ("1", "2"):
         env = {**os.environ, "PYTHONHASHSEED": seed}
         subprocess.run([sys.executable, "-c", script, str(tmp_path / seed)], check=True, env=env)
@@ -93,17 +96,24 @@ def test_manifest_records_hash_options_and_casadi_version():
     manifest = json.loads((REPO_ROOT / "generated" / "flexible_shaft" / "manifest.json").read_text())
     assert manifest["casadi_version"] == ca.__version__
     assert manifest["options"]["steps_per_period"] == 200
+    assert manifest["options"]["locate_crossings"] is True  # the default scheme is committed
     assert manifest["states"] == ["x1", "v1", "x2", "v2"]
     assert len(manifest["hash"]) == 64
     assert "omega" in manifest["parameters"] and "kS" in manifest["parameters"]
 
 
 # ------------------------------------------------------------------ compiled == in-process
-def test_compiled_and_in_process_agree():
-    compiled = compile_model("flexible_shaft", backend="compiled")
-    inproc = compile_model("flexible_shaft", backend="in-process")
+@pytest.mark.parametrize("scheme,points", [
+    (Integration.paper, ({"omega": 0.2}, {"omega": 1.7, "kS": 1.0})),
+    # located crossings: at omega=0.2 the two backends' rounding, through the located steps, parts by 1.2e-12
+    # in the log stretches after 60 periods; the periodic point keeps the 1e-12
+    (Integration, ({"omega": 1.7, "kS": 1.0},)),
+])
+def test_compiled_and_in_process_agree(scheme, points):
+    compiled = compile_model(system("flexible_shaft"), scheme(backend="compiled"))
+    inproc = compile_model(system("flexible_shaft"), scheme(backend="in-process"))
     assert compiled.backend == "compiled" and inproc.backend == "in-process"
-    for cm_pair_p in ({"omega": 0.2}, {"omega": 1.7, "kS": 1.0}):
+    for cm_pair_p in points:
         runs = []
         for cm in (compiled, inproc):
             inputs = cm.prepare(cm.parameter_vector(cm_pair_p))
@@ -118,7 +128,7 @@ def test_compiled_and_in_process_agree():
 
 
 def test_chunks_and_single_periods_give_the_same_run():
-    cm = compile_model("one_stage")
+    cm = compile_model(system("one_stage"))
     inputs = cm.prepare(cm.parameter_vector(omega=0.8))
     whole = cm.tangent_run(None, 53, inputs)  # one chunk of 50 and three single periods
     first = cm.tangent_run(None, 3, inputs)
@@ -130,26 +140,26 @@ def test_chunks_and_single_periods_give_the_same_run():
 
 # ------------------------------------------------------------------ parameters are inputs; cache
 def test_changing_parameters_never_rebuilds(monkeypatch):
-    cm = compile_model("one_stage")
+    cm = compile_model(system("one_stage"))
     calls = []
     monkeypatch.setattr(build_module, "build_functions", lambda *a, **k: calls.append(1))
     monkeypatch.setattr(build_module, "compile_library", lambda *a, **k: calls.append(1))
-    again = compile_model("one_stage", omega=0.7, zeta=0.05)
+    again = compile_model(system("one_stage").with_values(omega=0.7, zeta=0.05))
     assert calls == [] and again.functions is cm.functions
     assert again.parameter_vector()[list(again.parameter_names).index("omega")] == 0.7
 
 
 def test_library_cache_survives_a_new_process_and_misses_on_a_new_model(monkeypatch):
-    compile_model("lorenz")
+    compile_model(system("lorenz"))
     monkeypatch.setattr(build_module, "_LOADED", {})  # as in a fresh process
-    again = compile_model("lorenz")
+    again = compile_model(system("lorenz"))
     assert "compile" not in again.timings and again.library.is_file()
-    other = compile_model("lorenz", steps_per_period=100)
+    other = compile_model(system("lorenz"), Integration(steps_per_period=100))
     assert other.hash != again.hash and other.library != again.library
 
 
 def test_unknown_or_unphysical_parameter_values_are_rejected():
-    cm = compile_model("one_stage")
+    cm = compile_model(system("one_stage"))
     with pytest.raises(UnknownParameterError, match="Did you mean 'omega'"):
         cm.parameter_vector(omgea=1.0)
     with pytest.raises(ModelError, match="zeta"):
@@ -161,14 +171,13 @@ def test_without_a_compiler_auto_falls_back_and_compiled_explains(monkeypatch, c
     compiler.find_compiler.cache_clear()
     monkeypatch.setattr(build_module, "_WARNED", set())
     try:
-        cm = compile_model("lorenz", backend="auto", steps_per_period=100)
+        cm = compile_model(system("lorenz"), Integration(backend="auto", steps_per_period=100))
         assert cm.backend == "in-process"
         assert "no C compiler found" in capsys.readouterr().err
-        from gearsym.analysis import lyapunov_spectrum
-        assert lyapunov_spectrum(cm, periods=20, discard=5).sum == pytest.approx(-13.6667, abs=1e-3)
+        assert gearsym.lyapunov_spectrum(cm, options=cm.integration.run(20, 5)).sum == pytest.approx(-13.6667, abs=1e-3)
         monkeypatch.setattr(build_module, "_LOADED", {})
         with pytest.raises(CompilerError, match="apt install gcc"):
-            compile_model("lorenz", backend="compiled", steps_per_period=100)
+            compile_model(system("lorenz"), Integration(backend="compiled", steps_per_period=100))
     finally:
         compiler.find_compiler.cache_clear()
 
@@ -210,45 +219,45 @@ def _numpy_orbit(system, p, y0, t0, periods, steps):
 
 @pytest.mark.parametrize("backend", ["compiled", "in-process"])
 def test_piecewise_min_max_powers_and_time_conditions_survive_the_split(backend):
-    system = FirstOrderSystem.from_equations(
+    odd = FirstOrderSystem.from_equations(
         "odd", ["x", "v"],
         ["v", "-d*v - Piecewise((x**3, x > 0), (x, True)) + 0.1*Max(x, -1) + 0.01*Abs(x)**a "
               "+ F*cos(t) + Piecewise((0.3, sin(t) > 0), (0, True)) + Piecewise((-x, x > 2), (0.1*sin(2*t), True))"],
         {"d": 0.3, "a": 1.5, "F": 0.4}, time="t", period="2*pi", initial={"x": 0.5})
-    cm = compile_model(system, backend=backend, steps_per_period=100)
+    cm = compile_model(odd, Integration.paper(backend=backend, steps_per_period=100))  # the reference's plain RK4
     p = cm.parameter_vector(F=0.5)
     inputs = cm.prepare(p, t0=0.7)
     strobe, _, _ = cm.orbit_run([0.5, 0.1], 4, inputs)
-    reference = _numpy_orbit(system, p, [0.5, 0.1], 0.7, 4, 100)
+    reference = _numpy_orbit(odd, p, [0.5, 0.1], 0.7, 4, 100)
     assert strobe == pytest.approx(reference, abs=1e-9)
 
 
 def test_time_inside_a_function_of_the_state_is_explained():
-    system = FirstOrderSystem.from_equations("slip", ["x"], ["-x + sin(x - t)"], {}, time="t", period="2*pi")
+    slip = FirstOrderSystem.from_equations("slip", ["x"], ["-x + sin(x - t)"], {}, time="t", period="2*pi")
     with pytest.raises(ModelError, match="keep time out of functions of the state"):
-        compile_model(system, backend="in-process")
+        compile_model(slip, Integration(backend="in-process"))
 
 
 def test_periodicity_is_checked_at_the_values_of_each_run():
-    system = FirstOrderSystem.from_equations("forced", ["x"], ["-x + cos(w*t)"], {"w": 1.0}, time="t",
+    forced = FirstOrderSystem.from_equations("forced", ["x"], ["-x + cos(w*t)"], {"w": 1.0}, time="t",
                                              period="2*pi")
-    cm = compile_model(system)
+    cm = compile_model(forced)
     cm.prepare(cm.parameter_vector(w=2.0))  # still 2 pi periodic
     with pytest.raises(ModelError, match="not periodic .* at w=1.5"):
         cm.prepare(cm.parameter_vector(w=1.5))
 
 
 def test_generated_names_never_clash_with_user_names():
-    system = FirstOrderSystem.from_equations("clash", ["x"], ["-const_0*x + table_0*cos(t)"],
-                                             {"const_0": 0.5, "table_0": 1.0}, time="t", period="2*pi")
-    cm = compile_model(system, steps_per_period=50)
+    clash = FirstOrderSystem.from_equations("clash", ["x"], ["-const_0*x + table_0*cos(t)"],
+                                            {"const_0": 0.5, "table_0": 1.0}, time="t", period="2*pi")
+    cm = compile_model(clash, Integration(steps_per_period=50))
     r = cm.tangent_run([1.0], 3, cm.prepare())
     assert r.log_stretch.sum() / (3 * 2 * np.pi) == pytest.approx(-0.5, abs=1e-6)
 
 
 # ------------------------------------------------------------------ the native calls and their inputs
 def test_initial_state_may_be_any_array_view_and_Q0_is_not_changed():
-    cm = compile_model("flexible_shaft")
+    cm = compile_model(system("flexible_shaft"))
     inputs = cm.prepare(cm.parameter_vector(omega=0.8))
     y = np.array([-2.0, -0.5, 0.0, 0.0])
     base = cm.tangent_run(y, 7, inputs)
@@ -263,41 +272,40 @@ def test_initial_state_may_be_any_array_view_and_Q0_is_not_changed():
 
 
 def test_inputs_prepared_for_another_model_are_refused():
-    one, two = compile_model("one_stage"), compile_model("flexible_shaft")
+    one, two = compile_model(system("one_stage")), compile_model(system("flexible_shaft"))
     with pytest.raises(GearsymError, match="prepared by another model"):
         two.tangent_run(None, 2, one.prepare())
 
 
 def test_non_finite_values_and_formulas_on_a_built_model_are_refused():
-    cm = compile_model("one_stage")
+    cm = compile_model(system("one_stage"))
     with pytest.raises(GearsymError, match="finite"):
         cm.parameter_vector(B0=float("inf"))
     with pytest.raises(GearsymError, match="finite"):
         cm.initial_state([np.nan, 0.0])
-    with pytest.raises(GearsymError, match="compile_model"):
+    with pytest.raises(GearsymError, match=r"gearsym\.load\(model, k=\.\.\.\)"):
         cm.parameter_vector(k="1 + 0.3*cos(tau)")
     with pytest.raises(GearsymError, match="whole number"):
         cm.tangent_run(None, 2.5, cm.prepare())
 
 
 def test_a_diverging_orbit_names_the_period_and_the_values():
-    from gearsym.analysis import lyapunov_spectrum
     with pytest.raises(GearsymError, match=r"non-finite in period 1 \(sigma=1000"):
-        lyapunov_spectrum("lorenz", sigma=1000, periods=10, discard=2)
+        gearsym.lyapunov_spectrum(system("lorenz"), options=Integration(periods=10, discard=2), sigma=1000)
 
 
 def test_a_stiffness_formula_may_not_use_the_state():
     with pytest.raises(ModelError, match="uses the state"):
-        system_for("one_stage", k="1 + 0.1*x")
+        system("one_stage", k="1 + 0.1*x")
 
 
 def test_editing_the_code_generator_changes_the_hash(monkeypatch):
     import gearsym.codegen.generate as generate
     from gearsym.codegen import LoopOptions, code_hash
-    system = system_for("one_stage")
-    before = code_hash(system, LoopOptions())
+    one_stage = system("one_stage")
+    before = code_hash(one_stage, LoopOptions())
     monkeypatch.setattr(generate, "_generator_digest", lambda: "edited")
-    assert code_hash(system, LoopOptions()) != before
+    assert code_hash(one_stage, LoopOptions()) != before
 
 
 # ------------------------------------------------------------------ long periods: bounded code
@@ -306,7 +314,7 @@ def _period_run(options, monkeypatch=None, segment=None):
 
     if segment is not None:
         monkeypatch.setattr(functions, "SEGMENT_STEPS", segment)
-    mf = functions.build_functions(system_for("one_stage"), options)
+    mf = functions.build_functions(system("one_stage"), options)
     p = np.array([1.5, 0.08, 1.0, 4.0, 0.0, 10.0, 0.2])
     c, _ = mf.functions["constants"](p)
     table, _ = mf.functions["table"](0.0, p)
@@ -339,11 +347,11 @@ def test_generated_code_size_does_not_grow_with_the_steps_per_period(tmp_path):
     from gearsym.codegen.functions import LoopOptions, build_functions
     from gearsym.codegen.generate import code_hash, write_code
 
-    system = system_for("one_stage")
+    one_stage = system("one_stage")
     sizes = {}
     for steps in (200, 3200):
         options = LoopOptions(steps_per_period=steps)
-        write_code(build_functions(system, options), tmp_path / str(steps), code_hash(system, options))
+        write_code(build_functions(one_stage, options), tmp_path / str(steps), code_hash(one_stage, options))
         sizes[steps] = (tmp_path / str(steps) / "one_stage.c").stat().st_size
     # written out, 3200 steps were 16x the code (24 s of gcc); what still grows is data (the 2N+1 sample
     # times of the table function) and a few dozen segment calls

@@ -1,4 +1,4 @@
-"""Steps split at backlash crossings (``locate_crossings``): 4th order exponents, checked against DOP853.
+"""Steps split at backlash crossings (``locate_crossings``, the default): 4th order exponents, checked against DOP853.
 
 Plain RK4 with a fixed step is only first order for the exponents of the gear models: the slope of
 the backlash g jumps, so the variational equations have a discontinuous right-hand side and the
@@ -14,12 +14,13 @@ import pytest
 import sympy as sp
 from scipy.integrate import solve_ivp
 
-from gearsym import FirstOrderSystem, ModelError
+import gearsym
+from conftest import system
+from gearsym import FirstOrderSystem, Integration, ModelError, compile_model
 from gearsym.backlash import g
-from gearsym.codegen import compile_model
 from gearsym.codegen.functions import LoopOptions, build_functions
 from gearsym.codegen.generate import code_hash, write_code
-from gearsym.registry import REPO_ROOT, system_for
+from gearsym.paths import REPO_ROOT
 from gearsym.symbols import parameter_symbol
 
 PERIODS, DISCARD = 80, 30
@@ -29,7 +30,8 @@ REFERENCE_STEPS = 1600
 
 def exponents(model, steps: int, locate: bool, periods: int = PERIODS, discard: int = DISCARD,
               backend: str = "in-process", **values) -> np.ndarray:
-    cm = compile_model(model, steps_per_period=steps, locate_crossings=locate, backend=backend)
+    model = system(model) if isinstance(model, str) else model
+    cm = compile_model(model, Integration(steps_per_period=steps, locate_crossings=locate, backend=backend))
     inputs = cm.prepare(cm.parameter_vector(values))
     run = cm.tangent_run(None, periods, inputs)
     return np.sort(run.log_stretch[:, discard:].mean(axis=1) / inputs.period)[::-1]
@@ -56,9 +58,9 @@ def test_time_dependent_switching_surface_converges_at_fourth_order():
     t, x, v = sp.symbols("t x v", real=True)
     eta = parameter_symbol("eta")
     rhs = (v, -(1 + sp.Rational(3, 10) * sp.cos(t)) * g(x - sp.sin(t) / 2, eta) - v / 10 + 2 * sp.cos(t))
-    system = FirstOrderSystem("moving_kink", t, (x, v), rhs, {"eta": 1.0}, 2 * sp.pi, initial={"x": 0.3})
-    reference = exponents(system, 1600, True, periods=40, discard=20)
-    errs = [float(np.abs(exponents(system, n, True, periods=40, discard=20) - reference).max())
+    moving = FirstOrderSystem("moving_kink", t, (x, v), rhs, {"eta": 1.0}, 2 * sp.pi, initial={"x": 0.3})
+    reference = exponents(moving, 1600, True, periods=40, discard=20)
+    errs = [float(np.abs(exponents(moving, n, True, periods=40, discard=20) - reference).max())
             for n in (100, 200, 400)]
     assert all(a / b >= 8 for a, b in zip(errs, errs[1:])), errs
 
@@ -115,9 +117,18 @@ def test_sum_rule_holds_with_crossings_located(at_200_steps):
     assert abs(at_200_steps[True].sum() + 2 * ZETA / 1.5) < 1e-9  # trace of J = -2 zeta / omega
 
 
+def test_the_default_integration_locates_the_crossings(at_200_steps):
+    """gearsym.lyapunov_spectrum with no scheme asked for: DOP853's exponents, not the paper's plain RK4's."""
+    default = gearsym.lyapunov_spectrum(system("one_stage"), options=Integration(periods=60, discard=20),
+                                        omega=1.5).exponents
+    assert np.abs(default - dop853_exponents(1.5, 60, 20)).max() <= 1e-7
+    assert np.abs(default - at_200_steps[False]).max() >= 1e-4  # plain RK4 is 1e-3 off
+    assert Integration().locate_crossings and not Integration.paper().locate_crossings
+
+
 def test_compiled_and_in_process_agree_and_every_loop_steps_the_same_way():
-    compiled = compile_model("one_stage", locate_crossings=True, backend="auto")
-    in_process = compile_model("one_stage", locate_crossings=True, backend="in-process")
+    compiled = compile_model(system("one_stage"), Integration(locate_crossings=True, backend="auto"))
+    in_process = compile_model(system("one_stage"), Integration(locate_crossings=True, backend="in-process"))
     runs = []
     for cm in (compiled, in_process):
         inputs = cm.prepare(cm.parameter_vector(omega=1.5))
@@ -132,30 +143,32 @@ def test_compiled_and_in_process_agree_and_every_loop_steps_the_same_way():
     np.testing.assert_allclose(runs[0].strobe, runs[1].strobe, rtol=0, atol=1e-12)
 
 
-# ---------------------------------------------------------------- the option off, and what it does not handle
-def test_option_off_generates_the_committed_c_unchanged(tmp_path):
-    """locate_crossings=False (the default) adds nothing to the C: the loops are those of generated/."""
-    system = system_for("one_stage")
-    options = LoopOptions()
-    assert options == LoopOptions(locate_crossings=False)
-    fresh = write_code(build_functions(system, options), tmp_path, code_hash(system, options))
+# ---------------------------------------------------------------- default, paper scheme, what is not handled
+def test_the_default_options_generate_the_committed_c_and_the_paper_scheme_other_code(tmp_path):
+    """Integration() locates the crossings: its loops are those of generated/; Integration.paper() is other code."""
+    one_stage = system("one_stage")
+    options = LoopOptions.of(Integration())
+    assert options == LoopOptions(locate_crossings=True)
+    fresh = write_code(build_functions(one_stage, options), tmp_path, code_hash(one_stage, options))
     assert fresh.source.read_bytes() == (REPO_ROOT / "generated" / "one_stage" / "one_stage.c").read_bytes()
-    plain = compile_model("one_stage", backend="in-process")
-    assert plain.hash == compile_model("one_stage", locate_crossings=False, backend="in-process").hash
-    assert plain.options == options
+    default = compile_model(one_stage, Integration(backend="in-process"))
+    assert default.hash == compile_model(one_stage, Integration(locate_crossings=True, backend="in-process")).hash
+    assert default.options == options
+    plain = compile_model(one_stage, Integration.paper(backend="in-process"))
+    assert plain.hash != default.hash and plain.options == LoopOptions(locate_crossings=False)
 
 
 def test_split_runs_behind_a_real_branch_in_the_c(tmp_path):
-    system = system_for("one_stage")
+    one_stage = system("one_stage")
     options = LoopOptions(locate_crossings=True)
-    code = write_code(build_functions(system, options), tmp_path, code_hash(system, options))
+    code = write_code(build_functions(one_stage, options), tmp_path, code_hash(one_stage, options))
     text = code.source.read_text()
     switch = re.search(r"/\* tangent_switch:.*?\n}\n", text, re.S).group(0)
     assert re.search(r"\bif \(", switch) and "else" in switch
 
 
 def test_a_model_without_backlash_is_unchanged_and_other_switches_are_refused(tmp_path):
-    lorenz = system_for("lorenz")
+    lorenz = system("lorenz")
     texts = []
     for locate in (False, True):
         options = LoopOptions(locate_crossings=locate)

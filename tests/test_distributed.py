@@ -12,24 +12,25 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from gearsym.analysis import lyapunov_spectrum
+import conftest
+from conftest import interrupt_after
+from gearsym import Integration, ModelError, Workers, lyapunov_spectrum, read_sweep, run_sweep
 from gearsym.cli import main
-from gearsym.codegen import CompilerError, compile_model
+from gearsym.codegen import CompilerError
 from gearsym.codegen import compiler, portable
 from gearsym.codegen.portable import load_shipped, ship
 from gearsym.errors import GearsymError
-from gearsym.sweep import SweepInterrupted, read_sweep, run_sweep
+from gearsym.sweep import SweepInterrupted
 from gearsym.sweep import distributed as dsweep
-from conftest import interrupt_after
 
 distributed = pytest.importorskip("distributed")
 
-SHORT = dict(periods=60, discard=20, progress=False)
+SHORT = dict(options=Integration(periods=60, discard=20), progress=False)
 
 
 @pytest.fixture(scope="module")
 def one_stage():
-    return compile_model("one_stage")
+    return conftest.compiled("one_stage")
 
 
 @pytest.fixture(scope="module")
@@ -62,20 +63,22 @@ def test_a_cluster_sweep_equals_the_single_process_sweep_bit_for_bit(tmp_path, c
                                                                      model, axes, mode, direction):
     monkeypatch.setattr(dsweep, "POINTS_PER_TASK", 3)  # several chunks, and lines handed from task to task
     kw = dict(mode=mode, direction=direction, **SHORT)
-    run_sweep(model, axes, jobs=1, out=tmp_path / "one.csv", **kw)
-    result = run_sweep(model, axes, scheduler=cluster, out=tmp_path / "dask.csv", **kw)
+    system = conftest.system(model)
+    run_sweep(system, axes, workers=Workers(jobs=1), out=tmp_path / "one.csv", **kw)
+    result = run_sweep(system, axes, workers=Workers(scheduler=cluster), out=tmp_path / "dask.csv", **kw)
     _same_files(tmp_path / "one.csv", tmp_path / "dask.csv")
     assert len(result) == 10 * (2 if direction == "both" else 1)
     assert read_sweep(tmp_path / "dask.csv").record == read_sweep(tmp_path / "one.csv").record
     assert json.loads((tmp_path / "dask.json").read_text())["dask"]["workers"] == 2
-    library = compile_model(model).library  # the workers' cache holds the client's library, byte for byte
+    library = conftest.compiled(model).library  # the workers' cache holds the client's library, byte for byte
     assert (worker_cache / "lib" / library.name).read_bytes() == library.read_bytes()
 
 
 def test_the_in_process_backend_runs_on_workers_too(tmp_path, cluster):
-    kw = dict(mode="independent", backend="in-process", periods=20, discard=5, progress=False)
-    run_sweep("one_stage", ["omega=1.0,1.2,1.4"], jobs=1, out=tmp_path / "one.csv", **kw)
-    run_sweep("one_stage", ["omega=1.0,1.2,1.4"], scheduler=cluster, out=tmp_path / "dask.csv", **kw)
+    kw = dict(mode="independent", options=Integration(periods=20, discard=5, backend="in-process"), progress=False)
+    system = conftest.system("one_stage")
+    run_sweep(system, ["omega=1.0,1.2,1.4"], workers=Workers(jobs=1), out=tmp_path / "one.csv", **kw)
+    run_sweep(system, ["omega=1.0,1.2,1.4"], workers=Workers(scheduler=cluster), out=tmp_path / "dask.csv", **kw)
     _same_files(tmp_path / "one.csv", tmp_path / "dask.csv")
 
 
@@ -83,16 +86,16 @@ def test_interrupted_on_the_cluster_cancels_its_tasks_and_resumes_to_the_same_fi
                                                                                   monkeypatch):
     monkeypatch.setattr(dsweep, "POINTS_PER_TASK", 2)
     axes = ["omega=0.9:1.3:0.1", "B1=3.5,4"]
-    run_sweep(one_stage, axes, jobs=1, out=tmp_path / "whole.csv", **SHORT)
+    run_sweep(one_stage, axes, workers=Workers(jobs=1), out=tmp_path / "whole.csv", **SHORT)
     part = tmp_path / "part.csv"
     with pytest.raises(SweepInterrupted) as info:
-        run_sweep(one_stage, axes, scheduler=cluster, out=part, on_point=interrupt_after(3), **SHORT)
+        run_sweep(one_stage, axes, workers=Workers(scheduler=cluster), out=part, on_point=interrupt_after(3), **SHORT)
     assert len(part.read_text().splitlines()) - 1 == info.value.done >= 3
     deadline = time.monotonic() + 10
     while cluster.run_on_scheduler(lambda dask_scheduler: len(dask_scheduler.tasks)) and time.monotonic() < deadline:
         time.sleep(0.05)
     assert cluster.run_on_scheduler(lambda dask_scheduler: len(dask_scheduler.tasks)) == 0  # nothing left behind
-    run_sweep(one_stage, axes, scheduler=cluster, out=part, **SHORT)  # the client given is still usable
+    run_sweep(one_stage, axes, workers=Workers(scheduler=cluster), out=part, **SHORT)  # the client is still usable
     _same_files(tmp_path / "whole.csv", part)
 
 
@@ -108,9 +111,9 @@ def test_sweep_command_with_a_local_cluster(tmp_path, capsys):
 
 def test_an_error_on_a_worker_reaches_the_client_as_it_would_on_a_thread(tmp_path, cluster, one_stage):
     with pytest.raises(GearsymError, match=r"at omega=1e-08 \(independent\): one_stage: the solution became non-finite"):
-        run_sweep(one_stage, ["omega=1e-8,1.1,1.2"], mode="independent", scheduler=cluster, out=tmp_path / "s.csv",
-                  **SHORT)
-    run_sweep(one_stage, ["omega=1.1,1.2"], mode="independent", scheduler=cluster, **SHORT)  # the cluster goes on
+        run_sweep(one_stage, ["omega=1e-8,1.1,1.2"], mode="independent", workers=Workers(scheduler=cluster),
+                  out=tmp_path / "s.csv", **SHORT)
+    run_sweep(one_stage, ["omega=1.1,1.2"], mode="independent", workers=Workers(scheduler=cluster), **SHORT)  # goes on
 
 
 # ------------------------------------------------------------------ what a worker does with the shipped model
@@ -125,8 +128,11 @@ def test_a_worker_like_the_client_writes_the_shipped_bytes_and_needs_no_compiler
     model = load_shipped(shipped)
     assert model.library == tmp_path / "lib" / one_stage.library.name  # the name compile_library gives it
     assert model.library.read_bytes() == one_stage.library.read_bytes()
-    assert model.check is None and "compile" not in model.timings
-    a, b = (lyapunov_spectrum(m, periods=30, discard=10, omega=1.3) for m in (one_stage, model))
+    assert "compile" not in model.timings and model.integration == one_stage.integration
+    assert model.system.constraints == one_stage.system.constraints  # the parameter checks travel with the system
+    with pytest.raises(ModelError, match="zeta"):
+        model.parameter_vector(zeta=-0.1)
+    a, b = (lyapunov_spectrum(m, options=Integration(periods=30, discard=10), omega=1.3) for m in (one_stage, model))
     assert np.array_equal(a.exponents, b.exponents) and a.final_state == b.final_state
 
 
@@ -137,7 +143,7 @@ def test_a_worker_on_another_kind_of_machine_compiles_the_shipped_source(tmp_pat
     assert model.timings["compile"] > 0  # compiled here, from the C that travelled
     assert (tmp_path / "code" / f"one_stage-{one_stage.hash[:16]}" / "one_stage.c").read_bytes() == elsewhere.source
     assert model.library.parent == tmp_path / "lib" and model.library.read_bytes() != elsewhere.library
-    a, b = (lyapunov_spectrum(m, periods=30, discard=10, omega=1.3) for m in (one_stage, model))
+    a, b = (lyapunov_spectrum(m, options=Integration(periods=30, discard=10), omega=1.3) for m in (one_stage, model))
     assert np.array_equal(a.exponents, b.exponents)  # this machine's compiler and CPU: the same bits
 
 
@@ -168,7 +174,7 @@ def test_workers_keep_one_model_per_process_and_a_clone_per_thread(one_stage):
 def test_without_dask_the_error_names_the_extra(monkeypatch, capsys, tmp_path, one_stage):
     monkeypatch.setitem(sys.modules, "distributed", None)  # as if not installed
     with pytest.raises(GearsymError, match=r'needs the distributed extra: pip install "gearsym\[distributed\]"'):
-        run_sweep(one_stage, ["omega=1,1.1"], scheduler="local", **SHORT)
+        run_sweep(one_stage, ["omega=1,1.1"], workers=Workers(scheduler="local"), **SHORT)
     code = main(["sweep", "one_stage", "--param", "omega=1,1.1", "--dask", "--out", str(tmp_path / "s.csv")])
     assert code == 2 and 'pip install "gearsym[distributed]"' in capsys.readouterr().err
     assert not (tmp_path / "s.csv").exists()  # refused before any work
@@ -181,7 +187,7 @@ def test_an_unreachable_scheduler_is_named(monkeypatch, one_stage):
     monkeypatch.setattr(dsweep, "CONNECT_TIMEOUT", 0.5)
     with pytest.raises(GearsymError, match=rf"could not reach a Dask scheduler at tcp://127\.0\.0\.1:{port} "
                                            r"within 0\.5 s.*dask scheduler"):
-        run_sweep(one_stage, ["omega=1,1.1"], scheduler=f"tcp://127.0.0.1:{port}", **SHORT)
+        run_sweep(one_stage, ["omega=1,1.1"], workers=Workers(scheduler=f"tcp://127.0.0.1:{port}"), **SHORT)
 
 
 @pytest.mark.parametrize("scheduler, jobs, words", [
@@ -190,4 +196,4 @@ def test_an_unreachable_scheduler_is_named(monkeypatch, one_stage):
 ])
 def test_bad_scheduler_arguments_are_refused_before_any_work(one_stage, scheduler, jobs, words):
     with pytest.raises(GearsymError, match=words):
-        run_sweep(one_stage, ["omega=1,1.1"], scheduler=scheduler, jobs=jobs, **SHORT)
+        run_sweep(one_stage, ["omega=1,1.1"], workers=Workers(scheduler=scheduler, jobs=jobs), **SHORT)

@@ -28,6 +28,24 @@ def test_lyap_json_has_the_documented_keys(capsys):
     assert data["parameters"]["kS"] == 0.1 and data["periods"] == 200 and data["discard"] == 50
 
 
+def test_lyap_locates_the_crossings_unless_told_plain_as_the_python_api_does(capsys):
+    import gearsym
+    from conftest import system
+
+    argv = ("lyap", "one_stage", "--set", "omega=1.5", "--periods", "60", "--discard", "20")
+    for flags, options in (((), gearsym.Integration(periods=60, discard=20)),
+                           (("--locate-crossings",), gearsym.Integration(periods=60, discard=20)),  # the old flag
+                           (("--plain",), gearsym.Integration.paper(periods=60, discard=20))):
+        code, out, _ = run(capsys, *argv, *flags, "--format", "json")
+        assert code == 0
+        expected = gearsym.lyapunov_spectrum(system("one_stage"), options=options, omega=1.5)
+        assert json.loads(out)["exponents"] == list(expected.exponents), flags
+    code, out, _ = run(capsys, *argv, "--plain")
+    assert "200 RK4 steps/period, plain RK4" in out
+    code, out, _ = run(capsys, *argv)
+    assert "200 RK4 steps/period, crossings located" in out
+
+
 def test_lyap_accepts_a_new_stiffness_formula(capsys):
     code, out, _ = run(capsys, "lyap", "one_stage", "--set", "k=1+0.3*cos(tau)", "--set", "omega=0.5",
                        "--periods", "60", "--discard", "20", "--format", "json")

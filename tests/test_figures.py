@@ -11,9 +11,10 @@ from gearsym.figures.poincare import REGIME_MARKERS
 from gearsym.figures.sweep import plot_sweep
 from gearsym.reproduce import compute, paper_plan
 from gearsym.reproduce import figures as paper_figures
-from gearsym.sweep import run_sweep
+from conftest import system
+from gearsym import Integration, run_sweep
 
-SHORT = dict(periods=60, discard=20, progress=False)
+SHORT = dict(options=Integration(periods=60, discard=20), progress=False)
 
 
 @pytest.fixture(autouse=True)
@@ -25,7 +26,8 @@ def close_figures():
 # ------------------------------------------------------------------ gearsym sweep --plot
 @pytest.fixture(scope="module")
 def up_and_down():
-    return run_sweep("one_stage_resonant", ["omega=1.3:1.4:0.02"], direction="both", poincare=5, zeta=0.07, **SHORT)
+    return run_sweep(system("one_stage_resonant"), ["omega=1.3:1.4:0.02"], direction="both", poincare=5, zeta=0.07,
+                     **SHORT)
 
 
 def test_sweep_plot_legends_say_which_line_style_is_which_direction(up_and_down):
@@ -55,7 +57,7 @@ def test_sweep_plot_titles_carry_the_fixed_parameter_values(up_and_down):
 
 
 def test_2d_sweep_maps_name_their_axes_direction_and_fixed_values():
-    result = run_sweep("one_stage", ["omega=1.2,1.3", "B1=3.5,4"], **SHORT)
+    result = run_sweep(system("one_stage"), ["omega=1.2,1.3", "B1=3.5,4"], **SHORT)
     fig = plot_sweep(result)
     titles = [ax.get_title() for ax in fig.axes[:3]]  # (the colour bars come after the maps)
     assert all("over omega and B1 (up)" in t for t in titles)

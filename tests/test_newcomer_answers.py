@@ -13,11 +13,12 @@ import numpy as np
 import pytest
 
 import gearsym
-from gearsym import Disk, Drivetrain, FirstOrderSystem, Gear, Mesh, Shaft, Torque, reduce
-from gearsym.analysis import lyapunov_spectrum
+from gearsym import (Disk, Drivetrain, FirstOrderSystem, Gear, Integration, Mesh, Shaft, Torque, lyapunov_spectrum,
+                     reduce)
 from gearsym.cli import main
 from gearsym.errors import GearsymWarning, ModelError
-from gearsym.registry import REPO_ROOT, output_root
+from gearsym.paths import REPO_ROOT
+from gearsym.registry import output_root
 from gearsym.symbols import parameter_symbol
 
 LORENZ = (["x", "y", "z"], ["sigma*(y - x)", "x*(rho - z) - y", "x*y - beta*z"],
@@ -34,7 +35,7 @@ def run(capsys, *argv: str) -> tuple[int, str, str]:
 def test_lorenz_started_on_its_fixed_point_is_an_equilibrium_with_its_eigenvalues_not_chaos():
     lorenz = FirstOrderSystem.from_equations("lorenz_at_origin", *LORENZ)  # no initial: all states 0
     with pytest.warns(GearsymWarning, match=r"initial state \(x=0, y=0, z=0\) is a fixed point"):
-        r = lyapunov_spectrum(lorenz, periods=60, discard=10)
+        r = lyapunov_spectrum(lorenz, options=Integration(periods=60, discard=10))
     assert r.regime == "equilibrium" and r.at_rest
     # the exponents of the origin are its eigenvalues: -beta and (-(sigma+1) -+ sqrt((sigma-1)^2 + 4 sigma rho))/2
     root = np.sqrt(81 + 4 * 10 * 28)
@@ -50,7 +51,7 @@ def test_a_lorenz_run_that_leaves_the_fixed_point_is_still_chaotic_and_says_noth
     lorenz = FirstOrderSystem.from_equations("lorenz_at_origin", *LORENZ)
     with warnings.catch_warnings():
         warnings.simplefilter("error", GearsymWarning)
-        r = lyapunov_spectrum(lorenz, periods=60, discard=10, y0=[1e-6, 0.0, 0.0])
+        r = lyapunov_spectrum(lorenz, options=Integration(periods=60, discard=10), y0=[1e-6, 0.0, 0.0])
     assert r.regime == "chaotic" and not r.at_rest and r.as_dict()["equilibrium"] is None
 
 

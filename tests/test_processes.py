@@ -14,17 +14,18 @@ from pathlib import Path
 
 import pytest
 
+import conftest
 import gearsym.sweep.store as store
+from conftest import interrupt_after
+from gearsym import Integration, run_sweep
 from gearsym.cli import main
-from gearsym.codegen import compile_model
 from gearsym.errors import GearsymError
 from gearsym.files import write_atomically
-from gearsym.sweep import SweepInterrupted, run_sweep
+from gearsym.sweep import SweepInterrupted
 from gearsym.sweep.store import lock_path, release_lock, sidecar, take_lock
-from conftest import interrupt_after
 
 ROOT = Path(__file__).resolve().parents[1]
-SHORT = dict(periods=60, discard=20, progress=False)
+SHORT = dict(options=Integration(periods=60, discard=20), progress=False)
 #: two continuation lines of 41 points, one per worker process, about 1 s in all: time to kill it half-way
 SLOW = ["one_stage", "--param", "omega=0.8:1.2:0.01", "--param", "B1=3.5,4", "--periods", "1500", "--discard", "100",
         "--jobs", "2", "--parallel", "processes", "--quiet"]
@@ -39,7 +40,7 @@ needs_fork = pytest.mark.skipif("fork" not in multiprocessing.get_all_start_meth
 
 @pytest.fixture(scope="module")
 def one_stage():
-    return compile_model("one_stage")
+    return conftest.compiled("one_stage")
 
 
 def gearsym(*args: str, python: tuple[str, ...] = ("-m", "gearsym.cli"), **kwargs) -> subprocess.Popen:
@@ -232,7 +233,8 @@ def test_the_lock_file_is_removed_when_a_sweep_ends_in_any_way(tmp_path, one_sta
         run_sweep(one_stage, ["omega=1:1.3:0.1"], out=tmp_path / "i.csv", on_point=interrupt_after(1), **SHORT)
     assert not lock_path(tmp_path / "i.csv").exists()  # interrupted
     with pytest.raises(GearsymError, match="non-finite"):
-        run_sweep("lorenz", ["sigma=1000"], out=tmp_path / "f.csv", periods=10, discard=2, progress=False)
+        run_sweep(conftest.system("lorenz"), ["sigma=1000"], out=tmp_path / "f.csv",
+                  options=Integration(periods=10, discard=2), progress=False)
     assert not lock_path(tmp_path / "f.csv").exists()  # failed
 
 

@@ -13,7 +13,7 @@ import shlex
 import pytest
 
 from gearsym.cli import build_parser
-from gearsym.registry import REPO_ROOT
+from gearsym.paths import REPO_ROOT
 
 README = (REPO_ROOT / "README.md").read_text(encoding="utf-8")
 

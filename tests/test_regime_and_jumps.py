@@ -4,7 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gearsym.analysis import lyapunov_spectrum
+from conftest import compiled
+from gearsym import Integration, lyapunov_spectrum
 from gearsym.analysis.jumps import find_jumps, hysteresis_intervals
 from gearsym.analysis.regime import classify_regime
 
@@ -12,11 +13,11 @@ from gearsym.analysis.regime import classify_regime
 # ------------------------------------------------------------------ regimes
 @pytest.mark.parametrize("omega, regime", [(1.6, "periodic"), (1.2, "chaotic")])
 def test_known_gear_points(omega, regime):
-    assert lyapunov_spectrum("one_stage", omega=omega).regime == regime
+    assert lyapunov_spectrum(compiled("one_stage"), omega=omega).regime == regime  # the default run: 400 periods
 
 
 def test_lorenz_is_chaotic_once_the_flow_exponent_is_set_aside():
-    spectrum = lyapunov_spectrum("lorenz", periods=600, discard=100)
+    spectrum = lyapunov_spectrum(compiled("lorenz"), options=Integration(periods=600, discard=100))
     assert spectrum.autonomous and spectrum.regime == "chaotic"
 
 

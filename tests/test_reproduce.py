@@ -8,7 +8,7 @@ import re
 
 import pytest
 
-from gearsym.registry import REPO_ROOT
+from gearsym.paths import REPO_ROOT
 from gearsym.reproduce import claims as claim_checks
 from gearsym.reproduce import SCENARIOS, compute, paper_plan, render, reproduce
 from gearsym.reproduce.report import VERDICT_MARK

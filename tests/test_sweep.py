@@ -6,19 +6,20 @@ import json
 import numpy as np
 import pytest
 
-from gearsym.analysis import lyapunov_spectrum
-from gearsym.cli import main
-from gearsym.codegen import compile_model
-from gearsym.errors import GearsymError
-from gearsym.sweep import SweepInterrupted, parse_axis, read_sweep, run_sweep
+import conftest
 from conftest import interrupt_after
+from gearsym import Integration, Workers, lyapunov_spectrum, read_sweep, run_sweep
+from gearsym.cli import main
+from gearsym.errors import GearsymError
+from gearsym.sweep import SweepInterrupted, parse_axis
 
-SHORT = dict(periods=60, discard=20, progress=False)
+RUN = Integration(periods=60, discard=20)
+SHORT = dict(options=RUN, progress=False)
 
 
 @pytest.fixture(scope="module")
 def one_stage():
-    return compile_model("one_stage")
+    return conftest.compiled("one_stage")
 
 
 # ------------------------------------------------------------------ grid
@@ -44,7 +45,7 @@ def test_unknown_or_doubly_given_parameters_are_refused(one_stage):
     with pytest.raises(GearsymError, match="unknown parameter 'omgea'.*omega"):
         run_sweep(one_stage, ["omgea=1,2"], **SHORT)
     with pytest.raises(GearsymError, match="both swept"):
-        run_sweep("one_stage", ["omega=1,2"], omega=1.5, **SHORT)
+        run_sweep(one_stage, ["omega=1,2"], omega=1.5, **SHORT)
     with pytest.raises(GearsymError, match="must be positive|must not be negative"):
         run_sweep(one_stage, ["zeta=-1,0.1"], **SHORT)
 
@@ -54,17 +55,17 @@ def test_continuation_hands_the_final_state_on(one_stage):
     result = run_sweep(one_stage, {"omega": [1.0, 1.1, 1.2]}, **SHORT)
     state = None
     for i, w in enumerate((1.0, 1.1, 1.2)):
-        direct = lyapunov_spectrum(one_stage, periods=60, discard=20, y0=state, omega=w)
+        direct = lyapunov_spectrum(one_stage, options=RUN, y0=state, omega=w)
         assert result["lambda_1"][i] == direct.exponents[0] and result["A_x"][i] == direct.amplitude["x"]
         assert result["final_x"][i] == direct.final_state["x"]
         state = [direct.final_state["x"], direct.final_state["v"]]
-    from_default = lyapunov_spectrum(one_stage, periods=60, discard=20, omega=1.2)
+    from_default = lyapunov_spectrum(one_stage, options=RUN, omega=1.2)
     assert result["final_x"][2] != from_default.final_state["x"]  # it did not restart
 
 
 def test_independent_points_start_from_the_initial_state(one_stage):
     result = run_sweep(one_stage, {"omega": [1.0, 1.2]}, mode="independent", y0=[-1.0, 0.3], **SHORT)
-    direct = lyapunov_spectrum(one_stage, periods=60, discard=20, y0=[-1.0, 0.3], omega=1.2)
+    direct = lyapunov_spectrum(one_stage, options=RUN, y0=[-1.0, 0.3], omega=1.2)
     assert result["lambda_1"][1] == direct.exponents[0] and set(result["direction"]) == {"independent"}
 
 
@@ -73,13 +74,13 @@ def test_both_directions_go_up_then_back_down_from_where_up_ended(one_stage):
     assert result["direction"].tolist() == ["up"] * 3 + ["down"] * 3
     assert result["omega"].tolist() == [1.0, 1.1, 1.2, 1.2, 1.1, 1.0]
     top = [result["final_x"][2], result["final_v"][2]]
-    down = lyapunov_spectrum(one_stage, periods=60, discard=20, y0=top, omega=1.2)
+    down = lyapunov_spectrum(one_stage, options=RUN, y0=top, omega=1.2)
     assert result["final_x"][3] == down.final_state["x"]
 
 
 def test_regime_column_names_the_motion(one_stage):
-    result = run_sweep(one_stage, {"omega": [1.2, 1.6]}, mode="independent", periods=400, discard=100,
-                       progress=False)
+    result = run_sweep(one_stage, {"omega": [1.2, 1.6]}, mode="independent",
+                       options=Integration(periods=400, discard=100), progress=False)
     assert result["regime"].tolist() == ["chaotic", "periodic"]
 
 
@@ -87,20 +88,22 @@ def test_regime_column_names_the_motion(one_stage):
 @pytest.mark.parametrize("mode, jobs", [("continuation", 2), ("independent", 2), ("continuation", 1)])
 def test_an_interrupted_sweep_resumes_to_the_same_files(tmp_path, one_stage, mode, jobs):
     axes = ["omega=0.9:1.3:0.1", "B1=3.5,4"]
-    whole = run_sweep(one_stage, axes, mode=mode, jobs=jobs, out=tmp_path / "whole.csv", **SHORT)
+    whole = run_sweep(one_stage, axes, mode=mode, workers=Workers(jobs=jobs), out=tmp_path / "whole.csv", **SHORT)
     assert len(whole) == 10
     part = tmp_path / "part.csv"
     with pytest.raises(SweepInterrupted) as info:
-        run_sweep(one_stage, axes, mode=mode, jobs=jobs, out=part, on_point=interrupt_after(4), **SHORT)
+        run_sweep(one_stage, axes, mode=mode, workers=Workers(jobs=jobs), out=part, on_point=interrupt_after(4),
+                  **SHORT)
     assert info.value.done >= 4 and "run the same command again" in str(info.value)
     kept = part.read_text().splitlines()
     assert len(kept) - 1 == info.value.done  # every finished point is on disk
     part.write_text(part.read_text() + kept[-1][:10])  # as if killed while writing a row
-    resumed = run_sweep(one_stage, axes, mode=mode, jobs=jobs, out=part, **SHORT)
+    resumed = run_sweep(one_stage, axes, mode=mode, workers=Workers(jobs=jobs), out=part, **SHORT)
     assert part.read_bytes() == (tmp_path / "whole.csv").read_bytes()
     assert (tmp_path / "part.poincare.csv").read_bytes() == (tmp_path / "whole.poincare.csv").read_bytes()
     assert np.array_equal(resumed["lambda_1"], whole["lambda_1"])
-    again = run_sweep(one_stage, axes, mode=mode, jobs=jobs, out=part, on_point=interrupt_after(1), **SHORT)
+    again = run_sweep(one_stage, axes, mode=mode, workers=Workers(jobs=jobs), out=part, on_point=interrupt_after(1),
+                      **SHORT)
     assert len(again) == 10  # complete: nothing left to run, nothing recomputed
 
 
@@ -108,29 +111,30 @@ def test_an_interrupted_sweep_resumes_to_the_same_files(tmp_path, one_stage, mod
 def test_threads_and_processes_do_not_change_a_single_bit(tmp_path, one_stage, parallel):
     axes = ["omega=0.9:1.4:0.1", "B1=3.5,4"]
     for jobs in (1, 2):
-        run_sweep(one_stage, axes, mode="independent", jobs=jobs, out=tmp_path / f"j{jobs}.csv", parallel=parallel,
-                  **SHORT)
+        run_sweep(one_stage, axes, mode="independent", workers=Workers(jobs=jobs, parallel=parallel),
+                  out=tmp_path / f"j{jobs}.csv", **SHORT)
     for name in ("j{}.csv", "j{}.poincare.csv"):
         assert (tmp_path / name.format(1)).read_bytes() == (tmp_path / name.format(2)).read_bytes()
 
 
 def test_an_error_in_a_worker_process_names_the_point():
     with pytest.raises(GearsymError, match=r"at sigma=1000 \(independent\): .*non-finite"):  # the orbit diverges
-        run_sweep("lorenz", ["sigma=10,1000"], mode="independent", jobs=2, parallel="processes", periods=10,
-                  discard=2, progress=False)
+        run_sweep(conftest.system("lorenz"), ["sigma=10,1000"], mode="independent",
+                  workers=Workers(jobs=2, parallel="processes"), options=Integration(periods=10, discard=2),
+                  progress=False)
 
 
 def test_an_unknown_way_to_run_in_parallel_is_refused(one_stage):
     with pytest.raises(GearsymError, match="parallel='gpu'.*processes, threads"):
-        run_sweep(one_stage, ["omega=1.1,1.2"], parallel="gpu", **SHORT)
+        run_sweep(one_stage, ["omega=1.1,1.2"], workers=Workers(parallel="gpu"), **SHORT)
 
 
 def test_resuming_with_other_options_says_what_differs(tmp_path, one_stage):
     out = tmp_path / "s.csv"
     run_sweep(one_stage, ["omega=1,1.1"], out=out, **SHORT)
     with pytest.raises(GearsymError, match="different sweep.*periods: 60 before, 80 now.*--overwrite"):
-        run_sweep(one_stage, ["omega=1,1.1"], out=out, periods=80, discard=20, progress=False)
-    run_sweep(one_stage, ["omega=1,1.1"], out=out, periods=80, discard=20, progress=False, overwrite=True)
+        run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80), progress=False)
+    run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80), progress=False, overwrite=True)
     assert read_sweep(out).record["periods"] == 80
 
 
@@ -149,13 +153,13 @@ def test_a_damaged_sweep_file_is_named_with_its_row(tmp_path, one_stage):
 
 def test_the_table_has_the_documented_columns(tmp_path):
     out = tmp_path / "f.csv"
-    result = run_sweep("flexible_shaft", ["omega=1.4,1.5", "kS=0.1"], out=out, poincare=5, **SHORT)
+    result = run_sweep(conftest.system("flexible_shaft"), ["omega=1.4,1.5", "kS=0.1"], out=out, poincare=5, **SHORT)
     assert out.read_text().splitlines()[0] == (
         "omega,kS,direction,A_x1,A_x2,lambda_1,lambda_2,lambda_3,lambda_4,stderr_1,stderr_2,stderr_3,stderr_4,"
         "regime,final_x1,final_v1,final_x2,final_v2")
     assert len(result.strobe["x1"]) == 2 * 5
     record = read_sweep(out).record
-    assert record["parameters"]["kS"] == 0.1 and record["model_hash"] == compile_model("flexible_shaft").hash
+    assert record["parameters"]["kS"] == 0.1 and record["model_hash"] == conftest.compiled("flexible_shaft").hash
 
 
 def test_the_record_lists_the_jumps_and_hysteresis_found(tmp_path, one_stage):
@@ -174,8 +178,8 @@ def test_the_record_lists_the_jumps_and_hysteresis_found(tmp_path, one_stage):
 def test_continuation_lines_in_parallel_do_not_change_a_single_bit(tmp_path, one_stage, parallel):
     axes = ["omega=0.9:1.3:0.1", "B1=3.5,4"]
     for jobs in (1, 2):
-        run_sweep(one_stage, axes, direction="both", jobs=jobs, out=tmp_path / f"c{jobs}.csv", parallel=parallel,
-                  **SHORT)
+        run_sweep(one_stage, axes, direction="both", workers=Workers(jobs=jobs, parallel=parallel),
+                  out=tmp_path / f"c{jobs}.csv", **SHORT)
     assert (tmp_path / "c1.csv").read_bytes() == (tmp_path / "c2.csv").read_bytes()
 
 
@@ -202,7 +206,7 @@ def test_a_sweep_that_finished_no_point_starts_again_with_new_options(tmp_path, 
     with pytest.raises(SweepInterrupted):
         run_sweep(one_stage, ["omega=1,1.1"], out=out, on_point=interrupt_after(1), **SHORT)
     out.write_text(out.read_text().splitlines()[0] + "\n")  # as if stopped before the first point was written
-    result = run_sweep(one_stage, ["omega=1,1.1"], out=out, periods=80, discard=20, progress=False)
+    result = run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80), progress=False)
     assert len(result) == 2 and read_sweep(out).record["periods"] == 80
 
 

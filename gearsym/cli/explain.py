@@ -33,13 +33,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..fit import explain_files
+    from ..outputs import check_folder
 
     fit = [p.strip() for p in args.fit.split(",") if p.strip()]
     candidates = [e.strip() for e in args.effects.split(",")] if args.effects else None
     say = None if args.quiet else (lambda m: print(f"gearsym: {m}", file=sys.stderr, flush=True))
+    options = integration_from(args)
+    check_folder(args.out)  # before the model is reduced (seconds)
     report = explain_files(args.data, system_from(args), fit, out=args.out, time_scale=args.time_scale,
-                           held_out=args.held_out, candidates=candidates, progress=say,
-                           options=integration_from(args))
+                           held_out=args.held_out, candidates=candidates, progress=say, options=options)
     added = ", ".join(report["effects"]) or "none"
     print(f"effects added: {added}; held-out error {report['error_before']:.4g} -> {report['error_after']:.4g}; "
           f"unexplained: {'yes' if report['unexplained'] else 'no'}")

@@ -53,4 +53,5 @@ def compiled_from(args: argparse.Namespace, options: Integration | None = None, 
     """The compiled model of the command's MODEL with its --set values (or of ``system``)."""
     from ..codegen import compile_model
 
-    return compile_model(system or system_from(args), options or integration_from(args), verbose=True)
+    options = options or integration_from(args)  # checked before the model is reduced (seconds)
+    return compile_model(system or system_from(args), options, verbose=True)

@@ -62,10 +62,11 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         check_figure(args.plot)
     workers = Workers(args.jobs, args.parallel, "local" if args.dask else args.scheduler)
+    y0 = parse_state(args.y0)  # before the model is compiled
     compiled = compiled_from(args)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     try:
-        result = run_sweep(compiled, args.param, mode=args.mode, direction=args.direction, y0=parse_state(args.y0),
+        result = run_sweep(compiled, args.param, mode=args.mode, direction=args.direction, y0=y0,
                            out=args.out, overwrite=args.overwrite, poincare=args.poincare, workers=workers,
                            progress=not args.quiet)
     except KeyboardInterrupt as exc:  # SweepInterrupted says how many points were kept
