@@ -20,6 +20,8 @@ FEW_MEASURED_PERIODS = 50
 
 def whole_number(value, what: str, minimum: int = 0) -> int:
     """``value`` as an int (any integer type: int, numpy.int64, ...) of at least ``minimum``, or a clear error."""
+    if isinstance(value, bool):  # an int to Python, never meant as a count
+        raise GearsymError(f"{what} must be a whole number, got {value!r}")
     try:
         count = operator.index(value)
     except TypeError:

@@ -72,11 +72,6 @@ class Integration:
         return replace(self, periods=self.periods if periods is None else periods,
                        discard=self.discard if discard is None else discard)
 
-    def same_code(self, other: "Integration") -> bool:
-        """Whether ``other`` needs the same compiled code (steps, crossing location, backend)."""
-        return (self.steps_per_period, self.locate_crossings, self.backend) == \
-            (other.steps_per_period, other.locate_crossings, other.backend)
-
     def describe(self) -> str:
         """One line for reports: '400 periods (100 discarded), 200 RK4 steps/period, crossings located'."""
         scheme = "crossings located" if self.locate_crossings else "plain RK4 (the paper's scheme)"

@@ -9,14 +9,19 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from functools import cached_property
 
 import sympy as sp
 
 from .errors import GearsymError, ModelError, UnknownParameterError
 from .model.expressions import ExprLike, sign_violation, to_expr
+from .options import Integration
 from .symbols import parameter_symbol
+
+
+#: the fields of gearsym.Integration, which a caller of the old keywords may pass as parameter values
+_RUN_OPTIONS = tuple(f.name for f in fields(Integration))
 
 
 @dataclass(frozen=True)
@@ -80,6 +85,8 @@ class FirstOrderSystem:
     constraints: Mapping[str, Constraint] = field(default_factory=dict)
 
     def __post_init__(self):
+        if not isinstance(self.period, sp.Basic):  # a number (or a formula) given for the period
+            object.__setattr__(self, "period", to_expr(self.period, f"{self.name}: period"))
         if len(self.states) != len(self.rhs):
             raise ModelError(f"{len(self.states)} states but {len(self.rhs)} right-hand sides", self.name)
         if len({s.name for s in self.states}) != len(self.states):
@@ -148,6 +155,9 @@ class FirstOrderSystem:
         merged = dict(self.parameters)
         for name, value in (values or {}).items():
             if name not in merged:
+                if name in _RUN_OPTIONS:
+                    raise GearsymError(f"{name} is how to integrate, not a parameter of {self.name}: pass "
+                                       f"options=gearsym.Integration({name}=...)")
                 if isinstance(value, str):
                     raise GearsymError(
                         f"{self.name}: {name}={value!r} would change the model's equations; a system only takes "

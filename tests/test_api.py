@@ -101,7 +101,7 @@ def test_a_system_is_compiled_for_each_verbs_own_run_when_no_options_are_given()
         "weak_duffing", ["x", "v"], ["v", "-d*v + x - x**3 + F*cos(w*t)"], {"d": 0.3, "F": 0.1, "w": 1.2},
         time="t", period="2*pi/w", initial={"x": 1.0})
     found = gearsym.find_attractors(duffing, initial_states=[[1.0, 0.0]])
-    assert (found.periods, found.discard) == (200, 300)  # 500 periods in all, 300 of them a transient
+    assert (found.periods, found.discard, found.measured) == (500, 300, 200)  # 500 periods in all, 300 a transient
     table = gearsym.simulate_measurements(duffing, samples_per_period=25)
     assert table.rows == 40 * 25 + 1 and table.steps_per_period == 200  # 40 periods recorded after 100
     spectrum = gearsym.lyapunov_spectrum(duffing)
@@ -191,3 +191,8 @@ def test_the_fits_window_integrator_is_the_engines_rk4_bit_for_bit():
     assert engine["x"].min() < -1 and engine["x"].max() > 0  # through the whole gap: both kinks crossed
     window = simulate_segment(kinked, Segment(engine.time, {}, {}), engine.states[:, 0], period=1.0, options=scheme)
     assert np.array_equal(window, engine.states)
+
+
+def test_an_integration_option_passed_as_a_parameter_value_says_where_it_belongs():
+    with pytest.raises(gearsym.GearsymError, match=r"periods is how to integrate.*options=gearsym.Integration"):
+        gearsym.lyapunov_spectrum(system("one_stage"), periods=60)

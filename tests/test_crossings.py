@@ -177,5 +177,16 @@ def test_a_model_without_backlash_is_unchanged_and_other_switches_are_refused(tm
     assert texts[0] == texts[1]
     kinked = FirstOrderSystem.from_equations("abs_spring", ["x", "v"], ["v", "-Abs(x) - v/10 + cos(t)"], {},
                                              time="t", period="2*pi")
-    with pytest.raises(ModelError, match="locates the backlash g"):
+    with pytest.raises(ModelError, match=r"handles the backlash g.*Integration.paper\(\), --plain"):
         build_functions(kinked, LoopOptions(locate_crossings=True))
+
+
+def test_one_flank_of_the_backlash_is_located_on_the_backlash_surfaces():
+    """The data loop's coast-side stiffness adds c k min(g, 0): it switches where g does, so the default
+    scheme takes it (4th order) instead of refusing it."""
+    from gearsym.fit.effects import augment
+
+    coast = augment(system("one_stage"), ["coast_side_stiffness"], values={"c_coast": 0.5})
+    located = errors(coast, True, omega=1.8)
+    assert all(a / b >= 8 for a, b in zip(located, located[1:])), located
+    assert located[1] < 1e-8, located

@@ -156,7 +156,7 @@ class AttractorSet:
     state_names: tuple[str, ...]
     attractors: tuple[Attractor, ...]  # most members first, then by centroid
     results: tuple[InitialConditionResult, ...]  # one per initial state, in the order they were given
-    periods: int  # measured periods per run (after the transient)
+    periods: int  # forcing periods per run, the transient included (as everywhere)
     discard: int
     steps_per_period: int
     period: float
@@ -167,6 +167,11 @@ class AttractorSet:
 
     def __len__(self) -> int:
         return len(self.attractors)
+
+    @property
+    def measured(self) -> int:
+        """Periods each run measures, after its transient."""
+        return self.periods - self.discard
 
     def __iter__(self):
         return iter(self.attractors)
@@ -460,6 +465,6 @@ def _assemble(compiled, p, starts, spectra, groups, scale, periods, discard, see
     first = spectra[0]
     return AttractorSet(
         model=compiled.name, parameters=dict(zip(compiled.parameter_names, map(float, p))), state_names=names,
-        attractors=attractors, results=results, periods=periods, discard=discard,
+        attractors=attractors, results=results, periods=discard + periods, discard=discard,
         steps_per_period=compiled.steps_per_period, period=first.period, backend=compiled.backend, seed=seed,
         box=box, grouping=grouping)

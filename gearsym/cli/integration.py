@@ -54,4 +54,4 @@ def compiled_from(args: argparse.Namespace, options: Integration | None = None, 
     from ..codegen import compile_model
 
     options = options or integration_from(args)  # checked before the model is reduced (seconds)
-    return compile_model(system or system_from(args), options, verbose=True)
+    return compile_model(system or system_from(args), options, verbose=not getattr(args, "quiet", False))

@@ -77,7 +77,7 @@ def report(found: AttractorSet) -> str:
     box = ", ".join(f"{n} in [{lo:g}, {hi:g}]" for n, (lo, hi) in (found.box or {}).items())
     lines = [
         f"{found.model}: {len(found.results)} initial states ({box}, seed {found.seed}), "
-        f"{found.discard} periods discarded, {found.periods} measured, {found.steps_per_period} RK4 steps/period, "
+        f"{found.discard} periods discarded, {found.measured} measured, {found.steps_per_period} RK4 steps/period, "
         f"{found.backend}",
         "parameters: " + ", ".join(f"{k}={v:g}" for k, v in found.parameters.items()),
         f"{len(found)} attractor{'s' if len(found) != 1 else ''} ('1' regular, '2' chaotic, as the paper marks them):",

@@ -312,6 +312,16 @@ class _Switching:
 _OTHER_SWITCHES = (sp.Piecewise, sp.Heaviside, sp.Min, sp.Max, sp.Abs, sp.sign, sp.floor, sp.ceiling)
 
 
+def _flank_of_backlash(e: sp.Expr):
+    """The g(x, eta) of ``e`` if ``e`` is min(g, 0) (the coast flank: x + eta for x <= -eta) or max(g, 0)
+    (the drive flank: x for x >= 0), else None."""
+    if isinstance(e, (sp.Min, sp.Max)) and len(e.args) == 2 and sp.S.Zero in e.args:
+        inner = next(a for a in e.args if a != 0)
+        if isinstance(inner, g):
+            return inner
+    return None
+
+
 def _switching(system: FirstOrderSystem, split: SplitRHS) -> _Switching:
     """The backlash switching surfaces of ``split.rhs``, derived from the expressions, in a fixed order
     (SymPy's canonical argument order) so that the same model always gives the same C."""
@@ -336,10 +346,15 @@ def _switching(system: FirstOrderSystem, split: SplitRHS) -> _Switching:
             if isinstance(e, g_slope):
                 return on + off
             return on * x**2 / 2 + off * (x + eta) ** 2 / 2
+        flank = _flank_of_backlash(e)
+        if flank is not None:  # min(g, 0) or max(g, 0): one flank of g, switching on g's own surfaces
+            x, eta = flank.args
+            return side(x) * x if isinstance(e, sp.Max) else side(-(x + eta)) * (x + eta)
         if isinstance(e, _OTHER_SWITCHES) and e.free_symbols & states:
             raise ModelError(
-                f"locate_crossings locates the backlash g(x, eta) only; {e} switches on the state too and its "
-                "crossings would not be located (use the plain loops, locate_crossings=False)", system.name)
+                f"locating crossings handles the backlash g(x, eta) (and min/max(g, 0)) only; {e} switches on the "
+                "state too and its crossings would not be located: use the paper's plain scheme "
+                "(Integration.paper(), --plain)", system.name)
         if not e.args or isinstance(e, sp.Symbol):
             return e
         return e.func(*(freeze(a) for a in e.args))

@@ -216,7 +216,7 @@ def _caption(panels: Sequence[Sequence[AttractorSet]]) -> str:
     origin = f"seed {s.seed}" if s.seed is not None else "given initial states"
     regimes = {a.regime: None for panel in panels for s_ in panel for a in s_.attractors}
     marks = ", ".join(f"{MARKER_GLYPHS[REGIME_MARKERS.get(r, '.')]} {r}" for r in sorted(regimes, key=_regime_order))
-    return (f"{len(s.results)} initial states ({origin}), {s.periods} periods after {s.discard}; "
+    return (f"{len(s.results)} initial states ({origin}), {s.measured} periods after {s.discard}; "
             f"'1' regular, '2' chaotic; {marks}")
 
 
