@@ -26,8 +26,8 @@ from .options import Integration
 # gearsym.reduce to the package, so that gearsym.reduce(drivetrain) called the module
 from .reduce import NondimensionalModel, reduce
 from .system import FirstOrderSystem
+from .version import __version__
 
-__version__ = "0.1.0"
 
 #: public name -> the module that defines it (imported when the name is first used)
 _LAZY = {

@@ -22,7 +22,7 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from types import ModuleType
 
-from .. import __version__
+from ..version import __version__
 from ..errors import GearsymError, GearsymWarning
 from . import compile, derive, docs, explain, list_models, lyap, poincare, reproduce, simulate, sweep
 

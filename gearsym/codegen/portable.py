@@ -142,7 +142,7 @@ def _rebuild(shipped: ShippedModel, timings: dict) -> Path:
 
 
 def _versions() -> tuple[str, str]:
-    from .. import __version__
+    from ..version import __version__
 
     return __version__, ca.__version__
 

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
+from ..version import __version__
 from ..analysis.lyapunov import lyapunov_spectrum
 from ..checks import whole_number
 from ..codegen import CompiledModel, engine_verb
