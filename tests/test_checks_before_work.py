@@ -172,7 +172,7 @@ def test_the_command_line_prints_a_warning_as_one_line(capsys):
 @pytest.mark.parametrize("argv,needs", [
     (["--effect", "cubic_stiffness"], "--set k3=VALUE"),
     (["--effect", "cubic_stiffness", "--set", "k3=0"], "--set k3=VALUE"),
-    (["--effect", "mesh_stiffness_harmonic", "--set", "a_h=0"], "--set a_h=VALUE and/or --set b_h=VALUE"),
+    (["--effect", "mesh_stiffness_harmonic_2", "--set", "k_c2=0"], "--set k_c2=VALUE and/or --set k_s2=VALUE"),
 ])
 def test_simulating_an_effect_without_its_strength_is_refused(capsys, no_work, argv, needs):
     assert needs in error_line(capsys, "simulate", "one_stage", "--out", "m.csv", *argv)

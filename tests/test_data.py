@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+import sympy as sp
 
 import conftest
 from gearsym import Integration, load_measurements, phase_trajectory, simulate_measurements
@@ -207,6 +208,39 @@ def test_two_coordinates_and_a_partial_measurement(tmp_path):
     with pytest.raises(DataError, match="Did you mean 'x.' or 'x.'") as caught:
         load_measurements(write_csv(tmp_path / "x.csv", "tau,x", samples(3)), flexible)
     assert caught.value.column == "x"
+
+
+def test_derivative_channels_are_per_unit_of_the_files_time(one_stage, tmp_path):
+    """A t file's derivatives are per unit t: with tau = s t the model's output is scaled, s dx/dtau and
+    s^2 d2x/dtau2; a tau file's are per unit tau."""
+    from gearsym.data.measurements import channel_expression
+
+    system = one_stage.system
+    x, v = system.states
+    s = 250.0
+    rows = [[repr(float(t) / s), x_, x_] for t, x_ in samples(3)]
+    record = load_measurements(write_csv(tmp_path / "t.csv", "t,x_dot,x_ddot", rows), system, time_scale=s)[0]
+    assert set(record.observed) == {"x_dot", "x_ddot"}
+    assert channel_expression(record.channels["x_dot"], system) == s * v
+    assert channel_expression(record.channels["x_ddot"], system) == s**2 * system.rhs[1]
+    own = load_measurements(write_csv(tmp_path / "tau.csv", "tau,x_ddot", samples(3)), system)[0]
+    assert channel_expression(own.channels["x_ddot"], system) == system.rhs[1]
+
+
+def test_a_declared_combination_is_a_channel(tmp_path):
+    from gearsym.data.measurements import channel_expression
+
+    flexible = conftest.system("flexible_shaft")
+    path = write_csv(tmp_path / "acc.csv", "tau,acc", samples(3))
+    data = load_measurements(path, flexible, channels={"acc": "r1*x1_ddot + 0.5*x2"})
+    expr = channel_expression(data[0].channels["acc"], flexible)
+    assert sp.simplify(expr - (sp.Symbol("r1", real=True) * flexible.rhs[1] + 0.5 * flexible.states[2])) == 0
+    with pytest.raises(GearsymError, match="channel acc: unknown name x3_ddot"):
+        load_measurements(path, flexible, channels={"acc": "x3_ddot"})
+    with pytest.raises(GearsymError, match="channel other is declared but no file has a column other"):
+        load_measurements(path, flexible, channels={"acc": "x1", "other": "x2"})
+    with pytest.raises(DataError, match="unknown column.*x_ddot"):
+        load_measurements(write_csv(tmp_path / "b.csv", "tau,x1_dddot", samples(3)), flexible)
 
 
 # --------------------------------------------------------------------------- bad files

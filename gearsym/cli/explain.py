@@ -25,7 +25,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--held-out", type=float, default=0.25,
                         help="fraction of each record (its last whole periods) held out for judging (default 0.25)")
     parser.add_argument("--effects", default=None, metavar="NAME,NAME",
-                        help="candidate effects (default: the whole library)")
+                        help="candidate effects (default: the whole library); a harmonic family's bare name "
+                             "(torque_harmonic) stands for its orders 1 ... --harmonics, or name one (torque_harmonic_2)")
+    parser.add_argument("--harmonics", type=int, default=None, metavar="N",
+                        help="highest order of the harmonic families and of the proposals' harmonics (default 4)")
+    parser.add_argument("--channel", action="append", default=[], metavar="NAME=FORMULA",
+                        help="a column that measures a combination, e.g. acc=x1_ddot+0.5*x2_ddot (states, their "
+                             "derivatives x_dot and x_ddot, the time and parameters)")
+    parser.add_argument("--bias", default="", metavar="CHANNEL,CHANNEL",
+                        help="channels with an unknown constant offset fitted with the parameters (an "
+                             "accelerometer's: --bias x_ddot)")
+    parser.add_argument("--add-term", action="append", default=[], metavar="EXPR",
+                        help="a term c*EXPR added to dv/dtau of the mesh coordinate, tried as an effect (a proposal "
+                             "of report.json, or your own; g is the mesh's g(x, eta)); repeat for several")
     add_integration_arguments(parser, periods=None, steps_help="RK4 steps per forcing period between the samples "
                                                                "(default 200; the fit's windows are plain RK4)")
     parser.add_argument("--quiet", action="store_true")
@@ -37,13 +49,28 @@ def run(args: argparse.Namespace) -> int:
 
     fit = [p.strip() for p in args.fit.split(",") if p.strip()]
     candidates = [e.strip() for e in args.effects.split(",")] if args.effects else None
+    bias = [c.strip() for c in args.bias.split(",") if c.strip()]
+    channels = dict(_channel(text) for text in args.channel)
     say = None if args.quiet else (lambda m: print(f"gearsym: {m}", file=sys.stderr, flush=True))
     options = integration_from(args)
     check_folder(args.out)  # before the model is reduced (seconds)
     report = explain_files(args.data, system_from(args), fit, out=args.out, time_scale=args.time_scale,
-                           held_out=args.held_out, candidates=candidates, progress=say, options=options)
+                           held_out=args.held_out, candidates=candidates, progress=say, options=options,
+                           channels=channels, bias=bias, terms=args.add_term, harmonics=args.harmonics)
     added = ", ".join(report["effects"]) or "none"
-    print(f"effects added: {added}; held-out error {report['error_before']:.4g} -> {report['error_after']:.4g}; "
-          f"unexplained: {'yes' if report['unexplained'] else 'no'}")
+    print(f"{report['verdict']}: effects added: {added}; held-out error {report['error_before']:.4g} -> "
+          f"{report['error_after']:.4g}; unexplained: {'yes' if report['unexplained'] else 'no'}")
+    for p in report["proposed"][:1]:
+        print(f"proposed beyond the library: {p['term']} (held-out error {p['held_out_error']:.4g}); try it with "
+              f"--add-term \"{p['term']}\"")
     print(f"wrote {args.out / 'report.md'} and report.json")
     return 0
+
+
+def _channel(text: str) -> tuple[str, str]:
+    from ..errors import GearsymError
+
+    name, sep, formula = text.partition("=")
+    if not sep or not name.strip() or not formula.strip():
+        raise GearsymError(f"--channel {text!r}: write NAME=FORMULA, e.g. --channel acc=x1_ddot+0.5*x2_ddot")
+    return name.strip(), formula.strip()

@@ -33,8 +33,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--y0", metavar="x=-2,v=-0.5", help="initial state of every record (default: the model's)")
     parser.add_argument("--effect", action="append", default=[], metavar="NAME",
                         help="simulate the model with an effect of the library added (coulomb_friction, "
-                             "cubic_stiffness, mesh_stiffness_harmonic, transmission_error, coast_side_stiffness); "
-                             "set its strength with --set, e.g. --effect cubic_stiffness --set k3=0.02")
+                             "nonlinear_damping, cubic_stiffness, hertzian_contact, coast_side_stiffness, "
+                             "shaft_damping, or a harmonic with its order: mesh_stiffness_harmonic_3, "
+                             "torque_harmonic_2, transmission_error_1); set its strength with --set, e.g. "
+                             "--effect cubic_stiffness --set k3=0.02")
     parser.add_argument("--out", type=Path, required=True, metavar="FILE.csv", help="where to write the measurements")
 
 

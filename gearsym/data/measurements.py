@@ -5,9 +5,19 @@ One row per sample. The columns, in any order:
 * the time: ``tau``, the model's own (nondimensional) time, or ``t``, physical time, with a
   time scale given to :func:`load_measurements` (tau = time_scale * t; ``gearsym derive MODEL``
   shows the model's time unit). A model whose own time is ``t`` (Lorenz) reads ``t`` as is.
-* one column per measured state, named as in the model: ``x`` for ``one_stage``, ``x1`` and
-  ``x2`` for ``flexible_shaft``; velocity columns (``v``, ``v1``, ...) are optional. At least
-  one state is needed; states that were not measured are left out.
+* one column per observation *channel*, at least one (:data:`CHANNELS_HELP`):
+
+  - a state, named as in the model: ``x`` for ``one_stage``, ``x1`` and ``x2`` for
+    ``flexible_shaft``, velocities ``v``, ``v1``;
+  - its first or second time derivative, ``x_dot`` or ``x_ddot`` (an accelerometer on the
+    mesh coordinate: ``x_ddot`` = dv/dtau). A derivative is per unit of the file's time: per
+    unit tau in a ``tau`` file, per unit of ``t`` (a second) in a ``t`` file, where with
+    tau = s t the model's output is scaled to it: dx/dt = s dx/dtau, d2x/dt2 = s^2 d2x/dtau2;
+  - a combination declared when loading (``channels={"a": "x1_ddot + 0.5*x2_ddot"}``,
+    ``--channel a=...``): a formula of states, their derivatives, the time and parameters,
+    read by the safe formula parser.
+
+  Any state may be unmeasured.
 * optionally ``record``: a label (any text) that separates several runs in one file. The rows of
   a record are together and in time order. Without the column the file is one record, ``1``.
 * any number of operating conditions: columns named as model parameters (``omega``, ``B1``),
@@ -27,6 +37,7 @@ from __future__ import annotations
 
 import csv
 import math
+from functools import lru_cache
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -34,8 +45,11 @@ from typing import Union
 
 import numpy as np
 
+import sympy as sp
+
 from ..checks import whole_number
 from ..errors import GearsymError, suggest
+from ..model.expressions import to_expr
 from ..system import FirstOrderSystem
 
 RECORD = "record"
@@ -48,6 +62,10 @@ MIN_PERIODS = 3
 SPACING_TOLERANCE = 1e-3
 #: rounding allowance at window edges, as a fraction of a sample step
 _EDGE = 1e-6
+#: the suffixes of a state's time derivatives as channel names, and their order
+DERIVATIVES = {"_dot": 1, "_ddot": 2}
+CHANNELS_HELP = ("a state (x), its time derivative (x_dot) or second derivative (x_ddot, an accelerometer), or a "
+                 "combination declared with channels={name: formula} (--channel NAME=FORMULA)")
 
 PathLike = Union[str, Path]
 
@@ -66,7 +84,9 @@ class DataError(GearsymError):
 class Record:
     """One run at fixed operating conditions: evenly spaced samples of some of the model's states.
 
-    ``tau`` is the model's time; ``observed`` maps state names to arrays like ``tau``;
+    ``tau`` is the model's time; ``observed`` maps channel names to arrays like ``tau``, and
+    ``channels`` each channel name to what it measures (:func:`channel_symbols`: states, the
+    placeholders of their tau-derivatives, already scaled to the file's time unit);
     ``conditions`` the parameter values this record sets (the rest are the model's);
     ``period`` the forcing period in tau; ``step`` the sample step (the median, in tau);
     ``line_numbers`` the line of each sample in its file; ``origin`` the time at which
@@ -85,6 +105,11 @@ class Record:
     line_numbers: np.ndarray
     origin: float
     time_scale: float = 1.0
+    channels: Mapping[str, sp.Expr] | None = None
+
+    def __post_init__(self):
+        if self.channels is None:  # a record of states only
+            object.__setattr__(self, "channels", {k: sp.Symbol(k, real=True) for k in self.observed})
 
     @property
     def label(self) -> str:
@@ -201,9 +226,9 @@ class Measurements:
 
     @property
     def observed(self) -> tuple[str, ...]:
-        """The states measured in at least one record, in the model's order."""
-        seen = {name for r in self.records for name in r.observed}
-        return tuple(s for s in self.states if s in seen)
+        """The channels measured in at least one record: states in the model's order, then the others."""
+        seen = list(dict.fromkeys(name for r in self.records for name in r.observed))
+        return tuple(s for s in self.states if s in seen) + tuple(c for c in seen if c not in self.states)
 
     @property
     def sources(self) -> tuple[Path, ...]:
@@ -243,6 +268,7 @@ def load_measurements(
     min_samples_per_period: float = MIN_SAMPLES_PER_PERIOD,
     min_periods: int = MIN_PERIODS,
     spacing_tolerance: float = SPACING_TOLERANCE,
+    channels: Mapping[str, str] | None = None,
     **values: float,
 ) -> Measurements:
     """Read and check measured-data files (one path or several) for a model.
@@ -250,7 +276,9 @@ def load_measurements(
     ``system`` is the model's :class:`~gearsym.system.FirstOrderSystem` (``values``: parameter values that
     hold for every record unless a record's conditions set them). Records
     are identified per file (two files may both have a record ``1``). ``time_scale`` converts a
-    ``t`` column: tau = time_scale * t; files with a ``tau`` column ignore it.
+    ``t`` column: tau = time_scale * t; files with a ``tau`` column ignore it. ``channels``:
+    combinations of states and derivatives measured as one column, by column name (see the module
+    docstring).
     """
     if not isinstance(system, FirstOrderSystem):
         raise GearsymError(f"load_measurements takes the model's FirstOrderSystem, got {type(system).__name__}"
@@ -266,8 +294,80 @@ def load_measurements(
     twice = [p for i, p in enumerate(files) if Path(p).resolve() in {Path(q).resolve() for q in files[:i]}]
     if twice:
         raise GearsymError(f"{twice[0]} is given twice")
-    records = tuple(r for path in files for r in _read_file(Path(path), system, defaults, time_scale, rules))
+    declared = _declared_channels(system, channels or {})
+    records = tuple(r for path in files for r in _read_file(Path(path), system, defaults, time_scale, rules,
+                                                            declared))
+    unused = [name for name in declared if not any(name in r.observed for r in records)]
+    if unused:
+        raise GearsymError(f"channel {unused[0]} is declared but no file has a column {unused[0]}")
     return Measurements(system.name, system.state_names, defaults, records)
+
+
+def channel_symbols(system: FirstOrderSystem) -> dict[str, sp.Symbol]:
+    """The names a channel may use: every state, and the placeholder of each state's derivatives
+    (``x_dot``, ``x_ddot``: dx/dtau, d2x/dtau2), which :func:`channel_expression` resolves."""
+    out = {s.name: s for s in system.states}
+    for s in system.states:
+        out.update({s.name + suffix: sp.Symbol(s.name + suffix, real=True) for suffix in DERIVATIVES})
+    return out
+
+
+def channel_expression(channel: sp.Expr, system: FirstOrderSystem) -> sp.Expr:
+    """What ``channel`` (states and derivative placeholders) is as h(tau, y, p) of ``system``:
+    x_dot = f_x, x_ddot = df_x/dtau along the flow (= f_v for x' = v)."""
+    return _channel_expression(channel, system.time, system.states, system.rhs)
+
+
+@lru_cache(maxsize=256)
+def _channel_expression(channel: sp.Expr, time: sp.Symbol, states: tuple, rhs: tuple) -> sp.Expr:
+    rates = dict(zip(states, rhs))
+
+    def derivative(expr: sp.Expr, order: int) -> sp.Expr:
+        for _ in range(order):
+            expr = sp.diff(expr, time) + sum(sp.diff(expr, s) * rates[s] for s in states)
+        return expr
+
+    by_name = {s.name: s for s in states}
+    used = {s.name for s in channel.free_symbols}
+    for s in states:
+        for suffix, order in DERIVATIVES.items():
+            if s.name + suffix in used:
+                by_name[s.name + suffix] = derivative(s, order)
+    return channel.xreplace({s: by_name[s.name] for s in channel.free_symbols if s.name in by_name})
+
+
+def _declared_channels(system: FirstOrderSystem, channels: Mapping[str, str]) -> dict[str, sp.Expr]:
+    """Each declared combination as an expression of states and derivative placeholders (tau units)."""
+    names = channel_symbols(system)
+    out = {}
+    for name, formula in channels.items():
+        where = f"channel {name}"
+        if not str(name).isidentifier():
+            raise GearsymError(f"{where}: a channel name must be a column name like acc or a1 (letters, digits, _)")
+        if name in names or name in system.parameters or name in (RECORD, PHYSICAL_TIME, system.time.name):
+            raise GearsymError(f"{where}: the name is already a state, derivative, parameter or time column; "
+                               "name the combination otherwise")
+        expr = to_expr(formula, where, {**names, system.time.name: system.time})
+        unknown = sorted(s.name for s in expr.free_symbols
+                         if s not in names.values() and s != system.time and s.name not in system.parameters)
+        if unknown:
+            known = ", ".join(names)
+            raise GearsymError(f"{where}: unknown name {unknown[0]}.{suggest(unknown[0], list(names))} A channel "
+                               f"combines {known}, the time {system.time.name} and the parameters")
+        out[name] = expr
+    return out
+
+
+def _in_file_units(expr: sp.Expr, system: FirstOrderSystem, scale: float) -> sp.Expr:
+    """A channel of a file whose time is t (tau = scale t): derivatives per unit t, d^k/dt^k = scale^k d^k/dtau^k."""
+    if scale == 1.0:
+        return expr
+    mapping = {}
+    for s in system.states:
+        for suffix, order in DERIVATIVES.items():
+            mapping[sp.Symbol(s.name + suffix, real=True)] = sp.Float(scale) ** order * sp.Symbol(s.name + suffix,
+                                                                                                     real=True)
+    return expr.xreplace(mapping)
 
 
 def _positive(value, what: str) -> float:
@@ -294,8 +394,9 @@ class _Layout:
     time: str
     scale: float
     record: str | None
-    states: tuple[str, ...]
+    states: tuple[str, ...]  # the measured channels (states, derivatives, combinations)
     conditions: tuple[str, ...]
+    channels: Mapping[str, sp.Expr] = None  # what each measures, in the file's time unit
 
 
 @dataclass(frozen=True)
@@ -307,9 +408,10 @@ class _Rows:
     values: dict[str, np.ndarray]
 
 
-def _read_file(path: Path, system: FirstOrderSystem, defaults: dict, time_scale, rules: _Rules) -> list[Record]:
+def _read_file(path: Path, system: FirstOrderSystem, defaults: dict, time_scale, rules: _Rules,
+               declared: Mapping[str, sp.Expr]) -> list[Record]:
     header_line, header, rows = _read_csv(path)
-    layout = _layout(path, header_line, header, system, time_scale)
+    layout = _layout(path, header_line, header, system, time_scale, declared)
     return [_record(path, group, layout, system, defaults, rules) for group in _group(path, header, rows, layout)]
 
 
@@ -338,8 +440,11 @@ def _read_csv(path: Path) -> tuple[int, list[str], list[tuple[int, list[str]]]]:
     return header_line, header, rows
 
 
-def _layout(path: Path, line: int, header: list[str], system: FirstOrderSystem, time_scale) -> _Layout:
+def _layout(path: Path, line: int, header: list[str], system: FirstOrderSystem, time_scale,
+            declared: Mapping[str, sp.Expr]) -> _Layout:
     states, parameters = system.state_names, tuple(system.parameters)
+    symbols = channel_symbols(system)
+    channel_names = [*symbols, *declared]
     own_time = system.time.name
     times = [own_time] + ([PHYSICAL_TIME] if own_time != PHYSICAL_TIME else [])
     for i, name in enumerate(header):
@@ -347,13 +452,13 @@ def _layout(path: Path, line: int, header: list[str], system: FirstOrderSystem, 
             raise DataError(f"column {i + 1} has no name", path, line)
         if header.index(name) != i:
             raise DataError("the column appears twice", path, line, name)
-    known = [*times, RECORD, *states, *parameters]
+    known = [*times, RECORD, *channel_names, *parameters]
     for name in header:
         if name not in known:
             raise DataError(
                 f"unknown column.{suggest(name, known)} A column is the time ({' or '.join(times)}), "
-                f"{RECORD}, a state of {system.name} ({', '.join(states)}) or one of its parameters as an "
-                f"operating condition ({', '.join(parameters)})", path, line, name)
+                f"{RECORD}, a channel: {CHANNELS_HELP} (states of {system.name}: {', '.join(states)}), or one of "
+                f"its parameters as an operating condition ({', '.join(parameters)})", path, line, name)
     given = [t for t in times if t in header]
     if not given:
         raise DataError(f"no time column: name it {own_time} (the model's time)"
@@ -369,12 +474,13 @@ def _layout(path: Path, line: int, header: list[str], system: FirstOrderSystem, 
                 f"({own_time} = time_scale * t; `gearsym derive {system.name}` shows the time unit), or give "
                 f"the model's time as a {own_time} column", path, line, PHYSICAL_TIME)
         scale = float(time_scale)
-    measured = tuple(s for s in states if s in header)
+    measured = tuple(c for c in channel_names if c in header)
     if not measured:
-        raise DataError(f"no measured state: name at least one column as a state of {system.name} "
-                        f"({', '.join(states)})", path, line)
+        raise DataError(f"no measured state: name at least one column as a channel of {system.name}: {CHANNELS_HELP} "
+                        f"(states: {', '.join(states)})", path, line)
     conditions = tuple(p for p in parameters if p in header)
-    return _Layout(given[0], scale, RECORD if RECORD in header else None, measured, conditions)
+    channels = {c: _in_file_units(declared[c] if c in declared else symbols[c], system, scale) for c in measured}
+    return _Layout(given[0], scale, RECORD if RECORD in header else None, measured, conditions, channels)
 
 
 def _group(path: Path, header: list[str], rows, layout: _Layout) -> list[_Rows]:
@@ -432,7 +538,7 @@ def _record(path: Path, rows: _Rows, layout: _Layout, system: FirstOrderSystem, 
     step = _check_time(path, rows.values[layout.time], lines, layout.time, where, rules)
     tau = rows.values[layout.time] * layout.scale
     record = Record(path, rows.record, tau, {s: rows.values[s] for s in layout.states}, conditions, period,
-                    step * layout.scale, lines, float(tau[0]), layout.scale)
+                    step * layout.scale, lines, float(tau[0]), layout.scale, dict(layout.channels))
     _check_length(record, layout, rules)
     return record
 

@@ -4,29 +4,34 @@ add it to the symbolic model, and report the held-out error before and after.
 :mod:`.shooting` (multiple-shooting fit) -> :mod:`.prediction` (held-out error) ->
 :mod:`.explain` (forward selection over :mod:`.effects`) -> :mod:`.report`.
 """
-from .effects import EFFECTS, Effect, augment, effect_terms
+from .effects import EFFECTS, FAMILIES, Effect, augment, effect, effect_terms, term_effect
 from .explain import Explanation, explain
 from .prediction import Prediction, predict_ahead
 from .shooting import Fit, Segment, fit_windows
 
-__all__ = ["EFFECTS", "Effect", "Explanation", "Fit", "Prediction", "Segment", "augment", "effect_terms", "explain",
-           "explain_files", "fit_windows", "predict_ahead"]
+__all__ = ["EFFECTS", "Effect", "Explanation", "FAMILIES", "Fit", "Prediction", "Segment", "augment", "effect",
+           "effect_terms", "explain", "explain_files", "fit_windows", "predict_ahead", "term_effect"]
 
 
 def explain_files(paths, system, fit, *, out=None, time_scale=None, held_out: float = 0.25, candidates=None,
-                  progress=None, options=None, **values):
-    """The whole loop from files: load ``paths`` for ``system`` (``values`` fix parameter values), explain,
-    and with ``out`` write the report there. Returns the report's dict (the keys of report.json)."""
+                  progress=None, options=None, channels=None, bias=(), terms=(), harmonics=None, **values):
+    """The whole loop from files: load ``paths`` for ``system`` (``values`` fix parameter values; ``channels``
+    declares combinations measured as one column), explain (``bias``: channels with an unknown offset;
+    ``terms``: hand-written terms tried as effects), and with ``out`` write the report there. Returns the
+    report's dict (the keys of report.json)."""
     from ..data import load_measurements
     from ..outputs import check_folder
     from .report import write_report
 
     if out is not None:
         check_folder(out)
-    measurements = load_measurements(paths, system, time_scale=time_scale, **values)
+    measurements = load_measurements(paths, system, time_scale=time_scale, channels=channels, **values)
     system = system.with_values(**values)
+    extra = {"options": options} if options else {}
+    if harmonics is not None:
+        extra["harmonics"] = harmonics
     ex = explain(system, measurements, fit, held_out=held_out, candidates=candidates, progress=progress,
-                 **({"options": options} if options else {}))
+                 bias=bias, terms=terms, **extra)
     if out is not None:
         return write_report(ex, system, out, measurements.sources)
     from ..checks import json_safe

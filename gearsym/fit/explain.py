@@ -1,24 +1,36 @@
 """The data loop: fit, find what the residual says the model lacks, add it, report before and after.
 
-1. Split every record by time: the first part trains, the last ``held_out``
-   (whole forcing periods) is held out.
-2. Fit the named parameters to the training windows (multiple shooting,
-   :mod:`.shooting`); the held-out error is the one-period-ahead prediction error
-   (:mod:`.prediction`).
-3. Forward selection over the effect library (:mod:`.effects`): each candidate
-   not yet in the model is added and refitted (its own parameters with the
-   named ones); the one that lowers the *held-out* error most is kept if it
-   lowers it by at least ``min_gain`` (a fraction). Repeat while one does.
-   In-sample fit never decides: a term that only fits noise does not predict.
-4. Whether anything is left: the held-out residual of the final model should
-   be measurement noise, uncorrelated from one sample to the next. Its lag-1
-   autocorrelation above ``max_correlation`` means a smooth, systematic error
-   is left, which no candidate explained: ``unexplained``.
+1. Split every record by time: the first part trains, the last ``held_out`` (whole forcing
+   periods) is held out.
+2. Fit the named parameters to the training windows (multiple shooting, :mod:`.shooting`); the
+   held-out error is the one-period-ahead prediction error (:mod:`.prediction`). The held-out
+   residual's spectrum in harmonics of the forcing says which orders stand out (:func:`residual_spectrum`).
+3. Forward selection over the effect library (:mod:`.effects`): the effects without an order, the
+   harmonic families (stiffness, torque, transmission error) at the orders that stand out and at
+   each family's order of largest linearised gain, and any term written by hand. The linearised
+   gain (a score test on the exact sensitivities, :func:`linearised_gains`) ranks them: a parametric
+   harmonic's response spreads over neighbouring orders, so the spectrum alone can miss its order;
+   the first ``refits`` whose gain is at least ``MIN_SCORE`` are added and refitted (their own
+   parameters with the named ones, within
+   their physical bounds); the one that lowers the *held-out* error most is kept if it lowers it by
+   at least ``min_gain`` (a fraction). Repeat while one does. In-sample fit never decides: a term that only fits noise does not predict. A
+   candidate whose parameter ends on its physical bound (a friction that would push with the
+   motion) or that the data cannot determine is rejected, and the report says why.
+4. Whether anything is left: the held-out residual of the final model should be measurement noise,
+   uncorrelated from one sample to the next. Its lag-1 autocorrelation above ``max_correlation``
+   means a smooth, systematic error is left: ``unexplained``. Then terms beyond the library are
+   proposed from a generic dictionary (:mod:`.proposals`).
+
+Verdicts: ``explained`` (effects added, the residual is noise), ``partly explained`` (effects added,
+something systematic left), ``unexplained`` (nothing added, something left), ``nothing missing``.
+
+Every candidate is a setting of one system, the declared model with *all* candidate effects at 0
+(off), so one compiled window integrator serves every fit of the search.
 """
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -26,26 +38,59 @@ from ..data.measurements import Measurements
 from ..errors import GearsymError
 from ..options import Integration
 from ..system import FirstOrderSystem
-from .effects import EFFECTS, Effect, augment, effect
+from .canonical import amplitude_phase, canonical
+from .effects import EFFECTS, FAMILIES, Effect, applies_to, augment, bounds_of, effect, site, term_effect
 from .prediction import Prediction, predict_ahead
-from .shooting import Fit, Segment, fit_windows
+from .shooting import Fit, Problem, Segment, fit_windows
 
 MIN_GAIN = 0.2
 MAX_CORRELATION = 0.5
 MAX_EFFECTS = 2
+#: the harmonic families are in the library at orders 1 ... HARMONICS (and the dictionary's harmonics)
+HARMONICS = 4
+#: orders of the forcing shown in the residual's spectrum
+SPECTRUM_ORDERS = 8
+#: at most this many orders that stand out are tried per round
+STANDOUT_ORDERS = 3
+#: at most this many candidates are refitted per round, those of largest linearised gain first ...
+REFITS = 8
+#: ... and only those whose linearised gain is at least this fraction of the residual (to be kept, a candidate
+#: must lower the held-out error by MIN_GAIN, about 36 % of the residual's energy)
+MIN_SCORE = 0.02
+#: an order stands out if its amplitude is this many standard errors of a harmonic of white noise ...
+STANDOUT_SIGMAS = 5.0
+#: ... and at least this fraction of the largest
+STANDOUT_FRACTION = 0.2
 
 
 @dataclass(frozen=True)
 class Candidate:
-    """One model tried: its effects, fit and held-out prediction."""
+    """One model tried: its effects, fit and held-out prediction, and why it may not be chosen ('' if it may)."""
 
     effects: tuple[str, ...]
     fit: Fit
     prediction: Prediction
+    rejected: str = ""
 
     @property
     def error(self) -> float:
         return self.prediction.error
+
+
+@dataclass(frozen=True)
+class Spectrum:
+    """The residual's amplitude at each harmonic of the forcing (normalised by each channel's spread,
+    averaged over channels), the amplitude a harmonic of white noise would reach (one standard error),
+    and the orders that stand out, largest first."""
+
+    orders: tuple[int, ...]
+    amplitude: tuple[float, ...]
+    noise: float
+    standout: tuple[int, ...]
+
+    def as_dict(self) -> dict:
+        return {"orders": list(self.orders), "amplitude": list(self.amplitude), "noise": self.noise,
+                "standout": list(self.standout)}
 
 
 @dataclass(frozen=True)
@@ -58,27 +103,70 @@ class Explanation:
     fitted: tuple[str, ...]
     held_out: float
     info: dict = field(default_factory=dict)
+    spectrum: Spectrum | None = None  # of the declared model's training residual
+    final_spectrum: Spectrum | None = None
+    proposed: list = field(default_factory=list)  # proposals.Proposal
+    library: dict = field(default_factory=dict)  # name -> Effect of every candidate in the search
+    system: FirstOrderSystem | None = None  # the declared model
+    bias: tuple[str, ...] = ()
 
     @property
     def effects(self) -> list[str]:
         return list(self.final.effects)
 
+    @property
+    def verdict(self) -> str:
+        if self.effects:
+            return "partly explained" if self.unexplained else "explained"
+        return "unexplained" if self.unexplained else "nothing missing"
+
+    def harmonics(self, c: Candidate | None = None) -> dict[str, dict]:
+        """The (cos, sin) pairs of a candidate's harmonic effects as order, amplitude >= 0, phase in (-pi, pi]."""
+        c = c or self.final
+        out = {}
+        for name in c.effects:
+            e = self.library[name]
+            for a, b in e.pairs:
+                fit = c.fit
+                cov = fit.covariance
+                C = np.array([[cov[a][a], cov[a][b]], [cov[b][a], cov[b][b]]]) if a in cov and b in cov else None
+                A, theta, sA, st = amplitude_phase(fit.estimates[a], fit.estimates[b], C)
+                out[name] = {"order": e.order, "amplitude": A, "phase": theta, "amplitude_stderr": sA,
+                             "phase_stderr": st, "form": f"A cos({e.order} phi + phase)" if e.acts_on != "torque"
+                             else f"A cos({e.order} tau + phase)"}
+        return out
+
     def as_dict(self) -> dict:
         def fit_dict(c: Candidate) -> dict:
-            return {"effects": list(c.effects), "held_out_error": c.error, "estimates": c.fit.estimates,
-                    "stderr": c.fit.stderr, "training_sigma": c.fit.sigma, "converged": c.fit.success}
+            f = c.fit
+            return {"effects": list(c.effects), "held_out_error": c.error, "estimates": f.estimates,
+                    "stderr": f.stderr, "not_identifiable": [p for p, ok in f.identifiable.items() if not ok],
+                    "at_bound": {p: b for p, (b, _) in f.at_bound.items()}, "bias": f.bias,
+                    "training_sigma": f.sigma, "converged": f.success, "rejected": c.rejected or None}
+        final = self.final.fit
         return {
+            "verdict": self.verdict,
             "effects": self.effects,
             "unexplained": self.unexplained,
             "error_before": self.base.error,
             "error_after": self.final.error,
-            "parameters": self.final.fit.estimates,
-            "stderr": self.final.fit.stderr,
+            "parameters": final.estimates,
+            "stderr": final.stderr,
+            "not_identifiable": [p for p, ok in final.identifiable.items() if not ok],
+            "correlated": [[a, b, rho] for a, b, rho in final.correlations],
+            "harmonics": self.harmonics(),
+            "bias": final.bias,
+            "bias_stderr": final.bias_stderr,
             "parameters_before": self.base.fit.estimates,
+            "stderr_before": self.base.fit.stderr,
             "residual_correlation": self.correlation,
+            "spectrum": self.spectrum.as_dict() if self.spectrum else None,
+            "spectrum_after": self.final_spectrum.as_dict() if self.final_spectrum else None,
+            "proposed": [p.as_dict() for p in self.proposed],
             "fitted": list(self.fitted),
             "held_out_fraction": self.held_out,
             "candidates": [fit_dict(c) for c in self.tried],
+            "screened": self.info.get("screened", []),
         }
 
 
@@ -88,49 +176,216 @@ def segments_of(system: FirstOrderSystem, measurements: Measurements) -> tuple[l
     for r in measurements:
         values = {**system.parameters, **measurements.parameters(r)}
         for w in r.windows():
-            segments.append(Segment(w.tau, w.observed, values, f"{r.label} period {w.index}"))
-            keys.append(((str(r.source), r.record), w.index))  # (which record, which period)
+            key = ((str(r.source), r.record), w.index)  # (which record, which period)
+            segments.append(Segment(w.tau, w.observed, values, f"{r.label} period {w.index}", r.channels, key))
+            keys.append(key)
     return segments, keys
+
+
+def candidate_library(system: FirstOrderSystem, candidates: Sequence[str | Effect] | None = None,
+                      harmonics: int = HARMONICS, terms: Sequence[str] = ()) -> dict[str, Effect]:
+    """The effects a search may try, by name: ``candidates`` (default every effect that applies to ``system``;
+    a family's bare name stands for its orders 1 ... ``harmonics``), then the hand-written ``terms``."""
+    out: dict[str, Effect] = {}
+    names = candidates if candidates is not None else [*EFFECTS, *FAMILIES]
+    for name in names:
+        if isinstance(name, str) and name in FAMILIES:
+            chosen = [FAMILIES[name](n) for n in range(1, harmonics + 1)]
+        else:
+            chosen = [effect(name)]
+        for e in chosen:
+            if applies_to(system, e):
+                out[e.name] = e
+            elif candidates is not None:  # asked for by name: say why it has nowhere to act
+                site(system, e.acts_on)
+    for i, text in enumerate(terms, 1):
+        e = term_effect(text, system, i)
+        out[e.name] = e
+    return out
 
 
 def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[str], *,
             candidates: Sequence[str | Effect] | None = None, held_out: float = 0.25,
             min_gain: float = MIN_GAIN, max_effects: int = MAX_EFFECTS,
             max_correlation: float = MAX_CORRELATION, progress=None,
-            options: Integration = Integration()) -> Explanation:
-    """Fit ``fit`` on ``measurements``, then add effects from ``candidates`` (default: the whole library)
-    while they lower the held-out error; see the module docstring."""
+            options: Integration = Integration(), bias: Sequence[str] = (), terms: Sequence[str] = (),
+            harmonics: int = HARMONICS, propose: bool = True, refits: int = REFITS) -> Explanation:
+    """Fit ``fit`` on ``measurements``, then add effects from ``candidates`` (default: the whole library) and the
+    hand-written ``terms`` while they lower the held-out error; see the module docstring. ``bias``: channels
+    with an unknown constant offset, fitted with the parameters."""
     if not fit:
         raise GearsymError("name the parameters to fit, e.g. --fit zeta,B1")
     _check_one_value_each(measurements, fit)
-    library = {e.name: e for e in map(effect, candidates if candidates is not None else list(EFFECTS))}
+    for name in bias:
+        if name not in measurements.observed:
+            raise GearsymError(f"bias of {name}: no such channel in the data ({', '.join(measurements.observed)})")
+    library = candidate_library(system, candidates, harmonics, terms)
+    superset = augment(system, list(library.values()), name=f"{system.name}_candidates") if library else system
     train, test = measurements.split(held_out)
+    seg_train, keys_train = segments_of(superset, train)
+    seg_test, keys = segments_of(superset, test)
+    bounds = bounds_of(list(library.values()))
     say = progress or (lambda message: None)
 
-    def evaluate(effects: tuple[str, ...], guess: dict) -> Candidate:
-        model = augment(system, [library[e] for e in effects])
+    def evaluate(effects: tuple[str, ...], start: Candidate | None) -> Candidate:
         names = list(fit) + [p for e in effects for p in library[e].fitted]
-        seg_train, _ = segments_of(model, train)
-        seg_test, keys = segments_of(model, test)
-        result = fit_windows(model, seg_train, names, guess=guess, options=options)
-        prediction = predict_ahead(model, seg_test, keys, result.estimates, options=options)
-        say(f"{'+'.join(effects) or 'the model as declared'}: held-out error {prediction.error:.4g}")
-        return Candidate(effects, result, prediction)
+        guess = dict(start.fit.estimates) if start else {}
+        result = fit_windows(superset, seg_train, names, guess=guess, options=options, bias=bias, bounds=bounds,
+                             starts=start.fit.starts if start else None,
+                             guess_bias=start.fit.bias if start else None)
+        result = replace(result, estimates=canonical(superset, result.estimates))
+        anchors = {key[0]: (seg.tau[0], start) for key, seg, start in zip(keys_train, seg_train, result.starts.T)}
+        prediction = predict_ahead(superset, seg_test, keys, result.estimates, options=options, bias=result.bias,
+                                   anchors=anchors)  # the last training window of each record
+        rejected = _rejection(result, [library[e] for e in effects])
+        say(f"{'+'.join(effects) or 'the model as declared'}: held-out error {prediction.error:.4g}"
+            + (f" (rejected: {rejected})" if rejected else ""))
+        return Candidate(effects, result, prediction, rejected)
 
-    base = evaluate((), {})
-    tried, current = [base], base
+    def spectrum_of(c: Candidate) -> Spectrum:
+        return residual_spectrum(c.prediction, structured=_lag1(c.prediction) > max_correlation)
+
+    base = evaluate((), None)
+    spectrum = spectrum_of(base)
+    tried, current, current_spectrum, screened = [base], base, spectrum, []
     while len(current.effects) < max_effects:
-        round_ = [evaluate(current.effects + (c.name,), dict(current.fit.estimates))
-                  for c in library.values() if c.name not in current.effects]
+        open_ = [name for name in library if name not in current.effects]
+        gains = linearised_gains(superset, seg_train, current.fit, library, open_, bias, options)
+        names = _round(library, current, current_spectrum, superset, {k: g for k, (g, _) in gains.items()}, refits)
+        screened.append({"after": list(current.effects), "gains": {k: g for k, (g, _) in gains.items()},
+                         "why_not": {k: why for k, (_, why) in gains.items() if why}, "refitted": names})
+        round_ = [evaluate(current.effects + (name,), current) for name in names]
         tried.extend(round_)
-        if not round_:
+        eligible = [c for c in round_ if not c.rejected and np.isfinite(c.error)]
+        if not eligible:
             break
-        best = min(round_, key=lambda c: c.error)
+        best = min(eligible, key=lambda c: c.error)
         if best.error > (1 - min_gain) * current.error:
             break
         current = best
+        current_spectrum = spectrum_of(current)
     correlation = _lag1(current.prediction)
-    return Explanation(base, current, tried, bool(correlation > max_correlation), correlation, tuple(fit), held_out)
+    unexplained = bool(correlation > max_correlation)
+    ex = Explanation(base, current, tried, unexplained, correlation, tuple(fit), held_out, {"screened": screened},
+                     spectrum=spectrum, final_spectrum=current_spectrum, library=library, system=system,
+                     bias=tuple(bias))
+    if unexplained and propose:
+        from .proposals import propose_terms
+
+        ex = replace(ex, proposed=propose_terms(ex, superset, seg_train, seg_test, keys, options, harmonics, say))
+    return ex
+
+
+def _round(library: dict[str, Effect], current: Candidate, spectrum: Spectrum, system: FirstOrderSystem,
+           scores: dict[str, float], refits: int) -> list[str]:
+    """The candidates of the next round: every effect without an order or written by hand, and the harmonic
+    families at the orders the residual's spectrum suggests (a mesh family's order N is the forcing's N times the
+    mesh order) and at each family's order of largest linearised gain; the ``refits`` of largest gain first, if
+    that gain is at least ``MIN_SCORE``."""
+    out, best = [], {}
+    for name, e in library.items():
+        if name in current.effects:
+            continue
+        if not e.order:
+            out.append(name)
+            continue
+        ratio = _mesh_order(system) if e.acts_on == "mesh" else 1
+        if e.order * ratio in spectrum.standout:
+            out.append(name)
+        if scores.get(name, 0.0) > scores.get(best.get(e.family, ""), 0.0):
+            best[e.family] = name
+    out += [name for name in best.values() if name not in out]
+    ranked = sorted(out, key=lambda name: -scores.get(name, 0.0))
+    return [name for name in ranked if scores.get(name, 0.0) >= MIN_SCORE][:refits]
+
+
+def linearised_gains(system: FirstOrderSystem, segments: Sequence[Segment], fit: Fit, library: dict[str, Effect],
+                     names: Sequence[str], bias: Sequence[str], options: Integration) -> dict[str, tuple[float, str]]:
+    """For each candidate of ``names``: the fraction of the training residual its parameters would remove to first
+    order (the score test: the residual regressed on the candidate's exact sensitivity columns, with what the fit
+    already moves, its parameters, start states and offsets, projected out), and why it is 0 where a one-parameter
+    effect would need the wrong sign (its physical bound) or cannot act on these data."""
+    params = [p for name in names for p in library[name].fitted]
+    if not params:
+        return {}
+    fitted = list(fit.estimates)
+    problem = Problem(system, segments, fitted + params, list(bias), 2 * np.pi, options)
+    theta = np.array([fit.estimates[p] for p in fitted] + [0.0] * len(params))
+    u = np.concatenate([theta, [fit.bias[c] for c in problem.bias], fit.starts.reshape(-1, order="F")])
+    r, J = problem(u)
+    m = len(fitted)
+    D = J[:, m:m + len(params)]
+    Q, _ = np.linalg.qr(np.delete(J, np.s_[m:m + len(params)], axis=1))
+    y = -r - Q @ (Q.T @ -r)
+    D = D - Q @ (Q.T @ D)
+    total = float(y @ y) or 1.0
+    gains, at = {}, 0
+    for name in names:
+        e = library[name]
+        cols = D[:, at:at + len(e.fitted)]
+        at += len(e.fitted)
+        if not np.any(np.linalg.norm(cols, axis=0) > 1e-9 * (np.linalg.norm(y) + 1e-300)):
+            gains[name] = (0.0, "it does not act on these data")
+            continue
+        coef = np.linalg.lstsq(cols, y, rcond=None)[0]
+        if len(coef) == 1 and e.fitted[0] in e.bounds:
+            low, high, why = e.bounds[e.fitted[0]]
+            if not low <= coef[0] <= high:  # the data ask for the unphysical sign
+                gains[name] = (0.0, f"it would need {e.fitted[0]} {'<' if coef[0] < low else '>'} "
+                                    f"{low if coef[0] < low else high:g}, but {why}")
+                continue
+        fitted_part = cols @ coef
+        gains[name] = (float(fitted_part @ fitted_part) / total, "")
+    return gains
+
+
+def _mesh_order(system: FirstOrderSystem) -> int:
+    order = site(system, "mesh").coupling.order
+    try:
+        return int(order) if order else 1
+    except TypeError:
+        return 1
+
+
+def _rejection(result: Fit, effects: Sequence[Effect]) -> str:
+    """Why a candidate may not be chosen: a parameter on its physical bound, one the data cannot determine."""
+    reasons = []
+    for e in effects:
+        for p in e.fitted:
+            if p in result.at_bound:
+                bound, why = result.at_bound[p]
+                reasons.append(f"{p} ran into its bound {bound:g} ({why})")
+            elif not result.identifiable.get(p, True):
+                reasons.append(f"{p} is not identifiable from these data")
+    if not result.success:
+        reasons.append("the fit did not converge")
+    return "; ".join(reasons)
+
+
+def residual_spectrum(prediction: Prediction, orders: int = SPECTRUM_ORDERS, structured: bool = False) -> Spectrum:
+    """The held-out residual's amplitude at the forcing's harmonics 1 ... ``orders`` (least squares over all
+    predicted samples, in absolute tau), normalised by each channel's spread and averaged over the channels.
+
+    The held-out residual, not the training one: in training every window's start state absorbs much of what
+    the model misses. An order stands out if it is ``STANDOUT_SIGMAS`` standard errors of white noise and a
+    fifth of the largest; a ``structured`` residual (not noise) suggests its largest orders even if none does.
+    """
+    k = np.arange(1, orders + 1)
+    tau = prediction.tau
+    A = np.hstack([np.ones((tau.size, 1)), np.cos(np.outer(tau, k)), np.sin(np.outer(tau, k))])
+    amplitudes, noises = [], []
+    for name, r in prediction.residual.items():
+        r = r / (np.std(prediction.measured[name]) or 1.0)
+        coef, *_ = np.linalg.lstsq(A, r, rcond=None)
+        amplitudes.append(np.hypot(coef[1:orders + 1], coef[orders + 1:]))
+        noises.append(float(np.std(r - A @ coef)) * np.sqrt(2.0 / max(tau.size, 1)))
+    amplitude, noise = np.mean(amplitudes, axis=0), float(np.mean(noises))
+    threshold = max(STANDOUT_SIGMAS * noise, STANDOUT_FRACTION * float(amplitude.max(initial=0.0)))
+    ranked = [int(o) for o in np.argsort(-amplitude, kind="stable") + 1]
+    standout = [o for o in ranked if amplitude[o - 1] > threshold]
+    if structured and len(standout) < STANDOUT_ORDERS:
+        standout += [o for o in ranked if o not in standout][:STANDOUT_ORDERS - len(standout)]
+    return Spectrum(tuple(range(1, orders + 1)), tuple(map(float, amplitude)), noise, tuple(standout[:STANDOUT_ORDERS]))
 
 
 def _check_one_value_each(measurements: Measurements, fit: Sequence[str]) -> None:
@@ -145,7 +400,7 @@ def _check_one_value_each(measurements: Measurements, fit: Sequence[str]) -> Non
 
 
 def _lag1(prediction: Prediction) -> float:
-    """Lag-1 autocorrelation of the held-out residual, within each predicted period (averaged over coordinates)."""
+    """Lag-1 autocorrelation of the held-out residual, within each predicted period (averaged over channels)."""
     values = []
     for k, r in prediction.residual.items():
         r = r - r.mean()

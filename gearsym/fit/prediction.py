@@ -1,74 +1,118 @@
 """Held-out error: how well a fitted model predicts one forcing period ahead.
 
-For each pair of consecutive held-out windows (k, k+1) of a record, the state at
-the start of window k is estimated from window k's samples alone (parameters
-fixed at the fit), the model is run on through window k+1, and its samples
-there are compared with the measurement. The error is the normalised RMS:
-per measured coordinate, RMS(prediction - measurement) / std(measurement),
-averaged over the coordinates. None of the held-out samples enters the
-parameter fit, so an effect that only fits noise does not lower it.
+For each pair of consecutive held-out windows (k, k+1) of a record, the state at the start of
+window k is estimated from window k's samples alone (parameters and channel offsets fixed at the
+fit), the model is run on through window k+1 (the record's samples continue on one even grid, so
+window k+1 may hold one sample more or less than window k), and its outputs there are compared
+with the measurement. The error is the normalised RMS: per measured channel,
+RMS(prediction - measurement) / std(measurement), averaged over the channels. None of the
+held-out samples enters the parameter fit, so an effect that only fits noise does not lower it.
 """
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..options import Integration
 from ..system import FirstOrderSystem
-from .shooting import Segment, fit_windows, simulate_segment
+from .shooting import Problem, Segment, fit_windows
 
 
 @dataclass(frozen=True)
 class Prediction:
     """The held-out error and what it is made of (for the residual figures)."""
 
-    error: float  # normalised RMS over all predicted samples, averaged over coordinates
+    error: float  # normalised RMS over all predicted samples, averaged over channels
     tau: np.ndarray  # the predicted samples' times
     measured: dict[str, np.ndarray]
     predicted: dict[str, np.ndarray]
     states: np.ndarray  # (n, samples): the model's states along the prediction
     pairs: int
+    errors: dict[str, float] | None = None  # per channel
 
     @property
     def residual(self) -> dict[str, np.ndarray]:
         return {k: self.measured[k] - self.predicted[k] for k in self.measured}
 
 
-def pairs_of(segments: Sequence[Segment], keys: Sequence[tuple]) -> list[tuple[int, int]]:
-    """Indices (k, k+1) of consecutive windows of one record with equal sample counts.
-    ``keys``: per segment (record id, window index)."""
-    out = []
-    for i, (a, b) in enumerate(zip(keys, keys[1:])):
-        if a[0] == b[0] and b[1] == a[1] + 1 and len(segments[i].tau) == len(segments[i + 1].tau):
-            out.append((i, i + 1))
-    return out
+def _run_on(system: FirstOrderSystem, firsts: Sequence[Segment], anchors: Sequence, period: float,
+            options: Integration) -> np.ndarray | None:
+    """The model's state at each window's first sample, run from its record's anchor (None without one each)."""
+    if any(a is None for a in anchors):
+        return None
+    problem = Problem(system, firsts, [], [], period, options)
+    t0 = np.array([float(t) for t, _ in anchors])
+    dt = problem.t0 - t0
+    if np.any(dt <= 0):
+        return None
+    steps = np.maximum(1, np.ceil(options.steps_per_period * dt / period)).astype(np.int64)
+    y0 = np.column_stack([np.asarray(y, float) for _, y in anchors])
+    run = problem.engine.run(y0, t0, dt, np.full(len(firsts), 2), steps, problem.base, tangent=False)
+    return run.states[:, 1::2]
+
+
+def _starts(system: FirstOrderSystem, firsts: Sequence[Segment], anchors, period: float,
+            options: Integration) -> np.ndarray:
+    """Each window's start state fitted to its own samples, from two first guesses (the data's, and the model
+    run on from the record's anchor), keeping per window the better fit: a window that spends time in the
+    backlash gap, seen through an accelerometer, can have another local minimum near either guess."""
+    fits = [fit_windows(system, firsts, [], period=period, options=options)]
+    guess = _run_on(system, firsts, anchors, period, options) if anchors else None
+    if guess is not None:
+        fits.append(fit_windows(system, firsts, [], period=period, options=options, starts=guess))
+    cost = np.array([[sum(float(np.sum(r ** 2) / np.var(s.observed[k]) if np.var(s.observed[k]) else 0.0)
+                          for k, r in res.items()) for res, s in zip(f.residuals, firsts)] for f in fits])
+    best = np.argmin(cost, axis=0)
+    return np.column_stack([fits[b].starts[:, k] for k, b in enumerate(best)])
+
+
+def pairs_of(keys: Sequence[tuple]) -> list[tuple[int, int]]:
+    """Indices (k, k+1) of consecutive windows of one record. ``keys``: per segment (record id, window index)."""
+    return [(i, i + 1) for i, (a, b) in enumerate(zip(keys, keys[1:])) if a[0] == b[0] and b[1] == a[1] + 1]
 
 
 def predict_ahead(system: FirstOrderSystem, segments: Sequence[Segment], keys: Sequence[tuple],
                   estimates: Mapping[str, float], period: float = 2 * np.pi,
-                  options: Integration = Integration()) -> Prediction:
-    """One-forcing-period-ahead prediction of every held-out pair (see the module docstring)."""
-    pairs = pairs_of(segments, keys)
+                  options: Integration = Integration(), bias: Mapping[str, float] | None = None,
+                  anchors: Mapping | None = None) -> Prediction:
+    """One-forcing-period-ahead prediction of every held-out pair (see the module docstring).
+    ``bias``: the fitted offset of each biased channel, removed from the data first. ``anchors``: per record
+    (the first item of its keys) a known state (time, state), e.g. the fitted start of its last training
+    window: the model run on from there gives the first guess of each start state (the fit refines it from
+    the window's own samples), so that the guess is on the attractor the record is on."""
+    pairs = pairs_of(keys)
     if not pairs:
         raise ValueError("the held-out part has no two consecutive whole forcing periods of one record")
-    firsts = [segments[i] for i, _ in pairs]
-    fixed = [Segment(s.tau, s.observed, {**s.parameters, **estimates}, s.label) for s in firsts]
-    starts = fit_windows(system, fixed, [], period=period, options=options).starts
-    names = sorted({k for s in segments for k in s.observed})
+    bias = dict(bias or {})
+
+    def unbiased(seg: Segment) -> Segment:
+        observed = {k: v - bias.get(k, 0.0) for k, v in seg.observed.items()}
+        return replace(seg, observed=observed, parameters={**seg.parameters, **estimates})
+
+    firsts = [unbiased(segments[i]) for i, _ in pairs]
+    starts = _starts(system, firsts, [anchors.get(keys[i][0]) for i, _ in pairs] if anchors else None, period,
+                     options)
+    joined = [replace(unbiased(segments[i]),
+                      tau=np.concatenate([segments[i].tau, segments[j].tau]),
+                      observed={k: np.concatenate([segments[i].observed[k], segments[j].observed[k]]) - bias.get(k, 0.0)
+                                for k in segments[j].observed if k in segments[i].observed})
+              for i, j in pairs]
+    problem = Problem(system, joined, [], [], period, options)
+    run = problem.run(np.zeros(0), starts, False)
+    names = list(dict.fromkeys(k for s in joined for k in s.observed))
     tau, measured, predicted, states = [], {k: [] for k in names}, {k: [] for k in names}, []
-    state_names = [s.name for s in system.states]
-    for (i, j), seg, start in zip(pairs, fixed, starts.T):
-        samples = len(seg.tau)
-        Y = simulate_segment(system, seg, start, None, period, samples=2 * samples, options=options)[:, samples:]
-        nxt = segments[j]
-        tau.append(nxt.tau)
-        states.append(Y)
-        for k in names:
-            measured[k].append(nxt.observed[k])
-            predicted[k].append(Y[state_names.index(k)])
+    for k, ((i, j), seg) in enumerate(zip(pairs, joined)):
+        ahead = slice(problem.offsets[k] + len(segments[i].tau), problem.offsets[k + 1])
+        tau.append(segments[j].tau)
+        states.append(run.states[:, ahead])
+        for name, c in problem.channel_index[k].items():
+            measured[name].append(segments[j].observed[name] - bias.get(name, 0.0))
+            predicted[name].append(run.outputs[c, ahead])
     measured = {k: np.concatenate(v) for k, v in measured.items()}
     predicted = {k: np.concatenate(v) for k, v in predicted.items()}
-    errors = [np.sqrt(np.mean((predicted[k] - measured[k]) ** 2)) / (np.std(measured[k]) or 1.0) for k in names]
-    return Prediction(float(np.mean(errors)), np.concatenate(tau), measured, predicted, np.hstack(states), len(pairs))
+    errors = {k: float(np.sqrt(np.mean((predicted[k] - measured[k]) ** 2)) / (np.std(measured[k]) or 1.0))
+              for k in names}
+    return Prediction(float(np.mean(list(errors.values()))), np.concatenate(tau), measured, predicted,
+                      np.hstack(states), len(pairs), errors)

@@ -1,7 +1,14 @@
-"""What ``gearsym explain`` writes: report.md, report.json, figures and the derived model's equations."""
+"""What ``gearsym explain`` writes: report.md, report.json, figures and the derived model's equations.
+
+The page leads with the verdict; then each candidate with its held-out error (and why a rejected one
+was), the residual's spectrum in harmonics of the forcing with the orders that stand out, the terms
+proposed beyond the library, and the estimates before and after in canonical form (amplitudes >= 0,
+phases in (-pi, pi]; not identifiable or at a physical bound where so).
+"""
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import matplotlib
@@ -14,8 +21,15 @@ import sympy as sp  # noqa: E402
 from ..checks import json_safe  # noqa: E402
 from ..figures.save import save_figure  # noqa: E402
 from ..system import FirstOrderSystem  # noqa: E402
-from .effects import EFFECTS, augment, effect_terms, mesh_term  # noqa: E402
-from .explain import Candidate, Explanation  # noqa: E402
+from .effects import augment, effect_terms  # noqa: E402
+from .explain import MIN_SCORE, Candidate, Explanation  # noqa: E402
+
+VERDICTS = {
+    "explained": "the effects added explain the data: what is left looks like measurement noise",
+    "partly explained": "the effects added lower the error, but something systematic is left",
+    "unexplained": "no effect of the library explains what the model misses",
+    "nothing missing": "the model as declared predicts the data to the noise: no effect is missing",
+}
 
 
 def write_report(ex: Explanation, system: FirstOrderSystem, out: str | Path, sources=()) -> dict:
@@ -24,62 +38,132 @@ def write_report(ex: Explanation, system: FirstOrderSystem, out: str | Path, sou
     out.mkdir(parents=True, exist_ok=True)
     data = json_safe(ex.as_dict())
     (out / "report.json").write_text(json.dumps(data, indent=1, allow_nan=False) + "\n")
-    _residual_figure(ex, out / "residuals.png")
+    save_figure(residual_figure(ex, system), out / "residuals.png", dpi=100)
     _prediction_figure(ex, out / "prediction.png")
-    derived = augment(system, ex.effects) if ex.effects else system
-    (out / "derived_model.md").write_text(derived_model_page(system, derived, ex.effects))
+    effects = [ex.library[e] for e in ex.effects]
+    derived = augment(system, effects) if effects else system
+    (out / "derived_model.md").write_text(derived_model_page(system, derived, effects))
     (out / "report.md").write_text(report_page(ex, system, derived, data, sources))
     return data
 
 
 def report_page(ex: Explanation, system: FirstOrderSystem, derived: FirstOrderSystem, data: dict, sources) -> str:
     before, after = ex.base, ex.final
-    lines = [f"# What the data say {system.name} lacks", "",
-             "<!-- written by `gearsym explain` -->", ""]
+    lines = [f"# What the data say {system.name} lacks", "", "<!-- written by `gearsym explain` -->", ""]
+    lines += [f"## Verdict: {ex.verdict}", "", f"**{VERDICTS[ex.verdict].capitalize()}.**", ""]
+    if ex.effects:
+        lines += [f"- Added: **{', '.join(ex.effects)}**. Held-out error {before.error:.4g} → {after.error:.4g} "
+                  f"({before.error / after.error:.1f}× lower)."]
+    else:
+        lines += [f"- No effect added: no candidate lowered the held-out error ({before.error:.4g}) by the required "
+                  "margin."]
+    for name, h in data["harmonics"].items():
+        lines += [f"- {name}: order {h['order']}, amplitude {_pm(h['amplitude'], h['amplitude_stderr'])}, phase "
+                  f"{_pm(h['phase'], h['phase_stderr'])} rad (the term {h['form'].replace('A', 'amplitude')})."]
+    state = "is not noise" if ex.unexplained else "looks like measurement noise"
+    lines += [f"- The held-out residual {state}: its sample-to-sample correlation is {ex.correlation:.2f} (above "
+              f"0.5 means something systematic is left)."]
+    if data["not_identifiable"]:
+        lines += [f"- Not identifiable from these data: {', '.join(data['not_identifiable'])}."]
+    for a, b, rho in data["correlated"]:
+        lines += [f"- Strongly correlated: {a} and {b} (correlation {rho:+.3f}): the data fix a combination of the "
+                  "two better than either."]
+    if ex.proposed:
+        best = ex.proposed[0]
+        lines += [f"- Beyond the library, the residual asks for `{best.term}`: refitted with it, the held-out error is "
+                  f"{best.error:.4g} (see *Proposed terms*; try it with `--add-term \"{best.term}\"`)."]
+    lines += [""]
     if sources:
         lines += ["Data: " + ", ".join(f"`{Path(s).name}`" for s in sources) + ".", ""]
-    lines += [f"Fitted: {', '.join(ex.fitted)} (and every window's start state), by multiple shooting over "
-              f"one-forcing-period windows; the last {ex.held_out:.0%} of each record is held out and judged by "
-              "the one-period-ahead prediction error (normalised RMS).", "", "## Verdict", ""]
+    channels = ", ".join(dict.fromkeys(k for r in after.fit.residuals for k in r))
+    lines += [f"Fitted: {', '.join(ex.fitted)} (and every window's start state"
+              + (f", and the offsets of {', '.join(ex.bias)}" if ex.bias else "")
+              + f"), by multiple shooting over one-forcing-period windows of the channels {channels}; the last "
+              f"{ex.held_out:.0%} of each record is held out and judged by the one-period-ahead prediction error "
+              "(normalised RMS).", ""]
+    lines += _candidates(ex) + _spectrum(ex) + _proposals(ex) + _estimates(ex, data)
+    lines += ["## The derived model", ""]
     if ex.effects:
-        lines += [f"**Added: {', '.join(ex.effects)}.** Held-out error {before.error:.4g} → {after.error:.4g} "
-                  f"({before.error / after.error:.1f}× lower).", ""]
-    else:
-        lines += [f"**No effect added.** No candidate lowered the held-out error ({before.error:.4g}) by the "
-                  "required margin.", ""]
-    if ex.unexplained:
-        lines += [f"**Unexplained: yes.** The held-out residual is not noise: its sample-to-sample correlation is "
-                  f"{ex.correlation:.2f}. Something systematic is left that none of the candidate effects describes; "
-                  "see where it lives in `residuals.png` (against mesh phase, state and velocity, and its spectrum in "
-                  "harmonics of the forcing).", ""]
-    else:
-        lines += [f"**Unexplained: no.** The held-out residual looks like measurement noise (sample-to-sample "
-                  f"correlation {ex.correlation:.2f}).", ""]
-    lines += ["## Candidates (held-out error, lower is better)", "",
-              "| model | held-out error | training σ | " + " | ".join(_names(ex)) + " |",
-              "|---|---|---|" + "---|" * len(_names(ex))]
-    for c in ex.tried:
-        lines.append(f"| {'+'.join(c.effects) or 'as declared'} | {c.error:.4g} | {c.fit.sigma:.4g} | "
-                     + " | ".join(_estimate(c, n) for n in _names(ex)) + " |")
-    lines += ["", "## Estimates", "", "| parameter | before | after |", "|---|---|---|"]
-    for name in dict.fromkeys([*before.fit.estimates, *after.fit.estimates]):
-        lines.append(f"| {name} | {_estimate(before, name)} | {_estimate(after, name)} |")
-    lines += ["", "## The derived model", ""]
-    if ex.effects:
-        terms = effect_terms(system, ex.effects)
-        m = mesh_term(system)
-        for name, term in terms.items():
-            lines += [f"- **{name}** ({EFFECTS[name].description}) adds to $d{sp.latex(m.v)}/d\\tau$:", "",
-                      f"$$ {sp.latex(term)} $$", ""]
+        for name, rows in effect_terms(system, [ex.library[e] for e in ex.effects]).items():
+            lines += [f"- **{name}** ({ex.library[name].description}) adds:", ""]
+            for state, term in rows.items():
+                lines += [f"$$ \\frac{{d{sp.latex(sp.Symbol(state))}}}{{d\\tau}} \\mathrel{{+}}= {sp.latex(term)} $$", ""]
         lines += [f"Full equations of `{derived.name}`: [`derived_model.md`](derived_model.md).", ""]
     else:
         lines += ["The model as declared.", ""]
     lines += ["## Figures", "", "![held-out prediction before and after](prediction.png)", "",
-              "*One period ahead on the held-out data: measurement, and the model before and after.*", "",
+              "*One period ahead on the held-out data: the measurement, and the model as declared and after.*", "",
               "![residuals](residuals.png)", "",
-              "*Held-out residual (measurement − prediction) against mesh phase, state and velocity, and its "
-              "spectrum in harmonics of the forcing: before (grey) and after (black).*", ""]
+              "*The held-out residual (measurement − prediction) against the mesh phase, the coordinate and its "
+              "rate, as declared (grey) and after (black); and its spectrum in harmonics of the forcing, with the "
+              "level white noise would reach.*", ""]
     return "\n".join(lines)
+
+
+def _candidates(ex: Explanation) -> list[str]:
+    lines = ["## Candidates (held-out error, lower is better)", "",
+             "| model | held-out error | training σ | its estimates | note |", "|---|---|---|---|---|"]
+    for c in ex.tried:
+        own = [p for e in c.effects for p in ex.library[e].fitted] or list(ex.fitted)
+        shown = ", ".join(f"{p} = {_estimate(c, p)}" for p in own)
+        note = f"rejected: {c.rejected}" if c.rejected else ("**chosen**" if c is ex.final and c.effects else "")
+        lines.append(f"| {'+'.join(c.effects) or 'as declared'} | {c.error:.4g} | {c.fit.sigma:.4g} | {shown} | {note} |")
+    lines.append("")
+    for step in ex.info.get("screened", []):
+        skipped = [name for name in step["gains"] if name not in step["refitted"]]
+        if not skipped:
+            continue
+        after = f"after {'+'.join(step['after'])}" if step["after"] else "as declared"
+        shown = "; ".join(f"{name}: {step['why_not'][name]}" if name in step["why_not"]
+                          else f"{name} {step['gains'][name]:.2g}" for name in skipped)
+        lines += [f"Screened out {after} by the linearised gain (the fraction of the residual a candidate would remove "
+                  f"to first order; those of {MIN_SCORE:g} or more are refitted, the largest first): {shown}.", ""]
+    return lines
+
+
+def _spectrum(ex: Explanation) -> list[str]:
+    if ex.spectrum is None:
+        return []
+    s0, s1 = ex.spectrum, ex.final_spectrum
+    lines = ["## The residual's spectrum (harmonics of the forcing)", "",
+             "Amplitude of the held-out residual at each harmonic, relative to each channel's spread; white noise "
+             f"would reach about {s0.noise:.2g}. Orders that stand out as declared: "
+             f"{', '.join(map(str, s0.standout)) or 'none'}"
+             + (f"; after: {', '.join(map(str, s1.standout)) or 'none'}" if s1 is not s0 and ex.effects else "") + ".",
+             "", "| order | " + " | ".join(map(str, s0.orders)) + " |", "|---|" + "---|" * len(s0.orders),
+             "| as declared | " + " | ".join(_amp(a, o in s0.standout) for o, a in zip(s0.orders, s0.amplitude)) + " |"]
+    if ex.effects:
+        lines.append("| after | " + " | ".join(_amp(a, o in s1.standout) for o, a in zip(s1.orders, s1.amplitude))
+                     + " |")
+    return lines + [""]
+
+
+def _amp(value: float, standout: bool) -> str:
+    return f"**{value:.3g}**" if standout else f"{value:.3g}"
+
+
+def _proposals(ex: Explanation) -> list[str]:
+    if not ex.proposed:
+        return []
+    lines = ["## Proposed terms (beyond the library)", "",
+             "Terms of a generic dictionary (polynomials in the states, g(x, η) and its powers, harmonics of τ, their "
+             "products) that a sparse regression of the residual chose, each added to dv/dτ of the mesh coordinate "
+             "and refitted (`g` is the mesh's g(x, η)):", "",
+             "| term | coefficient | held-out error (without → with) |", "|---|---|---|"]
+    for p in ex.proposed:
+        lines.append(f"| `{p.term}` | {_pm(p.coefficient, p.stderr)} | {p.error_before:.4g} → {p.error:.4g} |")
+    return lines + ["", "Accept one with `gearsym explain ... --add-term \"TERM\"`: it is then tried like any effect.", ""]
+
+
+def _estimates(ex: Explanation, data: dict) -> list[str]:
+    before, after = ex.base, ex.final
+    lines = ["## Estimates (amplitudes ≥ 0, phases in (−π, π])", "", "| parameter | before | after |", "|---|---|---|"]
+    for name in dict.fromkeys([*before.fit.estimates, *after.fit.estimates]):
+        lines.append(f"| {name} | {_estimate(before, name)} | {_estimate(after, name)} |")
+    for name in after.fit.bias:
+        lines.append(f"| offset of {name} | {_pm(before.fit.bias[name], before.fit.bias_stderr[name])} | "
+                     f"{_pm(after.fit.bias[name], after.fit.bias_stderr[name])} |")
+    return lines + [""]
 
 
 def derived_model_page(system: FirstOrderSystem, derived: FirstOrderSystem, effects) -> str:
@@ -90,67 +174,94 @@ def derived_model_page(system: FirstOrderSystem, derived: FirstOrderSystem, effe
         lines += [f"$$ \\frac{{d{sp.latex(s)}}}{{d\\tau}} = {sp.latex(f)} $$", ""]
     if effects:
         lines += ["Terms added to the declared model:", ""]
-        for name, term in effect_terms(system, effects).items():
-            lines += [f"- {name}: $ {sp.latex(term)} $"]
+        for name, rows in effect_terms(system, effects).items():
+            for state, term in rows.items():
+                lines += [f"- {name}, in d{state}/dτ: $ {sp.latex(term)} $"]
         new = [p for p in derived.parameters if p not in system.parameters]
         lines += ["", "New parameters: " + ", ".join(f"`{p}`" for p in new) + ".", ""]
     return "\n".join(lines)
 
 
-def _names(ex: Explanation) -> list[str]:
-    return list(dict.fromkeys(n for c in ex.tried for n in c.fit.estimates))
+def _pm(value: float, err: float | None) -> str:
+    return f"{value:.4g} ± {err:.2g}" if err is not None and math.isfinite(err) else f"{value:.4g}"
 
 
 def _estimate(c: Candidate, name: str) -> str:
-    if name not in c.fit.estimates:
+    f = c.fit
+    if name not in f.estimates:
         return ""
-    return f"{c.fit.estimates[name]:.4g} ± {c.fit.stderr[name]:.2g}"
+    if name in f.at_bound:
+        return f"{f.estimates[name]:.4g} (at its bound)"
+    if not f.identifiable.get(name, True):
+        return "not identifiable"
+    return _pm(f.estimates[name], f.stderr[name])
 
 
-def _phase_views(c: Candidate, system: FirstOrderSystem):
+def _views(c: Candidate, system: FirstOrderSystem):
+    """Mesh phase, the mesh coordinate and its rate along the prediction, and the first channel's residual."""
     p = c.prediction
-    names = [s.name for s in system.states]
-    coordinate = next(iter(p.residual))
-    return (np.mod(p.tau, 2 * np.pi), p.states[names.index(coordinate)],
-            p.states[min(names.index(coordinate) + 1, len(names) - 1)], p.residual[coordinate], coordinate)
+    names = system.state_names
+    mesh = next((cp for cp in system.couplings if cp.kind == "mesh"), None)
+    x = names.index(mesh.coordinate) if mesh else 0
+    v = names.index(mesh.velocity) if mesh else min(1, len(names) - 1)
+    channel = next(iter(p.residual))
+    return np.mod(p.tau, 2 * np.pi), p.states[x], p.states[v], p.residual[channel], channel, names[x], names[v]
 
 
-def _residual_figure(ex: Explanation, path: Path) -> None:
-    fig, axs = plt.subplots(1, 4, figsize=(16, 3.6), constrained_layout=True)
-    for c, color, label in ((ex.base, "0.65", "as declared"), (ex.final, "k", "+".join(ex.effects) or "as declared")):
-        if c is ex.final and not ex.effects:
-            continue
-        phase, x, v, r, coordinate = _phase_views(c, c.fit.system)
+def residual_figure(ex: Explanation, system: FirstOrderSystem):
+    """Where the held-out residual lives (against the mesh phase, the coordinate and its rate) and its spectrum:
+    the model as declared always, and after when effects were added."""
+    fig, axs = plt.subplots(1, 4, figsize=(17, 3.8), constrained_layout=True)
+    shown = [(ex.base, "0.6", "as declared")]
+    if ex.effects:
+        shown.append((ex.final, "k", "+" + "+".join(ex.effects)))
+    for c, color, label in shown:
+        phase, x, v, r, channel, xname, vname = _views(c, system)
         for ax, what in zip(axs[:3], (phase, x, v)):
             ax.plot(what, r, ".", ms=2, color=color, label=label)
-        spectrum = np.abs(np.fft.rfft(r - r.mean())) / len(r)
-        harmonics = np.fft.rfftfreq(len(r), d=float(np.median(np.diff(c.prediction.tau)))) * 2 * np.pi
-        axs[3].semilogy(harmonics[1:], spectrum[1:], color=color, lw=1, label=label)  # the mean is removed
-    for ax, xlabel in zip(axs, ("mesh phase τ mod 2π", "state (predicted)", "velocity (predicted)",
-                                "frequency (harmonics of the forcing)")):
+    titles = ("residual against the mesh phase", f"against {xname}", f"against {vname}")
+    for ax, xlabel, title in zip(axs, ("τ mod 2π", f"{xname} (predicted)", f"{vname} (predicted)"), titles):
         ax.set_xlabel(xlabel)
-    axs[0].set_ylabel("held-out residual")
-    axs[3].set_xlim(0, 8)
+        ax.set_title(title, fontsize=10)
+    axs[0].set_ylabel(f"held-out residual of {channel}")
+    axs[0].legend(fontsize=8, markerscale=4)
+    spectra = [(ex.spectrum, "0.6", "as declared")] + ([(ex.final_spectrum, "k", "after")] if ex.effects else [])
+    width = 0.8 / len(spectra)
+    for i, (s, color, label) in enumerate(spectra):
+        if s is None:
+            continue
+        orders = np.array(s.orders)
+        axs[3].bar(orders + (i - (len(spectra) - 1) / 2) * width, s.amplitude, width, color=color, label=label)
+        for o in s.standout:
+            axs[3].annotate(str(o), (o + (i - (len(spectra) - 1) / 2) * width, s.amplitude[o - 1]), ha="center",
+                            va="bottom", fontsize=8)
+    if ex.spectrum is not None:
+        axs[3].axhline(ex.spectrum.noise, color="C3", lw=0.8, ls="--", label="white noise (1 s.e.)")
+        axs[3].set_xticks(list(ex.spectrum.orders))
+    axs[3].set_xlabel("harmonic of the forcing")
+    axs[3].set_ylabel("amplitude / channel spread")
+    axs[3].set_title("held-out residual's spectrum (numbers: orders tried)", fontsize=10)
     axs[3].legend(fontsize=8)
-    save_figure(fig, path, dpi=100)
+    return fig
 
 
 def _prediction_figure(ex: Explanation, path: Path) -> None:
     p0, p1 = ex.base.prediction, ex.final.prediction
-    coordinate = next(iter(p0.measured))
+    channel = next(iter(p0.measured))
     count = min(len(p0.tau), 3 * len(p0.tau) // max(p0.pairs, 1))  # the first three predicted periods
     idx = np.arange(count)
     fig, ax = plt.subplots(figsize=(11, 3.6), constrained_layout=True)
-    ax.plot(idx, p0.measured[coordinate][:count], ".", ms=3, color="C0", label="measured (held out)")
-    ax.plot(idx, p0.predicted[coordinate][:count], "-", color="0.6", lw=1.2,
+    ax.plot(idx, p0.measured[channel][:count], ".", ms=3, color="C0", label="measured (held out)")
+    ax.plot(idx, p0.predicted[channel][:count], "-", color="0.6", lw=1.2,
             label=f"as declared: error {ex.base.error:.3g}")
     if ex.effects:
-        ax.plot(idx, p1.predicted[coordinate][:count], "-", color="k", lw=1,
+        ax.plot(idx, p1.predicted[channel][:count], "-", color="k", lw=1,
                 label=f"+{'+'.join(ex.effects)}: error {ex.final.error:.3g}")
     ax.set_xlabel("held-out sample (one period ahead of each estimated start)")
-    ax.set_ylabel(coordinate)
+    ax.set_ylabel(channel)
+    ax.set_title(f"one-period-ahead prediction of {channel} on the held-out data", fontsize=10)
     ax.legend(fontsize=8)
     save_figure(fig, path, dpi=100)
 
 
-__all__ = ["derived_model_page", "report_page", "write_report"]
+__all__ = ["derived_model_page", "report_page", "residual_figure", "write_report"]

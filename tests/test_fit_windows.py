@@ -1,0 +1,66 @@
+"""The fit's compiled windows: outputs and their derivatives by the start state and every parameter, in one C
+call for all windows, the same as CasADi's in-process evaluation and as finite differences of the flow."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import conftest
+from gearsym.codegen.windows import Windows
+from gearsym.fit import augment
+
+
+@pytest.fixture(scope="module")
+def case():
+    system = augment(conftest.system("one_stage"), ["cubic_stiffness", "torque_harmonic_3"],
+                     values={"k3": 0.01, "B_c3": 0.4, "B_s3": -0.2})
+    x, v = system.states
+    channels = [x, system.rhs[1], sp.cos(7 * system.time) * x]  # a state, the acceleration, a high harmonic
+    K = 5
+    rng = np.random.default_rng(2)
+    starts = np.vstack([rng.uniform(-12, 4, K), rng.uniform(-2, 2, K)])
+    t0 = rng.uniform(0, 30, K)
+    dt = np.full(K, 2 * np.pi / 37.3)
+    samples = np.array([37, 38, 37, 38, 37])
+    substeps = np.full(K, 6)
+    p = np.tile(np.array(list(system.parameters.values()))[:, None], (1, K))
+    return system, channels, (starts, t0, dt, samples, substeps, p)
+
+
+def test_compiled_and_in_process_windows_agree(case):
+    system, channels, args = case
+    compiled = Windows(system, channels, "compiled").run(*args)
+    inprocess = Windows(system, channels, "in-process").run(*args)
+    for a, b in zip((compiled.states, compiled.outputs, compiled.derivatives),
+                    (inprocess.states, inprocess.outputs, inprocess.derivatives)):
+        np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+
+
+def test_window_derivatives_are_those_of_the_discrete_flow(case):
+    system, channels, (starts, t0, dt, samples, substeps, p) = case
+    windows = Windows(system, channels, "compiled")
+    run = windows.run(starts, t0, dt, samples, substeps, p)
+    n = system.dimension
+    names = list(system.parameters)
+    for column in (0, 1, n + names.index("zeta"), n + names.index("k3"), n + names.index("B_s3")):
+        h = 1e-6
+        up, down = starts.copy(), starts.copy()
+        pu, pd = p.copy(), p.copy()
+        if column < n:
+            up[column] += h
+            down[column] -= h
+        else:
+            pu[column - n] += h
+            pd[column - n] -= h
+        diff = (windows.run(up, t0, dt, samples, substeps, pu, tangent=False).outputs
+                - windows.run(down, t0, dt, samples, substeps, pd, tangent=False).outputs) / (2 * h)
+        scale = np.abs(run.derivatives[:, column, :]).max()
+        np.testing.assert_allclose(run.derivatives[:, column, :], diff, atol=1e-6 * scale)
+
+
+def test_harmonics_of_time_are_evaluated_exactly(case):
+    system, channels, (starts, t0, dt, samples, substeps, p) = case
+    run = Windows(system, channels, "compiled").run(starts, t0, dt, samples, substeps, p, tangent=False)
+    tau = np.concatenate([t + d * np.arange(s) for t, d, s in zip(t0, dt, samples)])
+    np.testing.assert_allclose(run.outputs[2], np.cos(7 * tau) * run.states[0], rtol=0, atol=1e-12 * 20)
