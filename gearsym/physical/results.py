@@ -159,7 +159,7 @@ def mesh_forces(scaling: Scaling, trajectory, omega: float) -> dict[str, pint.Qu
         phase = evaluate(rc.mesh_phase.xreplace({omega_symbol: 0, t: 0}), si, where).to("").magnitude
         k_of_phi = sp.lambdify(phi, variation, "numpy")
         x = state_to_physical(scaling, c.name, trajectory[c.name], omega, "m").magnitude
-        v = state_to_physical(scaling, c.velocity_name, trajectory[c.velocity_name], omega, "m/s").magnitude
+        v = state_to_physical(scaling, c.velocity_name, trajectory[c.velocity_name], omega).to("m/s").magnitude
         contact = np.where(x >= 0, x, np.where(x > -eta, 0.0, x + eta))  # g(x, eta), gearsym.backlash
         k = np.asarray(k_of_phi(float(rc.order) * tau + phase), dtype=float) * np.ones_like(tau)
         out[rc.name] = Quantity(stiffness * k * contact + damping * v, "N")
