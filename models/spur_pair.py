@@ -37,10 +37,10 @@ model.add(Mesh("mesh", pinion, wheel, stiffness="kZ", damping="cZ", backlash="et
 model.add(Torque("M1", on=pinion, mean="M1", harmonics=(Harmonic("M1a", phase="Theta", group="B1"),)))
 model.add(Torque("M2", on=wheel, mean="M2", load=True))
 model.set_physical(
-    I1=f"{inertia:.6g} kg*m^2", I2=f"{inertia:.6g} kg*m^2",
-    r1=f"{base_radius * 1e3:.6g} mm", r2=f"{base_radius * 1e3:.6g} mm",
-    kZ=f"{stiffness:.6g} N/m", cZ=f"{damping:.6g} N*s/m", eta="100 um",
-    M1=f"{TORQUE} N*m", M2=f"{TORQUE} N*m", M1a=f"{0.1 * TORQUE:.6g} N*m", Theta=0, k_a=0.2,
+    I1=f"{inertia:.9g} kg*m^2", I2=f"{inertia:.9g} kg*m^2",
+    r1=f"{base_radius * 1e3:.9g} mm", r2=f"{base_radius * 1e3:.9g} mm",
+    kZ=f"{stiffness:.9g} N/m", cZ=f"{damping:.9g} N*s/m", eta="100 um",
+    M1=f"{TORQUE} N*m", M2=f"{TORQUE} N*m", M1a=f"{0.1 * TORQUE:.9g} N*m", Theta=0, k_a=0.2,
     speed="6000 rpm",
 )
 model.set_initial_state(x=1.0)  # at the static deflection (the length unit)
