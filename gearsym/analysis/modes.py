@@ -188,8 +188,9 @@ def _solve(nd, values: dict[str, float], unit: str, assumed: tuple[str, ...]) ->
 
 def _mode(frequency: float, kind: str, multiplicity: int, shape: np.ndarray, names: list[str],
           transform: np.ndarray, coordinates: list[str]) -> Mode:
-    """A mode with its shape scaled so that its largest angle component is +1."""
-    big = int(np.argmax(np.abs(shape)))
+    """A mode with its shape scaled so that its largest angle component (the first of equal ones) is +1."""
+    size = np.abs(shape)
+    big = int(np.flatnonzero(size >= size.max() * (1 - 1e-9))[0])
     shape = shape / shape[big]
     return Mode(frequency, kind, multiplicity, {n: float(v) for n, v in zip(names, shape)},
                 {c: float(v) for c, v in zip(coordinates, transform @ shape)})

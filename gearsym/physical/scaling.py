@@ -119,6 +119,7 @@ class Scaling:
             self.roles[self.speed.parameter] = (SPEED, self.speed.where)
         self.inputs = self._inputs(physical)  # name -> Quantity, in the units given
         self._check_dimensions()
+        self._check_conditions()
 
     # ------------------------------------------------------------------ inputs
     def _inputs(self, given: Mapping[str, object]) -> dict[str, pint.Quantity]:
@@ -168,6 +169,19 @@ class Scaling:
                                  f"{self.name}: {field.where}")
         for name, q in self.inputs.items():
             _exponents(q, f"{self.name}: {name}")
+
+    def _check_conditions(self) -> None:
+        """The reduction's assumptions (a torque balance, Eq. 10) must hold at the physical values."""
+        for c in self.model.conditions:
+            if c.kind == "time_unit":
+                continue
+            where = f"{self.name}: {c.description.split(':')[0]}"
+            terms = [evaluate(a, self.inputs, where).to_base_units()
+                     for a in sp.Add.make_args(sp.expand(c.equation.lhs - c.equation.rhs))]
+            off = sum(terms[1:], terms[0])
+            if abs(off.magnitude) > 1e-9 * max(abs(t.magnitude) for t in terms):
+                raise ModelError(f"the physical values break a condition of the reduction: {c.equation.lhs} = "
+                                 f"{c.equation.rhs} is {shown(off)} off ({c.description})", self.name)
 
     def with_values(self, **physical) -> "Scaling":
         """The same drivetrain with some physical values changed (``speed="3000 rpm"``)."""

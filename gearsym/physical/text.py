@@ -16,6 +16,8 @@ _NAME = r"[A-Za-zµμΩ°][A-Za-z0-9µμΩ_]*"
 _POWER = r"(?:\*\*|\^)\s*-?\d{1,2}"
 _UNIT = rf"(?:{_NAME}|\()(?:{_NAME}|\(|\)|{_POWER}|\*|/|\s)*"
 QUANTITY = re.compile(rf"\s*(?P<number>{_NUMBER})\s*(?P<unit>{_UNIT})?\s*")
+#: a power of a power (m**10**10): no unit needs one, and pint would compute it
+POWER_OF_POWER = re.compile(rf"{_POWER}\s*(?:\*\*|\^)")
 GRAMMAR = ("a quantity is a number and a unit made of unit names, * / ** ^ (whole powers) and parentheses, "
            "e.g. '2e8 N/m', '3000 rpm', '2.1e-3 kg*m^2', '50 um'")
 

@@ -19,7 +19,7 @@ from functools import lru_cache
 import pint
 
 from ..errors import GearsymError
-from .text import GRAMMAR, MAX_LENGTH, QUANTITY
+from .text import GRAMMAR, MAX_LENGTH, POWER_OF_POWER, QUANTITY
 
 ureg = pint.UnitRegistry(on_redefinition="ignore")
 with warnings.catch_warnings():
@@ -41,6 +41,8 @@ def parse_quantity(text: str, where: str) -> pint.Quantity:
     if not math.isfinite(number):
         raise GearsymError(f"{where}: {shown} is not a finite number")
     unit_text = (match["unit"] or "").strip()
+    if POWER_OF_POWER.search(unit_text):
+        raise GearsymError(f"{where}: {shown} raises a power to a power; {GRAMMAR}")
     if unit_text.count("(") != unit_text.count(")"):
         raise GearsymError(f"{where}: {shown} has unbalanced parentheses; {GRAMMAR}")
     return Quantity(number, unit(unit_text, where, shown)) if unit_text else Quantity(number)
