@@ -62,6 +62,8 @@ def test_the_scaling_follows_the_paper_conventions():
     assert s.omega_n.to("rad/s").magnitude == pytest.approx(math.sqrt(2e8 * m), rel=1e-12)
     assert s.values["zeta"] == pytest.approx(400 * m / (2 * math.sqrt(2e8 * m)), rel=1e-12)  # c/(2 m_e omega_n)
     assert s.values["B0"] == pytest.approx(1.0, rel=1e-12)  # the static deflection is the length unit
+    assert s.scaled("kZ") == pytest.approx(1.0, rel=1e-12)  # the mass unit makes the first mesh's stiffness 1 ...
+    assert s.scaled("cZ") == pytest.approx(2 * s.values["zeta"], rel=1e-12)  # ... and its damping 2 zeta (Eq. 3)
     static = (0.030 * 50 / 2e-3 + 0.045 * 75 / 3e-3) / (2e8 * m)
     assert s.length.to("m").magnitude == pytest.approx(static, rel=1e-12)
     assert s.values["eta"] == pytest.approx(60e-6 / static, rel=1e-12)
@@ -161,6 +163,18 @@ def test_two_inertias_on_a_shaft_have_the_frequency_of_the_textbook():
     assert modes.modes[0].angles == pytest.approx({"d1": 1.0, "d2": 1.0})
     elastic = modes.modes[1].angles  # the inertias swing against each other, 3:2
     assert elastic["d1"] / elastic["d2"] == pytest.approx(-3.0 / 2.0)
+
+
+def test_two_separate_trains_have_one_rigid_body_mode_each():
+    m = chain([1.0, 2.0], [3.0])
+    c = m.add(Disk("d3", inertia="J3"))
+    d = m.add(Disk("d4", inertia="J4"))
+    m.add(Shaft("s2", c, d, stiffness="k2", radius=1, coordinate="x2"))
+    m.set_defaults(J3=1.0, J4=1.0, k2=2.0)
+    modes = natural_modes(m)
+    rigid = [mode.angles for mode in modes.modes if mode.kind == "rigid"]
+    assert rigid == [{"d1": 1.0, "d2": 1.0, "d3": 0.0, "d4": 0.0}, {"d1": 0.0, "d2": 0.0, "d3": 1.0, "d4": 1.0}]
+    assert modes.frequencies == pytest.approx([0.0, 0.0, 2.0, math.sqrt(3.0 * 1.5)])
 
 
 def test_three_inertias_in_a_chain_match_the_hand_computed_frequencies():
