@@ -146,8 +146,7 @@ def physical_settings(model, values: dict):
 
 
 def _function_names(model) -> set[str]:
-    """The stiffness functions of a drivetrain (``k``) as a formula can replace them: the names a mesh declares,
-    else those the reduction gives."""
+    """The names of a drivetrain's stiffness functions (``k``), which take a formula, not a physical value."""
     from .reduce import reduce
 
     nd = model if hasattr(model, "functions") else reduce(model)

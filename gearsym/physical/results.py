@@ -171,7 +171,6 @@ def sweep_to_physical(scaling: Scaling, result, length_unit: str = LENGTH_UNIT):
     amplitudes and coordinates in ``length_unit``, rates in mm/s and exponents per second; ``units`` says
     which."""
     from ..sweep.grid import Axis
-    from ..sweep.result import SweepResult
 
     if result.axes[0].name != "omega":
         raise GearsymError(f"{scaling.name}: a sweep carried to physical units must run along omega first, "

@@ -30,7 +30,7 @@ import sympy as sp
 from ..errors import GearsymError, ModelError, UnknownParameterError
 from ..model.drivetrain import Drivetrain, ResolvedCoupling
 from ..symbols import parameter_symbol
-from .roles import SPEED, Role, fields, parameter_roles, physical_parameters
+from .roles import SPEED, fields, parameter_roles, physical_parameters
 from .units import Quantity, as_quantity, dimension_text, shown, ureg
 
 LENGTH_SCALES = ("static", "backlash")
