@@ -7,11 +7,14 @@ The one-stage gear pair of Litak & Friswell typed here from the paper (not gener
 with k(tau) = 1 + k_a sum_n c_n cos(n tau) and g the backlash, integrated by SciPy's DOP853 at tight
 tolerances, started at rest, sampled after a transient at a rate that is no whole multiple of the
 forcing, from an arbitrary phase, with Gaussian noise; ``extra`` is what the model lacks.
+
+``python tests/rig.py PATH`` writes the measurements of the second worked example of docs/data-loop.md.
 """
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from pathlib import Path
 
 import numpy as np
 from scipy.integrate import ode
@@ -58,15 +61,40 @@ def record(omega: float, *, extra: Callable | None = None, periods: float = 16.3
 
 
 def write(path, runs: Sequence[tuple[float, dict]], channels: Sequence[str] = ("x",), noise: float = 0.01,
-          seed: int = 1, bias: dict | None = None):
+          seed: int = 1, bias: dict | None = None, time_scale: float | None = None):
     """A tidy CSV of the runs (record, omega as a condition), each channel with noise ``noise`` times its spread
-    and a constant offset ``bias[channel]``."""
+    and a constant offset ``bias[channel]``; with ``time_scale`` s, in physical time: a column t = tau/s and the
+    derivatives per unit t (x_dot * s, x_ddot * s^2)."""
     rng = np.random.default_rng(seed)
-    lines = [",".join(["tau", "record", "omega", *channels])]
+    lines = [",".join(["tau" if time_scale is None else "t", "record", "omega", *channels])]
+    scale = 1.0 if time_scale is None else time_scale
     for i, (omega, run) in enumerate(runs, 1):
-        columns = [run[c] + (bias or {}).get(c, 0.0) + rng.normal(0, noise * np.std(run[c]), run[c].size)
-                   for c in channels]
+        clean = [run[c] * scale ** {"x_dot": 1, "x_ddot": 2}.get(c, 0) for c in channels]
+        columns = [c + (bias or {}).get(name, 0.0) + rng.normal(0, noise * np.std(c), c.size)
+                   for name, c in zip(channels, clean)]
         for j, tau in enumerate(run["tau"]):
-            lines.append(",".join([repr(float(tau)), str(i), repr(omega), *(repr(float(c[j])) for c in columns)]))
+            lines.append(",".join([repr(float(tau) / scale), str(i), repr(omega), *(repr(float(c[j])) for c in columns)]))
     path.write_text("\n".join(lines) + "\n")
     return path
+
+
+#: the second worked example of docs/data-loop.md: a torque ripple at twice the forcing, felt by an
+#: accelerometer with an offset, in seconds (tau = 250 t)
+EXAMPLE = {"omegas": (1.0, 1.8), "ripple": (1.2, 0.5), "offset": 5000.0, "time_scale": 250.0}
+
+
+def torque_ripple(tau: float, x: float, v: float, omega: float) -> float:
+    a, b = EXAMPLE["ripple"]
+    return (a * math.cos(2 * tau) + b * math.sin(2 * tau)) / omega**2
+
+
+def example(path) -> Path:
+    """Write the worked example's measurements (``python tests/rig.py PATH``)."""
+    runs = [(w, record(w, extra=torque_ripple)) for w in EXAMPLE["omegas"]]
+    return write(Path(path), runs, ("x_ddot",), bias={"x_ddot": EXAMPLE["offset"]}, time_scale=EXAMPLE["time_scale"])
+
+
+if __name__ == "__main__":
+    import sys
+
+    print(f"wrote {example(sys.argv[1])}")

@@ -331,3 +331,29 @@ def test_the_committed_worked_example_is_what_explain_writes(tmp_path):
     committed = json.loads((example / "report.json").read_text())
     assert report["effects"] == committed["effects"] == ["cubic_stiffness"]
     assert report["error_after"] == pytest.approx(committed["error_after"], rel=1e-6)
+
+
+RIG_EXAMPLE = REPO_ROOT / "docs" / "examples" / "explain-rig-accelerometer"
+
+
+def test_the_rig_example_data_are_what_the_documented_command_writes(tmp_path):
+    page = (REPO_ROOT / "docs" / "data-loop.md").read_text()
+    assert "python tests/rig.py measured.csv" in page
+    rig.example(tmp_path / "measured.csv")
+    assert (tmp_path / "measured.csv").read_bytes() == (RIG_EXAMPLE / "measured.csv").read_bytes(), (
+        "docs/examples/explain-rig-accelerometer/measured.csv is not what `python tests/rig.py` writes: rerun it")
+
+
+def test_the_committed_rig_example_is_what_explain_writes(tmp_path, monkeypatch, capsys):
+    page = (REPO_ROOT / "docs" / "data-loop.md").read_text()
+    command = re.search(r"^\s*gearsym explain measured.csv .*--time-scale.*$", page, re.M).group(0).strip()
+    (tmp_path / "measured.csv").write_bytes((RIG_EXAMPLE / "measured.csv").read_bytes())
+    monkeypatch.chdir(tmp_path)
+    assert main([*shlex.split(command)[1:], "--quiet"]) == 0
+    for name in ("report.md", "derived_model.md"):
+        assert (tmp_path / name).read_text() == (RIG_EXAMPLE / name).read_text(), (
+            f"docs/examples/explain-rig-accelerometer/{name} is out of date: rerun the commands in docs/data-loop.md")
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert report["verdict"] == "explained" and report["effects"] == ["torque_harmonic_2"]
+    assert report["harmonics"]["torque_harmonic_2"]["amplitude"] == pytest.approx(math.hypot(*rig.EXAMPLE["ripple"]),
+                                                                                  rel=0.02)

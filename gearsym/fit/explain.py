@@ -314,10 +314,10 @@ def linearised_gains(system: FirstOrderSystem, segments: Sequence[Segment], fit:
     u = np.concatenate([theta, [fit.bias[c] for c in problem.bias], fit.starts.reshape(-1, order="F")])
     r, J = problem(u)
     m = len(fitted)
-    D = J[:, m:m + len(params)]
-    Q, _ = np.linalg.qr(np.delete(J, np.s_[m:m + len(params)], axis=1))
-    y = -r - Q @ (Q.T @ -r)
-    D = D - Q @ (Q.T @ D)
+    D = J.P[:, m:m + len(params)]
+    nuisance = replace(J, P=np.delete(J.P, np.s_[m:m + len(params)], axis=1))
+    projected = nuisance.project_out(np.hstack([-r[:, None], D]))
+    y, D = projected[:, 0], projected[:, 1:]
     total = float(y @ y) or 1.0
     gains, at = {}, 0
     for name in names:

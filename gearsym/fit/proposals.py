@@ -145,14 +145,13 @@ def propose_terms(ex, superset: FirstOrderSystem, train: Sequence[Segment], test
     u = np.concatenate([theta, [final.bias[c] for c in problem.bias], final.starts.reshape(-1, order="F")])
     r, J = problem(u)
     m = len(names)
-    D = J[:, m:m + len(coefficients)]
-    nuisance = np.delete(J, np.s_[m:m + len(coefficients)], axis=1)
-    Q, _ = np.linalg.qr(nuisance)
-    y = -r  # data - model, scaled
-    projected = D - Q @ (Q.T @ D)
+    D = J.P[:, m:m + len(coefficients)]
+    nuisance = replace(J, P=np.delete(J.P, np.s_[m:m + len(coefficients)], axis=1))
+    both = nuisance.project_out(np.hstack([-r[:, None], D]))  # data - model (scaled), and the columns
+    y, projected = both[:, 0], both[:, 1:]
     # a term the fit's own directions already make (its column all but gone) would be noise blown up
     projected[:, np.linalg.norm(projected, axis=0) < 1e-6 * np.linalg.norm(D, axis=0)] = 0.0
-    coef, strength = sparse_regression(projected, y - Q @ (Q.T @ y))
+    coef, strength = sparse_regression(projected, y)
     chosen = [int(i) for i in np.argsort(-strength) if strength[i] > 0][:MAX_PROPOSALS]
     bounds = bounds_of([ex.library[e] for e in ex.final.effects])
     out = []

@@ -42,7 +42,7 @@ STRONG_CORRELATION = 0.95
 WARM_UP_PERIODS = 60
 #: times the fitted start states of windows are carried over to the next window and the fit rerun, where some
 #: state is unmeasured (each window then has its own local minima, e.g. an accelerometer in the backlash gap)
-POLISH_ROUNDS = 3
+POLISH_ROUNDS = 2
 
 
 @dataclass(frozen=True)
@@ -139,6 +139,7 @@ class Problem:
     def __init__(self, system: FirstOrderSystem, segments: Sequence[Segment], fit: list[str], bias: list[str],
                  period: float, options: Integration):
         self.system, self.segments, self.fit, self.period = system, list(segments), fit, period
+        self._integrated = None
         self.names = tuple(system.parameters)
         self.index = np.array([self.names.index(p) for p in fit], dtype=int)
         self.n, self.m = system.dimension, len(fit)
@@ -181,6 +182,7 @@ class Problem:
         self.data, self.weight = np.concatenate(data), np.concatenate(weight)
         self.bias_of = np.concatenate(bias_of)
         self.offsets = offsets
+        self.row_offsets = np.concatenate([[0], np.cumsum(np.bincount(self.window, minlength=self.K))])
         measured = {name for seg in segments for name in seg.observed if seg.channel(name) == sp.Symbol(name, real=True)}
         rates = {f.name: s.name for s, f in zip(system.states, system.rhs) if f.is_Symbol and f in system.states}
         # states neither measured nor the rate of a measured coordinate: their start is only guessed
@@ -189,6 +191,17 @@ class Problem:
     @property
     def K(self) -> int:
         return len(self.segments)
+
+    def integrated(self) -> list:
+        """Per window and coordinate x (with x' = v) measured through its acceleration or rate only: ((row of x,
+        row of v), (window, x - mean, v, amplitude of x)) from :func:`from_rate`, computed once."""
+        if self._integrated is None:
+            names = self.system.state_names
+            pairs = [(names.index(s.name), names.index(f.name)) for s, f in zip(self.system.states, self.system.rhs)
+                     if f.is_Symbol and f in self.system.states]
+            self._integrated = [((i, j), (k, *found)) for k, seg in enumerate(self.segments) for i, j in pairs
+                                if (found := from_rate(seg, names[i], self.period)) is not None]
+        return self._integrated
 
     def unknowns(self, windows: int) -> int:
         return self.m + len(self.bias) + self.n * windows
@@ -213,14 +226,51 @@ class Problem:
         if not jacobian:
             return r, None
         D = run.derivatives[self.rows[0], :, self.rows[1]] * self.weight[:, None]  # (residuals, n + parameters)
-        m, nb, n = self.m, len(self.bias), self.n
-        J = np.zeros((r.size, self.unknowns(self.K)))
-        J[:, :m] = D[:, n + self.index]
-        for j in range(nb):
-            J[:, m + j] = np.where(self.bias_of == j, self.weight, 0.0)
-        cols = m + nb + n * self.window[:, None] + np.arange(n)[None, :]
-        np.put_along_axis(J, cols, D[:, :n], axis=1)
-        return r, J
+        offsets = np.stack([np.where(self.bias_of == j, self.weight, 0.0) for j in range(len(self.bias))], axis=1) \
+            if self.bias else np.zeros((r.size, 0))
+        return r, Jacobian(np.hstack([D[:, self.n + self.index], offsets]), D[:, :self.n], self.window,
+                           self.row_offsets)
+
+
+@dataclass(frozen=True)
+class Jacobian:
+    """The Jacobian of the residuals by u = [theta, bias, S[:, 0], S[:, 1], ...], kept in its structure: the
+    columns of the parameters and offsets (``P``, dense) and each residual's derivatives by its own window's
+    start state (``S``; the rows of window k are ``rows[k]:rows[k + 1]``). The normal equations are then
+    solved by the Schur complement on the parameters: O(windows) work, and small arrays only (threaded BLAS
+    on a busy machine made the dense products of the whole J 10x slower)."""
+
+    P: np.ndarray  # (residuals, parameters + offsets)
+    S: np.ndarray  # (residuals, n)
+    window: np.ndarray  # (residuals,)
+    rows: np.ndarray  # (windows + 1,)
+
+    @property
+    def finite(self) -> bool:
+        return bool(np.all(np.isfinite(self.P)) and np.all(np.isfinite(self.S)))
+
+    def blocks(self, X: np.ndarray) -> np.ndarray:
+        """Per window, the sum over its rows of ``X`` (rows first)."""
+        return np.add.reduceat(X, self.rows[:-1], axis=0)
+
+    def normal(self, r: np.ndarray):
+        """U = P^T P, W_k = P_k^T S_k, V_k = S_k^T S_k and the gradients P^T r, S_k^T r."""
+        P, S = self.P, self.S
+        return (np.einsum("ri,rj->ij", P, P), self.blocks(np.einsum("ri,rj->rij", P, S)),
+                self.blocks(np.einsum("ri,rj->rij", S, S)), np.einsum("ri,r->i", P, r),
+                self.blocks(S * r[:, None]))
+
+    def project_out(self, Y: np.ndarray) -> np.ndarray:
+        """``Y`` (residuals x q) with what the start states and then the parameters' columns can make removed."""
+        def out_of_starts(X):
+            V = np.linalg.pinv(self.blocks(np.einsum("rn,rm->rnm", self.S, self.S)))
+            SX = self.blocks(np.einsum("rn,rq->rnq", self.S, X))
+            return X - np.einsum("rn,rnq->rq", self.S, np.einsum("knm,kmq->knq", V, SX)[self.window])
+
+        Y, P = out_of_starts(Y), out_of_starts(self.P)
+        if P.shape[1]:
+            Y = Y - P @ (np.linalg.pinv(np.einsum("ri,rj->ij", P, P)) @ np.einsum("ri,rq->iq", P, Y))
+        return Y
 
 
 def _bounds(system: FirstOrderSystem, fit: Sequence[str], given: Mapping[str, tuple], count: int):
@@ -243,26 +293,25 @@ def _levenberg_marquardt(problem: Problem, u, low, high, max_iterations: int):
     r, J = problem(u)
     cost, mu = float(r @ r), 1e-3
     converged, iteration = False, 0
-    if not (np.isfinite(cost) and np.all(np.isfinite(J))):  # the model does not even run from the first guess
+    if not (np.isfinite(cost) and J.finite):  # the model does not even run from the first guess
         return u, J, r, iteration, converged
+    p = J.P.shape[1]
     for iteration in range(1, max_iterations + 1):
-        A, grad = J.T @ J, J.T @ r
-        held = ((u <= low) & (grad > 0)) | ((u >= high) & (grad < 0))  # the descent would leave the box
-        free = ~held
-        Af, gf = A[np.ix_(free, free)], grad[free]
-        diag = np.maximum(np.diag(Af), 1e-12)
+        U, W, V, gP, gS = J.normal(r)
+        held = ((u[:p] <= low[:p]) & (gP > 0)) | ((u[:p] >= high[:p]) & (gP < 0))  # the descent would leave the box
         while True:
-            step = np.zeros_like(u)
             try:
-                step[free] = -np.linalg.solve(Af + mu * np.diag(diag), gf)
+                step = _damped_step(U, W, V, gP, gS, mu, ~held)
             except np.linalg.LinAlgError:
+                step = None
+            if step is None or not np.all(np.isfinite(step)):
                 mu *= 10
                 if mu > 1e12:
                     return u, J, r, iteration, converged
                 continue
             u_new = np.clip(u + step, low, high)
             r_new, J_new = problem(u_new)
-            new_cost = float(r_new @ r_new) if np.all(np.isfinite(r_new)) else np.inf
+            new_cost = float(r_new @ r_new) if np.all(np.isfinite(r_new)) and J_new.finite else np.inf
             if new_cost < cost:
                 break
             mu *= 10
@@ -278,6 +327,22 @@ def _levenberg_marquardt(problem: Problem, u, low, high, max_iterations: int):
     return u, J, r, iteration, converged
 
 
+def _damped_step(U, W, V, gP, gS, mu: float, free: np.ndarray) -> np.ndarray:
+    """The Levenberg-Marquardt step for [parameters (the ``free`` ones), start states] from the normal equations'
+    blocks, by the Schur complement on the parameters (the start-state blocks are n x n per window)."""
+    K, n = V.shape[0], V.shape[1]
+    dV = np.maximum(np.diagonal(V, axis1=1, axis2=2), 1e-12)
+    Vinv = np.linalg.inv(V + mu * dV[:, :, None] * np.eye(n))
+    dP = np.zeros(U.shape[0])
+    if free.any():
+        Uf, Wf = U[np.ix_(free, free)], W[:, free, :]
+        WVi = np.einsum("kpn,knm->kpm", Wf, Vinv)
+        schur = Uf + mu * np.diag(np.maximum(np.diag(Uf), 1e-12)) - np.einsum("kpm,kqm->pq", WVi, Wf)
+        dP[free] = -np.linalg.solve(schur, gP[free] - np.einsum("kpm,km->p", WVi, gS))
+    dS = -np.einsum("knm,km->kn", Vinv, gS + np.einsum("kpn,p->kn", W, dP))
+    return np.concatenate([dP, dS.reshape(-1)])
+
+
 def _result(problem: Problem, u, J, r, iterations, converged, low, high, why) -> Fit:
     theta, b, S = problem.split(u)
     m, nb = problem.m, len(problem.bias)
@@ -288,10 +353,10 @@ def _result(problem: Problem, u, J, r, iterations, converged, low, high, why) ->
         for bound, side in ((low[i], u[i] - low[i]), (high[i], high[i] - u[i])):
             if np.isfinite(bound) and side <= tol[i]:
                 at[name] = (float(bound), why.get(name, "bounded"))
-    held = np.array([n in at for n in problem.fit] + [False] * (u.size - m))
-    dof = max(1, r.size - int((~held).sum()))
+    held = np.array([n in at for n in problem.fit] + [False] * nb, dtype=bool)
+    dof = max(1, r.size - int((~held).sum()) - S.size)
     sigma2 = float(r @ r) / dof
-    stderr, identifiable, correlations, covariance = _uncertainty(J[:, ~held], sigma2, names, held[:m + nb])
+    stderr, identifiable, correlations, covariance = _uncertainty(J, r, sigma2, names, held)
     estimates = dict(zip(problem.fit, map(float, theta)))
     for name in at:
         stderr[name] = None
@@ -306,32 +371,32 @@ def _result(problem: Problem, u, J, r, iterations, converged, low, high, why) ->
         states.append(run.states[:, cols])
     return Fit(problem.system, estimates, {n: stderr[n] for n in problem.fit}, S, predicted, residuals,
                float(np.sqrt(sigma2)), converged, iterations,
-               {"residuals": int(r.size), "unknowns": int(J.shape[1])}, states,
+               {"residuals": int(r.size), "unknowns": int(u.size)}, states,
                dict(zip(problem.bias, map(float, b))), {c: stderr[f"bias:{c}"] for c in problem.bias},
                {n: identifiable[n] for n in problem.fit if n not in at}, at, correlations, covariance)
 
 
-def _uncertainty(J: np.ndarray, sigma2: float, names: list[str], held: np.ndarray):
-    """Standard errors (None: not identifiable), identifiability and strong correlations of the first
-    parameters (``names``, those not ``held`` at a bound come first in J's columns)."""
+def _uncertainty(J: Jacobian, r: np.ndarray, sigma2: float, names: list[str], held: np.ndarray):
+    """Standard errors (None: not identifiable), identifiability, strong correlations and the covariance of the
+    parameters and offsets ``names`` (those ``held`` at a bound left out), with the start states profiled out:
+    the information matrix on them is the Schur complement U - sum_k W_k V_k^+ W_k^T."""
     free_names = [n for n, h in zip(names, held) if not h]
     p = len(free_names)
-    if not np.all(np.isfinite(J)) or not np.isfinite(sigma2):  # a fit that went nowhere: nothing is determined
+    if not J.finite or not np.isfinite(sigma2):  # a fit that went nowhere: nothing is determined
         return {n: None for n in names}, {n: False for n in names}, [], {}
-    norms = np.linalg.norm(J, axis=0)
+    U, W, V, _, _ = J.normal(r)
+    free = ~np.asarray(held, dtype=bool)
+    U, W = U[np.ix_(free, free)], W[:, free, :]
+    info = U - np.einsum("kpn,knm,kqm->pq", W, np.linalg.pinv(V), W)
+    norms = np.sqrt(np.maximum(np.diag(U), 0.0))
     scale = np.where(norms > 0, norms, 1.0)
-    Jn = J / scale
-    # the singular values and vectors of Jn from its small Gram matrix (threaded LAPACK's SVD of the tall Jn is
-    # slow on a busy machine); the threshold is well above what the squaring can resolve
-    eigenvalues, V = np.linalg.eigh(Jn.T @ Jn)
-    order = np.argsort(eigenvalues)[::-1]
-    s, Vt = np.sqrt(np.maximum(eigenvalues[order], 0.0)), V[:, order].T
-    null = s < NULL_SPACE * (s[0] if s.size else 1.0)
-    weight = (Vt[null, :] ** 2).sum(axis=0) if null.any() else np.zeros(J.shape[1])
-    bad = (norms <= 1e-300 * max(1.0, norms.max(initial=0.0))) | (weight > 0.5)
-    inv = np.where(s > NULL_SPACE * (s[0] if s.size else 1.0), 1 / np.where(s > 0, s, 1) ** 2, 0.0)
-    cov_n = (Vt.T * inv) @ Vt  # (Jn^T Jn)^+
-    cov = sigma2 * cov_n / np.outer(scale, scale)
+    eigenvalues, vectors = np.linalg.eigh(info / np.outer(scale, scale))
+    top = max(float(eigenvalues.max(initial=0.0)), 1e-300)
+    null = eigenvalues < NULL_SPACE**2 * top  # the column-normalised J's singular values below NULL_SPACE
+    weight = (vectors[:, null] ** 2).sum(axis=1)
+    bad = (norms <= 1e-300) | (weight > 0.5)
+    inverse = np.where(null, 0.0, 1 / np.where(null, 1.0, eigenvalues))
+    cov = sigma2 * (vectors * inverse) @ vectors.T / np.outer(scale, scale)
     stderr = {n: None for n in names}
     identifiable = {n: False for n in names}
     for i, name in enumerate(free_names):
@@ -409,31 +474,24 @@ def _integrated(problem: Problem, free: np.ndarray, unknown: np.ndarray) -> list
     """More first guesses where a coordinate x is unmeasured but its acceleration (or rate) is: x and v at each
     window's start from the window's Fourier series integrated in time (one period: the oscillating part), the
     mean of x, which the integral cannot give, tried at several offsets around the model's run."""
-    system = problem.system
-    names = system.state_names
-    pairs = [(names.index(s.name), names.index(f.name)) for s, f in zip(system.states, system.rhs)
-             if f.is_Symbol and f in system.states]
+    known = problem.integrated()
+    if not known:
+        return []
     guesses = []
     for offset in np.linspace(-1.0, 1.0, 9):
         guess = free.copy()
-        for k, seg in enumerate(problem.segments):
-            for i, j in pairs:
-                if not (unknown[i, k] or unknown[j, k]):
-                    continue
-                x0, v0, amplitude = _from_acceleration(seg, names[i], problem.period)
-                if x0 is None:
-                    continue
-                if unknown[i, k]:
-                    guess[i, k] = free[i, k] + x0 + offset * (2 * amplitude + 1)
-                if unknown[j, k]:
-                    guess[j, k] = v0
+        for (i, j), (k, x0, v0, amplitude) in known:
+            if unknown[i, k]:
+                guess[i, k] = free[i, k] + x0 + offset * (2 * amplitude + 1)
+            if unknown[j, k]:
+                guess[j, k] = v0
         guesses.append(guess)
-    return guesses if any(not np.array_equal(g, free) for g in guesses) else []
+    return guesses
 
 
-def _from_acceleration(seg: Segment, name: str, period: float):
+def from_rate(seg: Segment, name: str, period: float):
     """(x - mean, v, amplitude of x) at the window's first sample from its x_ddot (or x_dot) channel, if it has one
-    that is a multiple of the derivative alone; (None, None, None) otherwise."""
+    that is a multiple of the derivative alone; None otherwise."""
     for suffix, order in (("_ddot", 2), ("_dot", 1)):
         placeholder = sp.Symbol(name + suffix, real=True)
         channel = next((c for c in seg.observed if seg.channel(c).free_symbols == {placeholder}
@@ -452,7 +510,7 @@ def _from_acceleration(seg: Segment, name: str, period: float):
         if order == 2:  # x'' = sum a cos + b sin: v = sum (a sin - b cos)/nw, x = -sum (a cos + b sin)/nw^2
             return float(-np.sum(a / nw**2)), float(-np.sum(b / nw)), float(np.sum(np.hypot(a, b) / nw**2))
         return float(-np.sum(b / nw)), float(rate[0]), float(np.sum(np.hypot(a, b) / nw))
-    return None, None, None
+    return None
 
 
 def _best_of(problem: Problem, theta: np.ndarray, guesses: list[np.ndarray], offsets=None) -> np.ndarray:
@@ -473,15 +531,31 @@ def _best_of(problem: Problem, theta: np.ndarray, guesses: list[np.ndarray], off
 
 
 def _free_run(problem: Problem, theta: np.ndarray) -> np.ndarray:
-    """The model's state at each window's first sample after ``WARM_UP_PERIODS`` periods from its initial state."""
-    period = problem.period
-    y0 = np.tile(np.array(problem.system.initial_vector)[:, None], (1, problem.K))
-    t0 = problem.t0 - WARM_UP_PERIODS * period
-    steps = np.ceil(problem.substeps * period / problem.dt).astype(np.int64)
-    run = problem.engine.run(y0, t0, np.full(problem.K, period), np.full(problem.K, WARM_UP_PERIODS + 1), steps,
-                             problem.parameters(theta), tangent=False)
-    last = np.cumsum(np.full(problem.K, WARM_UP_PERIODS + 1)) - 1
-    return run.states[:, last]
+    """The model's state at each window's first sample: one run per record from the model's initial state,
+    ``WARM_UP_PERIODS`` periods before the record's first window and on through its windows, then a hop of a
+    fraction of a sample step to each window's first sample."""
+    period, K = problem.period, problem.K
+    records = [seg.key[0] if seg.key else k for k, seg in enumerate(problem.segments)]
+    firsts = list(dict.fromkeys(records))
+    first = np.array([records.index(r) for r in firsts])
+    whole = np.array([np.round((problem.t0[k] - problem.t0[first[firsts.index(records[k])]]) / period)
+                      for k in range(K)], dtype=np.int64)
+    count = np.array([max(whole[k] for k in range(K) if records[k] == r) for r in firsts], dtype=np.int64)
+    steps = np.ceil(problem.substeps[first] * period / problem.dt[first]).astype(np.int64)
+    y0 = np.tile(np.array(problem.system.initial_vector)[:, None], (1, len(firsts)))
+    P = problem.parameters(theta)
+    samples = WARM_UP_PERIODS + count + 1
+    run = problem.engine.run(y0, problem.t0[first] - WARM_UP_PERIODS * period, np.full(len(firsts), period),
+                             samples, steps, P[:, first], tangent=False)
+    offsets = np.concatenate([[0], np.cumsum(samples)])
+    which = np.array([firsts.index(r) for r in records])
+    nodes = run.states[:, offsets[which] + WARM_UP_PERIODS + whole]
+    hop = problem.t0 - (problem.t0[first[which]] + whole * period)
+    if not np.any(hop):
+        return nodes
+    hopped = problem.engine.run(nodes, problem.t0 - hop, np.where(hop == 0, 1e-300, hop), np.full(K, 2),
+                                np.ones(K, dtype=np.int64), P, tangent=False)
+    return np.where(hop == 0, nodes, hopped.states[:, 1::2])
 
 
 def simulate_segment(system: FirstOrderSystem, seg: Segment, start, estimates: Mapping[str, float] | None = None,
