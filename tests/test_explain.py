@@ -357,3 +357,24 @@ def test_the_committed_rig_example_is_what_explain_writes(tmp_path, monkeypatch,
     assert report["verdict"] == "explained" and report["effects"] == ["torque_harmonic_2"]
     assert report["harmonics"]["torque_harmonic_2"]["amplitude"] == pytest.approx(math.hypot(*rig.EXAMPLE["ripple"]),
                                                                                   rel=0.02)
+
+
+def test_a_file_in_seconds_takes_the_time_unit_of_a_model_with_physical_values(tmp_path, monkeypatch):
+    import gearsym.fit
+    from gearsym.physical import scaling
+
+    passed = []
+
+    def recorded(paths, system, fit, *, time_scale=None, **rest):
+        passed.append(time_scale)
+        return {"verdict": "nothing missing", "effects": [], "error_before": 0.0, "error_after": 0.0,
+                "unexplained": False, "proposed": []}
+
+    monkeypatch.setattr(gearsym.fit, "explain_files", recorded)
+    command = ["explain", "measured.csv", "--model", "spur_pair", "--fit", "zeta", "--out", str(tmp_path), "--quiet"]
+    assert main(command) == 0
+    omega_n = scaling(conftest.reduced("spur_pair")).omega_n.to("rad/s").magnitude  # tau = omega_n t, t in seconds
+    assert passed == [pytest.approx(omega_n)] and omega_n > 1000
+    assert main(["explain", "measured.csv", "--model", "one_stage", "--fit", "zeta", "--out", str(tmp_path),
+                 "--quiet"]) == 0
+    assert passed[-1] is None  # a nondimensional model has no seconds: a t column needs --time-scale

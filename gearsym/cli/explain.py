@@ -5,7 +5,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .integration import add_integration_arguments, integration_from, system_from
+from .integration import add_integration_arguments, integration_from, scaling_from, system_from
 from .settings import add_set_argument
 
 NAME = "explain"
@@ -21,7 +21,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", type=Path, required=True, metavar="DIR",
                         help="where report.md, report.json, the figures and derived_model.md go")
     parser.add_argument("--time-scale", type=float, default=None,
-                        help="tau = TIME_SCALE * t, for files with a physical time column t")
+                        help="tau = TIME_SCALE * t, for files with a physical time column t (default for a model "
+                             "with physical values: its omega_n in rad/s, so t is in seconds)")
     parser.add_argument("--held-out", type=float, default=0.25,
                         help="fraction of each record (its last whole periods) held out for judging (default 0.25)")
     parser.add_argument("--effects", default=None, metavar="NAME,NAME",
@@ -54,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
     say = None if args.quiet else (lambda m: print(f"gearsym: {m}", file=sys.stderr, flush=True))
     options = integration_from(args)
     check_folder(args.out)  # before the model is reduced (seconds)
-    report = explain_files(args.data, system_from(args), fit, out=args.out, time_scale=args.time_scale,
+    report = explain_files(args.data, system_from(args), fit, out=args.out, time_scale=_time_scale(args),
                            held_out=args.held_out, candidates=candidates, progress=say, options=options,
                            channels=channels, bias=bias, terms=args.add_term, harmonics=args.harmonics)
     added = ", ".join(report["effects"]) or "none"
@@ -65,6 +66,14 @@ def run(args: argparse.Namespace) -> int:
               f"--add-term \"{p['term']}\"")
     print(f"wrote {args.out / 'report.md'} and report.json")
     return 0
+
+
+def _time_scale(args: argparse.Namespace) -> float | None:
+    """--time-scale, or for a model with physical values its time unit: tau = omega_n t with t in seconds."""
+    if args.time_scale is not None:
+        return args.time_scale
+    scaling = scaling_from(args)
+    return None if scaling is None else float(scaling.omega_n.to("rad/s").magnitude)
 
 
 def _channel(text: str) -> tuple[str, str]:
