@@ -267,7 +267,7 @@ def test_effects_extend_the_symbolic_model(one_stage):
         3 * one_stage.time) / parameter_symbol("omega") ** 2
 
 
-def test_bad_requests_say_what_is_wrong(one_stage, tmp_path):
+def test_bad_requests_say_what_is_wrong(one_stage, tmp_path, capsys):
     with pytest.raises(GearsymError, match="unknown effect 'cubic'.*cubic_stiffness"):
         augment(one_stage, ["cubic"])
     with pytest.raises(GearsymError, match="torque_harmonic needs its order: torque_harmonic_2"):
@@ -281,6 +281,11 @@ def test_bad_requests_say_what_is_wrong(one_stage, tmp_path):
         explain(one_stage, data, ["zetta"])
     with pytest.raises(GearsymError, match="bias of x_ddot: no such channel in the data \\(x\\)"):
         explain(one_stage, data, ["zeta"], bias=["x_ddot"])
+    injection = "__import__('os').system('touch pwned')"  # --add-term goes through the safe parser only
+    assert main(["explain", str(tmp_path / "bad.csv"), "--model", "one_stage", "--fit", "zeta", "--out",
+                 str(tmp_path / "out"), "--add-term", injection]) == 2
+    assert "gearsym: error: term" in capsys.readouterr().err and not (REPO_ROOT / "pwned").exists()
+    assert not (tmp_path / "pwned").exists() and not (tmp_path / "out" / "report.md").exists()
 
 
 def test_explain_command_writes_the_report(one_stage, tmp_path, capsys):
