@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 import re
 import shlex
 
@@ -26,7 +27,8 @@ from gearsym.fit import Effect, augment, effect_terms, fit_windows, term_effect
 from gearsym.fit.canonical import amplitude_phase, canonical, wrap_phase
 from gearsym.fit.effects import Change
 from gearsym.fit.explain import segments_of
-from gearsym.fit.report import residual_figure
+from gearsym.checks import json_safe
+from gearsym.fit.report import report_page, residual_figure
 from gearsym.paths import REPO_ROOT
 from gearsym.symbols import parameter_symbol
 
@@ -218,13 +220,37 @@ def test_a_parameter_the_data_cannot_determine_is_not_identifiable_never_zero_pl
     assert result.stderr["c_coast"] is None and result.stderr["zeta"] > 0
 
 
-def test_the_as_declared_residual_figure_is_drawn_when_no_effect_is_added(rig_runs, tmp_path):
+@pytest.fixture(scope="module")
+def clean_explained(rig_runs, tmp_path_factory):
+    """Clean rig data explained by the declared model, one candidate tried: (the declared model, the explanation)."""
     declared = conftest.system("one_stage", **RIG_VALUES["clean"])
-    ex = explain(declared, rig_data(rig_runs, tmp_path, "clean"), ["zeta"], candidates=["cubic_stiffness"])
+    data = rig_data(rig_runs, tmp_path_factory.mktemp("clean"), "clean")
+    return declared, explain(declared, data, ["zeta"], candidates=["cubic_stiffness"])
+
+
+def test_the_as_declared_residual_figure_is_drawn_when_no_effect_is_added(clean_explained):
+    declared, ex = clean_explained
     assert ex.effects == []
     fig = residual_figure(ex, declared)
     assert all(ax.lines and len(ax.lines[0].get_xdata()) > 100 for ax in fig.axes[:3])
     assert fig.axes[0].get_title() and len(fig.axes[3].patches) == len(ex.spectrum.orders)
+
+
+def test_a_partly_explained_report_leads_with_its_verdict_and_never_says_zero_plus_minus_zero(clean_explained):
+    """A cubic stiffness made final, its k3 undetermined (a fit leaves its estimate at 0 with no error) and the
+    residual still structured."""
+    declared, ex = clean_explained
+    base = ex.base.fit
+    fit = replace(base, estimates={**base.estimates, "k3": 0.0}, stderr={**base.stderr, "k3": None},
+                  identifiable={**base.identifiable, "k3": False})
+    partly = replace(ex, final=replace(ex.base, effects=("cubic_stiffness",), fit=fit), unexplained=True)
+    data = json_safe(partly.as_dict())
+    page = report_page(partly, declared, augment(declared, ["cubic_stiffness"]), data, ())
+    assert partly.verdict == data["verdict"] == "partly explained"
+    assert page.index("## Verdict: partly explained") < page.index("## Candidates") < page.index("## Estimates")
+    assert data["not_identifiable"] == ["k3"] and "Not identifiable from these data: k3." in page
+    assert re.search(r"^\| k3 \|  \| not identifiable \|$", page, re.M)
+    assert not re.search(r"± 0(?![.\d])", page)
 
 
 def test_a_term_is_read_by_the_safe_parser_only(one_stage):
