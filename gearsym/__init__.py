@@ -9,6 +9,7 @@ One flat public face; the stages behind it, each handing one type to the next:
 * compile: :func:`compile_model` (FirstOrderSystem, :class:`Integration` -> :class:`CompiledModel`);
 * analyse: :func:`lyapunov_spectrum`, :func:`poincare_samples`, :func:`phase_trajectory`,
   :func:`find_attractors`, :func:`run_sweep` (on a CompiledModel, or on a system, compiled first);
+  periodic orbits and their branches: :func:`periodic_orbit`, :func:`continue_orbits`;
 * data: :func:`simulate_measurements`, :func:`load_measurements`, :func:`explain`;
 * document: :func:`derive` and :func:`render`.
 
@@ -42,6 +43,8 @@ _LAZY = {
     "phase_trajectory": "gearsym.analysis",
     "find_attractors": "gearsym.analysis",
     "classify_regime": "gearsym.analysis",
+    "periodic_orbit": "gearsym.periodic",
+    "continue_orbits": "gearsym.periodic",
     "run_sweep": "gearsym.sweep",
     "read_sweep": "gearsym.sweep",
     "Workers": "gearsym.sweep",
@@ -81,5 +84,6 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .data import load_measurements, simulate_measurements
     from .derivation import derive, render
     from .fit import EFFECTS, explain
+    from .periodic import continue_orbits, periodic_orbit
     from .registry import available_models, load, load_model
     from .sweep import SweepInterrupted, Workers, read_sweep, run_sweep
