@@ -11,6 +11,8 @@ One flat public face; the stages behind it, each handing one type to the next:
   :func:`find_attractors`, :func:`run_sweep` (on a CompiledModel, or on a system, compiled first);
   periodic orbits and their branches: :func:`periodic_orbit`, :func:`continue_orbits`;
 * data: :func:`simulate_measurements`, :func:`load_measurements`, :func:`explain`;
+* physical units: :func:`scaling` (a drivetrain with values in units -> its nondimensional values, and results
+  back to rpm, um, N, 1/s), :func:`natural_modes`, :func:`campbell`;
 * document: :func:`derive` and :func:`render`.
 
 The verbs are imported on first use, so ``import gearsym`` stays cheap for a command that needs few of them.
@@ -53,6 +55,10 @@ _LAZY = {
     "load_measurements": "gearsym.data",
     "explain": "gearsym.fit",
     "EFFECTS": "gearsym.fit",
+    "scaling": "gearsym.physical",
+    "Scaling": "gearsym.physical",
+    "natural_modes": "gearsym.analysis.modes",
+    "campbell": "gearsym.physical.campbell",
     "derive": "gearsym.derivation",
     "render": "gearsym.derivation",
 }
@@ -83,7 +89,10 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .codegen import CompiledModel, compile_model
     from .data import load_measurements, simulate_measurements
     from .derivation import derive, render
+    from .analysis.modes import natural_modes
     from .fit import EFFECTS, explain
     from .periodic import continue_orbits, periodic_orbit
+    from .physical import Scaling, scaling
+    from .physical.campbell import campbell
     from .registry import available_models, load, load_model
     from .sweep import SweepInterrupted, Workers, read_sweep, run_sweep

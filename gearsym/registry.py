@@ -99,12 +99,20 @@ def load(ref, **values) -> FirstOrderSystem:
     ``ref`` is a model name (``models/<name>.py``), the path of a model file, a Drivetrain, a reduced
     NondimensionalModel or a FirstOrderSystem. ``values`` give parameter values (``omega=1.5``) or, for a
     drivetrain, a new mesh stiffness as a formula in tau (``k="1 + 0.2*cos(tau)"``). Strings that read as
-    numbers are numbers.
+    numbers are numbers. A drivetrain with physical values (``model.set_physical``), or given one here
+    (``kZ="2e8 N/m"``, ``speed="3000 rpm"``, a pint Quantity; ``length_scale="backlash"``), is scaled to its
+    nondimensional values by :class:`gearsym.physical.Scaling`.
     """
     from .reduce import NondimensionalModel, reduce
 
     model = ref if isinstance(ref, NondimensionalModel) else load_model(ref)
     values = {k: _maybe_number(v) for k, v in values.items()}
+    split = physical_settings(model, values)
+    if split is not None:
+        from .physical import scaling
+
+        length_scale, physical, formulas = split
+        return scaling(model, length_scale, **physical).system(**formulas)
     if isinstance(model, FirstOrderSystem):
         for key, value in values.items():
             if not isinstance(value, (int, float)):
@@ -115,6 +123,34 @@ def load(ref, **values) -> FirstOrderSystem:
         return model.with_values(**values)
     nd = model if isinstance(model, NondimensionalModel) else reduce(model)
     return nd.system(**values)
+
+
+def physical_settings(model, values: dict):
+    """For a model with physical values (declared, or given in ``values``: a quantity, a pint Quantity or a
+    length scale): (length scale or None, physical values, stiffness formulas); else None."""
+    from .physical.text import looks_like_quantity
+
+    declared = model.drivetrain if hasattr(model, "drivetrain") else model
+    given = "length_scale" in values or any(
+        type(v).__module__.startswith("pint") or (isinstance(v, str) and looks_like_quantity(v)) for v in values.values())
+    if not (given or getattr(declared, "physical", None)):
+        return None
+    if isinstance(model, FirstOrderSystem):
+        raise GearsymError(f"{model.name}: physical values need a drivetrain model (a FirstOrderSystem has no "
+                           "components to give them units)")
+    functions = _function_names(model)
+    values = {k: _maybe_number(v) for k, v in values.items()}
+    length_scale = values.pop("length_scale", None)
+    return (length_scale, {k: v for k, v in values.items() if k not in functions},
+            {k: v for k, v in values.items() if k in functions})
+
+
+def _function_names(model) -> set[str]:
+    """The names of a drivetrain's stiffness functions (``k``), which take a formula, not a physical value."""
+    from .reduce import reduce
+
+    nd = model if hasattr(model, "functions") else reduce(model)
+    return {f.name for f in nd.functions}
 
 
 def _maybe_number(value):

@@ -87,9 +87,10 @@ def test_page_header_and_no_run_dependent_text(model):
 @pytest.mark.parametrize("model", GEAR_MODELS)
 def test_gear_page_has_every_section(model):
     headings = [line[3:] for line in page(model).splitlines() if line.startswith("## ")]
+    physical = ["Physical values and scaling"] if load_model(model).physical else []
     assert headings == [
         "Components", "Lagrangian", "Equations of motion", "Rigid-body modes", "Coordinate change",
-        "Reduced equations", "Coefficient groups and conditions", "Nondimensional equations",
+        "Reduced equations", "Coefficient groups and conditions", "Nondimensional equations", *physical,
         "First-order system", "Parameters", "Notes on the paper",
     ]
 

@@ -49,6 +49,22 @@ def system_from(args: argparse.Namespace):
     return load(args.model, **parse_settings(args.set))
 
 
+def scaling_from(args: argparse.Namespace):
+    """The :class:`~gearsym.physical.Scaling` of the command's MODEL and --set values, or None for a model without
+    physical values."""
+    from ..registry import load_model, physical_settings
+
+    settings = parse_settings(args.set)
+    model = load_model(args.model)
+    split = physical_settings(model, settings)
+    if split is None:
+        return None
+    from ..physical import scaling
+
+    length_scale, physical, _ = split
+    return scaling(model, length_scale, **physical)
+
+
 def compiled_from(args: argparse.Namespace, options: Integration | None = None, system=None):
     """The compiled model of the command's MODEL with its --set values (or of ``system``)."""
     from ..codegen import compile_model

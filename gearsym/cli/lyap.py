@@ -10,7 +10,7 @@ from ..analysis import lyapunov_spectrum, phase_trajectory
 from ..analysis.regime import describe_regime
 from ..checks import chosen_coordinate
 from ..outputs import check_figure
-from .integration import add_integration_arguments, compiled_from
+from .integration import add_integration_arguments, compiled_from, scaling_from
 from .settings import add_set_argument, parse_state
 
 NAME = "lyap"
@@ -32,9 +32,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     if args.plot:
         check_figure(args.plot)
+    scaling = scaling_from(args)
     compiled = compiled_from(args)
     coordinate = chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     result = lyapunov_spectrum(compiled, y0=parse_state(args.y0))
+    physical = _physical(scaling, compiled, result) if scaling is not None and scaling.speed else None
     if args.plot:
         from ..figures import plot_point  # matplotlib only when asked for
 
@@ -44,7 +46,7 @@ def run(args: argparse.Namespace) -> int:
         plot_point(result, trajectory, args.plot, x=coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     if args.format == "json":
-        print(json.dumps(result.as_dict(), indent=2))
+        print(json.dumps({**result.as_dict(), **({"physical": physical.as_dict()} if physical else {})}, indent=2))
         return 0
     print(f"{result.model}: {result.periods} periods ({result.discard} discarded), "
           f"{result.steps_per_period} RK4 steps/period, {'plain RK4' if args.plain else 'crossings located'}, "
@@ -65,4 +67,17 @@ def run(args: argparse.Namespace) -> int:
     for name, a in result.amplitude.items():
         print(f"amplitude A_{name} = {a:.6g}")
     print("final state: " + ", ".join(f"{k}={v:.6g}" for k, v in result.final_state.items()))
+    for line in physical.lines() if physical else ():
+        print(line)
     return 0
+
+
+#: forcing periods of the trajectory the mesh forces of a physical model are read from (after the run's end)
+FORCE_PERIODS = 20
+
+
+def _physical(scaling, compiled, result):
+    """The result in the model's physical units, with the mesh forces over FORCE_PERIODS periods from its end."""
+    options = compiled.integration.run(periods=FORCE_PERIODS, discard=0)
+    trajectory = phase_trajectory(compiled, options=options, y0=result.final_state)
+    return scaling.to_physical(result, trajectory=trajectory)

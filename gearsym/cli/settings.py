@@ -5,18 +5,21 @@ import argparse
 
 from ..errors import GearsymError
 from ..model.expressions import to_expr
+from ..physical.text import looks_like_quantity
 
 
 def add_set_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--set", action="append", default=[], metavar="NAME=VALUE",
-        help="a parameter value (omega=1.5) or a new mesh stiffness formula in tau "
+        help="a parameter value (omega=1.5), a physical value with its unit (kZ=\"2e8 N/m\", speed=\"3000 rpm\"; "
+             "length_scale=static|backlash|\"1 um\") or a new mesh stiffness formula in tau "
              "(\"k=1+0.2*cos(tau)\"); repeat for several",
     )
 
 
 def parse_settings(pairs: list[str]) -> dict[str, str]:
-    """``NAME=VALUE`` pairs; every value reads as a safe formula (checked here, before any work starts)."""
+    """``NAME=VALUE`` pairs; every value reads as a quantity (a number and a unit) or a safe formula (checked here,
+    before any work starts; neither is ever run as Python)."""
     settings = {}
     for pair in pairs:
         name, sep, value = pair.partition("=")
@@ -25,7 +28,16 @@ def parse_settings(pairs: list[str]) -> dict[str, str]:
             raise GearsymError(f"--set {pair!r}: expected NAME=VALUE, e.g. --set omega=1.5 or --set \"k=1+0.2*cos(tau)\"")
         if name in settings:
             raise GearsymError(f"--set gives {name} twice")
-        to_expr(value, f"--set {name}")
+        if looks_like_quantity(value):
+            from ..physical.units import parse_quantity  # pint only for physical values
+
+            parse_quantity(value, f"--set {name}")
+        elif name == "length_scale":
+            from ..physical.scaling import check_length_scale
+
+            check_length_scale(value, "--set length_scale")
+        else:
+            to_expr(value, f"--set {name}")
         settings[name] = value
     return settings
 

@@ -11,7 +11,7 @@ from ..outputs import check_figure, check_file
 from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, Workers, run_sweep
 from ..sweep.report import findings_lines
 from ..sweep.store import sidecar
-from .integration import add_integration_arguments, compiled_from
+from .integration import add_integration_arguments, compiled_from, scaling_from
 from .settings import add_set_argument, parse_state
 
 NAME = "sweep"
@@ -21,8 +21,9 @@ HELP = "Lyapunov spectra, amplitudes and regimes over a 1-D or 2-D parameter gri
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("model", help="a model name (see `gearsym list`) or the path of a model file")
     parser.add_argument("--param", action="append", required=True, metavar="NAME=VALUES",
-                        help="a swept parameter: START:STOP:STEP (stop included), V1,V2,... or one value; "
-                             "repeat for a 2-D grid (a continuation follows the first)")
+                        help="a swept parameter: START:STOP:STEP (stop included), V1,V2,... or one value, with a "
+                             "unit for a physical value (speed=500rpm:6000rpm:25rpm); repeat for a 2-D grid (a "
+                             "continuation follows the first)")
     add_set_argument(parser)
     parser.add_argument("--mode", choices=MODES, default="continuation",
                         help="continuation: each point starts from the last state of the previous one (the "
@@ -63,10 +64,12 @@ def run(args: argparse.Namespace) -> int:
         check_figure(args.plot)
     workers = Workers(args.jobs, args.parallel, "local" if args.dask else args.scheduler)
     y0 = parse_state(args.y0)  # before the model is compiled
+    scaling = scaling_from(args)
+    axes = _engine_axes(args.param, scaling)
     compiled = compiled_from(args)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     try:
-        result = run_sweep(compiled, args.param, mode=args.mode, direction=args.direction, y0=y0,
+        result = run_sweep(compiled, axes, mode=args.mode, direction=args.direction, y0=y0,
                            out=args.out, overwrite=args.overwrite, poincare=args.poincare, workers=workers,
                            progress=not args.quiet)
     except KeyboardInterrupt as exc:  # SweepInterrupted says how many points were kept
@@ -78,6 +81,11 @@ def run(args: argparse.Namespace) -> int:
     print("regimes: " + ", ".join(f"{k} {v}" for k, v in sorted(regimes.items())))
     for line in findings_lines(result, sidecar(args.out, ".json")):
         print(line)
+    if scaling is not None and scaling.speed and result.axes[0].name == "omega":
+        from ..physical.files import write_physical_table
+
+        result = scaling.to_physical(result)
+        print(f"in physical units: {write_physical_table(result, sidecar(args.out, '.physical.csv'))}")
     if args.plot:
         from ..figures.sweep import plot_sweep  # matplotlib only when asked for
 
@@ -85,3 +93,21 @@ def run(args: argparse.Namespace) -> int:
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     return 0
 
+
+def _engine_axes(params: list[str], scaling):
+    """The --param axes the engine sweeps: physical ones (speed=500rpm:6000rpm:25rpm) turned into the
+    nondimensional parameter they move, for a model with physical values."""
+    from ..sweep.grid import axes_from
+
+    axes = axes_from(params)
+    if scaling is None:
+        unit = next((a for a in axes if a.unit), None)
+        if unit:
+            from ..errors import GearsymError
+
+            raise GearsymError(f"--param {unit.spec!r} has a unit, but the model has no physical values; declare "
+                               "them (model.set_physical) or give them with --set NAME='VALUE UNIT'")
+        return axes
+    from ..physical.sweeps import nondimensional_axes
+
+    return nondimensional_axes(scaling, axes)

@@ -23,7 +23,7 @@ from ..system import FirstOrderSystem
 from .notes import default_wave_amplitude, paper_notes
 from .records import (
     BodyRecord, ConditionRecord, CoordinateRecord, CouplingRecord, Derivation, FunctionRecord, GroupRecord,
-    Mechanics, ParameterRecord, TorqueRecord,
+    Mechanics, ParameterRecord, ScalingRecord, TorqueRecord,
 )
 
 @functools.singledispatch
@@ -119,7 +119,9 @@ def _components(
 def _derive_reduced(nd: NondimensionalModel) -> Derivation:
     red, rd, model = nd.reduction, nd.reduction.resolved, nd.drivetrain
     engine_rhs, names = nd.engine_equations()  # symbolic: no parameter needs a default
-    values = {n: v for n, v in nd.declared_defaults.items() if n in names}
+    scaling = _scaling(nd)
+    scaled = scaling.values if scaling is not None else {}
+    values = {n: v for n, v in {**nd.declared_defaults, **scaled}.items() if n in names}
     descriptions = {gr.name: gr.description for gr in nd.groups} | dict(model.descriptions)
     groups = tuple(
         GroupRecord(gr.name, gr.definition, gr.kind, gr.description,
@@ -151,4 +153,39 @@ def _derive_reduced(nd: NondimensionalModel) -> Derivation:
         states=tuple(nd.states), rhs=tuple(nd.rhs), parameters=_parameters(names, values, descriptions, _roles(rd)),
         period=nd.period,
         mechanics=mechanics, notes=paper_notes(nd, groups, values),
+        scaling=_scaling_record(scaling) if scaling is not None else None,
     )
+
+
+def _scaling(nd: NondimensionalModel):
+    """The model's :class:`~gearsym.physical.Scaling` at its declared physical values, or None."""
+    if not nd.drivetrain.physical:
+        return None
+    from ..physical import scaling
+
+    return scaling(nd)
+
+
+def _scaling_record(s) -> ScalingRecord:
+    """What the docs show of a scaling: every number in a fixed unit, so the page is the same everywhere."""
+    def value(name: str) -> str:
+        role = s.roles.get(name, (None, ""))[0]
+        q = s.inputs[name]
+        return (f"{q.to(role.example).magnitude:.6g} {role.example}" if role is not None and role.example
+                else f"{q.to('').magnitude:.6g}")
+
+    condition = next(c for c in s.model.conditions if c.kind == "time_unit").equation
+    static = s.length_scale == "static"
+    rule = {"static": "the static deflection of the first mesh under the mean load",
+            "backlash": "half the backlash of the first mesh"}.get(s.length_scale) \
+        if isinstance(s.length_scale, str) else "a given length"
+    units = [("omega_n", f"{s.omega_n.magnitude:.6g} rad/s ({s.omega_n.to('Hz').magnitude:.6g} Hz)"),
+             ("T", f"{s.time.magnitude:.6g} s"), ("M", f"{s.mass.magnitude:.6g} kg"),
+             ("L", f"{s.length.to('um').magnitude:.6g} um")]
+    if s.speed and s.speed.parameter in s.inputs:
+        units.append(("mesh frequency", f"{s.mesh_frequency().magnitude:.6g} Hz at {value(s.speed.parameter)}"))
+    return ScalingRecord(
+        inputs=tuple((n, value(n), s.roles[n][0].meaning if n in s.roles else "") for n in s.inputs),
+        omega_n_squared=condition.lhs, mass=s.reference_mesh.stiffness, length=rule,
+        length_definition=s.model.group(s.static_group).definition if static and s.static_group else None,
+        units=tuple(units), values=tuple(s.values.items()))

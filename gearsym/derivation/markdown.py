@@ -136,6 +136,27 @@ def _mechanics(d: Derivation, m: Mechanics) -> list[str]:
     return out
 
 
+def _scaling(d: Derivation) -> list[str]:
+    sc = d.scaling
+    bare = d.bare_functions
+    out = _section("Physical values and scaling")
+    out += ["The model declares physical values (`model.set_physical`); `gearsym.physical.Scaling` turns them "
+            "into the nondimensional model's values with the groups and the time-unit condition above "
+            "(see [docs/units.md](../units.md)):"]
+    out += table(["Parameter", "Value", "What it is"], [[f"`{n}`", v, escape(w) or "—"] for n, v, w in sc.inputs])
+    out += [f"Units: time $T = 1/\\omega_{{n}}$, mass $M = {to_latex(sc.mass, bare)}/\\omega_{{n}}^{{2}}$, length $L$ = "
+            f"{escape(sc.length)}; every value of dimension $[M]^a [L]^b [T]^c$ is divided by $M^a L^b T^c$, and "
+            "the free groups are their definitions at those numbers."]
+    rows = [(r"\omega_{n}^{2}", to_latex(sc.omega_n_squared, bare))]
+    if sc.length_definition is not None:
+        rows.append(("L", r"\frac{" + to_latex(sc.length_definition, bare) + r"}{\omega_{n}^{2}}"))
+    out += display(rows)
+    out += table(["Unit", "Value"], [[u, v] for u, v in sc.units])
+    out += ["The nondimensional values this gives (the engine's parameters):"]
+    out += table(["Parameter", "Value"], [[inline(latex_name(n)), number(v)] for n, v in sc.values])
+    return out
+
+
 def _first_order(d: Derivation) -> list[str]:
     out = _section("First-order system")
     states = ", ".join(latex_name(s.name) for s in d.states)
@@ -150,7 +171,8 @@ def _first_order(d: Derivation) -> list[str]:
 
 def _parameters(d: Derivation) -> list[str]:
     out = _section("Parameters")
-    out += ["Defaults declared in the model file."]
+    out += ["Values derived from the physical values above." if d.scaling is not None
+            else "Defaults declared in the model file."]
     out += table(["Parameter", "Symbol", "Default", "Description"], [
         [f"`{p.name}`", inline(latex_name(p.name)), number(p.default) if p.default is not None else "no default",
          escape(p.description) or "—"]
@@ -171,6 +193,8 @@ def render_markdown(d: Derivation) -> str:
                 "$d/dt$; derivatives in $\\tau$ are written out. $g$ is the backlash function "
                 "(the paper's Eq. 5, with the third branch corrected: see the notes) and $G$ its potential."]
         out += _mechanics(d, d.mechanics)
+        if d.scaling is not None:
+            out += _scaling(d)
     else:
         out += ["A model declared directly as a first-order system (no drivetrain to reduce)."]
     out += _first_order(d)

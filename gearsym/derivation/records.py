@@ -138,6 +138,19 @@ class Mechanics:
 
 
 @dataclass(frozen=True)
+class ScalingRecord:
+    """A model's physical values and the units that scale them to the nondimensional model."""
+
+    inputs: tuple[tuple[str, str, str], ...]  # (parameter, value with its unit, what it is)
+    omega_n_squared: sp.Expr  # the left side of the time-unit condition
+    mass: sp.Expr  # the first mesh's stiffness: the mass unit is it over omega_n^2
+    length: str  # how the length unit is chosen
+    length_definition: Optional[sp.Expr]  # the group whose deflection it is (B0), for the static scale
+    units: tuple[tuple[str, str], ...]  # (unit, its value)
+    values: tuple[tuple[str, float], ...]  # the nondimensional values the scaling gives
+
+
+@dataclass(frozen=True)
 class Derivation:
     """A model's derivation: the first-order system always, the mechanics for a drivetrain.
 
@@ -155,6 +168,7 @@ class Derivation:
     period: sp.Expr
     mechanics: Optional[Mechanics]
     notes: tuple[str, ...]
+    scaling: Optional[ScalingRecord] = None  # a drivetrain with physical values
 
     @property
     def is_drivetrain(self) -> bool:

@@ -30,8 +30,15 @@ _STYLE_NAME = {"-": "solid", "--": "dashed"}
 _CONTINUATION = {"up": "continuation upward", "down": "continuation downward", "both": "continuation up, then down"}
 
 
-def _axis_label(name: str) -> str:
-    return {"omega": r"$\omega$", "kS": r"$k_S$", "zeta": r"$\zeta$", "k_a": r"$k_a$"}.get(name, name)
+def _axis_label(name: str, units: dict | None = None) -> str:
+    label = {"omega": r"$\omega$", "kS": r"$k_S$", "zeta": r"$\zeta$", "k_a": r"$k_a$"}.get(name, name)
+    return _with_unit(label, units, name)
+
+
+def _with_unit(label: str, units: dict | None, column: str) -> str:
+    """``label [unit]`` for a sweep carried to physical units (``SweepResult.units``)."""
+    unit = (units or {}).get(column)
+    return f"{label} [{unit}]" if unit else label
 
 
 def _runs(result: SweepResult, direction: str | None = None, **fixed):
@@ -48,7 +55,7 @@ def plot_amplitude(ax, result: SweepResult, coordinate: str | None = None, *, di
     for d, values, idx in _runs(result, direction, **fixed):
         ax.plot(result[x][idx], result[f"A_{coordinate}"][idx], _LINESTYLE.get(d, "-"), lw=1.1, color=color,
                 label=label if label is not None else _run_label(d, values))
-    ax.set_ylabel(f"$A$ ({coordinate})")
+    ax.set_ylabel(_with_unit(f"$A$ ({coordinate})", result.units, f"A_{coordinate}"))
 
 
 def plot_exponents(ax, result: SweepResult, which=(1,), *, direction: str | None = None, label: str | None = None,
@@ -64,7 +71,7 @@ def plot_exponents(ax, result: SweepResult, which=(1,), *, direction: str | None
                 err = result[f"stderr_{i}"][idx]
                 ax.fill_between(result[x][idx], lam - 3 * err, lam + 3 * err, color=line.get_color(), alpha=0.2, lw=0)
     ax.axhline(0, color="k", lw=0.6)
-    ax.set_ylabel(r"$\lambda_1$" if tuple(which) == (1,) else r"$\lambda_i$")
+    ax.set_ylabel(_with_unit(r"$\lambda_1$" if tuple(which) == (1,) else r"$\lambda_i$", result.units, "lambda_1"))
 
 
 def plot_bifurcation(ax, result: SweepResult, state: str | None = None, *, direction: str | None = None,
@@ -82,7 +89,7 @@ def plot_bifurcation(ax, result: SweepResult, state: str | None = None, *, direc
     for k, v in fixed.items():
         keep &= np.isclose(s[k], v)
     ax.plot(s[x][keep], s[state][keep], ".", ms=1.0, mew=0, color=color, alpha=0.7)
-    ax.set_ylabel(f"{state} at t = kT")
+    ax.set_ylabel(_with_unit(f"{state} at t = kT", result.units, state))
 
 
 def plot_regime_strip(ax, result: SweepResult, *, direction: str | None = None, **fixed) -> None:
@@ -127,8 +134,8 @@ def plot_map(ax, result: SweepResult, column: str = "lambda_1", *, direction: st
         ax.set_yscale("log")
         ax.set_yticks(ys, [f"{v:g}" for v in ys])
         ax.minorticks_off()
-    ax.set_xlabel(_axis_label(x))
-    ax.set_ylabel(_axis_label(y))
+    ax.set_xlabel(_axis_label(x, result.units))
+    ax.set_ylabel(_axis_label(y, result.units))
     return mesh
 
 
@@ -223,7 +230,7 @@ def plot_sweep(result: SweepResult, path: str | Path | None = None, coordinate: 
         axs[1].legend(handles=[*colours, *_style_legend(result)], fontsize=7, ncol=4)
         axs[2].set_title(f"bifurcation diagram: {coordinate} at t = kT"
                          + (f", the {direction} run" if direction else ", independent points"), fontsize=9)
-        axs[3].set_xlabel(_axis_label(result.axes[0].name))
+        axs[3].set_xlabel(_axis_label(result.axes[0].name, result.units))
         axs[0].set_title(sweep_title(result, 100), fontsize=8)
     if path is not None:
         save_figure(fig, path, dpi=120)

@@ -36,12 +36,29 @@ class Body:
     def radius(self) -> Optional[ExprLike]:
         return None
 
+    @property
+    def tooth_count(self) -> Optional[int]:
+        return getattr(self, "teeth", None)
+
+    @property
+    def speed_parameter(self) -> Optional[str]:
+        """The name of the parameter giving this body's rotational speed, if it is the declared operating speed."""
+        return getattr(self, "speed", None)
+
 
 @dataclass(eq=False, frozen=True)
 class Gear(Body):
-    """A gear wheel: moment of inertia and base-circle radius."""
+    """A gear wheel: moment of inertia and base-circle radius.
+
+    For physical values (:meth:`Drivetrain.set_physical`): ``teeth``, its tooth count (a mesh's frequency
+    is teeth x shaft speed), and ``speed``, the name of the parameter that gives this gear's rotational
+    speed, on the one body whose speed is the operating point (``speed="speed"``; then
+    ``--set speed="3000 rpm"``).
+    """
 
     base_radius: ExprLike = "r"
+    teeth: Optional[int] = None
+    speed: Optional[str] = None
 
     @property
     def radius(self) -> ExprLike:
@@ -50,7 +67,9 @@ class Gear(Body):
 
 @dataclass(eq=False, frozen=True)
 class Disk(Body):
-    """A disk (flywheel, rotor, load inertia): moment of inertia only."""
+    """A disk (flywheel, rotor, load inertia): moment of inertia only (``speed`` as for :class:`Gear`)."""
+
+    speed: Optional[str] = None
 
 
 BodyRef = Union[Body, str]

@@ -83,6 +83,8 @@ class Drivetrain:
         self._defaults: dict[str, ExprLike] = {}
         self._descriptions: dict[str, str] = {}
         self._initial: dict[str, float] = {}
+        self._physical: dict = {}  # name -> pint Quantity (gearsym.physical), read when set
+        self._length_scale = "static"
         self.version = 0  # bumped by every change, so derived results can be cached safely
 
     def _changed(self) -> None:
@@ -116,6 +118,37 @@ class Drivetrain:
         self._changed()
         self._defaults.update(values)
         return self
+
+    def set_physical(self, **values) -> "Drivetrain":
+        """Physical values of the component parameters, with their units: ``I1="2.1e-3 kg*m^2"``,
+        ``kZ="2e8 N/m"``, ``speed="3000 rpm"`` (strings read by the safe quantity parser, or pint Quantities;
+        a plain number is dimensionless). The engine's nondimensional values are then derived from them
+        (:class:`gearsym.physical.Scaling`), and its results carried back to these units."""
+        from ..physical.units import as_quantity  # pint only for models with physical values
+
+        self._changed()
+        for name, value in values.items():
+            self._physical[name] = as_quantity(value, f"{self.name}: set_physical {name}")
+        return self
+
+    def set_length_scale(self, scale) -> "Drivetrain":
+        """The length unit of the nondimensional model: ``"static"`` (the static deflection of the first mesh
+        under the mean load: B0 = 1, the paper's convention), ``"backlash"`` (half the first mesh's backlash)
+        or a length (``"1 um"``)."""
+        from ..physical.scaling import check_length_scale
+
+        self._changed()
+        self._length_scale = check_length_scale(scale, f"{self.name}: set_length_scale")
+        return self
+
+    @property
+    def physical(self) -> dict:
+        """The declared physical values (name -> pint Quantity)."""
+        return dict(self._physical)
+
+    @property
+    def length_scale(self):
+        return self._length_scale
 
     def set_initial_state(self, **values: float) -> "Drivetrain":
         """Default initial state of the reduced model (e.g. the paper's x=-2, v=-0.5); others start at 0."""

@@ -1,7 +1,9 @@
 """What a sweep visits: axes of parameter values, and the order of the points.
 
 ``omega=0.1:2.0:0.01`` is a range (stop included), ``kS=0,0.1,1.0`` a list,
-``D=2`` a single value. Ranges are counted in decimal arithmetic, so
+``D=2`` a single value. Values may carry a unit (``speed=500rpm:6000rpm:25rpm``,
+``cZ=200,500 N*s/m``): the axis keeps it, in the unit of its first value, for a model with
+physical values to turn into the engine's nondimensional values (:mod:`gearsym.physical.sweeps`). Ranges are counted in decimal arithmetic, so
 0.1:2.0:0.01 gives exactly 0.1, 0.11, ... 2.0 as written (not 0.30000000000000004),
 and the same command always visits the same floats.
 
@@ -33,6 +35,7 @@ class Axis:
     name: str
     values: tuple[float, ...]
     spec: str  # as written, for the record
+    unit: str = ""  # a physical unit of the values ("rpm"), or "" for the model's own numbers
 
     def __post_init__(self):
         if not self.values:
@@ -48,19 +51,43 @@ def parse_axis(text: str) -> Axis:
     name, sep, body = (part.strip() for part in text.partition("="))
     if not sep or not name or not body:
         raise GearsymError(usage)
+    ranged = ":" in body
+    texts, unit = _numbers_and_unit(text, body.split(":" if ranged else ","))
     try:
-        if ":" in body:
-            parts = [Decimal(p) for p in body.split(":")]
+        if ranged:
+            parts = [Decimal(p) for p in texts]
             if len(parts) != 3:
                 raise GearsymError(usage)
             values = _range(text, *parts)
         else:
-            values = [Decimal(p) for p in body.split(",")]
+            values = [Decimal(p) for p in texts]
     except InvalidOperation:
         raise GearsymError(usage) from None
     if not all(v.is_finite() for v in values):
         raise GearsymError(f"--param {text!r}: values must be finite numbers")
-    return Axis(name, tuple(sorted(float(v) for v in values)), text)
+    return Axis(name, tuple(sorted(float(v) for v in values)), text, unit)
+
+
+def _numbers_and_unit(text: str, parts: list[str]) -> tuple[list[str], str]:
+    """The numbers of ``parts`` as written, in the unit of the first part that has one (converted by pint if
+    another part has another unit), and that unit ("" if none has one). The units are checked by the safe
+    quantity parser."""
+    from ..physical.text import QUANTITY
+
+    units = [(m["unit"] or "").strip() if (m := QUANTITY.fullmatch(p)) else "" for p in parts]
+    if not any(units):
+        return [p.strip() for p in parts], ""
+    from ..physical.units import parse_quantity
+
+    unit = next(u for u in units if u)
+    numbers = []
+    for part, own in zip(parts, units):
+        q = parse_quantity(part if own else f"{part} {unit}", f"--param {text!r}")
+        try:
+            numbers.append(repr(q.to(unit).magnitude) if own != unit else QUANTITY.fullmatch(part)["number"])
+        except Exception:
+            raise GearsymError(f"--param {text!r}: {part.strip()} cannot be converted to {unit}") from None
+    return numbers, unit
 
 
 def _range(text: str, start: Decimal, stop: Decimal, step: Decimal) -> list[Decimal]:

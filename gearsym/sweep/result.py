@@ -4,7 +4,7 @@ from __future__ import annotations
 import csv
 import json
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +27,7 @@ class SweepResult:
     strobe: dict[str, np.ndarray]
     record: dict
     path: Path | None = None
+    units: dict[str, str] = field(default_factory=dict)  # column -> unit, for a sweep carried to physical units
 
     TEXT = ("direction", "regime")
 

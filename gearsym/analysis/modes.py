@@ -1,0 +1,196 @@
+"""Natural frequencies and mode shapes of a drivetrain's linear, time-averaged system.
+
+From the drivetrain's Lagrangian with the backlash closed and every mesh at its mean stiffness:
+the mass matrix is that of the inertias, the stiffness matrix ``K = sum_c k_c J_c^T J_c`` adds each
+coupling's deflection row ``J_c`` (``r_a psi_a - r_b psi_b`` for a mesh, ``psi_b - psi_a`` for a shaft)
+with its mean stiffness ``k_c`` (the declared stiffness times the mean of its variation over a mesh
+period). ``K phi = w^2 M phi`` is solved through ``M^(-1/2) K M^(-1/2)`` (M is diagonal), which stays
+symmetric, so repeated eigenvalues (the planet modes of a planetary set) come out with an orthonormal
+basis of their eigenspace and are reported with their multiplicity.
+
+Rigid-body modes are those of the reduction (the null space of the deflection rows): as many zero
+frequencies as it finds, with its shapes. With physical values (:mod:`gearsym.physical`) frequencies
+are in Hz; without, they are angular frequencies in the model's time unit 1/omega_n, with the
+component values the nondimensional model implies (the first mesh's stiffness from the time-unit
+condition, a second one's from its group K; inertias and radii without a declared value taken as 1).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import sympy as sp
+
+from ..errors import GearsymError
+from ..model.drivetrain import ResolvedCoupling
+from ..symbols import parameter_symbol, phi
+
+#: eigenvalues within this fraction of the largest count as one (a degenerate frequency)
+DEGENERATE = 1e-8
+#: samples of a mesh period for the mean of its stiffness variation (exact for Fourier series of lower degree)
+MEAN_SAMPLES = 1024
+
+
+@dataclass(frozen=True)
+class Mode:
+    """One natural mode: its frequency, whether it is a rigid-body mode, how many modes share its frequency,
+    and its shape by body angle and by relative coordinate (largest angle component 1)."""
+
+    frequency: float
+    kind: str  # "rigid" | "elastic"
+    multiplicity: int
+    angles: dict[str, float]
+    coordinates: dict[str, float]
+
+    def as_dict(self) -> dict:
+        return {"frequency": self.frequency, "kind": self.kind, "multiplicity": self.multiplicity,
+                "angles": self.angles, "coordinates": self.coordinates}
+
+
+@dataclass(frozen=True)
+class Modes:
+    """Every mode of a drivetrain, in ascending frequency (rigid-body modes first, at zero)."""
+
+    model: str
+    unit: str  # "Hz", or "omega_n" (angular frequency in the model's time unit)
+    modes: tuple[Mode, ...]
+    values: dict[str, float]  # the component values used (SI with physical values)
+    assumed: tuple[str, ...] = ()  # parameters without a value, taken as 1
+    shapes: str = field(default="angles: body angles psi_i; coordinates: relative coordinates x = T psi "
+                                  "(mesh deflections and shaft twists as lengths)")
+
+    @property
+    def frequencies(self) -> tuple[float, ...]:
+        return tuple(m.frequency for m in self.modes)
+
+    @property
+    def elastic(self) -> tuple[Mode, ...]:
+        return tuple(m for m in self.modes if m.kind == "elastic")
+
+    def as_dict(self) -> dict:
+        """JSON-ready: the keys of ``gearsym modes --format json``."""
+        return {"model": self.model, "unit": self.unit, "frequencies": list(self.frequencies),
+                "modes": [m.as_dict() for m in self.modes], "shapes": self.shapes, "values": self.values,
+                "assumed": list(self.assumed)}
+
+
+def natural_modes(model, **settings) -> Modes:
+    """The natural modes of ``model`` (a name, a file, a Drivetrain or its reduction). ``settings`` are physical
+    values (``kZ="2e8 N/m"``: frequencies in Hz; also for a model that declares physical values) or, for a
+    model without, nondimensional parameter values (``kS=0.5``)."""
+    from ..reduce import NondimensionalModel, reduce
+    from ..registry import load_model, physical_settings
+
+    declared = model if isinstance(model, NondimensionalModel) else load_model(model)
+    if not hasattr(declared, "functions") and not hasattr(declared, "bodies"):
+        raise GearsymError(f"{declared.name}: natural modes need a drivetrain (a FirstOrderSystem has no inertias)")
+    nd = declared if isinstance(declared, NondimensionalModel) else reduce(declared)
+    split = physical_settings(nd, dict(settings))
+    if split is not None:
+        from ..physical import scaling
+
+        length_scale, physical, _ = split
+        s = scaling(nd, length_scale, **physical)
+        values = {n: float(q.to_base_units().magnitude) for n, q in s.inputs.items()}
+        return _solve(nd, values, "Hz", ())
+    values, assumed = _nondimensional_values(nd, settings)
+    return _solve(nd, values, "omega_n", assumed)
+
+
+def _nondimensional_values(nd, settings) -> tuple[dict[str, float], tuple[str, ...]]:
+    """Component values in the model's own units: declared defaults and ``settings``, the mesh stiffnesses from
+    the time-unit condition and the K groups, and 1 for what is left."""
+    rd = nd.reduction.resolved
+    values = {**nd.declared_defaults, **{k: nd.check_value(k, v) for k, v in settings.items()}}
+    values.update({k: float(v) for k, v in nd.drivetrain.defaults.items()
+                   if k not in values and isinstance(v, (int, float))})
+    needed = set()
+    for rb in rd.bodies:
+        needed |= {s.name for s in rb.inertia.free_symbols | (rb.radius.free_symbols if rb.radius is not None else set())}
+    for rc in rd.couplings:
+        needed |= {s.name for s in sp.Matrix(rc.row).free_symbols}
+    assumed = tuple(sorted(n for n in needed if n not in values))
+    values.update({n: 1.0 for n in assumed})
+    for f in nd.functions:
+        rc = nd._mesh(f)
+        if not isinstance(rc.stiffness, sp.Symbol) or rc.stiffness.name in values:
+            continue
+        if rc is nd._mesh(nd.functions[0]):
+            condition = next(c for c in nd.conditions if c.kind == "time_unit").equation
+            equation = condition.lhs - condition.rhs
+        else:
+            group = next(gr for gr in nd.groups if gr.role == "stiffness" and rc.stiffness in gr.definition.free_symbols)
+            equation = group.definition - values.get(group.name, 1.0)
+        solved = sp.solve(equation.xreplace({parameter_symbol(k): v for k, v in values.items()
+                                             if parameter_symbol(k) != rc.stiffness}), rc.stiffness)
+        values[rc.stiffness.name] = float(solved[0])
+    return values, assumed
+
+
+def _number(expr: sp.Expr, values: dict[str, float], what: str) -> float:
+    value = sp.sympify(expr).xreplace({parameter_symbol(k): sp.Float(v) for k, v in values.items()})
+    if not value.is_number:
+        missing = ", ".join(sorted(s.name for s in value.free_symbols))
+        raise GearsymError(f"{what} needs a value for {missing}")
+    return float(value)
+
+
+def mean_stiffness(rc: ResolvedCoupling, values: dict[str, float]) -> float:
+    """A coupling's stiffness averaged over a mesh period (a shaft's is its own)."""
+    k = _number(rc.stiffness, values, f"the stiffness of {rc.name!r}")
+    if rc.kind != "mesh":
+        return k
+    variation = rc.variation.xreplace({parameter_symbol(n): v for n, v in values.items()})
+    if variation.free_symbols - {phi}:
+        missing = ", ".join(sorted(s.name for s in variation.free_symbols - {phi}))
+        raise GearsymError(f"the stiffness variation of {rc.name!r} needs a value for {missing}")
+    samples = np.linspace(0.0, 2 * math.pi, MEAN_SAMPLES, endpoint=False)
+    shape = np.asarray(sp.lambdify(phi, variation, "numpy")(samples), dtype=float) * np.ones(MEAN_SAMPLES)
+    return k * float(np.mean(shape))
+
+
+def _solve(nd, values: dict[str, float], unit: str, assumed: tuple[str, ...]) -> Modes:
+    rd = nd.reduction.resolved
+    names = [rb.body.name for rb in rd.bodies]
+    inertia = np.array([_number(rb.inertia, values, f"the inertia of {rb.body.name!r}") for rb in rd.bodies])
+    stiffness = np.zeros((len(names), len(names)))
+    for rc in rd.couplings:
+        row = np.array([_number(e, values, f"the deflection of {rc.name!r}") for e in rc.row])
+        stiffness += mean_stiffness(rc, values) * np.outer(row, row)
+    transform = np.array([[_number(e, values, "the coordinate change") for e in r]
+                          for r in nd.reduction.transform.tolist()])
+    scale = 1.0 / np.sqrt(inertia)
+    eigenvalues, vectors = np.linalg.eigh(scale[:, None] * stiffness * scale[None, :])
+    shapes = scale[:, None] * vectors  # mass-normalised phi = M^(-1/2) y
+    rigid = [np.array([_number(e, values, "a rigid-body mode") for e in u]) for u in nd.reduction.rigid_modes]
+    top = max(float(np.max(np.abs(eigenvalues))), 1e-300)
+    if rigid and np.max(np.abs(eigenvalues[:len(rigid)])) > 1e-9 * top:
+        raise GearsymError(f"{nd.name}: {len(rigid)} rigid-body mode(s) but the stiffness matrix has no such zero "
+                           "eigenvalues (a coupling with zero stiffness?)")
+    order = np.argsort(eigenvalues)
+    elastic = [i for i in order[len(rigid):]]
+    to_unit = (lambda w: w / (2 * math.pi)) if unit == "Hz" else (lambda w: w)
+    coordinates = [c.name for c in nd.coordinates]
+    modes = [_mode(0.0, "rigid", len(rigid), u, names, transform, coordinates) for u in rigid]
+    for i in elastic:
+        w2 = max(float(eigenvalues[i]), 0.0)
+        same = sum(1 for j in elastic if abs(float(eigenvalues[j]) - w2) <= DEGENERATE * top)
+        modes.append(_mode(to_unit(math.sqrt(w2)), "elastic", same, shapes[:, i], names, transform, coordinates))
+    used = set()
+    for rb in rd.bodies:
+        used |= rb.inertia.free_symbols | (rb.radius.free_symbols if rb.radius is not None else set())
+    for rc in rd.couplings:
+        used |= rc.stiffness.free_symbols | rc.variation.free_symbols | sp.Matrix(rc.row).free_symbols
+    shown = {n: v for n, v in values.items() if parameter_symbol(n) in used}
+    return Modes(nd.name, unit, tuple(modes), shown, assumed)
+
+
+def _mode(frequency: float, kind: str, multiplicity: int, shape: np.ndarray, names: list[str],
+          transform: np.ndarray, coordinates: list[str]) -> Mode:
+    """A mode with its shape scaled so that its largest angle component (the first of equal ones) is +1."""
+    size = np.abs(shape)
+    big = int(np.flatnonzero(size >= size.max() * (1 - 1e-9))[0])
+    shape = shape / shape[big]
+    return Mode(frequency, kind, multiplicity, {n: float(v) for n, v in zip(names, shape)},
+                {c: float(v) for c, v in zip(coordinates, transform @ shape)})

@@ -1,0 +1,72 @@
+"""``gearsym campbell MODEL --param speed=500rpm:9000rpm:50rpm``: the Campbell diagram beside the amplitude of
+a sweep over the same speeds (the sweep is resumable, as ``gearsym sweep``'s)."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from ..errors import GearsymError
+from ..outputs import check_figure, check_file
+from .integration import add_integration_arguments, compiled_from, scaling_from
+from .settings import add_set_argument, parse_settings
+
+NAME = "campbell"
+HELP = "Campbell diagram (natural frequencies, mesh and torque orders, crossings) beside the amplitude over speed"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("model", help="a model with physical values (see docs/units.md)")
+    parser.add_argument("--param", required=True, metavar="SPEED=START:STOP:STEP",
+                        help="the speed axis, e.g. speed=500rpm:9000rpm:50rpm")
+    add_set_argument(parser)
+    parser.add_argument("--orders", type=int, default=3, help="harmonics of the mesh frequency drawn (default 3)")
+    add_integration_arguments(parser, periods=300, discard=200)
+    parser.add_argument("--jobs", type=int, default=0, help="processes for the sweep (default 0: every core)")
+    parser.add_argument("--out", type=Path, required=True, metavar="FILE.csv",
+                        help="the amplitude sweep (resumed if it exists); FILE.campbell.json holds the diagram")
+    parser.add_argument("--plot", type=Path, required=True, metavar="FILE.png", help="the figure")
+    parser.add_argument("--no-sweep", action="store_true", help="the diagram alone (no amplitude panel)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..analysis.modes import natural_modes
+    from ..files import write_atomically
+    from ..physical.campbell import campbell
+    from ..physical.sweeps import nondimensional_axis
+    from ..sweep import Workers, run_sweep
+    from ..sweep.grid import parse_axis
+    from ..sweep.store import sidecar
+
+    check_file(args.out, (".csv",))
+    check_figure(args.plot)
+    if args.orders < 1:
+        raise GearsymError(f"--orders must be at least 1, got {args.orders}")
+    scaling = scaling_from(args)
+    if scaling is None or not scaling.speed:
+        raise GearsymError(f"{args.model}: a Campbell diagram needs physical values and a declared speed "
+                           "(model.set_physical, Gear(..., teeth=N, speed='speed')); see docs/units.md")
+    axis = parse_axis(args.param)
+    if axis.name != scaling.speed.parameter:
+        raise GearsymError(f"--param {args.param!r}: the Campbell diagram runs along the speed "
+                           f"({scaling.speed.parameter}=...), not {axis.name}")
+    unit = axis.unit or str(scaling._speed_quantity().units)
+    modes = natural_modes(scaling.model, **parse_settings(args.set))
+    diagram = campbell(scaling, axis.values, unit, modes, args.orders)
+    write_atomically(sidecar(args.out, ".campbell.json"), json.dumps(diagram.as_dict(), indent=2) + "\n")
+    print(f"{diagram.model}: natural frequencies " + ", ".join(f"{f:.6g} Hz" for f in diagram.natural_frequencies))
+    for c in diagram.crossings:
+        print(f"crossing: {c.order} meets {c.natural_frequency:.6g} Hz at {c.speed:.6g} {unit}")
+    sweep = None
+    if not args.no_sweep:
+        compiled = compiled_from(args)
+        result = run_sweep(compiled, [nondimensional_axis(scaling, axis)], options=compiled.integration,
+                           out=args.out, workers=Workers(args.jobs), progress=not args.quiet)
+        sweep = scaling.to_physical(result)
+    from ..figures.campbell import plot_campbell
+
+    plot_campbell(diagram, args.plot, sweep)
+    print(f"gearsym: wrote {args.plot}", file=sys.stderr)
+    return 0

@@ -1,0 +1,46 @@
+"""Sweeps over physical values: each physical axis becomes the axis of the one nondimensional parameter it
+moves (``speed`` -> omega, ``cZ`` -> zeta, ...), so the engine sweeps as before."""
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from ..errors import GearsymError
+from ..sweep.grid import Axis
+from .scaling import Scaling
+from .units import Quantity
+
+
+def nondimensional_axis(scaling: Scaling, axis: Axis) -> Axis:
+    """The engine's axis for ``axis``: a physical value swept (with or without a unit: the unit of its declared
+    value then) becomes the one nondimensional parameter it changes; other axes pass as they are."""
+    name = axis.name
+    if name not in scaling.inputs and not (scaling.speed and name == scaling.speed.parameter):
+        if axis.unit:
+            raise GearsymError(f"--param {axis.spec!r}: {name} is not a physical value of {scaling.name}, so it "
+                               f"takes no unit; physical values: {', '.join(scaling.roles)}")
+        return axis
+    unit = axis.unit or (str(scaling.inputs[name].units) if name in scaling.inputs else "rpm")
+    base = scaling.values
+    columns = [scaling.values_at(**{name: Quantity(v, unit)}) for v in axis.values]
+    moved = sorted({k for row in columns for k in row if row[k] != base[k]} or {_first_moved(scaling, name)})
+    if len(moved) != 1:
+        raise GearsymError(f"--param {axis.spec!r}: {name} moves {', '.join(moved)} of the nondimensional model "
+                           "together (it changes the units themselves); sweep a value that moves one of them, or "
+                           "fix the length scale with --set length_scale='1 um'")
+    target = moved[0]
+    values = tuple(row[target] for row in columns)
+    if len(set(values)) != len(values):
+        raise GearsymError(f"--param {axis.spec!r}: two values of {name} give the same {target}")
+    return Axis(target, values, axis.spec)
+
+
+def _first_moved(scaling: Scaling, name: str) -> str:
+    """The parameter a one-point axis moves: found by a small step away from it."""
+    q = scaling.inputs.get(name) or scaling._speed_quantity()
+    shifted = scaling.values_at(**{name: q * 1.01})
+    moved = [k for k, v in shifted.items() if v != scaling.values[k]]
+    return moved[0] if len(moved) == 1 else ",".join(moved)
+
+
+def nondimensional_axes(scaling: Scaling, axes: Sequence[Axis]) -> tuple[Axis, ...]:
+    return tuple(nondimensional_axis(scaling, a) for a in axes)
