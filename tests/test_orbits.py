@@ -192,3 +192,35 @@ def test_bad_orbit_options_are_one_line_errors(argv, message, capsys):
     assert main(["orbits", "duffing", *argv]) == 2
     err = capsys.readouterr().err
     assert message in err and err.count("\n") == 1, err
+
+
+def test_multiple_shooting_finds_the_single_shooting_orbit_and_a_period_two_orbit(one_stage):
+    single = periodic_orbit(one_stage, omega=0.6)
+    multiple = periodic_orbit(one_stage, y0=single.state + 0.05, segments=4, omega=0.6)
+    assert np.allclose(multiple.state, single.state, rtol=0, atol=1e-9)
+    assert np.allclose(np.sort_complex(multiple.multipliers), np.sort_complex(single.multipliers), rtol=1e-9)
+    doubled = periodic_orbit(one_stage, period_multiple=2, segments=2, omega=1.65)  # the stable period-2 orbit
+    assert doubled.stable and doubled.period == pytest.approx(4 * np.pi)
+    inputs = one_stage.prepare(one_stage.parameter_vector({"omega": 1.65}))
+    once, twice = one_stage.orbit_run(doubled.state, 2, inputs)[0].T
+    assert np.allclose(twice, doubled.state, atol=1e-8) and not np.allclose(once, doubled.state, atol=1e-3)
+
+
+def test_an_interrupted_continuation_keeps_and_writes_what_it_traced(tmp_path, capsys, monkeypatch):
+    from gearsym.periodic import continuation
+
+    step, calls = continuation.Tracer.step, []
+
+    def interrupted_later(self, *args, **kwargs):
+        calls.append(1)
+        if len(calls) == 12:
+            raise KeyboardInterrupt
+        return step(self, *args, **kwargs)
+
+    monkeypatch.setattr(continuation.Tracer, "step", interrupted_later)
+    out = tmp_path / "frc.csv"
+    assert main(["orbits", "duffing", "--param", "omega=0.8:1.6", "--out", str(out)]) == 130
+    assert "interrupted: kept 1 branch(es), 12 points" in capsys.readouterr().err
+    record = json.loads((tmp_path / "frc.json").read_text())
+    assert record["settings"]["interrupted"] is True and record["branches"][0]["end"] == "interrupted"
+    assert len(out.read_text().splitlines()) == 1 + 12

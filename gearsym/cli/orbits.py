@@ -132,11 +132,18 @@ def _one_orbit(compiled, args, y0) -> int:
 
 
 def _continuation(compiled, args, name, start, stop, y0, sweep) -> int:
-    from ..periodic import continue_orbits
+    from ..periodic import ContinuationInterrupted, continue_orbits
     from ..periodic.files import write_orbits
 
-    result = continue_orbits(compiled, name, start, stop, y0=y0, period_multiple=args.period_multiple,
-                             segments=args.segments, switch_depth=args.switch_depth, max_points=args.max_points)
+    try:
+        result = continue_orbits(compiled, name, start, stop, y0=y0, period_multiple=args.period_multiple,
+                                 segments=args.segments, switch_depth=args.switch_depth, max_points=args.max_points)
+    except ContinuationInterrupted as exc:  # keep what was traced: the files say it was interrupted
+        if args.out:
+            write_orbits(exc.result, args.out)
+        print(f"gearsym: {exc}" + (f" in {args.out} (rerun the command to compute them all)" if args.out else ""),
+              file=sys.stderr)
+        return 130
     for b in result.branches:
         stable = int(b.stable.sum())
         print(f"branch {b.index}: period {b.period_multiple}, {len(b)} points ({stable} stable), {name} "

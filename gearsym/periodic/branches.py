@@ -153,11 +153,36 @@ def continue_orbits(model: CompiledModel, parameter: str, start: float, stop: fl
         y0 = model.initial_state(y0)
     steps = Steps(step=step, max_step=max_step, max_points=whole_number(max_points, "max_points", 2))
     watches = mesh_watches(model)
-    tracer = Tracer(problem, start, stop, steps, watches)
+    started: list[Traced] = []
+    tracer = Tracer(problem, start, stop, steps, watches, started)
     ev, _ = find_orbit(problem, starting_states(model, y0, options, period_multiple, problem.inputs(start)), start)
-    traced = [tracer.trace(tracer.first(ev.z, start))]
-    traced[0].parent = None
-    _switch_branches(model, parameter, traced, start, stop, steps, watches, switch_depth)
+    settings = {"integration": options.describe(), "steps_per_period": model.steps_per_period,
+                "locate_crossings": model.options.locate_crossings, "period_multiple": period_multiple,
+                "segments": segments, "transient_periods": None if y0 is not None else options.periods,
+                "switch_depth": switch_depth, "steps": vars(tracer.steps)}
+    try:
+        traced = [tracer.trace(tracer.first(ev.z, start))]
+        _switch_branches(model, parameter, traced, start, stop, steps, watches, switch_depth, started)
+    except KeyboardInterrupt as exc:
+        if not started:
+            raise
+        started[-1].end = "interrupted"
+        partial = _continuation(model, problem, parameter, start, stop, started, watches,
+                                {**settings, "interrupted": True})
+        raise ContinuationInterrupted(partial) from exc
+    return _continuation(model, problem, parameter, start, stop, traced, watches, settings)
+
+
+class ContinuationInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a continuation: ``result`` holds the branches as far as they were traced."""
+
+    def __init__(self, result: Continuation):
+        self.result = result
+        points = sum(len(b) for b in result.branches)
+        super().__init__(f"interrupted: kept {len(result.branches)} branch(es), {points} points")
+
+
+def _continuation(model, problem, parameter, start, stop, traced, watches, settings) -> Continuation:
     branches, bifurcations = _results(model, traced, watches, parameter)
     fixed = dict(zip(model.parameter_names, map(float, problem.p)))
     fixed.pop(parameter)
@@ -165,13 +190,11 @@ def continue_orbits(model: CompiledModel, parameter: str, start: float, stop: fl
         model=model.name, model_hash=model.hash, parameter=parameter, start=start, stop=stop, parameters=fixed,
         state_names=model.state_names, observed=model.observed, meshes=tuple(w.name for w in watches),
         forcing_period=problem.inputs(start).period, branches=branches, bifurcations=bifurcations,
-        settings={"integration": options.describe(), "steps_per_period": model.steps_per_period,
-                  "locate_crossings": model.options.locate_crossings, "period_multiple": period_multiple,
-                  "segments": segments, "transient_periods": None if y0 is not None else options.periods,
-                  "switch_depth": switch_depth, "steps": vars(tracer.steps)})
+        settings=settings)
 
 
-def _switch_branches(model, parameter: str, traced: list[Traced], start, stop, steps, watches, depth: int) -> None:
+def _switch_branches(model, parameter: str, traced: list[Traced], start, stop, steps, watches, depth: int,
+                     started: list) -> None:
     """Branch switching at every period doubling (breadth first, ``depth`` doublings deep): a period-2n
     branch that rejoins its parent at another period doubling takes that one off the list."""
     queue = [(0, s) for s in traced[0].solutions if s.event and s.event[0] == PERIOD_DOUBLING] if depth else []
@@ -181,7 +204,7 @@ def _switch_branches(model, parameter: str, traced: list[Traced], start, stop, s
         if id(pd) in done:
             continue
         done.add(id(pd))
-        child = _doubled_branch(model, parameter, traced[parent], pd, start, stop, steps, watches)
+        child = _doubled_branch(model, parameter, traced[parent], pd, start, stop, steps, watches, started)
         if child is None:
             continue
         child.parent = parent
@@ -202,13 +225,14 @@ def _switch_branches(model, parameter: str, traced: list[Traced], start, stop, s
             queue += [(len(traced) - 1, s) for s in child.solutions if s.event and s.event[0] == PERIOD_DOUBLING]
 
 
-def _doubled_branch(model, parameter: str, parent: Traced, pd: Solution, start, stop, steps, watches) -> Traced | None:
+def _doubled_branch(model, parameter: str, parent: Traced, pd: Solution, start, stop, steps, watches,
+                    started: list) -> Traced | None:
     """The period-2n branch born at the period doubling ``pd``: its start is ``pd``'s orbit taken twice
     plus a step along the eigenvector of the multiplier nearest -1, carried around the doubled orbit."""
     base = pd.ev.z
     shooting = Shooting(parent.period_multiple * 2, len(base) // parent.period_multiple)
     problem = OrbitMap(model, shooting, parameter, dict(zip(model.parameter_names, pd.ev.inputs.p)))
-    tracer = Tracer(problem, start, stop, steps, watches)
+    tracer = Tracer(problem, start, stop, steps, watches, started)
     mu, vectors = np.linalg.eig(pd.ev.monodromy)
     k = int(np.argmin(np.abs(mu + 1)))
     direction = np.real(vectors[:, k])

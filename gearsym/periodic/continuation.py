@@ -12,13 +12,11 @@ the parameter moves at most ``max_parameter_step`` per step, so that a flat bran
 enough points. The branch ends where it leaves [start, stop] (with a last point exactly on the bound),
 after ``max_points`` points, or where no step gives a corrected point.
 
-Non-smooth spots: where a shallow excursion of the orbit across a backlash surface begins and ends within
-one RK4 step, the crossing is not located (the step is a plain one) and, as the excursion moves across a
-step's end, the map of the steps jumps by O(h^2 k depth) (1e-4 at omega = 0.12, 200 steps). Newton has
-no solution in such a jump: where the step falls below ``HOP_BELOW`` of the range, the tracer hops over
-it (a step of the size tried before) and lists the hop in ``non_smooth``. The true flow has a grazing
-there (continuous, with a square-root singularity in its derivative), so a multiplier may change fast
-across a hop.
+Non-smooth spots: at a grazing of the true flow the map stays continuous, but its derivative changes like a
+square root, and a third crossing within one RK4 step is integrated to first order (see the engine's
+located steps): Newton may fail to converge on such a spot at any step. Where the step falls below
+``HOP_BELOW`` of the range, the tracer hops over it (a step of the size tried before, accepted with a larger
+turn) and lists the hop in ``non_smooth``; a multiplier may change fast across it.
 
 Bifurcations: the test functions of :mod:`.floquet` are evaluated at every point; where one changes sign
 between two points, the zero is located by the Illinois variant of regula falsi on the arclength from the
@@ -37,10 +35,10 @@ import numpy as np
 from ..errors import GearsymError
 from .floquet import (FOLD, GRAZING, NEIMARK_SACKER, PERIOD_DOUBLING, grazing_tests, multipliers,
                       neimark_sacker_test, period_doubling_test, torus_pair)
+from .shooting import TOLERANCE, Evaluation, OrbitMap, _try_evaluate
 
 #: the test of a period-2n branch coming back to its period-n parent (not a bifurcation of its own)
 REJOIN = "rejoin"
-from .shooting import TOLERANCE, Evaluation, OrbitMap, _try_evaluate
 
 #: the largest angle (radians, in the weighted norm) between consecutive tangents
 MAX_TURN = 0.3
@@ -109,8 +107,9 @@ class Traced:
 class Tracer:
     """Follows branches of one shooting problem over [lo, hi] of its parameter."""
 
-    def __init__(self, problem: OrbitMap, start: float, stop: float, steps: Steps, watches=()):
+    def __init__(self, problem: OrbitMap, start: float, stop: float, steps: Steps, watches=(), started=None):
         self.problem, self.steps = problem, steps.resolved(stop - start)
+        self.started = started if started is not None else []  # every branch traced, finished or not, in order
         self.lo, self.hi, self.direction = min(start, stop), max(start, stop), (1.0 if stop >= start else -1.0)
         self.watches = watches
         K, n = problem.shooting.count, problem.n
@@ -132,8 +131,7 @@ class Tracer:
     def corrected(self, u_pred: np.ndarray, normal: np.ndarray, target: float | None = None,
                   start: np.ndarray | None = None) -> Solution | None:
         """Newton from ``u_pred`` (or ``start``) on the hyperplane <normal, u - u_pred> = 0 (weighted), or on
-        lambda = target;
-        None if it does not converge in ``MAX_CORRECTIONS`` iterations or leaves the range far behind. Every
+        lambda = target; None if it does not converge in ``MAX_CORRECTIONS`` iterations or leaves the range far behind. Every
         iteration differentiates by the parameter afresh: along a resonance the column changes so fast
         that a chord on it (the start's column kept) needs twice the iterations, measured."""
         a = self.weights * normal if target is None else np.eye(len(u_pred))[-1]
@@ -207,6 +205,7 @@ class Tracer:
         ds = ds or steps.step
         traced = Traced([start], f"{steps.max_points} points reached (max_points)",
                         self.problem.shooting.period_multiple)
+        self.started.append(traced)  # its points so far are kept if the run is interrupted
         a = start
         self.reference = self.halves(start) if doubled else None
         if doubled:
