@@ -187,6 +187,7 @@ def test_gearsym_orbits_writes_a_plain_odes_branches_bifurcations_and_curve(tmp_
     (["--param", "omega=0.5:2", "--segments", "3"], "3 shooting segments per period do not divide"),
     (["--param", "omega=0.5:2", "--period-multiple", "0"], "--period-multiple must be at least 1"),
     (["--param", "omegaa=0.5:2"], "unknown parameter 'omegaa'"),
+    (["--param", "speed=1000rpm:3000rpm"], "has a unit, but the model has no physical values"),
 ])
 def test_bad_orbit_options_are_one_line_errors(argv, message, capsys):
     assert main(["orbits", "duffing", *argv]) == 2
@@ -224,3 +225,18 @@ def test_an_interrupted_continuation_keeps_and_writes_what_it_traced(tmp_path, c
     record = json.loads((tmp_path / "frc.json").read_text())
     assert record["settings"]["interrupted"] is True and record["branches"][0]["end"] == "interrupted"
     assert len(out.read_text().splitlines()) == 1 + 12
+
+
+def test_a_physical_models_orbits_continue_over_a_speed_range_in_rpm(tmp_path, capsys):
+    """speed=1000rpm:3000rpm is the omega range it moves: the mesh frequency is proportional to the speed."""
+    from conftest import reduced
+    from gearsym.physical import scaling
+
+    at_3000 = scaling(reduced("spur_pair"), speed="3000 rpm").values["omega"]
+    assert main(["orbits", "spur_pair", "--param", "speed=1000rpm:3000rpm", "--switch-depth", "0",
+                 "--out", str(tmp_path / "frc.csv")]) == 0
+    record = json.loads((tmp_path / "frc.json").read_text())
+    assert record["parameter"] == "omega" and record["stop"] == pytest.approx(at_3000, rel=1e-12)
+    assert record["start"] == pytest.approx(at_3000 / 3, rel=1e-12)
+    assert record["branches"][0]["to"] == pytest.approx(at_3000, rel=1e-12)
+    assert "speed 1000 -> 3000 rpm is omega" in capsys.readouterr().out

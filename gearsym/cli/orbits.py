@@ -23,8 +23,8 @@ TRANSIENT = 300
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("model", help="a model name (see `gearsym list`) or the path of a model file")
     parser.add_argument("--param", metavar="NAME=START:STOP",
-                        help="continue the orbits in NAME from START to STOP (through folds); without it, the one "
-                             "orbit at the --set values")
+                        help="continue the orbits in NAME from START to STOP (through folds; a physical value "
+                             "with its unit: speed=1000rpm:3000rpm); without it, the one orbit at the --set values")
     add_set_argument(parser)
     parser.add_argument("--period-multiple", type=int, default=1, metavar="N",
                         help="the orbit's period in forcing periods (default 1; --periods is the run length of "
@@ -54,19 +54,45 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--coordinate", metavar="NAME", help="the coordinate --plot shows (default the first)")
 
 
-def parse_range(text: str) -> tuple[str, float, float]:
-    usage = f"--param {text!r}: expected NAME=START:STOP, e.g. --param omega=0.5:2.0"
+def parse_range(text: str) -> tuple[str, float, float, str]:
+    """NAME, START, STOP and the unit of a physical value ("" for the model's own numbers)."""
+    from ..sweep.grid import _numbers_and_unit
+
+    usage = f"--param {text!r}: expected NAME=START:STOP, e.g. --param omega=0.5:2.0 or speed=1000rpm:3000rpm"
     name, sep, body = (part.strip() for part in text.partition("="))
     parts = body.split(":")
     if not sep or not name or len(parts) != 2:
         raise GearsymError(usage)
+    numbers, unit = _numbers_and_unit(text, parts)
     try:
-        start, stop = (float(p) for p in parts)
+        start, stop = (float(p) for p in numbers)
     except ValueError:
         raise GearsymError(usage) from None
     if start == stop:
         raise GearsymError(f"--param {text!r}: START and STOP must differ")
-    return name, start, stop
+    return name, start, stop, unit
+
+
+def engine_range(args: argparse.Namespace, parameter: tuple) -> tuple[str, float, float]:
+    """The nondimensional parameter and range a physical range (speed=1000rpm:3000rpm) moves, as a sweep's
+    axis does (gearsym.physical.sweeps); a nondimensional range as it is."""
+    from ..sweep.grid import Axis
+    from .integration import scaling_from
+
+    name, start, stop, unit = parameter
+    scaling = scaling_from(args)
+    if scaling is None:
+        if unit:
+            raise GearsymError(f"--param {args.param!r} has a unit, but the model has no physical values; declare "
+                               "them (model.set_physical) or give them with --set NAME='VALUE UNIT'")
+        return name, start, stop
+    from ..physical.sweeps import nondimensional_axis
+
+    axis = nondimensional_axis(scaling, Axis(name, (start, stop), args.param, unit))
+    if axis.name != name:
+        print(f"{name} {start:g} -> {stop:g}{' ' + unit if unit else ''} is {axis.name} {axis.values[0]:.6g} -> "
+              f"{axis.values[1]:.6g}: continued in {axis.name}")
+    return axis.name, axis.values[0], axis.values[1]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -94,6 +120,8 @@ def run(args: argparse.Namespace) -> int:
     options = integration_from(args).run(periods=args.transient, discard=0)
     check_segments(args.segments, pieces_per_period(options.steps_per_period), f"--segments {args.segments}: ",
                    options.steps_per_period)
+    if parameter:
+        parameter = engine_range(args, parameter)
     system = system_from(args)
     if parameter and parameter[0] not in system.parameters:
         from ..errors import UnknownParameterError
