@@ -15,7 +15,7 @@ import gearsym
 from conftest import system
 from gearsym import FirstOrderSystem, Integration, compile_model
 from gearsym.cli import main
-from gearsym.periodic import FOLD, continue_orbits, periodic_orbit
+from gearsym.periodic import FOLD, PERIOD_DOUBLING, continue_orbits, periodic_orbit
 
 ZETA = 0.05
 
@@ -240,3 +240,17 @@ def test_a_physical_models_orbits_continue_over_a_speed_range_in_rpm(tmp_path, c
     assert record["start"] == pytest.approx(at_3000 / 3, rel=1e-12)
     assert record["branches"][0]["to"] == pytest.approx(at_3000, rel=1e-12)
     assert "speed 1000 -> 3000 rpm is omega" in capsys.readouterr().out
+
+
+def test_a_linear_regimes_period_doubling_has_a_vertical_period_two_branch_and_no_folds_on_it():
+    """A linear system with a time-varying stiffness (Mathieu) has, where a multiplier is -1, a whole line of
+    period-2 orbits at that one frequency: its branch is vertical, and rounding in its tangent is no fold."""
+    mathieu = FirstOrderSystem.from_equations(
+        "mathieu", ["x", "v"], ["v", "-2*zeta*v - (1 + eps*cos(omega*t))*x + F*cos(omega*t)"],
+        {"zeta": 0.02, "eps": 0.3, "F": 0.1, "omega": 1.0}, time="t", period="2*pi/omega")
+    result = continue_orbits(mathieu, "omega", 1.5, 2.0, max_points=60)
+    (pd,), doubled = result.of_kind(PERIOD_DOUBLING), result.branches[1]
+    assert doubled.period_multiple == 2 and len(doubled) == 60
+    assert np.ptp(doubled.values) < 1e-9 and doubled.values[0] == pytest.approx(pd.value, abs=1e-9)
+    assert np.ptp(doubled.amplitude[:, 0]) > doubled.amplitude[0, 0]  # it goes up the line
+    assert not result.of_kind(FOLD), [(f.value, f.branch) for f in result.of_kind(FOLD)]
