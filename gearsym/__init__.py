@@ -9,6 +9,7 @@ One flat public face; the stages behind it, each handing one type to the next:
 * compile: :func:`compile_model` (FirstOrderSystem, :class:`Integration` -> :class:`CompiledModel`);
 * analyse: :func:`lyapunov_spectrum`, :func:`poincare_samples`, :func:`phase_trajectory`,
   :func:`find_attractors`, :func:`run_sweep` (on a CompiledModel, or on a system, compiled first);
+  periodic orbits and their branches: :func:`periodic_orbit`, :func:`continue_orbits`;
 * data: :func:`simulate_measurements`, :func:`load_measurements`, :func:`explain`;
 * physical units: :func:`scaling` (a drivetrain with values in units -> its nondimensional values, and results
   back to rpm, um, N, 1/s), :func:`natural_modes`, :func:`campbell`;
@@ -44,6 +45,8 @@ _LAZY = {
     "phase_trajectory": "gearsym.analysis",
     "find_attractors": "gearsym.analysis",
     "classify_regime": "gearsym.analysis",
+    "periodic_orbit": "gearsym.periodic",
+    "continue_orbits": "gearsym.periodic",
     "run_sweep": "gearsym.sweep",
     "read_sweep": "gearsym.sweep",
     "Workers": "gearsym.sweep",
@@ -88,6 +91,7 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .derivation import derive, render
     from .analysis.modes import natural_modes
     from .fit import EFFECTS, explain
+    from .periodic import continue_orbits, periodic_orbit
     from .physical import Scaling, scaling
     from .physical.campbell import campbell
     from .registry import available_models, load, load_model

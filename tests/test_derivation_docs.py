@@ -25,7 +25,7 @@ from gearsym.symbols import parameter_symbol
 
 DOCS = REPO_ROOT / "docs" / "derivations"
 MODELS = available_models()
-GEAR_MODELS = [m for m in MODELS if m != "lorenz"]
+GEAR_MODELS = [m for m in MODELS if isinstance(conftest.load(m), Drivetrain)]
 
 
 @functools.cache

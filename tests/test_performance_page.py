@@ -29,7 +29,7 @@ def raw():
 
 
 def test_page_and_figure_regenerate_from_the_record(raw, tmp_path):
-    page, fig = report.write_report(RECORD, tmp_path / "performance.md", tmp_path / "performance.png")
+    page, fig = report.write_report(RECORD, tmp_path / "performance.md", tmp_path / "performance.png")[:2]
     assert page.read_text() == report.PAGE.read_text(), "docs/performance.md differs: run python -m bench.speed.report"
     # pixels, not bytes: another matplotlib release may encode the same picture differently
     from matplotlib.image import imread
@@ -131,3 +131,25 @@ def test_a_missed_target_is_reported_as_missed(raw):
             p["seconds"] = [x * 100 for x in p["seconds"]]
     rows = {v["what"]: v for v in summary.summarise(slow)["verdicts"]}
     assert not rows["gearsym / hand-written C, per point, one_stage"]["met"]
+
+
+ORBITS = REPO / "bench" / "results" / "orbits.json"
+
+
+def test_the_orbits_record_is_a_full_run_and_its_section_says_what_it_gives(tmp_path):
+    """``python -m bench.orbits``: the whole period-1 curve (folds located) against the 191-point sweep."""
+    from bench.orbits import report as orbits_report
+    from bench.orbits.__main__ import summary as orbits_summary
+
+    record = json.loads(ORBITS.read_text())
+    assert record["sweep"]["points"] == 191 and record["range"] == [0.1, 2.0]
+    assert all(len(v) == record["repeats"] >= 3 for v in record["seconds"].values())
+    assert {b["type"] for b in record["curve"]["bifurcations"]} >= {"fold", "period doubling"}
+    s = orbits_summary(record)
+    assert s == record["summary"]
+    assert f"**{s['curve_over_sweep']:.2f}×**" in report.PAGE.read_text()
+    from matplotlib.image import imread
+
+    fig = orbits_report.figure(record, tmp_path / "orbits-speed.png")
+    new, committed = imread(fig), imread(orbits_report.FIGURE)
+    assert new.shape == committed.shape and abs(new - committed).mean() < 2e-3, "docs/figures/orbits-speed.png differs"

@@ -8,7 +8,11 @@ import re
 
 import pytest
 
+from gearsym.checks import json_safe
 from gearsym.paths import REPO_ROOT
+from gearsym.periodic import FOLD, GRAZING, NEIMARK_SACKER, PERIOD_DOUBLING
+from gearsym.reproduce import jumps
+from gearsym.reproduce.plan import PAPER_JUMPS
 from gearsym.reproduce import claims as claim_checks
 from gearsym.reproduce import SCENARIOS, compute, paper_plan, render, reproduce
 from gearsym.reproduce.report import VERDICT_MARK
@@ -55,11 +59,27 @@ def test_figure_3_claims_recomputed_match_the_committed_record(tmp_path, committ
         claim = check(computed, {})
         assert claim["measured"] == recorded[claim["id"]]["measured"]
         assert claim["verdict"] == recorded[claim["id"]]["verdict"]
+    assert json_safe(computed.jumps) == committed["scenarios"][0]["orbits"]  # the branches, and what each jump is
+
+
+def test_every_paper_jump_and_hysteresis_end_is_a_located_bifurcation_or_a_crisis(committed):
+    """docs/reproduction.md says for each jump of the paper (Fig. 3a, D = 2) and each end of each hysteresis
+    interval what it is; each is one of the kinds the continuation locates, or a chaotic attractor's crisis."""
+    explained = {FOLD, PERIOD_DOUBLING, NEIMARK_SACKER, GRAZING, jumps.CRISIS, jumps.STEEP}
+    for scenario in committed["scenarios"]:
+        for orbits in scenario["orbits"].values():
+            ends = [h[run] for h in orbits["hysteresis"] for run in ("up", "down")]
+            assert ends and all(end["kind"] in explained for end in ends), ends
+    paper = committed["scenarios"][0]["orbits"][jumps.PAPER_SWEEP]["paper_jumps"]
+    assert [j["omega"] for j in paper] == list(PAPER_JUMPS) and all(j["kind"] in explained for j in paper), paper
+    page = (DOCS / "reproduction.md").read_text()
+    assert all(j["text"] in page for j in paper)
 
 
 def test_a_quick_reproduction_writes_every_output_and_reuses_its_data(tmp_path):
     record = reproduce(tmp_path / "figures", tmp_path / "reproduction.md", quick=True, progress=False)
-    for name in ("fig3.png", "fig4.png", "fig6.png", "fig7.png", "hysteresis.png", "study.png", "claims.json"):
+    for name in ("fig3.png", "fig3-orbits.png", "fig4.png", "fig6.png", "fig7.png", "hysteresis.png", "study.png",
+                 "claims.json"):
         assert (tmp_path / "figures" / name).stat().st_size > 1000, name
     page = (tmp_path / "reproduction.md").read_text()
     for scenario in record["scenarios"]:

@@ -161,7 +161,8 @@ def _profile_table(raw: dict) -> list[str]:
     return lines
 
 
-def render(raw: dict, notes: str | None = None) -> str:
+def render(raw: dict, notes: str | None = None, orbits: dict | None = None) -> str:
+    """The page; ``orbits``: the record of ``python -m bench.orbits``, whose section it adds."""
     summary = raw["summary"]
     m = raw["machine"]
     st = raw["settings"]
@@ -238,6 +239,10 @@ def render(raw: dict, notes: str | None = None) -> str:
             "Each model loaded in a fresh process with an empty cache, then again in another fresh process:", "",
             *_compile_table(raw), "", f"Target: at most {TARGETS['compile_seconds']:g} s of C compilation per "
             "model, and nothing compiled again for an unchanged model.", ""]
+    if orbits:
+        from bench.orbits.report import section
+
+        out += section(orbits)
     if notes:
         out += [notes.rstrip(), ""]
     return "\n".join(out)
@@ -313,12 +318,22 @@ def figure(raw: dict, path: Path) -> Path:
     return save_figure(fig, path, dpi=100)
 
 
-def write_report(json_path: Path = DEFAULT_JSON, page: Path = PAGE, figure_path: Path = FIGURE) -> list[Path]:
+def write_report(json_path: Path = DEFAULT_JSON, page: Path = PAGE, figure_path: Path = FIGURE,
+                 orbits_path: Path | None = None, orbits_figure: Path | None = None) -> list[Path]:
+    """The page and the figure from the benchmark's JSON, and (if its record exists) the orbits' section and
+    figure from ``bench/results/orbits.json``."""
+    from bench.orbits import report as orbits_report
+
     raw = json.loads(Path(json_path).read_text())
     raw["summary"] = summarise(raw)  # recomputed: the page never shows a number the raw data does not give
     notes = NOTES.read_text() if NOTES.exists() else None
-    page.write_text(render(raw, notes))
-    return [page, figure(raw, figure_path)]
+    orbits_path = orbits_path or orbits_report.RECORD
+    orbits = json.loads(orbits_path.read_text()) if orbits_path.is_file() else None
+    page.write_text(render(raw, notes, orbits))
+    written = [page, figure(raw, figure_path)]
+    if orbits:
+        written.append(orbits_report.figure(orbits, orbits_figure or figure_path.with_name(orbits_report.FIGURE.name)))
+    return written
 
 
 if __name__ == "__main__":

@@ -24,11 +24,12 @@ from types import ModuleType
 
 from ..version import __version__
 from ..errors import GearsymError, GearsymWarning
-from . import campbell, compile, derive, docs, explain, list_models, lyap, modes, poincare, reproduce, simulate, sweep
+from . import (campbell, compile, derive, docs, explain, list_models, lyap, modes, orbits, poincare, reproduce,
+               simulate, sweep)
 
 #: the subcommand modules, in the order ``gearsym --help`` lists them
-COMMANDS: tuple[ModuleType, ...] = (list_models, derive, docs, compile, lyap, sweep, poincare, reproduce, simulate, explain,
-                                    modes, campbell)
+COMMANDS: tuple[ModuleType, ...] = (list_models, derive, docs, compile, lyap, sweep, orbits, poincare, reproduce,
+                                    simulate, explain, modes, campbell)
 
 #: exit status of a GearsymError (argparse uses the same for bad arguments)
 USAGE_ERROR = 2

@@ -28,7 +28,7 @@ from .native import load_native
 
 #: every function the generated library exports
 FUNCTION_NAMES = ("rhs", "jacobian", "constants", "table", "lyapunov_chunk", "lyapunov_period",
-                  "orbit_chunk", "orbit_period", "trajectory")
+                  "orbit_chunk", "orbit_period", "trajectory", "monodromy_segment", "monodromy_period")
 
 _LOADED: dict[tuple, CompiledModel] = {}
 _WARNED = set()

@@ -43,6 +43,11 @@ class RunInputs:
     def constants_dm(self) -> ca.DM:
         return ca.DM(self.constants)
 
+    @cached_property
+    def addresses(self) -> tuple[int, int]:
+        """Where the table and the constants are, for the native calls."""
+        return self.table.ctypes.data, self.constants.ctypes.data
+
 
 @dataclass(frozen=True)
 class TangentRun:
@@ -53,6 +58,29 @@ class TangentRun:
     low: np.ndarray  # observed x periods: minimum over each period's steps
     high: np.ndarray
     Q: np.ndarray  # final orthonormal tangent vectors (columns)
+
+
+@dataclass(frozen=True)
+class Shot:
+    """Where a shot from y0 lands, with the exact Jacobian of the landing point by y0."""
+
+    state: np.ndarray  # (n,)
+    M: np.ndarray  # n x n: d state / d y0 (the monodromy matrix over whole periods), not re-orthonormalised
+    low: np.ndarray  # (observed,): the minimum over every step of the shot
+    high: np.ndarray
+
+
+class _ShotBuffers:
+    """Two states and two tangent matrices a shot writes into in turn, and the extremes of a call."""
+
+    def __init__(self, n: int, m: int):
+        self.eye = np.asfortranarray(np.eye(n))
+        self.y = [np.empty(n), np.empty(n)]
+        self.M = [np.empty((n, n), order="F"), np.empty((n, n), order="F")]
+        self.low, self.high = np.empty(m), np.empty(m)
+        self.y_at = [a.ctypes.data for a in self.y]
+        self.M_at = [a.ctypes.data for a in self.M]
+        self.low_at, self.high_at = self.low.ctypes.data, self.high.ctypes.data
 
 
 @dataclass
@@ -145,6 +173,30 @@ class CompiledModel:
         return RunInputs(p, np.asfortranarray(table, dtype=np.float64), np.ascontiguousarray(c.reshape(-1)),
                          period, float(t0), self.hash)
 
+    @cached_property
+    def timed_parameters(self) -> frozenset[str]:
+        """The parameters that enter the tables of time or the period: only a change of one of them needs
+        new tables (:meth:`retune`)."""
+        from .time_tables import split_rhs
+
+        exprs = [e for _, e in split_rhs(self.system, self.options.locate_crossings).tables] + [self.system.period]
+        return frozenset(s.name for e in exprs for s in e.free_symbols) & set(self.parameter_names)
+
+    def retune(self, inputs: RunInputs, p: np.ndarray) -> RunInputs:
+        """The inputs for the parameter vector ``p``: those of ``inputs`` with new constants if no parameter that
+        changed enters the tables or the period (a continuation in omega of a model in tau), else :meth:`prepare`."""
+        p = np.asarray(p, dtype=float)
+        if p.shape != inputs.p.shape or not np.isfinite(p).all() or any(
+                self.parameter_names[i] in self.timed_parameters for i in np.nonzero(p != inputs.p)[0]):
+            return self.prepare(p, inputs.t0)
+        if self.native:  # straight into the new constants (a continuation asks for thousands of them)
+            p = np.ascontiguousarray(p)
+            c, period = np.empty(inputs.constants.size), np.empty(1)
+            self.native["constants"].call((p.ctypes.data,), (c.ctypes.data, period.ctypes.data))
+        else:
+            c = np.array(self.functions["constants"](p)[0]).reshape(-1)
+        return RunInputs(p, inputs.table, c, inputs.period, inputs.t0, inputs.model_hash)
+
     def _check_periodic(self, p: np.ndarray, t0: float, period: float, probe: np.ndarray) -> None:
         """The loops repeat one sampled period; at other parameter values than the defaults
         (checked when the code was generated) the time dependence must still repeat.
@@ -155,7 +207,7 @@ class CompiledModel:
             from .time_tables import NotPeriodicError, split_rhs
 
             i = int(off[0])
-            expr = split_rhs(self.system).tables[i][1]
+            expr = split_rhs(self.system, self.options.locate_crossings).tables[i][1]
             values = ", ".join(f"{n}={v:g}" for n, v in zip(self.parameter_names, p))
             raise NotPeriodicError(self.system, expr, t0 + 0.37 * period, float(a[i]), float(b[i]), f"at {values}")
 
@@ -246,6 +298,66 @@ class CompiledModel:
                 parts.append((out, *rest))
         stacked = [_hcat([p[i] for p in parts], r) for i, r in enumerate(rows)]
         return stacked, (None if Qd is None else np.array(Qd))
+
+    @cached_property
+    def shooting_pieces(self) -> int:
+        """The pieces the generated code cuts a forcing period into for multiple shooting (4, or fewer
+        when the steps per period do not divide by 4)."""
+        return self.steps_per_period // int(self.functions["monodromy_segment"].size_in(2)[1])
+
+    def shoot(self, y0, inputs: RunInputs, pieces: int | None = None, first: int = 0) -> Shot:
+        """The state and the exact Jacobian d state/d y0 after ``pieces`` pieces of a period (default one
+        whole period; see :attr:`shooting_pieces`), starting at piece ``first`` of the period (the phase
+        t0 + first/pieces_per_period of ``inputs``): the exact variational equations along the same
+        (crossing-located) steps as every run, with no re-orthonormalisation."""
+        self._check_inputs(inputs)
+        pieces = self.shooting_pieces if pieces is None else whole_number(pieces, "pieces", 1)
+        y = y0 if isinstance(y0, np.ndarray) and y0.shape == (self.dimension,) else self.initial_state(y0)
+        shot = (self._native_shot if self.native else self._casadi_shot)(y, inputs, first, first + pieces)
+        if not (np.isfinite(shot.state).all() and np.isfinite(shot.M).all() and np.isfinite(y).all()):
+            self._check_finite(inputs, np.full((1, 1), np.nan))
+        return shot
+
+    def _shot_plan(self, first: int, end: int):
+        """(function, piece) calls from piece ``first`` to ``end``: whole periods where they line up."""
+        S, k = self.shooting_pieces, first
+        while k < end:
+            whole = k % S == 0 and end - k >= S
+            yield ("monodromy_period" if whole else "monodromy_segment"), k % S
+            k += S if whole else 1
+
+    @cached_property
+    def _shot_buffers(self) -> "_ShotBuffers":
+        return _ShotBuffers(self.dimension, len(self.observed))
+
+    def _native_shot(self, y, inputs: RunInputs, first: int, end: int) -> Shot:
+        """Piece after piece into two buffers taken in turn (Newton calls this thousands of times: nothing
+        here but the calls)."""
+        b = self._shot_buffers
+        b.y[0][:] = y
+        b.M[0][:] = b.eye
+        table, c = inputs.addresses
+        piece_bytes = inputs.table.shape[0] * 8 * (self.steps_per_period // self.shooting_pieces)
+        low = high = None
+        i = 0
+        for name, piece in self._shot_plan(first, end):
+            self.native[name].call((b.y_at[i], b.M_at[i], table + piece * piece_bytes, c),
+                                   (b.y_at[1 - i], b.M_at[1 - i], b.low_at, b.high_at))
+            i = 1 - i
+            low = b.low.copy() if low is None else np.minimum(low, b.low)
+            high = b.high.copy() if high is None else np.maximum(high, b.high)
+        return Shot(b.y[i].copy(), b.M[i].copy(), low, high)
+
+    def _casadi_shot(self, y, inputs: RunInputs, first: int, end: int) -> Shot:
+        m, width = len(self.observed), self.steps_per_period // self.shooting_pieces
+        yd, Md = ca.DM(y), ca.DM.eye(self.dimension)
+        low, high = np.full(m, np.inf), np.full(m, -np.inf)
+        for name, piece in self._shot_plan(first, end):
+            table = inputs.table_dm if name == "monodromy_period" else \
+                inputs.table_dm[:, piece * width:(piece + 1) * width]
+            yd, Md, lo, hi = self.functions[name](yd, Md, table, inputs.constants_dm)
+            low, high = np.minimum(low, np.array(lo).reshape(-1)), np.maximum(high, np.array(hi).reshape(-1))
+        return Shot(np.array(yd).reshape(-1), np.array(Md), low, high)
 
     def orbit_run(self, y0, periods: int, inputs: RunInputs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The state after each of ``periods`` periods (stroboscopic samples), with each period's min and max."""

@@ -88,7 +88,7 @@ class ModelFunctions:
 
 def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions()) -> ModelFunctions:
     """Every function the engine generates for ``system`` (see the module docstring)."""
-    split = split_rhs(system)
+    split = split_rhs(system, factored=options.locate_crossings)
     sym = _Symbols(system, split)
     n, m, nc = system.dimension, len(split.tables), len(split.constants)
     N, K = options.steps_per_period, options.block(n)
@@ -149,10 +149,37 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
     Yt = state_step.mapaccum("steps", N, 1)(Ym, Tm, Cm)
     trajectory = ca.Function("trajectory", [Ym, Tm, Cm], [Yt], ["y0", "table", "c"], ["states"])
 
+    monodromy_segment, monodromy_period = _monodromy(tangent_block, obs0, Ym, Qm, Cm, m, N, K)
+
     table = _table_function(constants, table_point, len(sym.params), nc, m, N)
     functions = {f.name(): f for f in (rhs, jacobian, constants, table, lyapunov_chunk, lyapunov_period,
-                                       orbit_chunk, orbit_period, trajectory)}
+                                       orbit_chunk, orbit_period, trajectory, monodromy_segment, monodromy_period)}
     return ModelFunctions(system, options, split, functions)
+
+
+#: a period is shot in up to this many pieces (multiple shooting of strongly unstable orbits)
+SHOOTING_SEGMENTS = 4
+
+
+def _monodromy(tangent_block, obs0, Ym: ca.MX, Qm: ca.MX, Cm: ca.MX, m: int, N: int, K: int):
+    """``monodromy_segment``: one piece of a period (``SHOOTING_SEGMENTS`` of them, or the largest number
+    below that the period's blocks divide into), the state and the raw tangent matrix Phi Q0 (no
+    Gram-Schmidt: the Jacobian of the map, for Newton) with the observed states' min and max over its
+    steps; ``monodromy_period``: the pieces of one period in turn (:mod:`gearsym.periodic`)."""
+    blocks = N // K
+    S = max(d for d in range(1, SHOOTING_SEGMENTS + 1) if blocks % d == 0)
+    width = N // S
+    Ts = ca.MX.sym("T", 3 * m, width)
+    yk, Qk, lk, hk = _over_period(tangent_block, [Ym, Qm, obs0, obs0], Ts, Cm, K, "shooting")
+    names = (["y0", "Q0", "table", "c"], ["strobe", "M", "low", "high"])
+    segment = ca.Function("monodromy_segment", [Ym, Qm, Ts, Cm], [yk, Qk, lk, hk], *names)
+    Tm = ca.MX.sym("T", 3 * m, N)
+    yk, Qk, lk, hk = Ym, Qm, obs0, obs0
+    for k in range(S):
+        yk, Qk, low, high = segment(yk, Qk, Tm[:, k * width:(k + 1) * width], Cm)
+        lk, hk = select_min(low, lk), select_max(high, hk)
+    period = ca.Function("monodromy_period", [Ym, Qm, Tm, Cm], [yk, Qk, lk, hk], *names)
+    return segment, period
 
 
 _OPTS = {"cse": True}
@@ -369,27 +396,31 @@ def _crossing_steps(sym: _Symbols, split: SplitRHS, switching: _Switching, where
     The right-hand side is continuous across a backlash surface but its slope jumps, so plain RK4 over a
     crossing step is only first order for the tangent map (and the exponents). Here each step is:
 
-    1. *try* (SX, every step): the plain RK4 step y0 -> y1 and a flag: does some surface s change side
-       between y0 and y1? (A crossing and return within one step is not seen: it stays a plain step.)
-    2. a CasADi ``Switch`` (a C ``if``): no crossing, keep y1; a crossing, the *split* (SX):
+    1. *try* (SX, every step): RK4 y0 -> y1 of the smooth extension of the branch at y0 (its sides, mode A,
+       frozen: a stage that overshoots a surface stays on A's formula), and a flag: has the cubic Hermite
+       of some surface's s over the step (values and slopes h ds/dt at both ends) a zero in it? The test
+       is its Bernstein coefficients s0, s0 + d0/3, s1 - d1/3, s1 all on the start's side (then, by the
+       convex hull, no zero): cheap, and it also sees an excursion across a surface and back within the
+       step (a *dip*, which comparing the sides at y0 and y1 would miss).
+    2. a CasADi ``Switch`` (a C ``if``): not flagged, keep y1; flagged, the *split* (SX):
 
-       * the sides at y0 (mode A) are frozen: RK4 of the smooth extension of mode A over the whole step
-         gives s at the end, and a cubic Hermite of s over the step (values and slopes h ds/dt at both
-         ends) locates theta in [0, 1] by Newton from the linear estimate (``_NEWTON`` iterations,
-         clamped). The extension is smooth, so theta is O(h^4) accurate; the earliest surface wins;
-         surfaces that the extension does not cross are left alone;
-       * RK4 of mode A over theta h, then of mode B (mode A with the crossed surface(s) flipped) over
-         (1 - theta) h, the tangent Q along. Each substep sees one smooth right-hand side: with every
-         stage evaluated on the frozen mode, stages that overshoot the surface stay on the branch they
-         belong to, which is what makes the step 4th order again.
+       * the earliest zero theta_1 of the cubic of mode A's extension (``_first_zero``: bracketed between
+         the cubic's extrema, then Newton kept inside the bracket), the earliest surface winning; RK4 of A
+         over theta_1 h; then the same for mode B (A with the crossed surface(s) flipped) over the rest of
+         the step, from the crossing, whose own zero there is not counted again: theta_2, the way out of a
+         dip (or a second surface); RK4 of B up to it and of mode C over the rest. Each substep sees one
+         smooth right-hand side, the tangent Q along: 4th order again. No zero: RK4 of A over the whole
+         step, which is the kept try, so the choice between the two branches of the ``Switch`` never
+         makes the step jump: the map of a period is a continuous function of its start (Newton on
+         P(y) - y needs that; a plain step over a dip, or a Newton that could leave the sign change, made
+         it jump by up to 1e-3 near a grazing at 200 steps, measured).
        * the tables at the substeps' stage times come from the quadratic through Ta, Tb, Tc (t, t + h/2,
          t + h): O(h^3) in the coefficients over O(1) split steps per period, 4th order overall.
 
     No saltation matrix: f is continuous across the surface (g is), so the tangent map is continuous
-    there; only J jumps, and each substep integrates J of its own mode. Two *different* surfaces crossed in
-    one step: the earliest is split at; the other is integrated on the extension of its old side for the
-    rest of that step (like a plain step, first order there). The min/max of the observed states are
-    taken after the step, as in the plain loops.
+    there; only J jumps, and each substep integrates J of its own mode. A third zero in one step is
+    integrated on the extension of the mode before it (first order there). The min/max of the observed
+    states are taken after the step, as in the plain loops.
     """
     step = _CrossingStep(sym, split, switching, where)
     # with tangent vectors: try, then Switch(keep | split), emitted straight into the caller's MX graph
@@ -443,59 +474,73 @@ class _CrossingStep:
     def side(s):
         return s >= 0
 
-    def plain(self, with_tangent: bool):
-        """The plain RK4 step, and whether some surface changed side over it."""
-        y, ch, Ta, Tc = self.sym.y, self.sym.ch, self.Ta, self.Tc
-        yn, Qn = rk4_step(lambda x, Tx: self.f_of(x, Tx, ch), lambda x, Tx: self.J_of(x, Tx, ch), y,
-                          self.Q if with_tangent else None, self.h, Ta, self.Tb, Tc)
-        flag = ca.sum1(self.side(self.s_of(y, Ta, ch)) != self.side(self.s_of(yn, Tc, ch))) > 0
-        return yn, Qn, flag
+    def f_mode(self, mode):
+        ch = self.sym.ch
+        return lambda x, Tx: self.fz_of(x, Tx, ch, mode)
+
+    def J_mode(self, mode):
+        ch = self.sym.ch
+        return lambda x, Tx: self.Jz_of(x, Tx, ch, mode)
+
+    def hermite(self, y0, y1, mode, h, Ta, Tb, Tc):
+        """s at both ends of a step of length ``h`` from ``y0`` to ``y1`` (mode frozen) and their slopes
+        h ds/dt, the tables' rates from their quadratic over the step."""
+        ch, f = self.sym.ch, self.f_mode(mode)
+        s0, s1 = self.s_of(y0, Ta, ch), self.s_of(y1, Tc, ch)
+        d0 = self.sdot_of(y0, Ta, ch, h * f(y0, Ta), 4 * Tb - 3 * Ta - Tc)
+        d1 = self.sdot_of(y1, Tc, ch, h * f(y1, Tc), Ta - 4 * Tb + 3 * Tc)
+        return s0, d0, s1, d1
+
+    def tried(self, with_tangent: bool):
+        """The step on the smooth extension of the branch at its start (the sides at y0 frozen: a stage that
+        overshoots a surface stays on the start's branch), and whether the cubic Hermite of some surface's
+        s over it has a zero in the step: a crossing, or an excursion across and back (a *dip*)."""
+        y, Ta, Tb, Tc = self.sym.y, self.Ta, self.Tb, self.Tc
+        mode = self.side(self.s_of(y, Ta, self.sym.ch))
+        yn, Qn = rk4_step(self.f_mode(mode), self.J_mode(mode), y, self.Q if with_tangent else None, self.h,
+                          Ta, Tb, Tc)
+        s0, d0, s1, d1 = self.hermite(y, yn, mode, self.h, Ta, Tb, Tc)
+        sign = 2 * mode - 1
+        # the cubic's Bernstein coefficients all on the start's side: no zero in the step (convex hull)
+        clear = [sign * b > 0 for b in (s1, s0 + d0 / 3, s1 - d1 / 3)]
+        return yn, Qn, ca.sum1(ca.logic_not(ca.logic_and(ca.logic_and(clear[0], clear[1]), clear[2]))) > 0
 
     def table_at(self, theta):
         """The quadratic through Ta, Tb, Tc, at t + theta h."""
         Ta, Tb, Tc = self.Ta, self.Tb, self.Tc
         return Ta + theta * (4 * Tb - 3 * Ta - Tc) + theta * theta * (2 * Ta - 4 * Tb + 2 * Tc)
 
-    def crossing(self, mode_a):
-        """(theta, mode B): where in the step the earliest surface is crossed on the extension of mode A
-        (1: none), and the mode after it."""
-        y, ch, h, Ta, Tb, Tc = self.sym.y, self.sym.ch, self.h, self.Ta, self.Tb, self.Tc
-        y_ext, _ = rk4_step(lambda x, Tx: self.fz_of(x, Tx, ch, mode_a), None, y, None, h, Ta, Tb, Tc)
-        s0, s1 = self.s_of(y, Ta, ch), self.s_of(y_ext, Tc, ch)
-        d0 = self.sdot_of(y, Ta, ch, h * self.fz_of(y, Ta, ch, mode_a), 4 * Tb - 3 * Ta - Tc)
-        d1 = self.sdot_of(y_ext, Tc, ch, h * self.fz_of(y_ext, Tc, ch, mode_a), Ta - 4 * Tb + 3 * Tc)
-        crossed = self.side(s1) != mode_a
-        theta = s0 / ca.if_else(crossed, s0 - s1, 1)  # the secant, then Newton on the cubic Hermite
-        for _ in range(_NEWTON):
-            t2 = theta * theta
-            t3 = t2 * theta
-            p = (2 * t3 - 3 * t2 + 1) * s0 + (t3 - 2 * t2 + theta) * d0 + (3 * t2 - 2 * t3) * s1 + (t3 - t2) * d1
-            dp = (6 * t2 - 6 * theta) * (s0 - s1) + (3 * t2 - 4 * theta + 1) * d0 + (3 * t2 - 2 * theta) * d1
-            theta = _clamp01(theta - p / ca.if_else(dp == 0, 1, dp))
-        theta = ca.if_else(crossed, theta, 2)  # 2: not crossed in this step
+    def crossing(self, y0, y1, mode, h, T0, Tm, T1, fresh):
+        """(theta, the mode after it): where in a step of length h from y0 (its end y1 on the extension of
+        ``mode``) the earliest surface is crossed (1: none), and the mode with the crossed surface(s)
+        flipped. ``fresh``: the surfaces y0 lies on (just crossed), whose zero at the start is not counted."""
+        found, theta = _first_zero(*self.hermite(y0, y1, mode, h, T0, Tm, T1), mode, fresh)
+        theta = ca.if_else(found, theta, 2)
         first = theta[0]
         for i in range(1, self.surfaces):
             first = ca.if_else(theta[i] < first, theta[i], first)
-        flip = ca.logic_and(crossed, theta <= first)
-        return ca.if_else(first > 1, 1, first), ca.if_else(flip, 1 - mode_a, mode_a)
+        flip = ca.logic_and(found, theta <= first)
+        return ca.if_else(first > 1, 1, first), ca.if_else(flip, 1 - mode, mode)
 
     def located(self, with_tangent: bool):
-        """RK4 of mode A up to the crossing, then of mode B over the rest of the step."""
-        y, ch, h, Ta, Tc = self.sym.y, self.sym.ch, self.h, self.Ta, self.Tc
-
-        def f_mode(mode):
-            return lambda x, Tx: self.fz_of(x, Tx, ch, mode)
-
-        def J_mode(mode):
-            return lambda x, Tx: self.Jz_of(x, Tx, ch, mode)
-
+        """Up to two crossings in the step (a crossing, or a dip's way in and out): RK4 of mode A up to the
+        first, of mode B up to the second, of mode C over the rest; each on its own smooth branch."""
+        y, ch, h, Ta, Tb, Tc = self.sym.y, self.sym.ch, self.h, self.Ta, self.Tb, self.Tc
+        Q = self.Q if with_tangent else None
         mode_a = self.side(self.s_of(y, Ta, ch))
-        first, mode_b = self.crossing(mode_a)
-        Tm = self.table_at(first)
-        y_c, Q_c = rk4_step(f_mode(mode_a), J_mode(mode_a), y, self.Q if with_tangent else None, first * h,
-                            Ta, self.table_at(first / 2), Tm)
-        return rk4_step(f_mode(mode_b), J_mode(mode_b), y_c, Q_c, (1 - first) * h, Tm, self.table_at((1 + first) / 2),
-                        Tc)
+        t1, mode_b = self.crossing(y, self.y1, mode_a, h, Ta, Tb, Tc, 0)  # y1: the try, on mode A's extension
+        T1 = self.table_at(t1)
+        y_b, Q_b = rk4_step(self.f_mode(mode_a), self.J_mode(mode_a), y, Q, t1 * h, Ta, self.table_at(t1 / 2), T1)
+        rest = (1 - t1) * h
+        T_rest = self.table_at((1 + t1) / 2)
+        y_ext, _ = rk4_step(self.f_mode(mode_b), None, y_b, None, rest, T1, T_rest, Tc)
+        t2, mode_c = self.crossing(y_b, y_ext, mode_b, rest, T1, T_rest, Tc, mode_b != mode_a)
+        t2 = t1 + t2 * (1 - t1)
+        T2 = self.table_at(t2)
+        y_c, Q_c = rk4_step(self.f_mode(mode_b), self.J_mode(mode_b), y_b, Q_b, (t2 - t1) * h, T1,
+                            self.table_at((t1 + t2) / 2), T2)
+        return rk4_step(self.f_mode(mode_c), self.J_mode(mode_c), y_c, Q_c, (1 - t2) * h, T2,
+                        self.table_at((1 + t2) / 2), Tc)
 
     def extremes(self, yn):
         obs = ca.vertcat(*[yn[j] for j in self.sym.observed])
@@ -505,7 +550,7 @@ class _CrossingStep:
         """``{kind}_try`` (the plain step and its crossing flag) and ``{kind}_switch`` (keep the try, or
         the located step), with or without tangent vectors."""
         y, ch, col = self.sym.y, self.sym.ch, self.col
-        yn, Qn, flag = self.plain(with_tangent)
+        yn, Qn, flag = self.tried(with_tangent)
         ys, Qs = self.located(with_tangent)
         if with_tangent:
             tried = ca.Function(f"{kind}_try", [y, self.Q, col, ch], [yn, Qn, flag], _OPTS)
@@ -528,11 +573,65 @@ class _CrossingStep:
         return ca.Function("state_step", [Ym, Ti, Cm], [step_switch(crossing, Ym, y_try, Ti, Cm)])
 
 
-_NEWTON = 4  # Newton iterations on the Hermite cubic from the secant (the error squares at each one)
+_NEWTON = 8  # safeguarded Newton iterations on the Hermite cubic from the secant (quadratic near the root)
 
 
-def _clamp01(x):
-    return ca.if_else(x < 0, 0, ca.if_else(x > 1, 1, x))
+def _first_zero(s0, d0, s1, d1, mode, fresh):
+    """Per surface: (found, theta) of the earliest zero in (0, 1] of the cubic Hermite r of s over a step
+    (values s0, s1 and slopes d0, d1 = h ds/dt at its ends), seen from the side ``mode`` of the start.
+    ``fresh`` (0/1 per surface): the step starts on that surface (s0 = 0, just crossed): r(theta)/theta is
+    searched instead, so that the zero at the start is not found again.
+
+    The cubic is monotone between its extrema, so the first of the points (its interior extrema in
+    order, then 1) where r is on the other side closes a bracket with a single zero; Newton from the
+    secant, kept inside the bracket (else bisecting it), finds it. Every piece is a continuous function of
+    the ends, which keeps the located step continuous in its start (see ``_crossing_steps``)."""
+    sign = 2 * mode - 1  # +1: the start is on the side s >= 0
+
+    def r(t):
+        cubic = (2 * t**3 - 3 * t**2 + 1) * s0 + (t**3 - 2 * t**2 + t) * d0 + (3 * t**2 - 2 * t**3) * s1 \
+            + (t**3 - t**2) * d1
+        deflated = (1 - t) ** 2 * d0 + t * (3 - 2 * t) * s1 + t * (t - 1) * d1
+        return ca.if_else(fresh, deflated, cubic)
+
+    def dr(t):
+        cubic = (6 * t**2 - 6 * t) * (s0 - s1) + (3 * t**2 - 4 * t + 1) * d0 + (3 * t**2 - 2 * t) * d1
+        deflated = -2 * (1 - t) * d0 + (3 - 4 * t) * s1 + (2 * t - 1) * d1
+        return ca.if_else(fresh, deflated, cubic)
+
+    # interior extrema: the roots of r' (a quadratic; linear for the deflated cubic)
+    a = ca.if_else(fresh, 0, 6 * (s0 - s1) + 3 * d0 + 3 * d1)
+    b = ca.if_else(fresh, 2 * d0 - 4 * s1 + 2 * d1, -6 * (s0 - s1) - 4 * d0 - 2 * d1)
+    c = ca.if_else(fresh, -2 * d0 + 3 * s1 - d1, d0)
+    disc = b * b - 4 * a * c
+    root = ca.sqrt(ca.if_else(disc > 0, disc, 0))
+    q = -(b + ca.if_else(b >= 0, root, -root)) / 2  # the stable pair of roots: q/a and c/q
+    e1 = ca.if_else(a == 0, ca.if_else(b == 0, 1, -c / ca.if_else(b == 0, 1, b)), q / ca.if_else(a == 0, 1, a))
+    e2 = ca.if_else(q == 0, e1, c / ca.if_else(q == 0, 1, q))
+    e1 = ca.if_else(disc < 0, 1, e1)
+    e2 = ca.if_else(disc < 0, 1, e2)
+    e1 = ca.if_else(ca.logic_and(e1 > 0, e1 < 1), e1, 1)
+    e2 = ca.if_else(ca.logic_and(e2 > 0, e2 < 1), e2, 1)
+    first, second = ca.fmin(e1, e2), ca.fmax(e1, e2)
+
+    def on(value):
+        return sign * value > 0
+
+    r1, r2, r3 = r(first), r(second), r(ca.SX.ones(s0.shape))
+    low = ca.if_else(on(r1), ca.if_else(on(r2), second, first), 0)
+    high = ca.if_else(on(r1), ca.if_else(on(r2), 1, second), first)
+    found = ca.logic_not(ca.logic_and(ca.logic_and(on(r1), on(r2)), on(r3)))
+    r_low, r_high = r(low), r(high)
+    theta = low + (high - low) * r_low / ca.if_else(r_low == r_high, 1, r_low - r_high)  # the secant
+    theta = ca.if_else(ca.logic_and(theta > low, theta <= high), theta, (low + high) / 2)
+    for _ in range(_NEWTON):
+        p, dp = r(theta), dr(theta)
+        before = on(p)  # still on the start's side: the zero is later
+        low, high = ca.if_else(before, theta, low), ca.if_else(before, high, theta)
+        newton = theta - p / ca.if_else(dp == 0, 1, dp)
+        inside = ca.logic_and(newton >= low, newton <= high)
+        theta = ca.if_else(p == 0, theta, ca.if_else(inside, newton, (low + high) / 2))
+    return found, theta
 
 
 def _gram_schmidt(n: int) -> ca.Function:

@@ -1,7 +1,8 @@
 """``gearsym reproduce``: the paper's Figs. 3, 4, 6 and 7, its claims checked, and a parameter study.
 
 Pipeline: :mod:`.plan` (what to run) -> :mod:`.compute` (sweeps, attractors,
-portraits) -> :mod:`.claims` (each claim measured and judged) ->
+portraits, periodic branches) -> :mod:`.claims` (each claim measured and judged) and
+:mod:`.jumps` (what each jump is, from the branches) ->
 :mod:`.figures` (PNGs) and :mod:`.report` (``docs/reproduction.md``).
 """
 from __future__ import annotations
@@ -29,7 +30,10 @@ def scenario_record(c: Computed) -> dict:
             params = c.sweeps[job.name].record["parameters"]
             values.setdefault(job.model, {k: params[k] for k in NOT_IN_PAPER if k in params})
     s = c.plan.scenario
-    return {"name": s.name, "label": s.label, "values": values, **evaluate(c)}
+    record = {"name": s.name, "label": s.label, "values": values, **evaluate(c)}
+    if c.jumps:
+        record["orbits"] = c.jumps
+    return record
 
 
 def record_of(computed: list[Computed]) -> dict:

@@ -7,15 +7,18 @@ only redraws; an interrupted one resumes where it stopped.
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..analysis import LyapunovSpectrum, Trajectory, lyapunov_spectrum, phase_trajectory
 from ..analysis.attractors import AttractorSet, find_attractors
 from ..codegen import compile_model
 from ..options import Integration
+from ..periodic import Continuation, continue_orbits
+from ..periodic.orbit import sweep_start
 from ..registry import load
 from ..sweep import SweepResult, Workers, run_sweep
+from .jumps import jump_records
 from .plan import Plan
 
 
@@ -35,6 +38,9 @@ class Computed:
     sweeps: dict[str, SweepResult]
     attractors: dict[tuple[str, float], AttractorSet]
     portraits: tuple[Portrait, ...]
+    orbits: dict[str, Continuation] = field(default_factory=dict)  # by the name of the sweep they follow
+    jumps: dict[str, dict] = field(default_factory=dict)  # what each of that sweep's jumps is (jumps.py)
+    local: dict[str, list] = field(default_factory=dict)  # orbits of other periods continued across its jumps
 
 
 def compute(plan: Plan, data_dir: str | Path, *, jobs: int = 0, progress: bool = True) -> Computed:
@@ -69,7 +75,28 @@ def compute(plan: Plan, data_dir: str | Path, *, jobs: int = 0, progress: bool =
         trajectory = phase_trajectory(model, options=scheme.run(discard=plan.periods - shown), **values)  # its end
         portraits.append(Portrait(job.letter, {"omega": plan.portrait_omega, **job.settings}, job.x, job.y,
                                   spectrum, trajectory))
-    return Computed(plan, sweeps, attractors, tuple(portraits))
+    orbits = _orbits(plan, sweeps, progress)
+    jumps, local = jump_records(plan, sweeps, orbits)
+    return Computed(plan, sweeps, attractors, tuple(portraits), orbits, jumps, local)
+
+
+#: the orbits' scheme: crossings located (their Jacobian, the monodromy matrix, is exact only so: plain RK4 is
+#: first order in it across the backlash's kink), where the sweeps keep the paper's plain scheme, like for like
+ORBITS = Integration()
+
+
+def _orbits(plan: Plan, sweeps: dict[str, SweepResult], progress: bool) -> dict[str, Continuation]:
+    """The periodic branches over each orbit job's range, started from its sweep's state there."""
+    out = {}
+    for job in plan.orbits:
+        sweep_job = plan.sweep(job.sweep)
+        _say(progress, f"periodic orbits: {sweep_job.model} omega={job.start:g}..{job.stop:g}"
+             + "".join(f" {k}={v}" for k, v in sweep_job.settings.items()))
+        model = compile_model(load(sweep_job.model), ORBITS)
+        start = sweep_start(sweeps[job.sweep], model, "omega", job.start, sweep_job.settings)
+        out[job.sweep] = continue_orbits(model, "omega", job.start, job.stop, y0=start,
+                                         switch_depth=job.switch_depth, **sweep_job.settings)
+    return out
 
 
 def _say(enabled: bool, message: str) -> None:

@@ -100,6 +100,36 @@ def figure3(c: Computed):
     return fig
 
 
+def figure3_orbits(c: Computed):
+    """Fig. 3a with the branches of periodic orbits: the sweeps' points (up and down) under the period-1 and
+    period-2 branches, stable solid and unstable dashed, their bifurcations marked."""
+    from matplotlib.lines import Line2D
+
+    from ..figures.orbits import branch_color, legend_handles, plot_branches, plot_sweep_points
+
+    fig, axs = plt.subplots(1, 2, figsize=(13, 5.4), constrained_layout=True)
+    for ax, (name, title), letter in zip(axs, (("fig3_D0", "'1'  D = 0 (Eq. 2)"), ("fig3_D2", "'2'  D = 2 (Eq. 6)")),
+                                         "ab"):
+        result = c.orbits[name]
+        plot_sweep_points(ax, c.sweeps[name], "omega", result.observed[0])
+        for local in c.local.get(name, ()):  # the orbits of other periods a jump left, continued across it
+            plot_branches(ax, local, label_values=False, legend=False)
+        plot_branches(ax, result, label_values=False, legend=False)
+        handles = legend_handles(result, sweep=True)
+        periods = sorted({b.period_multiple for r in c.local.get(name, ()) for b in r.branches} - {1, 2})
+        handles += [Line2D([], [], color=branch_color(n), lw=1.2, label=f"period {n} (a jump's orbit)") for n in periods]
+        ax.legend(handles=handles, fontsize=7, loc="upper right")
+        for w in PAPER_JUMPS if name == "fig3_D2" else ():
+            ax.axvline(w, color="0.4", ls=":", lw=0.9)
+        ax.set_title(f"{title}: periodic orbits over the continuation's points", fontsize=9)
+        ax.set_ylabel(r"$A$")
+        _finish_omega(ax)
+        _letter(ax, letter)
+    fig.suptitle("Fig. 3a with its periodic branches (crossings located; the sweeps: the paper's scheme) — "
+                 + parameter_set(c, _sweep_parameters(c, "fig3_D0", "fig3_D2"), ("omega", "D")), fontsize=8)
+    return fig
+
+
 def figure6(c: Computed):
     r = c.sweeps["fig6"]
     fig, axs = plt.subplots(2, 2, figsize=(12, 8.4), constrained_layout=True)
@@ -225,12 +255,12 @@ def study(c: Computed):
 
 
 #: the figures of one scenario: file stem -> (builder, dpi)
-FIGURES = {"fig3": (figure3, DPI), "fig4": (figure4, FINE_DPI), "fig6": (figure6, DPI), "fig7": (figure7, FINE_DPI),
-           "hysteresis": (hysteresis, DPI), "study": (study, DPI)}
+FIGURES = {"fig3": (figure3, DPI), "fig3-orbits": (figure3_orbits, DPI), "fig4": (figure4, FINE_DPI),
+           "fig6": (figure6, DPI), "fig7": (figure7, FINE_DPI), "hysteresis": (hysteresis, DPI), "study": (study, DPI)}
 
 
 def draw_all(c: Computed, out: str | Path, suffix: str = "") -> list[Path]:
     """Every figure of one computed plan; ``suffix`` tells the file names of another scenario apart."""
     out = Path(out)
-    names = [n for n in FIGURES if n != "study" or "study_ka" in c.sweeps]
+    names = [n for n in FIGURES if (n != "study" or "study_ka" in c.sweeps) and (n != "fig3-orbits" or c.orbits)]
     return [save_figure(FIGURES[n][0](c), out / f"{n}{suffix}.png", FIGURES[n][1]) for n in names]

@@ -44,6 +44,17 @@ class AttractorJob:
 
 
 @dataclass(frozen=True)
+class OrbitJob:
+    """Periodic orbits continued over omega from ``start`` to ``stop`` for the model and values of the sweep
+    ``sweep``, Newton starting from its final state at ``start`` (Fig. 3a's branches, and what the jumps are)."""
+
+    sweep: str
+    start: float = 0.1
+    stop: float = 2.0
+    switch_depth: int = 1
+
+
+@dataclass(frozen=True)
 class PortraitJob:
     """A phase portrait with its Poincare points from the paper's initial state (Fig. 7)."""
 
@@ -88,6 +99,7 @@ class Plan:
     discard: int = 100
     attractor_periods: int = 200
     attractor_discard: int = 300
+    orbits: tuple[OrbitJob, ...] = ()
 
     def sweep(self, name: str) -> SweepJob:
         return next(s for s in self.sweeps if s.name == name)
@@ -128,10 +140,12 @@ def paper_plan(quick: bool = False, scenario: Scenario = CALIBRATED, study: bool
         PortraitJob("c", {"kS": 0.1}, "x1", "v1"),
         PortraitJob("d", {"kS": 0.1}, "x2", "v2"),
     )
+    # quick: from omega = 2 down to 1 (the orbit at the start must be periodic: at 1.0 it may be chaotic)
+    orbits = tuple(OrbitJob(name, *((2.0, 1.0) if quick else (0.1, 2.0))) for name in ("fig3_D0", "fig3_D2"))
     if quick:
         return Plan(scenario, sweeps, attractors, portraits, periods=120, discard=40, attractor_periods=60,
-                    attractor_discard=60)
-    return Plan(scenario, sweeps, attractors, portraits)
+                    attractor_discard=60, orbits=orbits)
+    return Plan(scenario, sweeps, attractors, portraits, orbits=orbits)
 
 
 def _unswept(settings: dict, params: tuple[str, ...]) -> dict:

@@ -125,6 +125,7 @@ def render(record: dict, figures_dir: str = "figures") -> str:
         if NOTES.get(c["id"]):
             lines += [f"**Why:** {NOTES[c['id']]}", ""]
 
+    lines += _jumps_explained(record, figures_dir)
     lines += ["## Beyond the paper: hysteresis and bifurcation diagrams", "",
               f"![Up and down continuations, bifurcation diagrams and regimes]({figures_dir}/hysteresis.png)", "",
               "*Both one-stage models swept up and then back down in ω: where the two runs differ, two attractors "
@@ -138,6 +139,67 @@ def render(record: dict, figures_dir: str = "figures") -> str:
     lines += _study(main, figures_dir)
     lines += _method(record)
     return "\n".join(lines).rstrip() + "\n"
+
+
+#: the sweeps whose jumps the periodic branches explain, and what the page calls them
+ORBIT_SWEEPS = {"fig3_D0": "D = 0 (Eq. 2)", "fig3_D2": "D = 2 (Eq. 6)"}
+
+
+def _jumps_explained(record: dict, figures_dir: str) -> list[str]:
+    """The section on what each jump is, from the periodic branches of every scenario that has them."""
+    scenarios = [s for s in record["scenarios"] if s.get("orbits")]
+    if not scenarios:
+        return []
+    main = scenarios[0]
+    lines = ["## What the jumps are: periodic orbits and their bifurcations", "",
+             f"![Fig. 3a with the periodic branches]({figures_dir}/fig3-orbits.png)", "",
+             "*The continuation points of Fig. 3a (up: dots, down: rings) under the branches of period-1 and "
+             "period-2 orbits that `gearsym.continue_orbits` follows over ω by pseudo-arclength (stable solid, "
+             "unstable dashed; F fold, PD period doubling, NS Neimark–Sacker, G grazing of a backlash surface), "
+             f"{main['label']}.*", "",
+             "A jump leaves the attractor the run was on. Where that attractor is a stable orbit of a branch (the "
+             "orbit Newton finds from the branch at the run's ω has the run's amplitude within 1 %), the branch "
+             "says where its stable part ends, and so what the jump is: a fold (the orbit ceases to exist), a "
+             "period doubling or Neimark–Sacker bifurcation (it loses stability), or a grazing (it touches a "
+             "backlash surface). A periodic attractor of another period (read from the sweep's Poincaré points, up "
+             "to period 4) is continued itself, from the sweep's state, across the jump (the short coloured "
+             "branches). A chaotic attractor is on no branch: its end is a crisis; a run whose λ₁ is within its "
+             "error of zero next to a located bifurcation sits on it, unsettled. Every sentence "
+             "below is made by `gearsym/reproduce/jumps.py` from the branches and the sweeps, none is typed. The "
+             "orbits are computed with the crossings located (their monodromy matrix is the exact derivative of "
+             "the map only then: plain RK4 is first order in it across the backlash's kink), the sweeps with the "
+             "paper's plain scheme (like for like with the paper); their amplitudes differ by about 1e-3.", ""]
+    for s in scenarios:
+        lines += [f"### {s['label'].capitalize()}", ""]
+        paper = s["orbits"].get("fig3_D2", {}).get("paper_jumps", [])
+        if paper:
+            lines += ["The paper's jumps (Fig. 3a, D = 2, continuation up):", "",
+                      "| the paper's jump | our jump (up) | what it is |", "|---|---|---|"]
+            lines += [f"| ω ≈ {j['omega']:g} | " + (f"{j['from']:.2f} → {j['to']:.2f}" if "from" in j else "–")
+                      + f" | {j['text']} |" for j in paper]
+            lines.append("")
+        for name, label in ORBIT_SWEEPS.items():
+            o = s["orbits"].get(name)
+            if not o:
+                continue
+            kinds = {}
+            for b in o["bifurcations"]:
+                kinds[b["type"]] = kinds.get(b["type"], 0) + 1
+            lines += [f"{label}: " + ", ".join(f"{b['points']} points of period {b['period']} over "
+                                               f"[{b['from']:.3f}, {b['to']:.3f}]" for b in o["branches"])
+                      + "; " + (", ".join(f"{n} {k}" for k, n in kinds.items()) or "no bifurcations") + ".", ""]
+            if o["hysteresis"]:
+                lines += ["| hysteresis (up and down differ) | the up run leaves its attractor by | the down run leaves "
+                          "its attractor by |", "|---|---|---|"]
+                lines += [f"| [{h['from']:.2f}, {h['to']:.2f}] | {h['up']['text']} | {h['down']['text']} |"
+                          for h in o["hysteresis"]]
+                lines.append("")
+            if o["jumps_up"]:
+                lines += ["| jump of the up run | A | what it is |", "|---|---|---|"]
+                lines += [f"| {j['from']:.2f} → {j['to']:.2f} | {j['A_before']:.2f} → {j['A_after']:.2f} | {j['text']} |"
+                          for j in o["jumps_up"]]
+                lines.append("")
+    return lines
 
 
 def _anchor(heading: str) -> str:

@@ -1,0 +1,195 @@
+"""``gearsym orbits MODEL --param omega=0.5:2.0``: periodic orbits by shooting, their Floquet multipliers, and
+their branches over a parameter with the bifurcations located (the frequency-response curve)."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from ..checks import chosen_coordinate, whole_number
+from ..errors import GearsymError
+from ..files import write_atomically
+from ..outputs import check_figure, check_file
+from .integration import add_integration_arguments, compiled_from, integration_from, system_from
+from .settings import add_set_argument, parse_state
+
+NAME = "orbits"
+HELP = "periodic orbits, their Floquet multipliers and stability, and their branches over a parameter with folds, " \
+       "period doublings, Neimark-Sacker and grazing bifurcations located"
+TRANSIENT = 300
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("model", help="a model name (see `gearsym list`) or the path of a model file")
+    parser.add_argument("--param", metavar="NAME=START:STOP",
+                        help="continue the orbits in NAME from START to STOP (through folds; a physical value "
+                             "with its unit: speed=1000rpm:3000rpm); without it, the one orbit at the --set values")
+    add_set_argument(parser)
+    parser.add_argument("--period-multiple", type=int, default=1, metavar="N",
+                        help="the orbit's period in forcing periods (default 1; --periods is the run length of "
+                             "the other commands)")
+    parser.add_argument("--segments", type=int, default=1, metavar="M",
+                        help="shooting segments per forcing period (multiple shooting for strongly unstable "
+                             "orbits: 1, 2 or 4; default 1)")
+    parser.add_argument("--y0", metavar="x=-2,v=-0.5",
+                        help="Newton's start at the section t = 0 (default: where --transient periods from the "
+                             "model's initial state end, or the --sweep's point)")
+    parser.add_argument("--transient", type=int, default=TRANSIENT, metavar="P",
+                        help=f"forcing periods simulated before Newton starts (default {TRANSIENT})")
+    parser.add_argument("--sweep", type=Path, metavar="S.csv",
+                        help="a brute-force sweep (`gearsym sweep ... --out S.csv`) of the same model: Newton "
+                             "starts from its final state nearest START, and --plot draws its points")
+    parser.add_argument("--switch-depth", type=int, default=1, metavar="D",
+                        help="follow the period-2n branch born at each period doubling, D doublings deep "
+                             "(default 1; 0: none)")
+    parser.add_argument("--max-points", type=int, default=2000, help="points per branch at most (default 2000)")
+    add_integration_arguments(parser, periods=None)
+    parser.add_argument("--out", type=Path, metavar="F.csv",
+                        help="one row per branch point (parameter, amplitudes, |multipliers|, stable, contact "
+                             "regime per mesh); F.json beside it: the record and the bifurcations. Without "
+                             "--param: F.json, the one orbit")
+    parser.add_argument("--plot", type=Path, metavar="F.png",
+                        help="the frequency-response curve: stable solid, unstable dashed, bifurcations marked")
+    parser.add_argument("--coordinate", metavar="NAME", help="the coordinate --plot shows (default the first)")
+
+
+def parse_range(text: str) -> tuple[str, float, float, str]:
+    """NAME, START, STOP and the unit of a physical value ("" for the model's own numbers)."""
+    from ..sweep.grid import _numbers_and_unit
+
+    usage = f"--param {text!r}: expected NAME=START:STOP, e.g. --param omega=0.5:2.0 or speed=1000rpm:3000rpm"
+    name, sep, body = (part.strip() for part in text.partition("="))
+    parts = body.split(":")
+    if not sep or not name or len(parts) != 2:
+        raise GearsymError(usage)
+    numbers, unit = _numbers_and_unit(text, parts)
+    try:
+        start, stop = (float(p) for p in numbers)
+    except ValueError:
+        raise GearsymError(usage) from None
+    if start == stop:
+        raise GearsymError(f"--param {text!r}: START and STOP must differ")
+    return name, start, stop, unit
+
+
+def engine_range(args: argparse.Namespace, parameter: tuple) -> tuple[str, float, float]:
+    """The nondimensional parameter and range a physical range (speed=1000rpm:3000rpm) moves, as a sweep's
+    axis does (gearsym.physical.sweeps); a nondimensional range as it is."""
+    from ..sweep.grid import Axis
+    from .integration import scaling_from
+
+    name, start, stop, unit = parameter
+    scaling = scaling_from(args)
+    if scaling is None:
+        if unit:
+            raise GearsymError(f"--param {args.param!r} has a unit, but the model has no physical values; declare "
+                               "them (model.set_physical) or give them with --set NAME='VALUE UNIT'")
+        return name, start, stop
+    from ..physical.sweeps import nondimensional_axis
+
+    axis = nondimensional_axis(scaling, Axis(name, (start, stop), args.param, unit))
+    if axis.name != name:
+        print(f"{name} {start:g} -> {stop:g}{' ' + unit if unit else ''} is {axis.name} {axis.values[0]:.6g} -> "
+              f"{axis.values[1]:.6g}: continued in {axis.name}")
+    return axis.name, axis.values[0], axis.values[1]
+
+
+def run(args: argparse.Namespace) -> int:
+    parameter = parse_range(args.param) if args.param else None
+    for option, value, least in (("--period-multiple", args.period_multiple, 1), ("--segments", args.segments, 1),
+                                 ("--transient", args.transient, 1), ("--switch-depth", args.switch_depth, 0),
+                                 ("--max-points", args.max_points, 2)):
+        whole_number(value, option, least)
+    if args.out:
+        check_file(args.out, (".csv",) if parameter else (".json",))
+    if args.plot:
+        if parameter is None:
+            raise GearsymError("--plot draws the branches of a continuation: add --param NAME=START:STOP")
+        check_figure(args.plot)
+    if args.sweep and parameter is None:
+        raise GearsymError("--sweep starts a continuation: add --param NAME=START:STOP")
+    y0 = parse_state(args.y0)
+    sweep = None
+    if args.sweep:
+        from ..sweep import read_sweep
+
+        sweep = read_sweep(args.sweep)
+    from ..periodic.shooting import check_segments, pieces_per_period
+
+    options = integration_from(args).run(periods=args.transient, discard=0)
+    check_segments(args.segments, pieces_per_period(options.steps_per_period), f"--segments {args.segments}: ",
+                   options.steps_per_period)
+    if parameter:
+        parameter = engine_range(args, parameter)
+    system = system_from(args)
+    if parameter and parameter[0] not in system.parameters:
+        from ..errors import UnknownParameterError
+
+        raise UnknownParameterError(parameter[0], system.parameters, f"--param {args.param}")
+    compiled = compiled_from(args, options, system)
+    chosen_coordinate(args.coordinate, compiled.observed, args.plot)
+    if parameter is None:
+        return _one_orbit(compiled, args, y0)
+    name, start, stop = parameter
+    if sweep is not None and y0 is None:
+        from ..periodic.orbit import sweep_start
+
+        y0 = sweep_start(sweep, compiled, name, start)
+    return _continuation(compiled, args, name, start, stop, y0, sweep)
+
+
+def _one_orbit(compiled, args, y0) -> int:
+    from ..periodic import periodic_orbit
+
+    orbit = periodic_orbit(compiled, y0=y0, period_multiple=args.period_multiple, segments=args.segments)
+    print(f"{orbit.model}: period-{orbit.period_multiple} orbit, Newton residual {orbit.residual:.2g} after "
+          f"{orbit.iterations} iterations, {'stable' if orbit.stable else 'unstable'}")
+    print("parameters: " + ", ".join(f"{k}={v:g}" for k, v in orbit.parameters.items()))
+    print("state at the section: " + ", ".join(f"{k}={v:.10g}" for k, v in zip(orbit.state_names, orbit.state)))
+    print("Floquet multipliers: " + ", ".join(_complex(m) for m in orbit.multipliers)
+          + "  (|mu|: " + ", ".join(f"{abs(m):.6g}" for m in orbit.multipliers) + ")")
+    for name, a in orbit.amplitude.items():
+        print(f"amplitude A_{name} = {a:.6g}")
+    for mesh, regime in orbit.contact.items():
+        print(f"contact of {mesh}: {regime}")
+    if args.out:
+        write_atomically(args.out, json.dumps(orbit.as_dict(), indent=1) + "\n")
+        print(f"gearsym: wrote {args.out}", file=sys.stderr)
+    return 0
+
+
+def _continuation(compiled, args, name, start, stop, y0, sweep) -> int:
+    from ..periodic import ContinuationInterrupted, continue_orbits
+    from ..periodic.files import write_orbits
+
+    try:
+        result = continue_orbits(compiled, name, start, stop, y0=y0, period_multiple=args.period_multiple,
+                                 segments=args.segments, switch_depth=args.switch_depth, max_points=args.max_points)
+    except ContinuationInterrupted as exc:  # keep what was traced: the files say it was interrupted
+        if args.out:
+            write_orbits(exc.result, args.out)
+        print(f"gearsym: {exc}" + (f" in {args.out} (rerun the command to compute them all)" if args.out else ""),
+              file=sys.stderr)
+        return 130
+    for b in result.branches:
+        stable = int(b.stable.sum())
+        print(f"branch {b.index}: period {b.period_multiple}, {len(b)} points ({stable} stable), {name} "
+              f"{b.values[0]:.6g} -> {b.values[-1]:.6g}" + (f", from branch {b.parent}" if b.parent is not None
+                                                            else "") + f"; {b.end}")
+    for bif in result.bifurcations:
+        print(f"  {bif.kind} at {name}={bif.value:.6g} (branch {bif.branch}, period {bif.period_multiple}): mu = "
+              + ", ".join(_complex(m) for m in bif.multipliers) + (f"; {bif.detail}" if bif.detail else ""))
+    if args.out:
+        csv_path, json_path = write_orbits(result, args.out)
+        print(f"gearsym: wrote {csv_path} and {json_path}", file=sys.stderr)
+    if args.plot:
+        from ..figures.orbits import plot_orbits  # matplotlib only when asked for
+
+        plot_orbits(result, args.plot, coordinate=args.coordinate, sweep=sweep)
+        print(f"gearsym: wrote {args.plot}", file=sys.stderr)
+    return 0
+
+
+def _complex(m: complex) -> str:
+    return f"{m.real:.6g}{m.imag:+.6g}i" if abs(m.imag) > 1e-12 else f"{m.real:.6g}"
