@@ -138,11 +138,11 @@ def _combination_solver(transform: sp.Matrix):
     k = transform.rows
     numeric = transform.xreplace(generic_values(transform))
     _, pivots = numeric.rref()
-    inverse = sp.simplify(transform.extract(list(range(k)), list(pivots)).inv())
+    inverse = transform.extract(list(range(k)), list(pivots)).inv(method="LU").applyfunc(sp.cancel)
 
     def solve(row: sp.Matrix) -> list[sp.Expr]:
         coefficients = (row.extract([0], list(pivots)) * inverse).applyfunc(sp.factor)
-        residual = (coefficients * transform - row).applyfunc(sp.simplify)
+        residual = (coefficients * transform - row).applyfunc(sp.cancel)
         if residual != sp.zeros(1, transform.cols):
             raise ModelError(f"the deflection {list(row)} is not a combination of the coordinates' (a bug)", "reduction")
         return list(coefficients)

@@ -377,6 +377,7 @@ class _Assembly:
         self.rhs = [sp.S.Zero] * n  # forcing numerators (over omega^2)
         self.coupling_rows: dict[str, list[tuple[int, sp.Expr]]] = {}  # coupling -> (row, factor of its law)
         self._betas: dict[sp.Expr, sp.Expr] = {}
+        self._forcing: list[tuple[tuple, Group]] = []  # ((order, phase), group) of the forcing groups named
 
     def add_group(self, gr: Group) -> Group:
         """Add a group; one named like a group already added (meshes that declare the same damping_group, say)
@@ -494,13 +495,17 @@ class _Assembly:
                     "torque_balance",
                 ))
                 continue
-            name = self._forcing_name(row, order, phase, terms, used_names)
-            used_names.add(name)
             timefn = sp.S.One if order == 0 else sp.cos(order * tau + phase)
-            what = "constant forcing" if order == 0 else f"forcing amplitude of {timefn}"
-            gr = Group(name, definition, "free", f"{what} of {cx.name}", "forcing")
-            self.groups.append(gr)
-            self.rhs[row] += gr.symbol * timefn
+            same = next((gr for key, gr in self._forcing if key == (order, phase) and _equal(gr.definition, definition)),
+                        None)  # rows forced alike (a planetary set's sun meshes) share one group
+            if same is None:
+                name = self._forcing_name(row, order, phase, terms, used_names)
+                used_names.add(name)
+                what = "constant forcing" if order == 0 else f"forcing amplitude of {timefn}"
+                same = Group(name, definition, "free", f"{what} of {cx.name}", "forcing")
+                self.groups.append(same)
+                self._forcing.append(((order, phase), same))
+            self.rhs[row] += same.symbol * timefn
 
     def _forcing_name(self, row: int, order, phase, terms, used_names: set[str]) -> str:
         red = self.red
