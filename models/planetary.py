@@ -53,11 +53,13 @@ def balanced_forcing(planets: int, ring_fixed: bool) -> dict:
     return forcing
 
 
-def build(planets: int = 3, name: str = "planetary", ring_fixed: bool = True) -> Drivetrain:
+def build(planets: int = 3, name: str = "planetary", ring_fixed: bool = True, title: str | None = None,
+          carrier_load: bool = True) -> Drivetrain:
     """The planetary set with ``planets`` equally spaced planets; ``ring_fixed=False`` frees the ring (a
-    differential: sun and ring driven, carrier loaded)."""
-    title = (f"Planetary gear set, {planets} planets, ring held (sun in, carrier out)" if ring_fixed
-             else f"Planetary differential, {planets} planets (sun and ring in, carrier out)")
+    differential: sun and ring driven, carrier loaded); ``carrier_load=False`` leaves the carrier's load
+    torque (and the forcing defaults) to a stage that it drives."""
+    title = title or (f"Planetary gear set, {planets} planets, ring held (sun in, carrier out)" if ring_fixed
+                      else f"Planetary differential, {planets} planets (sun and ring in, carrier out)")
     m = Drivetrain(name, title=title)
     sun = m.add(Gear("sun", inertia="I_s", base_radius="r_s", teeth=SUN_TEETH))
     ring = m.add(Gear("ring", inertia=None if ring_fixed else "I_r", base_radius="r_r", teeth=RING_TEETH,
@@ -73,10 +75,13 @@ def build(planets: int = 3, name: str = "planetary", ring_fixed: bool = True) ->
     m.add(Torque("M_s", on=sun, mean="M_s", harmonics=(Harmonic("M_a", phase="Theta", group="B1"),)))
     if not ring_fixed:
         m.add(Torque("M_r", on=ring, mean="M_r"))
-    m.add(Torque("M_c", on=carrier, mean="M_c", load=True))
+    if carrier_load:
+        m.add(Torque("M_c", on=carrier, mean="M_c", load=True))
     ring_share = ring_mesh_share(planets)
     m.set_defaults(omega=1.0, zeta=0.05, zeta_r=0.05 * ring_share**0.5, K_r=ring_share, Theta=0.0, eta=1.0, k_a=0.2,
-                   **INERTIAS, **RADII, I_c=carrier_inertia(planets), **balanced_forcing(planets, ring_fixed))
+                   **INERTIAS, **RADII, I_c=carrier_inertia(planets))
+    if carrier_load:
+        m.set_defaults(**balanced_forcing(planets, ring_fixed))
     if not ring_fixed:
         m.set_defaults(I_r=RING_INERTIA)
     m.describe(

@@ -208,12 +208,17 @@ def test_equally_spaced_planets_give_rotational_modes_and_planet_modes_of_multip
         assert np.ptp([mode.angles[f"planet{n + 1}"] for n in range(planets)]) < 1e-9
 
 
-def test_the_differential_keeps_the_mode_classes_with_its_ring_at_rest_in_planet_modes():
+@pytest.mark.parametrize("model, planets, rigid, central", [
+    ("differential with 4 planets", 4, 2, ("sun", "ring", "carrier")),
+    ("planetary_two_stage", 3, 1, ("sun", "carrier", "pinion", "wheel")),
+])
+def test_a_free_ring_or_a_driven_parallel_stage_keeps_the_planet_modes_with_every_other_body_at_rest(
+        model, planets, rigid, central):
     from models.planetary import build
 
-    modes = natural_modes(build(4, ring_fixed=False))
-    assert sum(m.kind == "rigid" for m in modes.modes) == 2
-    planet_modes = [m for m in modes.elastic if m.multiplicity == 3]
-    assert len(planet_modes) == 3
+    modes = natural_modes(build(planets, ring_fixed=False) if model.startswith("differential") else reduced(model))
+    assert sum(m.kind == "rigid" for m in modes.modes) == rigid
+    planet_modes = [m for m in modes.elastic if m.multiplicity == planets - 1]
+    assert len(planet_modes) == planets - 1
     for mode in planet_modes:
-        assert max(abs(mode.angles[b]) for b in ("sun", "ring", "carrier")) < 1e-9
+        assert max(abs(mode.angles[b]) for b in central) < 1e-9
