@@ -15,7 +15,7 @@ import pytest
 import sympy as sp
 
 import gearsym
-from conftest import reduced
+from conftest import reduced, system
 from gearsym import Disk, Drivetrain, Gear, Harmonic, Mesh, ModelError, Planet, Torque
 from gearsym.analysis.modes import natural_modes
 from gearsym.symbols import parameter_symbol, tau
@@ -222,3 +222,11 @@ def test_a_free_ring_or_a_driven_parallel_stage_keeps_the_planet_modes_with_ever
     assert len(planet_modes) == planets - 1
     for mode in planet_modes:
         assert max(abs(mode.angles[b]) for b in central) < 1e-9
+
+
+def test_an_effect_asked_for_a_loop_closing_mesh_is_refused_naming_the_meshes_with_coordinates():
+    from gearsym.fit.effects import mesh_term
+
+    with pytest.raises(ModelError, match=r"no mesh force g\(x, eta\) acting on coordinate 'y2' \(meshes with "
+                                         r"backlash act on x1, x2, x3, y1\)"):
+        mesh_term(system("planetary"), "y2")

@@ -120,7 +120,8 @@ def effect(name: str | Effect) -> Effect:
 def mesh_term(system: FirstOrderSystem, coordinate: str | None = None) -> MeshTerm:
     """The mesh force -k(tau) g(x, eta)/omega^2 of ``coordinate`` (default: the first mesh with backlash),
     read from the couplings the reduction handed on with the system."""
-    meshes = [c for c in system.couplings if c.kind == "mesh" and c.backlash != 0]
+    # a mesh that closes a kinematic loop has no coordinate (no row) of its own to add an effect to
+    meshes = [c for c in system.couplings if c.kind == "mesh" and c.backlash != 0 and not c.closes_loop]
     chosen = [c for c in meshes if coordinate in (None, c.coordinate)]
     if not chosen:
         where = f"coordinate {coordinate!r}" if coordinate else "any coordinate"
