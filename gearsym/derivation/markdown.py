@@ -109,8 +109,9 @@ def _mechanics(d: Derivation, m: Mechanics) -> list[str]:
     out += display(blocks.equation_rows(d, m.equations_of_motion))
     out += _section("Rigid-body modes")
     angles = ", ".join(to_latex(a, d.bare_functions) for a in m.angles)
-    out += [f"Rotations that deflect no mesh and twist no shaft (components along ${angles}$); "
-            "one per separately rotating train:"]
+    per_train = ("one per separately rotating train, and one more for each further free input (a differential's)"
+                 if m.closing else "one per separately rotating train")
+    out += [f"Rotations that deflect no mesh and twist no shaft (components along ${angles}$); {per_train}:"]
     out += display(blocks.rigid_mode_rows(d, m))
     out += ["Along a rigid-body mode the coupling forces cancel, and the external torques accelerate the "
             "train as a whole:"]
