@@ -230,3 +230,32 @@ def test_an_effect_asked_for_a_loop_closing_mesh_is_refused_naming_the_meshes_wi
     with pytest.raises(ModelError, match=r"no mesh force g\(x, eta\) acting on coordinate 'y2' \(meshes with "
                                          r"backlash act on x1, x2, x3, y1\)"):
         mesh_term(system("planetary"), "y2")
+
+
+def _with(declare) -> Drivetrain:
+    """A sun, a held ring, a carrier and one planet, changed by ``declare(m, sun, ring, carrier)``."""
+    m = Drivetrain("bad")
+    sun = m.add(Gear("sun", inertia="I_s", base_radius="r_s"))
+    ring = m.add(Gear("ring", base_radius="r_r", internal=True, fixed=True))
+    carrier = m.add(Disk("carrier", inertia="I_c"))
+    declare(m, sun, ring, carrier)
+    return m
+
+
+@pytest.mark.parametrize("declare, message", [
+    (lambda m, s, r, c: (m.add(Planet("p", base_radius="r_p", carrier=c, fixed=True)), m.add(Mesh("m", s, "p"))),
+     r"Planet 'p': a planet cannot be fixed; fix its carrier instead"),
+    (lambda m, s, r, c: (m.add(Planet("p", inertia="I_p", base_radius="r_p")), m.add(Mesh("m", s, "p"))),
+     r"Planet 'p': needs its carrier: Planet\(..., carrier=carrier_body\)"),
+    (lambda m, s, r, c: (m.add(Gear("ring2", inertia="I", base_radius="r", internal=True)), m.add(Mesh("m", r, "ring2"))),
+     r"Mesh 'm': joins two ring gears"),
+    (lambda m, s, r, c: (m.add(Planet("p", inertia="I_p", base_radius="r_p", carrier=c)), m.add(Mesh("m", s, "p")),
+                         m.add(Mesh("n", r, "p")), m.add(Torque("T", on=r, mean="M"))),
+     r"Torque 'T': acts on 'ring', which is fixed"),
+    (lambda m, s, r, c: (m.add(Planet("p", inertia="I_p", base_radius="r_p", carrier=c, position="pi/2")),
+                         m.add(Mesh("m", s, "p")), m.add(Mesh("n", r, "p"))),
+     r"Mesh 'm': planet 'p' sits at pi/2, so the mesh phase needs the teeth of 'sun'"),
+])
+def test_a_planetary_declaration_that_cannot_work_is_refused_in_one_line(declare, message):
+    with pytest.raises(ModelError, match=message):
+        _with(declare).resolved
