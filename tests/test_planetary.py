@@ -259,3 +259,14 @@ def _with(declare) -> Drivetrain:
 def test_a_planetary_declaration_that_cannot_work_is_refused_in_one_line(declare, message):
     with pytest.raises(ModelError, match=message):
         _with(declare).resolved
+
+
+def test_derive_json_lists_each_loop_closing_deflection_with_its_combination(capsys):
+    import json
+
+    from gearsym.cli import main
+
+    assert main(["derive", "planetary", "--format", "json"]) == 0
+    closing = json.loads(capsys.readouterr().out)["closing"]
+    assert [(c["name"], c["coupling"], c["combination"]) for c in closing] == [
+        ("y2", "ring_planet2", "x1 - x2 + y1"), ("y3", "ring_planet3", "x1 - x3 + y1")]
