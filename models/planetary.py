@@ -16,8 +16,6 @@ import sympy as sp
 from gearsym import Disk, Drivetrain, Gear, Harmonic, Mesh, Planet, Torque
 
 SUN_TEETH, PLANET_TEETH, RING_TEETH = 26, 34, 94
-
-
 RADII = dict(r_s=SUN_TEETH / 20, r_p=PLANET_TEETH / 20, r_r=RING_TEETH / 20)  # in proportion to the teeth
 INERTIAS = dict(I_s=RADII["r_s"] ** 4, I_p=RADII["r_p"] ** 4)  # solid disks of one width: ~ r^4
 RING_INERTIA = RADII["r_r"] ** 4 - (RADII["r_r"] - 0.5) ** 4  # a rim of that width
