@@ -23,7 +23,7 @@ import importlib
 from typing import TYPE_CHECKING
 
 from .errors import GearsymError, ModelError, UnknownParameterError
-from .model import Disk, Drivetrain, Gear, Harmonic, Mesh, Shaft, Torque, rectangular_mesh_stiffness
+from .model import Disk, Drivetrain, Gear, Harmonic, Mesh, Planet, Shaft, Torque, rectangular_mesh_stiffness
 from .options import Integration
 # not lazy: gearsym.reduce is also a subpackage, and importing it (gearsym.load does) would bind the name
 # gearsym.reduce to the package, so that gearsym.reduce(drivetrain) called the module
@@ -65,7 +65,8 @@ _LAZY = {
 
 __all__ = [
     "Disk", "Drivetrain", "FirstOrderSystem", "Gear", "GearsymError", "Harmonic", "Integration", "Mesh",
-    "ModelError", "NondimensionalModel", "Shaft", "Torque", "UnknownParameterError", "rectangular_mesh_stiffness",
+    "ModelError", "NondimensionalModel", "Planet", "Shaft", "Torque", "UnknownParameterError",
+    "rectangular_mesh_stiffness",
     "reduce", *_LAZY,
 ]
 

@@ -29,25 +29,35 @@ class Coupling:
     """A mesh or shaft of a reduced drivetrain, as its first-order system carries it.
 
     The reduction knows every coupling; the engine, the effects of the data loop and the reports read
-    it here instead of searching the equations. The coupling's *law* in its own coordinate ``x`` is, in
-    the tau-form, ``2 zeta v/omega + k(tau) g(x, eta)/omega^2`` for a mesh (``beta (kS x/omega^2 +
-    cS v/omega)`` for a shaft); it enters the velocity equation of each row in ``rows`` as
-    ``-factor * law``.
+    it here instead of searching the equations. The coupling's *law* in its deflection ``x`` (``contact``)
+    is, in the tau-form, ``2 zeta x'/omega + k(tau) g(x, eta)/omega^2`` for a mesh (``beta (kS x/omega^2 +
+    cS x'/omega)`` for a shaft); it enters the velocity equation of each row in ``rows`` as
+    ``-factor * law``. A coupling that closes a kinematic loop (a planet's second mesh) has no coordinate
+    of its own: ``coordinate`` and ``velocity`` name its deflection, which is not a state, and ``contact``
+    and ``rate`` are combinations of the coordinates and their rates (x1 + x2 - x3, v1 + v2 - v3).
     """
 
     name: str  # the component ("mesh", "shaft")
     kind: str  # "mesh" | "shaft"
-    coordinate: str  # the state of its relative coordinate (x1)
-    velocity: str  # the state of its rate (v1)
+    coordinate: str  # the state of its relative coordinate (x1), or the name of a loop-closing deflection
+    velocity: str  # the state of its rate (v1), or the name of that deflection's rate
     backlash: sp.Expr  # eta; 0 for a linear mesh and for every shaft
     stiffness: sp.Expr  # the mesh stiffness k(tau) as the equations use it (for a shaft its kS)
     order: sp.Expr = sp.S.Zero  # mesh frequency over forcing frequency (0 for shafts)
     rows: tuple[tuple[int, sp.Expr], ...] = ()  # (index in rhs of a velocity equation, factor of the law)
-    contact: sp.Expr | None = None  # the argument of g: the coordinate (None), or it shifted by an effect
+    contact: sp.Expr | None = None  # the argument of g: the coordinate (None), a combination, or shifted by an effect
+    rate: sp.Expr | None = None  # the deflection's rate: the velocity (None), or the combination of rates
 
     def __post_init__(self):
         if self.contact is None:
             object.__setattr__(self, "contact", sp.Symbol(self.coordinate, real=True))
+        if self.rate is None:
+            object.__setattr__(self, "rate", sp.Symbol(self.velocity, real=True))
+
+    @property
+    def closes_loop(self) -> bool:
+        """True for a coupling whose deflection is a combination of the coordinates (no state of its own)."""
+        return self.rate != sp.Symbol(self.velocity, real=True)
 
 
 @dataclass(frozen=True)
@@ -109,8 +119,9 @@ class FirstOrderSystem:
             raise ModelError(f"names used both as state and parameter: {sorted(clash)}", self.name)
         names = {s.name for s in self.states}
         for c in self.couplings:
-            if not {c.coordinate, c.velocity} <= names:
-                raise ModelError(f"coupling {c.name!r} acts on {c.coordinate}, {c.velocity}, which are not states",
+            used = {c.coordinate, c.velocity} if not c.closes_loop else {s.name for s in c.rate.free_symbols}
+            if not used <= names:
+                raise ModelError(f"coupling {c.name!r} acts on {', '.join(sorted(used - names))}, which are not states",
                                  self.name)
 
     @classmethod

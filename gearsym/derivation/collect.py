@@ -22,7 +22,7 @@ from ..symbols import parameter_symbol, tau
 from ..system import FirstOrderSystem
 from .notes import default_wave_amplitude, paper_notes
 from .records import (
-    BodyRecord, ConditionRecord, CoordinateRecord, CouplingRecord, Derivation, FunctionRecord, GroupRecord,
+    BodyRecord, ClosingRecord, ConditionRecord, CoordinateRecord, CouplingRecord, Derivation, FunctionRecord, GroupRecord,
     Mechanics, ParameterRecord, ScalingRecord, TorqueRecord,
 )
 
@@ -128,7 +128,7 @@ def _derive_reduced(nd: NondimensionalModel) -> Derivation:
                     _value(gr.definition, values) if gr.kind == "derived" else values.get(gr.name))
         for gr in nd.groups
     )
-    bodies, couplings, torques = _components(rd, {c.coupling.name: c.name for c in red.coordinates})
+    bodies, couplings, torques = _components(rd, {c.coupling.name: c.name for c in red.deflections})
     kinetic, potential, dissipation = model.form_lagrangian()
     mechanics = Mechanics(
         bodies=bodies, couplings=couplings, torques=torques,
@@ -147,6 +147,8 @@ def _derive_reduced(nd: NondimensionalModel) -> Derivation:
         functions=tuple(FunctionRecord(f.name, f.mesh, f.definition, f.expression) for f in nd.functions),
         equations=tuple(nd.equations),
         engine_rhs=engine_rhs,
+        closing=tuple(ClosingRecord(c.name, c.coupling.name, c.definition, c.in_states()[0]) for c in red.dependent),
+        fixed=tuple(rb.body.name for rb in rd.fixed),
     )
     return Derivation(
         model=model.name, title=model.title, description=model.description, time=tau,

@@ -79,6 +79,11 @@ def derivation_dict(d: Derivation) -> dict[str, Any]:
              "definition": str(c.definition), "latex": to_latex(c.definition, bare)}
             for c in m.coordinates
         ],
+        "closing": [] if m is None else [  # deflections of couplings that close a loop: combinations of coordinates
+            {"name": c.name, "coupling": c.coupling, "definition": str(c.definition),
+             "combination": str(c.combination)}
+            for c in m.closing
+        ],
         "groups": [] if m is None else [
             {"name": gr.name, "definition": str(gr.definition), "latex": to_latex(gr.definition, bare),
              "symbol_latex": latex_name(gr.name), "kind": gr.kind, "description": gr.description, "value": gr.value}

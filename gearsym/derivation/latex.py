@@ -38,6 +38,12 @@ def coordinate_rows(d: Derivation, m: Mechanics) -> Rows:
     return [(latex_name(c.name), to_latex(c.definition, d.bare_functions)) for c in m.coordinates]
 
 
+def closing_rows(d: Derivation, m: Mechanics) -> Rows:
+    """Each loop-closing deflection: its definition in the angles, and the combination of coordinates it is."""
+    return [(latex_name(c.name), to_latex(c.definition, d.bare_functions) + " = " + to_latex(c.combination))
+            for c in m.closing]
+
+
 def transform_rows(d: Derivation, m: Mechanics) -> Rows:
     q = sp.Matrix([sp.Symbol(c.name) for c in m.coordinates])
     psi = sp.Matrix([sp.Symbol(b.angle.func.__name__) for b in m.bodies])

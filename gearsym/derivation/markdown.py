@@ -62,8 +62,17 @@ def _components(d: Derivation, m: Mechanics) -> list[str]:
          inline(to_latex(b.radius, bare)) if b.radius is not None else "—", inline(to_latex(b.angle, bare))]
         for b in m.bodies
     ])
-    out += ["Couplings (a mesh deflects by $r_a \\psi_a - r_b \\psi_b$ along the line of action, "
-            "a shaft twists by $\\psi_b - \\psi_a$; each gets one relative coordinate):"]
+    if m.fixed:
+        out += ["Fixed (held) bodies, which have no angle: " + ", ".join(f"`{name}`" for name in m.fixed) + "."]
+        out += [""]
+    if m.closing:
+        out += ["Couplings (a mesh deflects by $r_a \\psi_a - r_b \\psi_b$ along the line of action, by "
+                "$r_a \\psi_a + r_b \\psi_b$ with a ring gear; a planet's mesh with the angles relative to its "
+                "carrier, a planet counted opposite to it; a shaft twists by $\\psi_b - \\psi_a$; a planet's "
+                "position shifts its meshes' phase, Parker & Lin 2004):"]
+    else:
+        out += ["Couplings (a mesh deflects by $r_a \\psi_a - r_b \\psi_b$ along the line of action, "
+                "a shaft twists by $\\psi_b - \\psi_a$; each gets one relative coordinate):"]
     out += table(["Coupling", "Kind", "Ends (a, b)", "Stiffness", "Damping", "Backlash", "Mesh phase", "Coordinate"], [
         [f"`{c.name}`", c.kind, f"`{c.ends[0]}`, `{c.ends[1]}`", inline(to_latex(c.stiffness, bare)),
          inline(to_latex(c.damping, bare)),
@@ -100,15 +109,26 @@ def _mechanics(d: Derivation, m: Mechanics) -> list[str]:
     out += display(blocks.equation_rows(d, m.equations_of_motion))
     out += _section("Rigid-body modes")
     angles = ", ".join(to_latex(a, d.bare_functions) for a in m.angles)
-    out += [f"Rotations that deflect no mesh and twist no shaft (components along ${angles}$); "
-            "one per separately rotating train:"]
+    per_train = ("one per separately rotating train, and one more for each further free input (a differential's)"
+                 if m.closing else "one per separately rotating train")
+    out += [f"Rotations that deflect no mesh and twist no shaft (components along ${angles}$); {per_train}:"]
     out += display(blocks.rigid_mode_rows(d, m))
     out += ["Along a rigid-body mode the coupling forces cancel, and the external torques accelerate the "
             "train as a whole:"]
     out += display(blocks.equation_rows(d, m.rigid_body_equations))
     out += _section("Coordinate change")
-    out += ["One relative coordinate per coupling (the mesh deflection, or the shaft twist scaled to a length):"]
+    if m.closing:
+        out += ["The couplings' deflections are linearly dependent: they close "
+                f"{len(m.closing)} kinematic loop(s). The relative coordinates are the deflections of the couplings "
+                "independent of those declared before them (a spanning set of the couplings, in declaration "
+                "order):"]
+    else:
+        out += ["One relative coordinate per coupling (the mesh deflection, or the shaft twist scaled to a length):"]
     out += display(blocks.coordinate_rows(d, m))
+    if m.closing:
+        out += ["Every other coupling's deflection is a combination of them, on which its backlash and stiffness "
+                "act (declaring the couplings in another order chooses other coordinates, not other physics):"]
+        out += display(blocks.closing_rows(d, m))
     out += ["that is $q = T \\psi$ with"]
     out += display(blocks.transform_rows(d, m))
     out += _section("Reduced equations")

@@ -68,6 +68,17 @@ class CoordinateRecord:
 
 
 @dataclass(frozen=True)
+class ClosingRecord:
+    """The deflection of a coupling that closes a kinematic loop: its definition in the angles and the
+    combination of the relative coordinates it equals."""
+
+    name: str
+    coupling: str
+    definition: sp.Expr
+    combination: sp.Expr
+
+
+@dataclass(frozen=True)
 class GroupRecord:
     """A coefficient group; ``value`` is a derived group's value at the declared defaults."""
 
@@ -131,6 +142,8 @@ class Mechanics:
     functions: tuple[FunctionRecord, ...]
     equations: tuple[sp.Eq, ...]  # nondimensional, second order in tau
     engine_rhs: tuple[sp.Expr, ...]  # the right-hand side as the engine receives it
+    closing: tuple["ClosingRecord", ...] = ()  # deflections of couplings that close a kinematic loop
+    fixed: tuple[str, ...] = ()  # bodies declared fixed (held): no angle
 
     @property
     def angles(self) -> tuple[sp.Expr, ...]:

@@ -263,7 +263,8 @@ def site(system: FirstOrderSystem, acts_on: str, coordinate: str | None = None) 
     if acts_on == "torque":
         _tau_form(system)
         return _torque_site(system, omega)
-    couplings = [c for c in system.couplings if c.kind == acts_on]
+    # a mesh that closes a kinematic loop has no coordinate (no row) of its own to add an effect to
+    couplings = [c for c in system.couplings if c.kind == acts_on and not c.closes_loop]
     if acts_on == "mesh":  # the backlash meshes first
         couplings.sort(key=lambda c: c.backlash == 0)
     chosen = [c for c in couplings if coordinate in (None, c.coordinate)]

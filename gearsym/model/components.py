@@ -1,13 +1,26 @@
 """Drivetrain components, joined at their flanges (bodies) like Modelica Rotational.
 
 Bodies carry a rotation angle psi (the angle left after the steady rotation is
-removed). Couplings join two bodies: a :class:`Mesh` along the line of action,
-a :class:`Shaft` in torsion. :class:`Torque` acts on one body.
+removed); a body declared ``fixed=True`` (a held ring gear, a grounded carrier) has
+none. Couplings join two bodies: a :class:`Mesh` along the line of action,
+a :class:`Shaft` in torsion. :class:`Torque` acts on one body. A :class:`Planet`
+is a gear whose axis is carried by another body (its carrier), at an angular
+position on it: the planetary gear sets of Lin & Parker's rotational model.
 
-Sign conventions (those of the paper's Eqs. 1 and 8):
+Sign conventions (those of the paper's Eqs. 1 and 8, extended to planetary sets):
 
-* mesh deflection ``delta = r_a*psi_a - r_b*psi_b`` (the two angles of an
-  external pair are counted in opposite senses, so rigid rolling is delta = 0);
+* the two gears of a mesh are counted in opposite senses. An external pair turns in
+  opposite senses, so its deflection is ``delta = r_a*psi_a - r_b*psi_b`` (rigid
+  rolling is delta = 0); a ring gear (``internal=True``) and its pinion turn the same
+  way, so ``delta = r_a*psi_a + r_b*psi_b``;
+* on a carrier the angles are those relative to the carrier: the sun, ring and
+  carrier (the central members) are counted in one sense and each planet in the
+  opposite one, so a sun-planet mesh deflects by
+  ``r_s (psi_s - psi_c) - r_p (psi_p + psi_c)`` and a ring-planet mesh by
+  ``r_r (psi_r - psi_c) + r_p (psi_p + psi_c)`` (Lin & Parker's
+  ``u_s + u_p - u_c cos(alpha)`` and ``u_r - u_p - u_c cos(alpha)`` with
+  ``u = r theta`` in one sense, ``theta_p = -psi_p`` and ``r_c cos(alpha) = r_s + r_p``
+  resp. ``r_r - r_p``);
 * shaft twist ``theta = psi_b - psi_a``;
 * a torque with ``load=True`` is a resisting torque M: it enters as -M (the
   paper's M2 and M3); otherwise it drives (+M, the paper's M1).
@@ -27,10 +40,14 @@ from .stiffness import rectangular_mesh_stiffness
 
 @dataclass(eq=False, frozen=True)
 class Body:
-    """A rotating inertia (base class of :class:`Gear` and :class:`Disk`)."""
+    """A rotating inertia (base class of :class:`Gear` and :class:`Disk`).
+
+    ``fixed=True`` grounds it (a held ring gear or carrier): it has no angle and needs no inertia.
+    """
 
     name: str
-    inertia: ExprLike
+    inertia: Optional[ExprLike] = None
+    fixed: bool = field(default=False, kw_only=True)
 
     @property
     def radius(self) -> Optional[ExprLike]:
@@ -53,16 +70,34 @@ class Gear(Body):
     For physical values (:meth:`Drivetrain.set_physical`): ``teeth``, its tooth count (a mesh's frequency
     is teeth x shaft speed), and ``speed``, the name of the parameter that gives this gear's rotational
     speed, on the one body whose speed is the operating point (``speed="speed"``; then
-    ``--set speed="3000 rpm"``).
+    ``--set speed="3000 rpm"``). ``internal=True`` makes it a ring gear (internal teeth).
     """
 
     base_radius: ExprLike = "r"
     teeth: Optional[int] = None
     speed: Optional[str] = None
+    internal: bool = field(default=False, kw_only=True)
 
     @property
     def radius(self) -> ExprLike:
         return self.base_radius
+
+
+@dataclass(eq=False, frozen=True)
+class Planet(Gear):
+    """A planet gear: its axis turns with ``carrier`` (any body, often a :class:`Disk`), at the angle
+    ``position`` (radians, in the carrier's positive sense) from the planet whose meshes have phase 0.
+
+    Its angle is counted opposite to the carrier's (see the module's conventions). The carrier's inertia
+    is that of the rotational model: the carrier's own plus each planet's mass times the carrier radius
+    squared. With tooth counts on the central gears, each mesh's stiffness phase follows from
+    ``position`` (Parker & Lin 2004: ``-Z position`` in the mesh phase, with the sign of the central gear's
+    rotation relative to the carrier), and a sun and a ring with teeth must let the planet be assembled
+    there (``(Z_sun + Z_ring) position / 2 pi`` a whole number).
+    """
+
+    carrier: Optional[BodyRef] = field(default=None, kw_only=True)
+    position: ExprLike = field(default=0, kw_only=True)
 
 
 @dataclass(eq=False, frozen=True)
@@ -88,6 +123,7 @@ class Mesh:
     * ``function``: name under which the nondimensional stiffness k(tau) appears.
     * ``damping_group``: name of the damping ratio group (the paper's zeta).
     * ``backlash``: the clearance eta; 0 gives a linear mesh.
+    * ``phase``: added to the mesh phase; a planet's position adds its own (see :class:`Planet`).
     """
 
     name: str

@@ -7,7 +7,7 @@ components in any order; every error names the component to fix.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import Optional, Union
 
@@ -16,7 +16,7 @@ import sympy as sp
 from ..backlash import G
 from ..errors import ModelError, suggest
 from ..symbols import omega, parameter_symbol, phi, t
-from .components import Body, BodyRef, Coupling, Disk, Gear, Harmonic, Mesh, Shaft, Torque
+from .components import Body, BodyRef, Coupling, Disk, Gear, Harmonic, Mesh, Planet, Shaft, Torque
 from .expressions import ExprLike, parameter_names, sign_violation, to_expr
 from .stiffness import check_periodic
 
@@ -24,10 +24,14 @@ from .stiffness import check_periodic
 @dataclass(frozen=True)
 class ResolvedBody:
     body: Body
-    index: int  # 0-based position; the paper's psi_{index+1}
-    angle: sp.Expr  # psi_i(t)
-    inertia: sp.Expr
+    index: Optional[int]  # 0-based position among the moving bodies (the paper's psi_{index+1}); None if fixed
+    angle: sp.Expr  # psi_i(t); 0 for a fixed body
+    inertia: Optional[sp.Expr]  # None for a fixed body
     radius: Optional[sp.Expr]
+
+    @property
+    def fixed(self) -> bool:
+        return self.index is None
 
 
 @dataclass(frozen=True)
@@ -46,6 +50,9 @@ class ResolvedCoupling:
     variation: sp.Expr  # k(phi) shape (1 for shafts)
     mesh_phase: sp.Expr  # phi as a function of t (0 for shafts)
     order: sp.Expr = sp.S.Zero  # mesh frequency / forcing frequency (0 for shafts)
+    carrier: Optional[ResolvedBody] = None  # the carrier of a mesh with a planet
+    turning: tuple[tuple[sp.Expr, ...], tuple[sp.Expr, ...]] = ((), ())  # rows: each gear's angle relative to the carrier
+    planet_phase: sp.Expr = sp.S.Zero  # the part of the mesh phase a planet's position gives (Parker & Lin 2004)
 
     @property
     def name(self) -> str:
@@ -194,6 +201,12 @@ class Drivetrain:
         )
 
 
+def _whole_turns_removed(angle: sp.Expr) -> sp.Expr:
+    """``angle`` moved into [0, 2 pi) (a mesh phase is 2 pi-periodic), exactly for rational multiples of pi."""
+    turns = angle / (2 * sp.pi)
+    return 2 * sp.pi * (turns - sp.floor(turns))
+
+
 class ResolvedDrivetrain:
     """The checked, symbolic view of a :class:`Drivetrain`."""
 
@@ -203,11 +216,17 @@ class ResolvedDrivetrain:
             raise ModelError("the drivetrain has no bodies; add Gear or Disk components", model.name)
         if not model.couplings:
             raise ModelError("the drivetrain has no couplings; join its bodies with Mesh or Shaft", model.name)
-        self.bodies = [self._resolve_body(i, b) for i, b in enumerate(model.bodies)]
-        self._by_name = {rb.body.name: rb for rb in self.bodies}
+        moving = [b for b in model.bodies if not b.fixed]
+        if not moving:
+            raise ModelError("every body is fixed; a drivetrain needs at least one body that turns", model.name)
+        self.bodies = [self._resolve_body(i, b) for i, b in enumerate(moving)]
+        self.fixed = [self._resolve_body(None, b) for b in model.bodies if b.fixed]
+        self._by_name = {rb.body.name: rb for rb in (*self.bodies, *self.fixed)}
         self.couplings = [self._resolve_coupling(c) for c in model.couplings]
         self.forcing = [f for tq in model.torques for f in self._resolve_torque(tq)]
         self._check_connected()
+        self.couplings = [self._with_planet_phase(rc) for rc in self.couplings]
+        self._check_assembly()
 
     # ---- helpers
     def _default_value(self, expr: sp.Expr) -> Optional[float]:
@@ -247,14 +266,78 @@ class ResolvedDrivetrain:
         return rb
 
     # ---- bodies, couplings, torques
-    def _resolve_body(self, index: int, body: Body) -> ResolvedBody:
+    def _resolve_body(self, index: Optional[int], body: Body) -> ResolvedBody:
         where = f"{type(body).__name__} {body.name!r}"
-        inertia = self._positive(body.inertia, "the moment of inertia", where)
+        if index is None:  # fixed: no angle, and an inertia would never be used
+            if isinstance(body, Planet):
+                raise ModelError("a planet cannot be fixed; fix its carrier instead", where)
+            inertia, angle = None, sp.S.Zero
+        elif body.inertia is None:
+            raise ModelError("needs an inertia (Gear(..., inertia='I1')), or declare it fixed=True if it is held", where)
+        else:
+            inertia = self._positive(body.inertia, "the moment of inertia", where)
+            angle = sp.Function(f"psi_{index + 1}", real=True)(t)
         radius = None
         if isinstance(body, Gear):
             radius = self._positive(body.base_radius, "the base radius", where)
-        angle = sp.Function(f"psi_{index + 1}", real=True)(t)
         return ResolvedBody(body, index, angle, inertia, radius)
+
+    def _unit_row(self, rb: ResolvedBody) -> list[sp.Expr]:
+        """The row of psi that is this body's angle (zeros for a fixed body)."""
+        row = [sp.S.Zero] * len(self.bodies)
+        if rb.index is not None:
+            row[rb.index] = sp.S.One
+        return row
+
+    def _carrier_of(self, a: ResolvedBody, b: ResolvedBody, where: str) -> Optional[ResolvedBody]:
+        """The carrier of the one planet of a mesh (None without a planet); other arrangements are refused."""
+        planets = [end for end in (a, b) if isinstance(end.body, Planet)]
+        if not planets:
+            return None
+        if len(planets) == 2:
+            raise ModelError("joins two planets; meshes between planets (double-planet sets) are not supported", where)
+        planet = planets[0]
+        other = b if planet is a else a
+        if planet.body.carrier is None:
+            raise ModelError("needs its carrier: Planet(..., carrier=carrier_body)", f"Planet {planet.body.name!r}")
+        carrier = self.body(planet.body.carrier, f"Planet {planet.body.name!r}")
+        if carrier is planet or carrier is other:
+            raise ModelError(f"{carrier.body.name!r} carries the planet {planet.body.name!r}, so it cannot also mesh "
+                             "with it", where)
+        if planet.body.internal:
+            raise ModelError("a planet has external teeth; the ring gear is the one with internal=True",
+                             f"Planet {planet.body.name!r}")
+        return carrier
+
+    def _turning(self, end: ResolvedBody, carrier: Optional[ResolvedBody]) -> list[sp.Expr]:
+        """The row of the gear's angle relative to the carrier, in its own sense: a planet is counted opposite
+        to its carrier, a central gear in the carrier's sense."""
+        row = self._unit_row(end)
+        if carrier is not None:
+            sign = 1 if isinstance(end.body, Planet) else -1
+            row = [e + sign * c for e, c in zip(row, self._unit_row(carrier))]
+        return row
+
+    def _mesh_rows(self, a: ResolvedBody, b: ResolvedBody, where: str):
+        """The deflection row ``r_a phi_a -+ r_b phi_b`` (minus for an external, plus for an internal mesh) in
+        the angles phi relative to the carrier, the carrier, and the two relative-angle rows."""
+        for end in (a, b):
+            if end.radius is None:
+                raise ModelError(
+                    f"meshes with {end.body.name!r}, a {type(end.body).__name__} without a base radius; "
+                    "a mesh needs two Gear bodies",
+                    where,
+                )
+        if a.fixed and b.fixed:
+            raise ModelError(f"joins two fixed bodies ({a.body.name!r}, {b.body.name!r}); it could never deflect", where)
+        internal = [end.body.name for end in (a, b) if getattr(end.body, "internal", False)]
+        if len(internal) == 2:
+            raise ModelError("joins two ring gears (internal=True); a ring gear meshes with a pinion or planet", where)
+        carrier = self._carrier_of(a, b, where)
+        turn_a, turn_b = self._turning(a, carrier), self._turning(b, carrier)
+        sign = 1 if internal else -1
+        row = tuple(a.radius * x + sign * b.radius * y for x, y in zip(turn_a, turn_b))
+        return row, carrier, (tuple(turn_a), tuple(turn_b))
 
     def _resolve_coupling(self, c: Coupling) -> ResolvedCoupling:
         kind = "mesh" if isinstance(c, Mesh) else "shaft"
@@ -262,17 +345,8 @@ class ResolvedDrivetrain:
         a, b = (self.body(end, where) for end in c.ends)
         if a is b:
             raise ModelError(f"joins body {a.body.name!r} to itself; a {kind} must join two different bodies", where)
-        n = len(self.bodies)
-        row = [sp.S.Zero] * n
         if isinstance(c, Mesh):
-            for end in (a, b):
-                if end.radius is None:
-                    raise ModelError(
-                        f"meshes with {end.body.name!r}, a {type(end.body).__name__} without a base radius; "
-                        "a mesh needs two Gear bodies",
-                        where,
-                    )
-            row[a.index], row[b.index] = a.radius, -b.radius
+            row, carrier, turning = self._mesh_rows(a, b, where)
             order = to_expr(c.order, where)
             if not (order.is_number and order.is_positive and order.is_rational):
                 raise ModelError(f"the mesh order must be a positive rational number, got {order}", where)
@@ -285,15 +359,17 @@ class ResolvedDrivetrain:
             }
             check_periodic(variation, phi, where, {k: v for k, v in defaults.items() if v is not None})
             return ResolvedCoupling(
-                component=c, kind=kind, a=a, b=b, row=tuple(row), scale=sp.S.One,
+                component=c, kind=kind, a=a, b=b, row=row, scale=sp.S.One,
                 stiffness=self._positive(c.stiffness, "the mesh stiffness", where),
                 damping=self._positive(c.damping, "the mesh damping", where, allow_zero=True),
                 backlash=self._positive(c.backlash, "the backlash", where, allow_zero=True),
                 variation=variation,
                 mesh_phase=order * omega * t + to_expr(c.phase, where),
-                order=order,
+                order=order, carrier=carrier, turning=turning,
             )
-        row[a.index], row[b.index] = sp.S.NegativeOne, sp.S.One
+        if a.fixed and b.fixed:
+            raise ModelError(f"joins two fixed bodies ({a.body.name!r}, {b.body.name!r}); it could never twist", where)
+        row = [y - x for x, y in zip(self._unit_row(a), self._unit_row(b))]
         if c.radius is not None:
             scale = self._positive(c.radius, "the shaft's coordinate radius", where)
         elif a.radius is not None:
@@ -332,13 +408,114 @@ class ResolvedDrivetrain:
         return terms
 
     def _check_connected(self) -> None:
-        used = {rc.a.index for rc in self.couplings} | {rc.b.index for rc in self.couplings}
-        for rb in self.bodies:
-            if rb.index not in used:
+        """Every body must be loaded by some coupling (a carrier is, through its planets' meshes)."""
+        used = {i for rc in self.couplings for i, e in enumerate(rc.row) if e != 0}
+        ends = {end.body.name for rc in self.couplings for end in (rc.a, rc.b)}
+        for rb in (*self.bodies, *self.fixed):
+            if (rb.index not in used) if rb.index is not None else (rb.body.name not in ends):
                 raise ModelError(
                     "is not connected to anything; join it with a Mesh or Shaft, or remove it",
                     f"{type(rb.body).__name__} {rb.body.name!r}",
                 )
+        for f in self.forcing:
+            if f.body.fixed:
+                raise ModelError(f"acts on {f.body.body.name!r}, which is fixed: a torque on a held body does no work",
+                                 f"Torque {f.torque.name!r}")
+
+    # ---- planetary sets: mesh phasing and assembly (Parker & Lin 2004)
+    def _planet_and_central(self, rc: ResolvedCoupling) -> tuple[ResolvedBody, ResolvedBody]:
+        return (rc.a, rc.b) if isinstance(rc.a.body, Planet) else (rc.b, rc.a)
+
+    def _position(self, planet: ResolvedBody) -> sp.Expr:
+        where = f"Planet {planet.body.name!r}"
+        position = to_expr(planet.body.position, where)
+        if not position.is_number:
+            raise ModelError(f"the position must be a number (an angle in radians, e.g. '2*pi/3'), got {position}",
+                             where)
+        return position
+
+    def _with_planet_phase(self, rc: ResolvedCoupling) -> ResolvedCoupling:
+        """A planet's mesh at the position psi_n sees the central gear's teeth that its reference position
+        saw when the central gear was psi_n behind (relative to the carrier): its mesh phase is shifted by
+        ``-s Z psi_n``, ``s`` the sign of the central gear's rotation relative to the carrier (Parker & Lin
+        2004's gamma_sn = +-Z_s psi_n/2pi, gamma_rn = -+Z_r psi_n/2pi, in mesh periods)."""
+        if rc.kind != "mesh" or rc.carrier is None:
+            return rc
+        planet, central = self._planet_and_central(rc)
+        position = self._position(planet)
+        if position == 0:
+            return rc
+        teeth = central.body.tooth_count
+        if teeth is None:
+            raise ModelError(f"planet {planet.body.name!r} sits at {position}, so the mesh phase needs the teeth of "
+                             f"{central.body.name!r}: Gear(..., teeth=N)", f"Mesh {rc.name!r}")
+        shift = _whole_turns_removed(-self._nominal_sign(rc, central) * teeth * position)
+        return replace(rc, mesh_phase=rc.mesh_phase + shift, planet_phase=shift)
+
+    @cached_property
+    def _nominal_motion(self) -> Optional[list[float]]:
+        """The steady rotation of a train with one rigid-body mode, oriented so that its input (the body that
+        declares the speed, else the first driven body, else the first body) turns forward; None otherwise."""
+        rows = sp.Matrix([list(rc.row) for rc in self.couplings])
+        modes = rows.xreplace(self._numeric_values()).nullspace()
+        if len(modes) != 1:
+            return None
+        u = [float(e) for e in modes[0]]
+        driven = [f.body for f in self.forcing if f.amplitude.could_extract_minus_sign() is False and f.order == 0]
+        inputs = [rb for rb in self.bodies if rb.body.speed_parameter] + driven + self.bodies
+        reference = next(rb for rb in inputs if abs(u[rb.index]) > 1e-12)
+        return [x if u[reference.index] > 0 else -x for x in u]
+
+    def _nominal_sign(self, rc: ResolvedCoupling, central: ResolvedBody) -> int:
+        """Sign of the central gear's rotation relative to the carrier in the steady motion. With several
+        rigid-body modes (a differential) the kinematics leave it open; then the sun (an external central gear)
+        is taken to turn forward relative to the carrier and a ring backward, as with the ring held."""
+        motion = self._nominal_motion
+        if motion is None:
+            return -1 if getattr(central.body, "internal", False) else 1
+        turning = rc.turning[0] if central is rc.a else rc.turning[1]
+        rate = sum(float(e) * u for e, u in zip(turning, motion))
+        if abs(rate) < 1e-12:
+            raise ModelError(f"{central.body.name!r} does not turn relative to the carrier in the steady motion, so "
+                             "the mesh has no frequency", f"Mesh {rc.name!r}")
+        return 1 if rate > 0 else -1
+
+    def _numeric_values(self) -> dict[sp.Symbol, sp.Expr]:
+        """Numbers for the radii in the deflection rows: declared defaults and physical values, else generic
+        positive ones (the signs of rates in a gear train do not depend on the radii's exact values)."""
+        import random
+
+        rng = random.Random(7)
+        free = sorted({s for rc in self.couplings for e in rc.row for s in e.free_symbols}, key=str)
+        out = {}
+        for s in free:
+            value = self._default_value(s)
+            if value is None and s.name in self.model._physical:
+                value = float(self.model._physical[s.name].to_base_units().magnitude)
+            out[s] = sp.Rational(value) if value is not None else sp.Rational(rng.randint(11, 97), rng.randint(11, 97))
+        return out
+
+    def _check_assembly(self) -> None:
+        """A planet that meshes with a sun and a ring with teeth fits only where (Z_s + Z_r) psi / 2 pi is whole."""
+        by_planet: dict[str, dict[str, int]] = {}
+        for rc in self.couplings:
+            if rc.kind != "mesh" or rc.carrier is None:
+                continue
+            planet, central = self._planet_and_central(rc)
+            if central.body.tooth_count is not None:
+                kind = "ring" if getattr(central.body, "internal", False) else "sun"
+                by_planet.setdefault(planet.body.name, {})[kind] = central.body.tooth_count
+        for name, teeth in by_planet.items():
+            if set(teeth) != {"sun", "ring"}:
+                continue
+            planet = self._by_name[name]
+            turns = (teeth["sun"] + teeth["ring"]) * self._position(planet) / (2 * sp.pi)
+            if abs(float(turns) - round(float(turns))) > 1e-9:
+                step = sp.nsimplify(360 / sp.Integer(teeth["sun"] + teeth["ring"]))
+                raise ModelError(
+                    f"cannot be assembled at {self._position(planet)} rad: (Z_sun + Z_ring) position / 2 pi = "
+                    f"{float(turns):.6g} is not a whole number; place it at a multiple of 360/(Z_sun + Z_ring) = "
+                    f"{step} degrees", f"Planet {name!r}")
 
     # ---- kinematics and energies
     @property

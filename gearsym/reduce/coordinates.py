@@ -1,10 +1,16 @@
 """Rigid-body modes and the relative coordinates that remove them.
 
-Each coupling's deflection is a linear form J_c psi. The rigid-body rotation
-modes are the null space of the stacked J: motions that deflect no mesh and
-twist no shaft. The relative coordinates are one per coupling, the mesh
-deflection (r_a psi_a - r_b psi_b) or the shaft twist scaled to a length
-(r (psi_b - psi_a)), so q = T psi with T U = 0.
+Each coupling's deflection is a linear form C_c psi. The rigid-body rotation
+modes are the null space of the stacked C: motions that deflect no mesh and
+twist no shaft. The relative coordinates are the deflections of the couplings
+that are independent of those declared before them (a spanning tree of the
+couplings, in declaration order): the mesh deflection (r_a psi_a - r_b psi_b)
+or the shaft twist scaled to a length (r (psi_b - psi_a)), so q = T psi with
+T U = 0. In a chain or a tree every coupling is kept. A coupling whose
+deflection depends on those kept before it closes a kinematic loop (a planetary
+set: N planets give 2N meshes but N + 1 independent deflections); its
+deflection is the combination J_c q of the coordinates with C_c = J_c T, solved
+exactly, and its law acts on that combination.
 """
 from __future__ import annotations
 
@@ -20,15 +26,35 @@ from ..symbols import t
 
 @dataclass(frozen=True)
 class Coordinate:
-    """One relative coordinate: its name, the coupling it measures and its definition in psi."""
+    """The deflection of one coupling: its name, the coupling, its definition in psi and, for a coupling that
+    closes a loop, its combination of the relative coordinates (empty for a coordinate itself)."""
 
     name: str
     coupling: ResolvedCoupling
     definition: sp.Expr  # scale * deflection, in psi_i(t)
+    combination: tuple[tuple["Coordinate", sp.Expr], ...] = ()  # (coordinate, coefficient) for a dependent one
 
     @property
     def kind(self) -> str:
         return self.coupling.kind
+
+    @property
+    def independent(self) -> bool:
+        """True for a relative coordinate (a state), False for a deflection that closes a loop."""
+        return not self.combination
+
+    def contact(self, time: sp.Symbol) -> sp.Expr:
+        """The deflection as a function of time: the coordinate x(t), or its combination of coordinates."""
+        if self.independent:
+            return self.of(time)
+        return sp.Add(*(a * c.of(time) for c, a in self.combination))
+
+    def in_states(self) -> tuple[sp.Expr, sp.Expr]:
+        """The deflection and its rate in the state symbols (x1 + x2 - x3, v1 + v2 - v3)."""
+        if self.independent:
+            return sp.Symbol(self.name, real=True), sp.Symbol(self.velocity_name, real=True)
+        return (sp.Add(*(a * sp.Symbol(c.name, real=True) for c, a in self.combination)),
+                sp.Add(*(a * sp.Symbol(c.velocity_name, real=True) for c, a in self.combination)))
 
     @property
     def velocity_name(self) -> str:
@@ -42,9 +68,7 @@ class Coordinate:
 
 def generic_rank(m: sp.Matrix, seed: int = 7) -> int:
     """Rank at random positive values of the symbols (the rank for almost all parameter values)."""
-    rng = random.Random(seed)
-    subs = {s: sp.Rational(rng.randint(11, 97), rng.randint(11, 97)) for s in sorted(m.free_symbols, key=str)}
-    return m.xreplace(subs).rank()
+    return m.xreplace(generic_values(m, seed)).rank()
 
 
 def deflection_matrix(rd: ResolvedDrivetrain) -> sp.Matrix:
@@ -62,24 +86,22 @@ def rigid_body_modes(rd: ResolvedDrivetrain) -> list[sp.Matrix]:
 
 
 def relative_coordinates(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.Matrix]:
-    """One coordinate per coupling, and the transform T (q = T psi)."""
+    """The relative coordinates (one per independent coupling) and the transform T (q = T psi)."""
+    coords, transform, _ = coupling_deflections(rd)
+    return coords, transform
+
+
+def coupling_deflections(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.Matrix, list[Coordinate]]:
+    """The relative coordinates, the transform T and every coupling's deflection (the coordinates themselves and
+    the combinations of those that close a loop), in declaration order."""
     jac = deflection_matrix(rd)
     n_bodies, n_couplings = len(rd.bodies), len(rd.couplings)
-    if generic_rank(jac) < n_couplings:
-        # name the couplings that close a loop: those adding no independent deflection
-        closing, kept = [], []
-        for i, rc in enumerate(rd.couplings):
-            if generic_rank(jac.extract(kept + [i], list(range(n_bodies)))) > len(kept):
-                kept.append(i)
-            else:
-                closing.append(rc.name)
-        raise ModelError(
-            f"coupling(s) {', '.join(map(repr, closing))} close a kinematic loop with the couplings declared "
-            "before them; loops (e.g. planetary sets) are not supported yet: remove the redundant coupling",
-            rd.model.name,
-        )
+    kept: list[int] = []
+    for i in range(n_couplings):  # a spanning tree of the couplings, in declaration order
+        if generic_rank(jac.extract(kept + [i], list(range(n_bodies)))) > len(kept):
+            kept.append(i)
     single = n_couplings == 1
-    coords, seen = [], {}
+    names, seen = [], {}
     for i, rc in enumerate(rd.couplings):
         name = rc.component.coordinate or ("x" if single else f"x{i + 1}")
         if not name.isidentifier() or name in ("t", "tau", "phi"):
@@ -87,11 +109,50 @@ def relative_coordinates(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.M
         if name in seen:
             raise ModelError(f"coordinate name {name!r} is used by {seen[name]!r} too; give each a distinct name", rc.name)
         seen[name] = rc.name
-        definition = sp.Add(*(rc.scale * c * a for c, a in zip(rc.row, rd.angles)))
-        coords.append(Coordinate(name, rc, definition))
-    transform = sp.Matrix([[rc.scale * c for c in rc.row] for rc in rd.couplings])
-    assert transform.shape == (n_couplings, n_bodies)
-    return coords, transform
+        names.append(name)
+    scaled = [[rc.scale * c for c in rc.row] for rc in rd.couplings]
+    transform = sp.Matrix([scaled[i] for i in kept])
+    assert transform.shape == (len(kept), n_bodies)
+    coords = [Coordinate(names[i], rd.couplings[i], _definition(rd, i)) for i in kept]
+    solve = None
+    deflections = []
+    for i, rc in enumerate(rd.couplings):
+        if i in kept:
+            deflections.append(coords[kept.index(i)])
+            continue
+        solve = solve or _combination_solver(transform)
+        coefficients = solve(sp.Matrix([scaled[i]]))
+        combination = tuple((c, a) for c, a in zip(coords, coefficients) if a != 0)
+        deflections.append(Coordinate(names[i], rc, _definition(rd, i), combination))
+    return coords, transform, deflections
+
+
+def _definition(rd: ResolvedDrivetrain, i: int) -> sp.Expr:
+    rc = rd.couplings[i]
+    return sp.Add(*(rc.scale * c * a for c, a in zip(rc.row, rd.angles)))
+
+
+def _combination_solver(transform: sp.Matrix):
+    """A function giving the coefficients J with ``row = J T`` exactly, for a row in the span of T: solved on
+    columns where T is invertible (found at generic values), then checked on every column."""
+    k = transform.rows
+    numeric = transform.xreplace(generic_values(transform))
+    _, pivots = numeric.rref()
+    inverse = transform.extract(list(range(k)), list(pivots)).inv(method="LU").applyfunc(sp.cancel)
+
+    def solve(row: sp.Matrix) -> list[sp.Expr]:
+        coefficients = (row.extract([0], list(pivots)) * inverse).applyfunc(sp.factor)
+        residual = (coefficients * transform - row).applyfunc(sp.cancel)
+        if residual != sp.zeros(1, transform.cols):
+            raise ModelError(f"the deflection {list(row)} is not a combination of the coordinates' (a bug)", "reduction")
+        return list(coefficients)
+
+    return solve
+
+
+def generic_values(m: sp.Matrix, seed: int = 7) -> dict:
+    rng = random.Random(seed)
+    return {s: sp.Rational(rng.randint(11, 97), rng.randint(11, 97)) for s in sorted(m.free_symbols, key=str)}
 
 
 def angle_symbols(rd: ResolvedDrivetrain) -> tuple[list[sp.Symbol], list[sp.Symbol]]:

@@ -35,6 +35,7 @@ from ..model.expressions import ExprLike, parameter_names, sign_violation, to_ex
 from ..model.stiffness import check_periodic
 from ..symbols import omega, parameter_symbol, phi, t, tau
 from ..system import Constraint, Coupling, FirstOrderSystem
+from .coordinates import generic_values
 from .reduction import Reduction, reduce_drivetrain
 
 
@@ -334,16 +335,30 @@ class NondimensionalModel:
         derived = {gr.symbol: gr.definition for gr in self.groups if gr.kind == "derived"}
         own = {f.mesh: functions.get(f.name, f.expression) for f in self.functions}
         out = []
-        for c in self.coordinates:
+        for c in self.reduction.deflections:
             rc = c.coupling
             stiffness = own[rc.name] if rc.kind == "mesh" else rc.stiffness
             rows = tuple((2 * r + 1, factor.xreplace(derived)) for r, factor in self.coupling_rows[rc.name])
+            contact, rate = c.in_states()
             out.append(Coupling(rc.name, rc.kind, c.name, c.velocity_name, rc.backlash, stiffness.xreplace(derived),
-                                rc.order, rows))
+                                rc.order, rows, contact, None if c.independent else rate))
         return tuple(out)
 
 
 # ============================================================================ construction
+def _equal(a: sp.Expr, b: sp.Expr) -> bool:
+    """Whether two group definitions (rational functions of the parameters) are the same: different at generic
+    values is enough to tell them apart, and equal ones are confirmed exactly."""
+    difference = a - b
+    values = generic_values(difference)
+    try:
+        if difference.xreplace(values) != 0:
+            return False
+    except ZeroDivisionError:
+        pass
+    return sp.cancel(difference) == 0
+
+
 def _coordinate_suffix(red: Reduction, row: int) -> str:
     return "" if row == 0 else f"_{red.coordinates[row].name}"
 
@@ -362,13 +377,27 @@ class _Assembly:
         self.rhs = [sp.S.Zero] * n  # forcing numerators (over omega^2)
         self.coupling_rows: dict[str, list[tuple[int, sp.Expr]]] = {}  # coupling -> (row, factor of its law)
         self._betas: dict[sp.Expr, sp.Expr] = {}
+        self._forcing: list[tuple[tuple, Group]] = []  # ((order, phase), group) of the forcing groups named
+
+    def add_group(self, gr: Group) -> Group:
+        """Add a group; one named like a group already added (meshes that declare the same damping_group, say)
+        is that group if its definition is the same, and an error otherwise."""
+        for known in self.groups:
+            if known.name == gr.name:
+                if known.kind != gr.kind or not _equal(known.definition, gr.definition):
+                    raise ModelError(f"two groups are named {gr.name!r} but differ: {known.definition} "
+                                     f"({known.description}) and {gr.definition} ({gr.description}); give them "
+                                     "distinct names", self.red.drivetrain.name)
+                return known
+        self.groups.append(gr)
+        return gr
 
     def beta(self, definition: sp.Expr, description: str) -> sp.Expr:
         """The group standing for ``definition`` (one per distinct value), or the number itself."""
         if definition.is_number:
             return definition
         for known, sym in self._betas.items():
-            if sp.simplify(known - definition) == 0:
+            if _equal(known, definition):
                 return sym
         gr = Group(f"beta_{len(self._betas) + 1}", definition, "derived", description, "coupling")
         self.groups.append(gr)
@@ -376,14 +405,20 @@ class _Assembly:
         return gr.symbol
 
     def own_factor(self, rc: ResolvedCoupling) -> sp.Expr:
+        """The factor of a coupling's law in its own row; for one that closes a loop (no row of its own) the
+        same quantity, C_c M^-1 C_c^T (r_a^2/I_a + r_b^2/I_b + ... along its line of action)."""
         red = self.red
-        row = red.coordinates.index(red.coordinate_of(rc))
-        return next(ct.factor for ct in red.row_terms(row) if ct.coupling is rc)
+        own = red.deflection_of(rc)
+        if own.independent:
+            row = red.coordinates.index(own)
+            return next(ct.factor for ct in red.row_terms(row) if ct.coupling is rc)
+        inertias = [rb.inertia for rb in red.resolved.bodies]
+        return sp.factor(sp.Add(*(e**2 / i for e, i in zip(rc.row, inertias))))
 
     def add_shaft(self, rc: ResolvedCoupling) -> None:
         """beta * (kS x + cS x') in every row the shaft reaches."""
         red = self.red
-        x = red.coordinate_of(rc).of(tau)
+        x = red.deflection_of(rc).contact(tau)
         for ct in (ct for ct in red.coupling_terms if ct.coupling is rc):
             b = self.beta(sp.expand(ct.factor), f"coupling of shaft {rc.name!r} into {red.coordinates[ct.row].name}")
             self.lhs[ct.row] += b * rc.stiffness * x / omega**2 + b * rc.damping * sp.diff(x, tau) / omega
@@ -393,14 +428,16 @@ class _Assembly:
         """The mesh's terms in its own row, ``2 zeta x'/omega + k(tau) g(x, eta)/omega^2``: the own-row
         factor m is absorbed into its stiffness and damping, naming k(tau), zeta (and K for a second mesh)."""
         red = self.red
-        cx = red.coordinate_of(rc)
+        cx = red.deflection_of(rc)
         suffix = "" if rc is reference else f"_{cx.name}"
         m = sp.expand(self.own_factor(rc))
-        x = cx.of(tau)
+        x = cx.contact(tau)
         comp = rc.component
         fname = comp.function or ("k" if rc is reference else f"k{suffix}")
         varied = rc.variation.subs(phi, sp.expand(rc.mesh_phase.subs(t, tau / omega)))
-        if rc is reference:
+        if rc is not reference and _equal(m * rc.stiffness, self.own_factor(reference) * reference.stiffness):
+            expression = varied  # as stiff as the first mesh (another planet's): 1 by the time-unit condition
+        elif rc is reference:
             self.conditions.append(Condition(
                 sp.Eq(m * rc.stiffness, 1),
                 f"time unit: t is measured in units of 1/omega_n, omega_n^2 being the left-hand side (the mean "
@@ -410,18 +447,16 @@ class _Assembly:
             ))
             expression = varied
         else:
-            K = Group(comp.stiffness_group or f"K{suffix}", m * rc.stiffness, "free",
-                      f"mean stiffness of mesh {rc.name!r} relative to the first mesh", "stiffness")
-            self.groups.append(K)
+            K = self.add_group(Group(comp.stiffness_group or f"K{suffix}", m * rc.stiffness, "free",
+                                     f"mean stiffness of mesh {rc.name!r} relative to the first mesh", "stiffness"))
             expression = K.symbol * varied
         kfun = StiffnessFunction(fname, rc.name, m * red.resolved.stiffness_at(rc).subs(t, tau / omega),
                                  expression, 2 * sp.pi / rc.order)
         self.functions.append(kfun)
         terms = kfun.applied * g(x, rc.backlash) / omega**2
         if rc.damping != 0:
-            zeta = Group(comp.damping_group or f"zeta{suffix}", m * rc.damping / 2, "free",
-                         f"damping ratio of mesh {rc.name!r}", "damping")
-            self.groups.append(zeta)
+            zeta = self.add_group(Group(comp.damping_group or f"zeta{suffix}", m * rc.damping / 2, "free",
+                                        f"damping ratio of mesh {rc.name!r}", "damping"))
             terms = 2 * zeta.symbol * sp.diff(x, tau) / omega + terms
         return terms
 
@@ -430,7 +465,7 @@ class _Assembly:
         red = self.red
         m = self.own_factor(rc)
         for ct in (ct for ct in red.coupling_terms if ct.coupling is rc):
-            if ct.factor == m and red.coordinates[ct.row] is red.coordinate_of(rc):
+            if ct.factor == m and red.coordinates[ct.row] is red.deflection_of(rc):
                 self.lhs[ct.row] += law
                 self.coupling_rows.setdefault(rc.name, []).append((ct.row, sp.S.One))
             else:
@@ -460,13 +495,17 @@ class _Assembly:
                     "torque_balance",
                 ))
                 continue
-            name = self._forcing_name(row, order, phase, terms, used_names)
-            used_names.add(name)
             timefn = sp.S.One if order == 0 else sp.cos(order * tau + phase)
-            what = "constant forcing" if order == 0 else f"forcing amplitude of {timefn}"
-            gr = Group(name, definition, "free", f"{what} of {cx.name}", "forcing")
-            self.groups.append(gr)
-            self.rhs[row] += gr.symbol * timefn
+            same = next((gr for key, gr in self._forcing if key == (order, phase) and _equal(gr.definition, definition)),
+                        None)  # rows forced alike (a planetary set's sun meshes) share one group
+            if same is None:
+                name = self._forcing_name(row, order, phase, terms, used_names)
+                used_names.add(name)
+                what = "constant forcing" if order == 0 else f"forcing amplitude of {timefn}"
+                same = Group(name, definition, "free", f"{what} of {cx.name}", "forcing")
+                self.groups.append(same)
+                self._forcing.append(((order, phase), same))
+            self.rhs[row] += same.symbol * timefn
 
     def _forcing_name(self, row: int, order, phase, terms, used_names: set[str]) -> str:
         red = self.red
