@@ -12,6 +12,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import casadi as ca
 import numpy as np
@@ -19,9 +20,11 @@ import numpy as np
 from ..checks import whole_number
 from ..errors import GearsymError, ModelError, warn
 from ..options import Integration
-from ..system import FirstOrderSystem
-from .functions import LoopOptions
+from .loops import LoopOptions
 from .native import NativeFunction
+
+if TYPE_CHECKING:
+    from ..system import FirstOrderSystem
 
 
 @dataclass(frozen=True)
@@ -134,7 +137,7 @@ class CompiledModel:
 
     @cached_property  # read for every row a sweep writes
     def state_names(self) -> tuple[str, ...]:
-        return tuple(s.name for s in self.system.states)
+        return tuple(self.system.state_names)
 
     @cached_property
     def observed(self) -> tuple[str, ...]:

@@ -30,13 +30,15 @@ import math
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Union
+from typing import TYPE_CHECKING, Union
 
 import numpy as np
 
 from ..checks import whole_number
 from ..errors import GearsymError, suggest
-from ..system import FirstOrderSystem
+
+if TYPE_CHECKING:
+    from ..system import FirstOrderSystem
 
 RECORD = "record"
 PHYSICAL_TIME = "t"
@@ -252,6 +254,8 @@ def load_measurements(
     are identified per file (two files may both have a record ``1``). ``time_scale`` converts a
     ``t`` column: tau = time_scale * t; files with a ``tau`` column ignore it.
     """
+    from ..system import FirstOrderSystem
+
     if not isinstance(system, FirstOrderSystem):
         raise GearsymError(f"load_measurements takes the model's FirstOrderSystem, got {type(system).__name__}"
                            + ("; resolve a name with gearsym.load(...)" if isinstance(system, str) else ""))
