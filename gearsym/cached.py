@@ -111,19 +111,25 @@ def model_file(ref: str) -> Path | None:
 
 @lru_cache(maxsize=None)
 def _source_digest(folder: Path) -> str:
-    """The bytes of every Python file below ``folder``, hashed (gearsym's own code: whatever derives a system)."""
+    """Every Python file below ``folder`` (gearsym's own code: whatever derives a system) by its size and time of
+    change, as Python's own bytecode cache tells an edited module (reading them all would cost start-up time)."""
     digest = hashlib.sha256()
     for path in sorted(folder.rglob("*.py")):
-        digest.update(str(path.relative_to(folder)).encode() + b"\0" + path.read_bytes())
+        stat = path.stat()
+        digest.update(f"{path.relative_to(folder)}\0{stat.st_size}\0{stat.st_mtime_ns}\n".encode())
     return digest.hexdigest()
+
+
+def _model_files(folders: tuple[Path, ...]) -> dict[str, str]:
+    """The model files in ``folders`` by their content's hash (a model imports another; read every time: a model
+    file edited in a long-lived process must be noticed)."""
+    return {str(f): hashlib.sha256(f.read_bytes()).hexdigest() for folder in folders for f in sorted(folder.glob("*.py"))}
 
 
 def system_key(path: Path, values: Mapping[str, object]) -> str:
     """What the reduction of the model in ``path`` with ``values`` depends on, hashed: the model file, the
     model files beside it and in the models folder (a model imports another), gearsym's source, the values."""
-    folders = sorted({path.parent, models_dir().resolve()})
-    files = {str(f): hashlib.sha256(f.read_bytes()).hexdigest()
-             for folder in folders for f in sorted(folder.glob("*.py"))}
+    files = _model_files(tuple(sorted({path.parent, models_dir().resolve()})))
     description = {"format": SUMMARY_FORMAT, "model": str(path), "files": files,
                    "gearsym": _source_digest(Path(__file__).resolve().parent),
                    "python": sys.version, "values": {k: repr(v) for k, v in sorted(values.items())}}
@@ -203,11 +209,12 @@ def _from_cache(system_file: Path, build_file: Path, ref, values, options: Integ
     if not library.is_file() or library.resolve().parent != (cache_dir() / "lib").resolve():
         return None  # (only a library of our own cache is loaded)
     key = (digest, "compiled")
-    if key not in _LOADED:
+    if key in _LOADED:  # (loaded in this process already: its functions with work arrays of their own)
+        compiled = replace(_LOADED[key].clone(), system=summary, integration=options)
+    else:
         functions = {name: ca.external(name, str(library)) for name in FUNCTION_NAMES}
-        _LOADED[key] = CompiledModel(summary, loops, digest, functions, "compiled", library, {},
-                                     load_native(library, functions), options)
-    compiled = replace(_LOADED[key].clone(), system=summary, integration=options)
+        compiled = _LOADED[key] = CompiledModel(summary, loops, digest, functions, "compiled", library, {},
+                                                load_native(library, functions), options)
     compiled.__dict__["timed_parameters"] = timed  # (a cached_property: computing it needs the equations)
     return compiled
 
