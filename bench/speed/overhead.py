@@ -43,10 +43,9 @@ def _timed_native():
 
 def measure(repeats: int = REPEATS, log=lambda s: print(s, file=sys.stderr, flush=True)) -> dict:
     import gearsym
-    from gearsym.cached import load_compiled
 
     options = gearsym.Integration(periods=PERIODS, discard=DISCARD, steps_per_period=STEPS)
-    compiled = load_compiled(MODEL, {}, options)
+    compiled = gearsym.compile_model(gearsym.load(MODEL), options)
     grid = np.round(0.1 + 0.005 * np.arange(POINTS), 10)
     runs = []
     for rep in range(repeats):

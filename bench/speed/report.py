@@ -168,7 +168,8 @@ def _startup_lines(raw: dict) -> list[str]:
         return []
     out = ["## Start-up and the Python around each sweep point", ""]
     if start:
-        out += [f"`{start['command']}` end to end in a fresh process, the model's library and summary cached "
+        cached = ", Python's bytecode cached as for any user" if start.get("bytecode_cache") else ""
+        out += [f"`{start['command']}` end to end in a fresh process, the model's library and summary cached{cached} "
                 f"(median of {start['repeats']}; target ≤ {start['target_seconds']:g} s); `import numpy, casadi` "
                 f"alone: {start['imports_numpy_casadi']['median']:.2f} s.", "",
                 "| model | start-up (s) | first run (s) |", "|---|---|---|"]
