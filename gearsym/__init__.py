@@ -22,18 +22,29 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING
 
+import sys
+import types
+
 from .errors import GearsymError, ModelError, UnknownParameterError
-from .model import Disk, Drivetrain, Gear, Harmonic, Mesh, Planet, Shaft, Torque, rectangular_mesh_stiffness
 from .options import Integration
-# not lazy: gearsym.reduce is also a subpackage, and importing it (gearsym.load does) would bind the name
-# gearsym.reduce to the package, so that gearsym.reduce(drivetrain) called the module
-from .reduce import NondimensionalModel, reduce
-from .system import FirstOrderSystem
 from .version import __version__
 
 
-#: public name -> the module that defines it (imported when the name is first used)
+#: public name -> the module that defines it (imported when the name is first used: the declaring and
+#: reducing stages import SymPy, which a command on a cached model never needs)
 _LAZY = {
+    "Disk": "gearsym.model",
+    "Drivetrain": "gearsym.model",
+    "Gear": "gearsym.model",
+    "Harmonic": "gearsym.model",
+    "Mesh": "gearsym.model",
+    "Planet": "gearsym.model",
+    "Shaft": "gearsym.model",
+    "Torque": "gearsym.model",
+    "rectangular_mesh_stiffness": "gearsym.model",
+    "NondimensionalModel": "gearsym.reduce",
+    "reduce": "gearsym.reduce",
+    "FirstOrderSystem": "gearsym.system",
     "available_models": "gearsym.registry",
     "load": "gearsym.registry",
     "load_model": "gearsym.registry",
@@ -63,12 +74,19 @@ _LAZY = {
     "render": "gearsym.derivation",
 }
 
-__all__ = [
-    "Disk", "Drivetrain", "FirstOrderSystem", "Gear", "GearsymError", "Harmonic", "Integration", "Mesh",
-    "ModelError", "NondimensionalModel", "Planet", "Shaft", "Torque", "UnknownParameterError",
-    "rectangular_mesh_stiffness",
-    "reduce", *_LAZY,
-]
+__all__ = ["GearsymError", "Integration", "ModelError", "UnknownParameterError", *_LAZY]
+
+
+class _Package(types.ModuleType):
+    """gearsym.reduce is both a function of the face and a subpackage: importing the subpackage (gearsym.load
+    does) must not rebind the name to the package, or gearsym.reduce(drivetrain) would call the module."""
+
+    def __setattr__(self, name, value):
+        if not (name == "reduce" and isinstance(value, types.ModuleType)):
+            super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
 
 
 def __getattr__(name: str):
@@ -95,5 +113,8 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .periodic import continue_orbits, periodic_orbit
     from .physical import Scaling, scaling
     from .physical.campbell import campbell
+    from .model import Disk, Drivetrain, Gear, Harmonic, Mesh, Shaft, Torque, rectangular_mesh_stiffness
+    from .reduce import NondimensionalModel, reduce
     from .registry import available_models, load, load_model
+    from .system import FirstOrderSystem
     from .sweep import SweepInterrupted, Workers, read_sweep, run_sweep

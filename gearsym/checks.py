@@ -86,3 +86,10 @@ def chosen_coordinate(name: str | None, coordinates, plot) -> str | None:
         raise GearsymError(f"--coordinate {name}: no such coordinate.{suggest(name, coordinates)} "
                            f"The coordinates are {', '.join(coordinates)}")
     return name
+
+
+def sign_violation(number: float, allow_zero: bool) -> str | None:
+    """What is wrong with the sign of a physical quantity ('must be positive', ...), or None."""
+    if number < 0 or (number == 0 and not allow_zero):
+        return "must not be negative" if allow_zero else "must be positive"
+    return None

@@ -6,14 +6,16 @@ import importlib.util
 import sys
 import traceback
 from pathlib import Path
-from typing import Union
+from typing import TYPE_CHECKING, Union
 
 from .errors import GearsymError, ModelError, suggest
-from .model.drivetrain import Drivetrain
 from .paths import REPO_ROOT
-from .system import FirstOrderSystem
 
-Model = Union[Drivetrain, FirstOrderSystem]
+if TYPE_CHECKING:  # (imported where used: SymPy, which finding a model's file does not need)
+    from .model.drivetrain import Drivetrain
+    from .system import FirstOrderSystem
+
+Model = Union["Drivetrain", "FirstOrderSystem"]
 
 
 def models_dir() -> Path:
@@ -42,6 +44,9 @@ def available_models() -> list[str]:
 
 def load_model(ref: Union[str, Path, Model]) -> Model:
     """A model object from a name in ``models/``, a path to a ``.py`` file, or a model itself."""
+    from .model.drivetrain import Drivetrain
+    from .system import FirstOrderSystem
+
     if isinstance(ref, (Drivetrain, FirstOrderSystem)):
         return ref
     ref = str(ref)
@@ -104,6 +109,7 @@ def load(ref, **values) -> FirstOrderSystem:
     nondimensional values by :class:`gearsym.physical.Scaling`.
     """
     from .reduce import NondimensionalModel, reduce
+    from .system import FirstOrderSystem
 
     model = ref if isinstance(ref, NondimensionalModel) else load_model(ref)
     values = {k: _maybe_number(v) for k, v in values.items()}
@@ -135,6 +141,8 @@ def physical_settings(model, values: dict):
         type(v).__module__.startswith("pint") or (isinstance(v, str) and looks_like_quantity(v)) for v in values.values())
     if not (given or getattr(declared, "physical", None)):
         return None
+    from .system import FirstOrderSystem
+
     if isinstance(model, FirstOrderSystem):
         raise GearsymError(f"{model.name}: physical values need a drivetrain model (a FirstOrderSystem has no "
                            "components to give them units)")

@@ -9,19 +9,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 import sympy as sp
 
-from .errors import GearsymError, ModelError, UnknownParameterError
-from .model.expressions import ExprLike, sign_violation, to_expr
-from .options import Integration
+from .errors import ModelError, UnknownParameterError
+from .model.expressions import ExprLike, to_expr
+from .parameters import Constraint, ParameterChecks
 from .symbols import parameter_symbol
-
-
-#: the fields of gearsym.Integration, which a caller of the old keywords may pass as parameter values
-_RUN_OPTIONS = tuple(f.name for f in fields(Integration))
 
 
 @dataclass(frozen=True)
@@ -61,15 +57,7 @@ class Coupling:
 
 
 @dataclass(frozen=True)
-class Constraint:
-    """What a parameter is physically, and so which sign it must have."""
-
-    meaning: str  # "an inertia", "a damping ratio", ...
-    zero_allowed: bool = True
-
-
-@dataclass(frozen=True)
-class FirstOrderSystem:
+class FirstOrderSystem(ParameterChecks):
     """dy/d(time) = rhs(time, y, p), with named parameters and their values.
 
     ``period`` is the forcing period in ``time`` (2*pi for the gear models):
@@ -160,27 +148,6 @@ class FirstOrderSystem:
                 raise UnknownParameterError(k, self.parameters, self.name)
         return replace(self, parameters={**self.parameters, **{k: self.check_value(k, v) for k, v in values.items()}})
 
-    def parameter_values(self, values: Mapping[str, float] | None = None) -> dict[str, float]:
-        """Every parameter's value: the system's own, with ``values`` overriding (names, signs and
-        finiteness checked)."""
-        merged = dict(self.parameters)
-        for name, value in (values or {}).items():
-            if name not in merged:
-                if name in _RUN_OPTIONS:
-                    raise GearsymError(f"{name} is how to integrate, not a parameter of {self.name}: pass "
-                                       f"options=gearsym.Integration({name}=...)")
-                if isinstance(value, str):
-                    raise GearsymError(
-                        f"{self.name}: {name}={value!r} would change the model's equations; a system only takes "
-                        f"parameter values: load the model with it (gearsym.load(model, {name}=...))")
-                raise UnknownParameterError(name, merged, self.name)
-            merged[name] = self.check_value(name, value)
-        bad = [n for n, v in merged.items() if not math.isfinite(v)]
-        if bad:
-            raise GearsymError(f"{self.name}: parameter values must be finite numbers: "
-                               + ", ".join(f"{n}={merged[n]}" for n in bad))
-        return merged
-
     def period_at(self, values: Mapping[str, float] | None = None) -> float:
         """The forcing period (in the system's time) at these parameter values."""
         merged = self.parameter_values(values)
@@ -194,21 +161,6 @@ class FirstOrderSystem:
     @property
     def state_names(self) -> tuple[str, ...]:
         return tuple(s.name for s in self.states)
-
-    def check_value(self, name: str, value) -> float:
-        """``value`` as a float, if it is a finite number with the sign parameter ``name`` must have."""
-        if isinstance(value, str):
-            raise GearsymError(f"{self.name}: {name}={value!r} is not a number; a formula changes the equations: "
-                               f"give it when loading the model (gearsym.load(model, {name}=...))")
-        try:
-            number = float(value)
-        except (TypeError, ValueError):
-            raise GearsymError(f"{self.name}: {name} must be a number, got {value!r}") from None
-        constraint = self.constraints.get(name)
-        must = sign_violation(number, constraint.zero_allowed) if constraint else None
-        if must:
-            raise ModelError(f"is {constraint.meaning} and {must}, got {number:g}", f"parameter {name!r}")
-        return number
 
     def coupling(self, coordinate: str) -> Coupling:
         """The coupling whose relative coordinate is ``coordinate``."""

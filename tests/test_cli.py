@@ -8,8 +8,7 @@ import sys
 
 import pytest
 
-import gearsym.cli.derive
-import gearsym.cli.docs
+import gearsym.derivation
 from gearsym import available_models
 from gearsym.cli import COMMANDS, main
 from gearsym.derivation import derive
@@ -28,8 +27,7 @@ def cached_derivations():
         return derived[id(model)][1]
 
     patch = pytest.MonkeyPatch()
-    patch.setattr(gearsym.cli.derive, "derive", cached)
-    patch.setattr(gearsym.cli.docs, "derive", cached)
+    patch.setattr(gearsym.derivation, "derive", cached)  # (the commands import it when they run)
     yield
     patch.undo()
 

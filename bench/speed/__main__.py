@@ -16,7 +16,7 @@ from pathlib import Path
 
 from gearsym import Integration
 
-from . import compile_time, points, profile, reference, scaling, sweep
+from . import compile_time, overhead, points, profile, reference, scaling, startup, sweep
 from .machine import REPO, machine_info
 from .summary import CROSSINGS, summarise, summarise_model
 
@@ -133,6 +133,8 @@ def main(argv=None) -> int:
     ap.add_argument("--no-profile", action="store_true", help="skip the per-step profile")
     ap.add_argument("--no-scaling", action="store_true", help="skip the threads/Dask scaling runs")
     ap.add_argument("--no-compile", action="store_true", help="skip the compile-time runs")
+    ap.add_argument("--no-startup", action="store_true",
+                    help="skip the start-up and sweep-overhead runs (alone: python -m bench.speed.startup, .overhead)")
     ap.add_argument("--no-dask", action="store_true", help="scaling without the Dask LocalCluster")
     ap.add_argument("--out", type=Path, help=f"JSON to write (default {DEFAULT_OUT.relative_to(REPO)}; "
                                              "--quick writes nothing unless given)")
@@ -166,6 +168,10 @@ def main(argv=None) -> int:
 
         log("== compile time per model, empty cache, then again")
         raw["compile"] = compile_time.measure(available_models())
+    if not args.no_startup:
+        log("== start-up of a cached model, and the Python around each sweep point")
+        raw["startup"] = startup.measure(log=log)
+        raw["sweep_overhead"] = overhead.measure(log=log)
     raw["seconds"] = time.perf_counter() - started
     raw["summary"] = summarise(raw)
     for v in raw["summary"]["verdicts"]:

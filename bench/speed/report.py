@@ -161,6 +161,29 @@ def _profile_table(raw: dict) -> list[str]:
     return lines
 
 
+def _startup_lines(raw: dict) -> list[str]:
+    """Start-up and sweep overhead (bench/speed/startup.py, overhead.py), if this run measured them."""
+    start, over = raw.get("startup"), raw.get("sweep_overhead")
+    if not (start or over):
+        return []
+    out = ["## Start-up and the Python around each sweep point", ""]
+    if start:
+        cached = ", Python's bytecode cached as for any user" if start.get("bytecode_cache") else ""
+        out += [f"`{start['command']}` end to end in a fresh process, the model's library and summary cached{cached} "
+                f"(median of {start['repeats']}; target ≤ {start['target_seconds']:g} s); `import numpy, casadi` "
+                f"alone: {start['imports_numpy_casadi']['median']:.2f} s.", "",
+                "| model | start-up (s) | first run (s) |", "|---|---|---|"]
+        out += [f"| {m} | {r['median']:.2f} | {r['first']:.2f} |" for m, r in start["models"].items()]
+        out.append("")
+    if over:
+        out += [f"{over['model']}, {over['points']}-point continuation, {over['periods']} periods, "
+                f"{over['steps_per_period']} steps per period, one worker, files written: "
+                f"{over['median_ms_per_point']:.2f} ms per point, {over['median_compiled_ms_per_point']:.2f} ms of "
+                f"it in the compiled loops: **{over['median_overhead']:+.1%}** around them (target ≤ "
+                f"{over['target']:.0%}; median of {len(over['runs'])}).", ""]
+    return out
+
+
 def render(raw: dict, notes: str | None = None, orbits: dict | None = None) -> str:
     """The page; ``orbits``: the record of ``python -m bench.orbits``, whose section it adds."""
     summary = raw["summary"]
@@ -238,7 +261,7 @@ def render(raw: dict, notes: str | None = None, orbits: dict | None = None) -> s
             "## Compile time", "",
             "Each model loaded in a fresh process with an empty cache, then again in another fresh process:", "",
             *_compile_table(raw), "", f"Target: at most {TARGETS['compile_seconds']:g} s of C compilation per "
-            "model, and nothing compiled again for an unchanged model.", ""]
+            "model, and nothing compiled again for an unchanged model.", "", *_startup_lines(raw)]
     if orbits:
         from bench.orbits.report import section
 

@@ -3,7 +3,7 @@
 Each subcommand lives in its own module, which defines ``NAME``, ``HELP``,
 ``add_arguments(parser)`` and ``run(args) -> int`` (the exit status). Adding
 a subcommand (``compile``, ``lyap``, ``sweep``, ...) means writing such a
-module and listing it in :data:`COMMANDS`; :func:`main` does the rest,
+module and listing it in :data:`MODULES`; :func:`main` does the rest,
 including turning every :class:`~gearsym.errors.GearsymError` into a one-line
 message and exit status 2 (a user's mistake, not a crash: no traceback).
 A plain ``kill`` (SIGTERM) is handled like Ctrl-C: a sweep keeps its finished
@@ -13,6 +13,7 @@ Ctrl-C, 143 after SIGTERM (128 + the signal, as a shell reports either).
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import signal
 import sys
@@ -24,12 +25,12 @@ from types import ModuleType
 
 from ..version import __version__
 from ..errors import GearsymError, GearsymWarning
-from . import (campbell, compile, derive, docs, explain, list_models, lyap, modes, orbits, poincare, reproduce,
-               simulate, sweep)
 
-#: the subcommand modules, in the order ``gearsym --help`` lists them
-COMMANDS: tuple[ModuleType, ...] = (list_models, derive, docs, compile, lyap, sweep, orbits, poincare, reproduce,
-                                    simulate, explain, modes, campbell)
+#: each subcommand's module (its ``NAME`` -> the module in this package), in the order ``gearsym --help`` lists
+#: them; a run imports the module of its own command only (the others' imports would cost it start-up time)
+MODULES = {"list": "list_models", "derive": "derive", "docs": "docs", "compile": "compile", "lyap": "lyap",
+           "sweep": "sweep", "orbits": "orbits", "poincare": "poincare", "reproduce": "reproduce",
+           "simulate": "simulate", "explain": "explain", "modes": "modes", "campbell": "campbell"}
 
 #: exit status of a GearsymError (argparse uses the same for bad arguments)
 USAGE_ERROR = 2
@@ -39,13 +40,24 @@ CLOSED_PIPE = 141
 INTERRUPTED = 128 + signal.SIGINT
 
 
-def build_parser() -> argparse.ArgumentParser:
+def __getattr__(name: str):
+    if name == "COMMANDS":  # the subcommand modules, in the order ``gearsym --help`` lists them
+        return _modules(MODULES)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def _modules(names) -> tuple[ModuleType, ...]:
+    return tuple(importlib.import_module(f"{__name__}.{MODULES[name]}") for name in names)
+
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser of every subcommand, or of ``command`` alone (a name in :data:`MODULES`)."""
     parser = argparse.ArgumentParser(
         prog="gearsym", description="Symbolic drivetrain models, reduced and nondimensionalised automatically."
     )
     parser.add_argument("--version", action="version", version=f"gearsym {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for module in COMMANDS:
+    for module in _modules([command] if command in MODULES else MODULES):
         command = sub.add_parser(module.NAME, help=module.HELP, description=module.HELP)
         module.add_arguments(command)
         command.set_defaults(run=module.run)
@@ -54,7 +66,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``gearsym`` with ``argv`` (default: the process arguments); returns the exit status."""
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser(argv[0] if argv else None).parse_args(argv)
     with warnings.catch_warnings(), _sigterm_as_ctrl_c() as terminated:
         warnings.simplefilter("default", GearsymWarning)
         warnings.showwarning = _one_line

@@ -5,9 +5,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..codegen.generated import generate_model
 from ..outputs import check_folder
-from ..registry import available_models, load, output_root
+from ..registry import available_models, output_root
 from .integration import add_integration_arguments, integration_from
 from .settings import add_set_argument, parse_settings
 
@@ -29,6 +28,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..codegen.generated import generate_model  # the code generator (SymPy) only for this command
+    from ..registry import load
+
     if bool(args.all) == bool(args.models):
         print("gearsym compile: error: give model names or --all (not both)", file=sys.stderr)
         return 2

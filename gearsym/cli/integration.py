@@ -52,9 +52,13 @@ def system_from(args: argparse.Namespace):
 def scaling_from(args: argparse.Namespace):
     """The :class:`~gearsym.physical.Scaling` of the command's MODEL and --set values, or None for a model without
     physical values."""
+    from ..cached import cached_summary
     from ..registry import load_model, physical_settings
 
     settings = parse_settings(args.set)
+    summary = cached_summary(args.model, settings)
+    if summary is not None and not summary.physical:  # known without loading the model
+        return None
     model = load_model(args.model)
     split = physical_settings(model, settings)
     if split is None:
@@ -68,6 +72,10 @@ def scaling_from(args: argparse.Namespace):
 def compiled_from(args: argparse.Namespace, options: Integration | None = None, system=None):
     """The compiled model of the command's MODEL with its --set values (or of ``system``)."""
     from ..codegen import compile_model
+    from ..cached import load_compiled
 
     options = options or integration_from(args)  # checked before the model is reduced (seconds)
-    return compile_model(system or system_from(args), options, verbose=not getattr(args, "quiet", False))
+    verbose = not getattr(args, "quiet", False)
+    if system is not None:
+        return compile_model(system, options, verbose=verbose)
+    return load_compiled(args.model, parse_settings(args.set), options, verbose=verbose)

@@ -4,7 +4,6 @@ from __future__ import annotations
 import argparse
 
 from ..errors import GearsymError
-from ..model.drivetrain import Drivetrain
 from ..registry import available_models, load_model
 
 NAME = "list"
@@ -17,6 +16,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def title_of(name: str) -> str:
     """A model's title; a model that fails to load is listed with its error, not fatal to the listing."""
+    from ..model.drivetrain import Drivetrain
+
     try:
         model = load_model(name)
     except GearsymError as exc:

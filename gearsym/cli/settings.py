@@ -4,7 +4,6 @@ from __future__ import annotations
 import argparse
 
 from ..errors import GearsymError
-from ..model.expressions import to_expr
 from ..physical.text import looks_like_quantity
 
 
@@ -36,10 +35,20 @@ def parse_settings(pairs: list[str]) -> dict[str, str]:
             from ..physical.scaling import check_length_scale
 
             check_length_scale(value, "--set length_scale")
-        else:
+        elif not _is_number(value):  # (a number needs no parser, and so no SymPy)
+            from ..model.expressions import to_expr
+
             to_expr(value, f"--set {name}")
         settings[name] = value
     return settings
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def parse_state(text: str | None) -> dict[str, float] | None:

@@ -6,12 +6,33 @@ MX) -> ``generate`` (deterministic C and manifest) -> ``compiler`` (cached
 shared libraries) -> ``compiled`` (the :class:`CompiledModel` the analyses use);
 ``verbs`` is how the analyses take either a compiled model or a system.
 """
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
+
 from .build import compile_model
 from .compiled import CompiledModel, RunInputs, TangentRun
 from .compiler import CompilerError, cache_dir
-from .functions import LoopOptions, build_functions
-from .generate import code_hash, write_code
+from .loops import LoopOptions
 from .verbs import engine_verb
+
+#: the code generator's own names, imported on first use (SymPy): a model whose library is cached never needs them
+_GENERATOR = {"build_functions": "gearsym.codegen.functions", "code_hash": "gearsym.codegen.generate",
+              "write_code": "gearsym.codegen.generate"}
 
 __all__ = ["CompiledModel", "CompilerError", "LoopOptions", "RunInputs", "TangentRun", "build_functions",
            "cache_dir", "code_hash", "compile_model", "engine_verb", "write_code"]
+
+
+def __getattr__(name: str):
+    if name not in _GENERATOR:
+        raise AttributeError(f"module 'gearsym.codegen' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_GENERATOR[name]), name)
+    globals()[name] = value
+    return value
+
+
+if TYPE_CHECKING:
+    from .functions import build_functions
+    from .generate import code_hash, write_code

@@ -13,18 +13,20 @@ import sys
 import time
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import casadi as ca
 
 from ..errors import GearsymError
 from ..options import Integration
 from ..paths import GENERATED_DIR
-from ..system import FirstOrderSystem
 from .compiled import CompiledModel
 from .compiler import FALLBACK_NOTE, cache_dir, compile_library, compilers_looked_for, find_compiler
-from .functions import LoopOptions, build_functions
-from .generate import code_hash, read_manifest, write_code
+from .loops import LoopOptions
 from .native import load_native
+
+if TYPE_CHECKING:
+    from ..system import FirstOrderSystem
 
 #: every function the generated library exports
 FUNCTION_NAMES = ("rhs", "jacobian", "constants", "table", "lyapunov_chunk", "lyapunov_period",
@@ -45,6 +47,9 @@ def compile_model(system: FirstOrderSystem, options: Integration = Integration()
     defaults; they never enter the code, so another value never rebuilds anything. ``verbose`` says on
     stderr when it compiles (seconds, once).
     """
+    from ..system import FirstOrderSystem  # (SymPy: the code generator's imports are deferred to here)
+    from .generate import code_hash
+
     if not isinstance(system, FirstOrderSystem):
         raise GearsymError(f"compile_model takes a FirstOrderSystem, got {_kind(system)}; for a model name or file "
                            "use gearsym.load(...) first, e.g. compile_model(gearsym.load('one_stage'))")
@@ -59,6 +64,8 @@ def compile_model(system: FirstOrderSystem, options: Integration = Integration()
     if key in _LOADED:  # same code: reuse the loaded functions, with this system's values and these options
         return replace(_LOADED[key].clone(), system=system, integration=options)
     if backend == "in-process":
+        from .functions import build_functions
+
         t = time.perf_counter()
         functions, library = build_functions(system, loops).functions, None
         timings["build"] = time.perf_counter() - t
@@ -85,6 +92,9 @@ def _resolve_backend(asked: str) -> str:
 def _compiled_functions(system: FirstOrderSystem, loops: LoopOptions, digest: str, timings: dict,
                         verbose: bool) -> tuple[dict, Path]:
     """The library of ``digest``: C from generated/ or the cache (generated here if missing), compiled once."""
+    from .functions import build_functions
+    from .generate import read_manifest, write_code
+
     code_dir = code_directory(system.name, digest)
     source = code_dir / f"{system.name}.c"
     manifest = read_manifest(code_dir)
@@ -108,6 +118,8 @@ def _kind(value) -> str:
 def code_directory(name: str, digest: str) -> Path:
     """Where the C of the code ``digest`` is: the committed ``generated/<model>/`` if its manifest carries
     this hash (no need to generate it again), else the cache."""
+    from .generate import read_manifest
+
     committed = GENERATED_DIR / name
     if (read_manifest(committed) or {}).get("hash") == digest:
         return committed

@@ -12,6 +12,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import casadi as ca
 import numpy as np
@@ -19,9 +20,11 @@ import numpy as np
 from ..checks import whole_number
 from ..errors import GearsymError, ModelError, warn
 from ..options import Integration
-from ..system import FirstOrderSystem
-from .functions import LoopOptions
+from .loops import LoopOptions
 from .native import NativeFunction
+
+if TYPE_CHECKING:
+    from ..system import FirstOrderSystem
 
 
 @dataclass(frozen=True)
@@ -134,7 +137,7 @@ class CompiledModel:
 
     @cached_property  # read for every row a sweep writes
     def state_names(self) -> tuple[str, ...]:
-        return tuple(s.name for s in self.system.states)
+        return tuple(self.system.state_names)
 
     @cached_property
     def observed(self) -> tuple[str, ...]:
@@ -159,6 +162,17 @@ class CompiledModel:
         if p.shape != (len(self.parameter_names),) or not np.all(np.isfinite(p)):
             raise GearsymError(f"{self.name}: expected {len(self.parameter_names)} finite parameter values "
                                f"({', '.join(self.parameter_names)}), got {p}")
+        # a sweep's next point often changes only values outside the tables: then only the constants are new
+        last_p, last = self.__dict__.get("_last_inputs", (None, None))
+        if last is not None and last.t0 == float(t0) and not self._retimed(last_p, p):
+            inputs = self._with_constants(last, p)
+        else:
+            inputs = self._tables(p, float(t0))
+        self.__dict__["_last_inputs"] = (p.copy(), inputs)  # (a copy: the caller may change p in place)
+        return inputs
+
+    def _tables(self, p: np.ndarray, t0: float) -> RunInputs:
+        """New inputs for ``p``: the tables of time computed, the period checked."""
         if self.native:
             c, period = self.native["constants"](p)
             table, probe = self.native["table"](np.array([float(t0)]), p)
@@ -186,9 +200,12 @@ class CompiledModel:
         """The inputs for the parameter vector ``p``: those of ``inputs`` with new constants if no parameter that
         changed enters the tables or the period (a continuation in omega of a model in tau), else :meth:`prepare`."""
         p = np.asarray(p, dtype=float)
-        if p.shape != inputs.p.shape or not np.isfinite(p).all() or any(
-                self.parameter_names[i] in self.timed_parameters for i in np.nonzero(p != inputs.p)[0]):
+        if p.shape != inputs.p.shape or not np.isfinite(p).all() or self._retimed(inputs.p, p):
             return self.prepare(p, inputs.t0)
+        return self._with_constants(inputs, p)
+
+    def _with_constants(self, inputs: RunInputs, p: np.ndarray) -> RunInputs:
+        """``inputs`` with the constants of ``p``, whose timed parameters are those of ``inputs``."""
         if self.native:  # straight into the new constants (a continuation asks for thousands of them)
             p = np.ascontiguousarray(p)
             c, period = np.empty(inputs.constants.size), np.empty(1)
@@ -196,6 +213,14 @@ class CompiledModel:
         else:
             c = np.array(self.functions["constants"](p)[0]).reshape(-1)
         return RunInputs(p, inputs.table, c, inputs.period, inputs.t0, inputs.model_hash)
+
+    def _retimed(self, before: np.ndarray, after: np.ndarray) -> bool:
+        """Whether a parameter that enters the tables of time or the period differs between the vectors."""
+        return bool(np.any((after != before) & self._timed_mask))
+
+    @cached_property
+    def _timed_mask(self) -> np.ndarray:
+        return np.array([n in self.timed_parameters for n in self.parameter_names], dtype=bool)
 
     def _check_periodic(self, p: np.ndarray, t0: float, period: float, probe: np.ndarray) -> None:
         """The loops repeat one sampled period; at other parameter values than the defaults
@@ -394,6 +419,9 @@ class CompiledModel:
         return np.array(self.functions["jacobian"](t, y, p))
 
     def _check_finite(self, inputs: RunInputs, *per_period: np.ndarray) -> None:
+        # one pass each: a finite sum has finite terms (an infinite one may not: an overflow; the test below tells)
+        if all(np.isfinite(a.sum()) for a in per_period):
+            return
         bad = ~np.logical_and.reduce([np.isfinite(a).all(axis=0) for a in per_period])
         if bad.any():
             k = int(np.argmax(bad))

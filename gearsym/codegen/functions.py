@@ -34,42 +34,10 @@ import sympy as sp
 
 from ..backlash import G, g, g_slope
 from ..errors import ModelError
-from ..options import STEPS_PER_PERIOD, Integration
 from ..system import FirstOrderSystem
 from .time_tables import SplitRHS, split_rhs
+from .loops import LoopOptions  # (here before it had a module of its own)
 from .translate import select_max, select_min, to_casadi
-
-
-@dataclass(frozen=True)
-class LoopOptions:
-    """Structure of the generated loops (part of the model hash; values of parameters are not)."""
-
-    steps_per_period: int = STEPS_PER_PERIOD
-    chunk_periods: int = 50  # periods per compiled call
-    block_steps: int = 0  # RK4 steps unrolled per SX block; 0 chooses
-    locate_crossings: bool = False  # split steps at backlash switching surfaces (4th order exponents)
-
-    @classmethod
-    def of(cls, options: Integration) -> "LoopOptions":
-        """The part of an :class:`~gearsym.options.Integration` that shapes the generated code."""
-        return cls(steps_per_period=options.steps_per_period, locate_crossings=options.locate_crossings)
-
-    def __post_init__(self):
-        if self.steps_per_period < 1:
-            raise ModelError(f"steps per period must be at least 1, not {self.steps_per_period}")
-        if self.chunk_periods < 1:
-            raise ModelError(f"periods per chunk must be at least 1, not {self.chunk_periods}")
-
-    def block(self, dimension: int) -> int:
-        """RK4 steps per SX function call.
-
-        One, measured: the call costs little next to a tangent step, and longer
-        straight-line blocks run slower (register pressure) and compile slower.
-        """
-        if self.locate_crossings:  # the crossing test and its branch are per step
-            return 1
-        target = self.block_steps or 1
-        return max(d for d in range(1, target + 1) if self.steps_per_period % d == 0)
 
 
 @dataclass(frozen=True)

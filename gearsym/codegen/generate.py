@@ -25,7 +25,7 @@ CODEGEN_VERSION = 1
 
 #: the modules whose text determines the generated C; their bytes are part of the hash, so an edit
 #: can never leave a stale library or committed C in use (the tests then ask to regenerate)
-_GENERATOR_SOURCES = ("translate.py", "time_tables.py", "functions.py", "generate.py")
+_GENERATOR_SOURCES = ("translate.py", "time_tables.py", "functions.py", "loops.py", "generate.py")
 
 
 def _generator_digest() -> str:

@@ -77,7 +77,8 @@ class ShippedModel:
 
 def ship(compiled: CompiledModel) -> ShippedModel:
     """``compiled`` packed for another process or machine (see the module docstring)."""
-    base = dict(system=compiled.system, options=compiled.options, integration=compiled.integration,
+    system = getattr(compiled.system, "full", compiled.system)  # a cached model's summary: the system it stands for
+    base = dict(system=system, options=compiled.options, integration=compiled.integration,
                 hash=compiled.hash, backend=compiled.backend, versions=_versions())
     if compiled.backend != "compiled":
         return ShippedModel(**base)

@@ -9,34 +9,41 @@ gets an error saying so.
 from __future__ import annotations
 
 import functools
+import sys
+from collections.abc import Callable
 
 from ..errors import GearsymError
 from ..options import Integration
-from ..system import FirstOrderSystem
 from .build import compile_model
 from .compiled import CompiledModel
 
 
-def engine_verb(method=None, *, default: Integration | None = None):
+def engine_verb(method=None, *, default: Integration | Callable[..., Integration] | None = None):
     """``method(compiled, ..., options=None, ...)`` as a verb on a CompiledModel or a FirstOrderSystem.
 
     On a compiled model, ``options=None`` means the options it was compiled with. A system is compiled with
-    the call's options, else with ``default`` (the verb's own run length, e.g. a longer transient), else
-    with ``Integration()``.
+    the call's options, else with ``default`` (the verb's own run length, e.g. a longer transient; or a function
+    of the call's keywords that gives it), else with ``Integration()``.
     """
     if method is None:
         return functools.partial(engine_verb, default=default)
 
     @functools.singledispatch
-    def verb(model, *args, **kwargs):
+    def verb(model, *args, options: Integration | None = None, **kwargs):
+        if _is_system(model):
+            chosen = default(**kwargs) if callable(default) else default
+            return method(compile_model(model, options or chosen or Integration()), *args, **kwargs)
         hint = (f"; resolve the name first: {method.__name__}(gearsym.load({model!r}), ...)"
                 if isinstance(model, str) else "")
         raise GearsymError(f"{method.__name__} takes a compiled model or a FirstOrderSystem, got "
                            f"{type(model).__name__}{hint}")
 
-    @verb.register
-    def _on_system(system: FirstOrderSystem, *args, options: Integration | None = None, **kwargs):
-        return method(compile_model(system, options or default or Integration()), *args, **kwargs)
-
     verb.register(CompiledModel, method)
     return functools.update_wrapper(verb, method)
+
+
+def _is_system(value) -> bool:
+    """Whether ``value`` is a FirstOrderSystem, without importing gearsym.system (SymPy) to ask: if it is not
+    imported, no system exists."""
+    system = sys.modules.get("gearsym.system")
+    return system is not None and isinstance(value, system.FirstOrderSystem)

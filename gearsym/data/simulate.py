@@ -28,9 +28,8 @@ import numpy as np
 
 from ..analysis import phase_trajectory
 from ..checks import whole_number
-from ..codegen import CompiledModel, compile_model, engine_verb
+from ..codegen import CompiledModel, engine_verb
 from ..options import STEPS_PER_PERIOD, Integration
-from ..system import FirstOrderSystem
 from ..errors import GearsymError
 from .measurements import RECORD
 
@@ -80,7 +79,12 @@ class MeasurementTable:
         return np.nonzero(self.data[RECORD] == record)[0]
 
 
-@engine_verb
+def _default_options(*, samples_per_period: int = 50, **_) -> Integration:
+    """How a system is compiled for this verb: for ``RUN``, with steps per period that the samples divide."""
+    return Integration(**RUN, steps_per_period=steps_for(samples_per_period))
+
+
+@engine_verb(default=_default_options)
 def simulate_measurements(
     model: CompiledModel,
     *,
@@ -128,16 +132,6 @@ def simulate_measurements(
     if out is not None:
         write_measurements(table, out)
     return table
-
-
-@simulate_measurements.register
-def _on_system(system: FirstOrderSystem, *, options: Integration | None = None, samples_per_period: int = 50,
-               **kwargs) -> MeasurementTable:
-    """The high-level call: compiled with steps per period that the samples divide."""
-    if options is None:
-        options = Integration(**RUN, steps_per_period=steps_for(samples_per_period))
-    return simulate_measurements(compile_model(system, options), options=options,
-                                 samples_per_period=samples_per_period, **kwargs)
 
 
 def steps_for(samples_per_period: int, steps_per_period: int | None = None) -> int:

@@ -14,10 +14,11 @@ from typing import Optional, Union
 import sympy as sp
 
 from ..backlash import G
+from ..checks import sign_violation
 from ..errors import ModelError, suggest
 from ..symbols import omega, parameter_symbol, phi, t
 from .components import Body, BodyRef, Coupling, Disk, Gear, Harmonic, Mesh, Planet, Shaft, Torque
-from .expressions import ExprLike, parameter_names, sign_violation, to_expr
+from .expressions import ExprLike, parameter_names, to_expr
 from .stiffness import check_periodic
 
 

@@ -60,8 +60,3 @@ def parameter_names(expr: sp.Expr) -> set[str]:
     return {s.name for s in expr.free_symbols if s.name not in RESERVED}
 
 
-def sign_violation(number: float, allow_zero: bool) -> str | None:
-    """What is wrong with the sign of a physical quantity ('must be positive', ...), or None."""
-    if number < 0 or (number == 0 and not allow_zero):
-        return "must not be negative" if allow_zero else "must be positive"
-    return None

@@ -31,7 +31,8 @@ from sympy.core.function import AppliedUndef
 from ..backlash import g
 from ..errors import ModelError, UnknownParameterError
 from ..model.drivetrain import Drivetrain, ResolvedCoupling
-from ..model.expressions import ExprLike, parameter_names, sign_violation, to_expr
+from ..checks import sign_violation
+from ..model.expressions import ExprLike, parameter_names, to_expr
 from ..model.stiffness import check_periodic
 from ..symbols import omega, parameter_symbol, phi, t, tau
 from ..system import Constraint, Coupling, FirstOrderSystem

@@ -32,9 +32,12 @@ class SweepResult:
     TEXT = ("direction", "regime")
 
     @classmethod
-    def from_rows(cls, model, axes, mode, names: Sequence[str], rows: Sequence[dict], strobe_rows: Sequence[dict],
-                  record: dict, path: Path | None = None) -> "SweepResult":
-        return cls(model, tuple(axes), mode, _columns(names, rows), _columns(_keys(strobe_rows), strobe_rows),
+    def from_rows(cls, model, axes, mode, names: Sequence[str], rows: Sequence[dict],
+                  strobe_rows: Sequence[Sequence[str]], record: dict, path: Path | None = None,
+                  strobe_columns: Sequence[str] = ()) -> "SweepResult":
+        """``rows``: one dict per point; ``strobe_rows``: the Poincare rows, fields in ``strobe_columns`` order."""
+        strobe = [dict(zip(strobe_columns, r)) for r in strobe_rows[:1]]  # (the column names, if any row)
+        return cls(model, tuple(axes), mode, _columns(names, rows), _fields_columns(_keys(strobe), strobe_rows),
                    record, path)
 
     def __len__(self) -> int:
@@ -98,11 +101,15 @@ def _keys(rows: Sequence[dict]) -> list[str]:
 
 
 def _columns(names: Sequence[str], rows: Sequence[dict]) -> dict[str, np.ndarray]:
-    out = {}
-    for name in names:
-        values = [r[name] for r in rows]
-        out[name] = np.array(values, dtype=str) if name in SweepResult.TEXT else np.array(values, dtype=float)
-    return out
+    return {name: _typed(name, [r[name] for r in rows]) for name in names}
+
+
+def _fields_columns(names: Sequence[str], rows: Sequence[Sequence[str]]) -> dict[str, np.ndarray]:
+    return {name: _typed(name, [r[i] for r in rows]) for i, name in enumerate(names)}
+
+
+def _typed(name: str, values: list[str]) -> np.ndarray:
+    return np.array(values, dtype=str) if name in SweepResult.TEXT else np.array(values, dtype=float)
 
 
 def read_sweep(path: str | Path) -> SweepResult:
@@ -121,8 +128,9 @@ def read_sweep(path: str | Path) -> SweepResult:
     rows = read_rows(path)
     names = list(rows[0]) if rows else next(csv.reader(path.read_text().splitlines()), [])
     strobe_path = sidecar(path, ".poincare.csv")
-    strobe_rows = read_rows(strobe_path) if strobe_path.is_file() else []
+    strobe = read_rows(strobe_path) if strobe_path.is_file() else []
     try:
-        return SweepResult.from_rows(record["model"], axes, record["mode"], names, rows, strobe_rows, record, path)
+        return SweepResult.from_rows(record["model"], axes, record["mode"], names, rows,
+                                     [tuple(r.values()) for r in strobe], record, path, list(strobe[0]) if strobe else ())
     except (ValueError, TypeError) as exc:
         raise GearsymError(f"{path}: a value is not a number ({exc})") from None

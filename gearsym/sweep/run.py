@@ -136,7 +136,7 @@ def run_sweep(
         rows = [done[p.key] for p in plan.points]
         strobe_rows = [r for p in plan.points for r in strobes.get(p.key, [])]
         result = SweepResult.from_rows(model.name, plan.axes, mode, plan.columns, rows, strobe_rows, plan.record,
-                                       path=store.path if store else None)
+                                       path=store.path if store else None, strobe_columns=plan.strobe_columns)
         if store:
             _finish_files(store, result, rows, strobe_rows, len(done) - already, time.perf_counter() - t_start, ran)
         return result
@@ -291,10 +291,9 @@ class _Run:
         row["regime"] = spectrum.regime
         row.update({f"final_{s}": number(v) for s, v in spectrum.final_state.items()})
         strobe = spectrum.strobe[:, spectrum.strobe.shape[1] - self.poincare:] if self.poincare else np.zeros((n, 0))
-        where = {k: row[k] for k in (*self.names, "direction")}
-        states = compiled.state_names
-        strobe_rows = [{**where, "sample": str(j), **dict(zip(states, map(number, col.tolist())))}
-                       for j, col in enumerate(strobe.T)]
+        where = (*(row[k] for k in self.names), point.direction)
+        strobe_rows = [(*where, str(j), *map(repr, col))  # the strobe columns' fields (floats: repr is number())
+                       for j, col in enumerate(strobe.T.tolist())]
         final = np.array([spectrum.final_state[s] for s in compiled.state_names])
         return row, strobe_rows, final
 

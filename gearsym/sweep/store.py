@@ -18,6 +18,7 @@ import csv
 import fcntl
 import io
 import json
+import operator
 import os
 import socket
 import time
@@ -51,6 +52,7 @@ class SweepStore:
         self.record = record
         self._files: list = []
         self._lock_fd: int | None = None
+        self._appended: list[dict] | None = None  # the rows appended after a fresh start, in their order
 
     # ------------------------------------------------------------ opening
     def open(self, overwrite: bool = False) -> tuple[dict[tuple, dict], dict[tuple, list[dict]]]:
@@ -66,7 +68,7 @@ class SweepStore:
             strobes = {}
             if self.strobe_path.exists():
                 for row in read_rows(self.strobe_path, self.strobe_columns):
-                    strobes.setdefault(self.key(row), []).append(row)
+                    strobes.setdefault(self.key(row), []).append(tuple(row.values()))
             strobes = {k: v for k, v in strobes.items() if k in done}  # written before their main row
             lacking = [k for k in done if k not in strobes]
             if self.record.get("poincare_samples") and lacking:
@@ -74,10 +76,11 @@ class SweepStore:
                                    "points (deleted or damaged?), so the sweep cannot be resumed whole: pass "
                                    "--overwrite to start again")
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._write_table(self.path, self.columns, done.values())  # drops a row cut off mid-write
+        self._write_table(self.path, self.columns, map(_fields(self.columns), done.values()))  # (drops a row cut off)
         self._write_table(self.strobe_path, self.strobe_columns, (r for rows in strobes.values() for r in rows))
         self.write_record(status="running")
         self._files = [open(p, "a", newline="") for p in (self.strobe_path, self.path)]
+        self._appended = None if done else []
         return done, strobes
 
     def key(self, row: dict) -> tuple:
@@ -113,13 +116,16 @@ class SweepStore:
 
 
     # ------------------------------------------------------------ writing
-    def append(self, row: dict, strobe_rows: Iterable[dict]) -> None:
-        """One finished point: its Poincare rows first, then its row (whose presence marks it done)."""
+    def append(self, row: dict, strobe_rows: Iterable[tuple[str, ...]]) -> None:
+        """One finished point: its Poincare rows (fields in the order of the columns) first, then its row
+        (whose presence marks it done)."""
         strobe_file, main_file = self._files
-        csv.DictWriter(strobe_file, self.strobe_columns, lineterminator="\n").writerows(strobe_rows)
+        _writer(strobe_file).writerows(strobe_rows)
         strobe_file.flush()
-        csv.DictWriter(main_file, self.columns, lineterminator="\n").writerow(row)
+        _writer(main_file).writerow(_fields(self.columns)(row))
         main_file.flush()
+        if self._appended is not None:
+            self._appended.append(row)
 
     def close(self) -> None:
         for f in self._files:
@@ -138,10 +144,15 @@ class SweepStore:
             release_lock(self.path, self._lock_fd)
             self._lock_fd = None
 
-    def finish(self, rows: Iterable[dict], strobe_rows: Iterable[dict]) -> None:
-        """All points done: both tables rewritten in plan order (the lock is kept until ``release``)."""
+    def finish(self, rows: Iterable[dict], strobe_rows: Iterable[tuple[str, ...]]) -> None:
+        """All points done: both tables rewritten in plan order (the lock is kept until ``release``), unless
+        they were written in it (a fresh sweep whose points finished in order: the rewrite would copy them)."""
         self.close()
-        self._write_table(self.path, self.columns, rows)
+        rows = list(rows)
+        if self._appended is not None and len(self._appended) == len(rows) and all(
+                a is b for a, b in zip(self._appended, rows)):
+            return
+        self._write_table(self.path, self.columns, map(_fields(self.columns), rows))
         self._write_table(self.strobe_path, self.strobe_columns, strobe_rows)
 
     def write_record(self, **extra) -> None:
@@ -155,12 +166,23 @@ class SweepStore:
             return {}
 
     @staticmethod
-    def _write_table(path: Path, columns: list[str], rows: Iterable[dict]) -> None:
+    def _write_table(path: Path, columns: list[str], rows: Iterable[Sequence[str]]) -> None:
         buffer = io.StringIO()
-        writer = csv.DictWriter(buffer, columns, lineterminator="\n")
-        writer.writeheader()
+        writer = _writer(buffer)
+        writer.writerow(columns)
         writer.writerows(rows)
         write_atomically(path, buffer.getvalue())
+
+
+def _writer(file):
+    return csv.writer(file, lineterminator="\n")
+
+
+def _fields(columns: Sequence[str]):
+    """A row's fields in the order of ``columns`` (csv.DictWriter's, without its per-row check of the keys:
+    the rows are this module's own)."""
+    pick = operator.itemgetter(*columns)
+    return (lambda row: pick(row)) if len(columns) > 1 else (lambda row: (pick(row),))
 
 
 def row_key(row: dict, params) -> tuple:

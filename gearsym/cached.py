@@ -1,0 +1,233 @@
+"""A compiled model without its reduction: what a run needs, kept as JSON beside the compiled library.
+
+Reducing a drivetrain takes a second or two of SymPy, and importing SymPy (and pint) most of another; a
+command on a model whose library is cached needs neither. The first run of a model (a name or a file) with
+given ``--set`` values writes two small files into the cache (``$GEARSYM_CACHE/models``):
+
+* ``<model>-<key>.json``: the system's names, values, constraints and flags (:class:`SystemSummary`), under
+  a key that hashes the model's file, the other model files it may import, gearsym's own source and the
+  values: any change to one of them is another key, never a stale summary;
+* ``<model>-<key>-<loops>.json``: for one structure of the loops (steps per period, crossings located), the
+  code hash and the compiled library.
+
+Later runs build the :class:`~gearsym.codegen.compiled.CompiledModel` from them, with a
+:class:`SystemSummary` as its system, which loads (and reduces) the model only if something asks for what
+it does not keep (a SymPy expression). A summary that is missing, unreadable, not ours or pointing at a
+library that is gone is ignored and rewritten; files are written atomically. Only JSON is read.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import sys
+from collections.abc import Callable, Mapping
+from dataclasses import asdict, dataclass, field, replace
+from functools import lru_cache
+from pathlib import Path
+
+from .codegen.compiler import binary_key, cache_dir, compile_flags
+from .codegen.loops import LoopOptions
+from .files import write_atomically
+from .options import Integration
+from .parameters import Constraint, ParameterChecks
+from .registry import load, load_model, models_dir, physical_settings
+
+#: bump when what a summary holds changes
+SUMMARY_FORMAT = 1
+
+
+@dataclass(frozen=True, eq=False)
+class SystemSummary(ParameterChecks):
+    """The part of a :class:`~gearsym.system.FirstOrderSystem` a run reads, without SymPy; anything else
+    (its equations, couplings, period as an expression) comes from the full system, loaded on first use."""
+
+    name: str
+    title: str
+    time_name: str
+    state_names: tuple[str, ...]
+    parameters: Mapping[str, float]
+    initial: Mapping[str, float]
+    coordinates: tuple[str, ...]
+    descriptions: Mapping[str, str]
+    constraints: Mapping[str, Constraint]
+    autonomous: bool
+    physical: bool  # the model has physical values (its results are also given in its units)
+    load: Callable[[], object] = field(repr=False, default=None)  # the full system
+
+    @property
+    def dimension(self) -> int:
+        return len(self.state_names)
+
+    @property
+    def observed(self) -> tuple[str, ...]:
+        return self.coordinates or self.state_names
+
+    @property
+    def initial_vector(self) -> tuple[float, ...]:
+        return tuple(float(self.initial.get(s, 0.0)) for s in self.state_names)
+
+    @property
+    def full(self):
+        """The full system (the model loaded and reduced: seconds, once)."""
+        if "_full" not in self.__dict__:
+            object.__setattr__(self, "_full", self.load())
+        return self.__dict__["_full"]
+
+    def __getattr__(self, name: str):
+        if name.startswith("__") or name in ("_full", "load"):
+            raise AttributeError(name)
+        return getattr(self.full, name)
+
+    def as_dict(self) -> dict:
+        return {"name": self.name, "title": self.title, "time_name": self.time_name,
+                "state_names": list(self.state_names), "parameters": dict(self.parameters),
+                "initial": dict(self.initial), "coordinates": list(self.coordinates),
+                "descriptions": dict(self.descriptions),
+                "constraints": {k: [c.meaning, c.zero_allowed] for k, c in self.constraints.items()},
+                "autonomous": self.autonomous, "physical": self.physical}
+
+    @classmethod
+    def from_dict(cls, d: dict, load: Callable[[], object]) -> "SystemSummary":
+        return cls(str(d["name"]), str(d["title"]), str(d["time_name"]), tuple(map(str, d["state_names"])),
+                   {str(k): float(v) for k, v in d["parameters"].items()},
+                   {str(k): float(v) for k, v in d["initial"].items()}, tuple(map(str, d["coordinates"])),
+                   {str(k): str(v) for k, v in d["descriptions"].items()},
+                   {str(k): Constraint(str(m), bool(z)) for k, (m, z) in d["constraints"].items()},
+                   bool(d["autonomous"]), bool(d["physical"]), load)
+
+    @classmethod
+    def of(cls, system, physical: bool) -> "SystemSummary":
+        return cls(system.name, system.title, system.time.name, system.state_names, dict(system.parameters),
+                   dict(system.initial), tuple(system.coordinates), dict(system.descriptions),
+                   dict(system.constraints), system.autonomous, physical, lambda: system)
+
+
+def model_file(ref: str) -> Path | None:
+    """The file of a model name or path (None for a name that is no model: the loader says why)."""
+    path = Path(ref) if ref.endswith(".py") or "/" in ref else models_dir() / f"{ref}.py"
+    return path.resolve() if path.is_file() else None
+
+
+@lru_cache(maxsize=None)
+def _source_digest(folder: Path) -> str:
+    """Every Python file below ``folder`` (gearsym's own code: whatever derives a system) by its size and time of
+    change, as Python's own bytecode cache tells an edited module (reading them all would cost start-up time)."""
+    digest = hashlib.sha256()
+    for path in sorted(folder.rglob("*.py")):
+        stat = path.stat()
+        digest.update(f"{path.relative_to(folder)}\0{stat.st_size}\0{stat.st_mtime_ns}\n".encode())
+    return digest.hexdigest()
+
+
+def _model_files(folders: tuple[Path, ...]) -> dict[str, str]:
+    """The model files in ``folders`` by their content's hash (a model imports another; read every time: a model
+    file edited in a long-lived process must be noticed)."""
+    return {str(f): hashlib.sha256(f.read_bytes()).hexdigest() for folder in folders for f in sorted(folder.glob("*.py"))}
+
+
+def system_key(path: Path, values: Mapping[str, object]) -> str:
+    """What the reduction of the model in ``path`` with ``values`` depends on, hashed: the model file, the
+    model files beside it and in the models folder (a model imports another), gearsym's source, the values."""
+    files = _model_files(tuple(sorted({path.parent, models_dir().resolve()})))
+    description = {"format": SUMMARY_FORMAT, "model": str(path), "files": files,
+                   "gearsym": _source_digest(Path(__file__).resolve().parent),
+                   "python": sys.version, "values": {k: repr(v) for k, v in sorted(values.items())}}
+    return hashlib.sha256(json.dumps(description, sort_keys=True).encode()).hexdigest()[:24]
+
+
+def loops_key(loops: LoopOptions) -> str:
+    """The loops' structure and where the library must run (the compiler and its flags name the library)."""
+    flags = compile_flags()
+    description = {"loops": asdict(loops), "binary": binary_key(flags), "cc": os.environ.get("CC", "")}
+    return hashlib.sha256(json.dumps(description, sort_keys=True).encode()).hexdigest()[:12]
+
+
+def summary_path(name: str, key: str) -> Path:
+    return cache_dir() / "models" / f"{name}-{key}.json"
+
+
+def read_json(path: Path) -> dict | None:
+    """A summary this module wrote, or None (missing, partial, corrupt or of another format)."""
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) and data.get("format") == SUMMARY_FORMAT else None
+
+
+def write_json(path: Path, data: dict) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    # (keys in their order: the parameters' order is that of the parameter vector)
+    write_atomically(path, json.dumps({"format": SUMMARY_FORMAT, **data}, indent=1) + "\n")
+
+
+def load_compiled(ref: str, values: Mapping[str, object], options: Integration, *, verbose: bool = False):
+    """The compiled model of the model ``ref`` (a name or a file) with ``values``: from its summaries in the
+    cache when they and its library are there, else loaded, reduced and compiled (and the summaries written)."""
+    from .codegen.build import _resolve_backend
+
+    path = model_file(ref) if isinstance(ref, str) else None
+    if path is None or _resolve_backend(options.backend) != "compiled":
+        return _compile(ref, values, options, verbose)
+    key, loops = system_key(path, values), LoopOptions.of(options)
+    system_file = summary_path(path.stem, key)
+    build_file = summary_path(path.stem, f"{key}-{loops_key(loops)}")
+    compiled = _from_cache(system_file, build_file, ref, values, options, loops)
+    if compiled is not None:
+        return compiled
+    compiled = _compile(ref, values, options, verbose)
+    write_json(system_file, {"system": SystemSummary.of(compiled.system, _is_physical(ref, values)).as_dict()})
+    write_json(build_file, {"hash": compiled.hash, "library": str(compiled.library),
+                            "timed_parameters": sorted(compiled.timed_parameters)})
+    return compiled
+
+
+def cached_summary(ref: str, values: Mapping[str, object]) -> SystemSummary | None:
+    """The summary of ``ref`` with ``values`` if the cache has it (whatever the loops), else None."""
+    path = model_file(ref) if isinstance(ref, str) else None
+    data = read_json(summary_path(path.stem, system_key(path, values))) if path else None
+    try:
+        return SystemSummary.from_dict(data["system"], lambda: _load(ref, values)) if data else None
+    except (KeyError, TypeError, ValueError, AttributeError):
+        return None
+
+
+def _from_cache(system_file: Path, build_file: Path, ref, values, options: Integration, loops: LoopOptions):
+    import casadi as ca
+
+    from .codegen.build import FUNCTION_NAMES, _LOADED
+    from .codegen.compiled import CompiledModel
+    from .codegen.native import load_native
+
+    data, build = read_json(system_file), read_json(build_file)
+    try:
+        summary = SystemSummary.from_dict(data["system"], lambda: _load(ref, values))
+        digest, library, timed = str(build["hash"]), Path(build["library"]), frozenset(build["timed_parameters"])
+    except (KeyError, TypeError, ValueError, AttributeError):
+        return None
+    if not library.is_file() or library.resolve().parent != (cache_dir() / "lib").resolve():
+        return None  # (only a library of our own cache is loaded)
+    key = (digest, "compiled")
+    if key in _LOADED:  # (loaded in this process already: its functions with work arrays of their own)
+        compiled = replace(_LOADED[key].clone(), system=summary, integration=options)
+    else:
+        functions = {name: ca.external(name, str(library)) for name in FUNCTION_NAMES}
+        compiled = _LOADED[key] = CompiledModel(summary, loops, digest, functions, "compiled", library, {},
+                                                load_native(library, functions), options)
+    compiled.__dict__["timed_parameters"] = timed  # (a cached_property: computing it needs the equations)
+    return compiled
+
+
+def _compile(ref, values, options: Integration, verbose: bool):
+    from .codegen.build import compile_model
+
+    return compile_model(_load(ref, values), options, verbose=verbose)
+
+
+def _load(ref, values):
+    return load(ref, **values)
+
+
+def _is_physical(ref, values) -> bool:
+    return physical_settings(load_model(ref), dict(values)) is not None

@@ -1,0 +1,95 @@
+"""A command on a model whose library is cached neither reduces it again nor imports SymPy (gearsym/cached.py)."""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+import gearsym.reduce  # noqa: F401 (the subpackage, whose reduce is counted)
+from gearsym.cli import main
+from gearsym.codegen import cache_dir
+from gearsym.paths import REPO_ROOT
+
+ARGS = ("--periods", "30", "--discard", "10", "--format", "json")
+
+
+@pytest.fixture
+def model_file(tmp_path, monkeypatch):
+    """A copy of the one-stage model in a file of its own, with a cache of its own for the summaries (the
+    compiled libraries and code are the usual ones: nothing is compiled again)."""
+    real = cache_dir()
+    cache = tmp_path / "cache"
+    cache.mkdir()
+    for folder in ("lib", "code"):
+        (real / folder).mkdir(parents=True, exist_ok=True)
+        (cache / folder).symlink_to(real / folder)
+    monkeypatch.setenv("GEARSYM_CACHE", str(cache))
+    path = tmp_path / "gears.py"
+    path.write_text((REPO_ROOT / "models" / "one_stage.py").read_text())
+    return path
+
+
+@pytest.fixture
+def reductions(monkeypatch):
+    """How many drivetrains were reduced."""
+    count = []
+    package = sys.modules["gearsym.reduce"]  # (gearsym.reduce is the function)
+    original = package.reduce
+
+    def counting(*args, **kwargs):
+        count.append(1)
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(package, "reduce", counting)
+    return count
+
+
+def lyap(capsys, *argv: str) -> dict:
+    assert main(["lyap", *argv, *ARGS]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_a_cached_model_is_not_reduced_again_and_gives_the_same_results(model_file, reductions, capsys):
+    first = lyap(capsys, str(model_file), "--set", "omega=1.2")
+    assert len(reductions) == 1
+    again = lyap(capsys, str(model_file), "--set", "omega=1.2")
+    assert len(reductions) == 1
+    assert again == first
+
+
+def test_a_changed_model_file_or_value_is_reduced_again(model_file, reductions, capsys):
+    lyap(capsys, str(model_file))
+    lyap(capsys, str(model_file), "--set", "omega=1.2")
+    assert len(reductions) == 2
+    model_file.write_text(model_file.read_text().replace("omega=1.5", "omega=1.25"))
+    changed = lyap(capsys, str(model_file))
+    assert len(reductions) == 3
+    assert changed["parameters"]["omega"] == 1.25
+
+
+def test_a_corrupt_summary_is_ignored_and_written_again(model_file, reductions, capsys):
+    first = lyap(capsys, str(model_file))
+    summaries = sorted((cache_dir() / "models").glob("*.json"))
+    assert len(summaries) == 2
+    for path in summaries:
+        path.write_text(path.read_text()[:40])  # cut short, as by a crash without atomic writes
+    assert lyap(capsys, str(model_file)) == first
+    assert len(reductions) == 2
+    assert all(json.loads(path.read_text())["format"] for path in summaries)
+    assert lyap(capsys, str(model_file)) == first
+    assert len(reductions) == 2
+
+
+def test_a_command_on_a_cached_model_does_not_import_sympy(model_file, capsys):
+    lyap(capsys, str(model_file))
+    script = ("import sys; from gearsym.cli import main; "
+              f"main(['lyap', {str(model_file)!r}, *{list(ARGS)!r}]); "
+              "print(sorted(m for m in ('sympy', 'pint') if m in sys.modules), file=sys.stderr)")
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO_ROOT,
+                         env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120)
+    assert run.returncode == 0, run.stderr
+    assert run.stderr.strip().splitlines()[-1] == "[]"
+    assert json.loads(run.stdout) == lyap(capsys, str(model_file))
