@@ -357,3 +357,13 @@ def test_generated_code_size_does_not_grow_with_the_steps_per_period(tmp_path):
     # written out, 3200 steps were 16x the code (24 s of gcc); what still grows is data (the 2N+1 sample
     # times of the table function) and a few dozen segment calls
     assert sizes[3200] < 2 * sizes[200], sizes
+
+
+def test_the_backlash_term_of_a_sum_is_added_last_so_each_stage_waits_for_one_operation():
+    # the tabulated one-stage right-hand side: forcing T1, damping b v, stiffness T0 times g
+    x, v, b, T0, T1, eta = sp.symbols("x v b T0 T1 eta")
+    symbols = {s: ca.SX.sym(s.name) for s in (x, v, b, T0, T1, eta)}
+    for expr in (T1 + b * v + T0 * g(x, eta), T1 + b * v + T0 * (g(x, eta) + 1)):
+        out = to_casadi([expr], symbols)[0]
+        last, rest = out.dep(1), out.dep(0)
+        assert ca.depends_on(last, symbols[x]) and not ca.depends_on(rest, symbols[x]), expr

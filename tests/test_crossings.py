@@ -190,3 +190,21 @@ def test_one_flank_of_the_backlash_is_located_on_the_backlash_surfaces():
     located = errors(coast, True, omega=1.8)
     assert all(a / b >= 8 for a, b in zip(located, located[1:])), located
     assert located[1] < 1e-8, located
+
+
+def test_the_frozen_backlash_is_g_on_each_side_and_reads_the_state_once():
+    from gearsym.codegen.functions import _switching
+    from gearsym.codegen.time_tables import split_rhs
+
+    t, x, v = sp.symbols("t x v", real=True)
+    eta = parameter_symbol("eta")
+    kink = FirstOrderSystem("kink", t, (x, v), (v, -g(x, eta)), {"eta": 1.0}, 2 * sp.pi)
+    split = split_rhs(kink, factored=True)
+    switching = _switching(kink, split)
+    frozen = -switching.rhs[1].subs({c: value for c, value in split.constants})
+    contact, other_flank = switching.sides  # x >= 0, x <= -eta
+    for value in (1.5, -0.5, -2.5):  # contact, gap, the other flank
+        sides = {contact: int(value >= 0), other_flank: int(value <= -1)}
+        assert float(frozen.subs({x: value, eta: 1, **sides})) == float(g(value, 1))
+    # one product on the path from the state to the next stage: x appears once in the frozen g
+    assert frozen.count(x) == 1, frozen
