@@ -14,6 +14,10 @@ import pytest
 
 import gearsym
 import gearsym.cli.compile
+import gearsym.cached  # imported before no_work patches registry.load, so that it binds the real one
+import gearsym.codegen.generated
+import gearsym.registry
+import gearsym.reproduce.compute  # likewise
 import gearsym.cli.docs
 import gearsym.cli.explain
 import gearsym.cli.integration
@@ -44,7 +48,7 @@ def no_work(monkeypatch):
     for module, name in ((gearsym.cli.integration, "system_from"), (gearsym.cli.explain, "system_from"),
                          (gearsym.codegen, "compile_model"), (gearsym.cli.sweep, "run_sweep"),
                          (gearsym.cli.simulate, "_with_effects"),
-                         (gearsym.cli.compile, "load"), (gearsym.cli.compile, "generate_model"),
+                         (gearsym.registry, "load"), (gearsym.codegen.generated, "generate_model"),
                          (gearsym.cli.docs, "page"), (sys.modules["gearsym.reproduce"], "reproduce")):
         monkeypatch.setattr(module, name, work)
 

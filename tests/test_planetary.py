@@ -225,11 +225,11 @@ def test_a_free_ring_or_a_driven_parallel_stage_keeps_the_planet_modes_with_ever
 
 
 def test_an_effect_asked_for_a_loop_closing_mesh_is_refused_naming_the_meshes_with_coordinates():
-    from gearsym.fit.effects import mesh_term
+    from gearsym.fit.effects import site
 
     with pytest.raises(ModelError, match=r"no mesh force g\(x, eta\) acting on coordinate 'y2' \(meshes.* act on "
                                          r"x1, x2, x3, y1\)"):
-        mesh_term(system("planetary"), "y2")
+        site(system("planetary"), "mesh", "y2")
 
 
 def _with(declare) -> Drivetrain:

@@ -28,7 +28,7 @@ CODEGEN_VERSION = 1
 _GENERATOR_SOURCES = ("translate.py", "time_tables.py", "functions.py", "loops.py", "generate.py")
 
 
-def _generator_digest() -> str:
+def generator_digest() -> str:
     here = Path(__file__).resolve().parent
     digest = hashlib.sha256()
     for name in _GENERATOR_SOURCES:
@@ -41,7 +41,7 @@ def code_hash(system: FirstOrderSystem, options: LoopOptions) -> str:
     """SHA-256 of everything that determines the C: model equations, names, loop options, versions."""
     description = {
         "codegen": CODEGEN_VERSION,
-        "generator": _generator_digest(),
+        "generator": generator_digest(),
         "casadi": ca.__version__,
         "name": system.name,
         "time": system.time.name,

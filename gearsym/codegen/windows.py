@@ -36,6 +36,7 @@ from ..files import write_atomically
 from ..system import FirstOrderSystem
 from .compiler import cache_dir, compile_library, find_compiler
 from .functions import SystemSymbols, rk4_step
+from .generate import generator_digest
 from .translate import to_casadi
 
 #: bump when the generated window code changes for the same system and channels
@@ -207,7 +208,8 @@ def windows_hash(system: FirstOrderSystem, channels: Sequence[sp.Expr]) -> str:
     """What determines the window code: the equations, names, channels, this module and the versions."""
     description = {
         "version": WINDOWS_VERSION,
-        "generator": hashlib.sha256(Path(__file__).read_bytes()).hexdigest(),
+        # this module and the step's own generator (translate, functions, ...): an edit to either changes the C
+        "generator": hashlib.sha256(Path(__file__).read_bytes()).hexdigest() + generator_digest(),
         "casadi": ca.__version__,
         "name": system.name,
         "time": system.time.name,
