@@ -167,6 +167,7 @@ class Explanation:
             "held_out_fraction": self.held_out,
             "candidates": [fit_dict(c) for c in self.tried],
             "screened": self.info.get("screened", []),
+            "displaced": self.info.get("displaced"),  # library effects that only stood in for a proposed term
         }
 
 
@@ -273,6 +274,16 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
         from .proposals import propose_terms
 
         ex = replace(ex, proposed=propose_terms(ex, superset, seg_train, seg_test, keys, options, harmonics, say))
+        if ex.effects and ex.proposed:  # do the effects earn their place beside the term the residual asks for?
+            alone = replace(ex, final=base)
+            alone = replace(alone, proposed=propose_terms(alone, superset, seg_train, seg_test, keys, options,
+                                                          harmonics, say))
+            if alone.proposed and ex.proposed[0].error > (1 - min_gain) * alone.proposed[0].error:
+                say(f"{'+'.join(ex.effects)} stood in for {alone.proposed[0].term}: not reported as found")
+                displaced = {"effects": ex.effects, "error": current.error, "term": alone.proposed[0].term,
+                             "error_with": ex.proposed[0].error, "error_alone": alone.proposed[0].error}
+                ex = replace(alone, correlation=_lag1(base.prediction), final_spectrum=spectrum,
+                             info={**ex.info, "displaced": displaced})
     return ex
 
 

@@ -54,6 +54,12 @@ def report_page(ex: Explanation, system: FirstOrderSystem, derived: FirstOrderSy
     if ex.effects:
         lines += [f"- Added: **{', '.join(ex.effects)}**. Held-out error {before.error:.4g} → {after.error:.4g} "
                   f"({before.error / after.error:.1f}× lower)."]
+    elif "displaced" in ex.info:
+        d = ex.info["displaced"]
+        lines += [f"- No effect added: {', '.join(d['effects'])} lowered the held-out error to {d['error']:.4g}, but "
+                  f"only by standing in for `{d['term']}`: with that term, the model does as well without "
+                  f"{'them' if len(d['effects']) > 1 else 'it'} ({d['error_alone']:.4g}) as with "
+                  f"({d['error_with']:.4g}), so it is not reported as found."]
     else:
         lines += [f"- No effect added: no candidate lowered the held-out error ({before.error:.4g}) by the required "
                   "margin."]
