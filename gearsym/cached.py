@@ -4,7 +4,9 @@ Reducing a drivetrain takes a second or two of SymPy, and importing SymPy (and p
 command on a model whose library is cached needs neither. The first run of a model (a name or a file) with
 given ``--set`` values writes two small files into the cache (``$GEARSYM_CACHE/models``):
 
-* ``<model>-<key>.json``: the system's names, values, constraints and flags (:class:`SystemSummary`), under
+* ``<model>-<key>.json``: the system's names, values, constraints and flags (:class:`SystemSummary`) and, for
+  a model with physical values, the numbers that carry a spectrum run back to its units
+  (:class:`~gearsym.physical.point.PointUnits`: no pint needed), under
   a key that hashes the model's file, the other model files it may import, gearsym's own source and the
   values: any change to one of them is another key, never a stale summary;
 * ``<model>-<key>-<loops>.json``: for one structure of the loops (steps per period, crossings located), the
