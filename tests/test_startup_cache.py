@@ -131,3 +131,14 @@ def test_a_command_on_a_cached_model_imports_neither_sympy_nor_pint(model_copy, 
     assert run.returncode == 0, run.stderr
     assert run.stderr.strip().splitlines()[-1] == "[]"
     assert json.loads(run.stdout) == lyap(capsys, str(model_file))
+
+
+def test_a_sweep_of_a_cached_physical_model_is_carried_to_physical_units(model_copy, tmp_path, capsys):
+    spur = str(model_copy("spur_pair"))
+    lyap(capsys, spur, "--set", "speed=3000 rpm")
+    out = tmp_path / "sweep.csv"
+    run = subprocess.run([sys.executable, "-m", "gearsym.cli", "sweep", spur, "--param", "speed=3000:6000:3000",
+                          "--periods", "20", "--discard", "5", "--out", str(out)], capture_output=True, text=True,
+                         cwd=REPO_ROOT, env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert out.with_suffix(".physical.csv").read_text().startswith("speed [rpm],")
