@@ -4,7 +4,9 @@ Reducing a drivetrain takes a second or two of SymPy, and importing SymPy (and p
 command on a model whose library is cached needs neither. The first run of a model (a name or a file) with
 given ``--set`` values writes two small files into the cache (``$GEARSYM_CACHE/models``):
 
-* ``<model>-<key>.json``: the system's names, values, constraints and flags (:class:`SystemSummary`), under
+* ``<model>-<key>.json``: the system's names, values, constraints and flags (:class:`SystemSummary`) and, for
+  a model with physical values, the numbers that carry a spectrum run back to its units
+  (:class:`~gearsym.physical.point.PointUnits`: no pint needed), under
   a key that hashes the model's file, the other model files it may import, gearsym's own source and the
   values: any change to one of them is another key, never a stale summary;
 * ``<model>-<key>-<loops>.json``: for one structure of the loops (steps per period, crossings located), the
@@ -34,7 +36,7 @@ from .parameters import Constraint, ParameterChecks
 from .registry import load, load_model, models_dir, physical_settings
 
 #: bump when what a summary holds changes
-SUMMARY_FORMAT = 1
+SUMMARY_FORMAT = 2
 
 
 @dataclass(frozen=True, eq=False)
@@ -177,20 +179,35 @@ def load_compiled(ref: str, values: Mapping[str, object], options: Integration, 
     if compiled is not None:
         return compiled
     compiled = _compile(ref, values, options, verbose)
-    write_json(system_file, {"system": SystemSummary.of(compiled.system, _is_physical(ref, values)).as_dict()})
+    physical = _scaling(ref, values)
+    units = None if physical is None else _point_units(physical)
+    write_json(system_file, {"system": SystemSummary.of(compiled.system, physical is not None).as_dict(),
+                             "physical": units and units.as_dict()})
     write_json(build_file, {"hash": compiled.hash, "library": str(compiled.library),
                             "timed_parameters": sorted(compiled.timed_parameters)})
     return compiled
 
 
-def cached_summary(ref: str, values: Mapping[str, object]) -> SystemSummary | None:
-    """The summary of ``ref`` with ``values`` if the cache has it (whatever the loops), else None."""
-    path = model_file(ref) if isinstance(ref, str) else None
-    data = read_json(summary_path(path.stem, system_key(path, values))) if path else None
+def cached_scaling(ref: str, values: Mapping[str, object]):
+    """The :class:`~gearsym.physical.Scaling` of ``ref`` with ``values`` (None for a model without physical
+    values): a :class:`~gearsym.physical.point.CachedScaling` when the cache has its numbers (a spectrum run
+    then needs neither pint nor the reduction), else made (the model loaded and reduced)."""
+    from .physical.point import CachedScaling, PointUnits
+
+    data = _system_data(ref, values)
     try:
-        return SystemSummary.from_dict(data["system"], lambda: _load(ref, values)) if data else None
+        if data is not None and not data["system"]["physical"]:
+            return None
+        if data is not None and data["physical"]:
+            return CachedScaling(PointUnits.from_dict(data["physical"]), lambda: _scaling(ref, values))
     except (KeyError, TypeError, ValueError, AttributeError):
-        return None
+        pass
+    return _scaling(ref, values)
+
+
+def _system_data(ref, values) -> dict | None:
+    path = model_file(ref) if isinstance(ref, str) else None
+    return read_json(summary_path(path.stem, system_key(path, values))) if path else None
 
 
 def _from_cache(system_file: Path, build_file: Path, ref, values, options: Integration, loops: LoopOptions):
@@ -229,5 +246,19 @@ def _load(ref, values):
     return load(ref, **values)
 
 
-def _is_physical(ref, values) -> bool:
-    return physical_settings(load_model(ref), dict(values)) is not None
+def _scaling(ref, values):
+    """The Scaling of the model ``ref`` with ``values``, or None for a model without physical values."""
+    model = load_model(ref)
+    split = physical_settings(model, dict(values))
+    if split is None:
+        return None
+    from .physical.scaling import scaling  # (the function: the package's name may be the module by now)
+
+    length_scale, physical, _ = split
+    return scaling(model, length_scale, **physical)
+
+
+def _point_units(physical):
+    from .physical.results import point_units
+
+    return point_units(physical)

@@ -17,8 +17,14 @@ ARGS = ("--periods", "30", "--discard", "10", "--format", "json")
 
 
 @pytest.fixture
-def model_file(tmp_path, monkeypatch):
-    """A copy of the one-stage model in a file of its own, with a cache of its own for the summaries (the
+def model_file(model_copy):
+    """A copy of the one-stage model (see model_copy)."""
+    return model_copy("one_stage")
+
+
+@pytest.fixture
+def model_copy(tmp_path, monkeypatch):
+    """A shipped model copied into a file of its own, with a cache of its own for the summaries (the
     compiled libraries and code are the usual ones: nothing is compiled again)."""
     real = cache_dir()
     cache = tmp_path / "cache"
@@ -27,9 +33,13 @@ def model_file(tmp_path, monkeypatch):
         (real / folder).mkdir(parents=True, exist_ok=True)
         (cache / folder).symlink_to(real / folder)
     monkeypatch.setenv("GEARSYM_CACHE", str(cache))
-    path = tmp_path / "gears.py"
-    path.write_text((REPO_ROOT / "models" / "one_stage.py").read_text())
-    return path
+
+    def copy(name: str):
+        path = tmp_path / f"{name}_copy.py"
+        path.write_text((REPO_ROOT / "models" / f"{name}.py").read_text())
+        return path
+
+    return copy
 
 
 @pytest.fixture
@@ -83,7 +93,35 @@ def test_a_corrupt_summary_is_ignored_and_written_again(model_file, reductions, 
     assert len(reductions) == 2
 
 
-def test_a_command_on_a_cached_model_does_not_import_sympy(model_file, capsys):
+def lyap_text(capsys, *argv: str) -> str:
+    assert main(["lyap", *argv, "--periods", "30", "--discard", "10"]) == 0
+    return capsys.readouterr().out
+
+
+def test_a_cached_physical_model_is_not_reduced_again_and_prints_the_same(model_copy, reductions, capsys):
+    spur = str(model_copy("spur_pair"))
+    first_text, first_json = lyap_text(capsys, spur), lyap(capsys, spur)
+    done = len(reductions)
+    assert lyap_text(capsys, spur) == first_text
+    assert lyap(capsys, spur) == first_json
+    assert len(reductions) == done
+    assert "operating point: 6000 rpm" in first_text and "mesh force mesh: mean" in first_text
+    assert first_json["physical"]["mesh_force"]["mesh"]["mean"]["unit"] == "N"
+
+
+def test_a_changed_physical_value_is_carried_back_with_the_new_value(model_copy, reductions, capsys):
+    spur = str(model_copy("spur_pair"))
+    lyap_text(capsys, spur)
+    done = len(reductions)
+    stiffer = lyap_text(capsys, spur, "--set", "kZ=5.08e8 N/m")  # 4 x the mesh stiffness: 2 x omega_n
+    assert len(reductions) > done
+    assert "omega_n = 12119.9 Hz" in stiffer
+    assert lyap_text(capsys, spur, "--set", "kZ=5.08e8 N/m") == stiffer
+
+
+@pytest.mark.parametrize("name", ["one_stage", "spur_pair"])
+def test_a_command_on_a_cached_model_imports_neither_sympy_nor_pint(model_copy, name, capsys):
+    model_file = model_copy(name)
     lyap(capsys, str(model_file))
     script = ("import sys; from gearsym.cli import main; "
               f"main(['lyap', {str(model_file)!r}, *{list(ARGS)!r}]); "
@@ -93,3 +131,14 @@ def test_a_command_on_a_cached_model_does_not_import_sympy(model_file, capsys):
     assert run.returncode == 0, run.stderr
     assert run.stderr.strip().splitlines()[-1] == "[]"
     assert json.loads(run.stdout) == lyap(capsys, str(model_file))
+
+
+def test_a_sweep_of_a_cached_physical_model_is_carried_to_physical_units(model_copy, tmp_path, capsys):
+    spur = str(model_copy("spur_pair"))
+    lyap(capsys, spur, "--set", "speed=3000 rpm")
+    out = tmp_path / "sweep.csv"
+    run = subprocess.run([sys.executable, "-m", "gearsym.cli", "sweep", spur, "--param", "speed=3000:6000:3000",
+                          "--periods", "20", "--discard", "5", "--out", str(out)], capture_output=True, text=True,
+                         cwd=REPO_ROOT, env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert out.with_suffix(".physical.csv").read_text().startswith("speed [rpm],")

@@ -22,7 +22,8 @@ import time
 
 from .machine import REPO
 
-MODELS = ("one_stage", "one_stage_resonant", "flexible_shaft", "two_stage", "spur_pair", "duffing")
+MODELS = ("one_stage", "one_stage_resonant", "flexible_shaft", "two_stage", "spur_pair", "duffing", "planetary",
+          "planetary_differential", "planetary_two_stage")
 COMMAND = ("lyap", "{model}", "--periods", "10", "--discard", "0")
 REPEATS = 7
 TARGET_SECONDS = 0.6

@@ -52,21 +52,9 @@ def system_from(args: argparse.Namespace):
 def scaling_from(args: argparse.Namespace):
     """The :class:`~gearsym.physical.Scaling` of the command's MODEL and --set values, or None for a model without
     physical values."""
-    from ..cached import cached_summary
-    from ..registry import load_model, physical_settings
+    from ..cached import cached_scaling
 
-    settings = parse_settings(args.set)
-    summary = cached_summary(args.model, settings)
-    if summary is not None and not summary.physical:  # known without loading the model
-        return None
-    model = load_model(args.model)
-    split = physical_settings(model, settings)
-    if split is None:
-        return None
-    from ..physical import scaling
-
-    length_scale, physical, _ = split
-    return scaling(model, length_scale, **physical)
+    return cached_scaling(args.model, parse_settings(args.set))
 
 
 def compiled_from(args: argparse.Namespace, options: Integration | None = None, system=None):

@@ -7,7 +7,7 @@ units, ``kZ k(phi) g(x, eta) + cZ dx/dt``, not through the scaled groups.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 import pint
@@ -16,13 +16,8 @@ import sympy as sp
 from ..errors import GearsymError
 from ..symbols import omega as omega_symbol, phi, t
 from .scaling import Scaling, evaluate
-from .units import Quantity, shown
-
-#: the default units results are shown in
-LENGTH_UNIT = "um"
-VELOCITY_UNIT = "mm/s"
-SPEED_UNIT = "rpm"
-
+from .point import LENGTH_UNIT, SPEED_UNIT, VELOCITY_UNIT, Measured, MeshUnits, PhysicalPoint, PointUnits, Unit, contact
+from .units import Quantity
 
 def rate(scaling: Scaling, omega: float) -> float:
     """Radians per second of one unit of tau per unit time: omega * omega_n (tau = this * t)."""
@@ -49,74 +44,61 @@ def state_to_physical(scaling: Scaling, name: str, values, omega: float, length_
     raise GearsymError(f"{scaling.name}: {name!r} is not a state of the model")
 
 
-@dataclass(frozen=True)
-class PhysicalPoint:
-    """One operating point of a spectrum run, in physical units."""
-
-    model: str
-    speed: pint.Quantity
-    mesh_frequency: pint.Quantity  # Hz
-    natural_frequency: pint.Quantity  # omega_n in Hz
-    omega: float
-    exponents: pint.Quantity  # 1/s
-    stderr: pint.Quantity
-    amplitude: dict[str, pint.Quantity]
-    final_state: dict[str, pint.Quantity]
-    length_unit: pint.Quantity  # the scaling's L
-    mesh_force: dict = field(default_factory=dict)  # mesh -> {"mean", "min", "max", "dynamic"} in N
-
-    def as_dict(self) -> dict:
-        """JSON-ready: every value as a number with its unit beside it."""
-        def q(x):
-            return {"value": _number(x.magnitude), "unit": f"{x.units:~P}"}
-
-        out = {"model": self.model, "speed": q(self.speed), "mesh_frequency": q(self.mesh_frequency),
-               "natural_frequency": q(self.natural_frequency), "omega": self.omega,
-               "exponents": q(self.exponents), "stderr": q(self.stderr),
-               "amplitude": {k: q(v) for k, v in self.amplitude.items()},
-               "final_state": {k: q(v) for k, v in self.final_state.items()}, "length_unit": q(self.length_unit)}
-        if self.mesh_force:
-            out["mesh_force"] = {m: {k: q(v) for k, v in f.items()} for m, f in self.mesh_force.items()}
-        return out
-
-    def lines(self) -> list[str]:
-        """The text ``gearsym lyap`` prints for a model with physical values."""
-        out = [f"operating point: {shown(self.speed)}, mesh frequency {shown(self.mesh_frequency)}, "
-               f"omega_n = {shown(self.natural_frequency)} (omega = {self.omega:.6g})",
-               "Lyapunov exponents per second: " + ", ".join(f"{v:+.6g}" for v in self.exponents.magnitude)]
-        out += [f"amplitude A_{k} = {shown(v)}" for k, v in self.amplitude.items()]
-        for mesh, f in self.mesh_force.items():
-            out.append(f"mesh force {mesh}: mean {shown(f['mean'])}, {shown(f['min'])} to {shown(f['max'])} "
-                       f"(dynamic amplitude {shown(f['dynamic'])})")
-        return out
-
-
-def _number(x):
-    return x.tolist() if isinstance(x, np.ndarray) else float(x)
-
-
 def point_to_physical(scaling: Scaling, result, length_unit: str = LENGTH_UNIT, trajectory=None) -> PhysicalPoint:
     """A :class:`~gearsym.analysis.LyapunovSpectrum` in physical units (with mesh forces from ``trajectory``,
     a :class:`~gearsym.analysis.orbits.Trajectory` at the same point, if given)."""
-    w = float(result.parameters["omega"])
-    per_second = rate(scaling, w)
-    forces = mesh_forces(scaling, trajectory, w) if trajectory is not None else {}
-    return PhysicalPoint(
-        scaling.name, scaling.speed_at(w) if scaling.speed else Quantity(float("nan"), SPEED_UNIT),
-        Quantity(w * scaling.omega_n.magnitude * float(scaling.reference_mesh.order), "rad/s").to("Hz"),
-        scaling.omega_n.to("Hz"), w,
-        Quantity(np.asarray(result.exponents, dtype=float) * per_second, "1/s"),
-        Quantity(np.asarray(result.stderr, dtype=float) * per_second, "1/s"),
-        {k: state_to_physical(scaling, k, v, w, length_unit) for k, v in result.amplitude.items()},
-        {k: state_to_physical(scaling, k, v, w, length_unit) for k, v in result.final_state.items()},
-        scaling.length.to(length_unit), {m: _force_summary(f) for m, f in forces.items()})
+    point = point_units(scaling, length_unit).point(result, trajectory)
+    return replace(point, **{f.name: _quantities(getattr(point, f.name)) for f in fields(point)})
 
 
-def _force_summary(force: pint.Quantity) -> dict:
-    values = force.to("N").magnitude
-    return {"mean": Quantity(float(np.mean(values)), "N"), "min": Quantity(float(values.min()), "N"),
-            "max": Quantity(float(values.max()), "N"),
-            "dynamic": Quantity(float(values.max() - values.min()) / 2, "N")}
+def _quantities(value):
+    """:class:`~.point.Measured` values (in dicts) as pint Quantities, for a caller that converts them."""
+    if isinstance(value, Measured):
+        return Quantity(value.magnitude, value.units.name)
+    return {k: _quantities(v) for k, v in value.items()} if isinstance(value, dict) else value
+
+
+def point_units(scaling: Scaling, length_unit: str = LENGTH_UNIT) -> PointUnits:
+    """The numbers that carry a spectrum run of ``scaling`` to physical units (what the start-up cache keeps)."""
+    def factor(source: str, target: str) -> float:
+        return float(Quantity(1.0, source).to(target).magnitude)
+
+    def text(unit: str) -> Unit:
+        return Unit(unit, f"{Quantity(1, unit).units:~P}")
+
+    speed_unit = (str(scaling.inputs[scaling.speed.parameter].units) if scaling.speed and scaling.speed.parameter in
+                  scaling.inputs else SPEED_UNIT)
+    if scaling.speed:
+        scaling._speed_quantity(Quantity(1.0, speed_unit))  # (what speed_at checks)
+    return PointUnits(
+        scaling.name, scaling.speed, text(speed_unit), factor("rad/s", speed_unit), float(scaling.omega_n.magnitude),
+        float(scaling.omega_n.to("Hz").magnitude), float(scaling.forcing_ratio) if scaling.speed else float("nan"),
+        float(scaling.reference_mesh.order), factor("rad/s", "Hz"), float(scaling.length.to("m").magnitude),
+        float(scaling.length.to(length_unit).magnitude), length_unit, text(length_unit), factor("m", length_unit),
+        text(VELOCITY_UNIT), factor("m/s", VELOCITY_UNIT), factor(VELOCITY_UNIT, "m/s"), text("1/s"), text("N"), text("Hz"),
+        kinds(scaling), tuple(_mesh_units(scaling)))
+
+
+def _mesh_units(scaling: Scaling):
+    import casadi as ca
+
+    from ..codegen.translate import to_casadi
+
+    si = {n: q.to_base_units() for n, q in scaling.inputs.items()}
+    for c in scaling.model.coordinates:
+        rc = c.coupling
+        if rc.kind != "mesh":
+            continue
+        where = f"{scaling.name}: mesh {rc.name!r}"
+        variation = rc.variation.xreplace({sp.Symbol(n, real=True): float(q.to("").magnitude)
+                                           for n, q in scaling.inputs.items() if q.dimensionless})
+        angle = ca.SX.sym("phi")
+        k_of_phi = ca.Function("k", [angle], to_casadi([variation], {phi: angle}, where))
+        yield MeshUnits(rc.name, c.name, c.velocity_name, float(evaluate(rc.stiffness, si, where).to("N/m").magnitude),
+                        float(evaluate(rc.damping, si, where).to("N*s/m").magnitude),
+                        float(evaluate(rc.backlash, si, where).to("m").magnitude),
+                        float(evaluate(rc.mesh_phase.xreplace({omega_symbol: 0, t: 0}), si, where).to("").magnitude),
+                        float(rc.order), k_of_phi.serialize())
 
 
 @dataclass(frozen=True)
@@ -160,9 +142,8 @@ def mesh_forces(scaling: Scaling, trajectory, omega: float) -> dict[str, pint.Qu
         k_of_phi = sp.lambdify(phi, variation, "numpy")
         x = state_to_physical(scaling, c.name, trajectory[c.name], omega, "m").magnitude
         v = state_to_physical(scaling, c.velocity_name, trajectory[c.velocity_name], omega).to("m/s").magnitude
-        contact = np.where(x >= 0, x, np.where(x > -eta, 0.0, x + eta))  # g(x, eta), gearsym.backlash
         k = np.asarray(k_of_phi(float(rc.order) * tau + phase), dtype=float) * np.ones_like(tau)
-        out[rc.name] = Quantity(stiffness * k * contact + damping * v, "N")
+        out[rc.name] = Quantity(stiffness * k * contact(x, eta) + damping * v, "N")
     return out
 
 

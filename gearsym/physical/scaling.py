@@ -30,6 +30,7 @@ import sympy as sp
 from ..errors import GearsymError, ModelError, UnknownParameterError
 from ..model.drivetrain import Drivetrain, ResolvedCoupling
 from ..symbols import parameter_symbol
+from .point import Speed
 from .roles import SPEED, fields, parameter_roles, physical_parameters
 from .units import Quantity, as_quantity, dimension_text, shown, ureg
 
@@ -84,15 +85,6 @@ def _exponents(q: pint.Quantity, name: str) -> tuple[float, float, float]:
         raise GearsymError(f"{name}: a drivetrain value is made of mass, length and time, but {shown(q)} has "
                            f"the dimension {dimension_text(q.dimensionality)}")
     return tuple(float(dims.get(d, 0)) for d in BASE)
-
-
-@dataclass(frozen=True)
-class Speed:
-    """The declared operating speed: the body it drives and the parameter that names it."""
-
-    parameter: str
-    body: str
-    where: str
 
 
 class Scaling:

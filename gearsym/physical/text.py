@@ -26,3 +26,10 @@ def looks_like_quantity(text: str) -> bool:
     """True if ``text`` is a number followed by a unit (``--set kZ='2e8 N/m'`` is a quantity, not a formula)."""
     match = QUANTITY.fullmatch(text) if len(text) <= MAX_LENGTH else None
     return bool(match and (match["unit"] or "").strip())
+
+
+def shown(q, digits: int = 6) -> str:
+    """A quantity as a person reads it: '2e+08 N / m', '3000 rpm' (short unit symbols; a pint Quantity or a
+    :class:`~gearsym.physical.point.Measured`)."""
+    unit_text = f"{q.units:~P}" if not q.dimensionless or str(q.units) != "dimensionless" else ""
+    return f"{q.magnitude:.{digits}g} {unit_text}".strip()

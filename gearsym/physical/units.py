@@ -19,7 +19,7 @@ from functools import lru_cache
 import pint
 
 from ..errors import GearsymError
-from .text import GRAMMAR, MAX_LENGTH, POWER_OF_POWER, QUANTITY
+from .text import GRAMMAR, MAX_LENGTH, POWER_OF_POWER, QUANTITY, shown  # noqa: F401 (shown: here too)
 
 ureg = pint.UnitRegistry(on_redefinition="ignore")
 with warnings.catch_warnings():
@@ -88,9 +88,3 @@ def dimension_text(dimensionality) -> str:
     """'[mass] / [time] ** 2' or 'dimensionless'."""
     text = str(dimensionality)
     return text if text else "dimensionless"
-
-
-def shown(q: pint.Quantity, digits: int = 6) -> str:
-    """A quantity as a person reads it: '2e+08 N / m', '3000 rpm' (short unit symbols)."""
-    unit_text = f"{q.units:~P}" if not q.dimensionless or str(q.units) != "dimensionless" else ""
-    return f"{q.magnitude:.{digits}g} {unit_text}".strip()
