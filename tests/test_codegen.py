@@ -305,7 +305,7 @@ def test_editing_the_code_generator_changes_the_hash(monkeypatch):
     from gearsym.codegen import LoopOptions, code_hash
     one_stage = system("one_stage")
     before = code_hash(one_stage, LoopOptions())
-    monkeypatch.setattr(generate, "_generator_digest", lambda: "edited")
+    monkeypatch.setattr(generate, "generator_digest", lambda: "edited")
     assert code_hash(one_stage, LoopOptions()) != before
 
 
