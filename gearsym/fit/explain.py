@@ -41,7 +41,7 @@ from ..system import FirstOrderSystem
 from .canonical import amplitude_phase, canonical
 from .effects import EFFECTS, FAMILIES, Effect, applies_to, augment, bounds_of, effect, site, term_effect
 from .prediction import Prediction, predict_ahead
-from .shooting import Fit, Problem, Segment, fit_windows
+from .shooting import Fit, Segment, fit_windows, score_columns
 
 MIN_GAIN = 0.2
 MAX_CORRELATION = 0.5
@@ -319,16 +319,7 @@ def linearised_gains(system: FirstOrderSystem, segments: Sequence[Segment], fit:
     params = [p for name in names for p in library[name].fitted]
     if not params:
         return {}
-    fitted = list(fit.estimates)
-    problem = Problem(system, segments, fitted + params, list(bias), 2 * np.pi, options)
-    theta = np.array([fit.estimates[p] for p in fitted] + [0.0] * len(params))
-    u = np.concatenate([theta, [fit.bias[c] for c in problem.bias], fit.starts.reshape(-1, order="F")])
-    r, J = problem(u)
-    m = len(fitted)
-    D = J.P[:, m:m + len(params)]
-    nuisance = replace(J, P=np.delete(J.P, np.s_[m:m + len(params)], axis=1))
-    projected = nuisance.project_out(np.hstack([-r[:, None], D]))
-    y, D = projected[:, 0], projected[:, 1:]
+    y, D, _ = score_columns(system, segments, fit, params, bias, options)
     total = float(y @ y) or 1.0
     gains, at = {}, 0
     for name in names:

@@ -35,9 +35,9 @@ import sympy as sp
 
 from ..options import Integration
 from ..system import FirstOrderSystem
-from .effects import Effect, augment, bounds_of, own_term, site, term_text
+from .effects import augment, bounds_of, own_term, site, term_text
 from .prediction import predict_ahead
-from .shooting import Problem, Segment, fit_windows
+from .shooting import Segment, fit_windows, score_columns
 
 MAX_PROPOSALS = 3
 #: the ridge of STLSQ on unit-norm columns: steadies the fit where dictionary terms are nearly collinear
@@ -140,15 +140,7 @@ def propose_terms(ex, superset: FirstOrderSystem, train: Sequence[Segment], test
     final = ex.final.fit
     names = list(final.estimates)
     coefficients = [e.fitted[0] for e in effects]
-    problem = Problem(model, train, names + coefficients, list(ex.bias), 2 * np.pi, options)
-    theta = np.array([final.estimates[n] for n in names] + [0.0] * len(coefficients))
-    u = np.concatenate([theta, [final.bias[c] for c in problem.bias], final.starts.reshape(-1, order="F")])
-    r, J = problem(u)
-    m = len(names)
-    D = J.P[:, m:m + len(coefficients)]
-    nuisance = replace(J, P=np.delete(J.P, np.s_[m:m + len(coefficients)], axis=1))
-    both = nuisance.project_out(np.hstack([-r[:, None], D]))  # data - model (scaled), and the columns
-    y, projected = both[:, 0], both[:, 1:]
+    y, projected, D = score_columns(model, train, final, coefficients, ex.bias, options)
     # a term the fit's own directions already make (its column all but gone) would be noise blown up
     projected[:, np.linalg.norm(projected, axis=0) < 1e-6 * np.linalg.norm(D, axis=0)] = 0.0
     coef, strength = sparse_regression(projected, y)

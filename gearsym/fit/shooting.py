@@ -22,7 +22,7 @@ sigma^2 = RSS / (residuals - unknowns); a parameter whose column of J is zero, o
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import sympy as sp
@@ -273,6 +273,23 @@ class Jacobian:
         return Y
 
 
+def score_columns(system: FirstOrderSystem, segments: Sequence[Segment], fit: Fit, extra: Sequence[str],
+                  bias: Sequence[str], options: Integration) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The score test's pieces at ``fit`` with the parameters ``extra`` added at 0: the scaled residual (data -
+    model) and the exact sensitivity columns of ``extra``, both with what the fit already moves (its parameters,
+    start states and offsets) projected out; and the columns before the projection."""
+    fitted = list(fit.estimates)
+    problem = Problem(system, segments, fitted + list(extra), list(bias), 2 * np.pi, options)
+    theta = np.array([fit.estimates[p] for p in fitted] + [0.0] * len(extra))
+    u = np.concatenate([theta, [fit.bias[c] for c in problem.bias], fit.starts.reshape(-1, order="F")])
+    r, J = problem(u)
+    m = len(fitted)
+    columns = J.P[:, m:m + len(extra)]
+    nuisance = replace(J, P=np.delete(J.P, np.s_[m:m + len(extra)], axis=1))
+    both = nuisance.project_out(np.hstack([-r[:, None], columns]))
+    return both[:, 0], both[:, 1:], columns
+
+
 def _bounds(system: FirstOrderSystem, fit: Sequence[str], given: Mapping[str, tuple], count: int):
     """Lower and upper bounds of every unknown, and why each fitted parameter's are there."""
     low, high, why = np.full(count, -np.inf), np.full(count, np.inf), {}
@@ -330,7 +347,7 @@ def _levenberg_marquardt(problem: Problem, u, low, high, max_iterations: int):
 def _damped_step(U, W, V, gP, gS, mu: float, free: np.ndarray) -> np.ndarray:
     """The Levenberg-Marquardt step for [parameters (the ``free`` ones), start states] from the normal equations'
     blocks, by the Schur complement on the parameters (the start-state blocks are n x n per window)."""
-    K, n = V.shape[0], V.shape[1]
+    n = V.shape[1]
     dV = np.maximum(np.diagonal(V, axis1=1, axis2=2), 1e-12)
     Vinv = np.linalg.inv(V + mu * dV[:, :, None] * np.eye(n))
     dP = np.zeros(U.shape[0])
@@ -345,7 +362,7 @@ def _damped_step(U, W, V, gP, gS, mu: float, free: np.ndarray) -> np.ndarray:
 
 def _result(problem: Problem, u, J, r, iterations, converged, low, high, why) -> Fit:
     theta, b, S = problem.split(u)
-    m, nb = problem.m, len(problem.bias)
+    nb = len(problem.bias)
     names = [*problem.fit, *(f"bias:{c}" for c in problem.bias)]
     tol = 1e-12 * np.maximum(1.0, np.abs(u))
     at = {}

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import Optional, Union
+from typing import Optional
 
 import sympy as sp
 
@@ -17,7 +17,7 @@ from ..backlash import G
 from ..checks import sign_violation
 from ..errors import ModelError, suggest
 from ..symbols import omega, parameter_symbol, phi, t
-from .components import Body, BodyRef, Coupling, Disk, Gear, Harmonic, Mesh, Planet, Shaft, Torque
+from .components import Body, BodyRef, Coupling, Gear, Harmonic, Mesh, Planet, Shaft, Torque
 from .expressions import ExprLike, parameter_names, to_expr
 from .stiffness import check_periodic
 
