@@ -37,12 +37,122 @@ def test_a_fresh_sweep_whose_points_finish_in_order_writes_its_tables_once(tmp_p
     written = []
     original = SweepStore._write_table
 
-    def counting(path, columns, rows):
+    def counting(path, columns, rows, text=""):
         written.append(path.name)
-        return original(path, columns, rows)
+        return original(path, columns, rows, text)
 
     monkeypatch.setattr(SweepStore, "_write_table", staticmethod(counting))
     run_sweep(one_stage, {"omega": [1.0, 1.2, 1.4]}, options=RUN, progress=False, out=tmp_path / "s.csv")
     assert sorted(written) == ["s.csv", "s.poincare.csv"]  # started, then appended to; not rewritten at the end
     rows = (tmp_path / "s.csv").read_text().splitlines()
     assert len(rows) == 4 and rows[0].startswith("omega,direction")
+
+
+def test_a_batch_of_runs_is_summarised_exactly_as_each_run_alone(one_stage):
+    """The sweep summarises its points in batches; every number must be the bits lyapunov_spectrum gives."""
+    from gearsym import lyapunov_spectrum
+    from gearsym.analysis.lyapunov import summarise_runs
+    from gearsym.codegen import TangentRuns
+
+    omegas = [0.6, 0.95, 1.4, 1.75]  # periodic and chaotic points
+    runs = TangentRuns(one_stage.dimension, len(one_stage.observed), RUN.periods, len(omegas))
+    ps, periods = [], []
+    for i, omega in enumerate(omegas):
+        inputs = one_stage.prepare(one_stage.parameter_vector(omega=omega))
+        one_stage.tangent_run_into(runs, i, one_stage.initial_state(), inputs)
+        ps.append(inputs.p.copy())
+        periods.append(inputs.period)
+    batch = summarise_runs(one_stage, runs, np.array(ps), np.array(periods), RUN.discard)
+    for i, omega in enumerate(omegas):
+        run = one_stage.tangent_run(None, RUN.periods, one_stage.prepare(one_stage.parameter_vector(omega=omega)))
+        measured = run.log_stretch[:, RUN.discard:] / periods[i]  # the definitions, written out independently
+        order = np.argsort(-measured.mean(axis=1))
+        means = np.array([b.mean(axis=1) for b in np.array_split(measured, 10, axis=1)])
+        assert np.allclose(batch.exponents[i], measured.mean(axis=1)[order], rtol=1e-13, atol=1e-16)
+        assert np.allclose(batch.stderr[i], means.std(axis=0, ddof=1)[order] / np.sqrt(10), rtol=1e-10, atol=1e-16)
+        assert batch.amplitude[i].tolist() == ((run.high[:, RUN.discard:].max(axis=1)
+                                                - run.low[:, RUN.discard:].min(axis=1)) / 2).tolist()
+        alone = lyapunov_spectrum(one_stage, options=RUN, omega=omega)
+        assert batch.exponents[i].tobytes() == alone.exponents.tobytes()
+        assert batch.stderr[i].tobytes() == alone.stderr.tobytes()
+        assert batch.amplitude[i].tolist() == list(alone.amplitude.values())
+        assert batch.regimes[i] == alone.regime
+        assert runs.strobe[i, RUN.discard:].T.tobytes() == alone.strobe.tobytes()
+
+
+def test_an_autonomous_batch_names_its_rest_points_as_each_run_alone():
+    from gearsym import lyapunov_spectrum
+    from gearsym.analysis.lyapunov import summarise_runs
+    from gearsym.codegen import TangentRuns
+
+    lorenz, run = conftest.compiled("lorenz"), Integration(periods=40, discard=10)
+    starts = [np.zeros(3), lorenz.initial_state()]  # at rest on the (unstable) origin, and chaos
+    runs = TangentRuns(3, len(lorenz.observed), run.periods, 2)
+    inputs = lorenz.prepare(lorenz.parameter_vector(rho=28.0))
+    for i, y0 in enumerate(starts):
+        lorenz.tangent_run_into(runs, i, y0, inputs)
+    batch = summarise_runs(lorenz, runs, np.array([inputs.p] * 2), np.array([inputs.period] * 2), run.discard)
+    alone = [lyapunov_spectrum(lorenz, options=run, y0=y0, rho=28.0) for y0 in starts]
+    assert batch.regimes == [a.regime for a in alone] == ["equilibrium", "chaotic"]
+    assert np.array_equal(batch.eigenvalues[0], alone[0].eigenvalues) and batch.eigenvalues[1] is None
+    assert batch.exponents[0].tobytes() == alone[0].exponents.tobytes()
+    assert batch.stderr.tobytes() == np.array([a.stderr for a in alone]).tobytes()
+
+
+def test_regimes_of_many_spectra_at_once_are_those_of_each_alone():
+    from gearsym.analysis.regime import classify_regime, classify_regimes
+
+    rng = np.random.default_rng(7)
+    exponents = rng.normal(0, 0.05, (400, 3))
+    stderr = np.where(rng.random((400, 3)) < 0.2, np.nan, rng.uniform(0, 0.02, (400, 3)))
+    measured = rng.uniform(50, 5000, 400)
+    for autonomous in (False, True):
+        alone = [classify_regime(e, s, t, autonomous) for e, s, t in zip(exponents, stderr, measured)]
+        assert classify_regimes(exponents, stderr, measured, autonomous) == alone
+        assert len(set(alone)) >= 3  # (the draw covers several regimes)
+
+
+def test_batches_of_any_size_write_the_same_files(tmp_path, one_stage, monkeypatch):
+    import gearsym.sweep.run as sweep_run
+
+    axes = {"omega": [0.8, 0.9, 1.0, 1.1, 1.2]}
+    run_sweep(one_stage, axes, direction="both", options=RUN, progress=False, out=tmp_path / "a.csv")
+    monkeypatch.setattr(sweep_run, "POINTS_PER_BATCH", 2)  # batches of 2, 2, 1 each way
+    run_sweep(one_stage, axes, direction="both", options=RUN, progress=False, out=tmp_path / "b.csv")
+    for name in ("{}.csv", "{}.poincare.csv"):
+        assert (tmp_path / name.format("a")).read_bytes() == (tmp_path / name.format("b")).read_bytes()
+
+
+def test_a_point_that_fails_keeps_the_points_of_its_batch_before_it(tmp_path):
+    from gearsym.errors import GearsymError
+    from gearsym.sweep import read_sweep
+
+    out = tmp_path / "s.csv"
+    with pytest.raises(GearsymError, match=r"at sigma=1000 \(up\): .*non-finite"):
+        run_sweep(conftest.compiled("lorenz"), ["sigma=8,10,1000,12"], options=Integration(periods=10, discard=2),
+                  progress=False, out=out, workers=gearsym_workers(1))
+    assert read_sweep(out)["sigma"].tolist() == [8.0, 10.0, 12.0]  # (the grid runs in ascending order)
+
+
+def test_an_error_of_the_writer_thread_is_raised_not_lost(tmp_path, one_stage, monkeypatch):
+    from gearsym.sweep.store import PoincareRows, lock_path
+
+    import threading
+
+    text = PoincareRows.text
+
+    def full_disk(self):
+        if threading.current_thread().name == "gearsym-sweep-writer":  # (only where the appended points go)
+            raise OSError(28, "No space left on device")
+        return text(self)
+
+    monkeypatch.setattr(PoincareRows, "text", full_disk)
+    with pytest.raises(OSError, match="No space left"):
+        run_sweep(one_stage, {"omega": [1.0, 1.2]}, options=RUN, progress=False, out=tmp_path / "s.csv")
+    assert not lock_path(tmp_path / "s.csv").exists()  # the lock is let go all the same
+
+
+def gearsym_workers(jobs: int):
+    from gearsym import Workers
+
+    return Workers(jobs=jobs)

@@ -18,11 +18,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..checks import json_safe
-from ..codegen import CompiledModel, engine_verb
+from ..codegen import CompiledModel, TangentRuns, engine_verb
 from ..errors import warn
 from ..options import Integration
-from .orbits import amplitudes
-from .regime import EQUILIBRIUM, classify_regime
+from .regime import EQUILIBRIUM, classify_regime, classify_regimes
 from .statistics import batch_means_stderr
 
 #: a run rests on a fixed point when, over the measured periods, the state moves by no more than this and
@@ -128,37 +127,67 @@ def lyapunov_spectrum(model: CompiledModel, *, options: Integration | None = Non
         start = ", ".join(f"{n}={v:g}" for n, v in zip(model.state_names, model.initial_state()))
         warn(f"{model.name}: the initial state ({start}) is a fixed point, so the run stays there; "
              "give another initial state (initial=... in the model, y0=... or --y0)")
-    run = model.tangent_run(y0, options.periods, inputs)
-    discard = options.discard
-
-    measured = run.log_stretch[:, discard:] / inputs.period  # per unit time, each period
-    count = measured.shape[1]
-    exponents = measured.mean(axis=1)
-    stderr = batch_means_stderr(measured)
-    history = np.cumsum(measured, axis=1).T / np.arange(1, count + 1)[:, None]
-    final = run.strobe[:, -1]
-    eigenvalues = _fixed_point_eigenvalues(model, run, discard, p)
-    if eigenvalues is not None:  # the exponents of a fixed point, exactly
-        exponents, stderr = eigenvalues.real.copy(), np.zeros_like(stderr)
-    order = np.argsort(-exponents, kind="stable")
+    runs = TangentRuns(model.dimension, len(model.observed), options.periods, 1)
+    run = model.tangent_run(y0, options.periods, inputs, out=runs.slot(0))
+    summary = summarise_runs(model, runs, p[None, :], np.array([inputs.period]), options.discard)
+    measured = runs.log_stretch[0, options.discard:] / inputs.period  # (measured periods, n), each period
+    history = np.cumsum(measured, axis=0) / np.arange(1, measured.shape[0] + 1)[:, None]
     return LyapunovSpectrum(
         model=model.name,
         parameters=dict(zip(model.parameter_names, map(float, p))),
-        exponents=exponents[order],
-        stderr=stderr[order],
-        history=history[:, order],
-        amplitude=amplitudes(model.observed, run.low[:, discard:], run.high[:, discard:]),
-        final_state=dict(zip(model.state_names, map(float, final))),
-        strobe=run.strobe[:, discard:],
+        exponents=summary.exponents[0],
+        stderr=summary.stderr[0],
+        history=history[:, summary.order[0]],
+        amplitude=dict(zip(model.observed, map(float, summary.amplitude[0]))),
+        final_state=dict(zip(model.state_names, map(float, runs.strobe[0, -1]))),
+        strobe=run.strobe[:, options.discard:],
         periods=options.periods,
-        discard=discard,
+        discard=options.discard,
         steps_per_period=model.steps_per_period,
         period=inputs.period,
         backend=model.backend,
         autonomous=model.system.autonomous,
         info={"Q": run.Q, "locate_crossings": model.options.locate_crossings},
-        eigenvalues=None if eigenvalues is None else eigenvalues[order],
+        eigenvalues=summary.eigenvalues[0],
     )
+
+
+@dataclass(frozen=True)
+class RunsSummary:
+    """What the per-period records of several tangent runs of one model say, computed for all at once."""
+
+    exponents: np.ndarray  # (runs, n): descending, per unit time
+    stderr: np.ndarray  # (runs, n): batch-means standard errors, in the order of the exponents
+    order: np.ndarray  # (runs, n): the Gram-Schmidt index of each exponent
+    amplitude: np.ndarray  # (runs, observed): A = (max - min)/2 over the measured periods
+    eigenvalues: list  # per run: the Jacobian's eigenvalues at the fixed point it rested on (sorted), or None
+    regimes: list[str]
+
+
+def summarise_runs(model: CompiledModel, runs: TangentRuns, p: np.ndarray, period: np.ndarray,
+                   discard: int) -> RunsSummary:
+    """The spectra of the first ``len(p)`` runs of ``runs``, made at the parameter vectors ``p`` (runs x
+    parameters) with forcing periods ``period``, averaged over the periods after ``discard``. One set of
+    array operations serves them all: a sweep summarises its points in batches, and
+    :func:`lyapunov_spectrum` is the batch of one."""
+    count = len(p)
+    measured = runs.log_stretch[:count, discard:] / period[:, None, None]  # per unit time, each period
+    exponents = measured.mean(axis=1)
+    stderr = batch_means_stderr(measured, axis=1)
+    eigenvalues = [_fixed_point_eigenvalues(model, runs.strobe[i, discard:], runs.low[i, discard:],
+                                            runs.high[i, discard:], p[i]) for i in range(count)] \
+        if model.system.autonomous else [None] * count
+    for i, values in enumerate(eigenvalues):
+        if values is not None:  # the exponents of a fixed point, exactly
+            exponents[i], stderr[i] = values.real, 0.0
+    order = np.argsort(-exponents, axis=1, kind="stable")
+    exponents, stderr = (np.take_along_axis(a, order, axis=1) for a in (exponents, stderr))
+    eigenvalues = [None if e is None else e[o] for e, o in zip(eigenvalues, order)]
+    measured_time = (runs.log_stretch.shape[1] - discard) * period
+    regimes = classify_regimes(exponents, stderr, measured_time, model.system.autonomous)
+    regimes = [EQUILIBRIUM if e is not None else r for e, r in zip(eigenvalues, regimes)]
+    amplitude = (runs.high[:count, discard:].max(axis=1) - runs.low[:count, discard:].min(axis=1)) / 2
+    return RunsSummary(exponents, stderr, order, amplitude, eigenvalues, regimes)
 
 
 def _rests(compiled, y: np.ndarray, p: np.ndarray) -> bool:
@@ -166,15 +195,13 @@ def _rests(compiled, y: np.ndarray, p: np.ndarray) -> bool:
     return bool(np.max(np.abs(compiled.rhs(0.0, y, p))) <= AT_REST * (1 + np.max(np.abs(y))))
 
 
-def _fixed_point_eigenvalues(compiled, run, discard: int, p: np.ndarray) -> np.ndarray | None:
-    """The Jacobian's eigenvalues where an autonomous run stayed over its measured periods, if it stayed
-    on a fixed point; None otherwise (and always for forced systems, whose fixed points of the
-    stroboscopic map are periodic orbits)."""
-    if not compiled.system.autonomous:
-        return None
-    strobe = run.strobe[:, discard:]
-    y = strobe[:, -1]
-    moved = max(np.ptp(strobe, axis=1).max(), np.max(run.high[:, discard:] - run.low[:, discard:], initial=0.0))
+def _fixed_point_eigenvalues(compiled, strobe: np.ndarray, low: np.ndarray, high: np.ndarray,
+                             p: np.ndarray) -> np.ndarray | None:
+    """The Jacobian's eigenvalues where an autonomous run stayed over its measured periods (``strobe``,
+    ``low``, ``high``: periods x rows), if it stayed on a fixed point; None otherwise (the fixed points of
+    a forced system's stroboscopic map are periodic orbits, not rests)."""
+    y = strobe[-1]
+    moved = max(np.ptp(strobe, axis=0).max(), np.max(high - low, initial=0.0))
     if moved > AT_REST * (1 + np.max(np.abs(y))) or not _rests(compiled, y, p):
         return None
     return np.linalg.eigvals(compiled.jacobian(0.0, y, p))

@@ -34,10 +34,10 @@ ZERO_SIGMAS = 3.0
 ZERO_BIAS = 5.0
 
 
-def zero_band(stderr: Sequence[float], measured_time: float) -> np.ndarray:
+def zero_band(stderr: Sequence[float], measured_time) -> np.ndarray:
     """Half-width of the band around zero, per exponent (NaN errors: the bias term alone)."""
-    err = np.nan_to_num(np.asarray(stderr, dtype=float), nan=0.0)
-    return np.maximum(ZERO_SIGMAS * err, ZERO_BIAS / float(measured_time))
+    err = np.asarray(stderr, dtype=float)
+    return np.fmax(ZERO_SIGMAS * err, ZERO_BIAS / np.asarray(measured_time, dtype=float))
 
 
 def classify_regime(exponents: Sequence[float], stderr: Sequence[float], measured_time: float,
@@ -54,6 +54,19 @@ def classify_regime(exponents: Sequence[float], stderr: Sequence[float], measure
         if flow is None:
             return EQUILIBRIUM if (lam < 0).all() else _by_signs(lam, band)
         lam, band = np.delete(lam, flow), np.delete(band, flow)
+    return _by_signs(lam, band)
+
+
+def classify_regimes(exponents: np.ndarray, stderr: np.ndarray, measured_time: np.ndarray,
+                     autonomous: bool = False) -> list[str]:
+    """:func:`classify_regime` of many spectra at once (rows of ``exponents``/``stderr``, one measured time
+    each): a sweep's batch of points in a few array operations."""
+    lam = np.asarray(exponents, dtype=float)
+    if autonomous or lam.size == 0:  # (the flow exponent is left out point by point)
+        return [classify_regime(*row, autonomous) for row in zip(lam, stderr, measured_time)]
+    band = zero_band(stderr, np.asarray(measured_time, dtype=float)[:, None])
+    if not (np.isfinite(lam).all() and np.all(measured_time > 0)):
+        raise ValueError("exponents must be finite and the measured time positive")
     return _by_signs(lam, band)
 
 
@@ -85,11 +98,10 @@ def describe_regime(regime: str, exponents: Sequence[float], stderr: Sequence[fl
             f"system that does not come to rest) and is left out; of the others, {meaning}")
 
 
-def _by_signs(lam: np.ndarray, band: np.ndarray) -> str:
-    positive = int(np.sum(lam > band))
-    if positive >= 2:
-        return "hyperchaotic"
-    if positive == 1:
-        return "chaotic"
-    return "quasi-periodic" if np.any(np.abs(lam) <= band) else "periodic"
-
+def _by_signs(lam: np.ndarray, band: np.ndarray):
+    """The regime of a spectrum (1-D), or of each row (2-D), from how many exponents lie above the band."""
+    positive = np.sum(lam > band, axis=-1)
+    zero = np.any(np.abs(lam) <= band, axis=-1)
+    names = np.where(positive >= 2, "hyperchaotic", np.where(
+        positive == 1, "chaotic", np.where(zero, "quasi-periodic", "periodic")))
+    return names.tolist()

@@ -12,7 +12,7 @@ import importlib
 from typing import TYPE_CHECKING
 
 from .build import compile_model
-from .compiled import CompiledModel, RunInputs, TangentRun
+from .compiled import CompiledModel, RunInputs, TangentRun, TangentRuns
 from .compiler import CompilerError, cache_dir
 from .loops import LoopOptions
 from .verbs import engine_verb
@@ -21,7 +21,7 @@ from .verbs import engine_verb
 _GENERATOR = {"build_functions": "gearsym.codegen.functions", "code_hash": "gearsym.codegen.generate",
               "write_code": "gearsym.codegen.generate"}
 
-__all__ = ["CompiledModel", "CompilerError", "LoopOptions", "RunInputs", "TangentRun", "build_functions",
+__all__ = ["CompiledModel", "CompilerError", "LoopOptions", "RunInputs", "TangentRun", "TangentRuns", "build_functions",
            "cache_dir", "code_hash", "compile_model", "engine_verb", "write_code"]
 
 

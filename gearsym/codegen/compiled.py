@@ -63,6 +63,35 @@ class TangentRun:
     Q: np.ndarray  # final orthonormal tangent vectors (columns)
 
 
+class TangentRuns:
+    """Room for the per-period records of up to ``size`` tangent runs, to be summarised together (a sweep's
+    batch of points): each record is stacked period after period, as the loops write it, so ``slot(i)`` is
+    the ``out`` of :meth:`CompiledModel.tangent_run` for run i, and ``strobe[:k]`` etc. are runs 0..k-1 as
+    (runs, periods, rows) arrays. The addresses the native loops need are taken once, here
+    (:meth:`CompiledModel.tangent_run_into`)."""
+
+    def __init__(self, dimension: int, observed: int, periods: int, size: int):
+        self.strobe, self.log_stretch = (np.empty((size, periods, dimension)) for _ in range(2))
+        self.low, self.high = (np.empty((size, periods, observed)) for _ in range(2))
+        self.size, self.periods = size, periods
+        self.start, self.eye = np.empty(dimension), np.asfortranarray(np.eye(dimension))
+        self.Q = [np.empty((dimension, dimension), order="F") for _ in range(2)]
+        records = (self.strobe, self.log_stretch, self.low, self.high)
+        self._bases = [a.ctypes.data for a in records]
+        self.strides = [a.shape[2] * 8 for a in records]  # bytes from one period's column to the next
+        self._slot_bytes = [a.shape[1] * a.shape[2] * 8 for a in records]
+        self.start_address, self.Q_addresses = self.start.ctypes.data, [q.ctypes.data for q in self.Q]
+        self.calls: dict[int, list] = {}  # slot -> its native calls, planned by the model in ``planned_by``
+        self.planned_by = None
+
+    def slot(self, i: int) -> tuple[np.ndarray, ...]:
+        return tuple(a[i].T for a in (self.strobe, self.log_stretch, self.low, self.high))
+
+    def addresses(self, i: int) -> list[int]:
+        """Where run i's strobe, log stretches, lows and highs start."""
+        return [base + i * size for base, size in zip(self._bases, self._slot_bytes)]
+
+
 @dataclass(frozen=True)
 class Shot:
     """Where a shot from y0 lands, with the exact Jacobian of the landing point by y0."""
@@ -159,7 +188,7 @@ class CompiledModel:
 
     def prepare(self, p: np.ndarray | Mapping[str, float] | None = None, t0: float = 0.0) -> RunInputs:
         p = self.parameter_vector(p) if p is None or isinstance(p, Mapping) else np.asarray(p, dtype=float)
-        if p.shape != (len(self.parameter_names),) or not np.all(np.isfinite(p)):
+        if p.shape != (len(self.parameter_names),) or not np.isfinite(p).all():
             raise GearsymError(f"{self.name}: expected {len(self.parameter_names)} finite parameter values "
                                f"({', '.join(self.parameter_names)}), got {p}")
         # a sweep's next point often changes only values outside the tables: then only the constants are new
@@ -206,21 +235,28 @@ class CompiledModel:
 
     def _with_constants(self, inputs: RunInputs, p: np.ndarray) -> RunInputs:
         """``inputs`` with the constants of ``p``, whose timed parameters are those of ``inputs``."""
-        if self.native:  # straight into the new constants (a continuation asks for thousands of them)
-            p = np.ascontiguousarray(p)
-            c, period = np.empty(inputs.constants.size), np.empty(1)
-            self.native["constants"].call((p.ctypes.data,), (c.ctypes.data, period.ctypes.data))
-        else:
+        if not self.native:
             c = np.array(self.functions["constants"](p)[0]).reshape(-1)
-        return RunInputs(p, inputs.table, c, inputs.period, inputs.t0, inputs.model_hash)
+            return RunInputs(p, inputs.table, c, inputs.period, inputs.t0, inputs.model_hash)
+        # straight into the new constants (a continuation asks for thousands of them): p, the constants and
+        # the period (not used: it is that of ``inputs``) share one block, so one address serves the call
+        k, size = p.size, inputs.constants.size
+        block = np.empty(k + size + 1)
+        block[:k] = p
+        at = block.ctypes.data
+        self.native["constants"].call((at,), (at + 8 * k, at + 8 * (k + size)))
+        new = RunInputs(block[:k], inputs.table, block[k:k + size], inputs.period, inputs.t0, inputs.model_hash)
+        new.__dict__["addresses"] = (inputs.addresses[0], at + 8 * k)  # (the cached property, known already)
+        return new
 
     def _retimed(self, before: np.ndarray, after: np.ndarray) -> bool:
         """Whether a parameter that enters the tables of time or the period differs between the vectors."""
-        return bool(np.any((after != before) & self._timed_mask))
+        timed = self._timed_index
+        return before.take(timed).tolist() != after.take(timed).tolist()
 
     @cached_property
-    def _timed_mask(self) -> np.ndarray:
-        return np.array([n in self.timed_parameters for n in self.parameter_names], dtype=bool)
+    def _timed_index(self) -> np.ndarray:
+        return np.array([i for i, n in enumerate(self.parameter_names) if n in self.timed_parameters], dtype=np.intp)
 
     def _check_periodic(self, p: np.ndarray, t0: float, period: float, probe: np.ndarray) -> None:
         """The loops repeat one sampled period; at other parameter values than the defaults
@@ -265,8 +301,10 @@ class CompiledModel:
         return y
 
     # ---------------------------------------------------------------- runs
-    def tangent_run(self, y0, periods: int, inputs: RunInputs, Q0=None) -> TangentRun:
-        """``periods`` forcing periods of the state and n tangent vectors, re-orthonormalised every period."""
+    def tangent_run(self, y0, periods: int, inputs: RunInputs, Q0=None,
+                    out: tuple[np.ndarray, ...] | None = None) -> TangentRun:
+        """``periods`` forcing periods of the state and n tangent vectors, re-orthonormalised every period.
+        ``out``: where to write the strobe, log stretches, lows and highs (a slot of :class:`TangentRuns`)."""
         self._check_inputs(inputs)
         n, m = self.dimension, len(self.observed)
         y = self.initial_state(y0)
@@ -274,39 +312,76 @@ class CompiledModel:
         if Q.shape != (n, n):
             raise GearsymError(f"{self.name}: tangent vectors must be a {n}x{n} matrix, got {Q.shape}")
         schedule = self._schedule(periods, "lyapunov")
+        if out is not None and [(a.shape, a.flags.f_contiguous) for a in out] != [
+                ((rows, periods), True) for rows in (n, n, m, m)]:
+            raise GearsymError(f"{self.name}: tangent_run(out=...) needs column-major arrays of {n}, {n}, {m} and "
+                               f"{m} rows by {periods} periods (a TangentRuns slot)")
         if self.native:
-            strobe, logs = (np.empty((n, periods), order="F") for _ in range(2))
-            low, high = (np.empty((m, periods), order="F") for _ in range(2))
-            Q = self._native_loop(schedule, y, [Q, np.empty_like(Q)], inputs, strobe, [strobe, logs, low, high])
+            strobe, logs, low, high = out or [np.empty((r, periods), order="F") for r in (n, n, m, m)]
+            Qs = [Q, np.empty_like(Q)]
+            final = self._native_loop(schedule, y.ctypes.data, [q.ctypes.data for q in Qs], inputs,
+                                      *_addresses(strobe, logs, low, high))
+            Q = Qs[final]
         else:
-            (strobe, logs, low, high), Q = self._casadi_loop(schedule, y, Q, inputs, (n, n, m, m))
+            records, Q = self._casadi_loop(schedule, y, Q, inputs, (n, n, m, m))
+            if out is not None:
+                for into, record in zip(out, records):
+                    into[...] = record
+            strobe, logs, low, high = out or records
         self._check_finite(inputs, strobe, logs)
         return TangentRun(strobe, logs, low, high, Q)
 
-    def _native_loop(self, schedule, y, Qs, inputs: RunInputs, strobe, outputs) -> np.ndarray | None:
-        """Chunk after chunk, writing straight into ``outputs`` (column-major, one column per period).
+    def tangent_run_into(self, runs: TangentRuns, i: int, y: np.ndarray, inputs: RunInputs) -> None:
+        """:meth:`tangent_run` of ``runs.periods`` periods from ``y`` (a state already checked) with tangent
+        vectors from the identity, into run i of ``runs``: a sweep's per-point path, every address taken
+        beforehand."""
+        if not self.native:
+            self.tangent_run(y, runs.periods, inputs, out=runs.slot(i))
+            return
+        self._check_inputs(inputs)
+        if runs.planned_by is not self:  # (the calls are this model's: a clone has work arrays of its own)
+            runs.calls, runs.planned_by = {}, self
+        calls = runs.calls.get(i)
+        if calls is None:
+            calls = runs.calls[i] = self._chunk_calls(self._schedule(runs.periods, "lyapunov"), runs.start_address,
+                                                      runs.Q_addresses, runs.addresses(i), runs.strides)
+        runs.start[:] = y
+        runs.Q[0][...] = runs.eye
+        shared = inputs.addresses
+        for f, args, results in calls:
+            f.call((*args, *shared), results)
+        self._check_finite(inputs, runs.strobe[i], runs.log_stretch[i])
 
-        The start state of each chunk is read where the previous chunk wrote its last period; with
-        tangent vectors (``Qs``: two n x n buffers), Q ping-pongs between the two.
-        """
-        n = self.dimension
-        shared = [inputs.table.ctypes.data, inputs.constants.ctypes.data]  # RunInputs keeps both contiguous
-        bases, strides = [o.ctypes.data for o in outputs], [o.shape[0] * 8 for o in outputs]
-        Q_addr = [q.ctypes.data for q in Qs]
-        y_addr, col, strobe_base = y.ctypes.data, 0, strobe.ctypes.data
+    def _native_loop(self, schedule, y: int, Q: list[int], inputs: RunInputs, bases: list[int],
+                     strides: list[int]) -> int:
+        """Chunk after chunk from the state at address ``y``, writing straight into the outputs (the first
+        is the strobe), one column of ``strides`` bytes per period from ``bases``; with tangent vectors
+        (``Q``: the addresses of two n x n buffers) returns the index of the one holding the final Q."""
+        calls = self._chunk_calls(schedule, y, Q, bases, strides)
+        shared = inputs.addresses
+        for f, args, results in calls:
+            f.call((*args, *shared), results)
+        return len(calls) % 2
+
+    def _chunk_calls(self, schedule, y: int, Q: list[int], bases: list[int], strides: list[int]) -> list[tuple]:
+        """The native calls of a run, as (function, arguments before the table and constants, results).
+
+        The start state of each chunk is read where the previous chunk wrote its last period; Q ping-pongs
+        between its two buffers. The addresses depend only on the buffers, so a sweep plans the calls of each
+        of its buffers' slots once (:meth:`tangent_run_into`)."""
+        strobe, stride, col, calls = bases[0], strides[0], 0, []
         for fname, count in schedule:
             f, width = self.native[fname], (self.options.chunk_periods if fname.endswith("chunk") else 1)
             for _ in range(count):
                 at = [b + col * s for b, s in zip(bases, strides)]
-                if Qs:
-                    f.call([y_addr, Q_addr[0], *shared], [at[0], Q_addr[1], *at[1:]])
-                    Q_addr.reverse()
-                    Qs.reverse()
+                if Q:
+                    k = len(calls) % 2
+                    calls.append((f, (y, Q[k]), (at[0], Q[1 - k], *at[1:])))
                 else:
-                    f.call([y_addr, *shared], at)
+                    calls.append((f, (y,), tuple(at)))
                 col += width
-                y_addr = strobe_base + (col - 1) * n * 8
-        return Qs[0] if Qs else None
+                y = strobe + (col - 1) * stride
+        return calls
 
     def _casadi_loop(self, schedule, y, Q, inputs: RunInputs, rows: tuple[int, ...]):
         """The in-process twin of ``_native_loop``: the same chunks through CasADi's calls, outputs stacked
@@ -392,7 +467,7 @@ class CompiledModel:
         if self.native:
             strobe = np.empty((n, periods), order="F")
             low, high = (np.empty((m, periods), order="F") for _ in range(2))
-            self._native_loop(schedule, y, [], inputs, strobe, [strobe, low, high])
+            self._native_loop(schedule, y.ctypes.data, [], inputs, *_addresses(strobe, low, high))
         else:
             (strobe, low, high), _ = self._casadi_loop(schedule, y, None, inputs, (n, m, m))
         self._check_finite(inputs, strobe)
@@ -435,6 +510,11 @@ class CompiledModel:
     def _schedule(self, periods: int, kind: str) -> list[tuple[str, int]]:
         chunks, rest = divmod(whole_number(periods, "periods"), self.options.chunk_periods)
         return [(f"{kind}_chunk", chunks), (f"{kind}_period", rest)]
+
+
+def _addresses(*columns: np.ndarray) -> tuple[list[int], list[int]]:
+    """Where each column-major (rows x periods) array starts, and the bytes from one column to the next."""
+    return [a.ctypes.data for a in columns], [a.shape[0] * 8 for a in columns]
 
 
 def _hcat(blocks, rows: int) -> np.ndarray:

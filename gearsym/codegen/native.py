@@ -44,10 +44,8 @@ class NativeFunction:
 
     def call(self, args: Sequence[int], results: Sequence[int]) -> None:
         """Evaluate with input and output *addresses* (e.g. ``array.ctypes.data + offset``)."""
-        for i, a in enumerate(args):
-            self._arg[i] = a
-        for i, r in enumerate(results):
-            self._res[i] = r
+        self._arg[:len(args)] = args
+        self._res[:len(results)] = results
         if self._call(self._arg_ptr, self._res_ptr, self._iw_ptr, self._w_ptr, 0):
             raise GearsymError(f"the generated function {self.name} reported an error")
 

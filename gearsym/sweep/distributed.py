@@ -117,8 +117,8 @@ def _workers_ignore_ctrl_c():
 
 
 def execute_dask(run, tasks: list[tuple[list[Point], np.ndarray]], client,
-                 info: dict | None = None) -> Iterator[tuple[dict, list[dict]]]:
-    """Yield (row, Poincare rows) as points finish on the cluster of ``client``, like ``run._execute``;
+                 info: dict | None = None) -> Iterator[list[tuple[dict, list]]]:
+    """Yield batches of (row, Poincare rows) as points finish on the cluster of ``client``, like ``run._execute``;
     ``info`` is filled with the scheduler's address and the workers and threads it has.
 
     On an error or Ctrl-C (the generator closed) every outstanding task is cancelled; the points already
@@ -189,11 +189,11 @@ _MODELS_LOCK = threading.Lock()
 _THREAD = threading.local()
 
 
-def sweep_points(shipped: ShippedModel, run, points: list[Point], previous) -> list[tuple[dict, list[dict]]]:
-    """A task on a worker: the rows of ``points``, started from ``previous`` (a state, or the rows of the
-    segment before: its last row's final state, read back exactly as a resume reads it)."""
+def sweep_points(shipped: ShippedModel, run, points: list[Point], previous) -> list[list[tuple[dict, list]]]:
+    """A task on a worker: the rows of ``points`` in batches, started from ``previous`` (a state, or the
+    batches of the segment before: its last row's final state, read back exactly as a resume reads it)."""
     compiled = worker_model(shipped)
-    state = previous if isinstance(previous, np.ndarray) else run.final_state(previous[-1][0], compiled.state_names)
+    state = previous if isinstance(previous, np.ndarray) else run.final_state(previous[-1][-1][0], compiled.state_names)
     return list(run.task(compiled, points, state))
 
 

@@ -12,7 +12,7 @@ import numpy as np
 from ..analysis.jumps import find_jumps, hysteresis_intervals
 from ..errors import GearsymError
 from .grid import INDEPENDENT, Axis
-from .store import read_rows, sidecar
+from .store import PoincareRows, read_rows, sidecar
 
 
 @dataclass(frozen=True)
@@ -33,11 +33,10 @@ class SweepResult:
 
     @classmethod
     def from_rows(cls, model, axes, mode, names: Sequence[str], rows: Sequence[dict],
-                  strobe_rows: Sequence[Sequence[str]], record: dict, path: Path | None = None,
+                  strobes: Sequence[PoincareRows], record: dict, path: Path | None = None,
                   strobe_columns: Sequence[str] = ()) -> "SweepResult":
-        """``rows``: one dict per point; ``strobe_rows``: the Poincare rows, fields in ``strobe_columns`` order."""
-        strobe = [dict(zip(strobe_columns, r)) for r in strobe_rows[:1]]  # (the column names, if any row)
-        return cls(model, tuple(axes), mode, _columns(names, rows), _fields_columns(_keys(strobe), strobe_rows),
+        """``rows``: one dict per point; ``strobes``: their Poincare rows, in ``strobe_columns``."""
+        return cls(model, tuple(axes), mode, _columns(names, rows), _strobe_columns(strobe_columns, strobes),
                    record, path)
 
     def __len__(self) -> int:
@@ -96,16 +95,23 @@ def _ascending_on(values: np.ndarray, idx: np.ndarray, common: np.ndarray) -> np
     return keep[np.argsort(values[keep], kind="stable")]
 
 
-def _keys(rows: Sequence[dict]) -> list[str]:
-    return list(rows[0]) if rows else []
-
-
 def _columns(names: Sequence[str], rows: Sequence[dict]) -> dict[str, np.ndarray]:
     return {name: _typed(name, [r[name] for r in rows]) for name in names}
 
 
-def _fields_columns(names: Sequence[str], rows: Sequence[Sequence[str]]) -> dict[str, np.ndarray]:
-    return {name: _typed(name, [r[i] for r in rows]) for i, name in enumerate(names)}
+def _strobe_columns(names: Sequence[str], strobes: Sequence[PoincareRows]) -> dict[str, np.ndarray]:
+    """The Poincare table as columns (none without a sample)."""
+    strobes = [s for s in strobes if len(s.samples)]
+    if not strobes:
+        return {}
+    keys = len(strobes[0].where)
+    counts = [len(s.samples) for s in strobes]
+    columns = {name: _typed(name, np.repeat([s.where[i] for s in strobes], counts).tolist())
+               for i, name in enumerate(names[:keys])}
+    columns[names[keys]] = np.concatenate([np.arange(c, dtype=float) for c in counts])
+    states = np.concatenate([s.samples for s in strobes])
+    columns.update({name: states[:, i].copy() for i, name in enumerate(names[keys + 1:])})
+    return columns
 
 
 def _typed(name: str, values: list[str]) -> np.ndarray:
@@ -129,8 +135,14 @@ def read_sweep(path: str | Path) -> SweepResult:
     names = list(rows[0]) if rows else next(csv.reader(path.read_text().splitlines()), [])
     strobe_path = sidecar(path, ".poincare.csv")
     strobe = read_rows(strobe_path) if strobe_path.is_file() else []
+    keys = len(axes) + 1  # the swept values and the direction
+    points: dict[tuple, list] = {}
+    for r in strobe:
+        fields = tuple(r.values())
+        points.setdefault(fields[:keys], []).append(fields)
     try:
         return SweepResult.from_rows(record["model"], axes, record["mode"], names, rows,
-                                     [tuple(r.values()) for r in strobe], record, path, list(strobe[0]) if strobe else ())
+                                     [PoincareRows.from_fields(p, keys) for p in points.values()], record, path,
+                                     list(strobe[0]) if strobe else ())
     except (ValueError, TypeError) as exc:
         raise GearsymError(f"{path}: a value is not a number ({exc})") from None

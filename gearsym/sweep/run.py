@@ -1,7 +1,7 @@
 """Running a sweep: the Lyapunov spectrum and amplitudes at every point of a grid.
 
 The model is compiled once; every point only changes the parameter vector
-(the low-level call of :func:`~gearsym.analysis.lyapunov_spectrum`). Tasks
+(the low-level loops of :func:`~gearsym.analysis.lyapunov_spectrum`, summarised in batches). Tasks
 (single points, or whole continuation lines) run on ``jobs`` workers, each with
 its own clone of the compiled model: processes forked from this one where the
 OS can fork (they inherit the loaded model, so nothing is rebuilt, and they do
@@ -30,17 +30,20 @@ from pathlib import Path
 import numpy as np
 
 from ..version import __version__
-from ..analysis.lyapunov import lyapunov_spectrum
+from ..analysis.lyapunov import summarise_runs
 from ..checks import whole_number
-from ..codegen import CompiledModel, engine_verb
+from ..codegen import CompiledModel, TangentRuns, engine_verb
 from ..errors import GearsymError, UnknownParameterError
 from ..options import Integration
 from .grid import INDEPENDENT, Axis, Point, axes_from, plan, points
 from .result import SweepResult
-from .store import SweepStore, number, row_key
+from .store import PoincareRows, SweepStore, number, row_key
 
 #: stroboscopic samples kept per point for bifurcation diagrams
 POINCARE_SAMPLES = 50
+#: a task's points are summarised and handed on in batches of at most this many points, this much time
+#: (what a Ctrl-C or kill can cost) and this many bytes of per-period records
+POINTS_PER_BATCH, BATCH_SECONDS, BATCH_BYTES = 32, 0.2, 1 << 24
 #: ways to use more than one core of this machine (``run_sweep(parallel=...)``)
 PARALLEL = ("auto", "processes", "threads")
 
@@ -134,11 +137,11 @@ def run_sweep(
         finished = _execute_on(workers, run, todo, ran)
         _store_as_finished(finished, store, plan, done, strobes, progress, on_point, ran)
         rows = [done[p.key] for p in plan.points]
-        strobe_rows = [r for p in plan.points for r in strobes.get(p.key, [])]
-        result = SweepResult.from_rows(model.name, plan.axes, mode, plan.columns, rows, strobe_rows, plan.record,
+        poincare = [strobes[p.key] for p in plan.points if p.key in strobes]
+        result = SweepResult.from_rows(model.name, plan.axes, mode, plan.columns, rows, poincare, plan.record,
                                        path=store.path if store else None, strobe_columns=plan.strobe_columns)
         if store:
-            _finish_files(store, result, rows, strobe_rows, len(done) - already, time.perf_counter() - t_start, ran)
+            _finish_files(store, result, rows, poincare, len(done) - already, time.perf_counter() - t_start, ran)
         return result
     finally:
         if store:
@@ -211,14 +214,17 @@ def _store_as_finished(finished, store: SweepStore | None, plan: _SweepPlan, don
     is done, mark the record interrupted and say how to resume."""
     bar = _progress(len(plan.points), len(done), plan.record["model"], progress)
     try:
-        for row, strobe_rows in finished:
+        for batch in finished:
+            for row, poincare in batch:
+                if store:
+                    store.append(row, poincare)
+                key = row_key(row, plan.names)
+                done[key], strobes[key] = row, poincare
+                if on_point:
+                    on_point(row)
             if store:
-                store.append(row, strobe_rows)
-            key = row_key(row, plan.names)
-            done[key], strobes[key] = row, strobe_rows
-            bar.update(1)
-            if on_point:
-                on_point(row)
+                store.flush()
+            bar.update(len(batch))
     except KeyboardInterrupt:
         finished.close()  # now, not when the traceback lets go of it: workers stop, cluster tasks are cancelled
         bar.close()
@@ -234,14 +240,14 @@ def _store_as_finished(finished, store: SweepStore | None, plan: _SweepPlan, don
     bar.close()
 
 
-def _finish_files(store: SweepStore, result: SweepResult, rows, strobe_rows, computed: int, seconds: float,
+def _finish_files(store: SweepStore, result: SweepResult, rows, poincare, computed: int, seconds: float,
                   ran: dict) -> None:
     """Both tables rewritten in the plan's order, and the record completed with what the sweep found."""
     timing = {"seconds": round(seconds, 3), **({"dask": ran} if ran else {})}
     if not computed:  # a rerun of a finished sweep: keep the time it took, and where
         previous = store.previous_record()
         timing = {k: previous[k] for k in ("seconds", "dask") if k in previous} or timing
-    store.finish(rows, strobe_rows)
+    store.finish(rows, poincare)
     store.write_record(status="complete",
                        points={"planned": len(result), "done": len(rows), "computed": computed},
                        **timing, gearsym=__version__, **result.findings())
@@ -276,38 +282,67 @@ class _Run:
             state = self.start
         return task[count:], state
 
-    def point(self, compiled: CompiledModel, point: Point, y0: np.ndarray) -> tuple[dict, list[dict], np.ndarray]:
-        values = {**self.base, **dict(zip(self.names, point.values))}
-        try:
-            spectrum = lyapunov_spectrum(compiled, options=self.options, y0=y0, **values)
-        except GearsymError as exc:
-            where = ", ".join(f"{n}={v:g}" for n, v in zip(self.names, point.values))
-            raise GearsymError(f"at {where} ({point.direction}): {exc}") from None
-        n = compiled.dimension
-        row = {**{n_: number(v) for n_, v in zip(self.names, point.values)}, "direction": point.direction}
-        row.update({f"A_{c}": number(a) for c, a in spectrum.amplitude.items()})
-        row.update({f"lambda_{i + 1}": number(x) for i, x in enumerate(spectrum.exponents)})
-        row.update({f"stderr_{i + 1}": number(x) for i, x in enumerate(spectrum.stderr)})
-        row["regime"] = spectrum.regime
-        row.update({f"final_{s}": number(v) for s, v in spectrum.final_state.items()})
-        strobe = spectrum.strobe[:, spectrum.strobe.shape[1] - self.poincare:] if self.poincare else np.zeros((n, 0))
-        where = (*(row[k] for k in self.names), point.direction)
-        strobe_rows = [(*where, str(j), *map(repr, col))  # the strobe columns' fields (floats: repr is number())
-                       for j, col in enumerate(strobe.T.tolist())]
-        final = np.array([spectrum.final_state[s] for s in compiled.state_names])
-        return row, strobe_rows, final
-
     def task(self, compiled: CompiledModel, points: list[Point], state: np.ndarray):
-        """Yield (row, Poincare rows) point after point; a continuation hands each final state on."""
+        """Yield the (row, Poincare rows) of ``points`` in batches; a continuation hands each final state on.
+
+        The loops of each point write into a batch's shared records, which are summarised at once
+        (:func:`~gearsym.analysis.lyapunov.summarise_runs`) when the batch is full or has taken
+        ``BATCH_SECONDS``: the Python around a point is a few array operations shared by the batch, not its
+        own. A point that fails ends the task after the points before it are yielded."""
+        periods, n = self.options.periods, compiled.dimension
+        size = min(len(points), _batch_size(n, len(compiled.observed), periods))  # (a task of one point: one)
+        runs = TangentRuns(n, len(compiled.observed), periods, max(size, 1))
+        base = compiled.parameter_vector(self.base)
+        swept = [compiled.parameter_names.index(name) for name in self.names]
+        batch, started = [], time.perf_counter()
         for point in points:
-            row, strobe_rows, final = self.point(compiled, point, state)
+            p = base.copy()
+            p[swept] = point.values
+            try:
+                inputs = compiled.prepare(p)
+                compiled.tangent_run_into(runs, len(batch), state, inputs)
+            except GearsymError as exc:
+                if batch:
+                    yield self.rows(compiled, runs, batch)
+                where = ", ".join(f"{n_}={v:g}" for n_, v in zip(self.names, point.values))
+                raise GearsymError(f"at {where} ({point.direction}): {exc}") from None
+            batch.append((point, p, inputs.period))
             if point.direction != INDEPENDENT:
-                state = final
-            yield row, strobe_rows
+                state = runs.strobe[len(batch) - 1, -1].copy()
+            if len(batch) == runs.size or time.perf_counter() - started >= BATCH_SECONDS:
+                yield self.rows(compiled, runs, batch)
+                batch, started = [], time.perf_counter()
+        if batch:
+            yield self.rows(compiled, runs, batch)
+
+    def rows(self, compiled: CompiledModel, runs: TangentRuns, batch: list) -> list[tuple[dict, PoincareRows]]:
+        """The table rows and Poincare rows of the runs of ``batch`` ((point, parameters, period) each)."""
+        points, p, period = zip(*batch)
+        summary = summarise_runs(compiled, runs, np.array(p), np.array(period), self.options.discard)
+        count, n = len(batch), compiled.dimension
+        numbers = np.hstack([summary.amplitude, summary.exponents, summary.stderr]).tolist()
+        finals = runs.strobe[:count, -1].tolist()
+        strobes = runs.strobe[:count, self.options.periods - self.poincare:].copy()
+        fields, final_fields = self.columns[len(self.names) + 1:len(self.columns) - n - 1], self.columns[-n:]
+        out = []
+        for point, values, regime, final, strobe in zip(points, numbers, summary.regimes, finals, strobes):
+            where = (*map(number, point.values), point.direction)
+            row = dict(zip(self.names, where))
+            row["direction"] = point.direction
+            row.update(zip(fields, map(repr, values)))
+            row["regime"] = regime
+            row.update(zip(final_fields, map(repr, final)))
+            out.append((row, PoincareRows(where, strobe)))
+        return out
+
+
+def _batch_size(n: int, observed: int, periods: int) -> int:
+    """Points per batch: ``POINTS_PER_BATCH``, fewer when their records would pass ``BATCH_BYTES``."""
+    return max(1, min(POINTS_PER_BATCH, BATCH_BYTES // (8 * periods * (2 * n + 2 * observed))))
 
 
 def _execute(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], jobs: int):
-    """Yield (row, Poincare rows) as points finish; tasks run on up to ``jobs`` threads."""
+    """Yield batches of (row, Poincare rows) as points finish; tasks run on up to ``jobs`` threads."""
     if not tasks:
         return
     if jobs == 1 or len(tasks) == 1:  # no threads: simplest, and Ctrl-C stops at once
@@ -324,9 +359,9 @@ def _execute(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], jobs: int):
             compiled = local.compiled = run.compiled.clone()
         if stop.is_set():
             return
-        for item in run.task(compiled, task, state):
-            results.put(item)
-            if stop.is_set():  # checked before the next point is computed
+        for batch in run.task(compiled, task, state):
+            results.put(batch)
+            if stop.is_set():  # checked before the next batch is computed
                 return
 
     pool = ThreadPoolExecutor(max_workers=min(jobs, len(tasks)), thread_name_prefix="gearsym-sweep")
@@ -341,7 +376,7 @@ def _execute(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], jobs: int):
                 if failed:
                     raise failed.exception()
                 continue
-            pending -= 1
+            pending -= len(item)
             yield item
     finally:
         stop.set()  # on an error or Ctrl-C: threads stop after their current point
@@ -350,7 +385,7 @@ def _execute(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], jobs: int):
 
 def _execute_processes(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], jobs: int):
     """``_execute`` on ``jobs`` processes forked from this one (they inherit the loaded model: nothing is
-    rebuilt or shipped). Rows come back one by one through a queue, so the files, the progress bar and
+    rebuilt or shipped). Rows come back in batches through a queue, so the files, the progress bar and
     Ctrl-C behave as with threads; the threads' shared lock, which serialises the Python around every
     point (analysis, row formatting), is gone."""
     global _FORKED
@@ -383,7 +418,7 @@ def _execute_processes(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], j
                 continue
             if kind == "error":
                 raise GearsymError(item)
-            pending -= 1
+            pending -= len(item)
             yield item
     finally:
         _FORKED = None
@@ -408,8 +443,8 @@ def _process_worker(todo, done) -> None:
     while (index := todo.get()) is not None:
         task, state = tasks[index]
         try:
-            for item in run.task(compiled, task, state):
-                done.put(("row", item))
+            for batch in run.task(compiled, task, state):
+                done.put(("rows", batch))
         except Exception as exc:  # the message is what the parent reports
             done.put(("error", str(exc)))
             return

@@ -3,7 +3,8 @@
 Three files share a stem: ``FILE.csv`` (one row per point), ``FILE.json``
 (how the sweep was made and, at the end, what it found) and
 ``FILE.poincare.csv`` (the last stroboscopic samples of every point, for
-bifurcation diagrams). Rows are flushed one by one; a row cut off by a kill
+bifurcation diagrams). Rows are written by a thread of the store's own and flushed after each batch of
+points (at most a fraction of a second of work); a row cut off by a kill
 is dropped when the sweep resumes. Running the same command again resumes:
 the record in ``FILE.json`` must match the new command (else the error says
 what differs). When every point is done, both CSV files are rewritten in the
@@ -20,10 +21,15 @@ import io
 import json
 import operator
 import os
+import queue
 import socket
+import threading
 import time
 from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
+
+import numpy as np
 
 from ..errors import GearsymError
 from ..files import write_atomically
@@ -31,6 +37,30 @@ from ..files import write_atomically
 
 def number(x: float) -> str:
     return repr(float(x))
+
+
+@dataclass(frozen=True)
+class PoincareRows:
+    """One point's rows of the Poincare table: the point's fields as its main row writes them (swept values,
+    direction) and its samples (samples x states, floats: written with ``repr``, so a file read back gives
+    the same rows, to the bit)."""
+
+    where: tuple[str, ...]
+    samples: np.ndarray
+
+    def text(self) -> str:
+        """The CSV lines (fields: where, sample index, states)."""
+        head, n = ",".join(self.where) + ",", self.samples.shape[1]
+        reprs = list(map(float.__repr__, self.samples.ravel().tolist()))
+        return "".join([f"{head}{j},{','.join(reprs[k:k + n])}\n" for j, k in enumerate(range(0, len(reprs), n))])
+
+    @classmethod
+    def from_fields(cls, rows: Sequence[Sequence[str]], keys: int) -> "PoincareRows":
+        """One point's rows as read from the table (``keys``: the fields before the sample index)."""
+        return cls(tuple(rows[0][:keys]), np.array([r[keys + 1:] for r in rows], dtype=float).reshape(len(rows), -1))
+
+
+_FLUSH = object()  # the writer thread's signal to flush
 
 
 def sidecar(path: Path, suffix: str) -> Path:
@@ -53,6 +83,9 @@ class SweepStore:
         self._files: list = []
         self._lock_fd: int | None = None
         self._appended: list[dict] | None = None  # the rows appended after a fresh start, in their order
+        self._thread: threading.Thread | None = None  # the writer, started by the first append
+        self._queue: queue.SimpleQueue | None = None
+        self._failed: BaseException | None = None
 
     # ------------------------------------------------------------ opening
     def open(self, overwrite: bool = False) -> tuple[dict[tuple, dict], dict[tuple, list[dict]]]:
@@ -65,11 +98,13 @@ class SweepStore:
         elif self.path.exists() and (read_rows(self.path) if self.meta_path.exists() else True):
             self._check_record()  # (a file with no finished point is simply started again)
             done = self._read(self.path, self.columns)
-            strobes = {}
+            fields = {}
             if self.strobe_path.exists():
                 for row in read_rows(self.strobe_path, self.strobe_columns):
-                    strobes.setdefault(self.key(row), []).append(tuple(row.values()))
-            strobes = {k: v for k, v in strobes.items() if k in done}  # written before their main row
+                    fields.setdefault(self.key(row), []).append(tuple(row.values()))
+            keys = len(self.key_columns)
+            strobes = {k: PoincareRows.from_fields(v, keys) for k, v in fields.items()
+                       if k in done}  # (rows written before their main row are dropped)
             lacking = [k for k in done if k not in strobes]
             if self.record.get("poincare_samples") and lacking:
                 raise GearsymError(f"{self.strobe_path} lacks the Poincare samples of {len(lacking)} finished "
@@ -77,9 +112,11 @@ class SweepStore:
                                    "--overwrite to start again")
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._write_table(self.path, self.columns, map(_fields(self.columns), done.values()))  # (drops a row cut off)
-        self._write_table(self.strobe_path, self.strobe_columns, (r for rows in strobes.values() for r in rows))
+        self._write_table(self.strobe_path, self.strobe_columns, (), "".join(r.text() for r in strobes.values()))
         self.write_record(status="running")
         self._files = [open(p, "a", newline="") for p in (self.strobe_path, self.path)]
+        self._main_writer = _writer(self._files[1])
+        self._main_fields = _fields(self.columns)
         self._appended = None if done else []
         return done, strobes
 
@@ -116,21 +153,58 @@ class SweepStore:
 
 
     # ------------------------------------------------------------ writing
-    def append(self, row: dict, strobe_rows: Iterable[tuple[str, ...]]) -> None:
-        """One finished point: its Poincare rows (fields in the order of the columns) first, then its row
-        (whose presence marks it done)."""
-        strobe_file, main_file = self._files
-        _writer(strobe_file).writerows(strobe_rows)
-        strobe_file.flush()
-        _writer(main_file).writerow(_fields(self.columns)(row))
-        main_file.flush()
-        if self._appended is not None:
-            self._appended.append(row)
+    def append(self, row: dict, poincare: PoincareRows) -> None:
+        """One finished point: its Poincare rows first, then its row (whose presence marks it done); on disk
+        at the next :meth:`flush`. The formatting and writing happen on the store's writer thread: the
+        native loops release Python's lock, so the ``repr`` of every sample overlaps the next points'
+        integration instead of adding to it."""
+        self._writer().put((row, poincare))
+
+    def flush(self) -> None:
+        """Put every point appended so far on disk (without waiting for it)."""
+        self._writer().put(_FLUSH)
 
     def close(self) -> None:
+        """Write what was appended, stop the writer thread and close the files; an error of the writer is
+        raised here."""
+        thread, self._thread = self._thread, None
+        if thread is not None:
+            self._queue.put(None)
+            thread.join()
         for f in self._files:
             f.close()
         self._files = []
+        failed, self._failed = self._failed, None
+        if failed is not None:
+            raise failed
+
+    def _writer(self) -> queue.SimpleQueue:
+        if self._failed is not None:
+            self.close()  # raises it
+        if self._thread is None:
+            self._queue = queue.SimpleQueue()
+            self._thread = threading.Thread(target=self._write_appended, name="gearsym-sweep-writer", daemon=True)
+            self._thread.start()
+        return self._queue
+
+    def _write_appended(self) -> None:
+        strobe_file, main_file = self._files
+        try:
+            while (item := self._queue.get()) is not None:
+                if item is _FLUSH:
+                    strobe_file.flush()
+                    main_file.flush()
+                    continue
+                row, poincare = item
+                strobe_file.write(poincare.text())
+                self._main_writer.writerow(self._main_fields(row))
+                if self._appended is not None:
+                    self._appended.append(row)
+                time.sleep(0)  # let a loop that has finished its native call have the lock back at once
+        except BaseException as exc:  # (the disk full, ...): said by the next append, flush or close
+            self._failed = exc
+            while self._queue.get() is not None:  # the rest is dropped; close() waits for its None
+                pass
 
     def _lock(self) -> None:
         """One writer per sweep file: a second process on the same --out would interleave rows."""
@@ -139,12 +213,14 @@ class SweepStore:
 
     def release(self) -> None:
         """Close the files, remove the lock file and let another process have the sweep."""
-        self.close()
-        if self._lock_fd is not None:
-            release_lock(self.path, self._lock_fd)
-            self._lock_fd = None
+        try:
+            self.close()
+        finally:
+            if self._lock_fd is not None:
+                release_lock(self.path, self._lock_fd)
+                self._lock_fd = None
 
-    def finish(self, rows: Iterable[dict], strobe_rows: Iterable[tuple[str, ...]]) -> None:
+    def finish(self, rows: Iterable[dict], strobes: Iterable[PoincareRows]) -> None:
         """All points done: both tables rewritten in plan order (the lock is kept until ``release``), unless
         they were written in it (a fresh sweep whose points finished in order: the rewrite would copy them)."""
         self.close()
@@ -153,7 +229,7 @@ class SweepStore:
                 a is b for a, b in zip(self._appended, rows)):
             return
         self._write_table(self.path, self.columns, map(_fields(self.columns), rows))
-        self._write_table(self.strobe_path, self.strobe_columns, strobe_rows)
+        self._write_table(self.strobe_path, self.strobe_columns, (), "".join(r.text() for r in strobes))
 
     def write_record(self, **extra) -> None:
         write_atomically(self.meta_path, json.dumps({"sweep": self.record, **extra}, indent=2) + "\n")
@@ -166,11 +242,13 @@ class SweepStore:
             return {}
 
     @staticmethod
-    def _write_table(path: Path, columns: list[str], rows: Iterable[Sequence[str]]) -> None:
+    def _write_table(path: Path, columns: list[str], rows: Iterable[Sequence[str]], text: str = "") -> None:
+        """The header, ``rows`` (fields) and ``text`` (lines already formatted)."""
         buffer = io.StringIO()
         writer = _writer(buffer)
         writer.writerow(columns)
         writer.writerows(rows)
+        buffer.write(text)
         write_atomically(path, buffer.getvalue())
 
 
