@@ -156,3 +156,18 @@ def gearsym_workers(jobs: int):
     from gearsym import Workers
 
     return Workers(jobs=jobs)
+
+
+def test_independent_points_are_dealt_out_in_shrinking_tasks_that_cover_them_in_order():
+    from gearsym.sweep.grid import INDEPENDENT, Point
+    from gearsym.sweep.run import _guided
+
+    start = np.zeros(2)
+    points = [Point(INDEPENDENT, (float(v),)) for v in range(191)]
+    tasks = _guided([([p], start) for p in points], workers=2)
+    sizes = [len(t) for t, _ in tasks]
+    assert [p for t, _ in tasks for p in t] == points and all(s is start for _, s in tasks)
+    assert sizes[0] == 48 and sizes == sorted(sizes, reverse=True) and sizes[-3:] == [1, 1, 1]
+    assert _guided([([p], start) for p in points], workers=1) == [(points, start)]  # one worker: one batch run
+    line = [([Point("up", (1.0,)), Point("up", (2.0,))], start)]
+    assert _guided(line, workers=2) is line  # continuation lines stay whole

@@ -203,9 +203,25 @@ def _execute_on(workers: Workers, run: "_Run", todo: list, ran: dict):
     """The rows of ``todo`` as they finish, from wherever ``workers`` says the points run."""
     if workers.scheduler is not None:
         return _execute_dask(run, todo, workers.scheduler, workers.jobs, ran)
+    todo = _guided(todo, min(workers.count, len(todo)))
     if workers.mode == "processes" and workers.count > 1 and len(todo) > 1:
         return _execute_processes(run, todo, workers.count)
     return _execute(run, todo, workers.count)
+
+
+def _guided(tasks: list[tuple[list[Point], np.ndarray]], workers: int) -> list[tuple[list[Point], np.ndarray]]:
+    """Independent points (a task each, all from the same start) regrouped into tasks that shrink as the
+    sweep goes: each takes half of what is left per worker, down to single points. A task's points are
+    summarised as one batch, so few large tasks cost little around each point, and the small ones at the
+    end keep the workers finishing together. Continuation lines are left as they are."""
+    if not tasks or tasks[0][0][0].direction != INDEPENDENT:
+        return tasks
+    points, start, out = [p for task, _ in tasks for p in task], tasks[0][1], []
+    while points:
+        size = max(1, -(-len(points) // (2 * workers))) if workers > 1 else len(points)
+        out.append((points[:size], start))
+        points = points[size:]
+    return out
 
 
 def _store_as_finished(finished, store: SweepStore | None, plan: _SweepPlan, done: dict, strobes: dict,
