@@ -31,6 +31,20 @@ from ..errors import GearsymError
 
 DEFAULT_FLAGS = ("-O3", "-march=native", "-fno-tree-partial-pre")
 
+#: compiled into every library beside the generated code: the entry points are called through it, with the
+#: stack moved to a fixed place modulo 4 KiB relative to the caller's work arrays (see :mod:`.native`)
+CALL_SOURCE = r"""
+#include <stdint.h>
+#include <alloca.h>
+typedef int (*gearsym_entry)(const double**, double**, long long*, double*, int);
+int gearsym_call(gearsym_entry f, const double** arg, double** res, long long* iw, double* w, const void* anchor) {
+    char here;
+    volatile char* gap = alloca((((uintptr_t)&here - (uintptr_t)anchor) & 4095) + 1);
+    gap[0] = 0;
+    return f(arg, res, iw, w, 0);
+}
+"""
+
 
 class CompilerError(GearsymError):
     """No usable C compiler, or the compiler failed."""
@@ -122,7 +136,7 @@ def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple
     if cc is None:
         raise CompilerError(REQUIRED_NOTE.format(what=compilers_looked_for()))
     flags = compile_flags() if flags is None else tuple(flags)
-    digest = hashlib.sha256(Path(source).read_bytes()).hexdigest()[:16]
+    digest = hashlib.sha256(Path(source).read_bytes() + CALL_SOURCE.encode()).hexdigest()[:16]
     target = cache_dir() / "lib" / f"{name}-{digest}-{_machine_key(cc, flags)}.so"
     if target.is_file():
         return Library(target, False, 0.0)
@@ -131,8 +145,9 @@ def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple
         announce(f"compiling {name} ({' '.join(flags)}; once: cached in {target.parent})")
     start = time.perf_counter()
     with tempfile.TemporaryDirectory(dir=target.parent) as tmp:
-        out = Path(tmp) / target.name
-        cmd = [*shlex.split(cc), *flags, "-fPIC", "-shared", "-o", str(out), str(source), "-lm"]
+        out, call = Path(tmp) / target.name, Path(tmp) / "gearsym_call.c"
+        call.write_text(CALL_SOURCE)
+        cmd = [*shlex.split(cc), *flags, "-fPIC", "-shared", "-o", str(out), str(source), str(call), "-lm"]
         try:
             proc = subprocess.run(cmd, capture_output=True, text=True)
         except OSError as exc:
