@@ -10,8 +10,15 @@ lets the compiler use the CPU's fused multiply-add (measured 1.3x on the
 tangent loop) and makes the library specific to this CPU (part of the cache
 key). Partial redundancy elimination, on at -O3, lengthens live ranges in the
 long straight-line RK4 step: switching it off measured 8 % faster (58 -> 54 ns
-per flexible-shaft step). Set ``GEARSYM_CFLAGS`` to change the flags, e.g.
-``-O3`` for results bit-identical to CasADi's in-process evaluation.
+per flexible-shaft step). Measured again with the placement of the work arrays
+fixed (:mod:`.native`), 24 loads each on an AMD EPYC with AVX2, median ns per step
+of one_stage and flexible_shaft, paper's scheme / crossings located: these flags
+53.5/78.1 and 134/178; without ``-fno-tree-partial-pre`` 58.6/82.5 and 134/179;
+plain ``-O3`` 55.5/81.7 and 141/189; adding ``-mprefer-vector-width=128`` (what
+the hand-written C needs on AVX-512 CPUs) changed nothing (53.5/78.5, 134/178).
+Set ``GEARSYM_CFLAGS`` to change the flags, e.g. ``-O3`` for results
+bit-identical to CasADi's in-process evaluation. The flags are part of the
+library's cache key (:func:`_machine_key`), so a change rebuilds.
 """
 from __future__ import annotations
 
