@@ -47,11 +47,10 @@ DEFAULT_FLAGS = ("-O3", "-march=native", "-mtune=generic", "-fno-tree-partial-pr
 #: stack moved to a fixed place modulo 4 KiB relative to the caller's work arrays (see :mod:`.native`)
 CALL_SOURCE = r"""
 #include <stdint.h>
-#include <alloca.h>
 typedef int (*gearsym_entry)(const double**, double**, long long*, double*, int);
 int gearsym_call(gearsym_entry f, const double** arg, double** res, long long* iw, double* w, const void* anchor) {
     char here;
-    volatile char* gap = alloca((((uintptr_t)&here - (uintptr_t)anchor) & 4095) + 1);
+    volatile char* gap = __builtin_alloca((((uintptr_t)&here - (uintptr_t)anchor) & 4095) + 1);
     gap[0] = 0;
     return f(arg, res, iw, w, 0);
 }
