@@ -1,6 +1,7 @@
 """Code generation: translation, splitting, determinism, the committed generated/, cache, fallback."""
 from __future__ import annotations
 
+import ctypes
 import os
 import subprocess
 import sys
@@ -270,6 +271,26 @@ def test_initial_state_may_be_any_array_view_and_Q0_is_not_changed():
     kept = Q0.copy()
     again = cm.tangent_run(base.strobe[:, -1], 3, inputs, Q0=Q0)
     assert np.array_equal(Q0, kept) and again.Q is not Q0
+
+
+def test_every_load_places_the_work_arrays_and_the_stack_the_same_way():
+    """Where the arrays sit modulo 4 KiB decides the speed of every step (bench/speed/notes.md): one page-aligned
+    block, each array on cache lines of its own, and the call through the stack-anchoring entry of the library."""
+    cm = compile_model(system("one_stage"))
+    f = cm.clone().native["lyapunov_chunk"]
+    spans = sorted((address, address + size) for address, size in [
+        (f._arg_ptr, ctypes.sizeof(f._arg)), (f._res_ptr, ctypes.sizeof(f._res)),
+        (f._iw_ptr, f._iw.nbytes), (f._w_ptr, f._w.nbytes)])
+    assert f.base % 4096 == 0 and spans[0][0] == f.base
+    assert all(start % 64 == 0 for start, _ in spans)
+    assert all(end <= next_start for (_, end), (next_start, _) in zip(spans, spans[1:]))
+    assert f._aligned is not None  # (a library without the anchoring entry would run with the stack anywhere)
+    inputs = cm.prepare(cm.parameter_vector(omega=1.5))
+    anchored = cm.tangent_run(None, 60, inputs)
+    for g in cm.native.values():
+        g._aligned = None
+    direct = cm.tangent_run(None, 60, inputs)
+    assert np.array_equal(anchored.log_stretch, direct.log_stretch) and np.array_equal(anchored.Q, direct.Q)
 
 
 def test_inputs_prepared_for_another_model_are_refused():

@@ -5,13 +5,25 @@ or ``~/.cache/gearsym``) under a name that hashes the source, the compiler and
 its flags, so an unchanged model is never compiled twice and a changed one
 never picks up a stale library.
 
-Default flags: ``-O3 -march=native -fno-tree-partial-pre``. ``-march=native``
-lets the compiler use the CPU's fused multiply-add (measured 1.3x on the
-tangent loop) and makes the library specific to this CPU (part of the cache
-key). Partial redundancy elimination, on at -O3, lengthens live ranges in the
+Default flags: ``-O3 -march=native -mtune=generic -fno-tree-partial-pre``.
+``-march=native`` lets the compiler use the CPU's fused multiply-add (measured
+1.3x on the tangent loop) and makes the library specific to this CPU (part of the
+cache key). ``-mtune=generic`` keeps that instruction set but schedules for
+current CPUs in general rather than for the one the compiler detected: on the
+AMD EPYC virtual machine of the measurements GCC 12 detects znver1, and its
+znver1 tuning made every loop ~10 % slower (same instructions, same results to
+the bit). Partial redundancy elimination, on at -O3, lengthens live ranges in the
 long straight-line RK4 step: switching it off measured 8 % faster (58 -> 54 ns
-per flexible-shaft step). Set ``GEARSYM_CFLAGS`` to change the flags, e.g.
-``-O3`` for results bit-identical to CasADi's in-process evaluation.
+per flexible-shaft step). Measured with the placement of the work arrays fixed
+(:mod:`.native`), 18-24 loads each, median ns per step (incl. the call) of
+one_stage and flexible_shaft, paper's scheme / crossings located: these flags
+48.5/73.0 and 127/170; without ``-mtune=generic`` 53.7/78.4 and 136/180; without
+``-fno-tree-partial-pre`` 54.9/76.2 and 127/170; plain ``-O3`` (no FMA)
+55.5/81.7 and 141/189; ``-mprefer-vector-width=128`` (what the hand-written C
+needs on AVX-512 CPUs) changed nothing. Set ``GEARSYM_CFLAGS`` to change the
+flags, e.g. ``-O3`` for results bit-identical to CasADi's in-process evaluation.
+The flags are part of the library's cache key (:func:`_machine_key`), so a
+change rebuilds.
 """
 from __future__ import annotations
 
@@ -29,7 +41,20 @@ from pathlib import Path
 
 from ..errors import GearsymError
 
-DEFAULT_FLAGS = ("-O3", "-march=native", "-fno-tree-partial-pre")
+DEFAULT_FLAGS = ("-O3", "-march=native", "-mtune=generic", "-fno-tree-partial-pre")
+
+#: compiled into every library beside the generated code: the entry points are called through it, with the
+#: stack moved to a fixed place modulo 4 KiB relative to the caller's work arrays (see :mod:`.native`)
+CALL_SOURCE = r"""
+#include <stdint.h>
+typedef int (*gearsym_entry)(const double**, double**, long long*, double*, int);
+int gearsym_call(gearsym_entry f, const double** arg, double** res, long long* iw, double* w, const void* anchor) {
+    char here;
+    volatile char* gap = __builtin_alloca((((uintptr_t)&here - (uintptr_t)anchor) & 4095) + 1);
+    gap[0] = 0;
+    return f(arg, res, iw, w, 0);
+}
+"""
 
 
 class CompilerError(GearsymError):
@@ -122,7 +147,7 @@ def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple
     if cc is None:
         raise CompilerError(REQUIRED_NOTE.format(what=compilers_looked_for()))
     flags = compile_flags() if flags is None else tuple(flags)
-    digest = hashlib.sha256(Path(source).read_bytes()).hexdigest()[:16]
+    digest = hashlib.sha256(Path(source).read_bytes() + CALL_SOURCE.encode()).hexdigest()[:16]
     target = cache_dir() / "lib" / f"{name}-{digest}-{_machine_key(cc, flags)}.so"
     if target.is_file():
         return Library(target, False, 0.0)
@@ -131,8 +156,9 @@ def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple
         announce(f"compiling {name} ({' '.join(flags)}; once: cached in {target.parent})")
     start = time.perf_counter()
     with tempfile.TemporaryDirectory(dir=target.parent) as tmp:
-        out = Path(tmp) / target.name
-        cmd = [*shlex.split(cc), *flags, "-fPIC", "-shared", "-o", str(out), str(source), "-lm"]
+        out, call = Path(tmp) / target.name, Path(tmp) / "gearsym_call.c"
+        call.write_text(CALL_SOURCE)
+        cmd = [*shlex.split(cc), *flags, "-fPIC", "-shared", "-o", str(out), str(source), str(call), "-lm"]
         try:
             proc = subprocess.run(cmd, capture_output=True, text=True)
         except OSError as exc:

@@ -8,6 +8,20 @@ place (a run's outputs land directly in its result arrays; the next chunk
 reads its start state where the previous one wrote it). The generated
 functions keep no state (``checkout`` returns 0), so each ``NativeFunction``
 owns its work arrays and distinct objects may run in different threads.
+
+Where those arrays and the stack sit decides the speed of a step. Each step
+stores pointers into the argument arrays, its state into the work vector and
+temporaries onto the stack, and loads them back at once; a load whose address
+matches an older store's in its low 12 bits but not in the page (4K aliasing)
+waits for that store. With the arrays wherever the allocator put them and the
+stack wherever the process started, about one load in a few dozen ran every step
+1.2-2.4x slower for its whole life (measured on the one-stage and flexible-shaft
+loops, bench/speed/notes.md). So the arrays live in one page-aligned block
+(argument pointers, result pointers, integer and real work, each on its own cache
+lines, never overlapping), and the library's ``gearsym_call`` (compiled into every
+library, see :data:`.compiler.CALL_SOURCE`) moves the stack so that it starts at
+the same place modulo 4 KiB as that block: every load of a library then places its
+memory the same way, and measured at the fast speed.
 """
 from __future__ import annotations
 
@@ -20,6 +34,17 @@ import numpy as np
 from ..errors import GearsymError
 
 _ptr = ctypes.c_void_p
+PAGE = 4096
+LINE = 64
+
+
+def work_layout(sizes: Sequence[int]) -> tuple[list[int], int]:
+    """Offsets of consecutive arrays of ``sizes`` bytes, each starting on a cache line, and the total bytes."""
+    offsets, at = [], 0
+    for size in sizes:
+        offsets.append(at)
+        at += -(-max(size, 1) // LINE) * LINE
+    return offsets, at
 
 
 class NativeFunction:
@@ -35,18 +60,28 @@ class NativeFunction:
             if not reference.sparsity_in(i).is_dense():
                 raise GearsymError(f"{name}: input {i} is sparse; the native call needs dense arrays")
         self.shapes_out = [reference.size_out(i) for i in range(self.n_out)]
-        self._arg = (_ptr * max(reference.sz_arg(), 1))()
-        self._res = (_ptr * max(reference.sz_res(), 1))()
-        self._iw = np.zeros(max(reference.sz_iw(), 1), dtype=np.int64)
-        self._w = np.zeros(max(reference.sz_w(), 1), dtype=np.float64)
-        self._iw_ptr, self._w_ptr = self._iw.ctypes.data, self._w.ctypes.data
-        self._arg_ptr, self._res_ptr = ctypes.addressof(self._arg), ctypes.addressof(self._res)
+        sizes = [8 * max(n, 1) for n in (reference.sz_arg(), reference.sz_res(), reference.sz_iw(), reference.sz_w())]
+        offsets, total = work_layout(sizes)
+        self._block = np.zeros(total + PAGE, dtype=np.uint8)
+        self.base = -(-self._block.ctypes.data // PAGE) * PAGE  # (page-aligned: the layout is the same in every load)
+        at = [self.base + o for o in offsets]
+        self._arg = (_ptr * (sizes[0] // 8)).from_address(at[0])
+        self._res = (_ptr * (sizes[1] // 8)).from_address(at[1])
+        views = [self._block[a - self._block.ctypes.data:][:size] for a, size in zip(at, sizes)]
+        self._iw, self._w = views[2].view(np.int64), views[3].view(np.float64)
+        self._arg_ptr, self._res_ptr, self._iw_ptr, self._w_ptr = at
+        self._entry = ctypes.cast(self._call, _ptr).value
+        self._aligned = _stack_aligned_call(library)
 
     def call(self, args: Sequence[int], results: Sequence[int]) -> None:
         """Evaluate with input and output *addresses* (e.g. ``array.ctypes.data + offset``)."""
         self._arg[:len(args)] = args
         self._res[:len(results)] = results
-        if self._call(self._arg_ptr, self._res_ptr, self._iw_ptr, self._w_ptr, 0):
+        if self._aligned is not None:
+            failed = self._aligned(self._entry, self._arg_ptr, self._res_ptr, self._iw_ptr, self._w_ptr, self.base)
+        else:
+            failed = self._call(self._arg_ptr, self._res_ptr, self._iw_ptr, self._w_ptr, 0)
+        if failed:
             raise GearsymError(f"the generated function {self.name} reported an error")
 
     def __call__(self, *args: np.ndarray) -> list[np.ndarray]:
@@ -55,6 +90,17 @@ class NativeFunction:
         out = [np.zeros(shape, dtype=np.float64, order="F") for shape in self.shapes_out]
         self.call([a.ctypes.data for a in keep], [o.ctypes.data for o in out])
         return out
+
+
+def _stack_aligned_call(library: ctypes.CDLL):
+    """The library's ``gearsym_call`` (None in a library built without it)."""
+    try:
+        call = library.gearsym_call
+    except AttributeError:
+        return None
+    call.restype = ctypes.c_int
+    call.argtypes = [_ptr] * 6
+    return call
 
 
 def load_native(path, functions: dict[str, ca.Function]) -> dict[str, NativeFunction]:
