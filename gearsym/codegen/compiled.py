@@ -8,6 +8,7 @@ take one, so that a sweep builds it once and only changes the parameter vector
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from functools import cached_property
@@ -187,7 +188,10 @@ class CompiledModel:
         return np.array([merged[n] for n in self.parameter_names], dtype=float)
 
     def prepare(self, p: np.ndarray | Mapping[str, float] | None = None, t0: float = 0.0) -> RunInputs:
-        p = self.parameter_vector(p) if p is None or isinstance(p, Mapping) else np.asarray(p, dtype=float)
+        if not isinstance(p, np.ndarray):  # (a sweep's vectors skip the Mapping check)
+            p = self.parameter_vector(p) if p is None or isinstance(p, Mapping) else np.asarray(p, dtype=float)
+        elif p.dtype != np.float64:
+            p = p.astype(float)
         if p.shape != (len(self.parameter_names),) or not np.isfinite(p).all():
             raise GearsymError(f"{self.name}: expected {len(self.parameter_names)} finite parameter values "
                                f"({', '.join(self.parameter_names)}), got {p}")
@@ -495,7 +499,7 @@ class CompiledModel:
 
     def _check_finite(self, inputs: RunInputs, *per_period: np.ndarray) -> None:
         # one pass each: a finite sum has finite terms (an infinite one may not: an overflow; the test below tells)
-        if all(np.isfinite(a.sum()) for a in per_period):
+        if math.isfinite(sum(float(a.sum()) for a in per_period)):
             return
         bad = ~np.logical_and.reduce([np.isfinite(a).all(axis=0) for a in per_period])
         if bad.any():
