@@ -11,11 +11,11 @@ plain RK4 in ``python -m bench.speed``), on 1 thread, every core as threads and 
 processes (the default),
 interleaved over repetitions; the results of every configuration are compared
 with the single-thread run bit for bit (repr of every number in every row).
-The Dask cluster is started once, outside the timings; its start-up is reported.
+The Dask cluster is started after those timings (its idle processes would share the cores with the
+two-worker runs only), once, outside its own timings; its start-up is reported.
 """
 from __future__ import annotations
 
-import contextlib
 import os
 import sys
 import time
@@ -47,39 +47,52 @@ def measure(model: str, scheme, repeats: int, dask: bool = True, workloads=None,
                                    f"{cores} processes": Workers(jobs=cores, parallel="processes")}  # the default
     out: dict = {"cores": cores, "periods": scheme.periods, "discard": scheme.discard,
                  "locate_crossings": scheme.locate_crossings, "workloads": {}}
-    stack = contextlib.ExitStack()
+    names = list(workloads or WORKLOADS)
+    baselines = {}
+    for name in names:  # this machine's configurations first, with no cluster up: its idle processes
+        # would share the cores with the two-worker runs and not with the one-worker run
+        out["workloads"][name], baselines[name] = _time_configs(compiled, scheme, name, configs, repeats, None, log)
     if dask:
         try:
             from gearsym.sweep.distributed import connect
 
             t = time.perf_counter()
-            client = stack.enter_context(connect("local", cores))  # the cluster `gearsym sweep --dask` starts
-            client.wait_for_workers(cores)
-            out["dask_startup_seconds"] = time.perf_counter() - t
-            configs[f"Dask LocalCluster, {cores} workers"] = Workers(scheduler=client)
+            with connect("local", cores) as client:  # the cluster `gearsym sweep --dask` starts
+                client.wait_for_workers(cores)
+                out["dask_startup_seconds"] = time.perf_counter() - t
+                label = f"Dask LocalCluster, {cores} workers"
+                for name in names:
+                    entry, _ = _time_configs(compiled, scheme, name, {label: Workers(scheduler=client)}, repeats,
+                                             baselines[name], log)
+                    for key in ("seconds", "identical"):
+                        out["workloads"][name][key][label] = entry[key][label]
         except Exception as exc:  # the extra is optional: report why it is missing, keep the thread numbers
             out["dask"] = str(exc)
-    try:
-        for name in workloads or WORKLOADS:
-            axes, mode = WORKLOADS[name]
-            spec = [f"{k}={v}" for k, v in axes.items()]
-            entry = {"axes": axes, "mode": mode, "seconds": {c: [] for c in configs}, "identical": {}}
-            baseline = None
-            for rep in range(repeats + 1):  # repetition 0 warms up (and ships the library to the workers)
-                for label, workers in configs.items():
-                    t = time.perf_counter()
-                    res = gearsym.run_sweep(compiled, spec, options=scheme, mode=mode, workers=workers, progress=False)
-                    seconds = time.perf_counter() - t
-                    rows = _rows(res)
-                    if baseline is None:
-                        baseline, entry["points"] = rows, len(rows)
-                    entry["identical"][label] = entry["identical"].get(label, True) and rows == baseline
-                    if rep:
-                        entry["seconds"][label].append(seconds)
-                if rep:
-                    log(f"    {name} repetition {rep}/{repeats}: " + ", ".join(
-                        f"{label} {entry['seconds'][label][-1]:.3f} s" for label in configs))
-            out["workloads"][name] = entry
-    finally:
-        stack.close()
     return out
+
+
+def _time_configs(compiled, scheme, name: str, configs: dict, repeats: int, baseline, log) -> tuple[dict, list]:
+    """Workload ``name`` on each of ``configs``, interleaved over ``repeats`` repetitions after a warm-up
+    (which also ships the library to a cluster's workers); every result compared with ``baseline`` (default:
+    the first run's rows), bit for bit."""
+    import gearsym
+
+    axes, mode = WORKLOADS[name]
+    spec = [f"{k}={v}" for k, v in axes.items()]
+    entry = {"axes": axes, "mode": mode, "seconds": {c: [] for c in configs}, "identical": {}}
+    for rep in range(repeats + 1):
+        for label, workers in configs.items():
+            t = time.perf_counter()
+            res = gearsym.run_sweep(compiled, spec, options=scheme, mode=mode, workers=workers, progress=False)
+            seconds = time.perf_counter() - t
+            rows = _rows(res)
+            if baseline is None:
+                baseline = rows
+            entry["points"] = len(rows)
+            entry["identical"][label] = entry["identical"].get(label, True) and rows == baseline
+            if rep:
+                entry["seconds"][label].append(seconds)
+        if rep:
+            log(f"    {name} repetition {rep}/{repeats}: " + ", ".join(
+                f"{label} {entry['seconds'][label][-1]:.3f} s" for label in configs))
+    return entry, baseline
