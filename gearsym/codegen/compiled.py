@@ -351,9 +351,7 @@ class CompiledModel:
                                                       runs.Q_addresses, runs.addresses(i), runs.strides)
         runs.start[:] = y
         runs.Q[0][...] = runs.eye
-        shared = inputs.addresses
-        for f, args, results in calls:
-            f.call((*args, *shared), results)
+        _make_calls(calls, inputs)
         self._check_finite(inputs, runs.strobe[i], runs.log_stretch[i])
 
     def _native_loop(self, schedule, y: int, Q: list[int], inputs: RunInputs, bases: list[int],
@@ -362,9 +360,7 @@ class CompiledModel:
         is the strobe), one column of ``strides`` bytes per period from ``bases``; with tangent vectors
         (``Q``: the addresses of two n x n buffers) returns the index of the one holding the final Q."""
         calls = self._chunk_calls(schedule, y, Q, bases, strides)
-        shared = inputs.addresses
-        for f, args, results in calls:
-            f.call((*args, *shared), results)
+        _make_calls(calls, inputs)
         return len(calls) % 2
 
     def _chunk_calls(self, schedule, y: int, Q: list[int], bases: list[int], strides: list[int]) -> list[tuple]:
@@ -514,6 +510,13 @@ class CompiledModel:
     def _schedule(self, periods: int, kind: str) -> list[tuple[str, int]]:
         chunks, rest = divmod(whole_number(periods, "periods"), self.options.chunk_periods)
         return [(f"{kind}_chunk", chunks), (f"{kind}_period", rest)]
+
+
+def _make_calls(calls: list[tuple], inputs: RunInputs) -> None:
+    """The native calls planned by :meth:`CompiledModel._chunk_calls`, with the table and constants of ``inputs``."""
+    shared = inputs.addresses
+    for f, args, results in calls:
+        f.call((*args, *shared), results)
 
 
 def _addresses(*columns: np.ndarray) -> tuple[list[int], list[int]]:

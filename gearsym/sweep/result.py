@@ -12,7 +12,7 @@ import numpy as np
 from ..analysis.jumps import find_jumps, hysteresis_intervals
 from ..errors import GearsymError
 from .grid import INDEPENDENT, Axis
-from .store import PoincareRows, read_rows, sidecar
+from .store import PoincareRows, read_poincare, read_rows, sidecar
 
 
 @dataclass(frozen=True)
@@ -134,15 +134,9 @@ def read_sweep(path: str | Path) -> SweepResult:
     rows = read_rows(path)
     names = list(rows[0]) if rows else next(csv.reader(path.read_text().splitlines()), [])
     strobe_path = sidecar(path, ".poincare.csv")
-    strobe = read_rows(strobe_path) if strobe_path.is_file() else []
-    keys = len(axes) + 1  # the swept values and the direction
-    points: dict[tuple, list] = {}
-    for r in strobe:
-        fields = tuple(r.values())
-        points.setdefault(fields[:keys], []).append(fields)
-    try:
-        return SweepResult.from_rows(record["model"], axes, record["mode"], names, rows,
-                                     [PoincareRows.from_fields(p, keys) for p in points.values()], record, path,
-                                     list(strobe[0]) if strobe else ())
+    try:  # (the Poincare rows' keys: the swept values and the direction)
+        strobe_columns, strobes = read_poincare(strobe_path, len(axes) + 1) if strobe_path.is_file() else ([], [])
+        return SweepResult.from_rows(record["model"], axes, record["mode"], names, rows, strobes, record, path,
+                                     strobe_columns)
     except (ValueError, TypeError) as exc:
         raise GearsymError(f"{path}: a value is not a number ({exc})") from None

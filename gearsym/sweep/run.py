@@ -395,7 +395,7 @@ def _execute(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], jobs: int):
             pending -= len(item)
             yield item
     finally:
-        stop.set()  # on an error or Ctrl-C: threads stop after their current point
+        stop.set()  # on an error or Ctrl-C: threads stop after their current batch
         pool.shutdown(wait=True, cancel_futures=True)  # points finished meanwhile are redone on resume
 
 

@@ -60,6 +60,17 @@ class PoincareRows:
         return cls(tuple(rows[0][:keys]), np.array([r[keys + 1:] for r in rows], dtype=float).reshape(len(rows), -1))
 
 
+def read_poincare(path: Path, keys: int, columns: list[str] | None = None) -> tuple[list[str], list[PoincareRows]]:
+    """The columns of a Poincare table (none if it has no row) and its points, in the order they first appear
+    (``keys``: the fields before the sample index; ``columns``: the header it must have)."""
+    points: dict[tuple, list] = {}
+    rows = read_rows(path, columns)
+    for row in rows:
+        fields = tuple(row.values())
+        points.setdefault(fields[:keys], []).append(fields)
+    return list(rows[0]) if rows else [], [PoincareRows.from_fields(p, keys) for p in points.values()]
+
+
 _FLUSH = object()  # the writer thread's signal to flush
 
 
@@ -88,7 +99,7 @@ class SweepStore:
         self._failed: BaseException | None = None
 
     # ------------------------------------------------------------ opening
-    def open(self, overwrite: bool = False) -> tuple[dict[tuple, dict], dict[tuple, list[dict]]]:
+    def open(self, overwrite: bool = False) -> tuple[dict[tuple, dict], dict[tuple, PoincareRows]]:
         """Start the files, or resume them: returns the rows already done (and their Poincare rows) by key."""
         self._lock()
         done, strobes = {}, {}
@@ -98,13 +109,10 @@ class SweepStore:
         elif self.path.exists() and (read_rows(self.path) if self.meta_path.exists() else True):
             self._check_record()  # (a file with no finished point is simply started again)
             done = self._read(self.path, self.columns)
-            fields = {}
-            if self.strobe_path.exists():
-                for row in read_rows(self.strobe_path, self.strobe_columns):
-                    fields.setdefault(self.key(row), []).append(tuple(row.values()))
-            keys = len(self.key_columns)
-            strobes = {k: PoincareRows.from_fields(v, keys) for k, v in fields.items()
-                       if k in done}  # (rows written before their main row are dropped)
+            _, read = read_poincare(self.strobe_path, len(self.key_columns), self.strobe_columns) \
+                if self.strobe_path.exists() else ([], [])
+            strobes = {k: r for r in read if (k := self.key(dict(zip(self.key_columns, r.where)))) in done}
+            # (rows written before their main row are dropped)
             lacking = [k for k in done if k not in strobes]
             if self.record.get("poincare_samples") and lacking:
                 raise GearsymError(f"{self.strobe_path} lacks the Poincare samples of {len(lacking)} finished "
