@@ -113,14 +113,17 @@ def _scaling_table(raw: dict, summary: dict) -> list[str]:
     if not sc:
         return ["(not run)"]
     work = raw["scaling"]["workloads"]
-    lines = ["| workload | configuration | median (s) | min (s) | speed-up | rows bit-identical to 1 thread |",
-             "|---|---|---|---|---|---|"]
+    lines = ["| workload | configuration | median (s) | min (s) | speed-up | CPU (s) | CPU / 1 thread | cores busy "
+             "| stolen (s) | rows bit-identical to 1 thread |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for name, configs in sc.items():
         w = work[name]
         what = f"{name}: {w['points']} points, {w['mode']}, " + " × ".join(f"{k} {v}" for k, v in w["axes"].items())
         for label, c in configs.items():
-            lines.append(f"| {what} | {label} | {c['median']:.3f} | {c['min']:.3f} | {c['speedup']:.2f}× | "
-                         f"{'yes' if c['identical'] else '**no**'} |")
+            cpu = (f"{c['cpu']:.3f} | {c['work']:.3f} | {c['busy']:.2f}" if "cpu" in c else "– | – | –")
+            steal = f"{c['steal']:.2f}" if "steal" in c else "–"
+            lines.append(f"| {what} | {label} | {c['median']:.3f} | {c['min']:.3f} | {c['speedup']:.2f}× | {cpu} | "
+                         f"{steal} | {'yes' if c['identical'] else '**no**'} |")
             what = ""
     return lines
 

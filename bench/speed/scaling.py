@@ -13,6 +13,12 @@ interleaved over repetitions; the results of every configuration are compared
 with the single-thread run bit for bit (repr of every number in every row).
 The Dask cluster is started after those timings (its idle processes would share the cores with the
 two-worker runs only), once, outside its own timings; its start-up is reported.
+
+Beside the wall time, each run records the CPU time it used (this process and its joined workers: what the
+software asked of the machine; not known for a Dask cluster's processes) and the time the hypervisor
+took from this machine's CPUs meanwhile (*steal*, from ``/proc/stat`` where the kernel reports it). Work
+per point that grows with more workers is the software's; a wall time that does not fall as its CPU time
+says is the machine's.
 """
 from __future__ import annotations
 
@@ -64,7 +70,7 @@ def measure(model: str, scheme, repeats: int, dask: bool = True, workloads=None,
                 for name in names:
                     entry, _ = _time_configs(compiled, scheme, name, {label: Workers(scheduler=client)}, repeats,
                                              baselines[name], log)
-                    for key in ("seconds", "identical"):
+                    for key in ("seconds", "cpu_seconds", "steal_seconds", "identical"):
                         out["workloads"][name][key][label] = entry[key][label]
         except Exception as exc:  # the extra is optional: report why it is missing, keep the thread numbers
             out["dask"] = str(exc)
@@ -79,12 +85,16 @@ def _time_configs(compiled, scheme, name: str, configs: dict, repeats: int, base
 
     axes, mode = WORKLOADS[name]
     spec = [f"{k}={v}" for k, v in axes.items()]
-    entry = {"axes": axes, "mode": mode, "seconds": {c: [] for c in configs}, "identical": {}}
+    entry = {"axes": axes, "mode": mode, "seconds": {c: [] for c in configs}, "cpu_seconds": {c: [] for c in configs},
+             "steal_seconds": {c: [] for c in configs}, "identical": {}}
     for rep in range(repeats + 1):
         for label, workers in configs.items():
-            t = time.perf_counter()
+            before, t = _cpu_and_steal(), time.perf_counter()
             res = gearsym.run_sweep(compiled, spec, options=scheme, mode=mode, workers=workers, progress=False)
             seconds = time.perf_counter() - t
+            after = _cpu_and_steal()
+            cpu = after[0] - before[0]
+            steal = None if None in (before[1], after[1]) else after[1] - before[1]
             rows = _rows(res)
             if baseline is None:
                 baseline = rows
@@ -92,7 +102,22 @@ def _time_configs(compiled, scheme, name: str, configs: dict, repeats: int, base
             entry["identical"][label] = entry["identical"].get(label, True) and rows == baseline
             if rep:
                 entry["seconds"][label].append(seconds)
+                entry["cpu_seconds"][label].append(None if workers.scheduler is not None else cpu)
+                entry["steal_seconds"][label].append(steal)
         if rep:
             log(f"    {name} repetition {rep}/{repeats}: " + ", ".join(
                 f"{label} {entry['seconds'][label][-1]:.3f} s" for label in configs))
     return entry, baseline
+
+
+def _cpu_and_steal() -> tuple[float, float | None]:
+    """CPU seconds of this process and its finished children, and the machine's stolen seconds so far
+    (None where ``/proc/stat`` does not say)."""
+    times = os.times()
+    cpu = times.user + times.system + times.children_user + times.children_system
+    try:
+        fields = open("/proc/stat").readline().split()  # cpu user nice system idle iowait irq softirq steal
+        steal = int(fields[8]) / os.sysconf("SC_CLK_TCK")
+    except (OSError, IndexError, ValueError):
+        steal = None
+    return cpu, steal

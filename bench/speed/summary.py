@@ -142,13 +142,32 @@ def summarise_sweep(sweep: dict) -> dict:
 
 
 def summarise_scaling(scaling: dict) -> dict:
+    """Per workload and configuration: wall times and the speed-up over the first (one worker); where the
+    run recorded them, the CPU time used (``work``: relative to one worker, what more workers cost the
+    software; ``busy``: CPU / wall, the cores it kept busy) and the seconds stolen by the hypervisor."""
     out = {}
     for name, w in scaling.get("workloads", {}).items():
         labels = list(w["seconds"])
         one = statistics.median(w["seconds"][labels[0]])
-        out[name] = {label: {"median": statistics.median(s), "min": min(s), "speedup": one / statistics.median(s),
-                             "identical": w["identical"][label]} for label, s in w["seconds"].items()}
+        cpu_one = _median_known(w.get("cpu_seconds", {}).get(labels[0]))
+        out[name] = {}
+        for label, s in w["seconds"].items():
+            entry = {"median": statistics.median(s), "min": min(s), "speedup": one / statistics.median(s),
+                     "identical": w["identical"][label]}
+            cpu = _median_known(w.get("cpu_seconds", {}).get(label))
+            if cpu is not None and cpu_one:
+                entry.update(cpu=cpu, work=cpu / cpu_one, busy=statistics.median(
+                    c / t for c, t in zip(w["cpu_seconds"][label], s)))
+            steal = _median_known(w.get("steal_seconds", {}).get(label))
+            if steal is not None:
+                entry["steal"] = steal
+            out[name][label] = entry
     return out
+
+
+def _median_known(values) -> float | None:
+    known = [v for v in values or () if v is not None]
+    return statistics.median(known) if known else None
 
 
 def verdicts(models: dict, scaling: dict, compile_times: dict, startup: dict | None = None,
