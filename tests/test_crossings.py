@@ -166,14 +166,18 @@ def first_root(s0, d0, s1, d1, fresh) -> float:
     return float(min(r for r in poly.nroots(n=30) if r.is_real and 0 < r <= 1))
 
 
-def test_the_located_crossing_is_the_cubics_zero_to_rounding():
-    """The fixed count of iterations in _first_zero reaches the zero on the hardest crossing steps met."""
+def compiled_first_zero():
     import casadi as ca
 
     from gearsym.codegen.functions import _first_zero
 
     args = [ca.SX.sym(name) for name in ("s0", "d0", "s1", "d1", "mode", "fresh")]
-    first_zero = ca.Function("first_zero", args, list(_first_zero(*args)))
+    return ca.Function("first_zero", args, list(_first_zero(*args)))
+
+
+def test_the_located_crossing_is_the_cubics_zero_to_rounding():
+    """The fixed count of iterations in _first_zero reaches the zero on the hardest crossing steps met."""
+    first_zero = compiled_first_zero()
     for s0, d0, s1, d1, mode, fresh in HARD_CUBICS:
         for sign in (1, -1):  # the same crossing seen from the other side
             found, theta = first_zero(sign * s0, sign * d0, sign * s1, sign * d1, mode if sign > 0 else 1 - mode,
@@ -181,6 +185,19 @@ def test_the_located_crossing_is_the_cubics_zero_to_rounding():
             assert float(found) == 1
             assert abs(float(theta) - first_root(s0, d0, s1, d1, fresh)) <= 1e-15, (s0, d0, s1, d1, fresh)
 
+
+
+@pytest.mark.parametrize("middle, delta", [(0.6, 1e-4), (0.7, 1e-5), (0.45, 1e-6)])
+def test_near_a_grazing_the_located_crossing_is_the_zero_to_its_conditioning(middle, delta):
+    """s = a ((t - middle)^2 - delta) + b (t - middle)^3: two zeros sqrt(delta) apart, where Newton-like
+    iterations converge only linearly; the fixed count still reaches the first to what rounding allows."""
+    a, b = 0.01, 0.003
+    s = lambda t: a * ((t - middle) ** 2 - delta) + b * (t - middle) ** 3  # noqa: E731
+    slope = lambda t: 2 * a * (t - middle) + 3 * b * (t - middle) ** 2  # noqa: E731
+    found, theta = compiled_first_zero()(s(0.0), slope(0.0), s(1.0), slope(1.0), 1, 0)
+    root = first_root(s(0.0), slope(0.0), s(1.0), slope(1.0), 0)
+    rounding = 8 * np.finfo(float).eps * a / abs(slope(root))  # the zero's own sensitivity to rounding in s
+    assert float(found) == 1 and abs(float(theta) - root) <= 1e-15 + rounding, (float(theta) - root, rounding)
 
 # ---------------------------------------------------------------- default, paper scheme, what is not handled
 def test_the_default_options_generate_the_committed_c_and_the_paper_scheme_other_code(tmp_path):

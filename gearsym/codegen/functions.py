@@ -543,11 +543,13 @@ class _CrossingStep:
 
 #: Halley iterations (Newton with the cubic's curvature: third order) on r from the secant, kept inside the
 #: bracket. Fixed, so that theta stays a continuous function of the ends. On every crossing step of long
-#: orbits of one_stage, flexible_shaft and two_stage at omega 0.9-1.8, 4 reach a 30-iteration reference
-#: to rounding (|dtheta| <= 1e-15; Newton needed 6, 8 before this); 5 for a margin. Near a grazing (two
-#: zeros closing up) no fixed count reaches rounding; there 5 are at least as close as the 8 Newton
-#: iterations were, and r is flat, so the step's state barely depends on theta.
-_NEWTON = 5
+#: orbits (one_stage, flexible_shaft, two_stage at omega 0.6-2.2) 4 reach a 30-iteration reference to
+#: rounding (|dtheta| <= 1e-15; Newton needed 6). Near a grazing (two zeros sqrt(delta) apart: the
+#: convergence is linear there) no fixed count does: on random such cubics 8 leave |dtheta| <= 1e-13 for
+#: delta >= 1e-5 and < 6e-5 below (the former 8 Newton iterations: up to 7e-3). That is what makes the
+#: steps' map smooth enough to continue periodic orbits: the Fig. 3 branches are the same for 8 to 24
+#: iterations, while with 5 (and the former Newton) the D = 0 period-1 branch stopped at omega = 0.21.
+_NEWTON = 8
 
 
 def _first_zero(s0, d0, s1, d1, mode, fresh):
