@@ -143,6 +143,62 @@ def test_compiled_and_in_process_agree_and_every_loop_steps_the_same_way():
     np.testing.assert_allclose(runs[0].strobe, runs[1].strobe, rtol=0, atol=1e-12)
 
 
+#: (s0, d0, s1, d1, mode, fresh) of crossing steps' cubics on which fewer iterations stop short: the first
+#: two from two_stage at omega = 0.9 (an extremum just past the step's end: the secant starts far off), then
+#: flexible_shaft at 0.9 and two_stage at 1.0 (all at 200 steps), and a dip's way out after its way in
+#: (fresh: the zero at the start is not counted)
+HARD_CUBICS = [
+    (-0.006763789091944972, 0.01597439481748599, 0.001157322969682184, -0.00022153709545308836, 0, 0),
+    (0.0011570964042988408, -0.00022327042040917034, -0.007381266667559672, -0.01692898574603797, 1, 0),
+    (-0.002198732650235513, 0.0115627636321836, 0.005948018829446511, 0.004726433234713725, 0, 0),
+    (-0.005779022834273893, 0.006048622173602194, 0.004248976678907491, 0.014067138743883347, 0, 0),
+    (0.0, 0.02, -0.004, -0.03, 1, 1),
+]
+
+
+def first_root(s0, d0, s1, d1, fresh) -> float:
+    """The earliest zero in (0, 1] of the cubic Hermite (of it divided by t if fresh), to 30 digits."""
+    t = sp.Symbol("t")
+    s0, d0, s1, d1 = (sp.Rational(v) for v in (s0, d0, s1, d1))
+    cubic = (2 * t**3 - 3 * t**2 + 1) * s0 + (t**3 - 2 * t**2 + t) * d0 + (3 * t**2 - 2 * t**3) * s1 \
+        + (t**3 - t**2) * d1
+    poly = sp.Poly(sp.cancel(cubic / t) if fresh else cubic, t)
+    return float(min(r for r in poly.nroots(n=30) if r.is_real and 0 < r <= 1))
+
+
+def compiled_first_zero():
+    import casadi as ca
+
+    from gearsym.codegen.functions import _first_zero
+
+    args = [ca.SX.sym(name) for name in ("s0", "d0", "s1", "d1", "mode", "fresh")]
+    return ca.Function("first_zero", args, list(_first_zero(*args)))
+
+
+def test_the_located_crossing_is_the_cubics_zero_to_rounding():
+    """The fixed count of iterations in _first_zero reaches the zero on the hardest crossing steps met."""
+    first_zero = compiled_first_zero()
+    for s0, d0, s1, d1, mode, fresh in HARD_CUBICS:
+        for sign in (1, -1):  # the same crossing seen from the other side
+            found, theta = first_zero(sign * s0, sign * d0, sign * s1, sign * d1, mode if sign > 0 else 1 - mode,
+                                      fresh)
+            assert float(found) == 1
+            assert abs(float(theta) - first_root(s0, d0, s1, d1, fresh)) <= 1e-15, (s0, d0, s1, d1, fresh)
+
+
+
+@pytest.mark.parametrize("middle, delta", [(0.6, 1e-4), (0.7, 1e-5), (0.45, 1e-6)])
+def test_near_a_grazing_the_located_crossing_is_the_zero_to_its_conditioning(middle, delta):
+    """s = a ((t - middle)^2 - delta) + b (t - middle)^3: two zeros sqrt(delta) apart, where Newton-like
+    iterations converge only linearly; the fixed count still reaches the first to what rounding allows."""
+    a, b = 0.01, 0.003
+    s = lambda t: a * ((t - middle) ** 2 - delta) + b * (t - middle) ** 3  # noqa: E731
+    slope = lambda t: 2 * a * (t - middle) + 3 * b * (t - middle) ** 2  # noqa: E731
+    found, theta = compiled_first_zero()(s(0.0), slope(0.0), s(1.0), slope(1.0), 1, 0)
+    root = first_root(s(0.0), slope(0.0), s(1.0), slope(1.0), 0)
+    rounding = 8 * np.finfo(float).eps * a / abs(slope(root))  # the zero's own sensitivity to rounding in s
+    assert float(found) == 1 and abs(float(theta) - root) <= 1e-15 + rounding, (float(theta) - root, rounding)
+
 # ---------------------------------------------------------------- default, paper scheme, what is not handled
 def test_the_default_options_generate_the_committed_c_and_the_paper_scheme_other_code(tmp_path):
     """Integration() locates the crossings: its loops are those of generated/; Integration.paper() is other code."""
