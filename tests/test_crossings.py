@@ -164,8 +164,8 @@ def test_split_runs_behind_a_real_branch_in_the_c(tmp_path):
     code = write_code(build_functions(one_stage, options), tmp_path, code_hash(one_stage, options))
     text = code.source.read_text()
     step = re.search(r"void gs_tangent_step\(.*?\n}\n", text, re.S).group(0)  # (the printed loops' step)
-    assert re.search(r"\n  if \(flag != 0\) gs_tangent_split\(.*\n  else gs_tangent_keep\(", step)
-    assert "static GEARSYM_COLD void gs_tangent_split(" in text  # out of the way of the steps that do not cross
+    assert re.search(r"\n  if \(GEARSYM_UNLIKELY\(flag != 0\)\) gs_tangent_split\(.*\n  else gs_tangent_keep\(", step)
+    assert "static GEARSYM_NOINLINE void gs_tangent_split(" in text  # out of the way of the steps that do not cross
 
 
 def test_a_model_without_backlash_is_unchanged_and_other_switches_are_refused(tmp_path):

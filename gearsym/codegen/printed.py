@@ -17,7 +17,7 @@ trip through the work vector between steps: about 10-15 % of a step next to a ha
 * CasADi's static functions nothing calls any more are removed.
 
 With crossings located, the ``try`` is inline on every step and the ``split`` (about 1 % of steps) a
-separate cold function behind a real ``if``.
+separate function behind a real ``if``, marked unlikely.
 """
 from __future__ import annotations
 
@@ -104,7 +104,9 @@ def _inline(name: str, body: str, f: ca.Function) -> str:
         raise AssertionError(f"{name}: CasADi's C has a form the printer does not rewrite: {left[:3]}")
     args = [f"const casadi_real* restrict A{i}" for i in range(f.n_in())]
     args += [f"casadi_real* restrict R{i}" for i in range(f.n_out())]
-    where = "GEARSYM_COLD" if name.endswith("_split") else "GEARSYM_INLINE"
+    # the split (about 1 % of steps) stays a call: not `cold`, whose size optimisation (code hoisting) took
+    # gcc 20 s more on the largest model
+    where = "GEARSYM_NOINLINE" if name.endswith("_split") else "GEARSYM_INLINE"
     return f"/* {name}, from CasADi's C of it */\nstatic {where} void gs_{name}({', '.join(args)}) {{\n{body}\n}}\n"
 
 
@@ -135,12 +137,12 @@ class _Shape:
 _PREAMBLE = """/* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
 #if defined(__GNUC__)
 #define GEARSYM_INLINE inline __attribute__((always_inline))
-#define GEARSYM_COLD __attribute__((noinline, cold))
 #define GEARSYM_NOINLINE __attribute__((noinline))
+#define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
 #else
 #define GEARSYM_INLINE inline
-#define GEARSYM_COLD
 #define GEARSYM_NOINLINE
+#define GEARSYM_UNLIKELY(x) (x)
 #endif
 
 static const casadi_real gs_zeros[{zeros}] = {{0.}};
@@ -166,7 +168,8 @@ static inline void gs_store(const casadi_real* x, casadi_int n, casadi_real* y, 
 
 def _spans(mf: ModelFunctions, s: _Shape) -> list[str]:
     """One step of each kind (try, then split or keep; or the plain block) and the loop over a period's
-    blocks, with the state in local arrays, two steps per iteration."""
+    blocks, with the state in local arrays, two steps per iteration (two copies of the inline step: a
+    third for an odd number of blocks cost compile time)."""
     out = []
     for kind, carried in (("tangent", ("y", "Q")), ("state", ("y",))):
         state = [*carried, "lo", "hi"]
@@ -182,7 +185,7 @@ def _spans(mf: ModelFunctions, s: _Shape) -> list[str]:
             split_args = ", ".join([*state, *tried, "T", "c", *nexts])
             body = (f"  {declare} casadi_real flag;\n"
                     f"  gs_{kind}_try({', '.join([*carried, 'T', 'c', *tried])}, &flag);\n"
-                    f"  if (flag != 0) gs_{kind}_split({split_args});\n"
+                    f"  if (GEARSYM_UNLIKELY(flag != 0)) gs_{kind}_split({split_args});\n"
                     f"  else gs_{kind}_keep({split_args});\n")
         else:
             body = f"  gs_{kind}_block({args});\n"
@@ -199,16 +202,12 @@ def _spans(mf: ModelFunctions, s: _Shape) -> list[str]:
             f"static GEARSYM_NOINLINE void gs_{kind}_span({', '.join(decl)}, const casadi_real* restrict T, "
             "const casadi_real* restrict c, casadi_int blocks) {\n"
             f"  {locals_}\n  casadi_int k;\n  {copy(state, a)}\n"
-            "  for (k = 0; k + 1 < blocks; k += 2) {\n"
+            "  for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */\n"
             f"    gs_{kind}_step({', '.join([*a, table('k'), 'c', *b])});\n"
+            f"    if (k + 1 == blocks) {{ {copy(b, state)} return; }}\n"
             f"    gs_{kind}_step({', '.join([*b, table('k + 1'), 'c', *a])});\n"
             "  }\n"
-            "  if (k < blocks) {\n"
-            f"    gs_{kind}_step({', '.join([*a, table('k'), 'c', *b])});\n"
-            f"    {copy(b, state)}\n"
-            "  } else {\n"
-            f"    {copy(a, state)}\n"
-            "  }\n}\n")
+            f"  {copy(a, state)}\n}}\n")
     return out
 
 

@@ -636,12 +636,12 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
 /* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
 #if defined(__GNUC__)
 #define GEARSYM_INLINE inline __attribute__((always_inline))
-#define GEARSYM_COLD __attribute__((noinline, cold))
 #define GEARSYM_NOINLINE __attribute__((noinline))
+#define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
 #else
 #define GEARSYM_INLINE inline
-#define GEARSYM_COLD
 #define GEARSYM_NOINLINE
+#define GEARSYM_UNLIKELY(x) (x)
 #endif
 
 static const casadi_real gs_zeros[600] = {0.};
@@ -1026,16 +1026,12 @@ static GEARSYM_NOINLINE void gs_tangent_span(casadi_real* restrict y, casadi_rea
   casadi_real ya[2], yb[2]; casadi_real Qa[4], Qb[4]; casadi_real loa[2], lob[2]; casadi_real hia[2], hib[2];
   casadi_int k;
   gs_copy(y, 2, ya); gs_copy(Q, 4, Qa); gs_copy(lo, 2, loa); gs_copy(hi, 2, hia);
-  for (k = 0; k + 1 < blocks; k += 2) {
+  for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */
     gs_tangent_step(ya, Qa, loa, hia, T + 3*(k), c, yb, Qb, lob, hib);
+    if (k + 1 == blocks) { gs_copy(yb, 2, y); gs_copy(Qb, 4, Q); gs_copy(lob, 2, lo); gs_copy(hib, 2, hi); return; }
     gs_tangent_step(yb, Qb, lob, hib, T + 3*(k + 1), c, ya, Qa, loa, hia);
   }
-  if (k < blocks) {
-    gs_tangent_step(ya, Qa, loa, hia, T + 3*(k), c, yb, Qb, lob, hib);
-    gs_copy(yb, 2, y); gs_copy(Qb, 4, Q); gs_copy(lob, 2, lo); gs_copy(hib, 2, hi);
-  } else {
-    gs_copy(ya, 2, y); gs_copy(Qa, 4, Q); gs_copy(loa, 2, lo); gs_copy(hia, 2, hi);
-  }
+  gs_copy(ya, 2, y); gs_copy(Qa, 4, Q); gs_copy(loa, 2, lo); gs_copy(hia, 2, hi);
 }
 
 /* one block of state steps (the SX functions' step, as CasADi's Switch runs it) */
@@ -1048,16 +1044,12 @@ static GEARSYM_NOINLINE void gs_state_span(casadi_real* restrict y, casadi_real*
   casadi_real ya[2], yb[2]; casadi_real loa[2], lob[2]; casadi_real hia[2], hib[2];
   casadi_int k;
   gs_copy(y, 2, ya); gs_copy(lo, 2, loa); gs_copy(hi, 2, hia);
-  for (k = 0; k + 1 < blocks; k += 2) {
+  for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */
     gs_state_step(ya, loa, hia, T + 3*(k), c, yb, lob, hib);
+    if (k + 1 == blocks) { gs_copy(yb, 2, y); gs_copy(lob, 2, lo); gs_copy(hib, 2, hi); return; }
     gs_state_step(yb, lob, hib, T + 3*(k + 1), c, ya, loa, hia);
   }
-  if (k < blocks) {
-    gs_state_step(ya, loa, hia, T + 3*(k), c, yb, lob, hib);
-    gs_copy(yb, 2, y); gs_copy(lob, 2, lo); gs_copy(hib, 2, hi);
-  } else {
-    gs_copy(ya, 2, y); gs_copy(loa, 2, lo); gs_copy(hia, 2, hi);
-  }
+  gs_copy(ya, 2, y); gs_copy(loa, 2, lo); gs_copy(hia, 2, hi);
 }
 
 /* lyapunov_chunk:(y0[2],Q0[2x2],table[3x200],c[4])->(strobe[2x50],Q[2x2],log_stretch[2x50],low[2x50],high[2x50]) */

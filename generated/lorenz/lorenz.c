@@ -498,12 +498,12 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
 /* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
 #if defined(__GNUC__)
 #define GEARSYM_INLINE inline __attribute__((always_inline))
-#define GEARSYM_COLD __attribute__((noinline, cold))
 #define GEARSYM_NOINLINE __attribute__((noinline))
+#define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
 #else
 #define GEARSYM_INLINE inline
-#define GEARSYM_COLD
 #define GEARSYM_NOINLINE
+#define GEARSYM_UNLIKELY(x) (x)
 #endif
 
 static const casadi_real gs_zeros[1] = {0.};
@@ -1171,16 +1171,12 @@ static GEARSYM_NOINLINE void gs_tangent_span(casadi_real* restrict y, casadi_rea
   casadi_real ya[3], yb[3]; casadi_real Qa[9], Qb[9]; casadi_real loa[3], lob[3]; casadi_real hia[3], hib[3];
   casadi_int k;
   gs_copy(y, 3, ya); gs_copy(Q, 9, Qa); gs_copy(lo, 3, loa); gs_copy(hi, 3, hia);
-  for (k = 0; k + 1 < blocks; k += 2) {
+  for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */
     gs_tangent_step(ya, Qa, loa, hia, T, c, yb, Qb, lob, hib);
+    if (k + 1 == blocks) { gs_copy(yb, 3, y); gs_copy(Qb, 9, Q); gs_copy(lob, 3, lo); gs_copy(hib, 3, hi); return; }
     gs_tangent_step(yb, Qb, lob, hib, T, c, ya, Qa, loa, hia);
   }
-  if (k < blocks) {
-    gs_tangent_step(ya, Qa, loa, hia, T, c, yb, Qb, lob, hib);
-    gs_copy(yb, 3, y); gs_copy(Qb, 9, Q); gs_copy(lob, 3, lo); gs_copy(hib, 3, hi);
-  } else {
-    gs_copy(ya, 3, y); gs_copy(Qa, 9, Q); gs_copy(loa, 3, lo); gs_copy(hia, 3, hi);
-  }
+  gs_copy(ya, 3, y); gs_copy(Qa, 9, Q); gs_copy(loa, 3, lo); gs_copy(hia, 3, hi);
 }
 
 /* one block of state steps (the SX functions' step, as CasADi's Switch runs it) */
@@ -1193,16 +1189,12 @@ static GEARSYM_NOINLINE void gs_state_span(casadi_real* restrict y, casadi_real*
   casadi_real ya[3], yb[3]; casadi_real loa[3], lob[3]; casadi_real hia[3], hib[3];
   casadi_int k;
   gs_copy(y, 3, ya); gs_copy(lo, 3, loa); gs_copy(hi, 3, hia);
-  for (k = 0; k + 1 < blocks; k += 2) {
+  for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */
     gs_state_step(ya, loa, hia, T, c, yb, lob, hib);
+    if (k + 1 == blocks) { gs_copy(yb, 3, y); gs_copy(lob, 3, lo); gs_copy(hib, 3, hi); return; }
     gs_state_step(yb, lob, hib, T, c, ya, loa, hia);
   }
-  if (k < blocks) {
-    gs_state_step(ya, loa, hia, T, c, yb, lob, hib);
-    gs_copy(yb, 3, y); gs_copy(lob, 3, lo); gs_copy(hib, 3, hi);
-  } else {
-    gs_copy(ya, 3, y); gs_copy(loa, 3, lo); gs_copy(hia, 3, hi);
-  }
+  gs_copy(ya, 3, y); gs_copy(loa, 3, lo); gs_copy(hia, 3, hi);
 }
 
 /* lyapunov_chunk:(y0[3],Q0[3x3],table[0x200],c[4])->(strobe[3x50],Q[3x3],log_stretch[3x50],low[3x50],high[3x50]) */

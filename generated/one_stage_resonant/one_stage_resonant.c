@@ -815,12 +815,12 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
 /* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
 #if defined(__GNUC__)
 #define GEARSYM_INLINE inline __attribute__((always_inline))
-#define GEARSYM_COLD __attribute__((noinline, cold))
 #define GEARSYM_NOINLINE __attribute__((noinline))
+#define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
 #else
 #define GEARSYM_INLINE inline
-#define GEARSYM_COLD
 #define GEARSYM_NOINLINE
+#define GEARSYM_UNLIKELY(x) (x)
 #endif
 
 static const casadi_real gs_zeros[1200] = {0.};
@@ -1088,7 +1088,7 @@ static GEARSYM_INLINE void gs_tangent_keep(const casadi_real* restrict A0, const
 }
 
 /* tangent_split, from CasADi's C of it */
-static GEARSYM_COLD void gs_tangent_split(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, const casadi_real* restrict A6, const casadi_real* restrict A7, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3) {
+static GEARSYM_NOINLINE void gs_tangent_split(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, const casadi_real* restrict A6, const casadi_real* restrict A7, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
@@ -5298,7 +5298,7 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
 }
 
 /* state_split, from CasADi's C of it */
-static GEARSYM_COLD void gs_state_split(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+static GEARSYM_NOINLINE void gs_state_split(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
@@ -9153,7 +9153,7 @@ static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casad
 static GEARSYM_INLINE void gs_tangent_step(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real yt[2]; casadi_real Qt[4]; casadi_real flag;
   gs_tangent_try(y, Q, T, c, yt, Qt, &flag);
-  if (flag != 0) gs_tangent_split(y, Q, lo, hi, yt, Qt, T, c, y1, Q1, lo1, hi1);
+  if (GEARSYM_UNLIKELY(flag != 0)) gs_tangent_split(y, Q, lo, hi, yt, Qt, T, c, y1, Q1, lo1, hi1);
   else gs_tangent_keep(y, Q, lo, hi, yt, Qt, T, c, y1, Q1, lo1, hi1);
 }
 
@@ -9162,23 +9162,19 @@ static GEARSYM_NOINLINE void gs_tangent_span(casadi_real* restrict y, casadi_rea
   casadi_real ya[2], yb[2]; casadi_real Qa[4], Qb[4]; casadi_real loa[1], lob[1]; casadi_real hia[1], hib[1];
   casadi_int k;
   gs_copy(y, 2, ya); gs_copy(Q, 4, Qa); gs_copy(lo, 1, loa); gs_copy(hi, 1, hia);
-  for (k = 0; k + 1 < blocks; k += 2) {
+  for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */
     gs_tangent_step(ya, Qa, loa, hia, T + 6*(k), c, yb, Qb, lob, hib);
+    if (k + 1 == blocks) { gs_copy(yb, 2, y); gs_copy(Qb, 4, Q); gs_copy(lob, 1, lo); gs_copy(hib, 1, hi); return; }
     gs_tangent_step(yb, Qb, lob, hib, T + 6*(k + 1), c, ya, Qa, loa, hia);
   }
-  if (k < blocks) {
-    gs_tangent_step(ya, Qa, loa, hia, T + 6*(k), c, yb, Qb, lob, hib);
-    gs_copy(yb, 2, y); gs_copy(Qb, 4, Q); gs_copy(lob, 1, lo); gs_copy(hib, 1, hi);
-  } else {
-    gs_copy(ya, 2, y); gs_copy(Qa, 4, Q); gs_copy(loa, 1, lo); gs_copy(hia, 1, hi);
-  }
+  gs_copy(ya, 2, y); gs_copy(Qa, 4, Q); gs_copy(loa, 1, lo); gs_copy(hia, 1, hi);
 }
 
 /* one block of state steps (the SX functions' step, as CasADi's Switch runs it) */
 static GEARSYM_INLINE void gs_state_step(const casadi_real* restrict y, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real yt[2]; casadi_real flag;
   gs_state_try(y, T, c, yt, &flag);
-  if (flag != 0) gs_state_split(y, lo, hi, yt, T, c, y1, lo1, hi1);
+  if (GEARSYM_UNLIKELY(flag != 0)) gs_state_split(y, lo, hi, yt, T, c, y1, lo1, hi1);
   else gs_state_keep(y, lo, hi, yt, T, c, y1, lo1, hi1);
 }
 
@@ -9187,16 +9183,12 @@ static GEARSYM_NOINLINE void gs_state_span(casadi_real* restrict y, casadi_real*
   casadi_real ya[2], yb[2]; casadi_real loa[1], lob[1]; casadi_real hia[1], hib[1];
   casadi_int k;
   gs_copy(y, 2, ya); gs_copy(lo, 1, loa); gs_copy(hi, 1, hia);
-  for (k = 0; k + 1 < blocks; k += 2) {
+  for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */
     gs_state_step(ya, loa, hia, T + 6*(k), c, yb, lob, hib);
+    if (k + 1 == blocks) { gs_copy(yb, 2, y); gs_copy(lob, 1, lo); gs_copy(hib, 1, hi); return; }
     gs_state_step(yb, lob, hib, T + 6*(k + 1), c, ya, loa, hia);
   }
-  if (k < blocks) {
-    gs_state_step(ya, loa, hia, T + 6*(k), c, yb, lob, hib);
-    gs_copy(yb, 2, y); gs_copy(lob, 1, lo); gs_copy(hib, 1, hi);
-  } else {
-    gs_copy(ya, 2, y); gs_copy(loa, 1, lo); gs_copy(hia, 1, hi);
-  }
+  gs_copy(ya, 2, y); gs_copy(loa, 1, lo); gs_copy(hia, 1, hi);
 }
 
 /* lyapunov_chunk:(y0[2],Q0[2x2],table[6x200],c[5])->(strobe[2x50],Q[2x2],log_stretch[2x50],low[1x50],high[1x50]) */

@@ -1624,12 +1624,12 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
 /* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
 #if defined(__GNUC__)
 #define GEARSYM_INLINE inline __attribute__((always_inline))
-#define GEARSYM_COLD __attribute__((noinline, cold))
 #define GEARSYM_NOINLINE __attribute__((noinline))
+#define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
 #else
 #define GEARSYM_INLINE inline
-#define GEARSYM_COLD
 #define GEARSYM_NOINLINE
+#define GEARSYM_UNLIKELY(x) (x)
 #endif
 
 static const casadi_real gs_zeros[2400] = {0.};
@@ -5580,7 +5580,7 @@ static GEARSYM_INLINE void gs_tangent_keep(const casadi_real* restrict A0, const
 }
 
 /* tangent_split, from CasADi's C of it */
-static GEARSYM_COLD void gs_tangent_split(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, const casadi_real* restrict A6, const casadi_real* restrict A7, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3) {
+static GEARSYM_NOINLINE void gs_tangent_split(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, const casadi_real* restrict A6, const casadi_real* restrict A7, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3) {
   casadi_real a000, a001, a002, a003, a004, a005, a006, a007, a008, a009, a010, a011;
   casadi_real a012, a013, a014, a015, a016, a017, a018, a019, a020, a021, a022, a023;
   casadi_real a024, a025, a026, a027, a028, a029, a030, a031, a032, a033, a034, a035;
@@ -37905,7 +37905,7 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
 }
 
 /* state_split, from CasADi's C of it */
-static GEARSYM_COLD void gs_state_split(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+static GEARSYM_NOINLINE void gs_state_split(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
   casadi_real a000, a001, a002, a003, a004, a005, a006, a007, a008, a009, a010, a011;
   casadi_real a012, a013, a014, a015, a016, a017, a018, a019, a020, a021, a022, a023;
   casadi_real a024, a025, a026, a027, a028, a029, a030, a031, a032, a033, a034, a035;
@@ -62347,7 +62347,7 @@ static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casad
 static GEARSYM_INLINE void gs_tangent_step(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real yt[8]; casadi_real Qt[64]; casadi_real flag;
   gs_tangent_try(y, Q, T, c, yt, Qt, &flag);
-  if (flag != 0) gs_tangent_split(y, Q, lo, hi, yt, Qt, T, c, y1, Q1, lo1, hi1);
+  if (GEARSYM_UNLIKELY(flag != 0)) gs_tangent_split(y, Q, lo, hi, yt, Qt, T, c, y1, Q1, lo1, hi1);
   else gs_tangent_keep(y, Q, lo, hi, yt, Qt, T, c, y1, Q1, lo1, hi1);
 }
 
@@ -62356,23 +62356,19 @@ static GEARSYM_NOINLINE void gs_tangent_span(casadi_real* restrict y, casadi_rea
   casadi_real ya[8], yb[8]; casadi_real Qa[64], Qb[64]; casadi_real loa[4], lob[4]; casadi_real hia[4], hib[4];
   casadi_int k;
   gs_copy(y, 8, ya); gs_copy(Q, 64, Qa); gs_copy(lo, 4, loa); gs_copy(hi, 4, hia);
-  for (k = 0; k + 1 < blocks; k += 2) {
+  for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */
     gs_tangent_step(ya, Qa, loa, hia, T + 12*(k), c, yb, Qb, lob, hib);
+    if (k + 1 == blocks) { gs_copy(yb, 8, y); gs_copy(Qb, 64, Q); gs_copy(lob, 4, lo); gs_copy(hib, 4, hi); return; }
     gs_tangent_step(yb, Qb, lob, hib, T + 12*(k + 1), c, ya, Qa, loa, hia);
   }
-  if (k < blocks) {
-    gs_tangent_step(ya, Qa, loa, hia, T + 12*(k), c, yb, Qb, lob, hib);
-    gs_copy(yb, 8, y); gs_copy(Qb, 64, Q); gs_copy(lob, 4, lo); gs_copy(hib, 4, hi);
-  } else {
-    gs_copy(ya, 8, y); gs_copy(Qa, 64, Q); gs_copy(loa, 4, lo); gs_copy(hia, 4, hi);
-  }
+  gs_copy(ya, 8, y); gs_copy(Qa, 64, Q); gs_copy(loa, 4, lo); gs_copy(hia, 4, hi);
 }
 
 /* one block of state steps (the SX functions' step, as CasADi's Switch runs it) */
 static GEARSYM_INLINE void gs_state_step(const casadi_real* restrict y, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real yt[8]; casadi_real flag;
   gs_state_try(y, T, c, yt, &flag);
-  if (flag != 0) gs_state_split(y, lo, hi, yt, T, c, y1, lo1, hi1);
+  if (GEARSYM_UNLIKELY(flag != 0)) gs_state_split(y, lo, hi, yt, T, c, y1, lo1, hi1);
   else gs_state_keep(y, lo, hi, yt, T, c, y1, lo1, hi1);
 }
 
@@ -62381,16 +62377,12 @@ static GEARSYM_NOINLINE void gs_state_span(casadi_real* restrict y, casadi_real*
   casadi_real ya[8], yb[8]; casadi_real loa[4], lob[4]; casadi_real hia[4], hib[4];
   casadi_int k;
   gs_copy(y, 8, ya); gs_copy(lo, 4, loa); gs_copy(hi, 4, hia);
-  for (k = 0; k + 1 < blocks; k += 2) {
+  for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */
     gs_state_step(ya, loa, hia, T + 12*(k), c, yb, lob, hib);
+    if (k + 1 == blocks) { gs_copy(yb, 8, y); gs_copy(lob, 4, lo); gs_copy(hib, 4, hi); return; }
     gs_state_step(yb, lob, hib, T + 12*(k + 1), c, ya, loa, hia);
   }
-  if (k < blocks) {
-    gs_state_step(ya, loa, hia, T + 12*(k), c, yb, lob, hib);
-    gs_copy(yb, 8, y); gs_copy(lob, 4, lo); gs_copy(hib, 4, hi);
-  } else {
-    gs_copy(ya, 8, y); gs_copy(loa, 4, lo); gs_copy(hia, 4, hi);
-  }
+  gs_copy(ya, 8, y); gs_copy(loa, 4, lo); gs_copy(hia, 4, hi);
 }
 
 /* lyapunov_chunk:(y0[8],Q0[8x8],table[12x200],c[24])->(strobe[8x50],Q[8x8],log_stretch[8x50],low[4x50],high[4x50]) */

@@ -1151,12 +1151,12 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
 /* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
 #if defined(__GNUC__)
 #define GEARSYM_INLINE inline __attribute__((always_inline))
-#define GEARSYM_COLD __attribute__((noinline, cold))
 #define GEARSYM_NOINLINE __attribute__((noinline))
+#define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
 #else
 #define GEARSYM_INLINE inline
-#define GEARSYM_COLD
 #define GEARSYM_NOINLINE
+#define GEARSYM_UNLIKELY(x) (x)
 #endif
 
 static const casadi_real gs_zeros[1800] = {0.};
@@ -2648,7 +2648,7 @@ static GEARSYM_INLINE void gs_tangent_keep(const casadi_real* restrict A0, const
 }
 
 /* tangent_split, from CasADi's C of it */
-static GEARSYM_COLD void gs_tangent_split(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, const casadi_real* restrict A6, const casadi_real* restrict A7, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3) {
+static GEARSYM_NOINLINE void gs_tangent_split(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, const casadi_real* restrict A6, const casadi_real* restrict A7, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3) {
   casadi_real a000, a001, a002, a003, a004, a005, a006, a007, a008, a009, a010, a011;
   casadi_real a012, a013, a014, a015, a016, a017, a018, a019, a020, a021, a022, a023;
   casadi_real a024, a025, a026, a027, a028, a029, a030, a031, a032, a033, a034, a035;
@@ -13767,7 +13767,7 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
 }
 
 /* state_split, from CasADi's C of it */
-static GEARSYM_COLD void gs_state_split(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+static GEARSYM_NOINLINE void gs_state_split(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
@@ -22165,7 +22165,7 @@ static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casad
 static GEARSYM_INLINE void gs_tangent_step(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real yt[6]; casadi_real Qt[36]; casadi_real flag;
   gs_tangent_try(y, Q, T, c, yt, Qt, &flag);
-  if (flag != 0) gs_tangent_split(y, Q, lo, hi, yt, Qt, T, c, y1, Q1, lo1, hi1);
+  if (GEARSYM_UNLIKELY(flag != 0)) gs_tangent_split(y, Q, lo, hi, yt, Qt, T, c, y1, Q1, lo1, hi1);
   else gs_tangent_keep(y, Q, lo, hi, yt, Qt, T, c, y1, Q1, lo1, hi1);
 }
 
@@ -22174,23 +22174,19 @@ static GEARSYM_NOINLINE void gs_tangent_span(casadi_real* restrict y, casadi_rea
   casadi_real ya[6], yb[6]; casadi_real Qa[36], Qb[36]; casadi_real loa[3], lob[3]; casadi_real hia[3], hib[3];
   casadi_int k;
   gs_copy(y, 6, ya); gs_copy(Q, 36, Qa); gs_copy(lo, 3, loa); gs_copy(hi, 3, hia);
-  for (k = 0; k + 1 < blocks; k += 2) {
+  for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */
     gs_tangent_step(ya, Qa, loa, hia, T + 9*(k), c, yb, Qb, lob, hib);
+    if (k + 1 == blocks) { gs_copy(yb, 6, y); gs_copy(Qb, 36, Q); gs_copy(lob, 3, lo); gs_copy(hib, 3, hi); return; }
     gs_tangent_step(yb, Qb, lob, hib, T + 9*(k + 1), c, ya, Qa, loa, hia);
   }
-  if (k < blocks) {
-    gs_tangent_step(ya, Qa, loa, hia, T + 9*(k), c, yb, Qb, lob, hib);
-    gs_copy(yb, 6, y); gs_copy(Qb, 36, Q); gs_copy(lob, 3, lo); gs_copy(hib, 3, hi);
-  } else {
-    gs_copy(ya, 6, y); gs_copy(Qa, 36, Q); gs_copy(loa, 3, lo); gs_copy(hia, 3, hi);
-  }
+  gs_copy(ya, 6, y); gs_copy(Qa, 36, Q); gs_copy(loa, 3, lo); gs_copy(hia, 3, hi);
 }
 
 /* one block of state steps (the SX functions' step, as CasADi's Switch runs it) */
 static GEARSYM_INLINE void gs_state_step(const casadi_real* restrict y, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real yt[6]; casadi_real flag;
   gs_state_try(y, T, c, yt, &flag);
-  if (flag != 0) gs_state_split(y, lo, hi, yt, T, c, y1, lo1, hi1);
+  if (GEARSYM_UNLIKELY(flag != 0)) gs_state_split(y, lo, hi, yt, T, c, y1, lo1, hi1);
   else gs_state_keep(y, lo, hi, yt, T, c, y1, lo1, hi1);
 }
 
@@ -22199,16 +22195,12 @@ static GEARSYM_NOINLINE void gs_state_span(casadi_real* restrict y, casadi_real*
   casadi_real ya[6], yb[6]; casadi_real loa[3], lob[3]; casadi_real hia[3], hib[3];
   casadi_int k;
   gs_copy(y, 6, ya); gs_copy(lo, 3, loa); gs_copy(hi, 3, hia);
-  for (k = 0; k + 1 < blocks; k += 2) {
+  for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */
     gs_state_step(ya, loa, hia, T + 9*(k), c, yb, lob, hib);
+    if (k + 1 == blocks) { gs_copy(yb, 6, y); gs_copy(lob, 3, lo); gs_copy(hib, 3, hi); return; }
     gs_state_step(yb, lob, hib, T + 9*(k + 1), c, ya, loa, hia);
   }
-  if (k < blocks) {
-    gs_state_step(ya, loa, hia, T + 9*(k), c, yb, lob, hib);
-    gs_copy(yb, 6, y); gs_copy(lob, 3, lo); gs_copy(hib, 3, hi);
-  } else {
-    gs_copy(ya, 6, y); gs_copy(loa, 3, lo); gs_copy(hia, 3, hi);
-  }
+  gs_copy(ya, 6, y); gs_copy(loa, 3, lo); gs_copy(hia, 3, hi);
 }
 
 /* lyapunov_chunk:(y0[6],Q0[6x6],table[9x200],c[16])->(strobe[6x50],Q[6x6],log_stretch[6x50],low[3x50],high[3x50]) */
