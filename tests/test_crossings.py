@@ -137,7 +137,8 @@ def test_compiled_and_in_process_agree_and_every_loop_steps_the_same_way():
         _, states = cm.trajectory(None, 12, inputs)
         np.testing.assert_array_equal(strobe, tangent.strobe)  # orbit loops split the same steps
         np.testing.assert_array_equal(low, tangent.low)
-        np.testing.assert_array_equal(states[:, 200::200], strobe)  # and so does the trajectory
+        # and so does the trajectory: CasADi's loop, the others gearsym's, which gcc fuses differently (FMA)
+        np.testing.assert_allclose(states[:, 200::200], strobe, rtol=0, atol=0 if cm.backend == "in-process" else 1e-13)
         runs.append(tangent)
     np.testing.assert_allclose(runs[0].log_stretch, runs[1].log_stretch, rtol=0, atol=1e-12)
     np.testing.assert_allclose(runs[0].strobe, runs[1].strobe, rtol=0, atol=1e-12)

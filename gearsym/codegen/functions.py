@@ -13,6 +13,10 @@ and 80 000 inlined RK4 steps crash the C compiler):
   pointer (``mapaccum`` would copy them into each iteration: 16 % of the time,
   measured). A run is a few chunk calls; nothing per step or period is Python.
 
+The compiled library does not run these MX loops: :mod:`.printed` prints them in C around the SX step (the
+state in local arrays, no call through pointer arrays per step). They are what the in-process backend
+evaluates, and the reference the printed loops are tested against (the same bits without FMA).
+
 Tangent vectors follow the exact variational equations Q' = J(t, y) Q,
 integrated by the same RK4 as the state (RK4 of the augmented system), so the
 tangent map is the exact derivative of the discrete flow.
@@ -23,7 +27,7 @@ a value never regenerates or recompiles anything.
 ``LoopOptions(locate_crossings=True)`` makes every step that crosses a backlash
 switching surface split there, so that RK4 sees a smooth right-hand side on
 both substeps (see ``_crossing_steps``); the split runs only on crossing steps,
-behind a real ``if`` in the C (a CasADi ``Switch``).
+behind a real ``if`` in the C (in the MX loops a CasADi ``Switch``).
 """
 from __future__ import annotations
 

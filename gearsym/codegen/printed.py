@@ -25,7 +25,6 @@ import re
 
 import casadi as ca
 
-from ..system import FirstOrderSystem
 from .functions import ModelFunctions, shooting_segments
 
 #: the loop functions printed here (everything else in the file is CasADi's)
@@ -70,7 +69,7 @@ def print_loops(text: str, mf: ModelFunctions) -> str:
     missing = [name for name in (*LOOP_NAMES, *mf.steps) if name not in definitions]
     if missing:
         raise AssertionError(f"no C definition of {', '.join(missing)} in the generated code")
-    shape = _Shape.of(mf)
+    shape = _Shape(mf)
     printed = [_PREAMBLE.format(zeros=max(1, shape.rows * shape.N))]
     printed += [_inline(name, definitions[name].group("body"), mf.steps[name]) for name in mf.steps]
     printed += _spans(mf, shape)
@@ -113,7 +112,8 @@ def _inline(name: str, body: str, f: ca.Function) -> str:
 class _Shape:
     """The sizes the printed loops are written for."""
 
-    def __init__(self, system: FirstOrderSystem, mf: ModelFunctions):
+    def __init__(self, mf: ModelFunctions):
+        system = mf.system
         self.n = system.dimension
         self.observed = [i for i, s in enumerate(system.states) if s.name in system.observed]
         self.nc = len(mf.split.constants) + 1
@@ -124,10 +124,6 @@ class _Shape:
         self.P = mf.options.chunk_periods
         self.S = shooting_segments(self.N, K)
         self.located = "tangent_try" in mf.steps
-
-    @classmethod
-    def of(cls, mf: ModelFunctions) -> "_Shape":
-        return cls(mf.system, mf)
 
     def size(self, what: str) -> int:
         """Array length of a local: at least 1 (C has no empty arrays)."""
@@ -217,12 +213,14 @@ def _observed_start(s: _Shape, lo: str = "lo", hi: str = "hi") -> str:
 
 
 def _locals(s: _Shape, tangent: bool) -> str:
+    """A loop's locals: its inputs y0 (Q0) and c copied in, the table by pointer."""
+    table, c = (2, 3) if tangent else (1, 2)
     q = f" casadi_real Q[{s.size('Q')}];" if tangent else ""
+    load_q = f" gs_load(arg[1], {s.n * s.n}, Q);" if tangent else ""
     return (f"  casadi_real y[{s.size('y')}], lo[{s.size('o')}], hi[{s.size('o')}], c[{s.size('c')}];{q}\n"
-            "  const casadi_real* T = arg[{t}] ? arg[{t}] : gs_zeros;\n"
+            f"  const casadi_real* T = arg[{table}] ? arg[{table}] : gs_zeros;\n"
             "  casadi_int p;\n"
-            f"  gs_load(arg[0], {s.n}, y);{f' gs_load(arg[1], {s.n * s.n}, Q);' if tangent else ''} "
-            "gs_load(arg[{c}], " f"{s.nc}, c);\n").format(t=2 if tangent else 1, c=3 if tangent else 2)
+            f"  gs_load(arg[0], {s.n}, y);{load_q} gs_load(arg[{c}], {s.nc}, c);\n")
 
 
 def _lyapunov(s: _Shape, periods: int) -> str:
