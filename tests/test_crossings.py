@@ -137,7 +137,8 @@ def test_compiled_and_in_process_agree_and_every_loop_steps_the_same_way():
         _, states = cm.trajectory(None, 12, inputs)
         np.testing.assert_array_equal(strobe, tangent.strobe)  # orbit loops split the same steps
         np.testing.assert_array_equal(low, tangent.low)
-        np.testing.assert_array_equal(states[:, 200::200], strobe)  # and so does the trajectory
+        # and so does the trajectory: CasADi's loop, the others gearsym's, which gcc fuses differently (FMA)
+        np.testing.assert_allclose(states[:, 200::200], strobe, rtol=0, atol=0 if cm.backend == "in-process" else 1e-13)
         runs.append(tangent)
     np.testing.assert_allclose(runs[0].log_stretch, runs[1].log_stretch, rtol=0, atol=1e-12)
     np.testing.assert_allclose(runs[0].strobe, runs[1].strobe, rtol=0, atol=1e-12)
@@ -219,8 +220,9 @@ def test_split_runs_behind_a_real_branch_in_the_c(tmp_path):
     options = LoopOptions(locate_crossings=True)
     code = write_code(build_functions(one_stage, options), tmp_path, code_hash(one_stage, options))
     text = code.source.read_text()
-    switch = re.search(r"/\* tangent_switch:.*?\n}\n", text, re.S).group(0)
-    assert re.search(r"\bif \(", switch) and "else" in switch
+    step = re.search(r"void gs_tangent_step\(.*?\n}\n", text, re.S).group(0)  # (the printed loops' step)
+    assert re.search(r"\n  if \(GEARSYM_UNLIKELY\(flag != 0\)\) gs_tangent_split\(.*\n  else gs_tangent_keep\(", step)
+    assert "static GEARSYM_NOINLINE void gs_tangent_split(" in text  # out of the way of the steps that do not cross
 
 
 def test_a_model_without_backlash_is_unchanged_and_other_switches_are_refused(tmp_path):

@@ -13,6 +13,10 @@ and 80 000 inlined RK4 steps crash the C compiler):
   pointer (``mapaccum`` would copy them into each iteration: 16 % of the time,
   measured). A run is a few chunk calls; nothing per step or period is Python.
 
+The compiled library does not run these MX loops: :mod:`.printed` prints them in C around the SX step (the
+state in local arrays, no call through pointer arrays per step). They are what the in-process backend
+evaluates, and the reference the printed loops are tested against (the same bits without FMA).
+
 Tangent vectors follow the exact variational equations Q' = J(t, y) Q,
 integrated by the same RK4 as the state (RK4 of the augmented system), so the
 tangent map is the exact derivative of the discrete flow.
@@ -23,7 +27,7 @@ a value never regenerates or recompiles anything.
 ``LoopOptions(locate_crossings=True)`` makes every step that crosses a backlash
 switching surface split there, so that RK4 sees a smooth right-hand side on
 both substeps (see ``_crossing_steps``); the split runs only on crossing steps,
-behind a real ``if`` in the C (a CasADi ``Switch``).
+behind a real ``if`` in the C (in the MX loops a CasADi ``Switch``).
 """
 from __future__ import annotations
 
@@ -48,6 +52,9 @@ class ModelFunctions:
     options: LoopOptions
     split: SplitRHS
     functions: dict[str, ca.Function]
+    #: the SX pieces the printed loops call (:mod:`.printed`): ``tangent_block``/``state_block`` (plain), or
+    #: ``{tangent,state}_{try,keep,split}`` (crossings located), and ``gram_schmidt``
+    steps: dict[str, ca.Function]
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -82,9 +89,11 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
     switching = _switching(system, split) if options.locate_crossings else None
     if switching is None or not switching.surfaces:  # nothing switches (Lorenz): the plain loops
         tangent_block, state_block, state_step = _rk4_functions(sym, split, K, where)
+        steps = {"tangent_block": tangent_block, "state_block": state_block}
     else:
-        tangent_block, state_block, state_step = _crossing_steps(sym, split, switching, where)
+        tangent_block, state_block, state_step, steps = _crossing_steps(sym, split, switching, where)
     gram_schmidt = _gram_schmidt(n)
+    steps["gram_schmidt"] = gram_schmidt
 
     # MX loops over the SX functions
     Ym, Qm, Cm = ca.MX.sym("y", n), ca.MX.sym("Q", n, n), ca.MX.sym("c", nc + 1)
@@ -122,11 +131,17 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
     table = _table_function(constants, table_point, len(sym.params), nc, m, N)
     functions = {f.name(): f for f in (rhs, jacobian, constants, table, lyapunov_chunk, lyapunov_period,
                                        orbit_chunk, orbit_period, trajectory, monodromy_segment, monodromy_period)}
-    return ModelFunctions(system, options, split, functions)
+    return ModelFunctions(system, options, split, functions, steps)
 
 
 #: a period is shot in up to this many pieces (multiple shooting of strongly unstable orbits)
 SHOOTING_SEGMENTS = 4
+
+
+def shooting_segments(N: int, K: int) -> int:
+    """The pieces of a period in ``monodromy_period``: ``SHOOTING_SEGMENTS``, or the largest number below
+    that the period's N // K blocks divide into."""
+    return max(d for d in range(1, SHOOTING_SEGMENTS + 1) if (N // K) % d == 0)
 
 
 def _monodromy(tangent_block, obs0, Ym: ca.MX, Qm: ca.MX, Cm: ca.MX, m: int, N: int, K: int):
@@ -134,8 +149,7 @@ def _monodromy(tangent_block, obs0, Ym: ca.MX, Qm: ca.MX, Cm: ca.MX, m: int, N: 
     below that the period's blocks divide into), the state and the raw tangent matrix Phi Q0 (no
     Gram-Schmidt: the Jacobian of the map, for Newton) with the observed states' min and max over its
     steps; ``monodromy_period``: the pieces of one period in turn (:mod:`gearsym.periodic`)."""
-    blocks = N // K
-    S = max(d for d in range(1, SHOOTING_SEGMENTS + 1) if blocks % d == 0)
+    S = shooting_segments(N, K)
     width = N // S
     Ts = ca.MX.sym("T", 3 * m, width)
     yk, Qk, lk, hk = _over_period(tangent_block, [Ym, Qm, obs0, obs0], Ts, Cm, K, "shooting")
@@ -359,7 +373,8 @@ def _switching(system: FirstOrderSystem, split: SplitRHS) -> _Switching:
 
 
 def _crossing_steps(sym: _Symbols, split: SplitRHS, switching: _Switching, where: str):
-    """``tangent_block``, ``state_block`` and ``state_step`` (one step each) that split a step at a crossing.
+    """``tangent_block``, ``state_block`` and ``state_step`` (one step each) that split a step at a crossing,
+    and the SX pieces they call, by name (the printed loops call them directly, :mod:`.printed`).
 
     The right-hand side is continuous across a backlash surface but its slope jumps, so plain RK4 over a
     crossing step is only first order for the tangent map (and the exponents). Here each step is:
@@ -393,20 +408,23 @@ def _crossing_steps(sym: _Symbols, split: SplitRHS, switching: _Switching, where
     step = _CrossingStep(sym, split, switching, where)
     # with tangent vectors: try, then Switch(keep | split), emitted straight into the caller's MX graph
     # (a Function around the two calls would copy its inputs once more at every step)
-    tangent_try, tangent_switch = step.switched("tangent", with_tangent=True)
+    tangent_try, tangent_keep, tangent_split = step.switched("tangent", with_tangent=True)
+    tangent_switch = ca.Function.if_else("tangent_switch", tangent_split, tangent_keep)
 
     def tangent_block(yk, Qk, lk, hk, Tk, c):
         y_try, Q_try, crossing = tangent_try(yk, Qk, Tk, c)
         return tangent_switch(crossing, yk, Qk, lk, hk, y_try, Q_try, Tk, c)
 
     # the state alone: the same stepping (orbit loops and trajectory)
-    state_try, state_switch = step.switched("state", with_tangent=False)
+    state_try, state_keep, state_split = step.switched("state", with_tangent=False)
+    state_switch = ca.Function.if_else("state_switch", state_split, state_keep)
 
     def state_block(yk, lk, hk, Tk, c):
         y_try, crossing = state_try(yk, Tk, c)
         return state_switch(crossing, yk, lk, hk, y_try, Tk, c)
 
-    return tangent_block, state_block, step.single(state_try)
+    pieces = (tangent_try, tangent_keep, tangent_split, state_try, state_keep, state_split)
+    return tangent_block, state_block, step.single(state_try), {f.name(): f for f in pieces}
 
 
 class _CrossingStep:
@@ -514,9 +532,9 @@ class _CrossingStep:
         obs = ca.vertcat(*[yn[j] for j in self.sym.observed])
         return select_min(obs, self.lo), select_max(obs, self.hi)
 
-    def switched(self, kind: str, with_tangent: bool) -> tuple[ca.Function, ca.Function]:
-        """``{kind}_try`` (the plain step and its crossing flag) and ``{kind}_switch`` (keep the try, or
-        the located step), with or without tangent vectors."""
+    def switched(self, kind: str, with_tangent: bool) -> tuple[ca.Function, ca.Function, ca.Function]:
+        """``{kind}_try`` (the plain step and its crossing flag), ``{kind}_keep`` (keep the try) and
+        ``{kind}_split`` (the located step), with or without tangent vectors."""
         y, ch, col = self.sym.y, self.sym.ch, self.col
         yn, Qn, flag = self.tried(with_tangent)
         ys, Qs = self.located(with_tangent)
@@ -528,7 +546,7 @@ class _CrossingStep:
             inputs, kept, split = [y, self.lo, self.hi, self.y1, col, ch], [self.y1], [ys]
         keep = ca.Function(f"{kind}_keep", inputs, [*kept, *self.extremes(self.y1)], _OPTS)
         cross = ca.Function(f"{kind}_split", inputs, [*split, *self.extremes(ys)], _OPTS)
-        return tried, ca.Function.if_else(f"{kind}_switch", cross, keep)
+        return tried, keep, cross
 
     def single(self, state_try: ca.Function) -> ca.Function:
         """One located step of the state (phase portraits), as an MX function."""

@@ -19,13 +19,14 @@ import sympy as sp
 from ..files import write_atomically
 from ..system import FirstOrderSystem
 from .functions import LoopOptions, ModelFunctions
+from .printed import LOOP_NAMES, pieces, print_loops, stand_in
 
 #: bump when the generated code changes for the same model and options
-CODEGEN_VERSION = 1
+CODEGEN_VERSION = 2
 
 #: the modules whose text determines the generated C; their bytes are part of the hash, so an edit
 #: can never leave a stale library or committed C in use (the tests then ask to regenerate)
-_GENERATOR_SOURCES = ("translate.py", "time_tables.py", "functions.py", "loops.py", "generate.py")
+_GENERATOR_SOURCES = ("translate.py", "time_tables.py", "functions.py", "loops.py", "generate.py", "printed.py")
 
 
 def generator_digest() -> str:
@@ -84,21 +85,24 @@ class GeneratedCode:
 
 
 def write_code(mf: ModelFunctions, directory: Path, digest: str) -> GeneratedCode:
-    """Write ``<model>.c`` and ``manifest.json`` into ``directory`` (atomically: no half-written files)."""
+    """Write ``<model>.c`` and ``manifest.json`` into ``directory`` (atomically: no half-written files): CasADi's
+    C, with the integration loops printed by :mod:`.printed`."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     name = mf.system.name
     with tempfile.TemporaryDirectory(dir=directory) as tmp:
         gen = ca.CodeGenerator(f"{name}.c", {"with_header": False, "verbose": False, "prefix": ""})
-        for f in mf.functions.values():
-            gen.add(f)
+        for fname, f in mf.functions.items():
+            gen.add(stand_in(f, pieces(mf, fname)) if fname in LOOP_NAMES else f)
         cwd = os.getcwd()
         try:  # CasADi writes into the working directory
             os.chdir(tmp)
             gen.generate()
         finally:
             os.chdir(cwd)
-        os.replace(Path(tmp) / f"{name}.c", directory / f"{name}.c")
+        source = Path(tmp) / f"{name}.c"
+        source.write_text(print_loops(source.read_text(), mf))
+        os.replace(source, directory / f"{name}.c")
     text = json.dumps(manifest(mf, digest), indent=2, sort_keys=True) + "\n"
     write_atomically(directory / "manifest.json", text)
     return GeneratedCode(directory, directory / f"{name}.c", directory / "manifest.json", digest)

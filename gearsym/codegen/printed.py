@@ -1,0 +1,289 @@
+"""The integration loops printed by gearsym itself, around CasADi's C of one step.
+
+CasADi's C of an MX loop calls the SX step once per step through pointer arrays: every input is read as
+``arg[i]? arg[i][j] : 0`` and every output written behind ``if (res[i]!=0)``, and the state makes a round
+trip through the work vector between steps: about 10-15 % of a step next to a hand-written C loop
+(bench/speed/notes.md). So the six loop functions (:data:`LOOP_NAMES`) are printed here instead:
+
+* CasADi still writes the whole file: everything else as before, and for each loop function a *stand-in*
+  with its name, input/output names and shapes (:func:`stand_in`), so that the external API
+  (``NAME_n_in``, ``NAME_sparsity_in``, ``NAME_work``, ...) is CasADi's own. Its body calls each SX step
+  piece once, only so that CasADi writes their C (with the helpers they use);
+* each SX piece's C body is copied into a ``static inline`` function of restrict pointers
+  (``arg[i]? arg[i][j] : 0`` -> ``A<i>[j]``, ``if (res[i]!=0) res[i][j]=`` -> ``R<i>[j]=``);
+* the stand-ins' bodies are replaced by loops over those functions with the state in local arrays,
+  double-buffered (two steps per iteration, a -> b -> a), computing what the MX functions of
+  :mod:`.functions` compute, operation for operation (the same bits without FMA; the tests compare);
+* CasADi's static functions nothing calls any more are removed.
+
+With crossings located, the ``try`` is inline on every step and the ``split`` (about 1 % of steps) a
+separate function behind a real ``if``, marked unlikely.
+"""
+from __future__ import annotations
+
+import re
+
+import casadi as ca
+
+from .functions import ModelFunctions, shooting_segments
+
+#: the loop functions printed here (everything else in the file is CasADi's)
+LOOP_NAMES = ("lyapunov_chunk", "lyapunov_period", "orbit_chunk", "orbit_period", "monodromy_segment",
+              "monodromy_period")
+
+_HEADER = r"/\* (?P<name>\w+):\(.*?\)->\(.*?\) \*/\n"
+_SIGNATURE = (r"static int (?P<c>casadi_f\d+)\(const casadi_real\*\* arg, casadi_real\*\* res, casadi_int\* iw, "
+              r"casadi_real\* w, int mem\) \{\n")
+_DEFINITION = re.compile(_HEADER + _SIGNATURE + r"(?P<body>.*?)\n\}\n\n", re.S)
+
+
+def pieces(mf: ModelFunctions, loop: str) -> list[ca.Function]:
+    """The SX step functions the printed ``loop`` calls."""
+    kind = "state" if loop.startswith("orbit") else "tangent"
+    names = [f"{kind}_block"] if f"{kind}_block" in mf.steps else [f"{kind}_{p}" for p in ("try", "keep", "split")]
+    if loop.startswith("lyapunov"):
+        names.append("gram_schmidt")
+    return [mf.steps[name] for name in names]
+
+
+def stand_in(f: ca.Function, calls: list[ca.Function]) -> ca.Function:
+    """A Function with ``f``'s name, input and output names and shapes, whose body (replaced after code
+    generation) calls each of ``calls`` once, so that CasADi writes their C into the file."""
+    inputs = [ca.MX.sym(f.name_in(i), f.sparsity_in(i)) for i in range(f.n_in())]
+    anchor, x = 0, inputs[0][0]
+    for g in calls:  # (on a symbol: on constant inputs CasADi left some of the calls out)
+        anchor += g.call([x * ca.MX.ones(g.sparsity_in(i)) for i in range(g.n_in())])[0][0]
+    outputs = [ca.MX.zeros(f.sparsity_out(i)) for i in range(f.n_out())]
+    rows, cols = f.size_out(0)
+    outputs[0] = ca.reshape(ca.vertcat(anchor, ca.MX.zeros(rows * cols - 1, 1)), rows, cols)
+    standin = ca.Function(f.name(), inputs, outputs, f.name_in(), f.name_out())
+    for i in range(f.n_out()):
+        if standin.sparsity_out(i) != f.sparsity_out(i):
+            raise AssertionError(f"the stand-in of {f.name()} has another shape for output {i}")
+    return standin
+
+
+def print_loops(text: str, mf: ModelFunctions) -> str:
+    """CasADi's C ``text`` (written with :func:`stand_in` for the :data:`LOOP_NAMES`) with the loops printed."""
+    definitions = {m.group("name"): m for m in _DEFINITION.finditer(text)}
+    missing = [name for name in (*LOOP_NAMES, *mf.steps) if name not in definitions]
+    if missing:
+        raise AssertionError(f"no C definition of {', '.join(missing)} in the generated code")
+    shape = _Shape(mf)
+    printed = [_PREAMBLE.format(zeros=max(1, shape.rows * shape.N))]
+    printed += [_inline(name, definitions[name].group("body"), mf.steps[name]) for name in mf.steps]
+    printed += _spans(mf, shape)
+    # the printed C goes before the first stand-in; each stand-in's body becomes its loop
+    first = min(definitions[name].start() for name in LOOP_NAMES)
+    for name in sorted(LOOP_NAMES, key=lambda name: -definitions[name].start()):
+        d = definitions[name]
+        loop = _LOOPS[name](shape)
+        text = text[:d.start()] + d.group(0)[:d.start("body") - d.start()] + loop + "\n}\n\n" + text[d.end():]
+    text = text[:first] + "\n".join(printed) + "\n" + text[first:]
+    return _without_unused(text)
+
+
+def _without_unused(text: str) -> str:
+    """``text`` without CasADi's static functions that nothing calls any more (those the stand-ins called)."""
+    while True:
+        unused = [m for m in _DEFINITION.finditer(text) if text.count(m.group("c") + "(") == 1]
+        if not unused:
+            return text
+        for m in reversed(unused):
+            text = text[:m.start()] + text[m.end():]
+
+
+def _inline(name: str, body: str, f: ca.Function) -> str:
+    """The C body of the SX function ``f`` as ``gs_<name>``: inputs A0.., outputs R0.., restrict pointers."""
+    body = re.sub(r"arg\[(\d+)\]\? arg\[\1\]\[(\d+)\] : 0", r"A\1[\2]", body)
+    body = re.sub(r"if \(res\[(\d+)\]!=0\) res\[\1\]\[(\d+)\]=", r"R\1[\2]=", body)
+    body = re.sub(r"\n  return 0;$", "", body)
+    left = [line for line in body.splitlines() if re.search(r"\b(arg|res|iw|w)\[|\breturn\b|\bmem\b", line)]
+    if left:
+        raise AssertionError(f"{name}: CasADi's C has a form the printer does not rewrite: {left[:3]}")
+    args = [f"const casadi_real* restrict A{i}" for i in range(f.n_in())]
+    args += [f"casadi_real* restrict R{i}" for i in range(f.n_out())]
+    # the split (about 1 % of steps) stays a call: not `cold`, whose size optimisation (code hoisting) took
+    # gcc 20 s more on the largest model
+    where = "GEARSYM_NOINLINE" if name.endswith("_split") else "GEARSYM_INLINE"
+    return f"/* {name}, from CasADi's C of it */\nstatic {where} void gs_{name}({', '.join(args)}) {{\n{body}\n}}\n"
+
+
+class _Shape:
+    """The sizes the printed loops are written for."""
+
+    def __init__(self, mf: ModelFunctions):
+        system = mf.system
+        self.n = system.dimension
+        self.observed = [i for i, s in enumerate(system.states) if s.name in system.observed]
+        self.nc = len(mf.split.constants) + 1
+        self.N, K = mf.options.steps_per_period, mf.options.block(self.n)
+        self.rows = 3 * len(mf.split.tables)  # table rows: one column per step
+        self.step = self.rows * K  # table entries per block
+        self.blocks = self.N // K
+        self.P = mf.options.chunk_periods
+        self.S = shooting_segments(self.N, K)
+        self.located = "tangent_try" in mf.steps
+
+    def size(self, what: str) -> int:
+        """Array length of a local: at least 1 (C has no empty arrays)."""
+        return max(1, {"y": self.n, "Q": self.n * self.n, "o": len(self.observed), "c": self.nc}[what])
+
+
+_PREAMBLE = """/* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
+#if defined(__GNUC__)
+#define GEARSYM_INLINE inline __attribute__((always_inline))
+#define GEARSYM_NOINLINE __attribute__((noinline))
+#define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
+#else
+#define GEARSYM_INLINE inline
+#define GEARSYM_NOINLINE
+#define GEARSYM_UNLIKELY(x) (x)
+#endif
+
+static const casadi_real gs_zeros[{zeros}] = {{0.}};
+
+/* an input as CasADi passes it (a null pointer: zeros) into a local array */
+static inline void gs_load(const casadi_real* x, casadi_int n, casadi_real* y) {{
+  casadi_int i;
+  for (i = 0; i < n; ++i) y[i] = x ? x[i] : 0;
+}}
+
+static inline void gs_copy(const casadi_real* restrict x, casadi_int n, casadi_real* restrict y) {{
+  casadi_int i;
+  for (i = 0; i < n; ++i) y[i] = x[i];
+}}
+
+/* an output column (none if the caller passes a null pointer) */
+static inline void gs_store(const casadi_real* x, casadi_int n, casadi_real* y, casadi_int at) {{
+  casadi_int i;
+  if (y) for (i = 0; i < n; ++i) y[at + i] = x[i];
+}}
+"""
+
+
+def _spans(mf: ModelFunctions, s: _Shape) -> list[str]:
+    """One step of each kind (try, then split or keep; or the plain block) and the loop over a period's
+    blocks, with the state in local arrays, two steps per iteration (two copies of the inline step: a
+    third for an odd number of blocks cost compile time)."""
+    out = []
+    for kind, carried in (("tangent", ("y", "Q")), ("state", ("y",))):
+        state = [*carried, "lo", "hi"]
+        decl = [f"casadi_real* restrict {v}" for v in state]
+        ins = [f"const casadi_real* restrict {v}" for v in state] + ["const casadi_real* restrict T",
+                                                                   "const casadi_real* restrict c"]
+        nexts = [f"{v}1" for v in state]
+        outs = [f"casadi_real* restrict {v}" for v in nexts]
+        args = ", ".join([*state, "T", "c", *nexts])
+        if s.located:
+            tried = [f"{v}t" for v in carried]
+            declare = " ".join(f"casadi_real {v}[{s.size(v[0])}];" for v in tried)
+            split_args = ", ".join([*state, *tried, "T", "c", *nexts])
+            body = (f"  {declare} casadi_real flag;\n"
+                    f"  gs_{kind}_try({', '.join([*carried, 'T', 'c', *tried])}, &flag);\n"
+                    f"  if (GEARSYM_UNLIKELY(flag != 0)) gs_{kind}_split({split_args});\n"
+                    f"  else gs_{kind}_keep({split_args});\n")
+        else:
+            body = f"  gs_{kind}_block({args});\n"
+        out.append(f"/* one block of {kind} steps (the SX functions' step, as CasADi's Switch runs it) */\n"
+                   f"static GEARSYM_INLINE void gs_{kind}_step({', '.join(ins + outs)}) {{\n{body}}}\n")
+        sizes = {"y": s.size("y"), "Q": s.size("Q"), "lo": s.size("o"), "hi": s.size("o")}
+        a = [f"{v}a" for v in state]
+        b = [f"{v}b" for v in state]
+        locals_ = " ".join(f"casadi_real {v}a[{sizes[v]}], {v}b[{sizes[v]}];" for v in state)
+        table = (lambda k: f"T + {s.step}*({k})") if s.step else (lambda k: "T")
+        copy = lambda src, dst: " ".join(f"gs_copy({x}, {sizes[v]}, {y});" for v, x, y in zip(state, src, dst))
+        out.append(
+            f"/* blocks of {kind} steps from ({', '.join(state)}), in place: the state in local arrays, a -> b -> a */\n"
+            f"static GEARSYM_NOINLINE void gs_{kind}_span({', '.join(decl)}, const casadi_real* restrict T, "
+            "const casadi_real* restrict c, casadi_int blocks) {\n"
+            f"  {locals_}\n  casadi_int k;\n  {copy(state, a)}\n"
+            "  for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */\n"
+            f"    gs_{kind}_step({', '.join([*a, table('k'), 'c', *b])});\n"
+            f"    if (k + 1 == blocks) {{ {copy(b, state)} return; }}\n"
+            f"    gs_{kind}_step({', '.join([*b, table('k + 1'), 'c', *a])});\n"
+            "  }\n"
+            f"  {copy(a, state)}\n}}\n")
+    return out
+
+
+def _observed_start(s: _Shape, lo: str = "lo", hi: str = "hi") -> str:
+    """lo and hi reset to the observed states (a period's or a segment's start)."""
+    return " ".join(f"{lo}[{i}] = y[{j}]; {hi}[{i}] = y[{j}];" for i, j in enumerate(s.observed))
+
+
+def _locals(s: _Shape, tangent: bool) -> str:
+    """A loop's locals: its inputs y0 (Q0) and c copied in, the table by pointer."""
+    table, c = (2, 3) if tangent else (1, 2)
+    q = f" casadi_real Q[{s.size('Q')}];" if tangent else ""
+    load_q = f" gs_load(arg[1], {s.n * s.n}, Q);" if tangent else ""
+    return (f"  casadi_real y[{s.size('y')}], lo[{s.size('o')}], hi[{s.size('o')}], c[{s.size('c')}];{q}\n"
+            f"  const casadi_real* T = arg[{table}] ? arg[{table}] : gs_zeros;\n"
+            "  casadi_int p;\n"
+            f"  gs_load(arg[0], {s.n}, y);{load_q} gs_load(arg[{c}], {s.nc}, c);\n")
+
+
+def _lyapunov(s: _Shape, periods: int) -> str:
+    o = len(s.observed)
+    return (_locals(s, True)
+            + f"  casadi_real Qn[{s.size('Q')}], logs[{s.size('y')}];\n"
+            f"  for (p = 0; p < {periods}; ++p) {{\n"
+            f"    {_observed_start(s)}\n"
+            f"    gs_tangent_span(y, Q, lo, hi, T, c, {s.blocks});\n"
+            "    gs_gram_schmidt(Q, Qn, logs);\n"
+            f"    gs_copy(Qn, {s.n * s.n}, Q);\n"
+            f"    gs_store(y, {s.n}, res[0], {s.n}*p); gs_store(logs, {s.n}, res[2], {s.n}*p);\n"
+            f"    gs_store(lo, {o}, res[3], {o}*p); gs_store(hi, {o}, res[4], {o}*p);\n"
+            "  }\n"
+            f"  gs_store(Q, {s.n * s.n}, res[1], 0);\n"
+            "  return 0;")
+
+
+def _orbit(s: _Shape, periods: int) -> str:
+    o = len(s.observed)
+    return (_locals(s, False)
+            + f"  for (p = 0; p < {periods}; ++p) {{\n"
+            f"    {_observed_start(s)}\n"
+            f"    gs_state_span(y, lo, hi, T, c, {s.blocks});\n"
+            f"    gs_store(y, {s.n}, res[0], {s.n}*p); gs_store(lo, {o}, res[1], {o}*p); "
+            f"gs_store(hi, {o}, res[2], {o}*p);\n"
+            "  }\n"
+            "  return 0;")
+
+
+def _monodromy_end(s: _Shape) -> str:
+    o = len(s.observed)
+    return (f"  gs_store(y, {s.n}, res[0], 0); gs_store(Q, {s.n * s.n}, res[1], 0);\n"
+            f"  gs_store(lo, {o}, res[2], 0); gs_store(hi, {o}, res[3], 0);\n"
+            "  return 0;")
+
+
+def _monodromy_segment(s: _Shape) -> str:
+    return (_locals(s, True) + f"  (void) p;\n  {_observed_start(s)}\n"
+            f"  gs_tangent_span(y, Q, lo, hi, T, c, {s.blocks // s.S});\n" + _monodromy_end(s))
+
+
+def _monodromy_period(s: _Shape) -> str:
+    """The period's pieces in turn, each with its own extremes, combined by the selects of the MX function
+    ((a < b ? a : 0) + (!(a < b) ? b : 0): the same bits, signed zeros included)."""
+    width = s.N // s.S
+    select = "    {lo}[{i}] = ({a} {op} {b} ? {a} : 0) + ({a} {op} {b} ? 0 : {b});\n"
+    combine = "".join(select.format(lo=w, i=i, a=f"{part}[{i}]", b=f"{w}[{i}]", op=op)
+                      for i in range(len(s.observed)) for w, part, op in (("lk", "lo", "<"), ("hk", "hi", ">")))
+    return (_locals(s, True) + f"  casadi_real lk[{s.size('o')}], hk[{s.size('o')}];\n"
+            f"  {_observed_start(s, 'lk', 'hk')}\n"
+            f"  for (p = 0; p < {s.S}; ++p) {{\n"
+            f"    {_observed_start(s)}\n"
+            f"    gs_tangent_span(y, Q, lo, hi, {f'T + {s.rows * width}*p' if s.rows else 'T'}, c, "
+            f"{s.blocks // s.S});\n" + combine + "  }\n"
+            f"  gs_copy(lk, {s.size('o')}, lo); gs_copy(hk, {s.size('o')}, hi);\n" + _monodromy_end(s))
+
+
+_LOOPS = {
+    "lyapunov_chunk": lambda s: _lyapunov(s, s.P),
+    "lyapunov_period": lambda s: _lyapunov(s, 1),
+    "orbit_chunk": lambda s: _orbit(s, s.P),
+    "orbit_period": lambda s: _orbit(s, 1),
+    "monodromy_segment": _monodromy_segment,
+    "monodromy_period": _monodromy_period,
+}

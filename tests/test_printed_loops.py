@@ -1,0 +1,86 @@
+"""The integration loops printed by gearsym (gearsym/codegen/printed.py) compute what CasADi's MX loops compute."""
+from __future__ import annotations
+
+import re
+
+import casadi as ca
+import numpy as np
+import pytest
+
+import gearsym
+from gearsym import Integration, lyapunov_spectrum
+from gearsym.codegen.compiler import compile_library, find_compiler
+from gearsym.codegen.functions import LoopOptions, build_functions
+from gearsym.codegen.generate import code_hash, write_code
+from gearsym.codegen.native import load_native
+from gearsym.codegen.printed import LOOP_NAMES, _inline
+
+needs_cc = pytest.mark.skipif(find_compiler() is None, reason="needs a C compiler")
+
+#: without fused multiply-adds the C does each operation as CasADi's virtual machine does
+NO_FMA = ("-O3", "-ffp-contract=off")
+
+
+def _library(name: str, options: LoopOptions, tmp_path):
+    system = gearsym.load(name)
+    mf = build_functions(system, options)
+    code = write_code(mf, tmp_path / name, code_hash(system, options))
+    path = str(compile_library(code.source, name, flags=NO_FMA).path)
+    return system, mf, load_native(path, {f: ca.external(f, path) for f in LOOP_NAMES})
+
+
+@needs_cc
+@pytest.mark.parametrize("name, located", [("one_stage", False), ("one_stage", True), ("flexible_shaft", False),
+                                           ("flexible_shaft", True), ("lorenz", True)])
+def test_the_printed_loops_give_the_bits_of_casadis_loops_evaluated_in_process(name, located, tmp_path):
+    # 45 steps in blocks of 3 (plain): odd numbers of blocks per period and per shooting piece (3 of 15 steps)
+    options = LoopOptions(steps_per_period=45, chunk_periods=3, block_steps=3, locate_crossings=located)
+    system, mf, native = _library(name, options, tmp_path)
+    F = mf.functions
+    p = np.array(list(system.parameters.values()), dtype=float)
+    c, _ = F["constants"](p)
+    table, _ = F["table"](0.0, p)
+    n = system.dimension
+    y, Q = ca.DM([-2.0, -0.5] + [0.1 * i for i in range(2, n)]), ca.DM.eye(n)
+    width = F["monodromy_segment"].size_in(2)[1]
+    inputs = {"lyapunov_chunk": (y, Q, table, c), "lyapunov_period": (y, Q, table, c), "orbit_chunk": (y, table, c),
+              "orbit_period": (y, table, c), "monodromy_period": (y, Q, table, c),
+              "monodromy_segment": (y, Q, table[:, width:2 * width], c)}
+    for loop, args in inputs.items():
+        expected = [np.array(v) for v in F[loop].call(list(args))]
+        got = native[loop](*[np.array(a) for a in args])
+        for i, (a, b) in enumerate(zip(expected, got)):
+            assert np.array_equal(a, b), (loop, F[loop].name_out(i), np.max(np.abs(a - b)))
+    if located and name == "one_stage":  # the split ran: some step of the first period crosses
+        states = np.array(F["trajectory"](y, table, c))
+        starts = np.column_stack([np.array(y), states[:, :-1]])
+        flags = [float(mf.steps["state_try"](starts[:, k], table[:, k], c)[1]) for k in range(starts.shape[1])]
+        assert 0 < sum(flags) < len(flags)
+
+
+def test_the_default_engine_gives_the_spectrum_of_casadis_loops_on_a_periodic_orbit():
+    """With the default flags (fused multiply-adds across what were calls) the bits move, the spectrum not."""
+    system = gearsym.load("one_stage")
+    runs = [lyapunov_spectrum(system, options=Integration(periods=24, discard=4, backend=backend))
+            for backend in ("compiled", "in-process")]
+    assert runs[0].exponents[0] < -1e-3  # periodic: errors do not grow
+    assert runs[0].exponents == pytest.approx(runs[1].exponents, abs=1e-9)
+    assert list(runs[0].final_state.values()) == pytest.approx(list(runs[1].final_state.values()), abs=1e-9)
+
+
+def test_the_printed_steps_read_no_pointer_array_and_keep_the_state_in_local_arrays(tmp_path):
+    system, options = gearsym.load("one_stage"), LoopOptions(locate_crossings=True)
+    text = write_code(build_functions(system, options), tmp_path, code_hash(system, options)).source.read_text()
+    span = re.search(r"void gs_tangent_span\(.*?\n}\n", text, re.S).group(0)
+    assert "gs_tangent_step(ya, Qa, loa, hia, T + 6*(k), c, yb, Qb, lob, hib);" in span
+    for piece in ("tangent_try", "tangent_keep", "gram_schmidt"):
+        body = re.search(rf"void gs_{piece}\(.*?\n}}\n", text, re.S).group(0)
+        assert not re.search(r"\b(arg|res|w|iw)\[", body), piece
+    assert "/* tangent_switch:" not in text and "tangent_segment_50" not in text  # CasADi's loops are gone
+
+
+def test_a_step_in_a_form_the_printer_does_not_rewrite_fails_loudly():
+    x = ca.SX.sym("x")
+    f = ca.Function("odd", [x], [x])
+    with pytest.raises(AssertionError, match="odd: CasADi's C has a form the printer does not rewrite"):
+        _inline("odd", "  a0=w[3];\n  if (res[0]!=0) res[0][0]=a0;\n  return 0;", f)
