@@ -9,14 +9,17 @@ reads its start state where the previous one wrote it). The generated
 functions keep no state (``checkout`` returns 0), so each ``NativeFunction``
 owns its work arrays and distinct objects may run in different threads.
 
-Where those arrays and the stack sit decides the speed of a step. Each step
-stores pointers into the argument arrays, its state into the work vector and
-temporaries onto the stack, and loads them back at once; a load whose address
-matches an older store's in its low 12 bits but not in the page (4K aliasing)
-waits for that store. With the arrays wherever the allocator put them and the
-stack wherever the process started, about one load in a few dozen ran every step
-1.2-2.4x slower for its whole life (measured on the one-stage and flexible-shaft
-loops, bench/speed/notes.md). So the arrays live in one page-aligned block
+Where those arrays and the stack sit decided the speed of a step while CasADi's
+loops called each step through them: every step stored pointers into the argument
+arrays, its state into the work vector and temporaries onto the stack, and loaded
+them back at once; a load whose address matches an older store's in its low 12
+bits but not in the page (4K aliasing) waits for that store. With the arrays
+wherever the allocator put them and the stack wherever the process started, about
+one load in a few dozen ran every step 1.2-2.4x slower for its whole life
+(bench/speed/notes.md). The loops are now printed by gearsym (:mod:`.printed`:
+the state in local arrays, no pointer arrays per step), which leaves the stack
+and the per-call arrays; the same placement keeps every load of a library alike.
+So the arrays live in one page-aligned block
 (argument pointers, result pointers, integer and real work, each on its own cache
 lines, never overlapping), and the library's ``gearsym_call`` (compiled into every
 library, see :data:`.compiler.CALL_SOURCE`) moves the stack so that it starts at
