@@ -181,6 +181,11 @@ class FirstOrderSystem(ParameterChecks):
         return self.coordinates or tuple(s.name for s in self.states)
 
     @property
+    def observed_indices(self) -> list[int]:
+        """Where the :attr:`observed` states are in the state vector (the loops' min/max rows)."""
+        return [i for i, s in enumerate(self.states) if s.name in self.observed]
+
+    @property
     def initial_vector(self) -> tuple[float, ...]:
         return tuple(float(self.initial.get(s.name, 0.0)) for s in self.states)
 

@@ -229,7 +229,7 @@ class _Symbols:
         m, nc = len(split.tables), len(split.constants)
         base = self.base = SystemSymbols.of(system)
         self.params = list(system.parameters)
-        self.observed = [i for i, s in enumerate(system.states) if s.name in system.observed]
+        self.observed = system.observed_indices
         self.t, self.y, self.p = base.t, base.y, base.p
         self.T = ca.SX.sym("T", m)
         c = ca.SX.sym("c", nc)

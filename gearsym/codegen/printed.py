@@ -115,7 +115,7 @@ class _Shape:
     def __init__(self, mf: ModelFunctions):
         system = mf.system
         self.n = system.dimension
-        self.observed = [i for i, s in enumerate(system.states) if s.name in system.observed]
+        self.observed = system.observed_indices
         self.nc = len(mf.split.constants) + 1
         self.N, K = mf.options.steps_per_period, mf.options.block(self.n)
         self.rows = 3 * len(mf.split.tables)  # table rows: one column per step
