@@ -171,3 +171,26 @@ def test_independent_points_are_dealt_out_in_shrinking_tasks_that_cover_them_in_
     assert _guided([([p], start) for p in points], workers=1) == [(points, start)]  # one worker: one batch run
     line = [([Point("up", (1.0,)), Point("up", (2.0,))], start)]
     assert _guided(line, workers=2) is line  # continuation lines stay whole
+
+
+def test_a_batch_checked_at_once_names_the_point_and_period_that_became_non_finite(tmp_path, one_stage,
+                                                                                    monkeypatch):
+    """The sweep checks a batch's records with one sum; the error still names the first bad point and period,
+    and keeps the points before it."""
+    from gearsym.codegen import CompiledModel
+    from gearsym.errors import GearsymError
+    from gearsym.sweep import read_sweep
+
+    run_into = CompiledModel.tangent_run_into
+
+    def poisoned(self, runs, i, y, inputs, check_finite=True):
+        run_into(self, runs, i, y, inputs, check_finite)
+        if inputs.p[list(self.parameter_names).index("omega")] == 1.2:
+            runs.log_stretch[i, 6, 1] = np.nan  # period 7, second exponent
+
+    monkeypatch.setattr(CompiledModel, "tangent_run_into", poisoned)
+    out = tmp_path / "s.csv"
+    with pytest.raises(GearsymError, match=r"at omega=1.2 \(up\): one_stage: the solution became non-finite in "
+                                           r"period 7 "):
+        run_sweep(one_stage, {"omega": [1.0, 1.1, 1.2, 1.3]}, options=RUN, progress=False, out=out)
+    assert read_sweep(out)["omega"].tolist() == [1.0, 1.1]

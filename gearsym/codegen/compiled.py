@@ -8,6 +8,7 @@ take one, so that a sweep builds it once and only changes the parameter vector
 """
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
@@ -192,33 +193,59 @@ class CompiledModel:
             p = self.parameter_vector(p) if p is None or isinstance(p, Mapping) else np.asarray(p, dtype=float)
         elif p.dtype != np.float64:
             p = p.astype(float)
-        if p.shape != (len(self.parameter_names),) or not np.isfinite(p).all():
+        if p.shape != (len(self.parameter_names),) or not all(map(math.isfinite, p.tolist())):
             raise GearsymError(f"{self.name}: expected {len(self.parameter_names)} finite parameter values "
                                f"({', '.join(self.parameter_names)}), got {p}")
         # a sweep's next point often changes only values outside the tables: then only the constants are new
-        last_p, last = self.__dict__.get("_last_inputs", (None, None))
-        if last is not None and last.t0 == float(t0) and not self._retimed(last_p, p):
+        timed = self._timed_values(p)
+        last_timed, last = self.__dict__.get("_last_inputs", (None, None))
+        if last is not None and last.t0 == float(t0) and timed == last_timed:
             inputs = self._with_constants(last, p)
         else:
             inputs = self._tables(p, float(t0))
-        self.__dict__["_last_inputs"] = (p.copy(), inputs)  # (a copy: the caller may change p in place)
+        self.__dict__["_last_inputs"] = (timed, inputs)
         return inputs
 
     def _tables(self, p: np.ndarray, t0: float) -> RunInputs:
         """New inputs for ``p``: the tables of time computed, the period checked."""
         if self.native:
-            c, period = self.native["constants"](p)
-            table, probe = self.native["table"](np.array([float(t0)]), p)
-        else:
-            c, period = (np.array(v) for v in self.functions["constants"](p))
-            table, probe = (np.array(v) for v in self.functions["table"](t0, p))
-        period = float(period.reshape(-1)[0])
-        if not (np.isfinite(period) and period > 0):
+            return self._native_tables(p, t0)
+        c, period = (np.array(v) for v in self.functions["constants"](p))
+        table, probe = (np.array(v) for v in self.functions["table"](t0, p))
+        period = self._checked_period(p, t0, float(period.reshape(-1)[0]), probe)
+        return RunInputs(p, np.asfortranarray(table, dtype=np.float64), np.ascontiguousarray(c.reshape(-1)),
+                         period, t0, self.hash)
+
+    def _native_tables(self, p: np.ndarray, t0: float) -> RunInputs:
+        """:meth:`_tables` through the library: t0, p, the tables, the probe, the constants and the period in
+        one new block, so that one address serves both calls (a paper-scheme sweep in omega makes one a point)."""
+        k, (rows, steps), (probe_rows, _), size = self._table_layout
+        table_at, probe_at, c_at = 1 + k, 1 + k + rows * steps, 1 + k + rows * steps + 2 * probe_rows
+        block = np.zeros(c_at + size + 1)  # (zeros: what the library leaves unwritten reads as CasADi's)
+        block[0] = t0
+        block[1:table_at] = p
+        at = block.ctypes.data
+        self.native["constants"].call((at + 8,), (at + 8 * c_at, at + 8 * (c_at + size)))
+        self.native["table"].call((at, at + 8), (at + 8 * table_at, at + 8 * probe_at))
+        probe = block[probe_at:c_at].reshape((probe_rows, 2), order="F")
+        period = self._checked_period(p, t0, float(block[c_at + size]), probe)
+        inputs = RunInputs(block[1:table_at], block[table_at:probe_at].reshape((rows, steps), order="F"),
+                           block[c_at:c_at + size], period, t0, self.hash)
+        inputs.__dict__["addresses"] = (at + 8 * table_at, at + 8 * c_at)  # (the cached property, known already)
+        return inputs
+
+    @cached_property
+    def _table_layout(self) -> tuple[int, tuple[int, int], tuple[int, int], int]:
+        """Parameters, the shapes of the tables and of the probe, and the number of constants."""
+        table, probe = self.native["table"].shapes_out
+        return len(self.parameter_names), table, probe, self.native["constants"].shapes_out[0][0]
+
+    def _checked_period(self, p: np.ndarray, t0: float, period: float, probe: np.ndarray) -> float:
+        if not (math.isfinite(period) and period > 0):
             raise ModelError(f"the forcing period is {period} at these parameter values; it must be positive",
                              self.name)
-        self._check_periodic(p, float(t0), period, probe)
-        return RunInputs(p, np.asfortranarray(table, dtype=np.float64), np.ascontiguousarray(c.reshape(-1)),
-                         period, float(t0), self.hash)
+        self._check_periodic(p, t0, period, probe)
+        return period
 
     @cached_property
     def timed_parameters(self) -> frozenset[str]:
@@ -233,7 +260,7 @@ class CompiledModel:
         """The inputs for the parameter vector ``p``: those of ``inputs`` with new constants if no parameter that
         changed enters the tables or the period (a continuation in omega of a model in tau), else :meth:`prepare`."""
         p = np.asarray(p, dtype=float)
-        if p.shape != inputs.p.shape or not np.isfinite(p).all() or self._retimed(inputs.p, p):
+        if p.shape != inputs.p.shape or not all(map(math.isfinite, p.tolist())) or self._retimed(inputs.p, p):
             return self.prepare(p, inputs.t0)
         return self._with_constants(inputs, p)
 
@@ -255,26 +282,30 @@ class CompiledModel:
 
     def _retimed(self, before: np.ndarray, after: np.ndarray) -> bool:
         """Whether a parameter that enters the tables of time or the period differs between the vectors."""
-        timed = self._timed_index
-        return before.take(timed).tolist() != after.take(timed).tolist()
+        return self._timed_values(before) != self._timed_values(after)
+
+    def _timed_values(self, p: np.ndarray) -> list[float]:
+        """The values of ``p`` that enter the tables of time or the period (plain floats: cheap to compare)."""
+        values = p.tolist()
+        return [values[i] for i in self._timed_index]
 
     @cached_property
-    def _timed_index(self) -> np.ndarray:
-        return np.array([i for i, n in enumerate(self.parameter_names) if n in self.timed_parameters], dtype=np.intp)
+    def _timed_index(self) -> tuple[int, ...]:
+        return tuple(i for i, n in enumerate(self.parameter_names) if n in self.timed_parameters)
 
     def _check_periodic(self, p: np.ndarray, t0: float, period: float, probe: np.ndarray) -> None:
         """The loops repeat one sampled period; at other parameter values than the defaults
         (checked when the code was generated) the time dependence must still repeat.
         ``probe`` holds the tables at t0 + 0.37 T and one period later."""
-        a, b = probe[:, 0], probe[:, 1]
-        off = np.nonzero(~(np.abs(a - b) <= 1e-9 * (1 + np.abs(a))))[0]
-        if off.size:
+        a, b = probe[:, 0].tolist(), probe[:, 1].tolist()  # (a few values: plain floats, the same arithmetic)
+        off = [i for i, (x, y) in enumerate(zip(a, b)) if not abs(x - y) <= 1e-9 * (1 + abs(x))]
+        if off:
             from .time_tables import NotPeriodicError, split_rhs
 
-            i = int(off[0])
+            i = off[0]
             expr = split_rhs(self.system, self.options.locate_crossings).tables[i][1]
             values = ", ".join(f"{n}={v:g}" for n, v in zip(self.parameter_names, p))
-            raise NotPeriodicError(self.system, expr, t0 + 0.37 * period, float(a[i]), float(b[i]), f"at {values}")
+            raise NotPeriodicError(self.system, expr, t0 + 0.37 * period, a[i], b[i], f"at {values}")
 
     def _check_inputs(self, inputs: RunInputs) -> None:
         if inputs.model_hash != self.hash:
@@ -300,7 +331,7 @@ class CompiledModel:
         if y.shape != (self.dimension,):
             raise GearsymError(f"{self.name}: the initial state needs {self.dimension} values "
                                f"({', '.join(self.state_names)}), got {y.size}")
-        if not np.all(np.isfinite(y)):
+        if not all(map(math.isfinite, y.tolist())):
             raise GearsymError(f"{self.name}: the initial state must be finite, got {y}")
         return y
 
@@ -312,33 +343,56 @@ class CompiledModel:
         self._check_inputs(inputs)
         n, m = self.dimension, len(self.observed)
         y = self.initial_state(y0)
-        Q = np.array(np.eye(n) if Q0 is None else Q0, dtype=np.float64, order="F")  # a copy: written in place
-        if Q.shape != (n, n):
+        Q = None if Q0 is None else np.asarray(Q0, dtype=np.float64)
+        if Q is not None and Q.shape != (n, n):
             raise GearsymError(f"{self.name}: tangent vectors must be a {n}x{n} matrix, got {Q.shape}")
         schedule = self._schedule(periods, "lyapunov")
         if out is not None and [(a.shape, a.flags.f_contiguous) for a in out] != [
                 ((rows, periods), True) for rows in (n, n, m, m)]:
             raise GearsymError(f"{self.name}: tangent_run(out=...) needs column-major arrays of {n}, {n}, {m} and "
                                f"{m} rows by {periods} periods (a TangentRuns slot)")
-        if self.native:
-            strobe, logs, low, high = out or [np.empty((r, periods), order="F") for r in (n, n, m, m)]
-            Qs = [Q, np.empty_like(Q)]
-            final = self._native_loop(schedule, y.ctypes.data, [q.ctypes.data for q in Qs], inputs,
-                                      *_addresses(strobe, logs, low, high))
-            Q = Qs[final]
-        else:
-            records, Q = self._casadi_loop(schedule, y, Q, inputs, (n, n, m, m))
+        if not self.native:
+            records, Q = self._casadi_loop(schedule, y, np.array(np.eye(n) if Q is None else Q, order="F"), inputs,
+                                           (n, n, m, m))
             if out is not None:
                 for into, record in zip(out, records):
                     into[...] = record
             strobe, logs, low, high = out or records
-        self._check_finite(inputs, strobe, logs)
-        return TangentRun(strobe, logs, low, high, Q)
+            self.check_finite(inputs.p, strobe, logs)
+            return TangentRun(strobe, logs, low, high, Q)
+        # one new block for the start, both tangent buffers and (without ``out``) the records: one address
+        rows = (n, n, m, m)
+        sizes = [n, n * n, n * n] + ([] if out else [r * periods for r in rows])
+        block = np.empty(sum(sizes))
+        views = [block[a - size:a] for a, size in zip(itertools.accumulate(sizes), sizes)]
+        views[0][:] = y
+        Qs = [v.reshape(n, n).T for v in views[1:3]]  # (column-major views)
+        if Q is None:
+            views[1][:] = 0.0
+            views[1][::n + 1] = 1.0
+        else:
+            Qs[0][...] = Q
+        at = block.ctypes.data
+        if out:
+            strobe, logs, low, high = out
+            bases, strides = _addresses(*out)
+        else:
+            strobe, logs, low, high = (v.reshape(periods, r).T for v, r in zip(views[3:], rows))
+            first = at + 8 * (n + 2 * n * n)
+            bases = [first + 8 * periods * k for k in (0, n, 2 * n, 2 * n + m)]
+            strides = [8 * r for r in rows]
+        final = self._native_loop(schedule, at, [at + 8 * n, at + 8 * (n + n * n)], inputs, bases, strides)
+        # one sum over the strobe and log stretches (adjacent in the block): finite, unless told otherwise
+        if out or not math.isfinite(block[n + 2 * n * n:n + 2 * n * n + 2 * n * periods].sum()):
+            self.check_finite(inputs.p, strobe, logs)
+        return TangentRun(strobe, logs, low, high, Qs[final])
 
-    def tangent_run_into(self, runs: TangentRuns, i: int, y: np.ndarray, inputs: RunInputs) -> None:
+    def tangent_run_into(self, runs: TangentRuns, i: int, y: np.ndarray, inputs: RunInputs,
+                         check_finite: bool = True) -> None:
         """:meth:`tangent_run` of ``runs.periods`` periods from ``y`` (a state already checked) with tangent
         vectors from the identity, into run i of ``runs``: a sweep's per-point path, every address taken
-        beforehand."""
+        beforehand. ``check_finite=False``: the caller checks the records (a sweep checks a batch at once,
+        with :meth:`check_finite`)."""
         if not self.native:
             self.tangent_run(y, runs.periods, inputs, out=runs.slot(i))
             return
@@ -352,7 +406,8 @@ class CompiledModel:
         runs.start[:] = y
         runs.Q[0][...] = runs.eye
         _make_calls(calls, inputs)
-        self._check_finite(inputs, runs.strobe[i], runs.log_stretch[i])
+        if check_finite:
+            self.check_finite(inputs.p, runs.strobe[i].T, runs.log_stretch[i].T)
 
     def _native_loop(self, schedule, y: int, Q: list[int], inputs: RunInputs, bases: list[int],
                      strides: list[int]) -> int:
@@ -415,7 +470,7 @@ class CompiledModel:
         y = y0 if isinstance(y0, np.ndarray) and y0.shape == (self.dimension,) else self.initial_state(y0)
         shot = (self._native_shot if self.native else self._casadi_shot)(y, inputs, first, first + pieces)
         if not (np.isfinite(shot.state).all() and np.isfinite(shot.M).all() and np.isfinite(y).all()):
-            self._check_finite(inputs, np.full((1, 1), np.nan))
+            self.check_finite(inputs.p, np.full((1, 1), np.nan))
         return shot
 
     def _shot_plan(self, first: int, end: int):
@@ -470,7 +525,7 @@ class CompiledModel:
             self._native_loop(schedule, y.ctypes.data, [], inputs, *_addresses(strobe, low, high))
         else:
             (strobe, low, high), _ = self._casadi_loop(schedule, y, None, inputs, (n, m, m))
-        self._check_finite(inputs, strobe)
+        self.check_finite(inputs.p, strobe)
         return strobe, low, high
 
     def trajectory(self, y0, periods: int, inputs: RunInputs) -> tuple[np.ndarray, np.ndarray]:
@@ -493,14 +548,16 @@ class CompiledModel:
     def jacobian(self, t: float, y, p) -> np.ndarray:
         return np.array(self.functions["jacobian"](t, y, p))
 
-    def _check_finite(self, inputs: RunInputs, *per_period: np.ndarray) -> None:
+    def check_finite(self, p: np.ndarray, *per_period: np.ndarray) -> None:
+        """Raise the error of a run at the parameter vector ``p`` that became non-finite, if one of the
+        ``per_period`` records (rows x periods) did."""
         # one pass each: a finite sum has finite terms (an infinite one may not: an overflow; the test below tells)
         if math.isfinite(sum(float(a.sum()) for a in per_period)):
             return
         bad = ~np.logical_and.reduce([np.isfinite(a).all(axis=0) for a in per_period])
         if bad.any():
             k = int(np.argmax(bad))
-            values = ", ".join(f"{n}={v:g}" for n, v in zip(self.parameter_names, inputs.p))
+            values = ", ".join(f"{n}={v:g}" for n, v in zip(self.parameter_names, p))
             raise GearsymError(
                 f"{self.name}: the solution became non-finite in period {k + 1} ({values}). The orbit diverges "
                 f"or the step T/{self.steps_per_period} is too large for it: try more --steps-per-period, "

@@ -106,7 +106,7 @@ def _strobe_columns(names: Sequence[str], strobes: Sequence[PoincareRows]) -> di
         return {}
     keys = len(strobes[0].where)
     counts = [len(s.samples) for s in strobes]
-    columns = {name: _typed(name, np.repeat([s.where[i] for s in strobes], counts).tolist())
+    columns = {name: np.repeat(_typed(name, [s.where[i] for s in strobes]), counts)  # (each point's keys read once)
                for i, name in enumerate(names[:keys])}
     columns[names[keys]] = np.concatenate([np.arange(c, dtype=float) for c in counts])
     states = np.concatenate([s.samples for s in strobes])

@@ -14,6 +14,7 @@ everything.
 from __future__ import annotations
 
 import ctypes
+import math
 import multiprocessing
 import multiprocessing.connection
 import os
@@ -316,20 +317,39 @@ class _Run:
             p[swept] = point.values
             try:
                 inputs = compiled.prepare(p)
-                compiled.tangent_run_into(runs, len(batch), state, inputs)
+                compiled.tangent_run_into(runs, len(batch), state, inputs, check_finite=False)
             except GearsymError as exc:
                 if batch:
-                    yield self.rows(compiled, runs, batch)
-                where = ", ".join(f"{n_}={v:g}" for n_, v in zip(self.names, point.values))
-                raise GearsymError(f"at {where} ({point.direction}): {exc}") from None
+                    yield from self.checked_rows(compiled, runs, batch)
+                raise self.failed(point, exc) from None
             batch.append((point, p, inputs.period))
             if point.direction != INDEPENDENT:
                 state = runs.strobe[len(batch) - 1, -1].copy()
             if len(batch) == runs.size or time.perf_counter() - started >= BATCH_SECONDS:
-                yield self.rows(compiled, runs, batch)
+                yield from self.checked_rows(compiled, runs, batch)
                 batch, started = [], time.perf_counter()
         if batch:
-            yield self.rows(compiled, runs, batch)
+            yield from self.checked_rows(compiled, runs, batch)
+
+    def checked_rows(self, compiled: CompiledModel, runs: TangentRuns, batch: list):
+        """Yield the rows of ``batch`` once its runs are checked finite, all at once (one sum each for the
+        batch's strobes and log stretches, not two per point); a run that is not ends the task after the rows
+        of the points before it (the points after it, run from its state, are dropped)."""
+        count = len(batch)
+        if not math.isfinite(float(runs.strobe[:count].sum()) + float(runs.log_stretch[:count].sum())):
+            for i, (point, p, _) in enumerate(batch):
+                try:
+                    compiled.check_finite(p, runs.strobe[i].T, runs.log_stretch[i].T)
+                except GearsymError as exc:
+                    if i:
+                        yield self.rows(compiled, runs, batch[:i])
+                    raise self.failed(point, exc) from None
+        yield self.rows(compiled, runs, batch)
+
+    def failed(self, point: Point, exc: GearsymError) -> GearsymError:
+        """The error of a point, saying where it is."""
+        where = ", ".join(f"{n_}={v:g}" for n_, v in zip(self.names, point.values))
+        return GearsymError(f"at {where} ({point.direction}): {exc}")
 
     def rows(self, compiled: CompiledModel, runs: TangentRuns, batch: list) -> list[tuple[dict, PoincareRows]]:
         """The table rows and Poincare rows of the runs of ``batch`` ((point, parameters, period) each)."""
