@@ -45,7 +45,7 @@ def test_the_printed_loops_give_the_bits_of_casadis_loops_evaluated_in_process(n
     width = F["monodromy_segment"].size_in(2)[1]
     inputs = {"lyapunov_chunk": (y, Q, table, c), "lyapunov_period": (y, Q, table, c), "orbit_chunk": (y, table, c),
               "orbit_period": (y, table, c), "monodromy_period": (y, Q, table, c),
-              "monodromy_segment": (y, Q, table[:, width:2 * width], c)}
+              "monodromy_segment": (y, Q, table[:, width:2 * width], c), "trajectory": (y, table, c)}
     for loop, args in inputs.items():
         expected = [np.array(v) for v in F[loop].call(list(args))]
         got = native[loop](*[np.array(a) for a in args])
@@ -77,6 +77,23 @@ def test_the_printed_steps_read_no_pointer_array_and_keep_the_state_in_local_arr
         body = re.search(rf"void gs_{piece}\(.*?\n}}\n", text, re.S).group(0)
         assert not re.search(r"\b(arg|res|w|iw)\[", body), piece
     assert "/* tangent_switch:" not in text and "tangent_segment_50" not in text  # CasADi's loops are gone
+
+
+def test_the_split_calls_one_mode_rk4_step_for_every_substep_and_the_trajectory_is_printed_too(tmp_path):
+    system, options = gearsym.load("two_stage"), LoopOptions(locate_crossings=True)
+    text = write_code(build_functions(system, options), tmp_path, code_hash(system, options)).source.read_text()
+    calls = {}
+    for kind in ("tangent", "state"):
+        split = re.search(rf"void gs_{kind}_split\(.*?\) {{\n(.*?)\n}}\n", text, re.S).group(1).splitlines()
+        assert all(re.fullmatch(r"  (casadi_(real|int) .*;|(for \(.*\) )?gs_\w+\(.*\);)", line) for line in split), split
+        calls[kind] = re.findall(r"gs_(\w+)\(", "\n".join(split))
+    assert calls["tangent"].count("tangent_mode_step") == 3 and calls["tangent"].count("state_mode_step") == 1
+    assert calls["state"].count("state_mode_step") == 4 and calls["state"].count("first_zero") == 2
+    for piece in ("tangent_mode_step", "state_mode_step", "first_zero"):  # each compiled once
+        assert text.count(f"static GEARSYM_NOINLINE void gs_{piece}(") == 1
+    trajectory = re.search(r"/\* trajectory:.*?\n}\n", text, re.S).group(0)
+    assert "gs_state_span(y, lo, hi, T + 9*p, c, 1);" in trajectory
+    assert "/* step_split:" not in text and "/* state_switch:" not in text  # CasADi's trajectory is gone
 
 
 def test_a_step_in_a_form_the_printer_does_not_rewrite_fails_loudly():

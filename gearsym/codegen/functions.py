@@ -27,7 +27,8 @@ a value never regenerates or recompiles anything.
 ``LoopOptions(locate_crossings=True)`` makes every step that crosses a backlash
 switching surface split there, so that RK4 sees a smooth right-hand side on
 both substeps (see ``_crossing_steps``); the split runs only on crossing steps,
-behind a real ``if`` in the C (in the MX loops a CasADi ``Switch``).
+behind a real ``if`` in the C (in the MX loops a CasADi ``Switch``), as calls of
+SX pieces (``SPLIT_CALLS``): one mode-RK4 step for every substep.
 """
 from __future__ import annotations
 
@@ -52,8 +53,9 @@ class ModelFunctions:
     options: LoopOptions
     split: SplitRHS
     functions: dict[str, ca.Function]
-    #: the SX pieces the printed loops call (:mod:`.printed`): ``tangent_block``/``state_block`` (plain), or
-    #: ``{tangent,state}_{try,keep,split}`` (crossings located), and ``gram_schmidt``
+    #: the SX pieces the printed loops call (:mod:`.printed`): ``tangent_block``/``state_block`` (plain; and
+    #: ``trajectory_step`` for blocks of several steps), or ``{tangent,state}_{try,keep}`` and the split's pieces
+    #: (crossings located, :data:`SPLIT_CALLS`), and ``gram_schmidt``
     steps: dict[str, ca.Function]
 
     @property
@@ -90,6 +92,8 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
     if switching is None or not switching.surfaces:  # nothing switches (Lorenz): the plain loops
         tangent_block, state_block, state_step = _rk4_functions(sym, split, K, where)
         steps = {"tangent_block": tangent_block, "state_block": state_block}
+        if K > 1:  # the trajectory's steps one at a time
+            steps["trajectory_step"] = state_step
     else:
         tangent_block, state_block, state_step, steps = _crossing_steps(sym, split, switching, where)
     gram_schmidt = _gram_schmidt(n)
@@ -278,7 +282,7 @@ def _rk4_functions(sym: _Symbols, split: SplitRHS, K: int, where: str):
     state_block = ca.Function("state_block", [y, lo, hi, Tk, ch], [yb, lb, hb], _OPTS)
     col = ca.SX.sym("Ti", 3 * m)
     y_next, _ = rk4(y, None, col[:m], col[m:2 * m], col[2 * m:])
-    state_step = ca.Function("state_step", [y, col, ch], [y_next], _OPTS)
+    state_step = ca.Function("trajectory_step", [y, col, ch], [y_next], _OPTS)
     return tangent_block, state_block, state_step
 
 
@@ -385,7 +389,8 @@ def _crossing_steps(sym: _Symbols, split: SplitRHS, switching: _Switching, where
        is its Bernstein coefficients s0, s0 + d0/3, s1 - d1/3, s1 all on the start's side (then, by the
        convex hull, no zero): cheap, and it also sees an excursion across a surface and back within the
        step (a *dip*, which comparing the sides at y0 and y1 would miss).
-    2. a CasADi ``Switch`` (a C ``if``): not flagged, keep y1; flagged, the *split* (SX):
+    2. a CasADi ``Switch`` (a C ``if``): not flagged, keep y1; flagged, the *split* (calls of SX pieces,
+       :data:`SPLIT_CALLS`):
 
        * the earliest zero theta_1 of the cubic of mode A's extension (``_first_zero``: bracketed between
          the cubic's extrema, then Halley kept inside the bracket), the earliest surface winning; RK4 of A
@@ -406,25 +411,74 @@ def _crossing_steps(sym: _Symbols, split: SplitRHS, switching: _Switching, where
     states are taken after the step, as in the plain loops.
     """
     step = _CrossingStep(sym, split, switching, where)
-    # with tangent vectors: try, then Switch(keep | split), emitted straight into the caller's MX graph
-    # (a Function around the two calls would copy its inputs once more at every step)
-    tangent_try, tangent_keep, tangent_split = step.switched("tangent", with_tangent=True)
-    tangent_switch = ca.Function.if_else("tangent_switch", tangent_split, tangent_keep)
+    pieces = {f.name(): f for f in step.pieces()}
+    # try, then Switch(keep | split), emitted straight into the caller's MX graph (a Function around the two
+    # calls would copy its inputs once more at every step)
+    tangent_try, state_try = pieces["tangent_try"], pieces["state_try"]
+    tangent_switch = ca.Function.if_else("tangent_switch", split_function("tangent", pieces), pieces["tangent_keep"])
+    state_switch = ca.Function.if_else("state_switch", split_function("state", pieces), pieces["state_keep"])
 
     def tangent_block(yk, Qk, lk, hk, Tk, c):
         y_try, Q_try, crossing = tangent_try(yk, Qk, Tk, c)
         return tangent_switch(crossing, yk, Qk, lk, hk, y_try, Q_try, Tk, c)
 
-    # the state alone: the same stepping (orbit loops and trajectory)
-    state_try, state_keep, state_split = step.switched("state", with_tangent=False)
-    state_switch = ca.Function.if_else("state_switch", state_split, state_keep)
-
-    def state_block(yk, lk, hk, Tk, c):
+    def state_block(yk, lk, hk, Tk, c):  # the state alone: the same stepping (orbit loops and trajectory)
         y_try, crossing = state_try(yk, Tk, c)
         return state_switch(crossing, yk, lk, hk, y_try, Tk, c)
 
-    pieces = (tangent_try, tangent_keep, tangent_split, state_try, state_keep, state_split)
-    return tangent_block, state_block, step.single(state_try), {f.name(): f for f in pieces}
+    return tangent_block, state_block, step.single(state_try, state_switch), pieces
+
+
+#: the split of a located step (:meth:`_CrossingStep.pieces`) as calls of SX pieces, (piece, inputs, outputs):
+#: the one description of both the MX function (:func:`split_function`) and the printed C (:mod:`.printed`), so
+#: that the C holds the crossing's root search once and the mode-RK4 step once with tangent and once without,
+#: not once per substep. ``{kind}`` is tangent or state; the state's split leaves out the tangent matrices (the
+#: names that start with Q). A *leg* is a substep: the sides held fixed, its length, and the tables at its
+#: start, middle and end (:meth:`_CrossingStep.leg`); the first zero is searched on ``leg_try`` (mode A over the
+#: whole step: the try), the second on ``leg_ext`` (mode B from the first to the step's end).
+SPLIT_CALLS = (
+    ("split_start", ("y", "T", "c"), ("leg_try", "t0", "mode_a")),
+    ("crossing_ends", ("y", "yt", "leg_try", "mode_a", "c"), ("ends1",)),
+    ("first_zero", ("ends1",), ("zeros1",)),  # per surface: one column each (SPLIT_PER_SURFACE)
+    ("crossing_earliest", ("zeros1", "leg_try"), ("theta1", "mode_b")),
+    ("split_legs", ("theta1", "mode_b", "leg_try", "t0", "T", "c"), ("leg_a", "leg_ext", "t1")),
+    ("{kind}_mode_step", ("y", "Q", "leg_a", "c"), ("yb", "Qb")),
+    ("state_mode_step", ("yb", "leg_ext", "c"), ("ye",)),
+    ("crossing_ends", ("yb", "ye", "leg_ext", "mode_a", "c"), ("ends2",)),
+    ("first_zero", ("ends2",), ("zeros2",)),
+    ("crossing_earliest", ("zeros2", "leg_ext"), ("theta2", "mode_c")),
+    ("split_legs", ("theta2", "mode_c", "leg_ext", "t1", "T", "c"), ("leg_b", "leg_c", "t2")),
+    ("{kind}_mode_step", ("yb", "Qb", "leg_b", "c"), ("yc", "Qc")),
+    ("{kind}_mode_step", ("yc", "Qc", "leg_c", "c"), ("yn", "Qn")),
+    ("{kind}_keep", ("y", "Q", "lo", "hi", "yn", "Qn", "T", "c"), ("y1", "Q1", "lo1", "hi1")),  # the extremes
+)
+#: the pieces called once per surface, on a column each of their inputs and outputs
+SPLIT_PER_SURFACE = ("first_zero",)
+#: the split's inputs and outputs: those of ``{kind}_keep``
+SPLIT_INPUTS, SPLIT_OUTPUTS = ("y", "Q", "lo", "hi", "yt", "Qt", "T", "c"), ("y1", "Q1", "lo1", "hi1")
+
+
+def split_names(kind: str, names: tuple[str, ...]) -> tuple[str, ...]:
+    """``names`` as the split of ``kind`` has them (the state's without the tangent matrices)."""
+    return tuple(v for v in names if kind == "tangent" or not v.startswith("Q"))
+
+
+def split_calls(kind: str) -> list[tuple[str, tuple[str, ...], tuple[str, ...]]]:
+    """:data:`SPLIT_CALLS` of ``kind``."""
+    return [(f.format(kind=kind), split_names(kind, i), split_names(kind, o)) for f, i, o in SPLIT_CALLS]
+
+
+def split_function(kind: str, pieces: dict[str, ca.Function]) -> ca.Function:
+    """``{kind}_split``: the MX function of :data:`SPLIT_CALLS` (inputs and outputs those of ``{kind}_keep``)."""
+    keep = pieces[f"{kind}_keep"]
+    inputs, outputs = split_names(kind, SPLIT_INPUTS), split_names(kind, SPLIT_OUTPUTS)
+    values = {v: ca.MX.sym(v, keep.sparsity_in(i)) for i, v in enumerate(inputs)}
+    for piece, ins, outs in split_calls(kind):
+        f = pieces[piece]
+        if piece in SPLIT_PER_SURFACE:
+            f = f.map(values[ins[0]].size2())
+        values.update(zip(outs, f.call([values[v] for v in ins])))
+    return ca.Function(f"{kind}_split", [values[v] for v in inputs], [values[v] for v in outputs], inputs, outputs)
 
 
 class _CrossingStep:
@@ -496,11 +550,9 @@ class _CrossingStep:
         Ta, Tb, Tc = self.Ta, self.Tb, self.Tc
         return Ta + theta * (4 * Tb - 3 * Ta - Tc) + theta * theta * (2 * Ta - 4 * Tb + 2 * Tc)
 
-    def crossing(self, y0, y1, mode, h, T0, Tm, T1, fresh):
-        """(theta, the mode after it): where in a step of length h from y0 (its end y1 on the extension of
-        ``mode``) the earliest surface is crossed (1: none), and the mode with the crossed surface(s)
-        flipped. ``fresh``: the surfaces y0 lies on (just crossed), whose zero at the start is not counted."""
-        found, theta = _first_zero(*self.hermite(y0, y1, mode, h, T0, Tm, T1), mode, fresh)
+    def earliest(self, found, theta, mode):
+        """(theta, the mode after it): the earliest of the surfaces' zeros (``found`` and ``theta`` per
+        surface; 1: none), and ``mode`` with the surface(s) crossed there flipped."""
         theta = ca.if_else(found, theta, 2)
         first = theta[0]
         for i in range(1, self.surfaces):
@@ -508,55 +560,95 @@ class _CrossingStep:
         flip = ca.logic_and(found, theta <= first)
         return ca.if_else(first > 1, 1, first), ca.if_else(flip, 1 - mode, mode)
 
-    def located(self, with_tangent: bool):
-        """Up to two crossings in the step (a crossing, or a dip's way in and out): RK4 of mode A up to the
-        first, of mode B up to the second, of mode C over the rest; each on its own smooth branch."""
-        y, ch, h, Ta, Tb, Tc = self.sym.y, self.sym.ch, self.h, self.Ta, self.Tb, self.Tc
-        Q = self.Q if with_tangent else None
-        mode_a = self.side(self.s_of(y, Ta, ch))
-        t1, mode_b = self.crossing(y, self.y1, mode_a, h, Ta, Tb, Tc, 0)  # y1: the try, on mode A's extension
-        T1 = self.table_at(t1)
-        y_b, Q_b = rk4_step(self.f_mode(mode_a), self.J_mode(mode_a), y, Q, t1 * h, Ta, self.table_at(t1 / 2), T1)
-        rest = (1 - t1) * h
-        T_rest = self.table_at((1 + t1) / 2)
-        y_ext, _ = rk4_step(self.f_mode(mode_b), None, y_b, None, rest, T1, T_rest, Tc)
-        t2, mode_c = self.crossing(y_b, y_ext, mode_b, rest, T1, T_rest, Tc, mode_b != mode_a)
-        t2 = t1 + t2 * (1 - t1)
-        T2 = self.table_at(t2)
-        y_c, Q_c = rk4_step(self.f_mode(mode_b), self.J_mode(mode_b), y_b, Q_b, (t2 - t1) * h, T1,
-                            self.table_at((t1 + t2) / 2), T2)
-        return rk4_step(self.f_mode(mode_c), self.J_mode(mode_c), y_c, Q_c, (1 - t2) * h, T2,
-                        self.table_at((1 + t2) / 2), Tc)
+    def leg(self, mode, length, T0, Tm, T1):
+        """A substep as one vector: the sides held fixed, its length, the tables at its start, middle, end."""
+        return ca.vertcat(mode, length, T0, Tm, T1)
+
+    def unpack(self, leg):
+        """(mode, length, T0, Tm, T1) of a :meth:`leg`."""
+        S, m = self.surfaces, self.m
+        return leg[:S], leg[S], leg[S + 1:S + 1 + m], leg[S + 1 + m:S + 1 + 2 * m], leg[S + 1 + 2 * m:]
+
+    def mode_step(self, with_tangent: bool) -> ca.Function:
+        """``{tangent,state}_mode_step``: one RK4 step along a leg (its sides held fixed), with or without the
+        tangent matrix: the substeps of the split (:data:`SPLIT_CALLS`)."""
+        y, ch = self.sym.y, self.sym.ch
+        leg = ca.SX.sym("leg", self.surfaces + 1 + 3 * self.m)
+        mode, length, T0, Tm, T1 = self.unpack(leg)
+        Q = self.Q if with_tangent else None  # (the same RK4 as the try's)
+        yn, Qn = rk4_step(self.f_mode(mode), self.J_mode(mode), y, Q, length, T0, Tm, T1)
+        if with_tangent:
+            return ca.Function("tangent_mode_step", [y, Q, leg, ch], [yn, Qn], _OPTS)
+        return ca.Function("state_mode_step", [y, leg, ch], [yn], _OPTS)
+
+    def split_start(self) -> ca.Function:
+        """``split_start``: the try's leg (mode A, the sides at the step's start, over the whole step), the
+        step's start (0) and mode A. The located step (:data:`SPLIT_CALLS`): up to two crossings in the step (a
+        crossing, or a dip's way in and out), RK4 of mode A up to the first (``leg_a``), of mode B up to the
+        second (``leg_b``), of mode C over the rest (``leg_c``); each on its own smooth branch."""
+        y, ch = self.sym.y, self.sym.ch
+        mode_a = self.side(self.s_of(y, self.Ta, ch))
+        leg = self.leg(mode_a, self.h, self.Ta, self.Tb, self.Tc)
+        return ca.Function("split_start", [y, self.col, ch], [leg, ca.SX.zeros(1), mode_a], _OPTS)
+
+    def crossing(self) -> list[ca.Function]:
+        """``crossing_ends``: the ends of each surface's cubic on a leg from y0 (its end y_end on the leg's
+        extension), a column (s0, d0, s1, d1, side, fresh) per surface; fresh: the surfaces whose side differs
+        from ``before`` (just crossed), whose zero at the leg's start is not counted. ``first_zero``: a
+        surface's (found, theta), called per surface. ``crossing_earliest``: the earliest, and the mode after it."""
+        S = self.surfaces
+        y0, y_end, leg, before = (ca.SX.sym(v, k) for v, k in (("y0", self.n), ("y_end", self.n),
+                                                               ("leg", S + 1 + 3 * self.m), ("before", S)))
+        mode, length, T0, Tm, T1 = self.unpack(leg)
+        ends = ca.horzcat(*self.hermite(y0, y_end, mode, length, T0, Tm, T1), mode, mode != before).T
+        one = ca.SX.sym("ends", ends.size1())
+        zeros = ca.SX.sym("zeros", 2, S)
+        return [ca.Function("crossing_ends", [y0, y_end, leg, before, self.sym.ch], [ends], _OPTS),
+                ca.Function("first_zero", [one], [ca.vertcat(*_first_zero(*ca.vertsplit(one)))], _OPTS),
+                ca.Function("crossing_earliest", [zeros, leg], list(self.earliest(zeros[0, :].T, zeros[1, :].T, mode)),
+                            _OPTS)]
+
+    def split_legs(self) -> ca.Function:
+        """``split_legs``: on a leg from t (a fraction of the step) to the step's end, the leg up to its zero
+        at theta (a fraction of the leg) and the rest of the step (mode ``after``), and where the zero is."""
+        leg, t, theta, after = (ca.SX.sym(v, k) for v, k in (("leg", self.surfaces + 1 + 3 * self.m), ("t", 1),
+                                                             ("theta", 1), ("after", self.surfaces)))
+        mode, _, T0, _, _ = self.unpack(leg)
+        h, t_next = self.h, t + theta * (1 - t)
+        T_next = self.table_at(t_next)
+        leg_to = self.leg(mode, (t_next - t) * h, T0, self.table_at((t + t_next) / 2), T_next)
+        leg_rest = self.leg(after, (1 - t_next) * h, T_next, self.table_at((1 + t_next) / 2), self.Tc)
+        return ca.Function("split_legs", [theta, after, leg, t, self.col, self.sym.ch], [leg_to, leg_rest, t_next],
+                           _OPTS)
 
     def extremes(self, yn):
         obs = ca.vertcat(*[yn[j] for j in self.sym.observed])
         return select_min(obs, self.lo), select_max(obs, self.hi)
 
-    def switched(self, kind: str, with_tangent: bool) -> tuple[ca.Function, ca.Function, ca.Function]:
-        """``{kind}_try`` (the plain step and its crossing flag), ``{kind}_keep`` (keep the try) and
-        ``{kind}_split`` (the located step), with or without tangent vectors."""
+    def switched(self, kind: str, with_tangent: bool) -> tuple[ca.Function, ca.Function]:
+        """``{kind}_try`` (the plain step and its crossing flag) and ``{kind}_keep`` (keep the try), with or
+        without tangent vectors."""
         y, ch, col = self.sym.y, self.sym.ch, self.col
         yn, Qn, flag = self.tried(with_tangent)
-        ys, Qs = self.located(with_tangent)
         if with_tangent:
             tried = ca.Function(f"{kind}_try", [y, self.Q, col, ch], [yn, Qn, flag], _OPTS)
-            inputs, kept, split = [y, self.Q, self.lo, self.hi, self.y1, self.Q1, col, ch], [self.y1, self.Q1], [ys, Qs]
+            inputs, kept = [y, self.Q, self.lo, self.hi, self.y1, self.Q1, col, ch], [self.y1, self.Q1]
         else:
             tried = ca.Function(f"{kind}_try", [y, col, ch], [yn, flag], _OPTS)
-            inputs, kept, split = [y, self.lo, self.hi, self.y1, col, ch], [self.y1], [ys]
-        keep = ca.Function(f"{kind}_keep", inputs, [*kept, *self.extremes(self.y1)], _OPTS)
-        cross = ca.Function(f"{kind}_split", inputs, [*split, *self.extremes(ys)], _OPTS)
-        return tried, keep, cross
+            inputs, kept = [y, self.lo, self.hi, self.y1, col, ch], [self.y1]
+        return tried, ca.Function(f"{kind}_keep", inputs, [*kept, *self.extremes(self.y1)], _OPTS)
 
-    def single(self, state_try: ca.Function) -> ca.Function:
-        """One located step of the state (phase portraits), as an MX function."""
-        y, ch, col, n, m, nc = self.sym.y, self.sym.ch, self.col, self.n, self.m, self.nc
-        keep = ca.Function("step_keep", [y, self.y1, col, ch], [self.y1], _OPTS)
-        cross = ca.Function("step_split", [y, self.y1, col, ch], [self.located(False)[0]], _OPTS)
-        step_switch = ca.Function.if_else("step_switch", cross, keep)
-        Ym, Ti, Cm = ca.MX.sym("y", n), ca.MX.sym("Ti", 3 * m), ca.MX.sym("c", nc + 1)
+    def pieces(self) -> list[ca.Function]:
+        """The SX pieces of the located steps (:data:`SPLIT_CALLS`), in a fixed order."""
+        return [*self.switched("tangent", True), *self.switched("state", False), self.split_start(),
+                *self.crossing(), self.split_legs(), self.mode_step(True), self.mode_step(False)]
+
+    def single(self, state_try: ca.Function, state_switch: ca.Function) -> ca.Function:
+        """One located step of the state (phase portraits), as an MX function (the extremes unused)."""
+        Ym, Ti, Cm = ca.MX.sym("y", self.n), ca.MX.sym("Ti", 3 * self.m), ca.MX.sym("c", self.nc + 1)
         y_try, crossing = state_try(Ym, Ti, Cm)
-        return ca.Function("state_step", [Ym, Ti, Cm], [step_switch(crossing, Ym, y_try, Ti, Cm)])
+        none = ca.MX.zeros(self.lo.sparsity())
+        return ca.Function("state_step", [Ym, Ti, Cm], [state_switch(crossing, Ym, none, none, y_try, Ti, Cm)[0]])
 
 
 #: Halley iterations (Newton with the cubic's curvature: third order) on r from the secant, kept inside the

@@ -3,7 +3,7 @@
 CasADi's C of an MX loop calls the SX step once per step through pointer arrays: every input is read as
 ``arg[i]? arg[i][j] : 0`` and every output written behind ``if (res[i]!=0)``, and the state makes a round
 trip through the work vector between steps: about 10-15 % of a step next to a hand-written C loop
-(bench/speed/notes.md). So the six loop functions (:data:`LOOP_NAMES`) are printed here instead:
+(bench/speed/notes.md). So the loop functions (:data:`LOOP_NAMES`, the trajectory too) are printed here instead:
 
 * CasADi still writes the whole file: everything else as before, and for each loop function a *stand-in*
   with its name, input/output names and shapes (:func:`stand_in`), so that the external API
@@ -17,7 +17,8 @@ trip through the work vector between steps: about 10-15 % of a step next to a ha
 * CasADi's static functions nothing calls any more are removed.
 
 With crossings located, the ``try`` is inline on every step and the ``split`` (about 1 % of steps) a
-separate function behind a real ``if``, marked unlikely.
+separate function behind a real ``if``, marked unlikely: the calls of :data:`~.functions.SPLIT_CALLS` (the MX
+function's), so that the C holds the mode-RK4 step and the root search once each, not once per substep.
 """
 from __future__ import annotations
 
@@ -25,11 +26,12 @@ import re
 
 import casadi as ca
 
-from .functions import ModelFunctions, shooting_segments
+from .functions import (SPLIT_INPUTS, SPLIT_OUTPUTS, SPLIT_PER_SURFACE, ModelFunctions, shooting_segments,
+                        split_calls, split_names)
 
 #: the loop functions printed here (everything else in the file is CasADi's)
 LOOP_NAMES = ("lyapunov_chunk", "lyapunov_period", "orbit_chunk", "orbit_period", "monodromy_segment",
-              "monodromy_period")
+              "monodromy_period", "trajectory")
 
 _HEADER = r"/\* (?P<name>\w+):\(.*?\)->\(.*?\) \*/\n"
 _SIGNATURE = (r"static int (?P<c>casadi_f\d+)\(const casadi_real\*\* arg, casadi_real\*\* res, casadi_int\* iw, "
@@ -39,8 +41,12 @@ _DEFINITION = re.compile(_HEADER + _SIGNATURE + r"(?P<body>.*?)\n\}\n\n", re.S)
 
 def pieces(mf: ModelFunctions, loop: str) -> list[ca.Function]:
     """The SX step functions the printed ``loop`` calls."""
-    kind = "state" if loop.startswith("orbit") else "tangent"
-    names = [f"{kind}_block"] if f"{kind}_block" in mf.steps else [f"{kind}_{p}" for p in ("try", "keep", "split")]
+    kind = "state" if loop.startswith(("orbit", "trajectory")) else "tangent"
+    if f"{kind}_block" in mf.steps:
+        names = [f"{kind}_block", *(["trajectory_step"] if loop == "trajectory" and "trajectory_step" in mf.steps
+                                   else [])]
+    else:
+        names = list(dict.fromkeys([f"{kind}_try", *(piece for piece, _, _ in split_calls(kind))]))
     if loop.startswith("lyapunov"):
         names.append("gram_schmidt")
     return [mf.steps[name] for name in names]
@@ -72,6 +78,7 @@ def print_loops(text: str, mf: ModelFunctions) -> str:
     shape = _Shape(mf)
     printed = [_PREAMBLE.format(zeros=max(1, shape.rows * shape.N))]
     printed += [_inline(name, definitions[name].group("body"), mf.steps[name]) for name in mf.steps]
+    printed += [_split(mf, kind) for kind in ("tangent", "state") if shape.located]
     printed += _spans(mf, shape)
     # the printed C goes before the first stand-in; each stand-in's body becomes its loop
     first = min(definitions[name].start() for name in LOOP_NAMES)
@@ -103,10 +110,39 @@ def _inline(name: str, body: str, f: ca.Function) -> str:
         raise AssertionError(f"{name}: CasADi's C has a form the printer does not rewrite: {left[:3]}")
     args = [f"const casadi_real* restrict A{i}" for i in range(f.n_in())]
     args += [f"casadi_real* restrict R{i}" for i in range(f.n_out())]
-    # the split (about 1 % of steps) stays a call: not `cold`, whose size optimisation (code hoisting) took
-    # gcc 20 s more on the largest model
-    where = "GEARSYM_NOINLINE" if name.endswith("_split") else "GEARSYM_INLINE"
+    # the split's pieces (about 1 % of steps) stay calls, each compiled once: not `cold`, whose size
+    # optimisation (code hoisting) took gcc 20 s more on the largest model
+    where = "GEARSYM_NOINLINE" if name in _OUT_OF_LINE else "GEARSYM_INLINE"
     return f"/* {name}, from CasADi's C of it */\nstatic {where} void gs_{name}({', '.join(args)}) {{\n{body}\n}}\n"
+
+
+#: the split's pieces that are calls (the keep, also on the steps that do not cross, is inline)
+_OUT_OF_LINE = {piece for kind in ("tangent", "state") for piece, _, _ in split_calls(kind)
+                if not piece.endswith("_keep")}
+
+
+def _split(mf: ModelFunctions, kind: str) -> str:
+    """``gs_{kind}_split``, the located step that crosses (arguments those of ``gs_{kind}_keep``): the calls of
+    :data:`~.functions.SPLIT_CALLS`, as the MX function ``{kind}_split`` makes them, with locals between."""
+    inputs, outputs = split_names(kind, SPLIT_INPUTS), split_names(kind, SPLIT_OUTPUTS)
+    keep = mf.steps[f"{kind}_keep"]
+    sizes, body = {v: keep.numel_in(i) for i, v in enumerate(inputs)}, []
+    for piece, ins, outs in split_calls(kind):
+        f = mf.steps[piece]
+        count = sizes[ins[0]] // f.numel_in(0) if piece in SPLIT_PER_SURFACE else 1
+        sizes.update({v: count * f.numel_out(i) for i, v in enumerate(outs)})
+        if piece in SPLIT_PER_SURFACE:  # one call per column
+            args = [f"{v} + {f.numel_in(i)}*i" for i, v in enumerate(ins)]
+            args += [f"{v} + {f.numel_out(i)}*i" for i, v in enumerate(outs)]
+            body.append(f"  for (i = 0; i < {count}; ++i) gs_{piece}({', '.join(args)});\n")
+        else:
+            body.append(f"  gs_{piece}({', '.join([*ins, *outs])});\n")
+    locals_ = " ".join(f"casadi_real {v}[{max(1, sizes[v])}];" for v in sizes if v not in (*inputs, *outputs))
+    args = [f"const casadi_real* restrict {v}" for v in inputs] + [f"casadi_real* restrict {v}" for v in outputs]
+    return ("/* the located step that crosses: its legs, RK4 of the sides held fixed on each (calls of one\n"
+            "   mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/functions.py) */\n"
+            f"static GEARSYM_NOINLINE void gs_{kind}_split({', '.join(args)}) {{\n"
+            f"  {locals_}\n  casadi_int i;\n{''.join(body)}}}\n")
 
 
 class _Shape:
@@ -124,6 +160,7 @@ class _Shape:
         self.P = mf.options.chunk_periods
         self.S = shooting_segments(self.N, K)
         self.located = "tangent_try" in mf.steps
+        self.stepwise = "trajectory_step" in mf.steps  # (blocks of several steps: the trajectory steps alone)
 
     def size(self, what: str) -> int:
         """Array length of a local: at least 1 (C has no empty arrays)."""
@@ -279,6 +316,20 @@ def _monodromy_period(s: _Shape) -> str:
             f"  gs_copy(lk, {s.size('o')}, lo); gs_copy(hk, {s.size('o')}, hi);\n" + _monodromy_end(s))
 
 
+def _trajectory(s: _Shape) -> str:
+    """Every step of a period, one block (one step) at a time; the extremes unused."""
+    table = f"T + {s.rows}*p" if s.rows else "T"
+    step = (f"gs_trajectory_step(y, {table}, c, y1); gs_copy(y1, {s.n}, y);" if s.stepwise else
+            f"gs_state_span(y, lo, hi, {table}, c, 1);")
+    y1 = f"  casadi_real y1[{s.size('y')}];\n" if s.stepwise else ""
+    return (_locals(s, False) + y1 + f"  {_observed_start(s)}\n"
+            f"  for (p = 0; p < {s.N}; ++p) {{\n"
+            f"    {step}\n"
+            f"    gs_store(y, {s.n}, res[0], {s.n}*p);\n"
+            "  }\n"
+            "  return 0;")
+
+
 _LOOPS = {
     "lyapunov_chunk": lambda s: _lyapunov(s, s.P),
     "lyapunov_period": lambda s: _lyapunov(s, 1),
@@ -286,4 +337,5 @@ _LOOPS = {
     "orbit_period": lambda s: _orbit(s, 1),
     "monodromy_segment": _monodromy_segment,
     "monodromy_period": _monodromy_period,
+    "trajectory": _trajectory,
 }

@@ -40,10 +40,6 @@ extern "C" {
 #define casadi_f13 CASADI_PREFIX(f13)
 #define casadi_f14 CASADI_PREFIX(f14)
 #define casadi_f15 CASADI_PREFIX(f15)
-#define casadi_f16 CASADI_PREFIX(f16)
-#define casadi_f17 CASADI_PREFIX(f17)
-#define casadi_f18 CASADI_PREFIX(f18)
-#define casadi_f19 CASADI_PREFIX(f19)
 #define casadi_f2 CASADI_PREFIX(f2)
 #define casadi_f3 CASADI_PREFIX(f3)
 #define casadi_f4 CASADI_PREFIX(f4)
@@ -65,7 +61,6 @@ extern "C" {
 #define casadi_s8 CASADI_PREFIX(s8)
 #define casadi_s9 CASADI_PREFIX(s9)
 #define casadi_sq CASADI_PREFIX(sq)
-#define casadi_zeros CASADI_PREFIX(zeros)
 
 /* Symbol visibility in DLLs */
 #ifndef CASADI_SYMBOL_EXPORT
@@ -176,9 +171,6 @@ static const casadi_real casadi_c0[401] =
   384., 385., 386., 387., 388., 389., 390., 391.,
   392., 393., 394., 395., 396., 397., 398., 399.,
   400.};
-
-static const casadi_real casadi_zeros[600] = 
-  {0.};
 
 /* rhs:(t,y[2],p[4])->(dy[2]) */
 static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
@@ -1446,312 +1438,17 @@ CASADI_SYMBOL_EXPORT int orbit_period_work_bytes(casadi_int *sz_arg, casadi_int*
   return 0;
 }
 
-/* state_step:(i0[2],i1[3],i2[4])->(o0[2]) */
-static int casadi_f17(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14;
-  a00=arg[0]? arg[0][0] : 0;
-  a01=arg[2]? arg[2][3] : 0;
-  a02=6.;
-  a02=(a01/a02);
-  a03=arg[0]? arg[0][1] : 0;
-  a04=2.;
-  a04=(a01/a04);
-  a05=arg[2]? arg[2][1] : 0;
-  a06=(a03*a05);
-  a06=(a06-a00);
-  a07=arg[2]? arg[2][2] : 0;
-  a08=arg[1]? arg[1][0] : 0;
-  a08=(a07*a08);
-  a06=(a06+a08);
-  a08=arg[2]? arg[2][0] : 0;
-  a09=casadi_sq(a00);
-  a09=(a00*a09);
-  a09=(a08*a09);
-  a06=(a06+a09);
-  a09=(a04*a06);
-  a09=(a03+a09);
-  a10=(2.*a09);
-  a10=(a03+a10);
-  a11=(a09*a05);
-  a12=(a04*a03);
-  a12=(a00+a12);
-  a11=(a11-a12);
-  a13=arg[1]? arg[1][1] : 0;
-  a13=(a07*a13);
-  a11=(a11+a13);
-  a14=casadi_sq(a12);
-  a12=(a12*a14);
-  a12=(a08*a12);
-  a11=(a11+a12);
-  a12=(a04*a11);
-  a12=(a03+a12);
-  a14=(2.*a12);
-  a10=(a10+a14);
-  a14=(a12*a05);
-  a04=(a04*a09);
-  a04=(a00+a04);
-  a14=(a14-a04);
-  a14=(a14+a13);
-  a13=casadi_sq(a04);
-  a04=(a04*a13);
-  a04=(a08*a04);
-  a14=(a14+a04);
-  a04=(a01*a14);
-  a04=(a03+a04);
-  a10=(a10+a04);
-  a10=(a02*a10);
-  a10=(a00+a10);
-  if (res[0]!=0) res[0][0]=a10;
-  a11=(2.*a11);
-  a06=(a06+a11);
-  a14=(2.*a14);
-  a06=(a06+a14);
-  a04=(a04*a05);
-  a01=(a01*a12);
-  a00=(a00+a01);
-  a04=(a04-a00);
-  a01=arg[1]? arg[1][2] : 0;
-  a07=(a07*a01);
-  a04=(a04+a07);
-  a07=casadi_sq(a00);
-  a00=(a00*a07);
-  a08=(a08*a00);
-  a04=(a04+a08);
-  a06=(a06+a04);
-  a02=(a02*a06);
-  a03=(a03+a02);
-  if (res[0]!=0) res[0][1]=a03;
-  return 0;
-}
-
-/* state_step_acc10:(i0[2],i1[3x10],i2[4x10])->(o0[2x10]) */
-static int casadi_f16(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real **res1=res+1, *w0=w+15, *w1=w+17, *w2=w+20, *w3=w+24;
-  const casadi_real **arg1=arg+3;
-  casadi_copy(arg[0], 2, w0);
-  casadi_copy(arg[1], 3, w1);
-  casadi_copy(arg[2], 4, w2);
-  arg1[0]=w0;
-  arg1[1]=w1;
-  arg1[2]=w2;
-  res1[0]=w3;
-  if (casadi_f17(arg1, res1, iw, w, 0)) return 1;
-  casadi_copy(w3, 2, res[0]);
-  casadi_copy(arg[1] ? arg[1]+3 : 0, 3, w1);
-  casadi_copy(arg[2] ? arg[2]+4 : 0, 4, w2);
-  arg1[0]=w3;
-  arg1[1]=w1;
-  arg1[2]=w2;
-  res1[0]=w0;
-  if (casadi_f17(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w0, 2, res[0]+2);
-  casadi_copy(arg[1] ? arg[1]+6 : 0, 3, w1);
-  casadi_copy(arg[2] ? arg[2]+8 : 0, 4, w2);
-  arg1[0]=w0;
-  arg1[1]=w1;
-  arg1[2]=w2;
-  res1[0]=w3;
-  if (casadi_f17(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 2, res[0]+4);
-  casadi_copy(arg[1] ? arg[1]+9 : 0, 3, w1);
-  casadi_copy(arg[2] ? arg[2]+12 : 0, 4, w2);
-  arg1[0]=w3;
-  arg1[1]=w1;
-  arg1[2]=w2;
-  res1[0]=w0;
-  if (casadi_f17(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w0, 2, res[0]+6);
-  casadi_copy(arg[1] ? arg[1]+12 : 0, 3, w1);
-  casadi_copy(arg[2] ? arg[2]+16 : 0, 4, w2);
-  arg1[0]=w0;
-  arg1[1]=w1;
-  arg1[2]=w2;
-  res1[0]=w3;
-  if (casadi_f17(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 2, res[0]+8);
-  casadi_copy(arg[1] ? arg[1]+15 : 0, 3, w1);
-  casadi_copy(arg[2] ? arg[2]+20 : 0, 4, w2);
-  arg1[0]=w3;
-  arg1[1]=w1;
-  arg1[2]=w2;
-  res1[0]=w0;
-  if (casadi_f17(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w0, 2, res[0]+10);
-  casadi_copy(arg[1] ? arg[1]+18 : 0, 3, w1);
-  casadi_copy(arg[2] ? arg[2]+24 : 0, 4, w2);
-  arg1[0]=w0;
-  arg1[1]=w1;
-  arg1[2]=w2;
-  res1[0]=w3;
-  if (casadi_f17(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 2, res[0]+12);
-  casadi_copy(arg[1] ? arg[1]+21 : 0, 3, w1);
-  casadi_copy(arg[2] ? arg[2]+28 : 0, 4, w2);
-  arg1[0]=w3;
-  arg1[1]=w1;
-  arg1[2]=w2;
-  res1[0]=w0;
-  if (casadi_f17(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w0, 2, res[0]+14);
-  casadi_copy(arg[1] ? arg[1]+24 : 0, 3, w1);
-  casadi_copy(arg[2] ? arg[2]+32 : 0, 4, w2);
-  arg1[0]=w0;
-  arg1[1]=w1;
-  arg1[2]=w2;
-  res1[0]=w3;
-  if (casadi_f17(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 2, res[0]+16);
-  casadi_copy(arg[1] ? arg[1]+27 : 0, 3, w1);
-  casadi_copy(arg[2] ? arg[2]+36 : 0, 4, w2);
-  arg1[0]=w3;
-  arg1[1]=w1;
-  arg1[2]=w2;
-  res1[0]=w0;
-  if (casadi_f17(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w0, 2, res[0]+18);
-  return 0;
-}
-
-/* state_step_acc10_acc10:(i0[2],i1[3x100],i2[4x100])->(o0[2x100]) */
-static int casadi_f15(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real **res1=res+1, *w0=w+26, *w3=w+28;
-  const casadi_real **arg1=arg+3, *wr1, *wr2;
-  casadi_copy(arg[0], 2, w0);
-  wr1 = arg[1] ? arg[1] : casadi_zeros;
-  wr2 = arg[2] ? arg[2] : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=wr1;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
-  casadi_copy(w3, 20, res[0]);
-  casadi_copy(w3+18, 2, w0);
-  wr1 = arg[1] ? arg[1]+30 : casadi_zeros;
-  wr2 = arg[2] ? arg[2]+40 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=wr1;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 20, res[0]+20);
-  casadi_copy(w3+18, 2, w0);
-  wr1 = arg[1] ? arg[1]+60 : casadi_zeros;
-  wr2 = arg[2] ? arg[2]+80 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=wr1;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 20, res[0]+40);
-  casadi_copy(w3+18, 2, w0);
-  wr1 = arg[1] ? arg[1]+90 : casadi_zeros;
-  wr2 = arg[2] ? arg[2]+120 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=wr1;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 20, res[0]+60);
-  casadi_copy(w3+18, 2, w0);
-  wr1 = arg[1] ? arg[1]+120 : casadi_zeros;
-  wr2 = arg[2] ? arg[2]+160 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=wr1;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 20, res[0]+80);
-  casadi_copy(w3+18, 2, w0);
-  wr1 = arg[1] ? arg[1]+150 : casadi_zeros;
-  wr2 = arg[2] ? arg[2]+200 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=wr1;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 20, res[0]+100);
-  casadi_copy(w3+18, 2, w0);
-  wr1 = arg[1] ? arg[1]+180 : casadi_zeros;
-  wr2 = arg[2] ? arg[2]+240 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=wr1;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 20, res[0]+120);
-  casadi_copy(w3+18, 2, w0);
-  wr1 = arg[1] ? arg[1]+210 : casadi_zeros;
-  wr2 = arg[2] ? arg[2]+280 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=wr1;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 20, res[0]+140);
-  casadi_copy(w3+18, 2, w0);
-  wr1 = arg[1] ? arg[1]+240 : casadi_zeros;
-  wr2 = arg[2] ? arg[2]+320 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=wr1;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 20, res[0]+160);
-  casadi_copy(w3+18, 2, w0);
-  wr1 = arg[1] ? arg[1]+270 : casadi_zeros;
-  wr2 = arg[2] ? arg[2]+360 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=wr1;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f16(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 20, res[0]+180);
-  return 0;
-}
-
-/* steps:(i0[2],i1[3x200],i2[4x200])->(o0[2x200]) */
-static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real **res1=res+1, *w0=w+118, *w3=w+120;
-  const casadi_real **arg1=arg+3, *wr1, *wr2;
-  casadi_copy(arg[0], 2, w0);
-  wr1 = arg[1] ? arg[1] : casadi_zeros;
-  wr2 = arg[2] ? arg[2] : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=wr1;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
-  casadi_copy(w3, 200, res[0]);
-  casadi_copy(w3+198, 2, w0);
-  wr1 = arg[1] ? arg[1]+300 : casadi_zeros;
-  wr2 = arg[2] ? arg[2]+400 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=wr1;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 200, res[0]+200);
-  return 0;
-}
-
 /* trajectory:(y0[2],table[3x200],c[4])->(states[2x200]) */
 static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i;
-  casadi_real **res1=res+1, *w0=w+1020, *w2=w+1022, *w3=w+1026, *w4=w+1826;
-  const casadi_real **arg1=arg+3, *wr1;
-  casadi_copy(arg[0], 2, w0);
-  wr1 = arg[1] ? arg[1] : casadi_zeros;
-  casadi_copy(arg[2], 4, w2);
-  for (i=0;i<200;++i) {
-    casadi_copy(w2, 4, w3+ i*4);
+  casadi_real y[2], lo[2], hi[2], c[4];
+  const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
+  casadi_int p;
+  gs_load(arg[0], 2, y); gs_load(arg[2], 4, c);
+  lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[1]; hi[1] = y[1];
+  for (p = 0; p < 200; ++p) {
+    gs_state_span(y, lo, hi, T + 3*p, c, 1);
+    gs_store(y, 2, res[0], 2*p);
   }
-  arg1[0]=w0;
-  arg1[1]=wr1;
-  arg1[2]=w3;
-  res1[0]=w4;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
-  casadi_copy(w4, 400, res[0]);
   return 0;
 }
 
@@ -1815,23 +1512,23 @@ CASADI_SYMBOL_EXPORT const casadi_int* trajectory_sparsity_out(casadi_int i) {
 }
 
 CASADI_SYMBOL_EXPORT int trajectory_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 15;
-  if (sz_res) *sz_res = 5;
+  if (sz_arg) *sz_arg = 8;
+  if (sz_res) *sz_res = 4;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 2226;
+  if (sz_w) *sz_w = 429;
   return 0;
 }
 
 CASADI_SYMBOL_EXPORT int trajectory_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 15*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 5*sizeof(casadi_real*);
+  if (sz_arg) *sz_arg = 8*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 2226*sizeof(casadi_real);
+  if (sz_w) *sz_w = 429*sizeof(casadi_real);
   return 0;
 }
 
 /* monodromy_segment:(y0[2],Q0[2x2],table[3x50],c[4])->(strobe[2],M[2x2],low[2],high[2]) */
-static int casadi_f18(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[2], lo[2], hi[2], c[4]; casadi_real Q[4];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -1845,7 +1542,7 @@ static int casadi_f18(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f18(arg, res, iw, w, mem);
+  return casadi_f14(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment_checkout(void) {
@@ -1928,7 +1625,7 @@ CASADI_SYMBOL_EXPORT int monodromy_segment_work_bytes(casadi_int *sz_arg, casadi
 }
 
 /* monodromy_period:(y0[2],Q0[2x2],table[3x200],c[4])->(strobe[2],M[2x2],low[2],high[2]) */
-static int casadi_f19(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f15(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[2], lo[2], hi[2], c[4]; casadi_real Q[4];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -1950,7 +1647,7 @@ static int casadi_f19(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f19(arg, res, iw, w, mem);
+  return casadi_f15(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period_checkout(void) {

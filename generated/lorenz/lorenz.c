@@ -37,10 +37,6 @@ extern "C" {
 #define casadi_f11 CASADI_PREFIX(f11)
 #define casadi_f12 CASADI_PREFIX(f12)
 #define casadi_f13 CASADI_PREFIX(f13)
-#define casadi_f14 CASADI_PREFIX(f14)
-#define casadi_f15 CASADI_PREFIX(f15)
-#define casadi_f16 CASADI_PREFIX(f16)
-#define casadi_f17 CASADI_PREFIX(f17)
 #define casadi_f2 CASADI_PREFIX(f2)
 #define casadi_f3 CASADI_PREFIX(f3)
 #define casadi_f4 CASADI_PREFIX(f4)
@@ -62,7 +58,6 @@ extern "C" {
 #define casadi_s8 CASADI_PREFIX(s8)
 #define casadi_s9 CASADI_PREFIX(s9)
 #define casadi_sq CASADI_PREFIX(sq)
-#define casadi_zeros CASADI_PREFIX(zeros)
 
 /* Symbol visibility in DLLs */
 #ifndef CASADI_SYMBOL_EXPORT
@@ -121,9 +116,6 @@ static const casadi_int casadi_s8[4] = {0};
 static const casadi_int casadi_s9[3] = {3, 50, 1};
 static const casadi_int casadi_s10[3] = {3, 200, 1};
 static const casadi_int casadi_s11[3] = {0, 50, 1};
-
-static const casadi_real casadi_zeros[400] = 
-  {0.};
 
 /* rhs:(t,y[3],p[3])->(dy[3]) */
 static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
@@ -1591,302 +1583,17 @@ CASADI_SYMBOL_EXPORT int orbit_period_work_bytes(casadi_int *sz_arg, casadi_int*
   return 0;
 }
 
-/* state_step:(i0[3],i1[0],i2[4])->(o0[3]) */
-static int casadi_f15(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19;
-  a00=arg[0]? arg[0][0] : 0;
-  a01=arg[2]? arg[2][3] : 0;
-  a02=6.;
-  a02=(a01/a02);
-  a03=arg[2]? arg[2][0] : 0;
-  a04=arg[0]? arg[0][1] : 0;
-  a05=(a04-a00);
-  a05=(a03*a05);
-  a06=2.;
-  a06=(a01/a06);
-  a07=arg[2]? arg[2][1] : 0;
-  a08=arg[0]? arg[0][2] : 0;
-  a09=(a07-a08);
-  a09=(a00*a09);
-  a09=(a09-a04);
-  a10=(a06*a09);
-  a10=(a04+a10);
-  a11=(a06*a05);
-  a11=(a00+a11);
-  a12=(a10-a11);
-  a12=(a03*a12);
-  a13=(2.*a12);
-  a05=(a05+a13);
-  a13=(a00*a04);
-  a14=arg[2]? arg[2][2] : 0;
-  a15=(a08*a14);
-  a13=(a13+a15);
-  a15=(a06*a13);
-  a15=(a08+a15);
-  a16=(a07-a15);
-  a16=(a11*a16);
-  a16=(a16-a10);
-  a17=(a06*a16);
-  a17=(a04+a17);
-  a12=(a06*a12);
-  a12=(a00+a12);
-  a18=(a17-a12);
-  a18=(a03*a18);
-  a19=(2.*a18);
-  a05=(a05+a19);
-  a11=(a11*a10);
-  a15=(a15*a14);
-  a11=(a11+a15);
-  a06=(a06*a11);
-  a06=(a08+a06);
-  a15=(a07-a06);
-  a15=(a12*a15);
-  a15=(a15-a17);
-  a10=(a01*a15);
-  a10=(a04+a10);
-  a18=(a01*a18);
-  a18=(a00+a18);
-  a19=(a10-a18);
-  a03=(a03*a19);
-  a05=(a05+a03);
-  a05=(a02*a05);
-  a00=(a00+a05);
-  if (res[0]!=0) res[0][0]=a00;
-  a16=(2.*a16);
-  a09=(a09+a16);
-  a15=(2.*a15);
-  a09=(a09+a15);
-  a12=(a12*a17);
-  a06=(a06*a14);
-  a12=(a12+a06);
-  a01=(a01*a12);
-  a01=(a08+a01);
-  a07=(a07-a01);
-  a07=(a18*a07);
-  a07=(a07-a10);
-  a09=(a09+a07);
-  a09=(a02*a09);
-  a04=(a04+a09);
-  if (res[0]!=0) res[0][1]=a04;
-  a11=(2.*a11);
-  a13=(a13+a11);
-  a12=(2.*a12);
-  a13=(a13+a12);
-  a18=(a18*a10);
-  a01=(a01*a14);
-  a18=(a18+a01);
-  a13=(a13+a18);
-  a02=(a02*a13);
-  a08=(a08+a02);
-  if (res[0]!=0) res[0][2]=a08;
-  return 0;
-}
-
-/* state_step_acc10:(i0[3],i1[0x10],i2[4x10])->(o0[3x10]) */
-static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real **res1=res+1, *w0=w+20, *w2=w+23, *w3=w+27;
-  const casadi_real **arg1=arg+3;
-  casadi_copy(arg[0], 3, w0);
-  casadi_copy(arg[2], 4, w2);
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=w2;
-  res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
-  casadi_copy(w3, 3, res[0]);
-  casadi_copy(arg[2] ? arg[2]+4 : 0, 4, w2);
-  arg1[0]=w3;
-  arg1[1]=0;
-  arg1[2]=w2;
-  res1[0]=w0;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w0, 3, res[0]+3);
-  casadi_copy(arg[2] ? arg[2]+8 : 0, 4, w2);
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=w2;
-  res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 3, res[0]+6);
-  casadi_copy(arg[2] ? arg[2]+12 : 0, 4, w2);
-  arg1[0]=w3;
-  arg1[1]=0;
-  arg1[2]=w2;
-  res1[0]=w0;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w0, 3, res[0]+9);
-  casadi_copy(arg[2] ? arg[2]+16 : 0, 4, w2);
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=w2;
-  res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 3, res[0]+12);
-  casadi_copy(arg[2] ? arg[2]+20 : 0, 4, w2);
-  arg1[0]=w3;
-  arg1[1]=0;
-  arg1[2]=w2;
-  res1[0]=w0;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w0, 3, res[0]+15);
-  casadi_copy(arg[2] ? arg[2]+24 : 0, 4, w2);
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=w2;
-  res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 3, res[0]+18);
-  casadi_copy(arg[2] ? arg[2]+28 : 0, 4, w2);
-  arg1[0]=w3;
-  arg1[1]=0;
-  arg1[2]=w2;
-  res1[0]=w0;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w0, 3, res[0]+21);
-  casadi_copy(arg[2] ? arg[2]+32 : 0, 4, w2);
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=w2;
-  res1[0]=w3;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 3, res[0]+24);
-  casadi_copy(arg[2] ? arg[2]+36 : 0, 4, w2);
-  arg1[0]=w3;
-  arg1[1]=0;
-  arg1[2]=w2;
-  res1[0]=w0;
-  if (casadi_f15(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w0, 3, res[0]+27);
-  return 0;
-}
-
-/* state_step_acc10_acc10:(i0[3],i1[0x100],i2[4x100])->(o0[3x100]) */
-static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real **res1=res+1, *w0=w+30, *w3=w+33;
-  const casadi_real **arg1=arg+3, *wr2;
-  casadi_copy(arg[0], 3, w0);
-  wr2 = arg[2] ? arg[2] : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
-  casadi_copy(w3, 30, res[0]);
-  casadi_copy(w3+27, 3, w0);
-  wr2 = arg[2] ? arg[2]+40 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 30, res[0]+30);
-  casadi_copy(w3+27, 3, w0);
-  wr2 = arg[2] ? arg[2]+80 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 30, res[0]+60);
-  casadi_copy(w3+27, 3, w0);
-  wr2 = arg[2] ? arg[2]+120 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 30, res[0]+90);
-  casadi_copy(w3+27, 3, w0);
-  wr2 = arg[2] ? arg[2]+160 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 30, res[0]+120);
-  casadi_copy(w3+27, 3, w0);
-  wr2 = arg[2] ? arg[2]+200 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 30, res[0]+150);
-  casadi_copy(w3+27, 3, w0);
-  wr2 = arg[2] ? arg[2]+240 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 30, res[0]+180);
-  casadi_copy(w3+27, 3, w0);
-  wr2 = arg[2] ? arg[2]+280 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 30, res[0]+210);
-  casadi_copy(w3+27, 3, w0);
-  wr2 = arg[2] ? arg[2]+320 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 30, res[0]+240);
-  casadi_copy(w3+27, 3, w0);
-  wr2 = arg[2] ? arg[2]+360 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f14(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 30, res[0]+270);
-  return 0;
-}
-
-/* steps:(i0[3],i1[0x200],i2[4x200])->(o0[3x200]) */
-static int casadi_f12(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real **res1=res+1, *w0=w+103, *w3=w+106;
-  const casadi_real **arg1=arg+3, *wr2;
-  casadi_copy(arg[0], 3, w0);
-  wr2 = arg[2] ? arg[2] : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f13(arg1, res1, iw, w, 0)) return 1;
-  casadi_copy(w3, 300, res[0]);
-  casadi_copy(w3+297, 3, w0);
-  wr2 = arg[2] ? arg[2]+400 : casadi_zeros;
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=wr2;
-  res1[0]=w3;
-  if (casadi_f13(arg1, res1, iw, w, 0)) return 1;
-  if (res[0]) casadi_copy(w3, 300, res[0]+300);
-  return 0;
-}
-
 /* trajectory:(y0[3],table[0x200],c[4])->(states[3x200]) */
 static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i;
-  casadi_real **res1=res+1, *w0=w+806, *w2=w+809, *w3=w+813, *w4=w+1613;
-  const casadi_real **arg1=arg+3;
-  casadi_copy(arg[0], 3, w0);
-  casadi_copy(arg[2], 4, w2);
-  for (i=0;i<200;++i) {
-    casadi_copy(w2, 4, w3+ i*4);
+  casadi_real y[3], lo[3], hi[3], c[4];
+  const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
+  casadi_int p;
+  gs_load(arg[0], 3, y); gs_load(arg[2], 4, c);
+  lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[1]; hi[1] = y[1]; lo[2] = y[2]; hi[2] = y[2];
+  for (p = 0; p < 200; ++p) {
+    gs_state_span(y, lo, hi, T, c, 1);
+    gs_store(y, 3, res[0], 3*p);
   }
-  arg1[0]=w0;
-  arg1[1]=0;
-  arg1[2]=w3;
-  res1[0]=w4;
-  if (casadi_f12(arg1, res1, iw, w, 0)) return 1;
-  casadi_copy(w4, 600, res[0]);
   return 0;
 }
 
@@ -1950,23 +1657,23 @@ CASADI_SYMBOL_EXPORT const casadi_int* trajectory_sparsity_out(casadi_int i) {
 }
 
 CASADI_SYMBOL_EXPORT int trajectory_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 15;
-  if (sz_res) *sz_res = 5;
+  if (sz_arg) *sz_arg = 8;
+  if (sz_res) *sz_res = 4;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 2213;
+  if (sz_w) *sz_w = 635;
   return 0;
 }
 
 CASADI_SYMBOL_EXPORT int trajectory_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 15*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 5*sizeof(casadi_real*);
+  if (sz_arg) *sz_arg = 8*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 2213*sizeof(casadi_real);
+  if (sz_w) *sz_w = 635*sizeof(casadi_real);
   return 0;
 }
 
 /* monodromy_segment:(y0[3],Q0[3x3],table[0x50],c[4])->(strobe[3],M[3x3],low[3],high[3]) */
-static int casadi_f16(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f12(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[3], lo[3], hi[3], c[4]; casadi_real Q[9];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -1980,7 +1687,7 @@ static int casadi_f16(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f16(arg, res, iw, w, mem);
+  return casadi_f12(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment_checkout(void) {
@@ -2063,7 +1770,7 @@ CASADI_SYMBOL_EXPORT int monodromy_segment_work_bytes(casadi_int *sz_arg, casadi
 }
 
 /* monodromy_period:(y0[3],Q0[3x3],table[0x200],c[4])->(strobe[3],M[3x3],low[3],high[3]) */
-static int casadi_f17(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[3], lo[3], hi[3], c[4]; casadi_real Q[9];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -2087,7 +1794,7 @@ static int casadi_f17(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f17(arg, res, iw, w, mem);
+  return casadi_f13(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period_checkout(void) {
