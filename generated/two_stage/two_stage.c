@@ -1153,7 +1153,7 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
 #define GEARSYM_INLINE inline __attribute__((always_inline))
 #define GEARSYM_NOINLINE __attribute__((noinline))
 #define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
-/* a loop left for the vectoriser: gcc unrolls one of 2 iterations before it, and then does not vectorise it */
+/* a loop left to the vectoriser (gcc unrolls a loop of 2 iterations before it, which then stays scalar) */
 #define GEARSYM_NOT_UNROLLED _Pragma("GCC unroll 1")
 #else
 #define GEARSYM_INLINE inline
