@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import re
+import shutil
+import subprocess
 
 import casadi as ca
 import numpy as np
@@ -9,7 +11,7 @@ import pytest
 
 import gearsym
 from gearsym import Integration, lyapunov_spectrum
-from gearsym.codegen.compiler import compile_library, find_compiler
+from gearsym.codegen.compiler import DEFAULT_FLAGS, compile_library, find_compiler
 from gearsym.codegen.functions import LoopOptions, build_functions
 from gearsym.codegen.generate import code_hash, write_code
 from gearsym.codegen.native import load_native
@@ -94,6 +96,36 @@ def test_the_split_calls_one_mode_rk4_step_for_every_substep_and_the_trajectory_
     trajectory = re.search(r"/\* trajectory:.*?\n}\n", text, re.S).group(0)
     assert "gs_state_span(y, lo, hi, T + 9*p, c, 1);" in trajectory
     assert "/* step_split:" not in text and "/* state_switch:" not in text  # CasADi's trajectory is gone
+
+
+def _plain_code(name: str, tmp_path) -> str:
+    system, options = gearsym.load(name), LoopOptions(locate_crossings=False)
+    return write_code(build_functions(system, options), tmp_path, code_hash(system, options)).source.read_text()
+
+
+def test_the_plain_tangent_step_is_the_states_step_then_a_loop_over_the_tangent_vectors(tmp_path):
+    text = _plain_code("one_stage", tmp_path)
+    step = re.search(r"void gs_tangent_step\(.*?\n}\n", text, re.S).group(0)
+    assert "gs_tangent_state(y, lo, hi, T, c, y1, lo1, hi1, J);" in step
+    assert "for (j = 0; j < 2; ++j) gs_tangent_vector(Q + j, J, c, Q1 + j);" in step
+    # in the span the vectors are side by side: a vector's second entry is 2 further on
+    vector = re.search(r"void gs_tangent_vector\(.*?\n}\n", text, re.S).group(0)
+    assert re.findall(r"A0\[(\d+)\]", vector) == ["0", "2"] and sorted(re.findall(r"R0\[(\d+)\]", vector)) == ["0", "2"]
+    span = re.search(r"void gs_tangent_span\(.*?\n}\n", text, re.S).group(0)
+    assert "gs_transpose(Q, 2, Qa);" in span and span.count("gs_transpose(Qa, 2, Q);") == 1
+    assert span.count("gs_transpose(Qb, 2, Q);") == 1
+    assert "gs_tangent_block" not in text
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="needs gcc")
+def test_gcc_vectorises_the_loop_over_the_tangent_vectors_even_of_two(tmp_path):
+    """(gcc unrolls a loop of two iterations before its vectoriser sees it, unless told not to.)"""
+    source = tmp_path / "one_stage.c"
+    source.write_text(_plain_code("one_stage", tmp_path / "code"))
+    line = 1 + source.read_text()[:source.read_text().index("for (j = 0; j < 2; ++j)")].count("\n")
+    report = subprocess.run(["gcc", *DEFAULT_FLAGS, "-fopt-info-vec-optimized", "-c", "-o", str(tmp_path / "o.o"),
+                             str(source)], capture_output=True, text=True, check=True).stderr
+    assert re.search(rf"one_stage\.c:{line}:\d+: optimized: loop vectorized", report), report
 
 
 def test_a_step_in_a_form_the_printer_does_not_rewrite_fails_loudly():

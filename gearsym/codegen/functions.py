@@ -53,9 +53,9 @@ class ModelFunctions:
     options: LoopOptions
     split: SplitRHS
     functions: dict[str, ca.Function]
-    #: the SX pieces the printed loops call (:mod:`.printed`): ``tangent_block``/``state_block`` (plain; and
-    #: ``trajectory_step`` for blocks of several steps), or ``{tangent,state}_{try,keep}`` and the split's pieces
-    #: (crossings located, :data:`SPLIT_CALLS`), and ``gram_schmidt``
+    #: the SX pieces the printed loops call (:mod:`.printed`): ``tangent_state``, ``tangent_vector`` and
+    #: ``state_block`` (plain; and ``trajectory_step`` for blocks of several steps), or ``{tangent,state}_{try,keep}``
+    #: and the split's pieces (crossings located, :data:`SPLIT_CALLS`), and ``gram_schmidt``
     steps: dict[str, ca.Function]
 
     @property
@@ -91,7 +91,7 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
     switching = _switching(system, split) if options.locate_crossings else None
     if switching is None or not switching.surfaces:  # nothing switches (Lorenz): the plain loops
         tangent_block, state_block, state_step = _rk4_functions(sym, split, K, where)
-        steps = {"tangent_block": tangent_block, "state_block": state_block}
+        steps = {**_tangent_by_vector(sym, split, K, where), "state_block": state_block}
         if K > 1:  # the trajectory's steps one at a time
             steps["trajectory_step"] = state_step
     else:
@@ -284,6 +284,55 @@ def _rk4_functions(sym: _Symbols, split: SplitRHS, K: int, where: str):
     y_next, _ = rk4(y, None, col[:m], col[m:2 * m], col[2 * m:])
     state_step = ca.Function("trajectory_step", [y, col, ch], [y_next], _OPTS)
     return tangent_block, state_block, state_step
+
+
+def _tangent_by_vector(sym: _Symbols, split: SplitRHS, K: int, where: str) -> dict[str, ca.Function]:
+    """``tangent_block`` in two pieces, for the printed loop: ``tangent_state`` (the state's K steps, as
+    ``state_block``, and the Jacobian of every RK4 stage: its nonzeros that are not constants) and
+    ``tangent_vector`` (one tangent vector's K steps, given those Jacobians), which the loop applies to each
+    tangent vector in turn, a loop the C compiler vectorises. ``tangent_block`` computes each column of Q
+    with the same operations (``mtimes`` works column by column, and the constant entries, which it
+    simplifies, stay constants here), so the pieces give its bits."""
+    n, m, nc = sym.y.numel(), len(split.tables), sym.ch.numel() - 1
+    y, ch, h = sym.y, sym.ch, sym.ch[nc]
+    f_of, J_of = _tabulated_rhs(sym, split, where)
+    lo, hi = ca.SX.sym("lo", len(sym.observed)), ca.SX.sym("hi", len(sym.observed))
+    Tk, q = ca.SX.sym("Tk", 3 * m, K), ca.SX.sym("q", n)
+    stages, entries = [], []  # each stage's Jacobian; its distinct non-constant nonzeros
+
+    def recorded(x, T):
+        J = J_of(x, T, ch)
+        stages.append(J)
+        entries.extend(e for e in J.nonzeros() if not e.is_constant() and _position(entries, e) is None)
+        return J
+
+    yk, qk, lk, hk = y, ca.SX.sym("q0", n), lo, hi  # (a stand-in vector: only the Jacobians are kept)
+    for i in range(K):
+        col = Tk[:, i]
+        yk, qk = rk4_step(lambda x, T: f_of(x, T, ch), recorded, yk, qk, h, col[:m], col[m:2 * m], col[2 * m:])
+        obs = ca.vertcat(*[yk[j] for j in sym.observed])
+        lk, hk = select_min(obs, lk), select_max(obs, hk)
+    J_all = ca.vertcat(*entries) if entries else ca.SX(0, 1)
+    state = ca.Function("tangent_state", [y, lo, hi, Tk, ch], [yk, lk, hk, J_all], _OPTS)
+
+    symbols = ca.SX.sym("J", max(1, len(entries)))
+    given = []  # the same matrices with the symbols in place of the computed entries
+    for J in stages:
+        values = [e if e.is_constant() else symbols[_position(entries, e)] for e in J.nonzeros()]
+        given.append(ca.SX(J.sparsity(), ca.vertcat(*values) if values else ca.SX(0, 1)))
+    replay = iter(given)
+    qk = q
+    for i in range(K):
+        col = Tk[:, i]
+        _, qk = rk4_step(lambda x, T: f_of(x, T, ch), lambda x, T: next(replay), y, qk, h, col[:m], col[m:2 * m],
+                         col[2 * m:])
+    vector = ca.Function("tangent_vector", [q, symbols, ch], [qk], _OPTS)
+    return {"tangent_state": state, "tangent_vector": vector}
+
+
+def _position(entries: list, e) -> int | None:
+    """Where the SX node ``e`` itself (not an equal expression) is in ``entries``."""
+    return next((i for i, x in enumerate(entries) if ca.is_equal(x, e, 0)), None)
 
 
 def rk4_step(f, J, yk, Qk, h, Ta, Tb, Tc):

@@ -19,6 +19,13 @@ trip through the work vector between steps: about 10-15 % of a step next to a ha
 With crossings located, the ``try`` is inline on every step and the ``split`` (about 1 % of steps) a
 separate function behind a real ``if``, marked unlikely: the calls of :data:`~.functions.SPLIT_CALLS` (the MX
 function's), so that the C holds the mode-RK4 step and the root search once each, not once per substep.
+
+The plain tangent step is not CasADi's one function of the state and all tangent vectors (``tangent_block``),
+whose flat scalar code the compiler neither vectorises nor keeps in registers (on the flexible shaft: 654
+instructions a step, 260 of them loads, stores and copies of spilled values), but its two pieces
+(:func:`.functions._tangent_by_vector`): the state's step, which also gives each RK4 stage's Jacobian, and one
+tangent vector's step, applied to each vector in a loop that gcc vectorises across them, the vectors being
+stored side by side in the span (343 instructions a step; the same bits).
 """
 from __future__ import annotations
 
@@ -42,7 +49,9 @@ _DEFINITION = re.compile(_HEADER + _SIGNATURE + r"(?P<body>.*?)\n\}\n\n", re.S)
 def pieces(mf: ModelFunctions, loop: str) -> list[ca.Function]:
     """The SX step functions the printed ``loop`` calls."""
     kind = "state" if loop.startswith(("orbit", "trajectory")) else "tangent"
-    if f"{kind}_block" in mf.steps:
+    if kind == "tangent" and "tangent_vector" in mf.steps:
+        names = ["tangent_state", "tangent_vector"]
+    elif f"{kind}_block" in mf.steps:
         names = [f"{kind}_block", *(["trajectory_step"] if loop == "trajectory" and "trajectory_step" in mf.steps
                                    else [])]
     else:
@@ -77,7 +86,8 @@ def print_loops(text: str, mf: ModelFunctions) -> str:
         raise AssertionError(f"no C definition of {', '.join(missing)} in the generated code")
     shape = _Shape(mf)
     printed = [_PREAMBLE.format(zeros=max(1, shape.rows * shape.N))]
-    printed += [_inline(name, definitions[name].group("body"), mf.steps[name]) for name in mf.steps]
+    printed += [_inline(name, definitions[name].group("body"), mf.steps[name],
+                        shape.n if name == "tangent_vector" else 1) for name in mf.steps]
     printed += [_split(mf, kind) for kind in ("tangent", "state") if shape.located]
     printed += _spans(mf, shape)
     # the printed C goes before the first stand-in; each stand-in's body becomes its loop
@@ -100,10 +110,13 @@ def _without_unused(text: str) -> str:
             text = text[:m.start()] + text[m.end():]
 
 
-def _inline(name: str, body: str, f: ca.Function) -> str:
-    """The C body of the SX function ``f`` as ``gs_<name>``: inputs A0.., outputs R0.., restrict pointers."""
+def _inline(name: str, body: str, f: ca.Function, stride: int = 1) -> str:
+    """The C body of the SX function ``f`` as ``gs_<name>``: inputs A0.., outputs R0.., restrict pointers;
+    the first input and output ``stride`` entries apart (a tangent vector among others, row by row)."""
     body = re.sub(r"arg\[(\d+)\]\? arg\[\1\]\[(\d+)\] : 0", r"A\1[\2]", body)
     body = re.sub(r"if \(res\[(\d+)\]!=0\) res\[\1\]\[(\d+)\]=", r"R\1[\2]=", body)
+    if stride != 1:
+        body = re.sub(r"\b([AR])0\[(\d+)\]", lambda m: f"{m.group(1)}0[{int(m.group(2)) * stride}]", body)
     body = re.sub(r"\n  return 0;$", "", body)
     left = [line for line in body.splitlines() if re.search(r"\b(arg|res|iw|w)\[|\breturn\b|\bmem\b", line)]
     if left:
@@ -161,6 +174,9 @@ class _Shape:
         self.S = shooting_segments(self.N, K)
         self.located = "tangent_try" in mf.steps
         self.stepwise = "trajectory_step" in mf.steps  # (blocks of several steps: the trajectory steps alone)
+        #: the plain tangent step: the state's step, then each tangent vector's (:func:`_by_vector`)
+        self.by_vector = "tangent_vector" in mf.steps
+        self.jacobians = mf.steps["tangent_state"].nnz_out(3) if self.by_vector else 0
 
     def size(self, what: str) -> int:
         """Array length of a local: at least 1 (C has no empty arrays)."""
@@ -172,10 +188,13 @@ _PREAMBLE = """/* gearsym: the integration loops, printed around CasADi's C of o
 #define GEARSYM_INLINE inline __attribute__((always_inline))
 #define GEARSYM_NOINLINE __attribute__((noinline))
 #define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
+/* a loop left to the vectoriser (gcc unrolls a loop of 2 iterations before it, which then stays scalar) */
+#define GEARSYM_NOT_UNROLLED _Pragma("GCC unroll 1")
 #else
 #define GEARSYM_INLINE inline
 #define GEARSYM_NOINLINE
 #define GEARSYM_UNLIKELY(x) (x)
+#define GEARSYM_NOT_UNROLLED
 #endif
 
 static const casadi_real gs_zeros[{zeros}] = {{0.}};
@@ -189,6 +208,12 @@ static inline void gs_load(const casadi_real* x, casadi_int n, casadi_real* y) {
 static inline void gs_copy(const casadi_real* restrict x, casadi_int n, casadi_real* restrict y) {{
   casadi_int i;
   for (i = 0; i < n; ++i) y[i] = x[i];
+}}
+
+/* the n x n matrix x transposed into y (tangent vectors: from columns to side by side and back) */
+static inline void gs_transpose(const casadi_real* restrict x, casadi_int n, casadi_real* restrict y) {{
+  casadi_int i, j;
+  for (i = 0; i < n; ++i) for (j = 0; j < n; ++j) y[j * n + i] = x[i * n + j];
 }}
 
 /* an output column (none if the caller passes a null pointer) */
@@ -220,6 +245,8 @@ def _spans(mf: ModelFunctions, s: _Shape) -> list[str]:
                     f"  gs_{kind}_try({', '.join([*carried, 'T', 'c', *tried])}, &flag);\n"
                     f"  if (GEARSYM_UNLIKELY(flag != 0)) gs_{kind}_split({split_args});\n"
                     f"  else gs_{kind}_keep({split_args});\n")
+        elif kind == "tangent" and s.by_vector:
+            body = _by_vector(s)
         else:
             body = f"  gs_{kind}_block({args});\n"
         out.append(f"/* one block of {kind} steps (the SX functions' step, as CasADi's Switch runs it) */\n"
@@ -229,7 +256,9 @@ def _spans(mf: ModelFunctions, s: _Shape) -> list[str]:
         b = [f"{v}b" for v in state]
         locals_ = " ".join(f"casadi_real {v}a[{sizes[v]}], {v}b[{sizes[v]}];" for v in state)
         table = (lambda k: f"T + {s.step}*({k})") if s.step else (lambda k: "T")
-        copy = lambda src, dst: " ".join(f"gs_copy({x}, {sizes[v]}, {y});" for v, x, y in zip(state, src, dst))
+        copy = lambda src, dst: " ".join(
+            f"gs_transpose({x}, {s.n}, {y});" if v == "Q" and s.by_vector else f"gs_copy({x}, {sizes[v]}, {y});"
+            for v, x, y in zip(state, src, dst))
         out.append(
             f"/* blocks of {kind} steps from ({', '.join(state)}), in place: the state in local arrays, a -> b -> a */\n"
             f"static GEARSYM_NOINLINE void gs_{kind}_span({', '.join(decl)}, const casadi_real* restrict T, "
@@ -242,6 +271,16 @@ def _spans(mf: ModelFunctions, s: _Shape) -> list[str]:
             "  }\n"
             f"  {copy(a, state)}\n}}\n")
     return out
+
+
+def _by_vector(s: _Shape) -> str:
+    """The plain tangent step: the state's, which gives the Jacobian of every stage, then each tangent
+    vector's, in a loop that the C compiler vectorises across the vectors: in the span they are stored side by
+    side (row r of vector j at r*n + j), so that one vector instruction does the same operation of CasADi's
+    code on several of them (its bits: the operations of each vector are those of ``tangent_block``)."""
+    return (f"  casadi_real J[{max(1, s.jacobians)}]; casadi_int j;\n"
+            "  gs_tangent_state(y, lo, hi, T, c, y1, lo1, hi1, J);\n"
+            f"  GEARSYM_NOT_UNROLLED for (j = 0; j < {s.n}; ++j) gs_tangent_vector(Q + j, J, c, Q1 + j);\n")
 
 
 def _observed_start(s: _Shape, lo: str = "lo", hi: str = "hi") -> str:

@@ -40,6 +40,7 @@ extern "C" {
 #define casadi_f13 CASADI_PREFIX(f13)
 #define casadi_f14 CASADI_PREFIX(f14)
 #define casadi_f15 CASADI_PREFIX(f15)
+#define casadi_f16 CASADI_PREFIX(f16)
 #define casadi_f2 CASADI_PREFIX(f2)
 #define casadi_f3 CASADI_PREFIX(f3)
 #define casadi_f4 CASADI_PREFIX(f4)
@@ -52,6 +53,7 @@ extern "C" {
 #define casadi_s1 CASADI_PREFIX(s1)
 #define casadi_s10 CASADI_PREFIX(s10)
 #define casadi_s11 CASADI_PREFIX(s11)
+#define casadi_s12 CASADI_PREFIX(s12)
 #define casadi_s2 CASADI_PREFIX(s2)
 #define casadi_s3 CASADI_PREFIX(s3)
 #define casadi_s4 CASADI_PREFIX(s4)
@@ -113,11 +115,12 @@ static const casadi_int casadi_s3[3] = {2, 2, 1};
 static const casadi_int casadi_s4[3] = {3, 200, 1};
 static const casadi_int casadi_s5[3] = {1, 2, 1};
 static const casadi_int casadi_s6[2] = {0};
-static const casadi_int casadi_s7[4] = {0};
-static const casadi_int casadi_s8[3] = {0};
-static const casadi_int casadi_s9[3] = {2, 50, 1};
-static const casadi_int casadi_s10[3] = {2, 200, 1};
-static const casadi_int casadi_s11[3] = {3, 50, 1};
+static const casadi_int casadi_s7[3] = {0};
+static const casadi_int casadi_s8[4] = {0};
+static const casadi_int casadi_s9[5] = {0};
+static const casadi_int casadi_s10[3] = {2, 50, 1};
+static const casadi_int casadi_s11[3] = {2, 200, 1};
+static const casadi_int casadi_s12[3] = {3, 50, 1};
 
 static const casadi_real casadi_c0[401] = 
   {0., 1., 2., 3., 4., 5., 6., 7.,
@@ -630,10 +633,13 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
 #define GEARSYM_INLINE inline __attribute__((always_inline))
 #define GEARSYM_NOINLINE __attribute__((noinline))
 #define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
+/* a loop left to the vectoriser (gcc unrolls a loop of 2 iterations before it, which then stays scalar) */
+#define GEARSYM_NOT_UNROLLED _Pragma("GCC unroll 1")
 #else
 #define GEARSYM_INLINE inline
 #define GEARSYM_NOINLINE
 #define GEARSYM_UNLIKELY(x) (x)
+#define GEARSYM_NOT_UNROLLED
 #endif
 
 static const casadi_real gs_zeros[600] = {0.};
@@ -649,31 +655,37 @@ static inline void gs_copy(const casadi_real* restrict x, casadi_int n, casadi_r
   for (i = 0; i < n; ++i) y[i] = x[i];
 }
 
+/* the n x n matrix x transposed into y (tangent vectors: from columns to side by side and back) */
+static inline void gs_transpose(const casadi_real* restrict x, casadi_int n, casadi_real* restrict y) {
+  casadi_int i, j;
+  for (i = 0; i < n; ++i) for (j = 0; j < n; ++j) y[j * n + i] = x[i * n + j];
+}
+
 /* an output column (none if the caller passes a null pointer) */
 static inline void gs_store(const casadi_real* x, casadi_int n, casadi_real* y, casadi_int at) {
   casadi_int i;
   if (y) for (i = 0; i < n; ++i) y[at + i] = x[i];
 }
 
-/* tangent_block, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_block(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3) {
+/* tangent_state, from CasADi's C of it */
+static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21;
+  casadi_real a12, a13, a14, a15, a16, a17;
   a00=A0[0];
-  a01=A5[3];
+  a01=A4[3];
   a02=6.;
   a02=(a01/a02);
   a03=A0[1];
   a04=2.;
   a04=(a01/a04);
-  a05=A5[1];
+  a05=A4[1];
   a06=(a03*a05);
   a06=(a06-a00);
-  a07=A5[2];
-  a08=A4[0];
+  a07=A4[2];
+  a08=A3[0];
   a08=(a07*a08);
   a06=(a06+a08);
-  a08=A5[0];
+  a08=A4[0];
   a09=casadi_sq(a00);
   a10=(a00*a09);
   a10=(a08*a10);
@@ -686,7 +698,7 @@ static GEARSYM_INLINE void gs_tangent_block(const casadi_real* restrict A0, cons
   a13=(a04*a03);
   a13=(a00+a13);
   a12=(a12-a13);
-  a14=A4[1];
+  a14=A3[1];
   a14=(a07*a14);
   a12=(a12+a14);
   a15=casadi_sq(a13);
@@ -698,17 +710,17 @@ static GEARSYM_INLINE void gs_tangent_block(const casadi_real* restrict A0, cons
   a17=(2.*a16);
   a11=(a11+a17);
   a17=(a16*a05);
-  a10=(a04*a10);
-  a10=(a00+a10);
-  a17=(a17-a10);
+  a04=(a04*a10);
+  a04=(a00+a04);
+  a17=(a17-a04);
   a17=(a17+a14);
-  a14=casadi_sq(a10);
-  a18=(a10*a14);
-  a18=(a08*a18);
-  a17=(a17+a18);
-  a18=(a01*a17);
-  a18=(a03+a18);
-  a11=(a11+a18);
+  a14=casadi_sq(a04);
+  a10=(a04*a14);
+  a10=(a08*a10);
+  a17=(a17+a10);
+  a10=(a01*a17);
+  a10=(a03+a10);
+  a11=(a11+a10);
   a11=(a02*a11);
   a11=(a00+a11);
   R0[0]=a11;
@@ -716,154 +728,132 @@ static GEARSYM_INLINE void gs_tangent_block(const casadi_real* restrict A0, cons
   a06=(a06+a12);
   a17=(2.*a17);
   a06=(a06+a17);
-  a18=(a18*a05);
-  a16=(a01*a16);
-  a16=(a00+a16);
-  a18=(a18-a16);
-  a17=A4[2];
-  a07=(a07*a17);
-  a18=(a18+a07);
-  a07=casadi_sq(a16);
-  a17=(a16*a07);
-  a17=(a08*a17);
-  a18=(a18+a17);
-  a06=(a06+a18);
-  a06=(a02*a06);
-  a03=(a03+a06);
+  a10=(a10*a05);
+  a01=(a01*a16);
+  a01=(a00+a01);
+  a10=(a10-a01);
+  a16=A3[2];
+  a07=(a07*a16);
+  a10=(a10+a07);
+  a07=casadi_sq(a01);
+  a16=(a01*a07);
+  a16=(a08*a16);
+  a10=(a10+a16);
+  a06=(a06+a10);
+  a02=(a02*a06);
+  a03=(a03+a02);
   R0[1]=a03;
-  a06=A1[0];
-  a18=A1[1];
-  a17=-1.;
-  a12=(2.*a00);
-  a00=(a00*a12);
+  a02=A1[0];
+  a06=(a11<a02);
+  a10=(a06?a11:0);
+  a06=(!a06);
+  a06=(a06?a02:0);
+  a10=(a10+a06);
+  R1[0]=a10;
+  a10=A1[1];
+  a06=(a03<a10);
+  a02=(a06?a03:0);
+  a06=(!a06);
+  a06=(a06?a10:0);
+  a02=(a02+a06);
+  R1[1]=a02;
+  a02=A2[0];
+  a06=(a02<a11);
+  a11=(a06?a11:0);
+  a06=(!a06);
+  a06=(a06?a02:0);
+  a11=(a11+a06);
+  R2[0]=a11;
+  a11=A2[1];
+  a06=(a11<a03);
+  a03=(a06?a03:0);
+  a06=(!a06);
+  a06=(a06?a11:0);
+  a03=(a03+a06);
+  R2[1]=a03;
+  a03=-1.;
+  a06=(2.*a00);
+  a00=(a00*a06);
   a09=(a09+a00);
   a09=(a08*a09);
-  a09=(a17+a09);
-  a00=(a09*a06);
-  a12=(a05*a18);
-  a00=(a00+a12);
-  a12=(a04*a00);
-  a12=(a18+a12);
-  a19=(2.*a12);
-  a19=(a18+a19);
-  a20=(2.*a13);
-  a13=(a13*a20);
+  a09=(a03+a09);
+  R3[0]=a09;
+  R3[1]=a05;
+  a05=(2.*a13);
+  a13=(a13*a05);
   a15=(a15+a13);
   a15=(a08*a15);
-  a15=(a17+a15);
-  a13=(a04*a18);
-  a13=(a06+a13);
-  a13=(a15*a13);
-  a20=(a05*a12);
-  a13=(a13+a20);
-  a20=(a04*a13);
-  a20=(a18+a20);
-  a21=(2.*a20);
-  a19=(a19+a21);
-  a21=(2.*a10);
-  a10=(a10*a21);
-  a14=(a14+a10);
-  a14=(a08*a14);
-  a14=(a17+a14);
-  a12=(a04*a12);
-  a12=(a06+a12);
-  a12=(a14*a12);
-  a10=(a05*a20);
-  a12=(a12+a10);
-  a10=(a01*a12);
-  a10=(a18+a10);
-  a19=(a19+a10);
-  a19=(a02*a19);
-  a19=(a06+a19);
-  R1[0]=a19;
-  a13=(2.*a13);
-  a00=(a00+a13);
-  a12=(2.*a12);
-  a00=(a00+a12);
-  a12=(2.*a16);
-  a16=(a16*a12);
-  a07=(a07+a16);
-  a08=(a08*a07);
-  a17=(a17+a08);
-  a20=(a01*a20);
-  a06=(a06+a20);
-  a06=(a17*a06);
-  a10=(a05*a10);
-  a06=(a06+a10);
-  a00=(a00+a06);
-  a00=(a02*a00);
-  a18=(a18+a00);
-  R1[1]=a18;
-  a18=A1[2];
-  a00=A1[3];
-  a09=(a09*a18);
-  a06=(a05*a00);
-  a09=(a09+a06);
-  a06=(a04*a09);
-  a06=(a00+a06);
-  a10=(2.*a06);
-  a10=(a00+a10);
-  a20=(a04*a00);
-  a20=(a18+a20);
-  a15=(a15*a20);
-  a20=(a05*a06);
-  a15=(a15+a20);
-  a20=(a04*a15);
-  a20=(a00+a20);
-  a08=(2.*a20);
-  a10=(a10+a08);
-  a04=(a04*a06);
-  a04=(a18+a04);
-  a14=(a14*a04);
-  a04=(a05*a20);
+  a15=(a03+a15);
+  R3[2]=a15;
+  a15=(2.*a04);
+  a04=(a04*a15);
   a14=(a14+a04);
-  a04=(a01*a14);
+  a14=(a08*a14);
+  a14=(a03+a14);
+  R3[3]=a14;
+  a14=(2.*a01);
+  a01=(a01*a14);
+  a07=(a07+a01);
+  a08=(a08*a07);
+  a03=(a03+a08);
+  R3[4]=a03;
+}
+
+/* tangent_vector, from CasADi's C of it */
+static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  a00=A0[0];
+  a01=A2[3];
+  a02=6.;
+  a02=(a01/a02);
+  a03=A0[2];
+  a04=2.;
+  a04=(a01/a04);
+  a05=A1[0];
+  a05=(a05*a00);
+  a06=A1[1];
+  a07=(a06*a03);
+  a05=(a05+a07);
+  a07=(a04*a05);
+  a07=(a03+a07);
+  a08=(2.*a07);
+  a08=(a03+a08);
+  a09=A1[2];
+  a10=(a04*a03);
+  a10=(a00+a10);
+  a09=(a09*a10);
+  a10=(a06*a07);
+  a09=(a09+a10);
+  a10=(a04*a09);
+  a10=(a03+a10);
+  a11=(2.*a10);
+  a08=(a08+a11);
+  a11=A1[3];
+  a04=(a04*a07);
   a04=(a00+a04);
-  a10=(a10+a04);
-  a10=(a02*a10);
-  a10=(a18+a10);
-  R1[2]=a10;
-  a15=(2.*a15);
-  a09=(a09+a15);
-  a14=(2.*a14);
-  a09=(a09+a14);
-  a01=(a01*a20);
-  a18=(a18+a01);
-  a17=(a17*a18);
-  a05=(a05*a04);
-  a17=(a17+a05);
-  a09=(a09+a17);
-  a02=(a02*a09);
-  a00=(a00+a02);
-  R1[3]=a00;
-  a00=A2[0];
-  a02=(a11<a00);
-  a09=(a02?a11:0);
-  a02=(!a02);
-  a02=(a02?a00:0);
-  a09=(a09+a02);
-  R2[0]=a09;
-  a09=A2[1];
-  a02=(a03<a09);
-  a00=(a02?a03:0);
-  a02=(!a02);
-  a02=(a02?a09:0);
-  a00=(a00+a02);
-  R2[1]=a00;
-  a00=A3[0];
-  a02=(a00<a11);
-  a11=(a02?a11:0);
-  a02=(!a02);
-  a02=(a02?a00:0);
-  a11=(a11+a02);
-  R3[0]=a11;
-  a11=A3[1];
-  a02=(a11<a03);
-  a03=(a02?a03:0);
-  a02=(!a02);
-  a02=(a02?a11:0);
+  a11=(a11*a04);
+  a04=(a06*a10);
+  a11=(a11+a04);
+  a04=(a01*a11);
+  a04=(a03+a04);
+  a08=(a08+a04);
+  a08=(a02*a08);
+  a08=(a00+a08);
+  R0[0]=a08;
+  a09=(2.*a09);
+  a05=(a05+a09);
+  a11=(2.*a11);
+  a05=(a05+a11);
+  a11=A1[4];
+  a01=(a01*a10);
+  a00=(a00+a01);
+  a11=(a11*a00);
+  a06=(a06*a04);
+  a11=(a11+a06);
+  a05=(a05+a11);
+  a02=(a02*a05);
   a03=(a03+a02);
-  R3[1]=a03;
+  R0[2]=a03;
 }
 
 /* state_block, from CasADi's C of it */
@@ -1010,20 +1000,22 @@ static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casad
 
 /* one block of tangent steps (the SX functions' step, as CasADi's Switch runs it) */
 static GEARSYM_INLINE void gs_tangent_step(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
-  gs_tangent_block(y, Q, lo, hi, T, c, y1, Q1, lo1, hi1);
+  casadi_real J[5]; casadi_int j;
+  gs_tangent_state(y, lo, hi, T, c, y1, lo1, hi1, J);
+  GEARSYM_NOT_UNROLLED for (j = 0; j < 2; ++j) gs_tangent_vector(Q + j, J, c, Q1 + j);
 }
 
 /* blocks of tangent steps from (y, Q, lo, hi), in place: the state in local arrays, a -> b -> a */
 static GEARSYM_NOINLINE void gs_tangent_span(casadi_real* restrict y, casadi_real* restrict Q, casadi_real* restrict lo, casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_int blocks) {
   casadi_real ya[2], yb[2]; casadi_real Qa[4], Qb[4]; casadi_real loa[2], lob[2]; casadi_real hia[2], hib[2];
   casadi_int k;
-  gs_copy(y, 2, ya); gs_copy(Q, 4, Qa); gs_copy(lo, 2, loa); gs_copy(hi, 2, hia);
+  gs_copy(y, 2, ya); gs_transpose(Q, 2, Qa); gs_copy(lo, 2, loa); gs_copy(hi, 2, hia);
   for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */
     gs_tangent_step(ya, Qa, loa, hia, T + 3*(k), c, yb, Qb, lob, hib);
-    if (k + 1 == blocks) { gs_copy(yb, 2, y); gs_copy(Qb, 4, Q); gs_copy(lob, 2, lo); gs_copy(hib, 2, hi); return; }
+    if (k + 1 == blocks) { gs_copy(yb, 2, y); gs_transpose(Qb, 2, Q); gs_copy(lob, 2, lo); gs_copy(hib, 2, hi); return; }
     gs_tangent_step(yb, Qb, lob, hib, T + 3*(k + 1), c, ya, Qa, loa, hia);
   }
-  gs_copy(ya, 2, y); gs_copy(Qa, 4, Q); gs_copy(loa, 2, lo); gs_copy(hia, 2, hi);
+  gs_copy(ya, 2, y); gs_transpose(Qa, 2, Q); gs_copy(loa, 2, lo); gs_copy(hia, 2, hi);
 }
 
 /* one block of state steps (the SX functions' step, as CasADi's Switch runs it) */
@@ -1123,33 +1115,33 @@ CASADI_SYMBOL_EXPORT const casadi_int* lyapunov_chunk_sparsity_in(casadi_int i) 
 
 CASADI_SYMBOL_EXPORT const casadi_int* lyapunov_chunk_sparsity_out(casadi_int i) {
   switch (i) {
-    case 0: return casadi_s9;
+    case 0: return casadi_s10;
     case 1: return casadi_s3;
-    case 2: return casadi_s9;
-    case 3: return casadi_s9;
-    case 4: return casadi_s9;
+    case 2: return casadi_s10;
+    case 3: return casadi_s10;
+    case 4: return casadi_s10;
     default: return 0;
   }
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_chunk_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10;
+  if (sz_arg) *sz_arg = 9;
   if (sz_res) *sz_res = 9;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 242;
+  if (sz_w) *sz_w = 243;
   return 0;
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_chunk_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10*sizeof(const casadi_real*);
+  if (sz_arg) *sz_arg = 9*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 9*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 242*sizeof(casadi_real);
+  if (sz_w) *sz_w = 243*sizeof(casadi_real);
   return 0;
 }
 
 /* lyapunov_period:(y0[2],Q0[2x2],table[3x200],c[4])->(strobe[2],Q[2x2],log_stretch[2],low[2],high[2]) */
-static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[2], lo[2], hi[2], c[4]; casadi_real Q[4];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -1168,7 +1160,7 @@ static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f9(arg, res, iw, w, mem);
+  return casadi_f10(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period_checkout(void) {
@@ -1237,23 +1229,23 @@ CASADI_SYMBOL_EXPORT const casadi_int* lyapunov_period_sparsity_out(casadi_int i
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10;
+  if (sz_arg) *sz_arg = 9;
   if (sz_res) *sz_res = 9;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 43;
+  if (sz_w) *sz_w = 44;
   return 0;
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10*sizeof(const casadi_real*);
+  if (sz_arg) *sz_arg = 9*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 9*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 43*sizeof(casadi_real);
+  if (sz_w) *sz_w = 44*sizeof(casadi_real);
   return 0;
 }
 
 /* orbit_chunk:(y0[2],table[3x200],c[4])->(strobe[2x50],low[2x50],high[2x50]) */
-static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[2], lo[2], hi[2], c[4];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
@@ -1267,7 +1259,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int orbit_chunk(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f10(arg, res, iw, w, mem);
+  return casadi_f11(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int orbit_chunk_checkout(void) {
@@ -1322,9 +1314,9 @@ CASADI_SYMBOL_EXPORT const casadi_int* orbit_chunk_sparsity_in(casadi_int i) {
 
 CASADI_SYMBOL_EXPORT const casadi_int* orbit_chunk_sparsity_out(casadi_int i) {
   switch (i) {
-    case 0: return casadi_s9;
-    case 1: return casadi_s9;
-    case 2: return casadi_s9;
+    case 0: return casadi_s10;
+    case 1: return casadi_s10;
+    case 2: return casadi_s10;
     default: return 0;
   }
 }
@@ -1346,7 +1338,7 @@ CASADI_SYMBOL_EXPORT int orbit_chunk_work_bytes(casadi_int *sz_arg, casadi_int* 
 }
 
 /* orbit_period:(y0[2],table[3x200],c[4])->(strobe[2],low[2],high[2]) */
-static int casadi_f12(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[2], lo[2], hi[2], c[4];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
@@ -1360,7 +1352,7 @@ static int casadi_f12(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int orbit_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f12(arg, res, iw, w, mem);
+  return casadi_f13(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int orbit_period_checkout(void) {
@@ -1439,7 +1431,7 @@ CASADI_SYMBOL_EXPORT int orbit_period_work_bytes(casadi_int *sz_arg, casadi_int*
 }
 
 /* trajectory:(y0[2],table[3x200],c[4])->(states[2x200]) */
-static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[2], lo[2], hi[2], c[4];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
@@ -1453,7 +1445,7 @@ static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int trajectory(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f13(arg, res, iw, w, mem);
+  return casadi_f14(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int trajectory_checkout(void) {
@@ -1506,7 +1498,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* trajectory_sparsity_in(casadi_int i) {
 
 CASADI_SYMBOL_EXPORT const casadi_int* trajectory_sparsity_out(casadi_int i) {
   switch (i) {
-    case 0: return casadi_s10;
+    case 0: return casadi_s11;
     default: return 0;
   }
 }
@@ -1528,7 +1520,7 @@ CASADI_SYMBOL_EXPORT int trajectory_work_bytes(casadi_int *sz_arg, casadi_int* s
 }
 
 /* monodromy_segment:(y0[2],Q0[2x2],table[3x50],c[4])->(strobe[2],M[2x2],low[2],high[2]) */
-static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f15(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[2], lo[2], hi[2], c[4]; casadi_real Q[4];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -1542,7 +1534,7 @@ static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f14(arg, res, iw, w, mem);
+  return casadi_f15(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment_checkout(void) {
@@ -1592,7 +1584,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* monodromy_segment_sparsity_in(casadi_int 
   switch (i) {
     case 0: return casadi_s1;
     case 1: return casadi_s3;
-    case 2: return casadi_s11;
+    case 2: return casadi_s12;
     case 3: return casadi_s2;
     default: return 0;
   }
@@ -1609,23 +1601,23 @@ CASADI_SYMBOL_EXPORT const casadi_int* monodromy_segment_sparsity_out(casadi_int
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10;
+  if (sz_arg) *sz_arg = 9;
   if (sz_res) *sz_res = 8;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 41;
+  if (sz_w) *sz_w = 40;
   return 0;
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10*sizeof(const casadi_real*);
+  if (sz_arg) *sz_arg = 9*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 8*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 41*sizeof(casadi_real);
+  if (sz_w) *sz_w = 40*sizeof(casadi_real);
   return 0;
 }
 
 /* monodromy_period:(y0[2],Q0[2x2],table[3x200],c[4])->(strobe[2],M[2x2],low[2],high[2]) */
-static int casadi_f15(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f16(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[2], lo[2], hi[2], c[4]; casadi_real Q[4];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -1647,7 +1639,7 @@ static int casadi_f15(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f15(arg, res, iw, w, mem);
+  return casadi_f16(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period_checkout(void) {
@@ -1714,18 +1706,18 @@ CASADI_SYMBOL_EXPORT const casadi_int* monodromy_period_sparsity_out(casadi_int 
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10;
+  if (sz_arg) *sz_arg = 9;
   if (sz_res) *sz_res = 8;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 41;
+  if (sz_w) *sz_w = 40;
   return 0;
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10*sizeof(const casadi_real*);
+  if (sz_arg) *sz_arg = 9*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 8*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 41*sizeof(casadi_real);
+  if (sz_w) *sz_w = 40*sizeof(casadi_real);
   return 0;
 }
 

@@ -37,6 +37,7 @@ extern "C" {
 #define casadi_f11 CASADI_PREFIX(f11)
 #define casadi_f12 CASADI_PREFIX(f12)
 #define casadi_f13 CASADI_PREFIX(f13)
+#define casadi_f14 CASADI_PREFIX(f14)
 #define casadi_f2 CASADI_PREFIX(f2)
 #define casadi_f3 CASADI_PREFIX(f3)
 #define casadi_f4 CASADI_PREFIX(f4)
@@ -49,6 +50,7 @@ extern "C" {
 #define casadi_s1 CASADI_PREFIX(s1)
 #define casadi_s10 CASADI_PREFIX(s10)
 #define casadi_s11 CASADI_PREFIX(s11)
+#define casadi_s12 CASADI_PREFIX(s12)
 #define casadi_s2 CASADI_PREFIX(s2)
 #define casadi_s3 CASADI_PREFIX(s3)
 #define casadi_s4 CASADI_PREFIX(s4)
@@ -110,12 +112,14 @@ static const casadi_int casadi_s3[3] = {4, 1, 1};
 static const casadi_int casadi_s4[3] = {0, 200, 1};
 static const casadi_int casadi_s5[3] = {0, 2, 1};
 static const casadi_int casadi_s6[3] = {0};
-static const casadi_int casadi_s7[9] = 
+static const casadi_int casadi_s7[4] = {0};
+static const casadi_int casadi_s8[19] = 
   {0};
-static const casadi_int casadi_s8[4] = {0};
-static const casadi_int casadi_s9[3] = {3, 50, 1};
-static const casadi_int casadi_s10[3] = {3, 200, 1};
-static const casadi_int casadi_s11[3] = {0, 50, 1};
+static const casadi_int casadi_s9[9] = 
+  {0};
+static const casadi_int casadi_s10[3] = {3, 50, 1};
+static const casadi_int casadi_s11[3] = {3, 200, 1};
+static const casadi_int casadi_s12[3] = {0, 50, 1};
 
 /* rhs:(t,y[3],p[3])->(dy[3]) */
 static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
@@ -492,10 +496,13 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
 #define GEARSYM_INLINE inline __attribute__((always_inline))
 #define GEARSYM_NOINLINE __attribute__((noinline))
 #define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
+/* a loop left to the vectoriser (gcc unrolls a loop of 2 iterations before it, which then stays scalar) */
+#define GEARSYM_NOT_UNROLLED _Pragma("GCC unroll 1")
 #else
 #define GEARSYM_INLINE inline
 #define GEARSYM_NOINLINE
 #define GEARSYM_UNLIKELY(x) (x)
+#define GEARSYM_NOT_UNROLLED
 #endif
 
 static const casadi_real gs_zeros[1] = {0.};
@@ -511,28 +518,34 @@ static inline void gs_copy(const casadi_real* restrict x, casadi_int n, casadi_r
   for (i = 0; i < n; ++i) y[i] = x[i];
 }
 
+/* the n x n matrix x transposed into y (tangent vectors: from columns to side by side and back) */
+static inline void gs_transpose(const casadi_real* restrict x, casadi_int n, casadi_real* restrict y) {
+  casadi_int i, j;
+  for (i = 0; i < n; ++i) for (j = 0; j < n; ++j) y[j * n + i] = x[i * n + j];
+}
+
 /* an output column (none if the caller passes a null pointer) */
 static inline void gs_store(const casadi_real* x, casadi_int n, casadi_real* y, casadi_int at) {
   casadi_int i;
   if (y) for (i = 0; i < n; ++i) y[at + i] = x[i];
 }
 
-/* tangent_block, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_block(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3) {
+/* tangent_state, from CasADi's C of it */
+static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
-  casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
+  casadi_real a24;
   a00=A0[0];
-  a01=A5[3];
+  a01=A4[3];
   a02=6.;
   a02=(a01/a02);
-  a03=A5[0];
+  a03=A4[0];
   a04=A0[1];
   a05=(a04-a00);
   a05=(a03*a05);
   a06=2.;
   a06=(a01/a06);
-  a07=A5[1];
+  a07=A4[1];
   a08=A0[2];
   a09=(a07-a08);
   a10=(a00*a09);
@@ -546,7 +559,7 @@ static GEARSYM_INLINE void gs_tangent_block(const casadi_real* restrict A0, cons
   a14=(2.*a13);
   a05=(a05+a14);
   a14=(a00*a04);
-  a15=A5[2];
+  a15=A4[2];
   a16=(a08*a15);
   a14=(a14+a16);
   a16=(a06*a14);
@@ -565,369 +578,237 @@ static GEARSYM_INLINE void gs_tangent_block(const casadi_real* restrict A0, cons
   a21=(a12*a11);
   a16=(a16*a15);
   a21=(a21+a16);
-  a16=(a06*a21);
-  a16=(a08+a16);
-  a22=(a07-a16);
-  a23=(a13*a22);
-  a23=(a23-a19);
-  a24=(a01*a23);
-  a24=(a04+a24);
+  a06=(a06*a21);
+  a06=(a08+a06);
+  a16=(a07-a06);
+  a22=(a13*a16);
+  a22=(a22-a19);
+  a23=(a01*a22);
+  a23=(a04+a23);
   a20=(a01*a20);
   a20=(a00+a20);
-  a25=(a24-a20);
-  a25=(a03*a25);
-  a05=(a05+a25);
+  a24=(a23-a20);
+  a24=(a03*a24);
+  a05=(a05+a24);
   a05=(a02*a05);
   a05=(a00+a05);
   R0[0]=a05;
   a18=(2.*a18);
   a10=(a10+a18);
-  a23=(2.*a23);
-  a10=(a10+a23);
-  a23=(a13*a19);
-  a16=(a16*a15);
-  a23=(a23+a16);
-  a16=(a01*a23);
-  a16=(a08+a16);
-  a07=(a07-a16);
-  a18=(a20*a07);
-  a18=(a18-a24);
-  a10=(a10+a18);
+  a22=(2.*a22);
+  a10=(a10+a22);
+  a22=(a13*a19);
+  a06=(a06*a15);
+  a22=(a22+a06);
+  a01=(a01*a22);
+  a01=(a08+a01);
+  a07=(a07-a01);
+  a06=(a20*a07);
+  a06=(a06-a23);
+  a10=(a10+a06);
   a10=(a02*a10);
   a10=(a04+a10);
   R0[1]=a10;
   a21=(2.*a21);
   a14=(a14+a21);
-  a23=(2.*a23);
-  a14=(a14+a23);
-  a23=(a20*a24);
-  a16=(a16*a15);
-  a23=(a23+a16);
-  a14=(a14+a23);
-  a14=(a02*a14);
-  a08=(a08+a14);
-  R0[2]=a08;
-  a14=A1[0];
-  a23=A1[1];
-  a16=(a03*a23);
-  a21=(a03*a14);
-  a16=(a16-a21);
-  a21=(a09*a14);
-  a21=(a21-a23);
-  a18=A1[2];
-  a25=(a00*a18);
-  a21=(a21-a25);
-  a25=(a06*a21);
-  a25=(a23+a25);
-  a26=(a03*a25);
-  a27=(a06*a16);
-  a27=(a14+a27);
-  a28=(a03*a27);
-  a26=(a26-a28);
-  a28=(2.*a26);
-  a16=(a16+a28);
-  a28=(a17*a27);
-  a28=(a28-a25);
-  a29=(a04*a14);
-  a30=(a00*a23);
-  a29=(a29+a30);
-  a30=(a15*a18);
-  a29=(a29+a30);
-  a30=(a06*a29);
-  a30=(a18+a30);
-  a31=(a12*a30);
-  a28=(a28-a31);
-  a31=(a06*a28);
-  a31=(a23+a31);
-  a32=(a03*a31);
-  a26=(a06*a26);
-  a26=(a14+a26);
-  a33=(a03*a26);
-  a32=(a32-a33);
-  a33=(2.*a32);
-  a16=(a16+a33);
-  a33=(a22*a26);
-  a33=(a33-a31);
-  a27=(a11*a27);
-  a25=(a12*a25);
-  a27=(a27+a25);
-  a30=(a15*a30);
-  a27=(a27+a30);
-  a30=(a06*a27);
-  a30=(a18+a30);
-  a25=(a13*a30);
-  a33=(a33-a25);
-  a25=(a01*a33);
-  a25=(a23+a25);
-  a34=(a03*a25);
-  a32=(a01*a32);
-  a32=(a14+a32);
-  a35=(a03*a32);
-  a34=(a34-a35);
-  a16=(a16+a34);
-  a16=(a02*a16);
-  a14=(a14+a16);
-  R1[0]=a14;
-  a28=(2.*a28);
-  a21=(a21+a28);
-  a33=(2.*a33);
-  a21=(a21+a33);
-  a33=(a07*a32);
-  a33=(a33-a25);
-  a26=(a19*a26);
-  a31=(a13*a31);
-  a26=(a26+a31);
-  a30=(a15*a30);
-  a26=(a26+a30);
-  a30=(a01*a26);
-  a30=(a18+a30);
-  a31=(a20*a30);
-  a33=(a33-a31);
-  a21=(a21+a33);
-  a21=(a02*a21);
-  a23=(a23+a21);
-  R1[1]=a23;
-  a27=(2.*a27);
-  a29=(a29+a27);
-  a26=(2.*a26);
-  a29=(a29+a26);
-  a32=(a24*a32);
-  a25=(a20*a25);
-  a32=(a32+a25);
-  a30=(a15*a30);
-  a32=(a32+a30);
-  a29=(a29+a32);
-  a29=(a02*a29);
-  a18=(a18+a29);
-  R1[2]=a18;
-  a18=A1[3];
-  a29=A1[4];
-  a32=(a03*a29);
-  a30=(a03*a18);
-  a32=(a32-a30);
-  a30=(a09*a18);
-  a30=(a30-a29);
-  a25=A1[5];
-  a26=(a00*a25);
-  a30=(a30-a26);
-  a26=(a06*a30);
-  a26=(a29+a26);
-  a27=(a03*a26);
-  a23=(a06*a32);
-  a23=(a18+a23);
-  a21=(a03*a23);
-  a27=(a27-a21);
-  a21=(2.*a27);
-  a32=(a32+a21);
-  a21=(a17*a23);
-  a21=(a21-a26);
-  a33=(a04*a18);
-  a31=(a00*a29);
-  a33=(a33+a31);
-  a31=(a15*a25);
-  a33=(a33+a31);
-  a31=(a06*a33);
-  a31=(a25+a31);
-  a28=(a12*a31);
-  a21=(a21-a28);
-  a28=(a06*a21);
-  a28=(a29+a28);
-  a14=(a03*a28);
-  a27=(a06*a27);
-  a27=(a18+a27);
-  a16=(a03*a27);
-  a14=(a14-a16);
-  a16=(2.*a14);
-  a32=(a32+a16);
-  a16=(a22*a27);
-  a16=(a16-a28);
-  a23=(a11*a23);
-  a26=(a12*a26);
-  a23=(a23+a26);
-  a31=(a15*a31);
-  a23=(a23+a31);
-  a31=(a06*a23);
-  a31=(a25+a31);
-  a26=(a13*a31);
-  a16=(a16-a26);
-  a26=(a01*a16);
-  a26=(a29+a26);
-  a34=(a03*a26);
-  a14=(a01*a14);
-  a14=(a18+a14);
-  a35=(a03*a14);
-  a34=(a34-a35);
-  a32=(a32+a34);
-  a32=(a02*a32);
-  a18=(a18+a32);
-  R1[3]=a18;
-  a21=(2.*a21);
-  a30=(a30+a21);
-  a16=(2.*a16);
-  a30=(a30+a16);
-  a16=(a07*a14);
-  a16=(a16-a26);
-  a27=(a19*a27);
-  a28=(a13*a28);
-  a27=(a27+a28);
-  a31=(a15*a31);
-  a27=(a27+a31);
-  a31=(a01*a27);
-  a31=(a25+a31);
-  a28=(a20*a31);
-  a16=(a16-a28);
-  a30=(a30+a16);
-  a30=(a02*a30);
-  a29=(a29+a30);
-  R1[4]=a29;
-  a23=(2.*a23);
-  a33=(a33+a23);
-  a27=(2.*a27);
-  a33=(a33+a27);
-  a14=(a24*a14);
-  a26=(a20*a26);
-  a14=(a14+a26);
-  a31=(a15*a31);
-  a14=(a14+a31);
-  a33=(a33+a14);
-  a33=(a02*a33);
-  a25=(a25+a33);
-  R1[5]=a25;
-  a25=A1[6];
-  a33=A1[7];
-  a14=(a03*a33);
-  a31=(a03*a25);
-  a14=(a14-a31);
-  a09=(a09*a25);
-  a09=(a09-a33);
-  a31=A1[8];
-  a26=(a00*a31);
-  a09=(a09-a26);
-  a26=(a06*a09);
-  a26=(a33+a26);
-  a27=(a03*a26);
-  a23=(a06*a14);
-  a23=(a25+a23);
-  a29=(a03*a23);
-  a27=(a27-a29);
-  a29=(2.*a27);
-  a14=(a14+a29);
-  a17=(a17*a23);
-  a17=(a17-a26);
-  a04=(a04*a25);
-  a00=(a00*a33);
-  a04=(a04+a00);
-  a00=(a15*a31);
-  a04=(a04+a00);
-  a00=(a06*a04);
-  a00=(a31+a00);
-  a29=(a12*a00);
-  a17=(a17-a29);
-  a29=(a06*a17);
-  a29=(a33+a29);
-  a30=(a03*a29);
-  a27=(a06*a27);
-  a27=(a25+a27);
-  a16=(a03*a27);
-  a30=(a30-a16);
-  a16=(2.*a30);
-  a14=(a14+a16);
-  a22=(a22*a27);
-  a22=(a22-a29);
-  a11=(a11*a23);
-  a12=(a12*a26);
-  a11=(a11+a12);
-  a00=(a15*a00);
-  a11=(a11+a00);
-  a06=(a06*a11);
-  a06=(a31+a06);
-  a00=(a13*a06);
-  a22=(a22-a00);
-  a00=(a01*a22);
-  a00=(a33+a00);
-  a12=(a03*a00);
-  a30=(a01*a30);
-  a30=(a25+a30);
-  a03=(a03*a30);
-  a12=(a12-a03);
-  a14=(a14+a12);
-  a14=(a02*a14);
-  a25=(a25+a14);
-  R1[6]=a25;
-  a17=(2.*a17);
-  a09=(a09+a17);
   a22=(2.*a22);
-  a09=(a09+a22);
-  a07=(a07*a30);
-  a07=(a07-a00);
-  a19=(a19*a27);
-  a13=(a13*a29);
-  a19=(a19+a13);
-  a06=(a15*a06);
-  a19=(a19+a06);
-  a01=(a01*a19);
-  a01=(a31+a01);
-  a06=(a20*a01);
-  a07=(a07-a06);
-  a09=(a09+a07);
-  a09=(a02*a09);
-  a33=(a33+a09);
-  R1[7]=a33;
-  a11=(2.*a11);
-  a04=(a04+a11);
-  a19=(2.*a19);
-  a04=(a04+a19);
-  a24=(a24*a30);
-  a20=(a20*a00);
-  a24=(a24+a20);
-  a15=(a15*a01);
-  a24=(a24+a15);
-  a04=(a04+a24);
-  a02=(a02*a04);
-  a31=(a31+a02);
-  R1[8]=a31;
-  a31=A2[0];
-  a02=(a05<a31);
-  a04=(a02?a05:0);
-  a02=(!a02);
-  a02=(a02?a31:0);
-  a04=(a04+a02);
-  R2[0]=a04;
-  a04=A2[1];
-  a02=(a10<a04);
-  a31=(a02?a10:0);
-  a02=(!a02);
-  a02=(a02?a04:0);
-  a31=(a31+a02);
-  R2[1]=a31;
-  a31=A2[2];
-  a02=(a08<a31);
-  a04=(a02?a08:0);
-  a02=(!a02);
-  a02=(a02?a31:0);
-  a04=(a04+a02);
-  R2[2]=a04;
-  a04=A3[0];
-  a02=(a04<a05);
-  a05=(a02?a05:0);
-  a02=(!a02);
-  a02=(a02?a04:0);
-  a05=(a05+a02);
-  R3[0]=a05;
-  a05=A3[1];
-  a02=(a05<a10);
-  a10=(a02?a10:0);
-  a02=(!a02);
-  a02=(a02?a05:0);
-  a10=(a10+a02);
-  R3[1]=a10;
-  a10=A3[2];
-  a02=(a10<a08);
-  a08=(a02?a08:0);
-  a02=(!a02);
-  a02=(a02?a10:0);
+  a14=(a14+a22);
+  a22=(a20*a23);
+  a01=(a01*a15);
+  a22=(a22+a01);
+  a14=(a14+a22);
+  a02=(a02*a14);
   a08=(a08+a02);
-  R3[2]=a08;
+  R0[2]=a08;
+  a02=A1[0];
+  a14=(a05<a02);
+  a22=(a14?a05:0);
+  a14=(!a14);
+  a14=(a14?a02:0);
+  a22=(a22+a14);
+  R1[0]=a22;
+  a22=A1[1];
+  a14=(a10<a22);
+  a02=(a14?a10:0);
+  a14=(!a14);
+  a14=(a14?a22:0);
+  a02=(a02+a14);
+  R1[1]=a02;
+  a02=A1[2];
+  a14=(a08<a02);
+  a22=(a14?a08:0);
+  a14=(!a14);
+  a14=(a14?a02:0);
+  a22=(a22+a14);
+  R1[2]=a22;
+  a22=A2[0];
+  a14=(a22<a05);
+  a05=(a14?a05:0);
+  a14=(!a14);
+  a14=(a14?a22:0);
+  a05=(a05+a14);
+  R2[0]=a05;
+  a05=A2[1];
+  a14=(a05<a10);
+  a10=(a14?a10:0);
+  a14=(!a14);
+  a14=(a14?a05:0);
+  a10=(a10+a14);
+  R2[1]=a10;
+  a10=A2[2];
+  a14=(a10<a08);
+  a08=(a14?a08:0);
+  a14=(!a14);
+  a14=(a14?a10:0);
+  a08=(a08+a14);
+  R2[2]=a08;
+  a08=(-a03);
+  R3[0]=a08;
+  R3[1]=a09;
+  R3[2]=a04;
+  R3[3]=a03;
+  R3[4]=a00;
+  a00=(-a00);
+  R3[5]=a00;
+  R3[6]=a15;
+  R3[7]=a17;
+  R3[8]=a11;
+  R3[9]=a12;
+  a12=(-a12);
+  R3[10]=a12;
+  R3[11]=a16;
+  R3[12]=a19;
+  R3[13]=a13;
+  a13=(-a13);
+  R3[14]=a13;
+  R3[15]=a07;
+  R3[16]=a23;
+  R3[17]=a20;
+  a20=(-a20);
+  R3[18]=a20;
+}
+
+/* tangent_vector, from CasADi's C of it */
+static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21;
+  a00=A0[0];
+  a01=A2[3];
+  a02=6.;
+  a02=(a01/a02);
+  a03=A1[0];
+  a04=(a03*a00);
+  a05=A1[3];
+  a06=A0[3];
+  a07=(a05*a06);
+  a04=(a04+a07);
+  a07=2.;
+  a07=(a01/a07);
+  a08=(a07*a04);
+  a08=(a00+a08);
+  a09=(a03*a08);
+  a10=A1[1];
+  a10=(a10*a00);
+  a10=(a10-a06);
+  a11=A1[5];
+  a12=A0[6];
+  a11=(a11*a12);
+  a10=(a10+a11);
+  a11=(a07*a10);
+  a11=(a06+a11);
+  a13=(a05*a11);
+  a09=(a09+a13);
+  a13=(2.*a09);
+  a04=(a04+a13);
+  a09=(a07*a09);
+  a09=(a00+a09);
+  a13=(a03*a09);
+  a14=A1[7];
+  a14=(a14*a08);
+  a14=(a14-a11);
+  a15=A1[10];
+  a16=A1[2];
+  a16=(a16*a00);
+  a17=A1[4];
+  a17=(a17*a06);
+  a16=(a16+a17);
+  a17=A1[6];
+  a18=(a17*a12);
+  a16=(a16+a18);
+  a18=(a07*a16);
+  a18=(a12+a18);
+  a15=(a15*a18);
+  a14=(a14+a15);
+  a15=(a07*a14);
+  a15=(a06+a15);
+  a19=(a05*a15);
+  a13=(a13+a19);
+  a19=(2.*a13);
+  a04=(a04+a19);
+  a13=(a01*a13);
+  a13=(a00+a13);
+  a03=(a03*a13);
+  a19=A1[11];
+  a19=(a19*a09);
+  a19=(a19-a15);
+  a20=A1[14];
+  a21=A1[8];
+  a21=(a21*a08);
+  a08=A1[9];
+  a08=(a08*a11);
+  a21=(a21+a08);
+  a18=(a17*a18);
+  a21=(a21+a18);
+  a07=(a07*a21);
+  a07=(a12+a07);
+  a20=(a20*a07);
+  a19=(a19+a20);
+  a20=(a01*a19);
+  a20=(a06+a20);
+  a05=(a05*a20);
+  a03=(a03+a05);
+  a04=(a04+a03);
+  a04=(a02*a04);
+  a00=(a00+a04);
+  R0[0]=a00;
+  a14=(2.*a14);
+  a10=(a10+a14);
+  a19=(2.*a19);
+  a10=(a10+a19);
+  a19=A1[15];
+  a19=(a19*a13);
+  a19=(a19-a20);
+  a14=A1[18];
+  a00=A1[12];
+  a00=(a00*a09);
+  a09=A1[13];
+  a09=(a09*a15);
+  a00=(a00+a09);
+  a07=(a17*a07);
+  a00=(a00+a07);
+  a01=(a01*a00);
+  a01=(a12+a01);
+  a14=(a14*a01);
+  a19=(a19+a14);
+  a10=(a10+a19);
+  a10=(a02*a10);
+  a06=(a06+a10);
+  R0[3]=a06;
+  a21=(2.*a21);
+  a16=(a16+a21);
+  a00=(2.*a00);
+  a16=(a16+a00);
+  a00=A1[16];
+  a00=(a00*a13);
+  a13=A1[17];
+  a13=(a13*a20);
+  a00=(a00+a13);
+  a17=(a17*a01);
+  a00=(a00+a17);
+  a16=(a16+a00);
+  a02=(a02*a16);
+  a12=(a12+a02);
+  R0[6]=a12;
 }
 
 /* state_block, from CasADi's C of it */
@@ -1155,20 +1036,22 @@ static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casad
 
 /* one block of tangent steps (the SX functions' step, as CasADi's Switch runs it) */
 static GEARSYM_INLINE void gs_tangent_step(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
-  gs_tangent_block(y, Q, lo, hi, T, c, y1, Q1, lo1, hi1);
+  casadi_real J[19]; casadi_int j;
+  gs_tangent_state(y, lo, hi, T, c, y1, lo1, hi1, J);
+  GEARSYM_NOT_UNROLLED for (j = 0; j < 3; ++j) gs_tangent_vector(Q + j, J, c, Q1 + j);
 }
 
 /* blocks of tangent steps from (y, Q, lo, hi), in place: the state in local arrays, a -> b -> a */
 static GEARSYM_NOINLINE void gs_tangent_span(casadi_real* restrict y, casadi_real* restrict Q, casadi_real* restrict lo, casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_int blocks) {
   casadi_real ya[3], yb[3]; casadi_real Qa[9], Qb[9]; casadi_real loa[3], lob[3]; casadi_real hia[3], hib[3];
   casadi_int k;
-  gs_copy(y, 3, ya); gs_copy(Q, 9, Qa); gs_copy(lo, 3, loa); gs_copy(hi, 3, hia);
+  gs_copy(y, 3, ya); gs_transpose(Q, 3, Qa); gs_copy(lo, 3, loa); gs_copy(hi, 3, hia);
   for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */
     gs_tangent_step(ya, Qa, loa, hia, T, c, yb, Qb, lob, hib);
-    if (k + 1 == blocks) { gs_copy(yb, 3, y); gs_copy(Qb, 9, Q); gs_copy(lob, 3, lo); gs_copy(hib, 3, hi); return; }
+    if (k + 1 == blocks) { gs_copy(yb, 3, y); gs_transpose(Qb, 3, Q); gs_copy(lob, 3, lo); gs_copy(hib, 3, hi); return; }
     gs_tangent_step(yb, Qb, lob, hib, T, c, ya, Qa, loa, hia);
   }
-  gs_copy(ya, 3, y); gs_copy(Qa, 9, Q); gs_copy(loa, 3, lo); gs_copy(hia, 3, hi);
+  gs_copy(ya, 3, y); gs_transpose(Qa, 3, Q); gs_copy(loa, 3, lo); gs_copy(hia, 3, hi);
 }
 
 /* one block of state steps (the SX functions' step, as CasADi's Switch runs it) */
@@ -1268,33 +1151,33 @@ CASADI_SYMBOL_EXPORT const casadi_int* lyapunov_chunk_sparsity_in(casadi_int i) 
 
 CASADI_SYMBOL_EXPORT const casadi_int* lyapunov_chunk_sparsity_out(casadi_int i) {
   switch (i) {
-    case 0: return casadi_s9;
+    case 0: return casadi_s10;
     case 1: return casadi_s2;
-    case 2: return casadi_s9;
-    case 3: return casadi_s9;
-    case 4: return casadi_s9;
+    case 2: return casadi_s10;
+    case 3: return casadi_s10;
+    case 4: return casadi_s10;
     default: return 0;
   }
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_chunk_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10;
+  if (sz_arg) *sz_arg = 9;
   if (sz_res) *sz_res = 9;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 372;
+  if (sz_w) *sz_w = 380;
   return 0;
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_chunk_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10*sizeof(const casadi_real*);
+  if (sz_arg) *sz_arg = 9*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 9*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 372*sizeof(casadi_real);
+  if (sz_w) *sz_w = 380*sizeof(casadi_real);
   return 0;
 }
 
 /* lyapunov_period:(y0[3],Q0[3x3],table[0x200],c[4])->(strobe[3],Q[3x3],log_stretch[3],low[3],high[3]) */
-static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[3], lo[3], hi[3], c[4]; casadi_real Q[9];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -1313,7 +1196,7 @@ static int casadi_f7(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f7(arg, res, iw, w, mem);
+  return casadi_f8(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period_checkout(void) {
@@ -1382,23 +1265,23 @@ CASADI_SYMBOL_EXPORT const casadi_int* lyapunov_period_sparsity_out(casadi_int i
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10;
+  if (sz_arg) *sz_arg = 9;
   if (sz_res) *sz_res = 9;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 75;
+  if (sz_w) *sz_w = 83;
   return 0;
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10*sizeof(const casadi_real*);
+  if (sz_arg) *sz_arg = 9*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 9*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 75*sizeof(casadi_real);
+  if (sz_w) *sz_w = 83*sizeof(casadi_real);
   return 0;
 }
 
 /* orbit_chunk:(y0[3],table[0x200],c[4])->(strobe[3x50],low[3x50],high[3x50]) */
-static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f9(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[3], lo[3], hi[3], c[4];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
@@ -1412,7 +1295,7 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
 }
 
 CASADI_SYMBOL_EXPORT int orbit_chunk(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f8(arg, res, iw, w, mem);
+  return casadi_f9(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int orbit_chunk_checkout(void) {
@@ -1467,9 +1350,9 @@ CASADI_SYMBOL_EXPORT const casadi_int* orbit_chunk_sparsity_in(casadi_int i) {
 
 CASADI_SYMBOL_EXPORT const casadi_int* orbit_chunk_sparsity_out(casadi_int i) {
   switch (i) {
-    case 0: return casadi_s9;
-    case 1: return casadi_s9;
-    case 2: return casadi_s9;
+    case 0: return casadi_s10;
+    case 1: return casadi_s10;
+    case 2: return casadi_s10;
     default: return 0;
   }
 }
@@ -1491,7 +1374,7 @@ CASADI_SYMBOL_EXPORT int orbit_chunk_work_bytes(casadi_int *sz_arg, casadi_int* 
 }
 
 /* orbit_period:(y0[3],table[0x200],c[4])->(strobe[3],low[3],high[3]) */
-static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[3], lo[3], hi[3], c[4];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
@@ -1505,7 +1388,7 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int orbit_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f10(arg, res, iw, w, mem);
+  return casadi_f11(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int orbit_period_checkout(void) {
@@ -1584,7 +1467,7 @@ CASADI_SYMBOL_EXPORT int orbit_period_work_bytes(casadi_int *sz_arg, casadi_int*
 }
 
 /* trajectory:(y0[3],table[0x200],c[4])->(states[3x200]) */
-static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f12(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[3], lo[3], hi[3], c[4];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
@@ -1598,7 +1481,7 @@ static int casadi_f11(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int trajectory(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f11(arg, res, iw, w, mem);
+  return casadi_f12(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int trajectory_checkout(void) {
@@ -1651,7 +1534,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* trajectory_sparsity_in(casadi_int i) {
 
 CASADI_SYMBOL_EXPORT const casadi_int* trajectory_sparsity_out(casadi_int i) {
   switch (i) {
-    case 0: return casadi_s10;
+    case 0: return casadi_s11;
     default: return 0;
   }
 }
@@ -1673,7 +1556,7 @@ CASADI_SYMBOL_EXPORT int trajectory_work_bytes(casadi_int *sz_arg, casadi_int* s
 }
 
 /* monodromy_segment:(y0[3],Q0[3x3],table[0x50],c[4])->(strobe[3],M[3x3],low[3],high[3]) */
-static int casadi_f12(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[3], lo[3], hi[3], c[4]; casadi_real Q[9];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -1687,7 +1570,7 @@ static int casadi_f12(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f12(arg, res, iw, w, mem);
+  return casadi_f13(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment_checkout(void) {
@@ -1737,7 +1620,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* monodromy_segment_sparsity_in(casadi_int 
   switch (i) {
     case 0: return casadi_s1;
     case 1: return casadi_s2;
-    case 2: return casadi_s11;
+    case 2: return casadi_s12;
     case 3: return casadi_s3;
     default: return 0;
   }
@@ -1754,23 +1637,23 @@ CASADI_SYMBOL_EXPORT const casadi_int* monodromy_segment_sparsity_out(casadi_int
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10;
+  if (sz_arg) *sz_arg = 9;
   if (sz_res) *sz_res = 8;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 63;
+  if (sz_w) *sz_w = 74;
   return 0;
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10*sizeof(const casadi_real*);
+  if (sz_arg) *sz_arg = 9*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 8*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 63*sizeof(casadi_real);
+  if (sz_w) *sz_w = 74*sizeof(casadi_real);
   return 0;
 }
 
 /* monodromy_period:(y0[3],Q0[3x3],table[0x200],c[4])->(strobe[3],M[3x3],low[3],high[3]) */
-static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f14(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[3], lo[3], hi[3], c[4]; casadi_real Q[9];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -1794,7 +1677,7 @@ static int casadi_f13(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f13(arg, res, iw, w, mem);
+  return casadi_f14(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period_checkout(void) {
@@ -1861,18 +1744,18 @@ CASADI_SYMBOL_EXPORT const casadi_int* monodromy_period_sparsity_out(casadi_int 
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10;
+  if (sz_arg) *sz_arg = 9;
   if (sz_res) *sz_res = 8;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 63;
+  if (sz_w) *sz_w = 74;
   return 0;
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 10*sizeof(const casadi_real*);
+  if (sz_arg) *sz_arg = 9*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 8*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 63*sizeof(casadi_real);
+  if (sz_w) *sz_w = 74*sizeof(casadi_real);
   return 0;
 }
 

@@ -1627,10 +1627,13 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
 #define GEARSYM_INLINE inline __attribute__((always_inline))
 #define GEARSYM_NOINLINE __attribute__((noinline))
 #define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
+/* a loop left to the vectoriser (gcc unrolls a loop of 2 iterations before it, which then stays scalar) */
+#define GEARSYM_NOT_UNROLLED _Pragma("GCC unroll 1")
 #else
 #define GEARSYM_INLINE inline
 #define GEARSYM_NOINLINE
 #define GEARSYM_UNLIKELY(x) (x)
+#define GEARSYM_NOT_UNROLLED
 #endif
 
 static const casadi_real gs_zeros[2400] = {0.};
@@ -1644,6 +1647,12 @@ static inline void gs_load(const casadi_real* x, casadi_int n, casadi_real* y) {
 static inline void gs_copy(const casadi_real* restrict x, casadi_int n, casadi_real* restrict y) {
   casadi_int i;
   for (i = 0; i < n; ++i) y[i] = x[i];
+}
+
+/* the n x n matrix x transposed into y (tangent vectors: from columns to side by side and back) */
+static inline void gs_transpose(const casadi_real* restrict x, casadi_int n, casadi_real* restrict y) {
+  casadi_int i, j;
+  for (i = 0; i < n; ++i) for (j = 0; j < n; ++j) y[j * n + i] = x[i * n + j];
 }
 
 /* an output column (none if the caller passes a null pointer) */
