@@ -63,10 +63,9 @@ class Workers:
     """Where a sweep's points run: ``jobs`` workers (0: one per core) on this machine, as ``"processes"``
     (this one and ``jobs - 1`` forked from it: nothing is rebuilt; no lock shared between them, so the Python
     around each point does not serialise them), ``"threads"``, or ``"auto"`` (processes where the OS can fork:
-    Linux, macOS); or,
-    with ``scheduler``, on Dask (the ``distributed`` extra): ``"local"`` starts a cluster of ``jobs``
-    single-threaded worker processes on this machine for this sweep, ``"tcp://HOST:PORT"`` uses the cluster
-    of that scheduler, a ``distributed.Client`` its cluster. The files are the same, byte for byte, however
+    Linux, macOS); or, with ``scheduler``, on Dask (the ``distributed`` extra): ``"local"`` starts a cluster of
+    ``jobs`` single-threaded worker processes on this machine for this sweep, ``"tcp://HOST:PORT"`` uses the
+    cluster of that scheduler, a ``distributed.Client`` its cluster. The files are the same, byte for byte, however
     the points run (on Dask as long as the workers run the client's library: see
     :mod:`gearsym.codegen.portable`)."""
 
@@ -477,6 +476,7 @@ def _claim(next_task, count: int, procs: list = ()) -> int | None:
 
 
 def _check_alive(procs: list) -> None:
+    """Raise if a worker process has died (one that ran out of tasks ends with 0)."""
     dead = next((p for p in procs if p.exitcode not in (None, 0)), None)
     if dead is not None:
         raise GearsymError(f"a sweep worker process died (exit code {dead.exitcode}); the points finished so far "
