@@ -26,10 +26,11 @@ from gearsym.sweep.store import lock_path, release_lock, sidecar, take_lock
 
 ROOT = Path(__file__).resolve().parents[1]
 SHORT = dict(options=Integration(periods=60, discard=20), progress=False)
-#: two continuation lines of 41 points, one per worker process, about 1 s in all: time to kill it half-way
-SLOW = ["one_stage", "--param", "omega=0.8:1.2:0.01", "--param", "B1=3.5,4", "--periods", "1500", "--discard", "100",
-        "--jobs", "2", "--parallel", "processes", "--quiet"]
-PLANNED = 82
+#: three continuation lines of 27 points, one per worker (the sweep's process and two forked from it), about 1 s in
+#: all: time to kill it half-way
+SLOW = ["one_stage", "--param", "omega=0.8:1.06:0.01", "--param", "B1=3.5,3.75,4", "--periods", "1500", "--discard",
+        "100", "--jobs", "3", "--parallel", "processes", "--quiet"]
+PLANNED = 81
 #: a gearsym whose workers cannot ask the kernel to end them: the portable way (macOS) is used
 WITHOUT_PDEATHSIG = ("import sys, gearsym.sweep.run as run; run._kernel_ends_orphans = lambda: False; "
                      "from gearsym.cli import main; sys.exit(main(sys.argv[1:]))")

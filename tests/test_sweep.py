@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import os
 
 import numpy as np
 import pytest
@@ -115,6 +116,44 @@ def test_threads_and_processes_do_not_change_a_single_bit(tmp_path, one_stage, p
                   out=tmp_path / f"j{jobs}.csv", **SHORT)
     for name in ("j{}.csv", "j{}.poincare.csv"):
         assert (tmp_path / name.format(1)).read_bytes() == (tmp_path / name.format(2)).read_bytes()
+
+
+def test_the_sweeps_own_process_computes_beside_the_processes_it_forks(one_stage, monkeypatch):
+    from gearsym.sweep.run import _Run
+
+    computed_here, task = [], _Run.task
+
+    def counted(self, compiled, points, state):  # (a forked worker counts in its own copy of the list)
+        computed_here.extend(points)
+        yield from task(self, compiled, points, state)
+
+    monkeypatch.setattr(_Run, "task", counted)
+    run_sweep(one_stage, ["omega=0.9:1.4:0.1"], mode="independent", workers=Workers(jobs=2, parallel="processes"),
+              **SHORT)
+    assert computed_here
+
+
+def test_a_worker_process_that_dies_is_reported_and_the_points_finished_here_are_kept(tmp_path, one_stage,
+                                                                                      monkeypatch):
+    from gearsym.sweep.run import _Run
+
+    sweep_process, task = os.getpid(), _Run.task
+
+    def dies_if_forked(self, compiled, points, state):
+        if os.getpid() != sweep_process:
+            os._exit(3)
+        yield from task(self, compiled, points, state)
+
+    monkeypatch.setattr(_Run, "task", dies_if_forked)
+    out, axes = tmp_path / "s.csv", ["omega=0.9:1.4:0.1"]
+    with pytest.raises(GearsymError, match=r"a sweep worker process died \(exit code 3\); the points finished so far "
+                                           "are kept"):
+        run_sweep(one_stage, axes, mode="independent", workers=Workers(jobs=2, parallel="processes"), out=out,
+                  **SHORT)
+    assert 0 < len(out.read_text().splitlines()) - 1 < 6
+    monkeypatch.undo()
+    resumed = run_sweep(one_stage, axes, mode="independent", out=out, on_point=interrupt_after(6), **SHORT)  # (were all
+    assert len(resumed) == 6  # six recomputed, the sixth would press Ctrl-C)
 
 
 def test_an_error_in_a_worker_process_names_the_point():

@@ -2,10 +2,11 @@
 
 The model is compiled once; every point only changes the parameter vector
 (the low-level loops of :func:`~gearsym.analysis.lyapunov_spectrum`, summarised in batches). Tasks
-(single points, or whole continuation lines) run on ``jobs`` workers, each with
-its own clone of the compiled model: processes forked from this one where the
-OS can fork (they inherit the loaded model, so nothing is rebuilt, and they do
-not share Python's lock), else threads (the native loops release the GIL).
+(single points, or whole continuation lines) run on ``jobs`` workers: this
+process and ``jobs - 1`` processes forked from it where the OS can fork (they
+inherit the loaded model, so nothing is rebuilt, and they do not share Python's
+lock), else threads (the native loops release the GIL), each with work arrays of
+its own.
 Workers hand finished points to the main process, which alone writes the files
 and moves the progress bar. With ``scheduler`` the tasks run on a Dask cluster
 instead (:mod:`gearsym.sweep.distributed`); the main process still writes
@@ -60,12 +61,12 @@ class SweepInterrupted(KeyboardInterrupt):
 
 @dataclass(frozen=True)
 class Workers:
-    """Where a sweep's points run: ``jobs`` workers (0: one per core) on this machine, as forked
-    ``"processes"`` (nothing is rebuilt; no lock shared between them, so the Python around each point does
-    not serialise them), ``"threads"``, or ``"auto"`` (processes where the OS can fork: Linux, macOS); or,
-    with ``scheduler``, on Dask (the ``distributed`` extra): ``"local"`` starts a cluster of ``jobs``
-    single-threaded worker processes on this machine for this sweep, ``"tcp://HOST:PORT"`` uses the cluster
-    of that scheduler, a ``distributed.Client`` its cluster. The files are the same, byte for byte, however
+    """Where a sweep's points run: ``jobs`` workers (0: one per core) on this machine, as ``"processes"``
+    (this one and ``jobs - 1`` forked from it: nothing is rebuilt; no lock shared between them, so the Python
+    around each point does not serialise them), ``"threads"``, or ``"auto"`` (processes where the OS can fork:
+    Linux, macOS); or, with ``scheduler``, on Dask (the ``distributed`` extra): ``"local"`` starts a cluster of
+    ``jobs`` single-threaded worker processes on this machine for this sweep, ``"tcp://HOST:PORT"`` uses the
+    cluster of that scheduler, a ``distributed.Client`` its cluster. The files are the same, byte for byte, however
     the points run (on Dask as long as the workers run the client's library: see
     :mod:`gearsym.codegen.portable`)."""
 
@@ -420,42 +421,30 @@ def _execute(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], jobs: int):
 
 
 def _execute_processes(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], jobs: int):
-    """``_execute`` on ``jobs`` processes forked from this one (they inherit the loaded model: nothing is
-    rebuilt or shipped). Rows come back in batches through a queue, so the files, the progress bar and
-    Ctrl-C behave as with threads; the threads' shared lock, which serialises the Python around every
+    """``_execute`` on ``jobs`` workers: this process and ``jobs - 1`` processes forked from it (they inherit
+    the loaded model: nothing is rebuilt or shipped). Whoever is free takes the next task. This process
+    computes too, with its warm model, rather than fork one more worker and wait; between its own
+    batches it passes on the rows that came back through a queue, so the files, the progress bar and
+    Ctrl-C behave as with threads. The threads' shared lock, which serialises the Python around every
     point (analysis, row formatting), is gone."""
     global _FORKED
     if not tasks:
         return
     ctx = multiprocessing.get_context("fork")
-    todo, done = ctx.Queue(), ctx.Queue()
-    workers = min(jobs, len(tasks))
-    for i in range(len(tasks)):
-        todo.put(i)
-    for _ in range(workers):
-        todo.put(None)
+    next_task, done = ctx.Value("l", 0), ctx.Queue()
     _FORKED = (run, tasks, os.getpid())  # what the children inherit
-    procs = [ctx.Process(target=_process_worker, args=(todo, done), daemon=True, name=f"gearsym-sweep-{k}")
-             for k in range(workers)]
+    procs = [ctx.Process(target=_process_worker, args=(next_task, done), daemon=True, name=f"gearsym-sweep-{k}")
+             for k in range(min(jobs, len(tasks)) - 1)]
     try:
         for proc in procs:
             proc.start()
         _FORKED = None
         pending = sum(len(t) for t, _ in tasks)
-        while pending:
-            try:
-                kind, item = done.get(timeout=0.2)
-            except queue.Empty:
-                dead = next((p for p in procs if p.exitcode not in (None, 0)), None)
-                if dead is not None:
-                    raise GearsymError(f"a sweep worker process died (exit code {dead.exitcode}); the points "
-                                       "finished so far are kept: run the same command with --parallel threads "
-                                       "to resume")
-                continue
-            if kind == "error":
-                raise GearsymError(item)
-            pending -= len(item)
-            yield item
+        for batch in _own_and_received(run, tasks, next_task, done, procs):
+            pending -= len(batch)
+            yield batch
+            if not pending:
+                return
     finally:
         _FORKED = None
         for proc in procs:  # on an error or Ctrl-C: stop at once; unfinished points are redone on resume
@@ -463,20 +452,67 @@ def _execute_processes(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], j
                 proc.terminate()
         for proc in procs:
             proc.join()
-        todo.close()
         done.close()
+
+
+def _own_and_received(run: _Run, tasks: list, next_task, done, procs: list):
+    """This process's batches as it computes them, each followed by the workers' batches that have arrived
+    meanwhile; once no task is left, the workers' as they arrive (endlessly: the caller counts)."""
+    while (index := _claim(next_task, len(tasks), procs)) is not None:
+        for batch in run.task(run.compiled, *tasks[index]):
+            yield batch
+            yield from _received(done, procs, wait=False)
+    while True:
+        yield from _received(done, procs, wait=True)
+
+
+def _received(done, procs: list, wait: bool):
+    """The batches the workers have sent (``wait``: a batch, or none after 0.2 s); a worker's error raised here."""
+    while True:
+        try:
+            kind, item = done.get(timeout=0.2) if wait else done.get_nowait()
+        except queue.Empty:
+            _check_alive(procs)
+            return
+        if kind == "error":
+            raise GearsymError(item)
+        yield item
+        if wait:
+            return
+
+
+def _claim(next_task, count: int, procs: list = ()) -> int | None:
+    """The index of the next task nobody has taken (None: all are taken). The sweep's process (``procs``:
+    its workers) does not wait forever for a lock that a worker died holding."""
+    lock = next_task.get_lock()
+    while not lock.acquire(timeout=1.0):
+        _check_alive(procs)
+    try:
+        index = next_task.value
+        next_task.value = index + 1
+    finally:
+        lock.release()
+    return index if index < count else None
+
+
+def _check_alive(procs: list) -> None:
+    """Raise if a worker process has died (one that ran out of tasks ends with 0)."""
+    dead = next((p for p in procs if p.exitcode not in (None, 0)), None)
+    if dead is not None:
+        raise GearsymError(f"a sweep worker process died (exit code {dead.exitcode}); the points finished so far "
+                           "are kept: run the same command with --parallel threads to resume")
 
 
 _FORKED = None  # (run, tasks, parent pid) of the sweep being forked, read by _process_worker in the children
 
 
-def _process_worker(todo, done) -> None:
+def _process_worker(next_task, done) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle: it stops us
     signal.signal(signal.SIGTERM, signal.SIG_DFL)  # not the command line's handler: the parent's terminate() ends us
     run, tasks, parent = _FORKED
     _end_with_parent(parent)
     compiled = run.compiled.clone()  # work arrays of its own (the parent's are its own business)
-    while (index := todo.get()) is not None:
+    while (index := _claim(next_task, len(tasks))) is not None:
         task, state = tasks[index]
         try:
             for batch in run.task(compiled, task, state):
