@@ -220,8 +220,10 @@ def test_split_runs_behind_a_real_branch_in_the_c(tmp_path):
     options = LoopOptions(locate_crossings=True)
     code = write_code(build_functions(one_stage, options), tmp_path, code_hash(one_stage, options))
     text = code.source.read_text()
-    step = re.search(r"void gs_tangent_step\(.*?\n}\n", text, re.S).group(0)  # (the printed loops' step)
-    assert re.search(r"\n  if \(GEARSYM_UNLIKELY\(flag != 0\)\) gs_tangent_split\(.*\n  else gs_tangent_keep\(", step)
+    step = re.search(r"void gs_state_step\(.*?\n}\n", text, re.S).group(0)  # (the printed loops' step)
+    assert re.search(r"\n  if \(GEARSYM_UNLIKELY\(flag != 0\)\) gs_state_split\(.*\n  else gs_state_keep\(", step)
+    step = re.search(r"void gs_tangent_step\(.*?\n}\n", text, re.S).group(0)  # (the vectors' steps in the else)
+    assert re.search(r"\n  if \(GEARSYM_UNLIKELY\(flag != 0\)\) \{\n.*gs_tangent_split\(.*\n  \} else \{\n", step, re.S)
     assert "static GEARSYM_NOINLINE void gs_tangent_split(" in text  # out of the way of the steps that do not cross
 
 

@@ -75,7 +75,7 @@ def test_the_printed_steps_read_no_pointer_array_and_keep_the_state_in_local_arr
     text = write_code(build_functions(system, options), tmp_path, code_hash(system, options)).source.read_text()
     span = re.search(r"void gs_tangent_span\(.*?\n}\n", text, re.S).group(0)
     assert "gs_tangent_step(ya, Qa, loa, hia, T + 6*(k), c, yb, Qb, lob, hib);" in span
-    for piece in ("tangent_try", "tangent_keep", "gram_schmidt"):
+    for piece in ("tangent_state", "tangent_vector", "state_keep", "tangent_keep", "gram_schmidt"):
         body = re.search(rf"void gs_{piece}\(.*?\n}}\n", text, re.S).group(0)
         assert not re.search(r"\b(arg|res|w|iw)\[", body), piece
     assert "/* tangent_switch:" not in text and "tangent_segment_50" not in text  # CasADi's loops are gone
@@ -115,6 +115,21 @@ def test_the_plain_tangent_step_is_the_states_step_then_a_loop_over_the_tangent_
     assert "gs_transpose(Q, 2, Qa);" in span and span.count("gs_transpose(Qa, 2, Q);") == 1
     assert span.count("gs_transpose(Qb, 2, Q);") == 1
     assert "gs_tangent_block" not in text
+
+
+def test_the_located_tangent_try_is_the_states_then_a_loop_over_the_tangent_vectors_and_the_split_sees_columns(
+        tmp_path):
+    system, options = gearsym.load("one_stage"), LoopOptions(locate_crossings=True)
+    text = write_code(build_functions(system, options), tmp_path, code_hash(system, options)).source.read_text()
+    step = re.search(r"void gs_tangent_step\(.*?\n}\n", text, re.S).group(0)
+    assert "gs_tangent_state(y, T, c, yt, &flag, J);" in step
+    assert "for (j = 0; j < 2; ++j) gs_tangent_vector(Q + j, J, c, Q1 + j);" in step
+    assert "gs_state_keep(y, lo, hi, yt, T, c, y1, lo1, hi1);" in step
+    split = step[step.index("if (GEARSYM_UNLIKELY"):step.index("} else {")]
+    assert re.findall(r"gs_(\w+)\(", split) == ["transpose", "tangent_split", "transpose"]
+    span = re.search(r"void gs_tangent_span\(.*?\n}\n", text, re.S).group(0)
+    assert "gs_transpose(Q, 2, Qa);" in span
+    assert "gs_tangent_try" not in text and "gs_tangent_block" not in text
 
 
 @pytest.mark.skipif(shutil.which("gcc") is None, reason="needs gcc")

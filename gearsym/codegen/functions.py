@@ -53,9 +53,10 @@ class ModelFunctions:
     options: LoopOptions
     split: SplitRHS
     functions: dict[str, ca.Function]
-    #: the SX pieces the printed loops call (:mod:`.printed`): ``tangent_state``, ``tangent_vector`` and
-    #: ``state_block`` (plain; and ``trajectory_step`` for blocks of several steps), or ``{tangent,state}_{try,keep}``
-    #: and the split's pieces (crossings located, :data:`SPLIT_CALLS`), and ``gram_schmidt``
+    #: the SX pieces the printed loops call (:mod:`.printed`): ``tangent_state``, ``tangent_vector`` (the tangent
+    #: step, or with crossings located its try, by vector), ``state_block`` (plain; and ``trajectory_step`` for
+    #: blocks of several steps) or ``state_try``, ``{tangent,state}_keep`` and the split's pieces (located,
+    #: :data:`SPLIT_CALLS`), and ``gram_schmidt``
     steps: dict[str, ca.Function]
 
     @property
@@ -290,44 +291,56 @@ def _tangent_by_vector(sym: _Symbols, split: SplitRHS, K: int, where: str) -> di
     """``tangent_block`` in two pieces, for the printed loop: ``tangent_state`` (the state's K steps, as
     ``state_block``, and the Jacobian of every RK4 stage: its nonzeros that are not constants) and
     ``tangent_vector`` (one tangent vector's K steps, given those Jacobians), which the loop applies to each
-    tangent vector in turn, a loop the C compiler vectorises. ``tangent_block`` computes each column of Q
-    with the same operations (``mtimes`` works column by column, and the constant entries, which it
-    simplifies, stay constants here), so the pieces give its bits."""
+    tangent vector in turn, a loop the C compiler vectorises (:func:`_by_vector`)."""
     n, m, nc = sym.y.numel(), len(split.tables), sym.ch.numel() - 1
     y, ch, h = sym.y, sym.ch, sym.ch[nc]
     f_of, J_of = _tabulated_rhs(sym, split, where)
     lo, hi = ca.SX.sym("lo", len(sym.observed)), ca.SX.sym("hi", len(sym.observed))
-    Tk, q = ca.SX.sym("Tk", 3 * m, K), ca.SX.sym("q", n)
+    Tk = ca.SX.sym("Tk", 3 * m, K)
+    columns = [(Tk[:m, i], Tk[m:2 * m, i], Tk[2 * m:, i]) for i in range(K)]
+    states, J_all, q, qk, symbols = _by_vector(lambda x, T: f_of(x, T, ch), lambda x, T: J_of(x, T, ch), y, h,
+                                                columns)
+    lk, hk = lo, hi
+    for yk in states:
+        obs = ca.vertcat(*[yk[j] for j in sym.observed])
+        lk, hk = select_min(obs, lk), select_max(obs, hk)
+    state = ca.Function("tangent_state", [y, lo, hi, Tk, ch], [states[-1], lk, hk, J_all], _OPTS)
+    vector = ca.Function("tangent_vector", [q, symbols, ch], [qk], _OPTS)
+    return {"tangent_state": state, "tangent_vector": vector}
+
+
+def _by_vector(f, J, y, h, columns: list) -> tuple:
+    """RK4 steps of length h from ``y`` (one per ``(Ta, Tb, Tc)`` of ``columns``) split for the printed loops:
+    (the state after each step, the nonzeros of every stage's Jacobian that are not constants, a tangent vector
+    q, q after the steps given those nonzeros, the symbols that stand for them in it). ``rk4_step`` of the
+    tangent matrix computes each of its columns with these operations (``mtimes`` works column by column, and
+    the constant entries, which it simplifies, stay constants here), so the pieces give its bits."""
+    n = y.numel()
     stages, entries = [], []  # each stage's Jacobian; its distinct non-constant nonzeros
 
     def recorded(x, T):
-        J = J_of(x, T, ch)
-        stages.append(J)
-        entries.extend(e for e in J.nonzeros() if not e.is_constant() and _position(entries, e) is None)
-        return J
+        Jx = J(x, T)
+        stages.append(Jx)
+        entries.extend(e for e in Jx.nonzeros() if not e.is_constant() and _position(entries, e) is None)
+        return Jx
 
-    yk, qk, lk, hk = y, ca.SX.sym("q0", n), lo, hi  # (a stand-in vector: only the Jacobians are kept)
-    for i in range(K):
-        col = Tk[:, i]
-        yk, qk = rk4_step(lambda x, T: f_of(x, T, ch), recorded, yk, qk, h, col[:m], col[m:2 * m], col[2 * m:])
-        obs = ca.vertcat(*[yk[j] for j in sym.observed])
-        lk, hk = select_min(obs, lk), select_max(obs, hk)
+    yk, qk, states = y, ca.SX.sym("q0", n), []  # (a stand-in vector: only the Jacobians are kept)
+    for Ta, Tb, Tc in columns:
+        yk, qk = rk4_step(f, recorded, yk, qk, h, Ta, Tb, Tc)
+        states.append(yk)
     J_all = ca.vertcat(*entries) if entries else ca.SX(0, 1)
-    state = ca.Function("tangent_state", [y, lo, hi, Tk, ch], [yk, lk, hk, J_all], _OPTS)
 
     symbols = ca.SX.sym("J", max(1, len(entries)))
     given = []  # the same matrices with the symbols in place of the computed entries
-    for J in stages:
-        values = [e if e.is_constant() else symbols[_position(entries, e)] for e in J.nonzeros()]
-        given.append(ca.SX(J.sparsity(), ca.vertcat(*values) if values else ca.SX(0, 1)))
+    for Jx in stages:
+        values = [e if e.is_constant() else symbols[_position(entries, e)] for e in Jx.nonzeros()]
+        given.append(ca.SX(Jx.sparsity(), ca.vertcat(*values) if values else ca.SX(0, 1)))
     replay = iter(given)
+    q = ca.SX.sym("q", n)
     qk = q
-    for i in range(K):
-        col = Tk[:, i]
-        _, qk = rk4_step(lambda x, T: f_of(x, T, ch), lambda x, T: next(replay), y, qk, h, col[:m], col[m:2 * m],
-                         col[2 * m:])
-    vector = ca.Function("tangent_vector", [q, symbols, ch], [qk], _OPTS)
-    return {"tangent_state": state, "tangent_vector": vector}
+    for Ta, Tb, Tc in columns:
+        _, qk = rk4_step(f, lambda x, T: next(replay), y, qk, h, Ta, Tb, Tc)
+    return states, J_all, q, qk, symbols
 
 
 def _position(entries: list, e) -> int | None:
@@ -475,7 +488,9 @@ def _crossing_steps(sym: _Symbols, split: SplitRHS, switching: _Switching, where
         y_try, crossing = state_try(yk, Tk, c)
         return state_switch(crossing, yk, lk, hk, y_try, Tk, c)
 
-    return tangent_block, state_block, step.single(state_try, state_switch), pieces
+    # the printed loops' tangent try is the state's, then each tangent vector's (:meth:`_CrossingStep.tried_by_vector`)
+    printed = {name: f for name, f in pieces.items() if name != "tangent_try"}
+    return tangent_block, state_block, step.single(state_try, state_switch), printed
 
 
 #: the split of a located step (:meth:`_CrossingStep.pieces`) as calls of SX pieces, (piece, inputs, outputs):
@@ -588,11 +603,29 @@ class _CrossingStep:
         mode = self.side(self.s_of(y, Ta, self.sym.ch))
         yn, Qn = rk4_step(self.f_mode(mode), self.J_mode(mode), y, self.Q if with_tangent else None, self.h,
                           Ta, Tb, Tc)
+        return yn, Qn, self.crossed(yn, mode)
+
+    def crossed(self, yn, mode):
+        """The try's flag: has the cubic Hermite of some surface's s over the step to ``yn`` a zero in it?"""
+        y, Ta, Tb, Tc = self.sym.y, self.Ta, self.Tb, self.Tc
         s0, d0, s1, d1 = self.hermite(y, yn, mode, self.h, Ta, Tb, Tc)
         sign = 2 * mode - 1
         # the cubic's Bernstein coefficients all on the start's side: no zero in the step (convex hull)
         clear = [sign * b > 0 for b in (s1, s0 + d0 / 3, s1 - d1 / 3)]
-        return yn, Qn, ca.sum1(ca.logic_not(ca.logic_and(ca.logic_and(clear[0], clear[1]), clear[2]))) > 0
+        return ca.sum1(ca.logic_not(ca.logic_and(ca.logic_and(clear[0], clear[1]), clear[2]))) > 0
+
+    def tried_by_vector(self) -> list[ca.Function]:
+        """The tangent try in two pieces for the printed loop, as the plain step's (:func:`_by_vector`):
+        ``tangent_state`` (the state's try, its flag and each stage's Jacobian nonzeros) and ``tangent_vector``
+        (one tangent vector's try given them); with ``state_keep`` they compute ``tangent_try`` and
+        ``tangent_keep``, operation for operation."""
+        y, ch, Ta = self.sym.y, self.sym.ch, self.Ta
+        mode = self.side(self.s_of(y, Ta, ch))
+        states, J_all, q, qn, symbols = _by_vector(self.f_mode(mode), self.J_mode(mode), y, self.h,
+                                                    [(Ta, self.Tb, self.Tc)])
+        return [ca.Function("tangent_state", [y, self.col, ch], [states[0], self.crossed(states[0], mode), J_all],
+                            _OPTS),
+                ca.Function("tangent_vector", [q, symbols, ch], [qn], _OPTS)]
 
     def table_at(self, theta):
         """The quadratic through Ta, Tb, Tc, at t + theta h."""
@@ -690,7 +723,8 @@ class _CrossingStep:
     def pieces(self) -> list[ca.Function]:
         """The SX pieces of the located steps (:data:`SPLIT_CALLS`), in a fixed order."""
         return [*self.switched("tangent", True), *self.switched("state", False), self.split_start(),
-                *self.crossing(), self.split_legs(), self.mode_step(True), self.mode_step(False)]
+                *self.crossing(), self.split_legs(), self.mode_step(True), self.mode_step(False),
+                *self.tried_by_vector()]
 
     def single(self, state_try: ca.Function, state_switch: ca.Function) -> ca.Function:
         """One located step of the state (phase portraits), as an MX function (the extremes unused)."""

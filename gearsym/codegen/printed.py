@@ -25,7 +25,10 @@ whose flat scalar code the compiler neither vectorises nor keeps in registers (o
 instructions a step, 260 of them loads, stores and copies of spilled values), but its two pieces
 (:func:`.functions._tangent_by_vector`): the state's step, which also gives each RK4 stage's Jacobian, and one
 tangent vector's step, applied to each vector in a loop that gcc vectorises across them, the vectors being
-stored side by side in the span (343 instructions a step; the same bits).
+stored side by side in the span (343 instructions a step; the same bits). The located tangent step is split
+the same way (:meth:`.functions._CrossingStep.tried_by_vector`): the state's try, with its crossing flag and its
+stages' Jacobians, then, if it does not cross, the loop over the vectors and ``state_keep``; a step that crosses
+runs the split on the vectors as columns, transposed there and back.
 """
 from __future__ import annotations
 
@@ -49,13 +52,17 @@ _DEFINITION = re.compile(_HEADER + _SIGNATURE + r"(?P<body>.*?)\n\}\n\n", re.S)
 def pieces(mf: ModelFunctions, loop: str) -> list[ca.Function]:
     """The SX step functions the printed ``loop`` calls."""
     kind = "state" if loop.startswith(("orbit", "trajectory")) else "tangent"
-    if kind == "tangent" and "tangent_vector" in mf.steps:
+    located = "state_try" in mf.steps
+    if kind == "tangent":
         names = ["tangent_state", "tangent_vector"]
-    elif f"{kind}_block" in mf.steps:
+        if located:  # (the step that does not cross keeps the state's try and its extremes)
+            names += ["state_keep", *(piece for piece, _, _ in split_calls(kind))]
+    elif not located:
         names = [f"{kind}_block", *(["trajectory_step"] if loop == "trajectory" and "trajectory_step" in mf.steps
                                    else [])]
     else:
-        names = list(dict.fromkeys([f"{kind}_try", *(piece for piece, _, _ in split_calls(kind))]))
+        names = [f"{kind}_try", *(piece for piece, _, _ in split_calls(kind))]
+    names = list(dict.fromkeys(names))
     if loop.startswith("lyapunov"):
         names.append("gram_schmidt")
     return [mf.steps[name] for name in names]
@@ -172,11 +179,12 @@ class _Shape:
         self.blocks = self.N // K
         self.P = mf.options.chunk_periods
         self.S = shooting_segments(self.N, K)
-        self.located = "tangent_try" in mf.steps
+        self.located = "state_try" in mf.steps
         self.stepwise = "trajectory_step" in mf.steps  # (blocks of several steps: the trajectory steps alone)
-        #: the plain tangent step: the state's step, then each tangent vector's (:func:`_by_vector`)
+        #: the tangent step (or try): the state's step, then each tangent vector's (:func:`_by_vector`)
         self.by_vector = "tangent_vector" in mf.steps
-        self.jacobians = mf.steps["tangent_state"].nnz_out(3) if self.by_vector else 0
+        state = mf.steps["tangent_state"] if self.by_vector else None
+        self.jacobians = state.nnz_out(state.n_out() - 1) if state else 0  # (its last output)
 
     def size(self, what: str) -> int:
         """Array length of a local: at least 1 (C has no empty arrays)."""
@@ -237,7 +245,9 @@ def _spans(mf: ModelFunctions, s: _Shape) -> list[str]:
         nexts = [f"{v}1" for v in state]
         outs = [f"casadi_real* restrict {v}" for v in nexts]
         args = ", ".join([*state, "T", "c", *nexts])
-        if s.located:
+        if s.located and kind == "tangent" and s.by_vector:
+            body = _located_by_vector(s)
+        elif s.located:
             tried = [f"{v}t" for v in carried]
             declare = " ".join(f"casadi_real {v}[{s.size(v[0])}];" for v in tried)
             split_args = ", ".join([*state, *tried, "T", "c", *nexts])
@@ -281,6 +291,24 @@ def _by_vector(s: _Shape) -> str:
     return (f"  casadi_real J[{max(1, s.jacobians)}]; casadi_int j;\n"
             "  gs_tangent_state(y, lo, hi, T, c, y1, lo1, hi1, J);\n"
             f"  GEARSYM_NOT_UNROLLED for (j = 0; j < {s.n}; ++j) gs_tangent_vector(Q + j, J, c, Q1 + j);\n")
+
+
+def _located_by_vector(s: _Shape) -> str:
+    """The located tangent step, by vector as the plain one (:func:`_by_vector`): the state's try (its flag and
+    the Jacobians of its stages), then, if it does not cross, each tangent vector's try and the extremes (what
+    ``tangent_keep`` keeps), else the split, on the tangent vectors as columns (transposed there and back)."""
+    n, y, Q = s.n, s.size("y"), s.size("Q")
+    return (f"  casadi_real yt[{y}], flag, J[{max(1, s.jacobians)}]; casadi_int j;\n"
+            "  gs_tangent_state(y, T, c, yt, &flag, J);\n"
+            "  if (GEARSYM_UNLIKELY(flag != 0)) {\n"
+            f"    casadi_real Qc[{Q}], Qc1[{Q}];  /* (the try's tangent, an input the split does not read: Qc) */\n"
+            f"    gs_transpose(Q, {n}, Qc);\n"
+            "    gs_tangent_split(y, Qc, lo, hi, yt, Qc, T, c, y1, Qc1, lo1, hi1);\n"
+            f"    gs_transpose(Qc1, {n}, Q1);\n"
+            "  } else {\n"
+            f"    GEARSYM_NOT_UNROLLED for (j = 0; j < {n}; ++j) gs_tangent_vector(Q + j, J, c, Q1 + j);\n"
+            "    gs_state_keep(y, lo, hi, yt, T, c, y1, lo1, hi1);\n"
+            "  }\n")
 
 
 def _observed_start(s: _Shape, lo: str = "lo", hi: str = "hi") -> str:

@@ -50,6 +50,7 @@ extern "C" {
 #define casadi_f22 CASADI_PREFIX(f22)
 #define casadi_f23 CASADI_PREFIX(f23)
 #define casadi_f24 CASADI_PREFIX(f24)
+#define casadi_f25 CASADI_PREFIX(f25)
 #define casadi_f3 CASADI_PREFIX(f3)
 #define casadi_f4 CASADI_PREFIX(f4)
 #define casadi_f5 CASADI_PREFIX(f5)
@@ -68,6 +69,7 @@ extern "C" {
 #define casadi_s14 CASADI_PREFIX(s14)
 #define casadi_s15 CASADI_PREFIX(s15)
 #define casadi_s16 CASADI_PREFIX(s16)
+#define casadi_s17 CASADI_PREFIX(s17)
 #define casadi_s2 CASADI_PREFIX(s2)
 #define casadi_s3 CASADI_PREFIX(s3)
 #define casadi_s4 CASADI_PREFIX(s4)
@@ -149,17 +151,19 @@ static const casadi_int casadi_s4[3] = {9, 1, 1};
 static const casadi_int casadi_s5[3] = {6, 200, 1};
 static const casadi_int casadi_s6[3] = {2, 2, 1};
 static const casadi_int casadi_s7[4] = {0};
-static const casadi_int casadi_s8[16] = 
+static const casadi_int casadi_s8[6] = {0};
+static const casadi_int casadi_s9[9] = 
   {0};
-static const casadi_int casadi_s9[6] = {0};
-static const casadi_int casadi_s10[9] = 
+static const casadi_int casadi_s10[12] = 
   {0};
 static const casadi_int casadi_s11[2] = {0};
-static const casadi_int casadi_s12[3] = {4, 50, 1};
-static const casadi_int casadi_s13[3] = {2, 50, 1};
-static const casadi_int casadi_s14[3] = {2, 1, 1};
-static const casadi_int casadi_s15[3] = {4, 200, 1};
-static const casadi_int casadi_s16[3] = {6, 50, 1};
+static const casadi_int casadi_s12[16] = 
+  {0};
+static const casadi_int casadi_s13[3] = {4, 50, 1};
+static const casadi_int casadi_s14[3] = {2, 50, 1};
+static const casadi_int casadi_s15[3] = {2, 1, 1};
+static const casadi_int casadi_s16[3] = {4, 200, 1};
+static const casadi_int casadi_s17[3] = {6, 50, 1};
 
 static const casadi_real casadi_c0[401] = 
   {0., 1., 2., 3., 4., 5., 6., 7.,
@@ -948,605 +952,6 @@ static inline void gs_transpose(const casadi_real* restrict x, casadi_int n, cas
 static inline void gs_store(const casadi_real* x, casadi_int n, casadi_real* y, casadi_int at) {
   casadi_int i;
   if (y) for (i = 0; i < n; ++i) y[at + i] = x[i];
-}
-
-/* tangent_try, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
-  casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
-  casadi_real a36, a37, a38, a39;
-  a00=A0[0];
-  a01=A3[8];
-  a02=6.;
-  a02=(a01/a02);
-  a03=A0[1];
-  a04=2.;
-  a04=(a01/a04);
-  a05=A3[2];
-  a06=(a03*a05);
-  a07=A0[2];
-  a08=A3[3];
-  a09=(a07*a08);
-  a06=(a06+a09);
-  a09=A3[4];
-  a10=A2[1];
-  a10=(a09*a10);
-  a06=(a06+a10);
-  a10=A3[1];
-  a11=A2[0];
-  a12=(a10*a11);
-  a13=A3[0];
-  a14=0.;
-  a15=(a00+a13);
-  a16=(-a15);
-  a16=(a14<=a16);
-  a17=(a13*a16);
-  a18=(a14<=a00);
-  a19=(a18+a16);
-  a20=(a00*a19);
-  a20=(a17+a20);
-  a21=(a12*a20);
-  a06=(a06+a21);
-  a21=(a04*a06);
-  a21=(a03+a21);
-  a22=(2.*a21);
-  a22=(a03+a22);
-  a23=(a21*a05);
-  a24=A0[3];
-  a25=(a04*a24);
-  a25=(a07+a25);
-  a26=(a25*a08);
-  a23=(a23+a26);
-  a26=A2[3];
-  a26=(a09*a26);
-  a23=(a23+a26);
-  a27=A2[2];
-  a28=(a10*a27);
-  a29=(a04*a03);
-  a29=(a00+a29);
-  a29=(a29*a19);
-  a29=(a17+a29);
-  a30=(a28*a29);
-  a23=(a23+a30);
-  a30=(a04*a23);
-  a30=(a03+a30);
-  a31=(2.*a30);
-  a22=(a22+a31);
-  a31=(a30*a05);
-  a32=A3[7];
-  a33=(a03*a32);
-  a34=A3[5];
-  a35=(a07*a34);
-  a33=(a33+a35);
-  a35=A3[6];
-  a11=(a35*a11);
-  a20=(a11*a20);
-  a33=(a33+a20);
-  a20=(a04*a33);
-  a20=(a24+a20);
-  a36=(a04*a20);
-  a36=(a07+a36);
-  a37=(a36*a08);
-  a31=(a31+a37);
-  a31=(a31+a26);
-  a26=(a04*a21);
-  a26=(a00+a26);
-  a26=(a26*a19);
-  a26=(a17+a26);
-  a37=(a28*a26);
-  a31=(a31+a37);
-  a37=(a01*a31);
-  a37=(a03+a37);
-  a22=(a22+a37);
-  a22=(a02*a22);
-  a22=(a00+a22);
-  R0[0]=a22;
-  a23=(2.*a23);
-  a06=(a06+a23);
-  a31=(2.*a31);
-  a06=(a06+a31);
-  a31=(a37*a05);
-  a21=(a21*a32);
-  a25=(a25*a34);
-  a21=(a21+a25);
-  a27=(a35*a27);
-  a29=(a27*a29);
-  a21=(a21+a29);
-  a29=(a04*a21);
-  a29=(a24+a29);
-  a25=(a01*a29);
-  a25=(a07+a25);
-  a23=(a25*a08);
-  a31=(a31+a23);
-  a23=A2[5];
-  a09=(a09*a23);
-  a31=(a31+a09);
-  a09=A2[4];
-  a10=(a10*a09);
-  a23=(a01*a30);
-  a23=(a00+a23);
-  a23=(a23*a19);
-  a17=(a17+a23);
-  a23=(a10*a17);
-  a31=(a31+a23);
-  a06=(a06+a31);
-  a06=(a02*a06);
-  a06=(a03+a06);
-  R0[1]=a06;
-  a20=(2.*a20);
-  a20=(a24+a20);
-  a29=(2.*a29);
-  a20=(a20+a29);
-  a30=(a30*a32);
-  a36=(a36*a34);
-  a30=(a30+a36);
-  a26=(a27*a26);
-  a30=(a30+a26);
-  a26=(a01*a30);
-  a26=(a24+a26);
-  a20=(a20+a26);
-  a20=(a02*a20);
-  a07=(a07+a20);
-  R0[2]=a07;
-  a21=(2.*a21);
-  a33=(a33+a21);
-  a30=(2.*a30);
-  a33=(a33+a30);
-  a37=(a37*a32);
-  a25=(a25*a34);
-  a37=(a37+a25);
-  a35=(a35*a09);
-  a17=(a35*a17);
-  a37=(a37+a17);
-  a33=(a33+a37);
-  a33=(a02*a33);
-  a24=(a24+a33);
-  R0[3]=a24;
-  a24=A1[0];
-  a33=A1[1];
-  a12=(a12*a19);
-  a37=(a12*a24);
-  a17=(a05*a33);
-  a37=(a37+a17);
-  a17=A1[2];
-  a09=(a08*a17);
-  a37=(a37+a09);
-  a09=(a04*a37);
-  a09=(a33+a09);
-  a25=(2.*a09);
-  a25=(a33+a25);
-  a28=(a28*a19);
-  a30=(a04*a33);
-  a30=(a24+a30);
-  a21=(a28*a30);
-  a07=(a05*a09);
-  a21=(a21+a07);
-  a07=A1[3];
-  a20=(a04*a07);
-  a20=(a17+a20);
-  a26=(a08*a20);
-  a21=(a21+a26);
-  a26=(a04*a21);
-  a26=(a33+a26);
-  a36=(2.*a26);
-  a25=(a25+a36);
-  a36=(a04*a09);
-  a36=(a24+a36);
-  a29=(a28*a36);
-  a31=(a05*a26);
-  a29=(a29+a31);
-  a11=(a11*a19);
-  a31=(a11*a24);
-  a23=(a32*a33);
-  a31=(a31+a23);
-  a23=(a34*a17);
-  a31=(a31+a23);
-  a23=(a04*a31);
-  a23=(a07+a23);
-  a38=(a04*a23);
-  a38=(a17+a38);
-  a39=(a08*a38);
-  a29=(a29+a39);
-  a39=(a01*a29);
-  a39=(a33+a39);
-  a25=(a25+a39);
-  a25=(a02*a25);
-  a25=(a24+a25);
-  R1[0]=a25;
-  a21=(2.*a21);
-  a37=(a37+a21);
-  a29=(2.*a29);
-  a37=(a37+a29);
-  a10=(a10*a19);
-  a29=(a01*a26);
-  a24=(a24+a29);
-  a29=(a10*a24);
-  a21=(a05*a39);
-  a29=(a29+a21);
-  a27=(a27*a19);
-  a30=(a27*a30);
-  a09=(a32*a09);
-  a30=(a30+a09);
-  a20=(a34*a20);
-  a30=(a30+a20);
-  a20=(a04*a30);
-  a20=(a07+a20);
-  a09=(a01*a20);
-  a09=(a17+a09);
-  a21=(a08*a09);
-  a29=(a29+a21);
-  a37=(a37+a29);
-  a37=(a02*a37);
-  a33=(a33+a37);
-  R1[1]=a33;
-  a23=(2.*a23);
-  a23=(a07+a23);
-  a20=(2.*a20);
-  a23=(a23+a20);
-  a36=(a27*a36);
-  a26=(a32*a26);
-  a36=(a36+a26);
-  a38=(a34*a38);
-  a36=(a36+a38);
-  a38=(a01*a36);
-  a38=(a07+a38);
-  a23=(a23+a38);
-  a23=(a02*a23);
-  a17=(a17+a23);
-  R1[2]=a17;
-  a30=(2.*a30);
-  a31=(a31+a30);
-  a36=(2.*a36);
-  a31=(a31+a36);
-  a35=(a35*a19);
-  a24=(a35*a24);
-  a39=(a32*a39);
-  a24=(a24+a39);
-  a09=(a34*a09);
-  a24=(a24+a09);
-  a31=(a31+a24);
-  a31=(a02*a31);
-  a07=(a07+a31);
-  R1[3]=a07;
-  a07=A1[4];
-  a31=A1[5];
-  a24=(a12*a07);
-  a09=(a05*a31);
-  a24=(a24+a09);
-  a09=A1[6];
-  a39=(a08*a09);
-  a24=(a24+a39);
-  a39=(a04*a24);
-  a39=(a31+a39);
-  a19=(2.*a39);
-  a19=(a31+a19);
-  a36=(a04*a31);
-  a36=(a07+a36);
-  a30=(a28*a36);
-  a17=(a05*a39);
-  a30=(a30+a17);
-  a17=A1[7];
-  a23=(a04*a17);
-  a23=(a09+a23);
-  a38=(a08*a23);
-  a30=(a30+a38);
-  a38=(a04*a30);
-  a38=(a31+a38);
-  a26=(2.*a38);
-  a19=(a19+a26);
-  a26=(a04*a39);
-  a26=(a07+a26);
-  a20=(a28*a26);
-  a33=(a05*a38);
-  a20=(a20+a33);
-  a33=(a11*a07);
-  a37=(a32*a31);
-  a33=(a33+a37);
-  a37=(a34*a09);
-  a33=(a33+a37);
-  a37=(a04*a33);
-  a37=(a17+a37);
-  a29=(a04*a37);
-  a29=(a09+a29);
-  a21=(a08*a29);
-  a20=(a20+a21);
-  a21=(a01*a20);
-  a21=(a31+a21);
-  a19=(a19+a21);
-  a19=(a02*a19);
-  a19=(a07+a19);
-  R1[4]=a19;
-  a30=(2.*a30);
-  a24=(a24+a30);
-  a20=(2.*a20);
-  a24=(a24+a20);
-  a20=(a01*a38);
-  a07=(a07+a20);
-  a20=(a10*a07);
-  a30=(a05*a21);
-  a20=(a20+a30);
-  a36=(a27*a36);
-  a39=(a32*a39);
-  a36=(a36+a39);
-  a23=(a34*a23);
-  a36=(a36+a23);
-  a23=(a04*a36);
-  a23=(a17+a23);
-  a39=(a01*a23);
-  a39=(a09+a39);
-  a30=(a08*a39);
-  a20=(a20+a30);
-  a24=(a24+a20);
-  a24=(a02*a24);
-  a31=(a31+a24);
-  R1[5]=a31;
-  a37=(2.*a37);
-  a37=(a17+a37);
-  a23=(2.*a23);
-  a37=(a37+a23);
-  a26=(a27*a26);
-  a38=(a32*a38);
-  a26=(a26+a38);
-  a29=(a34*a29);
-  a26=(a26+a29);
-  a29=(a01*a26);
-  a29=(a17+a29);
-  a37=(a37+a29);
-  a37=(a02*a37);
-  a09=(a09+a37);
-  R1[6]=a09;
-  a36=(2.*a36);
-  a33=(a33+a36);
-  a26=(2.*a26);
-  a33=(a33+a26);
-  a07=(a35*a07);
-  a21=(a32*a21);
-  a07=(a07+a21);
-  a39=(a34*a39);
-  a07=(a07+a39);
-  a33=(a33+a07);
-  a33=(a02*a33);
-  a17=(a17+a33);
-  R1[7]=a17;
-  a17=A1[8];
-  a33=A1[9];
-  a07=(a12*a17);
-  a39=(a05*a33);
-  a07=(a07+a39);
-  a39=A1[10];
-  a21=(a08*a39);
-  a07=(a07+a21);
-  a21=(a04*a07);
-  a21=(a33+a21);
-  a26=(2.*a21);
-  a26=(a33+a26);
-  a36=(a04*a33);
-  a36=(a17+a36);
-  a09=(a28*a36);
-  a37=(a05*a21);
-  a09=(a09+a37);
-  a37=A1[11];
-  a29=(a04*a37);
-  a29=(a39+a29);
-  a38=(a08*a29);
-  a09=(a09+a38);
-  a38=(a04*a09);
-  a38=(a33+a38);
-  a23=(2.*a38);
-  a26=(a26+a23);
-  a23=(a04*a21);
-  a23=(a17+a23);
-  a31=(a28*a23);
-  a24=(a05*a38);
-  a31=(a31+a24);
-  a24=(a11*a17);
-  a20=(a32*a33);
-  a24=(a24+a20);
-  a20=(a34*a39);
-  a24=(a24+a20);
-  a20=(a04*a24);
-  a20=(a37+a20);
-  a30=(a04*a20);
-  a30=(a39+a30);
-  a19=(a08*a30);
-  a31=(a31+a19);
-  a19=(a01*a31);
-  a19=(a33+a19);
-  a26=(a26+a19);
-  a26=(a02*a26);
-  a26=(a17+a26);
-  R1[8]=a26;
-  a09=(2.*a09);
-  a07=(a07+a09);
-  a31=(2.*a31);
-  a07=(a07+a31);
-  a31=(a01*a38);
-  a17=(a17+a31);
-  a31=(a10*a17);
-  a09=(a05*a19);
-  a31=(a31+a09);
-  a36=(a27*a36);
-  a21=(a32*a21);
-  a36=(a36+a21);
-  a29=(a34*a29);
-  a36=(a36+a29);
-  a29=(a04*a36);
-  a29=(a37+a29);
-  a21=(a01*a29);
-  a21=(a39+a21);
-  a09=(a08*a21);
-  a31=(a31+a09);
-  a07=(a07+a31);
-  a07=(a02*a07);
-  a33=(a33+a07);
-  R1[9]=a33;
-  a20=(2.*a20);
-  a20=(a37+a20);
-  a29=(2.*a29);
-  a20=(a20+a29);
-  a23=(a27*a23);
-  a38=(a32*a38);
-  a23=(a23+a38);
-  a30=(a34*a30);
-  a23=(a23+a30);
-  a30=(a01*a23);
-  a30=(a37+a30);
-  a20=(a20+a30);
-  a20=(a02*a20);
-  a39=(a39+a20);
-  R1[10]=a39;
-  a36=(2.*a36);
-  a24=(a24+a36);
-  a23=(2.*a23);
-  a24=(a24+a23);
-  a17=(a35*a17);
-  a19=(a32*a19);
-  a17=(a17+a19);
-  a21=(a34*a21);
-  a17=(a17+a21);
-  a24=(a24+a17);
-  a24=(a02*a24);
-  a37=(a37+a24);
-  R1[11]=a37;
-  a37=A1[12];
-  a24=A1[13];
-  a12=(a12*a37);
-  a17=(a05*a24);
-  a12=(a12+a17);
-  a17=A1[14];
-  a21=(a08*a17);
-  a12=(a12+a21);
-  a21=(a04*a12);
-  a21=(a24+a21);
-  a19=(2.*a21);
-  a19=(a24+a19);
-  a23=(a04*a24);
-  a23=(a37+a23);
-  a36=(a28*a23);
-  a39=(a05*a21);
-  a36=(a36+a39);
-  a39=A1[15];
-  a20=(a04*a39);
-  a20=(a17+a20);
-  a30=(a08*a20);
-  a36=(a36+a30);
-  a30=(a04*a36);
-  a30=(a24+a30);
-  a38=(2.*a30);
-  a19=(a19+a38);
-  a38=(a04*a21);
-  a38=(a37+a38);
-  a28=(a28*a38);
-  a29=(a05*a30);
-  a28=(a28+a29);
-  a11=(a11*a37);
-  a29=(a32*a24);
-  a11=(a11+a29);
-  a29=(a34*a17);
-  a11=(a11+a29);
-  a29=(a04*a11);
-  a29=(a39+a29);
-  a33=(a04*a29);
-  a33=(a17+a33);
-  a07=(a08*a33);
-  a28=(a28+a07);
-  a07=(a01*a28);
-  a07=(a24+a07);
-  a19=(a19+a07);
-  a19=(a02*a19);
-  a19=(a37+a19);
-  R1[12]=a19;
-  a36=(2.*a36);
-  a12=(a12+a36);
-  a28=(2.*a28);
-  a12=(a12+a28);
-  a28=(a01*a30);
-  a37=(a37+a28);
-  a10=(a10*a37);
-  a05=(a05*a07);
-  a10=(a10+a05);
-  a23=(a27*a23);
-  a21=(a32*a21);
-  a23=(a23+a21);
-  a20=(a34*a20);
-  a23=(a23+a20);
-  a04=(a04*a23);
-  a04=(a39+a04);
-  a20=(a01*a04);
-  a20=(a17+a20);
-  a08=(a08*a20);
-  a10=(a10+a08);
-  a12=(a12+a10);
-  a12=(a02*a12);
-  a24=(a24+a12);
-  R1[13]=a24;
-  a29=(2.*a29);
-  a29=(a39+a29);
-  a04=(2.*a04);
-  a29=(a29+a04);
-  a27=(a27*a38);
-  a30=(a32*a30);
-  a27=(a27+a30);
-  a33=(a34*a33);
-  a27=(a27+a33);
-  a33=(a01*a27);
-  a33=(a39+a33);
-  a29=(a29+a33);
-  a29=(a02*a29);
-  a17=(a17+a29);
-  R1[14]=a17;
-  a23=(2.*a23);
-  a11=(a11+a23);
-  a27=(2.*a27);
-  a11=(a11+a27);
-  a35=(a35*a37);
-  a32=(a32*a07);
-  a35=(a35+a32);
-  a34=(a34*a20);
-  a35=(a35+a34);
-  a11=(a11+a35);
-  a02=(a02*a11);
-  a39=(a39+a02);
-  R1[15]=a39;
-  a18=(2.*a18);
-  a39=1.;
-  a18=(a18-a39);
-  a02=(a18*a22);
-  a02=(a14<a02);
-  a03=(a01*a03);
-  a11=3.;
-  a03=(a03/a11);
-  a00=(a00+a03);
-  a00=(a18*a00);
-  a00=(a14<a00);
-  a02=(a02&&a00);
-  a01=(a01*a06);
-  a01=(a01/a11);
-  a11=(a22-a01);
-  a18=(a18*a11);
-  a18=(a14<a18);
-  a02=(a02&&a18);
-  a02=(!a02);
-  a16=(2.*a16);
-  a16=(a16-a39);
-  a22=(a22+a13);
-  a13=(a16*a22);
-  a13=(-a13);
-  a13=(a14<a13);
-  a15=(a15+a03);
-  a15=(a16*a15);
-  a15=(-a15);
-  a15=(a14<a15);
-  a13=(a13&&a15);
-  a01=(a01-a22);
-  a16=(a16*a01);
-  a16=(a14<a16);
-  a13=(a13&&a16);
-  a13=(!a13);
-  a02=(a02+a13);
-  a14=(a14<a02);
-  R2[0]=a14;
 }
 
 /* tangent_keep, from CasADi's C of it */
@@ -3377,6 +2782,340 @@ static GEARSYM_NOINLINE void gs_state_mode_step(const casadi_real* restrict A0, 
   R0[3]=a18;
 }
 
+/* tangent_state, from CasADi's C of it */
+static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+  casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
+  casadi_real a36, a37;
+  a00=A0[0];
+  a01=A2[8];
+  a02=6.;
+  a02=(a01/a02);
+  a03=A0[1];
+  a04=2.;
+  a04=(a01/a04);
+  a05=A2[2];
+  a06=(a03*a05);
+  a07=A0[2];
+  a08=A2[3];
+  a09=(a07*a08);
+  a06=(a06+a09);
+  a09=A2[4];
+  a10=A1[1];
+  a10=(a09*a10);
+  a06=(a06+a10);
+  a10=A2[1];
+  a11=A1[0];
+  a12=(a10*a11);
+  a13=A2[0];
+  a14=0.;
+  a15=(a00+a13);
+  a16=(-a15);
+  a16=(a14<=a16);
+  a17=(a13*a16);
+  a18=(a14<=a00);
+  a19=(a18+a16);
+  a20=(a00*a19);
+  a20=(a17+a20);
+  a21=(a12*a20);
+  a06=(a06+a21);
+  a21=(a04*a06);
+  a21=(a03+a21);
+  a22=(2.*a21);
+  a22=(a03+a22);
+  a23=(a21*a05);
+  a24=A0[3];
+  a25=(a04*a24);
+  a25=(a07+a25);
+  a26=(a25*a08);
+  a23=(a23+a26);
+  a26=A1[3];
+  a26=(a09*a26);
+  a23=(a23+a26);
+  a27=A1[2];
+  a28=(a10*a27);
+  a29=(a04*a03);
+  a29=(a00+a29);
+  a29=(a29*a19);
+  a29=(a17+a29);
+  a30=(a28*a29);
+  a23=(a23+a30);
+  a30=(a04*a23);
+  a30=(a03+a30);
+  a31=(2.*a30);
+  a22=(a22+a31);
+  a31=(a30*a05);
+  a32=A2[7];
+  a33=(a03*a32);
+  a34=A2[5];
+  a35=(a07*a34);
+  a33=(a33+a35);
+  a35=A2[6];
+  a11=(a35*a11);
+  a20=(a11*a20);
+  a33=(a33+a20);
+  a20=(a04*a33);
+  a20=(a24+a20);
+  a36=(a04*a20);
+  a36=(a07+a36);
+  a37=(a36*a08);
+  a31=(a31+a37);
+  a31=(a31+a26);
+  a26=(a04*a21);
+  a26=(a00+a26);
+  a26=(a26*a19);
+  a26=(a17+a26);
+  a37=(a28*a26);
+  a31=(a31+a37);
+  a37=(a01*a31);
+  a37=(a03+a37);
+  a22=(a22+a37);
+  a22=(a02*a22);
+  a22=(a00+a22);
+  R0[0]=a22;
+  a23=(2.*a23);
+  a06=(a06+a23);
+  a31=(2.*a31);
+  a06=(a06+a31);
+  a31=(a37*a05);
+  a21=(a21*a32);
+  a25=(a25*a34);
+  a21=(a21+a25);
+  a27=(a35*a27);
+  a29=(a27*a29);
+  a21=(a21+a29);
+  a04=(a04*a21);
+  a04=(a24+a04);
+  a29=(a01*a04);
+  a29=(a07+a29);
+  a25=(a29*a08);
+  a31=(a31+a25);
+  a25=A1[5];
+  a09=(a09*a25);
+  a31=(a31+a09);
+  a09=A1[4];
+  a10=(a10*a09);
+  a25=(a01*a30);
+  a25=(a00+a25);
+  a25=(a25*a19);
+  a17=(a17+a25);
+  a25=(a10*a17);
+  a31=(a31+a25);
+  a06=(a06+a31);
+  a06=(a02*a06);
+  a06=(a03+a06);
+  R0[1]=a06;
+  a20=(2.*a20);
+  a20=(a24+a20);
+  a04=(2.*a04);
+  a20=(a20+a04);
+  a30=(a30*a32);
+  a36=(a36*a34);
+  a30=(a30+a36);
+  a26=(a27*a26);
+  a30=(a30+a26);
+  a26=(a01*a30);
+  a26=(a24+a26);
+  a20=(a20+a26);
+  a20=(a02*a20);
+  a07=(a07+a20);
+  R0[2]=a07;
+  a21=(2.*a21);
+  a33=(a33+a21);
+  a30=(2.*a30);
+  a33=(a33+a30);
+  a37=(a37*a32);
+  a29=(a29*a34);
+  a37=(a37+a29);
+  a35=(a35*a09);
+  a17=(a35*a17);
+  a37=(a37+a17);
+  a33=(a33+a37);
+  a02=(a02*a33);
+  a24=(a24+a02);
+  R0[3]=a24;
+  a18=(2.*a18);
+  a24=1.;
+  a18=(a18-a24);
+  a02=(a18*a22);
+  a02=(a14<a02);
+  a03=(a01*a03);
+  a33=3.;
+  a03=(a03/a33);
+  a00=(a00+a03);
+  a00=(a18*a00);
+  a00=(a14<a00);
+  a02=(a02&&a00);
+  a01=(a01*a06);
+  a01=(a01/a33);
+  a33=(a22-a01);
+  a18=(a18*a33);
+  a18=(a14<a18);
+  a02=(a02&&a18);
+  a02=(!a02);
+  a16=(2.*a16);
+  a16=(a16-a24);
+  a22=(a22+a13);
+  a13=(a16*a22);
+  a13=(-a13);
+  a13=(a14<a13);
+  a15=(a15+a03);
+  a15=(a16*a15);
+  a15=(-a15);
+  a15=(a14<a15);
+  a13=(a13&&a15);
+  a01=(a01-a22);
+  a16=(a16*a01);
+  a16=(a14<a16);
+  a13=(a13&&a16);
+  a13=(!a13);
+  a02=(a02+a13);
+  a14=(a14<a02);
+  R1[0]=a14;
+  a12=(a12*a19);
+  R2[0]=a12;
+  a11=(a11*a19);
+  R2[1]=a11;
+  R2[2]=a05;
+  R2[3]=a32;
+  R2[4]=a08;
+  R2[5]=a34;
+  a28=(a28*a19);
+  R2[6]=a28;
+  a27=(a27*a19);
+  R2[7]=a27;
+  R2[8]=a28;
+  R2[9]=a27;
+  a10=(a10*a19);
+  R2[10]=a10;
+  a35=(a35*a19);
+  R2[11]=a35;
+}
+
+/* tangent_vector, from CasADi's C of it */
+static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+  a00=A0[0];
+  a01=A2[8];
+  a02=6.;
+  a02=(a01/a02);
+  a03=A0[4];
+  a04=2.;
+  a04=(a01/a04);
+  a05=A1[0];
+  a05=(a05*a00);
+  a06=A1[2];
+  a07=(a06*a03);
+  a05=(a05+a07);
+  a07=A1[4];
+  a08=A0[8];
+  a09=(a07*a08);
+  a05=(a05+a09);
+  a09=(a04*a05);
+  a09=(a03+a09);
+  a10=(2.*a09);
+  a10=(a03+a10);
+  a11=A1[6];
+  a12=(a04*a03);
+  a12=(a00+a12);
+  a11=(a11*a12);
+  a13=(a06*a09);
+  a11=(a11+a13);
+  a13=A0[12];
+  a14=(a04*a13);
+  a14=(a08+a14);
+  a15=(a07*a14);
+  a11=(a11+a15);
+  a15=(a04*a11);
+  a15=(a03+a15);
+  a16=(2.*a15);
+  a10=(a10+a16);
+  a16=A1[8];
+  a17=(a04*a09);
+  a17=(a00+a17);
+  a16=(a16*a17);
+  a18=(a06*a15);
+  a16=(a16+a18);
+  a18=A1[1];
+  a18=(a18*a00);
+  a19=A1[3];
+  a20=(a19*a03);
+  a18=(a18+a20);
+  a20=A1[5];
+  a21=(a20*a08);
+  a18=(a18+a21);
+  a21=(a04*a18);
+  a21=(a13+a21);
+  a22=(a04*a21);
+  a22=(a08+a22);
+  a23=(a07*a22);
+  a16=(a16+a23);
+  a23=(a01*a16);
+  a23=(a03+a23);
+  a10=(a10+a23);
+  a10=(a02*a10);
+  a10=(a00+a10);
+  R0[0]=a10;
+  a11=(2.*a11);
+  a05=(a05+a11);
+  a16=(2.*a16);
+  a05=(a05+a16);
+  a16=A1[10];
+  a11=(a01*a15);
+  a00=(a00+a11);
+  a16=(a16*a00);
+  a06=(a06*a23);
+  a16=(a16+a06);
+  a06=A1[7];
+  a06=(a06*a12);
+  a09=(a19*a09);
+  a06=(a06+a09);
+  a14=(a20*a14);
+  a06=(a06+a14);
+  a04=(a04*a06);
+  a04=(a13+a04);
+  a14=(a01*a04);
+  a14=(a08+a14);
+  a07=(a07*a14);
+  a16=(a16+a07);
+  a05=(a05+a16);
+  a05=(a02*a05);
+  a03=(a03+a05);
+  R0[4]=a03;
+  a21=(2.*a21);
+  a21=(a13+a21);
+  a04=(2.*a04);
+  a21=(a21+a04);
+  a04=A1[9];
+  a04=(a04*a17);
+  a15=(a19*a15);
+  a04=(a04+a15);
+  a22=(a20*a22);
+  a04=(a04+a22);
+  a01=(a01*a04);
+  a01=(a13+a01);
+  a21=(a21+a01);
+  a21=(a02*a21);
+  a08=(a08+a21);
+  R0[8]=a08;
+  a06=(2.*a06);
+  a18=(a18+a06);
+  a04=(2.*a04);
+  a18=(a18+a04);
+  a04=A1[11];
+  a04=(a04*a00);
+  a19=(a19*a23);
+  a04=(a04+a19);
+  a20=(a20*a14);
+  a04=(a04+a20);
+  a18=(a18+a04);
+  a02=(a02*a18);
+  a13=(a13+a02);
+  R0[12]=a13;
+}
+
 /* gram_schmidt, from CasADi's C of it */
 static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
@@ -3605,23 +3344,30 @@ static GEARSYM_NOINLINE void gs_state_split(const casadi_real* restrict y, const
 
 /* one block of tangent steps (the SX functions' step, as CasADi's Switch runs it) */
 static GEARSYM_INLINE void gs_tangent_step(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
-  casadi_real yt[4]; casadi_real Qt[16]; casadi_real flag;
-  gs_tangent_try(y, Q, T, c, yt, Qt, &flag);
-  if (GEARSYM_UNLIKELY(flag != 0)) gs_tangent_split(y, Q, lo, hi, yt, Qt, T, c, y1, Q1, lo1, hi1);
-  else gs_tangent_keep(y, Q, lo, hi, yt, Qt, T, c, y1, Q1, lo1, hi1);
+  casadi_real yt[4], flag, J[12]; casadi_int j;
+  gs_tangent_state(y, T, c, yt, &flag, J);
+  if (GEARSYM_UNLIKELY(flag != 0)) {
+    casadi_real Qc[16], Qc1[16];  /* (the try's tangent, an input the split does not read: Qc) */
+    gs_transpose(Q, 4, Qc);
+    gs_tangent_split(y, Qc, lo, hi, yt, Qc, T, c, y1, Qc1, lo1, hi1);
+    gs_transpose(Qc1, 4, Q1);
+  } else {
+    GEARSYM_NOT_UNROLLED for (j = 0; j < 4; ++j) gs_tangent_vector(Q + j, J, c, Q1 + j);
+    gs_state_keep(y, lo, hi, yt, T, c, y1, lo1, hi1);
+  }
 }
 
 /* blocks of tangent steps from (y, Q, lo, hi), in place: the state in local arrays, a -> b -> a */
 static GEARSYM_NOINLINE void gs_tangent_span(casadi_real* restrict y, casadi_real* restrict Q, casadi_real* restrict lo, casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_int blocks) {
   casadi_real ya[4], yb[4]; casadi_real Qa[16], Qb[16]; casadi_real loa[2], lob[2]; casadi_real hia[2], hib[2];
   casadi_int k;
-  gs_copy(y, 4, ya); gs_copy(Q, 16, Qa); gs_copy(lo, 2, loa); gs_copy(hi, 2, hia);
+  gs_copy(y, 4, ya); gs_transpose(Q, 4, Qa); gs_copy(lo, 2, loa); gs_copy(hi, 2, hia);
   for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */
     gs_tangent_step(ya, Qa, loa, hia, T + 6*(k), c, yb, Qb, lob, hib);
-    if (k + 1 == blocks) { gs_copy(yb, 4, y); gs_copy(Qb, 16, Q); gs_copy(lob, 2, lo); gs_copy(hib, 2, hi); return; }
+    if (k + 1 == blocks) { gs_copy(yb, 4, y); gs_transpose(Qb, 4, Q); gs_copy(lob, 2, lo); gs_copy(hib, 2, hi); return; }
     gs_tangent_step(yb, Qb, lob, hib, T + 6*(k + 1), c, ya, Qa, loa, hia);
   }
-  gs_copy(ya, 4, y); gs_copy(Qa, 16, Q); gs_copy(loa, 2, lo); gs_copy(hia, 2, hi);
+  gs_copy(ya, 4, y); gs_transpose(Qa, 4, Q); gs_copy(loa, 2, lo); gs_copy(hia, 2, hi);
 }
 
 /* one block of state steps (the SX functions' step, as CasADi's Switch runs it) */
@@ -3724,11 +3470,11 @@ CASADI_SYMBOL_EXPORT const casadi_int* lyapunov_chunk_sparsity_in(casadi_int i) 
 
 CASADI_SYMBOL_EXPORT const casadi_int* lyapunov_chunk_sparsity_out(casadi_int i) {
   switch (i) {
-    case 0: return casadi_s12;
+    case 0: return casadi_s13;
     case 1: return casadi_s3;
-    case 2: return casadi_s12;
-    case 3: return casadi_s13;
-    case 4: return casadi_s13;
+    case 2: return casadi_s13;
+    case 3: return casadi_s14;
+    case 4: return casadi_s14;
     default: return 0;
   }
 }
@@ -3737,7 +3483,7 @@ CASADI_SYMBOL_EXPORT int lyapunov_chunk_work(casadi_int *sz_arg, casadi_int* sz_
   if (sz_arg) *sz_arg = 12;
   if (sz_res) *sz_res = 9;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 636;
+  if (sz_w) *sz_w = 634;
   return 0;
 }
 
@@ -3745,12 +3491,12 @@ CASADI_SYMBOL_EXPORT int lyapunov_chunk_work_bytes(casadi_int *sz_arg, casadi_in
   if (sz_arg) *sz_arg = 12*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 9*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 636*sizeof(casadi_real);
+  if (sz_w) *sz_w = 634*sizeof(casadi_real);
   return 0;
 }
 
 /* lyapunov_period:(y0[4],Q0[4x4],table[6x200],c[9])->(strobe[4],Q[4x4],log_stretch[4],low[2],high[2]) */
-static int casadi_f17(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f19(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[4], lo[2], hi[2], c[9]; casadi_real Q[16];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -3769,7 +3515,7 @@ static int casadi_f17(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f17(arg, res, iw, w, mem);
+  return casadi_f19(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period_checkout(void) {
@@ -3831,8 +3577,8 @@ CASADI_SYMBOL_EXPORT const casadi_int* lyapunov_period_sparsity_out(casadi_int i
     case 0: return casadi_s1;
     case 1: return casadi_s3;
     case 2: return casadi_s1;
-    case 3: return casadi_s14;
-    case 4: return casadi_s14;
+    case 3: return casadi_s15;
+    case 4: return casadi_s15;
     default: return 0;
   }
 }
@@ -3841,7 +3587,7 @@ CASADI_SYMBOL_EXPORT int lyapunov_period_work(casadi_int *sz_arg, casadi_int* sz
   if (sz_arg) *sz_arg = 12;
   if (sz_res) *sz_res = 9;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 140;
+  if (sz_w) *sz_w = 138;
   return 0;
 }
 
@@ -3849,12 +3595,12 @@ CASADI_SYMBOL_EXPORT int lyapunov_period_work_bytes(casadi_int *sz_arg, casadi_i
   if (sz_arg) *sz_arg = 12*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 9*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 140*sizeof(casadi_real);
+  if (sz_w) *sz_w = 138*sizeof(casadi_real);
   return 0;
 }
 
 /* orbit_chunk:(y0[4],table[6x200],c[9])->(strobe[4x50],low[2x50],high[2x50]) */
-static int casadi_f18(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f20(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[4], lo[2], hi[2], c[9];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
@@ -3868,7 +3614,7 @@ static int casadi_f18(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int orbit_chunk(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f18(arg, res, iw, w, mem);
+  return casadi_f20(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int orbit_chunk_checkout(void) {
@@ -3923,9 +3669,9 @@ CASADI_SYMBOL_EXPORT const casadi_int* orbit_chunk_sparsity_in(casadi_int i) {
 
 CASADI_SYMBOL_EXPORT const casadi_int* orbit_chunk_sparsity_out(casadi_int i) {
   switch (i) {
-    case 0: return casadi_s12;
-    case 1: return casadi_s13;
-    case 2: return casadi_s13;
+    case 0: return casadi_s13;
+    case 1: return casadi_s14;
+    case 2: return casadi_s14;
     default: return 0;
   }
 }
@@ -3947,7 +3693,7 @@ CASADI_SYMBOL_EXPORT int orbit_chunk_work_bytes(casadi_int *sz_arg, casadi_int* 
 }
 
 /* orbit_period:(y0[4],table[6x200],c[9])->(strobe[4],low[2],high[2]) */
-static int casadi_f21(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f22(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[4], lo[2], hi[2], c[9];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
@@ -3961,7 +3707,7 @@ static int casadi_f21(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int orbit_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f21(arg, res, iw, w, mem);
+  return casadi_f22(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int orbit_period_checkout(void) {
@@ -4017,8 +3763,8 @@ CASADI_SYMBOL_EXPORT const casadi_int* orbit_period_sparsity_in(casadi_int i) {
 CASADI_SYMBOL_EXPORT const casadi_int* orbit_period_sparsity_out(casadi_int i) {
   switch (i) {
     case 0: return casadi_s1;
-    case 1: return casadi_s14;
-    case 2: return casadi_s14;
+    case 1: return casadi_s15;
+    case 2: return casadi_s15;
     default: return 0;
   }
 }
@@ -4040,7 +3786,7 @@ CASADI_SYMBOL_EXPORT int orbit_period_work_bytes(casadi_int *sz_arg, casadi_int*
 }
 
 /* trajectory:(y0[4],table[6x200],c[9])->(states[4x200]) */
-static int casadi_f22(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f23(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[4], lo[2], hi[2], c[9];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
@@ -4054,7 +3800,7 @@ static int casadi_f22(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int trajectory(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f22(arg, res, iw, w, mem);
+  return casadi_f23(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int trajectory_checkout(void) {
@@ -4107,7 +3853,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* trajectory_sparsity_in(casadi_int i) {
 
 CASADI_SYMBOL_EXPORT const casadi_int* trajectory_sparsity_out(casadi_int i) {
   switch (i) {
-    case 0: return casadi_s15;
+    case 0: return casadi_s16;
     default: return 0;
   }
 }
@@ -4129,7 +3875,7 @@ CASADI_SYMBOL_EXPORT int trajectory_work_bytes(casadi_int *sz_arg, casadi_int* s
 }
 
 /* monodromy_segment:(y0[4],Q0[4x4],table[6x50],c[9])->(strobe[4],M[4x4],low[2],high[2]) */
-static int casadi_f23(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f24(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[4], lo[2], hi[2], c[9]; casadi_real Q[16];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -4143,7 +3889,7 @@ static int casadi_f23(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f23(arg, res, iw, w, mem);
+  return casadi_f24(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment_checkout(void) {
@@ -4193,7 +3939,7 @@ CASADI_SYMBOL_EXPORT const casadi_int* monodromy_segment_sparsity_in(casadi_int 
   switch (i) {
     case 0: return casadi_s1;
     case 1: return casadi_s3;
-    case 2: return casadi_s16;
+    case 2: return casadi_s17;
     case 3: return casadi_s4;
     default: return 0;
   }
@@ -4203,8 +3949,8 @@ CASADI_SYMBOL_EXPORT const casadi_int* monodromy_segment_sparsity_out(casadi_int
   switch (i) {
     case 0: return casadi_s1;
     case 1: return casadi_s3;
-    case 2: return casadi_s14;
-    case 3: return casadi_s14;
+    case 2: return casadi_s15;
+    case 3: return casadi_s15;
     default: return 0;
   }
 }
@@ -4213,7 +3959,7 @@ CASADI_SYMBOL_EXPORT int monodromy_segment_work(casadi_int *sz_arg, casadi_int* 
   if (sz_arg) *sz_arg = 12;
   if (sz_res) *sz_res = 8;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 136;
+  if (sz_w) *sz_w = 138;
   return 0;
 }
 
@@ -4221,12 +3967,12 @@ CASADI_SYMBOL_EXPORT int monodromy_segment_work_bytes(casadi_int *sz_arg, casadi
   if (sz_arg) *sz_arg = 12*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 8*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 136*sizeof(casadi_real);
+  if (sz_w) *sz_w = 138*sizeof(casadi_real);
   return 0;
 }
 
 /* monodromy_period:(y0[4],Q0[4x4],table[6x200],c[9])->(strobe[4],M[4x4],low[2],high[2]) */
-static int casadi_f24(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f25(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[4], lo[2], hi[2], c[9]; casadi_real Q[16];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -4248,7 +3994,7 @@ static int casadi_f24(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f24(arg, res, iw, w, mem);
+  return casadi_f25(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period_checkout(void) {
@@ -4308,8 +4054,8 @@ CASADI_SYMBOL_EXPORT const casadi_int* monodromy_period_sparsity_out(casadi_int 
   switch (i) {
     case 0: return casadi_s1;
     case 1: return casadi_s3;
-    case 2: return casadi_s14;
-    case 3: return casadi_s14;
+    case 2: return casadi_s15;
+    case 3: return casadi_s15;
     default: return 0;
   }
 }
@@ -4318,7 +4064,7 @@ CASADI_SYMBOL_EXPORT int monodromy_period_work(casadi_int *sz_arg, casadi_int* s
   if (sz_arg) *sz_arg = 12;
   if (sz_res) *sz_res = 8;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 136;
+  if (sz_w) *sz_w = 138;
   return 0;
 }
 
@@ -4326,7 +4072,7 @@ CASADI_SYMBOL_EXPORT int monodromy_period_work_bytes(casadi_int *sz_arg, casadi_
   if (sz_arg) *sz_arg = 12*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 8*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 136*sizeof(casadi_real);
+  if (sz_w) *sz_w = 138*sizeof(casadi_real);
   return 0;
 }
 

@@ -50,6 +50,7 @@ extern "C" {
 #define casadi_f22 CASADI_PREFIX(f22)
 #define casadi_f23 CASADI_PREFIX(f23)
 #define casadi_f24 CASADI_PREFIX(f24)
+#define casadi_f25 CASADI_PREFIX(f25)
 #define casadi_f3 CASADI_PREFIX(f3)
 #define casadi_f4 CASADI_PREFIX(f4)
 #define casadi_f5 CASADI_PREFIX(f5)
@@ -146,11 +147,11 @@ static const casadi_int casadi_s3[3] = {2, 2, 1};
 static const casadi_int casadi_s4[3] = {5, 1, 1};
 static const casadi_int casadi_s5[3] = {6, 200, 1};
 static const casadi_int casadi_s6[2] = {0};
-static const casadi_int casadi_s7[4] = {0};
-static const casadi_int casadi_s8[6] = {0};
-static const casadi_int casadi_s9[5] = {0};
-static const casadi_int casadi_s10[9] = 
+static const casadi_int casadi_s7[6] = {0};
+static const casadi_int casadi_s8[5] = {0};
+static const casadi_int casadi_s9[9] = 
   {0};
+static const casadi_int casadi_s10[4] = {0};
 static const casadi_int casadi_s11[3] = {2, 50, 1};
 static const casadi_int casadi_s12[3] = {1, 50, 1};
 static const casadi_int casadi_s13[3] = {2, 200, 1};
@@ -848,220 +849,6 @@ static inline void gs_transpose(const casadi_real* restrict x, casadi_int n, cas
 static inline void gs_store(const casadi_real* x, casadi_int n, casadi_real* y, casadi_int at) {
   casadi_int i;
   if (y) for (i = 0; i < n; ++i) y[at + i] = x[i];
-}
-
-/* tangent_try, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
-  casadi_real a24;
-  a00=A0[0];
-  a01=A3[4];
-  a02=6.;
-  a02=(a01/a02);
-  a03=A0[1];
-  a04=2.;
-  a04=(a01/a04);
-  a05=A3[2];
-  a06=(a03*a05);
-  a07=A3[3];
-  a08=A2[1];
-  a08=(a07*a08);
-  a06=(a06+a08);
-  a08=A3[1];
-  a09=A2[0];
-  a09=(a08*a09);
-  a10=A3[0];
-  a11=0.;
-  a12=(a00+a10);
-  a13=(-a12);
-  a13=(a11<=a13);
-  a14=(a10*a13);
-  a15=(a11<=a00);
-  a16=(a15+a13);
-  a17=(a00*a16);
-  a17=(a14+a17);
-  a17=(a09*a17);
-  a06=(a06+a17);
-  a17=(a04*a06);
-  a17=(a03+a17);
-  a18=(2.*a17);
-  a18=(a03+a18);
-  a19=(a17*a05);
-  a20=A2[3];
-  a20=(a07*a20);
-  a19=(a19+a20);
-  a21=A2[2];
-  a21=(a08*a21);
-  a22=(a04*a03);
-  a22=(a00+a22);
-  a22=(a22*a16);
-  a22=(a14+a22);
-  a22=(a21*a22);
-  a19=(a19+a22);
-  a22=(a04*a19);
-  a22=(a03+a22);
-  a23=(2.*a22);
-  a18=(a18+a23);
-  a23=(a22*a05);
-  a23=(a23+a20);
-  a17=(a04*a17);
-  a17=(a00+a17);
-  a17=(a17*a16);
-  a17=(a14+a17);
-  a17=(a21*a17);
-  a23=(a23+a17);
-  a17=(a01*a23);
-  a17=(a03+a17);
-  a18=(a18+a17);
-  a18=(a02*a18);
-  a18=(a00+a18);
-  R0[0]=a18;
-  a19=(2.*a19);
-  a06=(a06+a19);
-  a23=(2.*a23);
-  a06=(a06+a23);
-  a17=(a17*a05);
-  a23=A2[5];
-  a07=(a07*a23);
-  a17=(a17+a07);
-  a07=A2[4];
-  a08=(a08*a07);
-  a22=(a01*a22);
-  a22=(a00+a22);
-  a22=(a22*a16);
-  a14=(a14+a22);
-  a14=(a08*a14);
-  a17=(a17+a14);
-  a06=(a06+a17);
-  a06=(a02*a06);
-  a06=(a03+a06);
-  R0[1]=a06;
-  a17=A1[0];
-  a14=A1[1];
-  a09=(a09*a16);
-  a22=(a09*a17);
-  a07=(a05*a14);
-  a22=(a22+a07);
-  a07=(a04*a22);
-  a07=(a14+a07);
-  a23=(2.*a07);
-  a23=(a14+a23);
-  a21=(a21*a16);
-  a19=(a04*a14);
-  a19=(a17+a19);
-  a19=(a21*a19);
-  a20=(a05*a07);
-  a19=(a19+a20);
-  a20=(a04*a19);
-  a20=(a14+a20);
-  a24=(2.*a20);
-  a23=(a23+a24);
-  a07=(a04*a07);
-  a07=(a17+a07);
-  a07=(a21*a07);
-  a24=(a05*a20);
-  a07=(a07+a24);
-  a24=(a01*a07);
-  a24=(a14+a24);
-  a23=(a23+a24);
-  a23=(a02*a23);
-  a23=(a17+a23);
-  R1[0]=a23;
-  a19=(2.*a19);
-  a22=(a22+a19);
-  a07=(2.*a07);
-  a22=(a22+a07);
-  a08=(a08*a16);
-  a20=(a01*a20);
-  a17=(a17+a20);
-  a17=(a08*a17);
-  a24=(a05*a24);
-  a17=(a17+a24);
-  a22=(a22+a17);
-  a22=(a02*a22);
-  a14=(a14+a22);
-  R1[1]=a14;
-  a14=A1[2];
-  a22=A1[3];
-  a09=(a09*a14);
-  a17=(a05*a22);
-  a09=(a09+a17);
-  a17=(a04*a09);
-  a17=(a22+a17);
-  a24=(2.*a17);
-  a24=(a22+a24);
-  a20=(a04*a22);
-  a20=(a14+a20);
-  a20=(a21*a20);
-  a16=(a05*a17);
-  a20=(a20+a16);
-  a16=(a04*a20);
-  a16=(a22+a16);
-  a07=(2.*a16);
-  a24=(a24+a07);
-  a04=(a04*a17);
-  a04=(a14+a04);
-  a21=(a21*a04);
-  a04=(a05*a16);
-  a21=(a21+a04);
-  a04=(a01*a21);
-  a04=(a22+a04);
-  a24=(a24+a04);
-  a24=(a02*a24);
-  a24=(a14+a24);
-  R1[2]=a24;
-  a20=(2.*a20);
-  a09=(a09+a20);
-  a21=(2.*a21);
-  a09=(a09+a21);
-  a16=(a01*a16);
-  a14=(a14+a16);
-  a08=(a08*a14);
-  a05=(a05*a04);
-  a08=(a08+a05);
-  a09=(a09+a08);
-  a02=(a02*a09);
-  a22=(a22+a02);
-  R1[3]=a22;
-  a15=(2.*a15);
-  a22=1.;
-  a15=(a15-a22);
-  a02=(a15*a18);
-  a02=(a11<a02);
-  a03=(a01*a03);
-  a09=3.;
-  a03=(a03/a09);
-  a00=(a00+a03);
-  a00=(a15*a00);
-  a00=(a11<a00);
-  a02=(a02&&a00);
-  a01=(a01*a06);
-  a01=(a01/a09);
-  a09=(a18-a01);
-  a15=(a15*a09);
-  a15=(a11<a15);
-  a02=(a02&&a15);
-  a02=(!a02);
-  a13=(2.*a13);
-  a13=(a13-a22);
-  a18=(a18+a10);
-  a10=(a13*a18);
-  a10=(-a10);
-  a10=(a11<a10);
-  a12=(a12+a03);
-  a12=(a13*a12);
-  a12=(-a12);
-  a12=(a11<a12);
-  a10=(a10&&a12);
-  a01=(a01-a18);
-  a13=(a13*a01);
-  a13=(a11<a13);
-  a10=(a10&&a13);
-  a10=(!a10);
-  a02=(a02+a10);
-  a11=(a11<a02);
-  R2[0]=a11;
 }
 
 /* tangent_keep, from CasADi's C of it */
@@ -2315,6 +2102,197 @@ static GEARSYM_NOINLINE void gs_state_mode_step(const casadi_real* restrict A0, 
   R0[1]=a03;
 }
 
+/* tangent_state, from CasADi's C of it */
+static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+  a00=A0[0];
+  a01=A2[4];
+  a02=6.;
+  a02=(a01/a02);
+  a03=A0[1];
+  a04=2.;
+  a04=(a01/a04);
+  a05=A2[2];
+  a06=(a03*a05);
+  a07=A2[3];
+  a08=A1[1];
+  a08=(a07*a08);
+  a06=(a06+a08);
+  a08=A2[1];
+  a09=A1[0];
+  a09=(a08*a09);
+  a10=A2[0];
+  a11=0.;
+  a12=(a00+a10);
+  a13=(-a12);
+  a13=(a11<=a13);
+  a14=(a10*a13);
+  a15=(a11<=a00);
+  a16=(a15+a13);
+  a17=(a00*a16);
+  a17=(a14+a17);
+  a17=(a09*a17);
+  a06=(a06+a17);
+  a17=(a04*a06);
+  a17=(a03+a17);
+  a18=(2.*a17);
+  a18=(a03+a18);
+  a19=(a17*a05);
+  a20=A1[3];
+  a20=(a07*a20);
+  a19=(a19+a20);
+  a21=A1[2];
+  a21=(a08*a21);
+  a22=(a04*a03);
+  a22=(a00+a22);
+  a22=(a22*a16);
+  a22=(a14+a22);
+  a22=(a21*a22);
+  a19=(a19+a22);
+  a22=(a04*a19);
+  a22=(a03+a22);
+  a23=(2.*a22);
+  a18=(a18+a23);
+  a23=(a22*a05);
+  a23=(a23+a20);
+  a04=(a04*a17);
+  a04=(a00+a04);
+  a04=(a04*a16);
+  a04=(a14+a04);
+  a04=(a21*a04);
+  a23=(a23+a04);
+  a04=(a01*a23);
+  a04=(a03+a04);
+  a18=(a18+a04);
+  a18=(a02*a18);
+  a18=(a00+a18);
+  R0[0]=a18;
+  a19=(2.*a19);
+  a06=(a06+a19);
+  a23=(2.*a23);
+  a06=(a06+a23);
+  a04=(a04*a05);
+  a23=A1[5];
+  a07=(a07*a23);
+  a04=(a04+a07);
+  a07=A1[4];
+  a08=(a08*a07);
+  a22=(a01*a22);
+  a22=(a00+a22);
+  a22=(a22*a16);
+  a14=(a14+a22);
+  a14=(a08*a14);
+  a04=(a04+a14);
+  a06=(a06+a04);
+  a02=(a02*a06);
+  a02=(a03+a02);
+  R0[1]=a02;
+  a15=(2.*a15);
+  a06=1.;
+  a15=(a15-a06);
+  a04=(a15*a18);
+  a04=(a11<a04);
+  a03=(a01*a03);
+  a14=3.;
+  a03=(a03/a14);
+  a00=(a00+a03);
+  a00=(a15*a00);
+  a00=(a11<a00);
+  a04=(a04&&a00);
+  a01=(a01*a02);
+  a01=(a01/a14);
+  a14=(a18-a01);
+  a15=(a15*a14);
+  a15=(a11<a15);
+  a04=(a04&&a15);
+  a04=(!a04);
+  a13=(2.*a13);
+  a13=(a13-a06);
+  a18=(a18+a10);
+  a10=(a13*a18);
+  a10=(-a10);
+  a10=(a11<a10);
+  a12=(a12+a03);
+  a12=(a13*a12);
+  a12=(-a12);
+  a12=(a11<a12);
+  a10=(a10&&a12);
+  a01=(a01-a18);
+  a13=(a13*a01);
+  a13=(a11<a13);
+  a10=(a10&&a13);
+  a10=(!a10);
+  a04=(a04+a10);
+  a11=(a11<a04);
+  R1[0]=a11;
+  a09=(a09*a16);
+  R2[0]=a09;
+  R2[1]=a05;
+  a21=(a21*a16);
+  R2[2]=a21;
+  R2[3]=a21;
+  a08=(a08*a16);
+  R2[4]=a08;
+}
+
+/* tangent_vector, from CasADi's C of it */
+static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  a00=A0[0];
+  a01=A2[4];
+  a02=6.;
+  a02=(a01/a02);
+  a03=A0[2];
+  a04=2.;
+  a04=(a01/a04);
+  a05=A1[0];
+  a05=(a05*a00);
+  a06=A1[1];
+  a07=(a06*a03);
+  a05=(a05+a07);
+  a07=(a04*a05);
+  a07=(a03+a07);
+  a08=(2.*a07);
+  a08=(a03+a08);
+  a09=A1[2];
+  a10=(a04*a03);
+  a10=(a00+a10);
+  a09=(a09*a10);
+  a10=(a06*a07);
+  a09=(a09+a10);
+  a10=(a04*a09);
+  a10=(a03+a10);
+  a11=(2.*a10);
+  a08=(a08+a11);
+  a11=A1[3];
+  a04=(a04*a07);
+  a04=(a00+a04);
+  a11=(a11*a04);
+  a04=(a06*a10);
+  a11=(a11+a04);
+  a04=(a01*a11);
+  a04=(a03+a04);
+  a08=(a08+a04);
+  a08=(a02*a08);
+  a08=(a00+a08);
+  R0[0]=a08;
+  a09=(2.*a09);
+  a05=(a05+a09);
+  a11=(2.*a11);
+  a05=(a05+a11);
+  a11=A1[4];
+  a01=(a01*a10);
+  a00=(a00+a01);
+  a11=(a11*a00);
+  a06=(a06*a04);
+  a11=(a11+a06);
+  a05=(a05+a11);
+  a02=(a02*a05);
+  a03=(a03+a02);
+  R0[2]=a03;
+}
+
 /* gram_schmidt, from CasADi's C of it */
 static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
   casadi_real a0, a1, a2, a3, a4, a5, a6;
@@ -2395,23 +2373,30 @@ static GEARSYM_NOINLINE void gs_state_split(const casadi_real* restrict y, const
 
 /* one block of tangent steps (the SX functions' step, as CasADi's Switch runs it) */
 static GEARSYM_INLINE void gs_tangent_step(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
-  casadi_real yt[2]; casadi_real Qt[4]; casadi_real flag;
-  gs_tangent_try(y, Q, T, c, yt, Qt, &flag);
-  if (GEARSYM_UNLIKELY(flag != 0)) gs_tangent_split(y, Q, lo, hi, yt, Qt, T, c, y1, Q1, lo1, hi1);
-  else gs_tangent_keep(y, Q, lo, hi, yt, Qt, T, c, y1, Q1, lo1, hi1);
+  casadi_real yt[2], flag, J[5]; casadi_int j;
+  gs_tangent_state(y, T, c, yt, &flag, J);
+  if (GEARSYM_UNLIKELY(flag != 0)) {
+    casadi_real Qc[4], Qc1[4];  /* (the try's tangent, an input the split does not read: Qc) */
+    gs_transpose(Q, 2, Qc);
+    gs_tangent_split(y, Qc, lo, hi, yt, Qc, T, c, y1, Qc1, lo1, hi1);
+    gs_transpose(Qc1, 2, Q1);
+  } else {
+    GEARSYM_NOT_UNROLLED for (j = 0; j < 2; ++j) gs_tangent_vector(Q + j, J, c, Q1 + j);
+    gs_state_keep(y, lo, hi, yt, T, c, y1, lo1, hi1);
+  }
 }
 
 /* blocks of tangent steps from (y, Q, lo, hi), in place: the state in local arrays, a -> b -> a */
 static GEARSYM_NOINLINE void gs_tangent_span(casadi_real* restrict y, casadi_real* restrict Q, casadi_real* restrict lo, casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_int blocks) {
   casadi_real ya[2], yb[2]; casadi_real Qa[4], Qb[4]; casadi_real loa[1], lob[1]; casadi_real hia[1], hib[1];
   casadi_int k;
-  gs_copy(y, 2, ya); gs_copy(Q, 4, Qa); gs_copy(lo, 1, loa); gs_copy(hi, 1, hia);
+  gs_copy(y, 2, ya); gs_transpose(Q, 2, Qa); gs_copy(lo, 1, loa); gs_copy(hi, 1, hia);
   for (k = 0; k < blocks; k += 2) {  /* (an odd number of blocks ends in the middle) */
     gs_tangent_step(ya, Qa, loa, hia, T + 6*(k), c, yb, Qb, lob, hib);
-    if (k + 1 == blocks) { gs_copy(yb, 2, y); gs_copy(Qb, 4, Q); gs_copy(lob, 1, lo); gs_copy(hib, 1, hi); return; }
+    if (k + 1 == blocks) { gs_copy(yb, 2, y); gs_transpose(Qb, 2, Q); gs_copy(lob, 1, lo); gs_copy(hib, 1, hi); return; }
     gs_tangent_step(yb, Qb, lob, hib, T + 6*(k + 1), c, ya, Qa, loa, hia);
   }
-  gs_copy(ya, 2, y); gs_copy(Qa, 4, Q); gs_copy(loa, 1, lo); gs_copy(hia, 1, hi);
+  gs_copy(ya, 2, y); gs_transpose(Qa, 2, Q); gs_copy(loa, 1, lo); gs_copy(hia, 1, hi);
 }
 
 /* one block of state steps (the SX functions' step, as CasADi's Switch runs it) */
@@ -2527,7 +2512,7 @@ CASADI_SYMBOL_EXPORT int lyapunov_chunk_work(casadi_int *sz_arg, casadi_int* sz_
   if (sz_arg) *sz_arg = 12;
   if (sz_res) *sz_res = 9;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 331;
+  if (sz_w) *sz_w = 335;
   return 0;
 }
 
@@ -2535,12 +2520,12 @@ CASADI_SYMBOL_EXPORT int lyapunov_chunk_work_bytes(casadi_int *sz_arg, casadi_in
   if (sz_arg) *sz_arg = 12*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 9*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 331*sizeof(casadi_real);
+  if (sz_w) *sz_w = 335*sizeof(casadi_real);
   return 0;
 }
 
 /* lyapunov_period:(y0[2],Q0[2x2],table[6x200],c[5])->(strobe[2],Q[2x2],log_stretch[2],low,high) */
-static int casadi_f17(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f19(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[2], lo[1], hi[1], c[5]; casadi_real Q[4];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -2559,7 +2544,7 @@ static int casadi_f17(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f17(arg, res, iw, w, mem);
+  return casadi_f19(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int lyapunov_period_checkout(void) {
@@ -2631,7 +2616,7 @@ CASADI_SYMBOL_EXPORT int lyapunov_period_work(casadi_int *sz_arg, casadi_int* sz
   if (sz_arg) *sz_arg = 12;
   if (sz_res) *sz_res = 9;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 82;
+  if (sz_w) *sz_w = 86;
   return 0;
 }
 
@@ -2639,12 +2624,12 @@ CASADI_SYMBOL_EXPORT int lyapunov_period_work_bytes(casadi_int *sz_arg, casadi_i
   if (sz_arg) *sz_arg = 12*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 9*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 82*sizeof(casadi_real);
+  if (sz_w) *sz_w = 86*sizeof(casadi_real);
   return 0;
 }
 
 /* orbit_chunk:(y0[2],table[6x200],c[5])->(strobe[2x50],low[1x50],high[1x50]) */
-static int casadi_f18(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f20(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[2], lo[1], hi[1], c[5];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
@@ -2658,7 +2643,7 @@ static int casadi_f18(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int orbit_chunk(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f18(arg, res, iw, w, mem);
+  return casadi_f20(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int orbit_chunk_checkout(void) {
@@ -2737,7 +2722,7 @@ CASADI_SYMBOL_EXPORT int orbit_chunk_work_bytes(casadi_int *sz_arg, casadi_int* 
 }
 
 /* orbit_period:(y0[2],table[6x200],c[5])->(strobe[2],low,high) */
-static int casadi_f21(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f22(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[2], lo[1], hi[1], c[5];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
@@ -2751,7 +2736,7 @@ static int casadi_f21(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int orbit_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f21(arg, res, iw, w, mem);
+  return casadi_f22(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int orbit_period_checkout(void) {
@@ -2830,7 +2815,7 @@ CASADI_SYMBOL_EXPORT int orbit_period_work_bytes(casadi_int *sz_arg, casadi_int*
 }
 
 /* trajectory:(y0[2],table[6x200],c[5])->(states[2x200]) */
-static int casadi_f22(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f23(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[2], lo[1], hi[1], c[5];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
@@ -2844,7 +2829,7 @@ static int casadi_f22(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int trajectory(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f22(arg, res, iw, w, mem);
+  return casadi_f23(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int trajectory_checkout(void) {
@@ -2919,7 +2904,7 @@ CASADI_SYMBOL_EXPORT int trajectory_work_bytes(casadi_int *sz_arg, casadi_int* s
 }
 
 /* monodromy_segment:(y0[2],Q0[2x2],table[6x50],c[5])->(strobe[2],M[2x2],low,high) */
-static int casadi_f23(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f24(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[2], lo[1], hi[1], c[5]; casadi_real Q[4];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -2933,7 +2918,7 @@ static int casadi_f23(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f23(arg, res, iw, w, mem);
+  return casadi_f24(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_segment_checkout(void) {
@@ -3003,7 +2988,7 @@ CASADI_SYMBOL_EXPORT int monodromy_segment_work(casadi_int *sz_arg, casadi_int* 
   if (sz_arg) *sz_arg = 12;
   if (sz_res) *sz_res = 8;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 82;
+  if (sz_w) *sz_w = 86;
   return 0;
 }
 
@@ -3011,12 +2996,12 @@ CASADI_SYMBOL_EXPORT int monodromy_segment_work_bytes(casadi_int *sz_arg, casadi
   if (sz_arg) *sz_arg = 12*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 8*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 82*sizeof(casadi_real);
+  if (sz_w) *sz_w = 86*sizeof(casadi_real);
   return 0;
 }
 
 /* monodromy_period:(y0[2],Q0[2x2],table[6x200],c[5])->(strobe[2],M[2x2],low,high) */
-static int casadi_f24(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+static int casadi_f25(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[2], lo[1], hi[1], c[5]; casadi_real Q[4];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
@@ -3036,7 +3021,7 @@ static int casadi_f24(const casadi_real** arg, casadi_real** res, casadi_int* iw
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f24(arg, res, iw, w, mem);
+  return casadi_f25(arg, res, iw, w, mem);
 }
 
 CASADI_SYMBOL_EXPORT int monodromy_period_checkout(void) {
@@ -3106,7 +3091,7 @@ CASADI_SYMBOL_EXPORT int monodromy_period_work(casadi_int *sz_arg, casadi_int* s
   if (sz_arg) *sz_arg = 12;
   if (sz_res) *sz_res = 8;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 82;
+  if (sz_w) *sz_w = 86;
   return 0;
 }
 
@@ -3114,7 +3099,7 @@ CASADI_SYMBOL_EXPORT int monodromy_period_work_bytes(casadi_int *sz_arg, casadi_
   if (sz_arg) *sz_arg = 12*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 8*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 82*sizeof(casadi_real);
+  if (sz_w) *sz_w = 86*sizeof(casadi_real);
   return 0;
 }
 
