@@ -177,6 +177,18 @@ def test_resuming_with_other_options_says_what_differs(tmp_path, one_stage):
     assert read_sweep(out).record["periods"] == 80
 
 
+def test_a_cache_of_sweeps_starts_again_what_another_sweep_wrote_and_resumes_its_own(tmp_path, one_stage):
+    out, computed = tmp_path / "s.csv", []
+    run_sweep(one_stage, ["omega=1,1.1"], out=out, **SHORT)
+    run_sweep(one_stage, ["omega=1,1.1"], out=out, **SHORT, overwrite="stale", on_point=computed.append)
+    assert computed == []  # the same sweep: resumed, nothing to do
+    run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80), progress=False, overwrite="stale",
+              on_point=computed.append)
+    assert len(computed) == 2 and read_sweep(out).record["periods"] == 80
+    with pytest.raises(GearsymError, match="overwrite must be False, True or 'stale', not 'yes'"):
+        run_sweep(one_stage, ["omega=1,1.1"], out=out, **SHORT, overwrite="yes")
+
+
 def test_a_damaged_sweep_file_is_named_with_its_row(tmp_path, one_stage):
     out = tmp_path / "s.csv"
     run_sweep(one_stage, ["omega=1:1.3:0.1"], out=out, **SHORT)

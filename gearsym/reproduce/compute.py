@@ -57,6 +57,7 @@ def compute(plan: Plan, data_dir: str | Path, *, jobs: int = 0, progress: bool =
              + "".join(f" {k}={v}" for k, v in job.settings.items()))
         sweeps[job.name] = run_sweep(compiled[job.model], job.params, mode="continuation", direction=job.direction,
                                      workers=Workers(jobs), out=data_dir / f"{job.name}.csv", poincare=job.poincare,
+                                     overwrite="stale",  # (the data are a cache: a changed model starts again)
                                      progress=progress, **job.settings)
     attractors = {}
     transient = scheme.run(plan.attractor_discard + plan.attractor_periods, plan.attractor_discard)

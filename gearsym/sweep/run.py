@@ -105,7 +105,7 @@ def run_sweep(
     direction: str = "up",
     y0=None,
     out: str | Path | None = None,
-    overwrite: bool = False,
+    overwrite: bool | str = False,
     poincare: int = POINCARE_SAMPLES,
     workers: Workers = Workers(),
     progress: bool = True,
@@ -119,7 +119,8 @@ def run_sweep(
     periods per point and the scheme. ``mode="continuation"`` hands each point's final state to the next
     along the first axis (the paper's procedure), ``"independent"`` starts every point from ``y0``
     (default: the model's declared initial state). ``out``: write ``out`` (CSV), its ``.json`` record and
-    ``.poincare.csv`` as points finish, resuming if they exist. ``workers``: where the points run
+    ``.poincare.csv`` as points finish, resuming if they exist (``overwrite=True``: starting again;
+    ``"stale"``: starting again only files another sweep or model wrote). ``workers``: where the points run
     (:class:`Workers`). ``on_point(row)`` is called in the main thread after each point is stored.
     """
     options = model.run_options(options)

@@ -99,10 +99,16 @@ class SweepStore:
         self._failed: BaseException | None = None
 
     # ------------------------------------------------------------ opening
-    def open(self, overwrite: bool = False) -> tuple[dict[tuple, dict], dict[tuple, PoincareRows]]:
-        """Start the files, or resume them: returns the rows already done (and their Poincare rows) by key."""
+    def open(self, overwrite: bool | str = False) -> tuple[dict[tuple, dict], dict[tuple, PoincareRows]]:
+        """Start the files, or resume them: returns the rows already done (and their Poincare rows) by key.
+        ``overwrite="stale"``: start again files that another sweep wrote (or a changed model), resume the
+        same sweep's: how a cache of sweeps (the reproduction's data) is kept."""
+        if overwrite not in (False, True, "stale"):
+            raise GearsymError(f"overwrite must be False, True or 'stale', not {overwrite!r}")
         self._lock()
         done, strobes = {}, {}
+        if overwrite == "stale":
+            overwrite = self.path.exists() and self._record_differs() is not None
         if overwrite:
             for p in (self.path, self.meta_path, self.strobe_path):
                 p.unlink(missing_ok=True)
@@ -135,20 +141,27 @@ class SweepStore:
             raise GearsymError(f"{self.path}: a swept parameter is not a number: {exc}") from None
 
     def _check_record(self) -> None:
+        why = self._record_differs()
+        if why is not None:
+            raise GearsymError(why)
+
+    def _record_differs(self) -> str | None:
+        """Why the files cannot be resumed by this sweep (their record is missing, unreadable or another
+        sweep's), or None."""
         if not self.meta_path.exists():
-            raise GearsymError(f"{self.path} exists but {self.meta_path.name} (the record of how it was made) "
-                               "does not, so it cannot be resumed: pass --overwrite or choose another --out")
+            return (f"{self.path} exists but {self.meta_path.name} (the record of how it was made) "
+                    "does not, so it cannot be resumed: pass --overwrite or choose another --out")
         try:
             old = json.loads(self.meta_path.read_text())["sweep"]
         except (json.JSONDecodeError, KeyError, TypeError) as exc:
-            raise GearsymError(f"{self.meta_path}: not a gearsym sweep record ({exc}); pass --overwrite "
-                               "or choose another --out") from None
+            return f"{self.meta_path}: not a gearsym sweep record ({exc}); pass --overwrite or choose another --out"
         new = json.loads(json.dumps(self.record))  # compare as JSON sees them
         differ = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
-        if differ:
-            detail = "; ".join(f"{k}: {_short(old.get(k))} before, {_short(new.get(k))} now" for k in differ)
-            raise GearsymError(f"{self.path} was written by a different sweep ({detail}). To resume it, repeat "
-                               "the command it came from; to start again pass --overwrite, or choose another --out")
+        if not differ:
+            return None
+        detail = "; ".join(f"{k}: {_short(old.get(k))} before, {_short(new.get(k))} now" for k in differ)
+        return (f"{self.path} was written by a different sweep ({detail}). To resume it, repeat "
+                "the command it came from; to start again pass --overwrite, or choose another --out")
 
     def _read(self, path: Path, columns: list[str]) -> dict[tuple, dict]:
         rows = {}
