@@ -252,7 +252,7 @@ def _scaling(ref, values):
     split = physical_settings(model, dict(values))
     if split is None:
         return None
-    from .physical.scaling import scaling  # (the function: the package's name may be the module by now)
+    from .physical.scales import scaling
 
     length_scale, physical, _ = split
     return scaling(model, length_scale, **physical)

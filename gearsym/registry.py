@@ -115,7 +115,7 @@ def load(ref, **values) -> FirstOrderSystem:
     values = {k: _maybe_number(v) for k, v in values.items()}
     split = physical_settings(model, values)
     if split is not None:
-        from .physical.scaling import scaling
+        from .physical.scales import scaling
 
         length_scale, physical, formulas = split
         return scaling(model, length_scale, **physical).system(**formulas)

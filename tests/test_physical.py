@@ -369,3 +369,17 @@ def test_pint_never_sees_text_outside_the_quantity_grammar(text, monkeypatch):
         parse_quantity(text, "test")
     assert all("(" not in t or t.count("(") == t.count(")") for t in seen)
     assert not any(bad in t for t in seen for bad in ("__", ".", "[", ";", "'", "lambda", "**10"))
+
+
+def test_the_physical_package_names_stay_its_functions_whatever_submodule_was_imported_first():
+    """(A submodule of the same name as a re-exported function would replace it on the package once imported.)"""
+    import subprocess
+    import sys
+
+    code = ("import importlib, pkgutil, types, gearsym.physical as ph\n"
+            "for m in pkgutil.iter_modules(ph.__path__): importlib.import_module('gearsym.physical.' + m.name)\n"
+            "from gearsym.physical import scaling\n"
+            "bad = [n for n in ph.__all__ if isinstance(getattr(ph, n), types.ModuleType)]\n"
+            "assert not bad and callable(scaling), bad\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr

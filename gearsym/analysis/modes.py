@@ -88,7 +88,7 @@ def natural_modes(model, **settings) -> Modes:
     nd = declared if isinstance(declared, NondimensionalModel) else reduce(declared)
     split = physical_settings(nd, dict(settings))
     if split is not None:
-        from ..physical.scaling import scaling
+        from ..physical.scales import scaling
 
         length_scale, physical, _ = split
         s = scaling(nd, length_scale, **physical)

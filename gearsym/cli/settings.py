@@ -32,7 +32,7 @@ def parse_settings(pairs: list[str]) -> dict[str, str]:
 
             parse_quantity(value, f"--set {name}")
         elif name == "length_scale":
-            from ..physical.scaling import check_length_scale
+            from ..physical.scales import check_length_scale
 
             check_length_scale(value, "--set length_scale")
         elif not _is_number(value):  # (a number needs no parser, and so no SymPy)

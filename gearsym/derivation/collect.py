@@ -163,7 +163,7 @@ def _scaling(nd: NondimensionalModel):
     """The model's :class:`~gearsym.physical.Scaling` at its declared physical values, or None."""
     if not nd.drivetrain.physical:
         return None
-    from ..physical.scaling import scaling
+    from ..physical.scales import scaling
 
     return scaling(nd)
 

@@ -143,7 +143,7 @@ class Drivetrain:
         """The length unit of the nondimensional model: ``"static"`` (the static deflection of the first mesh
         under the mean load: B0 = 1, the paper's convention), ``"backlash"`` (half the first mesh's backlash)
         or a length (``"1 um"``)."""
-        from ..physical.scaling import check_length_scale
+        from ..physical.scales import check_length_scale
 
         self._changed()
         self._length_scale = check_length_scale(scale, f"{self.name}: set_length_scale")

@@ -16,10 +16,10 @@ def __getattr__(name: str):
     quantity string (``physical.text``) and a model without units never need."""
     if name not in __all__:
         raise AttributeError(f"module 'gearsym.physical' has no attribute {name!r}")
-    value = getattr(importlib.import_module("gearsym.physical.scaling"), name)
+    value = getattr(importlib.import_module("gearsym.physical.scales"), name)
     globals()[name] = value
     return value
 
 
 if TYPE_CHECKING:
-    from .scaling import LENGTH_SCALES, Scaling, scaling
+    from .scales import LENGTH_SCALES, Scaling, scaling

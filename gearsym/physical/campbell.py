@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .scaling import Scaling
+from .scales import Scaling
 from .units import Quantity
 
 

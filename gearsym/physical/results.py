@@ -15,7 +15,7 @@ import sympy as sp
 
 from ..errors import GearsymError
 from ..symbols import omega as omega_symbol, phi, t
-from .scaling import Scaling, evaluate
+from .scales import Scaling, evaluate
 from .point import LENGTH_UNIT, SPEED_UNIT, VELOCITY_UNIT, Measured, MeshUnits, PhysicalPoint, PointUnits, Unit, contact
 from .units import Quantity
 

@@ -6,7 +6,7 @@ from collections.abc import Sequence
 
 from ..errors import GearsymError
 from ..sweep.grid import Axis
-from .scaling import Scaling
+from .scales import Scaling
 from .units import Quantity
 
 
