@@ -292,7 +292,7 @@ def _tangent_by_vector(sym: _Symbols, split: SplitRHS, K: int, where: str) -> di
     ``state_block``, and the Jacobian of every RK4 stage: its nonzeros that are not constants) and
     ``tangent_vector`` (one tangent vector's K steps, given those Jacobians), which the loop applies to each
     tangent vector in turn, a loop the C compiler vectorises (:func:`_by_vector`)."""
-    n, m, nc = sym.y.numel(), len(split.tables), sym.ch.numel() - 1
+    m, nc = len(split.tables), sym.ch.numel() - 1
     y, ch, h = sym.y, sym.ch, sym.ch[nc]
     f_of, J_of = _tabulated_rhs(sym, split, where)
     lo, hi = ca.SX.sym("lo", len(sym.observed)), ca.SX.sym("hi", len(sym.observed))
@@ -742,7 +742,7 @@ class _CrossingStep:
 #: delta >= 1e-5 and < 6e-5 below (the former 8 Newton iterations: up to 7e-3). That is what makes the
 #: steps' map smooth enough to continue periodic orbits: the Fig. 3 branches are the same for 8 to 24
 #: iterations, while with 5 (and the former Newton) the D = 0 period-1 branch stopped at omega = 0.21.
-_NEWTON = 8
+_HALLEY_ITERATIONS = 8
 
 
 def _first_zero(s0, d0, s1, d1, mode, fresh):
@@ -793,7 +793,7 @@ def _first_zero(s0, d0, s1, d1, mode, fresh):
     r_low, r_high = r(low), r(high)
     theta = low + (high - low) * r_low / ca.if_else(r_low == r_high, 1, r_low - r_high)  # the secant
     theta = ca.if_else(ca.logic_and(theta > low, theta <= high), theta, (low + high) / 2)
-    for _ in range(_NEWTON):
+    for _ in range(_HALLEY_ITERATIONS):
         p, dp, ddp = r(theta), dr(theta), 6 * c3 * theta + 2 * c2
         before = on(p)  # still on the start's side: the zero is later
         low, high = ca.if_else(before, theta, low), ca.if_else(before, high, theta)
