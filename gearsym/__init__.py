@@ -12,7 +12,7 @@ One flat public face; the stages behind it, each handing one type to the next:
   periodic orbits and their branches: :func:`periodic_orbit`, :func:`continue_orbits`;
 * data: :func:`simulate_measurements`, :func:`load_measurements`, :func:`explain`;
 * physical units: :func:`scaling` (a drivetrain with values in units -> its nondimensional values, and results
-  back to rpm, um, N, 1/s), :func:`natural_modes`, :func:`campbell`;
+  back to rpm, um, N, 1/s), :func:`is_physical`, :func:`natural_modes`, :func:`campbell`;
 * document: :func:`derive` and :func:`render`.
 
 The verbs are imported on first use, so ``import gearsym`` stays cheap for a command that needs few of them.
@@ -22,9 +22,6 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING
 
-import sys
-import types
-
 from .errors import GearsymError, ModelError, UnknownParameterError
 from .options import Integration
 from .version import __version__
@@ -33,60 +30,49 @@ from .version import __version__
 #: public name -> the module that defines it (imported when the name is first used: the declaring and
 #: reducing stages import SymPy, which a command on a cached model never needs)
 _LAZY = {
-    "Disk": "gearsym.model",
-    "Drivetrain": "gearsym.model",
-    "Gear": "gearsym.model",
-    "Harmonic": "gearsym.model",
-    "Mesh": "gearsym.model",
-    "Planet": "gearsym.model",
-    "Shaft": "gearsym.model",
-    "Torque": "gearsym.model",
-    "rectangular_mesh_stiffness": "gearsym.model",
-    "NondimensionalModel": "gearsym.reduce",
-    "reduce": "gearsym.reduce",
+    "Disk": "gearsym.model.components",
+    "Drivetrain": "gearsym.model.drivetrain",
+    "Gear": "gearsym.model.components",
+    "Harmonic": "gearsym.model.components",
+    "Mesh": "gearsym.model.components",
+    "Planet": "gearsym.model.components",
+    "Shaft": "gearsym.model.components",
+    "Torque": "gearsym.model.components",
+    "rectangular_mesh_stiffness": "gearsym.model.stiffness",
+    "NondimensionalModel": "gearsym.reduction",
+    "reduce": "gearsym.reduction",
     "FirstOrderSystem": "gearsym.system",
     "available_models": "gearsym.registry",
-    "load": "gearsym.registry",
+    "load": "gearsym.loading",
     "load_model": "gearsym.registry",
     "CompiledModel": "gearsym.codegen",
-    "compile_model": "gearsym.codegen",
+    "compile_model": "gearsym.codegen.build",
     "LyapunovSpectrum": "gearsym.analysis",
-    "lyapunov_spectrum": "gearsym.analysis",
-    "poincare_samples": "gearsym.analysis",
-    "phase_trajectory": "gearsym.analysis",
-    "find_attractors": "gearsym.analysis",
+    "lyapunov_spectrum": "gearsym.verbs",
+    "poincare_samples": "gearsym.verbs",
+    "phase_trajectory": "gearsym.verbs",
+    "find_attractors": "gearsym.verbs",
     "classify_regime": "gearsym.analysis",
-    "periodic_orbit": "gearsym.periodic",
-    "continue_orbits": "gearsym.periodic",
-    "run_sweep": "gearsym.sweep",
+    "periodic_orbit": "gearsym.verbs",
+    "continue_orbits": "gearsym.verbs",
+    "run_sweep": "gearsym.verbs",
     "read_sweep": "gearsym.sweep",
     "Workers": "gearsym.sweep",
     "SweepInterrupted": "gearsym.sweep",
-    "simulate_measurements": "gearsym.data",
+    "simulate_measurements": "gearsym.verbs",
     "load_measurements": "gearsym.data",
     "explain": "gearsym.fit",
     "EFFECTS": "gearsym.fit",
-    "scaling": "gearsym.physical.scales",
-    "Scaling": "gearsym.physical.scales",
-    "natural_modes": "gearsym.analysis.modes",
+    "scaling": "gearsym.loading",
+    "Scaling": "gearsym.scales.map",
+    "natural_modes": "gearsym.loading",
     "campbell": "gearsym.physical.campbell",
+    "is_physical": "gearsym.loading",
     "derive": "gearsym.derivation",
     "render": "gearsym.derivation",
 }
 
 __all__ = ["GearsymError", "Integration", "ModelError", "UnknownParameterError", *_LAZY]
-
-
-class _Package(types.ModuleType):
-    """gearsym.reduce is both a function of the face and a subpackage: importing the subpackage (gearsym.load
-    does) must not rebind the name to the package, or gearsym.reduce(drivetrain) would call the module."""
-
-    def __setattr__(self, name, value):
-        if not (name == "reduce" and isinstance(value, types.ModuleType)):
-            super().__setattr__(name, value)
-
-
-sys.modules[__name__].__class__ = _Package
 
 
 def __getattr__(name: str):
@@ -103,18 +89,21 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
-    from .analysis import (LyapunovSpectrum, classify_regime, find_attractors, lyapunov_spectrum,
-                           phase_trajectory, poincare_samples)
-    from .codegen import CompiledModel, compile_model
-    from .data import load_measurements, simulate_measurements
+    from .analysis import LyapunovSpectrum, classify_regime
+    from .codegen import CompiledModel
+    from .codegen.build import compile_model
+    from .data import load_measurements
     from .derivation import derive, render
-    from .analysis.modes import natural_modes
     from .fit import EFFECTS, explain
-    from .periodic import continue_orbits, periodic_orbit
-    from .physical import Scaling, scaling
+    from .loading import is_physical, load, natural_modes, scaling
+    from .model.components import Disk, Gear, Harmonic, Mesh, Planet, Shaft, Torque
+    from .model.drivetrain import Drivetrain
+    from .model.stiffness import rectangular_mesh_stiffness
     from .physical.campbell import campbell
-    from .model import Disk, Drivetrain, Gear, Harmonic, Mesh, Shaft, Torque, rectangular_mesh_stiffness
-    from .reduce import NondimensionalModel, reduce
-    from .registry import available_models, load, load_model
+    from .reduction import NondimensionalModel, reduce
+    from .registry import available_models, load_model
+    from .scales.map import Scaling
     from .system import FirstOrderSystem
-    from .sweep import SweepInterrupted, Workers, read_sweep, run_sweep
+    from .sweep import SweepInterrupted, Workers, read_sweep
+    from .verbs import (continue_orbits, find_attractors, lyapunov_spectrum, periodic_orbit, phase_trajectory,
+                        poincare_samples, run_sweep, simulate_measurements)

@@ -28,15 +28,19 @@ from dataclasses import asdict, dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
 
+from .codegen.compiled import CompiledModel
 from .codegen.compiler import binary_key, cache_dir, compile_flags
+from .codegen.library import LOADED, library_functions, resolve_backend
 from .codegen.loops import LoopOptions
+from .codegen.native import load_native
 from .files import write_atomically
 from .options import Integration
 from .parameters import Constraint, ParameterChecks
-from .registry import load, load_model, models_dir, physical_settings
+from .physical.point import CachedScaling, PointUnits
+from .registry import model_file, models_dir
 
 #: bump when what a summary holds changes
-SUMMARY_FORMAT = 2
+SUMMARY_FORMAT = 3
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,12 +109,6 @@ class SystemSummary(ParameterChecks):
                    dict(system.constraints), system.autonomous, physical, lambda: system)
 
 
-def model_file(ref: str) -> Path | None:
-    """The file of a model name or path (None for a name that is no model: the loader says why)."""
-    path = Path(ref) if ref.endswith(".py") or "/" in ref else models_dir() / f"{ref}.py"
-    return path.resolve() if path.is_file() else None
-
-
 @lru_cache(maxsize=None)
 def _source_digest(folder: Path) -> str:
     """Every Python file below ``folder`` (gearsym's own code: whatever derives a system) by its size and time of
@@ -164,45 +162,45 @@ def write_json(path: Path, data: dict) -> None:
     write_atomically(path, json.dumps({"format": SUMMARY_FORMAT, **data}, indent=1) + "\n")
 
 
-def load_compiled(ref: str, values: Mapping[str, object], options: Integration, *, verbose: bool = False):
+def load_compiled(ref: str, values: Mapping[str, object], options: Integration, *,
+                  compile: Callable[[], object], scaling: Callable[[], object], verbose: bool = False):
     """The compiled model of the model ``ref`` (a name or a file) with ``values``: from its summaries in the
-    cache when they and its library are there, else loaded, reduced and compiled (and the summaries written)."""
-    from .codegen.build import _resolve_backend
-
+    cache when they and its library are there, else ``compile()`` (the model loaded, reduced and compiled) and
+    the summaries written; ``scaling()`` gives its scaling (None without physical values) for them. The two
+    callables are the caller's (the command line's face), so that this module never loads the generator."""
     path = model_file(ref) if isinstance(ref, str) else None
-    if path is None or _resolve_backend(options.backend) != "compiled":
-        return _compile(ref, values, options, verbose)
+    if path is None or resolve_backend(options.backend) != "compiled":
+        return compile()
     key, loops = system_key(path, values), LoopOptions.of(options)
     system_file = summary_path(path.stem, key)
     build_file = summary_path(path.stem, f"{key}-{loops_key(loops)}")
-    compiled = _from_cache(system_file, build_file, ref, values, options, loops)
+    compiled = _from_cache(system_file, build_file, options, loops, lambda: compile().system)
     if compiled is not None:
         return compiled
-    compiled = _compile(ref, values, options, verbose)
-    physical = _scaling(ref, values)
-    units = None if physical is None else _point_units(physical)
+    compiled = compile()
+    physical = scaling()
+    units = None if physical is None else physical.point_units()
     write_json(system_file, {"system": SystemSummary.of(compiled.system, physical is not None).as_dict(),
                              "physical": units and units.as_dict()})
     write_json(build_file, {"hash": compiled.hash, "library": str(compiled.library),
-                            "timed_parameters": sorted(compiled.timed_parameters)})
+                            "timed_parameters": sorted(compiled.timed_parameters),
+                            "table_texts": list(compiled.table_texts)})
     return compiled
 
 
-def cached_scaling(ref: str, values: Mapping[str, object]):
-    """The :class:`~gearsym.physical.Scaling` of ``ref`` with ``values`` (None for a model without physical
-    values): a :class:`~gearsym.physical.point.CachedScaling` when the cache has its numbers (a spectrum run
-    then needs neither pint nor the reduction), else made (the model loaded and reduced)."""
-    from .physical.point import CachedScaling, PointUnits
-
+def cached_scaling(ref: str, values: Mapping[str, object], scaling: Callable[[], object]):
+    """The scaling of ``ref`` with ``values`` (None for a model without physical values): a
+    :class:`~gearsym.physical.point.CachedScaling` when the cache has its numbers (a spectrum run then needs
+    neither pint nor the reduction), else ``scaling()`` (the model loaded and reduced)."""
     data = _system_data(ref, values)
     try:
         if data is not None and not data["system"]["physical"]:
             return None
         if data is not None and data["physical"]:
-            return CachedScaling(PointUnits.from_dict(data["physical"]), lambda: _scaling(ref, values))
+            return CachedScaling(PointUnits.from_dict(data["physical"]), scaling)
     except (KeyError, TypeError, ValueError, AttributeError):
         pass
-    return _scaling(ref, values)
+    return scaling()
 
 
 def _system_data(ref, values) -> dict | None:
@@ -210,55 +208,21 @@ def _system_data(ref, values) -> dict | None:
     return read_json(summary_path(path.stem, system_key(path, values))) if path else None
 
 
-def _from_cache(system_file: Path, build_file: Path, ref, values, options: Integration, loops: LoopOptions):
-    import casadi as ca
-
-    from .codegen.build import FUNCTION_NAMES, _LOADED
-    from .codegen.compiled import CompiledModel
-    from .codegen.native import load_native
-
+def _from_cache(system_file: Path, build_file: Path, options: Integration, loops: LoopOptions,
+                full: Callable[[], object]):
     data, build = read_json(system_file), read_json(build_file)
     try:
-        summary = SystemSummary.from_dict(data["system"], lambda: _load(ref, values))
+        summary = SystemSummary.from_dict(data["system"], full)
         digest, library, timed = str(build["hash"]), Path(build["library"]), frozenset(build["timed_parameters"])
+        texts = tuple(str(t) for t in build["table_texts"])
     except (KeyError, TypeError, ValueError, AttributeError):
         return None
     if not library.is_file() or library.resolve().parent != (cache_dir() / "lib").resolve():
         return None  # (only a library of our own cache is loaded)
     key = (digest, "compiled")
-    if key in _LOADED:  # (loaded in this process already: its functions with work arrays of their own)
-        compiled = replace(_LOADED[key].clone(), system=summary, integration=options)
-    else:
-        functions = {name: ca.external(name, str(library)) for name in FUNCTION_NAMES}
-        compiled = _LOADED[key] = CompiledModel(summary, loops, digest, functions, "compiled", library, {},
-                                                load_native(library, functions), options)
-    compiled.__dict__["timed_parameters"] = timed  # (a cached_property: computing it needs the equations)
+    if key in LOADED:  # (loaded in this process already: its functions with work arrays of their own)
+        return replace(LOADED[key].clone(), system=summary, integration=options)
+    functions = library_functions(library)
+    compiled = LOADED[key] = CompiledModel(summary, loops, digest, functions, "compiled", library, {},
+                                           load_native(library, functions), options, timed, texts)
     return compiled
-
-
-def _compile(ref, values, options: Integration, verbose: bool):
-    from .codegen.build import compile_model
-
-    return compile_model(_load(ref, values), options, verbose=verbose)
-
-
-def _load(ref, values):
-    return load(ref, **values)
-
-
-def _scaling(ref, values):
-    """The Scaling of the model ``ref`` with ``values``, or None for a model without physical values."""
-    model = load_model(ref)
-    split = physical_settings(model, dict(values))
-    if split is None:
-        return None
-    from .physical.scales import scaling
-
-    length_scale, physical, _ = split
-    return scaling(model, length_scale, **physical)
-
-
-def _point_units(physical):
-    from .physical.results import point_units
-
-    return point_units(physical)

@@ -1,7 +1,7 @@
 """The low-level entry: a first-order ODE dy/dtime = f(time, y, p) given as SymPy expressions.
 
 Every model ends up here: a reduced drivetrain becomes one (see
-:meth:`gearsym.reduce.NondimensionalModel.system`), and plain ODEs such as
+:meth:`gearsym.reduction.NondimensionalModel.system`), and plain ODEs such as
 Lorenz are declared directly with :meth:`FirstOrderSystem.from_equations`.
 The compiled engine takes nothing else, so it is one engine for both.
 """
@@ -14,6 +14,7 @@ from functools import cached_property
 
 import sympy as sp
 
+from .declared import Model
 from .errors import ModelError, UnknownParameterError
 from .model.expressions import ExprLike, to_expr
 from .parameters import Constraint, ParameterChecks
@@ -57,7 +58,7 @@ class Coupling:
 
 
 @dataclass(frozen=True)
-class FirstOrderSystem(ParameterChecks):
+class FirstOrderSystem(ParameterChecks, Model):
     """dy/d(time) = rhs(time, y, p), with named parameters and their values.
 
     ``period`` is the forcing period in ``time`` (2*pi for the gear models):
@@ -161,6 +162,10 @@ class FirstOrderSystem(ParameterChecks):
     @property
     def state_names(self) -> tuple[str, ...]:
         return tuple(s.name for s in self.states)
+
+    @property
+    def time_name(self) -> str:
+        return self.time.name
 
     def coupling(self, coordinate: str) -> Coupling:
         """The coupling whose relative coordinate is ``coordinate``."""

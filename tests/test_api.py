@@ -127,8 +127,8 @@ def test_import_gearsym_is_cheap_and_every_public_name_resolves():
 
 
 def test_gearsym_reduce_stays_the_function_once_its_subpackage_is_imported():
-    out = run_python("import gearsym, gearsym.reduce.nondimensional, gearsym.registry\n"
-                     "from gearsym.reduce import reduce\n"
+    out = run_python("import gearsym, gearsym.reduction.nondimensional, gearsym.registry\n"
+                     "from gearsym.reduction import reduce\n"
                      "print(gearsym.reduce is reduce, callable(gearsym.reduce))\n")
     assert out.split() == ["True", "True"]
 

@@ -251,11 +251,11 @@ def test_cli_text_lists_attractors_and_runs_and_plots(capsys, tmp_path):
 
 
 def test_cli_plot_shows_the_coordinate_asked_for(capsys, tmp_path, monkeypatch):
-    import gearsym.figures.poincare as figures
+    import gearsym.cli.poincare as command
 
     drawn = []
-    real = figures.plot_attractors
-    monkeypatch.setattr(figures, "plot_attractors", lambda *a, **k: drawn.append((a, real(*a, **k))) or drawn[-1][1])
+    real = command.plot_attractors
+    monkeypatch.setattr(command, "plot_attractors", lambda *a, **k: drawn.append((a, real(*a, **k))) or drawn[-1][1])
     code, _, _ = run_cli(capsys, "flexible_shaft", "--ics", "2", "--periods", "30", "--discard", "10",
                          "--plot", str(tmp_path / "p.png"), "--coordinate", "x2")
     assert code == 0

@@ -14,8 +14,9 @@ import pytest
 
 import gearsym
 import gearsym.cli.compile
-import gearsym.cached  # imported before no_work patches registry.load, so that it binds the real one
+import gearsym.cached
 import gearsym.codegen.generated
+import gearsym.loading
 import gearsym.registry
 import gearsym.reproduce.compute  # likewise
 import gearsym.cli.docs
@@ -46,9 +47,10 @@ def no_work(monkeypatch):
         raise AssertionError("the work started before the input was checked")
 
     for module, name in ((gearsym.cli.integration, "system_from"), (gearsym.cli.explain, "system_from"),
-                         (gearsym.codegen, "compile_model"), (gearsym.cli.sweep, "run_sweep"),
+                         (gearsym, "compile_model"), (gearsym.codegen.build, "compile_model"),
+                         (gearsym.cli.sweep, "run_sweep"),
                          (gearsym.cli.simulate, "_with_effects"),
-                         (gearsym.registry, "load"), (gearsym.codegen.generated, "generate_model"),
+                         (gearsym, "load"), (gearsym.loading, "load"), (gearsym.codegen.generated, "generate_model"),
                          (gearsym.cli.docs, "page"), (sys.modules["gearsym.reproduce"], "reproduce")):
         monkeypatch.setattr(module, name, work)
 

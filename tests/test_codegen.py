@@ -13,6 +13,7 @@ import sympy as sp
 
 import gearsym
 import gearsym.codegen.build as build_module
+import gearsym.codegen.library as library_module
 import gearsym.codegen.compiler as compiler
 import gearsym.codegen.functions
 from conftest import system
@@ -153,7 +154,7 @@ def test_changing_parameters_never_rebuilds(monkeypatch):
 
 def test_library_cache_survives_a_new_process_and_misses_on_a_new_model(monkeypatch):
     compile_model(system("lorenz"))
-    monkeypatch.setattr(build_module, "_LOADED", {})  # as in a fresh process
+    monkeypatch.setattr(build_module, "LOADED", {})  # as in a fresh process
     again = compile_model(system("lorenz"))
     assert "compile" not in again.timings and again.library.is_file()
     other = compile_model(system("lorenz"), Integration(steps_per_period=100))
@@ -171,13 +172,13 @@ def test_unknown_or_unphysical_parameter_values_are_rejected():
 def test_without_a_compiler_auto_falls_back_and_compiled_explains(monkeypatch, capsys):
     monkeypatch.setenv("CC", "no-such-compiler-gearsym")
     compiler.find_compiler.cache_clear()
-    monkeypatch.setattr(build_module, "_WARNED", set())
+    monkeypatch.setattr(library_module, "_WARNED", set())
     try:
         cm = compile_model(system("lorenz"), Integration(backend="auto", steps_per_period=100))
         assert cm.backend == "in-process"
         assert "no C compiler found" in capsys.readouterr().err
         assert gearsym.lyapunov_spectrum(cm, options=cm.integration.run(20, 5)).sum == pytest.approx(-13.6667, abs=1e-3)
-        monkeypatch.setattr(build_module, "_LOADED", {})
+        monkeypatch.setattr(build_module, "LOADED", {})
         with pytest.raises(CompilerError, match="apt install gcc"):
             compile_model(system("lorenz"), Integration(backend="compiled", steps_per_period=100))
     finally:
@@ -333,9 +334,10 @@ def test_editing_the_code_generator_changes_the_hash(monkeypatch):
 # ------------------------------------------------------------------ long periods: bounded code
 def _period_run(options, monkeypatch=None, segment=None):
     import gearsym.codegen.functions as functions
+    import gearsym.codegen.period_loops as period_loops
 
     if segment is not None:
-        monkeypatch.setattr(functions, "SEGMENT_STEPS", segment)
+        monkeypatch.setattr(period_loops, "SEGMENT_STEPS", segment)
     mf = functions.build_functions(system("one_stage"), options)
     p = np.array([1.5, 0.08, 1.0, 4.0, 0.0, 10.0, 0.2])
     c, _ = mf.functions["constants"](p)
@@ -350,7 +352,8 @@ def _period_run(options, monkeypatch=None, segment=None):
 
 @pytest.mark.parametrize("steps", [400, 410])  # whole segments; and a remainder segment
 def test_long_periods_run_in_segments_with_the_same_bits(monkeypatch, steps):
-    from gearsym.codegen.functions import SEGMENT_STEPS, LoopOptions
+    from gearsym.codegen.loops import LoopOptions
+    from gearsym.codegen.period_loops import SEGMENT_STEPS
 
     assert SEGMENT_STEPS == 50
 

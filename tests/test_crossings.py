@@ -170,7 +170,7 @@ def first_root(s0, d0, s1, d1, fresh) -> float:
 def compiled_first_zero():
     import casadi as ca
 
-    from gearsym.codegen.functions import _first_zero
+    from gearsym.codegen.crossing import _first_zero
 
     args = [ca.SX.sym(name) for name in ("s0", "d0", "s1", "d1", "mode", "fresh")]
     return ca.Function("first_zero", args, list(_first_zero(*args)))
@@ -253,7 +253,7 @@ def test_one_flank_of_the_backlash_is_located_on_the_backlash_surfaces():
 
 
 def test_the_frozen_backlash_is_g_on_each_side_and_reads_the_state_once():
-    from gearsym.codegen.functions import _switching
+    from gearsym.codegen.switching import switching_surfaces as _switching
     from gearsym.codegen.time_tables import split_rhs
 
     t, x, v = sp.symbols("t x v", real=True)

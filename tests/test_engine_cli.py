@@ -75,11 +75,11 @@ def test_lyap_text_names_the_regime_and_what_it_means(capsys):
 
 
 def test_lyap_plot_shows_the_coordinate_asked_for(capsys, tmp_path, monkeypatch):
-    import gearsym.figures as figures
+    import gearsym.cli.lyap as command
 
     drawn = []
-    real = figures.plot_point
-    monkeypatch.setattr(figures, "plot_point", lambda *a, **k: drawn.append((a, real(*a, **k))) or drawn[-1][1])
+    real = command.plot_point
+    monkeypatch.setattr(command, "plot_point", lambda *a, **k: drawn.append((a, real(*a, **k))) or drawn[-1][1])
     code, _, _ = run(capsys, "lyap", "flexible_shaft", "--periods", "40", "--discard", "10", "--plot",
                      str(tmp_path / "p.png"), "--coordinate", "x2")
     assert code == 0

@@ -392,8 +392,8 @@ def test_the_committed_rig_example_is_what_explain_writes(tmp_path, monkeypatch,
 
 
 def test_a_file_in_seconds_takes_the_time_unit_of_a_model_with_physical_values(tmp_path, monkeypatch):
-    import gearsym.fit
-    from gearsym.physical import scaling
+    import gearsym.cli.explain
+    from gearsym import scaling
 
     passed = []
 
@@ -402,7 +402,7 @@ def test_a_file_in_seconds_takes_the_time_unit_of_a_model_with_physical_values(t
         return {"verdict": "nothing missing", "effects": [], "error_before": 0.0, "error_after": 0.0,
                 "unexplained": False, "proposed": []}
 
-    monkeypatch.setattr(gearsym.fit, "explain_files", recorded)
+    monkeypatch.setattr(gearsym.cli.explain, "explain_files", recorded)
     command = ["explain", "measured.csv", "--model", "spur_pair", "--fit", "zeta", "--out", str(tmp_path), "--quiet"]
     assert main(command) == 0
     omega_n = scaling(conftest.reduced("spur_pair")).omega_n.to("rad/s").magnitude  # tau = omega_n t, t in seconds

@@ -15,7 +15,8 @@ import gearsym
 from conftest import system
 from gearsym import FirstOrderSystem, Integration, compile_model
 from gearsym.cli import main
-from gearsym.periodic import FOLD, PERIOD_DOUBLING, continue_orbits, periodic_orbit
+from gearsym import continue_orbits, periodic_orbit
+from gearsym.periodic import FOLD, PERIOD_DOUBLING
 
 ZETA = 0.05
 
@@ -230,7 +231,7 @@ def test_an_interrupted_continuation_keeps_and_writes_what_it_traced(tmp_path, c
 def test_a_physical_models_orbits_continue_over_a_speed_range_in_rpm(tmp_path, capsys):
     """speed=1000rpm:3000rpm is the omega range it moves: the mesh frequency is proportional to the speed."""
     from conftest import reduced
-    from gearsym.physical import scaling
+    from gearsym import scaling
 
     at_3000 = scaling(reduced("spur_pair"), speed="3000 rpm").values["omega"]
     assert main(["orbits", "spur_pair", "--param", "speed=1000rpm:3000rpm", "--switch-depth", "0",

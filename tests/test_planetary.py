@@ -17,7 +17,7 @@ import sympy as sp
 import gearsym
 from conftest import reduced, system
 from gearsym import Disk, Drivetrain, Gear, Harmonic, Mesh, ModelError, Planet, Torque
-from gearsym.analysis.modes import natural_modes
+from gearsym import natural_modes
 from gearsym.symbols import parameter_symbol, tau
 
 TEETH = dict(sun=26, ring=94)

@@ -343,11 +343,11 @@ def test_a_long_list_of_jumps_is_summarised_and_points_to_the_record(tmp_path, c
 
 
 def test_sweep_plot_shows_the_coordinate_asked_for(tmp_path, capsys, monkeypatch):
-    import gearsym.figures.sweep as sweep_figures
+    import gearsym.cli.sweep as command
 
     drawn = []
-    real = sweep_figures.plot_sweep
-    monkeypatch.setattr(sweep_figures, "plot_sweep", lambda *a, **k: drawn.append(real(*a, **k)) or drawn[-1])
+    real = command.plot_sweep
+    monkeypatch.setattr(command, "plot_sweep", lambda *a, **k: drawn.append(real(*a, **k)) or drawn[-1])
     out = tmp_path / "f.csv"
     code = main(["sweep", "flexible_shaft", "--param", "omega=1.3:1.5:0.1", "--periods", "30", "--discard", "10",
                  "--poincare", "5", "--out", str(out), "--plot", str(tmp_path / "f.png"), "--coordinate", "x2",

@@ -18,6 +18,9 @@ import sys
 import tempfile
 from pathlib import Path
 
+import gearsym
+from gearsym.fit import augment
+
 REPO = Path(__file__).resolve().parents[2]
 DEFAULT_OUT = REPO / "bench" / "results" / "fit.json"
 CASES = {"one_stage": "x", "flexible_shaft": "x1"}
@@ -46,9 +49,6 @@ def log(message: str) -> None:
 
 def simulate(model: str, coordinate: str, path: Path) -> None:
     """The measured data, from the current tree (a CSV both trees read)."""
-    import gearsym
-    from gearsym.fit import augment
-
     truth = augment(gearsym.load(model), ["cubic_stiffness"], values={"k3": 0.02})
     table = gearsym.simulate_measurements(truth, options=gearsym.Integration(periods=116, discard=100),
                                           samples_per_period=40, noise=0.01, seed=1,

@@ -5,8 +5,8 @@ one run.
 Both on one compiled model (crossings located, 200 steps per period: the orbits' scheme) and on one thread;
 the sweep is also timed with the paper's plain scheme (the reproduction's). Repetitions are interleaved
 (curve, sweep, plain sweep, then again) and the median of each is compared. Writes
-``bench/results/orbits.json``; ``--report`` renders ``docs/performance.md`` (its section on the orbits comes
-from this record) and ``docs/figures/orbits-speed.png``.
+``bench/results/orbits.json``; ``python -m bench.speed.report`` then renders ``docs/performance.md`` (its
+section on the orbits comes from this record) and ``docs/figures/orbits-speed.png``.
 """
 from __future__ import annotations
 
@@ -18,9 +18,11 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
+import gearsym
+from gearsym import Integration, Workers, continue_orbits
 
-from bench.speed.machine import REPO, machine_info
+from bench.orbits.report import summary
+from bench.machine import REPO, machine_info
 
 DEFAULT_OUT = REPO / "bench" / "results" / "orbits.json"
 MODEL, START, STOP, GRID = "one_stage", 0.1, 2.0, "omega=0.1:2.0:0.01"
@@ -33,10 +35,6 @@ def _timed(call) -> tuple[float, object]:
 
 
 def measure(repeats: int, log=lambda s: print(s, file=sys.stderr, flush=True)) -> dict:
-    import gearsym
-    from gearsym import Integration, Workers
-    from gearsym.periodic import continue_orbits
-
     located = gearsym.compile_model(gearsym.load(MODEL), Integration())
     plain = gearsym.compile_model(gearsym.load(MODEL), Integration.paper())
     jobs = {
@@ -65,19 +63,10 @@ def measure(repeats: int, log=lambda s: print(s, file=sys.stderr, flush=True)) -
     }
 
 
-def summary(record: dict) -> dict:
-    """Medians and the ratios the page reports (a pure function of the measurements)."""
-    med = {k: float(np.median(v)) for k, v in record["seconds"].items()}
-    return {"median_seconds": med, "curve_over_sweep": med["curve"] / med["sweep"],
-            "curve_over_plain_sweep": med["curve"] / med["sweep (paper's scheme)"],
-            "met": med["curve"] < med["sweep"]}
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m bench.orbits", description=__doc__.split("\n\n")[0])
     ap.add_argument("--repeats", type=int, default=5, help="interleaved repetitions (default 5)")
     ap.add_argument("--out", type=Path, default=DEFAULT_OUT, help="the record (default bench/results/orbits.json)")
-    ap.add_argument("--report", action="store_true", help="also render docs/performance.md and the figures")
     args = ap.parse_args(argv)
     started = time.perf_counter()
     record = {"command": "python -m bench.orbits " + shlex.join(argv if argv is not None else sys.argv[1:]),
@@ -91,11 +80,7 @@ def main(argv=None) -> int:
     print(f"curve {s['median_seconds']['curve']:.3f} s, sweep {s['median_seconds']['sweep']:.3f} s: "
           f"{s['curve_over_sweep']:.2f}x ({'MET' if s['met'] else 'MISSED'}: the curve in less time than the sweep)",
           file=sys.stderr)
-    if args.report:
-        from bench.speed.report import write_report
-
-        for path in write_report():
-            print(f"wrote {path}", file=sys.stderr)
+    print("render the page with: python -m bench.speed.report", file=sys.stderr)
     return 0
 
 

@@ -14,10 +14,12 @@ import sys
 import time
 from pathlib import Path
 
-from gearsym import Integration
-
+import gearsym
+from gearsym import available_models, Integration
 from . import compile_time, overhead, points, profile, reference, scaling, startup, sweep
-from .machine import REPO, machine_info
+from bench.peers import c_yardstick, gearsym_tool, jitcode_lyap, numba_rk4, scipy_ivp
+from bench.machine import machine_info, REPO
+from .report import write_report
 from .summary import CROSSINGS, summarise, summarise_model
 
 if str(REPO) not in sys.path:
@@ -38,16 +40,12 @@ def log(message: str) -> None:
 
 def _model_values(model: str) -> tuple[dict, list[float], float]:
     """The model's own defaults (every tool gets them explicitly), its initial state and zeta."""
-    import gearsym
-
     system = gearsym.load(model)
     params = {k: float(v) for k, v in system.parameters.items() if k != "omega"}
     return params, [float(v) for v in system.initial_vector], params["zeta"]
 
 
 def run_model(model: str, args, log=log) -> dict:
-    from bench.peers import c_yardstick, gearsym_tool, jitcode_lyap, numba_rk4, scipy_ivp
-
     params, y0, zeta = _model_values(model)
     P, D, steps = args.periods, args.discard, 200
     omegas = OMEGAS[:2] if args.quick else OMEGAS
@@ -164,8 +162,6 @@ def main(argv=None) -> int:
         raw["scaling"] = scaling.measure("flexible_shaft", scheme, args.repeats, dask=not args.no_dask,
                                          workloads=["independent"] if args.quick else None, log=log)
     if not args.no_compile:
-        from gearsym import available_models
-
         log("== compile time per model, empty cache, then again")
         raw["compile"] = compile_time.measure(available_models())
     if not args.no_startup:
@@ -181,8 +177,6 @@ def main(argv=None) -> int:
         out.write_text(json.dumps(raw, indent=1) + "\n")
         log(f"wrote {out} ({raw['seconds']:.0f} s)")
         if args.report:
-            from .report import write_report
-
             for path in write_report(out):
                 log(f"wrote {path}")
     return 0

@@ -19,7 +19,7 @@ import sys
 import tempfile
 import time
 
-from .machine import REPO
+from bench.machine import REPO
 
 _PROBE = """
 import json, sys, time

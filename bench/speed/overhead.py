@@ -18,6 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
+import gearsym
+from gearsym.codegen.native import NativeFunction
+
 MODEL = "one_stage"
 PERIODS, DISCARD, STEPS, POINTS = 400, 100, 200, 401
 REPEATS = 5
@@ -26,8 +29,6 @@ TARGET = 0.05
 
 def _timed_native():
     """Wrap NativeFunction.call to sum its time; returns (the total so far as a one-item list, undo)."""
-    from gearsym.codegen.native import NativeFunction
-
     spent, original = [0.0], NativeFunction.call
 
     def call(self, args, results):
@@ -42,8 +43,6 @@ def _timed_native():
 
 
 def measure(repeats: int = REPEATS, log=lambda s: print(s, file=sys.stderr, flush=True)) -> dict:
-    import gearsym
-
     options = gearsym.Integration(periods=PERIODS, discard=DISCARD, steps_per_period=STEPS)
     compiled = gearsym.compile_model(gearsym.load(MODEL), options)
     grid = np.round(0.1 + 0.005 * np.arange(POINTS), 10)

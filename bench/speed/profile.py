@@ -15,6 +15,9 @@ import statistics
 import sys
 from collections.abc import Callable
 
+from gearsym import Integration
+from bench.peers import c_yardstick, gearsym_tool
+
 STEPS = 200
 
 
@@ -25,10 +28,6 @@ def _median_seconds(tool, omega, periods, discard, repeats) -> float:
 def measure(models, c_flags: dict, periods: int = 400, omega: float = 1.5, repeats: int = 7,
             log: Callable[[str], None] = lambda s: print(s, file=sys.stderr, flush=True)) -> dict:
     """``c_flags[model]``: the flags of that model's fastest C build in this run."""
-    from gearsym import Integration
-
-    from bench.peers import c_yardstick, gearsym_tool
-
     out: dict = {"omega": omega, "periods": periods, "steps_per_period": STEPS, "models": {}}
     for model in models:
         tools = {"gearsym": gearsym_tool.make(model, {"steps": STEPS}, scheme=Integration.paper()),

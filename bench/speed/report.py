@@ -13,8 +13,11 @@ import json
 import sys
 from pathlib import Path
 
-from .machine import REPO
-from .summary import TARGETS, summarise
+from bench.orbits.report import section
+from gearsym.figures.save import save_figure
+from bench.orbits import report as orbits_report
+from bench.machine import REPO
+from .summary import summarise, TARGETS
 
 PAGE = REPO / "docs" / "performance.md"
 FIGURE = REPO / "docs" / "figures" / "performance.png"
@@ -266,8 +269,6 @@ def render(raw: dict, notes: str | None = None, orbits: dict | None = None) -> s
             *_compile_table(raw), "", f"Target: at most {TARGETS['compile_seconds']:g} s of C compilation per "
             "model, and nothing compiled again for an unchanged model.", "", *_startup_lines(raw)]
     if orbits:
-        from bench.orbits.report import section
-
         out += section(orbits)
     if notes:
         out += [notes.rstrip(), ""]
@@ -277,7 +278,6 @@ def render(raw: dict, notes: str | None = None, orbits: dict | None = None) -> s
 def figure(raw: dict, path: Path) -> Path:
     import matplotlib.pyplot as plt
 
-    from gearsym.figures.save import save_figure
 
     summary = raw["summary"]
     models = list(summary["models"])
@@ -348,8 +348,6 @@ def write_report(json_path: Path = DEFAULT_JSON, page: Path = PAGE, figure_path:
                  orbits_path: Path | None = None, orbits_figure: Path | None = None) -> list[Path]:
     """The page and the figure from the benchmark's JSON, and (if its record exists) the orbits' section and
     figure from ``bench/results/orbits.json``."""
-    from bench.orbits import report as orbits_report
-
     raw = json.loads(Path(json_path).read_text())
     raw["summary"] = summarise(raw)  # recomputed: the page never shows a number the raw data does not give
     notes = NOTES.read_text() if NOTES.exists() else None

@@ -28,6 +28,10 @@ import time
 from collections.abc import Callable
 from dataclasses import replace
 
+import gearsym
+from gearsym import Workers
+from gearsym.sweep.distributed import connect
+
 WORKLOADS = {
     "independent": ({"omega": "0.1:2.0:0.01"}, "independent"),
     "map": ({"omega": "0.1:2.0:0.02", "kS": "0,0.05,0.1,1.0"}, "independent"),
@@ -43,9 +47,6 @@ def _rows(result) -> list[tuple]:
 def measure(model: str, scheme, repeats: int, dask: bool = True, workloads=None,
             log: Callable[[str], None] = lambda s: print(s, file=sys.stderr, flush=True)) -> dict:
     """``scheme``: the :class:`gearsym.Integration` of every sweep (periods, discard, steps, crossings)."""
-    import gearsym
-    from gearsym import Workers
-
     compiled = gearsym.compile_model(gearsym.load(model), replace(scheme, backend="compiled"))
     cores = os.cpu_count() or 1
     configs: dict[str, Workers] = {"1 thread": Workers(jobs=1),
@@ -60,8 +61,6 @@ def measure(model: str, scheme, repeats: int, dask: bool = True, workloads=None,
         out["workloads"][name], baselines[name] = _time_configs(compiled, scheme, name, configs, repeats, None, log)
     if dask:
         try:
-            from gearsym.sweep.distributed import connect
-
             t = time.perf_counter()
             with connect("local", cores) as client:  # the cluster `gearsym sweep --dask` starts
                 client.wait_for_workers(cores)
@@ -81,8 +80,6 @@ def _time_configs(compiled, scheme, name: str, configs: dict, repeats: int, base
     """Workload ``name`` on each of ``configs``, interleaved over ``repeats`` repetitions after a warm-up
     (which also ships the library to a cluster's workers); every result compared with ``baseline`` (default:
     the first run's rows), bit for bit."""
-    import gearsym
-
     axes, mode = WORKLOADS[name]
     spec = [f"{k}={v}" for k, v in axes.items()]
     entry = {"axes": axes, "mode": mode, "seconds": {c: [] for c in configs}, "cpu_seconds": {c: [] for c in configs},

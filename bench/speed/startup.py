@@ -20,7 +20,7 @@ import sys
 import tempfile
 import time
 
-from .machine import REPO
+from bench.machine import REPO
 
 MODELS = ("one_stage", "one_stage_resonant", "flexible_shaft", "two_stage", "spur_pair", "duffing", "planetary",
           "planetary_differential", "planetary_two_stage")

@@ -17,19 +17,18 @@ condition, a second one's from its group K; inertias and radii without a declare
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
 import sympy as sp
 
 from ..errors import GearsymError
-from ..model.drivetrain import ResolvedCoupling
-from ..symbols import parameter_symbol, phi
+from ..reduction.statics import mean_over, mean_stiffness, number as _number
+from ..symbols import parameter_symbol, tau
 
 #: eigenvalues within this fraction of the largest count as one (a degenerate frequency)
 DEGENERATE = 1e-8
-#: samples of a mesh period for the mean of its stiffness variation (exact for Fourier series of lower degree)
-MEAN_SAMPLES = 1024
 
 
 @dataclass(frozen=True)
@@ -75,27 +74,38 @@ class Modes:
                 "assumed": list(self.assumed)}
 
 
-def natural_modes(model, **settings) -> Modes:
-    """The natural modes of ``model`` (a name, a file, a Drivetrain or its reduction). ``settings`` are physical
-    values (``kZ="2e8 N/m"``: frequencies in Hz; also for a model that declares physical values) or, for a
-    model without, nondimensional parameter values (``kS=0.5``)."""
-    from ..reduce import NondimensionalModel, reduce
-    from ..registry import load_model, physical_settings
+def physical_modes(scaling, formulas: Mapping[str, object] | None = None) -> Modes:
+    """The natural modes of a scaled drivetrain (a :class:`~gearsym.scales.map.Scaling`), in Hz; ``formulas``
+    replace mesh stiffness functions (their mean is what a linear, time-averaged system sees)."""
+    nd = scaling.model
+    return _solve(nd, dict(scaling.si_values), "Hz", (), _formula_means(nd, formulas or {}, scaling.values))
 
-    declared = model if isinstance(model, NondimensionalModel) else load_model(model)
-    if not hasattr(declared, "functions") and not hasattr(declared, "bodies"):
-        raise GearsymError(f"{declared.name}: natural modes need a drivetrain (a FirstOrderSystem has no inertias)")
-    nd = declared if isinstance(declared, NondimensionalModel) else reduce(declared)
-    split = physical_settings(nd, dict(settings))
-    if split is not None:
-        from ..physical.scales import scaling
 
-        length_scale, physical, _ = split
-        s = scaling(nd, length_scale, **physical)
-        values = {n: float(q.to_base_units().magnitude) for n, q in s.inputs.items()}
-        return _solve(nd, values, "Hz", ())
-    values, assumed = _nondimensional_values(nd, settings)
-    return _solve(nd, values, "omega_n", assumed)
+def nondimensional_modes(nd, settings: Mapping[str, object]) -> Modes:
+    """The natural modes of a reduced drivetrain without physical values, in its time unit 1/omega_n;
+    ``settings`` are parameter values (``kS=0.5``) or stiffness formulas (``k="1+0.2*cos(tau)"``)."""
+    functions = {f.name for f in nd.functions}
+    formulas = {k: v for k, v in settings.items() if k in functions}
+    numbers = {k: v for k, v in settings.items() if k not in functions}
+    values, assumed = _nondimensional_values(nd, numbers)
+    return _solve(nd, values, "omega_n", assumed, _formula_means(nd, formulas, values))
+
+
+def _formula_means(nd, formulas: Mapping[str, object], values: Mapping[str, float]) -> dict[str, float]:
+    """For each mesh whose stiffness function a formula replaces: the formula's mean over its period over the
+    declared function's (the factor its mean stiffness changes by)."""
+    out = {}
+    for f in nd.functions:
+        if f.name not in formulas:
+            continue
+        new = nd._function_expr(f, formulas[f.name])
+        period = float(f.period)
+        where = f"stiffness function {f.name}"
+        old = mean_over(f.expression, tau, period, values, where)
+        if old == 0:
+            raise GearsymError(f"{nd.name}: the declared {f.name}(tau) has mean 0; its modes have no mean stiffness")
+        out[f.mesh] = mean_over(new, tau, period, values, where) / old
+    return out
 
 
 def _nondimensional_values(nd, settings) -> tuple[dict[str, float], tuple[str, ...]]:
@@ -128,36 +138,15 @@ def _nondimensional_values(nd, settings) -> tuple[dict[str, float], tuple[str, .
     return values, assumed
 
 
-def _number(expr: sp.Expr, values: dict[str, float], what: str) -> float:
-    value = sp.sympify(expr).xreplace({parameter_symbol(k): sp.Float(v) for k, v in values.items()})
-    if not value.is_number:
-        missing = ", ".join(sorted(s.name for s in value.free_symbols))
-        raise GearsymError(f"{what} needs a value for {missing}")
-    return float(value)
-
-
-def mean_stiffness(rc: ResolvedCoupling, values: dict[str, float]) -> float:
-    """A coupling's stiffness averaged over a mesh period (a shaft's is its own)."""
-    k = _number(rc.stiffness, values, f"the stiffness of {rc.name!r}")
-    if rc.kind != "mesh":
-        return k
-    variation = rc.variation.xreplace({parameter_symbol(n): v for n, v in values.items()})
-    if variation.free_symbols - {phi}:
-        missing = ", ".join(sorted(s.name for s in variation.free_symbols - {phi}))
-        raise GearsymError(f"the stiffness variation of {rc.name!r} needs a value for {missing}")
-    samples = np.linspace(0.0, 2 * math.pi, MEAN_SAMPLES, endpoint=False)
-    shape = np.asarray(sp.lambdify(phi, variation, "numpy")(samples), dtype=float) * np.ones(MEAN_SAMPLES)
-    return k * float(np.mean(shape))
-
-
-def _solve(nd, values: dict[str, float], unit: str, assumed: tuple[str, ...]) -> Modes:
+def _solve(nd, values: dict[str, float], unit: str, assumed: tuple[str, ...],
+           factors: Mapping[str, float] | None = None) -> Modes:
     rd = nd.reduction.resolved
     names = [rb.body.name for rb in rd.bodies]
     inertia = np.array([_number(rb.inertia, values, f"the inertia of {rb.body.name!r}") for rb in rd.bodies])
     stiffness = np.zeros((len(names), len(names)))
     for rc in rd.couplings:
         row = np.array([_number(e, values, f"the deflection of {rc.name!r}") for e in rc.row])
-        stiffness += mean_stiffness(rc, values) * np.outer(row, row)
+        stiffness += mean_stiffness(rc, values) * (factors or {}).get(rc.name, 1.0) * np.outer(row, row)
     transform = np.array([[_number(e, values, "the coordinate change") for e in r]
                           for r in nd.reduction.transform.tolist()])
     scale = 1.0 / np.sqrt(inertia)

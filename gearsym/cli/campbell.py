@@ -7,8 +7,16 @@ import json
 import sys
 from pathlib import Path
 
+from ..loading import natural_modes
 from ..errors import GearsymError
+from ..figures.campbell import plot_campbell
+from ..files import write_atomically
 from ..outputs import check_figure, check_file
+from ..physical.campbell import campbell
+from ..physical.sweeps import nondimensional_axis
+from ..sweep import run_sweep, Workers
+from ..sweep.grid import parse_axis
+from ..sweep.store import sidecar
 from .integration import add_integration_arguments, compiled_from, scaling_from
 from .settings import add_set_argument, parse_settings
 
@@ -32,14 +40,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..analysis.modes import natural_modes
-    from ..files import write_atomically
-    from ..physical.campbell import campbell
-    from ..physical.sweeps import nondimensional_axis
-    from ..sweep import Workers, run_sweep
-    from ..sweep.grid import parse_axis
-    from ..sweep.store import sidecar
-
     check_file(args.out, (".csv",))
     check_figure(args.plot)
     if args.orders < 1:
@@ -65,7 +65,6 @@ def run(args: argparse.Namespace) -> int:
         result = run_sweep(compiled, [nondimensional_axis(scaling, axis)], options=compiled.integration,
                            out=args.out, workers=Workers(args.jobs), progress=not args.quiet)
         sweep = scaling.to_physical(result)
-    from ..figures.campbell import plot_campbell
 
     plot_campbell(diagram, args.plot, sweep)
     print(f"gearsym: wrote {args.plot}", file=sys.stderr)

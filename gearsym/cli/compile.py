@@ -5,7 +5,9 @@ import argparse
 import sys
 from pathlib import Path
 
+from ..codegen.generated import generate_model
 from ..outputs import check_folder
+from ..loading import load
 from ..registry import available_models, output_root
 from .integration import add_integration_arguments, integration_from
 from .settings import add_set_argument, parse_settings
@@ -28,9 +30,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..codegen.generated import generate_model  # the code generator (SymPy) only for this command
-    from ..registry import load
-
     if bool(args.all) == bool(args.models):
         print("gearsym compile: error: give model names or --all (not both)", file=sys.stderr)
         return 2

@@ -3,6 +3,9 @@ from __future__ import annotations
 
 import argparse
 
+from ..derivation import derive, render
+from ..registry import load_model
+
 
 NAME = "derive"
 HELP = "print the reduced, nondimensional equations and coefficient groups of a model"
@@ -18,8 +21,5 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..derivation import derive, render  # SymPy only for this command
-    from ..registry import load_model
-
     print(render(derive(load_model(args.model)), args.format, full=args.full), end="")
     return 0

@@ -9,8 +9,9 @@ import argparse
 import sys
 from pathlib import Path
 
+from ..derivation import derive, render
 from ..outputs import check_folder
-from ..registry import available_models, output_root
+from ..registry import available_models, load_model, output_root
 
 NAME = "docs"
 HELP = "write the Markdown derivation of models to DIR/<model>.md"
@@ -28,9 +29,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def page(model: str) -> tuple[str, str]:
     """(model name, Markdown page) for a model reference."""
-    from ..derivation import derive, render  # SymPy only for this command
-    from ..registry import load_model
-
     derivation = derive(load_model(model))
     return derivation.model, render(derivation, "markdown")
 

@@ -5,6 +5,9 @@ import argparse
 import sys
 from pathlib import Path
 
+from ..errors import GearsymError
+from ..fit import explain_files
+from ..outputs import check_folder
 from .integration import add_integration_arguments, integration_from, scaling_from, system_from
 from .settings import add_set_argument
 
@@ -45,9 +48,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..fit import explain_files
-    from ..outputs import check_folder
-
     fit = [p.strip() for p in args.fit.split(",") if p.strip()]
     candidates = [e.strip() for e in args.effects.split(",")] if args.effects else None
     bias = [c.strip() for c in args.bias.split(",") if c.strip()]
@@ -77,8 +77,6 @@ def _time_scale(args: argparse.Namespace) -> float | None:
 
 
 def _channel(text: str) -> tuple[str, str]:
-    from ..errors import GearsymError
-
     name, sep, formula = text.partition("=")
     if not sep or not name.strip() or not formula.strip():
         raise GearsymError(f"--channel {text!r}: write NAME=FORMULA, e.g. --channel acc=x1_ddot+0.5*x2_ddot")

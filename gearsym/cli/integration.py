@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import argparse
 
+import gearsym  # the face: its verbs load on first use, so a cached model's run never loads the generator
+
+from ..cached import cached_scaling, load_compiled
 from ..checks import check_run
 from ..options import BACKENDS, STEPS_PER_PERIOD, Integration
 from .settings import parse_settings
@@ -44,26 +47,39 @@ def integration_from(args: argparse.Namespace, steps_per_period: int | None = No
 
 def system_from(args: argparse.Namespace):
     """The system of the command's MODEL with its --set values (names and files are resolved here, at the edge)."""
-    from ..registry import load
+    return gearsym.load(args.model, **parse_settings(args.set))
 
-    return load(args.model, **parse_settings(args.set))
+
+def scaling_of(model, settings: dict):
+    """The scaling of ``model`` with ``settings`` (--set values), or None for a model without physical values."""
+    if not gearsym.is_physical(model, **settings):
+        return None
+    physical = dict(settings)
+    length_scale = physical.pop("length_scale", None)
+    functions = physical_functions(model)
+    return gearsym.scaling(model, length_scale, **{k: v for k, v in physical.items() if k not in functions})
+
+
+def physical_functions(model) -> set[str]:
+    """The stiffness functions of a drivetrain (they take a formula, not a physical value)."""
+    return {f.name for f in gearsym.reduce(gearsym.load_model(model)).functions}
 
 
 def scaling_from(args: argparse.Namespace):
-    """The :class:`~gearsym.physical.Scaling` of the command's MODEL and --set values, or None for a model without
-    physical values."""
-    from ..cached import cached_scaling
-
-    return cached_scaling(args.model, parse_settings(args.set))
+    """The scaling of the command's MODEL and --set values (a cached one when the start-up cache has its numbers),
+    or None for a model without physical values."""
+    settings = parse_settings(args.set)
+    return cached_scaling(args.model, settings, lambda: scaling_of(args.model, settings))
 
 
 def compiled_from(args: argparse.Namespace, options: Integration | None = None, system=None):
     """The compiled model of the command's MODEL with its --set values (or of ``system``)."""
-    from ..codegen import compile_model
-    from ..cached import load_compiled
-
     options = options or integration_from(args)  # checked before the model is reduced (seconds)
     verbose = not getattr(args, "quiet", False)
     if system is not None:
-        return compile_model(system, options, verbose=verbose)
-    return load_compiled(args.model, parse_settings(args.set), options, verbose=verbose)
+        return gearsym.compile_model(system, options, verbose=verbose)
+    settings = parse_settings(args.set)
+    return load_compiled(args.model, settings, options, verbose=verbose,
+                         compile=lambda: gearsym.compile_model(gearsym.load(args.model, **settings), options,
+                                                               verbose=verbose),
+                         scaling=lambda: scaling_of(args.model, settings))

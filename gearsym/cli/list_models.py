@@ -16,13 +16,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def title_of(name: str) -> str:
     """A model's title; a model that fails to load is listed with its error, not fatal to the listing."""
-    from ..model.drivetrain import Drivetrain
-
     try:
         model = load_model(name)
     except GearsymError as exc:
         return f"(cannot be loaded: {exc})"
-    if isinstance(model, Drivetrain):
+    if model.is_drivetrain:
         return model.title
     return model.title or f"first-order system, {model.dimension} states"
 

@@ -9,6 +9,7 @@ from pathlib import Path
 from ..analysis import lyapunov_spectrum, phase_trajectory
 from ..analysis.regime import describe_regime
 from ..checks import chosen_coordinate
+from ..figures import plot_point
 from ..outputs import check_figure
 from .integration import add_integration_arguments, compiled_from, scaling_from
 from .settings import add_set_argument, parse_state
@@ -38,8 +39,6 @@ def run(args: argparse.Namespace) -> int:
     result = lyapunov_spectrum(compiled, y0=parse_state(args.y0))
     physical = _physical(scaling, compiled, result) if scaling is not None and scaling.speed else None
     if args.plot:
-        from ..figures import plot_point  # matplotlib only when asked for
-
         shown = min(30, result.periods - result.discard)
         trajectory = phase_trajectory(compiled, options=compiled.integration.run(discard=result.periods - shown),
                                       y0=parse_state(args.y0))

@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 import json
 
+from ..loading import natural_modes
 from .settings import add_set_argument, parse_settings
 
 NAME = "modes"
@@ -17,8 +18,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..analysis.modes import natural_modes
-
     result = natural_modes(args.model, **parse_settings(args.set))
     if args.format == "json":
         print(json.dumps(result.as_dict(), indent=2))

@@ -8,10 +8,18 @@ import sys
 from pathlib import Path
 
 from ..checks import chosen_coordinate, whole_number
-from ..errors import GearsymError
+from ..errors import GearsymError, UnknownParameterError
+from ..figures.orbits import plot_orbits
 from ..files import write_atomically
 from ..outputs import check_figure, check_file
-from .integration import add_integration_arguments, compiled_from, integration_from, system_from
+from ..periodic import ContinuationInterrupted, continue_orbits, periodic_orbit
+from ..periodic.files import write_orbits
+from ..periodic.orbit import sweep_start
+from ..periodic.shooting import check_segments, pieces_per_period
+from ..physical.sweeps import nondimensional_axis
+from ..sweep import read_sweep
+from ..sweep.grid import _numbers_and_unit, Axis
+from .integration import add_integration_arguments, compiled_from, integration_from, scaling_from, system_from
 from .settings import add_set_argument, parse_state
 
 NAME = "orbits"
@@ -56,8 +64,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def parse_range(text: str) -> tuple[str, float, float, str]:
     """NAME, START, STOP and the unit of a physical value ("" for the model's own numbers)."""
-    from ..sweep.grid import _numbers_and_unit
-
     usage = f"--param {text!r}: expected NAME=START:STOP, e.g. --param omega=0.5:2.0 or speed=1000rpm:3000rpm"
     name, sep, body = (part.strip() for part in text.partition("="))
     parts = body.split(":")
@@ -76,9 +82,6 @@ def parse_range(text: str) -> tuple[str, float, float, str]:
 def engine_range(args: argparse.Namespace, parameter: tuple) -> tuple[str, float, float]:
     """The nondimensional parameter and range a physical range (speed=1000rpm:3000rpm) moves, as a sweep's
     axis does (gearsym.physical.sweeps); a nondimensional range as it is."""
-    from ..sweep.grid import Axis
-    from .integration import scaling_from
-
     name, start, stop, unit = parameter
     scaling = scaling_from(args)
     if scaling is None:
@@ -86,7 +89,6 @@ def engine_range(args: argparse.Namespace, parameter: tuple) -> tuple[str, float
             raise GearsymError(f"--param {args.param!r} has a unit, but the model has no physical values; declare "
                                "them (model.set_physical) or give them with --set NAME='VALUE UNIT'")
         return name, start, stop
-    from ..physical.sweeps import nondimensional_axis
 
     axis = nondimensional_axis(scaling, Axis(name, (start, stop), args.param, unit))
     if axis.name != name:
@@ -112,10 +114,7 @@ def run(args: argparse.Namespace) -> int:
     y0 = parse_state(args.y0)
     sweep = None
     if args.sweep:
-        from ..sweep import read_sweep
-
         sweep = read_sweep(args.sweep)
-    from ..periodic.shooting import check_segments, pieces_per_period
 
     options = integration_from(args).run(periods=args.transient, discard=0)
     check_segments(args.segments, pieces_per_period(options.steps_per_period), f"--segments {args.segments}: ",
@@ -124,8 +123,6 @@ def run(args: argparse.Namespace) -> int:
         parameter = engine_range(args, parameter)
     system = system_from(args)
     if parameter and parameter[0] not in system.parameters:
-        from ..errors import UnknownParameterError
-
         raise UnknownParameterError(parameter[0], system.parameters, f"--param {args.param}")
     compiled = compiled_from(args, options, system)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
@@ -133,15 +130,11 @@ def run(args: argparse.Namespace) -> int:
         return _one_orbit(compiled, args, y0)
     name, start, stop = parameter
     if sweep is not None and y0 is None:
-        from ..periodic.orbit import sweep_start
-
         y0 = sweep_start(sweep, compiled, name, start)
     return _continuation(compiled, args, name, start, stop, y0, sweep)
 
 
 def _one_orbit(compiled, args, y0) -> int:
-    from ..periodic import periodic_orbit
-
     orbit = periodic_orbit(compiled, y0=y0, period_multiple=args.period_multiple, segments=args.segments)
     print(f"{orbit.model}: period-{orbit.period_multiple} orbit, Newton residual {orbit.residual:.2g} after "
           f"{orbit.iterations} iterations, {'stable' if orbit.stable else 'unstable'}")
@@ -160,9 +153,6 @@ def _one_orbit(compiled, args, y0) -> int:
 
 
 def _continuation(compiled, args, name, start, stop, y0, sweep) -> int:
-    from ..periodic import ContinuationInterrupted, continue_orbits
-    from ..periodic.files import write_orbits
-
     try:
         result = continue_orbits(compiled, name, start, stop, y0=y0, period_multiple=args.period_multiple,
                                  segments=args.segments, switch_depth=args.switch_depth, max_points=args.max_points)
@@ -184,8 +174,6 @@ def _continuation(compiled, args, name, start, stop, y0, sweep) -> int:
         csv_path, json_path = write_orbits(result, args.out)
         print(f"gearsym: wrote {csv_path} and {json_path}", file=sys.stderr)
     if args.plot:
-        from ..figures.orbits import plot_orbits  # matplotlib only when asked for
-
         plot_orbits(result, args.plot, coordinate=args.coordinate, sweep=sweep)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     return 0

@@ -6,9 +6,10 @@ import json
 import sys
 from pathlib import Path
 
-from ..analysis.attractors import DEFAULT_BOX, RUN, AttractorSet, find_attractors
+from ..analysis.attractors import AttractorSet, DEFAULT_BOX, find_attractors, RUN
 from ..checks import chosen_coordinate
 from ..errors import GearsymError
+from ..figures.poincare import plot_attractors
 from ..outputs import check_figure
 from .integration import add_integration_arguments, compiled_from
 from .settings import add_set_argument
@@ -61,8 +62,6 @@ def run(args: argparse.Namespace) -> int:
     coordinate = chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     found = find_attractors(compiled, ics=args.ics, seed=args.seed, box=box)
     if args.plot:
-        from ..figures.poincare import plot_attractors  # matplotlib only when asked for
-
         plot_attractors(found, args.plot, x=coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     if args.format == "json":

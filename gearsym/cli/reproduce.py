@@ -5,6 +5,9 @@ import argparse
 import sys
 from pathlib import Path
 
+from ..outputs import check_file, check_folder
+from ..reproduce import reproduce
+
 NAME = "reproduce"
 HELP = "recompute the paper's Figs. 3, 4, 6, 7, check its claims and write docs/reproduction.md"
 
@@ -22,9 +25,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..outputs import check_file, check_folder
-    from ..reproduce import reproduce
-
     doc = args.doc or args.out.parent / "reproduction.md"
     check_folder(args.out)
     check_file(doc, (".md",), "--doc")

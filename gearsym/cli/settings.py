@@ -4,7 +4,9 @@ from __future__ import annotations
 import argparse
 
 from ..errors import GearsymError
-from ..physical.text import looks_like_quantity
+from ..model.grammar import check_formula
+from ..model.length_scale import check_length_scale
+from ..units import looks_like_quantity, parse_quantity
 
 
 def add_set_argument(parser: argparse.ArgumentParser) -> None:
@@ -28,17 +30,11 @@ def parse_settings(pairs: list[str]) -> dict[str, str]:
         if name in settings:
             raise GearsymError(f"--set gives {name} twice")
         if looks_like_quantity(value):
-            from ..physical.units import parse_quantity  # pint only for physical values
-
             parse_quantity(value, f"--set {name}")
         elif name == "length_scale":
-            from ..physical.scales import check_length_scale
-
             check_length_scale(value, "--set length_scale")
-        elif not _is_number(value):  # (a number needs no parser, and so no SymPy)
-            from ..model.expressions import to_expr
-
-            to_expr(value, f"--set {name}")
+        elif not _is_number(value):  # (the grammar alone: SymPy reads the formula when the model is loaded)
+            check_formula(value, f"--set {name}")
         settings[name] = value
     return settings
 

@@ -6,7 +6,9 @@ from pathlib import Path
 
 from ..data.simulate import RUN, simulate_measurements, steps_for
 from ..errors import GearsymError
+from ..fit.effects import augment, effect
 from ..outputs import check_file
+from ..loading import load
 from .integration import add_integration_arguments, compiled_from, integration_from
 from .settings import add_set_argument, parse_numbers, parse_settings, parse_state
 
@@ -62,9 +64,6 @@ def run(args: argparse.Namespace) -> int:
 
 def _with_effects(model: str, effects: list[str], settings: dict):
     """The model's equations with ``effects`` added; ``settings`` set the model's and the effects' parameters."""
-    from ..fit.effects import augment, effect
-    from ..registry import load
-
     own = {p for e in map(effect, effects) for p in e.parameters}
     base = load(model, **{k: v for k, v in settings.items() if k not in own})
     return augment(base, effects, values={k: v for k, v in settings.items() if k in own})
@@ -72,8 +71,6 @@ def _with_effects(model: str, effects: list[str], settings: dict):
 
 def check_strengths(effects: list[str], settings: dict) -> None:
     """Every effect needs a strength other than 0 (its off value) among ``settings``."""
-    from ..fit.effects import effect
-
     for e in map(effect, effects):
         if not any(_nonzero(settings.get(p)) for p in e.fitted):
             given = " and/or ".join(f"--set {p}=VALUE" for p in e.fitted)

@@ -7,8 +7,13 @@ from collections import Counter
 from pathlib import Path
 
 from ..checks import chosen_coordinate
+from ..errors import GearsymError
+from ..figures.sweep import plot_sweep
 from ..outputs import check_figure, check_file
-from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, Workers, run_sweep
+from ..physical.files import write_physical_table
+from ..physical.sweeps import nondimensional_axes
+from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, run_sweep, Workers
+from ..sweep.grid import axes_from
 from ..sweep.report import findings_lines
 from ..sweep.store import sidecar
 from .integration import add_integration_arguments, compiled_from, scaling_from
@@ -82,13 +87,9 @@ def run(args: argparse.Namespace) -> int:
     for line in findings_lines(result, sidecar(args.out, ".json")):
         print(line)
     if scaling is not None and scaling.speed and result.axes[0].name == "omega":
-        from ..physical.files import write_physical_table
-
         result = scaling.to_physical(result)
         print(f"in physical units: {write_physical_table(result, sidecar(args.out, '.physical.csv'))}")
     if args.plot:
-        from ..figures.sweep import plot_sweep  # matplotlib only when asked for
-
         plot_sweep(result, args.plot, coordinate=args.coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     return 0
@@ -97,17 +98,12 @@ def run(args: argparse.Namespace) -> int:
 def _engine_axes(params: list[str], scaling):
     """The --param axes the engine sweeps: physical ones (speed=500rpm:6000rpm:25rpm) turned into the
     nondimensional parameter they move, for a model with physical values."""
-    from ..sweep.grid import axes_from
-
     axes = axes_from(params)
     if scaling is None:
         unit = next((a for a in axes if a.unit), None)
         if unit:
-            from ..errors import GearsymError
-
             raise GearsymError(f"--param {unit.spec!r} has a unit, but the model has no physical values; declare "
                                "them (model.set_physical) or give them with --set NAME='VALUE UNIT'")
         return axes
-    from ..physical.sweeps import nondimensional_axes
 
     return nondimensional_axes(scaling, axes)

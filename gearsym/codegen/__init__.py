@@ -11,7 +11,6 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING
 
-from .build import compile_model
 from .compiled import CompiledModel, RunInputs, TangentRun, TangentRuns
 from .compiler import CompilerError, cache_dir
 from .loops import LoopOptions
@@ -19,7 +18,7 @@ from .verbs import engine_verb
 
 #: the code generator's own names, imported on first use (SymPy): a model whose library is cached never needs them
 _GENERATOR = {"build_functions": "gearsym.codegen.functions", "code_hash": "gearsym.codegen.generate",
-              "write_code": "gearsym.codegen.generate"}
+              "compile_model": "gearsym.codegen.build", "write_code": "gearsym.codegen.generate"}
 
 __all__ = ["CompiledModel", "CompilerError", "LoopOptions", "RunInputs", "TangentRun", "TangentRuns", "build_functions",
            "cache_dir", "code_hash", "compile_model", "engine_verb", "write_code"]
@@ -34,5 +33,6 @@ def __getattr__(name: str):
 
 
 if TYPE_CHECKING:
+    from .build import compile_model
     from .functions import build_functions
     from .generate import code_hash, write_code

@@ -13,27 +13,19 @@ import sys
 import time
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING
-
-import casadi as ca
 
 from ..errors import GearsymError
 from ..options import Integration
 from ..paths import GENERATED_DIR
+from ..system import FirstOrderSystem
 from .compiled import CompiledModel
-from .compiler import FALLBACK_NOTE, cache_dir, compile_library, compilers_looked_for, find_compiler
+from .compiler import cache_dir, compile_library
+from .functions import build_functions
+from .generate import code_hash, read_manifest, write_code
+from .library import LOADED, library_functions, resolve_backend
 from .loops import LoopOptions
 from .native import load_native
-
-if TYPE_CHECKING:
-    from ..system import FirstOrderSystem
-
-#: every function the generated library exports
-FUNCTION_NAMES = ("rhs", "jacobian", "constants", "table", "lyapunov_chunk", "lyapunov_period",
-                  "orbit_chunk", "orbit_period", "trajectory", "monodromy_segment", "monodromy_period")
-
-_LOADED: dict[tuple, CompiledModel] = {}
-_WARNED = set()
+from .time_tables import split_rhs
 
 
 def compile_model(system: FirstOrderSystem, options: Integration = Integration(), *,
@@ -47,9 +39,6 @@ def compile_model(system: FirstOrderSystem, options: Integration = Integration()
     defaults; they never enter the code, so another value never rebuilds anything. ``verbose`` says on
     stderr when it compiles (seconds, once).
     """
-    from ..system import FirstOrderSystem  # (SymPy: the code generator's imports are deferred to here)
-    from .generate import code_hash
-
     if not isinstance(system, FirstOrderSystem):
         raise GearsymError(f"compile_model takes a FirstOrderSystem, got {_kind(system)}; for a model name or file "
                            "use gearsym.load(...) first, e.g. compile_model(gearsym.load('one_stage'))")
@@ -59,42 +48,34 @@ def compile_model(system: FirstOrderSystem, options: Integration = Integration()
     loops = LoopOptions.of(options)
     digest = code_hash(system, loops)
     timings = {"symbolic": time.perf_counter() - start}
-    backend = _resolve_backend(options.backend)
+    backend = resolve_backend(options.backend)
     key = (digest, backend)
-    if key in _LOADED:  # same code: reuse the loaded functions, with this system's values and these options
-        return replace(_LOADED[key].clone(), system=system, integration=options)
+    if key in LOADED:  # same code: reuse the loaded functions, with this system's values and these options
+        return replace(LOADED[key].clone(), system=system, integration=options)
     if backend == "in-process":
-        from .functions import build_functions
-
         t = time.perf_counter()
         functions, library = build_functions(system, loops).functions, None
         timings["build"] = time.perf_counter() - t
     else:
         functions, library = _compiled_functions(system, loops, digest, timings, verbose)
     native = load_native(library, functions) if library else None
-    compiled = CompiledModel(system, loops, digest, functions, backend, library, timings, native, options)
-    _LOADED[key] = compiled
+    timed, texts = timed_tables(system, loops)
+    compiled = CompiledModel(system, loops, digest, functions, backend, library, timings, native, options,
+                             timed, texts)
+    LOADED[key] = compiled
     return compiled
 
 
-def _resolve_backend(asked: str) -> str:
-    """"auto" is compiled where a C compiler exists (else in-process, said once on stderr)."""
-    if asked != "auto":
-        return asked
-    if find_compiler():
-        return "compiled"
-    if "no-cc" not in _WARNED:
-        _WARNED.add("no-cc")
-        print(f"gearsym: warning: {FALLBACK_NOTE.format(what=compilers_looked_for())}", file=sys.stderr)
-    return "in-process"
+def timed_tables(system: FirstOrderSystem, loops: LoopOptions) -> tuple[frozenset[str], tuple[str, ...]]:
+    """The parameters that enter the tables of time or the period, and the tables as text."""
+    tables = [e for _, e in split_rhs(system, loops.locate_crossings).tables]
+    names = frozenset(s.name for e in (*tables, system.period) for s in e.free_symbols) & set(system.parameters)
+    return names, tuple(str(e) for e in tables)
 
 
 def _compiled_functions(system: FirstOrderSystem, loops: LoopOptions, digest: str, timings: dict,
                         verbose: bool) -> tuple[dict, Path]:
     """The library of ``digest``: C from generated/ or the cache (generated here if missing), compiled once."""
-    from .functions import build_functions
-    from .generate import read_manifest, write_code
-
     code_dir = code_directory(system.name, digest)
     source = code_dir / f"{system.name}.c"
     manifest = read_manifest(code_dir)
@@ -108,7 +89,7 @@ def _compiled_functions(system: FirstOrderSystem, loops: LoopOptions, digest: st
     lib = compile_library(source, system.name, announce=_to_stderr if verbose else None)
     if lib.compiled:
         timings["compile"] = lib.seconds
-    return {name: ca.external(name, str(lib.path)) for name in FUNCTION_NAMES}, lib.path
+    return library_functions(lib.path), lib.path
 
 
 def _kind(value) -> str:
@@ -118,8 +99,6 @@ def _kind(value) -> str:
 def code_directory(name: str, digest: str) -> Path:
     """Where the C of the code ``digest`` is: the committed ``generated/<model>/`` if its manifest carries
     this hash (no need to generate it again), else the cache."""
-    from .generate import read_manifest
-
     committed = GENERATED_DIR / name
     if (read_manifest(committed) or {}).get("hash") == digest:
         return committed

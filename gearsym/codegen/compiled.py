@@ -23,7 +23,8 @@ from ..checks import whole_number
 from ..errors import GearsymError, ModelError, warn
 from ..options import Integration
 from .loops import LoopOptions
-from .native import NativeFunction
+from .native import NativeFunction, load_native
+from .periodicity import NotPeriodicError
 
 if TYPE_CHECKING:
     from ..system import FirstOrderSystem
@@ -130,6 +131,8 @@ class CompiledModel:
     timings: dict[str, float] = field(default_factory=dict)
     native: Mapping[str, NativeFunction] | None = None  # the same functions, called without CasADi
     integration: Integration = field(default_factory=Integration)  # the options it was compiled with
+    timed: frozenset[str] = frozenset()  # the parameters in the tables of time or the period (the generator's)
+    table_texts: tuple[str, ...] = ()  # the tables of time, as text (for the error of one that does not repeat)
 
     def run_options(self, options: Integration | None) -> Integration:
         """The options a run on this model uses: its own, or ``options`` if they need the same code."""
@@ -152,8 +155,6 @@ class CompiledModel:
     def clone(self) -> "CompiledModel":
         """The same functions with work arrays of its own: one clone per thread runs in parallel
         (the native calls release the GIL; the generated functions keep no other state)."""
-        from .native import load_native
-
         native = load_native(self.library, dict(self.functions)) if self.native else None
         return replace(self, native=native, timings=dict(self.timings))
 
@@ -247,14 +248,11 @@ class CompiledModel:
         self._check_periodic(p, t0, period, probe)
         return period
 
-    @cached_property
+    @property
     def timed_parameters(self) -> frozenset[str]:
         """The parameters that enter the tables of time or the period: only a change of one of them needs
-        new tables (:meth:`retune`)."""
-        from .time_tables import split_rhs
-
-        exprs = [e for _, e in split_rhs(self.system, self.options.locate_crossings).tables] + [self.system.period]
-        return frozenset(s.name for e in exprs for s in e.free_symbols) & set(self.parameter_names)
+        new tables (:meth:`retune`). Found when the code is generated (:func:`.build.compile_model`)."""
+        return self.timed
 
     def retune(self, inputs: RunInputs, p: np.ndarray) -> RunInputs:
         """The inputs for the parameter vector ``p``: those of ``inputs`` with new constants if no parameter that
@@ -300,12 +298,11 @@ class CompiledModel:
         a, b = probe[:, 0].tolist(), probe[:, 1].tolist()  # (a few values: plain floats, the same arithmetic)
         off = [i for i, (x, y) in enumerate(zip(a, b)) if not abs(x - y) <= 1e-9 * (1 + abs(x))]
         if off:
-            from .time_tables import NotPeriodicError, split_rhs
-
             i = off[0]
-            expr = split_rhs(self.system, self.options.locate_crossings).tables[i][1]
+            expr = self.table_texts[i] if i < len(self.table_texts) else f"table {i}"
             values = ", ".join(f"{n}={v:g}" for n, v in zip(self.parameter_names, p))
-            raise NotPeriodicError(self.system, expr, t0 + 0.37 * period, a[i], b[i], f"at {values}")
+            raise NotPeriodicError(self.name, expr, str(self.system.period), self.system.time_name,
+                                   t0 + 0.37 * period, a[i], b[i], f"at {values}")
 
     def _check_inputs(self, inputs: RunInputs) -> None:
         if inputs.model_hash != self.hash:

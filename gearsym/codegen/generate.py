@@ -18,7 +18,8 @@ import sympy as sp
 
 from ..files import write_atomically
 from ..system import FirstOrderSystem
-from .functions import LoopOptions, ModelFunctions
+from .functions import ModelFunctions
+from .loops import LoopOptions
 from .printed import LOOP_NAMES, pieces, print_loops, stand_in
 
 #: bump when the generated code changes for the same model and options
@@ -26,7 +27,8 @@ CODEGEN_VERSION = 2
 
 #: the modules whose text determines the generated C; their bytes are part of the hash, so an edit
 #: can never leave a stale library or committed C in use (the tests then ask to regenerate)
-_GENERATOR_SOURCES = ("translate.py", "time_tables.py", "functions.py", "loops.py", "generate.py", "printed.py")
+_GENERATOR_SOURCES = ("translate.py", "time_tables.py", "casadi_symbols.py", "rk4.py", "switching.py", "crossing.py",
+                      "period_loops.py", "tables.py", "functions.py", "loops.py", "generate.py", "printed.py")
 
 
 def generator_digest() -> str:

@@ -8,7 +8,8 @@ from pathlib import Path
 from ..options import Integration
 from ..system import FirstOrderSystem
 from .compiler import compile_library
-from .functions import LoopOptions, build_functions
+from .functions import build_functions
+from .loops import LoopOptions
 from .generate import code_hash, write_code
 
 

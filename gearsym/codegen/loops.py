@@ -38,3 +38,13 @@ class LoopOptions:
             return 1
         target = self.block_steps or 1
         return max(d for d in range(1, target + 1) if self.steps_per_period % d == 0)
+
+
+#: a period is shot in up to this many pieces (multiple shooting of strongly unstable orbits)
+SHOOTING_SEGMENTS = 4
+
+
+def shooting_segments(N: int, K: int) -> int:
+    """The pieces of a period in ``monodromy_period``: ``SHOOTING_SEGMENTS``, or the largest number below
+    that the period's N // K blocks divide into."""
+    return max(d for d in range(1, SHOOTING_SEGMENTS + 1) if (N // K) % d == 0)

@@ -40,11 +40,14 @@ from ..errors import GearsymError
 from ..files import write_atomically
 from ..options import Integration
 from ..system import FirstOrderSystem
-from .build import FUNCTION_NAMES, cached_code_directory, code_directory
+from ..version import __version__
+from .build import cached_code_directory, code_directory
 from .compiled import CompiledModel
 from .compiler import CompilerError, binary_key, cache_dir, compile_flags, compile_library
-from .functions import LoopOptions, build_functions
+from .functions import build_functions
+from .loops import LoopOptions
 from .generate import code_hash, write_code
+from .library import library_functions
 from .native import load_native
 
 log = logging.getLogger("gearsym")
@@ -65,6 +68,8 @@ class ShippedModel:
     flags: tuple[str, ...] = ()
     binary_key: str = ""  # of the machine that built ``library``
     source: bytes = b""  # the generated C, to rebuild elsewhere
+    timed: frozenset[str] = frozenset()  # the parameters in the tables of time (CompiledModel.timed)
+    table_texts: tuple[str, ...] = ()
 
     @property
     def name(self) -> str:
@@ -79,7 +84,8 @@ def ship(compiled: CompiledModel) -> ShippedModel:
     """``compiled`` packed for another process or machine (see the module docstring)."""
     system = getattr(compiled.system, "full", compiled.system)  # a cached model's summary: the system it stands for
     base = dict(system=system, options=compiled.options, integration=compiled.integration,
-                hash=compiled.hash, backend=compiled.backend, versions=_versions())
+                hash=compiled.hash, backend=compiled.backend, versions=_versions(), timed=compiled.timed,
+                table_texts=compiled.table_texts)
     if compiled.backend != "compiled":
         return ShippedModel(**base)
     name = compiled.name
@@ -105,16 +111,17 @@ def load_shipped(shipped: ShippedModel) -> CompiledModel:
                                "(the code hash differs); install the same gearsym on every worker")
         functions = build_functions(shipped.system, shipped.options).functions
         return CompiledModel(shipped.system, shipped.options, shipped.hash, functions, "in-process",
-                             timings={"load": time.perf_counter() - start}, integration=shipped.integration)
+                             timings={"load": time.perf_counter() - start}, integration=shipped.integration,
+                             timed=shipped.timed, table_texts=shipped.table_texts)
     timings = {}
     if shipped.binary_key == binary_key(shipped.flags):
         path = _write_library(shipped)
     else:
         path = _rebuild(shipped, timings)
-    functions = {name: ca.external(name, str(path)) for name in FUNCTION_NAMES}
+    functions = library_functions(path)
     timings["load"] = time.perf_counter() - start
     return CompiledModel(shipped.system, shipped.options, shipped.hash, functions, "compiled", path, timings,
-                         load_native(path, functions), shipped.integration)
+                         load_native(path, functions), shipped.integration, shipped.timed, shipped.table_texts)
 
 
 def _write_library(shipped: ShippedModel) -> Path:
@@ -143,8 +150,6 @@ def _rebuild(shipped: ShippedModel, timings: dict) -> Path:
 
 
 def _versions() -> tuple[str, str]:
-    from ..version import __version__
-
     return __version__, ca.__version__
 
 

@@ -17,16 +17,16 @@ trip through the work vector between steps: about 10-15 % of a step next to a ha
 * CasADi's static functions nothing calls any more are removed.
 
 With crossings located, the ``try`` is inline on every step and the ``split`` (about 1 % of steps) a
-separate function behind a real ``if``, marked unlikely: the calls of :data:`~.functions.SPLIT_CALLS` (the MX
+separate function behind a real ``if``, marked unlikely: the calls of :data:`~.crossing.SPLIT_CALLS` (the MX
 function's), so that the C holds the mode-RK4 step and the root search once each, not once per substep.
 
 The plain tangent step is not CasADi's one function of the state and all tangent vectors (``tangent_block``),
 whose flat scalar code the compiler neither vectorises nor keeps in registers (on the flexible shaft: 654
 instructions a step, 260 of them loads, stores and copies of spilled values), but its two pieces
-(:func:`.functions._tangent_by_vector`): the state's step, which also gives each RK4 stage's Jacobian, and one
+(:func:`.rk4.tangent_by_vector`): the state's step, which also gives each RK4 stage's Jacobian, and one
 tangent vector's step, applied to each vector in a loop that gcc vectorises across them, the vectors being
 stored side by side in the span (343 instructions a step; the same bits). The located tangent step is split
-the same way (:meth:`.functions._CrossingStep.tried_by_vector`): the state's try, with its crossing flag and its
+the same way (:meth:`.crossing.CrossingStep.tried_by_vector`): the state's try, with its crossing flag and its
 stages' Jacobians, then, if it does not cross, the loop over the vectors and ``state_keep``; a step that crosses
 runs the split on the vectors as columns, transposed there and back.
 """
@@ -36,8 +36,9 @@ import re
 
 import casadi as ca
 
-from .functions import (SPLIT_INPUTS, SPLIT_OUTPUTS, SPLIT_PER_SURFACE, ModelFunctions, shooting_segments,
-                        split_calls, split_names)
+from .crossing import SPLIT_INPUTS, SPLIT_OUTPUTS, SPLIT_PER_SURFACE, split_calls, split_names
+from .functions import ModelFunctions
+from .loops import shooting_segments
 
 #: the loop functions printed here (everything else in the file is CasADi's)
 LOOP_NAMES = ("lyapunov_chunk", "lyapunov_period", "orbit_chunk", "orbit_period", "monodromy_segment",
@@ -143,7 +144,7 @@ _OUT_OF_LINE = {piece for kind in ("tangent", "state") for piece, _, _ in split_
 
 def _split(mf: ModelFunctions, kind: str) -> str:
     """``gs_{kind}_split``, the located step that crosses (arguments those of ``gs_{kind}_keep``): the calls of
-    :data:`~.functions.SPLIT_CALLS`, as the MX function ``{kind}_split`` makes them, with locals between."""
+    :data:`~.crossing.SPLIT_CALLS`, as the MX function ``{kind}_split`` makes them, with locals between."""
     inputs, outputs = split_names(kind, SPLIT_INPUTS), split_names(kind, SPLIT_OUTPUTS)
     keep = mf.steps[f"{kind}_keep"]
     sizes, body = {v: keep.numel_in(i) for i, v in enumerate(inputs)}, []
@@ -160,7 +161,7 @@ def _split(mf: ModelFunctions, kind: str) -> str:
     locals_ = " ".join(f"casadi_real {v}[{max(1, sizes[v])}];" for v in sizes if v not in (*inputs, *outputs))
     args = [f"const casadi_real* restrict {v}" for v in inputs] + [f"casadi_real* restrict {v}" for v in outputs]
     return ("/* the located step that crosses: its legs, RK4 of the sides held fixed on each (calls of one\n"
-            "   mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/functions.py) */\n"
+            "   mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/crossing.py) */\n"
             f"static GEARSYM_NOINLINE void gs_{kind}_split({', '.join(args)}) {{\n"
             f"  {locals_}\n  casadi_int i;\n{''.join(body)}}}\n")
 

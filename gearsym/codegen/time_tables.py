@@ -27,6 +27,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from ..system import FirstOrderSystem
+from .periodicity import NotPeriodicError
 
 
 @dataclass(frozen=True)
@@ -94,17 +95,6 @@ def split_rhs(system: FirstOrderSystem, factored: bool = False) -> SplitRHS:
     return split
 
 
-class NotPeriodicError(ModelError):
-    def __init__(self, system: FirstOrderSystem, expr, t0: float, a: float, b: float, where: str = "at the defaults"):
-        super().__init__(
-            f"time enters the right-hand side through {expr}, which is not periodic with the declared period "
-            f"{system.period} {where} ({a:.6g} at {system.time}={t0:.4g}, {b:.6g} one period later). The engine "
-            "samples one period and repeats it: declare the true forcing period, and keep time out of functions "
-            "of the state (write sin(x - t) as sin(x)cos(t) - cos(x)sin(t)).",
-            system.name,
-        )
-
-
 def _check_periodic(system: FirstOrderSystem, split: SplitRHS) -> None:
     """The tables repeat every period only if time enters periodically: check at the defaults."""
     values = {k: float(v) for k, v in system.parameters.items()}
@@ -124,4 +114,4 @@ def _check_periodic(system: FirstOrderSystem, split: SplitRHS) -> None:
             t0 = rng.uniform(0, period)
             a, b = f(t0), f(t0 + period)
             if not abs(a - b) <= 1e-9 * (1 + abs(a)):
-                raise NotPeriodicError(system, expr, t0, a, b)
+                raise NotPeriodicError(system.name, str(expr), str(system.period), str(system.time), t0, a, b)

@@ -4,7 +4,7 @@ The multiple-shooting fit (:mod:`gearsym.fit.shooting`) asks, at every Levenberg
 for each window's model outputs at its sample times and their derivatives by the window's start
 state and by the parameters. Here that is one C call for all windows:
 
-* ``fit_step`` (SX): one RK4 step (:func:`~gearsym.codegen.functions.rk4_step`, the one RK4) of the
+* ``fit_step`` (SX): one RK4 step (:func:`~gearsym.codegen.rk4.rk4_step`, the one RK4) of the
   state y and of its tangent Q = [dy/dy0 | dy/dp], as RK4 of the augmented system z = (y, p),
   z' = (f(tau, y, p), 0): the tangent is the exact derivative of the discrete flow;
 * ``fit_state_step``: the same step without the tangent;
@@ -35,7 +35,8 @@ from ..errors import GearsymError
 from ..files import write_atomically
 from ..system import FirstOrderSystem
 from .compiler import cache_dir, compile_library, find_compiler
-from .functions import SystemSymbols, rk4_step
+from .casadi_symbols import SystemSymbols
+from .rk4 import rk4_step
 from .generate import generator_digest
 from .translate import to_casadi
 

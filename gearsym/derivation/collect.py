@@ -10,16 +10,20 @@ model does not describe, a description of their role in the components.
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Mapping
 from pathlib import Path
 
 import sympy as sp
 
 from ..errors import GearsymError
-from ..model.drivetrain import Drivetrain, ResolvedDrivetrain
-from ..reduce.nondimensional import NondimensionalModel, reduce
+from ..model.drivetrain import Drivetrain
+from ..model.resolved import ResolvedDrivetrain
+from ..reduction.nondimensional import NondimensionalModel, reduce
+from ..scales.map import Scaling
 from ..symbols import parameter_symbol, tau
 from ..system import FirstOrderSystem
+from ..units import from_si
 from .notes import default_wave_amplitude, paper_notes
 from .records import (
     BodyRecord, ClosingRecord, ConditionRecord, CoordinateRecord, CouplingRecord, Derivation, FunctionRecord, GroupRecord,
@@ -120,7 +124,7 @@ def _derive_reduced(nd: NondimensionalModel) -> Derivation:
     red, rd, model = nd.reduction, nd.reduction.resolved, nd.drivetrain
     engine_rhs, names = nd.engine_equations()  # symbolic: no parameter needs a default
     scaling = _scaling(nd)
-    scaled = scaling.values if scaling is not None else {}
+    scaled = _scaled_values(scaling)
     values = {n: v for n, v in {**nd.declared_defaults, **scaled}.items() if n in names}
     descriptions = {gr.name: gr.description for gr in nd.groups} | dict(model.descriptions)
     groups = tuple(
@@ -160,34 +164,48 @@ def _derive_reduced(nd: NondimensionalModel) -> Derivation:
 
 
 def _scaling(nd: NondimensionalModel):
-    """The model's :class:`~gearsym.physical.Scaling` at its declared physical values, or None."""
+    """The model's :class:`~gearsym.scales.map.Scaling` at its declared physical values, or None."""
     if not nd.drivetrain.physical:
         return None
-    from ..physical.scales import scaling
+    return Scaling(nd, nd.drivetrain.physical, nd.drivetrain.length_scale)
 
-    return scaling(nd)
+
+def _scaled_values(scaling) -> dict[str, float]:
+    """The nondimensional values a scaling gives, or none where its length unit cannot be had (no mean load):
+    the equations, the groups and the page do not depend on it."""
+    if scaling is None:
+        return {}
+    try:
+        return scaling.values
+    except GearsymError:
+        return {}
 
 
 def _scaling_record(s) -> ScalingRecord:
-    """What the docs show of a scaling: every number in a fixed unit, so the page is the same everywhere."""
+    """What the docs show of a scaling: every number in a fixed unit, so the page is the same everywhere; a
+    length unit the values cannot give (no mean load) is said, not fatal: the equations do not depend on it."""
     def value(name: str) -> str:
         role = s.roles.get(name, (None, ""))[0]
         q = s.inputs[name]
-        return (f"{q.to(role.example).magnitude:.6g} {role.example}" if role is not None and role.example
-                else f"{q.to('').magnitude:.6g}")
+        return (f"{from_si(q.si, role.example):.6g} {role.example}" if role is not None and role.example
+                else f"{q.si:.6g}")
 
     condition = next(c for c in s.model.conditions if c.kind == "time_unit").equation
-    static = s.length_scale == "static"
-    rule = {"static": "the static deflection of the first mesh under the mean load",
+    rule = {"static": "the static deflection of the first mesh under the mean load (the static solution of the "
+                      "reduced equations)",
             "backlash": "half the backlash of the first mesh"}.get(s.length_scale) \
         if isinstance(s.length_scale, str) else "a given length"
-    units = [("omega_n", f"{s.omega_n.magnitude:.6g} rad/s ({s.omega_n.to('Hz').magnitude:.6g} Hz)"),
-             ("T", f"{s.time.magnitude:.6g} s"), ("M", f"{s.mass.magnitude:.6g} kg"),
-             ("L", f"{s.length.to('um').magnitude:.6g} um")]
+    units = [("omega_n", f"{s.omega_n_si:.6g} rad/s ({s.omega_n_si / (2 * math.pi):.6g} Hz)"),
+             ("T", f"{s.time_si:.6g} s"), ("M", f"{s.mass_si:.6g} kg")]
+    try:
+        units.append(("L", f"{s.length_si * 1e6:.6g} um"))
+        values = tuple(s.values.items())
+    except GearsymError as exc:
+        units.append(("L", f"none: {str(exc).split(': ', 1)[-1]}"))
+        values = ()
     if s.speed and s.speed.parameter in s.inputs:
         units.append(("mesh frequency", f"{s.mesh_frequency().magnitude:.6g} Hz at {value(s.speed.parameter)}"))
     return ScalingRecord(
         inputs=tuple((n, value(n), s.roles[n][0].meaning if n in s.roles else "") for n in s.inputs),
         omega_n_squared=condition.lhs, mass=s.reference_mesh.stiffness, length=rule,
-        length_definition=s.model.group(s.static_group).definition if static and s.static_group else None,
-        units=tuple(units), values=tuple(s.values.items()))
+        length_definition=None, units=tuple(units), values=values)

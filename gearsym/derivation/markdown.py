@@ -160,7 +160,7 @@ def _scaling(d: Derivation) -> list[str]:
     sc = d.scaling
     bare = d.bare_functions
     out = _section("Physical values and scaling")
-    out += ["The model declares physical values (`model.set_physical`); `gearsym.physical.Scaling` turns them "
+    out += ["The model declares physical values (`model.set_physical`); `gearsym.scaling` turns them "
             "into the nondimensional model's values with the groups and the time-unit condition above "
             "(see [docs/units.md](../units.md)):"]
     out += table(["Parameter", "Value", "What it is"], [[f"`{n}`", v, escape(w) or "—"] for n, v, w in sc.inputs])

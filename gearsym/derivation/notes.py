@@ -16,7 +16,7 @@ import sympy as sp
 
 from ..model.expressions import parameter_names
 from ..model.stiffness import DEFAULT_CONTACT_RATIO, DEFAULT_HARMONICS, rectangular_mesh_stiffness
-from ..reduce.nondimensional import NondimensionalModel
+from ..reduction.nondimensional import NondimensionalModel
 from ..symbols import phi
 from .printing import number
 from .records import GroupRecord

@@ -3,19 +3,17 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from .save import save_figure  # noqa: E402
+from .save import pyplot, save_figure
+from .sweep import plot_amplitude
 
 
 def plot_campbell(diagram, path: str | Path | None = None, sweep=None, coordinate: str | None = None):
     """Left: natural frequencies (horizontal), excitation orders (through the origin), their crossings.
     Right (with ``sweep``, a SweepResult in physical units over the same speeds): the amplitude, with the
     crossing speeds marked."""
+    plt = pyplot()
     panels = 2 if sweep is not None else 1
     fig, axs = plt.subplots(1, panels, figsize=(6.5 * panels, 4.8), constrained_layout=True, squeeze=False)
     ax = axs[0, 0]
@@ -38,8 +36,6 @@ def plot_campbell(diagram, path: str | Path | None = None, sweep=None, coordinat
     ax.set_title(f"{diagram.model}: Campbell diagram (circles: an order meets a natural frequency)", fontsize=9)
     ax.legend(fontsize=7, loc="upper left")
     if sweep is not None:
-        from .sweep import plot_amplitude
-
         right = axs[0, 1]
         plot_amplitude(right, sweep, coordinate)
         at: dict[float, list[str]] = {}

@@ -10,17 +10,12 @@ from __future__ import annotations
 import textwrap
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
-
-from ..errors import GearsymError  # noqa: E402
-from ..periodic import FOLD, GRAZING, NEIMARK_SACKER, PERIOD_DOUBLING, Continuation  # noqa: E402
-from .save import save_figure  # noqa: E402
-from .sweep import _axis_label  # noqa: E402
+from ..errors import GearsymError
+from ..periodic import FOLD, GRAZING, NEIMARK_SACKER, PERIOD_DOUBLING, Continuation
+from .save import pyplot, save_figure
+from .sweep import _axis_label
 
 #: marker and short label of each kind of bifurcation
 MARKS = {FOLD: ("o", "F", "fold (a multiplier through +1)"),
@@ -78,6 +73,7 @@ def plot_branches(ax, result: Continuation, coordinate: str | None = None, *, la
 
 
 def legend_handles(result: Continuation, sweep: bool = False) -> list:
+    from matplotlib.lines import Line2D
     handles = []
     for n in sorted({b.period_multiple for b in result.branches}):
         color = branch_color(n)
@@ -123,6 +119,7 @@ def orbits_title(result: Continuation, width: int = 110) -> str:
 def plot_orbits(result: Continuation, path: str | Path | None = None, coordinate: str | None = None, sweep=None):
     """The frequency-response curve of ``coordinate`` over the sweep's points (if given), and the largest
     multiplier below it; written to ``path`` if given. Returns the Figure."""
+    plt = pyplot()
     coordinate = coordinate or result.observed[0]
     fig, axs = plt.subplots(2, 1, figsize=(9, 8), sharex=True, constrained_layout=True,
                             gridspec_kw={"height_ratios": [3, 1.3]})

@@ -17,16 +17,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from ..analysis.attractors import Attractor, AttractorSet  # noqa: E402
-from ..analysis.orbits import Trajectory, phase_trajectory  # noqa: E402
-from ..errors import GearsymError  # noqa: E402
-from .save import save_figure  # noqa: E402
+from ..analysis.attractors import Attractor, AttractorSet
+from ..analysis.orbits import Trajectory, phase_trajectory
+from ..errors import GearsymError
+from .save import pyplot, save_figure
 
 #: how parameter names are written in titles and labels
 SYMBOLS = {"omega": "ω", "zeta": "ζ", "eta": "η", "Theta": "Θ", "Theta_p": "Θ'", "kS": "$k_S$", "k_a": "$k_a$"}
@@ -67,6 +63,7 @@ def plot_attractors(sets: AttractorSet | Sequence[AttractorSet | Sequence[Attrac
     (regular) or '2' (chaotic), the marker of its regime (:data:`REGIME_MARKERS`), and, alone in
     a panel, the colour of its class; so one kind of attractor looks the same in every panel.
     """
+    plt = pyplot()
     panels = _panels(sets)
     layers = max(len(p) for p in panels)
     colors = list(colors) if colors else list(LAYER_COLORS[:max(layers, 1)])
@@ -259,6 +256,7 @@ def phase_panel(model, *, title: str | None = None, x: str | None = None, y: str
 def plot_phase_portraits(panels: Sequence[PhasePanel], path: str | Path | None = None, columns: int | None = None):
     """A grid of phase portraits, captioned (a), (b), ... in order, written to ``path`` (PNG) if given;
     returns the Figure."""
+    plt = pyplot()
     panels = list(panels)
     if not panels or not all(isinstance(p, PhasePanel) for p in panels):
         raise GearsymError("plot_phase_portraits needs a list of PhasePanel (see phase_panel)")

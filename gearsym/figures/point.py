@@ -9,22 +9,19 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from ..analysis.lyapunov import LyapunovSpectrum  # noqa: E402
-from ..analysis.orbits import Trajectory  # noqa: E402
-from .poincare import phase_axes  # noqa: E402
-from .save import save_figure  # noqa: E402
+from ..analysis.lyapunov import LyapunovSpectrum
+from ..analysis.orbits import Trajectory
+from .poincare import phase_axes
+from .save import pyplot, save_figure
 
 
 def plot_point(spectrum: LyapunovSpectrum, trajectory: Trajectory, path: str | Path | None = None,
                x: str | None = None, y: str | None = None):
     """The two-panel figure, written to ``path`` (PNG) if given; returns the matplotlib Figure.
     ``x``/``y`` choose the phase-plane axes (default the first state, and the state after ``x``)."""
+    plt = pyplot()
     names = list(trajectory.state_names)
     x, y = phase_axes(names, x, y)
     fig, (ax_l, ax_p) = plt.subplots(1, 2, figsize=(11, 4.2), constrained_layout=True)

@@ -10,18 +10,12 @@ from __future__ import annotations
 import textwrap
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.colors import BoundaryNorm, ListedColormap, TwoSlopeNorm  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
-
-from ..analysis.regime import REGIMES  # noqa: E402
-from ..errors import GearsymError  # noqa: E402
-from ..sweep.result import SweepResult  # noqa: E402
-from .save import save_figure  # noqa: E402
+from ..analysis.regime import REGIMES
+from ..errors import GearsymError
+from ..sweep.result import SweepResult
+from .save import pyplot, save_figure
 
 REGIME_COLORS = {"periodic": "#4c72b0", "quasi-periodic": "#55a868", "chaotic": "#dd8452",
                  "hyperchaotic": "#c44e52", "equilibrium": "#8172b3"}
@@ -94,6 +88,7 @@ def plot_bifurcation(ax, result: SweepResult, state: str | None = None, *, direc
 
 def plot_regime_strip(ax, result: SweepResult, *, direction: str | None = None, **fixed) -> None:
     """One coloured bar per point: the regime along the first parameter (one row per run)."""
+    plt = pyplot()
     x = result.axes[0].name
     runs = list(_runs(result, direction, **fixed))
     for row, (d, values, idx) in enumerate(runs):
@@ -109,6 +104,9 @@ def plot_regime_strip(ax, result: SweepResult, *, direction: str | None = None, 
 
 def plot_map(ax, result: SweepResult, column: str = "lambda_1", *, direction: str | None = None):
     """``column`` over the first two parameters (lambda_1: diverging colours, zero white, and its zero contour)."""
+    from matplotlib.colors import BoundaryNorm
+    from matplotlib.colors import ListedColormap
+    from matplotlib.colors import TwoSlopeNorm
     x, y = result.axes[0].name, result.axes[1].name
     xs, ys = np.array(result.axes[0].values), np.array(result.axes[1].values)
     grid = np.full((len(ys), len(xs)), np.nan)
@@ -161,8 +159,9 @@ def _run_label(direction: str, values: dict, style: bool = True) -> str:
     return ", ".join(p for p in (run, fixed) if p) or "sweep"
 
 
-def _style_legend(result: SweepResult) -> list[Line2D]:
+def _style_legend(result: SweepResult) -> list:
     """Legend entries for the line styles of the directions in ``result`` (none for independent points)."""
+    from matplotlib.lines import Line2D
     directions = [d for d in dict.fromkeys(result["direction"].tolist()) if d in ("up", "down")]
     return [Line2D([], [], color="0.3", lw=1.0, ls=_LINESTYLE[d], label=f"{_STYLE_NAME[_LINESTYLE[d]]}: {d}")
             for d in directions]
@@ -198,6 +197,8 @@ def plot_sweep(result: SweepResult, path: str | Path | None = None, coordinate: 
     """Overview, written to ``path`` (PNG) if given; returns the Figure. For one swept parameter: A of
     ``coordinate`` (default the first), lambda_i, the bifurcation diagram of ``coordinate`` and the regimes
     against it; for two, maps of lambda_1, the regime and A over both."""
+    plt = pyplot()
+    from matplotlib.lines import Line2D
     coordinate = coordinate or result.coordinates[0]
     if coordinate not in result.coordinates:
         raise GearsymError(f"plot_sweep: no coordinate {coordinate!r}; the coordinates are "

@@ -4,10 +4,14 @@ add it to the symbolic model, and report the held-out error before and after.
 :mod:`.shooting` (multiple-shooting fit) -> :mod:`.prediction` (held-out error) ->
 :mod:`.explain` (forward selection over :mod:`.effects`) -> :mod:`.report`.
 """
-from .effects import EFFECTS, FAMILIES, Effect, augment, effect, effect_terms, term_effect
-from .explain import Explanation, explain
-from .prediction import Prediction, predict_ahead
-from .shooting import Fit, Segment, fit_windows
+from ..checks import json_safe
+from ..data import load_measurements
+from ..outputs import check_folder
+from .effects import augment, Effect, effect, effect_terms, EFFECTS, FAMILIES, term_effect
+from .explain import explain, Explanation
+from .prediction import predict_ahead, Prediction
+from .report import write_report
+from .shooting import Fit, fit_windows, Segment
 
 __all__ = ["EFFECTS", "Effect", "Explanation", "FAMILIES", "Fit", "Prediction", "Segment", "augment", "effect",
            "effect_terms", "explain", "explain_files", "fit_windows", "predict_ahead", "term_effect"]
@@ -19,10 +23,6 @@ def explain_files(paths, system, fit, *, out=None, time_scale=None, held_out: fl
     declares combinations measured as one column), explain (``bias``: channels with an unknown offset;
     ``terms``: hand-written terms tried as effects), and with ``out`` write the report there. Returns the
     report's dict (the keys of report.json)."""
-    from ..data import load_measurements
-    from ..outputs import check_folder
-    from .report import write_report
-
     if out is not None:
         check_folder(out)
     measurements = load_measurements(paths, system, time_scale=time_scale, channels=channels, **values)
@@ -34,6 +34,5 @@ def explain_files(paths, system, fit, *, out=None, time_scale=None, held_out: fl
                  bias=bias, terms=terms, **extra)
     if out is not None:
         return write_report(ex, system, out, measurements.sources)
-    from ..checks import json_safe
 
     return json_safe(ex.as_dict())

@@ -39,9 +39,10 @@ from ..errors import GearsymError
 from ..options import Integration
 from ..system import FirstOrderSystem
 from .canonical import amplitude_phase, canonical
-from .effects import EFFECTS, FAMILIES, Effect, applies_to, augment, bounds_of, effect, site, term_effect
-from .prediction import Prediction, predict_ahead
-from .shooting import Fit, Segment, fit_windows, score_columns
+from .effects import applies_to, augment, bounds_of, Effect, effect, EFFECTS, FAMILIES, site, term_effect
+from .prediction import predict_ahead, Prediction
+from .proposals import propose_terms
+from .shooting import Fit, fit_windows, score_columns, Segment
 
 MIN_GAIN = 0.2
 MAX_CORRELATION = 0.5
@@ -271,8 +272,6 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
                      spectrum=spectrum, final_spectrum=current_spectrum, library=library, system=system,
                      bias=tuple(bias))
     if unexplained and propose:
-        from .proposals import propose_terms
-
         ex = replace(ex, proposed=propose_terms(ex, superset, seg_train, seg_test, keys, options, harmonics, say))
         if ex.effects and ex.proposed:  # do the effects earn their place beside the term the residual asks for?
             alone = replace(ex, final=base)

@@ -11,18 +11,14 @@ import json
 import math
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+import sympy as sp
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import sympy as sp  # noqa: E402
-
-from ..checks import json_safe  # noqa: E402
-from ..figures.save import save_figure  # noqa: E402
-from ..system import FirstOrderSystem  # noqa: E402
-from .effects import augment, effect_terms  # noqa: E402
-from .explain import MIN_SCORE, Candidate, Explanation  # noqa: E402
+from ..checks import json_safe
+from ..figures.save import pyplot, save_figure
+from ..system import FirstOrderSystem
+from .effects import augment, effect_terms
+from .explain import MIN_SCORE, Candidate, Explanation
 
 VERDICTS = {
     "explained": "the effects added explain the data: what is left looks like measurement noise",
@@ -217,6 +213,7 @@ def _views(c: Candidate, system: FirstOrderSystem):
 def residual_figure(ex: Explanation, system: FirstOrderSystem):
     """Where the held-out residual lives (against the mesh phase, the coordinate and its rate) and its spectrum:
     the model as declared always, and after when effects were added."""
+    plt = pyplot()
     fig, axs = plt.subplots(1, 4, figsize=(17, 3.8), constrained_layout=True)
     shown = [(ex.base, "0.6", "as declared")]
     if ex.effects:
@@ -252,6 +249,7 @@ def residual_figure(ex: Explanation, system: FirstOrderSystem):
 
 
 def _prediction_figure(ex: Explanation, path: Path) -> None:
+    plt = pyplot()
     p0, p1 = ex.base.prediction, ex.final.prediction
     channel = next(iter(p0.measured))
     count = min(len(p0.tau), 3 * len(p0.tau) // max(p0.pairs, 1))  # the first three predicted periods

@@ -1,7 +1,9 @@
-"""Declaring drivetrains: components, parameters and the Lagrangian (pipeline step 1)."""
-from .components import Body, Disk, Gear, Harmonic, Mesh, Planet, Shaft, Torque
-from .drivetrain import Drivetrain
-from .stiffness import rectangular_mesh_stiffness
+"""Declaring drivetrains: components, parameters and the Lagrangian (pipeline step 1).
 
-__all__ = ["Body", "Disk", "Drivetrain", "Gear", "Harmonic", "Mesh", "Planet", "Shaft", "Torque",
-           "rectangular_mesh_stiffness"]
+:mod:`.components` (Gear, Disk, Planet, Mesh, Shaft, Torque, Harmonic), :mod:`.drivetrain` (the
+:class:`~.drivetrain.Drivetrain` they are added to), :mod:`.resolved` (every declaration checked, with its
+kinematics), :mod:`.lagrangian` and :mod:`.planetary` (its bases), :mod:`.expressions`, :mod:`.formula` and
+:mod:`.grammar` (what a user writes, read without running it), :mod:`.stiffness` (mesh stiffness shapes),
+:mod:`.length_scale`. The modules are imported by name (the face, ``gearsym.Drivetrain`` ..., hands them on),
+so that the light ones (the grammar, the length scale) never load SymPy.
+"""

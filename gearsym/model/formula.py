@@ -21,19 +21,10 @@ from collections.abc import Callable
 import sympy as sp
 
 from ..errors import ModelError
+from .grammar import FUNCTION_NAMES, GRAMMAR, MAX_DEPTH, REFUSED_NODES, REFUSED_OPERATORS, syntax_tree
 
-#: functions a formula may call: those the code generator translates (``abs`` is Python's name of Abs)
-FUNCTIONS: dict[str, Callable] = {
-    "sin": sp.sin, "cos": sp.cos, "tan": sp.tan, "exp": sp.exp, "log": sp.log, "sqrt": sp.sqrt,
-    "sinh": sp.sinh, "cosh": sp.cosh, "tanh": sp.tanh, "asin": sp.asin, "acos": sp.acos, "atan": sp.atan,
-    "atan2": sp.atan2, "Abs": sp.Abs, "abs": sp.Abs, "sign": sp.sign, "floor": sp.floor, "ceiling": sp.ceiling,
-    "erf": sp.erf, "Min": sp.Min, "Max": sp.Max, "Heaviside": sp.Heaviside, "Piecewise": sp.Piecewise,
-    "And": sp.And, "Or": sp.Or, "Not": sp.Not,
-}
-GRAMMAR = ("a formula may use numbers, names of parameters and states, t, tau, phi, pi, + - * / **, "
-           f"comparisons, and the functions {', '.join(FUNCTIONS)}")
-MAX_LENGTH = 10_000
-MAX_DEPTH = 100
+#: the SymPy function of each name the grammar allows (``abs`` is Python's name of Abs)
+FUNCTIONS: dict[str, Callable] = {name: getattr(sp, "Abs" if name == "abs" else name) for name in FUNCTION_NAMES}
 #: an exact power a**b with more bits than this would take minutes and gigabytes to compute
 MAX_EXACT_BITS = 1_000_000
 
@@ -41,19 +32,6 @@ _BINARY = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
            ast.Pow: operator.pow}
 _COMPARE = {ast.Lt: operator.lt, ast.LtE: operator.le, ast.Gt: operator.gt, ast.GtE: operator.ge,
             ast.Eq: sp.Eq, ast.NotEq: sp.Ne}
-_REFUSED_OPERATORS = {
-    ast.BitXor: "'^' (write powers as **)", ast.Mod: "'%'", ast.FloorDiv: "'//' (use floor(a/b))",
-    ast.MatMult: "'@'", ast.LShift: "'<<'", ast.RShift: "'>>'", ast.BitAnd: "'&' (use And(a, b))",
-    ast.BitOr: "'|' (use Or(a, b))", ast.Invert: "'~' (use Not(a))", ast.Not: "'not' (use Not(a))",
-    ast.And: "'and' (use And(a, b))", ast.Or: "'or' (use Or(a, b))",
-}
-_REFUSED_NODES = {
-    ast.Attribute: "attribute access (.)", ast.Subscript: "subscripts ([])", ast.Lambda: "lambda",
-    ast.Tuple: "a tuple (only a Piecewise takes (value, condition) pairs)", ast.List: "a list",
-    ast.Dict: "a dict", ast.Set: "a set", ast.ListComp: "a comprehension", ast.SetComp: "a comprehension",
-    ast.DictComp: "a comprehension", ast.GeneratorExp: "a comprehension", ast.JoinedStr: "an f-string",
-    ast.IfExp: "'if ... else' (use Piecewise)", ast.NamedExpr: "':='", ast.Starred: "'*' unpacking",
-}
 
 
 def parse_formula(text: str, where: str) -> sp.Basic:
@@ -74,20 +52,9 @@ class _Builder:
         return ModelError(f"the formula {self.shown} {what}; {GRAMMAR}", self.where)
 
     def build(self) -> sp.Basic:
-        if not self.text:
-            raise ModelError("empty formula; give a number, a parameter name or a formula", self.where)
-        if len(self.text) > MAX_LENGTH:
-            raise self.refuse(f"has {len(self.text)} characters, more than the {MAX_LENGTH} a formula may have")
+        tree = syntax_tree(self.text, self.where)  # the grammar, checked before anything is built
         try:
-            tree = ast.parse(self.text, mode="eval")
-        except SyntaxError as exc:
-            if "nested parentheses" in str(exc):
-                raise self.refuse(f"is nested too deeply (more than {MAX_DEPTH} levels)") from None
-            raise self.refuse(f"is not a formula ({exc.msg})") from None
-        except (RecursionError, MemoryError):
-            raise self.refuse("is nested too deeply for Python's parser") from None
-        try:
-            return self.node(tree.body, 0)
+            return self.node(tree, 0)
         except ModelError:
             raise
         except (TypeError, ValueError, ArithmeticError) as exc:  # SymPy refusing, e.g. sin(x, y) or (x < 1) + 1
@@ -110,9 +77,9 @@ class _Builder:
         if isinstance(n, ast.Call):
             return self.call(n, depth)
         op = getattr(n, "op", None)
-        if type(op) in _REFUSED_OPERATORS:
-            raise self.refuse(f"uses the operator {_REFUSED_OPERATORS[type(op)]}, which is not allowed")
-        what = _REFUSED_NODES.get(type(n), type(n).__name__)
+        if type(op) in REFUSED_OPERATORS:
+            raise self.refuse(f"uses the operator {REFUSED_OPERATORS[type(op)]}, which is not allowed")
+        what = REFUSED_NODES.get(type(n), type(n).__name__)
         raise self.refuse(f"uses {what}, which is not allowed in a formula")
 
     def constant(self, n: ast.Constant) -> sp.Basic:
@@ -164,7 +131,7 @@ class _Builder:
 
     def call(self, n: ast.Call, depth: int) -> sp.Basic:
         if isinstance(n.func, ast.Attribute):
-            raise self.refuse(f"uses {_REFUSED_NODES[ast.Attribute]}, which is not allowed in a formula")
+            raise self.refuse(f"uses {REFUSED_NODES[ast.Attribute]}, which is not allowed in a formula")
         if not isinstance(n.func, ast.Name):
             raise self.refuse("calls something other than a function by its name")
         name = n.func.id

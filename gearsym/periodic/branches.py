@@ -7,10 +7,10 @@ import numpy as np
 
 from ..checks import json_safe, whole_number
 from ..codegen import CompiledModel, engine_verb
-from ..errors import GearsymError
+from ..errors import GearsymError, UnknownParameterError
 from ..options import Integration
 from .continuation import Solution, Steps, Traced, Tracer
-from .floquet import PERIOD_DOUBLING, contact_regime, mesh_watches
+from .floquet import contact_regime, mesh_watches, PERIOD_DOUBLING
 from .orbit import find_orbit, starting_states
 from .shooting import OrbitMap, Shooting
 
@@ -140,8 +140,6 @@ def continue_orbits(model: CompiledModel, parameter: str, start: float, stop: fl
     """
     options = model.run_options(options)
     if parameter not in model.parameter_names:
-        from ..errors import UnknownParameterError
-
         raise UnknownParameterError(parameter, model.parameter_names, model.name)
     start, stop = float(start), float(stop)
     if not (np.isfinite(start) and np.isfinite(stop)) or start == stop:

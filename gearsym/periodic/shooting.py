@@ -26,6 +26,7 @@ import numpy as np
 
 from ..checks import whole_number
 from ..codegen import CompiledModel, RunInputs
+from ..codegen.loops import SHOOTING_SEGMENTS
 from ..errors import GearsymError
 
 #: Newton stops when every residual component is below this times (1 + the largest |state|)
@@ -58,8 +59,6 @@ class Shooting:
 def pieces_per_period(steps_per_period: int) -> int:
     """The pieces the generated code cuts a forcing period into (``monodromy_segment``): up to
     ``SHOOTING_SEGMENTS``, the largest number the steps divide into; known before the code is built."""
-    from ..codegen.functions import SHOOTING_SEGMENTS
-
     return max(d for d in range(1, SHOOTING_SEGMENTS + 1) if steps_per_period % d == 0)
 
 

@@ -1,25 +1,8 @@
-"""Physical units: values with units in, the nondimensional model's values out, results carried back.
+"""Results carried back to the user's units (rpm, µm, N, 1/s): the stage above the analyses it converts.
 
-A stage between the reduction and the engine: :func:`scaling` makes a :class:`Scaling` from a reduced
-drivetrain and its physical values (pint quantities); the engine stays nondimensional.
+:mod:`.answers` (the :class:`~.answers.PhysicalScaling` the face's ``gearsym.scaling`` returns, with
+``to_physical``), :mod:`.results` (spectra, trajectories and sweeps in physical units), :mod:`.point` (one
+operating point from cached numbers: the start-up path, no pint and no SymPy), :mod:`.sweeps` (physical
+sweep axes), :mod:`.campbell` and :mod:`.files`. The modules are imported by name, so the light
+:mod:`.point` never loads the others.
 """
-from __future__ import annotations
-
-import importlib
-from typing import TYPE_CHECKING
-
-__all__ = ["LENGTH_SCALES", "Scaling", "scaling"]
-
-
-def __getattr__(name: str):
-    """The scaling on first use: it loads pint's unit registry (most of a second), which the parsing of a
-    quantity string (``physical.text``) and a model without units never need."""
-    if name not in __all__:
-        raise AttributeError(f"module 'gearsym.physical' has no attribute {name!r}")
-    value = getattr(importlib.import_module("gearsym.physical.scales"), name)
-    globals()[name] = value
-    return value
-
-
-if TYPE_CHECKING:
-    from .scales import LENGTH_SCALES, Scaling, scaling

@@ -7,8 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .scales import Scaling
-from .units import Quantity
+from ..scales.map import Scaling
+from ..units import from_si, to_si
 
 
 @dataclass(frozen=True)
@@ -42,7 +42,7 @@ class Campbell:
 
     def speeds_rad_s(self, speeds=None) -> np.ndarray:
         values = self.speeds if speeds is None else speeds
-        return Quantity(np.asarray(values, dtype=float), self.speed_unit).to("rad/s").magnitude
+        return to_si(np.asarray(values, dtype=float), self.speed_unit)
 
     def as_dict(self) -> dict:
         return {"model": self.model, "speed_unit": self.speed_unit,
@@ -65,14 +65,13 @@ def campbell(scaling: Scaling, speeds, speed_unit: str, modes, mesh_orders: int 
     harmonics = sorted({ft.order for ft in scaling.model.reduction.resolved.forcing if ft.order})
     orders += [Order(f"torque {h}x", "torque", h * scaling.forcing_ratio) for h in harmonics]
     naturals = tuple(sorted({round(m.frequency, 9) for m in modes.elastic}))
-    low, high = Quantity(float(np.min(speeds)), speed_unit).to("rad/s").magnitude, \
-        Quantity(float(np.max(speeds)), speed_unit).to("rad/s").magnitude
+    low, high = to_si(float(np.min(speeds)), speed_unit), to_si(float(np.max(speeds)), speed_unit)
     crossings = []
     for order in orders:
         for fn in naturals:
             at = 2 * math.pi * fn / order.per_speed  # rad/s
             if low <= at <= high:
-                crossings.append(Crossing(order.label, fn, Quantity(at, "rad/s").to(speed_unit).magnitude))
+                crossings.append(Crossing(order.label, fn, float(from_si(at, speed_unit))))
     crossings.sort(key=lambda c: c.speed)
     return Campbell(scaling.name, speed_unit, np.asarray(speeds, dtype=float), naturals, tuple(orders),
                     tuple(crossings))

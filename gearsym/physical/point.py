@@ -14,21 +14,13 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from .text import shown
+from ..scales.speeds import Speed
+from ..units import shown
 
 #: the default units results are shown in
 LENGTH_UNIT = "um"
 VELOCITY_UNIT = "mm/s"
 SPEED_UNIT = "rpm"
-
-
-@dataclass(frozen=True)
-class Speed:
-    """The declared operating speed: the body it drives and the parameter that names it."""
-
-    parameter: str
-    body: str
-    where: str
 
 
 @dataclass(frozen=True)
@@ -209,7 +201,7 @@ class PointUnits:
 
 
 class CachedScaling:
-    """A :class:`~gearsym.physical.Scaling` as far as a spectrum run needs it, from cached :class:`PointUnits`;
+    """A :class:`~gearsym.scales.map.Scaling` as far as a spectrum run needs it, from cached :class:`PointUnits`;
     anything else comes from the full scaling, made on first use (the model reduced: seconds)."""
 
     def __init__(self, units: PointUnits, load: Callable[[], object]):

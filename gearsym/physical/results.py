@@ -10,18 +10,20 @@ from __future__ import annotations
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
-import pint
 import sympy as sp
 
+from ..codegen.translate import to_casadi
 from ..errors import GearsymError
+from ..scales.dimensions import evaluate
+from ..scales.map import Scaling
+from ..sweep.grid import Axis
 from ..symbols import omega as omega_symbol, phi, t
-from .scales import Scaling, evaluate
-from .point import LENGTH_UNIT, SPEED_UNIT, VELOCITY_UNIT, Measured, MeshUnits, PhysicalPoint, PointUnits, Unit, contact
-from .units import Quantity
+from ..units import Quantity, from_si, symbol
+from .point import LENGTH_UNIT, VELOCITY_UNIT, Measured, MeshUnits, PhysicalPoint, PointUnits, Unit, contact
 
 def rate(scaling: Scaling, omega: float) -> float:
     """Radians per second of one unit of tau per unit time: omega * omega_n (tau = this * t)."""
-    return float(omega) * scaling.omega_n.magnitude
+    return float(omega) * scaling.omega_n_si
 
 
 def kinds(scaling: Scaling) -> dict[str, str]:
@@ -36,7 +38,7 @@ def state_to_physical(scaling: Scaling, name: str, values, omega: float, length_
     """A state's values (numbers in the scaled units) as a quantity: a coordinate in ``length_unit``, a rate in
     ``VELOCITY_UNIT``."""
     kind = kinds(scaling).get(name)
-    length = scaling.length.to("m").magnitude
+    length = scaling.length_si
     if kind == "length":
         return Quantity(np.asarray(values, dtype=float) * length, "m").to(length_unit)
     if kind == "velocity":
@@ -64,17 +66,14 @@ def point_units(scaling: Scaling, length_unit: str = LENGTH_UNIT) -> PointUnits:
         return float(Quantity(1.0, source).to(target).magnitude)
 
     def text(unit: str) -> Unit:
-        return Unit(unit, f"{Quantity(1, unit).units:~P}")
+        return Unit(unit, symbol(unit))
 
-    speed_unit = (str(scaling.inputs[scaling.speed.parameter].units) if scaling.speed and scaling.speed.parameter in
-                  scaling.inputs else SPEED_UNIT)
-    if scaling.speed:
-        scaling._speed_quantity(Quantity(1.0, speed_unit))  # (what speed_at checks)
+    speed_unit = scaling.speed_unit
     return PointUnits(
-        scaling.name, scaling.speed, text(speed_unit), factor("rad/s", speed_unit), float(scaling.omega_n.magnitude),
-        float(scaling.omega_n.to("Hz").magnitude), float(scaling.forcing_ratio) if scaling.speed else float("nan"),
-        float(scaling.reference_mesh.order), factor("rad/s", "Hz"), float(scaling.length.to("m").magnitude),
-        float(scaling.length.to(length_unit).magnitude), length_unit, text(length_unit), factor("m", length_unit),
+        scaling.name, scaling.speed, text(speed_unit), factor("rad/s", speed_unit), scaling.omega_n_si,
+        scaling.omega_n_si / (2 * np.pi), float(scaling.forcing_ratio) if scaling.speed else float("nan"),
+        float(scaling.reference_mesh.order), factor("rad/s", "Hz"), scaling.length_si,
+        float(from_si(scaling.length_si, length_unit)), length_unit, text(length_unit), factor("m", length_unit),
         text(VELOCITY_UNIT), factor("m/s", VELOCITY_UNIT), factor(VELOCITY_UNIT, "m/s"), text("1/s"), text("N"), text("Hz"),
         kinds(scaling), tuple(_mesh_units(scaling)))
 
@@ -82,22 +81,19 @@ def point_units(scaling: Scaling, length_unit: str = LENGTH_UNIT) -> PointUnits:
 def _mesh_units(scaling: Scaling):
     import casadi as ca
 
-    from ..codegen.translate import to_casadi
-
-    si = {n: q.to_base_units() for n, q in scaling.inputs.items()}
+    si = scaling.inputs
     for c in scaling.model.coordinates:
         rc = c.coupling
         if rc.kind != "mesh":
             continue
         where = f"{scaling.name}: mesh {rc.name!r}"
-        variation = rc.variation.xreplace({sp.Symbol(n, real=True): float(q.to("").magnitude)
+        variation = rc.variation.xreplace({sp.Symbol(n, real=True): q.si
                                            for n, q in scaling.inputs.items() if q.dimensionless})
         angle = ca.SX.sym("phi")
         k_of_phi = ca.Function("k", [angle], to_casadi([variation], {phi: angle}, where))
-        yield MeshUnits(rc.name, c.name, c.velocity_name, float(evaluate(rc.stiffness, si, where).to("N/m").magnitude),
-                        float(evaluate(rc.damping, si, where).to("N*s/m").magnitude),
-                        float(evaluate(rc.backlash, si, where).to("m").magnitude),
-                        float(evaluate(rc.mesh_phase.xreplace({omega_symbol: 0, t: 0}), si, where).to("").magnitude),
+        yield MeshUnits(rc.name, c.name, c.velocity_name, evaluate(rc.stiffness, si, where).si,
+                        evaluate(rc.damping, si, where).si, evaluate(rc.backlash, si, where).si,
+                        evaluate(rc.mesh_phase.xreplace({omega_symbol: 0, t: 0}), si, where).si,
                         float(rc.order), k_of_phi.serialize())
 
 
@@ -106,11 +102,11 @@ class PhysicalTrajectory:
     """A trajectory in physical units: time in s, coordinates in the length unit, rates in mm/s, forces in N."""
 
     model: str
-    time: pint.Quantity
-    states: dict[str, pint.Quantity]
-    mesh_force: dict[str, pint.Quantity]
+    time: object  # pint Quantities, for a Python user
+    states: dict[str, object]
+    mesh_force: dict[str, object]
 
-    def __getitem__(self, name: str) -> pint.Quantity:
+    def __getitem__(self, name: str):
         return self.states[name]
 
 
@@ -122,7 +118,7 @@ def trajectory_to_physical(scaling: Scaling, trajectory, omega: float,
     return PhysicalTrajectory(scaling.name, Quantity(seconds, "s"), states, mesh_forces(scaling, trajectory, omega))
 
 
-def mesh_forces(scaling: Scaling, trajectory, omega: float) -> dict[str, pint.Quantity]:
+def mesh_forces(scaling: Scaling, trajectory, omega: float) -> dict:
     """The force of every mesh along a trajectory, from its law in physical units:
     ``kZ k(phi) g(x, eta) + cZ dx/dt`` with phi = order tau + phase."""
     out = {}
@@ -132,13 +128,13 @@ def mesh_forces(scaling: Scaling, trajectory, omega: float) -> dict[str, pint.Qu
         if rc.kind != "mesh":
             continue
         where = f"{scaling.name}: mesh {rc.name!r}"
-        si = {n: q.to_base_units() for n, q in scaling.inputs.items()}
-        stiffness = evaluate(rc.stiffness, si, where).to("N/m").magnitude
-        damping = evaluate(rc.damping, si, where).to("N*s/m").magnitude
-        eta = evaluate(rc.backlash, si, where).to("m").magnitude
-        variation = rc.variation.xreplace({sp.Symbol(n, real=True): float(q.to("").magnitude)
+        si = scaling.inputs
+        stiffness = evaluate(rc.stiffness, si, where).si
+        damping = evaluate(rc.damping, si, where).si
+        eta = evaluate(rc.backlash, si, where).si
+        variation = rc.variation.xreplace({sp.Symbol(n, real=True): q.si
                                            for n, q in scaling.inputs.items() if q.dimensionless})
-        phase = evaluate(rc.mesh_phase.xreplace({omega_symbol: 0, t: 0}), si, where).to("").magnitude
+        phase = evaluate(rc.mesh_phase.xreplace({omega_symbol: 0, t: 0}), si, where).si
         k_of_phi = sp.lambdify(phi, variation, "numpy")
         x = state_to_physical(scaling, c.name, trajectory[c.name], omega, "m").magnitude
         v = state_to_physical(scaling, c.velocity_name, trajectory[c.velocity_name], omega).to("m/s").magnitude
@@ -151,12 +147,10 @@ def sweep_to_physical(scaling: Scaling, result, length_unit: str = LENGTH_UNIT):
     """A :class:`~gearsym.sweep.SweepResult` over omega with a speed axis instead (in the speed's unit),
     amplitudes and coordinates in ``length_unit``, rates in mm/s and exponents per second; ``units`` says
     which."""
-    from ..sweep.grid import Axis
-
     if result.axes[0].name != "omega":
         raise GearsymError(f"{scaling.name}: a sweep carried to physical units must run along omega first, "
                            f"not {result.axes[0].name}")
-    unit = str(scaling.inputs[scaling.speed.parameter].units) if scaling.speed.parameter in scaling.inputs else SPEED_UNIT
+    unit = scaling.speed_unit
     speed_name = scaling.speed.parameter
 
     def speeds(w):
@@ -171,7 +165,7 @@ def sweep_to_physical(scaling: Scaling, result, length_unit: str = LENGTH_UNIT):
             elif name.startswith("A_"):
                 out[name] = state_to_physical(scaling, name[2:], values, 1.0, length_unit).magnitude
             elif name.startswith(("lambda_", "stderr_")):
-                out[name] = np.asarray(values, dtype=float) * w * scaling.omega_n.magnitude
+                out[name] = np.asarray(values, dtype=float) * w * scaling.omega_n_si
             elif name.startswith("final_") or name in kinds(scaling):
                 state = name[len("final_"):] if name.startswith("final_") else name
                 out[name] = np.asarray([state_to_physical(scaling, state, x, wi, length_unit).magnitude

@@ -3,11 +3,14 @@ moves (``speed`` -> omega, ``cZ`` -> zeta, ...), so the engine sweeps as before.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from ..errors import GearsymError
 from ..sweep.grid import Axis
-from .scales import Scaling
-from .units import Quantity
+from ..units import Quantity
+
+if TYPE_CHECKING:  # (the type only: a sweep of a cached model reads this module without SymPy)
+    from ..scales.map import Scaling
 
 
 def nondimensional_axis(scaling: Scaling, axis: Axis) -> Axis:
@@ -19,7 +22,12 @@ def nondimensional_axis(scaling: Scaling, axis: Axis) -> Axis:
             raise GearsymError(f"--param {axis.spec!r}: {name} is not a physical value of {scaling.name}, so it "
                                f"takes no unit; physical values: {', '.join(scaling.roles)}")
         return axis
-    unit = axis.unit or (str(scaling.inputs[name].units) if name in scaling.inputs else "rpm")
+    declared = scaling.inputs.get(name)
+    if not axis.unit and (declared is None or not declared.dimensionless):
+        unit = declared.unit if declared is not None else scaling.speed_unit
+        raise GearsymError(f"--param {axis.spec!r}: {name} has a unit, so its values need one: write them with it, "
+                           f"e.g. {name}={axis.values[0]:g}{unit}:{axis.values[-1]:g}{unit}:...")
+    unit = axis.unit
     base = scaling.values
     columns = [scaling.values_at(**{name: Quantity(v, unit)}) for v in axis.values]
     moved = sorted({k for row in columns for k in row if row[k] != base[k]} or {_first_moved(scaling, name)})
@@ -36,8 +44,9 @@ def nondimensional_axis(scaling: Scaling, axis: Axis) -> Axis:
 
 def _first_moved(scaling: Scaling, name: str) -> str:
     """The parameter a one-point axis moves: found by a small step away from it."""
-    q = scaling.inputs.get(name) or scaling._speed_quantity()
-    shifted = scaling.values_at(**{name: q * 1.01})
+    q = scaling.inputs.get(name)
+    shifted = scaling.values_at(**{name: q.with_si(q.si * 1.01) if q is not None
+                                   else Quantity(scaling.speed_si() * 1.01, "rad/s")})
     moved = [k for k, v in shifted.items() if v != scaling.values[k]]
     return moved[0] if len(moved) == 1 else ",".join(moved)
 

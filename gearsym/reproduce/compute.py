@@ -12,14 +12,14 @@ from pathlib import Path
 
 from ..analysis import LyapunovSpectrum, Trajectory, lyapunov_spectrum, phase_trajectory
 from ..analysis.attractors import AttractorSet, find_attractors
-from ..codegen import compile_model
+from ..codegen.build import compile_model
 from ..options import Integration
 from ..periodic import Continuation, continue_orbits
 from ..periodic.orbit import sweep_start
-from ..registry import load
+from ..loading import load
 from ..sweep import SweepResult, Workers, run_sweep
 from .jumps import jump_records
-from .plan import Plan
+from .plan import ORBITS, Plan
 
 
 @dataclass(frozen=True)
@@ -81,9 +81,6 @@ def compute(plan: Plan, data_dir: str | Path, *, jobs: int = 0, progress: bool =
     return Computed(plan, sweeps, attractors, tuple(portraits), orbits, jumps, local)
 
 
-#: the orbits' scheme: crossings located (their Jacobian, the monodromy matrix, is exact only so: plain RK4 is
-#: first order in it across the backlash's kink), where the sweeps keep the paper's plain scheme, like for like
-ORBITS = Integration()
 
 
 def _orbits(plan: Plan, sweeps: dict[str, SweepResult], progress: bool) -> dict[str, Continuation]:

@@ -14,17 +14,14 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from ..figures.poincare import parameter_text  # noqa: E402
-from ..figures.save import save_figure  # noqa: E402
-from ..figures.sweep import plot_amplitude, plot_bifurcation, plot_exponents, plot_map, plot_regime_strip  # noqa: E402
-from .compute import Computed  # noqa: E402
-from .plan import CHAOS_BAND, NEAR_ONE, NOT_IN_PAPER, PAPER_JUMPS  # noqa: E402
+from ..figures.orbits import branch_color, legend_handles, plot_branches, plot_sweep_points
+from ..figures.poincare import parameter_text, PhasePanel, plot_attractors, plot_phase_portraits
+from ..figures.save import pyplot, save_figure
+from ..figures.sweep import plot_amplitude, plot_bifurcation, plot_exponents, plot_map, plot_regime_strip
+from .compute import Computed
+from .plan import CHAOS_BAND, NEAR_ONE, NOT_IN_PAPER, PAPER_JUMPS
 
 CURVE_COLORS = ("C0", "C3", "C2")
 DPI = 110
@@ -79,6 +76,7 @@ def _finish_omega(ax) -> None:
 
 
 def figure3(c: Computed):
+    plt = pyplot()
     d0, d2 = c.sweeps["fig3_D0"], c.sweeps["fig3_D2"]
     fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4.8), constrained_layout=True)
     for ax in (a, b):
@@ -103,9 +101,9 @@ def figure3(c: Computed):
 def figure3_orbits(c: Computed):
     """Fig. 3a with the branches of periodic orbits: the sweeps' points (up and down) under the period-1 and
     period-2 branches, stable solid and unstable dashed, their bifurcations marked."""
+    plt = pyplot()
     from matplotlib.lines import Line2D
 
-    from ..figures.orbits import branch_color, legend_handles, plot_branches, plot_sweep_points
 
     fig, axs = plt.subplots(1, 2, figsize=(13, 5.4), constrained_layout=True)
     for ax, (name, title), letter in zip(axs, (("fig3_D0", "'1'  D = 0 (Eq. 2)"), ("fig3_D2", "'2'  D = 2 (Eq. 6)")),
@@ -131,6 +129,7 @@ def figure3_orbits(c: Computed):
 
 
 def figure6(c: Computed):
+    plt = pyplot()
     r = c.sweeps["fig6"]
     fig, axs = plt.subplots(2, 2, figsize=(12, 8.4), constrained_layout=True)
     (a, b), (cc, d) = axs
@@ -185,8 +184,6 @@ def _clip_peak(ax, x: np.ndarray, y: np.ndarray) -> None:
 
 
 def figure4(c: Computed):
-    from ..figures.poincare import plot_attractors
-
     panels = [[c.attractors[("one_stage", omega)], c.attractors[("one_stage_resonant", omega)]] for omega in (1.5, 1.6)]
     fig = plot_attractors(panels, colors=["0.6", "k"], labels=["D = 0 (Eq. 2)", "D = 2 (Eq. 6)"])
     runs = {s.model: s.parameters for panel in panels for s in panel}
@@ -196,8 +193,6 @@ def figure4(c: Computed):
 
 
 def figure7(c: Computed):
-    from ..figures.poincare import PhasePanel, plot_phase_portraits
-
     panels = [PhasePanel(p.trajectory, _portrait_title(p), p.x, p.y) for p in c.portraits]
     fig = plot_phase_portraits(panels)
     runs = {c.plan.portrait_model: c.portraits[0].spectrum.parameters} if c.portraits else {}
@@ -214,6 +209,7 @@ def _portrait_title(p) -> str:
 
 def hysteresis(c: Computed):
     """Beyond the paper: up and down runs, and the bifurcation diagrams, of both one-stage models."""
+    plt = pyplot()
     fig, axs = plt.subplots(3, 2, figsize=(12, 9.5), sharex=True, constrained_layout=True,
                             gridspec_kw={"height_ratios": [3, 3, 1]})
     for col, (name, title) in enumerate((("fig3_D0", "D = 0 (Eq. 2)"), ("fig3_D2", "D = 2 (Eq. 6)"))):
@@ -232,6 +228,7 @@ def hysteresis(c: Computed):
 
 def study(c: Computed):
     """Beyond the paper: lambda_1 and the regime over omega and a parameter the paper leaves open."""
+    plt = pyplot()
     names = ("study_kS", "study_ka", "study_inertia")
     fig, axs = plt.subplots(len(names), 2, figsize=(13, 11), constrained_layout=True)
     for row, name in enumerate(names):

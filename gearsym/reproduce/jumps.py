@@ -23,10 +23,12 @@ import numpy as np
 
 from ..analysis.attractors import orbit_period
 from ..codegen import CompiledModel
+from ..codegen.build import compile_model
 from ..errors import GearsymError
 from ..periodic import FOLD, GRAZING, NEIMARK_SACKER, PERIOD_DOUBLING, Continuation, continue_orbits, periodic_orbit
 from ..sweep import SweepResult
-from .plan import JUMP_TOLERANCE, PAPER_JUMPS
+from ..loading import load
+from .plan import JUMP_TOLERANCE, ORBITS, PAPER_JUMPS
 
 #: relative amplitude difference within which a sweep's point lies on a branch (the sweeps use the paper's
 #: plain RK4 and the branches the located steps: their amplitudes differ by ~1e-3)
@@ -222,10 +224,6 @@ def _stable_end(result: Continuation, b: int, k: int, direction: int) -> tuple[f
 def jump_records(plan, sweeps: dict, orbits: dict) -> tuple[dict, dict]:
     """For each orbit job of ``plan``: its sweep's jumps and hysteresis explained by its branches (the paper's
     jumps where the sweep is Fig. 3's D = 2), and the orbits of other periods continued across them."""
-    from ..codegen import compile_model
-    from ..registry import load
-    from .compute import ORBITS
-
     records, local = {}, {}
     for job in plan.orbits:
         sweep_job = plan.sweep(job.sweep)

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 
+from ..options import Integration
+
 #: the paper's frequency grid: omega = 0.1 .. 2.0 in steps of 0.01, by continuation
 PAPER_OMEGA = "omega=0.1:2.0:0.01"
 #: the paper's regions of chaos for D = 0 (Section 3): near omega = 1.0, and [1.24, 1.62]
@@ -151,3 +153,7 @@ def paper_plan(quick: bool = False, scenario: Scenario = CALIBRATED, study: bool
 def _unswept(settings: dict, params: tuple[str, ...]) -> dict:
     swept = {p.partition("=")[0].strip() for p in params}
     return {k: v for k, v in settings.items() if k not in swept}
+
+#: the orbits' scheme: crossings located (their Jacobian, the monodromy matrix, is exact only so: plain RK4 is
+#: first order in it across the backlash's kink), where the sweeps keep the paper's plain scheme, like for like
+ORBITS = Integration()

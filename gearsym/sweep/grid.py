@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from decimal import Decimal, InvalidOperation
 
 from ..errors import GearsymError
+from ..units import QUANTITY, parse_quantity
 
 MODES = ("continuation", "independent")
 DIRECTIONS = ("up", "down", "both")
@@ -72,13 +73,9 @@ def _numbers_and_unit(text: str, parts: list[str]) -> tuple[list[str], str]:
     """The numbers of ``parts`` as written, in the unit of the first part that has one (converted by pint if
     another part has another unit), and that unit ("" if none has one). The units are checked by the safe
     quantity parser."""
-    from ..physical.text import QUANTITY
-
     units = [(m["unit"] or "").strip() if (m := QUANTITY.fullmatch(p)) else "" for p in parts]
     if not any(units):
         return [p.strip() for p in parts], ""
-    from ..physical.units import parse_quantity
-
     unit = next(u for u in units if u)
     numbers = []
     for part, own in zip(parts, units):

@@ -31,15 +31,16 @@ from pathlib import Path
 
 import numpy as np
 
-from ..version import __version__
 from ..analysis.lyapunov import summarise_runs
 from ..checks import whole_number
-from ..codegen import CompiledModel, TangentRuns, engine_verb
+from ..codegen import CompiledModel, engine_verb, TangentRuns
 from ..errors import GearsymError, UnknownParameterError
 from ..options import Integration
-from .grid import INDEPENDENT, Axis, Point, axes_from, plan, points
+from ..version import __version__
+from .distributed import check_scheduler, connect, execute_dask
+from .grid import axes_from, Axis, INDEPENDENT, plan, Point, points
 from .result import SweepResult
-from .store import PoincareRows, SweepStore, number, row_key
+from .store import number, PoincareRows, row_key, SweepStore
 
 #: stroboscopic samples kept per point for bifurcation diagrams
 POINCARE_SAMPLES = 50
@@ -79,8 +80,6 @@ class Workers:
         if self.parallel not in PARALLEL:
             raise GearsymError(f"parallel={self.parallel!r}: choose one of {', '.join(PARALLEL)}")
         if self.scheduler is not None:
-            from .distributed import check_scheduler
-
             check_scheduler(self.scheduler, self.jobs)  # no Dask, a bad address: said before any work
 
     @property
@@ -562,7 +561,6 @@ def _execute_dask(run: _Run, tasks: list[tuple[list[Point], np.ndarray]], schedu
     ``ran`` is filled with where it ran."""
     if not tasks:
         return
-    from .distributed import connect, execute_dask
 
     if scheduler == "local":
         ran["scheduler"] = "local"  # not the cluster's passing port

@@ -3301,7 +3301,7 @@ static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casad
 }
 
 /* the located step that crosses: its legs, RK4 of the sides held fixed on each (calls of one
-   mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/functions.py) */
+   mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/crossing.py) */
 static GEARSYM_NOINLINE void gs_tangent_split(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict yt, const casadi_real* restrict Qt, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real leg_try[9]; casadi_real t0[1]; casadi_real mode_a[2]; casadi_real ends1[12]; casadi_real zeros1[4]; casadi_real theta1[1]; casadi_real mode_b[2]; casadi_real leg_a[9]; casadi_real leg_ext[9]; casadi_real t1[1]; casadi_real yb[4]; casadi_real Qb[16]; casadi_real ye[4]; casadi_real ends2[12]; casadi_real zeros2[4]; casadi_real theta2[1]; casadi_real mode_c[2]; casadi_real leg_b[9]; casadi_real leg_c[9]; casadi_real t2[1]; casadi_real yc[4]; casadi_real Qc[16]; casadi_real yn[4]; casadi_real Qn[16];
   casadi_int i;
@@ -3322,7 +3322,7 @@ static GEARSYM_NOINLINE void gs_tangent_split(const casadi_real* restrict y, con
 }
 
 /* the located step that crosses: its legs, RK4 of the sides held fixed on each (calls of one
-   mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/functions.py) */
+   mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/crossing.py) */
 static GEARSYM_NOINLINE void gs_state_split(const casadi_real* restrict y, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict yt, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real leg_try[9]; casadi_real t0[1]; casadi_real mode_a[2]; casadi_real ends1[12]; casadi_real zeros1[4]; casadi_real theta1[1]; casadi_real mode_b[2]; casadi_real leg_a[9]; casadi_real leg_ext[9]; casadi_real t1[1]; casadi_real yb[4]; casadi_real ye[4]; casadi_real ends2[12]; casadi_real zeros2[4]; casadi_real theta2[1]; casadi_real mode_c[2]; casadi_real leg_b[9]; casadi_real leg_c[9]; casadi_real t2[1]; casadi_real yc[4]; casadi_real yn[4];
   casadi_int i;

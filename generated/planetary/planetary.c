@@ -11189,7 +11189,7 @@ static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casad
 }
 
 /* the located step that crosses: its legs, RK4 of the sides held fixed on each (calls of one
-   mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/functions.py) */
+   mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/crossing.py) */
 static GEARSYM_NOINLINE void gs_tangent_split(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict yt, const casadi_real* restrict Qt, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real leg_try[25]; casadi_real t0[1]; casadi_real mode_a[12]; casadi_real ends1[72]; casadi_real zeros1[24]; casadi_real theta1[1]; casadi_real mode_b[12]; casadi_real leg_a[25]; casadi_real leg_ext[25]; casadi_real t1[1]; casadi_real yb[8]; casadi_real Qb[64]; casadi_real ye[8]; casadi_real ends2[72]; casadi_real zeros2[24]; casadi_real theta2[1]; casadi_real mode_c[12]; casadi_real leg_b[25]; casadi_real leg_c[25]; casadi_real t2[1]; casadi_real yc[8]; casadi_real Qc[64]; casadi_real yn[8]; casadi_real Qn[64];
   casadi_int i;
@@ -11210,7 +11210,7 @@ static GEARSYM_NOINLINE void gs_tangent_split(const casadi_real* restrict y, con
 }
 
 /* the located step that crosses: its legs, RK4 of the sides held fixed on each (calls of one
-   mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/functions.py) */
+   mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/crossing.py) */
 static GEARSYM_NOINLINE void gs_state_split(const casadi_real* restrict y, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict yt, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real leg_try[25]; casadi_real t0[1]; casadi_real mode_a[12]; casadi_real ends1[72]; casadi_real zeros1[24]; casadi_real theta1[1]; casadi_real mode_b[12]; casadi_real leg_a[25]; casadi_real leg_ext[25]; casadi_real t1[1]; casadi_real yb[8]; casadi_real ye[8]; casadi_real ends2[72]; casadi_real zeros2[24]; casadi_real theta2[1]; casadi_real mode_c[12]; casadi_real leg_b[25]; casadi_real leg_c[25]; casadi_real t2[1]; casadi_real yc[8]; casadi_real yn[8];
   casadi_int i;

@@ -19829,7 +19829,7 @@ static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casad
 }
 
 /* the located step that crosses: its legs, RK4 of the sides held fixed on each (calls of one
-   mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/functions.py) */
+   mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/crossing.py) */
 static GEARSYM_NOINLINE void gs_tangent_split(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict yt, const casadi_real* restrict Qt, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real leg_try[30]; casadi_real t0[1]; casadi_real mode_a[14]; casadi_real ends1[84]; casadi_real zeros1[28]; casadi_real theta1[1]; casadi_real mode_b[14]; casadi_real leg_a[30]; casadi_real leg_ext[30]; casadi_real t1[1]; casadi_real yb[12]; casadi_real Qb[144]; casadi_real ye[12]; casadi_real ends2[84]; casadi_real zeros2[28]; casadi_real theta2[1]; casadi_real mode_c[14]; casadi_real leg_b[30]; casadi_real leg_c[30]; casadi_real t2[1]; casadi_real yc[12]; casadi_real Qc[144]; casadi_real yn[12]; casadi_real Qn[144];
   casadi_int i;
@@ -19850,7 +19850,7 @@ static GEARSYM_NOINLINE void gs_tangent_split(const casadi_real* restrict y, con
 }
 
 /* the located step that crosses: its legs, RK4 of the sides held fixed on each (calls of one
-   mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/functions.py) */
+   mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/crossing.py) */
 static GEARSYM_NOINLINE void gs_state_split(const casadi_real* restrict y, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict yt, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real leg_try[30]; casadi_real t0[1]; casadi_real mode_a[14]; casadi_real ends1[84]; casadi_real zeros1[28]; casadi_real theta1[1]; casadi_real mode_b[14]; casadi_real leg_a[30]; casadi_real leg_ext[30]; casadi_real t1[1]; casadi_real yb[12]; casadi_real ye[12]; casadi_real ends2[84]; casadi_real zeros2[28]; casadi_real theta2[1]; casadi_real mode_c[14]; casadi_real leg_b[30]; casadi_real leg_c[30]; casadi_real t2[1]; casadi_real yc[12]; casadi_real yn[12];
   casadi_int i;

@@ -1,6 +1,6 @@
 """Coefficient groups, conditions and the nondimensional form in tau = omega t.
 
-From a :class:`~gearsym.reduce.reduction.Reduction` (row i holds
+From a :class:`~gearsym.reduction.reduction.Reduction` (row i holds
 ``-factor_ic * law_c`` and forcing terms), this module names the groups the
 paper names and writes Eqs. 2, 6 and 9:
 
@@ -30,7 +30,8 @@ from sympy.core.function import AppliedUndef
 
 from ..backlash import g
 from ..errors import ModelError, UnknownParameterError
-from ..model.drivetrain import Drivetrain, ResolvedCoupling
+from ..model.drivetrain import Drivetrain
+from ..model.resolved import ResolvedCoupling
 from ..checks import sign_violation
 from ..model.expressions import ExprLike, parameter_names, to_expr
 from ..model.stiffness import check_periodic
@@ -277,13 +278,14 @@ class NondimensionalModel:
         gsub = {gr.symbol: gr.definition for gr in self.groups if gr.kind == "derived"}
         return [f.xreplace(fsub).xreplace(gsub) for f in self.rhs]
 
-    def system(self, **settings: ExprLike) -> FirstOrderSystem:
+    def system(self, *, initial: Optional[Mapping[str, float]] = None, **settings: ExprLike) -> FirstOrderSystem:
         """The first-order system for the engine.
 
         ``settings`` override parameter values (``omega=1.2``) or replace a mesh
         stiffness function by a formula in tau (``k="1 + a*cos(tau)"``, then
         ``a=0.3`` gives the new parameter its value). A default for a function
-        name in ``set_defaults`` replaces it the same way.
+        name in ``set_defaults`` replaces it the same way. ``initial`` is the default initial state in the
+        engine's units (a scaling gives it for a model with physical values); else the declared one.
         """
         rhs, names, functions = self._engine(settings)
         defaults = self._defaults_except(set(settings) | (set(self.parameter_names) - set(names)))
@@ -302,7 +304,17 @@ class NondimensionalModel:
                        if name in params}
         return FirstOrderSystem(self.name, tau, self.states, rhs, params, self.period, descriptions,
                                 self.drivetrain.title, tuple(c.name for c in self.coordinates),
-                                self.drivetrain.initial_state, self._system_couplings(functions), constraints)
+                                self._initial(initial), self._system_couplings(functions), constraints)
+
+    def _initial(self, initial: Optional[Mapping[str, float]]) -> dict[str, float]:
+        """The initial state in the engine's units: ``initial``, or the declared numbers (a physical value needs
+        the model's scaling to become one)."""
+        declared = self.drivetrain.initial_state if initial is None else dict(initial)
+        for name, value in declared.items():
+            if not isinstance(value, (int, float)):
+                raise ModelError(f"the initial state {name} = {value} is a physical value: make the system from the "
+                                 "model's physical values (gearsym.load or gearsym.scaling(...).system())", self.name)
+        return {name: float(value) for name, value in declared.items()}
 
     def engine_equations(self, **settings: ExprLike) -> tuple[tuple[sp.Expr, ...], list[str]]:
         """The right-hand side :meth:`system` gives the engine (k(tau) written out, derived groups expanded)

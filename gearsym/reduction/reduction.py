@@ -11,6 +11,7 @@ paper calls r1^2/I1 + r2^2/I2, 1/I2, ... and become the coefficient groups.
 """
 from __future__ import annotations
 
+import random
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -18,7 +19,8 @@ import sympy as sp
 
 from ..backlash import g
 from ..errors import GearsymError
-from ..model.drivetrain import Drivetrain, ResolvedCoupling, ResolvedDrivetrain, ResolvedForcing
+from ..model.drivetrain import Drivetrain
+from ..model.resolved import ResolvedCoupling, ResolvedDrivetrain, ResolvedForcing
 from ..symbols import t
 from .coordinates import Coordinate, coupling_deflections, rigid_body_modes
 
@@ -179,8 +181,6 @@ def _check_against_lagrange(red: Reduction, eom_forces: list[sp.Expr]) -> None:
     """At random angles, rates, times and parameter values (exact rationals; backlash contacts on both flanks
     and in the gap), the reduced right-hand sides equal T psi'' with psi'' = M^-1 Q from Lagrange's equations,
     every coordinate, every loop-closing combination and every rigid coordinate eliminated."""
-    import random
-
     rd = red.resolved
     rng = random.Random(11)
     n = len(rd.bodies)

@@ -11,10 +11,10 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..model.drivetrain import ResolvedDrivetrain
+from ..model.resolved import ResolvedDrivetrain
 from ..model.expressions import parameter_names
 from ..symbols import omega, phi, t
-from .units import Quantity, dimension_text, unit
+from ..units import dimension_text, unit_dims
 
 
 @dataclass(frozen=True)
@@ -25,11 +25,12 @@ class Role:
     example: str  # a unit for messages and for showing values
 
     @property
-    def dimensionality(self):
-        return Quantity(1, unit(self.example, self.meaning)).dimensionality if self.example else Quantity(1).dimensionality
+    def dims(self) -> tuple[float, float, float]:
+        """The exponents of mass, length and time a value of this role has."""
+        return unit_dims(self.example)
 
     def describe(self) -> str:
-        dims = dimension_text(self.dimensionality)
+        dims = dimension_text(self.dims)
         return f"{self.meaning} in {self.example} ({dims})" if self.example else f"{self.meaning} (dimensionless)"
 
 

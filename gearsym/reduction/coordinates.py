@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..errors import ModelError
-from ..model.drivetrain import ResolvedCoupling, ResolvedDrivetrain
+from ..model.resolved import ResolvedCoupling, ResolvedDrivetrain
 from ..symbols import t
 
 

@@ -1,0 +1,41 @@
+"""The compiled models of this process and the backend a run asks for: what a cached start-up needs.
+
+A :class:`~gearsym.codegen.compiled.CompiledModel` is kept here by its code hash and backend once loaded,
+so that a second compile of the same code (another model object, other values) reuses its functions; the
+start-up cache (:mod:`gearsym.cached`) loads a library into the same table without generating anything.
+Nothing here needs SymPy.
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import casadi as ca
+
+from .compiled import CompiledModel
+from .compiler import FALLBACK_NOTE, compilers_looked_for, find_compiler
+
+#: every function the generated library exports
+FUNCTION_NAMES = ("rhs", "jacobian", "constants", "table", "lyapunov_chunk", "lyapunov_period",
+                  "orbit_chunk", "orbit_period", "trajectory", "monodromy_segment", "monodromy_period")
+
+#: (code hash, backend) -> the model loaded in this process
+LOADED: dict[tuple[str, str], CompiledModel] = {}
+_WARNED = set()
+
+
+def resolve_backend(asked: str) -> str:
+    """"auto" is compiled where a C compiler exists (else in-process, said once on stderr)."""
+    if asked != "auto":
+        return asked
+    if find_compiler():
+        return "compiled"
+    if "no-cc" not in _WARNED:
+        _WARNED.add("no-cc")
+        print(f"gearsym: warning: {FALLBACK_NOTE.format(what=compilers_looked_for())}", file=sys.stderr)
+    return "in-process"
+
+
+def library_functions(path: Path) -> dict[str, ca.Function]:
+    """The generated functions of the library at ``path``, through CasADi."""
+    return {name: ca.external(name, str(path)) for name in FUNCTION_NAMES}

@@ -1,0 +1,90 @@
+"""Names and files to systems, scalings and modes: the face's verbs that take a model by name.
+
+The registry turns a name or a file into the declared model; this module takes it down the pipeline with the
+caller's values: reduced (:func:`reduced`), scaled when it has physical values (:func:`scaling`), made the
+engine's first-order system (:func:`load`), or its natural modes (:func:`natural_modes`). Every stage below
+takes the typed object these make; nothing below resolves a name.
+"""
+from __future__ import annotations
+
+from .analysis.modes import Modes, nondimensional_modes, physical_modes
+from .errors import GearsymError
+from .physical.answers import PhysicalScaling
+from .reduction import NondimensionalModel, reduce
+from .registry import load_model
+from .scales.settings import maybe_number, physical_settings
+from .system import FirstOrderSystem
+from .units import is_quantity
+
+
+def reduced(ref) -> NondimensionalModel:
+    """The reduction of a model (a name, a file, a Drivetrain or its reduction)."""
+    if isinstance(ref, NondimensionalModel):
+        return ref
+    model = load_model(ref)
+    if not model.is_drivetrain:
+        raise GearsymError(f"{model.name}: a first-order system has no components to reduce (it is one already)")
+    return reduce(model)
+
+
+def scaling(model, length_scale=None, **physical) -> PhysicalScaling:
+    """The scaling of a model (a name, a file, a Drivetrain or its reduction) at its declared physical values,
+    with ``physical`` overriding them (``kZ="3e8 N/m"``, ``speed="3000 rpm"``)."""
+    declared = model if isinstance(model, NondimensionalModel) else load_model(model)
+    if not isinstance(declared, NondimensionalModel) and not declared.is_drivetrain:
+        raise GearsymError(f"{declared.name}: physical values need a drivetrain model (a FirstOrderSystem has no "
+                           "components to give them units)")
+    nd = reduced(declared)
+    scale = nd.drivetrain.length_scale if length_scale is None else length_scale
+    return PhysicalScaling(nd, {**nd.drivetrain.physical, **physical}, scale)
+
+
+def load(ref, **values) -> FirstOrderSystem:
+    """The first-order system of a model, ready for the engine: the one place names and files are resolved.
+
+    ``ref`` is a model name (``models/<name>.py``), the path of a model file, a Drivetrain, a reduced
+    NondimensionalModel or a FirstOrderSystem. ``values`` give parameter values (``omega=1.5``) or, for a
+    drivetrain, a new mesh stiffness as a formula in tau (``k="1 + 0.2*cos(tau)"``). Strings that read as
+    numbers are numbers. A drivetrain with physical values (``model.set_physical``), or given one here
+    (``kZ="2e8 N/m"``, ``speed="3000 rpm"``, a pint Quantity; ``length_scale="backlash"``), is scaled to its
+    nondimensional values by :class:`gearsym.scales.map.Scaling`.
+    """
+    model = ref if isinstance(ref, NondimensionalModel) else load_model(ref)
+    values = {k: maybe_number(v) for k, v in values.items()}
+    if isinstance(model, FirstOrderSystem):
+        for key, value in values.items():
+            if not isinstance(value, (int, float)):
+                raise GearsymError(
+                    f"{model.name}: {key}={value!r} is not a number; only drivetrain models accept a formula "
+                    "(a new mesh stiffness function) or a physical value"
+                )
+        return model.with_values(**values)
+    nd = reduced(model)
+    split = physical_settings(nd, values)
+    if split is not None:
+        length_scale, physical, formulas = split
+        return scaling(nd, length_scale, **physical).system(**formulas)
+    return nd.system(**values)
+
+
+def natural_modes(model, **settings) -> Modes:
+    """The natural modes of ``model`` (a name, a file, a Drivetrain or its reduction). ``settings`` are physical
+    values (``kZ="2e8 N/m"``: frequencies in Hz; also for a model that declares physical values) or, for a
+    model without, nondimensional parameter values (``kS=0.5``); a stiffness formula (``k="1+0.2*cos(tau)"``)
+    enters through its mean."""
+    nd = reduced(model)
+    split = physical_settings(nd, dict(settings))
+    if split is not None:
+        length_scale, physical, formulas = split
+        return physical_modes(scaling(nd, length_scale, **physical), formulas)
+    return nondimensional_modes(nd, settings)
+
+
+def is_physical(model, **values) -> bool:
+    """Whether ``model`` (a name, a file or a model) with ``values`` runs in physical units (it declares
+    physical values, or ``values`` give one or a length scale). Nothing is reduced to tell."""
+    declared = model if isinstance(model, NondimensionalModel) else load_model(model)
+    drivetrain = declared.drivetrain if isinstance(declared, NondimensionalModel) else declared
+    if not drivetrain.is_drivetrain:
+        return False
+    return bool(drivetrain.physical) or "length_scale" in values or any(is_quantity(v) for v in values.values())

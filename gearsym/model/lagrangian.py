@@ -1,0 +1,100 @@
+"""The Lagrangian of a resolved drivetrain and its equations of motion (the ``form_*`` half of the stage).
+
+:class:`LagrangianForms` is a base of :class:`~gearsym.model.resolved.ResolvedDrivetrain`: from its bodies'
+angles and its couplings' deflection rows it forms the kinetic and potential energies, the Rayleigh
+dissipation, the generalized forces of the external torques, and Lagrange's equations, one per body.
+"""
+from __future__ import annotations
+
+from functools import cached_property
+from typing import TYPE_CHECKING
+
+import sympy as sp
+
+from ..backlash import G
+from ..symbols import phi, t
+
+if TYPE_CHECKING:
+    from .resolved import ResolvedCoupling
+
+
+class LagrangianForms:
+    """Energies and equations of motion of a drivetrain whose ``bodies``, ``couplings`` and ``forcing`` are
+    resolved (the attributes :class:`~gearsym.model.resolved.ResolvedDrivetrain` sets)."""
+
+    @property
+    def angles(self) -> list[sp.Expr]:
+        return [rb.angle for rb in self.bodies]
+
+    def deflection(self, rc: ResolvedCoupling) -> sp.Expr:
+        """Mesh deflection r_a psi_a - r_b psi_b, or shaft twist psi_b - psi_a."""
+        return sum((c * q for c, q in zip(rc.row, self.angles)), sp.S.Zero)
+
+    def stiffness_at(self, rc: ResolvedCoupling) -> sp.Expr:
+        """The mesh stiffness as a function of time, kZ(t), kept opaque so equations stay readable.
+
+        Its definition is :meth:`stiffness_definition`; a shaft's stiffness is constant.
+        """
+        if rc.kind == "shaft":
+            return rc.stiffness
+        shared = sum(1 for other in self.couplings if other.kind == "mesh" and other.stiffness == rc.stiffness) > 1
+        plain = isinstance(rc.stiffness, sp.Symbol) and not shared
+        base = rc.stiffness.name if isinstance(rc.stiffness, sp.Symbol) else "kZ"
+        return sp.Function(base if plain else f"{base}_{rc.name}", real=True)(t)
+
+    def stiffness_definition(self, rc: ResolvedCoupling) -> sp.Expr:
+        """kZ(t) = kZ * k(phi(t)) with the declared variation k and mesh phase phi."""
+        return rc.stiffness * rc.variation.subs(phi, rc.mesh_phase)
+
+    def potential_of(self, rc: ResolvedCoupling) -> sp.Expr:
+        d = self.deflection(rc)
+        if rc.kind == "mesh":
+            return self.stiffness_at(rc) * G(d, rc.backlash)
+        return rc.stiffness * d**2 / 2
+
+    def dissipation_of(self, rc: ResolvedCoupling) -> sp.Expr:
+        return rc.damping * sp.diff(self.deflection(rc), t) ** 2 / 2
+
+    @cached_property
+    def kinetic_energy(self) -> sp.Expr:
+        return sum((rb.inertia * sp.diff(rb.angle, t) ** 2 / 2 for rb in self.bodies), sp.S.Zero)
+
+    @cached_property
+    def potential_energy(self) -> sp.Expr:
+        return sum((self.potential_of(rc) for rc in self.couplings), sp.S.Zero)
+
+    @cached_property
+    def dissipation(self) -> sp.Expr:
+        return sum((self.dissipation_of(rc) for rc in self.couplings), sp.S.Zero)
+
+    @cached_property
+    def generalized_forces(self) -> list[sp.Expr]:
+        """Q_i from the virtual work of the external torques, delta W = sum M_j delta psi_j."""
+        q = [sp.S.Zero] * len(self.bodies)
+        for f in self.forcing:
+            q[f.body.index] += f.amplitude * f.time_function
+        return q
+
+    def lagrange_lhs(self, lagrangian: sp.Expr, dissipation: sp.Expr) -> list[sp.Expr]:
+        """d/dt dL/dpsi' - dL/dpsi + dR/dpsi' for each body."""
+        out = []
+        for q in self.angles:
+            qd = sp.diff(q, t)
+            lhs = sp.diff(sp.diff(lagrangian, qd), t) - sp.diff(lagrangian, q) + sp.diff(dissipation, qd)
+            out.append(sp.Add(*(sp.factor_terms(term) for term in sp.Add.make_args(lhs))))
+        return out
+
+    @cached_property
+    def equations_of_motion(self) -> list[sp.Eq]:
+        lagrangian = self.kinetic_energy - self.potential_energy
+        lhs = self.lagrange_lhs(lagrangian, self.dissipation)
+        return [sp.Eq(l, r) for l, r in zip(lhs, self.generalized_forces)]
+
+    def coupling_forces(self, rc: ResolvedCoupling) -> list[sp.Expr]:
+        """Generalized forces of one coupling alone: -(dV_c/dpsi + dR_c/dpsi')."""
+        return [-e for e in self.lagrange_lhs(-self.potential_of(rc), self.dissipation_of(rc))]
+
+    @cached_property
+    def mass_matrix(self) -> sp.Matrix:
+        acc = [sp.diff(q, t, 2) for q in self.angles]
+        return sp.Matrix([[sp.expand(eq.lhs).coeff(a) for a in acc] for eq in self.equations_of_motion])

@@ -1,0 +1,167 @@
+"""The layout holds: imports run one way down the pipeline, no circle of files or folders, nothing imported
+inside a function but heavy third-party libraries, and no face name shared with a subpackage.
+
+The graph is read from the source (every import, those inside functions too; ``if TYPE_CHECKING:`` blocks
+left out), as a reader of the code sees it.
+"""
+from __future__ import annotations
+
+import ast
+import collections
+from pathlib import Path
+
+import pytest
+
+import gearsym
+
+ROOT = Path(gearsym.__file__).resolve().parent
+BENCH = ROOT.parent / "bench"
+
+#: the stages from the bottom up (docs/architecture.md): a module may import its own stage and those below
+LAYERS = [
+    {"errors", "version", "paths", "files", "outputs", "units", "declared", "symbols", "backlash", "checks",
+     "options", "parameters"},
+    {"model"},
+    {"system", "registry"},
+    {"reduction"},
+    {"scales"},
+    {"codegen", "derivation"},
+    {"analysis", "data"},
+    {"sweep", "periodic"},
+    {"figures"},
+    {"fit", "physical"},
+    {"verbs", "loading", "cached"},
+    {"reproduce"},
+    {"cli", "__init__"},
+]
+RANK = {unit: i for i, layer in enumerate(LAYERS) for unit in layer}
+#: heavy third-party libraries: the only imports a function may hold (start-up of a cached model stays fast)
+HEAVY = {"sympy", "pint", "casadi", "matplotlib", "scipy", "numba", "jitcode", "dask", "distributed", "tqdm",
+         "fmpy", "gearsym_geometry_native"}
+
+
+def modules(root: Path) -> dict[str, Path]:
+    out = {}
+    for p in sorted(root.rglob("*.py")):
+        name = ".".join(p.relative_to(root.parent).with_suffix("").parts)
+        out[name[: -len(".__init__")] if name.endswith(".__init__") else name] = p
+    return out
+
+
+def _type_checking_nodes(tree: ast.AST) -> set[int]:
+    skip = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+            skip |= {id(sub) for sub in ast.walk(node)}
+    return skip
+
+
+def imports(root: Path):
+    """(importer, imported module, inside a function?) for every import of the package's own modules."""
+    mods = modules(root)
+    for name, path in mods.items():
+        tree = ast.parse(path.read_text())
+        skip = _type_checking_nodes(tree)
+        inside = {id(sub) for f in ast.walk(tree) if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef))
+                  for sub in ast.walk(f)}
+        package = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
+        for node in ast.walk(tree):
+            if id(node) in skip or not isinstance(node, (ast.Import, ast.ImportFrom)):
+                continue
+            if isinstance(node, ast.ImportFrom):
+                base = ".".join((package[: len(package) - node.level + 1] if node.level else [])
+                                + ([node.module] if node.module else []))
+                targets = [f"{base}.{a.name}" for a in node.names] + [base]
+            else:
+                targets = [a.name for a in node.names]
+            for target in targets:
+                while target and target not in mods:
+                    target = target.rpartition(".")[0]
+                if target and target != name:
+                    yield name, target, id(node) in inside
+                    break
+
+
+def circles(edges: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected parts with more than one member (Tarjan)."""
+    index, low, stack, on, out, counter = {}, {}, [], set(), [], [0]
+
+    def visit(v):
+        index[v] = low[v] = counter[0]
+        counter[0] += 1
+        stack.append(v)
+        on.add(v)
+        for w in edges.get(v, ()):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            part = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                part.append(w)
+                if w == v:
+                    break
+            if len(part) > 1:
+                out.append(sorted(part))
+
+    for v in list(edges):
+        if v not in index:
+            visit(v)
+    return out
+
+
+def unit(module: str) -> str:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else "__init__"
+
+
+@pytest.mark.parametrize("root", [ROOT, BENCH], ids=["gearsym", "bench"])
+def test_no_file_and_no_folder_imports_itself_round_a_circle(root):
+    files, folders = collections.defaultdict(set), collections.defaultdict(set)
+    for a, b, _ in imports(root):
+        files[a].add(b)
+        fa, fb = ".".join(a.split(".")[:2]), ".".join(b.split(".")[:2])
+        if fa != fb and fb != root.name:  # (a package's own face is its parent: not a folder of its own)
+            folders[fa].add(fb)
+    assert circles(files) == []
+    assert circles(folders) == []
+
+
+@pytest.mark.parametrize("root", [ROOT, BENCH], ids=["gearsym", "bench"])
+def test_functions_import_no_module_of_the_project(root):
+    inside = [f"{a} -> {b}" for a, b, within in imports(root) if within]
+    assert inside == []
+
+
+def test_imports_run_down_the_pipeline():
+    against = [f"{a} -> {b}" for a, b, _ in imports(ROOT)
+               if unit(b) != "__init__" and RANK[unit(b)] > RANK[unit(a)]]
+    assert against == []
+    assert {unit(m) for m in modules(ROOT)} <= set(RANK), "a new top-level module: give it its stage in LAYERS"
+
+
+def test_functions_import_only_heavy_libraries():
+    light = []
+    for name, path in modules(ROOT).items():
+        tree = ast.parse(path.read_text())
+        for f in ast.walk(tree):
+            if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                for node in ast.walk(f):
+                    if isinstance(node, ast.Import):
+                        light += [f"{name}: {a.name}" for a in node.names if a.name.split(".")[0] not in HEAVY]
+                    elif isinstance(node, ast.ImportFrom) and node.level == 0 and \
+                            node.module.split(".")[0] not in HEAVY:
+                        light.append(f"{name}: {node.module}")
+    assert light == []
+
+
+def test_no_module_swaps_its_class_and_no_face_name_is_a_subpackage():
+    source = (ROOT / "__init__.py").read_text()
+    assert "__class__" not in source
+    subpackages = {p.name for p in ROOT.iterdir() if (p / "__init__.py").is_file()}
+    top_modules = {p.stem for p in ROOT.glob("*.py")}
+    assert set(gearsym.__all__) & (subpackages | top_modules) == set()
