@@ -259,21 +259,30 @@ def test_continuation_lines_in_parallel_do_not_change_a_single_bit(tmp_path, one
 
 
 def test_resume_in_the_down_half_after_a_kill_mid_row(tmp_path, one_stage):
-    axes = ["omega=0.9:1.3:0.1"]
-    run_sweep(one_stage, axes, direction="both", out=tmp_path / "whole.csv", **SHORT)
+    """Up 0.7 ... 1.0 and down again: at omega = 0.9 the two runs hold different orbits (hysteresis)."""
+    axes = ["omega=0.7:1.0:0.1"]
+    whole = run_sweep(one_stage, axes, direction="both", out=tmp_path / "whole.csv", **SHORT)
+    up, down = ({w: a for w, a, d in zip(whole["omega"], whole["A_x"], whole["direction"]) if d == run}
+                for run in ("up", "down"))
+    # where both runs of the interrupted sweep below went, the amplitudes differ by more than 5 % (the
+    # library's threshold) at 0.9, the up run's larger orbit (measured: there only; 1.0 is chaotic both ways)
+    differ = [w for w in (0.8, 0.9, 1.0) if abs(up[w] - down[w]) > 0.05 * max(up[w], down[w])]
+    assert differ[:1] == [0.9], (up, down)
     part = tmp_path / "part.csv"
     with pytest.raises(SweepInterrupted):
         run_sweep(one_stage, axes, direction="both", out=part, on_point=interrupt_after(7), **SHORT)
     whole_rows = (tmp_path / "whole.csv").read_text().splitlines()
     part.write_text(part.read_text() + whole_rows[8][:15])  # the 8th point (going down) cut while written
     strobe = tmp_path / "part.poincare.csv"
-    strobe.write_text(strobe.read_text() + "1.0,down,0,0.12")  # and its Poincare rows
+    strobe.write_text(strobe.read_text() + "0.7,down,0,0.12")  # and its Poincare rows
     partial = read_sweep(part)  # reading an interrupted sweep leaves the cut row out ...
-    assert len(partial) == 7 and partial["direction"].tolist() == ["up"] * 5 + ["down"] * 2
-    assert partial.findings()["hysteresis"] is not None  # ... and compares only what both runs have
-    run_sweep(one_stage, axes, direction="both", out=part, **SHORT)
+    assert len(partial) == 7 and partial["direction"].tolist() == ["up"] * 4 + ["down"] * 3
+    # ... and compares only what both runs have, point by point: the one interval where they differ
+    assert partial.findings()["hysteresis"] == [{"coordinate": "x", "from": 0.9, "to": differ[-1]}]
+    resumed = run_sweep(one_stage, axes, direction="both", out=part, **SHORT)
     assert part.read_bytes() == (tmp_path / "whole.csv").read_bytes()
     assert strobe.read_bytes() == (tmp_path / "whole.poincare.csv").read_bytes()
+    assert resumed.findings() == whole.findings() == read_sweep(part).findings()
 
 
 def test_a_sweep_that_finished_no_point_starts_again_with_new_options(tmp_path, one_stage):
