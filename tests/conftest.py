@@ -10,6 +10,7 @@ from __future__ import annotations
 import functools
 import sys
 
+import numpy as np
 import sympy as sp
 
 import gearsym
@@ -109,6 +110,46 @@ def psi(i: int) -> sp.Expr:
 
 def coord(name: str, time: sp.Symbol) -> sp.Expr:
     return sp.Function(name, real=True)(time)
+
+
+# --------------------------------------------------------------------------- an independent reference
+def paper_rk4_spectrum(omega, periods, discard, steps, zeta=0.08, B0=1.0, B1=4.0, eta=10.0, a=0.2):
+    """Eq. 2 with k(tau) = 1 + a cos(tau), typed from the paper: plain NumPy RK4 on the state and
+    its 2x2 tangent matrix, Gram-Schmidt (QR) once per period (the paper's scheme), from the paper's start
+    (x, v) = (-2, -0.5). Returns the exponents (in Gram-Schmidt order), the final state and the amplitude of x."""
+    def g(x):
+        return x if x >= 0 else (x + eta if x <= -eta else 0.0)
+
+    def dg(x):
+        return 1.0 if (x >= 0 or x <= -eta) else 0.0
+
+    def f(tau, y, Q):
+        x, v = y
+        k = 1 + a * np.cos(tau)
+        dy = np.array([v, -2 * zeta / omega * v - k * g(x) / omega**2 + (B0 + B1 * np.cos(tau)) / omega**2])
+        J = np.array([[0.0, 1.0], [-k * dg(x) / omega**2, -2 * zeta / omega]])
+        return dy, J @ Q
+
+    h = 2 * np.pi / steps
+    y, Q = np.array([-2.0, -0.5]), np.eye(2)
+    logs, lo, hi = [], np.inf, -np.inf
+    for period in range(periods):
+        for i in range(steps):
+            tau = i * h
+            k1, K1 = f(tau, y, Q)
+            k2, K2 = f(tau + h / 2, y + h / 2 * k1, Q + h / 2 * K1)
+            k3, K3 = f(tau + h / 2, y + h / 2 * k2, Q + h / 2 * K2)
+            k4, K4 = f(tau + h, y + h * k3, Q + h * K3)
+            y = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            Q = Q + h / 6 * (K1 + 2 * K2 + 2 * K3 + K4)
+            if period >= discard:
+                lo, hi = min(lo, y[0]), max(hi, y[0])
+        q, r = np.linalg.qr(Q)
+        signs = np.sign(np.diag(r))
+        Q = q * signs
+        logs.append(np.log(np.abs(np.diag(r))))
+    lam = np.array(logs[discard:]).sum(axis=0) / ((periods - discard) * 2 * np.pi)
+    return lam, y, (hi - lo) / 2
 
 
 # --------------------------------------------------------------------------- compiled engine

@@ -4,9 +4,10 @@ The one-stage gear pair of Litak & Friswell typed here from the paper (not gener
 
     x'' = -2 zeta x'/omega + (B0 + B1 cos(tau + Theta))/omega^2 - k(tau) g(x, eta)/omega^2 + extra(tau, x, x')
 
-with k(tau) = 1 + k_a sum_n c_n cos(n tau) and g the backlash, integrated by SciPy's DOP853 at tight
-tolerances, started at rest, sampled after a transient at a rate that is no whole multiple of the
-forcing, from an arbitrary phase, with Gaussian noise; ``extra`` is what the model lacks.
+with k(tau) = 1 + k_a sum_n c_n cos(n tau) (gearsym's default c_n: STIFFNESS) and g the backlash,
+integrated by SciPy's DOP853 at tight tolerances, started at rest, sampled after a transient at a rate
+that is no whole multiple of the forcing, from an arbitrary phase, with Gaussian noise; ``extra`` is what
+the model lacks.
 
 ``python tests/rig.py PATH`` writes the measurements of the second worked example of docs/data-loop.md.
 """
@@ -19,7 +20,9 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import ode
 
-#: the paper's mesh stiffness variation: coefficients of cos(n tau), n = 1 ... 7
+#: the mesh stiffness variation, coefficients of cos(n tau), n = 1 ... 7: gearsym's own default k(tau)
+#: (rectangular_mesh_stiffness(): contact ratio 1.6, 7 Lanczos-smoothed harmonics, 12 digits), not the paper's,
+#: which shows k only as a plot; test_crossings.py checks them against that formula by quadrature
 STIFFNESS = (1.18003861468, -0.336894506314, -0.195632837787, 0.192724343884, 0.0, -0.0605674179821,
              0.0148837545288)
 DEFAULTS = {"zeta": 0.08, "B0": 1.0, "B1": 4.0, "Theta": 0.0, "eta": 10.0, "k_a": 0.2}

@@ -16,6 +16,7 @@ import sys
 import numpy as np
 import pytest
 
+import conftest
 from gearsym import FirstOrderSystem, GearsymError, Integration, compile_model, find_attractors, lyapunov_spectrum
 from gearsym.analysis.attractors import cloud_distance, orbit_period, self_distance
 from gearsym.cli import poincare
@@ -227,19 +228,31 @@ FAST = ("--set", "omega=1.6", "--ics", "3", "--periods", "70", "--discard", "40"
 
 
 def test_cli_json_partitions_the_initial_states(capsys):
+    """At omega = 1.6 the one-stage pair settles on one periodic orbit of period 2 from every start in the box:
+    one attractor, periodic, holding all three initial states, each with the spectrum of its own run."""
     code, out, _ = run_cli(capsys, "one_stage", *FAST, "--box", "x=-3:3", "--format", "json")
     assert code == 0
     data = json.loads(out)
     assert data["parameters"]["omega"] == 1.6 and data["seed"] == 0
     assert data["box"] == {"x": [-3.0, 3.0], "v": [-5.0, 5.0]}
     assert len(data["initial_conditions"]) == 3
-    members = sorted(i for a in data["attractors"] for i in a["members"])
-    assert members == [0, 1, 2]
-    for a in data["attractors"]:
-        assert a["regime"] in ("periodic", "quasi-periodic", "chaotic", "hyperchaotic")
-        assert len(a["exponents"]) == len(a["stderr"]) == 2 and set(a["centroid"]) == {"x", "v"}
-        assert all(data["initial_conditions"][i]["attractor"] == a["number"] for i in a["members"])
-        assert -3 <= a["initial_states"][0]["x"] <= 3
+    (found,) = data["attractors"]
+    assert found["members"] == [0, 1, 2] and found["number"] == 1
+    assert (found["regime"], found["paper_label"], found["period"]) == ("periodic", "1", 2)
+    assert len(found["exponents"]) == len(found["stderr"]) == 2 and set(found["centroid"]) == {"x", "v"}
+    assert max(found["exponents"]) < 0
+    model = conftest.compiled("one_stage")
+    for ic, start in zip(data["initial_conditions"], found["initial_states"]):
+        assert ic["attractor"] == 1 and ic["initial_state"] == start and -3 <= start["x"] <= 3
+        own = lyapunov_spectrum(model, options=Integration(periods=70, discard=40), y0=start, omega=1.6)
+        assert ic["exponents"] == own.exponents.tolist() and ic["regime"] == own.regime
+        # what the attractor is, seen on 200 more periods of each run, without the grouping: periodic, and
+        # its Poincare points repeat after two periods, not one
+        later = lyapunov_spectrum(model, options=Integration(periods=200, discard=0), y0=own.final_state,
+                                  omega=1.6)
+        assert later.regime == "periodic" and max(later.exponents) < -0.03
+        strobe = later.strobe[:, 100:]
+        assert np.abs(strobe[:, 2:] - strobe[:, :-2]).max() < 1e-9 < 1 < np.abs(strobe[:, 1:] - strobe[:, :-1]).min()
 
 
 def test_cli_text_lists_attractors_and_runs_and_plots(capsys, tmp_path):

@@ -15,13 +15,15 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 
 import gearsym
+import rig
 from conftest import system
 from gearsym import FirstOrderSystem, Integration, ModelError, compile_model
 from gearsym.backlash import g
 from gearsym.codegen.functions import LoopOptions, build_functions
 from gearsym.codegen.generate import code_hash, write_code
+from gearsym.model.stiffness import rectangular_mesh_stiffness
 from gearsym.paths import REPO_ROOT
-from gearsym.symbols import parameter_symbol
+from gearsym.symbols import parameter_symbol, phi
 
 PERIODS, DISCARD = 80, 30
 STEPS = (100, 200, 400, 800)
@@ -67,8 +69,42 @@ def test_time_dependent_switching_surface_converges_at_fourth_order():
 
 # ---------------------------------------------------------------- an independent reference: DOP853
 ZETA, B0, B1, THETA, ETA, K_A = 0.08, 1.0, 4.0, 0.0, 10.0, 0.2
+#: (n, coefficient of cos(n tau)) of the mesh stiffness variation: gearsym's own default k(tau)
+#: (rectangular_mesh_stiffness(): contact ratio 1.6, 7 Lanczos-smoothed harmonics, 12 digits; the paper shows
+#: k only as a plot), checked against its formula by quadrature in the test below
 HARMONICS = ((1, 1.18003861468), (2, -0.336894506314), (3, -0.195632837787), (4, 0.192724343884),
              (6, -0.0605674179821), (7, 0.0148837545288))
+
+
+def test_the_stiffness_constants_are_the_smoothed_rectangular_wave():
+    """HARMONICS, and STIFFNESS of tests/rig.py, against what rectangular_mesh_stiffness() says they are, computed
+    here by quadrature: the Fourier coefficients of a rectangular wave of mean 0 and height 2 (the double-contact
+    fraction d = contact ratio - 1 = 0.6 of each period above the rest) averaged over a window of 2 pi/8 (Lanczos'
+    sigma factors on 7 harmonics are that moving average), to the 12 digits they are rounded to; and gearsym's
+    default k(tau) is made of these numbers."""
+    d, harmonics = 0.6, 7
+    window = 2 * np.pi / (harmonics + 1)
+
+    def smoothed(angle):  # the wave's mean over angle -+ window/2, for an angle in [-pi, pi]
+        inside = np.minimum(angle + window / 2, np.pi * d) - np.maximum(angle - window / 2, -np.pi * d)
+        return 2 * np.clip(inside, 0, None) / window - 2 * d
+
+    nodes, weights = np.polynomial.legendre.leggauss(40)
+    kinks = [-np.pi, -np.pi * d - window / 2, -np.pi * d + window / 2, np.pi * d - window / 2,
+             np.pi * d + window / 2, np.pi]
+
+    def integral(f):  # Gauss-Legendre between the kinks: exact to rounding for each smooth piece
+        return sum((b - a) / 2 * weights @ f((b - a) / 2 * nodes + (a + b) / 2) for a, b in zip(kinks, kinks[1:]))
+
+    assert integral(smoothed) == pytest.approx(0, abs=1e-14)  # mean 0: the stiffness's mean is 1
+    coefficients = [integral(lambda angle: smoothed(angle) * np.cos(n * angle)) / np.pi
+                    for n in range(1, harmonics + 1)]
+    assert list(rig.STIFFNESS) == pytest.approx(coefficients, rel=1e-11, abs=1e-14)
+    assert dict(HARMONICS) == pytest.approx({n: c for n, c in enumerate(coefficients, 1) if abs(c) > 1e-12},
+                                            rel=1e-11)
+    wave = sp.expand((rectangular_mesh_stiffness() - 1) / parameter_symbol("k_a"))
+    assert {n: float(wave.coeff(sp.cos(n * phi))) for n in range(1, harmonics + 1)} == \
+        dict(enumerate(rig.STIFFNESS, 1))
 
 
 def dop853_exponents(omega: float, periods: int, discard: int) -> np.ndarray:

@@ -336,13 +336,9 @@ def test_system_misspelt_setting_suggests():
 
 
 def test_system_replaced_k_with_new_parameter_can_be_given_its_value():
-    """A replaced k(tau) may use a new parameter; the error asks for 'a=...', so a=... must work.
-
-    LIBRARY BUG: NondimensionalModel.system rejects every keyword that is not already a
-    parameter before it looks at the replaced function, so this raises
-    UnknownParameterError("unknown parameter 'a'") although without it the error says
-    "parameter 'a' (used by a replaced function) needs a value: pass a=...".
-    """
+    """A replaced k(tau) may use a new parameter: without its value the error asks for 'a=...', and a=... is
+    accepted as a parameter of the replaced function (a keyword is checked against the parameters of the
+    equations with the replacement written in, not only the model's own)."""
     nd = reduced("one_stage")
     with pytest.raises(gearsym.ModelError, match="pass a="):
         nd.system(k="1+a*cos(tau)")

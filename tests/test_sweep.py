@@ -2,7 +2,9 @@
 from __future__ import annotations
 
 import json
+import multiprocessing
 import os
+import time
 
 import numpy as np
 import pytest
@@ -86,6 +88,37 @@ def test_regime_column_names_the_motion(one_stage):
 
 
 # ------------------------------------------------------------------ files, resume, threads
+#: how long the sweep's own process waits at most for a live forked worker to take a task (it takes milliseconds)
+WORKER_START = 60.0
+
+
+def share_with_a_forked_worker(monkeypatch, in_the_worker=None) -> list:
+    """Make the next sweep on forked workers share its tasks whatever the machine's load, with no race: the
+    sweep's own process, once it holds a task, waits until a forked worker has taken one too. A forked worker
+    then calls ``in_the_worker()`` before it computes. Returns the points computed in the sweep's own process
+    (a forked worker would count in its own copy of the list)."""
+    from gearsym.sweep.run import _Run
+
+    worker_took_a_task = multiprocessing.get_context("fork").Event()  # made before the fork: shared with it
+    sweep_process, task, computed_here = os.getpid(), _Run.task, []
+
+    def shared(self, compiled, points, state):
+        if os.getpid() != sweep_process:
+            worker_took_a_task.set()
+            if in_the_worker:
+                in_the_worker()
+        else:  # (a worker that took a task has said so before it can end: no child left means none will)
+            deadline = time.monotonic() + WORKER_START
+            while not worker_took_a_task.wait(0.05):
+                assert multiprocessing.active_children() and time.monotonic() < deadline, \
+                    "no forked worker took a task, and none is alive: did the sweep fork?"
+            computed_here.extend(points)
+        yield from task(self, compiled, points, state)
+
+    monkeypatch.setattr(_Run, "task", shared)
+    return computed_here
+
+
 @pytest.mark.parametrize("mode, jobs", [("continuation", 2), ("independent", 2), ("continuation", 1)])
 def test_an_interrupted_sweep_resumes_to_the_same_files(tmp_path, one_stage, mode, jobs):
     axes = ["omega=0.9:1.3:0.1", "B1=3.5,4"]
@@ -109,42 +142,29 @@ def test_an_interrupted_sweep_resumes_to_the_same_files(tmp_path, one_stage, mod
 
 
 @pytest.mark.parametrize("parallel", ["threads", "processes"])
-def test_threads_and_processes_do_not_change_a_single_bit(tmp_path, one_stage, parallel):
+def test_threads_and_processes_do_not_change_a_single_bit(tmp_path, one_stage, parallel, monkeypatch):
     axes = ["omega=0.9:1.4:0.1", "B1=3.5,4"]
-    for jobs in (1, 2):
-        run_sweep(one_stage, axes, mode="independent", workers=Workers(jobs=jobs, parallel=parallel),
-                  out=tmp_path / f"j{jobs}.csv", **SHORT)
+    run_sweep(one_stage, axes, mode="independent", workers=Workers(jobs=1, parallel=parallel),
+              out=tmp_path / "j1.csv", **SHORT)
+    computed_here = share_with_a_forked_worker(monkeypatch) if parallel == "processes" else None
+    run_sweep(one_stage, axes, mode="independent", workers=Workers(jobs=2, parallel=parallel),
+              out=tmp_path / "j2.csv", **SHORT)
+    if parallel == "processes":  # the two processes both computed
+        assert 0 < len(computed_here) < 12
     for name in ("j{}.csv", "j{}.poincare.csv"):
         assert (tmp_path / name.format(1)).read_bytes() == (tmp_path / name.format(2)).read_bytes()
 
 
 def test_the_sweeps_own_process_computes_beside_the_processes_it_forks(one_stage, monkeypatch):
-    from gearsym.sweep.run import _Run
-
-    computed_here, task = [], _Run.task
-
-    def counted(self, compiled, points, state):  # (a forked worker counts in its own copy of the list)
-        computed_here.extend(points)
-        yield from task(self, compiled, points, state)
-
-    monkeypatch.setattr(_Run, "task", counted)
-    run_sweep(one_stage, ["omega=0.9:1.4:0.1"], mode="independent", workers=Workers(jobs=2, parallel="processes"),
-              **SHORT)
-    assert computed_here
+    computed_here = share_with_a_forked_worker(monkeypatch)
+    result = run_sweep(one_stage, ["omega=0.9:1.4:0.1"], mode="independent",
+                       workers=Workers(jobs=2, parallel="processes"), **SHORT)
+    assert len(result) == 6 and 0 < len(computed_here) < 6  # the rest came from the forked worker
 
 
 def test_a_worker_process_that_dies_is_reported_and_the_points_finished_here_are_kept(tmp_path, one_stage,
                                                                                       monkeypatch):
-    from gearsym.sweep.run import _Run
-
-    sweep_process, task = os.getpid(), _Run.task
-
-    def dies_if_forked(self, compiled, points, state):
-        if os.getpid() != sweep_process:
-            os._exit(3)
-        yield from task(self, compiled, points, state)
-
-    monkeypatch.setattr(_Run, "task", dies_if_forked)
+    share_with_a_forked_worker(monkeypatch, in_the_worker=lambda: os._exit(3))
     out, axes = tmp_path / "s.csv", ["omega=0.9:1.4:0.1"]
     with pytest.raises(GearsymError, match=r"a sweep worker process died \(exit code 3\); the points finished so far "
                                            "are kept"):
@@ -226,30 +246,43 @@ def test_the_record_lists_the_jumps_and_hysteresis_found(tmp_path, one_stage):
 
 
 @pytest.mark.parametrize("parallel", ["threads", "processes"])
-def test_continuation_lines_in_parallel_do_not_change_a_single_bit(tmp_path, one_stage, parallel):
+def test_continuation_lines_in_parallel_do_not_change_a_single_bit(tmp_path, one_stage, parallel, monkeypatch):
     axes = ["omega=0.9:1.3:0.1", "B1=3.5,4"]
-    for jobs in (1, 2):
-        run_sweep(one_stage, axes, direction="both", workers=Workers(jobs=jobs, parallel=parallel),
-                  out=tmp_path / f"c{jobs}.csv", **SHORT)
+    run_sweep(one_stage, axes, direction="both", workers=Workers(jobs=1, parallel=parallel),
+              out=tmp_path / "c1.csv", **SHORT)
+    computed_here = share_with_a_forked_worker(monkeypatch) if parallel == "processes" else None
+    run_sweep(one_stage, axes, direction="both", workers=Workers(jobs=2, parallel=parallel),
+              out=tmp_path / "c2.csv", **SHORT)
+    if parallel == "processes":  # one line here, the other in the forked worker
+        assert len(computed_here) == 10
     assert (tmp_path / "c1.csv").read_bytes() == (tmp_path / "c2.csv").read_bytes()
 
 
 def test_resume_in_the_down_half_after_a_kill_mid_row(tmp_path, one_stage):
-    axes = ["omega=0.9:1.3:0.1"]
-    run_sweep(one_stage, axes, direction="both", out=tmp_path / "whole.csv", **SHORT)
+    """Up 0.7 ... 1.0 and down again: at omega = 0.9 the two runs hold different orbits (hysteresis)."""
+    axes = ["omega=0.7:1.0:0.1"]
+    whole = run_sweep(one_stage, axes, direction="both", out=tmp_path / "whole.csv", **SHORT)
+    up, down = ({w: a for w, a, d in zip(whole["omega"], whole["A_x"], whole["direction"]) if d == run}
+                for run in ("up", "down"))
+    # where both runs of the interrupted sweep below went, the amplitudes differ by more than 5 % (the
+    # library's threshold) at 0.9, the up run's larger orbit (measured: there only; 1.0 is chaotic both ways)
+    differ = [w for w in (0.8, 0.9, 1.0) if abs(up[w] - down[w]) > 0.05 * max(up[w], down[w])]
+    assert differ[:1] == [0.9], (up, down)
     part = tmp_path / "part.csv"
     with pytest.raises(SweepInterrupted):
         run_sweep(one_stage, axes, direction="both", out=part, on_point=interrupt_after(7), **SHORT)
     whole_rows = (tmp_path / "whole.csv").read_text().splitlines()
     part.write_text(part.read_text() + whole_rows[8][:15])  # the 8th point (going down) cut while written
     strobe = tmp_path / "part.poincare.csv"
-    strobe.write_text(strobe.read_text() + "1.0,down,0,0.12")  # and its Poincare rows
+    strobe.write_text(strobe.read_text() + "0.7,down,0,0.12")  # and its Poincare rows
     partial = read_sweep(part)  # reading an interrupted sweep leaves the cut row out ...
-    assert len(partial) == 7 and partial["direction"].tolist() == ["up"] * 5 + ["down"] * 2
-    assert partial.findings()["hysteresis"] is not None  # ... and compares only what both runs have
-    run_sweep(one_stage, axes, direction="both", out=part, **SHORT)
+    assert len(partial) == 7 and partial["direction"].tolist() == ["up"] * 4 + ["down"] * 3
+    # ... and compares only what both runs have, point by point: the one interval where they differ
+    assert partial.findings()["hysteresis"] == [{"coordinate": "x", "from": 0.9, "to": differ[-1]}]
+    resumed = run_sweep(one_stage, axes, direction="both", out=part, **SHORT)
     assert part.read_bytes() == (tmp_path / "whole.csv").read_bytes()
     assert strobe.read_bytes() == (tmp_path / "whole.poincare.csv").read_bytes()
+    assert resumed.findings() == whole.findings() == read_sweep(part).findings()
 
 
 def test_a_sweep_that_finished_no_point_starts_again_with_new_options(tmp_path, one_stage):

@@ -31,7 +31,8 @@ Y0: dict[str, tuple[float, ...]] = {
 }
 DIM = {m: len(y) for m, y in Y0.items()}
 
-# Mesh stiffness k(tau) = 1 + k_a * sum_m c_m cos(m tau) (the paper's series).
+# Mesh stiffness k(tau) = 1 + k_a * sum_m c_m cos(m tau): gearsym's default (rectangular_mesh_stiffness(), 12 digits;
+# the paper shows k only as a plot): the same numbers tests/test_crossings.py checks against that formula.
 K_HARMONICS: tuple[tuple[int, float], ...] = (
     (1, 1.18003861468), (2, -0.336894506314), (3, -0.195632837787),
     (4, 0.192724343884), (6, -0.0605674179821), (7, 0.0148837545288),
