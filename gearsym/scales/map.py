@@ -28,7 +28,7 @@ import sympy as sp
 
 from ..errors import GearsymError, ModelError, UnknownParameterError
 from ..model.length_scale import check_length_scale
-from ..model.resolved import ResolvedCoupling
+from ..model.resolved_components import ResolvedCoupling
 from ..reduction import NondimensionalModel
 from ..reduction.statics import StaticState, static_state, torque_imbalance
 from ..symbols import parameter_symbol
