@@ -11,6 +11,7 @@ One flat public face; the stages behind it, each handing one type to the next:
   :func:`find_attractors`, :func:`run_sweep` (on a CompiledModel, or on a system, compiled first);
   periodic orbits and their branches: :func:`periodic_orbit`, :func:`continue_orbits`;
 * data: :func:`simulate_measurements`, :func:`load_measurements`, :func:`explain`;
+* FMUs: :func:`export_fmu` (a model as an FMI 2.0 FMU, co-simulation and model exchange, for other tools);
 * physical units: :func:`scaling` (a drivetrain with values in units -> its nondimensional values, and results
   back to rpm, um, N, 1/s), :func:`natural_modes`, :func:`campbell`;
 * document: :func:`derive` and :func:`render`.
@@ -70,6 +71,7 @@ _LAZY = {
     "Scaling": "gearsym.physical.scales",
     "natural_modes": "gearsym.analysis.modes",
     "campbell": "gearsym.physical.campbell",
+    "export_fmu": "gearsym.fmu.export",
     "derive": "gearsym.derivation",
     "render": "gearsym.derivation",
 }
@@ -110,6 +112,7 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .derivation import derive, render
     from .analysis.modes import natural_modes
     from .fit import EFFECTS, explain
+    from .fmu.export import export_fmu
     from .periodic import continue_orbits, periodic_orbit
     from .physical import Scaling, scaling
     from .physical.campbell import campbell
