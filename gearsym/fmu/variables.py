@@ -61,10 +61,6 @@ class Layout:
         """The meshes with backlash: each has a contact state and the first pairs of event indicators."""
         return tuple(c for c in self.meshes if c.backlash != 0)
 
-    @property
-    def states(self) -> tuple[str, ...]:
-        return self.system.state_names
-
     def index(self, name: str) -> int:
         """A variable's index (1-based) in ModelVariables."""
         return next(i for i, v in enumerate(self.variables, 1) if v.name == name)
