@@ -179,6 +179,13 @@ class Scaling:
                 f"to accelerate the whole train, so there is no steady operating point. "
                 f"{' or '.join(options[:2])} balances them", self.name)
 
+    @classmethod
+    def of(cls, nd: NondimensionalModel, length_scale=None, **physical) -> "Scaling":
+        """The scaling of ``nd`` at its declared physical values, ``physical`` overriding them, in its declared
+        length unit unless ``length_scale`` is given."""
+        scale = nd.drivetrain.length_scale if length_scale is None else length_scale
+        return cls(nd, {**nd.drivetrain.physical, **physical}, scale)
+
     def with_values(self, **physical) -> "Scaling":
         """The same drivetrain with some physical values changed (``speed="3000 rpm"``)."""
         return type(self)(self.model, {**self.inputs, **physical}, self.length_scale)
