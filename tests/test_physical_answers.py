@@ -358,3 +358,20 @@ def test_gearsym_campbell_writes_a_physical_table_and_the_orders_units(tmp_path,
     diagram = json.loads((tmp_path / "c.campbell.json").read_text())
     assert diagram["orders"][0] == {"label": "1x mesh", "kind": "mesh", "cycles_per_revolution": 28.0}
     assert diagram["speed"] == "the speed of 'pinion'"
+
+
+def test_a_physical_model_without_a_declared_speed_still_answers_in_its_units(capsys):
+    """The paper's flexible shaft given physical values (no body declares a speed; omega stays the engine's):
+    the mesh in µm and N, the shaft's twist in rad and its torque in N·m."""
+    values = dict(I1="2e-3 kg*m^2", I2="3e-3 kg*m^2", I3="5e-3 kg*m^2", r1="30 mm", r2="45 mm", kZ="2e8 N/m",
+                  cZ="400 N*s/m", eta="60 um", kS="2e4 N*m/rad", M1="160 N*m", M2="90 N*m", M3="150 N*m",
+                  M1a="5 N*m", Theta="0.3", k_a="0.2")
+    argv = ["lyap", "flexible_shaft", "--periods", "60", "--discard", "40"]
+    for name, value in values.items():
+        argv += ["--set", f"{name}={value}"]
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert "operating point: mesh frequency" in text and "nan" not in text
+    assert text.split("amplitude A_x2 = ")[-1].split("\n")[0].endswith(" rad")
+    assert text.split("amplitude A_x1 = ")[-1].split("\n")[0].endswith(" µm")
+    assert "shaft torque shaft: mean " in text and " N·m" in text.split("shaft torque shaft:")[1]

@@ -38,7 +38,7 @@ def run(args: argparse.Namespace) -> int:
     coordinate = chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     result = lyapunov_spectrum(compiled, y0=parse_state(args.y0))
     # (the mesh forces and shaft torques from a trajectory at the point, as in Python: physical/point.py)
-    physical = scaling.to_physical(result, model=compiled) if scaling is not None and scaling.speed else None
+    physical = scaling.to_physical(result, model=compiled) if scaling is not None else None
     if args.plot:
         shown = min(30, result.periods - result.discard)
         trajectory = phase_trajectory(compiled, options=compiled.integration.run(discard=result.periods - shown),

@@ -123,7 +123,7 @@ def run(args: argparse.Namespace) -> int:
     check_segments(args.segments, pieces_per_period(options.steps_per_period), f"--segments {args.segments}: ",
                    options.steps_per_period)
     scaling = scaling_from(args)
-    physical = scaling if scaling is not None and scaling.speed else None  # (answers also in its units)
+    physical = scaling  # (None without physical values; else the answers are also in its units)
     if parameter:
         parameter = engine_range(args, parameter, scaling)
     system = system_from(args)
@@ -156,10 +156,11 @@ def _one_orbit(compiled, args, y0, physical) -> int:
         units, w = physical.point_units(), orbit.parameters["omega"]
         amplitude = {k: units.state(k, v, w) for k, v in orbit.amplitude.items()}
         state = {k: units.state(k, v, w) for k, v in zip(orbit.state_names, orbit.state)}
-        speed = Measured(float(units.speed_of(w)), units.speed_unit)
-        print(f"in physical units: {shown(speed)}; " + ", ".join(f"A_{k} = {shown(v)}" for k, v in amplitude.items())
+        speed = Measured(float(units.speed_of(w)), units.speed_unit) if units.speed else None
+        print("in physical units: " + (f"{shown(speed)}; " if speed else "")
+              + ", ".join(f"A_{k} = {shown(v)}" for k, v in amplitude.items())
               + "; state at the section: " + ", ".join(f"{k}={shown(v, 10)}" for k, v in state.items()))
-        record["physical"] = {"speed": _json(speed), "amplitude": {k: _json(v) for k, v in amplitude.items()},
+        record["physical"] = {**({"speed": _json(speed)} if speed else {}), "amplitude": {k: _json(v) for k, v in amplitude.items()},
                               "state": {k: _json(v) for k, v in state.items()}}
     if args.out:
         write_atomically(args.out, json.dumps(record, indent=1) + "\n")

@@ -83,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 130
     regimes = Counter(result["regime"].tolist())
-    physical = scaling is not None and scaling.speed
+    physical = scaling is not None
     print(f"{result.model}: {len(result)} points -> {args.out} (+ .json, .poincare.csv"
           + (", .physical.csv, .physical.json)" if physical else ")"))
     print("regimes: " + ", ".join(f"{k} {v}" for k, v in sorted(regimes.items())))

@@ -91,7 +91,8 @@ class PhysicalPoint:
 
     def lines(self) -> list[str]:
         """The text ``gearsym lyap`` prints for a model with physical values."""
-        out = [f"operating point: {shown(self.speed)}, mesh frequency {shown(self.mesh_frequency)}, "
+        speed = f"{shown(self.speed)}, " if math.isfinite(float(np.asarray(self.speed.magnitude))) else ""
+        out = [f"operating point: {speed}mesh frequency {shown(self.mesh_frequency)}, "
                f"omega_n = {shown(self.natural_frequency)} (omega = {self.omega:.6g})",
                "Lyapunov exponents per second: " + ", ".join(f"{v:+.6g}" for v in self.exponents.magnitude)]
         out += [f"amplitude A_{k} = {shown(v)}" for k, v in self.amplitude.items()]
