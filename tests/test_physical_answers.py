@@ -375,3 +375,15 @@ def test_a_physical_model_without_a_declared_speed_still_answers_in_its_units(ca
     assert text.split("amplitude A_x2 = ")[-1].split("\n")[0].endswith(" rad")
     assert text.split("amplitude A_x1 = ")[-1].split("\n")[0].endswith(" µm")
     assert "shaft torque shaft: mean " in text and " N·m" in text.split("shaft torque shaft:")[1]
+
+
+def test_a_two_dimensional_physical_sweep_is_drawn_in_its_units(spur):
+    from gearsym.figures.sweep import plot_sweep
+
+    result = gearsym.run_sweep(spur, {"speed": ["9000 rpm", "9500 rpm"], "cZ": ["200 N*s/m", "500 N*s/m"]},
+                               options=Integration(periods=30, discard=20), progress=False,
+                               workers=gearsym.Workers(1, "threads"))
+    assert sorted(set(result["cZ"])) == [200.0, 500.0] and result.units["cZ"] == "N·s/m"
+    labels = [a.get_ylabel() for a in plot_sweep(result).axes] + [a.get_xlabel() for a in plot_sweep(result).axes]
+    assert "speed [rpm]" in labels and "cZ [N·s/m]" in labels
+    assert r"$\lambda_1$ [1/s]" in labels and "A (x) [µm]" in labels  # (the colour bars)

@@ -223,7 +223,7 @@ def plot_sweep(result: SweepResult, path: str | Path | None = None, coordinate: 
             mesh = plot_map(ax, result, column, direction=direction)
             ax.set_title(f"{label} {over}{run}", fontsize=9)
             if column != "regime":
-                fig.colorbar(mesh, ax=ax, label=label)
+                fig.colorbar(mesh, ax=ax, label=_with_unit(label, result.units, column))
             else:
                 cbar = fig.colorbar(mesh, ax=ax, ticks=range(4))
                 cbar.ax.set_yticklabels(REGIMES, fontsize=7)
