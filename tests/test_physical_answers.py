@@ -215,6 +215,17 @@ def test_a_unitless_speed_in_python_is_refused_with_the_same_message(spur, call,
     assert UNITLESS + fix in str(err.value)
 
 
+def test_a_model_that_declares_a_plain_number_for_a_stiffness_gets_the_same_message():
+    model = motor_coupling_gear()
+    model.set_physical(kZ=2e8)
+    with pytest.raises(GearsymError, match=r"motor_coupling_gear_si: kZ: 2e\+08 has no unit, and a mesh stiffness "
+                                           r"needs one: write kZ='2e\+08 N/m'"):
+        gearsym.scaling(model)
+    model.set_physical(kZ=gearsym.units.Quantity(2e8))  # (a dimensionless pint Quantity alike)
+    with pytest.raises(GearsymError, match=r"kZ: 2e\+08 has no unit"):
+        gearsym.scaling(model)
+
+
 def test_a_unitless_backlash_gets_the_same_message_in_its_unit(capsys):
     assert main(["lyap", "spur_pair", "--set", "eta=50"]) == 2
     assert "spur_pair: eta: 50 has no unit, and a backlash needs one: write eta='50 µm'" in capsys.readouterr().err

@@ -133,12 +133,11 @@ class Scaling:
         """One physical value in SI; a plain number (or text that reads as one) for a value that has a unit is
         refused (one rule everywhere: a number is never silently read in some unit)."""
         where = f"{self.name}: {name}"
-        number = maybe_number(value)
-        if isinstance(number, (int, float)) and not isinstance(number, bool):
+        out = measure(maybe_number(value), where)
+        if out.dimensionless and not out.unit:  # a number, text that reads as one, a declared plain number
             unit = self.unit_needed(name)
             if unit:
-                raise ModelError(self.unitless(name, number, f"{name}='{number:g} {symbol(unit)}'"), where)
-        out = measure(value, where)
+                raise ModelError(self.unitless(name, out.given, f"{name}='{out.given:g} {symbol(unit)}'"), where)
         role = self.roles.get(name, (None, ""))[0]
         if role is SPEED and same_dimension(out.dims, SPEED.dims) and out.unit \
                 and not any(a in out.unit for a in _ANGLES):
