@@ -24,8 +24,8 @@ from ..scales.dimensions import evaluate
 from ..scales.map import Scaling
 from ..sweep.grid import Axis
 from ..symbols import parameter_symbol, phi, tau
-from ..units import Quantity, from_si, shown, symbol
-from .point import (ANGLE, ANGULAR_VELOCITY, LENGTH, LENGTH_UNIT, RATES, VELOCITY, VELOCITY_UNIT, Measured,
+from ..units import Quantity, from_si, symbol
+from .point import (ANGLE, ANGULAR_VELOCITY, LENGTH, LENGTH_UNIT, VELOCITY, VELOCITY_UNIT, Measured,
                     MeshUnits, PhysicalPoint, PointUnits, ShaftUnits, Unit, loads_trajectory)
 
 
@@ -273,8 +273,3 @@ def _findings(units: PointUnits, renamed: dict, first: str, findings: dict) -> d
              for j in findings["jumps"]]
     return {"axis": renamed[first][0] if first in renamed else first, "jumps": jumps,
             "hysteresis": [axis_values(h) for h in findings["hysteresis"]]}
-
-
-def summary_text(scaling: Scaling) -> str:
-    """The physical values a figure's title gives: 'speed=9000 rpm, kZ=1.27e+08 N/m, ...' (as the user gave them)."""
-    return ", ".join(f"{n}={shown(q)}" for n, q in scaling.inputs.items())

@@ -27,11 +27,11 @@ from functools import cached_property
 import sympy as sp
 
 from ..errors import GearsymError, ModelError, UnknownParameterError
+from ..model.expressions import parameter_names
 from ..model.length_scale import check_length_scale
 from ..model.resolved import ResolvedCoupling
 from ..reduction import NondimensionalModel
 from ..reduction.statics import StaticState, static_state, torque_imbalance
-from ..model.expressions import parameter_names
 from ..symbols import parameter_symbol
 from ..units import Measure, Quantity, dimension_text, measure, symbol
 from .dimensions import evaluate, same_dimension
@@ -98,7 +98,6 @@ class Scaling:
     def _inputs(self, given: Mapping[str, object]) -> dict[str, Measure]:
         names = physical_parameters(self.model.reduction.resolved)
         known = names + ([self.speed.parameter] if self.speed else [])
-        declared = self.model.drivetrain.physical
         out: dict[str, Measure] = {}
         derived = {gr.name: gr for gr in self.model.groups if gr.kind == "free"}
         for name, value in given.items():
@@ -111,7 +110,7 @@ class Scaling:
                                  f"set {behind} instead", self.name)
             if name not in known:
                 raise UnknownParameterError(name, known, f"{self.name}: physical values")
-            out[name] = self._input(name, value, declared.get(name))
+            out[name] = self._input(name, value)
         defaults = self.model.drivetrain.defaults
         missing = []
         for name in names:
@@ -129,7 +128,7 @@ class Scaling:
                              f"(--set {missing[0]}='...')", self.name)
         return out
 
-    def _input(self, name: str, value, declared: Measure | None) -> Measure:
+    def _input(self, name: str, value) -> Measure:
         """One physical value in SI; a plain number (or text that reads as one) for a value that has a unit is
         refused (one rule everywhere: a number is never silently read in some unit)."""
         where = f"{self.name}: {name}"
@@ -360,7 +359,7 @@ class Scaling:
                 raise GearsymError(f"{self.name}: no value for the speed; give it (--set {self.speed.parameter}="
                                    "'3000 rpm')")
             return self.inputs[self.speed.parameter].si
-        q = self._input(self.speed.parameter, speed, self.inputs.get(self.speed.parameter))
+        q = self._input(self.speed.parameter, speed)
         if not same_dimension(q.dims, SPEED.dims):
             raise ModelError(f"{q.text()} is not {SPEED.describe()}", f"{self.name}: {self.speed.parameter}")
         return q.si
