@@ -37,12 +37,17 @@ def run(args: argparse.Namespace) -> int:
     compiled = compiled_from(args)
     coordinate = chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     result = lyapunov_spectrum(compiled, y0=parse_state(args.y0))
-    physical = _physical(scaling, compiled, result) if scaling is not None and scaling.speed else None
+    # (the mesh forces and shaft torques from a trajectory at the point, as in Python: physical/point.py)
+    physical = scaling.to_physical(result, model=compiled) if scaling is not None else None
     if args.plot:
         shown = min(30, result.periods - result.discard)
         trajectory = phase_trajectory(compiled, options=compiled.integration.run(discard=result.periods - shown),
                                       y0=parse_state(args.y0))
-        plot_point(result, trajectory, args.plot, x=coordinate)
+        if physical is not None:  # in the model's units: exponents per second, um, mm/s, rad
+            spectrum, shown_trajectory, units, title = scaling.point_units().figure(result, trajectory)
+            plot_point(spectrum, shown_trajectory, args.plot, x=coordinate, units=units, title=title)
+        else:
+            plot_point(result, trajectory, args.plot, x=coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     if args.format == "json":
         print(json.dumps({**result.as_dict(), **({"physical": physical.as_dict()} if physical else {})}, indent=2))
@@ -69,14 +74,3 @@ def run(args: argparse.Namespace) -> int:
     for line in physical.lines() if physical else ():
         print(line)
     return 0
-
-
-#: forcing periods of the trajectory the mesh forces of a physical model are read from (after the run's end)
-FORCE_PERIODS = 20
-
-
-def _physical(scaling, compiled, result):
-    """The result in the model's physical units, with the mesh forces over FORCE_PERIODS periods from its end."""
-    options = compiled.integration.run(periods=FORCE_PERIODS, discard=0)
-    trajectory = phase_trajectory(compiled, options=options, y0=result.final_state)
-    return scaling.to_physical(result, trajectory=trajectory)

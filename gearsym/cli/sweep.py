@@ -10,7 +10,7 @@ from ..checks import chosen_coordinate
 from ..errors import GearsymError
 from ..figures.sweep import plot_sweep
 from ..outputs import check_figure, check_file
-from ..physical.files import write_physical_table
+from ..physical.files import write_physical_record, write_physical_table
 from ..physical.sweeps import nondimensional_axes
 from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, run_sweep, Workers
 from ..sweep.grid import axes_from
@@ -70,7 +70,8 @@ def run(args: argparse.Namespace) -> int:
     workers = Workers(args.jobs, args.parallel, "local" if args.dask else args.scheduler)
     y0 = parse_state(args.y0)  # before the model is compiled
     scaling = scaling_from(args)
-    axes = _engine_axes(args.param, scaling)
+    given = axes_from(args.param)
+    axes = _engine_axes(given, scaling)
     compiled = compiled_from(args)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     try:
@@ -82,23 +83,29 @@ def run(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 130
     regimes = Counter(result["regime"].tolist())
-    print(f"{result.model}: {len(result)} points -> {args.out} (+ .json, .poincare.csv)")
+    physical = scaling is not None
+    print(f"{result.model}: {len(result)} points -> {args.out} (+ .json, .poincare.csv"
+          + (", .physical.csv, .physical.json)" if physical else ")"))
     print("regimes: " + ", ".join(f"{k} {v}" for k, v in sorted(regimes.items())))
-    for line in findings_lines(result, sidecar(args.out, ".json")):
-        print(line)
-    if scaling is not None and scaling.speed and result.axes[0].name == "omega":
-        result = scaling.to_physical(result)
-        print(f"in physical units: {write_physical_table(result, sidecar(args.out, '.physical.csv'))}")
+    if physical:  # the findings along the values swept, in their units, and the tables in them
+        result = scaling.to_physical(result, given=given)
+        record = write_physical_record(result, sidecar(args.out, ".physical.json"))
+        for line in findings_lines(result, record, result.record["physical"]):
+            print(line)
+        print(f"in physical units: {write_physical_table(result, sidecar(args.out, '.physical.csv'))} "
+              f"(and {record})")
+    else:
+        for line in findings_lines(result, sidecar(args.out, ".json")):
+            print(line)
     if args.plot:
         plot_sweep(result, args.plot, coordinate=args.coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     return 0
 
 
-def _engine_axes(params: list[str], scaling):
+def _engine_axes(axes, scaling):
     """The --param axes the engine sweeps: physical ones (speed=500rpm:6000rpm:25rpm) turned into the
     nondimensional parameter they move, for a model with physical values."""
-    axes = axes_from(params)
     if scaling is None:
         unit = next((a for a in axes if a.unit), None)
         if unit:

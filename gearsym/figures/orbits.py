@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import GearsymError
 from ..periodic import FOLD, GRAZING, NEIMARK_SACKER, PERIOD_DOUBLING, Continuation
 from .save import pyplot, save_figure
-from .sweep import _axis_label
+from .sweep import _axis_label, _with_unit
 
 #: marker and short label of each kind of bifurcation
 MARKS = {FOLD: ("o", "F", "fold (a multiplier through +1)"),
@@ -64,10 +64,11 @@ def plot_branches(ax, result: Continuation, coordinate: str | None = None, *, la
         marker, short, _ = MARKS[b.kind]
         ax.plot(b.value, br.amplitude[i, j], marker, ms=5, mfc="white", mec="C3", mew=1.2, zorder=5)
         if labelled:
-            ax.annotate(f"{short} {b.value:.3f}", (b.value, br.amplitude[i, j]), fontsize=6, color="C3",
+            value = f"{b.value:.0f}" if abs(b.value) >= 1000 else f"{b.value:.3f}"  # (rpm: whole numbers)
+            ax.annotate(f"{short} {value}", (b.value, br.amplitude[i, j]), fontsize=6, color="C3",
                         xytext=(3, 4 if k % 2 == 0 else -9), textcoords="offset points")
-    ax.set_xlabel(_axis_label(result.parameter))
-    ax.set_ylabel(f"$A$ ({coordinate})")
+    ax.set_xlabel(_axis_label(result.parameter, result.units))
+    ax.set_ylabel(_with_unit(f"$A$ ({coordinate})", result.units, f"A_{coordinate}"))
     if legend:
         ax.legend(handles=legend_handles(result), fontsize=7, loc="best")
 
@@ -95,7 +96,7 @@ def plot_largest_multiplier(ax, result: Continuation) -> None:
                     color=branch_color(br.period_multiple))
     ax.axhline(1.0, color="C3", lw=0.7)
     ax.set_ylabel(r"largest $|\mu|$")
-    ax.set_xlabel(_axis_label(result.parameter))
+    ax.set_xlabel(_axis_label(result.parameter, result.units))
 
 
 def plot_sweep_points(ax, sweep, parameter: str, coordinate: str) -> None:
@@ -110,10 +111,17 @@ def plot_sweep_points(ax, sweep, parameter: str, coordinate: str) -> None:
 
 
 def orbits_title(result: Continuation, width: int = 110) -> str:
-    fixed = ", ".join(f"{k}={v:g}" for k, v in result.parameters.items())
+    """The model, the range, the bifurcations found and the fixed values (a physical model's as the user gave
+    them)."""
+    physical = result.settings.get("physical")
+    if physical:
+        fixed = "values: " + ", ".join(f"{k}={v}" for k, v in physical["inputs"].items() if k != result.parameter)
+    else:
+        fixed = ", ".join(f"{k}={v:g}" for k, v in result.parameters.items())
+    unit = f" {result.units[result.parameter]}" if result.parameter in result.units else ""
     kinds = ", ".join(f"{len(result.of_kind(k))} {k}" for k in MARKS if result.of_kind(k)) or "no bifurcations"
-    return textwrap.fill(f"{result.model}: periodic orbits over {result.parameter} = {result.start:g}..{result.stop:g} "
-                         f"({len(result.branches)} branches; {kinds}). {fixed}", width)
+    return textwrap.fill(f"{result.model}: periodic orbits over {result.parameter} = {result.start:g}..{result.stop:g}"
+                         f"{unit} ({len(result.branches)} branches; {kinds}). {fixed}", width)
 
 
 def plot_orbits(result: Continuation, path: str | Path | None = None, coordinate: str | None = None, sweep=None):

@@ -168,8 +168,12 @@ def _style_legend(result: SweepResult) -> list:
 
 
 def fixed_parameters(result: SweepResult) -> str:
-    """The values of every parameter not swept: those the sweep set first, then the model's defaults."""
+    """The values of every parameter not swept: those the sweep set first, then the model's defaults; for a sweep
+    in physical units, the physical values as the user gave them."""
     swept = {a.name for a in result.axes}
+    physical = result.record.get("physical")
+    if physical:
+        return "values: " + ", ".join(f"{k}={v}" for k, v in physical["inputs"].items() if k not in swept)
     given = {k: v for k, v in result.record.get("settings", {}).items() if k not in swept}
     defaults = {k: v for k, v in result.record.get("parameters", {}).items() if k not in swept and k not in given}
     parts = [*(["set: " + ", ".join(f"{k}={v}" for k, v in given.items())] if given else []),
@@ -179,10 +183,16 @@ def fixed_parameters(result: SweepResult) -> str:
 
 def sweep_title(result: SweepResult, width: int = 110) -> str:
     """The model, the swept ranges and the fixed parameters, wrapped to ``width`` characters."""
-    swept = ", ".join(f"{a.name} = {a.values[0]:g}..{a.values[-1]:g} ({len(a.values)} values)" for a in result.axes)
+    swept = ", ".join(f"{a.name} = {a.values[0]:g}..{a.values[-1]:g}{_unit_text(result, a.name)} ({len(a.values)} values)"
+                      for a in result.axes)
     mode = ("independent points" if result.mode == "independent" else
             _CONTINUATION.get(result.record.get("direction"), "continuation"))
     return textwrap.fill(f"{result.model}: {swept}, {mode}. {fixed_parameters(result)}", width)
+
+
+def _unit_text(result: SweepResult, column: str) -> str:
+    unit = result.units.get(column)
+    return f" {unit}" if unit else ""
 
 
 def _shown_direction(result: SweepResult) -> str | None:
@@ -213,7 +223,7 @@ def plot_sweep(result: SweepResult, path: str | Path | None = None, coordinate: 
             mesh = plot_map(ax, result, column, direction=direction)
             ax.set_title(f"{label} {over}{run}", fontsize=9)
             if column != "regime":
-                fig.colorbar(mesh, ax=ax, label=label)
+                fig.colorbar(mesh, ax=ax, label=_with_unit(label, result.units, column))
             else:
                 cbar = fig.colorbar(mesh, ax=ax, ticks=range(4))
                 cbar.ax.set_yticklabels(REGIMES, fontsize=7)

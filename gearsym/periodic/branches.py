@@ -88,6 +88,7 @@ class Continuation:
     branches: tuple[Branch, ...]
     bifurcations: tuple[Bifurcation, ...]
     settings: dict
+    units: dict[str, str] = field(default_factory=dict)  # column -> unit, for a continuation in physical units
 
     def of_kind(self, kind: str) -> list[Bifurcation]:
         return [b for b in self.bifurcations if b.kind == kind]
