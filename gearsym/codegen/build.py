@@ -9,6 +9,7 @@ reducing models by name is the caller's (``gearsym.load``), not the code generat
 """
 from __future__ import annotations
 
+import os
 import sys
 import time
 from dataclasses import replace
@@ -24,6 +25,7 @@ from .compiled import CompiledModel
 from .compiler import FALLBACK_NOTE, cache_dir, compile_library, compilers_looked_for, find_compiler
 from .loops import LoopOptions
 from .native import load_native
+from .trust import record, trusted
 
 if TYPE_CHECKING:
     from ..system import FirstOrderSystem
@@ -91,24 +93,43 @@ def _resolve_backend(asked: str) -> str:
 
 def _compiled_functions(system: FirstOrderSystem, loops: LoopOptions, digest: str, timings: dict,
                         verbose: bool) -> tuple[dict, Path]:
-    """The library of ``digest``: C from generated/ or the cache (generated here if missing), compiled once."""
+    """The library of ``digest``: C from generated/ or the cache (generated here if missing or not the C gearsym
+    wrote), compiled once."""
     from .functions import build_functions
-    from .generate import read_manifest, write_code
+    from .generate import write_code
 
     code_dir = code_directory(system.name, digest)
     source = code_dir / f"{system.name}.c"
-    manifest = read_manifest(code_dir)
-    if not (manifest and manifest.get("hash") == digest and source.is_file()):
+    if code_dir != GENERATED_DIR / system.name and trusted(source, source_describes(system.name, digest)) is None:
         t = time.perf_counter()
         mf = build_functions(system, loops)
         timings["build"] = time.perf_counter() - t
         t = time.perf_counter()
-        write_code(mf, code_dir, digest)
+        keep_generated(write_code(mf, code_dir, digest))
         timings["generate"] = time.perf_counter() - t
-    lib = compile_library(source, system.name, announce=_to_stderr if verbose else None)
+    lib = compile_library(source, system.name, announce=_to_stderr if verbose else None,
+                          describes=library_describes(system, digest))
     if lib.compiled:
         timings["compile"] = lib.seconds
     return {name: ca.external(name, str(lib.path)) for name in FUNCTION_NAMES}, lib.path
+
+
+def library_describes(system, digest: str) -> dict:
+    """What a model's library is, as its record keeps it: a summary that points at it is checked against this."""
+    return {"model": system.name, "code": digest, "states": list(system.state_names),
+            "parameters": list(system.parameters)}
+
+
+def source_describes(name: str, digest: str) -> dict:
+    """What the generated C of a model is, as its record in the cache keeps it."""
+    return {"model": name, "code": digest}
+
+
+def keep_generated(code) -> None:
+    """Generated C just written into the cache (a :class:`~.generate.GeneratedCode`): made private and recorded."""
+    for path in (code.manifest, code.source):
+        os.chmod(path, 0o600)  # (the files were made with the umask's mode)
+    record(code.source, code.source.read_bytes(), source_describes(code.source.stem, code.hash))
 
 
 def _kind(value) -> str:
@@ -127,8 +148,8 @@ def code_directory(name: str, digest: str) -> Path:
 
 
 def cached_code_directory(name: str, digest: str) -> Path:
-    """Where the cache keeps the C of the code ``digest`` when it is generated (or received) here."""
-    return cache_dir() / "code" / f"{name}-{digest[:16]}"
+    """Where the cache keeps the C of the code ``digest`` when it is generated (or received) here (made private)."""
+    return cache_dir("code", f"{name}-{digest[:16]}")
 
 
 def _to_stderr(message: str) -> None:
