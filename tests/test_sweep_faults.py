@@ -116,6 +116,27 @@ def test_a_disk_full_mid_sweep_keeps_whole_points_says_so_and_resumes_to_the_sam
     assert json.loads(out.with_suffix(".json").read_text())["status"] == "complete"
 
 
+def test_a_disk_full_as_the_sweep_completes_is_a_one_line_error_the_record_says_failed_and_a_rerun_completes(
+        one_stage, tmp_path, clean, monkeypatch):
+    out = tmp_path / "s.csv"
+    write_atomically = store_module.write_atomically
+
+    def full_at_the_end(path, data):
+        if '"complete"' in data or '"failed"' in data:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+        return write_atomically(path, data)
+
+    monkeypatch.setattr(store_module, "write_atomically", full_at_the_end)
+    with pytest.raises(GearsymError) as failed:
+        run_sweep(one_stage, AXES, out=out, **SHORT)
+    assert str(failed.value).startswith(f"writing the sweep {out} failed: No space left on device ({out.with_suffix('.json')})")
+    record = json.loads(out.with_suffix(".json").read_text())
+    assert record["status"] == "failed" and record["error"] == str(failed.value)
+    monkeypatch.undo()
+    run_sweep(one_stage, AXES, out=out, **SHORT)
+    assert files(out) == clean and json.loads(out.with_suffix(".json").read_text())["status"] == "complete"
+
+
 def test_a_point_whose_poincare_samples_were_cut_off_is_computed_again_on_resume(one_stage, tmp_path, clean):
     out = tmp_path / "s.csv"
     run_sweep(one_stage, AXES, out=out, **SHORT)

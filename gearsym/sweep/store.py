@@ -304,24 +304,25 @@ class SweepStore:
         self._write_table(self.path, self.columns, map(_fields(self.columns), rows))
         self._write_table(self.strobe_path, self.strobe_columns, (), "".join(r.text() for r in strobes))
 
-    def write_record(self, room: int = 0, **extra) -> bool:
-        """The record with ``extra`` (status, ...): written atomically, else (the disk full) over the old one in
-        place if it fits in the old one's room; ``room`` bytes of spaces are kept for that. False if neither could
-        be done."""
-        text = json.dumps({"sweep": self.record, **extra}, indent=2)
-        try:
-            write_atomically(self.meta_path, text + " " * room + "\n")
-            return True
-        except OSError:
-            return _write_in_place(self.meta_path, text)
+    def write_record(self, room: int = 0, **extra) -> None:
+        """The record with ``extra`` (status, ...), written atomically; with ``room`` bytes of spaces kept, so that
+        a failure can be written over it in place on a full disk (:meth:`write_failure`)."""
+        write_atomically(self.meta_path, self._record_text(extra) + " " * room + "\n")
 
     def write_failure(self, error: BaseException, planned: int) -> None:
-        """The record says the sweep failed and why (the error's message), with the points kept whole."""
+        """The record says the sweep failed and why (the error's message), with the points kept whole: written
+        atomically, else (the disk full) over the record in place, in its room."""
         self.close_quietly()
-        written = self.write_record(status="failed", error=str(error) or type(error).__name__,
-                                    points={"planned": planned, "done": self.stored})
-        if not written:
-            warn(f"{self.meta_path} could not be updated (it still says the sweep is running)")
+        extra = dict(status="failed", error=str(error) or type(error).__name__,
+                     points={"planned": planned, "done": self.stored})
+        try:
+            self.write_record(**extra)
+        except OSError:
+            if not _write_in_place(self.meta_path, self._record_text(extra)):
+                warn(f"{self.meta_path} could not be updated (it still says the sweep is running)")
+
+    def _record_text(self, extra: dict) -> str:
+        return json.dumps({"sweep": self.record, **extra}, indent=2)
 
     def close_quietly(self) -> None:
         """Close the files; an error of the writer (being reported) is not raised again."""
