@@ -201,7 +201,8 @@ def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple
     if trusted(target, describes) is not None:
         return Library(target, False, 0.0)
     if announce:
-        announce(f"compiling {name} ({' '.join(flags)}; once: cached in {target.parent})")
+        kept = "for this run only" if str(configured_cache()) in _BYPASSED else f"once: cached in {target.parent}"
+        announce(f"compiling {name} ({' '.join(flags)}; {kept})")
     start = time.perf_counter()
     with tempfile.TemporaryDirectory(dir=target.parent) as tmp:
         out, call = Path(tmp) / target.name, Path(tmp) / "gearsym_call.c"
