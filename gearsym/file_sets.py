@@ -44,6 +44,10 @@ def written_together(folder: str | Path, names: Sequence[str], marker: str, what
         missing = [n for n in names if not (stage / n).is_file()]
         if missing:
             raise GearsymError(f"{what}: {', '.join(missing)} was not written")
+        blocked = [n for n in names if (folder / n).is_dir()]  # (a rename over it would fail halfway)
+        if blocked:
+            raise GearsymError(f"{folder / blocked[0]} is a folder, so {what} cannot be written there; move it away "
+                               "or choose another --out (nothing was changed)")
         note = (f"This folder holds parts of two runs: {what} was being replaced when the run was stopped. "
                 f"Run the command again; until then, do not trust {', '.join(names)}.\n")
         with _signals_held():

@@ -90,3 +90,16 @@ def test_a_run_killed_while_the_files_are_renamed_leaves_a_marker_that_says_the_
     assert "parts of two runs" in marker and "report.md" in marker
     write_report(unexplained, system, tmp_path)  # the next run makes it whole again
     assert sorted(contents(tmp_path)) == sorted(REPORT_FILES)
+
+
+def test_a_report_file_name_taken_by_a_folder_changes_nothing(explanations, previous, tmp_path):
+    system, _, unexplained = explanations
+    for name, data in previous.items():
+        (tmp_path / name).write_bytes(data)
+    (tmp_path / "derived_model.md").unlink()
+    (tmp_path / "derived_model.md").mkdir()  # (renamed last but one: the other files would be replaced by then)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()}
+    with pytest.raises(GearsymError, match="derived_model.md is a folder, so the report cannot be written there"):
+        write_report(unexplained, system, tmp_path)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()} == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(REPORT_FILES)
