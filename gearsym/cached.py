@@ -35,8 +35,10 @@ from dataclasses import asdict, dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
 
+from .codegen.build import library_describes
 from .codegen.compiler import binary_key, cache_dir, compile_flags
 from .codegen.loops import LoopOptions
+from .codegen.trust import check, differences
 from .errors import warn
 from .options import Integration
 from .parameters import Constraint, ParameterChecks
@@ -258,10 +260,9 @@ def _system_data(ref, values) -> dict | None:
 def _from_cache(system_file: Path, build_file: Path, ref, values, options: Integration, loops: LoopOptions):
     import casadi as ca
 
-    from .codegen.build import FUNCTION_NAMES, _LOADED, library_describes
+    from .codegen.build import FUNCTION_NAMES, _LOADED
     from .codegen.compiled import CompiledModel
     from .codegen.native import load_native
-    from .codegen.trust import check, differences
 
     data, build = read_json(system_file), read_json(build_file)
     try:
