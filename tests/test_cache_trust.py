@@ -326,3 +326,12 @@ def test_a_cache_path_that_is_no_folder_is_a_one_line_error_before_any_work(tmp_
     assert run.returncode == 2
     assert run.stderr.startswith(f"gearsym: error: the library cache GEARSYM_CACHE={path} cannot be used: ")
     assert len(run.stderr.splitlines()) == 1 and "Traceback" not in run.stderr
+
+
+def test_the_library_gearsym_compile_makes_is_the_one_a_run_loads(tmp_path):
+    cache = tmp_path / "cache"
+    made = gearsym(cache, "compile", "duffing", "--out", str(tmp_path / "generated"))
+    assert made.returncode == 0, made.stderr
+    run = gearsym(cache, "lyap", "duffing", *ARGS)
+    assert run.returncode == 0 and "compiling" not in run.stderr, run.stderr
+    assert len(list((cache / "lib").glob("duffing-*.so"))) == 1

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from ..options import Integration
 from ..system import FirstOrderSystem
+from .build import library_describes
 from .compiler import compile_library
 from .functions import LoopOptions, build_functions
 from .generate import code_hash, write_code
@@ -41,6 +42,6 @@ def generate_model(system: FirstOrderSystem, out: Path, options: Integration = I
     code = write_code(mf, target, digest)
     report = GenerateReport(system.name, code.source, digest, code.source.stat().st_size)
     if compile:
-        lib = compile_library(code.source, system.name)
+        lib = compile_library(code.source, system.name, describes=library_describes(system, digest))  # (the one runs load)
         report.library, report.compile_seconds = lib.path, lib.seconds if lib.compiled else 0.0
     return report
