@@ -7,6 +7,9 @@ running their code. So the cache follows the rules ssh follows for its keys (Str
 * the cache's own levels (its root and everything below) must be this user's and writable by nobody else;
 * the levels above it must be this user's or root's and writable by nobody else, unless sticky (``/tmp``:
   nobody can rename or remove an entry they do not own);
+* "nobody else" counts a group as this user alone when it is the user's private group (named after the user,
+  their primary group, no other member: Debian's and Fedora's default, where umask 002 makes folders 0775), as
+  Debian's ssh does;
 * a symlink on the way is followed only if it is this user's or root's (the path is resolved once, and the
   resolved path used from then on, so a link switched later changes nothing);
 * a file is opened with ``O_NOFOLLOW`` (a symlink is never a cache file) and checked on the open
@@ -54,7 +57,7 @@ def private_folder(path: str | Path, cache: str | Path | None = None) -> Path:
     for level, st in chain:
         if not stat.S_ISDIR(st.st_mode):
             raise GearsymError(f"{level} is not a folder")
-        writable = st.st_mode & (stat.S_IWGRP | stat.S_IWOTH)
+        writable = _writable_by_others(st)
         if level == root or root in level.parents:
             if st.st_uid != uid:
                 raise NotPrivate(f"{level} belongs to {_user(st.st_uid)}, not to you")
@@ -86,7 +89,7 @@ def read_private(path: str | Path) -> bytes:
             raise NotPrivate(f"{path} is not a regular file")
         if st.st_uid != owner():
             raise NotPrivate(f"{path} belongs to {_user(st.st_uid)}, not to you")
-        if st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+        if _writable_by_others(st):
             raise NotPrivate(f"{path} is writable by others (mode {stat.S_IMODE(st.st_mode):04o})")
         return f.read()
 
@@ -173,6 +176,24 @@ def _resolve(path: Path) -> tuple[Path, list[tuple[Path, os.stat_result]]]:
         current = step
         chain.append((current, st))
     return current, chain
+
+
+def _writable_by_others(st: os.stat_result) -> bool:
+    """Whether someone other than this user can write the file or folder of ``st`` (by its mode bits)."""
+    return bool(st.st_mode & stat.S_IWOTH or (st.st_mode & stat.S_IWGRP and not _private_group(st.st_gid)))
+
+
+def _private_group(gid: int) -> bool:
+    """Whether the group ``gid`` is this user's private group: named after them, their primary group, no other
+    member."""
+    try:
+        import grp
+        import pwd
+
+        user, group = pwd.getpwuid(owner()), grp.getgrgid(gid)
+    except (ImportError, KeyError):
+        return False
+    return gid == user.pw_gid and group.gr_name == user.pw_name and set(group.gr_mem) <= {user.pw_name}
 
 
 def _user(uid: int) -> str:

@@ -335,3 +335,21 @@ def test_the_library_gearsym_compile_makes_is_the_one_a_run_loads(tmp_path):
     run = gearsym(cache, "lyap", "duffing", *ARGS)
     assert run.returncode == 0 and "compiling" not in run.stderr, run.stderr
     assert len(list((cache / "lib").glob("duffing-*.so"))) == 1
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="changing a folder's group needs root")
+def test_a_cache_writable_by_the_users_private_group_is_theirs_by_any_other_group_it_is_not(tmp_path, configured):
+    import grp
+    import pwd
+
+    me = pwd.getpwuid(os.geteuid())
+    private = grp.getgrgid(me.pw_gid)
+    assert private.gr_name == me.pw_name and set(private.gr_mem) <= {me.pw_name}  # (root's group here)
+    cache = configured(tmp_path / "cache")
+    cache.mkdir(mode=0o700)
+    cache.chmod(0o770)  # umask 002, as Debian's and Fedora's users have
+    assert compiler.cache_dir() == cache
+    shared = next(g for g in grp.getgrall() if g.gr_gid != me.pw_gid)
+    os.chown(cache, -1, shared.gr_gid)
+    with pytest.warns(GearsymWarning, match=rf"{cache} is writable by others \(mode 0770\)"):
+        assert compiler.cache_dir() != cache
