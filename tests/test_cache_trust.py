@@ -42,8 +42,9 @@ def gearsym(cache: Path, *argv: str, umask: int | None = None) -> subprocess.Com
     """``gearsym *argv`` with ``cache`` (the libraries compiled -O1: faster to compile, and these tests compile
     often; the runs they are compared with too)."""
     env = {**os.environ, "GEARSYM_CACHE": str(cache), "PYTHONPATH": str(REPO_ROOT), "GEARSYM_CFLAGS": "-O1"}
+    umasked = (lambda: os.umask(umask)) if umask is not None else None
     return subprocess.run([sys.executable, "-m", "gearsym.cli", *argv], capture_output=True, text=True, env=env,
-                          cwd=REPO_ROOT, timeout=300, preexec_fn=(lambda: os.umask(umask)) if umask is not None else None)
+                          cwd=REPO_ROOT, timeout=300, preexec_fn=umasked)
 
 
 @pytest.fixture(scope="module")

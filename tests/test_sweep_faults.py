@@ -129,7 +129,8 @@ def test_a_disk_full_as_the_sweep_completes_is_a_one_line_error_the_record_says_
     monkeypatch.setattr(store_module, "write_atomically", full_at_the_end)
     with pytest.raises(GearsymError) as failed:
         run_sweep(one_stage, AXES, out=out, **SHORT)
-    assert str(failed.value).startswith(f"writing the sweep {out} failed: No space left on device ({out.with_suffix('.json')})")
+    record_file = out.with_suffix(".json")
+    assert str(failed.value).startswith(f"writing the sweep {out} failed: No space left on device ({record_file})")
     record = json.loads(out.with_suffix(".json").read_text())
     assert record["status"] == "failed" and record["error"] == str(failed.value)
     monkeypatch.undo()

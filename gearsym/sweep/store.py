@@ -481,8 +481,8 @@ def _open_lock(lock: Path) -> int | None:
             return None
         except OSError as exc:
             if os.path.islink(lock):
-                raise GearsymError(f"{lock}, the sweep's lock file, is a symlink (to {os.readlink(lock)}); gearsym never "
-                                   "writes through one: remove it, or choose another --out") from None
+                raise GearsymError(f"{lock}, the sweep's lock file, is a symlink (to {os.readlink(lock)}); gearsym "
+                                   "never writes through one: remove it, or choose another --out") from None
             raise GearsymError(f"cannot open the sweep's lock file {lock} ({exc.strerror}); remove it, or choose "
                                "another --out") from None
     if not stat.S_ISREG(os.fstat(fd).st_mode):
