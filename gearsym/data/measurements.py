@@ -421,8 +421,10 @@ def _read_csv(path: Path) -> tuple[int, list[str], list[tuple[int, list[str]]]]:
         text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
         raise DataError("no such file", path) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise DataError(f"cannot read it as UTF-8 text ({exc})", path) from None
+    except UnicodeDecodeError as exc:  # (its position, not its bytes: the file may not be a measurement)
+        raise DataError(f"cannot read it as UTF-8 text (byte {exc.start + 1} is not UTF-8)", path) from None
+    except OSError as exc:
+        raise DataError(f"cannot read it ({exc.strerror})", path) from None
     reader = csv.reader(text.splitlines())
     header_line, header, rows = 0, None, []
     for cells in reader:
@@ -447,12 +449,18 @@ def _layout(path: Path, line: int, header: list[str], system: FirstOrderSystem, 
     channel_names = [*symbols, *declared]
     own_time = system.time.name
     times = [own_time] + ([PHYSICAL_TIME] if own_time != PHYSICAL_TIME else [])
+    known = [*times, RECORD, *channel_names, *parameters]
+    if not set(header) & set(known):  # (perhaps no measurement at all, e.g. a system file: none of it is quoted)
+        raise DataError(
+            f"none of the {len(header)} column(s) of its header is one gearsym knows: is it a measurement file? Its "
+            f"first line names the columns: the time ({' or '.join(times)}), {RECORD}, channels: {CHANNELS_HELP} "
+            f"(states of {system.name}: {', '.join(states)}), or parameters as operating conditions "
+            f"({', '.join(parameters)})", path, line)
     for i, name in enumerate(header):
         if not name:
             raise DataError(f"column {i + 1} has no name", path, line)
         if header.index(name) != i:
             raise DataError("the column appears twice", path, line, name)
-    known = [*times, RECORD, *channel_names, *parameters]
     for name in header:
         if name not in known:
             raise DataError(

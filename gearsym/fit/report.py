@@ -15,6 +15,7 @@ import numpy as np
 import sympy as sp
 
 from ..checks import json_safe
+from ..file_sets import written_together
 from ..figures.save import pyplot, save_figure
 from ..system import FirstOrderSystem
 from .effects import augment, effect_terms
@@ -28,18 +29,25 @@ VERDICTS = {
 }
 
 
+#: the files of a report, replaced together (:func:`~gearsym.file_sets.written_together`)
+REPORT_FILES = ("report.json", "residuals.png", "prediction.png", "derived_model.md", "report.md")
+#: the file that says a report folder is partial (a run killed while it replaced the files)
+PARTIAL_MARKER = "REPORT-INCOMPLETE.txt"
+
+
 def write_report(ex: Explanation, system: FirstOrderSystem, out: str | Path, sources=()) -> dict:
-    """Write DIR/report.md, DIR/report.json, DIR/residuals.png, DIR/prediction.png and DIR/derived_model.md."""
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    data = json_safe(ex.as_dict())
-    (out / "report.json").write_text(json.dumps(data, indent=1, allow_nan=False) + "\n")
-    save_figure(residual_figure(ex, system), out / "residuals.png", dpi=100)
-    _prediction_figure(ex, out / "prediction.png")
-    effects = [ex.library[e] for e in ex.effects]
-    derived = augment(system, effects) if effects else system
-    (out / "derived_model.md").write_text(derived_model_page(system, derived, effects))
-    (out / "report.md").write_text(report_page(ex, system, derived, data, sources))
+    """Write DIR/report.md, DIR/report.json, DIR/residuals.png, DIR/prediction.png and DIR/derived_model.md, all
+    or none: a failure or a kill while they are made leaves the previous report as it was (never a new
+    report.json beside an old report.md)."""
+    with written_together(out, REPORT_FILES, PARTIAL_MARKER, "the report") as stage:
+        data = json_safe(ex.as_dict())
+        (stage / "report.json").write_text(json.dumps(data, indent=1, allow_nan=False) + "\n")
+        save_figure(residual_figure(ex, system), stage / "residuals.png", dpi=100)
+        _prediction_figure(ex, stage / "prediction.png")
+        effects = [ex.library[e] for e in ex.effects]
+        derived = augment(system, effects) if effects else system
+        (stage / "derived_model.md").write_text(derived_model_page(system, derived, effects))
+        (stage / "report.md").write_text(report_page(ex, system, derived, data, sources))
     return data
 
 

@@ -49,7 +49,7 @@ class Unit:
 
 @dataclass(frozen=True)
 class Measured:
-    """A number (or array) with its unit, shown as a pint Quantity is (:func:`~gearsym.physical.text.shown`)."""
+    """A number (or array) with its unit, shown as a pint Quantity is (:func:`~gearsym.units.shown`)."""
 
     magnitude: object
     units: Unit

@@ -126,8 +126,10 @@ def run_sweep(
     plan = _SweepPlan.make(model, axes, options, mode, direction, y0, poincare, values)
     store = SweepStore(out, plan.columns, plan.strobe_columns, [*plan.names, "direction"], plan.record) \
         if out else None
+    opened = False
     try:  # the files stay locked against a second writer until this sweep returns or fails
         done, strobes = store.open(overwrite) if store else ({}, {})
+        opened = store is not None
         unknown = set(done) - {p.key for p in plan.points}
         if unknown:
             raise GearsymError(f"{out}: holds points this sweep does not plan, e.g. {sorted(unknown)[0]}; "
@@ -145,9 +147,28 @@ def run_sweep(
         if store:
             _finish_files(store, result, rows, poincare, len(done) - already, time.perf_counter() - t_start, ran)
         return result
+    except KeyboardInterrupt:
+        raise
+    except BaseException as exc:  # a point that failed, the disk full, ...: the record says so, not "running"
+        error = _one_line(exc, store)
+        if opened:
+            store.write_failure(error, len(plan.points))
+        if error is exc:
+            raise
+        raise error from None
     finally:
         if store:
             store.release()
+
+
+def _one_line(exc: BaseException, store: SweepStore | None) -> BaseException:
+    """A failure to write the sweep's files (the disk full: an OSError) as a one-line error; others as they are."""
+    if store is None or not isinstance(exc, OSError):
+        return exc
+    where = f" ({exc.filename})" if exc.filename else ""
+    return GearsymError(f"writing the sweep {store.path} failed: {exc.strerror or exc}{where}; the points finished "
+                        "before are kept whole: make room (or choose another --out) and run the same command again "
+                        "to resume")
 
 
 @dataclass(frozen=True)
@@ -248,9 +269,10 @@ def _store_as_finished(finished, store: SweepStore | None, plan: _SweepPlan, don
         bar.close()
         if store:
             store.close()
-            store.write_record(status="interrupted", points={"planned": len(plan.points), "done": len(done)},
+            store.write_record(status="interrupted", points={"planned": len(plan.points), "done": store.stored},
                                **({"dask": ran} if ran else {}))
-        raise SweepInterrupted(len(done), len(plan.points), store.path if store else None) from None
+        raise SweepInterrupted(store.stored if store else len(done), len(plan.points),
+                               store.path if store else None) from None
     except BaseException:
         finished.close()
         bar.close()
