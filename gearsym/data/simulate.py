@@ -31,7 +31,7 @@ from ..checks import whole_number
 from ..codegen import CompiledModel, engine_verb
 from ..options import STEPS_PER_PERIOD, Integration
 from ..errors import GearsymError
-from .measurements import RECORD
+from .columns import RECORD
 
 #: the run of each record when no options are given: 40 periods recorded after a transient of 100
 RUN = {"periods": 140, "discard": 100}

@@ -7,7 +7,9 @@ add it to the symbolic model, and report the held-out error before and after.
 from .effects import EFFECTS, FAMILIES, Effect, augment, effect, effect_terms, term_effect
 from .explain import Explanation, explain
 from .prediction import Prediction, predict_ahead
-from .shooting import Fit, Segment, fit_windows
+from .result import Fit
+from .segment import Segment
+from .shooting import fit_windows
 
 __all__ = ["EFFECTS", "Effect", "Explanation", "FAMILIES", "Fit", "Prediction", "Segment", "augment", "effect",
            "effect_terms", "explain", "explain_files", "fit_windows", "predict_ahead", "term_effect"]

@@ -34,14 +34,17 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..data.measurements import Measurements
+from ..data.dataset import Measurements
 from ..errors import GearsymError
 from ..options import Integration
 from ..system import FirstOrderSystem
 from .canonical import amplitude_phase, canonical
 from .effects import EFFECTS, FAMILIES, Effect, applies_to, augment, bounds_of, effect, site, term_effect
 from .prediction import Prediction, predict_ahead
-from .shooting import Fit, Segment, fit_windows, score_columns
+from .result import Fit
+from .score import score_columns
+from .segment import Segment
+from .shooting import fit_windows
 
 MIN_GAIN = 0.2
 MAX_CORRELATION = 0.5
