@@ -10,7 +10,7 @@ from pathlib import Path
 from ..errors import GearsymError
 from ..outputs import check_figure, check_file
 from .integration import add_integration_arguments, compiled_from, scaling_from
-from .settings import add_set_argument, parse_settings
+from .settings import add_set_argument, parse_settings, refuse_swept_and_set
 
 NAME = "campbell"
 HELP = "Campbell diagram (natural frequencies, mesh and torque orders, crossings) beside the amplitude over speed"
@@ -52,6 +52,7 @@ def run(args: argparse.Namespace) -> int:
     if axis.name != scaling.speed.parameter:
         raise GearsymError(f"--param {args.param!r}: the Campbell diagram runs along the speed "
                            f"({scaling.speed.parameter}=...), not {axis.name}")
+    refuse_swept_and_set([(axis.name, args.param)], parse_settings(args.set))
     unit = axis.unit or str(scaling._speed_quantity().units)
     modes = natural_modes(scaling.model, **parse_settings(args.set))
     diagram = campbell(scaling, axis.values, unit, modes, args.orders)

@@ -46,9 +46,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ..fit import explain_files
+    from ..fit.explain import check_fit_names, check_harmonics
     from ..outputs import check_folder
 
-    fit = [p.strip() for p in args.fit.split(",") if p.strip()]
+    fit = check_fit_names([p.strip() for p in args.fit.split(",") if p.strip()])  # before the model is reduced
+    if args.harmonics is not None:
+        check_harmonics(args.harmonics)
     candidates = [e.strip() for e in args.effects.split(",")] if args.effects else None
     bias = [c.strip() for c in args.bias.split(",") if c.strip()]
     channels = dict(_channel(text) for text in args.channel)

@@ -12,7 +12,7 @@ from ..errors import GearsymError
 from ..files import write_atomically
 from ..outputs import check_figure, check_file
 from .integration import add_integration_arguments, compiled_from, integration_from, system_from
-from .settings import add_set_argument, parse_state
+from .settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
 
 NAME = "orbits"
 HELP = "periodic orbits, their Floquet multipliers and stability, and their branches over a parameter with folds, " \
@@ -121,7 +121,9 @@ def run(args: argparse.Namespace) -> int:
     check_segments(args.segments, pieces_per_period(options.steps_per_period), f"--segments {args.segments}: ",
                    options.steps_per_period)
     if parameter:
+        given = parameter[0]
         parameter = engine_range(args, parameter)
+        refuse_swept_and_set([(given, args.param), (parameter[0], args.param)], parse_settings(args.set))
     system = system_from(args)
     if parameter and parameter[0] not in system.parameters:
         from ..errors import UnknownParameterError

@@ -9,10 +9,11 @@ from pathlib import Path
 from ..checks import chosen_coordinate
 from ..outputs import check_figure, check_file
 from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, Workers, run_sweep
+from ..sweep.grid import axes_from
 from ..sweep.report import findings_lines
 from ..sweep.store import sidecar
 from .integration import add_integration_arguments, compiled_from, scaling_from
-from .settings import add_set_argument, parse_state
+from .settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
 
 NAME = "sweep"
 HELP = "Lyapunov spectra, amplitudes and regimes over a 1-D or 2-D parameter grid (resumable)"
@@ -66,6 +67,8 @@ def run(args: argparse.Namespace) -> int:
     y0 = parse_state(args.y0)  # before the model is compiled
     scaling = scaling_from(args)
     axes = _engine_axes(args.param, scaling)
+    given = axes_from(args.param)
+    refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], parse_settings(args.set))
     compiled = compiled_from(args)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     try:
@@ -97,8 +100,6 @@ def run(args: argparse.Namespace) -> int:
 def _engine_axes(params: list[str], scaling):
     """The --param axes the engine sweeps: physical ones (speed=500rpm:6000rpm:25rpm) turned into the
     nondimensional parameter they move, for a model with physical values."""
-    from ..sweep.grid import axes_from
-
     axes = axes_from(params)
     if scaling is None:
         unit = next((a for a in axes if a.unit), None)

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import sympy as sp
 
+from ..caller import option
 from ..errors import suggest
 from ..system import FirstOrderSystem
 from .channels import CHANNELS_HELP, channel_symbols, in_file_units
@@ -58,7 +59,7 @@ def layout_of(path: Path, line: int, header: list[str], system: FirstOrderSystem
     if given[0] == PHYSICAL_TIME and own_time != PHYSICAL_TIME:
         if time_scale is None:
             raise DataError(
-                f"the time is t (physical time) but no time scale was given: pass time_scale=... "
+                f"the time is t (physical time) but no time scale was given: pass {option('time_scale')} "
                 f"({own_time} = time_scale * t; `gearsym derive {system.name}` shows the time unit), or give "
                 f"the model's time as a {own_time} column", path, line, PHYSICAL_TIME)
         scale = float(time_scale)

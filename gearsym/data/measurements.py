@@ -47,7 +47,7 @@ from ..system import FirstOrderSystem
 # the names this module defined before the reading was split into one file per step (kept importable from here)
 from .channels import CHANNELS_HELP, DERIVATIVES, channel_expression, channel_symbols, declared_channels
 from .columns import PHYSICAL_TIME, RECORD
-from .csvtext import read_csv
+from .csvtext import csv_rows
 from .dataset import Measurements
 from .errors import DataError, PathLike
 from .grouping import group_rows
@@ -105,10 +105,10 @@ def load_measurements(
 
 def _read_file(path: Path, system: FirstOrderSystem, defaults: dict, time_scale, rules: Rules,
                declared: Mapping[str, sp.Expr]) -> list[Record]:
-    header_line, header, rows = read_csv(path)
-    layout = layout_of(path, header_line, header, system, time_scale, declared)
-    return [checked_record(path, group, layout, system, defaults, rules)
-            for group in group_rows(path, header, rows, layout)]
+    with csv_rows(path) as (header_line, header, rows):
+        layout = layout_of(path, header_line, header, system, time_scale, declared)
+        groups = group_rows(path, header, rows, layout)
+    return [checked_record(path, group, layout, system, defaults, rules) for group in groups]
 
 
 def _positive(value, what: str) -> float:

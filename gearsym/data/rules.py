@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..caller import option
 from ..errors import GearsymError
 from ..system import FirstOrderSystem
 from .columns import PHYSICAL_TIME, RECORD
@@ -87,7 +88,7 @@ def _check_time(path: Path, time: np.ndarray, lines: np.ndarray, column: str, wh
 
 def _check_length(record: Record, layout: Layout, rules: Rules) -> None:
     where = f"record {record.record} (lines {record.lines[0]}-{record.lines[1]})"
-    scaled = f" with time_scale={layout.scale:g}" if layout.time == PHYSICAL_TIME and layout.scale != 1 else ""
+    scaled = f" with {option('time_scale', layout.scale)}" if layout.time == PHYSICAL_TIME and layout.scale != 1 else ""
     if record.samples_per_period < rules.min_samples_per_period * (1 - 1e-9):
         raise DataError(
             f"{where} has {record.samples_per_period:.3g} samples per forcing period (period {record.period:.6g} "

@@ -63,6 +63,9 @@ def fit_windows(system: FirstOrderSystem, segments: Sequence[Segment], fit: Sequ
     if not segments:
         raise GearsymError("nothing to fit: no whole forcing period in the data")
     names = tuple(system.parameters)
+    twice = [p for i, p in enumerate(fit) if p in fit[:i]]
+    if twice:
+        raise GearsymError(f"{twice[0]} is named twice among the parameters to fit; name each once")
     unknown = [p for p in fit if p not in names]
     if unknown:
         raise GearsymError(f"cannot fit {', '.join(unknown)}: not parameters of {system.name} ({', '.join(names)})")

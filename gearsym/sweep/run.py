@@ -33,13 +33,15 @@ import numpy as np
 
 from ..version import __version__
 from ..analysis.lyapunov import summarise_runs
-from ..checks import whole_number
+from ..checks import run_bytes_per_period, whole_number
 from ..codegen import CompiledModel, TangentRuns, engine_verb
-from ..errors import GearsymError, UnknownParameterError
+from .. import caller
+from ..errors import GearsymError, UnknownParameterError, warn
+from ..memory import check_fits
 from ..options import Integration
 from .grid import INDEPENDENT, Axis, Point, axes_from, plan, points
 from .result import SweepResult
-from .store import PoincareRows, SweepStore, number, row_key
+from .store import PoincareRows, SweepStore, number, overwrite_option, row_key, start_again
 
 #: stroboscopic samples kept per point for bifurcation diagrams
 POINCARE_SAMPLES = 50
@@ -59,6 +61,14 @@ class SweepInterrupted(KeyboardInterrupt):
         super().__init__(f"interrupted: kept {done} of {planned} points{where}")
 
 
+def cores() -> int:
+    """The cores this process may run on (its affinity where the OS says it, else every core)."""
+    try:
+        return len(os.sched_getaffinity(0)) or 1
+    except AttributeError:
+        return os.cpu_count() or 1
+
+
 @dataclass(frozen=True)
 class Workers:
     """Where a sweep's points run: ``jobs`` workers (0: one per core) on this machine, as ``"processes"``
@@ -75,17 +85,22 @@ class Workers:
     scheduler: object = None
 
     def __post_init__(self):
-        whole_number(self.jobs, "jobs")
+        jobs = whole_number(self.jobs, "jobs")
         if self.parallel not in PARALLEL:
             raise GearsymError(f"parallel={self.parallel!r}: choose one of {', '.join(PARALLEL)}")
         if self.scheduler is not None:
             from .distributed import check_scheduler
 
             check_scheduler(self.scheduler, self.jobs)  # no Dask, a bad address: said before any work
+        here = cores()
+        if jobs > here and self.scheduler in (None, "local"):  # (a cluster elsewhere has cores of its own)
+            warn(f"{caller.option('jobs', jobs)}: this machine has {here} core{'s' if here > 1 else ''}; running "
+                 f"{here} worker{'s' if here > 1 else ''} (more would only share them)")
+            object.__setattr__(self, "jobs", here)
 
     @property
     def count(self) -> int:
-        return self.jobs or os.cpu_count() or 1
+        return self.jobs or cores()
 
     @property
     def mode(self) -> str:
@@ -125,6 +140,11 @@ def run_sweep(
     """
     options = model.run_options(options)
     plan = _SweepPlan.make(model, axes, options, mode, direction, y0, poincare, values)
+    at_once = 1 if workers.scheduler is not None else min(workers.count, len(plan.points))
+    if at_once > 1:  # each worker holds the records of a point
+        check_fits(options.periods, at_once * run_bytes_per_period(model.dimension, len(model.observed)),
+                   asked=caller.option("periods", options.periods), item="period",
+                   what=f"{at_once} workers' states, stretches and extremes of each period")
     store = SweepStore(out, plan.columns, plan.strobe_columns, [*plan.names, "direction"], plan.record) \
         if out else None
     try:  # the files stay locked against a second writer until this sweep returns or fails
@@ -132,7 +152,7 @@ def run_sweep(
         unknown = set(done) - {p.key for p in plan.points}
         if unknown:
             raise GearsymError(f"{out}: holds points this sweep does not plan, e.g. {sorted(unknown)[0]}; "
-                               "pass --overwrite or choose another --out")
+                               + start_again())
         run = _Run(model, plan.base, plan.names, plan.start, options, plan.poincare, plan.columns,
                    plan.strobe_columns)
         todo = [t for t in (run.remaining(task, done) for task in plan.tasks) if t[0]]
@@ -294,7 +314,7 @@ class _Run:
         count = sum(finished)
         if not all(finished[:count]) or any(finished[count:]):
             raise GearsymError("the sweep file holds points of a continuation line out of order (not its first "
-                               "points), so it cannot be resumed: pass --overwrite to start again")
+                               f"points), so it cannot be resumed: pass {overwrite_option()} to start again")
         if count and task[0].direction != INDEPENDENT:
             state = self.final_state(done[task[count - 1].key], self.compiled.state_names)
         else:
