@@ -16,11 +16,11 @@ __all__ = ["EFFECTS", "Effect", "Explanation", "FAMILIES", "Fit", "Prediction", 
 
 
 def explain_files(paths, system, fit, *, out=None, time_scale=None, held_out: float = 0.25, candidates=None,
-                  progress=None, options=None, channels=None, bias=(), terms=(), harmonics=None, **values):
+                  progress=None, options=None, channels=None, bias=None, terms=(), harmonics=None, **values):
     """The whole loop from files: load ``paths`` for ``system`` (``values`` fix parameter values; ``channels``
-    declares combinations measured as one column), explain (``bias``: channels with an unknown offset;
-    ``terms``: hand-written terms tried as effects), and with ``out`` write the report there. Returns the
-    report's dict (the keys of report.json)."""
+    declares combinations measured as one column), explain (``bias``: channels with an unknown offset, by default
+    the acceleration channels; ``terms``: hand-written terms tried as effects), and with ``out`` write the report
+    there. Returns the report's dict (the keys of report.json)."""
     from ..data import load_measurements
     from ..outputs import check_folder
     from .report import write_report

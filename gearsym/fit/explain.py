@@ -118,6 +118,7 @@ class Explanation:
     library: dict = field(default_factory=dict)  # name -> Effect of every candidate in the search
     system: FirstOrderSystem | None = None  # the declared model
     bias: tuple[str, ...] = ()
+    bias_by_default: tuple[str, ...] = ()  # the acceleration channels whose offsets were fitted without being asked
 
     @property
     def effects(self) -> list[str]:
@@ -166,6 +167,7 @@ class Explanation:
             "harmonics": self.harmonics(),
             "bias": final.bias,
             "bias_stderr": final.bias_stderr,
+            "bias_by_default": list(self.bias_by_default),
             "parameters_before": self.base.fit.estimates,
             "stderr_before": self.base.fit.stderr,
             "residual_correlation": self.correlation,
@@ -218,15 +220,23 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
             candidates: Sequence[str | Effect] | None = None, held_out: float = 0.25,
             min_gain: float = MIN_GAIN, max_effects: int = MAX_EFFECTS,
             max_correlation: float = MAX_CORRELATION, progress=None,
-            options: Integration = Integration(), bias: Sequence[str] = (), terms: Sequence[str] = (),
+            options: Integration = Integration(), bias: Sequence[str] | None = None, terms: Sequence[str] = (),
             harmonics: int | None = None, propose: bool = True, refits: int = REFITS) -> Explanation:
     """Fit ``fit`` on ``measurements``, then add effects from ``candidates`` (default: the whole library) and the
     hand-written ``terms`` while they lower the held-out error; see the module docstring. ``bias``: channels
-    with an unknown constant offset, fitted with the parameters. ``harmonics``: the highest order of the harmonic families (default ``HARMONICS``, or fewer if the data
+    with an unknown constant offset, fitted with the parameters (default: the acceleration channels, whose steady
+    mean is zero for bounded motion, so that a constant offset in one is the sensor's bias; ``()``: none).
+    ``harmonics``: the highest order of the harmonic families (default ``HARMONICS``, or fewer if the data
     resolve fewer)."""
     fit = check_fit_names(fit, system)
     harmonics = check_harmonics(harmonics, measurements)
     _check_one_value_each(measurements, fit)
+    by_default = acceleration_channels(measurements, system) if bias is None else ()
+    bias = list(by_default if bias is None else bias)
+    if by_default:
+        (progress or (lambda message: None))(
+            f"fitting the offset of {', '.join(by_default)} (an acceleration's steady mean is zero for bounded "
+            f"motion, so a constant offset is the sensor's bias; {_no_bias()} fits none)")
     for name in bias:
         if name not in measurements.observed:
             raise GearsymError(f"bias of {name}: no such channel in the data ({', '.join(measurements.observed)})")
@@ -279,7 +289,7 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
     unexplained = bool(correlation > max_correlation)
     ex = Explanation(base, current, tried, unexplained, correlation, tuple(fit), held_out, {"screened": screened},
                      spectrum=spectrum, final_spectrum=current_spectrum, library=library, system=system,
-                     bias=tuple(bias))
+                     bias=tuple(bias), bias_by_default=tuple(by_default))
     if unexplained and propose:
         from .proposals import propose_terms
 
@@ -398,6 +408,28 @@ def residual_spectrum(prediction: Prediction, orders: int = SPECTRUM_ORDERS, str
     if structured and len(standout) < STANDOUT_ORDERS:
         standout += [o for o in ranked if o not in standout][:STANDOUT_ORDERS - len(standout)]
     return Spectrum(tuple(range(1, orders + 1)), tuple(map(float, amplitude)), noise, tuple(standout[:STANDOUT_ORDERS]))
+
+
+def acceleration_channels(measurements: Measurements, system: FirstOrderSystem) -> tuple[str, ...]:
+    """The channels that measure accelerations alone (``x_ddot``, or a combination such as r1*x1_ddot + x2_ddot,
+    in every record): bounded motion has a zero steady mean acceleration, so a constant offset in one is sensor
+    bias, fitted by default."""
+    return tuple(name for name in measurements.observed
+                 if all(_accelerations_only(r.channels[name], system) for r in measurements if name in r.observed))
+
+
+def _accelerations_only(channel, system: FirstOrderSystem) -> bool:
+    """``channel`` is linear and homogeneous in second derivatives, with parameters (no state, rate, time) beside."""
+    second = {s for s in channel.free_symbols if s.name.endswith("_ddot")}
+    others = {s.name for s in channel.free_symbols - second}
+    if not second or not others <= set(system.parameters):
+        return False
+    return channel.xreplace({s: 0 for s in second}) == 0 and \
+        all(not (channel.diff(s).free_symbols & second) for s in second)
+
+
+def _no_bias() -> str:
+    return "--bias none" if on_command_line() else "bias=()"
 
 
 def check_fit_names(fit: Sequence[str], system: FirstOrderSystem | None = None) -> list[str]:
