@@ -12,7 +12,7 @@ from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, Workers, run_
 from ..sweep.grid import axes_from
 from ..sweep.report import findings_lines
 from ..sweep.store import sidecar
-from .integration import add_integration_arguments, compiled_from, scaling_from
+from .integration import add_integration_arguments, compiled_from, integration_from, scaling_from
 from .settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
 
 NAME = "sweep"
@@ -65,11 +65,12 @@ def run(args: argparse.Namespace) -> int:
         check_figure(args.plot)
     workers = Workers(args.jobs, args.parallel, "local" if args.dask else args.scheduler)
     y0 = parse_state(args.y0)  # before the model is compiled
-    scaling = scaling_from(args)
-    axes = _engine_axes(args.param, scaling)
+    options = integration_from(args)  # (sizes too) before the model is loaded
     given = axes_from(args.param)
+    scaling = scaling_from(args)
+    axes = _engine_axes(given, scaling)
     refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], parse_settings(args.set))
-    compiled = compiled_from(args)
+    compiled = compiled_from(args, options)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     try:
         result = run_sweep(compiled, axes, mode=args.mode, direction=args.direction, y0=y0,
@@ -97,10 +98,9 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _engine_axes(params: list[str], scaling):
+def _engine_axes(axes, scaling):
     """The --param axes the engine sweeps: physical ones (speed=500rpm:6000rpm:25rpm) turned into the
     nondimensional parameter they move, for a model with physical values."""
-    axes = axes_from(params)
     if scaling is None:
         unit = next((a for a in axes if a.unit), None)
         if unit:
