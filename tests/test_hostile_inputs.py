@@ -117,7 +117,8 @@ def test_a_binary_file_is_refused_by_the_position_of_its_first_bad_byte_not_its_
     (tmp_path / "data.csv").write_bytes(b"tau,x\n0,1\n\xfe\xed\n")
     err = one_line_error(*run(capsys, "explain", str(tmp_path / "data.csv"), "--model", "one_stage", "--fit", "zeta",
                               "--out", str(tmp_path / "report"))[::2])
-    assert "cannot read it as UTF-8 text (byte 11 is not UTF-8)" in err and "0xfe" not in err
+    assert "cannot read it as UTF-8 text (byte 11, on line 3, is not UTF-8)" in err
+    assert "0xfe" not in err and "\\xfe" not in err and "fe" not in err.split("data.csv")[-1]
 
 
 def test_a_measurement_file_still_names_its_unknown_column(tmp_path, capsys):

@@ -191,7 +191,7 @@ def test_an_unknown_way_to_run_in_parallel_is_refused(one_stage):
 def test_resuming_with_other_options_says_what_differs(tmp_path, one_stage):
     out = tmp_path / "s.csv"
     run_sweep(one_stage, ["omega=1,1.1"], out=out, **SHORT)
-    with pytest.raises(GearsymError, match="different sweep.*periods: 60 before, 80 now.*--overwrite"):
+    with pytest.raises(GearsymError, match="different sweep.*periods: 60 before, 80 now.*overwrite=True"):
         run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80), progress=False)
     run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80), progress=False, overwrite=True)
     assert read_sweep(out).record["periods"] == 80

@@ -31,10 +31,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..caller import option
 from ..checks import json_safe, whole_number
 from ..codegen import CompiledModel, engine_verb
 from ..options import Integration
 from ..errors import GearsymError, suggest
+from ..memory import check_fits
 from .lyapunov import LyapunovSpectrum, lyapunov_spectrum
 from .regime import classify_regime
 
@@ -249,7 +251,7 @@ def find_attractors(
         starts = _explicit_states(compiled, initial_states)
         used_seed, used_box = None, None
     else:
-        ics = whole_number(ics, "ics (the number of initial states)", 1)
+        ics = check_ics(ics, compiled.dimension, options.periods)
         seed = whole_number(seed, "seed")
         used_box = _full_box(compiled.state_names, box)
         low, high = (np.array([used_box[s][i] for s in compiled.state_names]) for i in (0, 1))
@@ -266,6 +268,15 @@ def find_attractors(
 
 
 # ------------------------------------------------------------------------------------------ inputs
+def check_ics(ics, dimension: int, periods: int) -> int:
+    """``ics`` as a count of initial states whose runs fit in memory together: each keeps its stroboscopic states
+    and its exponents' running estimates over its ``periods`` until the runs are grouped."""
+    ics = whole_number(ics, "ics (the number of initial states)", 1)
+    check_fits(ics, 8 * dimension * (2 * periods + 1), asked=option("ics", ics), item="initial state",
+               what="each run's Poincare points and exponents kept for the grouping")
+    return ics
+
+
 def _full_box(states: Sequence[str], box: Mapping[str, tuple[float, float]] | None) -> dict[str, tuple[float, float]]:
     """Every state's (low, high): the caller's, or DEFAULT_BOX; names and bounds checked."""
     full = {s: DEFAULT_BOX for s in states}

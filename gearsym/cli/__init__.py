@@ -23,6 +23,7 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from types import ModuleType
 
+from ..caller import command_line
 from ..version import __version__
 from ..errors import GearsymError, GearsymWarning
 
@@ -69,7 +70,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run ``gearsym`` with ``argv`` (default: the process arguments); returns the exit status."""
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser(argv[0] if argv else None).parse_args(argv)
-    with warnings.catch_warnings(), _sigterm_as_ctrl_c() as terminated:
+    with warnings.catch_warnings(), _sigterm_as_ctrl_c() as terminated, command_line():
         warnings.simplefilter("default", GearsymWarning)
         warnings.showwarning = _one_line
         try:

@@ -36,7 +36,7 @@ def integration_from(args: argparse.Namespace, steps_per_period: int | None = No
     """The command's options, checked before any work: ``steps_per_period`` if the command chose them (else
     --steps-per-period); a run too coarse, or (for ``exponents``) too short to mean anything, is refused, and
     one in the grey zone warned about."""
-    steps = steps_per_period or args.steps_per_period or STEPS_PER_PERIOD
+    steps = next((s for s in (steps_per_period, args.steps_per_period) if s is not None), STEPS_PER_PERIOD)
     run = {"periods": args.periods, "discard": args.discard} if hasattr(args, "periods") else {}
     if exponents and run:
         check_run(steps_per_period=steps, measured=args.periods - args.discard, discard=args.discard)

@@ -24,7 +24,7 @@ from ..sweep.grid import _numbers_and_unit, Axis
 from ..sweep.store import sidecar
 from ..units import shown
 from .integration import add_integration_arguments, compiled_from, integration_from, scaling_from, system_from
-from .settings import add_set_argument, parse_state
+from .settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
 
 NAME = "orbits"
 HELP = "periodic orbits, their Floquet multipliers and stability, and their branches over a parameter with folds, " \
@@ -125,7 +125,9 @@ def run(args: argparse.Namespace) -> int:
     scaling = scaling_from(args)
     physical = scaling  # (None without physical values; else the answers are also in its units)
     if parameter:
+        given = parameter[0]
         parameter = engine_range(args, parameter, scaling)
+        refuse_swept_and_set([(given, args.param), (parameter[0], args.param)], parse_settings(args.set))
     system = system_from(args)
     if parameter and parameter[0] not in system.parameters:
         raise UnknownParameterError(parameter[0], system.parameters, f"--param {args.param}")

@@ -12,12 +12,12 @@ from ..figures.sweep import plot_sweep
 from ..outputs import check_figure, check_file
 from ..physical.files import write_physical_record, write_physical_table
 from ..physical.sweeps import nondimensional_axes
-from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, run_sweep, Workers
+from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, Workers, run_sweep
 from ..sweep.grid import axes_from
 from ..sweep.report import findings_lines
 from ..sweep.store import sidecar
-from .integration import add_integration_arguments, compiled_from, scaling_from
-from .settings import add_set_argument, parse_state
+from .integration import add_integration_arguments, compiled_from, integration_from, scaling_from
+from .settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
 
 NAME = "sweep"
 HELP = "Lyapunov spectra, amplitudes and regimes over a 1-D or 2-D parameter grid (resumable)"
@@ -69,10 +69,12 @@ def run(args: argparse.Namespace) -> int:
         check_figure(args.plot)
     workers = Workers(args.jobs, args.parallel, "local" if args.dask else args.scheduler)
     y0 = parse_state(args.y0)  # before the model is compiled
-    scaling = scaling_from(args)
+    options = integration_from(args)  # (sizes too) before the model is loaded
     given = axes_from(args.param)
+    scaling = scaling_from(args)
     axes = _engine_axes(given, scaling)
-    compiled = compiled_from(args)
+    refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], parse_settings(args.set))
+    compiled = compiled_from(args, options)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     try:
         result = run_sweep(compiled, axes, mode=args.mode, direction=args.direction, y0=y0,

@@ -17,7 +17,9 @@ import numpy as np
 
 from ..options import Integration
 from ..system import FirstOrderSystem
-from .shooting import Problem, Segment, fit_windows
+from .problem import Problem
+from .segment import Segment
+from .shooting import fit_windows
 
 
 @dataclass(frozen=True)

@@ -88,6 +88,8 @@ def report_page(ex: Explanation, system: FirstOrderSystem, derived: FirstOrderSy
     channels = ", ".join(dict.fromkeys(k for r in after.fit.residuals for k in r))
     lines += [f"Fitted: {', '.join(ex.fitted)} (and every window's start state"
               + (f", and the offsets of {', '.join(ex.bias)}" if ex.bias else "")
+              + (", fitted by default: an acceleration's steady mean is zero for bounded motion, so a constant "
+                 "offset is the sensor's bias" if ex.bias_by_default else "")
               + f"), by multiple shooting over one-forcing-period windows of the channels {channels}; the last "
               f"{ex.held_out:.0%} of each record is held out and judged by the one-period-ahead prediction error "
               "(normalised RMS).", ""]

@@ -32,15 +32,17 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.lyapunov import summarise_runs
-from ..checks import whole_number
-from ..codegen import CompiledModel, engine_verb, TangentRuns
-from ..errors import GearsymError, UnknownParameterError
+from .. import caller
+from ..checks import run_bytes_per_period, whole_number
+from ..codegen import CompiledModel, TangentRuns, engine_verb
+from ..errors import GearsymError, UnknownParameterError, warn
+from ..memory import check_fits
 from ..options import Integration
 from ..version import __version__
 from .distributed import check_scheduler, connect, execute_dask
 from .grid import axes_from, Axis, INDEPENDENT, plan, Point, points
 from .result import SweepResult
-from .store import number, PoincareRows, row_key, SweepStore
+from .store import PoincareRows, SweepStore, number, overwrite_option, row_key, start_again
 
 #: stroboscopic samples kept per point for bifurcation diagrams
 POINCARE_SAMPLES = 50
@@ -60,6 +62,14 @@ class SweepInterrupted(KeyboardInterrupt):
         super().__init__(f"interrupted: kept {done} of {planned} points{where}")
 
 
+def cores() -> int:
+    """The cores this process may run on (its affinity where the OS says it, else every core)."""
+    try:
+        return len(os.sched_getaffinity(0)) or 1
+    except AttributeError:
+        return os.cpu_count() or 1
+
+
 @dataclass(frozen=True)
 class Workers:
     """Where a sweep's points run: ``jobs`` workers (0: one per core) on this machine, as ``"processes"``
@@ -76,15 +86,20 @@ class Workers:
     scheduler: object = None
 
     def __post_init__(self):
-        whole_number(self.jobs, "jobs")
+        jobs = whole_number(self.jobs, "jobs")
         if self.parallel not in PARALLEL:
             raise GearsymError(f"parallel={self.parallel!r}: choose one of {', '.join(PARALLEL)}")
         if self.scheduler is not None:
             check_scheduler(self.scheduler, self.jobs)  # no Dask, a bad address: said before any work
+        here = cores()
+        if jobs > here and self.scheduler in (None, "local"):  # (a cluster elsewhere has cores of its own)
+            warn(f"{caller.option('jobs', jobs)}: this machine has {here} core{'s' if here > 1 else ''}; running "
+                 f"{here} worker{'s' if here > 1 else ''} (more would only share them)")
+            object.__setattr__(self, "jobs", here)
 
     @property
     def count(self) -> int:
-        return self.jobs or os.cpu_count() or 1
+        return self.jobs or cores()
 
     @property
     def mode(self) -> str:
@@ -124,6 +139,11 @@ def run_sweep(
     """
     options = model.run_options(options)
     plan = _SweepPlan.make(model, axes, options, mode, direction, y0, poincare, values)
+    at_once = 1 if workers.scheduler is not None else min(workers.count, len(plan.points))
+    if at_once > 1:  # each worker holds the records of a point
+        check_fits(options.periods, at_once * run_bytes_per_period(model.dimension, len(model.observed)),
+                   asked=caller.option("periods", options.periods), item="period",
+                   what=f"{at_once} workers' states, stretches and extremes of each period")
     store = SweepStore(out, plan.columns, plan.strobe_columns, [*plan.names, "direction"], plan.record) \
         if out else None
     opened = False
@@ -133,7 +153,7 @@ def run_sweep(
         unknown = set(done) - {p.key for p in plan.points}
         if unknown:
             raise GearsymError(f"{out}: holds points this sweep does not plan, e.g. {sorted(unknown)[0]}; "
-                               "pass --overwrite or choose another --out")
+                               + start_again())
         run = _Run(model, plan.base, plan.names, plan.start, options, plan.poincare, plan.columns,
                    plan.strobe_columns)
         todo = [t for t in (run.remaining(task, done) for task in plan.tasks) if t[0]]
@@ -315,7 +335,7 @@ class _Run:
         count = sum(finished)
         if not all(finished[:count]) or any(finished[count:]):
             raise GearsymError("the sweep file holds points of a continuation line out of order (not its first "
-                               "points), so it cannot be resumed: pass --overwrite to start again")
+                               f"points), so it cannot be resumed: pass {overwrite_option()} to start again")
         if count and task[0].direction != INDEPENDENT:
             state = self.final_state(done[task[count - 1].key], self.compiled.state_names)
         else:

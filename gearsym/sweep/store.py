@@ -37,11 +37,22 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import caller
 from ..errors import GearsymError, warn
 from ..files import write_atomically
 
 #: spaces kept in the record of a running sweep, so that a failure can be recorded in place on a full disk
 RECORD_ROOM = 2048
+
+
+def overwrite_option() -> str:
+    """The option that starts a sweep's files again, as the caller writes it (--overwrite, overwrite=True)."""
+    return caller.option("overwrite", True)
+
+
+def start_again() -> str:
+    """The advice 'pass --overwrite or choose another --out', as the caller writes it."""
+    return f"pass {overwrite_option()} or choose another {caller.name('out')}"
 
 
 def number(x: float) -> str:
@@ -140,7 +151,7 @@ class SweepStore:
             if samples and lacking:
                 raise GearsymError(f"{self.strobe_path} lacks the Poincare samples of {len(lacking)} finished "
                                    "points (deleted or damaged?), so the sweep cannot be resumed whole: pass "
-                                   "--overwrite to start again")
+                                   f"{overwrite_option()} to start again")
             partial = [k for k, r in strobes.items() if not r.whole(samples or 0)]
             for k in partial:  # (cut off as they were written, by an older gearsym: computed again)
                 del done[k], strobes[k]
@@ -174,25 +185,25 @@ class SweepStore:
         sweep's), or None."""
         if not self.meta_path.exists():
             return (f"{self.path} exists but {self.meta_path.name} (the record of how it was made) "
-                    "does not, so it cannot be resumed: pass --overwrite or choose another --out")
+                    f"does not, so it cannot be resumed: {start_again()}")
         try:
             old = json.loads(self.meta_path.read_text())["sweep"]
         except (json.JSONDecodeError, KeyError, TypeError) as exc:
-            return f"{self.meta_path}: not a gearsym sweep record ({exc}); pass --overwrite or choose another --out"
+            return f"{self.meta_path}: not a gearsym sweep record ({exc}); {start_again()}"
         new = json.loads(json.dumps(self.record))  # compare as JSON sees them
         differ = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
         if not differ:
             return None
         detail = "; ".join(f"{k}: {_short(old.get(k))} before, {_short(new.get(k))} now" for k in differ)
         return (f"{self.path} was written by a different sweep ({detail}). To resume it, repeat "
-                "the command it came from; to start again pass --overwrite, or choose another --out")
+                f"the command it came from; to start again {start_again()}")
 
     def _read(self, path: Path, columns: list[str]) -> dict[tuple, dict]:
         rows = {}
         for row in read_rows(path, columns):
             key = self.key(row)
             if key in rows:
-                raise GearsymError(f"{path}: the point {key} appears twice; pass --overwrite to start again")
+                raise GearsymError(f"{path}: the point {key} appears twice; pass {overwrite_option()} to start again")
             rows[key] = row
         return rows
 
@@ -412,12 +423,12 @@ def read_rows(path: Path, columns: list[str] | None = None) -> list[dict]:
     columns = header if columns is None else columns
     if header != columns:
         raise GearsymError(f"{path}: its columns ({', '.join(header)}) are not this sweep's "
-                           f"({', '.join(columns)}); pass --overwrite or choose another --out")
+                           f"({', '.join(columns)}); {start_again()}")
     rows = []
     for line, fields in enumerate(reader, start=2):
         if len(fields) != len(columns):
             raise GearsymError(f"{path}, row {line}: {len(fields)} fields, expected {len(columns)}; "
-                               "the file was edited or damaged: fix the row or pass --overwrite")
+                               f"the file was edited or damaged: fix the row or pass {overwrite_option()}")
         rows.append(dict(zip(columns, fields)))
     return rows
 
