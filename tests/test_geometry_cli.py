@@ -35,9 +35,9 @@ def test_json_has_the_issues_keys_in_si(capsys):
     iso = data["iso6336"]
     assert iso["unit"] == "N/(mm um)" and iso["c_gamma_beta"] == pytest.approx(0.85 * iso["c_gamma_alpha"])
     assert iso["mean_N_per_m"] == pytest.approx(iso["c_gamma_alpha"] * 6.35 * 1e6)
-    assert data["contact_ratio"] == pytest.approx(1.6380042, rel=1e-7)
+    assert data["contact_ratio"] == pytest.approx(1.6380042, rel=1e-7, abs=0)
     assert data["units"]["mean"] == "N/m"
-    assert data["gears"][0]["base_diameter"] == pytest.approx(0.0889 * math.cos(math.radians(20)))
+    assert data["gears"][0]["base_diameter"] == pytest.approx(0.0889 * math.cos(math.radians(20)), rel=1e-14, abs=0)
 
 
 def test_text_answers_in_the_users_units(capsys):
@@ -109,5 +109,9 @@ def test_the_committed_figure_and_data_regenerate(capsys, tmp_path):
     from matplotlib.image import imread
 
     new, committed = imread(tmp_path / "k.png"), imread(FIGURE.with_suffix(".png"))
-    assert new.shape == committed.shape and np.abs(new - committed).mean() < 2e-3, \
-        "docs/figures/stiffness-nasa-rig.png differs: rerun the command in this test's docstring"
+    # pixels, not bytes (another matplotlib may encode the same picture differently): faint differences of
+    # antialiasing pass, a line or a word that moved does not
+    assert new.shape == committed.shape, "docs/figures/stiffness-nasa-rig.png differs in size"
+    moved = (np.abs(new - committed).max(axis=-1) > 0.25).mean()
+    assert np.abs(new - committed).mean() < 2e-3 and moved < 2e-4, \
+        f"docs/figures/stiffness-nasa-rig.png differs ({moved:.2%} of its pixels): rerun the command in this docstring"

@@ -50,11 +50,11 @@ def test_isotr_6336_30_example_1_mesh_stiffness(example):
     iso = iso6336_stiffness(example)
     assert example.contact_ratio == pytest.approx(1.549342, abs=1e-6)
     implied = (PRINTED["c_gamma_alpha"] / PRINTED["c_prime"] - 0.25) / 0.75
-    assert example.contact_ratio == pytest.approx(implied, rel=2e-4)
-    assert iso.mesh_alpha == pytest.approx(PRINTED["c_gamma_alpha"], rel=1.5e-4)
-    assert iso.mesh_beta == pytest.approx(PRINTED["c_gamma_beta"], rel=1.5e-4)
-    assert iso.mesh_beta == pytest.approx(0.85 * iso.mesh_alpha, rel=1e-15)
-    assert iso.mean_stiffness == pytest.approx(iso.mesh_alpha * 100 * 1e6, rel=1e-15)  # per 100 mm, in N/m
+    assert example.contact_ratio == pytest.approx(implied, rel=2e-4, abs=0)
+    assert iso.mesh_alpha == pytest.approx(PRINTED["c_gamma_alpha"], rel=1.5e-4, abs=0)
+    assert iso.mesh_beta == pytest.approx(PRINTED["c_gamma_beta"], rel=1.5e-4, abs=0)
+    assert iso.mesh_beta == pytest.approx(0.85 * iso.mesh_alpha, rel=1e-15, abs=0)
+    assert iso.mean_stiffness == pytest.approx(iso.mesh_alpha * 100 * 1e6, rel=1e-15, abs=0)  # per 100 mm, in N/m
 
 
 def test_the_iso_factors_follow_the_standards_formulas():

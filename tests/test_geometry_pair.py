@@ -49,14 +49,14 @@ def test_contact_ratios_and_centre_distance_are_the_closed_forms(case):
     pair = GearPair(GearGeometry(z1, m, alpha, b, x1, beta, fillet_coefficient=rho),
                     GearGeometry(z2, m, alpha, b, x2, -beta, fillet_coefficient=rho))
     eps_a, eps_b, a = closed_form(z1, z2, m, alpha, b, x1, x2, beta)
-    assert pair.centre_distance == pytest.approx(a, rel=1e-13)
-    assert pair.contact_ratio == pytest.approx(eps_a, rel=1e-12)
+    assert pair.centre_distance == pytest.approx(a, rel=1e-13, abs=0)
+    assert pair.contact_ratio == pytest.approx(eps_a, rel=1e-12, abs=0)
     assert pair.overlap_ratio == pytest.approx(eps_b, rel=1e-13, abs=1e-15)
-    assert pair.total_contact_ratio == pytest.approx(eps_a + eps_b, rel=1e-12)
+    assert pair.total_contact_ratio == pytest.approx(eps_a + eps_b, rel=1e-12, abs=0)
     # a wider centre distance (backlash) shortens the path of contact
     wide = GearPair(pair.gear1, pair.gear2, a + 0.1 * m)
     assert wide.contact_ratio == pytest.approx(closed_form(z1, z2, m, alpha, b, x1, x2, beta, a=a + 0.1 * m)[0],
-                                               rel=1e-12)
+                                               rel=1e-12, abs=0)
     assert wide.contact_ratio < pair.contact_ratio
 
 
@@ -65,10 +65,11 @@ def test_a_gear_body_is_isos_disk_of_the_mean_diameter_less_its_bore():
     d, d_a, d_f = 80e-3, 80e-3 + 2 * 2e-3 * 1.2, 80e-3 - 2 * 2e-3 * 1.05
     d_m = (d_a + d_f) / 2
     mass = 7850 * math.pi / 4 * (d_m ** 2 - 0.03 ** 2) * 25e-3
-    assert gear.mass == pytest.approx(mass, rel=1e-13)
-    assert gear.polar_inertia == pytest.approx(mass * (d_m ** 2 + 0.03 ** 2) / 8, rel=1e-13)
-    assert (2 * gear.tip_radius, 2 * gear.root_radius, 2 * gear.reference_radius) == pytest.approx((d_a, d_f, d))
-    assert gear.base_radius == pytest.approx(0.04 * math.cos(20 * DEG), rel=1e-15)
+    assert gear.mass == pytest.approx(mass, rel=1e-13, abs=0)
+    assert gear.polar_inertia == pytest.approx(mass * (d_m ** 2 + 0.03 ** 2) / 8, rel=1e-13, abs=0)
+    assert (2 * gear.tip_radius, 2 * gear.root_radius, 2 * gear.reference_radius) == pytest.approx((d_a, d_f, d),
+                                                                                                 rel=1e-14, abs=0)
+    assert gear.base_radius == pytest.approx(0.04 * math.cos(20 * DEG), rel=1e-15, abs=0)
 
 
 def test_the_mesh_frequency_is_the_tooth_count_times_the_speed():
@@ -83,9 +84,10 @@ def test_the_face_takes_pint_quantities_and_refuses_text():
 
     g = gear_geometry(teeth=28, module=Quantity(3.175, "mm"), pressure_angle=Quantity(20, "deg"),
                       face_width=Quantity(0.25, "inch"))
-    assert g.module == pytest.approx(3.175e-3) and g.pressure_angle == pytest.approx(20 * DEG)
-    assert g.face_width == pytest.approx(6.35e-3)
-    assert gear_pair(g, g, Quantity(88.9, "mm")).centre_distance == pytest.approx(0.0889)
+    assert g.module == pytest.approx(3.175e-3, rel=1e-14, abs=0)
+    assert g.pressure_angle == pytest.approx(20 * DEG, rel=1e-14, abs=0)
+    assert g.face_width == pytest.approx(6.35e-3, rel=1e-14, abs=0)
+    assert gear_pair(g, g, Quantity(88.9, "mm")).centre_distance == pytest.approx(0.0889, rel=1e-14, abs=0)
     with pytest.raises(GearsymError, match="text"):
         gear_geometry(teeth=28, module="3 mm", pressure_angle=0.3, face_width=0.01)
     with pytest.raises(GearsymError, match="not in m"):
