@@ -276,3 +276,36 @@ class _no_warning:
 
     def __exit__(self, *exc):
         return self._catch.__exit__(*exc)
+
+
+def test_a_curve_in_chunks_is_the_same_and_a_huge_one_is_refused_first(monkeypatch):
+    from gearsym.errors import GearsymError
+    from gearsym.geometry import meshing
+
+    gear = GearGeometry(28, 3.175e-3, math.radians(20), 6.35e-3, bore_diameter=0.02)
+    pair = GearPair(gear, gear)
+    whole = mesh_stiffness(pair, phase_points=64)
+    monkeypatch.setattr(meshing, "_CHUNK_ELEMENTS", 500)  # a few phases at a time
+    chunked = mesh_stiffness(pair, phase_points=64)
+    assert np.array_equal(whole.stiffness, chunked.stiffness) and whole.mean == chunked.mean
+    helical = GearGeometry(30, 3e-3, math.radians(20), 20e-3, helix_angle=0.2, bore_diameter=0.02)
+    other = GearGeometry(30, 3e-3, math.radians(20), 20e-3, helix_angle=-0.2, bore_diameter=0.02)
+    def no_work(*args, **kwargs):
+        raise AssertionError("the work started before the size was checked")
+
+    monkeypatch.setattr(meshing, "pair_stiffness", no_work)
+    with pytest.raises(GearsymError, match="evaluations allowed"):
+        mesh_stiffness(GearPair(helical, other), phase_points=100_000, slices=100)
+
+
+def test_the_geometry_stage_imports_no_sympy_pint_or_casadi():
+    """It sits below the model stage: SI floats and numpy only (the command line reads units above it)."""
+    import subprocess
+    import sys
+
+    code = ("import sys, gearsym.geometry as g; import math; "
+            "k = g.mesh_stiffness(g.gear_pair(*(2 * [g.gear_geometry(teeth=30, module=2e-3, pressure_angle=0.35, "
+            "face_width=0.01, bore_diameter=0.02)])), phase_points=16); "
+            "print(sorted(m for m in ('sympy', 'pint', 'casadi', 'scipy', 'matplotlib') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"

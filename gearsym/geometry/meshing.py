@@ -40,6 +40,10 @@ HELICAL_SLICES = 20
 MAX_PHASE_POINTS = 1_000_000
 MAX_SLICES = 2000
 MAX_QUADRATURE_POINTS = 200
+#: at most this many phases x slices are computed (about a minute); refused before any work beyond it
+MAX_EVALUATIONS = 4_000_000
+#: numbers per quadrature array when a curve is evaluated (in chunks of phases): ~32 MB each
+_CHUNK_ELEMENTS = 4_000_000
 #: Gauss–Legendre nodes along the path of contact for the mean (k_pair(s) is smooth there: converged to rounding),
 #: and four more per Fourier order and per pair in contact for the oscillating factor
 _PIECE_POINTS = 48
@@ -77,6 +81,13 @@ class StiffnessOptions:
         object.__setattr__(self, "phase_points", points)
         object.__setattr__(self, "quadrature_points", nodes)
         object.__setattr__(self, "terms", check_terms(self.terms))
+
+    def check_size(self, pair: GearPair) -> None:
+        """Refuse, before any work, a curve of more phases x slices than :data:`MAX_EVALUATIONS`."""
+        slices = self.slices_for(pair)
+        if self.phase_points * slices > MAX_EVALUATIONS:
+            raise GearsymError(f"stiffness: {self.phase_points} phase points x {slices} slices is more than the "
+                               f"{MAX_EVALUATIONS:.0e} evaluations allowed; lower either")
 
     def slices_for(self, pair: GearPair) -> int:
         if pair.gear1.helix_angle == 0.0:
@@ -126,8 +137,15 @@ class _Curve:
 
     def __call__(self, phase) -> np.ndarray:
         phase = np.asarray(phase, dtype=float)
-        fraction = np.mod(phase[..., None] / (2.0 * math.pi) + self.shifts, 1.0)  # (..., slices)
-        positions = self.start + (fraction[..., None] + np.arange(self.pairs)) * self.pair.base_pitch  # (..., slices, pairs)
+        flat = phase.ravel()
+        # in chunks, so that the involute's quadrature arrays stay near _CHUNK_ELEMENTS numbers each
+        chunk = max(1, _CHUNK_ELEMENTS // (self.slices * self.pairs * self.options.quadrature_points))
+        k = np.concatenate([self._evaluate(flat[i:i + chunk]) for i in range(0, flat.size, chunk)] or [flat])
+        return k.reshape(phase.shape)
+
+    def _evaluate(self, phase: np.ndarray) -> np.ndarray:
+        fraction = np.mod(phase[:, None] / (2.0 * math.pi) + self.shifts, 1.0)  # (phases, slices)
+        positions = self.start + (fraction[..., None] + np.arange(self.pairs)) * self.pair.base_pitch  # (.., pairs)
         inside = positions < self.end
         k = np.zeros(positions.shape)
         k[inside] = pair_stiffness(self.pair, positions[inside], width=self.width,
@@ -239,6 +257,7 @@ def mesh_stiffness(pair: GearPair, options: StiffnessOptions | None = None, *, l
     options = StiffnessOptions() if options is None else options
     if not isinstance(options, StiffnessOptions):
         raise GearsymError(f"mesh stiffness: options must be a StiffnessOptions, got {type(options).__name__}")
+    options.check_size(pair)
     curve = _Curve(pair, options)
     phase = np.linspace(0.0, 2.0 * math.pi, options.phase_points, endpoint=False)
     stiffness = curve(phase)
