@@ -57,7 +57,7 @@ class GearGeometry:
     * ``addendum_coefficient``: h_aP / m_n of the basic rack, the gear's addendum (1.0).
     * ``dedendum_coefficient``: h_fP / m_n, the gear's dedendum and the tool's addendum (1.25).
     * ``fillet_coefficient``: rho_fP / m_n, the radius of the tool tip's rounding, which cuts the root
-      fillet (0.38, ISO 53 profiles A and B; 0.25 for C, 0.39 for D).
+      fillet (0.38: ISO 53 profile A; B has 0.30, C 0.25, D 0.39 with a dedendum of 1.4).
     * ``bore_diameter``: d_i (m); 0 for a solid gear.
     * ``material``: :class:`Material` (steel by default).
     """
