@@ -72,6 +72,15 @@ _LAZY = {
     "export_fmu": "gearsym.fmu.export",
     "derive": "gearsym.derivation",
     "render": "gearsym.derivation",
+    "GearGeometry": "gearsym.geometry",
+    "GearPair": "gearsym.geometry",
+    "Material": "gearsym.geometry",
+    "MeshStiffness": "gearsym.geometry",
+    "StiffnessOptions": "gearsym.geometry",
+    "gear_geometry": "gearsym.geometry",
+    "gear_pair": "gearsym.geometry",
+    "mesh_stiffness": "gearsym.geometry",
+    "iso6336_stiffness": "gearsym.geometry",
 }
 
 __all__ = ["GearsymError", "Integration", "ModelError", "UnknownParameterError", *_LAZY]

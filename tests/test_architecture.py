@@ -21,6 +21,7 @@ BENCH = ROOT.parent / "bench"
 LAYERS = [
     {"errors", "version", "paths", "files", "outputs", "units", "declared", "symbols", "backlash", "checks",
      "options", "parameters", "private_files", "file_sets", "caller", "memory"},
+    {"geometry"},
     {"model"},
     {"system", "registry"},
     {"reduction"},

@@ -32,7 +32,7 @@ from ..errors import GearsymError, GearsymWarning
 MODULES = {"list": "list_models", "derive": "derive", "docs": "docs", "compile": "compile", "lyap": "lyap",
            "sweep": "sweep", "orbits": "orbits", "poincare": "poincare", "reproduce": "reproduce",
            "simulate": "simulate", "explain": "explain", "modes": "modes", "campbell": "campbell",
-           "fmu": "fmu"}
+           "fmu": "fmu", "stiffness": "stiffness"}
 
 #: exit status of a GearsymError (argparse uses the same for bad arguments)
 USAGE_ERROR = 2

@@ -81,7 +81,7 @@ def _lines(handle: IO[str], path: Path) -> Iterator[str]:
     while True:
         try:
             block = handle.read(BLOCK_CHARS)
-        except UnicodeDecodeError as exc:
+        except UnicodeDecodeError:
             raise DataError(f"cannot read it as UTF-8 text ({_first_bad_byte(path, number)}): save it as UTF-8 CSV",
                             path) from None
         total += len(block)
@@ -116,7 +116,7 @@ def _first_bad_byte(path: Path, lines_read: int) -> str:
                 data = carry + block
                 try:
                     data.decode("utf-8")
-                except UnicodeDecodeError as exc:
+                except UnicodeDecodeError:
                     if block and exc.end == len(data):  # (a character cut by the block's end: read on)
                         lines, offset, carry = lines + data[:exc.start].count(b"\n"), offset + exc.start, data[exc.start:]
                         continue
