@@ -135,6 +135,7 @@ def test_a_point_that_fails_keeps_the_points_of_its_batch_before_it(tmp_path):
 
 
 def test_an_error_of_the_writer_thread_is_raised_not_lost(tmp_path, one_stage, monkeypatch):
+    from gearsym.errors import GearsymError
     from gearsym.sweep.store import PoincareRows, lock_path
 
     import threading
@@ -147,8 +148,8 @@ def test_an_error_of_the_writer_thread_is_raised_not_lost(tmp_path, one_stage, m
         return text(self)
 
     monkeypatch.setattr(PoincareRows, "text", full_disk)
-    with pytest.raises(OSError, match="No space left"):
-        run_sweep(one_stage, {"omega": [1.0, 1.2]}, options=RUN, progress=False, out=tmp_path / "s.csv")
+    with pytest.raises(GearsymError, match="No space left on device; the 0 points before are kept whole"):
+        run_sweep(one_stage, {"omega": [1.0, 1.2]}, options=RUN, progress=False, out=tmp_path / "s.csv")  # (one line)
     assert not lock_path(tmp_path / "s.csv").exists()  # the lock is let go all the same
 
 
