@@ -21,6 +21,7 @@ import gearsym
 from gearsym import Integration, lyapunov_spectrum, periodic_orbit, run_sweep
 from gearsym.analysis import batch_means_stderr
 from gearsym.analysis.divergence import GROWING, PAST_BOUND
+from gearsym.analysis.pairs import finite_time_bias
 from gearsym.cli import main
 from gearsym.errors import GearsymError
 from gearsym.model.stiffness import rectangular_mesh_stiffness
@@ -87,6 +88,18 @@ def test_spur_pairs_orbit_has_both_exponents_at_minus_zeta_omega_n():
     per_second = exponents[0] / r.exponents[0]
     measured = run.log_stretch[:, r.discard:] / r.period * per_second
     assert np.max(np.abs(measured.mean(axis=1) - exact)) > 9 * batch_means_stderr(measured).max()
+
+
+@pytest.mark.parametrize("theta", [0.3, 1.1, 2.9])
+def test_the_finite_time_bias_estimate_covers_an_oscillating_one_over_k_bias(theta):
+    """A running mean with bounded, oscillating partial sums (what Gram-Schmidt gives a column of a turning plane,
+    or a pair's mean while its plane settles) is off by c(M)/M: the estimate must cover it, within a few times."""
+    k = np.arange(1, 301)
+    for phase in np.linspace(0, 2 * np.pi, 7):
+        x = -0.05 + 0.8 * np.cos(theta * k + phase)
+        true = abs(x.mean() + 0.05)
+        bound = 0.8 / abs(np.sin(theta / 2)) / k.size  # |sum cos| <= 1/|sin(theta/2)|
+        assert true <= finite_time_bias(x[:, None])[0] <= 4 * bound
 
 
 # ------------------------------------------------------------------ item 5: what the exponents cannot decide

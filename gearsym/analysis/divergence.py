@@ -161,10 +161,27 @@ def _failed(model, p: np.ndarray, strobe: np.ndarray, log_stretch: np.ndarray, w
     return GearsymError(f"{model.name}: the run failed ({why})")
 
 
-def within_bound(state: np.ndarray, start: np.ndarray) -> bool:
-    """``state`` (a run's last) is finite and within BOUND times the larger of 1 and |``start``| (the run's
-    first): a continuation may go on from it."""
-    return bool(np.all(np.isfinite(state)) and np.max(np.abs(state)) <= BOUND * max(1.0, float(np.max(np.abs(start)))))
+def within_bound(state: np.ndarray, start: np.ndarray, names: Sequence[str],
+                 counted: Callable[[Sequence[str]], Sequence[str]] = lambda names: names) -> bool:
+    """``state`` (a run's last, its entries named ``names``) is finite and no coordinate that ``counted`` keeps
+    is beyond BOUND times the larger of 1 and |``start``| (the run's first): a continuation may go on from it
+    (a free disk's twist may be anywhere)."""
+    if not np.all(np.isfinite(state)):
+        return False
+    bound = BOUND * max(1.0, float(np.max(np.abs(start))))
+    beyond = [n for n, v in zip(names, state) if abs(v) > bound]
+    return not beyond or not counted(beyond)
+
+
+def counted_coordinates(model, names: Sequence[str]) -> list[str]:
+    """Of the coordinates ``names`` that grew, those whose growth is a divergence: a drivetrain's meshes (a
+    shaft's twist may grow freely: a disk on a shaft of zero stiffness), every one of a plain ODE. (Asked only
+    when a coordinate grew: a cached model's couplings load the model.)"""
+    couplings = getattr(model.system, "couplings", ())
+    if not couplings:
+        return list(names)
+    meshes = {c.coordinate for c in couplings if c.kind == "mesh"}
+    return [n for n in names if n in meshes]
 
 
 def _growing(size: np.ndarray, scale: float) -> np.ndarray:

@@ -28,7 +28,7 @@ from ..checks import json_safe
 from ..codegen import CompiledModel, TangentRuns, engine_verb
 from ..errors import warn
 from ..options import Integration
-from .divergence import Divergence, find_divergence, run_failure
+from .divergence import Divergence, counted_coordinates, find_divergence, run_failure
 from .pairs import merge_pairs
 from .regime import DIVERGED, EQUILIBRIUM, UNDETERMINED, classify_regimes, periods_to_decide, zero_band
 from .settling import Settling, poincare_settling
@@ -228,7 +228,7 @@ def summarise_runs(model: CompiledModel, runs: TangentRuns, p: np.ndarray, perio
     measured_time = (runs.log_stretch.shape[1] - discard) * period
     band = zero_band(stderr, measured_time[:, None])
     contracting = np.where(finite, exponents[:, 0] < -band[:, 0], False)
-    counted = functools.partial(_counted, model)
+    counted = functools.partial(counted_coordinates, model)
     divergences = [find_divergence(runs.strobe[i], runs.low[i], runs.high[i], model.state_names, model.observed,
                                    discard, bool(contracting[i]), counted) for i in range(count)]
     live = [i for i in range(count) if divergences[i] is None and np.isfinite(exponents[i]).all()]
@@ -250,17 +250,6 @@ def summarise_runs(model: CompiledModel, runs: TangentRuns, p: np.ndarray, perio
 #: the regime of a run whose tangent vectors became non-finite while its state did not (an error for the caller:
 #: :func:`gearsym.analysis.divergence.run_failure`)
 FAILED = "failed"
-
-
-def _counted(model: CompiledModel, names):
-    """Of the coordinates ``names`` that grew, those whose growth is a divergence: a drivetrain's meshes (a
-    shaft's twist may grow freely: a disk on a shaft of zero stiffness), every one of a plain ODE. (Asked only
-    when a coordinate grew: a cached model's couplings load the model.)"""
-    couplings = getattr(model.system, "couplings", ())
-    if not couplings:
-        return list(names)
-    meshes = {c.coordinate for c in couplings if c.kind == "mesh"}
-    return [n for n in names if n in meshes]
 
 
 def _rests(compiled, y: np.ndarray, p: np.ndarray) -> bool:

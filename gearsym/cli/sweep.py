@@ -111,8 +111,8 @@ def verdict_lines(result) -> list[str]:
     undetermined = int(np.sum(result["regime"] == "undetermined"))
     if undetermined:
         lines.append(f"  undetermined at {undetermined} point(s): lambda_1 could not be told from 0 there and the "
-                     "Poincare points still converged or spread (a transient); `gearsym lyap` at one says how many "
-                     "periods would decide, or run again with more --periods and --discard")
+                     "Poincare points did not settle (a transient, or too few periods to say); `gearsym lyap` at one "
+                     "says how many periods would decide, or run again with more --periods and --discard")
     return lines
 
 

@@ -15,6 +15,7 @@ everything.
 from __future__ import annotations
 
 import ctypes
+import functools
 import math
 import multiprocessing
 import multiprocessing.connection
@@ -31,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.divergence import run_failure, within_bound
+from ..analysis.divergence import counted_coordinates, run_failure, within_bound
 from ..analysis.lyapunov import summarise_runs
 from ..analysis.regime import DIVERGED
 from ..checks import whole_number
@@ -319,6 +320,7 @@ class _Run:
         base = compiled.parameter_vector(self.base)
         swept = [compiled.parameter_names.index(name) for name in self.names]
         batch, started = [], time.perf_counter()
+        counted = functools.partial(counted_coordinates, compiled)
         for point in points:
             p = base.copy()
             p[swept] = point.values
@@ -331,7 +333,7 @@ class _Run:
                 raise self.failed(point, exc) from None
             batch.append((point, p, inputs.period, state))
             final = runs.strobe[len(batch) - 1, -1]
-            if point.direction != INDEPENDENT and within_bound(final, state):
+            if point.direction != INDEPENDENT and within_bound(final, state, compiled.state_names, counted):
                 state = final.copy()
             if len(batch) == runs.size or time.perf_counter() - started >= BATCH_SECONDS:
                 yield from self.checked_rows(compiled, runs, batch)
