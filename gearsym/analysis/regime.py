@@ -150,9 +150,13 @@ MEANING = {
 
 
 def describe_regime(regime: str, exponents: Sequence[float], stderr: Sequence[float], measured_time: float,
-                    autonomous: bool = False) -> str:
-    """The regime and what it means, in one line ('zero' is the band of :func:`zero_band`)."""
+                    autonomous: bool = False, settling: Settling | None = None) -> str:
+    """The regime and what it means, in one line ('zero' is the band of :func:`zero_band`); ``settling``: what
+    the Poincare points did, where they decided."""
     meaning = MEANING.get(regime, regime)
+    if settling is not None and regime in ("periodic", "quasi-periodic"):  # the exponents could not decide
+        return (f"{regime}: the largest exponent cannot be told from zero in this run, but {settling.describe()}: "
+                + ("a periodic orbit, reached" if regime == "periodic" else "a torus (or a point on a bifurcation)"))
     flow = flow_exponent(exponents, zero_band(stderr, measured_time)) if autonomous else None
     if flow is None:
         return f"{regime}: {meaning}"

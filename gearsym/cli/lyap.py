@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
               + ")")
     else:
         print("regime: " + describe_regime(result.regime, result.exponents, result.stderr, result.measured_time,
-                                           result.autonomous))
+                                           result.autonomous, result.settling))
         for line in _undecided(result):
             print(line)
     for name, a in result.amplitude.items():
@@ -81,23 +81,17 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _undecided(result) -> list[str]:
-    """What an undetermined (or quasi-periodic) run's Poincare points did, and how many periods would decide."""
-    if result.settling is None:
+    """What an undetermined run's Poincare points did, and how many periods would decide."""
+    if result.settling is None or result.regime != "undetermined":
         return []
-    lines = [f"  {result.settling.describe(_time_unit(result))}"]
-    if result.regime == "undetermined":
-        band = float(zero_band(result.stderr, result.measured_time)[0])
-        needed = result.periods_to_decide
-        lines.append(f"  lambda_1 = {result.exponents[0]:+.6g} lies within {band:.3g} of zero (the zero band: 3 standard "
-                     f"errors or 5/(measured time)) after {result.periods - result.discard} measured periods: "
-                     + (f"about {needed} measured periods would decide (--periods {needed + result.discard} "
-                        f"--discard {result.discard}, or a longer --discard to let the transient pass)" if needed else
-                        "no run length within reach would decide while the points move this way"))
-    return lines
-
-
-def _time_unit(result) -> str:
-    return "unit time"
+    band = float(zero_band(result.stderr, result.measured_time)[0])
+    needed = result.periods_to_decide
+    return [f"  {result.settling.describe()}",
+            f"  lambda_1 = {result.exponents[0]:+.6g} lies within {band:.3g} of zero (the zero band: 3 standard errors "
+            f"or 5/(measured time)) after {result.periods - result.discard} measured periods: "
+            + (f"about {needed} measured periods would decide (--periods {needed + result.discard} --discard "
+               f"{result.discard}, or a longer --discard to let the transient pass)" if needed else
+               "no run length within reach would decide while the points move this way")]
 
 
 def diverged_message(compiled, result) -> str:
