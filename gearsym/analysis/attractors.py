@@ -59,7 +59,8 @@ MAX_PERIOD = 64
 RUN = {"periods": 500, "discard": 300}
 
 #: the paper's labels in Fig. 4: '1' a regular attractor, '2' a chaotic one
-PAPER_LABELS = {"periodic": "1", "quasi-periodic": "1", "equilibrium": "1", "chaotic": "2", "hyperchaotic": "2"}
+PAPER_LABELS = {"periodic": "1", "quasi-periodic": "1", "equilibrium": "1", "undetermined": "1", "chaotic": "2",
+                "hyperchaotic": "2"}
 
 
 @dataclass(frozen=True)
@@ -310,11 +311,15 @@ def _explicit_states(compiled: CompiledModel, initial_states) -> np.ndarray:
 
 def _run(compiled: CompiledModel, p: np.ndarray, y0: np.ndarray, index: int,
          options: Integration) -> LyapunovSpectrum:
+    start = ", ".join(f"{n}={v:g}" for n, v in zip(compiled.state_names, y0))
     try:
-        return lyapunov_spectrum(compiled, options=options, y0=y0, **dict(zip(compiled.parameter_names, p)))
+        spectrum = lyapunov_spectrum(compiled, options=options, y0=y0, **dict(zip(compiled.parameter_names, p)))
     except GearsymError as exc:
-        start = ", ".join(f"{n}={v:g}" for n, v in zip(compiled.state_names, y0))
         raise GearsymError(f"initial state #{index} ({start}): {exc}") from exc
+    if spectrum.divergence is not None:  # no attractor to group it with
+        raise GearsymError(f"initial state #{index} ({start}): the motion diverged: "
+                           f"{spectrum.divergence.describe(spectrum.period)}; start from a smaller box")
+    return spectrum
 
 
 # ------------------------------------------------------------------------------------------ grouping
@@ -442,6 +447,17 @@ def orbit_period(strobes: Sequence[np.ndarray], scale: np.ndarray) -> int | None
 
 
 # ------------------------------------------------------------------------------------------ results
+def _group_regime(regime: str, runs: Sequence[LyapunovSpectrum]) -> str:
+    """The regime of the members' mean spectrum, where the exponents cannot decide (quasi-periodic) decided as
+    each member's Poincare points did (gearsym.analysis.regime): a torus only if every member says so,
+    periodic if every member settled on its orbit, undetermined otherwise."""
+    if regime != "quasi-periodic" or any(r.settling is None for r in runs):
+        return regime
+    if all(r.regime == "periodic" for r in runs):
+        return "periodic"
+    return regime if all(r.settling.decides for r in runs) else "undetermined"
+
+
 def _assemble(compiled, p, starts, spectra, groups, scale, periods, discard, seed, box, grouping) -> AttractorSet:
     names = compiled.state_names
     autonomous = bool(getattr(compiled.system, "autonomous", False))
@@ -456,7 +472,7 @@ def _assemble(compiled, p, starts, spectra, groups, scale, periods, discard, see
         points = np.hstack([r.strobe for r in runs])
         exponents = np.mean([r.exponents for r in runs], axis=0)
         stderr = np.sqrt(np.sum([np.square(r.stderr) for r in runs], axis=0)) / len(runs)
-        regime = classify_regime(exponents, stderr, measured_time, autonomous)
+        regime = _group_regime(classify_regime(exponents, stderr, measured_time, autonomous), runs)
         period = orbit_period([r.strobe for r in runs], scale) if regime == "periodic" else None
         amplitude = {k: float(np.mean([r.amplitude[k] for r in runs])) for k in runs[0].amplitude}
         drafts.append(dict(members=tuple(members), points=points, exponents=exponents, stderr=stderr,
@@ -470,7 +486,7 @@ def _assemble(compiled, p, starts, spectra, groups, scale, periods, discard, see
     results = tuple(
         InitialConditionResult(
             index=i, initial_state=state(y0), attractor=number[i], exponents=r.exponents, stderr=r.stderr,
-            regime=classify_regime(r.exponents, r.stderr, measured_time, autonomous), amplitude=r.amplitude,
+            regime=r.regime, amplitude=r.amplitude,
             final_state=r.final_state, strobe=r.strobe)
         for i, (y0, r) in enumerate(zip(starts, spectra)))
     first = spectra[0]

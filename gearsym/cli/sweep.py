@@ -6,6 +6,8 @@ import sys
 from collections import Counter
 from pathlib import Path
 
+import numpy as np
+
 from ..checks import chosen_coordinate
 from ..errors import GearsymError
 from ..figures.sweep import plot_sweep
@@ -89,6 +91,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"{result.model}: {len(result)} points -> {args.out} (+ .json, .poincare.csv"
           + (", .physical.csv, .physical.json)" if physical else ")"))
     print("regimes: " + ", ".join(f"{k} {v}" for k, v in sorted(regimes.items())))
+    for line in verdict_lines(result):
+        print(line)
     if physical:  # the findings along the values swept, in their units, and the tables in them
         result = scaling.to_physical(result, given=given)
         record = write_physical_record(result, sidecar(args.out, ".physical.json"))
@@ -103,6 +107,23 @@ def run(args: argparse.Namespace) -> int:
         plot_sweep(result, args.plot, coordinate=args.coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     return 0
+
+
+def verdict_lines(result) -> list[str]:
+    """What the sweep's 'diverged' and 'undetermined' points mean, where there are any (see docs/engine.md)."""
+    lines, first = [], result.axes[0].name
+    diverged = result["regime"] == "diverged"
+    if diverged.any():
+        values = result[first][diverged]
+        lines.append(f"  diverged at {diverged.sum()} point(s), {first} in [{values.min():g}, {values.max():g}]: the "
+                     "motion grew without bound there (no regime; `gearsym lyap` at one says how and why); a "
+                     "continuation went on from the last point that did not")
+    undetermined = int(np.sum(result["regime"] == "undetermined"))
+    if undetermined:
+        lines.append(f"  undetermined at {undetermined} point(s): lambda_1 could not be told from 0 there and the "
+                     "Poincare points did not settle (a transient, or too few periods to say); `gearsym lyap` at one "
+                     "says how many periods would decide, or run again with more --periods and --discard")
+    return lines
 
 
 def _engine_axes(axes, scaling):

@@ -342,9 +342,10 @@ class CompiledModel:
 
     # ---------------------------------------------------------------- runs
     def tangent_run(self, y0, periods: int, inputs: RunInputs, Q0=None,
-                    out: tuple[np.ndarray, ...] | None = None) -> TangentRun:
+                    out: tuple[np.ndarray, ...] | None = None, check_finite: bool = True) -> TangentRun:
         """``periods`` forcing periods of the state and n tangent vectors, re-orthonormalised every period.
-        ``out``: where to write the strobe, log stretches, lows and highs (a slot of :class:`TangentRuns`)."""
+        ``out``: where to write the strobe, log stretches, lows and highs (a slot of :class:`TangentRuns`).
+        ``check_finite=False``: a run that becomes non-finite is returned as it is (the caller judges it)."""
         self._check_inputs(inputs)
         n, m = self.dimension, len(self.observed)
         y = self.initial_state(y0)
@@ -363,7 +364,8 @@ class CompiledModel:
                 for into, record in zip(out, records):
                     into[...] = record
             strobe, logs, low, high = out or records
-            self.check_finite(inputs.p, strobe, logs)
+            if check_finite:
+                self.check_finite(inputs.p, strobe, logs)
             return TangentRun(strobe, logs, low, high, Q)
         # one new block for the start, both tangent buffers and (without ``out``) the records: one address
         rows = (n, n, m, m)
@@ -388,7 +390,7 @@ class CompiledModel:
             strides = [8 * r for r in rows]
         final = self._native_loop(schedule, at, [at + 8 * n, at + 8 * (n + n * n)], inputs, bases, strides)
         # one sum over the strobe and log stretches (adjacent in the block): finite, unless told otherwise
-        if out or not math.isfinite(block[n + 2 * n * n:n + 2 * n * n + 2 * n * periods].sum()):
+        if check_finite and (out or not math.isfinite(block[n + 2 * n * n:n + 2 * n * n + 2 * n * periods].sum())):
             self.check_finite(inputs.p, strobe, logs)
         return TangentRun(strobe, logs, low, high, Qs[final])
 

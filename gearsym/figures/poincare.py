@@ -31,12 +31,13 @@ LAYER_COLORS = ("0.55", "k", "C3", "C0", "C2", "C1")
 #: one set alone: a colour per class of attractor, the paper's '1' (regular) and '2' (chaotic)
 CLASS_COLORS = {"1": "k", "2": "C3"}
 #: regular attractors: a marker per regime (chaotic ones are clouds of dots)
-REGIME_MARKERS = {"periodic": "o", "quasi-periodic": "s", "equilibrium": "D", "chaotic": ".", "hyperchaotic": "."}
+REGIME_MARKERS = {"periodic": "o", "quasi-periodic": "s", "equilibrium": "D", "undetermined": "^", "chaotic": ".",
+                  "hyperchaotic": "."}
 #: how captions write each marker
-MARKER_GLYPHS = {"o": "○", "s": "□", "D": "◇", ".": "·"}
+MARKER_GLYPHS = {"o": "○", "s": "□", "D": "◇", "^": "△", ".": "·"}
 #: short forms of the regimes in the annotations
 SHORT = {"periodic": "P", "quasi-periodic": "QP", "chaotic": "chaotic", "hyperchaotic": "hyperchaotic",
-         "equilibrium": "eq."}
+         "equilibrium": "eq.", "undetermined": "undetermined"}
 
 _STYLE = {"font.size": 9, "axes.titlesize": 10, "axes.labelsize": 10, "legend.fontsize": 8,
           "axes.linewidth": 0.8, "xtick.direction": "in", "ytick.direction": "in",

@@ -12,13 +12,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.regime import REGIMES
+from ..analysis.regime import DIVERGED, REGIMES, UNDETERMINED
 from ..errors import GearsymError
 from ..sweep.result import SweepResult
 from .save import pyplot, save_figure
 
 REGIME_COLORS = {"periodic": "#4c72b0", "quasi-periodic": "#55a868", "chaotic": "#dd8452",
-                 "hyperchaotic": "#c44e52", "equilibrium": "#8172b3"}
+                 "hyperchaotic": "#c44e52", "equilibrium": "#8172b3", UNDETERMINED: "#b0b0b0", DIVERGED: "#222222"}
+#: what a regime strip or map can show: the regimes, and the two verdicts that are not (shown where they occur)
+SHOWN = (*REGIMES, UNDETERMINED, DIVERGED)
 _LINESTYLE = {"up": "-", "down": "--", "independent": "-"}
 _STYLE_NAME = {"-": "solid", "--": "dashed"}
 _CONTINUATION = {"up": "continuation upward", "down": "continuation downward", "both": "continuation up, then down"}
@@ -98,8 +100,11 @@ def plot_regime_strip(ax, result: SweepResult, *, direction: str | None = None, 
             ax.broken_barh([(xv - width / 2, width)], (row, 0.8), color=REGIME_COLORS.get(reg, "0.5"), lw=0)
     ax.set_yticks([r + 0.4 for r in range(len(runs))], [_run_label(d, v, style=False) for d, v, _ in runs], fontsize=7)
     ax.set_ylim(0, max(len(runs), 1))
-    handles = [plt.Rectangle((0, 0), 1, 1, color=REGIME_COLORS[r]) for r in REGIMES]
-    ax.legend(handles, REGIMES, ncol=4, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.45), frameon=False)
+    present = set(result["regime"].tolist())
+    names = [r for r in SHOWN if r in REGIMES or r in present]
+    handles = [plt.Rectangle((0, 0), 1, 1, color=REGIME_COLORS[r]) for r in names]
+    ax.legend(handles, names, ncol=min(len(names), 6), fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.45),
+              frameon=False)
 
 
 def plot_map(ax, result: SweepResult, column: str = "lambda_1", *, direction: str | None = None):
@@ -114,10 +119,11 @@ def plot_map(ax, result: SweepResult, column: str = "lambda_1", *, direction: st
     ix = np.searchsorted(xs, result[x][keep])
     iy = np.searchsorted(ys, result[y][keep])
     if column == "regime":
-        codes = {r: i for i, r in enumerate(REGIMES)}
+        codes = {r: i for i, r in enumerate(SHOWN)}
         grid[iy, ix] = [codes.get(r, np.nan) for r in result["regime"][keep]]
-        cmap = ListedColormap([REGIME_COLORS[r] for r in REGIMES])
-        mesh = ax.pcolormesh(_edges(xs), _edges(ys), grid, cmap=cmap, norm=BoundaryNorm(np.arange(-0.5, 4), 4))
+        cmap = ListedColormap([REGIME_COLORS[r] for r in SHOWN])
+        mesh = ax.pcolormesh(_edges(xs), _edges(ys), grid, cmap=cmap,
+                             norm=BoundaryNorm(np.arange(-0.5, len(SHOWN)), len(SHOWN)))
     elif column.startswith("lambda_"):
         grid[iy, ix] = result[column][keep]
         finite = np.abs(grid[np.isfinite(grid)])
@@ -225,8 +231,8 @@ def plot_sweep(result: SweepResult, path: str | Path | None = None, coordinate: 
             if column != "regime":
                 fig.colorbar(mesh, ax=ax, label=_with_unit(label, result.units, column))
             else:
-                cbar = fig.colorbar(mesh, ax=ax, ticks=range(4))
-                cbar.ax.set_yticklabels(REGIMES, fontsize=7)
+                cbar = fig.colorbar(mesh, ax=ax, ticks=range(len(SHOWN)))
+                cbar.ax.set_yticklabels(SHOWN, fontsize=7)
         fig.suptitle(sweep_title(result, 160), fontsize=9)
     else:
         fig, axs = plt.subplots(4, 1, figsize=(8, 10), sharex=True, constrained_layout=True,

@@ -19,7 +19,7 @@ import numpy as np
 from ..figures.orbits import branch_color, legend_handles, plot_branches, plot_sweep_points
 from ..figures.poincare import parameter_text, PhasePanel, plot_attractors, plot_phase_portraits
 from ..figures.save import pyplot, save_figure
-from ..figures.sweep import plot_amplitude, plot_bifurcation, plot_exponents, plot_map, plot_regime_strip
+from ..figures.sweep import SHOWN, plot_amplitude, plot_bifurcation, plot_exponents, plot_map, plot_regime_strip
 from .compute import Computed
 from .plan import CHAOS_BAND, NEAR_ONE, NOT_IN_PAPER, PAPER_JUMPS
 
@@ -236,8 +236,9 @@ def study(c: Computed):
         mesh = plot_map(axs[row, 0], r, "lambda_1", direction="up")
         fig.colorbar(mesh, ax=axs[row, 0], label=r"$\lambda_1$")
         mesh = plot_map(axs[row, 1], r, "regime", direction="up")
-        bar = fig.colorbar(mesh, ax=axs[row, 1], ticks=range(4))
-        bar.ax.set_yticklabels(["periodic", "quasi-per.", "chaotic", "hyperchaotic"], fontsize=7)
+        bar = fig.colorbar(mesh, ax=axs[row, 1], ticks=range(len(SHOWN)))
+        bar.ax.set_yticklabels(["periodic", "quasi-per.", "chaotic", "hyperchaotic", "undetermined", "diverged"],
+                               fontsize=7)
         job = c.plan.sweep(name)
         fixed = open_text(r.record["parameters"], [a.name for a in r.axes])
         axs[row, 0].set_title(f"{job.model}: {job.title}" + (f"; {fixed}" if fixed else ""), fontsize=8, loc="left")

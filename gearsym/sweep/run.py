@@ -15,6 +15,7 @@ everything.
 from __future__ import annotations
 
 import ctypes
+import functools
 import math
 import multiprocessing
 import multiprocessing.connection
@@ -31,7 +32,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis.divergence import counted_coordinates, run_failure, within_bound
 from ..analysis.lyapunov import summarise_runs
+from ..analysis.regime import DIVERGED
 from .. import caller
 from ..checks import run_bytes_per_period, whole_number
 from ..codegen import CompiledModel, TangentRuns, engine_verb
@@ -336,10 +339,12 @@ class _Run:
         if not all(finished[:count]) or any(finished[count:]):
             raise GearsymError("the sweep file holds points of a continuation line out of order (not its first "
                                f"points), so it cannot be resumed: pass {overwrite_option()} to start again")
-        if count and task[0].direction != INDEPENDENT:
-            state = self.final_state(done[task[count - 1].key], self.compiled.state_names)
-        else:
-            state = self.start
+        state = self.start
+        if task[0].direction != INDEPENDENT:  # from the last point that did not diverge
+            for point in reversed(task[:count]):
+                if done[point.key]["regime"] != DIVERGED:
+                    state = self.final_state(done[point.key], self.compiled.state_names)
+                    break
         return task[count:], state
 
     def task(self, compiled: CompiledModel, points: list[Point], state: np.ndarray):
@@ -348,13 +353,16 @@ class _Run:
         The loops of each point write into a batch's shared records, which are summarised at once
         (:func:`~gearsym.analysis.lyapunov.summarise_runs`) when the batch is full or has taken
         ``BATCH_SECONDS``: the Python around a point is a few array operations shared by the batch, not its
-        own. A point that fails ends the task after the points before it are yielded."""
+        own. A point that fails ends the task after the points before it are yielded; a point that diverged is
+        a row like any other ("diverged"), and a continuation goes on from the last state that stayed within
+        the bound of :mod:`gearsym.analysis.divergence`."""
         periods, n = self.options.periods, compiled.dimension
         size = min(len(points), _batch_size(n, len(compiled.observed), periods))  # (a task of one point: one)
         runs = TangentRuns(n, len(compiled.observed), periods, max(size, 1))
         base = compiled.parameter_vector(self.base)
         swept = [compiled.parameter_names.index(name) for name in self.names]
         batch, started = [], time.perf_counter()
+        counted = functools.partial(counted_coordinates, compiled)
         for point in points:
             p = base.copy()
             p[swept] = point.values
@@ -365,9 +373,10 @@ class _Run:
                 if batch:
                     yield from self.checked_rows(compiled, runs, batch)
                 raise self.failed(point, exc) from None
-            batch.append((point, p, inputs.period))
-            if point.direction != INDEPENDENT:
-                state = runs.strobe[len(batch) - 1, -1].copy()
+            batch.append((point, p, inputs.period, state))
+            final = runs.strobe[len(batch) - 1, -1]
+            if point.direction != INDEPENDENT and within_bound(final, state, compiled.state_names, counted):
+                state = final.copy()
             if len(batch) == runs.size or time.perf_counter() - started >= BATCH_SECONDS:
                 yield from self.checked_rows(compiled, runs, batch)
                 batch, started = [], time.perf_counter()
@@ -375,29 +384,34 @@ class _Run:
             yield from self.checked_rows(compiled, runs, batch)
 
     def checked_rows(self, compiled: CompiledModel, runs: TangentRuns, batch: list):
-        """Yield the rows of ``batch`` once its runs are checked finite, all at once (one sum each for the
-        batch's strobes and log stretches, not two per point); a run that is not ends the task after the rows
-        of the points before it (the points after it, run from its state, are dropped)."""
-        count = len(batch)
-        if not math.isfinite(float(runs.strobe[:count].sum()) + float(runs.log_stretch[:count].sum())):
-            for i, (point, p, _) in enumerate(batch):
-                try:
-                    compiled.check_finite(p, runs.strobe[i].T, runs.log_stretch[i].T)
-                except GearsymError as exc:
-                    if i:
-                        yield self.rows(compiled, runs, batch[:i])
-                    raise self.failed(point, exc) from None
-        yield self.rows(compiled, runs, batch)
+        """Yield the rows of ``batch`` (a point that diverged is a row); a run that failed instead (non-finite
+        tangent vectors, or a step too large for RK4: :func:`~gearsym.analysis.divergence.run_failure`) ends
+        the task after the rows of the points before it (the points after it, run from its state, are
+        dropped)."""
+        rows, failed = self.rows(compiled, runs, batch)
+        if failed is None:
+            yield rows
+            return
+        i, exc = failed
+        if i:
+            yield rows[:i]
+        raise self.failed(batch[i][0], exc) from None
 
     def failed(self, point: Point, exc: GearsymError) -> GearsymError:
         """The error of a point, saying where it is."""
         where = ", ".join(f"{n_}={v:g}" for n_, v in zip(self.names, point.values))
         return GearsymError(f"at {where} ({point.direction}): {exc}")
 
-    def rows(self, compiled: CompiledModel, runs: TangentRuns, batch: list) -> list[tuple[dict, PoincareRows]]:
-        """The table rows and Poincare rows of the runs of ``batch`` ((point, parameters, period) each)."""
-        points, p, period = zip(*batch)
+    def rows(self, compiled: CompiledModel, runs: TangentRuns, batch: list) -> tuple[list, tuple | None]:
+        """The table rows and Poincare rows of the runs of ``batch`` ((point, parameters, period, start) each),
+        and (index, error) of the first that failed (None: none did)."""
+        points, p, period, starts = zip(*batch)
         summary = summarise_runs(compiled, runs, np.array(p), np.array(period), self.options.discard)
+        failed = None
+        if not math.isfinite(float(runs.log_stretch[:len(batch)].sum())) or any(summary.divergences):
+            failed = next(((i, e) for i, e in ((i, run_failure(compiled, p[i], period[i], starts[i], runs.strobe[i],
+                                                                runs.log_stretch[i], summary.divergences[i]))
+                                               for i in range(len(batch))) if e is not None), None)
         count, n = len(batch), compiled.dimension
         numbers = np.hstack([summary.amplitude, summary.exponents, summary.stderr]).tolist()
         finals = runs.strobe[:count, -1].tolist()
@@ -412,7 +426,7 @@ class _Run:
             row["regime"] = regime
             row.update(zip(final_fields, map(repr, final)))
             out.append((row, PoincareRows(where, strobe)))
-        return out
+        return out, failed
 
 
 def _batch_size(n: int, observed: int, periods: int) -> int:
