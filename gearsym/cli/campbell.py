@@ -66,6 +66,7 @@ def run(args: argparse.Namespace) -> int:
                            out=args.out, workers=Workers(args.jobs), progress=not args.quiet)
         sweep = scaling.to_physical(result)
 
-    plot_campbell(diagram, args.plot, sweep)
+    given = dict(setting.split("=", 1) for setting in args.set or () if "=" in setting)
+    plot_campbell(diagram, args.plot, sweep, settings=given)
     print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     return 0
