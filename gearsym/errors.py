@@ -9,6 +9,34 @@ from collections.abc import Iterable
 class GearsymError(Exception):
     """Base class of every error gearsym raises on purpose."""
 
+    def for_command_line(self) -> str:
+        """The message as the ``gearsym`` command prints it (options spelled as flags: :class:`AdviceError`)."""
+        return str(self)
+
+
+#: an option named in an error's advice, as each caller spells it: (in Python, on the command line)
+SPELLINGS = {"overwrite": ("overwrite=True", "--overwrite"), "out": ("out=", "--out"),
+             "threads": ('workers=Workers(parallel="threads")', "--parallel threads"),
+             "same_run": ("the call", "the command")}
+
+
+class AdviceError(GearsymError):
+    """An error whose advice names options of the caller: the message is a template with ``{overwrite}``,
+    ``{out}``, ... (:data:`SPELLINGS`), written as Python spells them (``overwrite=True``), and as the command
+    line does (``--overwrite``) by :meth:`for_command_line`, so that each caller reads its own spelling."""
+
+    def __init__(self, template: str):
+        self.template = template
+        super().__init__(template.format(**{k: python for k, (python, _) in SPELLINGS.items()}))
+
+    def for_command_line(self) -> str:
+        return self.template.format(**{k: flag for k, (_, flag) in SPELLINGS.items()})
+
+
+def literal(value) -> str:
+    """``value`` as text inside an :class:`AdviceError` template (its braces kept as they are)."""
+    return str(value).replace("{", "{{").replace("}", "}}")
+
 
 class GearsymWarning(UserWarning):
     """Something gearsym does that the user may not expect: the command line prints it as one line."""

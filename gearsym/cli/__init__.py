@@ -75,7 +75,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             status = args.run(args)
             sys.stdout.flush()  # a closed pipe shows here rather than at the interpreter's exit
         except GearsymError as exc:
-            print(f"gearsym: error: {exc}", file=sys.stderr)
+            print(f"gearsym: error: {exc.for_command_line()}", file=sys.stderr)
             return USAGE_ERROR
         except BrokenPipeError:
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nobody reads the rest

@@ -34,7 +34,7 @@ import numpy as np
 from ..analysis.lyapunov import summarise_runs
 from ..checks import whole_number
 from ..codegen import CompiledModel, engine_verb, TangentRuns
-from ..errors import GearsymError, UnknownParameterError
+from ..errors import AdviceError, GearsymError, literal, UnknownParameterError
 from ..options import Integration
 from ..version import __version__
 from .distributed import check_scheduler, connect, execute_dask
@@ -130,8 +130,8 @@ def run_sweep(
         done, strobes = store.open(overwrite) if store else ({}, {})
         unknown = set(done) - {p.key for p in plan.points}
         if unknown:
-            raise GearsymError(f"{out}: holds points this sweep does not plan, e.g. {sorted(unknown)[0]}; "
-                               "pass --overwrite or choose another --out")
+            raise AdviceError(f"{literal(out)}: holds points this sweep does not plan, e.g. "
+                              f"{literal(sorted(unknown)[0])}; pass {{overwrite}} or choose another {{out}}")
         run = _Run(model, plan.base, plan.names, plan.start, options, plan.poincare, plan.columns,
                    plan.strobe_columns)
         todo = [t for t in (run.remaining(task, done) for task in plan.tasks) if t[0]]
@@ -292,8 +292,8 @@ class _Run:
         finished = [p.key in done for p in task]
         count = sum(finished)
         if not all(finished[:count]) or any(finished[count:]):
-            raise GearsymError("the sweep file holds points of a continuation line out of order (not its first "
-                               "points), so it cannot be resumed: pass --overwrite to start again")
+            raise AdviceError("the sweep file holds points of a continuation line out of order (not its first "
+                              "points), so it cannot be resumed: pass {overwrite} to start again")
         if count and task[0].direction != INDEPENDENT:
             state = self.final_state(done[task[count - 1].key], self.compiled.state_names)
         else:
@@ -499,8 +499,8 @@ def _check_alive(procs: list) -> None:
     """Raise if a worker process has died (one that ran out of tasks ends with 0)."""
     dead = next((p for p in procs if p.exitcode not in (None, 0)), None)
     if dead is not None:
-        raise GearsymError(f"a sweep worker process died (exit code {dead.exitcode}); the points finished so far "
-                           "are kept: run the same command with --parallel threads to resume")
+        raise AdviceError(f"a sweep worker process died (exit code {dead.exitcode}); the points finished so far "
+                          "are kept: repeat {same_run} with {threads} to resume")
 
 
 _FORKED = None  # (run, tasks, parent pid) of the sweep being forked, read by _process_worker in the children

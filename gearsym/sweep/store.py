@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import GearsymError
+from ..errors import AdviceError, GearsymError, literal
 from ..files import write_atomically
 
 
@@ -121,9 +121,9 @@ class SweepStore:
             # (rows written before their main row are dropped)
             lacking = [k for k in done if k not in strobes]
             if self.record.get("poincare_samples") and lacking:
-                raise GearsymError(f"{self.strobe_path} lacks the Poincare samples of {len(lacking)} finished "
-                                   "points (deleted or damaged?), so the sweep cannot be resumed whole: pass "
-                                   "--overwrite to start again")
+                raise AdviceError(f"{literal(self.strobe_path)} lacks the Poincare samples of {len(lacking)} "
+                                  "finished points (deleted or damaged?), so the sweep cannot be resumed whole: pass "
+                                  "{overwrite} to start again")
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._write_table(self.path, self.columns, map(_fields(self.columns), done.values()))  # (drops a row cut off)
         self._write_table(self.strobe_path, self.strobe_columns, (), "".join(r.text() for r in strobes.values()))
@@ -143,32 +143,34 @@ class SweepStore:
     def _check_record(self) -> None:
         why = self._record_differs()
         if why is not None:
-            raise GearsymError(why)
+            raise AdviceError(why)
 
     def _record_differs(self) -> str | None:
         """Why the files cannot be resumed by this sweep (their record is missing, unreadable or another
-        sweep's), or None."""
+        sweep's), or None; a template of :class:`AdviceError`."""
         if not self.meta_path.exists():
-            return (f"{self.path} exists but {self.meta_path.name} (the record of how it was made) "
-                    "does not, so it cannot be resumed: pass --overwrite or choose another --out")
+            return (f"{literal(self.path)} exists but {literal(self.meta_path.name)} (the record of how it was "
+                    "made) does not, so it cannot be resumed: pass {overwrite} or choose another {out}")
         try:
             old = json.loads(self.meta_path.read_text())["sweep"]
         except (json.JSONDecodeError, KeyError, TypeError) as exc:
-            return f"{self.meta_path}: not a gearsym sweep record ({exc}); pass --overwrite or choose another --out"
+            return (f"{literal(self.meta_path)}: not a gearsym sweep record ({literal(exc)}); pass {{overwrite}} "
+                    "or choose another {out}")
         new = json.loads(json.dumps(self.record))  # compare as JSON sees them
         differ = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
         if not differ:
             return None
         detail = "; ".join(f"{k}: {_short(old.get(k))} before, {_short(new.get(k))} now" for k in differ)
-        return (f"{self.path} was written by a different sweep ({detail}). To resume it, repeat "
-                "the command it came from; to start again pass --overwrite, or choose another --out")
+        return (f"{literal(self.path)} was written by a different sweep ({literal(detail)}). To resume it, repeat "
+                "{same_run} it came from; to start again pass {overwrite}, or choose another {out}")
 
     def _read(self, path: Path, columns: list[str]) -> dict[tuple, dict]:
         rows = {}
         for row in read_rows(path, columns):
             key = self.key(row)
             if key in rows:
-                raise GearsymError(f"{path}: the point {key} appears twice; pass --overwrite to start again")
+                raise AdviceError(f"{literal(path)}: the point {literal(key)} appears twice; pass {{overwrite}} to "
+                                  "start again")
             rows[key] = row
         return rows
 
@@ -301,13 +303,13 @@ def read_rows(path: Path, columns: list[str] | None = None) -> list[dict]:
         return []
     columns = header if columns is None else columns
     if header != columns:
-        raise GearsymError(f"{path}: its columns ({', '.join(header)}) are not this sweep's "
-                           f"({', '.join(columns)}); pass --overwrite or choose another --out")
+        raise AdviceError(f"{literal(path)}: its columns ({literal(', '.join(header))}) are not this sweep's "
+                          f"({literal(', '.join(columns))}); pass {{overwrite}} or choose another {{out}}")
     rows = []
     for line, fields in enumerate(reader, start=2):
         if len(fields) != len(columns):
-            raise GearsymError(f"{path}, row {line}: {len(fields)} fields, expected {len(columns)}; "
-                               "the file was edited or damaged: fix the row or pass --overwrite")
+            raise AdviceError(f"{literal(path)}, row {line}: {len(fields)} fields, expected {len(columns)}; "
+                              "the file was edited or damaged: fix the row or pass {overwrite}")
         rows.append(dict(zip(columns, fields)))
     return rows
 
