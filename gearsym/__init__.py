@@ -12,6 +12,7 @@ One flat public face; the stages behind it, each handing one type to the next:
   :func:`find_attractors`, :func:`run_sweep` (on a CompiledModel, or on a system, compiled first);
   periodic orbits and their branches: :func:`periodic_orbit`, :func:`continue_orbits`;
 * data: :func:`simulate_measurements`, :func:`load_measurements`, :func:`explain`;
+* FMUs: :func:`export_fmu` (a model as an FMI 2.0 FMU, co-simulation and model exchange, for other tools);
 * physical units: :func:`scaling` (a drivetrain with values in units -> its nondimensional values, and results
   back to rpm, um, N, 1/s), :func:`is_physical`, :func:`natural_modes`, :func:`campbell`;
 * document: :func:`derive` and :func:`render`.
@@ -70,6 +71,7 @@ _LAZY = {
     "natural_modes": "gearsym.loading",
     "campbell": "gearsym.physical.campbell",
     "is_physical": "gearsym.loading",
+    "export_fmu": "gearsym.fmu.export",
     "derive": "gearsym.derivation",
     "render": "gearsym.derivation",
 }
@@ -97,6 +99,7 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .data import load_measurements
     from .derivation import derive, render
     from .fit import EFFECTS, explain
+    from .fmu.export import export_fmu
     from .loading import is_physical, load, natural_modes, scaling
     from .model.components import Disk, Gear, Harmonic, Mesh, Planet, Shaft, Torque
     from .model.drivetrain import Drivetrain

@@ -34,9 +34,7 @@ def scaling(model, length_scale=None, **physical) -> PhysicalScaling:
     if not isinstance(declared, NondimensionalModel) and not declared.is_drivetrain:
         raise GearsymError(f"{declared.name}: physical values need a drivetrain model (a FirstOrderSystem has no "
                            "components to give them units)")
-    nd = reduced(declared)
-    scale = nd.drivetrain.length_scale if length_scale is None else length_scale
-    return PhysicalScaling(nd, {**nd.drivetrain.physical, **physical}, scale)
+    return PhysicalScaling.of(reduced(declared), length_scale, **physical)
 
 
 def load(ref, **values) -> FirstOrderSystem:

@@ -30,7 +30,7 @@ LAYERS = [
     {"sweep", "periodic"},
     {"figures"},
     {"fit", "physical"},
-    {"verbs", "loading", "cached"},
+    {"verbs", "loading", "cached", "fmu"},
     {"reproduce"},
     {"cli", "__init__"},
 ]

@@ -31,7 +31,7 @@ from sympy.core.function import AppliedUndef
 from ..backlash import g
 from ..errors import ModelError, UnknownParameterError
 from ..model.drivetrain import Drivetrain
-from ..model.resolved import ResolvedCoupling
+from ..model.resolved_components import ResolvedCoupling
 from ..checks import sign_violation
 from ..model.expressions import ExprLike, parameter_names, to_expr
 from ..model.stiffness import check_periodic

@@ -28,7 +28,7 @@ import sympy as sp
 
 from ..errors import GearsymError, ModelError, UnknownParameterError
 from ..model.length_scale import check_length_scale
-from ..model.resolved import ResolvedCoupling
+from ..model.resolved_components import ResolvedCoupling
 from ..reduction import NondimensionalModel
 from ..reduction.statics import StaticState, static_state, torque_imbalance
 from ..symbols import parameter_symbol
@@ -178,6 +178,13 @@ class Scaling:
                 f"the mean torques do not balance: they leave {_torque(gap.net)} (on the axis of {gap.reference!r}) "
                 f"to accelerate the whole train, so there is no steady operating point. "
                 f"{' or '.join(options[:2])} balances them", self.name)
+
+    @classmethod
+    def of(cls, nd: NondimensionalModel, length_scale=None, **physical) -> "Scaling":
+        """The scaling of ``nd`` at its declared physical values, ``physical`` overriding them, in its declared
+        length unit unless ``length_scale`` is given."""
+        scale = nd.drivetrain.length_scale if length_scale is None else length_scale
+        return cls(nd, {**nd.drivetrain.physical, **physical}, scale)
 
     def with_values(self, **physical) -> "Scaling":
         """The same drivetrain with some physical values changed (``speed="3000 rpm"``)."""
