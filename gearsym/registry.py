@@ -101,6 +101,17 @@ def load_model(ref: Union[str, Path, Model]) -> Model:
     return model
 
 
+def model_module(name: str):
+    """The module of a model of ``models/`` by name, with everything its file defines beside ``model`` (a
+    builder such as ``build(planets)``, its constants): what ``import models.<name>`` gives in a clone, for a
+    script that runs anywhere."""
+    if name.endswith(".py") or "/" in name:
+        raise GearsymError(f"model_module takes the name of a model in {models_dir()} (see gearsym list), not a "
+                           f"file: {name!r}; import your own file as any Python module")
+    load_model(name)  # checks the name and runs the file once
+    return sys.modules[f"models.{name}"]
+
+
 def _with_models_importable(action, model_file: Path | None = None):
     """Run ``action`` with the folder holding ``models/`` importable (model files import each other);
     a model file that fails to run (a syntax error, a missing import, ...) is a one-line error naming

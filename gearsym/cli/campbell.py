@@ -70,6 +70,7 @@ def run(args: argparse.Namespace) -> int:
         sweep = scaling.to_physical(result, given=[axis])
         print(f"in physical units: {write_physical_table(sweep, sidecar(args.out, '.physical.csv'))}")
 
-    plot_campbell(diagram, args.plot, sweep)
+    given = dict(setting.split("=", 1) for setting in args.set or () if "=" in setting)
+    plot_campbell(diagram, args.plot, sweep, settings=given)
     print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     return 0

@@ -188,9 +188,11 @@ def segments_of(system: FirstOrderSystem, measurements: Measurements) -> tuple[l
     segments, keys = [], []
     for r in measurements:
         values = {**system.parameters, **measurements.parameters(r)}
+        conditions = ", ".join(f"{k}={v:g}" for k, v in r.conditions.items())
+        record = f"{r.label} ({conditions})" if conditions else r.label
         for w in r.windows():
             key = ((str(r.source), r.record), w.index)  # (which record, which period)
-            segments.append(Segment(w.tau, w.observed, values, f"{r.label} period {w.index}", r.channels, key))
+            segments.append(Segment(w.tau, w.observed, values, f"{record} period {w.index}", r.channels, key))
             keys.append(key)
     return segments, keys
 

@@ -16,6 +16,7 @@ import sympy as sp
 
 from ..checks import json_safe
 from ..file_sets import written_together
+from ..figures.layout import fit_texts
 from ..figures.save import pyplot, save_figure
 from ..system import FirstOrderSystem
 from .effects import augment, effect_terms
@@ -43,7 +44,7 @@ def write_report(ex: Explanation, system: FirstOrderSystem, out: str | Path, sou
         data = json_safe(ex.as_dict())
         (stage / "report.json").write_text(json.dumps(data, indent=1, allow_nan=False) + "\n")
         save_figure(residual_figure(ex, system), stage / "residuals.png", dpi=100)
-        _prediction_figure(ex, stage / "prediction.png")
+        save_figure(prediction_figure(ex, system.name), stage / "prediction.png", dpi=100)
         effects = [ex.library[e] for e in ex.effects]
         derived = augment(system, effects) if effects else system
         (stage / "derived_model.md").write_text(derived_model_page(system, derived, effects))
@@ -255,14 +256,25 @@ def residual_figure(ex: Explanation, system: FirstOrderSystem):
     axs[3].set_ylabel("amplitude / channel spread")
     axs[3].set_title("held-out residual's spectrum (numbers: orders tried)", fontsize=10)
     axs[3].legend(fontsize=8)
+    fig.suptitle(f"{system.name}: the held-out residual of {channel}, {_which(ex.base.prediction)}", fontsize=10)
+    fit_texts(fig)
     return fig
 
 
-def _prediction_figure(ex: Explanation, path: Path) -> None:
+def _which(prediction) -> str:
+    """'every held-out window (12) of measured.csv record 1 (omega=1.2), measured.csv record 2 (omega=1.6)'."""
+    records = prediction.records()
+    return (f"every held-out window ({prediction.pairs}) of " + "; ".join(records) if records
+            else f"every held-out window ({prediction.pairs})")
+
+
+def prediction_figure(ex: Explanation, system_name: str = ""):
+    """The measurement and the predictions of the first three held-out windows of the first record (the
+    title says which)."""
     plt = pyplot()
     p0, p1 = ex.base.prediction, ex.final.prediction
     channel = next(iter(p0.measured))
-    count = min(len(p0.tau), 3 * len(p0.tau) // max(p0.pairs, 1))  # the first three predicted periods
+    count, shown = p0.shown(3)
     idx = np.arange(count)
     fig, ax = plt.subplots(figsize=(11, 3.6), constrained_layout=True)
     ax.plot(idx, p0.measured[channel][:count], ".", ms=3, color="C0", label="measured (held out)")
@@ -273,9 +285,11 @@ def _prediction_figure(ex: Explanation, path: Path) -> None:
                 label=f"+{'+'.join(ex.effects)}: error {ex.final.error:.3g}")
     ax.set_xlabel("held-out sample (one period ahead of each estimated start)")
     ax.set_ylabel(channel)
-    ax.set_title(f"one-period-ahead prediction of {channel} on the held-out data", fontsize=10)
+    ax.set_title(f"{system_name + ': ' if system_name else ''}one-period-ahead prediction of {channel} on the "
+                 f"held-out data: {shown}", fontsize=10)
     ax.legend(fontsize=8)
-    save_figure(fig, path, dpi=100)
+    fit_texts(fig)
+    return fig
 
 
-__all__ = ["derived_model_page", "report_page", "residual_figure", "write_report"]
+__all__ = ["derived_model_page", "prediction_figure", "report_page", "residual_figure", "write_report"]

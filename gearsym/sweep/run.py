@@ -556,7 +556,9 @@ def _check_alive(procs: list) -> None:
     dead = next((p for p in procs if p.exitcode not in (None, 0)), None)
     if dead is not None:
         raise GearsymError(f"a sweep worker process died (exit code {dead.exitcode}); the points finished so far "
-                           "are kept: run the same command with --parallel threads to resume")
+                           f"are kept: repeat the {'command' if caller.on_command_line() else 'call'} with "
+                           + ("--parallel threads" if caller.on_command_line() else 'workers=Workers(parallel="threads")')
+                           + " to resume")
 
 
 _FORKED = None  # (run, tasks, parent pid) of the sweep being forked, read by _process_worker in the children

@@ -196,7 +196,7 @@ class SweepStore:
             return None
         detail = "; ".join(f"{k}: {_short(old.get(k))} before, {_short(new.get(k))} now" for k in differ)
         return (f"{self.path} was written by a different sweep ({detail}). To resume it, repeat "
-                f"the command it came from; to start again {start_again()}")
+                f"the {'command' if caller.on_command_line() else 'call'} it came from; to start again {start_again()}")
 
     def _read(self, path: Path, columns: list[str]) -> dict[tuple, dict]:
         rows = {}
