@@ -41,6 +41,7 @@ _LAZY = {
     "Shaft": "gearsym.model.components",
     "Torque": "gearsym.model.components",
     "rectangular_mesh_stiffness": "gearsym.model.stiffness",
+    "parse_formula": "gearsym.model.formula",
     "NondimensionalModel": "gearsym.reduction",
     "reduce": "gearsym.reduction",
     "FirstOrderSystem": "gearsym.system",

@@ -5,8 +5,9 @@ import argparse
 import math
 import sys
 
+import gearsym  # the face: SymPy is loaded only when a formula is given
+
 from ..errors import GearsymError
-from ..model.grammar import check_formula
 from ..model.length_scale import check_length_scale
 from ..units import looks_like_quantity, parse_quantity
 
@@ -39,8 +40,8 @@ def parse_settings(pairs: list[str]) -> dict[str, str]:
             if not math.isfinite(float(value)):
                 raise GearsymError(f"--set {name}={value}: not a finite number (a double holds at most "
                                    f"{sys.float_info.max:.3g}); give a finite value")
-        else:  # (the grammar alone: SymPy reads the formula when the model is loaded)
-            check_formula(value, f"--set {name}")
+        else:  # (its grammar and its numbers: 1/0 or 1e400 are refused here, not in the C)
+            gearsym.parse_formula(value, f"--set {name}")
         settings[name] = value
     return settings
 

@@ -37,6 +37,8 @@ MATCH = 0.01
 CONTINUED_PERIOD = 4
 CHAOTIC = ("chaotic", "hyperchaotic", "quasi-periodic")
 FOLD_KIND, CRISIS, STEEP, LEFT, OTHER = FOLD, "crisis", "no bifurcation", "left a continuing orbit", "other orbit"
+#: an end where the sweep's attractor is 'undetermined': said as such, not explained
+UNDECIDED = "undetermined attractor"
 MEANING = {FOLD: "it ceases to exist", PERIOD_DOUBLING: "it loses stability, a multiplier through -1",
            NEIMARK_SACKER: "it loses stability, a complex pair through |mu| = 1",
            GRAZING: "it touches a backlash surface and its multipliers jump through the unit circle"}
@@ -174,7 +176,8 @@ class _Classifier:
         if regime in CHAOTIC:
             return {"kind": CRISIS, "at": None, "text": f"a crisis of a {regime} attractor ({near})"}
         if regime == "undetermined":
-            return {"kind": OTHER, "at": None, "text": f"an attractor whose regime the run cannot decide ({near})"}
+            return {"kind": UNDECIDED, "at": None,
+                    "text": f"an attractor whose regime the run cannot decide ({near}; more --periods would tell)"}
         which = f"a period-{period} orbit (from the sweep's Poincaré points)" if period else f"a {regime} attractor"
         return {"kind": OTHER, "at": None, "text": f"{which}, not on the continued period-1 and period-2 branches: "
                                                     f"its own end ({near})"}
