@@ -109,7 +109,10 @@ def parse_quantity(text: str, where: str):
     if not unit_text:
         return Quantity(number)
     q = Quantity(number, unit(unit_text, where, quoted))
-    magnitude = q.to_base_units().magnitude
+    try:
+        magnitude = q.to_base_units().magnitude
+    except (OverflowError, ZeroDivisionError):  # (pint's factor of rpm**-1e9 overflows before any check)
+        magnitude = math.inf
     if not (math.isfinite(magnitude) and (magnitude == 0 or 1e-300 < abs(magnitude) < 1e300)):
         raise GearsymError(f"{where}: {quoted} is {magnitude:g} in SI units, out of the range of a number; "
                            "give a value with an ordinary unit")

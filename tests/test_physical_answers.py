@@ -238,6 +238,7 @@ def test_a_unitless_backlash_gets_the_same_message_in_its_unit(capsys):
     ({"I1": "0 kg*m^2"}, r"spur_pair: I1: 0 kg·m² is an inertia and must be positive"),
     ({"speed": "150 1/s"}, r"150 1/s is a frequency without an angle: write '150 rev/s' \(revolutions\) or '150 rad/s'"),
     ({"speed": "9000 rpms"}, r"unknown unit 'rpms' in '9000 rpms'; did you mean 'rpm'\?"),
+    ({"speed": "3000 rpm**-1e9"}, r"'3000 rpm\*\*-1e9' is inf in SI units, out of the range of a number"),
 ])
 def test_bad_values_are_reported_in_the_units_they_were_given_in(value, message, capsys):
     name, text = next(iter(value.items()))
