@@ -228,8 +228,9 @@ def stiffness_notes(system, values: Mapping[str, float], defaults: Mapping[str, 
             continue
         what = f"{c.kind} '{c.name}'"
         if time not in expr.free_symbols:
-            given = f" = {k_min:g}" if not names else f" = {k_min:g} at {', '.join(f'{n}={values[n]:g}' for n in names)}"
-            notes.append(f"the stiffness of {what} is {sp.sstr(expr) if names else ''}{given}: "
+            given = f"{k_min:g}" if not names else \
+                f"{sp.sstr(expr)} = {k_min:g} at {', '.join(f'{n}={values[n]:g}' for n in names)}"
+            notes.append(f"the stiffness of {what} is {given}: "
                          + ("zero, nothing holds the deflection" if k_min == 0 else "negative, it pushes the deflection "
                             "on instead of back"))
             continue
