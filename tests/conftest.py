@@ -175,11 +175,11 @@ def _private_library_cache(tmp_path_factory):
 def _cores_for_two_workers():
     """gearsym runs no more workers than the machine has cores; the tests ask for two to exercise the parallel
     paths, so they see at least two cores even on a machine of one (a test of the cap patches it itself)."""
-    import gearsym.sweep.run as run
+    import gearsym.sweep.workers as workers
 
-    cores = run.cores
+    cores = workers.cores
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(run, "cores", lambda: max(2, cores()))
+        patch.setattr(workers, "cores", lambda: max(2, cores()))
         yield
 
 

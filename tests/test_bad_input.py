@@ -22,7 +22,7 @@ import gearsym
 import gearsym.data.csvtext as csvtext
 import gearsym.data.grouping as grouping
 import gearsym.memory
-import gearsym.sweep.run
+import gearsym.sweep.workers
 from gearsym import Integration, Workers, explain, find_attractors, load_measurements, run_sweep, simulate_measurements
 from gearsym.cli import main
 from gearsym.codegen.compiled import CompiledModel
@@ -108,7 +108,7 @@ def test_the_python_face_checks_the_same_sizes_where_they_enter(one_gib, one_sta
 
 
 def test_a_sweep_counts_the_memory_of_every_worker(one_gib, one_stage, monkeypatch):
-    monkeypatch.setattr(gearsym.sweep.run, "cores", lambda: 4)
+    monkeypatch.setattr(gearsym.sweep.workers, "cores", lambda: 4)
     monkeypatch.setattr(CompiledModel, "tangent_run_into", lambda *a, **k: pytest.fail("the run started"))
     options = Integration(periods=5_000_000, discard=100)  # 0.37 GiB for one point's records, 1.49 GiB for four
     with pytest.raises(GearsymError, match=r"^periods=5000000 needs 1.49 GiB .*4 workers'"):
@@ -295,7 +295,7 @@ def test_zero_steps_per_period_are_refused_not_replaced_by_the_default(capsys, n
 
 
 def test_more_jobs_than_cores_run_on_the_cores_and_say_so(capsys, one_stage, tmp_path, monkeypatch):
-    monkeypatch.setattr(gearsym.sweep.run, "cores", lambda: 2)
+    monkeypatch.setattr(gearsym.sweep.workers, "cores", lambda: 2)
     with pytest.warns(GearsymWarning, match=r"^jobs=1000: this machine has 2 cores; running 2 workers"):
         workers = Workers(jobs=1000)
     assert workers.count == 2

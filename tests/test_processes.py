@@ -33,10 +33,11 @@ SLOW = ["one_stage", "--param", "omega=0.8:1.06:0.01", "--param", "B1=3.5,3.75,4
 PLANNED = 81
 #: gearsym on a machine of three cores or more, whatever this one has (it runs no more workers than cores; these
 #: tests are about three workers' processes, not their speed)
-THREE_CORES = "import sys, gearsym.sweep.run as run; cores = run.cores; run.cores = lambda: max(3, cores()); "
+THREE_CORES = "import sys, gearsym.sweep.workers as workers; cores = workers.cores; workers.cores = lambda: max(3, cores()); "
 COMMAND = ("-c", THREE_CORES + "from gearsym.cli import main; sys.exit(main(sys.argv[1:]))")
 #: a gearsym whose workers cannot ask the kernel to end them: the portable way (macOS) is used
-WITHOUT_PDEATHSIG = (THREE_CORES + "run._kernel_ends_orphans = lambda: False; "
+WITHOUT_PDEATHSIG = (THREE_CORES + "import gearsym.sweep.processes as processes; "
+                     "processes._kernel_ends_orphans = lambda: False; "
                      "from gearsym.cli import main; sys.exit(main(sys.argv[1:]))")
 
 needs_fork = pytest.mark.skipif("fork" not in multiprocessing.get_all_start_methods() or not Path("/proc").is_dir(),

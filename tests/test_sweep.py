@@ -97,10 +97,10 @@ def share_with_a_forked_worker(monkeypatch, in_the_worker=None) -> list:
     sweep's own process, once it holds a task, waits until a forked worker has taken one too. A forked worker
     then calls ``in_the_worker()`` before it computes. Returns the points computed in the sweep's own process
     (a forked worker would count in its own copy of the list)."""
-    from gearsym.sweep.run import _Run
+    from gearsym.sweep.point_runs import PointRuns
 
     worker_took_a_task = multiprocessing.get_context("fork").Event()  # made before the fork: shared with it
-    sweep_process, task, computed_here = os.getpid(), _Run.task, []
+    sweep_process, task, computed_here = os.getpid(), PointRuns.task, []
 
     def shared(self, compiled, points, state):
         if os.getpid() != sweep_process:
@@ -115,7 +115,7 @@ def share_with_a_forked_worker(monkeypatch, in_the_worker=None) -> list:
             computed_here.extend(points)
         yield from task(self, compiled, points, state)
 
-    monkeypatch.setattr(_Run, "task", shared)
+    monkeypatch.setattr(PointRuns, "task", shared)
     return computed_here
 
 

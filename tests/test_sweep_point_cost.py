@@ -117,11 +117,11 @@ def test_regimes_of_many_spectra_at_once_are_those_of_each_alone():
 
 
 def test_batches_of_any_size_write_the_same_files(tmp_path, one_stage, monkeypatch):
-    import gearsym.sweep.run as sweep_run
+    import gearsym.sweep.point_runs as point_runs
 
     axes = {"omega": [0.8, 0.9, 1.0, 1.1, 1.2]}
     run_sweep(one_stage, axes, direction="both", options=RUN, progress=False, out=tmp_path / "a.csv")
-    monkeypatch.setattr(sweep_run, "POINTS_PER_BATCH", 2)  # batches of 2, 2, 1 each way
+    monkeypatch.setattr(point_runs, "POINTS_PER_BATCH", 2)  # batches of 2, 2, 1 each way
     run_sweep(one_stage, axes, direction="both", options=RUN, progress=False, out=tmp_path / "b.csv")
     for name in ("{}.csv", "{}.poincare.csv"):
         assert (tmp_path / name.format("a")).read_bytes() == (tmp_path / name.format("b")).read_bytes()
@@ -165,17 +165,17 @@ def gearsym_workers(jobs: int):
 
 def test_independent_points_are_dealt_out_in_shrinking_tasks_that_cover_them_in_order():
     from gearsym.sweep.grid import INDEPENDENT, Point
-    from gearsym.sweep.run import _guided
+    from gearsym.sweep.threads import guided
 
     start = np.zeros(2)
     points = [Point(INDEPENDENT, (float(v),)) for v in range(191)]
-    tasks = _guided([([p], start) for p in points], workers=2)
+    tasks = guided([([p], start) for p in points], workers=2)
     sizes = [len(t) for t, _ in tasks]
     assert [p for t, _ in tasks for p in t] == points and all(s is start for _, s in tasks)
     assert sizes[0] == 48 and sizes == sorted(sizes, reverse=True) and sizes[-3:] == [1, 1, 1]
-    assert _guided([([p], start) for p in points], workers=1) == [(points, start)]  # one worker: one batch run
+    assert guided([([p], start) for p in points], workers=1) == [(points, start)]  # one worker: one batch run
     line = [([Point("up", (1.0,)), Point("up", (2.0,))], start)]
-    assert _guided(line, workers=2) is line  # continuation lines stay whole
+    assert guided(line, workers=2) is line  # continuation lines stay whole
 
 
 def test_a_batch_checked_at_once_names_the_point_and_period_that_became_non_finite(tmp_path, one_stage,

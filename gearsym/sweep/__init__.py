@@ -6,7 +6,8 @@ finish (resumable); ``read_sweep(path)`` reads a sweep back.
 """
 from .grid import DIRECTIONS, MODES, Axis, parse_axis
 from .result import SweepResult, read_sweep
-from .run import PARALLEL, POINCARE_SAMPLES, SweepInterrupted, Workers, run_sweep
+from .run import POINCARE_SAMPLES, SweepInterrupted, run_sweep
+from .workers import PARALLEL, Workers
 
 __all__ = ["Axis", "DIRECTIONS", "MODES", "PARALLEL", "POINCARE_SAMPLES", "SweepInterrupted", "SweepResult", "Workers",
            "parse_axis", "read_sweep", "run_sweep"]

@@ -7,7 +7,7 @@ only the points are computed on the workers.
 
 What travels, once per worker (``scatter(broadcast=True)``): the model as a
 :class:`~gearsym.codegen.portable.ShippedModel` (library bytes, C source,
-system; about 0.4 MB) and the sweep's shared settings (a ``_Run`` without its
+system; about 0.4 MB) and the sweep's shared settings (a ``PointRuns`` without its
 compiled model). Each worker process loads the model once (from the bytes, or
 rebuilt from the C on another kind of machine: see
 :mod:`gearsym.codegen.portable`) and keeps it by code hash; each worker thread
@@ -118,7 +118,8 @@ def _workers_ignore_ctrl_c():
 
 def execute_dask(run, tasks: list[tuple[list[Point], np.ndarray]], client,
                  info: dict | None = None) -> Iterator[list[tuple[dict, list]]]:
-    """Yield batches of (row, Poincare rows) as points finish on the cluster of ``client``, like ``run._execute``;
+    """Yield batches of (row, Poincare rows) as points finish on the cluster of ``client``, like
+    ``threads.execute_threads``;
     ``info`` is filled with the scheduler's address and the workers and threads it has.
 
     On an error or Ctrl-C (the generator closed) every outstanding task is cancelled; the points already
@@ -211,3 +212,15 @@ def worker_model(shipped: ShippedModel) -> CompiledModel:
     if clone.system is not shipped.system:  # the same code, another sweep's parameter defaults
         clone = clones[key] = replace(clone, system=shipped.system)
     return clone
+
+
+def execute_on_dask(run, tasks: list[tuple[list[Point], np.ndarray]], scheduler, workers: int, ran: dict):
+    """``threads.execute_threads`` on a Dask cluster, connected (or started) only if there is something to compute;
+    ``ran`` is filled with where it ran."""
+    if not tasks:
+        return
+
+    if scheduler == "local":
+        ran["scheduler"] = "local"  # not the cluster's passing port
+    with connect(scheduler, workers) as client:
+        yield from execute_dask(run, tasks, client, ran)

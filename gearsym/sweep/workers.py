@@ -1,0 +1,62 @@
+"""Where a sweep's points run: :class:`Workers` (processes, threads or a Dask cluster) and the cores this
+process may use."""
+from __future__ import annotations
+
+import multiprocessing
+import os
+from dataclasses import dataclass
+
+from .. import caller
+from ..checks import whole_number
+from ..errors import GearsymError, warn
+from .distributed import check_scheduler
+
+#: ways to use more than one core of this machine (``run_sweep(parallel=...)``)
+PARALLEL = ("auto", "processes", "threads")
+
+
+def cores() -> int:
+    """The cores this process may run on (its affinity where the OS says it, else every core)."""
+    try:
+        return len(os.sched_getaffinity(0)) or 1
+    except AttributeError:
+        return os.cpu_count() or 1
+
+
+@dataclass(frozen=True)
+class Workers:
+    """Where a sweep's points run: ``jobs`` workers (0: one per core) on this machine, as ``"processes"``
+    (this one and ``jobs - 1`` forked from it: nothing is rebuilt; no lock shared between them, so the Python
+    around each point does not serialise them), ``"threads"``, or ``"auto"`` (processes where the OS can fork:
+    Linux, macOS); or, with ``scheduler``, on Dask (the ``distributed`` extra): ``"local"`` starts a cluster of
+    ``jobs`` single-threaded worker processes on this machine for this sweep, ``"tcp://HOST:PORT"`` uses the
+    cluster of that scheduler, a ``distributed.Client`` its cluster. The files are the same, byte for byte, however
+    the points run (on Dask as long as the workers run the client's library: see
+    :mod:`gearsym.codegen.portable`)."""
+
+    jobs: int = 0
+    parallel: str = "auto"
+    scheduler: object = None
+
+    def __post_init__(self):
+        jobs = whole_number(self.jobs, "jobs")
+        if self.parallel not in PARALLEL:
+            raise GearsymError(f"parallel={self.parallel!r}: choose one of {', '.join(PARALLEL)}")
+        if self.scheduler is not None:
+            check_scheduler(self.scheduler, self.jobs)  # no Dask, a bad address: said before any work
+        here = cores()
+        if jobs > here and self.scheduler in (None, "local"):  # (a cluster elsewhere has cores of its own)
+            warn(f"{caller.option('jobs', jobs)}: this machine has {here} core{'s' if here > 1 else ''}; running "
+                 f"{here} worker{'s' if here > 1 else ''} (more would only share them)")
+            object.__setattr__(self, "jobs", here)
+
+    @property
+    def count(self) -> int:
+        return self.jobs or cores()
+
+    @property
+    def mode(self) -> str:
+        """"processes" or "threads" (on this machine)."""
+        if self.parallel != "auto":
+            return self.parallel
+        return "processes" if "fork" in multiprocessing.get_all_start_methods() else "threads"
