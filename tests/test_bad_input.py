@@ -29,7 +29,7 @@ from gearsym.codegen.compiled import CompiledModel
 from gearsym.data import DataError
 from gearsym.errors import GearsymError, GearsymWarning, ModelError
 from gearsym.fit import fit_windows
-from gearsym.fit.explain import segments_of
+from gearsym.fit.selection import segments_of
 from test_checks_before_work import error_line, no_work  # noqa: F401 (a fixture)
 
 GIB = 2**30
@@ -254,7 +254,7 @@ def test_a_parameter_named_twice_in_fit_is_refused(capsys, no_work, one_stage, t
 def test_a_parameter_the_model_lacks_is_named_with_the_model_and_what_it_has(capsys, one_stage, tmp_path,
                                                                             monkeypatch):
     path = measurement_file(tmp_path)
-    monkeypatch.setattr(sys.modules["gearsym.fit.explain"], "fit_windows", lambda *a, **k: pytest.fail("fitted"))
+    monkeypatch.setattr(sys.modules["gearsym.fit.selection"], "fit_windows", lambda *a, **k: pytest.fail("fitted"))
     err = error_line(capsys, "explain", str(path), "--model", "one_stage", "--fit", "zeta,B2", "--out",
                      str(tmp_path / "r"), "--quiet")
     assert "cannot fit B2: one_stage has no parameter B2. Did you mean 'B1' or 'B0'?" in err
@@ -273,7 +273,7 @@ def test_harmonics_below_one_are_refused(capsys, no_work, value, one_stage, tmp_
 
 def test_harmonics_the_data_cannot_resolve_are_refused(one_stage, tmp_path, monkeypatch):
     data = load_measurements(measurement_file(tmp_path, per_period=20), one_stage.system)
-    monkeypatch.setattr(sys.modules["gearsym.fit.explain"], "fit_windows", lambda *a, **k: pytest.fail("fitted"))
+    monkeypatch.setattr(sys.modules["gearsym.fit.selection"], "fit_windows", lambda *a, **k: pytest.fail("fitted"))
     with pytest.raises(GearsymError, match=r"^harmonics=10: these data resolve orders up to 9 .*record has 20\)$"):
         explain(one_stage.system, data, ["zeta"], harmonics=10)
 

@@ -201,7 +201,7 @@ def test_fitting_a_parameter_the_records_set_differently_is_refused_before_fitti
     gearsym.simulate_measurements(model, options=model.integration.run(periods=14, discard=10), samples_per_period=20,
                                   records=[{"omega": 1.2}, {"omega": 1.6}], out=path)
     measurements = gearsym.load_measurements(path, model.system)
-    monkeypatch.setattr(sys.modules["gearsym.fit.explain"], "fit_windows", lambda *a, **k: pytest.fail("fitted anyway"))
+    monkeypatch.setattr(sys.modules["gearsym.fit.selection"], "fit_windows", lambda *a, **k: pytest.fail("fitted anyway"))
     with pytest.raises(GearsymError, match=r"cannot fit omega: the records set it to different values \(1.2, 1.6\)"):
         gearsym.explain(model.system, measurements, ["zeta", "omega"])
 

@@ -26,7 +26,7 @@ from gearsym.errors import GearsymError, ModelError
 from gearsym.fit import Effect, augment, effect_terms, fit_windows, term_effect
 from gearsym.fit.canonical import amplitude_phase, canonical, wrap_phase
 from gearsym.fit.effects import Change
-from gearsym.fit.explain import segments_of
+from gearsym.fit.selection import segments_of
 from gearsym.checks import json_safe
 from gearsym.fit.report import report_page, residual_figure
 from gearsym.paths import REPO_ROOT
@@ -149,7 +149,7 @@ def test_an_accelerometers_offset_is_fitted_by_default_and_the_report_says_so(on
 
 
 def test_only_channels_of_accelerations_get_an_offset_by_default(tmp_path):
-    from gearsym.fit.explain import acceleration_channels
+    from gearsym.fit.selection import acceleration_channels
 
     flexible = conftest.system("flexible_shaft")
     tau = np.linspace(0, 30 * np.pi, 301)

@@ -8,7 +8,7 @@ from ..checks import json_safe
 from ..data import load_measurements
 from ..outputs import check_folder
 from .effects import EFFECTS, FAMILIES, Effect, augment, effect, effect_terms, term_effect
-from .explain import Explanation, explain
+from .selection import Explanation, explain
 from .prediction import Prediction, predict_ahead
 from .report import write_report
 from .result import Fit

@@ -20,7 +20,7 @@ from ..figures.layout import fit_texts
 from ..figures.save import pyplot, save_figure
 from ..system import FirstOrderSystem
 from .effects import augment, effect_terms
-from .explain import MIN_SCORE, Candidate, Explanation
+from .selection import MIN_SCORE, Candidate, Explanation
 
 VERDICTS = {
     "explained": "the effects added explain the data: what is left looks like measurement noise",
