@@ -230,3 +230,20 @@ def test_two_gears_giving_one_parameter_two_values_are_refused():
     model.add(Gear.from_geometry("a", inertia="I", base_radius="r1", **PINION))
     with pytest.raises(ModelError, match="gives I = .* but 'a' gave it"):
         model.add(Gear.from_geometry("b", inertia="I", base_radius="r2", **WHEEL))
+
+
+def test_the_located_crossings_converge_at_fourth_order_with_the_computed_stiffness():
+    """At 12 000 rpm spur_pair's teeth separate; with the series smooth in time, the located crossings keep RK4's
+    fourth order (step halving divides the error by about 16) and beat the unlocated steps by orders of magnitude."""
+    system = gearsym.scaling("spur_pair", speed="12000 rpm").system()
+
+    def final(steps, locate):
+        options = Integration(periods=20, discard=0, steps_per_period=steps, locate_crossings=locate)
+        r = gearsym.lyapunov_spectrum(gearsym.compile_model(system, options))
+        return np.array(list(r.final_state.values()))
+
+    reference = final(3200, True)
+    located = [np.abs(final(steps, True) - reference).max() for steps in (200, 400)]
+    unlocated = np.abs(final(200, False) - reference).max()
+    assert 10 < located[0] / located[1] < 24
+    assert located[0] < 1e-2 * unlocated
