@@ -28,8 +28,8 @@ from ..units import Measure, measure
 #: period the 7th mesh harmonic gets 28 steps per cycle (RK4's error per step ~ (2 pi/28)^5 / 120, 5e-6),
 #: the 15th would get 13; (2) with Lanczos's sigma factors the series has no Gibbs overshoot: for the NASA
 #: rig pair it stays inside the curve's own minimum and maximum (0.658-1.207 of the mean), where the plain
-#: truncated series over- and undershoots by 2 % of the mean at each jump between single and double contact;
-#: (3) the harmonics above the 7th carry under 1 % of the variation's power each (4 % together for the NASA pair),
+#: truncated series over- and undershoots by up to 4 % of the mean at the jumps between single and double contact;
+#: (3) the harmonics above the 7th carry under 1 % of the variation's power each (5 % together for the NASA pair),
 #: and they excite resonances only at speeds below 1/8 of the main one.
 GEOMETRY_HARMONICS = 7
 #: significant digits of the computed mean and Fourier coefficients written into the model: the generated code
