@@ -175,8 +175,11 @@ def test_flexible_shaft_page_shows_the_paper_equations():
 def test_notes_on_the_paper(model):
     notes = derivation(model).notes
     assert any("x ≤ −η" in n and "x ≤ η" in n for n in notes)
+    computed = [c for c in conftest.load(model).couplings if getattr(c, "computed", None) is not None]
     assert any("rectangular_mesh_stiffness" in n and "contact ratio 1.6" in n and "7 Fourier harmonics" in n
-               and "= 0.2" in n for n in notes)
+               and "= 0.2" in n for n in notes) == (not computed)
+    assert all(any("from the gears' geometry" in n and "7 Fourier harmonics with Lanczos factors" in n
+                   and f"contact ratio {c.computed.curve.contact_ratio:.4f}" in n for n in notes) for c in computed)
     assert any(n.startswith("Time unit") for n in notes)
     assert any(n.startswith("Inertias and radii") for n in notes) == (model in {"flexible_shaft", "two_stage"}
                                                                        or model.startswith("planetary"))

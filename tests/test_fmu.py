@@ -283,7 +283,7 @@ def test_a_physical_fmu_is_in_seconds_and_metres(spur):
     assert (v["speed"].unit, v["speed"].displayUnit, v["kZ"].unit, v["eta"].displayUnit) == ("rad/s", "rpm", "N/m",
                                                                                            "um")
     assert v["speed"].start == repr(6000 * TWO_PI / 60)
-    assert v["kZ"].description.startswith("mean mesh stiffness, ISO 6336-1")  # the model file's describe
+    assert v["kZ"].description.startswith("mean mesh stiffness, computed from the pair's geometry")  # the model file's describe
     tunable = {x.name for x in md.modelVariables if x.causality == "parameter" and x.variability == "tunable"}
     fixed = {x.name for x in md.modelVariables if x.causality == "parameter" and x.variability == "fixed"}
     assert tunable == {"speed", "cZ", "eta", "M1a", "Theta", "substeps"}

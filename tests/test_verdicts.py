@@ -73,8 +73,9 @@ def test_distinct_real_exponents_stay_distinct(duffing):
 
 def test_spur_pairs_orbit_has_both_exponents_at_minus_zeta_omega_n():
     """The orbit stays in contact: x'' + 2 zeta x' + k(tau) x = ..., whose trace is -2 zeta everywhere, so a complex
-    pair has the real part -zeta omega_n = -1903.79 /s exactly (up to RK4's error at 200 steps, 1e-6 of it)."""
-    s = gearsym.scaling("spur_pair", speed="6000 rpm")
+    pair has the real part -zeta omega_n = -1724.93 /s exactly (up to RK4's error at 200 steps, 1e-6 of it). At
+    5000 rpm, below the resonance of the mesh frequency's second harmonic (5883 rpm), where the teeth separate."""
+    s = gearsym.scaling("spur_pair", speed="5000 rpm")
     compiled = gearsym.compile_model(s.system())
     r = lyapunov_spectrum(compiled)
     point = s.to_physical(r)
@@ -82,12 +83,12 @@ def test_spur_pairs_orbit_has_both_exponents_at_minus_zeta_omega_n():
     exponents, stderr = point.exponents.magnitude, point.stderr.magnitude
     assert r.pairs == ((0, 1),) and exponents[0] == exponents[1]
     assert abs(exponents[0] - exact) <= 3 * stderr[0] + 1e-6 * abs(exact)
-    # what the pair replaces: Gram-Schmidt's two columns, -1897.1 and -1910.5 /s, split by a bias of 6.7 /s that
-    # their batch-means error of 0.74 /s does not see
+    # what the pair replaces: Gram-Schmidt's two columns, -1730.1 and -1719.8 /s, split by a bias of 5.2 /s that
+    # their batch-means error of 1.0 /s does not see
     run = compiled.tangent_run(None, r.periods, compiled.prepare(compiled.parameter_vector()))
     per_second = exponents[0] / r.exponents[0]
     measured = run.log_stretch[:, r.discard:] / r.period * per_second
-    assert np.max(np.abs(measured.mean(axis=1) - exact)) > 9 * batch_means_stderr(measured).max()
+    assert np.max(np.abs(measured.mean(axis=1) - exact)) > 4 * batch_means_stderr(measured).max()
 
 
 @pytest.mark.parametrize("theta", [0.3, 1.1, 2.9])

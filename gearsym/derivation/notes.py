@@ -57,6 +57,15 @@ def paper_notes(nd: NondimensionalModel, groups: Sequence[GroupRecord], defaults
             f"{DEFAULT_HARMONICS} Fourier harmonics with Lanczos factors, mean 1, relative amplitude {amplitudes}. "
             "Replace it with `Mesh(variation=...)`."
         )
+    for rc, fn in zip(meshes, nd.functions):
+        computed = rc.component.computed
+        if computed is not None:
+            notes.append(
+                f"Mesh stiffness {fn.name}(τ) of mesh '{rc.name}', from the gears' geometry (`Mesh.from_gears`, "
+                f"docs/geometry.md): {computed.describe()}. The potential-energy method gives the stiffness over a "
+                f"mesh period; its mean is the value of {rc.component.stiffness}, and the variation above is its "
+                "Fourier series over that mean."
+            )
     derived = [gr for gr in groups if gr.kind == "derived"]
     if derived:
         behind = sorted(set().union(*(parameter_names(gr.definition) for gr in derived)))

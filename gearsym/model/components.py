@@ -34,7 +34,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Optional, Union
 
+from ..geometry import GearGeometry, StiffnessOptions
+from ..units import Measure
 from .expressions import ExprLike
+from .geometric import GEOMETRY_HARMONICS, ComputedStiffness, body_values, computed_stiffness, geometry_from
 from .stiffness import rectangular_mesh_stiffness
 
 
@@ -62,6 +65,12 @@ class Body:
         """The name of the parameter giving this body's rotational speed, if it is the declared operating speed."""
         return getattr(self, "speed", None)
 
+    def physical_values(self) -> dict[str, Measure]:
+        """The physical values this body gives the model when it is added (a gear from its geometry: its
+        inertia and base radius); none for a body declared with parameters."""
+        geometry = getattr(self, "geometry", None)
+        return {} if geometry is None else body_values(geometry, str(self.inertia), str(self.radius))
+
 
 @dataclass(eq=False, frozen=True)
 class Gear(Body):
@@ -71,12 +80,30 @@ class Gear(Body):
     is teeth x shaft speed), and ``speed``, the name of the parameter that gives this gear's rotational
     speed, on the one body whose speed is the operating point (``speed="speed"``; then
     ``--set speed="3000 rpm"``). ``internal=True`` makes it a ring gear (internal teeth).
+    ``geometry``: the :class:`~gearsym.geometry.GearGeometry` of a gear declared from it (:meth:`from_geometry`).
     """
 
     base_radius: ExprLike = "r"
     teeth: Optional[int] = None
     speed: Optional[str] = None
     internal: bool = field(default=False, kw_only=True)
+    geometry: Optional[GearGeometry] = field(default=None, kw_only=True)
+
+    @classmethod
+    def from_geometry(cls, name: str, geometry: Optional[GearGeometry] = None, *, inertia: Optional[str] = None,
+                      base_radius: Optional[str] = None, speed: Optional[str] = None, **dimensions) -> "Gear":
+        """A gear declared from its geometry: a :class:`~gearsym.geometry.GearGeometry` (SI), or its dimensions
+        as quantities with units (``teeth=28, module="3.175 mm", pressure_angle="20 deg", face_width="6.35 mm"``,
+        and ``profile_shift``, ``helix_angle``, ``bore_diameter``, the rack's coefficients, ``material``).
+
+        Its inertia is the disk with its bore (:attr:`GearGeometry.polar_inertia`), its base radius and tooth count
+        the geometry's: the parameters ``inertia`` and ``base_radius`` (default ``I_<name>``, ``r_<name>``) get them
+        as physical values when the gear is added to a drivetrain. A :meth:`Mesh.from_gears` between two such gears
+        computes its stiffness from them.
+        """
+        geometry = geometry_from(f"Gear {name!r}", geometry, dimensions)
+        return cls(name, inertia=inertia or f"I_{name}", base_radius=base_radius or f"r_{name}",
+                   teeth=geometry.teeth, speed=speed, geometry=geometry)
 
     @property
     def radius(self) -> ExprLike:
@@ -124,6 +151,7 @@ class Mesh:
     * ``damping_group``: name of the damping ratio group (the paper's zeta).
     * ``backlash``: the clearance eta; 0 gives a linear mesh.
     * ``phase``: added to the mesh phase; a planet's position adds its own (see :class:`Planet`).
+    * ``computed``: the stiffness of a mesh declared from its gears' geometry (:meth:`from_gears`).
     """
 
     name: str
@@ -139,10 +167,34 @@ class Mesh:
     function: Optional[str] = None
     damping_group: Optional[str] = None
     stiffness_group: Optional[str] = None
+    computed: Optional[ComputedStiffness] = field(default=None, kw_only=True, repr=False)
 
     @property
     def ends(self) -> tuple[BodyRef, BodyRef]:
         return (self.gear_a, self.gear_b)
+
+    @classmethod
+    def from_gears(cls, name: str, gear_a: Gear, gear_b: Gear, *, harmonics: int = GEOMETRY_HARMONICS,
+                   smoothed: bool = True, options: Optional[StiffnessOptions] = None, centre_distance=None,
+                   stiffness: str = "kZ", **mesh) -> "Mesh":
+        """A mesh between two gears declared from their geometry (``gear_a`` drives): its stiffness over one mesh
+        period by the potential-energy method (:func:`gearsym.geometry.mesh_stiffness`, ``options``), entered as its
+        mean (the physical value of ``stiffness``, N/m, given when the mesh is added to a drivetrain) times its
+        Fourier series in the mesh phase to ``harmonics`` terms (with Lanczos's sigma factors unless
+        ``smoothed=False``). The mesh frequency is the gears' tooth counts times their speed, and the phase
+        0 is the instant a pair of teeth comes into contact. ``centre_distance`` (with its unit) opens a backlash
+        in the geometry, None meshes tight; the model's backlash is still the ``backlash`` parameter. The other
+        keywords are :class:`Mesh`'s (``damping``, ``backlash``, ``coordinate`` ...).
+        """
+        computed = computed_stiffness(f"Mesh {name!r}", getattr(gear_a, "geometry", None),
+                                      getattr(gear_b, "geometry", None),
+                                      (getattr(gear_a, "name", gear_a), getattr(gear_b, "name", gear_b)), options,
+                                      centre_distance, harmonics, smoothed)
+        return cls(name, gear_a, gear_b, stiffness=stiffness, variation=computed.variation(), computed=computed, **mesh)
+
+    def physical_values(self) -> dict[str, Measure]:
+        """The physical values this mesh gives the model when it is added: the mean of a computed stiffness."""
+        return {} if self.computed is None else self.computed.values(str(self.stiffness))
 
 
 @dataclass(eq=False, frozen=True)

@@ -40,6 +40,7 @@ class Drivetrain(Model):
         self._descriptions: dict[str, str] = {}
         self._initial: dict[str, float | Measure] = {}
         self._physical: dict[str, Measure] = {}  # name -> value in SI, read (and checked) when set
+        self._from_geometry: dict[str, tuple[str, Measure]] = {}  # name -> (the component, its value)
         self._length_scale: str | Measure = "static"
         self.version = 0  # bumped by every change, so derived results can be cached safely
 
@@ -56,6 +57,7 @@ class Drivetrain(Model):
             raise ModelError("every component needs a name (a non-empty string)", repr(component))
         if component.name in names:
             raise ModelError("a component with this name was already added; names must be unique", component.name)
+        self._add_physical_values(component)
         if isinstance(component, Body):
             self.bodies.append(component)
         elif isinstance(component, (Mesh, Shaft)):
@@ -68,6 +70,18 @@ class Drivetrain(Model):
                 getattr(component, "name", None),
             )
         return component
+
+    def _add_physical_values(self, component) -> None:
+        """The physical values a component declared from its geometry gives (a gear's inertia and base radius, a
+        mesh's mean stiffness); a value set later with :meth:`set_physical` replaces them."""
+        values = getattr(component, "physical_values", dict)()
+        for name, value in values.items():
+            given = self._from_geometry.get(name)
+            if given is not None and given[1].si != value.si:
+                raise ModelError(f"gives {name} = {value}, but {given[0]!r} gave it {given[1]}: name the parameters "
+                                 f"of the two apart (e.g. inertia='I1' and inertia='I2')", component.name)
+            self._from_geometry[name] = (component.name, value)
+            self._physical[name] = value
 
     def set_defaults(self, **values: ExprLike) -> "Drivetrain":
         """Default values of the model's parameters (checked against the reduced model's parameters)."""

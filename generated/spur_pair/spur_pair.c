@@ -141,7 +141,7 @@ CASADI_SYMBOL_EXPORT int _casadi_real_size(void) { return (int) sizeof(casadi_re
 
 static const casadi_int casadi_s0[3] = {1, 1, 1};
 static const casadi_int casadi_s1[3] = {2, 1, 1};
-static const casadi_int casadi_s2[3] = {7, 1, 1};
+static const casadi_int casadi_s2[3] = {6, 1, 1};
 static const casadi_int casadi_s3[3] = {2, 2, 1};
 static const casadi_int casadi_s4[3] = {5, 1, 1};
 static const casadi_int casadi_s5[3] = {6, 200, 1};
@@ -209,9 +209,9 @@ static const casadi_real casadi_c0[401] =
   392., 393., 394., 395., 396., 397., 398., 399.,
   400.};
 
-/* rhs:(t,y[2],p[7])->(dy[2]) */
+/* rhs:(t,y[2],p[6])->(dy[2]) */
 static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a0, a1, a2, a3, a4, a5, a6, a7;
+  casadi_real a0, a1, a2, a3, a4, a5, a6, a7, a8, a9;
   a0=arg[1]? arg[1][1] : 0;
   if (res[0]!=0) res[0][0]=a0;
   a1=-2.;
@@ -243,40 +243,72 @@ static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a2=(a2+a6);
   a2=(a2/a0);
   a0=1.;
-  a6=arg[2]? arg[2][6] : 0;
-  a3=1.1800386146799999e+00;
-  a4=cos(a5);
-  a3=(a3*a4);
-  a4=1.9272434388400000e-01;
-  a7=4.;
-  a7=(a7*a5);
-  a7=cos(a7);
-  a4=(a4*a7);
-  a3=(a3+a4);
-  a4=1.4883754528799999e-02;
-  a7=7.;
-  a7=(a7*a5);
-  a7=cos(a7);
-  a4=(a4*a7);
-  a3=(a3+a4);
-  a4=-6.0567417982099997e-02;
-  a7=6.;
-  a7=(a7*a5);
-  a7=cos(a7);
-  a4=(a4*a7);
-  a3=(a3+a4);
-  a4=-3.3689450631399998e-01;
+  a6=2.7661221359999999e-01;
+  a3=sin(a5);
+  a6=(a6*a3);
+  a0=(a0+a6);
+  a6=-1.2805164159999999e-01;
+  a3=cos(a5);
+  a6=(a6*a3);
+  a0=(a0+a6);
+  a6=6.2617029230000003e-03;
+  a3=7.;
+  a3=(a3*a5);
+  a4=sin(a3);
+  a6=(a6*a4);
+  a0=(a0+a6);
+  a6=1.3450290380000000e-02;
+  a4=5.;
+  a4=(a4*a5);
+  a7=cos(a4);
+  a6=(a6*a7);
+  a0=(a0+a6);
+  a6=6.7468832359999995e-02;
   a7=(2.*a5);
-  a7=cos(a7);
-  a4=(a4*a7);
-  a3=(a3+a4);
-  a4=-1.9563283778700000e-01;
+  a8=cos(a7);
+  a6=(a6*a8);
+  a0=(a0+a6);
+  a6=4.3708772070000000e-03;
+  a8=6.;
+  a8=(a8*a5);
+  a9=sin(a8);
+  a6=(a6*a9);
+  a0=(a0+a6);
+  a6=9.1421067960000008e-03;
+  a4=sin(a4);
+  a6=(a6*a4);
+  a0=(a0+a6);
+  a6=7.9504500709999995e-02;
+  a7=sin(a7);
+  a6=(a6*a7);
+  a0=(a0+a6);
+  a6=6.7080805820000000e-04;
+  a3=cos(a3);
+  a6=(a6*a3);
+  a0=(a0+a6);
+  a6=4.9745246999999999e-02;
+  a3=4.;
+  a3=(a3*a5);
+  a7=sin(a3);
+  a6=(a6*a7);
+  a0=(a0+a6);
+  a6=6.8506266280000004e-03;
   a7=3.;
   a7=(a7*a5);
+  a5=sin(a7);
+  a6=(a6*a5);
+  a0=(a0+a6);
+  a6=-2.4739900039999999e-02;
   a7=cos(a7);
-  a4=(a4*a7);
-  a3=(a3+a4);
+  a6=(a6*a7);
+  a0=(a0+a6);
+  a6=-8.2022960919999992e-03;
+  a3=cos(a3);
   a6=(a6*a3);
+  a0=(a0+a6);
+  a6=-7.2871874210000001e-03;
+  a8=cos(a8);
+  a6=(a6*a8);
   a0=(a0+a6);
   a2=(a2*a0);
   a1=(a1-a2);
@@ -359,59 +391,91 @@ CASADI_SYMBOL_EXPORT int rhs_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, 
   return 0;
 }
 
-/* jacobian:(t,y[2],p[7])->(J[2x2]) */
+/* jacobian:(t,y[2],p[6])->(J[2x2]) */
 static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a0, a1, a2, a3, a4, a5, a6;
+  casadi_real a0, a1, a2, a3, a4, a5, a6, a7, a8, a9;
   a0=0.;
   if (res[0]!=0) res[0][0]=a0;
   a1=1.;
-  a2=arg[2]? arg[2][6] : 0;
-  a3=1.1800386146799999e+00;
-  a4=arg[0]? arg[0][0] : 0;
-  a5=cos(a4);
-  a3=(a3*a5);
-  a5=1.9272434388400000e-01;
-  a6=4.;
-  a6=(a6*a4);
-  a6=cos(a6);
-  a5=(a5*a6);
-  a3=(a3+a5);
-  a5=1.4883754528799999e-02;
-  a6=7.;
-  a6=(a6*a4);
-  a6=cos(a6);
-  a5=(a5*a6);
-  a3=(a3+a5);
-  a5=-6.0567417982099997e-02;
-  a6=6.;
-  a6=(a6*a4);
-  a6=cos(a6);
-  a5=(a5*a6);
-  a3=(a3+a5);
-  a5=-3.3689450631399998e-01;
-  a6=(2.*a4);
-  a6=cos(a6);
-  a5=(a5*a6);
-  a3=(a3+a5);
-  a5=-1.9563283778700000e-01;
-  a6=3.;
-  a6=(a6*a4);
-  a6=cos(a6);
-  a5=(a5*a6);
-  a3=(a3+a5);
-  a2=(a2*a3);
+  a2=2.7661221359999999e-01;
+  a3=arg[0]? arg[0][0] : 0;
+  a4=sin(a3);
+  a2=(a2*a4);
   a2=(a1+a2);
-  a3=arg[1]? arg[1][0] : 0;
-  a0=(a0<=a3);
+  a4=-1.2805164159999999e-01;
+  a5=cos(a3);
+  a4=(a4*a5);
+  a2=(a2+a4);
+  a4=6.2617029230000003e-03;
+  a5=7.;
+  a5=(a5*a3);
+  a6=sin(a5);
+  a4=(a4*a6);
+  a2=(a2+a4);
+  a4=1.3450290380000000e-02;
+  a6=5.;
+  a6=(a6*a3);
+  a7=cos(a6);
+  a4=(a4*a7);
+  a2=(a2+a4);
+  a4=6.7468832359999995e-02;
+  a7=(2.*a3);
+  a8=cos(a7);
+  a4=(a4*a8);
+  a2=(a2+a4);
+  a4=4.3708772070000000e-03;
+  a8=6.;
+  a8=(a8*a3);
+  a9=sin(a8);
+  a4=(a4*a9);
+  a2=(a2+a4);
+  a4=9.1421067960000008e-03;
+  a6=sin(a6);
+  a4=(a4*a6);
+  a2=(a2+a4);
+  a4=7.9504500709999995e-02;
+  a7=sin(a7);
+  a4=(a4*a7);
+  a2=(a2+a4);
+  a4=6.7080805820000000e-04;
+  a5=cos(a5);
+  a4=(a4*a5);
+  a2=(a2+a4);
+  a4=4.9745246999999999e-02;
+  a5=4.;
+  a5=(a5*a3);
+  a7=sin(a5);
+  a4=(a4*a7);
+  a2=(a2+a4);
+  a4=6.8506266280000004e-03;
+  a7=3.;
+  a7=(a7*a3);
+  a3=sin(a7);
+  a4=(a4*a3);
+  a2=(a2+a4);
+  a4=-2.4739900039999999e-02;
+  a7=cos(a7);
+  a4=(a4*a7);
+  a2=(a2+a4);
+  a4=-8.2022960919999992e-03;
+  a5=cos(a5);
+  a4=(a4*a5);
+  a2=(a2+a4);
+  a4=-7.2871874210000001e-03;
+  a8=cos(a8);
+  a4=(a4*a8);
+  a2=(a2+a4);
+  a4=arg[1]? arg[1][0] : 0;
+  a0=(a0<=a4);
   a0=(a0?a1:0);
-  a5=arg[2]? arg[2][5] : 0;
-  a5=(-a5);
-  a3=(a3<=a5);
-  a3=(a3?a1:0);
-  a0=(a0+a3);
-  a3=arg[2]? arg[2][0] : 0;
-  a5=casadi_sq(a3);
-  a0=(a0/a5);
+  a8=arg[2]? arg[2][5] : 0;
+  a8=(-a8);
+  a4=(a4<=a8);
+  a4=(a4?a1:0);
+  a0=(a0+a4);
+  a4=arg[2]? arg[2][0] : 0;
+  a8=casadi_sq(a4);
+  a0=(a0/a8);
   a2=(a2*a0);
   a2=(-a2);
   if (res[0]!=0) res[0][1]=a2;
@@ -419,7 +483,7 @@ static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a1=-2.;
   a2=arg[2]? arg[2][1] : 0;
   a1=(a1*a2);
-  a1=(a1/a3);
+  a1=(a1/a4);
   if (res[0]!=0) res[0][3]=a1;
   return 0;
 }
@@ -499,7 +563,7 @@ CASADI_SYMBOL_EXPORT int jacobian_work_bytes(casadi_int *sz_arg, casadi_int* sz_
   return 0;
 }
 
-/* constants:(p[7])->(c[5],period) */
+/* constants:(p[6])->(c[5],period) */
 static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a0, a1, a2, a3;
   a0=arg[0]? arg[0][5] : 0;
@@ -595,59 +659,91 @@ CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz
   return 0;
 }
 
-/* table_point:(t,p[7])->(values[2]) */
+/* table_point:(t,p[6])->(values[2]) */
 static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a0, a1, a2, a3, a4, a5;
+  casadi_real a0, a1, a2, a3, a4, a5, a6, a7;
   a0=1.;
-  a1=arg[1]? arg[1][6] : 0;
-  a2=1.1800386146799999e+00;
-  a3=arg[0]? arg[0][0] : 0;
-  a4=cos(a3);
-  a2=(a2*a4);
-  a4=1.9272434388400000e-01;
-  a5=4.;
-  a5=(a5*a3);
-  a5=cos(a5);
-  a4=(a4*a5);
-  a2=(a2+a4);
-  a4=1.4883754528799999e-02;
-  a5=7.;
-  a5=(a5*a3);
-  a5=cos(a5);
-  a4=(a4*a5);
-  a2=(a2+a4);
-  a4=-6.0567417982099997e-02;
-  a5=6.;
-  a5=(a5*a3);
-  a5=cos(a5);
-  a4=(a4*a5);
-  a2=(a2+a4);
-  a4=-3.3689450631399998e-01;
-  a5=(2.*a3);
-  a5=cos(a5);
-  a4=(a4*a5);
-  a2=(a2+a4);
-  a4=-1.9563283778700000e-01;
+  a1=2.7661221359999999e-01;
+  a2=arg[0]? arg[0][0] : 0;
+  a3=sin(a2);
+  a1=(a1*a3);
+  a0=(a0+a1);
+  a1=-1.2805164159999999e-01;
+  a3=cos(a2);
+  a1=(a1*a3);
+  a0=(a0+a1);
+  a1=6.2617029230000003e-03;
+  a3=7.;
+  a3=(a3*a2);
+  a4=sin(a3);
+  a1=(a1*a4);
+  a0=(a0+a1);
+  a1=1.3450290380000000e-02;
+  a4=5.;
+  a4=(a4*a2);
+  a5=cos(a4);
+  a1=(a1*a5);
+  a0=(a0+a1);
+  a1=6.7468832359999995e-02;
+  a5=(2.*a2);
+  a6=cos(a5);
+  a1=(a1*a6);
+  a0=(a0+a1);
+  a1=4.3708772070000000e-03;
+  a6=6.;
+  a6=(a6*a2);
+  a7=sin(a6);
+  a1=(a1*a7);
+  a0=(a0+a1);
+  a1=9.1421067960000008e-03;
+  a4=sin(a4);
+  a1=(a1*a4);
+  a0=(a0+a1);
+  a1=7.9504500709999995e-02;
+  a5=sin(a5);
+  a1=(a1*a5);
+  a0=(a0+a1);
+  a1=6.7080805820000000e-04;
+  a3=cos(a3);
+  a1=(a1*a3);
+  a0=(a0+a1);
+  a1=4.9745246999999999e-02;
+  a3=4.;
+  a3=(a3*a2);
+  a5=sin(a3);
+  a1=(a1*a5);
+  a0=(a0+a1);
+  a1=6.8506266280000004e-03;
   a5=3.;
-  a5=(a5*a3);
+  a5=(a5*a2);
+  a4=sin(a5);
+  a1=(a1*a4);
+  a0=(a0+a1);
+  a1=-2.4739900039999999e-02;
   a5=cos(a5);
-  a4=(a4*a5);
-  a2=(a2+a4);
-  a1=(a1*a2);
+  a1=(a1*a5);
+  a0=(a0+a1);
+  a1=-8.2022960919999992e-03;
+  a3=cos(a3);
+  a1=(a1*a3);
+  a0=(a0+a1);
+  a1=-7.2871874210000001e-03;
+  a6=cos(a6);
+  a1=(a1*a6);
   a0=(a0+a1);
   if (res[0]!=0) res[0][0]=a0;
   a0=arg[1]? arg[1][2] : 0;
   a1=arg[1]? arg[1][3] : 0;
-  a2=arg[1]? arg[1][4] : 0;
-  a2=(a2+a3);
-  a2=cos(a2);
-  a1=(a1*a2);
+  a6=arg[1]? arg[1][4] : 0;
+  a6=(a6+a2);
+  a6=cos(a6);
+  a1=(a1*a6);
   a0=(a0+a1);
   if (res[0]!=0) res[0][1]=a0;
   return 0;
 }
 
-/* map401_table_point:(t[1x401],p[7x401])->(values[2x401]) */
+/* map401_table_point:(t[1x401],p[6x401])->(values[2x401]) */
 static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_int i;
   casadi_real* *res1;
@@ -659,21 +755,21 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   for (i=0; i<401; ++i) {
     if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
     if (arg1[0]) arg1[0]+=1;
-    if (arg1[1]) arg1[1]+=7;
+    if (arg1[1]) arg1[1]+=6;
     if (res1[0]) res1[0]+=2;
   }
   return 0;
 }
 
-/* table:(t0,p[7])->(table[6x200],probe[2x2]) */
+/* table:(t0,p[6])->(table[6x200],probe[2x2]) */
 static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_int i, j;
-  casadi_real **res1=res+2, *rr, w00, *w01=w+6, *w02=w+407, *w03=w+414, w04, w05, w06, *w07=w+419, *w08=w+3226, *w09=w+4028;
-  casadi_real *w10=w+4428, *w11=w+4828, *w12=w+5228, *w13=w+5628, *w14=w+6828, *w15=w+8028;
+  casadi_real **res1=res+2, *rr, w00, *w01=w+8, *w02=w+409, *w03=w+415, w04, w05, w06, *w07=w+420, *w08=w+2826, *w09=w+3628;
+  casadi_real *w10=w+4028, *w11=w+4428, *w12=w+4828, *w13=w+5228, *w14=w+6428, *w15=w+7628;
   const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01;
   w00 = arg[0] ? arg[0][0] : 0;
   wr01 = casadi_c0;
-  casadi_copy(arg[1], 7, w02);
+  casadi_copy(arg[1], 6, w02);
   arg1[0]=w02;
   res1[0]=w03;
   res1[1]=(&w04);
@@ -684,7 +780,7 @@ static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w05);
   for (i=0, rr=w01, cs=w01; i<401; ++i) (*rr++)  = (w00+(*cs++));
   for (i=0;i<401;++i) {
-    casadi_copy(w02, 7, w07+ i*7);
+    casadi_copy(w02, 6, w07+ i*6);
   }
   arg1[0]=w01;
   arg1[1]=w07;
@@ -784,7 +880,7 @@ CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casa
   if (sz_arg) *sz_arg = 6;
   if (sz_res) *sz_res = 4;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 8030;
+  if (sz_w) *sz_w = 7630;
   return 0;
 }
 
@@ -792,7 +888,7 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
   if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 4*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 8030*sizeof(casadi_real);
+  if (sz_w) *sz_w = 7630*sizeof(casadi_real);
   return 0;
 }
 
