@@ -111,11 +111,22 @@ class LaneRunner:
     """Runs of ``model`` from many starts, ``discard`` periods of transient then ``measured`` recorded, L at a
     time (the lanes) or, without lanes, one at a time (the scalar loops: the same numbers)."""
 
-    def __init__(self, model: CompiledModel, discard: int, measured: int, *, lanes: bool = True,
+    def __init__(self, model: CompiledModel, discard: int, measured: int, *, lanes: bool | LaneLibrary = True,
                  verbose: bool = False):
+        """``lanes``: True (the model's lanes, compiled the first time), False (the scalar loops), or a
+        :class:`LaneLibrary` of the model's lanes built otherwise."""
         self.model, self.discard, self.measured = model, int(discard), int(measured)
-        self.library = lanes_of(model, verbose) if lanes else None
+        self.library = lanes if isinstance(lanes, LaneLibrary) else lanes_of(model, verbose) if lanes else None
         self.width = self.library.width if self.library else 1
+        self._local = threading.local()  # the scalar loops' model of each thread (its work arrays are its own)
+
+    def _scalar_model(self) -> CompiledModel:
+        if threading.current_thread() is threading.main_thread():
+            return self.model
+        model = getattr(self._local, "model", None)
+        if model is None:
+            model = self._local.model = self.model.clone()
+        return model
 
     @property
     def vectorised(self) -> bool:
@@ -171,7 +182,7 @@ class LaneRunner:
         final[...] = lanes.T[:count]
 
     def _scalar_block(self, starts, inputs: RunInputs, c, tangent, strobe, low, high, final, logs) -> None:
-        model, d, periods = self.model, self.discard, self.discard + self.measured
+        model, d, periods = self._scalar_model(), self.discard, self.discard + self.measured
         for i, y0 in enumerate(starts):
             point = _with_constants(inputs, c[i]) if np.ndim(c) == 2 else inputs
             try:

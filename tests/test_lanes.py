@@ -1,0 +1,136 @@
+"""The lanes (gearsym/codegen/lanes.py): L trajectories at once give, lane by lane, the scalar loop's numbers.
+
+Without fused multiply-adds every lane does the scalar loop's operations in its order, so the records must be the
+same bits; a chaotic model (Lorenz) turns any difference into an O(1) one within a few periods, so it is the
+sharpest check. The libraries are built with -O3 alone: no -march, so the lanes' entry points are the portable
+build's (cloned for AVX2 and the baseline, the CPU choosing at load time), which is also what must run on a CPU
+without AVX2.
+"""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gearsym import Integration
+from gearsym.codegen.compiled import CompiledModel
+from gearsym.codegen.compiler import compile_library, find_compiler
+from gearsym.codegen.functions import LoopOptions, build_functions
+from gearsym.codegen.generate import code_hash, write_code
+from gearsym.codegen.lane_runs import LaneLibrary, LaneRunner
+from gearsym.codegen.library import library_functions
+from gearsym.codegen.native import load_native
+from gearsym.paths import REPO_ROOT
+
+import conftest
+
+needs_cc = pytest.mark.skipif(find_compiler() is None, reason="needs a C compiler")
+
+#: no fused multiply-adds, no -march: the portable build
+PORTABLE = ("-O3",)
+
+
+def _built(name: str, options: LoopOptions, tmp_path: Path, flags=PORTABLE) -> tuple[CompiledModel, LaneLibrary]:
+    """The model's scalar loops and its lanes, both compiled with ``flags`` from freshly generated C."""
+    system = conftest.system(name)
+    mf = build_functions(system, options)
+    digest = code_hash(system, options)
+    code = write_code(mf, tmp_path / name, digest)
+    main = compile_library(code.source, name, flags=flags).path
+    lanes = compile_library(code.lanes, f"{name}_lanes", flags=flags).path
+    functions = library_functions(main)
+    integration = Integration(steps_per_period=options.steps_per_period, locate_crossings=options.locate_crossings)
+    model = CompiledModel(system, options, digest, functions, "compiled", main, {}, load_native(main, functions),
+                          integration)
+    return model, LaneLibrary(lanes)
+
+
+def _records_equal(a, b) -> list[str]:
+    return [f for f in a.__dataclass_fields__ if not np.array_equal(getattr(a, f), getattr(b, f), equal_nan=True)]
+
+
+@needs_cc
+@pytest.mark.parametrize("name, located, omega", [("one_stage", True, 1.5), ("one_stage", False, 1.0),
+                                                  ("lorenz", False, None)])
+def test_every_lane_gives_the_bits_of_the_scalar_loop_from_its_start(name, located, omega, tmp_path):
+    # the plain scheme in blocks of 3 steps and 45 steps a period: blocks of several steps, an odd number of them
+    options = LoopOptions(steps_per_period=45 if not located else 90, block_steps=3, locate_crossings=located)
+    model, lanes = _built(name, options, tmp_path)
+    assert lanes.width >= 2, "the portable build has lanes (cloned for AVX2 and the baseline on x86-64)"
+    values = {"omega": omega} if omega else {}
+    inputs = model.prepare(model.parameter_vector(values))
+    n = model.dimension
+    starts = np.random.default_rng(5).uniform(-5, 5, size=(2 * lanes.width + 1, n))  # a last block not full
+    if name == "lorenz":
+        starts += [0, 0, 25]
+    for tangent in (False, True):
+        wide = LaneRunner(model, 7, 30, lanes=lanes).orbits(starts, inputs, tangent=tangent)
+        one = LaneRunner(model, 7, 30, lanes=False).orbits(starts, inputs, tangent=tangent)
+        assert np.isfinite(one.strobe).all()
+        assert _records_equal(wide, one) == [], (name, located, tangent)
+    if located:  # the lanes' split ran: some trajectory crossed the backlash surface x = 0
+        x = one.strobe[:, :, 0]
+        assert ((x.min(axis=1) < 0) & (x.max(axis=1) > 0)).any()
+
+
+@needs_cc
+def test_constants_may_differ_from_lane_to_lane(tmp_path):
+    """Points of a sweep that share their tables (omega in tau) run in one call, each lane with its constants."""
+    model, lanes = _built("one_stage", LoopOptions(steps_per_period=60, locate_crossings=True), tmp_path)
+    omegas = np.linspace(0.9, 1.6, lanes.width + 2)
+    inputs = [model.prepare(model.parameter_vector(omega=w)) for w in omegas]
+    constants = np.array([i.constants for i in inputs])
+    start = np.tile([-2.0, -0.5], (len(omegas), 1))
+    wide = LaneRunner(model, 5, 20, lanes=lanes).orbits(start, inputs[0], constants=constants, tangent=True)
+    for i, point in enumerate(inputs):
+        one = LaneRunner(model, 5, 20, lanes=False).orbits(start[i:i + 1], point, tangent=True)
+        assert np.array_equal(wide.strobe[i], one.strobe[0]) and np.array_equal(wide.log_stretch[i], one.log_stretch[0])
+
+
+def _cpu_flags() -> set[str]:
+    try:
+        text = Path("/proc/cpuinfo").read_text()
+    except OSError:
+        return set()
+    line = next((l for l in text.splitlines() if l.startswith("flags")), "")
+    return set(line.split(":", 1)[-1].split())
+
+
+@needs_cc
+def test_the_lanes_are_as_wide_as_the_target_says():
+    """With the default flags (-march=native) the width comes from the target's macros: 8 doubles with AVX-512,
+    4 with AVX, else the portable build's."""
+    model = conftest.compiled("one_stage")
+    width = LaneRunner(model, 1, 1).width
+    cpu = _cpu_flags()
+    if not cpu:
+        pytest.skip("no /proc/cpuinfo to read the CPU's flags from")
+    expected = 8 if "avx512f" in cpu else 4
+    assert width == expected
+
+
+@needs_cc
+def test_under_the_default_flags_the_lanes_agree_with_the_scalar_loop_to_rounding():
+    """With fused multiply-adds gcc may fuse other multiply-adds in the scalar loop (where its basic-block
+    vectoriser packs operations) than in the lanes: the same numbers to rounding (on a periodic attractor,
+    where rounding does not grow)."""
+    model = conftest.compiled("one_stage")
+    inputs = model.prepare(model.parameter_vector(omega=1.5))
+    starts = np.array([[-2.0, -0.5], [-1.5, -0.4], [-2.5, -0.7], [-1.8, -0.6], [-2.2, -0.3]])
+    wide = LaneRunner(model, 50, 50).orbits(starts, inputs)
+    one = LaneRunner(model, 50, 50, lanes=False).orbits(starts, inputs)
+    assert np.allclose(wide.strobe, one.strobe, rtol=0, atol=1e-10)
+
+
+def test_every_per_step_piece_is_printed_as_a_loop_over_the_lanes():
+    """The lanes' C of a committed model: each per-step piece in a loop over the lanes with its inputs indexed by
+    lane (the table shared), the split and Gram-Schmidt the scalar loops' own functions."""
+    source = (REPO_ROOT / "generated" / "one_stage" / "one_stage_lanes.c").read_text()
+    for piece in ("tangent_state", "tangent_vector", "state_try", "state_keep"):
+        body = re.search(rf"static GEARSYM_INLINE void gsl_{piece}\(.*?\n}}\n", source, re.S).group(0)
+        assert "GS_LANES {" in body and "[GS_L*" in body and not re.search(r"\bA0\[\d+\]", body), piece
+    assert "gs_state_split(ys, los, his, yts, T, cs, y1s, lo1s, hi1s);" in source
+    assert "gs_gram_schmidt(Qc, Qn, lg);" in source
+    assert 'target_clones("avx2", "default")' in source
