@@ -35,7 +35,7 @@ from ..checks import json_safe, whole_number
 from ..codegen import CompiledModel, engine_verb
 from ..options import Integration
 from ..errors import GearsymError, suggest
-from .lyapunov import LyapunovSpectrum, lyapunov_spectrum
+from .lyapunov import LyapunovSpectrum, lyapunov_spectra
 from .regime import classify_regime
 
 #: the box initial states are drawn from, for every state the caller does not name
@@ -256,7 +256,7 @@ def find_attractors(
         starts = np.random.default_rng(seed).uniform(low, high, size=(ics, compiled.dimension))
         used_seed = seed
 
-    spectra = [_run(compiled, p, y0, i, options) for i, y0 in enumerate(starts)]
+    spectra = lyapunov_spectra(compiled, starts, options, p)  # many at once, in the lanes
     clouds = [s.strobe for s in spectra]
     scale = _scales(clouds)
     groups = _group(clouds, scale, merge_factor, resolution, merge_floor)
@@ -295,15 +295,6 @@ def _explicit_states(compiled: CompiledModel, initial_states) -> np.ndarray:
     if not states:
         raise GearsymError("initial_states is empty: give at least one initial state")
     return np.array([compiled.initial_state(y0) for y0 in states])
-
-
-def _run(compiled: CompiledModel, p: np.ndarray, y0: np.ndarray, index: int,
-         options: Integration) -> LyapunovSpectrum:
-    try:
-        return lyapunov_spectrum(compiled, options=options, y0=y0, **dict(zip(compiled.parameter_names, p)))
-    except GearsymError as exc:
-        start = ", ".join(f"{n}={v:g}" for n, v in zip(compiled.state_names, y0))
-        raise GearsymError(f"initial state #{index} ({start}): {exc}") from exc
 
 
 # ------------------------------------------------------------------------------------------ grouping

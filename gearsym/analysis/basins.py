@@ -167,6 +167,31 @@ class BasinMap:
             data["labels"] = self.labels.tolist()  # rows: the values of the second state; columns: the first's
         return data
 
+    @classmethod
+    def from_dict(cls, data: dict) -> "BasinMap":
+        """The map :meth:`as_dict` wrote (with its labels), read back: JSON's floats give the same bits."""
+        states = tuple(data["states"])
+        grid = data["grid"]
+        names = [k for k in grid if k not in ("held", "starts")]
+
+        def array(values):
+            return np.array([np.nan if v is None else v for v in values], dtype=float)
+
+        attractors = tuple(BasinAttractor(
+            number=a["number"], basin=Fraction(a["starts"], grid["starts"]), period=a["period"], regime=a["regime"],
+            amplitude=dict(a["amplitude"]), exponents=array(a["exponents"]),
+            exponents_stderr=array(a["exponents_stderr"]),
+            points=np.array([array(a["points"][s]) for s in states]).reshape(len(states), -1),
+            representative=dict(a["representative"])) for a in data["attractors"])
+        return cls(data["model"], dict(data["parameters"]), states,
+                   tuple((n, np.array(grid[n], dtype=float)) for n in names), dict(grid["held"]),
+                   np.array(data["labels"], dtype=int), attractors,
+                   Fraction(data["diverged"]["starts"], grid["starts"]),
+                   Fraction(data["undecided"]["starts"], grid["starts"]),
+                   np.array([data["scale"][s] for s in states]), data["periods"], data["discard"],
+                   data["steps_per_period"], data["period"], data["backend"], data["locate_crossings"], data["lanes"],
+                   dict(data["method"]))
+
 
 # ------------------------------------------------------------------------------------------ entry point
 @engine_verb(default=Integration(**RUN))

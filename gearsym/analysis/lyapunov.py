@@ -19,7 +19,8 @@ import numpy as np
 
 from ..checks import json_safe
 from ..codegen import CompiledModel, TangentRuns, engine_verb
-from ..errors import warn
+from ..codegen.lane_runs import LaneRunner
+from ..errors import GearsymError, warn
 from ..options import Integration
 from .regime import EQUILIBRIUM, classify_regime, classify_regimes
 from .statistics import batch_means_stderr
@@ -150,6 +151,41 @@ def lyapunov_spectrum(model: CompiledModel, *, options: Integration | None = Non
         info={"Q": run.Q, "locate_crossings": model.options.locate_crossings},
         eigenvalues=summary.eigenvalues[0],
     )
+
+
+def lyapunov_spectra(model: CompiledModel, starts: np.ndarray, options: Integration, p: np.ndarray, *,
+                     lanes: bool = True) -> list[LyapunovSpectrum]:
+    """:func:`lyapunov_spectrum` of ``model`` at the parameter vector ``p`` from each of ``starts`` (runs x n),
+    many at once in the lanes (:mod:`gearsym.codegen.lane_runs`: each lane the scalar loop's numbers); a run that
+    does not stay finite raises the error :func:`lyapunov_spectrum` raises, naming its start."""
+    inputs = model.prepare(p)
+    records = LaneRunner(model, 0, options.periods, lanes=lanes).orbits(starts, inputs, tangent=True)
+    count, n, o = len(starts), model.dimension, len(model.observed)
+    runs = TangentRuns(n, o, options.periods, max(count, 1))
+    for i in range(count):
+        try:
+            model.check_finite(p, records.strobe[i].T, records.log_stretch[i].T)
+        except GearsymError as exc:
+            start = ", ".join(f"{name}={v:g}" for name, v in zip(model.state_names, starts[i]))
+            raise GearsymError(f"initial state #{i} ({start}): {exc}") from None
+    runs.strobe[:count], runs.log_stretch[:count] = records.strobe, records.log_stretch
+    runs.low[:count], runs.high[:count] = records.low, records.high
+    summary = summarise_runs(model, runs, np.tile(p, (count, 1)), np.full(count, inputs.period), options.discard)
+    out = []
+    for i in range(count):
+        measured = runs.log_stretch[i, options.discard:] / inputs.period
+        history = np.cumsum(measured, axis=0) / np.arange(1, measured.shape[0] + 1)[:, None]
+        out.append(LyapunovSpectrum(
+            model=model.name, parameters=dict(zip(model.parameter_names, map(float, p))),
+            exponents=summary.exponents[i], stderr=summary.stderr[i], history=history[:, summary.order[i]],
+            amplitude=dict(zip(model.observed, map(float, summary.amplitude[i]))),
+            final_state=dict(zip(model.state_names, map(float, records.final[i]))),
+            strobe=runs.strobe[i, options.discard:].T.copy(), periods=options.periods, discard=options.discard,
+            steps_per_period=model.steps_per_period, period=inputs.period, backend=model.backend,
+            autonomous=model.system.autonomous,
+            info={"Q": records.Q[i], "locate_crossings": model.options.locate_crossings},
+            eigenvalues=summary.eigenvalues[i]))
+    return out
 
 
 @dataclass(frozen=True)

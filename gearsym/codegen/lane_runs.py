@@ -102,9 +102,11 @@ class OrbitRecords:
 
 @dataclass(frozen=True)
 class TangentRecords(OrbitRecords):
-    """:class:`OrbitRecords` with each measured period's log stretches of the tangent vectors."""
+    """:class:`OrbitRecords` with each measured period's log stretches of the tangent vectors, and the final
+    tangent vectors."""
 
     log_stretch: np.ndarray  # (starts, periods, n)
+    Q: np.ndarray  # (starts, n, n): the final orthonormal tangent vectors (columns)
 
 
 class LaneRunner:
@@ -142,17 +144,18 @@ class LaneRunner:
         k, P = starts.shape[0], self.measured
         strobe, logs = np.empty((k, P, n)), (np.empty((k, P, n)) if tangent else None)
         low, high, final = np.empty((k, P, o)), np.empty((k, P, o)), np.empty((k, n))
+        Q = np.empty((k, n, n)) if tangent else None
         run = self._lane_block if self.library else self._scalar_block
         for at in range(0, k, self.width):
             rows = slice(at, min(k, at + self.width))
             c = inputs.constants if constants is None else constants[rows]
             run(starts[rows], inputs, c, tangent, strobe[rows], low[rows], high[rows], final[rows],
-                None if logs is None else logs[rows])
+                None if logs is None else logs[rows], None if Q is None else Q[rows])
         if tangent:
-            return TangentRecords(strobe, low, high, final, logs)
+            return TangentRecords(strobe, low, high, final, logs, Q)
         return OrbitRecords(strobe, low, high, final)
 
-    def _lane_block(self, starts, inputs: RunInputs, c, tangent, strobe, low, high, final, logs) -> None:
+    def _lane_block(self, starts, inputs: RunInputs, c, tangent, strobe, low, high, final, logs, Qs) -> None:
         L, (count, n), o, P = self.width, starts.shape, len(self.model.observed), self.measured
         lanes = np.empty((n, L))
         lanes[:, :count] = starts.T
@@ -173,6 +176,7 @@ class LaneRunner:
             lib.lyapunov(table, cl.ctypes.data, P, lanes.ctypes.data, Q.ctypes.data, s.ctypes.data, lg.ctypes.data,
                          lo.ctypes.data, hi.ctypes.data)
             logs[...] = lg.transpose(2, 0, 1)[:count]
+            Qs[...] = Q.reshape(n, n, L).transpose(2, 0, 1)[:count]  # (r, j) of lane l: row r of vector j
         else:
             if self.discard:
                 lib.orbit(table, cl.ctypes.data, self.discard, lanes.ctypes.data, None, None, None)
@@ -181,7 +185,7 @@ class LaneRunner:
         low[...], high[...] = lo.transpose(2, 0, 1)[:count], hi.transpose(2, 0, 1)[:count]
         final[...] = lanes.T[:count]
 
-    def _scalar_block(self, starts, inputs: RunInputs, c, tangent, strobe, low, high, final, logs) -> None:
+    def _scalar_block(self, starts, inputs: RunInputs, c, tangent, strobe, low, high, final, logs, Qs) -> None:
         model, d, periods = self._scalar_model(), self.discard, self.discard + self.measured
         for i, y0 in enumerate(starts):
             point = _with_constants(inputs, c[i]) if np.ndim(c) == 2 else inputs
@@ -189,14 +193,14 @@ class LaneRunner:
                 if tangent:
                     run = model.tangent_run(y0, periods, point)
                     s, lo, hi = run.strobe, run.low, run.high
-                    logs[i] = run.log_stretch[:, d:].T
+                    logs[i], Qs[i] = run.log_stretch[:, d:].T, run.Q
                 else:
                     s, lo, hi = model.orbit_run(y0, periods, point)
             except GearsymError:  # diverged: its records are not finite (as the lanes' would be: inf or NaN)
                 o = len(model.observed)
                 s, lo, hi = (np.full((rows, periods), np.nan) for rows in (model.dimension, o, o))
                 if tangent:
-                    logs[i] = np.nan
+                    logs[i], Qs[i] = np.nan, np.nan
             strobe[i], low[i], high[i], final[i] = s[:, d:].T, lo[:, d:].T, hi[:, d:].T, s[:, -1]
 
 

@@ -130,8 +130,13 @@ def plot_basin_map(result, path: str | Path | None = None, shown: Shown | None =
     ax.set_xlabel(_label(x, ux))
     ax.set_ylabel(_label(y, uy))
     ax.margins(0.02)
-    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7.5, frameon=False,
-              title="attractor: what it is, its basin (the markers: its Poincaré points)", title_fontsize=7.5)
+    title = "attractor: what it is, its basin (the markers: its Poincaré points)"
+    if own:
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7.5, frameon=False,
+                  title=title, title_fontsize=7.5)
+    else:  # a panel among others: the legend below it
+        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.14), fontsize=6.5, frameon=False,
+                  title=title, title_fontsize=6.5)
     if own:
         ax.set_title(map_title(result, shown), fontsize=8.5)
         fig.supxlabel(textwrap.fill(run_text(result) + ". Each attractor's exponents from one tangent run on it; a "
@@ -170,12 +175,14 @@ def plot_basin_fractions(result, path: str | Path | None = None, shown: Shown | 
         f = result.fractions(kind)
         if f.any():
             top.plot(values, f, color=c if kind == "diverged" else "0.6", ls="--", lw=1.0, label=kind)
+    said: dict[float, list[str]] = {}
     for e in result.events:
-        xv = where[e["value"]]
-        text = {"appears": f"{e['attractor']} appears", "vanishes": f"{e['attractor']} vanishes",
-                "merges": f"{e['attractor']} merges into {e['into']}"}[e["event"]]
+        said.setdefault(where[e["value"]], []).append(
+            {"appears": f"{e['attractor']} appears", "vanishes": f"{e['attractor']} vanishes",
+             "merges": f"{e['attractor']} merges into {e['into']}"}[e["event"]])
+    for xv, texts in said.items():  # (one line per value: the events of one value never overlap)
         top.axvline(xv, color="0.7", ls=":", lw=0.8)
-        top.annotate(text, (xv, 1.0), xytext=(2, -4), textcoords="offset points", rotation=90, va="top",
+        top.annotate(", ".join(texts), (xv, 1.0), xytext=(2, -4), textcoords="offset points", rotation=90, va="top",
                      fontsize=6.5, color="0.3")
     top.set_ylim(-0.02, 1.05)
     top.set_ylabel("fraction of starts (± binomial s.e.)")
@@ -197,7 +204,7 @@ def plot_basin_fractions(result, path: str | Path | None = None, shown: Shown | 
              + (f"; {shown.parameters(fixed)}" if fixed else "")
              + f"; {record['periods']} periods per start, {record['discard']} discarded, "
              + ("crossings located" if record.get("locate_crossings") else "plain RK4"))
-    fig.suptitle(textwrap.fill(title, 140), fontsize=8)
+    fig.suptitle(textwrap.fill(title, 150), fontsize=8)
     if path is not None:
         save_figure(fig, path, dpi=120)
     return fig

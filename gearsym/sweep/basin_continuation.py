@@ -106,7 +106,7 @@ def _row_dict(r: Tracked, parameter: str) -> dict:
 @engine_verb(default=Integration(**RUN))
 def continue_basins(model: CompiledModel, grid, parameter: str, values: Sequence[float], *,
                     options: Integration | None = None, y0=None, out: str | Path | None = None,
-                    overwrite: bool = False, jobs: int = 0, lanes: bool = True,
+                    overwrite: bool | str = False, jobs: int = 0, lanes: bool = True,
                     match_distance: float = MATCH_DISTANCE, grid_spec: Sequence[str] = (), progress: bool = False,
                     on_value: Callable[[BasinMap], None] | None = None, **fixed: float) -> BasinContinuation:
     """Basin maps of ``model`` on ``grid`` at each of ``values`` of ``parameter`` (ascending), their attractors
@@ -138,6 +138,8 @@ def continue_basins(model: CompiledModel, grid, parameter: str, values: Sequence
     store = _Store(Path(out), model.state_names, model.observed, model.dimension, parameter) if out else None
     try:
         rows, done = store.open(record, overwrite) if store else ([], [])
+        # (a rerun of a finished continuation reads its files and writes nothing)
+        finished = bool(store) and len(done) == len(values) and store.status() == "complete"
         previous = _last(rows, done)
         for value in values:
             if value in done:
@@ -158,7 +160,7 @@ def continue_basins(model: CompiledModel, grid, parameter: str, values: Sequence
         rows.sort(key=lambda r: (order[r.value], _class_order(r)))
         result = BasinContinuation(model.name, parameter, values, model.state_names, tuple(rows),
                                    tuple(events(rows, values)), record, store.path if store else None)
-        if store:
+        if store and not finished:
             store.write(rows, done, record, complete=True)
         return result
     finally:
@@ -254,26 +256,22 @@ class _Store:
         self.point_columns = [parameter, "attractor", "point", *states]
         self._lock: int | None = None
 
-    def open(self, record: dict, overwrite: bool) -> tuple[list[Tracked], list[float]]:
-        """The rows of the values already done, and those values in order (none: a fresh start)."""
+    def open(self, record: dict, overwrite: bool | str) -> tuple[list[Tracked], list[float]]:
+        """The rows of the values already done, and those values in order (none: a fresh start).
+        ``overwrite="stale"``: start again files another continuation (or another model) wrote, resume this one's
+        (how the reproduction keeps its data)."""
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._lock = take_lock(self.path)
+        if overwrite == "stale":
+            overwrite = self.path.exists() and self._differs(record) is not None
         if overwrite:
             for p in (self.path, self.points_path, self.meta_path):
                 p.unlink(missing_ok=True)
         if not self.path.exists():
             return [], []
-        try:
-            old = json.loads(self.meta_path.read_text())["basins"]
-        except (OSError, ValueError, KeyError, TypeError):
-            raise GearsymError(f"{self.path} exists but {self.meta_path.name} (the record of how it was made) is "
-                               "missing or damaged, so it cannot be resumed: pass --overwrite or choose another "
-                               "--out") from None
-        new = json.loads(json.dumps(record))
-        differ = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
-        if differ:
-            raise GearsymError(f"{self.path} was written by another basin continuation ({', '.join(differ)} "
-                               "differ); repeat the command it came from to resume it, or pass --overwrite")
+        why = self._differs(record)
+        if why:
+            raise GearsymError(why)
         points: dict[tuple[float, int], list] = {}
         for row in read_rows(self.points_path, self.point_columns) if self.points_path.exists() else []:
             key = (float(row[self.parameter]), int(row["attractor"]))
@@ -281,6 +279,20 @@ class _Store:
         rows = [self._tracked(row, points) for row in read_rows(self.path, self.columns)]
         done = list(dict.fromkeys(r.value for r in rows))
         return rows, done
+
+    def _differs(self, record: dict) -> str | None:
+        """Why the files cannot be resumed with ``record`` (another continuation's, or damaged), or None."""
+        try:
+            old = json.loads(self.meta_path.read_text())["basins"]
+        except (OSError, ValueError, KeyError, TypeError):
+            return (f"{self.path} exists but {self.meta_path.name} (the record of how it was made) is missing or "
+                    "damaged, so it cannot be resumed: pass --overwrite or choose another --out")
+        new = json.loads(json.dumps(record))
+        differ = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
+        if differ:
+            return (f"{self.path} was written by another basin continuation ({', '.join(differ)} differ); repeat "
+                    "the command it came from to resume it, or pass --overwrite")
+        return None
 
     def _tracked(self, row: dict, points: dict) -> Tracked:
         value = float(row[self.parameter])
@@ -320,6 +332,13 @@ class _Store:
                 "values": {"planned": len(record["values"]), "done": len(done)},
                 "events": json_safe(events(rows, done)), "gearsym": __version__}
         write_atomically(self.meta_path, json.dumps(meta, indent=2) + "\n")
+
+    def status(self) -> str | None:
+        """What the record says of the continuation: running, complete (None: no record)."""
+        try:
+            return json.loads(self.meta_path.read_text()).get("status")
+        except (OSError, ValueError, AttributeError):
+            return None
 
     def release(self) -> None:
         if self._lock is not None:
