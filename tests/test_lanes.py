@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import gearsym
 from gearsym import Integration
 from gearsym.codegen.compiled import CompiledModel
 from gearsym.codegen.compiler import compile_library, find_compiler
@@ -134,3 +135,25 @@ def test_every_per_step_piece_is_printed_as_a_loop_over_the_lanes():
     assert "gs_state_split(ys, los, his, yts, T, cs, y1s, lo1s, hi1s);" in source
     assert "gs_gram_schmidt(Qc, Qn, lg);" in source
     assert 'target_clones("avx2", "default")' in source
+
+
+@needs_cc
+@pytest.mark.parametrize("name, axes", [("one_stage", ["omega=1.5,1.6,1.7,1.8,1.9"]),
+                                        ("flexible_shaft", ["omega=1.5,1.8", "kS=0.5,1.0,2.0"])])
+def test_an_independent_sweep_in_the_lanes_gives_the_scalar_sweeps_rows(name, axes):
+    """Points that only move constants share a lanes call, each lane with its constants: the rows are those of
+    the scalar sweep (periodic points, where a rounding difference would not grow: the lanes may fuse other
+    multiply-adds than the scalar loop)."""
+    model = conftest.compiled(name)
+    kw = dict(mode="independent", options=Integration(periods=60, discard=20), progress=False,
+              workers=gearsym.Workers(jobs=1))
+    wide = gearsym.run_sweep(model, axes, lanes=True, **kw)
+    one = gearsym.run_sweep(model, axes, **kw)
+    assert len(wide) == len(one) == (5 if name == "one_stage" else 6)
+    for column in one.columns:
+        a, b = wide[column], one[column]
+        if a.dtype.kind in "fc":
+            assert np.allclose(a, b, rtol=1e-9, atol=1e-12), column
+        else:
+            assert list(a) == list(b), column
+    assert list(wide.record.items()) == list(one.record.items())

@@ -34,6 +34,7 @@ import numpy as np
 from ..analysis.lyapunov import summarise_runs
 from ..checks import whole_number
 from ..codegen import CompiledModel, engine_verb, TangentRuns
+from ..codegen.lane_runs import LaneRunner
 from ..errors import GearsymError, UnknownParameterError
 from ..options import Integration
 from ..version import __version__
@@ -109,6 +110,7 @@ def run_sweep(
     workers: Workers = Workers(),
     progress: bool = True,
     on_point: Callable[[dict], None] | None = None,
+    lanes: bool = False,
     **values: float,
 ) -> SweepResult:
     """Sweep ``model`` over ``axes`` (``{"omega": values}`` or ``["omega=0.1:2.0:0.01", ...]``).
@@ -121,6 +123,11 @@ def run_sweep(
     ``.poincare.csv`` as points finish, resuming if they exist (``overwrite=True``: starting again;
     ``"stale"``: starting again only files another sweep or model wrote). ``workers``: where the points run
     (:class:`Workers`). ``on_point(row)`` is called in the main thread after each point is stored.
+    ``lanes``: independent points whose tables of time are the same (a map over values that only move
+    constants: omega of a model in tau, kS, zeta, ...) run L at a time in the lanes
+    (:mod:`gearsym.codegen.lane_runs`), each giving the scalar loop's numbers (to the bit without fused
+    multiply-adds; with them, to rounding); off by default, so that a sweep's files stay those of the scalar loops
+    wherever it runs.
     """
     options = model.run_options(options)
     plan = _SweepPlan.make(model, axes, options, mode, direction, y0, poincare, values)
@@ -133,7 +140,7 @@ def run_sweep(
             raise GearsymError(f"{out}: holds points this sweep does not plan, e.g. {sorted(unknown)[0]}; "
                                "pass --overwrite or choose another --out")
         run = _Run(model, plan.base, plan.names, plan.start, options, plan.poincare, plan.columns,
-                   plan.strobe_columns)
+                   plan.strobe_columns, lanes)
         todo = [t for t in (run.remaining(task, done) for task in plan.tasks) if t[0]]
         t_start, already, ran = time.perf_counter(), len(done), {}  # ran: where the points ran (Dask only)
         finished = _execute_on(workers, run, todo, ran)
@@ -274,10 +281,11 @@ def _finish_files(store: SweepStore, result: SweepResult, rows, poincare, comput
 class _Run:
     """What every point of one sweep shares, and how a point becomes a row."""
 
-    def __init__(self, compiled, base, names, start, options, poincare, columns, strobe_columns):
+    def __init__(self, compiled, base, names, start, options, poincare, columns, strobe_columns, lanes=False):
         self.compiled, self.base, self.names, self.start = compiled, base, names, start
         self.options, self.poincare = options, poincare
         self.columns, self.strobe_columns = columns, strobe_columns
+        self.lanes = lanes
 
     def __getstate__(self) -> dict:  # sent to Dask workers without the compiled model: each loads its own
         return {**self.__dict__, "compiled": None}
@@ -307,6 +315,9 @@ class _Run:
         (:func:`~gearsym.analysis.lyapunov.summarise_runs`) when the batch is full or has taken
         ``BATCH_SECONDS``: the Python around a point is a few array operations shared by the batch, not its
         own. A point that fails ends the task after the points before it are yielded."""
+        if self.lanes and len(points) > 1 and points[0].direction == INDEPENDENT and compiled.backend == "compiled":
+            yield from self.lane_task(compiled, points, state)
+            return
         periods, n = self.options.periods, compiled.dimension
         size = min(len(points), _batch_size(n, len(compiled.observed), periods))  # (a task of one point: one)
         runs = TangentRuns(n, len(compiled.observed), periods, max(size, 1))
@@ -329,6 +340,50 @@ class _Run:
             if len(batch) == runs.size or time.perf_counter() - started >= BATCH_SECONDS:
                 yield from self.checked_rows(compiled, runs, batch)
                 batch, started = [], time.perf_counter()
+        if batch:
+            yield from self.checked_rows(compiled, runs, batch)
+
+    def lane_task(self, compiled: CompiledModel, points: list[Point], state: np.ndarray):
+        """:meth:`task` of independent points, L at a time in the lanes: consecutive points whose tables of time
+        are the same share a call, each lane with its point's constants."""
+        periods, n = self.options.periods, compiled.dimension
+        size = min(len(points), _batch_size(n, len(compiled.observed), periods))
+        runs = TangentRuns(n, len(compiled.observed), periods, max(size, 1))
+        runner = LaneRunner(compiled, 0, periods)
+        base = compiled.parameter_vector(self.base)
+        swept = [compiled.parameter_names.index(name) for name in self.names]
+        batch, block = [], []  # block: (point, p, inputs) of the points of the next call
+
+        def call():
+            records = runner.orbits(np.tile(state, (len(block), 1)), block[0][2],
+                                    constants=np.array([inputs.constants for _, _, inputs in block]), tangent=True)
+            for i, (point, p, inputs) in enumerate(block):
+                k = len(batch)
+                runs.strobe[k], runs.log_stretch[k] = records.strobe[i], records.log_stretch[i]
+                runs.low[k], runs.high[k] = records.low[i], records.high[i]
+                batch.append((point, p, inputs.period))
+            block.clear()
+
+        for point in points:
+            p = base.copy()
+            p[swept] = point.values
+            try:
+                inputs = compiled.prepare(p)
+            except GearsymError as exc:
+                if block:
+                    call()
+                if batch:
+                    yield from self.checked_rows(compiled, runs, batch)
+                raise self.failed(point, exc) from None
+            if block and (inputs.table is not block[0][2].table or len(block) == runner.width
+                          or len(batch) + len(block) == runs.size):
+                call()
+            if len(batch) == runs.size:
+                yield from self.checked_rows(compiled, runs, batch)
+                batch = []
+            block.append((point, p, inputs))
+        if block:
+            call()
         if batch:
             yield from self.checked_rows(compiled, runs, batch)
 

@@ -1,0 +1,77 @@
+"""The section of ``docs/performance.md`` on the lanes and basin maps, rendered from ``bench/results/basins.json``
+(by ``bench/speed/report.py``, which writes the page)."""
+from __future__ import annotations
+
+import numpy as np
+
+from bench.machine import REPO
+
+RECORD = REPO / "bench" / "results" / "basins.json"
+#: the issue's targets: per trajectory against the best scalar C, and the 441-start map against the C's same starts
+TARGETS = {"per_trajectory": 0.4, "map_441": 0.5}
+
+
+def summary(record: dict) -> dict:
+    """Medians, ratios and verdicts (a pure function of the measurements)."""
+    per = {k: float(np.median(v)) for k, v in record["per_trajectory_seconds"].items()}
+    c = per[f"C {record['best_c_build']}"]
+    ratios = {k: v / c for k, v in per.items()}
+    m441 = record["map_441"]
+    c441, g441 = float(np.median(m441["c_seconds"])), float(np.median(m441["gearsym_seconds"]))
+    m200 = record["map_200"]
+    out = {"per_trajectory_ms": {k: 1e3 * v for k, v in per.items()}, "per_trajectory_over_c": ratios,
+           "lanes_over_c": ratios["gearsym lanes, tangent"],
+           "lanes_over_scalar": per["gearsym lanes, tangent"] / per["gearsym scalar loop, tangent"],
+           "map_441": {"c_seconds": c441, "gearsym_seconds": g441, "ratio": g441 / c441},
+           "map_200": {jobs: m200[jobs]["seconds"] for jobs in m200},
+           "two_cores": m200["1"]["seconds"] / m200["2"]["seconds"]}
+    out["met"] = {"per_trajectory": out["lanes_over_c"] <= TARGETS["per_trajectory"],
+                  "map_441": out["map_441"]["ratio"] <= TARGETS["map_441"]}
+    out["lines"] = [
+        f"per trajectory: lanes (tangent) {out['lanes_over_c']:.2f}x the best C ({record['best_c_build']}), "
+        f"{'met' if out['met']['per_trajectory'] else 'MISSED'} (<= {TARGETS['per_trajectory']})",
+        f"441-start map: gearsym basins {g441:.2f} s (start-up included), C {c441:.2f} s: {out['map_441']['ratio']:.2f}x "
+        f"{'met' if out['met']['map_441'] else 'MISSED'} (<= {TARGETS['map_441']})",
+        f"200 x 200 map: {m200['2']['seconds']:.1f} s on 2 cores, {m200['1']['seconds']:.1f} s on 1 "
+        f"({out['two_cores']:.2f}x)"]
+    return out
+
+
+def _result_text(result: dict) -> str:
+    parts = [f"{100 * a['fraction']:.1f} % " + (f"period {a['period']}" if a["period"] else a["regime"])
+             for a in result["attractors"]]
+    parts += [f"{100 * result[k]['fraction']:.1f} % {k}" for k in ("undecided", "diverged") if result[k]["starts"]]
+    return ", ".join(parts)
+
+
+def section(record: dict) -> list[str]:
+    s = summary(record)
+    m = record["machine"]
+    per = s["per_trajectory_ms"]
+    rows = [f"| {name} | {ms:.3f} | {s['per_trajectory_over_c'][name]:.2f}× |" for name, ms in per.items()]
+    mark = {True: "yes", False: "**no**"}
+    return [
+        "## Many trajectories at once: the lanes and basin maps", "",
+        f"Measured {record['date']} by `{record['command']}` ({record['total_seconds']:.0f} s; {m['cpu_model']}, "
+        f"{m['nproc']} cores, {', '.join(m['cpu_simd'])}; load at start "
+        f"{', '.join(map(str, m['loadavg_at_start'] or []))}). {record['model']} at ω = {record['omega']:g}, "
+        f"{record['periods']} periods of which {record['discard']} discarded, 200 RK4 steps per period, from the "
+        f"{record['starts']} starts of a 21 × 21 grid over [-5, 5]²; the lanes hold {record['lanes']} trajectories "
+        f"(AVX2). The C yardstick runs one process per start and is timed by its own clock (start-up excluded); it "
+        f"and the scalar loop are timed on every {record['starts'] // record['sample']}th start. Medians of "
+        f"{record['repeats']} interleaved repetitions, one core.", "",
+        "| per trajectory | ms | × the best C |", "|---|---|---|", *rows, "",
+        "| target | measured | goal | met |", "|---|---|---|---|",
+        f"| lanes (tangent, the C's job) / the best scalar C, per trajectory | {s['lanes_over_c']:.2f} | ≤ "
+        f"{TARGETS['per_trajectory']} | {mark[s['met']['per_trajectory']]} |",
+        f"| `gearsym basins` of the 441 starts (start-up included) / the best C on the same starts | "
+        f"{s['map_441']['ratio']:.2f} | ≤ {TARGETS['map_441']} | {mark[s['met']['map_441']]} |", "",
+        f"The 441-start map, `{record['map_441']['command']}`: {s['map_441']['gearsym_seconds']:.2f} s in a fresh "
+        f"process (Python's start-up, loading the cached library and lanes, 441 runs in the lanes without tangent "
+        f"vectors, the classification, one tangent run per attractor) against {s['map_441']['c_seconds']:.2f} s of "
+        f"the C for the same starts (their Lyapunov spectra, the C's job); it finds "
+        f"{_result_text(record['map_441']['result'])}.", "",
+        f"A 200 × 200 map, `{record['map_200']['command']}`: **{s['map_200']['2']:.1f} s on 2 cores**, "
+        f"{s['map_200']['1']:.1f} s on 1 ({s['two_cores']:.2f}×); it finds {_result_text(record['map_200']['2']['result'])}.",
+        "",
+    ]
