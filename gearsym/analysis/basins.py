@@ -7,7 +7,8 @@ its Poincare points (the state at t0 + kT) and every period's extremes. Then, st
 * **diverged**: a record that is not finite. Its own class.
 * **periodic**: the last ``TAIL`` Poincare points repeat with a period k <= ``MAX_PERIOD`` forcing periods to
   ``PERIOD_TOLERANCE`` (in coordinates scaled by the spread of every start's points, as
-  :func:`~gearsym.analysis.attractors.find_attractors` scales them). Two periodic starts are one attractor when
+  :func:`~gearsym.analysis.attractors.find_attractors` scales them, or by the spread of the starts where that
+  is larger: every start may end on one orbit). Two periodic starts are one attractor when
   their period is the same and their k points coincide as sets (Hausdorff distance within ``MATCH_TOLERANCE``):
   an orbit reached at another phase visits the same points in another order.
 * **undecided**: neither periodic nor settled: the recurrence of its best period still shrinks along the tail
@@ -226,9 +227,13 @@ def basin_map(model: CompiledModel, grid: Mapping[str, Sequence[float]], *, opti
         lanes=runner.width, method=method())
 
 
+#: bump when the classification changes for the same constants (records of maps and continuations carry it)
+CLASSIFIER = 2
+
+
 def method() -> dict:
     """The classification's constants, for the record."""
-    return {"max_period": MAX_PERIOD, "tail": TAIL, "cloud": CLOUD, "period_tolerance": PERIOD_TOLERANCE,
+    return {"classifier": CLASSIFIER, "max_period": MAX_PERIOD, "tail": TAIL, "cloud": CLOUD, "period_tolerance": PERIOD_TOLERANCE,
             "match_tolerance": MATCH_TOLERANCE, "converging": CONVERGING, "merge_factor": MERGE_FACTOR,
             "resolution": RESOLUTION, "merge_floor": MERGE_FLOOR}
 
@@ -317,7 +322,7 @@ def periods_of(tail: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     half = length // 2
     for k in np.unique(best_k[period == 0]):
         rows = (period == 0) & (best_k == k)
-        if half > k:
+        if half >= 2 * k:  # (each half compares at least half its points: a maximum over a few is chance)
             first = recurrence(tail[rows, :half], k)
             second = recurrence(tail[rows, half:], k)
             converging[rows] = second < CONVERGING * first
@@ -395,26 +400,34 @@ def classify(summary: Summary, starts: np.ndarray) -> tuple[np.ndarray, list[tup
             same = left & (hausdorff(sets, sets[first]) <= MATCH_TOLERANCE)
             groups.append((list(finite[rows[same]]), int(k)))
             left &= ~same
-    # the rest: undecided while converging or moving, else clouds compared with each attractor's first member
-    rest = finite[(period == 0) & ~converging]
-    clouds = np.concatenate([_scaled_clouds(summary, rest[at:at + BATCH], scale) for at in range(0, rest.size, BATCH)]) \
-        if rest.size else np.zeros((0, scale.size, 1))
+    # a start still converging whose last points are already on a periodic attractor's (to MATCH_TOLERANCE) joins it
+    slow = np.flatnonzero((period == 0) & converging)
+    for members, k in list(groups):
+        if slow.size and tail.shape[1] >= k:
+            near = hausdorff(tail[slow, -k:], tail[np.searchsorted(finite, members[0]), -k:]) <= MATCH_TOLERANCE
+            members += list(finite[slow[near]])
+            slow = slow[~near]
+    # the rest: clouds; those settled compared with each cloud attractor's first member; one not settled joins
+    # the attractor it is one cloud with, else it is undecided (a transient still moving)
+    rest = np.flatnonzero((period == 0) & ~converging)
+    clouds = _batched_clouds(summary, finite[rest], scale)
     still = np.concatenate([settled(clouds[at:at + BATCH]) for at in range(0, rest.size, BATCH)]) \
         if rest.size else np.zeros(0, dtype=bool)
-    rest, clouds = rest[still], clouds[still]
     selfs, sizes = _batched(self_distances, clouds), extents(clouds)
     lows, highs = clouds.min(axis=2), clouds.max(axis=2)
-    left = np.ones(rest.size, dtype=bool)
+    left = still.copy()
     cloud_groups = []
-    while left.any():
+    while left.any():  # the attractors, from the settled clouds
         first = int(np.argmax(left))
-        limit = MERGE_FACTOR * np.maximum(selfs, selfs[first]) + RESOLUTION * np.maximum(sizes, sizes[first]) \
-            + MERGE_FLOOR
-        gap = np.max(np.maximum(lows - highs[first], lows[first] - highs), axis=1)
-        near = np.flatnonzero(left & (gap <= limit))
-        same = near[_batched(lambda c: distances(c, clouds[first:first + 1]), clouds[near]) <= limit[near]]
-        cloud_groups.append(list(rest[same]))
+        same = _same_cloud(clouds, selfs, sizes, lows, highs, first, left)
+        cloud_groups.append(list(same))
         left[same] = False
+    left = ~still
+    for members in cloud_groups:  # a cloud not settled joins the attractor it is one cloud with
+        same = _same_cloud(clouds, selfs, sizes, lows, highs, members[0], left)
+        members += list(same)
+        left[same] = False
+    cloud_groups = [list(finite[rest[members]]) for members in cloud_groups]
     groups += [(members, 0) for members in cloud_groups]
     groups.sort(key=lambda g: g[0][0])
     for number, (members, _) in enumerate(groups, 1):
@@ -424,6 +437,21 @@ def classify(summary: Summary, starts: np.ndarray) -> tuple[np.ndarray, list[tup
 
 #: clouds compared at once (a few MB of distances)
 BATCH = 512
+
+
+def _batched_clouds(summary: Summary, rows: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """The scaled clouds of ``rows``, (count, n, points)."""
+    if not rows.size:
+        return np.zeros((0, scale.size, max(1, summary.cloud.shape[1])))
+    return np.concatenate([_scaled_clouds(summary, rows[at:at + BATCH], scale) for at in range(0, rows.size, BATCH)])
+
+
+def _same_cloud(clouds, selfs, sizes, lows, highs, first: int, among: np.ndarray) -> np.ndarray:
+    """The clouds of ``among`` (a mask) that are one with cloud ``first`` by find_attractors' rule."""
+    limit = MERGE_FACTOR * np.maximum(selfs, selfs[first]) + RESOLUTION * np.maximum(sizes, sizes[first]) + MERGE_FLOOR
+    gap = np.max(np.maximum(lows - highs[first], lows[first] - highs), axis=1)
+    near = np.flatnonzero(among & (gap <= limit))
+    return near[_batched(lambda c: distances(c, clouds[first:first + 1]), clouds[near]) <= limit[near]]
 
 
 def _scaled_clouds(summary: Summary, rows: np.ndarray, scale: np.ndarray) -> np.ndarray:

@@ -180,7 +180,7 @@ def lyapunov_spectra(model: CompiledModel, starts: np.ndarray, options: Integrat
             exponents=summary.exponents[i], stderr=summary.stderr[i], history=history[:, summary.order[i]],
             amplitude=dict(zip(model.observed, map(float, summary.amplitude[i]))),
             final_state=dict(zip(model.state_names, map(float, records.final[i]))),
-            strobe=runs.strobe[i, options.discard:].T.copy(), periods=options.periods, discard=options.discard,
+            strobe=runs.strobe[i].T[:, options.discard:], periods=options.periods, discard=options.discard,
             steps_per_period=model.steps_per_period, period=inputs.period, backend=model.backend,
             autonomous=model.system.autonomous,
             info={"Q": records.Q[i], "locate_crossings": model.options.locate_crossings},

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..analysis import LyapunovSpectrum, Trajectory, lyapunov_spectrum, phase_trajectory
 from ..analysis.attractors import DEFAULT_BOX, AttractorSet, find_attractors
-from ..analysis.basins import BasinMap, basin_map
+from ..analysis.basins import BasinMap, basin_map, method
 from ..codegen.build import compile_model
 from ..options import Integration
 from ..periodic import Continuation, continue_orbits
@@ -119,7 +119,8 @@ def _basins(plan: Plan, compiled: dict, options: Integration, data_dir: Path, jo
 def _cached_map(model, grid: dict, options: Integration, values: dict, path: Path, jobs: int) -> BasinMap:
     """The basin map, from ``path`` if it holds this one (same code, grid, run and values), else computed there."""
     record = json.loads(json.dumps({"model_hash": model.hash, "grid": {k: v.tolist() for k, v in grid.items()},
-                                    "periods": options.periods, "discard": options.discard, "values": values}))
+                                    "periods": options.periods, "discard": options.discard, "values": values,
+                                    "method": method()}))
     try:
         data = json.loads(path.read_text())
         if data["record"] == record:

@@ -3,10 +3,28 @@
 ``run_sweep(model, {"omega": values}, ...)`` computes the Lyapunov spectrum,
 amplitudes and regime at every point and, given ``out``, writes them as they
 finish (resumable); ``read_sweep(path)`` reads a sweep back.
+
+The running of sweeps (:mod:`.run`, with its Dask side, which loads the code generator and SymPy) is imported
+when first asked for, so that a command that only reads grids or sweep files (``gearsym basins`` on a cached
+model) starts without it.
 """
+from __future__ import annotations
+
+import importlib
+
 from .grid import DIRECTIONS, MODES, Axis, parse_axis
 from .result import SweepResult, read_sweep
-from .run import PARALLEL, POINCARE_SAMPLES, SweepInterrupted, Workers, run_sweep
+
+#: the names of :mod:`.run`, imported on first use
+_RUN = ("PARALLEL", "POINCARE_SAMPLES", "SweepInterrupted", "Workers", "run_sweep")
 
 __all__ = ["Axis", "DIRECTIONS", "MODES", "PARALLEL", "POINCARE_SAMPLES", "SweepInterrupted", "SweepResult", "Workers",
            "parse_axis", "read_sweep", "run_sweep"]
+
+
+def __getattr__(name: str):
+    if name in _RUN:
+        value = getattr(importlib.import_module(f"{__name__}.run"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
