@@ -56,8 +56,8 @@ def section(record: dict) -> list[str]:
         f"{m['nproc']} cores, {', '.join(m['cpu_simd'])}; load at start "
         f"{', '.join(map(str, m['loadavg_at_start'] or []))}). {record['model']} at ω = {record['omega']:g}, "
         f"{record['periods']} periods of which {record['discard']} discarded, 200 RK4 steps per period, from the "
-        f"{record['starts']} starts of a 21 × 21 grid over [-5, 5]²; the lanes hold {record['lanes']} trajectories "
-        f"(AVX2). The C yardstick runs one process per start and is timed by its own clock (start-up excluded); it "
+        f"{record['starts']} starts of a 21 × 21 grid over [-5, 5]²; the lanes hold {record["lanes"]} trajectories "
+        f"per call. The C yardstick runs one process per start and is timed by its own clock (start-up excluded); it "
         f"and the scalar loop are timed on every {record['starts'] // record['sample']}th start. Medians of "
         f"{record['repeats']} interleaved repetitions, one core.", "",
         "| per trajectory | ms | × the best C |", "|---|---|---|", *rows, "",

@@ -66,9 +66,8 @@ def _darker(c: str) -> tuple:
 
 def run_text(result) -> str:
     scheme = "crossings located" if result.locate_crossings else "plain RK4 (the paper's scheme)"
-    lanes = f"{result.lanes} trajectories per call (lanes)" if result.lanes > 1 else "one trajectory per call"
     return (f"{result.periods} periods per start, the first {result.discard} discarded; {result.steps_per_period} "
-            f"RK4 steps/period, {scheme}; {lanes}")
+            f"RK4 steps/period, {scheme}")
 
 
 def map_title(result, shown: Shown, width: int = 100) -> str:
