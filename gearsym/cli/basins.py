@@ -115,6 +115,10 @@ def _continuation(args, compiled, grid_axes: list[Axis], axis: Axis, units, show
         print(f"gearsym: interrupted; the values finished are in {args.out}: run the same command again to resume",
               file=sys.stderr)
         return 130
+    if units is not None:
+        path = sidecar(args.out, ".physical.csv")
+        _write_physical_fractions(path, result, shown)
+        print(f"gearsym: wrote {path} (the fractions in the model's units)", file=sys.stderr)
     if args.plot:
         plot_basin_fractions(result, args.plot, shown)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
@@ -123,6 +127,24 @@ def _continuation(args, compiled, grid_axes: list[Axis], axis: Axis, units, show
     else:
         print(continuation_report(result, shown))
     return 0
+
+
+def _write_physical_fractions(path: Path, result, shown) -> None:
+    """The continuation's rows with the parameter as the speed and amplitudes in the length unit."""
+    name, values, unit = shown.parameter(result.parameter, result.values)
+    speed = dict(zip(result.values, values))
+    coordinates = list(dict.fromkeys(k for r in result.rows for k in r.amplitude))
+    units = {k: shown.state(k, [0.0], 1.0)[1] for k in coordinates}
+    text = io.StringIO()
+    writer = csv.writer(text, lineterminator="\n")
+    writer.writerow([f"{name} [{unit}]" if unit else name, "class", "attractor", "fraction", "stderr", "period",
+                     "regime", *(f"A_{k} [{units[k]}]" if units[k] else f"A_{k}" for k in coordinates)])
+    for r in result.rows:
+        amplitude = [repr(float(shown.state(k, [r.amplitude[k]], r.value)[0][0])) if k in r.amplitude else ""
+                     for k in coordinates]
+        writer.writerow([repr(float(speed[r.value])), r.kind, "" if r.id is None else r.id, repr(r.fraction),
+                         repr(r.stderr), "" if r.period is None else r.period, r.regime, *amplitude])
+    write_atomically(path, text.getvalue())
 
 
 def _write_map(path: Path, result: BasinMap, shown, axes: list[Axis]) -> None:

@@ -200,7 +200,8 @@ def plot_basin_fractions(result, path: str | Path | None = None, shown: Shown | 
         f"{k} in [{min(v):g}, {max(v):g}] ({len(v)})" for k, v in grid.items())
     title = (f"{result.model}: basin fractions along {SYMBOLS.get(name, name)} (each attractor by its id, matched "
              f"from one value to the next by its Poincaré set); grid {grid_text}"
-             + (f"; {shown.parameters(fixed)}" if fixed else "")
+             + (f"; {shown.parameters(fixed)} (the rest: the model's declared values)" if fixed
+                else "; the other parameters: the model's declared values")
              + f"; {record['periods']} periods per start, {record['discard']} discarded, "
              + ("crossings located" if record.get("locate_crossings") else "plain RK4"))
     fig.suptitle(textwrap.fill(title, 150), fontsize=8)
