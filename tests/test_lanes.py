@@ -127,13 +127,13 @@ def test_under_the_default_flags_the_lanes_agree_with_the_scalar_loop_to_roundin
 
 
 def test_every_per_step_piece_is_printed_as_a_loop_over_the_lanes():
-    """The lanes' C of a committed model: each per-step piece in a loop over the lanes with its inputs indexed by
-    lane (the table shared), the split and Gram-Schmidt the scalar loops' own functions."""
+    """The lanes' C of a committed model: each per-step piece in a loop over the lanes with every input indexed by
+    lane (the tables of time too), the split and Gram-Schmidt the scalar loops' own functions."""
     source = (REPO_ROOT / "generated" / "one_stage" / "one_stage_lanes.c").read_text()
     for piece in ("tangent_state", "tangent_vector", "state_try", "state_keep"):
         body = re.search(rf"static GEARSYM_INLINE void gsl_{piece}\(.*?\n}}\n", source, re.S).group(0)
-        assert "GS_LANES {" in body and "[GS_L*" in body and not re.search(r"\bA0\[\d+\]", body), piece
-    assert "gs_state_split(ys, los, his, yts, T, cs, y1s, lo1s, hi1s);" in source
+        assert "GS_LANES {" in body and "[GS_L*" in body and not re.search(r"\b[AR]\d\[\d+\]", body), piece
+    assert "gs_state_split(ys, los, his, yts, Ts, cs, y1s, lo1s, hi1s);" in source
     assert "gs_gram_schmidt(Qc, Qn, lg);" in source
     assert 'target_clones("avx2", "default")' in source
 

@@ -85,15 +85,15 @@ def measure(repeats: int, log=lambda s: print(s, file=sys.stderr, flush=True)) -
     paper = Integration.paper(periods=PERIODS, discard=DISCARD)
     plain = gearsym.compile_model(gearsym.load(MODEL), paper)
     located = gearsym.compile_model(gearsym.load(MODEL), Integration(periods=PERIODS, discard=DISCARD))
-    inputs = {m: m.prepare(m.parameter_vector(omega=OMEGA)) for m in (plain, located)}
-    lanes = {m: LaneRunner(m, DISCARD, PERIODS - DISCARD, verbose=True) for m in (plain, located)}
+    inputs = {id(m): m.prepare(m.parameter_vector(omega=OMEGA)) for m in (plain, located)}
+    lanes = {id(m): LaneRunner(m, DISCARD, PERIODS - DISCARD, verbose=True) for m in (plain, located)}
 
     def lanes_run(model, tangent):
-        return lambda: lanes[model].orbits(starts, inputs[model], tangent=tangent)
+        return lambda: lanes[id(model)].orbits(starts, inputs[id(model)], tangent=tangent)
 
     def scalar_run():
         for y0 in sample:
-            plain.tangent_run(y0, PERIODS, inputs[plain])
+            plain.tangent_run(y0, PERIODS, inputs[id(plain)])
 
     gearsym_jobs = {  # name -> (call, trajectories it runs)
         "gearsym scalar loop, tangent": (scalar_run, len(sample)),
@@ -123,6 +123,7 @@ def measure(repeats: int, log=lambda s: print(s, file=sys.stderr, flush=True)) -
         map_441["gearsym_seconds"].append(seconds)
         map_441["result"] = result
         log(f"  441-start map {rep + 1}: C {map_441['c_seconds'][-1]:.3f} s, gearsym basins {seconds:.3f} s")
+    sweep_map = _sweep_map(repeats, log)
     map_200 = {}
     for jobs in (2, 1):
         seconds, result = _timed_command(_command(MAP_200, jobs))
@@ -130,9 +131,38 @@ def measure(repeats: int, log=lambda s: print(s, file=sys.stderr, flush=True)) -
         log(f"  200 x 200 map on {jobs} core(s): {seconds:.1f} s")
     return {"model": MODEL, "omega": OMEGA, "periods": PERIODS, "discard": DISCARD, "starts": len(starts),
             "sample": len(sample), "c_builds": list(binaries), "best_c_build": best,
-            "lanes": lanes[plain].width, "per_trajectory_seconds": per_trajectory,
+            "lanes": lanes[id(plain)].width, "per_trajectory_seconds": per_trajectory,
             "map_441": {**map_441, "command": shlex.join(["gearsym", *_command(MAP_441, 1)[3:]])},
-            "map_200": {**map_200, "command": shlex.join(["gearsym", *_command(MAP_200, 2)[3:]])}}
+            "map_200": {**map_200, "command": shlex.join(["gearsym", *_command(MAP_200, 2)[3:]])},
+            "sweep_map": sweep_map}
+
+
+#: the 2-D map of python -m bench.speed's scaling stage: flexible_shaft, independent points, the paper's scheme
+SWEEP_MODEL, SWEEP_AXES = "flexible_shaft", ["omega=0.1:2.0:0.02", "kS=0,0.05,0.1,1.0"]
+
+
+def _sweep_map(repeats: int, log) -> dict:
+    """The 2-D map through run_sweep on 1 and 2 workers, with and without the lanes (interleaved), its rows
+    compared between the two."""
+    model = gearsym.compile_model(gearsym.load(SWEEP_MODEL), Integration.paper(periods=PERIODS, discard=DISCARD))
+    configs = {f"{jobs} {'process' if jobs == 1 else 'processes'}{', lanes' if lanes else ''}": (jobs, lanes)
+               for lanes in (False, True) for jobs in (1, 2)}
+    seconds = {name: [] for name in configs}
+    rows = {}
+    for rep in range(repeats + 1):  # (the first: a warm-up, not counted)
+        for name, (jobs, lanes) in configs.items():
+            t = time.perf_counter()
+            result = gearsym.run_sweep(model, SWEEP_AXES, mode="independent", lanes=lanes, progress=False,
+                                       workers=gearsym.Workers(jobs=jobs))
+            if rep:
+                seconds[name].append(time.perf_counter() - t)
+            rows[name] = [float(x) for x in result["lambda_1"]]
+        if rep:
+            log(f"  2-D map {rep}/{repeats}: " + ", ".join(f"{k} {v[-1]:.2f} s" for k, v in seconds.items()))
+    scalar, wide = rows["1 process"], rows["1 process, lanes"]
+    return {"model": SWEEP_MODEL, "axes": SWEEP_AXES, "points": len(scalar), "seconds": seconds,
+            "largest_difference": max(abs(a - b) for a, b in zip(scalar, wide)),
+            "identical": scalar == wide}
 
 
 def main(argv=None) -> int:

@@ -54,6 +54,9 @@ CLOUD = 64
 PERIOD_TOLERANCE = 1e-3
 #: two periodic starts are one attractor when their points coincide to this
 MATCH_TOLERANCE = 1e-2
+#: two periodic groups whose point sets are within this of each other are one attractor (one orbit, approached
+#: along a slowly decaying spiral, looks periodic with a multiple of its period first)
+ORBIT_MERGE = 5e-2
 #: a start whose best recurrence error over the second half of its tail is below this fraction of the first
 #: half's still converges: undecided
 CONVERGING = 0.1
@@ -228,13 +231,13 @@ def basin_map(model: CompiledModel, grid: Mapping[str, Sequence[float]], *, opti
 
 
 #: bump when the classification changes for the same constants (records of maps and continuations carry it)
-CLASSIFIER = 2
+CLASSIFIER = 3
 
 
 def method() -> dict:
     """The classification's constants, for the record."""
     return {"classifier": CLASSIFIER, "max_period": MAX_PERIOD, "tail": TAIL, "cloud": CLOUD, "period_tolerance": PERIOD_TOLERANCE,
-            "match_tolerance": MATCH_TOLERANCE, "converging": CONVERGING, "merge_factor": MERGE_FACTOR,
+            "match_tolerance": MATCH_TOLERANCE, "orbit_merge": ORBIT_MERGE, "converging": CONVERGING, "merge_factor": MERGE_FACTOR,
             "resolution": RESOLUTION, "merge_floor": MERGE_FLOOR}
 
 
@@ -400,6 +403,7 @@ def classify(summary: Summary, starts: np.ndarray) -> tuple[np.ndarray, list[tup
             same = left & (hausdorff(sets, sets[first]) <= MATCH_TOLERANCE)
             groups.append((list(finite[rows[same]]), int(k)))
             left &= ~same
+    groups = _merged_orbits(groups, tail, finite)
     # a start still converging whose last points are already on a periodic attractor's (to MATCH_TOLERANCE) joins it
     slow = np.flatnonzero((period == 0) & converging)
     for members, k in list(groups):
@@ -433,6 +437,42 @@ def classify(summary: Summary, starts: np.ndarray) -> tuple[np.ndarray, list[tup
     for number, (members, _) in enumerate(groups, 1):
         labels[members] = number
     return labels, groups, scale
+
+
+def set_distance(a: np.ndarray, b: np.ndarray) -> float:
+    """The Hausdorff distance (max-norm) between two sets of points, (k1, n) and (k2, n)."""
+    d = np.abs(a[:, None, :] - b[None, :, :]).max(axis=2)
+    return float(max(d.min(axis=1).max(), d.min(axis=0).max()))
+
+
+def _merged_orbits(groups: list[tuple[list[int], int]], tail: np.ndarray, finite: np.ndarray):
+    """Periodic groups whose point sets lie within ``ORBIT_MERGE`` of each other are one attractor: a weakly
+    stable orbit approached along a slowly decaying spiral looks periodic with a multiple of its period (its k
+    points ring the orbit's) before it has converged. The merged group is the shortest period's: its first member
+    first (whose points and final state stand for the attractor), then the others in start order."""
+    if len(groups) < 2:
+        return groups
+    sets = [tail[np.searchsorted(finite, members[0]), -k:] for members, k in groups]
+    parent = list(range(len(groups)))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            i = parent[i]
+        return i
+
+    for i in range(len(groups)):
+        for j in range(i + 1, len(groups)):
+            if root(i) != root(j) and set_distance(sets[i], sets[j]) <= ORBIT_MERGE:
+                parent[max(root(i), root(j))] = min(root(i), root(j))
+    merged: dict[int, list[int]] = {}
+    for i in range(len(groups)):
+        merged.setdefault(root(i), []).append(i)
+    out = []
+    for parts in merged.values():
+        shortest = min(parts, key=lambda i: (groups[i][1], groups[i][0][0]))
+        first = groups[shortest][0][0]
+        out.append(([first, *sorted(m for i in parts for m in groups[i][0] if m != first)], groups[shortest][1]))
+    return out
 
 
 #: clouds compared at once (a few MB of distances)

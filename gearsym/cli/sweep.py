@@ -61,9 +61,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--coordinate", metavar="NAME",
                         help="the coordinate --plot shows (amplitude, bifurcation diagram; default the first)")
     parser.add_argument("--lanes", action="store_true",
-                        help="independent points that share their tables of time (values that only move constants) "
-                             "run several at once in SIMD lanes: the same numbers (to rounding with fused "
-                             "multiply-adds), faster")
+                        help="independent points run several at once in SIMD lanes, each with its own parameters: "
+                             "the same numbers (to rounding with fused multiply-adds), faster")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
 
 

@@ -134,37 +134,48 @@ class LaneRunner:
     def vectorised(self) -> bool:
         return self.library is not None
 
-    def orbits(self, starts: np.ndarray, inputs: RunInputs, constants: np.ndarray | None = None,
+    def orbits(self, starts: np.ndarray, inputs: RunInputs | Sequence[RunInputs], constants: np.ndarray | None = None,
                tangent: bool = False) -> OrbitRecords:
-        """The records of runs from ``starts`` (k, n) at ``inputs`` (``constants``: one row per start instead of
-        the constants of ``inputs``, whose table they share: points of a sweep that only moves constants);
-        ``tangent``: with n tangent vectors from the identity, re-orthonormalised every period."""
+        """The records of runs from ``starts`` (k, n) at ``inputs``: one point's for all, or one per start (points
+        of a sweep; ``constants``: one row per start instead of the constants of the one ``inputs``, whose table
+        they share); ``tangent``: with n tangent vectors from the identity, re-orthonormalised every period."""
         starts = np.asarray(starts, dtype=float)
         n, o = self.model.dimension, len(self.model.observed)
         k, P = starts.shape[0], self.measured
+        points = list(inputs) if not isinstance(inputs, RunInputs) else [
+            inputs if constants is None else _with_constants(inputs, constants[i]) for i in range(k)]
+        if len(points) != k:
+            raise GearsymError(f"{self.model.name}: {k} starts but the inputs of {len(points)} points")
         strobe, logs = np.empty((k, P, n)), (np.empty((k, P, n)) if tangent else None)
         low, high, final = np.empty((k, P, o)), np.empty((k, P, o)), np.empty((k, n))
         Q = np.empty((k, n, n)) if tangent else None
         run = self._lane_block if self.library else self._scalar_block
         for at in range(0, k, self.width):
             rows = slice(at, min(k, at + self.width))
-            c = inputs.constants if constants is None else constants[rows]
-            run(starts[rows], inputs, c, tangent, strobe[rows], low[rows], high[rows], final[rows],
+            run(starts[rows], points[rows], tangent, strobe[rows], low[rows], high[rows], final[rows],
                 None if logs is None else logs[rows], None if Q is None else Q[rows])
         if tangent:
             return TangentRecords(strobe, low, high, final, logs, Q)
         return OrbitRecords(strobe, low, high, final)
 
-    def _lane_block(self, starts, inputs: RunInputs, c, tangent, strobe, low, high, final, logs, Qs) -> None:
+    def _lane_block(self, starts, points: list[RunInputs], tangent, strobe, low, high, final, logs, Qs) -> None:
         L, (count, n), o, P = self.width, starts.shape, len(self.model.observed), self.measured
         lanes = np.empty((n, L))
         lanes[:, :count] = starts.T
         lanes[:, count:] = starts[-1:].T  # (unused lanes repeat the last start: finite numbers)
-        cl = np.empty((inputs.constants.size, L))
-        cl[:, :count] = np.asarray(c, dtype=float).T if np.ndim(c) == 2 else np.asarray(c, dtype=float)[:, None]
-        cl[:, count:] = cl[:, count - 1:count]
+        used = points + [points[-1]] * (L - count)
+        cl = np.stack([p.constants for p in used], axis=-1)  # (constants, lanes)
+        tables = [p.table for p in used]
+        if all(x is tables[0] for x in tables):  # one point's: the same table in every lane (made once)
+            made = self.__dict__.get("_shared")
+            if made is None or made[0] is not tables[0]:
+                made = self._shared = (tables[0], np.repeat(tables[0].reshape(-1, order="F")[:, None], L, axis=1))
+            Tl = made[1]
+        else:  # step k's entry j of lane l at L*(rows*k + j) + l (a table is column-major: rows x steps)
+            Tl = np.stack([x.reshape(-1, order="F") for x in tables], axis=-1)
+        Tl = np.ascontiguousarray(Tl)
         s, lo, hi = np.empty((P, n, L)), np.empty((P, o, L)), np.empty((P, o, L))
-        table = inputs.addresses[0]
+        table = Tl.ctypes.data
         lib = self.library
         if tangent:
             Q = np.zeros((n * n, L))
@@ -185,10 +196,9 @@ class LaneRunner:
         low[...], high[...] = lo.transpose(2, 0, 1)[:count], hi.transpose(2, 0, 1)[:count]
         final[...] = lanes.T[:count]
 
-    def _scalar_block(self, starts, inputs: RunInputs, c, tangent, strobe, low, high, final, logs, Qs) -> None:
+    def _scalar_block(self, starts, points: list[RunInputs], tangent, strobe, low, high, final, logs, Qs) -> None:
         model, d, periods = self._scalar_model(), self.discard, self.discard + self.measured
-        for i, y0 in enumerate(starts):
-            point = _with_constants(inputs, c[i]) if np.ndim(c) == 2 else inputs
+        for i, (y0, point) in enumerate(zip(starts, points)):
             try:
                 if tangent:
                     run = model.tangent_run(y0, periods, point)

@@ -6,8 +6,9 @@ the chain from one RK4 stage to the next; here L trajectories sit in the lanes o
 arrays: entry k of lane l at ``k*GS_L + l``), and every operation of CasADi's step runs on all of them at once:
 
 * each per-step SX piece's C body (the same text the scalar loops inline) is wrapped in a ``for`` over the
-  lanes, its inputs and outputs indexed by lane (``A0[j]`` -> ``A0[GS_L*j + l]``), the table shared by all
-  lanes; gcc vectorises that loop across the lanes (the bodies are arithmetic, comparisons and selects);
+  lanes, every input and output indexed by lane (``A0[j]`` -> ``A0[GS_L*j + l]``: the tables of time too, so
+  that the lanes may be points of a sweep whose tables differ); gcc vectorises that loop across the lanes (the
+  bodies are arithmetic, comparisons and selects);
 * with crossings located, the try runs on every lane; a lane whose try flags a crossing takes the split,
   scalar (``gs_{kind}_split``, the scalar loops' own function), and its results replace the kept try's in
   that lane; the other lanes go on;
@@ -97,19 +98,14 @@ def lanes_source(text: str, mf: ModelFunctions) -> str:
 
 
 def _lane_piece(name: str, body: str, mf: ModelFunctions, s: _Shape) -> str:
-    """``gsl_<name>``: the SX piece's C body in a loop over the lanes; every input and output one value per lane
-    (``GS_L`` apart; a tangent vector's rows ``n*GS_L`` apart), except the table (the one before the
-    constants), which all lanes share."""
+    """``gsl_<name>``: the SX piece's C body in a loop over the lanes; every input and output (the table of time
+    and the constants too) one value per lane, ``GS_L`` apart (a tangent vector's rows ``n*GS_L`` apart)."""
     f = mf.steps[name]
-    shared = set() if name == "tangent_vector" else {f.n_in() - 2}
-    for i in shared:
-        if f.numel_in(i) not in (s.rows, s.step) or f.numel_in(f.n_in() - 1) != s.nc:
-            raise AssertionError(f"{name}: input {i} is not the table, or the last input not the constants")
+    if f.numel_in(f.n_in() - 1) != s.nc:
+        raise AssertionError(f"{name}: the last input is not the constants")
     stride = s.n if name == "tangent_vector" else 1
 
     def lane(kind: str, i: int, j: int) -> str:
-        if kind == "A" and i in shared:
-            return f"A{i}[{j}]"
         k = j * stride if i == 0 else j
         return f"{kind}{i}[GS_L*{k} + l]"
 
@@ -145,7 +141,7 @@ def _lane_steps(s: _Shape) -> list[str]:
         length = {"y": f"{n}*{L}", "Q": f"{n * n}*{L}", "lo": f"{o}*{L}", "hi": f"{o}*{L}"}
         a, b = [f"{v}a" for v in state], [f"{v}b" for v in state]
         locals_ = " ".join(f"casadi_real {v}a[{sizes[v]}], {v}b[{sizes[v]}];" for v in state)
-        table = (lambda k: f"T + {s.step}*({k})") if s.step else (lambda k: "T")
+        table = (lambda k: f"T + {s.step}*GS_L*({k})") if s.step else (lambda k: "T")
         copy = lambda src, dst: " ".join(f"gs_copy({x}, {length[v]}, {y});" for v, x, y in zip(state, src, dst))
         out.append(
             f"/* blocks of {kind} steps of every lane from ({', '.join(state)}), in place, a -> b -> a */\n"
@@ -184,18 +180,19 @@ def _lane_step(s: _Shape, kind: str) -> str:
         head = (f"  casadi_real yt[{y}*GS_L], flag[GS_L]; casadi_int l, i; int any, finite;\n"
                 "  gsl_state_try(y, T, c, yt, flag);\n")
     head += "  gsl_state_keep(y, lo, hi, yt, T, c, y1, lo1, hi1);\n"
-    gathered = [("y", "ys", n), ("lo", "los", o), ("hi", "his", o), ("yt", "yts", n), ("c", "cs", nc)]
-    declare = (f"    casadi_real ys[{y}], los[{O}], his[{O}], yts[{y}], cs[{nc}], y1s[{y}], lo1s[{O}], "
-               f"hi1s[{O}];\n")
+    gathered = [("y", "ys", n), ("lo", "los", o), ("hi", "his", o), ("yt", "yts", n), ("c", "cs", nc),
+                ("T", "Ts", s.step)]
+    declare = (f"    casadi_real ys[{y}], los[{O}], his[{O}], yts[{y}], cs[{nc}], Ts[{max(1, s.step)}], y1s[{y}], "
+               f"lo1s[{O}], hi1s[{O}];\n")
     scatter = "".join(f"    for (i = 0; i < {size}; ++i) {dst}[GS_L*i + l] = {src}[i];\n"
                       for src, dst, size in (("y1s", "y1", n), ("lo1s", "lo1", o), ("hi1s", "hi1", o)))
     if kind == "tangent":  # the split takes the tangent vectors as columns: (r, j) of lane l at GS_L*(r*n + j) + l
         declare += f"    casadi_real Qc[{Qn}], Qc1[{Qn}];\n"
         columns = (f"    for (i = 0; i < {n * n}; ++i) Qc[(i % {n})*{n} + i / {n}] = Q[GS_L*i + l];\n"
-                   "    gs_tangent_split(ys, Qc, los, his, yts, Qc, T, cs, y1s, Qc1, lo1s, hi1s);\n"
+                   "    gs_tangent_split(ys, Qc, los, his, yts, Qc, Ts, cs, y1s, Qc1, lo1s, hi1s);\n"
                    f"    for (i = 0; i < {n * n}; ++i) Q1[GS_L*i + l] = Qc1[(i % {n})*{n} + i / {n}];\n")
     else:
-        columns = "    gs_state_split(ys, los, his, yts, T, cs, y1s, lo1s, hi1s);\n"
+        columns = "    gs_state_split(ys, los, his, yts, Ts, cs, y1s, lo1s, hi1s);\n"
     return (head + "  any = 0;\n  GS_LANES any |= flag[l] != 0;\n"
             "  if (GEARSYM_UNLIKELY(any)) for (l = 0; l < GS_L; ++l) if (flag[l] != 0) {  /* this lane crosses */\n"
             + declare + _gather(s, gathered)
@@ -219,8 +216,9 @@ def _entries(s: _Shape) -> list[str]:
         "/* the lanes of this build */\n"
         "CASADI_SYMBOL_EXPORT int gearsym_lanes(void) { return GS_L; }\n",
         "/* `periods` periods of the state of GS_L trajectories from y (n x GS_L, lane fastest; in place), with the\n"
-        "   constants c (per lane) and the table T of a period; each period's strobe, low and high written where\n"
-        "   given (periods x n x GS_L, periods x observed x GS_L) */\n"
+        "   constants c (nc x GS_L) and the tables of a period T (steps x rows x GS_L: entry j of step k of lane l at\n"
+        "   GS_L*(rows*k + j) + l), one of each per lane; each period's strobe, low and high written where given\n"
+        "   (periods x n x GS_L, periods x observed x GS_L) */\n"
         "CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_orbit(const casadi_real* restrict T, "
         "const casadi_real* restrict c, casadi_int periods, casadi_real* restrict y, casadi_real* strobe, "
         "casadi_real* low, casadi_real* high) {\n"

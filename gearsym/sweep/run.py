@@ -123,9 +123,8 @@ def run_sweep(
     ``.poincare.csv`` as points finish, resuming if they exist (``overwrite=True``: starting again;
     ``"stale"``: starting again only files another sweep or model wrote). ``workers``: where the points run
     (:class:`Workers`). ``on_point(row)`` is called in the main thread after each point is stored.
-    ``lanes``: independent points whose tables of time are the same (a map over values that only move
-    constants: omega of a model in tau, kS, zeta, ...) run L at a time in the lanes
-    (:mod:`gearsym.codegen.lane_runs`), each giving the scalar loop's numbers (to the bit without fused
+    ``lanes``: independent points run L at a time in the lanes (:mod:`gearsym.codegen.lane_runs`: each lane with
+    its point's tables and constants), each giving the scalar loop's numbers (to the bit without fused
     multiply-adds; with them, to rounding); off by default, so that a sweep's files stay those of the scalar loops
     wherever it runs.
     """
@@ -344,8 +343,8 @@ class _Run:
             yield from self.checked_rows(compiled, runs, batch)
 
     def lane_task(self, compiled: CompiledModel, points: list[Point], state: np.ndarray):
-        """:meth:`task` of independent points, L at a time in the lanes: consecutive points whose tables of time
-        are the same share a call, each lane with its point's constants."""
+        """:meth:`task` of independent points, L at a time in the lanes, each lane with its point's tables and
+        constants."""
         periods, n = self.options.periods, compiled.dimension
         size = min(len(points), _batch_size(n, len(compiled.observed), periods))
         runs = TangentRuns(n, len(compiled.observed), periods, max(size, 1))
@@ -355,8 +354,7 @@ class _Run:
         batch, block = [], []  # block: (point, p, inputs) of the points of the next call
 
         def call():
-            records = runner.orbits(np.tile(state, (len(block), 1)), block[0][2],
-                                    constants=np.array([inputs.constants for _, _, inputs in block]), tangent=True)
+            records = runner.orbits(np.tile(state, (len(block), 1)), [inputs for _, _, inputs in block], tangent=True)
             for i, (point, p, inputs) in enumerate(block):
                 k = len(batch)
                 runs.strobe[k], runs.log_stretch[k] = records.strobe[i], records.log_stretch[i]
@@ -375,8 +373,7 @@ class _Run:
                 if batch:
                     yield from self.checked_rows(compiled, runs, batch)
                 raise self.failed(point, exc) from None
-            if block and (inputs.table is not block[0][2].table or len(block) == runner.width
-                          or len(batch) + len(block) == runs.size):
+            if block and (len(block) == runner.width or len(batch) + len(block) == runs.size):
                 call()
             if len(batch) == runs.size:
                 yield from self.checked_rows(compiled, runs, batch)

@@ -599,7 +599,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a06=(a03*a05);
     a06=(a06-a00);
     a07=A4[GS_L*2 + l];
-    a08=A3[0];
+    a08=A3[GS_L*0 + l];
     a08=(a07*a08);
     a06=(a06+a08);
     a08=A4[GS_L*0 + l];
@@ -615,7 +615,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a13=(a04*a03);
     a13=(a00+a13);
     a12=(a12-a13);
-    a14=A3[1];
+    a14=A3[GS_L*1 + l];
     a14=(a07*a14);
     a12=(a12+a14);
     a15=casadi_sq(a13);
@@ -649,7 +649,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a01=(a01*a16);
     a01=(a00+a01);
     a10=(a10-a01);
-    a16=A3[2];
+    a16=A3[GS_L*2 + l];
     a07=(a07*a16);
     a10=(a10+a07);
     a07=casadi_sq(a01);
@@ -794,7 +794,7 @@ static GEARSYM_INLINE void gsl_state_block(const casadi_real* restrict A0, const
     a06=(a03*a05);
     a06=(a06-a00);
     a07=A4[GS_L*2 + l];
-    a08=A3[0];
+    a08=A3[GS_L*0 + l];
     a08=(a07*a08);
     a06=(a06+a08);
     a08=A4[GS_L*0 + l];
@@ -810,7 +810,7 @@ static GEARSYM_INLINE void gsl_state_block(const casadi_real* restrict A0, const
     a12=(a04*a03);
     a12=(a00+a12);
     a11=(a11-a12);
-    a13=A3[1];
+    a13=A3[GS_L*1 + l];
     a13=(a07*a13);
     a11=(a11+a13);
     a14=casadi_sq(a12);
@@ -844,7 +844,7 @@ static GEARSYM_INLINE void gsl_state_block(const casadi_real* restrict A0, const
     a01=(a01*a12);
     a00=(a00+a01);
     a04=(a04-a00);
-    a01=A3[2];
+    a01=A3[GS_L*2 + l];
     a07=(a07*a01);
     a04=(a04+a07);
     a07=casadi_sq(a00);
@@ -899,9 +899,9 @@ static GEARSYM_INLINE void gsl_tangent_span(casadi_real* restrict y, casadi_real
   casadi_int k;
   gs_copy(y, 2*GS_L, ya); gs_copy(Q, 4*GS_L, Qa); gs_copy(lo, 2*GS_L, loa); gs_copy(hi, 2*GS_L, hia);
   for (k = 0; k < blocks; k += 2) {
-    gsl_tangent_step(ya, Qa, loa, hia, T + 3*(k), c, yb, Qb, lob, hib);
+    gsl_tangent_step(ya, Qa, loa, hia, T + 3*GS_L*(k), c, yb, Qb, lob, hib);
     if (k + 1 == blocks) { gs_copy(yb, 2*GS_L, y); gs_copy(Qb, 4*GS_L, Q); gs_copy(lob, 2*GS_L, lo); gs_copy(hib, 2*GS_L, hi); return; }
-    gsl_tangent_step(yb, Qb, lob, hib, T + 3*(k + 1), c, ya, Qa, loa, hia);
+    gsl_tangent_step(yb, Qb, lob, hib, T + 3*GS_L*(k + 1), c, ya, Qa, loa, hia);
   }
   gs_copy(ya, 2*GS_L, y); gs_copy(Qa, 4*GS_L, Q); gs_copy(loa, 2*GS_L, lo); gs_copy(hia, 2*GS_L, hi);
 }
@@ -917,9 +917,9 @@ static GEARSYM_INLINE void gsl_state_span(casadi_real* restrict y, casadi_real* 
   casadi_int k;
   gs_copy(y, 2*GS_L, ya); gs_copy(lo, 2*GS_L, loa); gs_copy(hi, 2*GS_L, hia);
   for (k = 0; k < blocks; k += 2) {
-    gsl_state_step(ya, loa, hia, T + 3*(k), c, yb, lob, hib);
+    gsl_state_step(ya, loa, hia, T + 3*GS_L*(k), c, yb, lob, hib);
     if (k + 1 == blocks) { gs_copy(yb, 2*GS_L, y); gs_copy(lob, 2*GS_L, lo); gs_copy(hib, 2*GS_L, hi); return; }
-    gsl_state_step(yb, lob, hib, T + 3*(k + 1), c, ya, loa, hia);
+    gsl_state_step(yb, lob, hib, T + 3*GS_L*(k + 1), c, ya, loa, hia);
   }
   gs_copy(ya, 2*GS_L, y); gs_copy(loa, 2*GS_L, lo); gs_copy(hia, 2*GS_L, hi);
 }
@@ -928,8 +928,9 @@ static GEARSYM_INLINE void gsl_state_span(casadi_real* restrict y, casadi_real* 
 CASADI_SYMBOL_EXPORT int gearsym_lanes(void) { return GS_L; }
 
 /* `periods` periods of the state of GS_L trajectories from y (n x GS_L, lane fastest; in place), with the
-   constants c (per lane) and the table T of a period; each period's strobe, low and high written where
-   given (periods x n x GS_L, periods x observed x GS_L) */
+   constants c (nc x GS_L) and the tables of a period T (steps x rows x GS_L: entry j of step k of lane l at
+   GS_L*(rows*k + j) + l), one of each per lane; each period's strobe, low and high written where given
+   (periods x n x GS_L, periods x observed x GS_L) */
 CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_orbit(const casadi_real* restrict T, const casadi_real* restrict c, casadi_int periods, casadi_real* restrict y, casadi_real* strobe, casadi_real* low, casadi_real* high) {
   casadi_real lo[2*GS_L], hi[2*GS_L]; casadi_int p, l;
   for (p = 0; p < periods; ++p) {

@@ -2707,11 +2707,11 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a09=(a07*a08);
     a06=(a06+a09);
     a09=A2[GS_L*4 + l];
-    a10=A1[1];
+    a10=A1[GS_L*1 + l];
     a10=(a09*a10);
     a06=(a06+a10);
     a10=A2[GS_L*1 + l];
-    a11=A1[0];
+    a11=A1[GS_L*0 + l];
     a12=(a10*a11);
     a13=A2[GS_L*0 + l];
     a14=0.;
@@ -2735,10 +2735,10 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a25=(a07+a25);
     a26=(a25*a08);
     a23=(a23+a26);
-    a26=A1[3];
+    a26=A1[GS_L*3 + l];
     a26=(a09*a26);
     a23=(a23+a26);
-    a27=A1[2];
+    a27=A1[GS_L*2 + l];
     a28=(a10*a27);
     a29=(a04*a03);
     a29=(a00+a29);
@@ -2796,10 +2796,10 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a29=(a07+a29);
     a25=(a29*a08);
     a31=(a31+a25);
-    a25=A1[5];
+    a25=A1[GS_L*5 + l];
     a09=(a09*a25);
     a31=(a31+a09);
-    a09=A1[4];
+    a09=A1[GS_L*4 + l];
     a10=(a10*a09);
     a25=(a01*a30);
     a25=(a00+a25);
@@ -3046,11 +3046,11 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a09=(a07*a08);
     a06=(a06+a09);
     a09=A2[GS_L*4 + l];
-    a10=A1[1];
+    a10=A1[GS_L*1 + l];
     a10=(a09*a10);
     a06=(a06+a10);
     a10=A2[GS_L*1 + l];
-    a11=A1[0];
+    a11=A1[GS_L*0 + l];
     a12=(a10*a11);
     a13=A2[GS_L*0 + l];
     a14=0.;
@@ -3074,10 +3074,10 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a24=(a07+a24);
     a25=(a24*a08);
     a22=(a22+a25);
-    a25=A1[3];
+    a25=A1[GS_L*3 + l];
     a25=(a09*a25);
     a22=(a22+a25);
-    a26=A1[2];
+    a26=A1[GS_L*2 + l];
     a27=(a10*a26);
     a28=(a04*a03);
     a28=(a00+a28);
@@ -3135,10 +3135,10 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a28=(a07+a28);
     a08=(a28*a08);
     a05=(a05+a08);
-    a08=A1[5];
+    a08=A1[GS_L*5 + l];
     a09=(a09*a08);
     a05=(a05+a09);
-    a09=A1[4];
+    a09=A1[GS_L*4 + l];
     a10=(a10*a09);
     a08=(a01*a29);
     a08=(a00+a08);
@@ -3273,17 +3273,18 @@ static GEARSYM_INLINE void gsl_tangent_step(const casadi_real* restrict y, const
   any = 0;
   GS_LANES any |= flag[l] != 0;
   if (GEARSYM_UNLIKELY(any)) for (l = 0; l < GS_L; ++l) if (flag[l] != 0) {  /* this lane crosses */
-    casadi_real ys[4], los[2], his[2], yts[4], cs[9], y1s[4], lo1s[2], hi1s[2];
+    casadi_real ys[4], los[2], his[2], yts[4], cs[9], Ts[6], y1s[4], lo1s[2], hi1s[2];
     casadi_real Qc[16], Qc1[16];
     for (i = 0; i < 4; ++i) ys[i] = y[GS_L*i + l];
     for (i = 0; i < 2; ++i) los[i] = lo[GS_L*i + l];
     for (i = 0; i < 2; ++i) his[i] = hi[GS_L*i + l];
     for (i = 0; i < 4; ++i) yts[i] = yt[GS_L*i + l];
     for (i = 0; i < 9; ++i) cs[i] = c[GS_L*i + l];
+    for (i = 0; i < 6; ++i) Ts[i] = T[GS_L*i + l];
     for (i = 0, finite = 1; i < 4; ++i) finite &= ys[i] - ys[i] == 0;
     if (!finite) continue;  /* a lane that diverged keeps the try (every flag of it would split) */
     for (i = 0; i < 16; ++i) Qc[(i % 4)*4 + i / 4] = Q[GS_L*i + l];
-    gs_tangent_split(ys, Qc, los, his, yts, Qc, T, cs, y1s, Qc1, lo1s, hi1s);
+    gs_tangent_split(ys, Qc, los, his, yts, Qc, Ts, cs, y1s, Qc1, lo1s, hi1s);
     for (i = 0; i < 16; ++i) Q1[GS_L*i + l] = Qc1[(i % 4)*4 + i / 4];
     for (i = 0; i < 4; ++i) y1[GS_L*i + l] = y1s[i];
     for (i = 0; i < 2; ++i) lo1[GS_L*i + l] = lo1s[i];
@@ -3297,9 +3298,9 @@ static GEARSYM_INLINE void gsl_tangent_span(casadi_real* restrict y, casadi_real
   casadi_int k;
   gs_copy(y, 4*GS_L, ya); gs_copy(Q, 16*GS_L, Qa); gs_copy(lo, 2*GS_L, loa); gs_copy(hi, 2*GS_L, hia);
   for (k = 0; k < blocks; k += 2) {
-    gsl_tangent_step(ya, Qa, loa, hia, T + 6*(k), c, yb, Qb, lob, hib);
+    gsl_tangent_step(ya, Qa, loa, hia, T + 6*GS_L*(k), c, yb, Qb, lob, hib);
     if (k + 1 == blocks) { gs_copy(yb, 4*GS_L, y); gs_copy(Qb, 16*GS_L, Q); gs_copy(lob, 2*GS_L, lo); gs_copy(hib, 2*GS_L, hi); return; }
-    gsl_tangent_step(yb, Qb, lob, hib, T + 6*(k + 1), c, ya, Qa, loa, hia);
+    gsl_tangent_step(yb, Qb, lob, hib, T + 6*GS_L*(k + 1), c, ya, Qa, loa, hia);
   }
   gs_copy(ya, 4*GS_L, y); gs_copy(Qa, 16*GS_L, Q); gs_copy(loa, 2*GS_L, lo); gs_copy(hia, 2*GS_L, hi);
 }
@@ -3312,15 +3313,16 @@ static GEARSYM_INLINE void gsl_state_step(const casadi_real* restrict y, const c
   any = 0;
   GS_LANES any |= flag[l] != 0;
   if (GEARSYM_UNLIKELY(any)) for (l = 0; l < GS_L; ++l) if (flag[l] != 0) {  /* this lane crosses */
-    casadi_real ys[4], los[2], his[2], yts[4], cs[9], y1s[4], lo1s[2], hi1s[2];
+    casadi_real ys[4], los[2], his[2], yts[4], cs[9], Ts[6], y1s[4], lo1s[2], hi1s[2];
     for (i = 0; i < 4; ++i) ys[i] = y[GS_L*i + l];
     for (i = 0; i < 2; ++i) los[i] = lo[GS_L*i + l];
     for (i = 0; i < 2; ++i) his[i] = hi[GS_L*i + l];
     for (i = 0; i < 4; ++i) yts[i] = yt[GS_L*i + l];
     for (i = 0; i < 9; ++i) cs[i] = c[GS_L*i + l];
+    for (i = 0; i < 6; ++i) Ts[i] = T[GS_L*i + l];
     for (i = 0, finite = 1; i < 4; ++i) finite &= ys[i] - ys[i] == 0;
     if (!finite) continue;  /* a lane that diverged keeps the try (every flag of it would split) */
-    gs_state_split(ys, los, his, yts, T, cs, y1s, lo1s, hi1s);
+    gs_state_split(ys, los, his, yts, Ts, cs, y1s, lo1s, hi1s);
     for (i = 0; i < 4; ++i) y1[GS_L*i + l] = y1s[i];
     for (i = 0; i < 2; ++i) lo1[GS_L*i + l] = lo1s[i];
     for (i = 0; i < 2; ++i) hi1[GS_L*i + l] = hi1s[i];
@@ -3333,9 +3335,9 @@ static GEARSYM_INLINE void gsl_state_span(casadi_real* restrict y, casadi_real* 
   casadi_int k;
   gs_copy(y, 4*GS_L, ya); gs_copy(lo, 2*GS_L, loa); gs_copy(hi, 2*GS_L, hia);
   for (k = 0; k < blocks; k += 2) {
-    gsl_state_step(ya, loa, hia, T + 6*(k), c, yb, lob, hib);
+    gsl_state_step(ya, loa, hia, T + 6*GS_L*(k), c, yb, lob, hib);
     if (k + 1 == blocks) { gs_copy(yb, 4*GS_L, y); gs_copy(lob, 2*GS_L, lo); gs_copy(hib, 2*GS_L, hi); return; }
-    gsl_state_step(yb, lob, hib, T + 6*(k + 1), c, ya, loa, hia);
+    gsl_state_step(yb, lob, hib, T + 6*GS_L*(k + 1), c, ya, loa, hia);
   }
   gs_copy(ya, 4*GS_L, y); gs_copy(loa, 2*GS_L, lo); gs_copy(hia, 2*GS_L, hi);
 }
@@ -3344,8 +3346,9 @@ static GEARSYM_INLINE void gsl_state_span(casadi_real* restrict y, casadi_real* 
 CASADI_SYMBOL_EXPORT int gearsym_lanes(void) { return GS_L; }
 
 /* `periods` periods of the state of GS_L trajectories from y (n x GS_L, lane fastest; in place), with the
-   constants c (per lane) and the table T of a period; each period's strobe, low and high written where
-   given (periods x n x GS_L, periods x observed x GS_L) */
+   constants c (nc x GS_L) and the tables of a period T (steps x rows x GS_L: entry j of step k of lane l at
+   GS_L*(rows*k + j) + l), one of each per lane; each period's strobe, low and high written where given
+   (periods x n x GS_L, periods x observed x GS_L) */
 CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_orbit(const casadi_real* restrict T, const casadi_real* restrict c, casadi_int periods, casadi_real* restrict y, casadi_real* strobe, casadi_real* low, casadi_real* high) {
   casadi_real lo[2*GS_L], hi[2*GS_L]; casadi_int p, l;
   for (p = 0; p < periods; ++p) {

@@ -1166,8 +1166,9 @@ static GEARSYM_INLINE void gsl_state_span(casadi_real* restrict y, casadi_real* 
 CASADI_SYMBOL_EXPORT int gearsym_lanes(void) { return GS_L; }
 
 /* `periods` periods of the state of GS_L trajectories from y (n x GS_L, lane fastest; in place), with the
-   constants c (per lane) and the table T of a period; each period's strobe, low and high written where
-   given (periods x n x GS_L, periods x observed x GS_L) */
+   constants c (nc x GS_L) and the tables of a period T (steps x rows x GS_L: entry j of step k of lane l at
+   GS_L*(rows*k + j) + l), one of each per lane; each period's strobe, low and high written where given
+   (periods x n x GS_L, periods x observed x GS_L) */
 CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_orbit(const casadi_real* restrict T, const casadi_real* restrict c, casadi_int periods, casadi_real* restrict y, casadi_real* strobe, casadi_real* low, casadi_real* high) {
   casadi_real lo[3*GS_L], hi[3*GS_L]; casadi_int p, l;
   for (p = 0; p < periods; ++p) {

@@ -9928,11 +9928,11 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a018=(a016*a014);
     a010=(a010+a018);
     a019=A2[GS_L*10 + l];
-    a020=A1[3];
+    a020=A1[GS_L*3 + l];
     a020=(a019*a020);
     a010=(a010+a020);
     a021=A2[GS_L*1 + l];
-    a022=A1[0];
+    a022=A1[GS_L*0 + l];
     a023=(a021*a022);
     a024=A2[GS_L*0 + l];
     a025=0.;
@@ -9947,7 +9947,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a032=(a023*a031);
     a010=(a010+a032);
     a032=A2[GS_L*3 + l];
-    a033=A1[1];
+    a033=A1[GS_L*1 + l];
     a034=(a032*a033);
     a035=A0[GS_L*2 + l];
     a036=(a035+a024);
@@ -9960,7 +9960,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a041=(a038+a041);
     a042=(a034*a041);
     a010=(a010+a042);
-    a043=A1[2];
+    a043=A1[GS_L*2 + l];
     a044=(a032*a043);
     a045=A0[GS_L*4 + l];
     a046=(a045+a024);
@@ -10129,10 +10129,10 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a102=(a102+a071);
     a061=(a080*a014);
     a102=(a102+a061);
-    a051=A1[7];
+    a051=A1[GS_L*7 + l];
     a051=(a019*a051);
     a102=(a102+a051);
-    a031=A1[4];
+    a031=A1[GS_L*4 + l];
     a020=(a021*a031);
     a015=(a004*a003);
     a015=(a000+a015);
@@ -10140,7 +10140,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a013=(a028+a013);
     a041=(a020*a013);
     a102=(a102+a041);
-    a041=A1[5];
+    a041=A1[GS_L*5 + l];
     a106=(a032*a041);
     a107=(a004*a011);
     a107=(a035+a107);
@@ -10148,7 +10148,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a108=(a038+a108);
     a109=(a106*a108);
     a102=(a102+a109);
-    a110=A1[6];
+    a110=A1[GS_L*6 + l];
     a111=(a032*a110);
     a112=(a004*a016);
     a112=(a045+a112);
@@ -10412,10 +10412,10 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a137=(a137+a108);
     a134=(a013*a014);
     a137=(a137+a134);
-    a132=A1[11];
+    a132=A1[GS_L*11 + l];
     a019=(a019*a132);
     a137=(a137+a019);
-    a132=A1[8];
+    a132=A1[GS_L*8 + l];
     a072=(a021*a132);
     a120=(a001*a120);
     a120=(a000+a120);
@@ -10423,7 +10423,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a028=(a028+a113);
     a113=(a072*a028);
     a137=(a137+a113);
-    a113=A1[9];
+    a113=A1[GS_L*9 + l];
     a051=(a032*a113);
     a114=(a001*a015);
     a114=(a035+a114);
@@ -10431,7 +10431,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a038=(a038+a116);
     a116=(a051*a038);
     a137=(a137+a116);
-    a052=A1[10];
+    a052=A1[GS_L*10 + l];
     a117=(a032*a052);
     a112=(a001*a107);
     a112=(a045+a112);
@@ -11533,11 +11533,11 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a018=(a016*a014);
     a010=(a010+a018);
     a019=A2[GS_L*10 + l];
-    a020=A1[3];
+    a020=A1[GS_L*3 + l];
     a020=(a019*a020);
     a010=(a010+a020);
     a021=A2[GS_L*1 + l];
-    a022=A1[0];
+    a022=A1[GS_L*0 + l];
     a023=(a021*a022);
     a024=A2[GS_L*0 + l];
     a025=0.;
@@ -11552,7 +11552,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a023=(a023*a031);
     a010=(a010+a023);
     a023=A2[GS_L*3 + l];
-    a032=A1[1];
+    a032=A1[GS_L*1 + l];
     a033=(a023*a032);
     a034=A0[GS_L*2 + l];
     a035=(a034+a024);
@@ -11565,7 +11565,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a040=(a037+a040);
     a033=(a033*a040);
     a010=(a010+a033);
-    a041=A1[2];
+    a041=A1[GS_L*2 + l];
     a042=(a023*a041);
     a043=A0[GS_L*4 + l];
     a044=(a043+a024);
@@ -11734,10 +11734,10 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a090=(a090+a041);
     a067=(a068*a014);
     a090=(a090+a067);
-    a022=A1[7];
+    a022=A1[GS_L*7 + l];
     a022=(a019*a022);
     a090=(a090+a022);
-    a033=A1[4];
+    a033=A1[GS_L*4 + l];
     a049=(a021*a033);
     a018=(a004*a003);
     a018=(a000+a018);
@@ -11745,7 +11745,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a020=(a028+a020);
     a015=(a049*a020);
     a090=(a090+a015);
-    a015=A1[5];
+    a015=A1[GS_L*5 + l];
     a013=(a023*a015);
     a058=(a004*a011);
     a058=(a034+a058);
@@ -11753,7 +11753,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a042=(a037+a042);
     a031=(a013*a042);
     a090=(a090+a031);
-    a040=A1[6];
+    a040=A1[GS_L*6 + l];
     a017=(a023*a040);
     a094=(a004*a016);
     a094=(a043+a094);
@@ -12017,10 +12017,10 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a107=(a107+a040);
     a014=(a101*a014);
     a107=(a107+a014);
-    a059=A1[11];
+    a059=A1[GS_L*11 + l];
     a019=(a019*a059);
     a107=(a107+a019);
-    a059=A1[8];
+    a059=A1[GS_L*8 + l];
     a033=(a021*a059);
     a102=(a001*a102);
     a102=(a000+a102);
@@ -12028,7 +12028,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a028=(a028+a030);
     a033=(a033*a028);
     a107=(a107+a033);
-    a033=A1[9];
+    a033=A1[GS_L*9 + l];
     a030=(a023*a033);
     a031=(a001*a018);
     a031=(a034+a031);
@@ -12036,7 +12036,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a037=(a037+a039);
     a030=(a030*a037);
     a107=(a107+a030);
-    a039=A1[10];
+    a039=A1[GS_L*10 + l];
     a074=(a023*a039);
     a013=(a001*a058);
     a013=(a043+a013);
@@ -12516,17 +12516,18 @@ static GEARSYM_INLINE void gsl_tangent_step(const casadi_real* restrict y, const
   any = 0;
   GS_LANES any |= flag[l] != 0;
   if (GEARSYM_UNLIKELY(any)) for (l = 0; l < GS_L; ++l) if (flag[l] != 0) {  /* this lane crosses */
-    casadi_real ys[8], los[4], his[4], yts[8], cs[24], y1s[8], lo1s[4], hi1s[4];
+    casadi_real ys[8], los[4], his[4], yts[8], cs[24], Ts[12], y1s[8], lo1s[4], hi1s[4];
     casadi_real Qc[64], Qc1[64];
     for (i = 0; i < 8; ++i) ys[i] = y[GS_L*i + l];
     for (i = 0; i < 4; ++i) los[i] = lo[GS_L*i + l];
     for (i = 0; i < 4; ++i) his[i] = hi[GS_L*i + l];
     for (i = 0; i < 8; ++i) yts[i] = yt[GS_L*i + l];
     for (i = 0; i < 24; ++i) cs[i] = c[GS_L*i + l];
+    for (i = 0; i < 12; ++i) Ts[i] = T[GS_L*i + l];
     for (i = 0, finite = 1; i < 8; ++i) finite &= ys[i] - ys[i] == 0;
     if (!finite) continue;  /* a lane that diverged keeps the try (every flag of it would split) */
     for (i = 0; i < 64; ++i) Qc[(i % 8)*8 + i / 8] = Q[GS_L*i + l];
-    gs_tangent_split(ys, Qc, los, his, yts, Qc, T, cs, y1s, Qc1, lo1s, hi1s);
+    gs_tangent_split(ys, Qc, los, his, yts, Qc, Ts, cs, y1s, Qc1, lo1s, hi1s);
     for (i = 0; i < 64; ++i) Q1[GS_L*i + l] = Qc1[(i % 8)*8 + i / 8];
     for (i = 0; i < 8; ++i) y1[GS_L*i + l] = y1s[i];
     for (i = 0; i < 4; ++i) lo1[GS_L*i + l] = lo1s[i];
@@ -12540,9 +12541,9 @@ static GEARSYM_INLINE void gsl_tangent_span(casadi_real* restrict y, casadi_real
   casadi_int k;
   gs_copy(y, 8*GS_L, ya); gs_copy(Q, 64*GS_L, Qa); gs_copy(lo, 4*GS_L, loa); gs_copy(hi, 4*GS_L, hia);
   for (k = 0; k < blocks; k += 2) {
-    gsl_tangent_step(ya, Qa, loa, hia, T + 12*(k), c, yb, Qb, lob, hib);
+    gsl_tangent_step(ya, Qa, loa, hia, T + 12*GS_L*(k), c, yb, Qb, lob, hib);
     if (k + 1 == blocks) { gs_copy(yb, 8*GS_L, y); gs_copy(Qb, 64*GS_L, Q); gs_copy(lob, 4*GS_L, lo); gs_copy(hib, 4*GS_L, hi); return; }
-    gsl_tangent_step(yb, Qb, lob, hib, T + 12*(k + 1), c, ya, Qa, loa, hia);
+    gsl_tangent_step(yb, Qb, lob, hib, T + 12*GS_L*(k + 1), c, ya, Qa, loa, hia);
   }
   gs_copy(ya, 8*GS_L, y); gs_copy(Qa, 64*GS_L, Q); gs_copy(loa, 4*GS_L, lo); gs_copy(hia, 4*GS_L, hi);
 }
@@ -12555,15 +12556,16 @@ static GEARSYM_INLINE void gsl_state_step(const casadi_real* restrict y, const c
   any = 0;
   GS_LANES any |= flag[l] != 0;
   if (GEARSYM_UNLIKELY(any)) for (l = 0; l < GS_L; ++l) if (flag[l] != 0) {  /* this lane crosses */
-    casadi_real ys[8], los[4], his[4], yts[8], cs[24], y1s[8], lo1s[4], hi1s[4];
+    casadi_real ys[8], los[4], his[4], yts[8], cs[24], Ts[12], y1s[8], lo1s[4], hi1s[4];
     for (i = 0; i < 8; ++i) ys[i] = y[GS_L*i + l];
     for (i = 0; i < 4; ++i) los[i] = lo[GS_L*i + l];
     for (i = 0; i < 4; ++i) his[i] = hi[GS_L*i + l];
     for (i = 0; i < 8; ++i) yts[i] = yt[GS_L*i + l];
     for (i = 0; i < 24; ++i) cs[i] = c[GS_L*i + l];
+    for (i = 0; i < 12; ++i) Ts[i] = T[GS_L*i + l];
     for (i = 0, finite = 1; i < 8; ++i) finite &= ys[i] - ys[i] == 0;
     if (!finite) continue;  /* a lane that diverged keeps the try (every flag of it would split) */
-    gs_state_split(ys, los, his, yts, T, cs, y1s, lo1s, hi1s);
+    gs_state_split(ys, los, his, yts, Ts, cs, y1s, lo1s, hi1s);
     for (i = 0; i < 8; ++i) y1[GS_L*i + l] = y1s[i];
     for (i = 0; i < 4; ++i) lo1[GS_L*i + l] = lo1s[i];
     for (i = 0; i < 4; ++i) hi1[GS_L*i + l] = hi1s[i];
@@ -12576,9 +12578,9 @@ static GEARSYM_INLINE void gsl_state_span(casadi_real* restrict y, casadi_real* 
   casadi_int k;
   gs_copy(y, 8*GS_L, ya); gs_copy(lo, 4*GS_L, loa); gs_copy(hi, 4*GS_L, hia);
   for (k = 0; k < blocks; k += 2) {
-    gsl_state_step(ya, loa, hia, T + 12*(k), c, yb, lob, hib);
+    gsl_state_step(ya, loa, hia, T + 12*GS_L*(k), c, yb, lob, hib);
     if (k + 1 == blocks) { gs_copy(yb, 8*GS_L, y); gs_copy(lob, 4*GS_L, lo); gs_copy(hib, 4*GS_L, hi); return; }
-    gsl_state_step(yb, lob, hib, T + 12*(k + 1), c, ya, loa, hia);
+    gsl_state_step(yb, lob, hib, T + 12*GS_L*(k + 1), c, ya, loa, hia);
   }
   gs_copy(ya, 8*GS_L, y); gs_copy(loa, 4*GS_L, lo); gs_copy(hia, 4*GS_L, hi);
 }
@@ -12587,8 +12589,9 @@ static GEARSYM_INLINE void gsl_state_span(casadi_real* restrict y, casadi_real* 
 CASADI_SYMBOL_EXPORT int gearsym_lanes(void) { return GS_L; }
 
 /* `periods` periods of the state of GS_L trajectories from y (n x GS_L, lane fastest; in place), with the
-   constants c (per lane) and the table T of a period; each period's strobe, low and high written where
-   given (periods x n x GS_L, periods x observed x GS_L) */
+   constants c (nc x GS_L) and the tables of a period T (steps x rows x GS_L: entry j of step k of lane l at
+   GS_L*(rows*k + j) + l), one of each per lane; each period's strobe, low and high written where given
+   (periods x n x GS_L, periods x observed x GS_L) */
 CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_orbit(const casadi_real* restrict T, const casadi_real* restrict c, casadi_int periods, casadi_real* restrict y, casadi_real* strobe, casadi_real* low, casadi_real* high) {
   casadi_real lo[4*GS_L], hi[4*GS_L]; casadi_int p, l;
   for (p = 0; p < periods; ++p) {

@@ -18096,11 +18096,11 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a021=(a019*a020);
     a010=(a010+a021);
     a022=A2[GS_L*11 + l];
-    a023=A1[3];
+    a023=A1[GS_L*3 + l];
     a023=(a022*a023);
     a010=(a010+a023);
     a024=A2[GS_L*1 + l];
-    a025=A1[0];
+    a025=A1[GS_L*0 + l];
     a026=(a024*a025);
     a027=A2[GS_L*0 + l];
     a028=0.;
@@ -18115,7 +18115,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a035=(a026*a034);
     a010=(a010+a035);
     a035=A2[GS_L*4 + l];
-    a036=A1[1];
+    a036=A1[GS_L*1 + l];
     a037=(a035*a036);
     a038=A0[GS_L*2 + l];
     a039=(a038+a027);
@@ -18128,7 +18128,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a044=(a041+a044);
     a045=(a037*a044);
     a010=(a010+a045);
-    a046=A1[2];
+    a046=A1[GS_L*2 + l];
     a047=(a035*a046);
     a048=A0[GS_L*4 + l];
     a049=(a048+a027);
@@ -18305,10 +18305,10 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a015=(a019+a015);
     a013=(a015*a020);
     a105=(a105+a013);
-    a114=A1[8];
+    a114=A1[GS_L*8 + l];
     a114=(a022*a114);
     a105=(a105+a114);
-    a115=A1[5];
+    a115=A1[GS_L*5 + l];
     a116=(a024*a115);
     a117=(a004*a003);
     a117=(a000+a117);
@@ -18316,7 +18316,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a118=(a031+a118);
     a119=(a116*a118);
     a105=(a105+a119);
-    a119=A1[6];
+    a119=A1[GS_L*6 + l];
     a120=(a035*a119);
     a121=(a004*a011);
     a121=(a038+a121);
@@ -18324,7 +18324,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a122=(a041+a122);
     a123=(a120*a122);
     a105=(a105+a123);
-    a124=A1[7];
+    a124=A1[GS_L*7 + l];
     a125=(a035*a124);
     a126=(a004*a016);
     a126=(a048+a126);
@@ -18497,7 +18497,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a064=(a025*a064);
     a112=(a112+a064);
     a064=A2[GS_L*33 + l];
-    a159=A1[4];
+    a159=A1[GS_L*4 + l];
     a160=(a064*a159);
     a161=A2[GS_L*32 + l];
     a162=A0[GS_L*10 + l];
@@ -18701,7 +18701,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a115=(a054*a115);
     a131=(a115*a131);
     a013=(a013+a131);
-    a131=A1[9];
+    a131=A1[GS_L*9 + l];
     a127=(a064*a131);
     a186=(a004*a151);
     a186=(a162+a186);
@@ -18721,10 +18721,10 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a121=(a019+a121);
     a187=(a121*a020);
     a182=(a182+a187);
-    a188=A1[13];
+    a188=A1[GS_L*13 + l];
     a022=(a022*a188);
     a182=(a182+a022);
-    a188=A1[10];
+    a188=A1[GS_L*10 + l];
     a189=(a024*a188);
     a190=(a001*a134);
     a190=(a000+a190);
@@ -18732,7 +18732,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a031=(a031+a191);
     a191=(a189*a031);
     a182=(a182+a191);
-    a191=A1[11];
+    a191=A1[GS_L*11 + l];
     a192=(a035*a191);
     a193=(a001*a126);
     a193=(a038+a193);
@@ -18740,7 +18740,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a041=(a041+a194);
     a194=(a192*a041);
     a182=(a182+a194);
-    a195=A1[12];
+    a195=A1[GS_L*12 + l];
     a196=(a035*a195);
     a197=(a001*a147);
     a197=(a048+a197);
@@ -18996,7 +18996,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a188=(a054*a188);
     a061=(a188*a061);
     a105=(a105+a061);
-    a061=A1[14];
+    a061=A1[GS_L*14 + l];
     a064=(a064*a061);
     a051=(a001*a186);
     a051=(a162+a051);
@@ -20325,11 +20325,11 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a021=(a019*a020);
     a010=(a010+a021);
     a022=A2[GS_L*11 + l];
-    a023=A1[3];
+    a023=A1[GS_L*3 + l];
     a023=(a022*a023);
     a010=(a010+a023);
     a024=A2[GS_L*1 + l];
-    a025=A1[0];
+    a025=A1[GS_L*0 + l];
     a026=(a024*a025);
     a027=A2[GS_L*0 + l];
     a028=0.;
@@ -20344,7 +20344,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a026=(a026*a034);
     a010=(a010+a026);
     a026=A2[GS_L*4 + l];
-    a035=A1[1];
+    a035=A1[GS_L*1 + l];
     a036=(a026*a035);
     a037=A0[GS_L*2 + l];
     a038=(a037+a027);
@@ -20357,7 +20357,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a043=(a040+a043);
     a036=(a036*a043);
     a010=(a010+a036);
-    a044=A1[2];
+    a044=A1[GS_L*2 + l];
     a045=(a026*a044);
     a046=A0[GS_L*4 + l];
     a047=(a046+a027);
@@ -20534,10 +20534,10 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a023=(a019+a023);
     a021=(a023*a020);
     a093=(a093+a021);
-    a015=A1[8];
+    a015=A1[GS_L*8 + l];
     a015=(a022*a015);
     a093=(a093+a015);
-    a013=A1[5];
+    a013=A1[GS_L*5 + l];
     a098=(a024*a013);
     a099=(a004*a003);
     a099=(a000+a099);
@@ -20545,7 +20545,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a100=(a031+a100);
     a101=(a098*a100);
     a093=(a093+a101);
-    a101=A1[6];
+    a101=A1[GS_L*6 + l];
     a102=(a026*a101);
     a103=(a004*a011);
     a103=(a037+a103);
@@ -20553,7 +20553,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a104=(a040+a104);
     a105=(a102*a104);
     a093=(a093+a105);
-    a106=A1[7];
+    a106=A1[GS_L*7 + l];
     a107=(a026*a106);
     a108=(a004*a016);
     a108=(a046+a108);
@@ -20726,7 +20726,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a025=(a025*a061);
     a017=(a017+a025);
     a025=A2[GS_L*33 + l];
-    a061=A1[4];
+    a061=A1[GS_L*4 + l];
     a052=(a025*a061);
     a043=A2[GS_L*32 + l];
     a034=A0[GS_L*10 + l];
@@ -20930,7 +20930,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a013=(a140*a013);
     a113=(a013*a113);
     a110=(a110+a113);
-    a113=A1[9];
+    a113=A1[GS_L*9 + l];
     a109=(a025*a113);
     a146=(a004*a133);
     a146=(a034+a146);
@@ -20950,10 +20950,10 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a103=(a019+a103);
     a020=(a103*a020);
     a121=(a121+a020);
-    a132=A1[13];
+    a132=A1[GS_L*13 + l];
     a022=(a022*a132);
     a121=(a121+a022);
-    a132=A1[10];
+    a132=A1[GS_L*10 + l];
     a131=(a024*a132);
     a128=(a001*a116);
     a128=(a000+a128);
@@ -20961,7 +20961,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a031=(a031+a033);
     a131=(a131*a031);
     a121=(a121+a131);
-    a131=A1[11];
+    a131=A1[GS_L*11 + l];
     a033=(a026*a131);
     a021=(a001*a108);
     a021=(a037+a021);
@@ -20969,7 +20969,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a040=(a040+a042);
     a033=(a033*a040);
     a121=(a121+a033);
-    a042=A1[12];
+    a042=A1[GS_L*12 + l];
     a045=(a026*a042);
     a120=(a001*a129);
     a120=(a046+a120);
@@ -21225,7 +21225,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a132=(a140*a132);
     a132=(a132*a058);
     a123=(a123+a132);
-    a132=A1[14];
+    a132=A1[GS_L*14 + l];
     a025=(a025*a132);
     a058=(a001*a146);
     a058=(a034+a058);
@@ -21659,17 +21659,18 @@ static GEARSYM_INLINE void gsl_tangent_step(const casadi_real* restrict y, const
   any = 0;
   GS_LANES any |= flag[l] != 0;
   if (GEARSYM_UNLIKELY(any)) for (l = 0; l < GS_L; ++l) if (flag[l] != 0) {  /* this lane crosses */
-    casadi_real ys[12], los[6], his[6], yts[12], cs[39], y1s[12], lo1s[6], hi1s[6];
+    casadi_real ys[12], los[6], his[6], yts[12], cs[39], Ts[15], y1s[12], lo1s[6], hi1s[6];
     casadi_real Qc[144], Qc1[144];
     for (i = 0; i < 12; ++i) ys[i] = y[GS_L*i + l];
     for (i = 0; i < 6; ++i) los[i] = lo[GS_L*i + l];
     for (i = 0; i < 6; ++i) his[i] = hi[GS_L*i + l];
     for (i = 0; i < 12; ++i) yts[i] = yt[GS_L*i + l];
     for (i = 0; i < 39; ++i) cs[i] = c[GS_L*i + l];
+    for (i = 0; i < 15; ++i) Ts[i] = T[GS_L*i + l];
     for (i = 0, finite = 1; i < 12; ++i) finite &= ys[i] - ys[i] == 0;
     if (!finite) continue;  /* a lane that diverged keeps the try (every flag of it would split) */
     for (i = 0; i < 144; ++i) Qc[(i % 12)*12 + i / 12] = Q[GS_L*i + l];
-    gs_tangent_split(ys, Qc, los, his, yts, Qc, T, cs, y1s, Qc1, lo1s, hi1s);
+    gs_tangent_split(ys, Qc, los, his, yts, Qc, Ts, cs, y1s, Qc1, lo1s, hi1s);
     for (i = 0; i < 144; ++i) Q1[GS_L*i + l] = Qc1[(i % 12)*12 + i / 12];
     for (i = 0; i < 12; ++i) y1[GS_L*i + l] = y1s[i];
     for (i = 0; i < 6; ++i) lo1[GS_L*i + l] = lo1s[i];
@@ -21683,9 +21684,9 @@ static GEARSYM_INLINE void gsl_tangent_span(casadi_real* restrict y, casadi_real
   casadi_int k;
   gs_copy(y, 12*GS_L, ya); gs_copy(Q, 144*GS_L, Qa); gs_copy(lo, 6*GS_L, loa); gs_copy(hi, 6*GS_L, hia);
   for (k = 0; k < blocks; k += 2) {
-    gsl_tangent_step(ya, Qa, loa, hia, T + 15*(k), c, yb, Qb, lob, hib);
+    gsl_tangent_step(ya, Qa, loa, hia, T + 15*GS_L*(k), c, yb, Qb, lob, hib);
     if (k + 1 == blocks) { gs_copy(yb, 12*GS_L, y); gs_copy(Qb, 144*GS_L, Q); gs_copy(lob, 6*GS_L, lo); gs_copy(hib, 6*GS_L, hi); return; }
-    gsl_tangent_step(yb, Qb, lob, hib, T + 15*(k + 1), c, ya, Qa, loa, hia);
+    gsl_tangent_step(yb, Qb, lob, hib, T + 15*GS_L*(k + 1), c, ya, Qa, loa, hia);
   }
   gs_copy(ya, 12*GS_L, y); gs_copy(Qa, 144*GS_L, Q); gs_copy(loa, 6*GS_L, lo); gs_copy(hia, 6*GS_L, hi);
 }
@@ -21698,15 +21699,16 @@ static GEARSYM_INLINE void gsl_state_step(const casadi_real* restrict y, const c
   any = 0;
   GS_LANES any |= flag[l] != 0;
   if (GEARSYM_UNLIKELY(any)) for (l = 0; l < GS_L; ++l) if (flag[l] != 0) {  /* this lane crosses */
-    casadi_real ys[12], los[6], his[6], yts[12], cs[39], y1s[12], lo1s[6], hi1s[6];
+    casadi_real ys[12], los[6], his[6], yts[12], cs[39], Ts[15], y1s[12], lo1s[6], hi1s[6];
     for (i = 0; i < 12; ++i) ys[i] = y[GS_L*i + l];
     for (i = 0; i < 6; ++i) los[i] = lo[GS_L*i + l];
     for (i = 0; i < 6; ++i) his[i] = hi[GS_L*i + l];
     for (i = 0; i < 12; ++i) yts[i] = yt[GS_L*i + l];
     for (i = 0; i < 39; ++i) cs[i] = c[GS_L*i + l];
+    for (i = 0; i < 15; ++i) Ts[i] = T[GS_L*i + l];
     for (i = 0, finite = 1; i < 12; ++i) finite &= ys[i] - ys[i] == 0;
     if (!finite) continue;  /* a lane that diverged keeps the try (every flag of it would split) */
-    gs_state_split(ys, los, his, yts, T, cs, y1s, lo1s, hi1s);
+    gs_state_split(ys, los, his, yts, Ts, cs, y1s, lo1s, hi1s);
     for (i = 0; i < 12; ++i) y1[GS_L*i + l] = y1s[i];
     for (i = 0; i < 6; ++i) lo1[GS_L*i + l] = lo1s[i];
     for (i = 0; i < 6; ++i) hi1[GS_L*i + l] = hi1s[i];
@@ -21719,9 +21721,9 @@ static GEARSYM_INLINE void gsl_state_span(casadi_real* restrict y, casadi_real* 
   casadi_int k;
   gs_copy(y, 12*GS_L, ya); gs_copy(lo, 6*GS_L, loa); gs_copy(hi, 6*GS_L, hia);
   for (k = 0; k < blocks; k += 2) {
-    gsl_state_step(ya, loa, hia, T + 15*(k), c, yb, lob, hib);
+    gsl_state_step(ya, loa, hia, T + 15*GS_L*(k), c, yb, lob, hib);
     if (k + 1 == blocks) { gs_copy(yb, 12*GS_L, y); gs_copy(lob, 6*GS_L, lo); gs_copy(hib, 6*GS_L, hi); return; }
-    gsl_state_step(yb, lob, hib, T + 15*(k + 1), c, ya, loa, hia);
+    gsl_state_step(yb, lob, hib, T + 15*GS_L*(k + 1), c, ya, loa, hia);
   }
   gs_copy(ya, 12*GS_L, y); gs_copy(loa, 6*GS_L, lo); gs_copy(hia, 6*GS_L, hi);
 }
@@ -21730,8 +21732,9 @@ static GEARSYM_INLINE void gsl_state_span(casadi_real* restrict y, casadi_real* 
 CASADI_SYMBOL_EXPORT int gearsym_lanes(void) { return GS_L; }
 
 /* `periods` periods of the state of GS_L trajectories from y (n x GS_L, lane fastest; in place), with the
-   constants c (per lane) and the table T of a period; each period's strobe, low and high written where
-   given (periods x n x GS_L, periods x observed x GS_L) */
+   constants c (nc x GS_L) and the tables of a period T (steps x rows x GS_L: entry j of step k of lane l at
+   GS_L*(rows*k + j) + l), one of each per lane; each period's strobe, low and high written where given
+   (periods x n x GS_L, periods x observed x GS_L) */
 CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_orbit(const casadi_real* restrict T, const casadi_real* restrict c, casadi_int periods, casadi_real* restrict y, casadi_real* strobe, casadi_real* low, casadi_real* high) {
   casadi_real lo[6*GS_L], hi[6*GS_L]; casadi_int p, l;
   for (p = 0; p < periods; ++p) {

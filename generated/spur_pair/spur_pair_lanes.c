@@ -1821,11 +1821,11 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a05=A2[GS_L*2 + l];
     a06=(a03*a05);
     a07=A2[GS_L*3 + l];
-    a08=A1[1];
+    a08=A1[GS_L*1 + l];
     a08=(a07*a08);
     a06=(a06+a08);
     a08=A2[GS_L*1 + l];
-    a09=A1[0];
+    a09=A1[GS_L*0 + l];
     a09=(a08*a09);
     a10=A2[GS_L*0 + l];
     a11=0.;
@@ -1844,10 +1844,10 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a18=(2.*a17);
     a18=(a03+a18);
     a19=(a17*a05);
-    a20=A1[3];
+    a20=A1[GS_L*3 + l];
     a20=(a07*a20);
     a19=(a19+a20);
-    a21=A1[2];
+    a21=A1[GS_L*2 + l];
     a21=(a08*a21);
     a22=(a04*a03);
     a22=(a00+a22);
@@ -1878,10 +1878,10 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a23=(2.*a23);
     a06=(a06+a23);
     a04=(a04*a05);
-    a23=A1[5];
+    a23=A1[GS_L*5 + l];
     a07=(a07*a23);
     a04=(a04+a07);
-    a07=A1[4];
+    a07=A1[GS_L*4 + l];
     a08=(a08*a07);
     a22=(a01*a22);
     a22=(a00+a22);
@@ -2018,11 +2018,11 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a05=A2[GS_L*2 + l];
     a06=(a03*a05);
     a07=A2[GS_L*3 + l];
-    a08=A1[1];
+    a08=A1[GS_L*1 + l];
     a08=(a07*a08);
     a06=(a06+a08);
     a08=A2[GS_L*1 + l];
-    a09=A1[0];
+    a09=A1[GS_L*0 + l];
     a09=(a08*a09);
     a10=A2[GS_L*0 + l];
     a11=0.;
@@ -2041,10 +2041,10 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a17=(2.*a09);
     a17=(a03+a17);
     a18=(a09*a05);
-    a19=A1[3];
+    a19=A1[GS_L*3 + l];
     a19=(a07*a19);
     a18=(a18+a19);
-    a20=A1[2];
+    a20=A1[GS_L*2 + l];
     a20=(a08*a20);
     a21=(a04*a03);
     a21=(a00+a21);
@@ -2075,10 +2075,10 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a22=(2.*a22);
     a06=(a06+a22);
     a20=(a20*a05);
-    a05=A1[5];
+    a05=A1[GS_L*5 + l];
     a07=(a07*a05);
     a20=(a20+a07);
-    a07=A1[4];
+    a07=A1[GS_L*4 + l];
     a08=(a08*a07);
     a21=(a01*a21);
     a21=(a00+a21);
@@ -2166,17 +2166,18 @@ static GEARSYM_INLINE void gsl_tangent_step(const casadi_real* restrict y, const
   any = 0;
   GS_LANES any |= flag[l] != 0;
   if (GEARSYM_UNLIKELY(any)) for (l = 0; l < GS_L; ++l) if (flag[l] != 0) {  /* this lane crosses */
-    casadi_real ys[2], los[1], his[1], yts[2], cs[5], y1s[2], lo1s[1], hi1s[1];
+    casadi_real ys[2], los[1], his[1], yts[2], cs[5], Ts[6], y1s[2], lo1s[1], hi1s[1];
     casadi_real Qc[4], Qc1[4];
     for (i = 0; i < 2; ++i) ys[i] = y[GS_L*i + l];
     for (i = 0; i < 1; ++i) los[i] = lo[GS_L*i + l];
     for (i = 0; i < 1; ++i) his[i] = hi[GS_L*i + l];
     for (i = 0; i < 2; ++i) yts[i] = yt[GS_L*i + l];
     for (i = 0; i < 5; ++i) cs[i] = c[GS_L*i + l];
+    for (i = 0; i < 6; ++i) Ts[i] = T[GS_L*i + l];
     for (i = 0, finite = 1; i < 2; ++i) finite &= ys[i] - ys[i] == 0;
     if (!finite) continue;  /* a lane that diverged keeps the try (every flag of it would split) */
     for (i = 0; i < 4; ++i) Qc[(i % 2)*2 + i / 2] = Q[GS_L*i + l];
-    gs_tangent_split(ys, Qc, los, his, yts, Qc, T, cs, y1s, Qc1, lo1s, hi1s);
+    gs_tangent_split(ys, Qc, los, his, yts, Qc, Ts, cs, y1s, Qc1, lo1s, hi1s);
     for (i = 0; i < 4; ++i) Q1[GS_L*i + l] = Qc1[(i % 2)*2 + i / 2];
     for (i = 0; i < 2; ++i) y1[GS_L*i + l] = y1s[i];
     for (i = 0; i < 1; ++i) lo1[GS_L*i + l] = lo1s[i];
@@ -2190,9 +2191,9 @@ static GEARSYM_INLINE void gsl_tangent_span(casadi_real* restrict y, casadi_real
   casadi_int k;
   gs_copy(y, 2*GS_L, ya); gs_copy(Q, 4*GS_L, Qa); gs_copy(lo, 1*GS_L, loa); gs_copy(hi, 1*GS_L, hia);
   for (k = 0; k < blocks; k += 2) {
-    gsl_tangent_step(ya, Qa, loa, hia, T + 6*(k), c, yb, Qb, lob, hib);
+    gsl_tangent_step(ya, Qa, loa, hia, T + 6*GS_L*(k), c, yb, Qb, lob, hib);
     if (k + 1 == blocks) { gs_copy(yb, 2*GS_L, y); gs_copy(Qb, 4*GS_L, Q); gs_copy(lob, 1*GS_L, lo); gs_copy(hib, 1*GS_L, hi); return; }
-    gsl_tangent_step(yb, Qb, lob, hib, T + 6*(k + 1), c, ya, Qa, loa, hia);
+    gsl_tangent_step(yb, Qb, lob, hib, T + 6*GS_L*(k + 1), c, ya, Qa, loa, hia);
   }
   gs_copy(ya, 2*GS_L, y); gs_copy(Qa, 4*GS_L, Q); gs_copy(loa, 1*GS_L, lo); gs_copy(hia, 1*GS_L, hi);
 }
@@ -2205,15 +2206,16 @@ static GEARSYM_INLINE void gsl_state_step(const casadi_real* restrict y, const c
   any = 0;
   GS_LANES any |= flag[l] != 0;
   if (GEARSYM_UNLIKELY(any)) for (l = 0; l < GS_L; ++l) if (flag[l] != 0) {  /* this lane crosses */
-    casadi_real ys[2], los[1], his[1], yts[2], cs[5], y1s[2], lo1s[1], hi1s[1];
+    casadi_real ys[2], los[1], his[1], yts[2], cs[5], Ts[6], y1s[2], lo1s[1], hi1s[1];
     for (i = 0; i < 2; ++i) ys[i] = y[GS_L*i + l];
     for (i = 0; i < 1; ++i) los[i] = lo[GS_L*i + l];
     for (i = 0; i < 1; ++i) his[i] = hi[GS_L*i + l];
     for (i = 0; i < 2; ++i) yts[i] = yt[GS_L*i + l];
     for (i = 0; i < 5; ++i) cs[i] = c[GS_L*i + l];
+    for (i = 0; i < 6; ++i) Ts[i] = T[GS_L*i + l];
     for (i = 0, finite = 1; i < 2; ++i) finite &= ys[i] - ys[i] == 0;
     if (!finite) continue;  /* a lane that diverged keeps the try (every flag of it would split) */
-    gs_state_split(ys, los, his, yts, T, cs, y1s, lo1s, hi1s);
+    gs_state_split(ys, los, his, yts, Ts, cs, y1s, lo1s, hi1s);
     for (i = 0; i < 2; ++i) y1[GS_L*i + l] = y1s[i];
     for (i = 0; i < 1; ++i) lo1[GS_L*i + l] = lo1s[i];
     for (i = 0; i < 1; ++i) hi1[GS_L*i + l] = hi1s[i];
@@ -2226,9 +2228,9 @@ static GEARSYM_INLINE void gsl_state_span(casadi_real* restrict y, casadi_real* 
   casadi_int k;
   gs_copy(y, 2*GS_L, ya); gs_copy(lo, 1*GS_L, loa); gs_copy(hi, 1*GS_L, hia);
   for (k = 0; k < blocks; k += 2) {
-    gsl_state_step(ya, loa, hia, T + 6*(k), c, yb, lob, hib);
+    gsl_state_step(ya, loa, hia, T + 6*GS_L*(k), c, yb, lob, hib);
     if (k + 1 == blocks) { gs_copy(yb, 2*GS_L, y); gs_copy(lob, 1*GS_L, lo); gs_copy(hib, 1*GS_L, hi); return; }
-    gsl_state_step(yb, lob, hib, T + 6*(k + 1), c, ya, loa, hia);
+    gsl_state_step(yb, lob, hib, T + 6*GS_L*(k + 1), c, ya, loa, hia);
   }
   gs_copy(ya, 2*GS_L, y); gs_copy(loa, 1*GS_L, lo); gs_copy(hia, 1*GS_L, hi);
 }
@@ -2237,8 +2239,9 @@ static GEARSYM_INLINE void gsl_state_span(casadi_real* restrict y, casadi_real* 
 CASADI_SYMBOL_EXPORT int gearsym_lanes(void) { return GS_L; }
 
 /* `periods` periods of the state of GS_L trajectories from y (n x GS_L, lane fastest; in place), with the
-   constants c (per lane) and the table T of a period; each period's strobe, low and high written where
-   given (periods x n x GS_L, periods x observed x GS_L) */
+   constants c (nc x GS_L) and the tables of a period T (steps x rows x GS_L: entry j of step k of lane l at
+   GS_L*(rows*k + j) + l), one of each per lane; each period's strobe, low and high written where given
+   (periods x n x GS_L, periods x observed x GS_L) */
 CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_orbit(const casadi_real* restrict T, const casadi_real* restrict c, casadi_int periods, casadi_real* restrict y, casadi_real* strobe, casadi_real* low, casadi_real* high) {
   casadi_real lo[1*GS_L], hi[1*GS_L]; casadi_int p, l;
   for (p = 0; p < periods; ++p) {

@@ -4447,11 +4447,11 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a09=(a07*a08);
     a06=(a06+a09);
     a09=A2[GS_L*4 + l];
-    a10=A1[1];
+    a10=A1[GS_L*1 + l];
     a10=(a09*a10);
     a06=(a06+a10);
     a10=A2[GS_L*1 + l];
-    a11=A1[0];
+    a11=A1[GS_L*0 + l];
     a12=(a10*a11);
     a13=A2[GS_L*0 + l];
     a14=0.;
@@ -4475,10 +4475,10 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a25=(a07+a25);
     a26=(a25*a08);
     a23=(a23+a26);
-    a26=A1[4];
+    a26=A1[GS_L*4 + l];
     a26=(a09*a26);
     a23=(a23+a26);
-    a27=A1[3];
+    a27=A1[GS_L*3 + l];
     a28=(a10*a27);
     a29=(a04*a03);
     a29=(a00+a29);
@@ -4505,7 +4505,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a20=(a11*a20);
     a33=(a33+a20);
     a20=A2[GS_L*10 + l];
-    a38=A1[2];
+    a38=A1[GS_L*2 + l];
     a39=(a20*a38);
     a40=A2[GS_L*9 + l];
     a41=A0[GS_L*4 + l];
@@ -4564,7 +4564,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a27=(a37*a27);
     a29=(a27*a29);
     a21=(a21+a29);
-    a29=A1[5];
+    a29=A1[GS_L*5 + l];
     a55=(a20*a29);
     a56=(a04*a34);
     a56=(a41+a56);
@@ -4578,10 +4578,10 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a58=(a07+a58);
     a59=(a58*a08);
     a31=(a31+a59);
-    a59=A1[7];
+    a59=A1[GS_L*7 + l];
     a09=(a09*a59);
     a31=(a31+a09);
-    a09=A1[6];
+    a09=A1[GS_L*6 + l];
     a10=(a10*a09);
     a59=(a01*a30);
     a59=(a00+a59);
@@ -4645,7 +4645,7 @@ static GEARSYM_INLINE void gsl_tangent_state(const casadi_real* restrict A0, con
     a37=(a37*a09);
     a17=(a37*a17);
     a50=(a50+a17);
-    a17=A1[8];
+    a17=A1[GS_L*8 + l];
     a20=(a20*a17);
     a09=(a01*a56);
     a09=(a41+a09);
@@ -5018,11 +5018,11 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a09=(a07*a08);
     a06=(a06+a09);
     a09=A2[GS_L*4 + l];
-    a10=A1[1];
+    a10=A1[GS_L*1 + l];
     a10=(a09*a10);
     a06=(a06+a10);
     a10=A2[GS_L*1 + l];
-    a11=A1[0];
+    a11=A1[GS_L*0 + l];
     a12=(a10*a11);
     a13=A2[GS_L*0 + l];
     a14=0.;
@@ -5046,10 +5046,10 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a24=(a07+a24);
     a25=(a24*a08);
     a22=(a22+a25);
-    a25=A1[4];
+    a25=A1[GS_L*4 + l];
     a25=(a09*a25);
     a22=(a22+a25);
-    a26=A1[3];
+    a26=A1[GS_L*3 + l];
     a27=(a10*a26);
     a28=(a04*a03);
     a28=(a00+a28);
@@ -5076,7 +5076,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a11=(a11*a20);
     a32=(a32+a11);
     a11=A2[GS_L*10 + l];
-    a20=A1[2];
+    a20=A1[GS_L*2 + l];
     a37=(a11*a20);
     a38=A2[GS_L*9 + l];
     a39=A0[GS_L*4 + l];
@@ -5135,7 +5135,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a26=(a36*a26);
     a28=(a26*a28);
     a12=(a12+a28);
-    a28=A1[5];
+    a28=A1[GS_L*5 + l];
     a45=(a11*a28);
     a50=(a04*a33);
     a50=(a39+a50);
@@ -5149,10 +5149,10 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a52=(a07+a52);
     a08=(a52*a08);
     a05=(a05+a08);
-    a08=A1[7];
+    a08=A1[GS_L*7 + l];
     a09=(a09*a08);
     a05=(a05+a09);
-    a09=A1[6];
+    a09=A1[GS_L*6 + l];
     a10=(a10*a09);
     a08=(a01*a29);
     a08=(a00+a08);
@@ -5216,7 +5216,7 @@ static GEARSYM_INLINE void gsl_state_try(const casadi_real* restrict A0, const c
     a36=(a36*a09);
     a36=(a36*a17);
     a27=(a27+a36);
-    a36=A1[8];
+    a36=A1[GS_L*8 + l];
     a11=(a11*a36);
     a17=(a01*a50);
     a17=(a39+a17);
@@ -5398,17 +5398,18 @@ static GEARSYM_INLINE void gsl_tangent_step(const casadi_real* restrict y, const
   any = 0;
   GS_LANES any |= flag[l] != 0;
   if (GEARSYM_UNLIKELY(any)) for (l = 0; l < GS_L; ++l) if (flag[l] != 0) {  /* this lane crosses */
-    casadi_real ys[6], los[3], his[3], yts[6], cs[16], y1s[6], lo1s[3], hi1s[3];
+    casadi_real ys[6], los[3], his[3], yts[6], cs[16], Ts[9], y1s[6], lo1s[3], hi1s[3];
     casadi_real Qc[36], Qc1[36];
     for (i = 0; i < 6; ++i) ys[i] = y[GS_L*i + l];
     for (i = 0; i < 3; ++i) los[i] = lo[GS_L*i + l];
     for (i = 0; i < 3; ++i) his[i] = hi[GS_L*i + l];
     for (i = 0; i < 6; ++i) yts[i] = yt[GS_L*i + l];
     for (i = 0; i < 16; ++i) cs[i] = c[GS_L*i + l];
+    for (i = 0; i < 9; ++i) Ts[i] = T[GS_L*i + l];
     for (i = 0, finite = 1; i < 6; ++i) finite &= ys[i] - ys[i] == 0;
     if (!finite) continue;  /* a lane that diverged keeps the try (every flag of it would split) */
     for (i = 0; i < 36; ++i) Qc[(i % 6)*6 + i / 6] = Q[GS_L*i + l];
-    gs_tangent_split(ys, Qc, los, his, yts, Qc, T, cs, y1s, Qc1, lo1s, hi1s);
+    gs_tangent_split(ys, Qc, los, his, yts, Qc, Ts, cs, y1s, Qc1, lo1s, hi1s);
     for (i = 0; i < 36; ++i) Q1[GS_L*i + l] = Qc1[(i % 6)*6 + i / 6];
     for (i = 0; i < 6; ++i) y1[GS_L*i + l] = y1s[i];
     for (i = 0; i < 3; ++i) lo1[GS_L*i + l] = lo1s[i];
@@ -5422,9 +5423,9 @@ static GEARSYM_INLINE void gsl_tangent_span(casadi_real* restrict y, casadi_real
   casadi_int k;
   gs_copy(y, 6*GS_L, ya); gs_copy(Q, 36*GS_L, Qa); gs_copy(lo, 3*GS_L, loa); gs_copy(hi, 3*GS_L, hia);
   for (k = 0; k < blocks; k += 2) {
-    gsl_tangent_step(ya, Qa, loa, hia, T + 9*(k), c, yb, Qb, lob, hib);
+    gsl_tangent_step(ya, Qa, loa, hia, T + 9*GS_L*(k), c, yb, Qb, lob, hib);
     if (k + 1 == blocks) { gs_copy(yb, 6*GS_L, y); gs_copy(Qb, 36*GS_L, Q); gs_copy(lob, 3*GS_L, lo); gs_copy(hib, 3*GS_L, hi); return; }
-    gsl_tangent_step(yb, Qb, lob, hib, T + 9*(k + 1), c, ya, Qa, loa, hia);
+    gsl_tangent_step(yb, Qb, lob, hib, T + 9*GS_L*(k + 1), c, ya, Qa, loa, hia);
   }
   gs_copy(ya, 6*GS_L, y); gs_copy(Qa, 36*GS_L, Q); gs_copy(loa, 3*GS_L, lo); gs_copy(hia, 3*GS_L, hi);
 }
@@ -5437,15 +5438,16 @@ static GEARSYM_INLINE void gsl_state_step(const casadi_real* restrict y, const c
   any = 0;
   GS_LANES any |= flag[l] != 0;
   if (GEARSYM_UNLIKELY(any)) for (l = 0; l < GS_L; ++l) if (flag[l] != 0) {  /* this lane crosses */
-    casadi_real ys[6], los[3], his[3], yts[6], cs[16], y1s[6], lo1s[3], hi1s[3];
+    casadi_real ys[6], los[3], his[3], yts[6], cs[16], Ts[9], y1s[6], lo1s[3], hi1s[3];
     for (i = 0; i < 6; ++i) ys[i] = y[GS_L*i + l];
     for (i = 0; i < 3; ++i) los[i] = lo[GS_L*i + l];
     for (i = 0; i < 3; ++i) his[i] = hi[GS_L*i + l];
     for (i = 0; i < 6; ++i) yts[i] = yt[GS_L*i + l];
     for (i = 0; i < 16; ++i) cs[i] = c[GS_L*i + l];
+    for (i = 0; i < 9; ++i) Ts[i] = T[GS_L*i + l];
     for (i = 0, finite = 1; i < 6; ++i) finite &= ys[i] - ys[i] == 0;
     if (!finite) continue;  /* a lane that diverged keeps the try (every flag of it would split) */
-    gs_state_split(ys, los, his, yts, T, cs, y1s, lo1s, hi1s);
+    gs_state_split(ys, los, his, yts, Ts, cs, y1s, lo1s, hi1s);
     for (i = 0; i < 6; ++i) y1[GS_L*i + l] = y1s[i];
     for (i = 0; i < 3; ++i) lo1[GS_L*i + l] = lo1s[i];
     for (i = 0; i < 3; ++i) hi1[GS_L*i + l] = hi1s[i];
@@ -5458,9 +5460,9 @@ static GEARSYM_INLINE void gsl_state_span(casadi_real* restrict y, casadi_real* 
   casadi_int k;
   gs_copy(y, 6*GS_L, ya); gs_copy(lo, 3*GS_L, loa); gs_copy(hi, 3*GS_L, hia);
   for (k = 0; k < blocks; k += 2) {
-    gsl_state_step(ya, loa, hia, T + 9*(k), c, yb, lob, hib);
+    gsl_state_step(ya, loa, hia, T + 9*GS_L*(k), c, yb, lob, hib);
     if (k + 1 == blocks) { gs_copy(yb, 6*GS_L, y); gs_copy(lob, 3*GS_L, lo); gs_copy(hib, 3*GS_L, hi); return; }
-    gsl_state_step(yb, lob, hib, T + 9*(k + 1), c, ya, loa, hia);
+    gsl_state_step(yb, lob, hib, T + 9*GS_L*(k + 1), c, ya, loa, hia);
   }
   gs_copy(ya, 6*GS_L, y); gs_copy(loa, 3*GS_L, lo); gs_copy(hia, 3*GS_L, hi);
 }
@@ -5469,8 +5471,9 @@ static GEARSYM_INLINE void gsl_state_span(casadi_real* restrict y, casadi_real* 
 CASADI_SYMBOL_EXPORT int gearsym_lanes(void) { return GS_L; }
 
 /* `periods` periods of the state of GS_L trajectories from y (n x GS_L, lane fastest; in place), with the
-   constants c (per lane) and the table T of a period; each period's strobe, low and high written where
-   given (periods x n x GS_L, periods x observed x GS_L) */
+   constants c (nc x GS_L) and the tables of a period T (steps x rows x GS_L: entry j of step k of lane l at
+   GS_L*(rows*k + j) + l), one of each per lane; each period's strobe, low and high written where given
+   (periods x n x GS_L, periods x observed x GS_L) */
 CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_orbit(const casadi_real* restrict T, const casadi_real* restrict c, casadi_int periods, casadi_real* restrict y, casadi_real* strobe, casadi_real* low, casadi_real* high) {
   casadi_real lo[3*GS_L], hi[3*GS_L]; casadi_int p, l;
   for (p = 0; p < periods; ++p) {
