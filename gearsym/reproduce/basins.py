@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..checks import json_safe
 from .compute import Computed
-from .plan import PAPER_JUMPS
+from .plan import JUMP_TOLERANCE, PAPER_JUMPS
 
 
 def _attractor(a) -> dict:
@@ -15,7 +15,8 @@ def _attractor(a) -> dict:
 
 def basins_record(c: Computed) -> dict:
     """The basin maps (their attractors and shares) and the fractions along omega with their events; the
-    fractions on both sides of each of the paper's jumps."""
+    fractions on both sides of each of the paper's jumps (``JUMP_TOLERANCE`` away: as far as a jump of ours may be
+    from the paper's and still be it) and the events between."""
     maps = [{"model": model, "omega": omega, "starts": m.starts, "points": int(m.labels.shape[0]),
              "periods": m.periods, "discard": m.discard,
              "attractors": [_attractor(a) for a in m.attractors], "diverged": m.diverged.as_dict(),
@@ -26,9 +27,9 @@ def basins_record(c: Computed) -> dict:
         rows = [{"omega": x.value, "attractor": x.id, "class": x.kind, "fraction": x.fraction, "stderr": x.stderr,
                  "period": x.period, "regime": x.regime, "amplitude": x.amplitude.get("x")} for x in r.rows]
         sides = []
-        for jump in PAPER_JUMPS:
-            below = [v for v in values if v < jump]
-            above = [v for v in values if v > jump]
+        for jump in PAPER_JUMPS:  # the values on either side of the paper's jump, as far as a jump may be from it
+            below = [v for v in values if v <= jump - JUMP_TOLERANCE + 1e-9]
+            above = [v for v in values if v >= jump + JUMP_TOLERANCE - 1e-9]
             if not below or not above:
                 continue
             lo, hi = below[-1], above[0]

@@ -237,7 +237,8 @@ def _basins(record: dict, figures_dir: str) -> list[str]:
                   "while its Poincaré set stays within half the points' spread; dashed: the paper's jumps (D = 2); "
                   f"{main['label']}.*", "",
                   "A continuation jumps where the attractor it follows loses its basin. At each of the paper's jumps, "
-                  "the attractors and their shares on either side of it:", "",
+                  "the attractors and their shares on either side of it (as far from it as a jump of ours may be "
+                  "and still count as the paper's), and what happened between:", "",
                   "| the paper's jump | ω | attractors (id: what it is, share of the box) | what happened between |",
                   "|---|---|---|---|"]
         for side in fr["jumps"]:
@@ -262,7 +263,7 @@ def _basin_tables(b: dict) -> list[str]:
             lines.append(f"| {m['omega']:g} | {MODEL_LABELS.get(m['model'], m['model'])} | {a['number']} | "
                          f"{a['description']} | {100 * a['fraction']:.1f} ± {100 * a['stderr']:.1f} % | "
                          f"{_num(a['amplitude'], 3)} | {a['lambda_1']:+.4f} | {100 * (1 - (1 - a['fraction']) ** 10):.0f} % |")
-        others = [f"{k} {100 * m[k]['fraction']:.1f} %" for k in ("diverged", "undecided") if m[k]["starts"]]
+        others = [f"{k}: {m[k]['starts']} of {m['starts']} starts" for k in ("diverged", "undecided") if m[k]["starts"]]
         if others:
             lines.append(f"| {m['omega']:g} | {MODEL_LABELS.get(m['model'], m['model'])} | – | "
                          f"{', '.join(others)} | | | | |")
