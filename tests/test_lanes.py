@@ -23,7 +23,6 @@ from gearsym.codegen.generate import code_hash, write_code
 from gearsym.codegen.lane_runs import LaneLibrary, LaneRunner
 from gearsym.codegen.library import library_functions
 from gearsym.codegen.native import load_native
-from gearsym.paths import REPO_ROOT
 
 import conftest
 
@@ -33,8 +32,19 @@ needs_cc = pytest.mark.skipif(find_compiler() is None, reason="needs a C compile
 PORTABLE = ("-O3",)
 
 
+_BUILT: dict = {}
+
+
 def _built(name: str, options: LoopOptions, tmp_path: Path, flags=PORTABLE) -> tuple[CompiledModel, LaneLibrary]:
-    """The model's scalar loops and its lanes, both compiled with ``flags`` from freshly generated C."""
+    """The model's scalar loops and its lanes, both compiled with ``flags`` from freshly generated C (once per
+    session for the same model and options)."""
+    key = (name, options, flags)
+    if key not in _BUILT:
+        _BUILT[key] = _build(name, options, tmp_path, flags)
+    return _BUILT[key][:2]
+
+
+def _build(name: str, options: LoopOptions, tmp_path: Path, flags) -> tuple[CompiledModel, LaneLibrary]:
     system = conftest.system(name)
     mf = build_functions(system, options)
     digest = code_hash(system, options)
@@ -45,7 +55,7 @@ def _built(name: str, options: LoopOptions, tmp_path: Path, flags=PORTABLE) -> t
     integration = Integration(steps_per_period=options.steps_per_period, locate_crossings=options.locate_crossings)
     model = CompiledModel(system, options, digest, functions, "compiled", main, {}, load_native(main, functions),
                           integration)
-    return model, LaneLibrary(lanes)
+    return model, LaneLibrary(lanes), code.lanes
 
 
 def _records_equal(a, b) -> list[str]:
@@ -79,7 +89,7 @@ def test_every_lane_gives_the_bits_of_the_scalar_loop_from_its_start(name, locat
 @needs_cc
 def test_constants_may_differ_from_lane_to_lane(tmp_path):
     """Points of a sweep that share their tables (omega in tau) run in one call, each lane with its constants."""
-    model, lanes = _built("one_stage", LoopOptions(steps_per_period=60, locate_crossings=True), tmp_path)
+    model, lanes = _built("one_stage", LoopOptions(steps_per_period=90, block_steps=3, locate_crossings=True), tmp_path)
     omegas = np.linspace(0.9, 1.6, lanes.width + 2)
     inputs = [model.prepare(model.parameter_vector(omega=w)) for w in omegas]
     constants = np.array([i.constants for i in inputs])
@@ -126,10 +136,13 @@ def test_under_the_default_flags_the_lanes_agree_with_the_scalar_loop_to_roundin
     assert np.allclose(wide.strobe, one.strobe, rtol=0, atol=1e-10)
 
 
-def test_every_per_step_piece_is_printed_as_a_loop_over_the_lanes():
-    """The lanes' C of a committed model: each per-step piece in a loop over the lanes with every input indexed by
-    lane (the tables of time too), the split and Gram-Schmidt the scalar loops' own functions."""
-    source = (REPO_ROOT / "generated" / "one_stage" / "one_stage_lanes.c").read_text()
+@needs_cc
+def test_every_per_step_piece_is_printed_as_a_loop_over_the_lanes(tmp_path):
+    """The lanes' C (as the generator writes it): each per-step piece in a loop over the lanes with every input
+    indexed by lane (the tables of time too), the split and Gram-Schmidt the scalar loops' own functions."""
+    options = LoopOptions(steps_per_period=90, block_steps=3, locate_crossings=True)
+    _built("one_stage", options, tmp_path)
+    source = _BUILT[("one_stage", options, PORTABLE)][2].read_text()
     for piece in ("tangent_state", "tangent_vector", "state_try", "state_keep"):
         body = re.search(rf"static GEARSYM_INLINE void gsl_{piece}\(.*?\n}}\n", source, re.S).group(0)
         assert "GS_LANES {" in body and "[GS_L*" in body and not re.search(r"\b[AR]\d\[\d+\]", body), piece

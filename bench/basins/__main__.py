@@ -5,10 +5,12 @@
   (``bench/yardstick/one_stage.c``: state and tangent vectors, Gram-Schmidt every period) in its three builds,
   one process per start, its own clock per point; gearsym's scalar loop (``tangent_run``) on a sample of the starts;
   gearsym's lanes with tangent vectors (the C's job) and without (what a basin map runs), and both with the
-  crossings located. Interleaved repetitions, medians.
+  crossings located. Interleaved repetitions, medians; wall and CPU time (the C's process less its start-up; the
+  lanes' thread), the verdicts on CPU time, which other jobs on a shared machine do not count into it.
 * **The 441-start map**: ``gearsym basins one_stage --grid x=-5:5:0.5 --grid v=-5:5:0.5 --plain --jobs 1`` in a
-  fresh process (start-up included: the library and the lanes cached) against the best C build's time for the same
-  441 starts (the sum of its per-point clocks: its process start-ups not included).
+  fresh process (start-up included: the library, the lanes and Python's bytecode cached, as for any user) against
+  the best C build's time for the same 441 starts (the sum of its per-point clocks, and of its processes' CPU less
+  their start-ups).
 * **A 200 x 200 map**: the same command on 200 x 200 starts, on 2 cores and on 1.
 
 Writes ``bench/results/basins.json``; ``python -m bench.speed.report`` renders its section of
@@ -20,9 +22,11 @@ import argparse
 import datetime as _dt
 import json
 import os
+import resource
 import shlex
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -56,26 +60,43 @@ def _command(grid, jobs: int) -> list[str]:
             "--format", "json", "--quiet"]
 
 
-def _timed_command(cmd: list[str]) -> tuple[float, dict]:
-    t = time.perf_counter()
-    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=REPO)
-    seconds = time.perf_counter() - t
+def _children_cpu() -> float:
+    """CPU seconds (user + system) of this process's finished children so far."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+#: the commands' environment: Python keeps its bytecode as for any user (in a temporary PYTHONPYCACHEPREFIX, not in
+#: the repository), even where PYTHONDONTWRITEBYTECODE is set, which would add compiling gearsym's sources to every
+#: start-up (as in bench/speed/startup.py)
+_PYCACHE = tempfile.TemporaryDirectory(prefix="bench-basins-pycache-")
+_ENV = {**{k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}, "PYTHONPYCACHEPREFIX": _PYCACHE.name}
+
+
+def _timed_command(cmd: list[str]) -> tuple[float, float, dict]:
+    """Wall seconds, CPU seconds (the process and its threads, start-up included) and the result of a command."""
+    t, cpu = time.perf_counter(), _children_cpu()
+    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=REPO, env=_ENV)
+    seconds, cpu = time.perf_counter() - t, _children_cpu() - cpu
     if proc.returncode != 0:
         raise RuntimeError(f"{shlex.join(cmd)} failed:\n{proc.stderr[-2000:]}")
     data = json.loads(proc.stdout)
-    return seconds, {"attractors": [{k: a[k] for k in ("fraction", "stderr", "period", "regime", "amplitude")}
+    return seconds, cpu, {"attractors": [{k: a[k] for k in ("fraction", "stderr", "period", "regime", "amplitude")}
                                     for a in data["attractors"]],
                      "undecided": data["undecided"], "diverged": data["diverged"], "lanes": data["lanes"]}
 
 
-def _c_points(binary, starts) -> list[float]:
-    """The C program's own seconds for each start (one process each)."""
-    out = []
+def _c_points(binary, starts, periods: int = PERIODS, discard: int = DISCARD) -> tuple[list[float], list[float]]:
+    """The C program's own (wall) seconds for each start, one process each, and the CPU seconds of each process
+    (its start-up included)."""
+    wall, cpu = [], []
     for y0 in starts:
-        r = runner.run(binary, periods=PERIODS, discard=DISCARD, omega_start=OMEGA, omega_stop=OMEGA, omega_step=1.0,
+        before = _children_cpu()
+        r = runner.run(binary, periods=periods, discard=discard, omega_start=OMEGA, omega_stop=OMEGA, omega_step=1.0,
                        y0=tuple(map(float, y0)), model=MODEL)
-        out.append(float(r["point_seconds"][0]))
-    return out
+        cpu.append(_children_cpu() - before)
+        wall.append(float(r["point_seconds"][0]))
+    return wall, cpu
 
 
 def measure(repeats: int, log=lambda s: print(s, file=sys.stderr, flush=True)) -> dict:
@@ -104,34 +125,47 @@ def measure(repeats: int, log=lambda s: print(s, file=sys.stderr, flush=True)) -
     }
     for call, _ in gearsym_jobs.values():  # warm-up
         call()
-    per_trajectory = {name: [] for name in [*(f"C {b}" for b in binaries), *gearsym_jobs]}
+    # the C's start-up and one period, per process: taken off its CPU time per start (its own clock excludes it)
+    c_startup = {b: float(np.median(_c_points(binary, sample, periods=1, discard=0)[1])) for b, binary in
+                 binaries.items()}
+    names = [*(f"C {b}" for b in binaries), *gearsym_jobs]
+    per_trajectory = {name: [] for name in names}
+    per_trajectory_cpu = {name: [] for name in names}
     for rep in range(repeats):
         for build, binary in binaries.items():
-            per_trajectory[f"C {build}"].append(float(np.median(_c_points(binary, sample))))
+            wall, cpu = _c_points(binary, sample)
+            per_trajectory[f"C {build}"].append(float(np.median(wall)))
+            per_trajectory_cpu[f"C {build}"].append(float(np.median(cpu)) - c_startup[build])
         for name, (call, count) in gearsym_jobs.items():
-            t = time.perf_counter()
+            t, cpu = time.perf_counter(), time.thread_time()
             call()
             per_trajectory[name].append((time.perf_counter() - t) / count)
+            per_trajectory_cpu[name].append((time.thread_time() - cpu) / count)
         log(f"  repetition {rep + 1}/{repeats}: " + ", ".join(f"{k} {v[-1] * 1e3:.3f} ms" for k, v in
-                                                                per_trajectory.items()))
-    best = min(binaries, key=lambda b: np.median(per_trajectory[f"C {b}"]))
-    subprocess.run(_command(MAP_441, 1), capture_output=True, cwd=REPO)  # the summaries and lanes cached
-    map_441 = {"c_seconds": [], "gearsym_seconds": []}
+                                                                per_trajectory_cpu.items()) + " (CPU)")
+    best = min(binaries, key=lambda b: np.median(per_trajectory_cpu[f"C {b}"]))
+    subprocess.run(_command(MAP_441, 1), capture_output=True, cwd=REPO, env=_ENV)  # the lanes and bytecode cached
+    map_441 = {"c_seconds": [], "c_cpu_seconds": [], "gearsym_seconds": [], "gearsym_cpu_seconds": []}
     for rep in range(max(2, repeats // 2)):
-        map_441["c_seconds"].append(float(np.sum(_c_points(binaries[best], starts))))
-        seconds, result = _timed_command(_command(MAP_441, 1))
+        wall, cpu = _c_points(binaries[best], starts)
+        map_441["c_seconds"].append(float(np.sum(wall)))
+        map_441["c_cpu_seconds"].append(float(np.sum(cpu)) - len(starts) * c_startup[best])
+        seconds, cpu_seconds, result = _timed_command(_command(MAP_441, 1))
         map_441["gearsym_seconds"].append(seconds)
+        map_441["gearsym_cpu_seconds"].append(cpu_seconds)
         map_441["result"] = result
-        log(f"  441-start map {rep + 1}: C {map_441['c_seconds'][-1]:.3f} s, gearsym basins {seconds:.3f} s")
+        log(f"  441-start map {rep + 1}: C {map_441['c_seconds'][-1]:.3f} s ({map_441['c_cpu_seconds'][-1]:.3f} s "
+            f"CPU), gearsym basins {seconds:.3f} s ({cpu_seconds:.3f} s CPU)")
     sweep_map = _sweep_map(repeats, log)
     map_200 = {}
     for jobs in (2, 1):
-        seconds, result = _timed_command(_command(MAP_200, jobs))
-        map_200[str(jobs)] = {"seconds": seconds, "result": result}
-        log(f"  200 x 200 map on {jobs} core(s): {seconds:.1f} s")
+        seconds, cpu_seconds, result = _timed_command(_command(MAP_200, jobs))
+        map_200[str(jobs)] = {"seconds": seconds, "cpu_seconds": cpu_seconds, "result": result}
+        log(f"  200 x 200 map on {jobs} core(s): {seconds:.1f} s ({cpu_seconds:.1f} s CPU)")
     return {"model": MODEL, "omega": OMEGA, "periods": PERIODS, "discard": DISCARD, "starts": len(starts),
             "sample": len(sample), "c_builds": list(binaries), "best_c_build": best,
             "lanes": lanes[id(plain)].width, "per_trajectory_seconds": per_trajectory,
+            "per_trajectory_cpu_seconds": per_trajectory_cpu, "c_startup_cpu_seconds": c_startup,
             "map_441": {**map_441, "command": shlex.join(["gearsym", *_command(MAP_441, 1)[3:]])},
             "map_200": {**map_200, "command": shlex.join(["gearsym", *_command(MAP_200, 2)[3:]])},
             "sweep_map": sweep_map}
