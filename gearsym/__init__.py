@@ -3,7 +3,8 @@
 One flat public face; the stages behind it, each handing one type to the next:
 
 * declare: :class:`Drivetrain` from components (:class:`Gear`, :class:`Mesh`, ...), or a plain ODE as a
-  :class:`FirstOrderSystem`; ``load_model(name)`` reads one from ``models/`` or a file;
+  :class:`FirstOrderSystem`; ``load_model(name)`` reads one from ``models/`` or a file (``model_module(name)``:
+  the whole file, its builders too);
 * reduce: :func:`reduce` (Drivetrain -> :class:`NondimensionalModel`), whose ``.system(**values)`` is the
   :class:`FirstOrderSystem` the engine takes; :func:`load` does name -> system in one call;
 * compile: :func:`compile_model` (FirstOrderSystem, :class:`Integration` -> :class:`CompiledModel`);
@@ -12,6 +13,7 @@ One flat public face; the stages behind it, each handing one type to the next:
   (basin fractions along a parameter), :func:`run_sweep` (on a CompiledModel, or on a system, compiled first);
   periodic orbits and their branches: :func:`periodic_orbit`, :func:`continue_orbits`;
 * data: :func:`simulate_measurements`, :func:`load_measurements`, :func:`explain`;
+* FMUs: :func:`export_fmu` (a model as an FMI 2.0 FMU, co-simulation and model exchange, for other tools);
 * physical units: :func:`scaling` (a drivetrain with values in units -> its nondimensional values, and results
   back to rpm, um, N, 1/s), :func:`is_physical`, :func:`natural_modes`, :func:`campbell`;
 * document: :func:`derive` and :func:`render`.
@@ -46,6 +48,7 @@ _LAZY = {
     "available_models": "gearsym.registry",
     "load": "gearsym.loading",
     "load_model": "gearsym.registry",
+    "model_module": "gearsym.registry",
     "CompiledModel": "gearsym.codegen",
     "compile_model": "gearsym.codegen.build",
     "LyapunovSpectrum": "gearsym.analysis",
@@ -71,8 +74,18 @@ _LAZY = {
     "natural_modes": "gearsym.loading",
     "campbell": "gearsym.physical.campbell",
     "is_physical": "gearsym.loading",
+    "export_fmu": "gearsym.fmu.export",
     "derive": "gearsym.derivation",
     "render": "gearsym.derivation",
+    "GearGeometry": "gearsym.geometry",
+    "GearPair": "gearsym.geometry",
+    "Material": "gearsym.geometry",
+    "MeshStiffness": "gearsym.geometry",
+    "StiffnessOptions": "gearsym.geometry",
+    "gear_geometry": "gearsym.geometry",
+    "gear_pair": "gearsym.geometry",
+    "mesh_stiffness": "gearsym.geometry",
+    "iso6336_stiffness": "gearsym.geometry",
 }
 
 __all__ = ["GearsymError", "Integration", "ModelError", "UnknownParameterError", *_LAZY]
@@ -98,6 +111,7 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .data import load_measurements
     from .derivation import derive, render
     from .fit import EFFECTS, explain
+    from .fmu.export import export_fmu
     from .loading import is_physical, load, natural_modes, scaling
     from .model.components import Disk, Gear, Harmonic, Mesh, Planet, Shaft, Torque
     from .model.drivetrain import Drivetrain

@@ -29,14 +29,13 @@ def reduced(ref) -> NondimensionalModel:
 
 def scaling(model, length_scale=None, **physical) -> PhysicalScaling:
     """The scaling of a model (a name, a file, a Drivetrain or its reduction) at its declared physical values,
-    with ``physical`` overriding them (``kZ="3e8 N/m"``, ``speed="3000 rpm"``)."""
+    with ``physical`` overriding them (``kZ="3e8 N/m"``, ``speed="3000 rpm"``) or replacing a stiffness function
+    by a formula in tau or phi (``k="1+0.2*cos(tau)"``, with the values of its new parameters)."""
     declared = model if isinstance(model, NondimensionalModel) else load_model(model)
     if not isinstance(declared, NondimensionalModel) and not declared.is_drivetrain:
         raise GearsymError(f"{declared.name}: physical values need a drivetrain model (a FirstOrderSystem has no "
                            "components to give them units)")
-    nd = reduced(declared)
-    scale = nd.drivetrain.length_scale if length_scale is None else length_scale
-    return PhysicalScaling(nd, {**nd.drivetrain.physical, **physical}, scale)
+    return PhysicalScaling.of(reduced(declared), length_scale, **physical)
 
 
 def load(ref, **values) -> FirstOrderSystem:
@@ -63,7 +62,7 @@ def load(ref, **values) -> FirstOrderSystem:
     split = physical_settings(nd, values)
     if split is not None:
         length_scale, physical, formulas = split
-        return scaling(nd, length_scale, **physical).system(**formulas)
+        return scaling(nd, length_scale, **physical, **formulas).system()
     return nd.system(**values)
 
 
@@ -76,7 +75,7 @@ def natural_modes(model, **settings) -> Modes:
     split = physical_settings(nd, dict(settings))
     if split is not None:
         length_scale, physical, formulas = split
-        return physical_modes(scaling(nd, length_scale, **physical), formulas)
+        return physical_modes(scaling(nd, length_scale, **physical, **formulas))
     return nondimensional_modes(nd, settings)
 
 

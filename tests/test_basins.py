@@ -11,7 +11,7 @@ from scipy.integrate import solve_ivp
 
 import gearsym
 from gearsym import FirstOrderSystem, Integration
-from gearsym.analysis.basins import DIVERGED, UNDECIDED, basin_map
+from gearsym.analysis.basins import DIVERGED, UNDETERMINED, basin_map
 from gearsym.cli import main
 from gearsym.sweep.basin_continuation import APPEARS, VANISHES, continue_basins
 
@@ -64,7 +64,7 @@ def clusters(points: np.ndarray, tolerance: float = 1e-4) -> tuple[np.ndarray, n
 def test_duffing_basins_in_its_hysteresis_window_agree_with_scipy(duffing):
     xs, vs = np.linspace(-4, 4, 11), np.linspace(-4, 4, 11)
     found = basin_map(duffing, {"x": xs, "v": vs}, options=RUN, omega=WINDOW_OMEGA)
-    assert [a.period for a in found.attractors] == [1, 1] and found.undecided.starts == found.diverged.starts == 0
+    assert [a.period for a in found.attractors] == [1, 1] and found.undetermined.starts == found.diverged.starts == 0
     final = scipy_final_states(xs, vs, WINDOW_OMEGA, RUN.periods)
     centres, scipy_label = clusters(final)
     assert len(centres) == 2  # SciPy sees the same two attractors ...
@@ -125,20 +125,20 @@ def test_a_start_that_diverges_is_a_class_of_its_own_and_the_fractions_sum_to_on
     assert [a.period for a in found.attractors] == [1]  # the rest: the one orbit in the well
     assert np.array_equal(found.labels == 1, ~escapes)
     assert sum(found.fractions.values()) == pytest.approx(1.0, abs=1e-12)
-    assert sum(a.basin.starts for a in found.attractors) + found.diverged.starts + found.undecided.starts \
+    assert sum(a.basin.starts for a in found.attractors) + found.diverged.starts + found.undetermined.starts \
         == found.starts == xs.size * vs.size
     data = found.as_dict()
     assert data["diverged"]["fraction"] == found.diverged.fraction
     assert sum(a["fraction"] for a in data["attractors"]) + data["diverged"]["fraction"] \
-        + data["undecided"]["fraction"] == pytest.approx(1.0, abs=1e-12)
+        + data["undetermined"]["fraction"] == pytest.approx(1.0, abs=1e-12)
 
 
-def test_fractions_sum_to_one_with_chaotic_and_undecided_starts():
+def test_fractions_sum_to_one_with_chaotic_and_undetermined_starts():
     model = conftest.compiled("one_stage", Integration.paper(periods=160, discard=60))
     found = basin_map(model, {"x": np.linspace(-5, 5, 9), "v": np.linspace(-5, 5, 9)}, omega=1.0)
     counts = {k: int(np.sum(found.labels == k)) for k in np.unique(found.labels)}
     assert counts == {**{a.number: a.basin.starts for a in found.attractors},
-                      **({UNDECIDED: found.undecided.starts} if found.undecided.starts else {}),
+                      **({UNDETERMINED: found.undetermined.starts} if found.undetermined.starts else {}),
                       **({DIVERGED: found.diverged.starts} if found.diverged.starts else {})}
     assert sum(found.fractions.values()) == pytest.approx(1.0, abs=1e-12)
     assert any(a.regime == "chaotic" and a.period is None for a in found.attractors)
@@ -187,7 +187,7 @@ def test_cli_json_has_the_fractions_periods_regimes_amplitudes_and_exponents(cap
         assert a["period"] == 1 and a["regime"] == "periodic" and set(a["amplitude"]) == {"x", "v"}
         assert len(a["exponents"]) == 2 and max(a["exponents"]) < 0
     assert sum(a["fraction"] for a in data["attractors"]) + data["diverged"]["fraction"] \
-        + data["undecided"]["fraction"] == pytest.approx(1.0)
+        + data["undetermined"]["fraction"] == pytest.approx(1.0)
     rows = (tmp_path / "map.csv").read_text().splitlines()
     assert rows[0] == "x,v,attractor" and len(rows) == 26
     assert (tmp_path / "map.png").stat().st_size > 10_000

@@ -289,7 +289,7 @@ def test_one_flank_of_the_backlash_is_located_on_the_backlash_surfaces():
 
 
 def test_the_frozen_backlash_is_g_on_each_side_and_reads_the_state_once():
-    from gearsym.codegen.switching import switching_surfaces as _switching
+    from gearsym.codegen.switching import find_switching as _switching
     from gearsym.codegen.time_tables import split_rhs
 
     t, x, v = sp.symbols("t x v", real=True)

@@ -83,7 +83,7 @@ def _timed_command(cmd: list[str]) -> tuple[float, float, dict]:
     data = json.loads(proc.stdout)
     return seconds, cpu, {"attractors": [{k: a[k] for k in ("fraction", "stderr", "period", "regime", "amplitude")}
                                     for a in data["attractors"]],
-                     "undecided": data["undecided"], "diverged": data["diverged"], "lanes": data["lanes"]}
+                     "undetermined": data["undetermined"], "diverged": data["diverged"], "lanes": data["lanes"]}
 
 
 def _c_points(binary, starts, periods: int = PERIODS, discard: int = DISCARD) -> tuple[list[float], list[float]]:

@@ -60,7 +60,7 @@ def summary(record: dict) -> dict:
 def _result_text(result: dict) -> str:
     parts = [f"{100 * a['fraction']:.1f} % " + (f"period {a['period']}" if a["period"] else a["regime"])
              for a in result["attractors"]]
-    parts += [f"{100 * result[k]['fraction']:.1f} % {k}" for k in ("undecided", "diverged") if result[k]["starts"]]
+    parts += [f"{100 * result[k]['fraction']:.1f} % {k}" for k in ("undetermined", "diverged") if result[k]["starts"]]
     return ", ".join(parts)
 
 

@@ -4,17 +4,19 @@ A grid over two states (the others held) gives the starts. Each runs ``discard``
 ``measured`` more, L at a time in the lanes (:mod:`gearsym.codegen.lane_runs`; no tangent vectors), recording
 its Poincare points (the state at t0 + kT) and every period's extremes. Then, start by start:
 
-* **diverged**: a record that is not finite. Its own class.
+* **diverged**: a record that is not finite (the verdict ``diverged`` of :mod:`gearsym.analysis.regime`). Its own
+  class.
 * **periodic**: the last ``TAIL`` Poincare points repeat with a period k <= ``MAX_PERIOD`` forcing periods to
   ``PERIOD_TOLERANCE`` (in coordinates scaled by the spread of every start's points, as
   :func:`~gearsym.analysis.attractors.find_attractors` scales them, or by the spread of the starts where that
   is larger: every start may end on one orbit). Two periodic starts are one attractor when
   their period is the same and their k points coincide as sets (Hausdorff distance within ``MATCH_TOLERANCE``):
   an orbit reached at another phase visits the same points in another order.
-* **undecided**: neither periodic nor settled: the recurrence of its best period still shrinks along the tail
+* **undetermined**: neither periodic nor settled: the recurrence of its best period still shrinks along the tail
   (``CONVERGING``: a periodic orbit not yet reached), or the first and the second half of its measured points
   are not one cloud by :func:`~gearsym.analysis.attractors.find_attractors`' rule (a transient still moving).
-  Its own class: more periods (``--periods``) decide it.
+  Its own class, the verdict ``undetermined`` of :mod:`gearsym.analysis.regime` (a transient, or too few periods
+  to say): more periods (``--periods``) decide it.
 * **aperiodic** (chaotic, quasi-periodic, or periodic beyond ``MAX_PERIOD``): its points are a cloud; two
   starts are one attractor by :func:`~gearsym.analysis.attractors.find_attractors`' rule (cloud distance within
   twice the larger self distance, plus 1 % of the extent), compared with each attractor's first member.
@@ -41,6 +43,7 @@ from ..errors import GearsymError, suggest
 from ..options import Integration
 from .attractors import MERGE_FACTOR, MERGE_FLOOR, RESOLUTION
 from .lyapunov import lyapunov_spectrum
+from .regime import DIVERGED as DIVERGED_VERDICT, UNDETERMINED as UNDETERMINED_VERDICT
 
 #: the run of each start when no options are given (the paper's run)
 RUN = {"periods": 400, "discard": 100}
@@ -58,13 +61,13 @@ MATCH_TOLERANCE = 1e-2
 #: along a slowly decaying spiral, looks periodic with a multiple of its period first)
 ORBIT_MERGE = 5e-2
 #: a start whose best recurrence error over the second half of its tail is below this fraction of the first
-#: half's still converges: undecided
+#: half's still converges: undetermined
 CONVERGING = 0.1
 #: starts at most (each keeps ~1-2 KB of records until it is classified)
 MAX_STARTS = 1_000_000
 #: the labels of the two classes that are not attractors
-DIVERGED, UNDECIDED = -1, 0
-CLASSES = {DIVERGED: "diverged", UNDECIDED: "undecided"}
+DIVERGED, UNDETERMINED = -1, 0
+CLASSES = {DIVERGED: DIVERGED_VERDICT, UNDETERMINED: UNDETERMINED_VERDICT}
 
 
 @dataclass(frozen=True)
@@ -132,10 +135,10 @@ class BasinMap:
     state_names: tuple[str, ...]
     axes: tuple[tuple[str, np.ndarray], ...]  # ((x, values), (y, values)): the grid's two states
     held: dict[str, float]  # the other states' start
-    labels: np.ndarray  # (len(y values), len(x values)): attractor number, 0 undecided, -1 diverged
+    labels: np.ndarray  # (len(y values), len(x values)): attractor number, 0 undetermined, -1 diverged
     attractors: tuple[BasinAttractor, ...]
     diverged: Fraction
-    undecided: Fraction
+    undetermined: Fraction
     scale: np.ndarray  # per state: the spread the tolerances are in units of
     periods: int
     discard: int
@@ -152,9 +155,9 @@ class BasinMap:
 
     @property
     def fractions(self) -> dict[str, float]:
-        """Every class's share: the attractors by number, then diverged and undecided (they sum to 1)."""
+        """Every class's share: the attractors by number, then diverged and undetermined (they sum to 1)."""
         return {**{str(a.number): a.fraction for a in self.attractors}, "diverged": self.diverged.fraction,
-                "undecided": self.undecided.fraction}
+                "undetermined": self.undetermined.fraction}
 
     def as_dict(self, labels: bool = True) -> dict:
         (x, xs), (y, ys) = self.axes
@@ -162,7 +165,7 @@ class BasinMap:
             "model": self.model, "parameters": self.parameters, "states": list(self.state_names),
             "grid": {x: json_safe(xs), y: json_safe(ys), "held": self.held, "starts": self.starts},
             "attractors": [a.as_dict(self.state_names) for a in self.attractors],
-            "diverged": self.diverged.as_dict(), "undecided": self.undecided.as_dict(),
+            "diverged": self.diverged.as_dict(), "undetermined": self.undetermined.as_dict(),
             "periods": self.periods, "discard": self.discard, "steps_per_period": self.steps_per_period,
             "period": self.period, "backend": self.backend, "locate_crossings": self.locate_crossings,
             "lanes": self.lanes, "scale": dict(zip(self.state_names, map(float, self.scale))), "method": self.method,
@@ -191,7 +194,7 @@ class BasinMap:
                    tuple((n, np.array(grid[n], dtype=float)) for n in names), dict(grid["held"]),
                    np.array(data["labels"], dtype=int), attractors,
                    Fraction(data["diverged"]["starts"], grid["starts"]),
-                   Fraction(data["undecided"]["starts"], grid["starts"]),
+                   Fraction(data["undetermined"]["starts"], grid["starts"]),
                    np.array([data["scale"][s] for s in states]), data["periods"], data["discard"],
                    data["steps_per_period"], data["period"], data["backend"], data["locate_crossings"], data["lanes"],
                    dict(data["method"]))
@@ -220,18 +223,18 @@ def basin_map(model: CompiledModel, grid: Mapping[str, Sequence[float]], *, opti
     values = dict(zip(model.parameter_names, map(float, p)))
     attractors = _attractors(model, options, values, summary, starts, labels, groups)
     shape = (len(axes[1][1]), len(axes[0][1]))
-    counts = {k: int(np.sum(labels == k)) for k in (DIVERGED, UNDECIDED)}
+    counts = {k: int(np.sum(labels == k)) for k in (DIVERGED, UNDETERMINED)}
     return BasinMap(
         model=model.name, parameters=values, state_names=model.state_names, axes=axes, held=held,
         labels=_renumbered(labels, attractors).reshape(shape), attractors=tuple(a for a, _ in attractors),
-        diverged=Fraction(counts[DIVERGED], len(starts)), undecided=Fraction(counts[UNDECIDED], len(starts)),
+        diverged=Fraction(counts[DIVERGED], len(starts)), undetermined=Fraction(counts[UNDETERMINED], len(starts)),
         scale=scale, periods=options.periods, discard=options.discard, steps_per_period=model.steps_per_period,
         period=inputs.period, backend=model.backend, locate_crossings=model.options.locate_crossings,
         lanes=runner.width, method=method())
 
 
 #: bump when the classification changes for the same constants (records of maps and continuations carry it)
-CLASSIFIER = 3
+CLASSIFIER = 4  # 4: the class "undecided" is the verdict "undetermined" of gearsym.analysis.regime
 
 
 def method() -> dict:
@@ -382,12 +385,12 @@ def hausdorff(sets: np.ndarray, one: np.ndarray) -> np.ndarray:
 
 
 def classify(summary: Summary, starts: np.ndarray) -> tuple[np.ndarray, list[tuple[list[int], int]], np.ndarray]:
-    """Per start a label (DIVERGED, UNDECIDED, or a provisional attractor number from 1), the attractors' members
+    """Per start a label (DIVERGED, UNDETERMINED, or a provisional attractor number from 1), the attractors' members
     (in start order, first member first) with their period (0: a cloud), and the scale the tolerances are in
     units of."""
     scale = scales(summary, starts)
     count = summary.finite.size
-    labels = np.full(count, UNDECIDED, dtype=int)
+    labels = np.full(count, UNDETERMINED, dtype=int)
     labels[~summary.finite] = DIVERGED
     finite = np.flatnonzero(summary.finite)
     tail = summary.tail[finite] / scale
@@ -412,7 +415,7 @@ def classify(summary: Summary, starts: np.ndarray) -> tuple[np.ndarray, list[tup
             members += list(finite[slow[near]])
             slow = slow[~near]
     # the rest: clouds; those settled compared with each cloud attractor's first member; one not settled joins
-    # the attractor it is one cloud with, else it is undecided (a transient still moving)
+    # the attractor it is one cloud with, else it is undetermined (a transient still moving)
     rest = np.flatnonzero((period == 0) & ~converging)
     clouds = _batched_clouds(summary, finite[rest], scale)
     still = np.concatenate([settled(clouds[at:at + BATCH]) for at in range(0, rest.size, BATCH)]) \

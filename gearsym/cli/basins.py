@@ -9,7 +9,7 @@ import json
 import sys
 from pathlib import Path
 
-from ..analysis.basins import RUN, BasinMap, basin_map
+from ..analysis.basins import CLASSES, RUN, BasinMap, basin_map
 from ..errors import GearsymError
 from ..figures.basins import Shown, plot_basin_fractions, plot_basin_map
 from ..files import write_atomically
@@ -156,7 +156,7 @@ def _write_map(path: Path, result: BasinMap, shown, axes: list[Axis]) -> None:
     text = io.StringIO()
     writer = csv.writer(text, lineterminator="\n")
     writer.writerow([f"{x} [{ux}]" if ux else x, f"{y} [{uy}]" if uy else y, "attractor"])
-    names = {-1: "diverged", 0: "undecided"}
+    names = CLASSES
     for j, yv in enumerate(sy):
         for i, xv in enumerate(sx):
             label = int(result.labels[j, i])
@@ -190,7 +190,7 @@ def report(result: BasinMap, shown) -> str:
                               for k, v in a.amplitude.items())
         lines += [f"  {a.number}: {a.description}: {a.fraction:.4f} ± {a.stderr:.4f} ({a.basin.starts} starts)",
                   f"     {amplitude}; lambda = " + ", ".join(f"{v:+.5f}" for v in a.exponents)]
-    for name, share in (("diverged", result.diverged), ("undecided", result.undecided)):
+    for name, share in (("diverged", result.diverged), ("undetermined", result.undetermined)):
         lines.append(f"  {name}: {share.fraction:.4f} ± {share.stderr:.4f} ({share.starts} starts)")
     return "\n".join(lines)
 

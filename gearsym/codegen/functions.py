@@ -43,7 +43,7 @@ from .crossing import crossing_steps
 from .loops import LoopOptions
 from .period_loops import gram_schmidt_function, monodromy, over_period
 from .rk4 import rk4_functions, tangent_by_vector
-from .switching import switching_surfaces
+from .switching import find_switching
 from .tables import table_function
 from .time_tables import SplitRHS, split_rhs
 from .translate import to_casadi
@@ -92,7 +92,7 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
     table_point = ca.Function("table_point", [sym.t, sym.p], [ca.vertcat(*table_values) if m else ca.SX(0, 1)],
                               ["t", "p"], ["values"], SX_OPTIONS)
 
-    switching = switching_surfaces(system, split) if options.locate_crossings else None
+    switching = find_switching(system, split) if options.locate_crossings else None
     if switching is None or not switching.surfaces:  # nothing switches (Lorenz): the plain loops
         tangent_block, state_block, state_step = rk4_functions(sym, split, K, where)
         steps = {**tangent_by_vector(sym, split, K, where), "state_block": state_block}

@@ -43,7 +43,7 @@ def _flank_of_backlash(e: sp.Expr):
     return None
 
 
-def switching_surfaces(system: FirstOrderSystem, split: SplitRHS) -> Switching:
+def find_switching(system: FirstOrderSystem, split: SplitRHS) -> Switching:
     """The backlash switching surfaces of ``split.rhs``, derived from the expressions, in a fixed order
     (SymPy's canonical argument order) so that the same model always gives the same C."""
     states = set(system.states)

@@ -1,7 +1,7 @@
 """Basin maps and basin fractions along a parameter.
 
 :func:`plot_basin_map` colours every start of the grid by the attractor it reached (a colour per attractor;
-black: diverged; light grey: undecided), draws each attractor's Poincare points on top in a darker shade of its
+black: diverged; light grey: undetermined), draws each attractor's Poincare points on top in a darker shade of its
 colour (the axes widen to show them where they lie outside the grid), and says in the legend what each attractor
 is (period, regime, amplitude) and how much of the grid its basin covers. :func:`plot_basin_fractions` draws the
 fraction of every attractor (by its id along the parameter) with its standard error, and its amplitude, against
@@ -23,8 +23,8 @@ from .save import pyplot, save_figure
 #: colours of the attractors by number (or id), then of the two other classes
 COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf",
           "#7f7f7f")
-DIVERGED_COLOR, UNDECIDED_COLOR = "#000000", "#dddddd"
-REGIME_MARKERS = {"periodic": "o", "quasi-periodic": "s", "chaotic": "^", "hyperchaotic": "D"}
+DIVERGED_COLOR, UNDETERMINED_COLOR = "#000000", "#dddddd"
+REGIME_MARKERS = {"periodic": "o", "quasi-periodic": "s", "chaotic": "^", "hyperchaotic": "D", "undetermined": "v"}
 
 
 class Shown:
@@ -106,7 +106,7 @@ def plot_basin_map(result, path: str | Path | None = None, shown: Shown | None =
     sy, uy = shown.state(y, ys, omega)
     numbers = [a.number for a in result.attractors]
     classes = [-1, 0, *numbers]
-    cmap = ListedColormap([DIVERGED_COLOR, UNDECIDED_COLOR, *(color(k) for k in numbers)])
+    cmap = ListedColormap([DIVERGED_COLOR, UNDETERMINED_COLOR, *(color(k) for k in numbers)])
     index = np.searchsorted(classes, result.labels)  # (classes are sorted: -1, 0, 1, 2, ...)
     own = ax is None
     fig, ax = (plt.subplots(figsize=(10.5, 6.2), constrained_layout=True) if own else (ax.figure, ax))
@@ -122,14 +122,19 @@ def plot_basin_map(result, path: str | Path | None = None, shown: Shown | None =
         size = 28 if a.points.shape[1] <= 64 else 6
         ax.scatter(px, py, s=size, marker=marker, color=c, edgecolors=[_darker(c)], linewidths=0.9, zorder=3)
         handles.append(Patch(facecolor=c, edgecolor=_darker(c), label=attractor_label(a, shown, omega)))
-    for label, share, c in (("diverged", result.diverged, DIVERGED_COLOR), ("undecided", result.undecided,
-                                                                             UNDECIDED_COLOR)):
-        handles.append(Patch(facecolor=c, edgecolor="0.4",
-                             label=f"{label}: {100 * share.fraction:.1f} ± {100 * share.stderr:.1f} % of starts"))
+    empty = []  # (a class no start is in has no colour on the map: the legend's title says so instead)
+    for label, share, c in (("diverged", result.diverged, DIVERGED_COLOR), ("undetermined", result.undetermined,
+                                                                             UNDETERMINED_COLOR)):
+        if share.starts:
+            handles.append(Patch(facecolor=c, edgecolor="0.4",
+                                 label=f"{label}: {100 * share.fraction:.1f} ± {100 * share.stderr:.1f} % of starts"))
+        else:
+            empty.append(label)
     ax.set_xlabel(_label(x, ux))
     ax.set_ylabel(_label(y, uy))
     ax.margins(0.02)
-    title = "attractor: what it is, its basin (the markers: its Poincaré points)"
+    title = "attractor: what it is, its basin (the markers: its Poincaré points)" + (
+        "\nno start " + " or ".join(empty) if empty else "")
     if own:
         ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7.5, frameon=False,
                   title=title, title_fontsize=7.5)
@@ -155,11 +160,15 @@ def plot_basin_fractions(result, path: str | Path | None = None, shown: Shown | 
     where = dict(zip(result.values, values))
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(10, 7.5), sharex=True, constrained_layout=True,
                                       gridspec_kw={"height_ratios": [3, 2]})
+    from matplotlib.lines import Line2D
+
+    keys = []  # (the legend's keys are the lines the error bars are drawn on: a key per attractor, as drawn)
     for aid in result.ids:
         rows = [r for r in result.rows if r.id == aid]
         px = np.array([where[r.value] for r in rows])
         top.errorbar(px, [r.fraction for r in rows], yerr=[r.stderr for r in rows], color=color(aid), lw=1.2,
-                     marker="o", ms=3.5, capsize=2, label=f"attractor {aid}")
+                     marker="o", ms=3.5, capsize=2)
+        keys.append(Line2D([], [], color=color(aid), lw=1.2, marker="o", ms=3.5, label=f"attractor {aid}"))
         for r, xv in zip(rows, px):
             for k, amp in r.amplitude.items():
                 shown_amp, _ = shown.state(k, [amp], r.value if result.parameter == "omega" else None)
@@ -170,7 +179,7 @@ def plot_basin_fractions(result, path: str | Path | None = None, shown: Shown | 
             amps = [shown.state(first, [r.amplitude[first]], r.value if result.parameter == "omega" else None)[0][0]
                     for r in rows]
             bottom.plot(px, amps, color=color(aid), lw=0.8, alpha=0.6)
-    for kind, c in (("diverged", DIVERGED_COLOR), ("undecided", UNDECIDED_COLOR)):
+    for kind, c in (("diverged", DIVERGED_COLOR), ("undetermined", UNDETERMINED_COLOR)):
         f = result.fractions(kind)
         if f.any():
             top.plot(values, f, color=c if kind == "diverged" else "0.6", ls="--", lw=1.0, label=kind)
@@ -185,12 +194,14 @@ def plot_basin_fractions(result, path: str | Path | None = None, shown: Shown | 
                      fontsize=6.5, color="0.3")
     top.set_ylim(-0.02, 1.05)
     top.set_ylabel("fraction of starts (± binomial s.e.)")
-    top.legend(fontsize=7, ncol=4, loc="lower left", bbox_to_anchor=(0.0, 1.0), frameon=False)
+    top.legend(handles=[*keys, *top.get_legend_handles_labels()[0]], fontsize=7, ncol=4, loc="lower left",
+               bbox_to_anchor=(0.0, 1.0), frameon=False)
     coordinate = next((k for r in result.rows for k in r.amplitude), "")
     _, unit_a = shown.state(coordinate, [0.0], None) if coordinate else (None, "")
     bottom.set_ylabel(f"A ({coordinate})" + (f" [{unit_a}]" if unit_a else ""))
-    from matplotlib.lines import Line2D
-    bottom.legend(handles=[Line2D([], [], marker=m, ls="none", color="0.3", label=k) for k, m in REGIME_MARKERS.items()],
+    regimes = {r.regime for r in result.rows}  # (a key for each regime drawn, none for the others)
+    bottom.legend(handles=[Line2D([], [], marker=m, ls="none", color="0.3", label=k) for k, m in REGIME_MARKERS.items()
+                           if k in regimes],
                   fontsize=7, ncol=4, loc="best", title="regime (from the exponents)", title_fontsize=7)
     bottom.set_xlabel(_label(name, unit))
     record = result.record

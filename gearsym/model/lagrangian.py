@@ -7,15 +7,13 @@ dissipation, the generalized forces of the external torques, and Lagrange's equa
 from __future__ import annotations
 
 from functools import cached_property
-from typing import TYPE_CHECKING
 
 import sympy as sp
 
 from ..backlash import G
 from ..symbols import phi, t
+from .resolved_components import ResolvedCoupling
 
-if TYPE_CHECKING:
-    from .resolved import ResolvedCoupling
 
 
 class LagrangianForms:

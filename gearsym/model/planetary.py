@@ -9,16 +9,15 @@ from __future__ import annotations
 import random
 from dataclasses import replace
 from functools import cached_property
-from typing import TYPE_CHECKING, Optional
+from typing import Optional
 
 import sympy as sp
 
 from ..errors import ModelError
 from .components import Planet
 from .expressions import to_expr
+from .resolved_components import ResolvedBody, ResolvedCoupling
 
-if TYPE_CHECKING:
-    from .resolved import ResolvedBody, ResolvedCoupling
 
 
 def _whole_turns_removed(angle: sp.Expr) -> sp.Expr:

@@ -20,7 +20,8 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..errors import ModelError
-from ..model.resolved import ResolvedCoupling, ResolvedDrivetrain
+from ..model.resolved import ResolvedDrivetrain
+from ..model.resolved_components import ResolvedCoupling
 from ..symbols import t
 
 

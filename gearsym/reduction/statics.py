@@ -23,7 +23,7 @@ import numpy as np
 import sympy as sp
 
 from ..errors import GearsymError
-from ..model.resolved import ResolvedCoupling
+from ..model.resolved_components import ResolvedCoupling
 from ..symbols import parameter_symbol, phi
 from .reduction import Reduction
 

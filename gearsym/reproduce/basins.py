@@ -20,7 +20,7 @@ def basins_record(c: Computed) -> dict:
     maps = [{"model": model, "omega": omega, "starts": m.starts, "points": int(m.labels.shape[0]),
              "periods": m.periods, "discard": m.discard,
              "attractors": [_attractor(a) for a in m.attractors], "diverged": m.diverged.as_dict(),
-             "undecided": m.undecided.as_dict()} for (model, omega), m in c.basins.items()]
+             "undetermined": m.undetermined.as_dict()} for (model, omega), m in c.basins.items()]
     fractions = {}
     for model, r in c.fractions.items():
         values = list(r.values)

@@ -222,7 +222,7 @@ def _basins(record: dict, figures_dir: str) -> list[str]:
              f"![Fig. 4 as basins of attraction]({figures_dir}/basins.png)", "",
              f"*Every start of a {first['points']} x {first['points']} grid over the box [-5, 5]² that Fig. 4's ten "
              "random starts come from, coloured by the attractor it reaches (`gearsym basins`: the attractors told "
-             "apart by their Poincaré sets; black: diverged, light grey: undecided), with each attractor's Poincaré "
+             "apart by their Poincaré sets; black: diverged, light grey: undetermined), with each attractor's Poincaré "
              f"points; {main['label']}.*", "",
              f"Each start runs as the attractor search's runs do ({first['discard']} periods discarded, "
              f"{first['periods'] - first['discard']} measured, the paper's scheme), many at once in the lanes; each "
@@ -263,7 +263,7 @@ def _basin_tables(b: dict) -> list[str]:
             lines.append(f"| {m['omega']:g} | {MODEL_LABELS.get(m['model'], m['model'])} | {a['number']} | "
                          f"{a['description']} | {100 * a['fraction']:.1f} ± {100 * a['stderr']:.1f} % | "
                          f"{_num(a['amplitude'], 3)} | {a['lambda_1']:+.4f} | {100 * (1 - (1 - a['fraction']) ** 10):.0f} % |")
-        others = [f"{k}: {m[k]['starts']} of {m['starts']} starts" for k in ("diverged", "undecided") if m[k]["starts"]]
+        others = [f"{k}: {m[k]['starts']} of {m['starts']} starts" for k in ("diverged", "undetermined") if m[k]["starts"]]
         if others:
             lines.append(f"| {m['omega']:g} | {MODEL_LABELS.get(m['model'], m['model'])} | – | "
                          f"{', '.join(others)} | | | | |")
@@ -313,9 +313,13 @@ def _method(record: dict) -> list[str]:
             "with Gram–Schmidt every period; continuation hands the final state on (start x = −2, v = −0.5 "
             "at ω = 0.1), as in the paper.",
             "- Regimes from the spectrum and its batch-means standard error (`gearsym/analysis/regime.py`): "
-            "an exponent is zero within max(3 σ, 5/T); chaotic = one positive exponent, hyperchaotic = two. "
-            "At kS = 0 the shaft twist is free and adds two exactly zero exponents, so a regular x₁ shows "
-            "as quasi-periodic there.",
+            "an exponent is zero within max(3 σ, 5/T); chaotic = one positive exponent, hyperchaotic = two; "
+            "the two exponents of a complex pair of Floquet multipliers are given as their common real part. "
+            "Where λ₁ is zero within its error, the Poincaré points decide: stationary is quasi-periodic, "
+            "still converging or spreading (a transient) is undetermined, counted neither regular nor chaotic "
+            "(docs/engine.md, 'Verdicts'). At kS = 0 the shaft twist is free and adds two exactly zero "
+            "exponents, and its Poincaré points drift with the free disk: a regular x₁ shows as quasi-periodic "
+            "or undetermined there.",
             "- Jumps: a step in A between neighbouring ω that is 5× the median step around it and 5 % of A "
             "(`gearsym/analysis/jumps.py`).",
             "- The paper's parameters: B0 = 1, B1 = 4, Θ = 0, ζ = 0.08, η = 10, D = 2, Θ' = 0.1. What it leaves "

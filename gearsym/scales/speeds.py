@@ -15,7 +15,7 @@ from ..errors import GearsymError, ModelError
 
 if TYPE_CHECKING:  # (types only: the start-up path reads Speed without SymPy)
     from ..model.drivetrain import Drivetrain
-    from ..model.resolved import ResolvedCoupling
+    from ..model.resolved_components import ResolvedCoupling
 
 #: how closely a gear pair's radii must follow its tooth counts (both set the same speed ratio)
 RATIO_TOLERANCE = 1e-3

@@ -44,10 +44,10 @@ CONTINUES, APPEARS, MERGES, VANISHES = "continues", "appears", "merges", "vanish
 
 @dataclass(frozen=True)
 class Tracked:
-    """One class of starts at one value: an attractor (with its id across the values), or diverged/undecided."""
+    """One class of starts at one value: an attractor (with its id across the values), or diverged/undetermined."""
 
     value: float
-    kind: str  # "attractor", "diverged" or "undecided"
+    kind: str  # "attractor", "diverged" or "undetermined"
     id: int | None
     fraction: float
     stderr: float
@@ -57,7 +57,7 @@ class Tracked:
     amplitude: dict[str, float]
     exponents: tuple[float, ...]
     event: str  # continues, appears, "merges 3" (attractor 3 of the last value merged into it); "" otherwise
-    points: np.ndarray  # (n, k): its Poincare points (none for diverged/undecided)
+    points: np.ndarray  # (n, k): its Poincare points (none for diverged/undetermined)
     scale: tuple[float, ...]  # per state: the spread of the value's map (what its distances are in units of)
 
 
@@ -82,7 +82,7 @@ class BasinContinuation:
         return [r for r in self.rows if r.value == value]
 
     def fractions(self, key: int | str) -> np.ndarray:
-        """The fraction of attractor ``key`` (an id), or of "diverged" or "undecided", at every value (0 where
+        """The fraction of attractor ``key`` (an id), or of "diverged" or "undetermined", at every value (0 where
         it does not exist)."""
         out = np.zeros(len(self.values))
         where = {v: i for i, v in enumerate(self.values)}
@@ -214,7 +214,7 @@ def track(found: BasinMap, value: float, previous, match_distance: float, next_i
         rows.append(Tracked(value, "attractor", aid, a.fraction, a.stderr, a.basin.starts, a.period, a.regime,
                             dict(a.amplitude), tuple(map(float, a.exponents)), event, a.points, scale_of))
     rows.sort(key=lambda r: r.id)
-    for kind, share in (("diverged", found.diverged), ("undecided", found.undecided)):
+    for kind, share in (("diverged", found.diverged), ("undetermined", found.undetermined)):
         rows.append(Tracked(value, kind, None, share.fraction, share.stderr, share.starts, None, kind, {}, (), "",
                             np.zeros((len(found.state_names), 0)), scale_of))
     return rows

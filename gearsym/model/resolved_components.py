@@ -1,0 +1,64 @@
+"""The parts of a resolved drivetrain: a body with its angle, a coupling with its deflection row, a torque term."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import sympy as sp
+
+from ..symbols import omega, t
+from .components import Body, Coupling, Torque
+
+
+@dataclass(frozen=True)
+class ResolvedBody:
+    body: Body
+    index: Optional[int]  # 0-based position among the moving bodies (the paper's psi_{index+1}); None if fixed
+    angle: sp.Expr  # psi_i(t); 0 for a fixed body
+    inertia: Optional[sp.Expr]  # None for a fixed body
+    radius: Optional[sp.Expr]
+
+    @property
+    def fixed(self) -> bool:
+        return self.index is None
+
+
+@dataclass(frozen=True)
+class ResolvedCoupling:
+    """A mesh or shaft with its expressions parsed and its kinematics set up."""
+
+    component: Coupling
+    kind: str  # "mesh" | "shaft"
+    a: ResolvedBody
+    b: ResolvedBody
+    row: tuple[sp.Expr, ...]  # J: deflection = sum(row[i] * psi_i)
+    scale: sp.Expr  # relative coordinate = scale * deflection
+    stiffness: sp.Expr  # mean stiffness (kZ) or torsional stiffness (kS)
+    damping: sp.Expr
+    backlash: sp.Expr  # eta (0 for shafts)
+    variation: sp.Expr  # k(phi) shape (1 for shafts)
+    mesh_phase: sp.Expr  # phi as a function of t (0 for shafts)
+    order: sp.Expr = sp.S.Zero  # mesh frequency / forcing frequency (0 for shafts)
+    carrier: Optional[ResolvedBody] = None  # the carrier of a mesh with a planet
+    turning: tuple[tuple[sp.Expr, ...], tuple[sp.Expr, ...]] = ((), ())  # rows: each gear's angle relative to the carrier
+    planet_phase: sp.Expr = sp.S.Zero  # the part of the mesh phase a planet's position gives (Parker & Lin 2004)
+
+    @property
+    def name(self) -> str:
+        return self.component.name
+
+
+@dataclass(frozen=True)
+class ResolvedForcing:
+    """One term of an external torque: sign * amplitude * timefn(t) on a body."""
+
+    torque: Torque
+    body: ResolvedBody
+    amplitude: sp.Expr  # signed (load torques enter with -1)
+    order: int  # 0 for the mean
+    phase: sp.Expr
+    group: Optional[str]
+
+    @property
+    def time_function(self) -> sp.Expr:
+        return sp.S.One if self.order == 0 else sp.cos(self.order * omega * t + self.phase)
