@@ -15,7 +15,9 @@ import numpy as np
 import pytest
 
 import gearsym
-from gearsym import Integration
+from gearsym import FirstOrderSystem, GearsymError, Integration, find_attractors, lyapunov_spectrum
+from gearsym.analysis.lyapunov import lyapunov_spectra
+from gearsym.analysis.regime import DIVERGED
 from gearsym.codegen.compiled import CompiledModel
 from gearsym.codegen.compiler import compile_library, find_compiler
 from gearsym.codegen.functions import LoopOptions, build_functions
@@ -171,3 +173,38 @@ def test_an_independent_sweep_in_the_lanes_gives_the_scalar_sweeps_rows(name, ax
         else:
             assert list(a) == list(b), column
     assert list(wide.record.items()) == list(one.record.items())
+
+
+def test_the_lanes_spectra_carry_each_start_s_verdict_as_lyapunov_spectrum_gives_it():
+    """lyapunov_spectra (find_attractors' runs, in the lanes) gives each start what lyapunov_spectrum gives it from
+    there: the regime (where the exponents cannot decide, decided by the Poincare points: periodic, or
+    undetermined), the complex pairs, no divergence, and what the Poincare points did."""
+    model = conftest.compiled("one_stage_resonant", Integration(periods=500, discard=300))
+    starts = np.random.default_rng(0).uniform(-5, 5, size=(6, model.dimension))
+    wide = lyapunov_spectra(model, starts, model.run_options(None), model.parameter_vector(omega=1.5))
+    for y0, w in zip(starts, wide):
+        one = lyapunov_spectrum(model, y0=y0, omega=1.5)
+        assert (w.regime, w.pairs, w.divergence) == (one.regime, one.pairs, one.divergence), y0
+        assert (w.settling is None) == (one.settling is None) and (w.settling is None or (
+            w.settling.state, w.settling.lag) == (one.settling.state, one.settling.lag)), y0
+        assert np.allclose(w.exponents, one.exponents, rtol=0, atol=1e-9)
+    assert any(w.settling is not None for w in wide)  # (at omega = 1.5 the exponents cannot decide alone)
+
+
+def escape_oscillator() -> FirstOrderSystem:
+    """x'' + d x' + x - x^2 = F cos(w t): bounded in the well around 0, escaping in finite time beyond x = 1."""
+    return FirstOrderSystem.from_equations("escape", ["x", "v"], ["v", "-d*v - x + x**2 + F*cos(w*t)"],
+                                           {"d": 0.1, "F": 0.02, "w": 0.8}, time="t", period="2*pi/w")
+
+
+def test_a_start_that_diverges_in_the_lanes_is_diverged_and_find_attractors_names_it():
+    """A run that grows without bound is 'diverged' in the lanes as in lyapunov_spectrum (not an error, not a
+    regime); find_attractors, which has no attractor to group it with, says which start and what to do."""
+    model = gearsym.compile_model(escape_oscillator(), Integration(periods=80, discard=40))
+    starts = np.array([[0.1, 0.0], [3.0, 0.0]])
+    wide = lyapunov_spectra(model, starts, model.run_options(None), model.parameter_vector())
+    one = lyapunov_spectrum(model, y0=starts[1])
+    assert wide[0].divergence is None and wide[0].regime == "periodic"
+    assert wide[1].regime == one.regime == DIVERGED and wide[1].divergence == one.divergence is not None
+    with pytest.raises(GearsymError, match=r"initial state #1 \(x=3, v=0\): the motion diverged: .*smaller box"):
+        find_attractors(model, initial_states=[{"x": 0.1, "v": 0.0}, {"x": 3.0, "v": 0.0}])
