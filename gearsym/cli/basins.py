@@ -178,7 +178,7 @@ def report(result: BasinMap, shown) -> str:
     lines = [
         f"{result.model}: {result.starts} starts, {x} in [{sx.min():g}, {sx.max():g}]{ux} ({xs.size}) x {y} in "
         f"[{sy.min():g}, {sy.max():g}]{uy} ({ys.size})" + (f", held {held}" if held else ""),
-        f"parameters: {shown.parameters(result.parameters)}",
+        f"parameters: {shown.parameters(result.parameters).replace('$', '')}",  # (no figure mathtext in text)
         f"{result.periods} periods per start ({result.discard} discarded), {result.steps_per_period} RK4 steps/period, "
         f"{'crossings located' if result.locate_crossings else 'plain RK4'}, {result.backend}, "
         f"{result.lanes} trajectories per call",
