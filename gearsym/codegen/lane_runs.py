@@ -28,10 +28,16 @@ from ..errors import GearsymError
 from ..paths import GENERATED_DIR
 from .compiled import CompiledModel, RunInputs
 from .compiler import cache_dir, compile_library
+from .trust import trusted
 
 _ptr = ctypes.c_void_p
 #: starts per task of a threaded run: a few dozen native calls, then the caller's reduction of them
 CHUNK = 64
+
+
+def lanes_describes(name: str, digest: str) -> dict:
+    """What the lanes' C of a model is, as its record in the cache keeps it."""
+    return {"model": f"{name}_lanes", "code": digest}
 
 
 def lanes_file(name: str) -> str:
@@ -81,6 +87,11 @@ def lanes_of(model: CompiledModel, verbose: bool = False) -> LaneLibrary | None:
         if not source.is_file():
             raise GearsymError(f"{model.name}: the C of its lanes ({source}) is missing; generate it again: "
                                f"`gearsym compile {model.name}` (or delete {source.parent} and rerun)")
+        # (C in the cache is code: compiled only if it is what gearsym wrote there, as the model's own C)
+        if source.parent != GENERATED_DIR / model.name and \
+                trusted(source, lanes_describes(model.name, model.hash)) is None:
+            raise GearsymError(f"{model.name}: the C of its lanes ({source}) is not what gearsym wrote for this "
+                               f"model; delete {source.parent} and rerun: gearsym makes it again")
         announce = (lambda message: print(f"gearsym: {message}", file=sys.stderr, flush=True)) if verbose else None
         library = compile_library(source, f"{model.name}_lanes", announce=announce)
         key = (model.hash, str(library.path))
