@@ -9,7 +9,8 @@ One flat public face; the stages behind it, each handing one type to the next:
   :class:`FirstOrderSystem` the engine takes; :func:`load` does name -> system in one call;
 * compile: :func:`compile_model` (FirstOrderSystem, :class:`Integration` -> :class:`CompiledModel`);
 * analyse: :func:`lyapunov_spectrum`, :func:`poincare_samples`, :func:`phase_trajectory`,
-  :func:`find_attractors`, :func:`run_sweep` (on a CompiledModel, or on a system, compiled first);
+  :func:`find_attractors`, :func:`basin_map` (basins of attraction, many starts at once in the lanes), :func:`continue_basins`
+  (basin fractions along a parameter), :func:`run_sweep` (on a CompiledModel, or on a system, compiled first);
   periodic orbits and their branches: :func:`periodic_orbit`, :func:`continue_orbits`;
 * data: :func:`simulate_measurements`, :func:`load_measurements`, :func:`explain`;
 * FMUs: :func:`export_fmu` (a model as an FMI 2.0 FMU, co-simulation and model exchange, for other tools);
@@ -56,6 +57,8 @@ _LAZY = {
     "poincare_samples": "gearsym.verbs",
     "phase_trajectory": "gearsym.verbs",
     "find_attractors": "gearsym.verbs",
+    "basin_map": "gearsym.verbs",
+    "continue_basins": "gearsym.verbs",
     "classify_regime": "gearsym.analysis",
     "periodic_orbit": "gearsym.verbs",
     "continue_orbits": "gearsym.verbs",
@@ -120,5 +123,5 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .scales.map import Scaling
     from .system import FirstOrderSystem
     from .sweep import SweepInterrupted, Workers, read_sweep
-    from .verbs import (continue_orbits, find_attractors, lyapunov_spectrum, periodic_orbit, phase_trajectory,
-                        poincare_samples, run_sweep, simulate_measurements)
+    from .verbs import (basin_map, continue_basins, continue_orbits, find_attractors, lyapunov_spectrum, periodic_orbit,
+                        phase_trajectory, poincare_samples, run_sweep, simulate_measurements)

@@ -12,6 +12,7 @@ import functools
 from collections.abc import Mapping
 
 from .analysis.attractors import find_attractors as _find_attractors
+from .analysis.basins import basin_map as _basin_map
 from .analysis.lyapunov import lyapunov_spectrum as _lyapunov_spectrum
 from .analysis.orbits import phase_trajectory as _phase_trajectory, poincare_samples as _poincare_samples
 from .codegen.build import compile_model
@@ -23,6 +24,7 @@ from .periodic.branches import continue_orbits as _continue_orbits
 from .periodic.orbit import periodic_orbit as _periodic_orbit
 from .physical.answers import PhysicalScaling
 from .physical.sweeps import axes_with_units, nondimensional_axes
+from .sweep.basin_continuation import continue_basins as _continue_basins
 from .sweep.run import run_sweep as _run_sweep
 from .system import FirstOrderSystem
 from .units import is_quantity
@@ -55,6 +57,8 @@ lyapunov_spectrum = high_level(_lyapunov_spectrum)
 poincare_samples = high_level(_poincare_samples)
 phase_trajectory = high_level(_phase_trajectory)
 find_attractors = high_level(_find_attractors)
+basin_map = high_level(_basin_map)
+continue_basins = high_level(_continue_basins)
 run_sweep = high_level(_run_sweep)
 
 
@@ -98,5 +102,5 @@ periodic_orbit = high_level(_periodic_orbit)
 continue_orbits = high_level(_continue_orbits)
 simulate_measurements = high_level(_simulate_measurements)
 
-__all__ = ["continue_orbits", "find_attractors", "high_level", "lyapunov_spectrum", "periodic_orbit",
+__all__ = ["basin_map", "continue_basins", "continue_orbits", "find_attractors", "high_level", "lyapunov_spectrum", "periodic_orbit",
            "phase_trajectory", "poincare_samples", "run_sweep", "simulate_measurements"]

@@ -39,8 +39,9 @@ def run(capsys, *argv: str) -> tuple[int, str, str]:
 
 
 def test_subcommands_are_registered():
-    assert [m.NAME for m in COMMANDS] == ["list", "derive", "docs", "compile", "lyap", "sweep", "orbits", "poincare", "reproduce",
-                                          "simulate", "explain", "modes", "campbell", "fmu", "stiffness"]
+    assert [m.NAME for m in COMMANDS] == ["list", "derive", "docs", "compile", "lyap", "sweep", "orbits", "poincare",
+                                          "basins", "reproduce", "simulate", "explain", "modes", "campbell", "fmu",
+                                          "stiffness"]
 
 
 def test_list_shows_every_model_with_its_title(capsys):

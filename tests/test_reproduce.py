@@ -8,6 +8,9 @@ import re
 
 import pytest
 
+import gearsym
+from gearsym import Integration
+from gearsym.analysis.basins import basin_map
 from gearsym.checks import json_safe
 from gearsym.paths import REPO_ROOT
 from gearsym.periodic import FOLD, GRAZING, NEIMARK_SACKER, PERIOD_DOUBLING
@@ -15,6 +18,7 @@ from gearsym.reproduce import jumps
 from gearsym.reproduce.plan import PAPER_JUMPS
 from gearsym.reproduce import claims as claim_checks
 from gearsym.reproduce import SCENARIOS, compute, paper_plan, render, reproduce
+from gearsym.reproduce.compute import box_grid
 from gearsym.reproduce.report import VERDICT_MARK
 
 DOCS = REPO_ROOT / "docs"
@@ -34,7 +38,9 @@ def test_the_committed_report_is_rendered_from_the_committed_record(committed):
 def test_every_figure_the_report_shows_is_committed():
     text = (DOCS / "reproduction.md").read_text()
     shown = re.findall(r"\]\((figures/[^)]+\.png)\)", text)
-    assert {"figures/fig3.png", "figures/fig4.png", "figures/fig6.png", "figures/fig7.png"} <= set(shown)
+    assert {"figures/fig3.png", "figures/fig4.png", "figures/fig6.png", "figures/fig7.png", "figures/basins.png",
+            "figures/basin-fractions.png", "figures/basins-defaults.png", "figures/basin-fractions-defaults.png"} \
+        <= set(shown)
     for name in shown:
         assert (DOCS / name).stat().st_size > 20_000, name
 
@@ -87,6 +93,7 @@ def test_every_paper_jump_and_hysteresis_end_is_a_located_bifurcation_a_crisis_o
 def test_a_quick_reproduction_writes_every_output_and_reuses_its_data(tmp_path):
     record = reproduce(tmp_path / "figures", tmp_path / "reproduction.md", quick=True, progress=False)
     for name in ("fig3.png", "fig3-orbits.png", "fig4.png", "fig6.png", "fig7.png", "hysteresis.png", "study.png",
+                 "basins.png", "basin-fractions.png", "basins-defaults.png", "basin-fractions-defaults.png",
                  "claims.json"):
         assert (tmp_path / "figures" / name).stat().st_size > 1000, name
     page = (tmp_path / "reproduction.md").read_text()
@@ -96,6 +103,26 @@ def test_a_quick_reproduction_writes_every_output_and_reuses_its_data(tmp_path):
     records = sorted((tmp_path / "figures" / "data").glob("*/*.json"))
     assert len(records) == sum(len(paper_plan(True, s, study=i == 0).sweeps) for i, s in enumerate(SCENARIOS))
     assert all(json.loads(p.read_text())["points"]["computed"] > 0 for p in records)
+    maps = sorted((tmp_path / "figures" / "data").glob("*/basins/map-*.json"))
+    assert len(maps) == 2 * len(paper_plan(True).basins)
+    stamps = {p: p.stat().st_mtime_ns for p in (*maps, *(tmp_path / "figures" / "data").glob("*/basins/*.csv"))}
     again = reproduce(tmp_path / "figures", tmp_path / "reproduction.md", quick=True, progress=False)
     assert all(json.loads(p.read_text())["points"]["computed"] == 0 for p in records)  # the data were reused
+    assert {p: p.stat().st_mtime_ns for p in stamps} == stamps  # the basins' too: read, not written again
     assert again == record
+
+
+def test_a_basin_map_recomputed_matches_the_committed_record(committed):
+    """Fig. 4 as basins (D = 2, omega = 1.5, calibrated), again on the committed grid: the same attractors, and
+    their shares to a start or two (a start on a basin boundary may go either way on another CPU's rounding)."""
+    plan = paper_plan(scenario=SCENARIOS[0])
+    job = next(j for j in plan.basins if j.model == "one_stage_resonant" and j.omega == 1.5)
+    recorded = next(m for m in committed["scenarios"][0]["basins"]["maps"]
+                    if m["model"] == job.model and m["omega"] == job.omega)
+    options = Integration.paper(periods=plan.attractor_discard + plan.attractor_periods, discard=plan.attractor_discard)
+    model = gearsym.compile_model(gearsym.load(job.model), options)
+    found = basin_map(model, box_grid(job.points), **SCENARIOS[0].settings(job.model), omega=job.omega)
+    assert [(a.description, a.period) for a in found.attractors] == \
+        [(a["description"], a["period"]) for a in recorded["attractors"]]
+    for a, r in zip(found.attractors, recorded["attractors"]):
+        assert abs(a.basin.starts - r["starts"]) <= 2

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from bench.orbits.report import section
 from gearsym.figures.save import save_figure
+from bench.basins import report as basins_report
 from bench.orbits import report as orbits_report
 from bench.machine import REPO
 from .summary import summarise, TARGETS
@@ -190,8 +191,9 @@ def _startup_lines(raw: dict) -> list[str]:
     return out
 
 
-def render(raw: dict, notes: str | None = None, orbits: dict | None = None) -> str:
-    """The page; ``orbits``: the record of ``python -m bench.orbits``, whose section it adds."""
+def render(raw: dict, notes: str | None = None, orbits: dict | None = None, basins: dict | None = None) -> str:
+    """The page; ``orbits``, ``basins``: the records of ``python -m bench.orbits`` and ``python -m bench.basins``,
+    whose sections it adds."""
     summary = raw["summary"]
     m = raw["machine"]
     st = raw["settings"]
@@ -270,6 +272,8 @@ def render(raw: dict, notes: str | None = None, orbits: dict | None = None) -> s
             "model, and nothing compiled again for an unchanged model.", "", *_startup_lines(raw)]
     if orbits:
         out += section(orbits)
+    if basins:
+        out += basins_report.section(basins)
     if notes:
         out += [notes.rstrip(), ""]
     return "\n".join(out)
@@ -353,7 +357,8 @@ def write_report(json_path: Path = DEFAULT_JSON, page: Path = PAGE, figure_path:
     notes = NOTES.read_text() if NOTES.exists() else None
     orbits_path = orbits_path or orbits_report.RECORD
     orbits = json.loads(orbits_path.read_text()) if orbits_path.is_file() else None
-    page.write_text(render(raw, notes, orbits))
+    basins = json.loads(basins_report.RECORD.read_text()) if basins_report.RECORD.is_file() else None
+    page.write_text(render(raw, notes, orbits, basins))
     written = [page, figure(raw, figure_path)]
     if orbits:
         written.append(orbits_report.figure(orbits, orbits_figure or figure_path.with_name(orbits_report.FIGURE.name)))

@@ -37,7 +37,7 @@ from ..codegen import CompiledModel, engine_verb
 from ..options import Integration
 from ..errors import GearsymError, suggest
 from ..memory import check_fits
-from .lyapunov import LyapunovSpectrum, lyapunov_spectrum
+from .lyapunov import LyapunovSpectrum, lyapunov_spectra
 from .regime import classify_regime
 
 #: the box initial states are drawn from, for every state the caller does not name
@@ -259,7 +259,8 @@ def find_attractors(
         starts = np.random.default_rng(seed).uniform(low, high, size=(ics, compiled.dimension))
         used_seed = seed
 
-    spectra = [_run(compiled, p, y0, i, options) for i, y0 in enumerate(starts)]
+    spectra = lyapunov_spectra(compiled, starts, options, p)  # many at once, in the lanes
+    _diverged(compiled, starts, spectra)
     clouds = [s.strobe for s in spectra]
     scale = _scales(clouds)
     groups = _group(clouds, scale, merge_factor, resolution, merge_floor)
@@ -309,17 +310,13 @@ def _explicit_states(compiled: CompiledModel, initial_states) -> np.ndarray:
     return np.array([compiled.initial_state(y0) for y0 in states])
 
 
-def _run(compiled: CompiledModel, p: np.ndarray, y0: np.ndarray, index: int,
-         options: Integration) -> LyapunovSpectrum:
-    start = ", ".join(f"{n}={v:g}" for n, v in zip(compiled.state_names, y0))
-    try:
-        spectrum = lyapunov_spectrum(compiled, options=options, y0=y0, **dict(zip(compiled.parameter_names, p)))
-    except GearsymError as exc:
-        raise GearsymError(f"initial state #{index} ({start}): {exc}") from exc
-    if spectrum.divergence is not None:  # no attractor to group it with
-        raise GearsymError(f"initial state #{index} ({start}): the motion diverged: "
-                           f"{spectrum.divergence.describe(spectrum.period)}; start from a smaller box")
-    return spectrum
+def _diverged(compiled: CompiledModel, starts: np.ndarray, spectra: Sequence[LyapunovSpectrum]) -> None:
+    """The error of the first run that diverged: it has no attractor to be grouped with."""
+    for index, (y0, spectrum) in enumerate(zip(starts, spectra)):
+        if spectrum.divergence is not None:
+            start = ", ".join(f"{n}={v:g}" for n, v in zip(compiled.state_names, y0))
+            raise GearsymError(f"initial state #{index} ({start}): the motion diverged: "
+                               f"{spectrum.divergence.describe(spectrum.period)}; start from a smaller box")
 
 
 # ------------------------------------------------------------------------------------------ grouping

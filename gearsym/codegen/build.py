@@ -23,6 +23,7 @@ from .compiled import CompiledModel
 from .compiler import cache_dir, compile_library
 from .functions import build_functions
 from .generate import code_hash, read_manifest, write_code
+from .lane_runs import lanes_describes, lanes_file
 from .library import LOADED, library_describes, library_functions, resolve_backend
 from .loops import LoopOptions
 from .native import load_native
@@ -81,7 +82,9 @@ def _compiled_functions(system: FirstOrderSystem, loops: LoopOptions, digest: st
     wrote), compiled once."""
     code_dir = code_directory(system.name, digest)
     source = code_dir / f"{system.name}.c"
-    if code_dir != GENERATED_DIR / system.name and trusted(source, source_describes(system.name, digest)) is None:
+    lanes = code_dir / lanes_file(system.name)
+    if code_dir != GENERATED_DIR / system.name and (trusted(source, source_describes(system.name, digest)) is None
+                                                    or trusted(lanes, lanes_describes(system.name, digest)) is None):
         t = time.perf_counter()
         mf = build_functions(system, loops)
         timings["build"] = time.perf_counter() - t
@@ -102,9 +105,10 @@ def source_describes(name: str, digest: str) -> dict:
 
 def keep_generated(code) -> None:
     """Generated C just written into the cache (a :class:`~.generate.GeneratedCode`): made private and recorded."""
-    for path in (code.manifest, code.source):
+    for path in (code.manifest, code.source, code.lanes):
         os.chmod(path, 0o600)  # (the files were made with the umask's mode)
     record(code.source, code.source.read_bytes(), source_describes(code.source.stem, code.hash))
+    record(code.lanes, code.lanes.read_bytes(), lanes_describes(code.source.stem, code.hash))
 
 
 def _kind(value) -> str:

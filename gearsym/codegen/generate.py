@@ -20,6 +20,8 @@ from ..files import write_atomically
 from ..system import FirstOrderSystem
 from .functions import ModelFunctions
 from .loops import LoopOptions
+from .lane_runs import lanes_file
+from .lanes import lanes_source
 from .printed import LOOP_NAMES, pieces, print_loops, stand_in
 
 #: bump when the generated code changes for the same model and options
@@ -28,7 +30,8 @@ CODEGEN_VERSION = 2
 #: the modules whose text determines the generated C; their bytes are part of the hash, so an edit
 #: can never leave a stale library or committed C in use (the tests then ask to regenerate)
 _GENERATOR_SOURCES = ("translate.py", "time_tables.py", "casadi_symbols.py", "rk4.py", "switching.py", "crossing.py",
-                      "period_loops.py", "tables.py", "functions.py", "loops.py", "generate.py", "printed.py")
+                      "period_loops.py", "tables.py", "functions.py", "loops.py", "generate.py", "printed.py",
+                      "lanes.py")
 
 
 def generator_digest() -> str:
@@ -84,11 +87,13 @@ class GeneratedCode:
     source: Path
     manifest: Path
     hash: str
+    lanes: Path | None = None  # the lanes' C (:mod:`.lanes`), compiled only when lanes are asked for
 
 
 def write_code(mf: ModelFunctions, directory: Path, digest: str) -> GeneratedCode:
-    """Write ``<model>.c`` and ``manifest.json`` into ``directory`` (atomically: no half-written files): CasADi's
-    C, with the integration loops printed by :mod:`.printed`."""
+    """Write ``<model>.c``, ``<model>_lanes.c`` and ``manifest.json`` into ``directory`` (atomically: no
+    half-written files): CasADi's C, with the integration loops printed by :mod:`.printed`, and the lanes printed
+    from the same C by :mod:`.lanes`."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     name = mf.system.name
@@ -102,12 +107,16 @@ def write_code(mf: ModelFunctions, directory: Path, digest: str) -> GeneratedCod
             gen.generate()
         finally:
             os.chdir(cwd)
-        source = Path(tmp) / f"{name}.c"
-        source.write_text(print_loops(source.read_text(), mf))
+        source, lanes = Path(tmp) / f"{name}.c", Path(tmp) / lanes_file(name)
+        text = source.read_text()
+        lanes.write_text(lanes_source(text, mf))
+        source.write_text(print_loops(text, mf))
+        os.replace(lanes, directory / lanes.name)
         os.replace(source, directory / f"{name}.c")
     text = json.dumps(manifest(mf, digest), indent=2, sort_keys=True) + "\n"
     write_atomically(directory / "manifest.json", text)
-    return GeneratedCode(directory, directory / f"{name}.c", directory / "manifest.json", digest)
+    return GeneratedCode(directory, directory / f"{name}.c", directory / "manifest.json", digest,
+                         directory / lanes_file(name))
 
 
 def read_manifest(directory: Path) -> dict | None:

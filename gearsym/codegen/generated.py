@@ -36,7 +36,7 @@ def generate_model(system: FirstOrderSystem, out: Path, options: Integration = I
     if check:
         with tempfile.TemporaryDirectory() as tmp:
             fresh = write_code(mf, Path(tmp) / system.name, digest)
-            stale = [target / p.name for p in (fresh.source, fresh.manifest)
+            stale = [target / p.name for p in (fresh.source, fresh.lanes, fresh.manifest)
                      if not (target / p.name).is_file() or (target / p.name).read_bytes() != p.read_bytes()]
             return GenerateReport(system.name, target / fresh.source.name, digest, fresh.source.stat().st_size,
                                   stale=stale)

@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 from ..checks import json_safe
+from .basins import basins_record
 from .claims import evaluate
 from .compute import Computed, compute
 from .figures import draw_all
@@ -33,6 +34,8 @@ def scenario_record(c: Computed) -> dict:
     record = {"name": s.name, "label": s.label, "values": values, **evaluate(c)}
     if c.jumps:
         record["orbits"] = c.jumps
+    if c.basins or c.fractions:
+        record["basins"] = basins_record(c)
     return record
 
 

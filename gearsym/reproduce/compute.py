@@ -7,17 +7,23 @@ only redraws; an interrupted one resumes where it stopped.
 from __future__ import annotations
 
 import sys
+import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from ..analysis import LyapunovSpectrum, Trajectory, lyapunov_spectrum, phase_trajectory
-from ..analysis.attractors import AttractorSet, find_attractors
+from ..analysis.attractors import DEFAULT_BOX, AttractorSet, find_attractors
+from ..analysis.basins import BasinMap, basin_map, method
 from ..codegen.build import compile_model
 from ..options import Integration
 from ..periodic import Continuation, continue_orbits
 from ..periodic.orbit import sweep_start
 from ..loading import load
-from ..sweep import SweepResult, Workers, run_sweep
+from ..files import write_atomically
+from ..sweep import SweepResult, Workers, parse_axis, run_sweep
+from ..sweep.basin_continuation import BasinContinuation, continue_basins
 from .jumps import jump_records
 from .plan import ORBITS, Plan
 
@@ -41,6 +47,8 @@ class Computed:
     orbits: dict[str, Continuation] = field(default_factory=dict)  # by the name of the sweep they follow
     jumps: dict[str, dict] = field(default_factory=dict)  # what each of that sweep's jumps is (jumps.py)
     local: dict[str, list] = field(default_factory=dict)  # orbits of other periods continued across its jumps
+    basins: dict[tuple[str, float], BasinMap] = field(default_factory=dict)  # Fig. 4 as basin maps
+    fractions: dict[str, BasinContinuation] = field(default_factory=dict)  # basin fractions across Fig. 3's jumps
 
 
 def compute(plan: Plan, data_dir: str | Path, *, jobs: int = 0, progress: bool = True) -> Computed:
@@ -50,6 +58,7 @@ def compute(plan: Plan, data_dir: str | Path, *, jobs: int = 0, progress: bool =
     scheme = Integration.paper(periods=plan.periods, discard=plan.discard)
     compiled = {name: compile_model(load(name), scheme)
                 for name in dict.fromkeys([j.model for j in plan.sweeps] + [j.model for j in plan.attractors]
+                                          + [j.model for j in (*plan.basins, *plan.fractions)]
                                           + ([plan.portrait_model] if plan.portraits else []))}
     sweeps = {}
     for job in plan.sweeps:
@@ -78,7 +87,49 @@ def compute(plan: Plan, data_dir: str | Path, *, jobs: int = 0, progress: bool =
                                   spectrum, trajectory))
     orbits = _orbits(plan, sweeps, progress)
     jumps, local = jump_records(plan, sweeps, orbits)
-    return Computed(plan, sweeps, attractors, tuple(portraits), orbits, jumps, local)
+    maps, fractions = _basins(plan, compiled, transient, data_dir, jobs, progress)
+    return Computed(plan, sweeps, attractors, tuple(portraits), orbits, jumps, local, maps, fractions)
+
+
+def box_grid(points: int) -> dict[str, np.ndarray]:
+    """The grid over Fig. 4's box of random starts, ``points`` per state."""
+    return {s: np.linspace(*DEFAULT_BOX, points) for s in ("x", "v")}
+
+
+def _basins(plan: Plan, compiled: dict, options: Integration, data_dir: Path, jobs: int, progress: bool):
+    """Fig. 4's basin maps (kept in ``data_dir/basins`` as JSON: a rerun reads them) and the basin fractions
+    across Fig. 3's jumps (a resumable continuation there)."""
+    maps = {}
+    for job in plan.basins:
+        _say(progress, f"basins: {job.model} at omega={job.omega:g}, {job.points} x {job.points} starts")
+        values = {**plan.scenario.settings(job.model), "omega": job.omega}
+        maps[(job.model, job.omega)] = _cached_map(compiled[job.model], box_grid(job.points), options, values,
+                                                   data_dir / "basins" / f"map-{job.model}-{job.omega:g}.json", jobs)
+    fractions = {}
+    for job in plan.fractions:
+        axis = parse_axis(job.omegas)
+        _say(progress, f"basin fractions: {job.model} {job.omegas}, {job.points} x {job.points} starts each")
+        fractions[job.model] = continue_basins(
+            compiled[job.model], box_grid(job.points), "omega", axis.values, options=options,
+            out=data_dir / "basins" / f"fractions-{job.model}.csv", overwrite="stale", jobs=jobs,
+            **plan.scenario.settings(job.model))
+    return maps, fractions
+
+
+def _cached_map(model, grid: dict, options: Integration, values: dict, path: Path, jobs: int) -> BasinMap:
+    """The basin map, from ``path`` if it holds this one (same code, grid, run and values), else computed there."""
+    record = json.loads(json.dumps({"model_hash": model.hash, "grid": {k: v.tolist() for k, v in grid.items()},
+                                    "periods": options.periods, "discard": options.discard, "values": values,
+                                    "method": method()}))
+    try:
+        data = json.loads(path.read_text())
+        if data["record"] == record:
+            return BasinMap.from_dict(data["map"])
+    except (OSError, ValueError, KeyError, TypeError):
+        pass
+    found = basin_map(model, grid, options=options, jobs=jobs, **values)
+    write_atomically(path, json.dumps({"record": record, "map": found.as_dict(labels=True)}) + "\n")
+    return found
 
 
 

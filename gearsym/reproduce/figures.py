@@ -11,11 +11,13 @@ Each ``figureN(c)`` returns a matplotlib Figure (tests read it); :func:`draw_all
 """
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 
+from ..figures.basins import plot_basin_fractions, plot_basin_map, run_text
 from ..figures.layout import fit_texts, outside_below
 from ..figures.orbits import legend_handles, plot_branches, plot_sweep_points
 from ..figures.poincare import parameter_text, PhasePanel, plot_attractors, plot_phase_portraits
@@ -262,9 +264,53 @@ def study(c: Computed):
     return fig
 
 
+MODEL_NAMES = {"one_stage": "D = 0 (Eq. 2)", "one_stage_resonant": "D = 2 (Eq. 6)"}
+
+
+def basin_maps(c: Computed):
+    """Fig. 4 seen as basins: which attractor every start of the box of Fig. 4's random starts reaches."""
+    plt = pyplot()
+    omegas = sorted({w for _, w in c.basins})
+    models = list(dict.fromkeys(m for m, _ in c.basins))
+    fig, axs = plt.subplots(len(omegas), len(models), figsize=(6.2 * len(models), 6.4 * len(omegas)), squeeze=False,
+                            constrained_layout=True)
+    for i, omega in enumerate(omegas):
+        for j, model in enumerate(models):
+            m = c.basins[(model, omega)]
+            plot_basin_map(m, ax=axs[i, j])
+            axs[i, j].set_title(f"({chr(ord('a') + i * len(models) + j)}) {MODEL_NAMES.get(model, model)}, "
+                                f"ω = {omega:g}: {m.labels.shape[1]} x {m.labels.shape[0]} starts", fontsize=9)
+    first = next(iter(c.basins.values()))
+    runs = {m.model: m.parameters for m in c.basins.values()}
+    fig.suptitle("Fig. 4 as basins of attraction (colour: the attractor a start reaches; markers: its Poincaré "
+                 "points) — " + parameter_set(c, runs, ("omega", "D")) + "\n" + run_text(first), fontsize=8)
+    return fig
+
+
+def basin_fractions(c: Computed):
+    """The basin fractions along omega across the paper's jumps of Fig. 3 (D = 2)."""
+    model, r = next(iter(c.fractions.items()))
+    fig = plot_basin_fractions(r)
+    for ax in fig.axes[:2]:
+        for w in PAPER_JUMPS:
+            ax.axvline(w, color="0.3", ls="--", lw=0.9)
+    fig.axes[0].text(PAPER_JUMPS[0], 0.5, " the paper's jumps (dashed)", fontsize=7, color="0.3",
+                     transform=fig.axes[0].get_xaxis_transform())
+    grid = r.record["grid"]
+    values = next((m.parameters for (name, _), m in c.basins.items() if name == model), r.record["settings"])
+    fig.suptitle(textwrap.fill(f"The jumps of Fig. 3a as basins: {MODEL_NAMES.get(model, model)}, the fraction of "
+                               f"the starts of a {len(grid['x'])} x {len(grid['v'])} grid over [-5, 5]² that reach "
+                               "each attractor (by its id, followed from one ω to the next by its Poincaré set); "
+                               f"{r.record['periods']} periods per start, {r.record['discard']} discarded, plain RK4 "
+                               "(the paper's scheme)", 150)
+                 + "\n" + parameter_set(c, {model: values}, ("omega", "D")), fontsize=8)
+    return fig
+
+
 #: the figures of one scenario: file stem -> (builder, dpi)
 FIGURES = {"fig3": (figure3, DPI), "fig3-orbits": (figure3_orbits, DPI), "fig4": (figure4, FINE_DPI),
-           "fig6": (figure6, DPI), "fig7": (figure7, FINE_DPI), "hysteresis": (hysteresis, DPI), "study": (study, DPI)}
+           "fig6": (figure6, DPI), "fig7": (figure7, FINE_DPI), "hysteresis": (hysteresis, DPI), "study": (study, DPI),
+           "basins": (basin_maps, DPI), "basin-fractions": (basin_fractions, DPI)}
 
 
 def build(name: str, c: Computed):
@@ -275,5 +321,6 @@ def build(name: str, c: Computed):
 def draw_all(c: Computed, out: str | Path, suffix: str = "") -> list[Path]:
     """Every figure of one computed plan; ``suffix`` tells the file names of another scenario apart."""
     out = Path(out)
-    names = [n for n in FIGURES if (n != "study" or "study_ka" in c.sweeps) and (n != "fig3-orbits" or c.orbits)]
+    names = [n for n in FIGURES if (n != "study" or "study_ka" in c.sweeps) and (n != "fig3-orbits" or c.orbits)
+             and (n != "basins" or c.basins) and (n != "basin-fractions" or c.fractions)]
     return [save_figure(build(n, c), out / f"{n}{suffix}.png", FIGURES[n][1]) for n in names]

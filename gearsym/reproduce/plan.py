@@ -46,6 +46,25 @@ class AttractorJob:
 
 
 @dataclass(frozen=True)
+class BasinJob:
+    """A basin map over the box Fig. 4's random starts are drawn from ([-5, 5] in x and v): Fig. 4 seen as
+    basins, every start of a grid instead of ten."""
+
+    model: str
+    omega: float
+    points: int = 51  # starts per state
+
+
+@dataclass(frozen=True)
+class FractionJob:
+    """Basin fractions along omega across the paper's jumps of Fig. 3 (D = 2), on a grid over the same box."""
+
+    model: str
+    omegas: str  # an --param range of omega
+    points: int = 17
+
+
+@dataclass(frozen=True)
 class OrbitJob:
     """Periodic orbits continued over omega from ``start`` to ``stop`` for the model and values of the sweep
     ``sweep``, Newton starting from its final state at ``start`` (Fig. 3a's branches, and what the jumps are)."""
@@ -102,6 +121,8 @@ class Plan:
     attractor_periods: int = 200
     attractor_discard: int = 300
     orbits: tuple[OrbitJob, ...] = ()
+    basins: tuple[BasinJob, ...] = ()
+    fractions: tuple[FractionJob, ...] = ()
 
     def sweep(self, name: str) -> SweepJob:
         return next(s for s in self.sweeps if s.name == name)
@@ -144,10 +165,13 @@ def paper_plan(quick: bool = False, scenario: Scenario = CALIBRATED, study: bool
     )
     # quick: from omega = 2 down to 1 (the orbit at the start must be periodic: at 1.0 it may be chaotic)
     orbits = tuple(OrbitJob(name, *((2.0, 1.0) if quick else (0.1, 2.0))) for name in ("fig3_D0", "fig3_D2"))
+    basins = tuple(BasinJob(m, w, 9 if quick else 51) for w in (1.5, 1.6) for m in ("one_stage", "one_stage_resonant"))
+    fractions = (FractionJob("one_stage_resonant", "omega=1.3:1.8:0.1" if quick else "omega=1.3:1.8:0.02",
+                             7 if quick else 17),)
     if quick:
         return Plan(scenario, sweeps, attractors, portraits, periods=120, discard=40, attractor_periods=60,
-                    attractor_discard=60, orbits=orbits)
-    return Plan(scenario, sweeps, attractors, portraits, orbits=orbits)
+                    attractor_discard=60, orbits=orbits, basins=basins, fractions=fractions)
+    return Plan(scenario, sweeps, attractors, portraits, orbits=orbits, basins=basins, fractions=fractions)
 
 
 def _unswept(settings: dict, params: tuple[str, ...]) -> dict:

@@ -126,6 +126,7 @@ def render(record: dict, figures_dir: str = "figures") -> str:
             lines += [f"**Why:** {NOTES[c['id']]}", ""]
 
     lines += _jumps_explained(record, figures_dir)
+    lines += _basins(record, figures_dir)
     lines += ["## Beyond the paper: hysteresis and bifurcation diagrams", "",
               f"![Up and down continuations, bifurcation diagrams and regimes]({figures_dir}/hysteresis.png)", "",
               "*Both one-stage models swept up and then back down in ω: where the two runs differ, two attractors "
@@ -136,6 +137,10 @@ def render(record: dict, figures_dir: str = "figures") -> str:
             name, caption = FIGURES[key]
             stem, ext = name.rsplit(".", 1)
             lines += [f"![{caption}]({figures_dir}/{stem}-{s['name']}.{ext})", ""]
+        if s.get("basins"):
+            lines += [f"![Fig. 4 as basins of attraction]({figures_dir}/basins-{s['name']}.png)", "",
+                      f"![The jumps of Fig. 3a as basin fractions]({figures_dir}/basin-fractions-{s['name']}.png)", ""]
+            lines += _basin_tables(s["basins"])
     lines += _study(main, figures_dir)
     lines += _method(record)
     return "\n".join(lines).rstrip() + "\n"
@@ -200,6 +205,69 @@ def _jumps_explained(record: dict, figures_dir: str) -> list[str]:
                           for j in o["jumps_up"]]
                 lines.append("")
     return lines
+
+
+MODEL_LABELS = {"one_stage": "D = 0", "one_stage_resonant": "D = 2"}
+
+
+def _basins(record: dict, figures_dir: str) -> list[str]:
+    """Fig. 4 and the jumps of Fig. 3 as basins: the maps, their attractors' shares, the fractions along omega."""
+    main = record["scenarios"][0]
+    if not main.get("basins"):
+        return []
+    b = main["basins"]
+    first = b["maps"][0]
+    fr = next(iter(b["fractions"].values()), None)
+    lines = ["## Fig. 4 and the jumps of Fig. 3 as basins of attraction", "",
+             f"![Fig. 4 as basins of attraction]({figures_dir}/basins.png)", "",
+             f"*Every start of a {first['points']} x {first['points']} grid over the box [-5, 5]² that Fig. 4's ten "
+             "random starts come from, coloured by the attractor it reaches (`gearsym basins`: the attractors told "
+             "apart by their Poincaré sets; black: diverged, light grey: undetermined), with each attractor's Poincaré "
+             f"points; {main['label']}.*", "",
+             f"Each start runs as the attractor search's runs do ({first['discard']} periods discarded, "
+             f"{first['periods'] - first['discard']} measured, the paper's scheme), many at once in the lanes; each "
+             "attractor's exponents come from one tangent run on it, a share's ± is its binomial standard error. "
+             "The last column is the chance that Fig. 4's ten random starts, drawn from the same box, find the "
+             "attractor at all: 1 − (1 − share)¹⁰.", ""]
+    lines += _basin_tables(b)
+    if fr:
+        lines += [f"![The jumps of Fig. 3a as basin fractions]({figures_dir}/basin-fractions.png)", "",
+                  f"*The share of the box (a {fr['points']} x {fr['points']} grid) that reaches each attractor, "
+                  f"ω = {fr['values'][0]:g} … {fr['values'][-1]:g}; an attractor keeps its id from one ω to the next "
+                  "while its Poincaré set stays within half the points' spread; dashed: the paper's jumps (D = 2); "
+                  f"{main['label']}.*", "",
+                  "A continuation jumps where the attractor it follows loses its basin. At each of the paper's jumps, "
+                  "the attractors and their shares on either side of it (as far from it as a jump of ours may be "
+                  "and still count as the paper's), and what happened between:", "",
+                  "| the paper's jump | ω | attractors (id: what it is, share of the box) | what happened between |",
+                  "|---|---|---|---|"]
+        for side in fr["jumps"]:
+            for when, key in ((side["below"], "before"), (side["above"], "after")):
+                shares = "; ".join(f"{a['attractor']}: {_what(a)} {100 * a['fraction']:.0f} %" for a in side[key])
+                events = ", ".join(f"{e['attractor']} {e['event']}" + (f" into {e['into']}" if e["into"] else "")
+                                   for e in side["events"]) if key == "after" else ""
+                lines.append(f"| ω ≈ {side['jump']:g} | {when:g} | {shares or 'none'} | {events or ('–' if key == 'after' else '')} |")
+        lines.append("")
+    return lines
+
+
+def _what(a: dict) -> str:
+    return f"period {a['period']}" if a.get("period") else a["regime"]
+
+
+def _basin_tables(b: dict) -> list[str]:
+    lines = ["| ω | model | attractor | what it is | share of the box (± s.e.) | A | λ₁ | found by ten random starts |",
+             "|---|---|---|---|---|---|---|---|"]
+    for m in b["maps"]:
+        for a in m["attractors"]:
+            lines.append(f"| {m['omega']:g} | {MODEL_LABELS.get(m['model'], m['model'])} | {a['number']} | "
+                         f"{a['description']} | {100 * a['fraction']:.1f} ± {100 * a['stderr']:.1f} % | "
+                         f"{_num(a['amplitude'], 3)} | {a['lambda_1']:+.4f} | {100 * (1 - (1 - a['fraction']) ** 10):.0f} % |")
+        others = [f"{k}: {m[k]['starts']} of {m['starts']} starts" for k in ("diverged", "undetermined") if m[k]["starts"]]
+        if others:
+            lines.append(f"| {m['omega']:g} | {MODEL_LABELS.get(m['model'], m['model'])} | – | "
+                         f"{', '.join(others)} | | | | |")
+    return lines + [""]
 
 
 def _anchor(heading: str) -> str:

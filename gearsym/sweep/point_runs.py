@@ -12,6 +12,7 @@ from ..analysis.divergence import counted_coordinates, run_failure, within_bound
 from ..analysis.lyapunov import summarise_runs
 from ..analysis.regime import DIVERGED
 from ..codegen import CompiledModel, TangentRuns
+from ..codegen.lane_runs import LaneRunner
 from ..errors import GearsymError
 from .grid import INDEPENDENT, Point
 from .store import number, overwrite_option, PoincareRows
@@ -24,10 +25,11 @@ POINTS_PER_BATCH, BATCH_SECONDS, BATCH_BYTES = 32, 0.2, 1 << 24
 class PointRuns:
     """What every point of one sweep shares, and how a point becomes a row."""
 
-    def __init__(self, compiled, base, names, start, options, poincare, columns, strobe_columns):
+    def __init__(self, compiled, base, names, start, options, poincare, columns, strobe_columns, lanes=False):
         self.compiled, self.base, self.names, self.start = compiled, base, names, start
         self.options, self.poincare = options, poincare
         self.columns, self.strobe_columns = columns, strobe_columns
+        self.lanes = lanes
 
     def __getstate__(self) -> dict:  # sent to Dask workers without the compiled model: each loads its own
         return {**self.__dict__, "compiled": None}
@@ -61,6 +63,9 @@ class PointRuns:
         own. A point that fails ends the task after the points before it are yielded; a point that diverged is
         a row like any other ("diverged"), and a continuation goes on from the last state that stayed within
         the bound of :mod:`gearsym.analysis.divergence`."""
+        if self.lanes and len(points) > 1 and points[0].direction == INDEPENDENT and compiled.backend == "compiled":
+            yield from self.lane_task(compiled, points, state)
+            return
         periods, n = self.options.periods, compiled.dimension
         size = min(len(points), batch_size(n, len(compiled.observed), periods))  # (a task of one point: one)
         runs = TangentRuns(n, len(compiled.observed), periods, max(size, 1))
@@ -85,6 +90,48 @@ class PointRuns:
             if len(batch) == runs.size or time.perf_counter() - started >= BATCH_SECONDS:
                 yield from self.checked_rows(compiled, runs, batch)
                 batch, started = [], time.perf_counter()
+        if batch:
+            yield from self.checked_rows(compiled, runs, batch)
+
+    def lane_task(self, compiled: CompiledModel, points: list[Point], state: np.ndarray):
+        """:meth:`task` of independent points, L at a time in the lanes, each lane with its point's tables and
+        constants."""
+        periods, n = self.options.periods, compiled.dimension
+        size = min(len(points), batch_size(n, len(compiled.observed), periods))
+        runs = TangentRuns(n, len(compiled.observed), periods, max(size, 1))
+        runner = LaneRunner(compiled, 0, periods)
+        base = compiled.parameter_vector(self.base)
+        swept = [compiled.parameter_names.index(name) for name in self.names]
+        batch, block = [], []  # block: (point, p, inputs) of the points of the next call
+
+        def call():
+            records = runner.orbits(np.tile(state, (len(block), 1)), [inputs for _, _, inputs in block], tangent=True)
+            for i, (point, p, inputs) in enumerate(block):
+                k = len(batch)
+                runs.strobe[k], runs.log_stretch[k] = records.strobe[i], records.log_stretch[i]
+                runs.low[k], runs.high[k] = records.low[i], records.high[i]
+                batch.append((point, p, inputs.period, state))
+            block.clear()
+
+        for point in points:
+            p = base.copy()
+            p[swept] = point.values
+            try:
+                inputs = compiled.prepare(p)
+            except GearsymError as exc:
+                if block:
+                    call()
+                if batch:
+                    yield from self.checked_rows(compiled, runs, batch)
+                raise self.failed(point, exc) from None
+            if block and (len(block) == runner.width or len(batch) + len(block) == runs.size):
+                call()
+            if len(batch) == runs.size:
+                yield from self.checked_rows(compiled, runs, batch)
+                batch = []
+            block.append((point, p, inputs))
+        if block:
+            call()
         if batch:
             yield from self.checked_rows(compiled, runs, batch)
 

@@ -60,6 +60,7 @@ def run_sweep(
     workers: Workers = Workers(),
     progress: bool = True,
     on_point: Callable[[dict], None] | None = None,
+    lanes: bool = False,
     **values: float,
 ) -> SweepResult:
     """Sweep ``model`` over ``axes`` (``{"omega": values}`` or ``["omega=0.1:2.0:0.01", ...]``).
@@ -72,6 +73,10 @@ def run_sweep(
     ``.poincare.csv`` as points finish, resuming if they exist (``overwrite=True``: starting again;
     ``"stale"``: starting again only files another sweep or model wrote). ``workers``: where the points run
     (:class:`Workers`). ``on_point(row)`` is called in the main thread after each point is stored.
+    ``lanes``: independent points run L at a time in the lanes (:mod:`gearsym.codegen.lane_runs`: each lane with
+    its point's tables and constants), each giving the scalar loop's numbers (to the bit without fused
+    multiply-adds; with them, to rounding); off by default, so that a sweep's files stay those of the scalar loops
+    wherever it runs.
     """
     options = model.run_options(options)
     plan = _SweepPlan.make(model, axes, options, mode, direction, y0, poincare, values)
@@ -91,7 +96,7 @@ def run_sweep(
             raise GearsymError(f"{out}: holds points this sweep does not plan, e.g. {sorted(unknown)[0]}; "
                                + start_again())
         run = PointRuns(model, plan.base, plan.names, plan.start, options, plan.poincare, plan.columns,
-                   plan.strobe_columns)
+                        plan.strobe_columns, lanes)
         todo = [t for t in (run.remaining(task, done) for task in plan.tasks) if t[0]]
         t_start, already, ran = time.perf_counter(), len(done), {}  # ran: where the points ran (Dask only)
         finished = _execute_on(workers, run, todo, ran)

@@ -1,0 +1,221 @@
+"""Basin maps and basin fractions along a parameter.
+
+:func:`plot_basin_map` colours every start of the grid by the attractor it reached (a colour per attractor;
+black: diverged; light grey: undetermined), draws each attractor's Poincare points on top in a darker shade of its
+colour (the axes widen to show them where they lie outside the grid), and says in the legend what each attractor
+is (period, regime, amplitude) and how much of the grid its basin covers. :func:`plot_basin_fractions` draws the
+fraction of every attractor (by its id along the parameter) with its standard error, and its amplitude, against
+the parameter, with the appearances, merges and vanishings marked.
+
+Values are shown in the units a :class:`Shown` gives (a model with physical values: µm, mm/s, rpm), by default
+the model's own.
+"""
+from __future__ import annotations
+
+import textwrap
+from pathlib import Path
+
+import numpy as np
+
+from .poincare import SYMBOLS, parameter_text
+from .save import pyplot, save_figure
+
+#: colours of the attractors by number (or id), then of the two other classes
+COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf",
+          "#7f7f7f")
+DIVERGED_COLOR, UNDETERMINED_COLOR = "#000000", "#dddddd"
+REGIME_MARKERS = {"periodic": "o", "quasi-periodic": "s", "chaotic": "^", "hyperchaotic": "D", "undetermined": "v"}
+
+
+class Shown:
+    """How values are shown: the model's own numbers (a model with physical values overrides it)."""
+
+    def state(self, name: str, values, omega: float | None = None) -> tuple[np.ndarray, str]:
+        """A state's values as shown, and their unit ('' for the model's own)."""
+        return np.asarray(values, dtype=float), ""
+
+    def parameter(self, name: str, values) -> tuple[str, np.ndarray, str]:
+        """A parameter's values as shown: (name, values, unit)."""
+        return name, np.asarray(values, dtype=float), ""
+
+    def parameters(self, values: dict) -> str:
+        """The parameter values of a run, as a title shows them."""
+        return ", ".join(parameter_text(k, v) for k, v in values.items())
+
+
+def color(number: int) -> str:
+    return COLORS[(number - 1) % len(COLORS)]
+
+
+def _label(name: str, unit: str) -> str:
+    symbol = SYMBOLS.get(name, name)
+    return f"{symbol} [{unit}]" if unit else symbol
+
+
+def _edges(v: np.ndarray) -> np.ndarray:
+    if v.size == 1:
+        return np.array([v[0] - 0.5, v[0] + 0.5])
+    mid = (v[1:] + v[:-1]) / 2
+    return np.concatenate([[2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]])
+
+
+def _darker(c: str) -> tuple:
+    from matplotlib.colors import to_rgb
+    return tuple(0.55 * x for x in to_rgb(c))
+
+
+def run_text(result) -> str:
+    scheme = "crossings located" if result.locate_crossings else "plain RK4 (the paper's scheme)"
+    return (f"{result.periods} periods per start, the first {result.discard} discarded; {result.steps_per_period} "
+            f"RK4 steps/period, {scheme}")
+
+
+def map_title(result, shown: Shown, width: int = 100) -> str:
+    held = ", ".join(f"{n} = {_shown_number(shown, n, v, result.parameters)}" for n, v in result.held.items())
+    (x, xs), (y, ys) = result.axes
+    text = (f"{result.model}: basins of attraction over {x} and {y} ({xs.size} x {ys.size} starts"
+            + (f"; held: {held}" if held else "") + f") at {shown.parameters(result.parameters)}")
+    return textwrap.fill(text, width)
+
+
+def _shown_number(shown: Shown, name: str, value: float, parameters: dict) -> str:
+    v, unit = shown.state(name, [value], parameters.get("omega"))
+    return f"{float(v[0]):.4g}" + (f" {unit}" if unit else "")
+
+
+def attractor_label(a, shown: Shown, omega: float | None = None) -> str:
+    amplitude = ", ".join(f"A_{k} = {float(shown.state(k, [v], omega)[0][0]):.4g}"
+                          + (f" {shown.state(k, [v], omega)[1]}" if shown.state(k, [v], omega)[1] else "")
+                          for k, v in a.amplitude.items())
+    lam = f", λ₁ = {a.exponents[0]:+.4f}" if len(a.exponents) and np.isfinite(a.exponents[0]) else ""
+    return (f"{a.number}: {a.description}, {100 * a.fraction:.1f} ± {100 * a.stderr:.1f} % of starts; "
+            f"{amplitude}{lam}")
+
+
+def plot_basin_map(result, path: str | Path | None = None, shown: Shown | None = None, ax=None):
+    """The basin map of a :class:`~gearsym.analysis.basins.BasinMap` (written to ``path`` if given); returns the
+    Figure."""
+    plt = pyplot()
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    shown = shown or Shown()
+    omega = result.parameters.get("omega")
+    (x, xs), (y, ys) = result.axes
+    sx, ux = shown.state(x, xs, omega)
+    sy, uy = shown.state(y, ys, omega)
+    numbers = [a.number for a in result.attractors]
+    classes = [-1, 0, *numbers]
+    cmap = ListedColormap([DIVERGED_COLOR, UNDETERMINED_COLOR, *(color(k) for k in numbers)])
+    index = np.searchsorted(classes, result.labels)  # (classes are sorted: -1, 0, 1, 2, ...)
+    own = ax is None
+    fig, ax = (plt.subplots(figsize=(10.5, 6.2), constrained_layout=True) if own else (ax.figure, ax))
+    ax.pcolormesh(_edges(sx), _edges(sy), index, cmap=cmap, vmin=-0.5, vmax=len(classes) - 0.5, shading="flat",
+                  rasterized=True)
+    ix, iy = result.state_names.index(x), result.state_names.index(y)
+    handles = []
+    for a in result.attractors:
+        c = color(a.number)
+        px, _ = shown.state(x, a.points[ix], omega)
+        py, _ = shown.state(y, a.points[iy], omega)
+        marker = REGIME_MARKERS.get(a.regime, "o")
+        size = 28 if a.points.shape[1] <= 64 else 6
+        ax.scatter(px, py, s=size, marker=marker, color=c, edgecolors=[_darker(c)], linewidths=0.9, zorder=3)
+        handles.append(Patch(facecolor=c, edgecolor=_darker(c), label=attractor_label(a, shown, omega)))
+    empty = []  # (a class no start is in has no colour on the map: the legend's title says so instead)
+    for label, share, c in (("diverged", result.diverged, DIVERGED_COLOR), ("undetermined", result.undetermined,
+                                                                             UNDETERMINED_COLOR)):
+        if share.starts:
+            handles.append(Patch(facecolor=c, edgecolor="0.4",
+                                 label=f"{label}: {100 * share.fraction:.1f} ± {100 * share.stderr:.1f} % of starts"))
+        else:
+            empty.append(label)
+    ax.set_xlabel(_label(x, ux))
+    ax.set_ylabel(_label(y, uy))
+    ax.margins(0.02)
+    title = "attractor: what it is, its basin (the markers: its Poincaré points)" + (
+        "\nno start " + " or ".join(empty) if empty else "")
+    if own:
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7.5, frameon=False,
+                  title=title, title_fontsize=7.5)
+    else:  # a panel among others: the legend below it
+        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.14), fontsize=6.5, frameon=False,
+                  title=title, title_fontsize=6.5)
+    if own:
+        ax.set_title(map_title(result, shown), fontsize=8.5)
+        fig.supxlabel(textwrap.fill(run_text(result) + ". Each attractor's exponents from one tangent run on it; a "
+                                    "basin's ± is the binomial standard error of the fraction.", 150),
+                      fontsize=7, color="0.35")
+    if path is not None:
+        save_figure(fig, path, dpi=120)
+    return fig
+
+
+def plot_basin_fractions(result, path: str | Path | None = None, shown: Shown | None = None):
+    """The fractions and amplitudes of a :class:`~gearsym.sweep.basin_continuation.BasinContinuation` against its
+    parameter (written to ``path`` if given); returns the Figure."""
+    plt = pyplot()
+    shown = shown or Shown()
+    name, values, unit = shown.parameter(result.parameter, result.values)
+    where = dict(zip(result.values, values))
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(10, 7.5), sharex=True, constrained_layout=True,
+                                      gridspec_kw={"height_ratios": [3, 2]})
+    from matplotlib.lines import Line2D
+
+    keys = []  # (the legend's keys are the lines the error bars are drawn on: a key per attractor, as drawn)
+    for aid in result.ids:
+        rows = [r for r in result.rows if r.id == aid]
+        px = np.array([where[r.value] for r in rows])
+        top.errorbar(px, [r.fraction for r in rows], yerr=[r.stderr for r in rows], color=color(aid), lw=1.2,
+                     marker="o", ms=3.5, capsize=2)
+        keys.append(Line2D([], [], color=color(aid), lw=1.2, marker="o", ms=3.5, label=f"attractor {aid}"))
+        for r, xv in zip(rows, px):
+            for k, amp in r.amplitude.items():
+                shown_amp, _ = shown.state(k, [amp], r.value if result.parameter == "omega" else None)
+                bottom.plot(xv, shown_amp[0], marker=REGIME_MARKERS.get(r.regime, "o"), color=color(aid), ms=4.5,
+                            ls="none")
+        first = next(iter(rows[0].amplitude), None)
+        if first is not None:
+            amps = [shown.state(first, [r.amplitude[first]], r.value if result.parameter == "omega" else None)[0][0]
+                    for r in rows]
+            bottom.plot(px, amps, color=color(aid), lw=0.8, alpha=0.6)
+    for kind, c in (("diverged", DIVERGED_COLOR), ("undetermined", UNDETERMINED_COLOR)):
+        f = result.fractions(kind)
+        if f.any():
+            top.plot(values, f, color=c if kind == "diverged" else "0.6", ls="--", lw=1.0, label=kind)
+    said: dict[float, list[str]] = {}
+    for e in result.events:
+        said.setdefault(where[e["value"]], []).append(
+            {"appears": f"{e['attractor']} appears", "vanishes": f"{e['attractor']} vanishes",
+             "merges": f"{e['attractor']} merges into {e['into']}"}[e["event"]])
+    for xv, texts in said.items():  # (one line per value: the events of one value never overlap)
+        top.axvline(xv, color="0.7", ls=":", lw=0.8)
+        top.annotate(", ".join(texts), (xv, 1.0), xytext=(2, -4), textcoords="offset points", rotation=90, va="top",
+                     fontsize=6.5, color="0.3")
+    top.set_ylim(-0.02, 1.05)
+    top.set_ylabel("fraction of starts (± binomial s.e.)")
+    top.legend(handles=[*keys, *top.get_legend_handles_labels()[0]], fontsize=7, ncol=4, loc="lower left",
+               bbox_to_anchor=(0.0, 1.0), frameon=False)
+    coordinate = next((k for r in result.rows for k in r.amplitude), "")
+    _, unit_a = shown.state(coordinate, [0.0], None) if coordinate else (None, "")
+    bottom.set_ylabel(f"A ({coordinate})" + (f" [{unit_a}]" if unit_a else ""))
+    regimes = {r.regime for r in result.rows}  # (a key for each regime drawn, none for the others)
+    bottom.legend(handles=[Line2D([], [], marker=m, ls="none", color="0.3", label=k) for k, m in REGIME_MARKERS.items()
+                           if k in regimes],
+                  fontsize=7, ncol=4, loc="best", title="regime (from the exponents)", title_fontsize=7)
+    bottom.set_xlabel(_label(name, unit))
+    record = result.record
+    fixed = {k: v for k, v in record.get("settings", {}).items()}
+    grid = record.get("grid")
+    grid_text = ", ".join(grid) if isinstance(grid, list) else " x ".join(
+        f"{k} in [{min(v):g}, {max(v):g}] ({len(v)})" for k, v in grid.items())
+    title = (f"{result.model}: basin fractions along {SYMBOLS.get(name, name)} (each attractor by its id, matched "
+             f"from one value to the next by its Poincaré set); grid {grid_text}"
+             + (f"; {shown.parameters(fixed)} (the rest: the model's declared values)" if fixed
+                else "; the other parameters: the model's declared values")
+             + f"; {record['periods']} periods per start, {record['discard']} discarded, "
+             + ("crossings located" if record.get("locate_crossings") else "plain RK4"))
+    fig.suptitle(textwrap.fill(title, 150), fontsize=8)
+    if path is not None:
+        save_figure(fig, path, dpi=120)
+    return fig

@@ -1,0 +1,346 @@
+"""Basin fractions along a parameter: the basin map at each value, its attractors matched with the last value's.
+
+At each value of the parameter :func:`~gearsym.analysis.basins.basin_map` maps the grid; each attractor found is
+matched with one of the previous value's by the distance between their Poincare sets (the symmetric mean
+nearest-neighbour distance of :func:`~gearsym.analysis.attractors.cloud_distance`, in coordinates scaled by the
+two maps' spreads): the closest pairs first, each attractor in at most one pair, and only within
+``match_distance``. A matched attractor keeps its id (``continues``); a new one gets the next id (``appears``);
+a previous one left without a partner ``vanishes``, unless it lies within ``match_distance`` of one of the
+new attractors, into which it then ``merges`` (two basins became one). This is the global continuation of
+Attractors.jl (matching by the distance of attractors' sets) on Poincare sets.
+
+With ``out`` the rows are written after each value (``FILE.csv``: one row per class and value;
+``FILE.attractors.csv``: every attractor's Poincare points; ``FILE.json``: how it was made and what happened),
+whole files each time; the same call again resumes after the last value finished and gives the same files as a
+run that was never interrupted (nothing in them depends on when or how fast it ran).
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.attractors import cloud_distance
+from ..analysis.basins import RUN, BasinMap, basin_map, method
+from ..checks import json_safe
+from ..codegen import CompiledModel, engine_verb
+from ..errors import GearsymError, UnknownParameterError
+from ..files import write_atomically
+from ..options import Integration
+from ..version import __version__
+from .store import number, read_rows, release_lock, sidecar, take_lock
+
+#: two attractors at neighbouring values are one when their Poincare sets are within this distance (in units of
+#: the spread of all points, as the basin maps scale them)
+MATCH_DISTANCE = 0.5
+#: what happens to an attractor at a value
+CONTINUES, APPEARS, MERGES, VANISHES = "continues", "appears", "merges", "vanishes"
+
+
+@dataclass(frozen=True)
+class Tracked:
+    """One class of starts at one value: an attractor (with its id across the values), or diverged/undetermined."""
+
+    value: float
+    kind: str  # "attractor", "diverged" or "undetermined"
+    id: int | None
+    fraction: float
+    stderr: float
+    starts: int
+    period: int | None
+    regime: str
+    amplitude: dict[str, float]
+    exponents: tuple[float, ...]
+    event: str  # continues, appears, "merges 3" (attractor 3 of the last value merged into it); "" otherwise
+    points: np.ndarray  # (n, k): its Poincare points (none for diverged/undetermined)
+    scale: tuple[float, ...]  # per state: the spread of the value's map (what its distances are in units of)
+
+
+@dataclass(frozen=True)
+class BasinContinuation:
+    """The classes of every value, in order, and what happened to the attractors along the way."""
+
+    model: str
+    parameter: str
+    values: tuple[float, ...]
+    state_names: tuple[str, ...]
+    rows: tuple[Tracked, ...]
+    events: tuple[dict, ...]  # {"value", "event", "attractor", "into"}
+    record: dict
+    path: Path | None = None
+
+    @property
+    def ids(self) -> list[int]:
+        return sorted({r.id for r in self.rows if r.id is not None})
+
+    def at(self, value: float) -> list[Tracked]:
+        return [r for r in self.rows if r.value == value]
+
+    def fractions(self, key: int | str) -> np.ndarray:
+        """The fraction of attractor ``key`` (an id), or of "diverged" or "undetermined", at every value (0 where
+        it does not exist)."""
+        out = np.zeros(len(self.values))
+        where = {v: i for i, v in enumerate(self.values)}
+        for r in self.rows:
+            if (r.id == key) if isinstance(key, int) else (r.kind == key):
+                out[where[r.value]] = r.fraction
+        return out
+
+    def as_dict(self) -> dict:
+        return json_safe({"model": self.model, "parameter": self.parameter, "values": list(self.values),
+                          "rows": [_row_dict(r, self.parameter) for r in self.rows], "events": list(self.events),
+                          "record": self.record})
+
+
+def _row_dict(r: Tracked, parameter: str) -> dict:
+    return {parameter: r.value, "class": r.kind, "attractor": r.id, "fraction": r.fraction, "stderr": r.stderr,
+            "starts": r.starts, "period": r.period, "regime": r.regime, "amplitude": r.amplitude,
+            "exponents": list(r.exponents), "event": r.event}
+
+
+@engine_verb(default=Integration(**RUN))
+def continue_basins(model: CompiledModel, grid, parameter: str, values: Sequence[float], *,
+                    options: Integration | None = None, y0=None, out: str | Path | None = None,
+                    overwrite: bool | str = False, jobs: int = 0, lanes: bool = True,
+                    match_distance: float = MATCH_DISTANCE, grid_spec: Sequence[str] = (), progress: bool = False,
+                    on_value: Callable[[BasinMap], None] | None = None, **fixed: float) -> BasinContinuation:
+    """Basin maps of ``model`` on ``grid`` at each of ``values`` of ``parameter`` (ascending), their attractors
+    matched from one value to the next (module docstring). ``grid``: {state: values} for two states, or a
+    function of the parameter values giving it (a grid in physical units whose engine values move with the
+    speed); ``grid_spec``: how the grid was given, for the record. ``out``: write the files as values finish and
+    resume them (``overwrite``: start again). ``on_value(map)`` is called after each value is stored."""
+    options = model.run_options(options)
+    if parameter not in model.parameter_names:
+        raise UnknownParameterError(parameter, model.parameter_names, f"{model.name}: --param")
+    if parameter in fixed:
+        raise GearsymError(f"{parameter} is both continued (--param) and fixed (--set); drop one")
+    values = tuple(sorted(float(v) for v in values))
+    if not values or len(set(values)) != len(values):
+        raise GearsymError(f"--param {parameter}: give distinct values, at least one")
+    for v in values:
+        model.parameter_vector(fixed, **{parameter: v})  # every value checked before any run
+    if not (np.isfinite(match_distance) and match_distance > 0):
+        raise GearsymError(f"match_distance must be a positive number, got {match_distance!r}")
+    grid_at = grid if callable(grid) else (lambda point: grid)
+    first = {k: np.asarray(v, dtype=float).tolist() for k, v in grid_at({**fixed, parameter: values[0]}).items()}
+    record = {"model": model.name, "model_hash": model.hash, "backend": model.backend, "parameter": parameter,
+              "values": list(values), "settings": {k: float(v) for k, v in fixed.items()},
+              "grid": grid_spec and list(grid_spec) or first, "initial_state": dict(zip(
+                  model.state_names, map(float, model.initial_state(y0)))), "periods": options.periods,
+              "discard": options.discard, "steps_per_period": model.steps_per_period,
+              "locate_crossings": model.options.locate_crossings, "match_distance": float(match_distance),
+              "method": method()}
+    store = _Store(Path(out), model.state_names, model.observed, model.dimension, parameter) if out else None
+    try:
+        rows, done = store.open(record, overwrite) if store else ([], [])
+        # (a rerun of a finished continuation reads its files and writes nothing)
+        finished = bool(store) and len(done) == len(values) and store.status() == "complete"
+        previous = _last(rows, done)
+        for value in values:
+            if value in done:
+                continue
+            if progress:
+                print(f"gearsym: basins at {parameter}={value:g}", flush=True)
+            point = {**fixed, parameter: value}
+            found = basin_map(model, grid_at(point), options=options, y0=y0, jobs=jobs, lanes=lanes, **point)
+            tracked = track(found, value, previous, match_distance, _next_id(rows))
+            rows += tracked
+            done.append(value)
+            previous = (tracked, found.scale)
+            if store:
+                store.write(rows, done, record, complete=len(done) == len(values))
+            if on_value:
+                on_value(found)
+        order = {v: i for i, v in enumerate(values)}
+        rows.sort(key=lambda r: (order[r.value], _class_order(r)))
+        result = BasinContinuation(model.name, parameter, values, model.state_names, tuple(rows),
+                                   tuple(events(rows, values)), record, store.path if store else None)
+        if store and not finished:
+            store.write(rows, done, record, complete=True)
+        return result
+    finally:
+        if store:
+            store.release()
+
+
+def _class_order(r: Tracked) -> tuple:
+    return (0, r.id) if r.kind == "attractor" else (1 if r.kind == "diverged" else 2, 0)
+
+
+def _next_id(rows: list[Tracked]) -> int:
+    return 1 + max((r.id for r in rows if r.id is not None), default=0)
+
+
+def _last(rows: list[Tracked], done: list[float]):
+    """The last finished value's classes and scale, to match the next value's attractors with."""
+    if not done:
+        return None
+    last = [r for r in rows if r.value == done[-1]]
+    return last, np.array(last[0].scale)
+
+
+def track(found: BasinMap, value: float, previous, match_distance: float, next_id: int) -> list[Tracked]:
+    """The classes of ``found`` at ``value``, its attractors matched with ``previous`` (the last value's classes
+    and scale, or None)."""
+    attractors = list(found.attractors)
+    ids: dict[int, int] = {}
+    events: dict[int, list[str]] = {}
+    if previous is not None:
+        before, scale_before = previous
+        old = [r for r in before if r.kind == "attractor"]
+        scale = (found.scale + scale_before) / 2 if scale_before is not None else found.scale
+        pairs = sorted((cloud_distance(r.points / scale[:, None], a.points / scale[:, None]), r.id, a.number)
+                       for r in old for a in attractors)
+        used_old, used_new = set(), set()
+        for d, old_id, new in pairs:
+            if d <= match_distance and old_id not in used_old and new not in used_new:
+                ids[new], used_old, used_new = old_id, used_old | {old_id}, used_new | {new}
+        for d, old_id, new in pairs:  # an old attractor left alone, near a new one: their basins merged
+            if old_id not in used_old and d <= match_distance:
+                events.setdefault(new, []).append(f"{MERGES} {old_id}")
+                used_old.add(old_id)
+    rows, scale_of = [], tuple(map(float, found.scale))
+    for a in sorted(attractors, key=lambda a: a.number):
+        if a.number in ids:
+            aid, event = ids[a.number], CONTINUES
+        else:
+            aid, event, next_id = next_id, APPEARS, next_id + 1
+        event = " ".join([event, *events.get(a.number, [])]) if previous is not None else APPEARS
+        rows.append(Tracked(value, "attractor", aid, a.fraction, a.stderr, a.basin.starts, a.period, a.regime,
+                            dict(a.amplitude), tuple(map(float, a.exponents)), event, a.points, scale_of))
+    rows.sort(key=lambda r: r.id)
+    for kind, share in (("diverged", found.diverged), ("undetermined", found.undetermined)):
+        rows.append(Tracked(value, kind, None, share.fraction, share.stderr, share.starts, None, kind, {}, (), "",
+                            np.zeros((len(found.state_names), 0)), scale_of))
+    return rows
+
+
+def events(rows: Sequence[Tracked], values: Sequence[float]) -> list[dict]:
+    """What happened, value by value: appearances, merges and vanishings (from the rows' events)."""
+    out, alive = [], set()
+    for v in values:
+        here = [r for r in rows if r.value == v and r.kind == "attractor"]
+        merged = set()
+        for r in here:
+            words = r.event.split()
+            if words and words[0] == APPEARS and alive:
+                out.append({"value": v, "event": APPEARS, "attractor": r.id, "into": None})
+            for i, w in enumerate(words):
+                if w == MERGES:
+                    merged.add(int(words[i + 1]))
+                    out.append({"value": v, "event": MERGES, "attractor": int(words[i + 1]), "into": r.id})
+        now = {r.id for r in here}
+        out += [{"value": v, "event": VANISHES, "attractor": k, "into": None} for k in sorted(alive - now - merged)]
+        alive = now
+    return out
+
+
+class _Store:
+    """``FILE.csv``, ``FILE.attractors.csv`` and ``FILE.json`` of one continuation, locked against a second writer
+    and written whole after each value."""
+
+    def __init__(self, path: Path, states: Sequence[str], observed: Sequence[str], n: int, parameter: str):
+        if path.suffix.lower() != ".csv":
+            raise GearsymError(f"--out {path}: the basin fractions are written as CSV; name the file *.csv")
+        self.path, self.parameter = path, parameter
+        self.points_path, self.meta_path = sidecar(path, ".attractors.csv"), sidecar(path, ".json")
+        self.states, self.observed = list(states), list(observed)
+        self.columns = [parameter, "class", "attractor", "fraction", "stderr", "starts", "period", "regime",
+                        *(f"A_{c}" for c in observed), *(f"lambda_{i}" for i in range(1, n + 1)), "event",
+                        *(f"scale_{s}" for s in states)]
+        self.point_columns = [parameter, "attractor", "point", *states]
+        self._lock: int | None = None
+
+    def open(self, record: dict, overwrite: bool | str) -> tuple[list[Tracked], list[float]]:
+        """The rows of the values already done, and those values in order (none: a fresh start).
+        ``overwrite="stale"``: start again files another continuation (or another model) wrote, resume this one's
+        (how the reproduction keeps its data)."""
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._lock = take_lock(self.path)
+        if overwrite == "stale":
+            overwrite = self.path.exists() and self._differs(record) is not None
+        if overwrite:
+            for p in (self.path, self.points_path, self.meta_path):
+                p.unlink(missing_ok=True)
+        if not self.path.exists():
+            return [], []
+        why = self._differs(record)
+        if why:
+            raise GearsymError(why)
+        points: dict[tuple[float, int], list] = {}
+        for row in read_rows(self.points_path, self.point_columns) if self.points_path.exists() else []:
+            key = (float(row[self.parameter]), int(row["attractor"]))
+            points.setdefault(key, []).append([float(row[s]) for s in self.states])
+        rows = [self._tracked(row, points) for row in read_rows(self.path, self.columns)]
+        done = list(dict.fromkeys(r.value for r in rows))
+        return rows, done
+
+    def _differs(self, record: dict) -> str | None:
+        """Why the files cannot be resumed with ``record`` (another continuation's, or damaged), or None."""
+        try:
+            old = json.loads(self.meta_path.read_text())["basins"]
+        except (OSError, ValueError, KeyError, TypeError):
+            return (f"{self.path} exists but {self.meta_path.name} (the record of how it was made) is missing or "
+                    "damaged, so it cannot be resumed: pass --overwrite or choose another --out")
+        new = json.loads(json.dumps(record))
+        differ = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
+        if differ:
+            return (f"{self.path} was written by another basin continuation ({', '.join(differ)} differ); repeat "
+                    "the command it came from to resume it, or pass --overwrite")
+        return None
+
+    def _tracked(self, row: dict, points: dict) -> Tracked:
+        value = float(row[self.parameter])
+        aid = int(row["attractor"]) if row["attractor"] else None
+        pts = np.array(points.get((value, aid), []), dtype=float).reshape(-1, len(self.states)).T
+        if aid is not None and not pts.size:
+            raise GearsymError(f"{self.points_path} lacks the points of attractor {aid} at {self.parameter}="
+                               f"{value:g} (deleted or damaged?): pass --overwrite to start again")
+        lambdas = [row[f"lambda_{i}"] for i in range(1, len(self.states) + 1)]
+        return Tracked(value, row["class"], aid, float(row["fraction"]), float(row["stderr"]), int(row["starts"]),
+                       int(row["period"]) if row["period"] else None, row["regime"],
+                       {c: float(row[f"A_{c}"]) for c in self.observed if row[f"A_{c}"]},
+                       tuple(float(x) for x in lambdas if x), row["event"], pts,
+                       tuple(float(row[f"scale_{s}"]) for s in self.states))
+
+    def write(self, rows: Sequence[Tracked], done: Sequence[float], record: dict, complete: bool) -> None:
+        """Every file whole: the points first, then the rows (a value counts as done once its rows are there),
+        then the record."""
+        text = io.StringIO()
+        writer = csv.writer(text, lineterminator="\n")
+        writer.writerow(self.point_columns)
+        for r in rows:
+            for k, point in enumerate(r.points.T):
+                writer.writerow([number(r.value), r.id, k, *map(number, point)])
+        write_atomically(self.points_path, text.getvalue())
+        text = io.StringIO()
+        writer = csv.writer(text, lineterminator="\n")
+        writer.writerow(self.columns)
+        for r in rows:
+            amplitude = [number(r.amplitude[c]) if c in r.amplitude else "" for c in self.observed]
+            lambdas = [number(x) for x in r.exponents] + [""] * (len(self.states) - len(r.exponents))
+            writer.writerow([number(r.value), r.kind, "" if r.id is None else r.id, number(r.fraction),
+                             number(r.stderr), r.starts, "" if r.period is None else r.period, r.regime, *amplitude,
+                             *lambdas, r.event, *map(number, r.scale)])
+        write_atomically(self.path, text.getvalue())
+        meta = {"basins": record, "status": "complete" if complete else "running",
+                "values": {"planned": len(record["values"]), "done": len(done)},
+                "events": json_safe(events(rows, done)), "gearsym": __version__}
+        write_atomically(self.meta_path, json.dumps(meta, indent=2) + "\n")
+
+    def status(self) -> str | None:
+        """What the record says of the continuation: running, complete (None: no record)."""
+        try:
+            return json.loads(self.meta_path.read_text()).get("status")
+        except (OSError, ValueError, AttributeError):
+            return None
+
+    def release(self) -> None:
+        if self._lock is not None:
+            release_lock(self.path, self._lock)
+            self._lock = None

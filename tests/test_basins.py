@@ -1,0 +1,238 @@
+"""Basins of attraction (gearsym/analysis/basins.py) and their fractions along a parameter
+(gearsym/sweep/basin_continuation.py), against independent SciPy computations."""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import gearsym
+from gearsym import FirstOrderSystem, Integration
+from gearsym.analysis.basins import DIVERGED, UNDETERMINED, basin_map
+from gearsym.cli import main
+from gearsym.sweep.basin_continuation import APPEARS, VANISHES, continue_basins
+
+import conftest
+
+#: the forced Duffing oscillator of models/duffing.py: x'' + 2 zeta x' + x + beta x^3 = F cos(omega t)
+ZETA, BETA, F = 0.05, 0.2, 0.3
+#: inside its hysteresis window two period-1 orbits coexist (a small and a large one)
+WINDOW_OMEGA = 1.25
+RUN = Integration(periods=150, discard=100)
+
+
+@pytest.fixture(scope="module")
+def duffing():
+    return conftest.compiled("duffing", Integration(periods=150, discard=100))
+
+
+def scipy_final_states(xs, vs, omega: float, periods: int) -> np.ndarray:
+    """Every start of the grid (rows: v, columns: x) integrated by DOP853 to t = periods T, all at once: the final
+    Poincare points, (len(vs), len(xs), 2). The Duffing equation typed here, not gearsym's."""
+    X, V = np.meshgrid(xs, vs)
+    k = X.size
+
+    def f(t, y):
+        x, v = y[:k], y[k:]
+        return np.concatenate([v, -2 * ZETA * v - x - BETA * x ** 3 + F * np.cos(omega * t)])
+
+    T = 2 * math.pi / omega
+    sol = solve_ivp(f, (0.0, periods * T), np.concatenate([X.ravel(), V.ravel()]), method="DOP853", rtol=1e-9,
+                    atol=1e-9)
+    assert sol.success
+    return np.stack([sol.y[:k, -1], sol.y[k:, -1]], axis=-1).reshape(*X.shape, 2)
+
+
+def clusters(points: np.ndarray, tolerance: float = 1e-4) -> tuple[np.ndarray, np.ndarray]:
+    """Greedy clusters of points (..., 2) within ``tolerance``: their centres and each point's cluster index."""
+    flat = points.reshape(-1, 2)
+    centres, index = [], np.full(len(flat), -1)
+    for i, p in enumerate(flat):
+        for j, c in enumerate(centres):
+            if np.abs(p - c).max() <= tolerance:
+                index[i] = j
+                break
+        else:
+            centres.append(p)
+            index[i] = len(centres) - 1
+    return np.array(centres), index.reshape(points.shape[:-1])
+
+
+def test_duffing_basins_in_its_hysteresis_window_agree_with_scipy(duffing):
+    xs, vs = np.linspace(-4, 4, 11), np.linspace(-4, 4, 11)
+    found = basin_map(duffing, {"x": xs, "v": vs}, options=RUN, omega=WINDOW_OMEGA)
+    assert [a.period for a in found.attractors] == [1, 1] and found.undetermined.starts == found.diverged.starts == 0
+    final = scipy_final_states(xs, vs, WINDOW_OMEGA, RUN.periods)
+    centres, scipy_label = clusters(final)
+    assert len(centres) == 2  # SciPy sees the same two attractors ...
+    ours = np.array([a.points[:, 0] for a in found.attractors])  # ... at the same Poincare points (RK4: ~1e-6)
+    match = [int(np.argmin(np.abs(centres - p).max(axis=1))) for p in ours]
+    assert sorted(match) == [0, 1]
+    assert np.abs(centres[match] - ours).max() < 1e-4
+    expected = np.array(match)[scipy_label] + 1  # SciPy's cluster as our attractor's number
+    agree = np.mean(expected == found.labels)
+    assert agree >= 0.95, f"{agree:.3f} of starts agree"
+    for a in found.attractors:
+        scipy_fraction = np.mean(expected == a.number)
+        assert abs(a.fraction - scipy_fraction) <= 2 * a.stderr + 1e-12
+    assert found.attractors[0].amplitude["x"] != pytest.approx(found.attractors[1].amplitude["x"], rel=0.1)
+
+
+def test_the_lanes_and_the_scalar_loops_give_the_same_map(duffing):
+    grid = {"x": np.linspace(-4, 4, 7), "v": np.linspace(-4, 4, 5)}
+    wide = basin_map(duffing, grid, options=RUN, omega=WINDOW_OMEGA)
+    one = basin_map(duffing, grid, options=RUN, lanes=False, omega=WINDOW_OMEGA)
+    assert wide.lanes > 1 and one.lanes == 1
+    assert np.array_equal(wide.labels, one.labels)
+    assert [a.fraction for a in wide.attractors] == [a.fraction for a in one.attractors]
+
+
+def escape_oscillator() -> FirstOrderSystem:
+    """The escape equation x'' + d x' + x - x^2 = F cos(w t): bounded in the well around 0, unbounded (in finite
+    time) beyond the hilltop at x = 1."""
+    return FirstOrderSystem.from_equations("escape", ["x", "v"], ["v", "-d*v - x + x**2 + F*cos(w*t)"],
+                                           {"d": 0.1, "F": 0.02, "w": 0.8}, time="t", period="2*pi/w")
+
+
+def scipy_escapes(xs, vs, periods: int) -> np.ndarray:
+    """Per start (rows: v, columns: x): does x leave [-50, 50] within ``periods`` periods (DOP853, typed here)?"""
+    d, F, w = 0.1, 0.02, 0.8
+
+    def leaves(t, y):
+        return 50.0 - abs(y[0])
+    leaves.terminal = True
+    out = np.zeros((len(vs), len(xs)), dtype=bool)
+    for j, v in enumerate(vs):
+        for i, x in enumerate(xs):
+            sol = solve_ivp(lambda t, y: [y[1], -d * y[1] - y[0] + y[0] ** 2 + F * math.cos(w * t)],
+                            (0.0, periods * 2 * math.pi / w), [x, v], method="DOP853", rtol=1e-9, atol=1e-9,
+                            events=leaves)
+            out[j, i] = sol.status == 1
+    return out
+
+
+def test_a_start_that_diverges_is_a_class_of_its_own_and_the_fractions_sum_to_one():
+    model = gearsym.compile_model(escape_oscillator(), Integration(periods=80, discard=40))
+    xs, vs = np.linspace(-1.2, 1.8, 7), np.linspace(-1.0, 1.0, 5)
+    found = basin_map(model, {"x": xs, "v": vs})
+    escapes = scipy_escapes(xs, vs, 80)
+    assert escapes.any() and (~escapes).any()
+    assert np.array_equal(found.labels == DIVERGED, escapes)
+    assert found.diverged.starts == escapes.sum() and found.diverged.fraction == escapes.mean()
+    assert [a.period for a in found.attractors] == [1]  # the rest: the one orbit in the well
+    assert np.array_equal(found.labels == 1, ~escapes)
+    assert sum(found.fractions.values()) == pytest.approx(1.0, abs=1e-12)
+    assert sum(a.basin.starts for a in found.attractors) + found.diverged.starts + found.undetermined.starts \
+        == found.starts == xs.size * vs.size
+    data = found.as_dict()
+    assert data["diverged"]["fraction"] == found.diverged.fraction
+    assert sum(a["fraction"] for a in data["attractors"]) + data["diverged"]["fraction"] \
+        + data["undetermined"]["fraction"] == pytest.approx(1.0, abs=1e-12)
+
+
+def _accounted(found) -> None:
+    """Every start is in exactly one class, each class's share is its count of the labels, and they sum to 1."""
+    counts = {k: int(np.sum(found.labels == k)) for k in np.unique(found.labels)}
+    assert counts == {**{a.number: a.basin.starts for a in found.attractors},
+                      **({UNDETERMINED: found.undetermined.starts} if found.undetermined.starts else {}),
+                      **({DIVERGED: found.diverged.starts} if found.diverged.starts else {})}
+    assert sum(found.fractions.values()) == pytest.approx(1.0, abs=1e-12)
+
+
+def test_fractions_sum_to_one_with_chaotic_and_undetermined_starts():
+    model = conftest.compiled("one_stage", Integration.paper(periods=160, discard=60))
+    found = basin_map(model, {"x": np.linspace(-5, 5, 9), "v": np.linspace(-5, 5, 9)}, omega=1.0)
+    _accounted(found)
+    assert any(a.regime == "chaotic" and a.period is None for a in found.attractors)
+    # too short a run in Duffing's window: most starts still spiral onto their orbit, undetermined
+    short = basin_map(conftest.compiled("duffing", Integration(periods=40, discard=4)),
+                      {"x": np.linspace(-4, 4, 11), "v": np.linspace(-4, 4, 11)}, omega=WINDOW_OMEGA)
+    assert short.undetermined.starts > 0 and short.attractors
+    _accounted(short)
+
+
+def test_an_interrupted_basin_continuation_resumes_to_the_same_files(duffing, tmp_path):
+    grid = {"x": np.linspace(-4, 4, 7), "v": np.linspace(-4, 4, 7)}
+    omegas = [1.1, 1.2, 1.3, 1.4]
+    whole = continue_basins(duffing, grid, "omega", omegas, options=RUN, out=tmp_path / "whole.csv")
+    seen = []
+
+    def stop_after_two(found):
+        seen.append(found)
+        if len(seen) == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        continue_basins(duffing, grid, "omega", omegas, options=RUN, out=tmp_path / "cut.csv", on_value=stop_after_two)
+    assert json.loads((tmp_path / "cut.json").read_text())["values"]["done"] == 2
+    resumed = continue_basins(duffing, grid, "omega", omegas, options=RUN, out=tmp_path / "cut.csv",
+                              on_value=seen.append)
+    assert len(seen) == 4  # two values computed before the interruption, two after it
+    for suffix in (".csv", ".attractors.csv", ".json"):
+        assert (tmp_path / f"whole{suffix}").read_bytes() == (tmp_path / f"cut{suffix}").read_bytes(), suffix
+    assert resumed.as_dict()["rows"] == whole.as_dict()["rows"]
+    # the window's second attractor appears at 1.2 and the first vanishes past it: a period-1 orbit each
+    assert [(e["value"], e["event"]) for e in whole.events] == [(1.2, APPEARS), (1.4, VANISHES)]
+    assert [len(whole.at(w)) - 2 for w in omegas] == [1, 2, 2, 1]
+
+
+def run_cli(capsys, *argv: str) -> tuple[int, str, str]:
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_cli_json_has_the_fractions_periods_regimes_amplitudes_and_exponents(capsys, tmp_path):
+    code, out, _ = run_cli(capsys, "basins", "duffing", "--set", f"omega={WINDOW_OMEGA}", "--grid", "x=-4:4:2",
+                           "--grid", "v=-4:4:2", "--periods", "150", "--discard", "100", "--format", "json",
+                           "--out", str(tmp_path / "map.csv"), "--plot", str(tmp_path / "map.png"))
+    assert code == 0
+    data = json.loads(out)
+    assert data["grid"]["x"] == [-4.0, -2.0, 0.0, 2.0, 4.0] and data["grid"]["starts"] == 25
+    for a in data["attractors"]:
+        assert {"fraction", "stderr", "period", "regime", "amplitude", "exponents"} <= set(a)
+        assert a["period"] == 1 and a["regime"] == "periodic" and set(a["amplitude"]) == {"x", "v"}
+        assert len(a["exponents"]) == 2 and max(a["exponents"]) < 0
+    assert sum(a["fraction"] for a in data["attractors"]) + data["diverged"]["fraction"] \
+        + data["undetermined"]["fraction"] == pytest.approx(1.0)
+    rows = (tmp_path / "map.csv").read_text().splitlines()
+    assert rows[0] == "x,v,attractor" and len(rows) == 26
+    assert (tmp_path / "map.png").stat().st_size > 10_000
+
+
+def test_cli_text_and_the_continuation_figure(capsys, tmp_path):
+    code, out, _ = run_cli(capsys, "basins", "duffing", "--grid", "x=-4:4:4", "--grid", "v=-4:4:4",
+                           "--param", "omega=1.2:1.3:0.1", "--periods", "150", "--discard", "100",
+                           "--out", str(tmp_path / "c.csv"), "--plot", str(tmp_path / "c.png"), "--quiet")
+    assert code == 0
+    assert "basin fractions at 2 values of omega" in out and "omega=1.2:" in out
+    assert (tmp_path / "c.png").stat().st_size > 10_000 and (tmp_path / "c.attractors.csv").is_file()
+
+
+@pytest.mark.parametrize("argv, message", [
+    (("--grid", "x=-1:1:1"), "give two different states"),
+    (("--grid", "x=-1:1:1", "--grid", "q=0,1"), "--grid q: not a state of one_stage"),
+    (("--grid", "x=-1um:1um:1um", "--grid", "v=0,1"), "has a unit, but the model has no physical values"),
+    (("--grid", "x=-1:1:1", "--grid", "v=0,1", "--param", "omega=1:2:0.5"), "give --out FILE.csv"),
+])
+def test_cli_errors_are_one_line_messages(capsys, argv, message):
+    code, _, err = run_cli(capsys, "basins", "one_stage", *argv)
+    *before, last = err.strip().splitlines()
+    assert code == 2 and message in last and last.startswith("gearsym: error:") and "Traceback" not in err
+    assert all(line.startswith("gearsym: compiling") for line in before)  # (at most the note of a first compile)
+
+
+def test_a_model_with_physical_values_is_mapped_and_answered_in_its_units(capsys):
+    code, out, _ = run_cli(capsys, "basins", "spur_pair", "--grid", "x=-20um:20um:20um", "--grid",
+                           "v=-300mm/s:300mm/s:300mm/s", "--periods", "60", "--discard", "20", "--format", "json")
+    assert code == 0
+    data = json.loads(out)
+    assert data["grid"]["x"] == {"values": [-20.0, 0.0, 20.0], "unit": "um"}
+    assert data["grid"]["v"]["unit"] == "mm/s" and data["speed"]["unit"] == "rpm"
+    for a in data["attractors"]:
+        assert a["amplitude"]["x"]["unit"] == "µm" and a["points"]["v"]["unit"] == "mm/s"
+    code, _, err = run_cli(capsys, "basins", "spur_pair", "--grid", "x=-1:1:1", "--grid", "v=0,1")
+    assert code == 2 and "give the grid with its unit" in err
