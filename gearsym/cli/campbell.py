@@ -18,7 +18,7 @@ from ..sweep import run_sweep, Workers
 from ..sweep.grid import parse_axis
 from ..sweep.store import sidecar
 from .integration import add_integration_arguments, compiled_from, scaling_from
-from .settings import add_set_argument, parse_settings
+from .settings import add_set_argument, model_settings
 
 NAME = "campbell"
 HELP = "Campbell diagram (natural frequencies, mesh and torque orders, crossings) beside the amplitude over speed"
@@ -53,7 +53,7 @@ def run(args: argparse.Namespace) -> int:
         raise GearsymError(f"--param {args.param!r}: the Campbell diagram runs along the speed "
                            f"({scaling.speed.parameter}=...), not {axis.name}")
     unit = axis.unit or str(scaling._speed_quantity().units)
-    modes = natural_modes(scaling.model, **parse_settings(args.set))
+    modes = natural_modes(scaling.model, **model_settings(args))
     diagram = campbell(scaling, axis.values, unit, modes, args.orders)
     write_atomically(sidecar(args.out, ".campbell.json"), json.dumps(diagram.as_dict(), indent=2) + "\n")
     print(f"{diagram.model}: natural frequencies " + ", ".join(f"{f:.6g} Hz" for f in diagram.natural_frequencies))
