@@ -8,6 +8,7 @@ One flat public face; the stages behind it, each handing one type to the next:
   :class:`FirstOrderSystem` the engine takes; :func:`load` does name -> system in one call;
 * compile: :func:`compile_model` (FirstOrderSystem, :class:`Integration` -> :class:`CompiledModel`);
 * analyse: :func:`lyapunov_spectrum`, :func:`poincare_samples`, :func:`phase_trajectory`,
+  :func:`simulated_order_spectrum` (and :func:`order_spectrum` of any signal: mesh orders, shaft-order sidebands),
   :func:`find_attractors`, :func:`run_sweep` (on a CompiledModel, or on a system, compiled first);
   periodic orbits and their branches: :func:`periodic_orbit`, :func:`continue_orbits`;
 * data: :func:`simulate_measurements`, :func:`load_measurements`, :func:`explain`;
@@ -61,6 +62,8 @@ _LAZY = {
     "Workers": "gearsym.sweep",
     "SweepInterrupted": "gearsym.sweep",
     "simulate_measurements": "gearsym.verbs",
+    "simulated_order_spectrum": "gearsym.verbs",
+    "order_spectrum": "gearsym.analysis",
     "load_measurements": "gearsym.data",
     "explain": "gearsym.fit",
     "EFFECTS": "gearsym.fit",
@@ -91,7 +94,7 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
-    from .analysis import LyapunovSpectrum, classify_regime
+    from .analysis import LyapunovSpectrum, classify_regime, order_spectrum
     from .codegen import CompiledModel
     from .codegen.build import compile_model
     from .data import load_measurements
@@ -109,4 +112,4 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .system import FirstOrderSystem
     from .sweep import SweepInterrupted, Workers, read_sweep
     from .verbs import (continue_orbits, find_attractors, lyapunov_spectrum, periodic_orbit, phase_trajectory,
-                        poincare_samples, run_sweep, simulate_measurements)
+                        poincare_samples, run_sweep, simulate_measurements, simulated_order_spectrum)

@@ -51,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
     options = integration_from(args, steps_for(args.samples_per_period, args.steps_per_period), exponents=False)
     check_file(args.out, (".csv",))
     check_strengths([e for e in args.effect if not is_shaft_effect(e)], settings)  # (shaft-order ones: on the model)
-    system = _with_effects(args.model, args.effect, settings) if args.effect else None
+    system = with_effects(args.model, args.effect, settings) if args.effect else None
     compiled = compiled_from(args, options, system)
     table = simulate_measurements(compiled, samples_per_period=args.samples_per_period,
                                   noise=args.noise, seed=args.seed, records=records or None,
@@ -65,7 +65,7 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _with_effects(model: str, effects: list[str], settings: dict):
+def with_effects(model: str, effects: list[str], settings: dict):
     """The model's equations with ``effects`` added; ``settings`` set the model's and the effects' parameters (a
     shaft-order effect is found on the gears of the model, with --teeth's counts)."""
     geared = load(model, teeth=settings.get("teeth"))
