@@ -274,7 +274,7 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
         if name not in measurements.observed:
             raise GearsymError(f"bias of {name}: no such channel in the data ({', '.join(measurements.observed)})")
     library = candidate_library(system, candidates, harmonics, terms)
-    too_short = _too_short(system, measurements, library, named=candidates is not None)
+    too_short = _too_short(system, measurements, library, named={c for c in candidates or () if isinstance(c, str)})
     library = {name: e for name, e in library.items() if name not in too_short}
     superset = augment(system, list(library.values()), name=f"{system.name}_candidates") if library else system
     train, test = measurements.split(held_out)
@@ -391,9 +391,9 @@ def placed(segments: Sequence[Segment], placements: dict, library: dict[str, Eff
 
 
 def _too_short(system: FirstOrderSystem, measurements: Measurements, library: dict[str, Effect],
-               named: bool) -> dict[str, str]:
+               named: set) -> dict[str, str]:
     """The shaft-order effects a record is too short to show (shorter than one revolution of the gear), with why:
-    refused with an error if they were asked for by name."""
+    refused with an error if they were asked for by their own name (``tooth_fault_gear2``, not ``tooth_fault``)."""
     out = {}
     for name, e in library.items():
         if not e.shaft_order:
@@ -405,7 +405,7 @@ def _too_short(system: FirstOrderSystem, measurements: Measurements, library: di
             out[name] = (f"{r.label} covers {r.samples * r.step / (2 * np.pi):.4g} mesh periods (tau "
                          f"{r.samples * r.step:.4g}), shorter than one revolution of {e.gear}: {e.teeth} mesh periods "
                          f"(tau {need:.4g}); record at least that long to look for {name}")
-            if named:
+            if name in named:
                 raise GearsymError(f"cannot look for {name}: {out[name]}")
     return out
 

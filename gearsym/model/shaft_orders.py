@@ -20,8 +20,9 @@ centred on phi = 0 mod 2 pi (:func:`~gearsym.model.stiffness.rectangular_mesh_st
 into mesh at phi = 2 pi (n - 1) - pi (e - 1) and leaves at 2 pi n + pi (e - 1), e the contact ratio.
 
 Every window is smooth and periodic over one revolution (no floor or mod, which would make the tables of time
-jump): ``(1 + tanh(kappa (cos(a) - cos(h))))/2``, a the gear's angle from the window's centre and h its half
-width, with kappa chosen so that each edge rises over ``edge`` mesh periods (from 12 % to 88 %).
+jump): a product of two smooth steps, ``(1 + tanh(kappa sin(a + h)))(1 + tanh(kappa sin(h - a)))/4``, a the
+gear's angle from the window's centre and h its half width, with kappa chosen so that each edge rises over
+``edge`` mesh periods (from 12 % to 88 %) (:func:`window`).
 """
 from __future__ import annotations
 
@@ -58,27 +59,38 @@ def gear_angle(phi: sp.Expr, teeth) -> sp.Expr:
 def window(phi: sp.Expr, teeth, centre, length, edge=DEFAULT_EDGE) -> sp.Expr:
     """About 1 while the mesh phase is within ``length``/2 mesh periods of ``centre`` (in mesh periods, counted
     from phi = 0), about 0 elsewhere; periodic over one revolution of the gear of ``teeth`` teeth. ``centre``
-    may be a parameter (a tooth that the data loop moves); ``length`` and ``edge`` are numbers."""
+    may be a parameter (a tooth that the data loop moves); ``length`` and ``edge`` are numbers.
+
+    ``S(a + h) S(h - a)`` with ``S(z) = (1 + tanh(kappa sin z))/2``, a the gear's angle from the centre and h the
+    half width: each factor a smooth step at one edge (sin z is z there), periodic; the product is the window as
+    long as it is shorter than half a revolution. kappa = Z/(pi edge) makes each edge rise over ``edge`` mesh
+    periods (12 % to 88 %), and since S(-z) = 1 - S(z), the windows of neighbouring teeth that share an edge add
+    up to 1 across it."""
     Z = sp.Integer(teeth)
     length, edge = sp.nsimplify(length), sp.nsimplify(edge)
-    if not (0 < length < Z):
-        raise ModelError(f"a window of {length} mesh periods does not fit into a revolution of {Z}", "tooth window")
     if not edge > 0:
         raise ModelError(f"the edge of a window must be positive, got {edge}", "tooth window")
+    if not (0 < length and length + 4 * edge < Z / 2):
+        raise ModelError(f"a window of {length} mesh periods (edges {edge}) needs a gear of more than "
+                         f"{2 * (length + 4 * edge)} teeth: it must stay well within half a revolution, not {Z}",
+                         "tooth window")
     half = sp.pi * length / Z
-    sharpness = sp.Float(f"{float(Z / (sp.pi * edge * sp.sin(half))):.12g}")  # (12 digits: the same C everywhere)
+    sharpness = sp.Float(f"{float(Z / (sp.pi * edge)):.12g}")  # (12 digits: the same C everywhere)
     angle = (phi - 2 * sp.pi * centre) / Z
-    return (1 + sp.tanh(sharpness * (sp.cos(angle) - sp.cos(half)))) / 2
+    return (1 + sp.tanh(sharpness * sp.sin(angle + half))) * (1 + sp.tanh(sharpness * sp.sin(half - angle))) / 4
 
 
 def tooth_share(phi: sp.Expr, teeth, tooth, contact_ratio, edge=DEFAULT_EDGE) -> sp.Expr:
     """The share of the mesh stiffness that the pair of tooth ``tooth`` carries: 1/2 over its whole path of
-    contact (``contact_ratio`` mesh periods) and another 1/2 over its single contact (2 - contact_ratio)."""
+    contact (``contact_ratio`` mesh periods, the window W_n), and another 1/2 where it carries the load alone,
+    in mesh while neither neighbour is: W_n (1 - W_(n-1)) (1 - W_(n+1)). So the shares of all teeth add up to
+    1 - (1 - W_n)(1 - W_(n+1)) where two pairs share the load: exactly 1 wherever one of them is fully in mesh,
+    and the edges of the double and single contact are the same ones."""
     e = sp.nsimplify(contact_ratio)
     if not 1 < e < 2:
         raise ModelError(f"the contact ratio must lie in (1, 2), got {contact_ratio}", "tooth share")
-    centre = tooth - sp.Rational(1, 2)
-    return (window(phi, teeth, centre, e, edge) + window(phi, teeth, centre, 2 - e, edge)) / 2
+    whole = [window(phi, teeth, tooth + k - sp.Rational(1, 2), e, edge) for k in (-1, 0, 1)]
+    return whole[1] / 2 + whole[1] * (1 - whole[0]) * (1 - whole[2]) / 2
 
 
 def path_window(phi: sp.Expr, teeth, tooth, contact_ratio, start, end, edge=DEFAULT_EDGE) -> sp.Expr:

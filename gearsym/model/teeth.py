@@ -50,8 +50,9 @@ def with_teeth(model: Model, teeth) -> Model:
     pinion, wheel = first_mesh_gears(model)
     declared = [b.name for b in (pinion, wheel) if b.tooth_count is not None]
     if declared:
-        raise GearsymError(f"{model.name}: {', '.join(declared)} declares its tooth count already (Gear(..., teeth=)); "
-                           "--teeth is for a model that declares none")
+        told = "declare their tooth counts" if len(declared) > 1 else "declares its tooth count"
+        raise GearsymError(f"{model.name}: {' and '.join(declared)} {told} already (Gear(..., teeth=)); --teeth is "
+                           "for a model that declares none")
     for z, gear in zip(counts, (pinion, wheel)):
         teeth_of(z, f"--teeth for {gear.name!r}")
     copy = _copy(model, {pinion.name: counts[0], wheel.name: counts[1]})
