@@ -40,6 +40,10 @@ _LAZY = {
     "Planet": "gearsym.model.components",
     "Shaft": "gearsym.model.components",
     "Torque": "gearsym.model.components",
+    "ToothFault": "gearsym.model.faults",
+    "Spall": "gearsym.model.faults",
+    "Eccentricity": "gearsym.model.faults",
+    "SpacingErrors": "gearsym.model.faults",
     "rectangular_mesh_stiffness": "gearsym.model.stiffness",
     "NondimensionalModel": "gearsym.reduction",
     "reduce": "gearsym.reduction",
@@ -104,6 +108,7 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .loading import is_physical, load, natural_modes, scaling
     from .model.components import Disk, Gear, Harmonic, Mesh, Planet, Shaft, Torque
     from .model.drivetrain import Drivetrain
+    from .model.faults import Eccentricity, Spall, SpacingErrors, ToothFault
     from .model.stiffness import rectangular_mesh_stiffness
     from .physical.campbell import campbell
     from .reduction import NondimensionalModel, reduce

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import json
 import math
+import re
+import shlex
 
 import numpy as np
 import pytest
@@ -21,6 +23,7 @@ from gearsym import explain, load_measurements
 from gearsym.cli import main
 from gearsym.errors import GearsymError
 from gearsym.fit.explain import candidate_library
+from gearsym.paths import REPO_ROOT
 
 TEETH = (9, 13)
 OMEGAS = (1.2, 1.6)
@@ -142,3 +145,39 @@ def test_shaft_order_effects_need_tooth_counts():
     with pytest.raises(GearsymError, match="'gear3' is not a gear with a tooth count"):
         candidate_library(gearsym.load("one_stage", teeth=TEETH), ["eccentricity_gear3"])
     assert not any(e.shaft_order for e in candidate_library(one_stage).values())  # none in the default library
+
+
+# --------------------------------------------------------------------------- the worked example
+EXAMPLE = REPO_ROOT / "docs" / "examples" / "explain-cracked-tooth"
+
+
+def example_commands() -> dict[str, list[str]]:
+    """The worked example's three commands, as docs/data-loop.md gives them."""
+    page = (REPO_ROOT / "docs" / "data-loop.md").read_text()
+    found = {}
+    for verb in ("simulate", "explain", "spectrum"):
+        line = re.search(rf"^\s*gearsym {verb} .*--teeth 20,53.*$", page, re.M).group(0).strip()
+        found[verb] = shlex.split(line)[1:]
+    return found
+
+
+def test_the_cracked_tooth_example_is_what_its_commands_write(tmp_path, monkeypatch):
+    commands = example_commands()
+    monkeypatch.chdir(tmp_path)
+    for verb in ("simulate", "explain", "spectrum"):
+        assert main([*commands[verb], *(["--quiet"] if verb == "explain" else [])]) == 0
+    assert (tmp_path / "measured.csv").read_bytes() == (EXAMPLE / "measured.csv").read_bytes(), (
+        "docs/examples/explain-cracked-tooth/measured.csv is not what docs/data-loop.md's command writes: rerun it")
+    for name in ("report.md", "derived_model.md"):
+        assert (tmp_path / name).read_text() == (EXAMPLE / name).read_text(), (
+            f"docs/examples/explain-cracked-tooth/{name} is out of date: rerun the commands in docs/data-loop.md")
+    report = json.loads((tmp_path / "report.json").read_text())
+    (fault,) = report["faults"]
+    assert report["effects"] == ["tooth_fault_gear1"] and fault["tooth"] == 7 and fault["gear"] == "gear1"
+    assert fault["severity"] == pytest.approx(0.3, abs=3 * fault["severity_stderr"])
+    assert "**tooth 7 of gear1: stiffness −29.3 % ± 0.42 %**" in (EXAMPLE / "report.md").read_text()
+    made, committed = (json.loads(p.read_text()) for p in (tmp_path / "spectrum.json", EXAMPLE / "spectrum.json"))
+    for a, b in zip(made["spectra"], committed["spectra"]):
+        assert [ln["label"] for ln in a["lines"]] == [ln["label"] for ln in b["lines"]]
+        np.testing.assert_allclose([ln["amplitude"] for ln in a["lines"]], [ln["amplitude"] for ln in b["lines"]],
+                                   rtol=1e-6, atol=1e-12)

@@ -58,8 +58,11 @@ def run(args: argparse.Namespace) -> int:
                                   y0=parse_state(args.y0), velocities=args.velocities, out=args.out)
     per_record = table.rows // table.records
     conditions = f"; conditions {', '.join(table.conditions)}" if table.conditions else ""
-    print(f"{table.model}: {table.records} record(s) of {per_record} samples ({table.samples_per_period} per period, "
-          f"{options.measured} periods after {args.discard} discarded, {table.steps_per_period} RK4 steps/period), "
+    cycles = compiled.cycles  # (a period of several forcing periods: a gear's revolution)
+    unit = "period" if cycles == 1 else "forcing period"
+    periods = "periods" if cycles == 1 else f"periods of {cycles} forcing periods"
+    print(f"{table.model}: {table.records} record(s) of {per_record} samples ({table.samples_per_period} per {unit}, "
+          f"{options.measured} {periods} after {args.discard} discarded, {table.steps_per_period} RK4 steps/{unit}), "
           f"noise {args.noise:g}{conditions}; columns {', '.join(table.columns)}")
     print(f"wrote {args.out}")
     return 0

@@ -80,7 +80,8 @@ def run(args: argparse.Namespace) -> int:
                                                           "spectra": [s.as_dict() for s in spectra]}), indent=1) + "\n")
         print(f"wrote {args.out}")
     if args.plot:
-        plot_order_spectra(spectra, args.plot, title=f"Order spectrum: {what}",
+        gears = ", ".join(f"{g} {z} teeth" for g, z in spectra[0].gears.items())
+        plot_order_spectra(spectra, args.plot, title=f"Order spectrum of {what} (model {args.model}: {gears})",
                            max_order=args.mesh_harmonics + 0.5)
         print(f"wrote {args.plot}")
     return 0

@@ -37,8 +37,11 @@ def plot_order_spectra(spectra: Sequence[OrderSpectrum], path: str | Path, title
                         ls="none", label=name)
         strongest = sorted((ln for ln in s.lines if ln.gear is not None and np.isfinite(ln.amplitude)),
                            key=lambda ln: -ln.amplitude)[:3]
-        for ln in strongest:
-            ax.annotate(ln.label, (ln.order, ln.amplitude), textcoords="offset points", xytext=(4, 6), fontsize=7)
+        named: list[float] = []
+        for ln in strongest:  # (one label where lines crowd)
+            if all(abs(ln.order - o) > 0.04 * top for o in named):
+                ax.annotate(ln.label, (ln.order, ln.amplitude), textcoords="offset points", xytext=(4, 6), fontsize=7)
+                named.append(ln.order)
         ax.set_xlim(0, top)
         ax.set_ylabel(f"amplitude of {s.channel}")
         ax.set_title(textwrap.fill((labels[i] if labels else "") or s.title, 110), fontsize=8)
