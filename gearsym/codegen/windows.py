@@ -28,6 +28,8 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import json
+import os
+from concurrent.futures import ThreadPoolExecutor
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -48,6 +50,8 @@ from .translate import to_casadi
 #: bump when the generated window code changes for the same system and channels
 WINDOWS_VERSION = 2
 _OPTS = {"cse": True}
+#: RK4 steps in a call below which its windows run in one thread
+MIN_SHARED_STEPS = 20_000
 
 
 @dataclass(frozen=True)
@@ -213,7 +217,6 @@ class Windows:
         that order: a fit pays only for the columns it asks for."""
         starts = np.asfortranarray(starts, dtype=float)
         parameters = np.asfortranarray(parameters, dtype=float)
-        count = starts.shape[1]
         samples = np.ascontiguousarray(samples, dtype=np.int64)
         substeps = np.ascontiguousarray(substeps, dtype=np.int64)
         t0, dt = np.ascontiguousarray(t0, dtype=float), np.ascontiguousarray(dt, dtype=float)
@@ -226,11 +229,14 @@ class Windows:
         outputs = np.zeros((c, total), order="F")
         derivatives = np.zeros((c, width, total), order="F") if tangent else None
         if self._library is not None:
-            status = self._library(count, samples.ctypes.data, substeps.ctypes.data, t0.ctypes.data,
-                                   dt.ctypes.data, starts.ctypes.data, parameters.ctypes.data, int(tangent),
-                                   chosen.size, chosen.ctypes.data, states.ctypes.data, outputs.ctypes.data,
-                                   derivatives.ctypes.data if tangent else None)
-            if status:
+            arrays = (samples, substeps, t0, dt, starts, parameters, chosen, states, outputs, derivatives)
+            pieces = _pieces(samples, substeps)
+            if len(pieces) == 1:
+                status = [self._call(*arrays, *pieces[0], tangent)]
+            else:  # (the call releases the GIL and writes disjoint columns: the same bits as one call)
+                with ThreadPoolExecutor(max_workers=len(pieces), thread_name_prefix="gearsym-windows") as pool:
+                    status = list(pool.map(lambda piece: self._call(*arrays, *piece, tangent), pieces))
+            if any(status):
                 raise GearsymError("the compiled window integrator reported an error")
         else:
             full = np.zeros((c, self.n + self.parameters, total), order="F") if tangent else None
@@ -238,6 +244,19 @@ class Windows:
             if tangent:
                 derivatives[...] = full[:, np.concatenate([np.arange(self.n), self.n + chosen]), :]
         return WindowRun(states, outputs, derivatives)
+
+    def _call(self, samples, substeps, t0, dt, starts, parameters, chosen, states, outputs, derivatives,
+              first: int, last: int, column: int, tangent: bool) -> int:
+        """The compiled integrator on windows ``first`` ... ``last - 1``, whose samples start at ``column``."""
+        f8, i8 = 8, 8  # (float64 and int64 arrays, Fortran order: window k's column is k times its height)
+        width = derivatives.shape[1] if tangent else 0
+        return self._library(last - first, samples.ctypes.data + i8 * first, substeps.ctypes.data + i8 * first,
+                             t0.ctypes.data + f8 * first, dt.ctypes.data + f8 * first,
+                             starts.ctypes.data + f8 * self.n * first,
+                             parameters.ctypes.data + f8 * self.parameters * first, int(tangent), chosen.size,
+                             chosen.ctypes.data, states.ctypes.data + f8 * self.n * column,
+                             outputs.ctypes.data + f8 * len(self.channels) * column,
+                             derivatives.ctypes.data + f8 * len(self.channels) * width * column if tangent else None)
 
     def _run_in_process(self, starts, t0, dt, samples, substeps, parameters, tangent, states, outputs, derivatives):
         """The same steps in CasADi's virtual machine, each group of windows with equal substeps mapped."""
@@ -268,6 +287,19 @@ class Windows:
                 outputs[:, cols] = out[:, live]
                 if tangent:
                     derivatives[:, :, cols] = dout.reshape(len(self.channels), width, K, order="F")[:, :, live]
+
+
+def _pieces(samples: np.ndarray, substeps: np.ndarray) -> list[tuple[int, int, int]]:
+    """The windows split into contiguous pieces of about equal work, one per core (first, last, first column),
+    or one piece when there is too little work to share (a thread costs more than a few thousand steps)."""
+    work = np.cumsum(np.maximum(samples - 1, 0) * substeps)
+    cores = min(os.cpu_count() or 1, len(samples))
+    if cores < 2 or work[-1] < MIN_SHARED_STEPS:
+        return [(0, len(samples), 0)]
+    cuts = [0, *(int(np.searchsorted(work, work[-1] * i / cores)) + 1 for i in range(1, cores)), len(samples)]
+    cuts = sorted(set(min(c, len(samples)) for c in cuts))
+    columns = np.concatenate([[0], np.cumsum(samples)])
+    return [(a, b, int(columns[a])) for a, b in zip(cuts, cuts[1:]) if b > a]
 
 
 def windows_hash(system: FirstOrderSystem, channels: Sequence[sp.Expr]) -> str:
