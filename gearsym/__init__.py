@@ -3,7 +3,8 @@
 One flat public face; the stages behind it, each handing one type to the next:
 
 * declare: :class:`Drivetrain` from components (:class:`Gear`, :class:`Mesh`, ...), or a plain ODE as a
-  :class:`FirstOrderSystem`; ``load_model(name)`` reads one from ``models/`` or a file;
+  :class:`FirstOrderSystem`; ``load_model(name)`` reads one from ``models/`` or a file (``model_module(name)``:
+  the whole file, its builders too);
 * reduce: :func:`reduce` (Drivetrain -> :class:`NondimensionalModel`), whose ``.system(**values)`` is the
   :class:`FirstOrderSystem` the engine takes; :func:`load` does name -> system in one call;
 * compile: :func:`compile_model` (FirstOrderSystem, :class:`Integration` -> :class:`CompiledModel`);
@@ -51,6 +52,7 @@ _LAZY = {
     "available_models": "gearsym.registry",
     "load": "gearsym.loading",
     "load_model": "gearsym.registry",
+    "model_module": "gearsym.registry",
     "CompiledModel": "gearsym.codegen",
     "compile_model": "gearsym.codegen.build",
     "LyapunovSpectrum": "gearsym.analysis",
@@ -79,6 +81,15 @@ _LAZY = {
     "export_fmu": "gearsym.fmu.export",
     "derive": "gearsym.derivation",
     "render": "gearsym.derivation",
+    "GearGeometry": "gearsym.geometry",
+    "GearPair": "gearsym.geometry",
+    "Material": "gearsym.geometry",
+    "MeshStiffness": "gearsym.geometry",
+    "StiffnessOptions": "gearsym.geometry",
+    "gear_geometry": "gearsym.geometry",
+    "gear_pair": "gearsym.geometry",
+    "mesh_stiffness": "gearsym.geometry",
+    "iso6336_stiffness": "gearsym.geometry",
 }
 
 __all__ = ["GearsymError", "Integration", "ModelError", "UnknownParameterError", *_LAZY]

@@ -16,6 +16,13 @@ Later runs build the :class:`~gearsym.codegen.compiled.CompiledModel` from them,
 :class:`SystemSummary` as its system, which loads (and reduces) the model only if something asks for what
 it does not keep (a SymPy expression). A summary that is missing, unreadable, not ours or pointing at a
 library that is gone is ignored and rewritten; files are written atomically. Only JSON is read.
+
+A summary is trusted no more than the library: it is read as a private file
+(:func:`~gearsym.private_files.read_private`), its content must match the seal written with it (a hash of the
+content and the file's name, which hashes the model and values it is for), and what it says must match what
+it describes: the library's record (:mod:`gearsym.codegen.trust`) must name the same model, code hash, states
+and parameters. A summary that does not (edited: states swapped, values changed, another model's library) is
+written again, and a warning says so.
 """
 from __future__ import annotations
 
@@ -30,13 +37,15 @@ from pathlib import Path
 
 from .codegen.compiled import CompiledModel
 from .codegen.compiler import binary_key, cache_dir, compile_flags
-from .codegen.library import LOADED, library_functions, resolve_backend
+from .codegen.library import LOADED, library_describes, library_functions, resolve_backend
 from .codegen.loops import LoopOptions
 from .codegen.native import load_native
-from .files import write_atomically
+from .codegen.trust import check, differences
+from .errors import warn
 from .options import Integration
 from .parameters import Constraint, ParameterChecks
 from .physical.point import CachedScaling, PointUnits
+from .private_files import NotPrivate, read_private, write_private
 from .registry import model_file, models_dir
 
 #: bump when what a summary holds changes
@@ -124,7 +133,20 @@ def _source_digest(folder: Path) -> str:
 def _model_files(folders: tuple[Path, ...]) -> dict[str, str]:
     """The model files in ``folders`` by their content's hash (a model imports another; read every time: a model
     file edited in a long-lived process must be noticed)."""
-    return {str(f): hashlib.sha256(f.read_bytes()).hexdigest() for folder in folders for f in sorted(folder.glob("*.py"))}
+    return {str(f): _content(f) for folder in folders for f in sorted(folder.glob("*.py"))}
+
+
+def _content(path: Path) -> str:
+    """The hash of a model file's bytes; what else stands at a ``*.py`` name (a folder, a broken symlink: no
+    model, but it may become one) by its kind."""
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest() if path.is_file() else f"not a file: {_kind(path)}"
+    except OSError as exc:
+        return f"unreadable: {exc.strerror}"
+
+
+def _kind(path: Path) -> str:
+    return "a folder" if path.is_dir() else "a broken symlink" if path.is_symlink() else "not a regular file"
 
 
 def system_key(path: Path, values: Mapping[str, object]) -> str:
@@ -145,22 +167,45 @@ def loops_key(loops: LoopOptions) -> str:
 
 
 def summary_path(name: str, key: str) -> Path:
-    return cache_dir() / "models" / f"{name}-{key}.json"
+    return cache_dir("models") / f"{name}-{key}.json"
 
 
 def read_json(path: Path) -> dict | None:
-    """A summary this module wrote, or None (missing, partial, corrupt or of another format)."""
+    """A summary this module wrote, or None (missing, partial, corrupt, of another format; or not private, or
+    changed since it was written: said in a warning)."""
     try:
-        data = json.loads(path.read_text())
+        data = json.loads(read_private(path))
+    except NotPrivate as exc:
+        _distrust(path, str(exc))
+        return None
     except (OSError, ValueError):
         return None
-    return data if isinstance(data, dict) and data.get("format") == SUMMARY_FORMAT else None
+    if not (isinstance(data, dict) and data.get("format") == SUMMARY_FORMAT):
+        return None
+    if data.pop("seal", None) != _seal(path, data):
+        _distrust(path, "its content is not what gearsym wrote (edited?)")
+        return None
+    return data
 
 
 def write_json(path: Path, data: dict) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
     # (keys in their order: the parameters' order is that of the parameter vector)
-    write_atomically(path, json.dumps({"format": SUMMARY_FORMAT, **data}, indent=1) + "\n")
+    data = {"format": SUMMARY_FORMAT, **data}
+    write_private(path, (json.dumps({**data, "seal": _seal(path, data)}, indent=1) + "\n").encode())
+
+
+def _seal(path: Path, data: dict) -> str:
+    """The hash of a summary's content and file name (which hashes the model and values it is for)."""
+    return hashlib.sha256(f"{path.name}\0{json.dumps(data, sort_keys=True)}".encode()).hexdigest()
+
+
+def _distrust(path: Path, why: str) -> None:
+    if path not in _DISTRUSTED:  # (a summary is read more than once in a run: said once)
+        _DISTRUSTED.add(path)
+        warn(f"the cached summary {path} is not used: {why}; gearsym writes it again")
+
+
+_DISTRUSTED: set[Path] = set()
 
 
 def load_compiled(ref: str, values: Mapping[str, object], options: Integration, *,
@@ -218,8 +263,18 @@ def _from_cache(system_file: Path, build_file: Path, options: Integration, loops
         texts = tuple(str(t) for t in build["table_texts"])
     except (KeyError, TypeError, ValueError, AttributeError):
         return None
-    if not library.is_file() or library.resolve().parent != (cache_dir() / "lib").resolve():
+    if library.parent != cache_dir("lib") or library.name.startswith("."):
         return None  # (only a library of our own cache is loaded)
+    if not set(timed) <= set(summary.parameters):
+        _distrust(build_file, "it names parameters its model does not have")
+        return None
+    verdict = check(library)  # (a library not as compiled is said and made again by compile_model)
+    if verdict.data is None:
+        return None
+    why = differences(verdict.describes, library_describes(summary, digest))
+    if why is not None:  # (the summaries do not describe the library they point at: edited)
+        _distrust(build_file, f"{library.name}, the library it points at, does not match it: {why}")
+        return None
     key = (digest, "compiled")
     if key in LOADED:  # (loaded in this process already: its functions with work arrays of their own)
         return replace(LOADED[key].clone(), system=summary, integration=options)

@@ -12,6 +12,23 @@ from .errors import GearsymError, suggest, warn
 #: leave the paper's models' exponents and amplitudes off by a per cent or more (one_stage at 8 steps: 3 %)
 MIN_STEPS_PER_PERIOD = 8
 FEW_STEPS_PER_PERIOD = 20
+#: at most this many RK4 steps per forcing period: 200 steps for each natural period 5000 times shorter than the
+#: forcing's. The compiled time tables hold every step: building them takes some KiB and tenths of a millisecond a
+#: step (one_stage at 10^6 steps: 3 GB and 100 s), so 10^8 steps ran out of memory after minutes
+MAX_STEPS_PER_PERIOD = 1_000_000
+#: the least memory compiling the time tables takes per step (one_stage: 3 KiB)
+TABLE_BYTES_PER_STEP = 2048
+
+
+def run_bytes_per_period(dimension: int, observed: int) -> int:
+    """The memory a run with tangent vectors keeps per forcing period: the state after it and the log stretch of
+    each tangent vector, each observed coordinate's minimum and maximum, and the stretches per unit time its
+    summary makes (doubles)."""
+    return 8 * (4 * dimension + 2 * observed)
+
+
+#: the least memory a run takes per forcing period (one state, observed)
+RUN_BYTES_PER_PERIOD = run_bytes_per_period(1, 1)
 #: measured periods (after the transient): the standard error comes from 10 batches of at least one period
 #: each (refused below), and an exponent within 5/(measured time) of zero counts as zero (warned below FEW)
 MIN_MEASURED_PERIODS = 10
@@ -36,7 +53,7 @@ def check_run(*, steps_per_period: int | None = None, measured: int | None = Non
     """Refuse a run too coarse or too short to mean anything, and warn (one line) in the grey zone below
     the usual values; ``measured_is`` says how the measured periods came about, for the message."""
     if steps_per_period is not None:
-        steps = whole_number(steps_per_period, "steps per period")
+        steps = whole_number(steps_per_period, "steps per period", -2**63)  # (below the minimum: the message below)
         if steps < MIN_STEPS_PER_PERIOD:
             raise GearsymError(f"{steps} RK4 steps per forcing period (--steps-per-period) cannot resolve the "
                                f"forcing: give at least {MIN_STEPS_PER_PERIOD} (200 is the default)")

@@ -38,8 +38,9 @@ def reduced(ref, teeth=None) -> NondimensionalModel:
 
 def scaling(model, length_scale=None, *, teeth=None, **physical) -> PhysicalScaling:
     """The scaling of a model (a name, a file, a Drivetrain or its reduction) at its declared physical values,
-    with ``physical`` overriding them (``kZ="3e8 N/m"``, ``speed="3000 rpm"``); ``teeth``: tooth counts for a
-    model that declares none."""
+    with ``physical`` overriding them (``kZ="3e8 N/m"``, ``speed="3000 rpm"``) or replacing a stiffness function
+    by a formula in tau or phi (``k="1+0.2*cos(tau)"``, with the values of its new parameters); ``teeth``: tooth
+    counts for a model that declares none."""
     if not isinstance(model, NondimensionalModel):
         model, teeth = declared(model, teeth), None
         if not model.is_drivetrain:
@@ -73,7 +74,7 @@ def load(ref, *, teeth=None, **values) -> FirstOrderSystem:
     split = physical_settings(nd, values)
     if split is not None:
         length_scale, physical, formulas = split
-        return scaling(nd, length_scale, **physical).system(**formulas)
+        return scaling(nd, length_scale, **physical, **formulas).system()
     return nd.system(**values)
 
 
@@ -86,7 +87,7 @@ def natural_modes(model, *, teeth=None, **settings) -> Modes:
     split = physical_settings(nd, dict(settings))
     if split is not None:
         length_scale, physical, formulas = split
-        return physical_modes(scaling(nd, length_scale, **physical), formulas)
+        return physical_modes(scaling(nd, length_scale, **physical, **formulas))
     return nondimensional_modes(nd, settings)
 
 

@@ -8,8 +8,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from .checks import whole_number
+from .caller import option
+from .checks import MAX_STEPS_PER_PERIOD, RUN_BYTES_PER_PERIOD, TABLE_BYTES_PER_STEP, whole_number
 from .errors import GearsymError
+from .memory import check_fits
 
 #: RK4 steps per forcing period (the paper's 200): the one definition of the default
 STEPS_PER_PERIOD = 200
@@ -48,6 +50,14 @@ class Integration:
             raise GearsymError(f"the transient (discard={discard}) must be shorter than the run (periods={periods}): "
                                "periods counts every forcing period, the discarded ones included")
         steps = whole_number(self.steps_per_period, "steps per period", 1)
+        if steps > MAX_STEPS_PER_PERIOD:
+            raise GearsymError(f"{option('steps_per_period', steps)}: at most {MAX_STEPS_PER_PERIOD} RK4 steps per "
+                               "forcing period (200 for each natural period 5000 times shorter than the forcing's; "
+                               "the compiled tables hold every step)")
+        check_fits(steps, TABLE_BYTES_PER_STEP, asked=option("steps_per_period", steps), item="step",
+                   what="the compiled tables of time, at least")
+        check_fits(periods, RUN_BYTES_PER_PERIOD, asked=option("periods", periods), item="period",
+                   what="each period's state, stretch and extremes, at least")
         if not isinstance(self.locate_crossings, bool):
             raise GearsymError(f"locate_crossings must be True or False, got {self.locate_crossings!r}")
         if self.backend not in BACKENDS:

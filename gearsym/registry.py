@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Union
 
 from .declared import Model
-from .errors import GearsymError, ModelError, suggest
+from .errors import GearsymError, ModelError, suggest, warn
 from .paths import REPO_ROOT
 
 
@@ -21,21 +21,52 @@ def models_dir() -> Path:
 
 
 def output_root(ref) -> Path:
-    """Where a model's derivation page (``docs/derivations/``) and C (``generated/``) go by default: the
-    repository for a model of its own ``models/``, else the current directory (a user's model must
-    not write into the installed tree)."""
-    shipped = (REPO_ROOT / "models").resolve()
-    if isinstance(ref, (str, Path)):
-        text = str(ref)
-        folder = Path(text).resolve().parent if text.endswith(".py") or "/" in text else models_dir().resolve()
-        if folder == shipped:
-            return REPO_ROOT
+    """Where a model's derivation page (``docs/derivations/``) and C (``generated/``) go by default: the current
+    directory, whatever the model (a command never writes into the installed tree; run from the repository's
+    root, it regenerates the committed pages and C)."""
     return Path.cwd()
 
 
 def available_models() -> list[str]:
     d = models_dir()
-    return sorted(p.stem for p in d.glob("*.py") if not p.stem.startswith("_"))
+    return sorted(p.stem for p in d.glob("*.py") if not p.stem.startswith("_") and p.is_file())
+
+
+def model_path(ref: str) -> Path | None:
+    """The file (resolved) of a model name or path; None if there is none (:func:`load_model` says why). A name
+    that the working directory's ``models/`` gives another file than the shipped model of that name is said
+    in a warning: the working directory decides what runs."""
+    try:
+        if _is_path(ref):
+            path = Path(ref)
+        elif ref.isidentifier():
+            path = models_dir() / f"{ref}.py"
+            _say_if_shadowed(ref, path)
+        else:
+            return None
+        return path.resolve() if path.is_file() else None
+    except OSError:  # (a name too long for the system, ...)
+        return None
+
+
+_SHADOWED: set[Path] = set()  # said already
+
+
+def _say_if_shadowed(name: str, path: Path) -> None:
+    shipped = REPO_ROOT / "models" / f"{name}.py"
+    if path.parent.resolve() == shipped.parent.resolve() or not shipped.is_file() or path in _SHADOWED:
+        return
+    _SHADOWED.add(path)
+    warn(f"model {name} is {path} (the models/ of the working directory), not the shipped {shipped}")
+
+
+def _is_path(ref: str) -> bool:
+    return ref.endswith(".py") or "/" in ref
+
+
+def _shown(ref: str, quote=str) -> str:
+    """``ref`` as an error message shows it (``quote``: ``repr`` for a name); one of thousands of characters cut."""
+    return quote(ref) if len(ref) <= 80 else f"{quote(ref[:60])}... ({len(ref)} characters)"
 
 
 def load_model(ref: Union[str, Path, Model]) -> Model:
@@ -43,19 +74,23 @@ def load_model(ref: Union[str, Path, Model]) -> Model:
     if isinstance(ref, Model):
         return ref
     ref = str(ref)
-    if ref.endswith(".py") or "/" in ref:
-        path = Path(ref)
-        if not path.is_file():
-            raise GearsymError(f"model file {ref} does not exist")
+    path = model_path(ref)
+    if _is_path(ref):
+        if path is None:
+            why = "is a folder" if _exists(ref) else "does not exist"
+            raise GearsymError(f"model file {_shown(ref)} {why}")
+        if path.suffix != ".py":
+            raise GearsymError(f"{ref} is not a model file: a model file is Python, named *.py (e.g. models/"
+                               "one_stage.py), and a model name is one of `gearsym list`")
         spec = importlib.util.spec_from_file_location(f"gearsym_user_model_{path.stem}", path)
         module = importlib.util.module_from_spec(spec)
         _with_models_importable(lambda: spec.loader.exec_module(module), path)
     else:
         names = available_models()
-        if ref not in names:
+        if ref not in names or path is None:
             raise GearsymError(
-                f"unknown model {ref!r}.{suggest(ref, names)} Models in {models_dir()}: {', '.join(names)}; "
-                "or give the path of a model file."
+                f"unknown model {_shown(ref, repr)}.{suggest(ref, names) if len(ref) <= 80 else ''} Models in "
+                f"{models_dir()}: {', '.join(names)}; or give the path of a model file."
             )
         module = _with_models_importable(lambda: importlib.import_module(f"models.{ref}"))
     model = getattr(module, "model", None)
@@ -64,6 +99,17 @@ def load_model(ref: Union[str, Path, Model]) -> Model:
             "a model file must define `model`, a Drivetrain or a FirstOrderSystem", getattr(module, "__file__", ref)
         )
     return model
+
+
+def model_module(name: str):
+    """The module of a model of ``models/`` by name, with everything its file defines beside ``model`` (a
+    builder such as ``build(planets)``, its constants): what ``import models.<name>`` gives in a clone, for a
+    script that runs anywhere."""
+    if name.endswith(".py") or "/" in name:
+        raise GearsymError(f"model_module takes the name of a model in {models_dir()} (see gearsym list), not a "
+                           f"file: {name!r}; import your own file as any Python module")
+    load_model(name)  # checks the name and runs the file once
+    return sys.modules[f"models.{name}"]
 
 
 def _with_models_importable(action, model_file: Path | None = None):
@@ -81,10 +127,13 @@ def _with_models_importable(action, model_file: Path | None = None):
         raise
     except SyntaxError as exc:
         raise GearsymError(f"{exc.filename}, line {exc.lineno}: {type(exc).__name__}: {exc.msg}") from None
-    except Exception as exc:
+    except (Exception, SystemExit) as exc:  # (a model file that exits would end gearsym, with its status)
         frames = traceback.extract_tb(exc.__traceback__)
         models = [f for f in frames if not f.filename.startswith("<") and Path(f.filename).parent.resolve() in folders]
         where = (models or frames)[-1]  # the model file's own line, not one in a library it called
+        if isinstance(exc, SystemExit):
+            raise GearsymError(f"{where.filename}, line {where.lineno}: the model file calls exit ({exc.code!r}) "
+                               "while it is loaded; a model file defines `model` and must not exit") from None
         raise GearsymError(f"{where.filename}, line {where.lineno}: {type(exc).__name__}: {exc}") from None
     finally:
         if added:
@@ -92,6 +141,14 @@ def _with_models_importable(action, model_file: Path | None = None):
 
 
 def model_file(ref: str) -> Path | None:
-    """The file of a model name or path (None for a name that is no model: the loader says why)."""
-    path = Path(ref) if ref.endswith(".py") or "/" in ref else models_dir() / f"{ref}.py"
-    return path.resolve() if path.is_file() else None
+    """The file of a model name or path (None for a name that is no model, or a file that is none: the loader
+    says why)."""
+    path = model_path(ref)
+    return path if path is not None and path.suffix == ".py" else None
+
+
+def _exists(ref: str) -> bool:
+    try:
+        return Path(ref).exists()
+    except OSError:
+        return False

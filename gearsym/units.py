@@ -73,6 +73,7 @@ def registry():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ureg.define("hertz = revolution / second = Hz")
+    ureg.formatter.default_sort_func = None  # units in the order written: N·m, not pint's alphabetical m·N
     return ureg
 
 

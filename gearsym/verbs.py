@@ -9,6 +9,7 @@ options (else the verb's own default, else ``Integration()``).
 from __future__ import annotations
 
 import functools
+from collections.abc import Mapping
 
 from .analysis.attractors import find_attractors as _find_attractors
 from .analysis.lyapunov import lyapunov_spectrum as _lyapunov_spectrum
@@ -21,8 +22,11 @@ from .errors import GearsymError
 from .options import Integration
 from .periodic.branches import continue_orbits as _continue_orbits
 from .periodic.orbit import periodic_orbit as _periodic_orbit
+from .physical.answers import PhysicalScaling
+from .physical.sweeps import axes_with_units, nondimensional_axes
 from .sweep.run import run_sweep as _run_sweep
 from .system import FirstOrderSystem
+from .units import is_quantity
 
 
 def high_level(verb):
@@ -53,6 +57,44 @@ poincare_samples = high_level(_poincare_samples)
 phase_trajectory = high_level(_phase_trajectory)
 find_attractors = high_level(_find_attractors)
 run_sweep = high_level(_run_sweep)
+
+
+def _numbers_only(engine):
+    """``engine`` (run_sweep on a compiled model or a system), refusing a physical value on an axis with the call
+    that sweeps it."""
+    @functools.wraps(engine)
+    def call(model, axes, *args, **kwargs):
+        for name, values in (axes.items() if isinstance(axes, Mapping) else ()):
+            value = next((v for v in values if is_quantity(v)), None)
+            if value is not None:
+                raise GearsymError(f"run_sweep: {name}={value!r} is a physical value, and {model.name} here takes the "
+                                   f"engine's numbers: sweep the model's scaling, gearsym.run_sweep(gearsym.scaling("
+                                   f"{model.name!r}), {{{name!r}: [{value!r}, ...]}}), which gives the engine its "
+                                   "numbers and the result in these units")
+        return engine(model, axes, *args, **kwargs)
+
+    return call
+
+
+for _kind in (CompiledModel, FirstOrderSystem):
+    run_sweep.register(_kind)(_numbers_only(run_sweep.dispatch(_kind)))
+
+
+@run_sweep.register
+def _physical_sweep(model: PhysicalScaling, axes, *, options: Integration | None = None, **kwargs):
+    """A sweep of a model with physical values (``gearsym.scaling(...)``): axes of physical values with their
+    units (``{"speed": ["1000 rpm", "2000 rpm"]}``, pint Quantities, or ``"speed=1000rpm:3000rpm:500rpm"``) become
+    the nondimensional parameters they move, other keywords that are physical values (``kZ="2e8 N/m"``) fix
+    them, and the result comes back in physical units (along the values as given)."""
+    engine_keywords = {"mode", "direction", "y0", "out", "overwrite", "poincare", "workers", "progress", "on_point"}
+    physical = {k: v for k, v in kwargs.items() if k not in engine_keywords}
+    at = model.with_values(**physical) if physical else model
+    given = axes_with_units(axes)
+    engine_axes = nondimensional_axes(at, given, "run_sweep")
+    compiled = compile_model(at.system(), options or Integration())
+    result = _run_sweep(compiled, engine_axes, options=options,
+                        **{k: v for k, v in kwargs.items() if k in engine_keywords})
+    return at.to_physical(result, given=given)
 periodic_orbit = high_level(_periodic_orbit)
 continue_orbits = high_level(_continue_orbits)
 simulate_measurements = high_level(_simulate_measurements)

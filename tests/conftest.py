@@ -171,6 +171,18 @@ def _private_library_cache(tmp_path_factory):
         os.environ["GEARSYM_CACHE"] = old
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _cores_for_two_workers():
+    """gearsym runs no more workers than the machine has cores; the tests ask for two to exercise the parallel
+    paths, so they see at least two cores even on a machine of one (a test of the cap patches it itself)."""
+    import gearsym.sweep.run as run
+
+    cores = run.cores
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(run, "cores", lambda: max(2, cores()))
+        yield
+
+
 def interrupt_after(count):
     """An ``on_point`` for sweeps that presses Ctrl-C once ``count`` points are stored."""
     seen = []

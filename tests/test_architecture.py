@@ -20,7 +20,8 @@ BENCH = ROOT.parent / "bench"
 #: the stages from the bottom up (docs/architecture.md): a module may import its own stage and those below
 LAYERS = [
     {"errors", "version", "paths", "files", "outputs", "units", "declared", "symbols", "backlash", "checks",
-     "options", "parameters"},
+     "options", "parameters", "private_files", "file_sets", "caller", "memory"},
+    {"geometry"},
     {"model"},
     {"system", "registry"},
     {"reduction"},

@@ -40,7 +40,7 @@ def run(capsys, *argv: str) -> tuple[int, str, str]:
 
 def test_subcommands_are_registered():
     assert [m.NAME for m in COMMANDS] == ["list", "derive", "docs", "compile", "lyap", "sweep", "orbits", "poincare", "reproduce",
-                                          "simulate", "explain", "spectrum", "modes", "campbell", "fmu"]
+                                          "simulate", "explain", "spectrum", "modes", "campbell", "fmu", "stiffness"]
 
 
 def test_list_shows_every_model_with_its_title(capsys):
@@ -124,7 +124,8 @@ def test_errors_exit_2_without_traceback_in_a_real_process():
     assert "Traceback" not in proc.stderr
 
 
-def test_docs_check_passes_on_the_committed_pages(capsys):
+def test_docs_check_passes_on_the_committed_pages(capsys, monkeypatch):
+    monkeypatch.chdir(REPO_ROOT)  # (the pages are checked where they would be written: the current folder's)
     code, out, err = run(capsys, "docs", "--all", "--check")
     assert code == 0, err
     assert f"{len(available_models())} page(s) up to date" in out

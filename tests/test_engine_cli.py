@@ -9,6 +9,7 @@ import pytest
 from conftest import compiled, paper_rk4_spectrum
 from gearsym import Integration, available_models, lyapunov_spectrum
 from gearsym.cli import main
+from gearsym.paths import REPO_ROOT
 
 
 def run(capsys, *argv: str) -> tuple[int, str, str]:
@@ -140,7 +141,8 @@ def test_lyap_errors_are_one_line_messages(capsys, argv, message):
     assert message in err and "Traceback" not in err
 
 
-def test_compile_check_reports_up_to_date(capsys):
+def test_compile_check_reports_up_to_date(capsys, monkeypatch):
+    monkeypatch.chdir(REPO_ROOT)  # (the C is checked where it would be written: the current folder's)
     code, out, _ = run(capsys, "compile", "--all", "--check")
     assert code == 0 and f"up to date ({len(available_models())} models)" in out
 

@@ -83,6 +83,9 @@ TRUTHS = {
     "torque_2": lambda t, x, v, w: (1.2 * math.cos(2 * t) + 0.5 * math.sin(2 * t)) / w**2,
     "quadratic_damping": lambda t, x, v, w: -0.3 * v * abs(v),
     "damping_ripple": lambda t, x, v, w: -0.15 * v * math.cos(2 * t),  # in no library: a damping varying with mesh
+    # a profile error e = 0.5 cos(tau) + 0.3 sin(tau): the mesh force k(tau) g(x - e) instead of k(tau) g(x)
+    "transmission_error": lambda t, x, v, w: -stiffness(t) * (rig.backlash(x - 0.5 * math.cos(t) - 0.3 * math.sin(t),
+                                                                            10.0) - rig.backlash(x, 10.0)) / w**2,
     "clean": None,
 }
 RIG_VALUES = {"clean": {"Theta": 2.0, "B1": 3.5}}
@@ -120,6 +123,43 @@ def test_an_accelerometer_record_with_an_offset_is_explained_as_well_as_a_displa
         assert ex.final.fit.estimates["zeta"] == pytest.approx(0.08, rel=0.05)
     assert felt.final.error <= 1.5 * shown.final.error, (felt.final.error, shown.final.error)
     assert felt.final.fit.bias["x_ddot"] == pytest.approx(0.3, abs=3 * felt.final.fit.bias_stderr["x_ddot"] + 0.01)
+
+
+def test_an_accelerometers_offset_is_fitted_by_default_and_the_report_says_so(one_stage, rig_runs, tmp_path):
+    """Issue 25: with a 5 % offset in an accelerometer's channel every candidate made the held-out error worse and
+    the verdict was 'unexplained', unless --bias was given. Bounded motion has zero mean acceleration, so the
+    offset of an acceleration channel is fitted by default."""
+    runs = rig_runs("transmission_error", (1.0, 1.8))
+    offset = 0.05 * float(np.std(np.concatenate([run["x_ddot"] for _, run in runs])))  # 5 % of the spread
+    data = load_measurements([rig.write(tmp_path / "acc.csv", runs, ("x_ddot",), bias={"x_ddot": offset})],
+                             conftest.system("one_stage"))
+    ex = explain(one_stage, data, ["zeta", "B1"],
+                 candidates=["transmission_error", "torque_harmonic", "cubic_stiffness", "coulomb_friction"])
+    assert ex.bias_by_default == ex.bias == ("x_ddot",)
+    assert ex.verdict == "explained" and ex.effects == ["transmission_error_1"]
+    assert ex.final.error <= ex.base.error / 5, (ex.base.error, ex.final.error)
+    assert ex.final.fit.estimates["e_c1"] == pytest.approx(0.5, rel=0.05)
+    assert ex.final.fit.estimates["e_s1"] == pytest.approx(0.3, rel=0.05)
+    assert ex.final.fit.bias["x_ddot"] == pytest.approx(offset, abs=3 * ex.final.fit.bias_stderr["x_ddot"])
+    data = json_safe(ex.as_dict())
+    assert data["bias_by_default"] == ["x_ddot"]
+    page = report_page(ex, one_stage, augment(one_stage, ex.effects), data, ())
+    assert ("and the offsets of x_ddot, fitted by default: an acceleration's steady mean is zero for bounded "
+            "motion, so a constant offset is the sensor's bias") in page
+
+
+def test_only_channels_of_accelerations_get_an_offset_by_default(tmp_path):
+    from gearsym.fit.explain import acceleration_channels
+
+    flexible = conftest.system("flexible_shaft")
+    tau = np.linspace(0, 30 * np.pi, 301)
+    columns = {"x1": np.sin(tau), "x1_ddot": -np.sin(tau), "v2": np.cos(tau), "x2_dot": np.cos(tau),
+               "acc": -np.sin(tau), "mix": np.sin(tau)}
+    path = tmp_path / "channels.csv"
+    path.write_text("\n".join([",".join(["tau", *columns])] + [
+        ",".join([repr(float(t)), *(repr(float(c[i])) for c in columns.values())]) for i, t in enumerate(tau)]) + "\n")
+    data = load_measurements([path], flexible, channels={"acc": "r1*x1_ddot + 0.5*x2_ddot", "mix": "x1_ddot + x2"})
+    assert acceleration_channels(data, flexible) == ("x1_ddot", "acc")
 
 
 def test_an_additive_third_stiffness_harmonic_is_named_with_its_order_amplitude_and_phase(one_stage, rig_runs, tmp_path):

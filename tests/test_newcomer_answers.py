@@ -178,9 +178,22 @@ def test_a_user_model_writes_docs_and_c_beside_the_user_not_into_the_installed_t
         shutil.rmtree(REPO_ROOT / "generated" / "my_oscillator", ignore_errors=True)
 
 
-def test_shipped_models_keep_writing_into_the_repository(tmp_path, monkeypatch):
+def test_shipped_models_run_from_a_scratch_folder_write_into_it_not_into_the_installed_tree(tmp_path):
+    before = repository_state()
+    for command in (["docs", "flexible_shaft"], ["compile", "one_stage", "lorenz", "--no-compile"]):
+        proc = subprocess.run([sys.executable, "-m", "gearsym.cli", *command], cwd=tmp_path, capture_output=True,
+                              text=True, env={**os.environ, "PYTHONPATH": str(REPO_ROOT)})
+        assert proc.returncode == 0, proc.stderr
+    assert (tmp_path / "docs" / "derivations" / "flexible_shaft.md").read_bytes() == \
+        (REPO_ROOT / "docs" / "derivations" / "flexible_shaft.md").read_bytes()  # (the committed page, here)
+    for name in ("one_stage", "lorenz"):
+        assert (tmp_path / "generated" / name / f"{name}.c").read_bytes() == \
+            (REPO_ROOT / "generated" / name / f"{name}.c").read_bytes()
+    assert repository_state() == before
+
+
+def test_the_default_output_folder_is_the_current_one_for_every_model(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    assert output_root("one_stage") == REPO_ROOT
-    assert output_root(str(REPO_ROOT / "models" / "one_stage.py")) == REPO_ROOT
     (tmp_path / "m.py").write_text(USER_MODEL)
-    assert output_root("m.py") == tmp_path and output_root(gearsym.load_model("m.py")) == tmp_path
+    for ref in ("one_stage", str(REPO_ROOT / "models" / "one_stage.py"), "m.py", gearsym.load_model("m.py")):
+        assert output_root(ref) == tmp_path

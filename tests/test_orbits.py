@@ -255,3 +255,19 @@ def test_a_linear_regimes_period_doubling_has_a_vertical_period_two_branch_and_n
     assert np.ptp(doubled.values) < 1e-9 and doubled.values[0] == pytest.approx(pd.value, abs=1e-9)
     assert np.ptp(doubled.amplitude[:, 0]) > doubled.amplitude[0, 0]  # it goes up the line
     assert not result.of_kind(FOLD), [(f.value, f.branch) for f in result.of_kind(FOLD)]
+
+
+# ------------------------------------------------------------------ (g) into the interval from either end
+def test_the_continuation_goes_through_the_interval_from_either_end_and_finds_the_same_curve():
+    """k = 1 + 0.2 cos(tau): from omega = 0.1 the branch went back out through 0.1 after 8 points (the corrector
+    had converged behind the start), from 2.0 it came back to 2.0. Each way, the first branch must reach the
+    other end, and the two traversals of the one curve must locate the same folds."""
+    model = compile_model(system("one_stage", k="1 + 0.2*cos(tau)"), Integration())  # (as test_engine_invariants)
+    ends = {}
+    for start, stop in ((0.1, 2.0), (2.0, 0.1)):
+        c = continue_orbits(model, "omega", start, stop, switch_depth=0)
+        first = c.branches[0]
+        assert first.values[0] == start and first.values[-1] == stop and first.end == f"reached omega={stop:g}"
+        assert min(first.values) == 0.1 and max(first.values) == 2.0
+        ends[start] = sorted(b.value for b in c.of_kind(FOLD))
+    assert len(ends[0.1]) == 8 and ends[0.1] == pytest.approx(ends[2.0], abs=1e-7)

@@ -270,3 +270,35 @@ def test_derive_json_lists_each_loop_closing_deflection_with_its_combination(cap
     closing = json.loads(capsys.readouterr().out)["closing"]
     assert [(c["name"], c["coupling"], c["combination"]) for c in closing] == [
         ("y2", "ring_planet2", "x1 - x2 + y1"), ("y3", "ring_planet3", "x1 - x3 + y1")]
+
+
+def test_the_modes_table_keeps_its_columns_apart_and_prints_rounding_as_zero(capsys):
+    """It ran columns together ('elastic x2-1.099e-16 2.192e-16') and printed 1e-16 where the docs say 0."""
+    from gearsym.cli import main
+
+    assert main(["modes", "planetary"]) == 0
+    header, *rows = [line for line in capsys.readouterr().out.splitlines()
+                     if "|" in line and not line.startswith("shapes")]
+    names = header.split("|")[0].split()[2:] + header.split("|")[1].split()
+    for row in rows:
+        left, right = row.split("|")
+        cells = left.split()[1:] + right.split()  # (after the frequency)
+        kind_words = 2 if "x2" in cells[:2] else 1
+        values = cells[kind_words:]
+        assert len(values) == len(names), f"columns run together: {row!r}"
+        assert not any("e-1" in v for v in values), f"rounding printed as a number: {row!r}"
+    planet_mode = next(r for r in rows if "elastic x2" in r).split("|")[0].split()
+    assert planet_mode[3:5] == ["0", "0"]  # the sun and the carrier at rest
+    from gearsym.cli.modes import shown, table_row
+
+    wide = [shown(-1.2345678e-5)] * 3  # ten characters each
+    assert table_row("0  rigid", wide, wide).split() == ["0", "rigid", *wide, "|", *wide]
+
+
+def test_model_module_gives_a_shipped_models_builder_wherever_gearsym_runs(tmp_path, monkeypatch):
+    """planetary.md's `from models.planetary import build` fails outside the clone."""
+    monkeypatch.chdir(tmp_path)
+    planetary = gearsym.model_module("planetary")
+    assert callable(planetary.build) and planetary.model is gearsym.load_model("planetary")
+    with pytest.raises(gearsym.GearsymError, match="takes the name of a model"):
+        gearsym.model_module("models/planetary.py")

@@ -31,8 +31,12 @@ SHORT = dict(options=Integration(periods=60, discard=20), progress=False)
 SLOW = ["one_stage", "--param", "omega=0.8:1.06:0.01", "--param", "B1=3.5,3.75,4", "--periods", "1500", "--discard",
         "100", "--jobs", "3", "--parallel", "processes", "--quiet"]
 PLANNED = 81
+#: gearsym on a machine of three cores or more, whatever this one has (it runs no more workers than cores; these
+#: tests are about three workers' processes, not their speed)
+THREE_CORES = "import sys, gearsym.sweep.run as run; cores = run.cores; run.cores = lambda: max(3, cores()); "
+COMMAND = ("-c", THREE_CORES + "from gearsym.cli import main; sys.exit(main(sys.argv[1:]))")
 #: a gearsym whose workers cannot ask the kernel to end them: the portable way (macOS) is used
-WITHOUT_PDEATHSIG = ("import sys, gearsym.sweep.run as run; run._kernel_ends_orphans = lambda: False; "
+WITHOUT_PDEATHSIG = (THREE_CORES + "run._kernel_ends_orphans = lambda: False; "
                      "from gearsym.cli import main; sys.exit(main(sys.argv[1:]))")
 
 needs_fork = pytest.mark.skipif("fork" not in multiprocessing.get_all_start_methods() or not Path("/proc").is_dir(),
@@ -44,7 +48,7 @@ def one_stage():
     return conftest.compiled("one_stage")
 
 
-def gearsym(*args: str, python: tuple[str, ...] = ("-m", "gearsym.cli"), **kwargs) -> subprocess.Popen:
+def gearsym(*args: str, python: tuple[str, ...] = COMMAND, **kwargs) -> subprocess.Popen:
     """``gearsym ARGS`` in a process of its own, on this checkout and the session's library cache."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
     return subprocess.Popen([sys.executable, *python, *args], env=env, text=True, **kwargs)
@@ -61,7 +65,7 @@ def sweep_process(tmp_path):
     Workers still alive at the end (a failed test) are killed, not left to run on."""
     workers: list[int] = []
 
-    def start(out: Path, python=("-m", "gearsym.cli")) -> tuple[subprocess.Popen, list[int], Path]:
+    def start(out: Path, python=COMMAND) -> tuple[subprocess.Popen, list[int], Path]:
         err = out.with_suffix(".stderr")
         with open(err, "w") as stderr:
             proc = gearsym("sweep", *SLOW, "--out", str(out), python=python, stdout=subprocess.DEVNULL,

@@ -191,10 +191,23 @@ def test_an_unknown_way_to_run_in_parallel_is_refused(one_stage):
 def test_resuming_with_other_options_says_what_differs(tmp_path, one_stage):
     out = tmp_path / "s.csv"
     run_sweep(one_stage, ["omega=1,1.1"], out=out, **SHORT)
-    with pytest.raises(GearsymError, match="different sweep.*periods: 60 before, 80 now.*--overwrite"):
+    with pytest.raises(GearsymError, match="different sweep.*periods: 60 before, 80 now") as refused:
         run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80), progress=False)
+    assert str(refused.value).endswith("repeat the call it came from; to start again pass overwrite=True or choose "
+                                       "another out")  # (Python's spelling: no --flags)
     run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80), progress=False, overwrite=True)
     assert read_sweep(out).record["periods"] == 80
+
+
+def test_the_command_line_advises_its_own_flags_where_python_is_advised_keywords(tmp_path, capsys):
+    """sweeps.md's Python example after its CLI example was told to 'pass --overwrite'."""
+    out = tmp_path / "d2.csv"
+    short = ["--periods", "30", "--discard", "10", "--quiet", "--jobs", "1"]
+    assert main(["sweep", "one_stage", "--param", "omega=1,1.1", "--out", str(out), *short]) == 0
+    assert main(["sweep", "one_stage", "--param", "omega=1.3,1.31", "--out", str(out), *short]) == 2
+    err = capsys.readouterr().err
+    assert "repeat the command it came from; to start again pass --overwrite or choose another --out" in err
+    assert "overwrite=True" not in err and "out=" not in err.replace("--out", "")
 
 
 def test_a_cache_of_sweeps_starts_again_what_another_sweep_wrote_and_resumes_its_own(tmp_path, one_stage):

@@ -68,15 +68,19 @@ def test_a_batch_of_runs_is_summarised_exactly_as_each_run_alone(one_stage):
         measured = run.log_stretch[:, RUN.discard:] / periods[i]  # the definitions, written out independently
         order = np.argsort(-measured.mean(axis=1))
         means = np.array([b.mean(axis=1) for b in np.array_split(measured, 10, axis=1)])
-        assert np.allclose(batch.exponents[i], measured.mean(axis=1)[order], rtol=1e-13, atol=1e-16)
-        assert np.allclose(batch.stderr[i], means.std(axis=0, ddof=1)[order] / np.sqrt(10), rtol=1e-10, atol=1e-16)
+        expected, errors = measured.mean(axis=1)[order], means.std(axis=0, ddof=1)[order] / np.sqrt(10)
+        alone_ = [k for k in range(len(order)) if not any(k in pair for pair in batch.pairs[i])]
+        for a, b in batch.pairs[i]:  # one rotating pair: both its exponents are the pair's mean (analysis/pairs.py)
+            expected[[a, b]] = expected[[a, b]].mean()
+        assert np.allclose(batch.exponents[i], expected, rtol=1e-13, atol=1e-16)
+        assert np.allclose(batch.stderr[i][alone_], errors[alone_], rtol=1e-10, atol=1e-16)
         assert batch.amplitude[i].tolist() == ((run.high[:, RUN.discard:].max(axis=1)
                                                 - run.low[:, RUN.discard:].min(axis=1)) / 2).tolist()
         alone = lyapunov_spectrum(one_stage, options=RUN, omega=omega)
         assert batch.exponents[i].tobytes() == alone.exponents.tobytes()
         assert batch.stderr[i].tobytes() == alone.stderr.tobytes()
         assert batch.amplitude[i].tolist() == list(alone.amplitude.values())
-        assert batch.regimes[i] == alone.regime
+        assert batch.regimes[i] == alone.regime and batch.pairs[i] == list(alone.pairs)
         assert runs.strobe[i, RUN.discard:].T.tobytes() == alone.strobe.tobytes()
 
 
@@ -135,6 +139,7 @@ def test_a_point_that_fails_keeps_the_points_of_its_batch_before_it(tmp_path):
 
 
 def test_an_error_of_the_writer_thread_is_raised_not_lost(tmp_path, one_stage, monkeypatch):
+    from gearsym.errors import GearsymError
     from gearsym.sweep.store import PoincareRows, lock_path
 
     import threading
@@ -147,8 +152,8 @@ def test_an_error_of_the_writer_thread_is_raised_not_lost(tmp_path, one_stage, m
         return text(self)
 
     monkeypatch.setattr(PoincareRows, "text", full_disk)
-    with pytest.raises(OSError, match="No space left"):
-        run_sweep(one_stage, {"omega": [1.0, 1.2]}, options=RUN, progress=False, out=tmp_path / "s.csv")
+    with pytest.raises(GearsymError, match="No space left on device; the 0 points before are kept whole"):
+        run_sweep(one_stage, {"omega": [1.0, 1.2]}, options=RUN, progress=False, out=tmp_path / "s.csv")  # (one line)
     assert not lock_path(tmp_path / "s.csv").exists()  # the lock is let go all the same
 
 

@@ -31,10 +31,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..caller import option
 from ..checks import json_safe, whole_number
 from ..codegen import CompiledModel, engine_verb
 from ..options import Integration
 from ..errors import GearsymError, suggest
+from ..memory import check_fits
 from .lyapunov import LyapunovSpectrum, lyapunov_spectrum
 from .regime import classify_regime
 
@@ -57,7 +59,8 @@ MAX_PERIOD = 64
 RUN = {"periods": 500, "discard": 300}
 
 #: the paper's labels in Fig. 4: '1' a regular attractor, '2' a chaotic one
-PAPER_LABELS = {"periodic": "1", "quasi-periodic": "1", "equilibrium": "1", "chaotic": "2", "hyperchaotic": "2"}
+PAPER_LABELS = {"periodic": "1", "quasi-periodic": "1", "equilibrium": "1", "undetermined": "1", "chaotic": "2",
+                "hyperchaotic": "2"}
 
 
 @dataclass(frozen=True)
@@ -249,7 +252,7 @@ def find_attractors(
         starts = _explicit_states(compiled, initial_states)
         used_seed, used_box = None, None
     else:
-        ics = whole_number(ics, "ics (the number of initial states)", 1)
+        ics = check_ics(ics, compiled.dimension, options.periods)
         seed = whole_number(seed, "seed")
         used_box = _full_box(compiled.state_names, box)
         low, high = (np.array([used_box[s][i] for s in compiled.state_names]) for i in (0, 1))
@@ -266,6 +269,15 @@ def find_attractors(
 
 
 # ------------------------------------------------------------------------------------------ inputs
+def check_ics(ics, dimension: int, periods: int) -> int:
+    """``ics`` as a count of initial states whose runs fit in memory together: each keeps its stroboscopic states
+    and its exponents' running estimates over its ``periods`` until the runs are grouped."""
+    ics = whole_number(ics, "ics (the number of initial states)", 1)
+    check_fits(ics, 8 * dimension * (2 * periods + 1), asked=option("ics", ics), item="initial state",
+               what="each run's Poincare points and exponents kept for the grouping")
+    return ics
+
+
 def _full_box(states: Sequence[str], box: Mapping[str, tuple[float, float]] | None) -> dict[str, tuple[float, float]]:
     """Every state's (low, high): the caller's, or DEFAULT_BOX; names and bounds checked."""
     full = {s: DEFAULT_BOX for s in states}
@@ -299,11 +311,15 @@ def _explicit_states(compiled: CompiledModel, initial_states) -> np.ndarray:
 
 def _run(compiled: CompiledModel, p: np.ndarray, y0: np.ndarray, index: int,
          options: Integration) -> LyapunovSpectrum:
+    start = ", ".join(f"{n}={v:g}" for n, v in zip(compiled.state_names, y0))
     try:
-        return lyapunov_spectrum(compiled, options=options, y0=y0, **dict(zip(compiled.parameter_names, p)))
+        spectrum = lyapunov_spectrum(compiled, options=options, y0=y0, **dict(zip(compiled.parameter_names, p)))
     except GearsymError as exc:
-        start = ", ".join(f"{n}={v:g}" for n, v in zip(compiled.state_names, y0))
         raise GearsymError(f"initial state #{index} ({start}): {exc}") from exc
+    if spectrum.divergence is not None:  # no attractor to group it with
+        raise GearsymError(f"initial state #{index} ({start}): the motion diverged: "
+                           f"{spectrum.divergence.describe(spectrum.period)}; start from a smaller box")
+    return spectrum
 
 
 # ------------------------------------------------------------------------------------------ grouping
@@ -431,6 +447,17 @@ def orbit_period(strobes: Sequence[np.ndarray], scale: np.ndarray) -> int | None
 
 
 # ------------------------------------------------------------------------------------------ results
+def _group_regime(regime: str, runs: Sequence[LyapunovSpectrum]) -> str:
+    """The regime of the members' mean spectrum, where the exponents cannot decide (quasi-periodic) decided as
+    each member's Poincare points did (gearsym.analysis.regime): a torus only if every member says so,
+    periodic if every member settled on its orbit, undetermined otherwise."""
+    if regime != "quasi-periodic" or any(r.settling is None for r in runs):
+        return regime
+    if all(r.regime == "periodic" for r in runs):
+        return "periodic"
+    return regime if all(r.settling.decides for r in runs) else "undetermined"
+
+
 def _assemble(compiled, p, starts, spectra, groups, scale, periods, discard, seed, box, grouping) -> AttractorSet:
     names = compiled.state_names
     autonomous = bool(getattr(compiled.system, "autonomous", False))
@@ -445,7 +472,7 @@ def _assemble(compiled, p, starts, spectra, groups, scale, periods, discard, see
         points = np.hstack([r.strobe for r in runs])
         exponents = np.mean([r.exponents for r in runs], axis=0)
         stderr = np.sqrt(np.sum([np.square(r.stderr) for r in runs], axis=0)) / len(runs)
-        regime = classify_regime(exponents, stderr, measured_time, autonomous)
+        regime = _group_regime(classify_regime(exponents, stderr, measured_time, autonomous), runs)
         period = orbit_period([r.strobe for r in runs], scale) if regime == "periodic" else None
         amplitude = {k: float(np.mean([r.amplitude[k] for r in runs])) for k in runs[0].amplitude}
         drafts.append(dict(members=tuple(members), points=points, exponents=exponents, stderr=stderr,
@@ -459,7 +486,7 @@ def _assemble(compiled, p, starts, spectra, groups, scale, periods, discard, see
     results = tuple(
         InitialConditionResult(
             index=i, initial_state=state(y0), attractor=number[i], exponents=r.exponents, stderr=r.stderr,
-            regime=classify_regime(r.exponents, r.stderr, measured_time, autonomous), amplitude=r.amplitude,
+            regime=r.regime, amplitude=r.amplitude,
             final_state=r.final_state, strobe=r.strobe)
         for i, (y0, r) in enumerate(zip(starts, spectra)))
     first = spectra[0]

@@ -10,9 +10,16 @@ An autonomous run that never leaves a fixed point (Lorenz started at the
 origin) has exponents too, the real parts of the Jacobian's eigenvalues there,
 and a positive one says the point is unstable, not that the motion is chaotic:
 such a run is reported as an ``equilibrium`` with those eigenvalues, exactly.
+
+Before any regime, a run that grew without bound is reported as ``diverged`` (the rule:
+:mod:`gearsym.analysis.divergence`); two exponents of one rotating plane (a complex pair of Floquet
+multipliers) are reported as their common real part (:mod:`gearsym.analysis.pairs`); and where the largest
+exponent cannot be told from zero, the Poincare points decide between a torus and a transient, or say
+``undetermined`` and how many periods would decide (:mod:`gearsym.analysis.regime`).
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -21,7 +28,10 @@ from ..checks import json_safe
 from ..codegen import CompiledModel, TangentRuns, engine_verb
 from ..errors import warn
 from ..options import Integration
-from .regime import EQUILIBRIUM, classify_regime, classify_regimes
+from .divergence import Divergence, counted_coordinates, find_divergence, run_failure
+from .pairs import merge_pairs
+from .regime import DIVERGED, EQUILIBRIUM, UNDETERMINED, classify_regimes, periods_to_decide, zero_band
+from .settling import Settling, poincare_settling
 from .statistics import batch_means_stderr
 
 #: a run rests on a fixed point when, over the measured periods, the state moves by no more than this and
@@ -35,8 +45,8 @@ class LyapunovSpectrum:
 
     model: str
     parameters: dict[str, float]
-    exponents: np.ndarray  # descending, per unit time
-    stderr: np.ndarray  # batch-means standard error of each exponent
+    exponents: np.ndarray  # descending, per unit time (a rotating pair's two: their common real part)
+    stderr: np.ndarray  # batch-means standard error of each exponent (a pair's: with its finite-time bias)
     history: np.ndarray  # (measured periods, n): running estimates after each period
     amplitude: dict[str, float]  # A = (max - min)/2 of each relative coordinate over the measured periods
     final_state: dict[str, float]
@@ -49,6 +59,13 @@ class LyapunovSpectrum:
     autonomous: bool = False  # time-free equations: one exponent is zero along the flow
     info: dict = field(default_factory=dict)
     eigenvalues: np.ndarray | None = None  # of the Jacobian at the fixed point the run rested on, if it did
+    #: periodic, quasi-periodic, chaotic or hyperchaotic (see :mod:`gearsym.analysis.regime`); equilibrium for a
+    #: run at rest on a fixed point, stable or not; undetermined where neither the exponents nor the Poincare
+    #: points decide; diverged for a run that grew without bound (``divergence`` says how)
+    regime: str = ""
+    pairs: tuple[tuple[int, int], ...] = ()  # (0-based) exponents reported as one rotating pair's real part
+    divergence: Divergence | None = None
+    settling: Settling | None = None  # what the Poincare points did, where the exponents needed them
 
     @property
     def at_rest(self) -> bool:
@@ -61,12 +78,13 @@ class LyapunovSpectrum:
         return (self.periods - self.discard) * self.period
 
     @property
-    def regime(self) -> str:
-        """periodic, quasi-periodic, chaotic or hyperchaotic (see :mod:`gearsym.analysis.regime`);
-        equilibrium for a run at rest on a fixed point, stable or not."""
-        if self.at_rest:
-            return EQUILIBRIUM
-        return classify_regime(self.exponents, self.stderr, self.measured_time, self.autonomous)
+    def periods_to_decide(self) -> int | None:
+        """An undetermined run: the measured periods that would put lambda_1 outside the zero band (None
+        otherwise; see :func:`gearsym.analysis.regime.periods_to_decide`)."""
+        if self.regime != UNDETERMINED:
+            return None
+        rate = self.settling.rate if self.settling is not None else None
+        return periods_to_decide(self.exponents[0], self.stderr[0], self.measured_time, self.period, rate)
 
     @property
     def sum(self) -> float:
@@ -94,6 +112,9 @@ class LyapunovSpectrum:
             "sum": self.sum,
             "kaplan_yorke_dimension": json_safe(self.kaplan_yorke_dimension),
             "regime": self.regime,
+            "pairs": [[i + 1, j + 1] for i, j in self.pairs],  # lambda_i = lambda_j: one complex pair's real part
+            "divergence": None if self.divergence is None else self.divergence.as_dict(),
+            "periods_to_decide": self.periods_to_decide,
             "equilibrium": None if not self.at_rest else {  # the exponents are the real parts of these
                 "state": self.final_state,
                 "eigenvalues": [{"re": float(e.real), "im": float(e.imag)} for e in self.eigenvalues],
@@ -128,16 +149,23 @@ def lyapunov_spectrum(model: CompiledModel, *, options: Integration | None = Non
         warn(f"{model.name}: the initial state ({start}) is a fixed point, so the run stays there; "
              "give another initial state (initial=... in the model, y0=... or --y0)")
     runs = TangentRuns(model.dimension, len(model.observed), options.periods, 1)
-    run = model.tangent_run(y0, options.periods, inputs, out=runs.slot(0))
+    start = model.initial_state(y0)
+    run = model.tangent_run(start, options.periods, inputs, out=runs.slot(0), check_finite=False)
     summary = summarise_runs(model, runs, p[None, :], np.array([inputs.period]), options.discard)
+    failure = run_failure(model, p, inputs.period, start, runs.strobe[0], runs.log_stretch[0], summary.divergences[0])
+    if failure is not None:
+        raise failure
     measured = runs.log_stretch[0, options.discard:] / inputs.period  # (measured periods, n), each period
     history = np.cumsum(measured, axis=0) / np.arange(1, measured.shape[0] + 1)[:, None]
+    history = history[:, summary.order[0]]
+    for i, j in summary.pairs[0]:  # a pair's running estimate: its common real part's
+        history[:, [i, j]] = history[:, [i, j]].mean(axis=1, keepdims=True)
     return LyapunovSpectrum(
         model=model.name,
         parameters=dict(zip(model.parameter_names, map(float, p))),
         exponents=summary.exponents[0],
         stderr=summary.stderr[0],
-        history=history[:, summary.order[0]],
+        history=history,
         amplitude=dict(zip(model.observed, map(float, summary.amplitude[0]))),
         final_state=dict(zip(model.state_names, map(float, runs.strobe[0, -1]))),
         strobe=run.strobe[:, options.discard:],
@@ -149,6 +177,10 @@ def lyapunov_spectrum(model: CompiledModel, *, options: Integration | None = Non
         autonomous=model.system.autonomous,
         info={"Q": run.Q, "locate_crossings": model.options.locate_crossings},
         eigenvalues=summary.eigenvalues[0],
+        regime=summary.regimes[0],
+        pairs=tuple(summary.pairs[0]),
+        divergence=summary.divergences[0],
+        settling=summary.settlings[0],
     )
 
 
@@ -162,6 +194,9 @@ class RunsSummary:
     amplitude: np.ndarray  # (runs, observed): A = (max - min)/2 over the measured periods
     eigenvalues: list  # per run: the Jacobian's eigenvalues at the fixed point it rested on (sorted), or None
     regimes: list[str]
+    pairs: list  # per run: the (i, i + 1) reported as one rotating pair's common real part
+    divergences: list  # per run: its Divergence, or None
+    settlings: list  # per run: its Poincare points' Settling where the exponents could not decide, or None
 
 
 def summarise_runs(model: CompiledModel, runs: TangentRuns, p: np.ndarray, period: np.ndarray,
@@ -171,23 +206,50 @@ def summarise_runs(model: CompiledModel, runs: TangentRuns, p: np.ndarray, perio
     array operations serves them all: a sweep summarises its points in batches, and
     :func:`lyapunov_spectrum` is the batch of one."""
     count = len(p)
+    autonomous = model.system.autonomous
     measured = runs.log_stretch[:count, discard:] / period[:, None, None]  # per unit time, each period
-    exponents = measured.mean(axis=1)
-    stderr = batch_means_stderr(measured, axis=1)
+    with np.errstate(invalid="ignore", over="ignore"):  # (a run that diverged: judged below)
+        exponents = measured.mean(axis=1)
+        stderr = batch_means_stderr(measured, axis=1)
+    finite = np.isfinite(runs.strobe[:count]).all(axis=(1, 2)) & np.isfinite(exponents).all(axis=1)
     eigenvalues = [_fixed_point_eigenvalues(model, runs.strobe[i, discard:], runs.low[i, discard:],
-                                            runs.high[i, discard:], p[i]) for i in range(count)] \
-        if model.system.autonomous else [None] * count
+                                            runs.high[i, discard:], p[i]) if finite[i] else None
+                   for i in range(count)] if autonomous else [None] * count
     for i, values in enumerate(eigenvalues):
         if values is not None:  # the exponents of a fixed point, exactly
             exponents[i], stderr[i] = values.real, 0.0
-    order = np.argsort(-exponents, axis=1, kind="stable")
+    order = np.argsort(-np.nan_to_num(exponents, nan=-np.inf), axis=1, kind="stable")
     exponents, stderr = (np.take_along_axis(a, order, axis=1) for a in (exponents, stderr))
     eigenvalues = [None if e is None else e[o] for e, o in zip(eigenvalues, order)]
+    pairs = [[] for _ in range(count)]
+    for i in range(count):
+        if finite[i] and eigenvalues[i] is None:
+            exponents[i], stderr[i], pairs[i] = merge_pairs(measured[i][:, order[i]], exponents[i], stderr[i])
     measured_time = (runs.log_stretch.shape[1] - discard) * period
-    regimes = classify_regimes(exponents, stderr, measured_time, model.system.autonomous)
-    regimes = [EQUILIBRIUM if e is not None else r for e, r in zip(eigenvalues, regimes)]
-    amplitude = (runs.high[:count, discard:].max(axis=1) - runs.low[:count, discard:].min(axis=1)) / 2
-    return RunsSummary(exponents, stderr, order, amplitude, eigenvalues, regimes)
+    band = zero_band(stderr, measured_time[:, None])
+    contracting = np.where(finite, exponents[:, 0] < -band[:, 0], False)
+    counted = functools.partial(counted_coordinates, model)
+    divergences = [find_divergence(runs.strobe[i], runs.low[i], runs.high[i], model.state_names, model.observed,
+                                   discard, bool(contracting[i]), counted) for i in range(count)]
+    live = [i for i in range(count) if divergences[i] is None and np.isfinite(exponents[i]).all()]
+    regimes, settlings = [DIVERGED if d is not None else FAILED for d in divergences], [None] * count
+    if live:
+        exps = classify_regimes(exponents[live], stderr[live], measured_time[live], autonomous)
+        for i, r in zip(live, exps):
+            if r == "quasi-periodic" and not autonomous and eigenvalues[i] is None:
+                settlings[i] = poincare_settling(runs.strobe[i, discard:], period[i])
+        regimes_live = classify_regimes(exponents[live], stderr[live], measured_time[live], autonomous,
+                                        [settlings[i] for i in live])
+        for i, r in zip(live, regimes_live):
+            regimes[i] = EQUILIBRIUM if eigenvalues[i] is not None else r
+    with np.errstate(invalid="ignore", over="ignore"):
+        amplitude = (runs.high[:count, discard:].max(axis=1) - runs.low[:count, discard:].min(axis=1)) / 2
+    return RunsSummary(exponents, stderr, order, amplitude, eigenvalues, regimes, pairs, divergences, settlings)
+
+
+#: the regime of a run whose tangent vectors became non-finite while its state did not (an error for the caller:
+#: :func:`gearsym.analysis.divergence.run_failure`)
+FAILED = "failed"
 
 
 def _rests(compiled, y: np.ndarray, p: np.ndarray) -> bool:

@@ -76,9 +76,12 @@ class Modes:
 
 def physical_modes(scaling, formulas: Mapping[str, object] | None = None) -> Modes:
     """The natural modes of a scaled drivetrain (a :class:`~gearsym.scales.map.Scaling`), in Hz; ``formulas``
-    replace mesh stiffness functions (their mean is what a linear, time-averaged system sees)."""
+    (default the scaling's own) replace mesh stiffness functions (their mean is what a linear, time-averaged
+    system sees)."""
     nd = scaling.model
-    return _solve(nd, dict(scaling.si_values), "Hz", (), _formula_means(nd, formulas or {}, scaling.values))
+    formulas = scaling.functions if formulas is None else formulas
+    values = {**scaling.values, **scaling.formula_values}
+    return _solve(nd, dict(scaling.si_values), "Hz", (), _formula_means(nd, formulas, values))
 
 
 def nondimensional_modes(nd, settings: Mapping[str, object]) -> Modes:
@@ -98,7 +101,7 @@ def _formula_means(nd, formulas: Mapping[str, object], values: Mapping[str, floa
     for f in nd.functions:
         if f.name not in formulas:
             continue
-        new = nd._function_expr(f, formulas[f.name])
+        new = nd.stiffness_formula(f, formulas[f.name])
         period = float(f.period)
         where = f"stiffness function {f.name}"
         old = mean_over(f.expression, tau, period, values, where)

@@ -16,8 +16,24 @@ left out first (``equilibrium`` when there is none: every exponent negative).
 "Zero" is decided with the measurement's own uncertainty: an exponent counts
 as zero when |lambda| <= max(3 stderr, 5 / measured time). The second term is
 the finite-time bias of a zero exponent, which decays only like 1/T (a bounded
-tangent vector stretch over time T). So a point on a bifurcation, where lambda_1
-passes through zero, is reported quasi-periodic: the spectrum cannot tell the two apart.
+tangent vector stretch over time T).
+
+Two verdicts are not regimes of an attractor:
+
+* ``diverged``: the run grew without bound (:mod:`gearsym.analysis.divergence`); decided first, and then
+  no regime is given.
+* ``undetermined``: the largest exponent lies in the zero band, so the exponents cannot tell a torus
+  (lambda_1 = 0) from a weakly stable orbit not reached yet (or a weakly unstable one), and the Poincare
+  points do not show a torus either: they still converge or spread (a transient), or scatter too much to say
+  (:mod:`gearsym.analysis.settling`). With the points stationary (their distance at a return changes by less
+  than 10 % over the run, at its fitted rate plus two standard errors) the verdict is ``quasi-periodic`` (a
+  torus, or a point on a bifurcation, at the run's resolution); with the points repeating to rounding it is
+  ``periodic``. :func:`periods_to_decide` says how many measured periods would decide: with the points
+  converging at a rate r (which estimates lambda_1: the slowest decay), T' = 10 / |r|, after which the
+  transient has decayed by exp(-10) and the band's 5/T is |r|/2; otherwise the band's 3 stderr shrinks like
+  1/sqrt(T) and its 5/T like 1/T, so T' = max(T (6 stderr / |lambda_1|)^2, 10 / |lambda_1|) leaves lambda_1
+  twice the band from zero. Autonomous systems keep the rule of the exponents alone (their stroboscopic
+  points sample a flow, not a map).
 """
 from __future__ import annotations
 
@@ -25,8 +41,14 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .settling import SETTLED_STATE, Settling
+
 REGIMES = ("periodic", "quasi-periodic", "chaotic", "hyperchaotic")
 EQUILIBRIUM = "equilibrium"  # autonomous systems only
+UNDETERMINED = "undetermined"  # the exponents cannot decide, and the Poincare points show a transient
+DIVERGED = "diverged"  # unbounded growth: no regime
+#: every verdict a run can get
+VERDICTS = (*REGIMES, EQUILIBRIUM, UNDETERMINED, DIVERGED)
 
 #: an exponent within this many standard errors of zero counts as zero
 ZERO_SIGMAS = 3.0
@@ -41,8 +63,23 @@ def zero_band(stderr: Sequence[float], measured_time) -> np.ndarray:
 
 
 def classify_regime(exponents: Sequence[float], stderr: Sequence[float], measured_time: float,
-                    autonomous: bool = False) -> str:
-    """The regime name for one spectrum; ``measured_time`` is the time the exponents were averaged over."""
+                    autonomous: bool = False, settling: Settling | None = None) -> str:
+    """The regime name for one spectrum; ``measured_time`` is the time the exponents were averaged over.
+    ``settling``: what the Poincare points did (a forced system's), which decides where the exponents
+    cannot (``quasi-periodic``, ``undetermined`` or ``periodic``, see the module's docstring)."""
+    return _settled(_classify(exponents, stderr, measured_time, autonomous), settling, autonomous)
+
+
+def _settled(regime: str, settling: Settling | None, autonomous: bool) -> str:
+    """The exponents' ``regime`` with what the Poincare points say where the exponents cannot decide."""
+    if regime != "quasi-periodic" or settling is None or autonomous:
+        return regime
+    if settling.state == SETTLED_STATE:
+        return "periodic"
+    return regime if settling.decides else UNDETERMINED
+
+
+def _classify(exponents: Sequence[float], stderr: Sequence[float], measured_time: float, autonomous: bool) -> str:
     lam = np.asarray(exponents, dtype=float)
     band = zero_band(stderr, measured_time)
     if lam.shape != band.shape or lam.ndim != 1 or lam.size == 0:
@@ -58,16 +95,38 @@ def classify_regime(exponents: Sequence[float], stderr: Sequence[float], measure
 
 
 def classify_regimes(exponents: np.ndarray, stderr: np.ndarray, measured_time: np.ndarray,
-                     autonomous: bool = False) -> list[str]:
+                     autonomous: bool = False, settlings: Sequence[Settling | None] | None = None) -> list[str]:
     """:func:`classify_regime` of many spectra at once (rows of ``exponents``/``stderr``, one measured time
-    each): a sweep's batch of points in a few array operations."""
+    each, and a settling each or None): a sweep's batch of points in a few array operations."""
     lam = np.asarray(exponents, dtype=float)
+    settlings = settlings if settlings is not None else [None] * len(lam)
     if autonomous or lam.size == 0:  # (the flow exponent is left out point by point)
         return [classify_regime(*row, autonomous) for row in zip(lam, stderr, measured_time)]
     band = zero_band(stderr, np.asarray(measured_time, dtype=float)[:, None])
     if not (np.isfinite(lam).all() and np.all(measured_time > 0)):
         raise ValueError("exponents must be finite and the measured time positive")
-    return _by_signs(lam, band)
+    return [_settled(r, s, autonomous) for r, s in zip(_by_signs(lam, band), settlings)]
+
+
+#: a run that would need more than this many times its measured periods to decide: none said
+FARTHEST = 1000
+
+
+def periods_to_decide(exponent: float, stderr: float, measured_time: float, period: float,
+                      rate: float | None = None) -> int | None:
+    """Measured periods after which the run would decide (see the module's docstring): with the Poincare points
+    converging at ``rate`` (< 0), 2 ZERO_BIAS / |rate| (the transient has decayed by exp(-10), and the zero
+    band's 1/T part is half the rate); otherwise those after which ``exponent`` would lie twice the zero band
+    from zero, its error falling like 1/sqrt(T). None if that is more than FARTHEST times this run."""
+    if rate is not None and np.isfinite(rate) and rate < 0:
+        needed = 2 * ZERO_BIAS / abs(rate)
+    else:
+        size = abs(float(exponent))
+        if not size > 0 or not np.isfinite(size):
+            return None
+        err = float(stderr) if np.isfinite(stderr) else 0.0
+        needed = max(measured_time * (2 * ZERO_SIGMAS * err / size) ** 2, 2 * ZERO_BIAS / size)
+    return int(np.ceil(needed / period)) if needed <= FARTHEST * measured_time else None
 
 
 def flow_exponent(exponents: Sequence[float], band: Sequence[float]) -> int | None:
@@ -84,13 +143,20 @@ MEANING = {
     "chaotic": "exactly one exponent above zero",
     "hyperchaotic": "two or more exponents above zero",
     EQUILIBRIUM: "every exponent below zero, none along a flow: the motion comes to rest at a fixed point",
+    UNDETERMINED: "the largest exponent cannot be told from zero in this run, and the Poincare points do not show "
+                  "a torus: a transient, or too few periods to say",
+    DIVERGED: "the motion grew without bound: no attractor, no regime",
 }
 
 
 def describe_regime(regime: str, exponents: Sequence[float], stderr: Sequence[float], measured_time: float,
-                    autonomous: bool = False) -> str:
-    """The regime and what it means, in one line ('zero' is the band of :func:`zero_band`)."""
+                    autonomous: bool = False, settling: Settling | None = None) -> str:
+    """The regime and what it means, in one line ('zero' is the band of :func:`zero_band`); ``settling``: what
+    the Poincare points did, where they decided."""
     meaning = MEANING.get(regime, regime)
+    if settling is not None and regime in ("periodic", "quasi-periodic"):  # the exponents could not decide
+        return (f"{regime}: the largest exponent cannot be told from zero in this run, but {settling.describe()}: "
+                + ("a periodic orbit, reached" if regime == "periodic" else "a torus (or a point on a bifurcation)"))
     flow = flow_exponent(exponents, zero_band(stderr, measured_time)) if autonomous else None
     if flow is None:
         return f"{regime}: {meaning}"

@@ -23,6 +23,7 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from types import ModuleType
 
+from ..caller import command_line
 from ..version import __version__
 from ..errors import GearsymError, GearsymWarning
 
@@ -31,7 +32,7 @@ from ..errors import GearsymError, GearsymWarning
 MODULES = {"list": "list_models", "derive": "derive", "docs": "docs", "compile": "compile", "lyap": "lyap",
            "sweep": "sweep", "orbits": "orbits", "poincare": "poincare", "reproduce": "reproduce",
            "simulate": "simulate", "explain": "explain", "spectrum": "spectrum", "modes": "modes", "campbell": "campbell",
-           "fmu": "fmu"}
+           "fmu": "fmu", "stiffness": "stiffness"}
 
 #: exit status of a GearsymError (argparse uses the same for bad arguments)
 USAGE_ERROR = 2
@@ -69,7 +70,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run ``gearsym`` with ``argv`` (default: the process arguments); returns the exit status."""
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser(argv[0] if argv else None).parse_args(argv)
-    with warnings.catch_warnings(), _sigterm_as_ctrl_c() as terminated:
+    with warnings.catch_warnings(), _sigterm_as_ctrl_c() as terminated, command_line():
         warnings.simplefilter("default", GearsymWarning)
         warnings.showwarning = _one_line
         try:

@@ -13,12 +13,13 @@ from ..figures.campbell import plot_campbell
 from ..files import write_atomically
 from ..outputs import check_figure, check_file
 from ..physical.campbell import campbell
+from ..physical.files import write_physical_table
 from ..physical.sweeps import nondimensional_axis
 from ..sweep import run_sweep, Workers
 from ..sweep.grid import parse_axis
 from ..sweep.store import sidecar
 from .integration import add_integration_arguments, compiled_from, scaling_from
-from .settings import add_set_argument, model_settings
+from .settings import add_set_argument, model_settings, parse_settings, refuse_swept_and_set
 
 NAME = "campbell"
 HELP = "Campbell diagram (natural frequencies, mesh and torque orders, crossings) beside the amplitude over speed"
@@ -33,7 +34,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_integration_arguments(parser, periods=300, discard=200)
     parser.add_argument("--jobs", type=int, default=0, help="processes for the sweep (default 0: every core)")
     parser.add_argument("--out", type=Path, required=True, metavar="FILE.csv",
-                        help="the amplitude sweep (resumed if it exists); FILE.campbell.json holds the diagram")
+                        help="the amplitude sweep (resumed if it exists); FILE.physical.csv the same in the speed's unit, "
+                             "um and 1/s; FILE.campbell.json holds the diagram")
     parser.add_argument("--plot", type=Path, required=True, metavar="FILE.png", help="the figure")
     parser.add_argument("--no-sweep", action="store_true", help="the diagram alone (no amplitude panel)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -52,20 +54,23 @@ def run(args: argparse.Namespace) -> int:
     if axis.name != scaling.speed.parameter:
         raise GearsymError(f"--param {args.param!r}: the Campbell diagram runs along the speed "
                            f"({scaling.speed.parameter}=...), not {axis.name}")
-    unit = axis.unit or str(scaling._speed_quantity().units)
+    refuse_swept_and_set([(axis.name, args.param)], parse_settings(args.set))
+    engine_axis = nondimensional_axis(scaling, axis)  # (a speed without its unit is refused here)
     modes = natural_modes(scaling.model, **model_settings(args))
-    diagram = campbell(scaling, axis.values, unit, modes, args.orders)
+    diagram = campbell(scaling, axis.values, axis.unit, modes, args.orders)
     write_atomically(sidecar(args.out, ".campbell.json"), json.dumps(diagram.as_dict(), indent=2) + "\n")
     print(f"{diagram.model}: natural frequencies " + ", ".join(f"{f:.6g} Hz" for f in diagram.natural_frequencies))
     for c in diagram.crossings:
-        print(f"crossing: {c.order} meets {c.natural_frequency:.6g} Hz at {c.speed:.6g} {unit}")
+        print(f"crossing: {c.order} meets {c.natural_frequency:.6g} Hz at {c.speed:.6g} {axis.unit}")
     sweep = None
     if not args.no_sweep:
         compiled = compiled_from(args)
-        result = run_sweep(compiled, [nondimensional_axis(scaling, axis)], options=compiled.integration,
+        result = run_sweep(compiled, [engine_axis], options=compiled.integration,
                            out=args.out, workers=Workers(args.jobs), progress=not args.quiet)
-        sweep = scaling.to_physical(result)
+        sweep = scaling.to_physical(result, given=[axis])
+        print(f"in physical units: {write_physical_table(sweep, sidecar(args.out, '.physical.csv'))}")
 
-    plot_campbell(diagram, args.plot, sweep)
+    given = dict(setting.split("=", 1) for setting in args.set or () if "=" in setting)
+    plot_campbell(diagram, args.plot, sweep, settings=given)
     print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     return 0

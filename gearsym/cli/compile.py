@@ -22,8 +22,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_set_argument(parser)
     add_integration_arguments(parser, periods=None)
     parser.add_argument("--out", type=Path, default=None, metavar="DIR",
-                        help="where <model>/ is written (default: generated/ of the repository for its own models, "
-                             "of the current directory for others)")
+                        help="where <model>/ is written (default: generated/ of the current directory)")
     parser.add_argument("--no-compile", action="store_true", help="write the C only")
     parser.add_argument("--check", action="store_true",
                         help="write nothing; exit 1 and name the files that differ from what would be written")

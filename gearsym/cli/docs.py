@@ -23,8 +23,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("models", nargs="*", metavar="MODEL", help="model names or model file paths")
     parser.add_argument("--all", action="store_true", help="every model of `gearsym list`")
     parser.add_argument("--out", type=Path, default=None, metavar="DIR",
-                        help="output folder (default: docs/derivations/ of the repository for its own models, "
-                             "of the current directory for others)")
+                        help="output folder (default: docs/derivations/ of the current directory)")
     parser.add_argument("--check", action="store_true",
                         help="write nothing; exit 1 and name the pages that differ from what would be written")
     add_teeth_argument(parser)

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from ..errors import GearsymError
 from ..fit import explain_files
+from ..fit.explain import check_fit_names, check_harmonics
 from ..outputs import check_folder
 from .integration import add_integration_arguments, integration_from, scaling_from, system_from
 from .settings import add_set_argument
@@ -36,9 +37,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--channel", action="append", default=[], metavar="NAME=FORMULA",
                         help="a column that measures a combination, e.g. acc=x1_ddot+0.5*x2_ddot (states, their "
                              "derivatives x_dot and x_ddot, the time and parameters)")
-    parser.add_argument("--bias", default="", metavar="CHANNEL,CHANNEL",
-                        help="channels with an unknown constant offset fitted with the parameters (an "
-                             "accelerometer's: --bias x_ddot)")
+    parser.add_argument("--bias", default=None, metavar="CHANNEL,CHANNEL",
+                        help="channels with an unknown constant offset fitted with the parameters (default: the "
+                             "acceleration channels, x_ddot: bounded motion has zero mean acceleration, so an offset "
+                             "is the sensor's bias; none: no offset)")
     parser.add_argument("--add-term", action="append", default=[], metavar="EXPR",
                         help="a term c*EXPR added to dv/dtau of the mesh coordinate, tried as an effect (a proposal "
                              "of report.json, or your own; g is the mesh's g(x, eta)); repeat for several")
@@ -48,9 +50,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    fit = [p.strip() for p in args.fit.split(",") if p.strip()]
+    fit = check_fit_names([p.strip() for p in args.fit.split(",") if p.strip()])  # before the model is reduced
+    if args.harmonics is not None:
+        check_harmonics(args.harmonics)
     candidates = [e.strip() for e in args.effects.split(",")] if args.effects else None
-    bias = [c.strip() for c in args.bias.split(",") if c.strip()]
+    bias = None if args.bias is None else [c.strip() for c in args.bias.split(",") if c.strip() not in ("", "none")]
     channels = dict(_channel(text) for text in args.channel)
     say = None if args.quiet else (lambda m: print(f"gearsym: {m}", file=sys.stderr, flush=True))
     options = integration_from(args)
@@ -61,6 +65,10 @@ def run(args: argparse.Namespace) -> int:
     added = ", ".join(report["effects"]) or "none"
     print(f"{report['verdict']}: effects added: {added}; held-out error {report['error_before']:.4g} -> "
           f"{report['error_after']:.4g}; unexplained: {'yes' if report['unexplained'] else 'no'}")
+    if report.get("bias_by_default"):
+        offsets = ", ".join(f"{c} {report['bias'][c]:.4g}" for c in report["bias_by_default"])
+        print(f"offset fitted by default (an acceleration's steady mean is zero for bounded motion): {offsets}; "
+              "--bias none fits none")
     for p in report["proposed"][:1]:
         print(f"proposed beyond the library: {p['term']} (held-out error {p['held_out_error']:.4g}); try it with "
               f"--add-term \"{p['term']}\"")

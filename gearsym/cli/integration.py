@@ -36,7 +36,7 @@ def integration_from(args: argparse.Namespace, steps_per_period: int | None = No
     """The command's options, checked before any work: ``steps_per_period`` if the command chose them (else
     --steps-per-period); a run too coarse, or (for ``exponents``) too short to mean anything, is refused, and
     one in the grey zone warned about."""
-    steps = steps_per_period or args.steps_per_period or STEPS_PER_PERIOD
+    steps = next((s for s in (steps_per_period, args.steps_per_period) if s is not None), STEPS_PER_PERIOD)
     run = {"periods": args.periods, "discard": args.discard} if hasattr(args, "periods") else {}
     if exponents and run:
         check_run(steps_per_period=steps, measured=args.periods - args.discard, discard=args.discard)
@@ -56,13 +56,7 @@ def scaling_of(model, settings: dict):
         return None
     physical = dict(settings)
     length_scale = physical.pop("length_scale", None)
-    functions = physical_functions(model)
-    return gearsym.scaling(model, length_scale, **{k: v for k, v in physical.items() if k not in functions})
-
-
-def physical_functions(model) -> set[str]:
-    """The stiffness functions of a drivetrain (they take a formula, not a physical value)."""
-    return {f.name for f in gearsym.reduce(gearsym.load_model(model)).functions}
+    return gearsym.scaling(model, length_scale, **physical)  # (a stiffness formula too: the mesh forces use it)
 
 
 def scaling_from(args: argparse.Namespace):

@@ -7,8 +7,10 @@ import sys
 from pathlib import Path
 
 from ..analysis import lyapunov_spectrum, phase_trajectory
-from ..analysis.regime import describe_regime
+from ..analysis.divergence import stiffness_notes
+from ..analysis.regime import describe_regime, zero_band
 from ..checks import chosen_coordinate
+from ..errors import GearsymError
 from ..figures import plot_point
 from ..outputs import check_figure
 from .integration import add_integration_arguments, compiled_from, scaling_from
@@ -37,12 +39,19 @@ def run(args: argparse.Namespace) -> int:
     compiled = compiled_from(args)
     coordinate = chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     result = lyapunov_spectrum(compiled, y0=parse_state(args.y0))
-    physical = _physical(scaling, compiled, result) if scaling is not None and scaling.speed else None
+    if result.divergence is not None:
+        raise GearsymError(diverged_message(compiled, result))
+    # (the mesh forces and shaft torques from a trajectory at the point, as in Python: physical/point.py)
+    physical = scaling.to_physical(result, model=compiled) if scaling is not None else None
     if args.plot:
         shown = min(30, result.periods - result.discard)
         trajectory = phase_trajectory(compiled, options=compiled.integration.run(discard=result.periods - shown),
                                       y0=parse_state(args.y0))
-        plot_point(result, trajectory, args.plot, x=coordinate)
+        if physical is not None:  # in the model's units: exponents per second, um, mm/s, rad
+            spectrum, shown_trajectory, units, title = scaling.point_units().figure(result, trajectory)
+            plot_point(spectrum, shown_trajectory, args.plot, x=coordinate, units=units, title=title)
+        else:
+            plot_point(result, trajectory, args.plot, x=coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     if args.format == "json":
         print(json.dumps({**result.as_dict(), **({"physical": physical.as_dict()} if physical else {})}, indent=2))
@@ -52,8 +61,11 @@ def run(args: argparse.Namespace) -> int:
           f"{result.backend}")
     print("parameters: " + ", ".join(f"{k}={v:g}" for k, v in result.parameters.items()))
     print("Lyapunov exponents (per unit time, +- standard error):")
+    paired = {j: i for i, j in result.pairs}
     for i, (lam, err) in enumerate(zip(result.exponents, result.stderr), 1):
-        print(f"  lambda_{i} = {lam:+.6f} +- {err:.6f}")
+        same = (f"  (= lambda_{paired[i - 1] + 1}: one complex pair of Floquet multipliers, its common real part)"
+                if i - 1 in paired else "")
+        print(f"  lambda_{i} = {lam:+.6f} +- {err:.6f}{same}")
     print(f"  sum      = {result.sum:+.6f}")
     if result.at_rest:
         print(f"regime: equilibrium, {'stable' if max(result.exponents) < 0 else 'unstable'} (the run never left a "
@@ -62,7 +74,9 @@ def run(args: argparse.Namespace) -> int:
               + ")")
     else:
         print("regime: " + describe_regime(result.regime, result.exponents, result.stderr, result.measured_time,
-                                           result.autonomous))
+                                           result.autonomous, result.settling))
+        for line in _undecided(result):
+            print(line)
     for name, a in result.amplitude.items():
         print(f"amplitude A_{name} = {a:.6g}")
     print("final state: " + ", ".join(f"{k}={v:.6g}" for k, v in result.final_state.items()))
@@ -71,12 +85,30 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-#: forcing periods of the trajectory the mesh forces of a physical model are read from (after the run's end)
-FORCE_PERIODS = 20
+def _undecided(result) -> list[str]:
+    """What an undetermined run's Poincare points did, and how many periods would decide."""
+    if result.settling is None or result.regime != "undetermined":
+        return []
+    band = float(zero_band(result.stderr, result.measured_time)[0])
+    needed = result.periods_to_decide
+    return [f"  {result.settling.describe()}",
+            f"  lambda_1 = {result.exponents[0]:+.6g} lies within {band:.3g} of zero (the zero band: 3 standard errors "
+            f"or 5/(measured time)) after {result.periods - result.discard} measured periods: "
+            + (f"about {needed} measured periods would decide (--periods {needed + result.discard} --discard "
+               f"{result.discard}, or a longer --discard to let the transient pass)" if needed else
+               "no run length within reach would decide while the points move this way")]
 
 
-def _physical(scaling, compiled, result):
-    """The result in the model's physical units, with the mesh forces over FORCE_PERIODS periods from its end."""
-    options = compiled.integration.run(periods=FORCE_PERIODS, discard=0)
-    trajectory = phase_trajectory(compiled, options=options, y0=result.final_state)
-    return scaling.to_physical(result, trajectory=trajectory)
+def diverged_message(compiled, result) -> str:
+    """One line: how the run diverged, and where a stiffness of the model goes negative (the likely cause)."""
+    system = compiled.system
+    time_name = getattr(system, "time_name", None) or getattr(getattr(system, "time", None), "name", "t")
+    text = f"{result.model}: the motion diverged: {result.divergence.describe(result.period, time_name)}"
+    try:
+        notes = stiffness_notes(system, result.parameters)
+    except Exception:  # noqa: BLE001 (an explanation that cannot be computed is left out, the verdict stands)
+        notes = []
+    if notes:
+        text += "; " + "; ".join(notes)
+    return text + ". A run that grows without bound has no regime (see docs/engine.md, 'Verdicts')"
+

@@ -28,11 +28,25 @@ def run(args: argparse.Namespace) -> int:
         print(f"not given, taken as 1: {', '.join(result.assumed)}")
     bodies = list(result.modes[0].angles)
     coordinates = list(result.modes[0].coordinates)
-    print(f"{'frequency':>14}  {'kind':<8}" + "".join(f"{b:>10}" for b in bodies) + "  |"
-          + "".join(f"{c:>10}" for c in coordinates))
-    for m in result.modes:
-        kind = m.kind + (f" x{m.multiplicity}" if m.multiplicity > 1 else "")
-        print(f"{m.frequency:>14.6g}  {kind:<8}" + "".join(f"{m.angles[b]:>10.4g}" for b in bodies) + "  |"
-              + "".join(f"{m.coordinates[c]:>10.4g}" for c in coordinates))
-    print("shapes: body angles (largest 1) | relative coordinates x = T psi")
+    kinds = [m.kind + (f" x{m.multiplicity}" if m.multiplicity > 1 else "") for m in result.modes]
+    kind_width = max(len("kind"), *map(len, kinds))
+    print(table_row(f"{'frequency':>14}  {'kind':<{kind_width}}", bodies, coordinates))
+    for m, kind in zip(result.modes, kinds):
+        print(table_row(f"{m.frequency:>14.6g}  {kind:<{kind_width}}", [shown(m.angles[b]) for b in bodies],
+                        [shown(m.coordinates[c]) for c in coordinates]))
+    print(f"shapes: body angles (largest 1) | relative coordinates x = T psi; components below {TINY:g} printed as 0")
     return 0
+
+
+#: a mode-shape component below this is rounding (the shapes are scaled to a largest angle of 1): printed as 0
+TINY = 1e-12
+
+
+def table_row(first: str, angles, coordinates) -> str:
+    """One line of the table: at least one space before every cell, however wide its number."""
+    return first + "".join(f" {a:>10}" for a in angles) + "  |" + "".join(f" {c:>10}" for c in coordinates)
+
+
+def shown(value: float) -> str:
+    """A mode-shape component as the table prints it: 4 significant digits, rounding noise as 0."""
+    return "0" if abs(value) < TINY else f"{value:.4g}"

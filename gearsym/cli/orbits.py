@@ -16,11 +16,15 @@ from ..periodic import ContinuationInterrupted, continue_orbits, periodic_orbit
 from ..periodic.files import write_orbits
 from ..periodic.orbit import sweep_start
 from ..periodic.shooting import check_segments, pieces_per_period
+from ..physical.files import write_physical_rows
+from ..physical.point import Measured
 from ..physical.sweeps import nondimensional_axis
 from ..sweep import read_sweep
 from ..sweep.grid import _numbers_and_unit, Axis
+from ..sweep.store import sidecar
+from ..units import shown
 from .integration import add_integration_arguments, compiled_from, integration_from, scaling_from, system_from
-from .settings import add_set_argument, parse_state
+from .settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
 
 NAME = "orbits"
 HELP = "periodic orbits, their Floquet multipliers and stability, and their branches over a parameter with folds, " \
@@ -80,11 +84,10 @@ def parse_range(text: str) -> tuple[str, float, float, str]:
     return name, start, stop, unit
 
 
-def engine_range(args: argparse.Namespace, parameter: tuple) -> tuple[str, float, float]:
+def engine_range(args: argparse.Namespace, parameter: tuple, scaling) -> tuple[str, float, float]:
     """The nondimensional parameter and range a physical range (speed=1000rpm:3000rpm) moves, as a sweep's
     axis does (gearsym.physical.sweeps); a nondimensional range as it is."""
     name, start, stop, unit = parameter
-    scaling = scaling_from(args)
     if scaling is None:
         if unit:
             raise GearsymError(f"--param {args.param!r} has a unit, but the model has no physical values; declare "
@@ -118,8 +121,12 @@ def run(args: argparse.Namespace) -> int:
         sweep = read_sweep(args.sweep)
 
     options = integration_from(args).run(periods=args.transient, discard=0)
+    scaling = scaling_from(args)
+    physical = scaling  # (None without physical values; else the answers are also in its units)
     if parameter:
-        parameter = engine_range(args, parameter)
+        given = parameter[0]
+        parameter = engine_range(args, parameter, scaling)
+        refuse_swept_and_set([(given, args.param), (parameter[0], args.param)], parse_settings(args.set))
     system = system_from(args)
     if args.segments is not None:  # (before the code is compiled: a period of cycles forcing periods has
         pieces = system.cycles * pieces_per_period(options.steps_per_period)  # pieces in each)
@@ -129,14 +136,14 @@ def run(args: argparse.Namespace) -> int:
     compiled = compiled_from(args, options, system)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     if parameter is None:
-        return _one_orbit(compiled, args, y0)
+        return _one_orbit(compiled, args, y0, physical)
     name, start, stop = parameter
     if sweep is not None and y0 is None:
         y0 = sweep_start(sweep, compiled, name, start)
-    return _continuation(compiled, args, name, start, stop, y0, sweep)
+    return _continuation(compiled, args, name, start, stop, y0, sweep, physical)
 
 
-def _one_orbit(compiled, args, y0) -> int:
+def _one_orbit(compiled, args, y0, physical) -> int:
     orbit = periodic_orbit(compiled, y0=y0, period_multiple=args.period_multiple, segments=args.segments)
     print(f"{orbit.model}: period-{orbit.period_multiple} orbit, Newton residual {orbit.residual:.2g} after "
           f"{orbit.iterations} iterations, {'stable' if orbit.stable else 'unstable'}")
@@ -148,37 +155,83 @@ def _one_orbit(compiled, args, y0) -> int:
         print(f"amplitude A_{name} = {a:.6g}")
     for mesh, regime in orbit.contact.items():
         print(f"contact of {mesh}: {regime}")
+    record = orbit.as_dict()
+    if physical is not None:  # the same in the model's units
+        units, w = physical.point_units(), orbit.parameters["omega"]
+        amplitude = {k: units.state(k, v, w) for k, v in orbit.amplitude.items()}
+        state = {k: units.state(k, v, w) for k, v in zip(orbit.state_names, orbit.state)}
+        speed = Measured(float(units.speed_of(w)), units.speed_unit) if units.speed else None
+        print("in physical units: " + (f"{shown(speed)}; " if speed else "")
+              + ", ".join(f"A_{k} = {shown(v)}" for k, v in amplitude.items())
+              + "; state at the section: " + ", ".join(f"{k}={shown(v, 10)}" for k, v in state.items()))
+        record["physical"] = {**({"speed": _json(speed)} if speed else {}), "amplitude": {k: _json(v) for k, v in amplitude.items()},
+                              "state": {k: _json(v) for k, v in state.items()}}
     if args.out:
-        write_atomically(args.out, json.dumps(orbit.as_dict(), indent=1) + "\n")
+        write_atomically(args.out, json.dumps(record, indent=1) + "\n")
         print(f"gearsym: wrote {args.out}", file=sys.stderr)
     return 0
 
 
-def _continuation(compiled, args, name, start, stop, y0, sweep) -> int:
+def _json(value: Measured) -> dict:
+    return {"value": float(value.magnitude), "unit": str(value.units)}
+
+
+def _continuation(compiled, args, name, start, stop, y0, sweep, physical) -> int:
     try:
         result = continue_orbits(compiled, name, start, stop, y0=y0, period_multiple=args.period_multiple,
                                  segments=args.segments, switch_depth=args.switch_depth, max_points=args.max_points)
     except ContinuationInterrupted as exc:  # keep what was traced: the files say it was interrupted
         if args.out:
-            write_orbits(exc.result, args.out)
+            _write(exc.result, args.out, physical)
         print(f"gearsym: {exc}" + (f" in {args.out} (rerun the command to compute them all)" if args.out else ""),
               file=sys.stderr)
         return 130
-    for b in result.branches:
-        stable = int(b.stable.sum())
-        print(f"branch {b.index}: period {b.period_multiple}, {len(b)} points ({stable} stable), {name} "
-              f"{b.values[0]:.6g} -> {b.values[-1]:.6g}" + (f", from branch {b.parent}" if b.parent is not None
-                                                            else "") + f"; {b.end}")
-    for bif in result.bifurcations:
-        print(f"  {bif.kind} at {name}={bif.value:.6g} (branch {bif.branch}, period {bif.period_multiple}): mu = "
-              + ", ".join(_complex(m) for m in bif.multipliers) + (f"; {bif.detail}" if bif.detail else ""))
+    shown_result = physical.to_physical(result) if physical is not None else result  # rpm and um
+    if physical is not None and sweep is not None and sweep.axes[0].name == "omega":
+        sweep = physical.to_physical(sweep)
+    for line in _summary(shown_result):
+        print(line)
     if args.out:
-        csv_path, json_path = write_orbits(result, args.out)
-        print(f"gearsym: wrote {csv_path} and {json_path}", file=sys.stderr)
+        written = _write(result, args.out, physical, shown_result)
+        print(f"gearsym: wrote {' and '.join(map(str, written))}", file=sys.stderr)
     if args.plot:
-        plot_orbits(result, args.plot, coordinate=args.coordinate, sweep=sweep)
+        plot_orbits(shown_result, args.plot, coordinate=args.coordinate, sweep=sweep)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     return 0
+
+
+def _summary(result) -> list[str]:
+    """What the command prints of a continuation, in its units (a physical model's: rpm, um)."""
+    name = result.parameter
+    unit = f" {result.units[name]}" if name in result.units else ""
+    lines = []
+    for b in result.branches:
+        stable = int(b.stable.sum())
+        lines.append(f"branch {b.index}: period {b.period_multiple}, {len(b)} points ({stable} stable), {name} "
+                     f"{b.values[0]:.6g} -> {b.values[-1]:.6g}{unit}"
+                     + (f", from branch {b.parent}" if b.parent is not None else "") + f"; {b.end}")
+    for bif in result.bifurcations:
+        lines.append(f"  {bif.kind} at {name}={bif.value:.6g}{unit} (branch {bif.branch}, period "
+                     f"{bif.period_multiple}): mu = " + ", ".join(_complex(m) for m in bif.multipliers)
+                     + (f"; {bif.detail}" if bif.detail else ""))
+    return lines
+
+
+def _write(result, out: Path, physical, shown_result=None) -> list[Path]:
+    """The continuation's files: the engine's table and record and, for a physical model, the table in its units
+    (``F.physical.csv``) and the record's ``physical`` part (the scaling, the units, the bifurcations there)."""
+    if physical is None:
+        return list(write_orbits(result, out))
+    shown_result = shown_result or physical.to_physical(result)
+    extra = {"physical": {**shown_result.settings["physical"], "parameter": shown_result.parameter,
+                          "units": shown_result.units, "start": shown_result.start, "stop": shown_result.stop,
+                          "bifurcations": [b.as_dict(shown_result.parameter, shown_result.state_names)
+                                           for b in shown_result.bifurcations]}}
+    written = list(write_orbits(result, out, extra))
+    rows = shown_result.rows()
+    names = list(rows[0]) if rows else [shown_result.parameter]
+    written.append(write_physical_rows(names, rows, shown_result.units, sidecar(out, ".physical.csv")))
+    return written
 
 
 def _complex(m: complex) -> str:

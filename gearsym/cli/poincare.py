@@ -6,12 +6,12 @@ import json
 import sys
 from pathlib import Path
 
-from ..analysis.attractors import AttractorSet, DEFAULT_BOX, find_attractors, RUN
+from ..analysis.attractors import DEFAULT_BOX, RUN, AttractorSet, check_ics, find_attractors
 from ..checks import chosen_coordinate
 from ..errors import GearsymError
 from ..figures.poincare import plot_attractors
 from ..outputs import check_figure
-from .integration import add_integration_arguments, compiled_from
+from .integration import add_integration_arguments, compiled_from, integration_from
 from .settings import add_set_argument
 
 NAME = "poincare"
@@ -58,7 +58,9 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         check_figure(args.plot)
     box = parse_box(args.box)
-    compiled = compiled_from(args)
+    options = integration_from(args)
+    check_ics(args.ics, 1, options.periods)  # at least one state each: before the model is compiled
+    compiled = compiled_from(args, options)
     coordinate = chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     found = find_attractors(compiled, ics=args.ics, seed=args.seed, box=box)
     if args.plot:

@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import argparse
+import math
+import sys
 
 from ..errors import GearsymError
 from ..model.grammar import check_formula
@@ -54,10 +56,23 @@ def parse_settings(pairs: list[str]) -> dict[str, str]:
             parse_quantity(value, f"--set {name}")
         elif name == "length_scale":
             check_length_scale(value, "--set length_scale")
-        elif not _is_number(value):  # (the grammar alone: SymPy reads the formula when the model is loaded)
+        elif _is_number(value):  # (a number needs no parser, and so no SymPy)
+            if not math.isfinite(float(value)):
+                raise GearsymError(f"--set {name}={value}: not a finite number (a double holds at most "
+                                   f"{sys.float_info.max:.3g}); give a finite value")
+        else:  # (the grammar alone: SymPy reads the formula when the model is loaded)
             check_formula(value, f"--set {name}")
         settings[name] = value
     return settings
+
+
+def refuse_swept_and_set(swept: list[tuple[str, str]], settings: dict[str, str]) -> None:
+    """A parameter both swept (``swept``: its name and the --param that moves it) and given with --set: the swept
+    values would win and the --set value be ignored without a word, so say so before any work."""
+    for name, spec in swept:
+        if name in settings:
+            raise GearsymError(f"{name} is both swept (--param {spec}) and set (--set {name}={settings[name]}); the "
+                               f"swept values would be used and --set {name} ignored: drop one of the two")
 
 
 def _is_number(text: str) -> bool:

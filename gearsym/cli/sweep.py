@@ -6,18 +6,20 @@ import sys
 from collections import Counter
 from pathlib import Path
 
+import numpy as np
+
 from ..checks import chosen_coordinate
 from ..errors import GearsymError
 from ..figures.sweep import plot_sweep
 from ..outputs import check_figure, check_file
-from ..physical.files import write_physical_table
+from ..physical.files import write_physical_record, write_physical_table
 from ..physical.sweeps import nondimensional_axes
-from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, run_sweep, Workers
+from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, Workers, run_sweep
 from ..sweep.grid import axes_from
 from ..sweep.report import findings_lines
 from ..sweep.store import sidecar
-from .integration import add_integration_arguments, compiled_from, scaling_from
-from .settings import add_set_argument, parse_state
+from .integration import add_integration_arguments, compiled_from, integration_from, scaling_from
+from .settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
 
 NAME = "sweep"
 HELP = "Lyapunov spectra, amplitudes and regimes over a 1-D or 2-D parameter grid (resumable)"
@@ -69,9 +71,12 @@ def run(args: argparse.Namespace) -> int:
         check_figure(args.plot)
     workers = Workers(args.jobs, args.parallel, "local" if args.dask else args.scheduler)
     y0 = parse_state(args.y0)  # before the model is compiled
+    options = integration_from(args)  # (sizes too) before the model is loaded
+    given = axes_from(args.param)
     scaling = scaling_from(args)
-    axes = _engine_axes(args.param, scaling)
-    compiled = compiled_from(args)
+    axes = _engine_axes(given, scaling)
+    refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], parse_settings(args.set))
+    compiled = compiled_from(args, options)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     try:
         result = run_sweep(compiled, axes, mode=args.mode, direction=args.direction, y0=y0,
@@ -82,23 +87,48 @@ def run(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 130
     regimes = Counter(result["regime"].tolist())
-    print(f"{result.model}: {len(result)} points -> {args.out} (+ .json, .poincare.csv)")
+    physical = scaling is not None
+    print(f"{result.model}: {len(result)} points -> {args.out} (+ .json, .poincare.csv"
+          + (", .physical.csv, .physical.json)" if physical else ")"))
     print("regimes: " + ", ".join(f"{k} {v}" for k, v in sorted(regimes.items())))
-    for line in findings_lines(result, sidecar(args.out, ".json")):
+    for line in verdict_lines(result):
         print(line)
-    if scaling is not None and scaling.speed and result.axes[0].name == "omega":
-        result = scaling.to_physical(result)
-        print(f"in physical units: {write_physical_table(result, sidecar(args.out, '.physical.csv'))}")
+    if physical:  # the findings along the values swept, in their units, and the tables in them
+        result = scaling.to_physical(result, given=given)
+        record = write_physical_record(result, sidecar(args.out, ".physical.json"))
+        for line in findings_lines(result, record, result.record["physical"]):
+            print(line)
+        print(f"in physical units: {write_physical_table(result, sidecar(args.out, '.physical.csv'))} "
+              f"(and {record})")
+    else:
+        for line in findings_lines(result, sidecar(args.out, ".json")):
+            print(line)
     if args.plot:
         plot_sweep(result, args.plot, coordinate=args.coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     return 0
 
 
-def _engine_axes(params: list[str], scaling):
+def verdict_lines(result) -> list[str]:
+    """What the sweep's 'diverged' and 'undetermined' points mean, where there are any (see docs/engine.md)."""
+    lines, first = [], result.axes[0].name
+    diverged = result["regime"] == "diverged"
+    if diverged.any():
+        values = result[first][diverged]
+        lines.append(f"  diverged at {diverged.sum()} point(s), {first} in [{values.min():g}, {values.max():g}]: the "
+                     "motion grew without bound there (no regime; `gearsym lyap` at one says how and why); a "
+                     "continuation went on from the last point that did not")
+    undetermined = int(np.sum(result["regime"] == "undetermined"))
+    if undetermined:
+        lines.append(f"  undetermined at {undetermined} point(s): lambda_1 could not be told from 0 there and the "
+                     "Poincare points did not settle (a transient, or too few periods to say); `gearsym lyap` at one "
+                     "says how many periods would decide, or run again with more --periods and --discard")
+    return lines
+
+
+def _engine_axes(axes, scaling):
     """The --param axes the engine sweeps: physical ones (speed=500rpm:6000rpm:25rpm) turned into the
     nondimensional parameter they move, for a model with physical values."""
-    axes = axes_from(params)
     if scaling is None:
         unit = next((a for a in axes if a.unit), None)
         if unit:

@@ -9,6 +9,7 @@ reducing models by name is the caller's (``gearsym.load``), not the code generat
 """
 from __future__ import annotations
 
+import os
 import sys
 import time
 from dataclasses import replace
@@ -22,10 +23,11 @@ from .compiled import CompiledModel
 from .compiler import cache_dir, compile_library
 from .functions import build_functions
 from .generate import code_hash, read_manifest, write_code
-from .library import LOADED, library_functions, resolve_backend
+from .library import LOADED, library_describes, library_functions, resolve_backend
 from .loops import LoopOptions
 from .native import load_native
 from .time_tables import split_rhs
+from .trust import record, trusted
 
 
 def compile_model(system: FirstOrderSystem, options: Integration = Integration(), *,
@@ -75,21 +77,34 @@ def timed_tables(system: FirstOrderSystem, loops: LoopOptions) -> tuple[frozense
 
 def _compiled_functions(system: FirstOrderSystem, loops: LoopOptions, digest: str, timings: dict,
                         verbose: bool) -> tuple[dict, Path]:
-    """The library of ``digest``: C from generated/ or the cache (generated here if missing), compiled once."""
+    """The library of ``digest``: C from generated/ or the cache (generated here if missing or not the C gearsym
+    wrote), compiled once."""
     code_dir = code_directory(system.name, digest)
     source = code_dir / f"{system.name}.c"
-    manifest = read_manifest(code_dir)
-    if not (manifest and manifest.get("hash") == digest and source.is_file()):
+    if code_dir != GENERATED_DIR / system.name and trusted(source, source_describes(system.name, digest)) is None:
         t = time.perf_counter()
         mf = build_functions(system, loops)
         timings["build"] = time.perf_counter() - t
         t = time.perf_counter()
-        write_code(mf, code_dir, digest)
+        keep_generated(write_code(mf, code_dir, digest))
         timings["generate"] = time.perf_counter() - t
-    lib = compile_library(source, system.name, announce=_to_stderr if verbose else None)
+    lib = compile_library(source, system.name, announce=_to_stderr if verbose else None,
+                          describes=library_describes(system, digest))
     if lib.compiled:
         timings["compile"] = lib.seconds
     return library_functions(lib.path), lib.path
+
+
+def source_describes(name: str, digest: str) -> dict:
+    """What the generated C of a model is, as its record in the cache keeps it."""
+    return {"model": name, "code": digest}
+
+
+def keep_generated(code) -> None:
+    """Generated C just written into the cache (a :class:`~.generate.GeneratedCode`): made private and recorded."""
+    for path in (code.manifest, code.source):
+        os.chmod(path, 0o600)  # (the files were made with the umask's mode)
+    record(code.source, code.source.read_bytes(), source_describes(code.source.stem, code.hash))
 
 
 def _kind(value) -> str:
@@ -106,8 +121,8 @@ def code_directory(name: str, digest: str) -> Path:
 
 
 def cached_code_directory(name: str, digest: str) -> Path:
-    """Where the cache keeps the C of the code ``digest`` when it is generated (or received) here."""
-    return cache_dir() / "code" / f"{name}-{digest[:16]}"
+    """Where the cache keeps the C of the code ``digest`` when it is generated (or received) here (made private)."""
+    return cache_dir("code", f"{name}-{digest[:16]}")
 
 
 def _to_stderr(message: str) -> None:

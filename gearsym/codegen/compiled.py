@@ -19,8 +19,10 @@ from typing import TYPE_CHECKING
 import casadi as ca
 import numpy as np
 
-from ..checks import whole_number
+from ..caller import option
+from ..checks import run_bytes_per_period, whole_number
 from ..errors import GearsymError, ModelError, warn
+from ..memory import check_fits
 from ..options import Integration
 from .loops import LoopOptions
 from .native import NativeFunction, load_native
@@ -135,9 +137,15 @@ class CompiledModel:
     table_texts: tuple[str, ...] = ()  # the tables of time, as text (for the error of one that does not repeat)
 
     def run_options(self, options: Integration | None) -> Integration:
-        """The options a run on this model uses: its own, or ``options`` if they need the same code."""
-        if options is None:
-            return self.integration
+        """The options a run on this model uses: its own, or ``options`` if they need the same code; a run longer
+        than the memory can hold is refused here, before it starts."""
+        options = self.integration if options is None else self._same_code(options)
+        check_fits(options.periods, run_bytes_per_period(self.dimension, len(self.observed)),
+                   asked=option("periods", options.periods), item="period",
+                   what=f"{self.name}'s state, stretches and extremes of each period")
+        return options
+
+    def _same_code(self, options: Integration) -> Integration:
         if not isinstance(options, Integration):
             raise GearsymError(f"options must be a gearsym.Integration, got {type(options).__name__}")
         mine = self.integration
@@ -345,9 +353,10 @@ class CompiledModel:
 
     # ---------------------------------------------------------------- runs
     def tangent_run(self, y0, periods: int, inputs: RunInputs, Q0=None,
-                    out: tuple[np.ndarray, ...] | None = None) -> TangentRun:
+                    out: tuple[np.ndarray, ...] | None = None, check_finite: bool = True) -> TangentRun:
         """``periods`` forcing periods of the state and n tangent vectors, re-orthonormalised every period.
-        ``out``: where to write the strobe, log stretches, lows and highs (a slot of :class:`TangentRuns`)."""
+        ``out``: where to write the strobe, log stretches, lows and highs (a slot of :class:`TangentRuns`).
+        ``check_finite=False``: a run that becomes non-finite is returned as it is (the caller judges it)."""
         self._check_inputs(inputs)
         n, m = self.dimension, len(self.observed)
         y = self.initial_state(y0)
@@ -366,7 +375,8 @@ class CompiledModel:
                 for into, record in zip(out, records):
                     into[...] = record
             strobe, logs, low, high = out or records
-            self.check_finite(inputs.p, strobe, logs)
+            if check_finite:
+                self.check_finite(inputs.p, strobe, logs)
             return TangentRun(strobe, logs, low, high, Q)
         # one new block for the start, both tangent buffers and (without ``out``) the records: one address
         rows = (n, n, m, m)
@@ -391,7 +401,7 @@ class CompiledModel:
             strides = [8 * r for r in rows]
         final = self._native_loop(schedule, at, [at + 8 * n, at + 8 * (n + n * n)], inputs, bases, strides)
         # one sum over the strobe and log stretches (adjacent in the block): finite, unless told otherwise
-        if out or not math.isfinite(block[n + 2 * n * n:n + 2 * n * n + 2 * n * periods].sum()):
+        if check_finite and (out or not math.isfinite(block[n + 2 * n * n:n + 2 * n * n + 2 * n * periods].sum())):
             self.check_finite(inputs.p, strobe, logs)
         return TangentRun(strobe, logs, low, high, Qs[final])
 
@@ -540,6 +550,9 @@ class CompiledModel:
         """Every RK4 step of ``periods`` periods: times (steps,) and states (n, steps), the start included."""
         self._check_inputs(inputs)
         whole_number(periods, "periods")
+        check_fits(periods, 16 * self.steps_per_period * (self.dimension + 1),
+                   asked=f"a trajectory of {periods} periods", item="period",
+                   what=f"{self.name}'s time and state at every RK4 step, twice while joined")
         y = ca.DM(self.initial_state(y0))
         cols = [np.array(y)]
         for _ in range(periods):

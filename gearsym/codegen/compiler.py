@@ -3,7 +3,10 @@
 Libraries live in a cache (``$GEARSYM_CACHE``, else ``$XDG_CACHE_HOME/gearsym``
 or ``~/.cache/gearsym``) under a name that hashes the source, the compiler and
 its flags, so an unchanged model is never compiled twice and a changed one
-never picks up a stale library.
+never picks up a stale library. A library is code, so the cache is private
+(:mod:`gearsym.private_files`: made 0700, used only while nobody else can write
+it) and a library is loaded only if its bytes are those recorded when it was
+compiled (:mod:`.trust`).
 
 Default flags: ``-O3 -march=native -mtune=generic -fno-tree-partial-pre``.
 ``-march=native`` lets the compiler use the CPU's fused multiply-add (measured
@@ -27,7 +30,9 @@ change rebuilds.
 """
 from __future__ import annotations
 
+import atexit
 import hashlib
+import json
 import os
 import platform
 import shlex
@@ -39,7 +44,9 @@ from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
-from ..errors import GearsymError
+from ..errors import GearsymError, warn
+from ..private_files import NotPrivate, private_folder
+from .trust import record, trusted
 
 DEFAULT_FLAGS = ("-O3", "-march=native", "-mtune=generic", "-fno-tree-partial-pre")
 
@@ -61,12 +68,50 @@ class CompilerError(GearsymError):
     """No usable C compiler, or the compiler failed."""
 
 
-def cache_dir() -> Path:
+def configured_cache() -> Path:
+    """Where the cache is asked to be: ``$GEARSYM_CACHE``, else ``$XDG_CACHE_HOME/gearsym`` or ``~/.cache/gearsym``."""
     root = os.environ.get("GEARSYM_CACHE")
     if root:
         return Path(root)
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
     return Path(base) / "gearsym"
+
+
+def cache_dir(*levels: str) -> Path:
+    """The library cache (or its folder ``levels``, e.g. ``"lib"``), made private if missing and checked.
+
+    A cache that someone else could write (not yours, writable by group or others, reached through their
+    symlink) is not used: a one-line warning says why, and this process keeps its libraries in a private
+    temporary folder instead (removed at exit). A cache path that cannot be a folder is an error."""
+    configured = configured_cache()
+    root = _BYPASSED.get(str(configured))
+    if root is None:
+        try:
+            root = private_folder(configured)
+            return private_folder(root.joinpath(*levels), cache=root) if levels else root
+        except NotPrivate as exc:
+            root = _bypass(configured, exc)
+        except GearsymError as exc:
+            raise GearsymError(f"the library cache {_named(configured)} cannot be used: {exc}; set GEARSYM_CACHE "
+                               "to a folder of your own (made if missing)") from None
+    return private_folder(root.joinpath(*levels), cache=root)
+
+
+_BYPASSED: dict[str, Path] = {}  # refused caches -> the private temporary folder used instead
+
+
+def _bypass(configured: Path, why: NotPrivate) -> Path:
+    root = Path(tempfile.mkdtemp(prefix="gearsym-cache-"))
+    atexit.register(shutil.rmtree, root, ignore_errors=True)
+    _BYPASSED[str(configured)] = root
+    warn(f"the library cache {_named(configured)} is not used, as someone else could put code in it: {why}. "
+         f"This run compiles into a private temporary folder; give gearsym a cache only you can write "
+         f"(chmod go-w, or set GEARSYM_CACHE to a folder of your own)")
+    return root
+
+
+def _named(configured: Path) -> str:
+    return f"GEARSYM_CACHE={configured}" if os.environ.get("GEARSYM_CACHE") else str(configured)
 
 
 def compile_flags() -> tuple[str, ...]:
@@ -138,22 +183,26 @@ class Library:
 
 
 def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple[str, ...] | None = None,
-                    announce=None) -> Library:
+                    announce=None, describes: dict | None = None) -> Library:
     """The shared library of ``source`` for this machine: from the cache, or compiled into it.
 
-    ``announce(message)`` is called before an actual compilation (a few seconds), not on a cache hit.
+    ``describes`` says what the library is (the model, its code hash, states, parameters: kept in its record,
+    part of its name). A cached library is used only if its bytes are those recorded when it was compiled
+    (:func:`.trust.trusted`); one that is not (cut short, damaged, changed) is compiled again, and a warning
+    says so. ``announce(message)`` is called before an actual compilation (a few seconds), not on a cache hit.
     """
     cc = cc or find_compiler()
     if cc is None:
         raise CompilerError(REQUIRED_NOTE.format(what=compilers_looked_for()))
     flags = compile_flags() if flags is None else tuple(flags)
-    digest = hashlib.sha256(Path(source).read_bytes() + CALL_SOURCE.encode()).hexdigest()[:16]
-    target = cache_dir() / "lib" / f"{name}-{digest}-{_machine_key(cc, flags)}.so"
-    if target.is_file():
+    described = json.dumps(describes or {}, sort_keys=True).encode()
+    digest = hashlib.sha256(Path(source).read_bytes() + CALL_SOURCE.encode() + described).hexdigest()[:16]
+    target = library_path(f"{name}-{digest}-{_machine_key(cc, flags)}.so")
+    if trusted(target, describes) is not None:
         return Library(target, False, 0.0)
-    target.parent.mkdir(parents=True, exist_ok=True)
     if announce:
-        announce(f"compiling {name} ({' '.join(flags)}; once: cached in {target.parent})")
+        kept = "for this run only" if str(configured_cache()) in _BYPASSED else f"once: cached in {target.parent}"
+        announce(f"compiling {name} ({' '.join(flags)}; {kept})")
     start = time.perf_counter()
     with tempfile.TemporaryDirectory(dir=target.parent) as tmp:
         out, call = Path(tmp) / target.name, Path(tmp) / "gearsym_call.c"
@@ -168,5 +217,14 @@ def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple
                 f"compiling {source} failed ({' '.join(cmd)}):\n{proc.stderr.strip()[-2000:]}\n"
                 "Check $CC and $GEARSYM_CFLAGS, or report the model that caused it."
             )
+        os.chmod(out, 0o700)  # (whatever the umask)
+        record(target, out.read_bytes(), describes)  # (before the rename: the library in place always has one)
         os.replace(out, target)  # atomic: concurrent compilers of the same model do not collide
     return Library(target, True, time.perf_counter() - start)
+
+
+def library_path(file_name: str) -> Path:
+    """Where the cache keeps the library ``file_name`` (its folder made private and checked)."""
+    if Path(file_name).name != file_name or file_name.startswith("."):
+        raise GearsymError(f"{file_name!r} is not a library's file name")
+    return cache_dir("lib") / file_name

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from ..options import Integration
 from ..system import FirstOrderSystem
+from .library import library_describes
 from .compiler import compile_library
 from .functions import build_functions
 from .loops import LoopOptions
@@ -42,6 +43,7 @@ def generate_model(system: FirstOrderSystem, out: Path, options: Integration = I
     code = write_code(mf, target, digest)
     report = GenerateReport(system.name, code.source, digest, code.source.stat().st_size)
     if compile:
-        lib = compile_library(code.source, system.name)
+        # (described as compile_model describes it: the library runs load)
+        lib = compile_library(code.source, system.name, describes=library_describes(system, digest))
         report.library, report.compile_seconds = lib.path, lib.seconds if lib.compiled else 0.0
     return report

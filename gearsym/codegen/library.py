@@ -39,3 +39,10 @@ def resolve_backend(asked: str) -> str:
 def library_functions(path: Path) -> dict[str, ca.Function]:
     """The generated functions of the library at ``path``, through CasADi."""
     return {name: ca.external(name, str(path)) for name in FUNCTION_NAMES}
+
+
+def library_describes(system, digest: str) -> dict:
+    """What a model's library is, as its record keeps it: a summary that points at it is checked against this
+    (``system``: a FirstOrderSystem or the start-up cache's summary of one)."""
+    return {"model": system.name, "code": digest, "states": list(system.state_names),
+            "parameters": list(system.parameters)}

@@ -37,18 +37,20 @@ from pathlib import Path
 import casadi as ca
 
 from ..errors import GearsymError
-from ..files import write_atomically
 from ..options import Integration
+from ..paths import GENERATED_DIR
+from ..private_files import write_private
 from ..system import FirstOrderSystem
 from ..version import __version__
-from .build import cached_code_directory, code_directory
+from .build import cached_code_directory, code_directory, keep_generated, source_describes
 from .compiled import CompiledModel
-from .compiler import CompilerError, binary_key, cache_dir, compile_flags, compile_library
+from .compiler import CompilerError, binary_key, compile_flags, compile_library, library_path
 from .functions import build_functions
 from .loops import LoopOptions
 from .generate import code_hash, write_code
-from .library import library_functions
+from .library import library_describes, library_functions
 from .native import load_native
+from .trust import record, trusted
 
 log = logging.getLogger("gearsym")
 
@@ -89,11 +91,16 @@ def ship(compiled: CompiledModel) -> ShippedModel:
     if compiled.backend != "compiled":
         return ShippedModel(**base)
     name = compiled.name
-    source = code_directory(name, compiled.hash) / f"{name}.c"
-    if not source.is_file():  # the cache was cleaned since the library was built: generate it again
-        write_code(build_functions(compiled.system, compiled.options), source.parent, compiled.hash)
+    code_dir = code_directory(name, compiled.hash)
+    source = code_dir / f"{name}.c"
+    if code_dir != GENERATED_DIR / name and trusted(source, source_describes(name, compiled.hash)) is None:
+        # (the cache was cleaned since the library was built, or its C is not what gearsym wrote: generate it)
+        keep_generated(write_code(build_functions(system, compiled.options), code_dir, compiled.hash))
+    library = trusted(compiled.library, library_describes(system, compiled.hash))
+    if library is None:
+        raise GearsymError(f"{compiled.library} changed since it was loaded; run again to compile it anew")
     flags = compile_flags()
-    return ShippedModel(**base, library_name=compiled.library.name, library=compiled.library.read_bytes(),
+    return ShippedModel(**base, library_name=compiled.library.name, library=library,
                         flags=flags, binary_key=binary_key(flags), source=source.read_bytes())
 
 
@@ -125,20 +132,25 @@ def load_shipped(shipped: ShippedModel) -> CompiledModel:
 
 
 def _write_library(shipped: ShippedModel) -> Path:
-    """The shipped bytes in this machine's cache, under the name compile_library gave them (atomically)."""
-    target = cache_dir() / "lib" / shipped.library_name
-    if not target.is_file():  # e.g. a worker on the client's machine sharing its cache has it already
-        write_atomically(target, shipped.library)  # concurrent workers write the same bytes
+    """The shipped bytes in this machine's cache, under the name compile_library gave them (atomically, with the
+    record of what they are: the client built them)."""
+    target = library_path(shipped.library_name)
+    describes = library_describes(shipped.system, shipped.hash)
+    if trusted(target, describes) != shipped.library:  # (e.g. a worker on the client's machine has it already)
+        record(target, shipped.library, describes)
+        write_private(target, shipped.library, 0o700)  # concurrent workers write the same bytes
     return target
 
 
 def _rebuild(shipped: ShippedModel, timings: dict) -> Path:
     """The shipped C compiled here (the library was built for another system, CPU or C library)."""
     source = cached_code_directory(shipped.name, shipped.hash) / f"{shipped.name}.c"
-    if not (source.is_file() and source.read_bytes() == shipped.source):
-        write_atomically(source, shipped.source)
+    if trusted(source, source_describes(shipped.name, shipped.hash)) != shipped.source:
+        record(source, shipped.source, source_describes(shipped.name, shipped.hash))
+        write_private(source, shipped.source)
     try:
-        lib = compile_library(source, shipped.name, flags=shipped.flags)
+        lib = compile_library(source, shipped.name, flags=shipped.flags,
+                              describes=library_describes(shipped.system, shipped.hash))
     except CompilerError as exc:
         raise CompilerError(f"{_host()}: the {shipped.name} library sent by the client was built for another "
                             f"system, CPU or C library, so this worker compiles it and cannot: {exc}") from None

@@ -39,13 +39,14 @@ import numpy as np
 import sympy as sp
 
 from ..errors import GearsymError
-from ..files import write_atomically
+from ..private_files import write_private
 from ..system import FirstOrderSystem
 from .compiler import cache_dir, compile_library, find_compiler
 from .casadi_symbols import SystemSymbols
 from .rk4 import rk4_step
 from .generate import generator_digest
 from .translate import to_casadi
+from .trust import record, trusted
 
 #: bump when the generated window code changes for the same system and channels
 WINDOWS_VERSION = 2
@@ -187,10 +188,13 @@ class Windows:
         return self._functions
 
     def _compile(self):
-        source = cache_dir() / "code" / f"{self.system.name}-windows-{self.digest[:16]}.c"
-        if not source.is_file():
-            write_atomically(source, self._source())
-        library = compile_library(source, f"{self.system.name}_windows")
+        source = cache_dir("code") / f"{self.system.name}-windows-{self.digest[:16]}.c"
+        describes = {"model": f"{self.system.name}_windows", "code": self.digest}
+        if trusted(source, describes) is None:  # (missing, or not the C gearsym wrote)
+            text = self._source().encode()
+            record(source, text, describes)
+            write_private(source, text)
+        library = compile_library(source, f"{self.system.name}_windows", describes=describes)
         lib = ctypes.CDLL(str(library.path))
         call = lib.gearsym_fit_windows
         call.restype = ctypes.c_int

@@ -27,11 +27,13 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis import phase_trajectory
-from ..checks import whole_number
+from ..caller import name as caller_name, option
+from ..checks import MAX_STEPS_PER_PERIOD, whole_number
 from ..codegen import CompiledModel, engine_verb
 from ..options import STEPS_PER_PERIOD, Integration
 from ..errors import GearsymError
-from .measurements import RECORD
+from ..memory import check_fits
+from .columns import RECORD
 
 #: the run of each record when no options are given: 40 periods recorded after a transient of 100
 RUN = {"periods": 140, "discard": 100}
@@ -115,6 +117,10 @@ def simulate_measurements(
         raise GearsymError(f"noise must be a relative size of 0 or more (0.01 = 1 % of the signal), got {noise!r}")
     steps_for(m, model.steps_per_cycle)
     runs = [dict(r) for r in records] if records else [{}]
+    columns = 2 + len(model.parameter_names) + 2 * len(model.state_names)  # at most: tau, record, conditions, states
+    check_fits(options.measured, 8 * (model.steps_per_period * (model.dimension + 1) + len(runs) * m * columns),
+               asked=f"{option('samples_per_period', m)} over {option('periods', options.periods)}", item="period",
+               what="a record's run at every RK4 step and the table's rows")
     condition_names = tuple(p for p in model.parameter_names if any(p in r for r in runs))
     for run in runs:
         model.parameter_vector({**values, **run})  # unknown names and bad values, before any run
@@ -137,10 +143,14 @@ def simulate_measurements(
 def steps_for(samples_per_period: int, steps_per_period: int | None = None) -> int:
     """The engine's steps per period for sampling ``samples_per_period`` times a period: ``steps_per_period``
     if given (checked to be a multiple), else the smallest multiple of at least the default steps."""
-    samples = whole_number(samples_per_period, "samples_per_period", 1)
+    samples = whole_number(samples_per_period, caller_name("samples_per_period"), 1)
+    if samples > MAX_STEPS_PER_PERIOD:
+        raise GearsymError(f"{option('samples_per_period', samples)}: the samples are RK4 steps of the engine, and "
+                           f"a forcing period has at most {MAX_STEPS_PER_PERIOD} "
+                           f"(see {caller_name('steps_per_period')})")
     if steps_per_period is None:
         return samples * -(-STEPS_PER_PERIOD // samples)
-    steps = whole_number(steps_per_period, "steps_per_period", 1)
+    steps = whole_number(steps_per_period, caller_name("steps_per_period"), 1)
     if steps % samples:
         raise GearsymError(f"samples_per_period={samples} must divide the engine's {steps} steps per period (the "
                            f"samples are RK4 steps): choose a divisor, or steps_per_period="

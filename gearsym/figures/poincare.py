@@ -22,6 +22,7 @@ import numpy as np
 from ..analysis.attractors import Attractor, AttractorSet
 from ..analysis.orbits import Trajectory, phase_trajectory
 from ..errors import GearsymError
+from .layout import fit_texts
 from .save import pyplot, save_figure
 
 #: how parameter names are written in titles and labels
@@ -31,12 +32,13 @@ LAYER_COLORS = ("0.55", "k", "C3", "C0", "C2", "C1")
 #: one set alone: a colour per class of attractor, the paper's '1' (regular) and '2' (chaotic)
 CLASS_COLORS = {"1": "k", "2": "C3"}
 #: regular attractors: a marker per regime (chaotic ones are clouds of dots)
-REGIME_MARKERS = {"periodic": "o", "quasi-periodic": "s", "equilibrium": "D", "chaotic": ".", "hyperchaotic": "."}
+REGIME_MARKERS = {"periodic": "o", "quasi-periodic": "s", "equilibrium": "D", "undetermined": "^", "chaotic": ".",
+                  "hyperchaotic": "."}
 #: how captions write each marker
-MARKER_GLYPHS = {"o": "○", "s": "□", "D": "◇", ".": "·"}
+MARKER_GLYPHS = {"o": "○", "s": "□", "D": "◇", "^": "△", ".": "·"}
 #: short forms of the regimes in the annotations
 SHORT = {"periodic": "P", "quasi-periodic": "QP", "chaotic": "chaotic", "hyperchaotic": "hyperchaotic",
-         "equilibrium": "eq."}
+         "equilibrium": "eq.", "undetermined": "undetermined"}
 
 _STYLE = {"font.size": 9, "axes.titlesize": 10, "axes.labelsize": 10, "legend.fontsize": 8,
           "axes.linewidth": 0.8, "xtick.direction": "in", "ytick.direction": "in",
@@ -101,9 +103,32 @@ def plot_attractors(sets: AttractorSet | Sequence[AttractorSet | Sequence[Attrac
             ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), frameon=False, handletextpad=0.3,
                       fontsize=7.5, markerscale=1.0)
         fig.supxlabel(_caption(panels), fontsize=7, color="0.35")
+        fig.suptitle(attractors_title(panels, labels), fontsize=9)
+        fit_texts(fig)
         if path is not None:
             save_figure(fig, path, dpi=150)
         return fig
+
+
+def attractors_title(panels: Sequence[Sequence[AttractorSet]], labels: Sequence[str] | None = None) -> str:
+    """'one_stage: ω=1.6, ζ=0.08, B0=1, ...': the model(s) and every parameter value the sets share; then,
+    per overlaid layer, the values that set it apart (those that differ between panels are in the panels'
+    titles)."""
+    sets = [s for panel in panels for s in panel]
+    models = ", ".join(dict.fromkeys(s.model for s in sets))
+    shared = dict(sets[0].parameters)
+    for s in sets[1:]:
+        shared = {k: v for k, v in shared.items() if s.parameters.get(k) == v}
+    text = f"{models}: " + (", ".join(parameter_text(k, v) for k, v in shared.items()) or "(no shared values)")
+    layers = max(len(p) for p in panels)
+    for layer in range(layers if layers > 1 else 0):
+        in_layer = [p[layer] for p in panels if layer < len(p)]
+        own = {k: v for k, v in in_layer[0].parameters.items() if k not in shared
+               and all(s.parameters.get(k) == v for s in in_layer)}
+        if own:
+            name = labels[layer] if labels is not None else in_layer[0].model
+            text += f"; {name}: " + ", ".join(parameter_text(k, v) for k, v in own.items())
+    return text
 
 
 def _panels(sets) -> list[list[AttractorSet]]:
@@ -289,6 +314,7 @@ def plot_phase_portraits(panels: Sequence[PhasePanel], path: str | Path | None =
             ax.text(0.02, 0.97, f"({chr(ord('a') + k)})", transform=ax.transAxes, ha="left", va="top",
                     fontsize=11, fontweight="bold")
         fig.supxlabel(_window_caption(panels), fontsize=7, color="0.35")
+        fit_texts(fig)
         if path is not None:
             save_figure(fig, path, dpi=150)
         return fig

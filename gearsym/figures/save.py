@@ -3,6 +3,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .layout import fit_texts
+
 
 def pyplot():
     """matplotlib's pyplot on the Agg backend (no display needed), imported when a figure is drawn: a command
@@ -16,10 +18,12 @@ def pyplot():
 
 
 def save_figure(fig, path: str | Path, dpi: int) -> Path:
-    """Write ``fig`` to ``path`` (folders made as needed) and close it. No 'Software' entry, so the
-    bytes do not depend on the matplotlib version: committed figures are compared as files."""
+    """Write ``fig`` to ``path`` (folders made as needed) and close it, its titles wrapped to fit
+    (:func:`~.layout.fit_texts`). No 'Software' entry, so the bytes do not depend on the matplotlib version:
+    committed figures are compared as files."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    fit_texts(fig)
     fig.savefig(path, dpi=dpi, metadata={"Software": None})
     pyplot().close(fig)
     return path

@@ -12,15 +12,22 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis.regime import REGIMES
+from ..analysis.regime import DIVERGED, REGIMES, UNDETERMINED
 from ..errors import GearsymError
 from ..sweep.result import SweepResult
+from .layout import fit_texts, line_style
 from .save import pyplot, save_figure
 
 REGIME_COLORS = {"periodic": "#4c72b0", "quasi-periodic": "#55a868", "chaotic": "#dd8452",
-                 "hyperchaotic": "#c44e52", "equilibrium": "#8172b3"}
+                 "hyperchaotic": "#c44e52", "equilibrium": "#8172b3", UNDETERMINED: "#b0b0b0", DIVERGED: "#222222"}
+#: what a regime strip or map can show: the regimes, and the two verdicts that are not (shown where they occur)
+SHOWN = (*REGIMES, UNDETERMINED, DIVERGED)
+#: a regime without a colour of its own (a verdict added later)
+OTHER_REGIME_COLOR = "0.65"
 _LINESTYLE = {"up": "-", "down": "--", "independent": "-"}
 _STYLE_NAME = {"-": "solid", "--": "dashed"}
+#: the bifurcation diagram's dots (points): a period-1 orbit is one dot per parameter value, and must show
+BIFURCATION_DOT = 2.4
 _CONTINUATION = {"up": "continuation upward", "down": "continuation downward", "both": "continuation up, then down"}
 
 
@@ -56,10 +63,12 @@ def plot_exponents(ax, result: SweepResult, which=(1,), *, direction: str | None
                    color=None, errors: bool = False, **fixed) -> None:
     """lambda_i against the first parameter (``which``: the exponent numbers), with a zero line."""
     x = result.axes[0].name
+    which = list(which)
     for d, values, idx in _runs(result, direction, **fixed):
-        for i in which:
+        for k, i in enumerate(which):
             lam = result[f"lambda_{i}"][idx]
-            line, = ax.plot(result[x][idx], lam, _LINESTYLE.get(d, "-"), lw=1.0, color=color or f"C{i - 1}",
+            style = line_style(k, len(which), len(idx)) if color is None else {"color": color}
+            line, = ax.plot(result[x][idx], lam, _LINESTYLE.get(d, "-"), lw=1.0, **style,
                             label=label if label is not None else rf"$\lambda_{i}$")
             if errors:
                 err = result[f"stderr_{i}"][idx]
@@ -82,12 +91,24 @@ def plot_bifurcation(ax, result: SweepResult, state: str | None = None, *, direc
         keep &= s["direction"] == direction
     for k, v in fixed.items():
         keep &= np.isclose(s[k], v)
-    ax.plot(s[x][keep], s[state][keep], ".", ms=1.0, mew=0, color=color, alpha=0.7)
+    ax.plot(s[x][keep], s[state][keep], ".", ms=BIFURCATION_DOT, mew=0, color=color, alpha=0.6, rasterized=True)
     ax.set_ylabel(_with_unit(f"{state} at t = kT", result.units, state))
 
 
+def regimes_shown(regimes) -> list[str]:
+    """The regimes among ``regimes``, in the order of :data:`REGIMES` (any other, e.g. a verdict added
+    later, after them in the order met)."""
+    present = dict.fromkeys(str(r) for r in regimes)
+    return [r for r in REGIMES if r in present] + [r for r in present if r not in REGIMES]
+
+
+def regime_color(regime: str) -> str:
+    return REGIME_COLORS.get(regime, OTHER_REGIME_COLOR)
+
+
 def plot_regime_strip(ax, result: SweepResult, *, direction: str | None = None, **fixed) -> None:
-    """One coloured bar per point: the regime along the first parameter (one row per run)."""
+    """One coloured bar per point: the regime along the first parameter (one row per run), and a legend of
+    the regimes drawn."""
     plt = pyplot()
     x = result.axes[0].name
     runs = list(_runs(result, direction, **fixed))
@@ -95,18 +116,24 @@ def plot_regime_strip(ax, result: SweepResult, *, direction: str | None = None, 
         xs = result[x][idx]
         width = np.min(np.diff(np.sort(xs))) if len(xs) > 1 else 1.0
         for xv, reg in zip(xs, result["regime"][idx]):
-            ax.broken_barh([(xv - width / 2, width)], (row, 0.8), color=REGIME_COLORS.get(reg, "0.5"), lw=0)
+            ax.broken_barh([(xv - width / 2, width)], (row, 0.8), color=regime_color(reg), lw=0)
     ax.set_yticks([r + 0.4 for r in range(len(runs))], [_run_label(d, v, style=False) for d, v, _ in runs], fontsize=7)
     ax.set_ylim(0, max(len(runs), 1))
-    handles = [plt.Rectangle((0, 0), 1, 1, color=REGIME_COLORS[r]) for r in REGIMES]
-    ax.legend(handles, REGIMES, ncol=4, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.45), frameon=False)
+    shown = regimes_shown(r for _, _, idx in runs for r in result["regime"][idx])
+    handles = [plt.Rectangle((0, 0), 1, 1, color=regime_color(r)) for r in shown]
+    ax.legend(handles, shown, ncol=min(len(shown), 5) or 1, fontsize=7, loc="upper center",
+              bbox_to_anchor=(0.5, -0.45), frameon=False)
 
 
 def plot_map(ax, result: SweepResult, column: str = "lambda_1", *, direction: str | None = None):
-    """``column`` over the first two parameters (lambda_1: diverging colours, zero white, and its zero contour)."""
+    """``column`` over the first two parameters. lambda_1: diverging colours, zero white, each sign over its
+    own range (the 2nd and 98th percentiles: one outlier does not wash out the rest; beyond them the colour
+    bar's ends), and its zero contour, which the title names. Another column: viridis, on a log scale where
+    it spans more than two decades. The regime: a colour per regime drawn (the
+    mesh's ``regimes``, for :func:`add_colorbar`)."""
     from matplotlib.colors import BoundaryNorm
     from matplotlib.colors import ListedColormap
-    from matplotlib.colors import TwoSlopeNorm
+    from matplotlib.colors import LogNorm
     x, y = result.axes[0].name, result.axes[1].name
     xs, ys = np.array(result.axes[0].values), np.array(result.axes[1].values)
     grid = np.full((len(ys), len(xs)), np.nan)
@@ -114,20 +141,24 @@ def plot_map(ax, result: SweepResult, column: str = "lambda_1", *, direction: st
     ix = np.searchsorted(xs, result[x][keep])
     iy = np.searchsorted(ys, result[y][keep])
     if column == "regime":
-        codes = {r: i for i, r in enumerate(REGIMES)}
-        grid[iy, ix] = [codes.get(r, np.nan) for r in result["regime"][keep]]
-        cmap = ListedColormap([REGIME_COLORS[r] for r in REGIMES])
-        mesh = ax.pcolormesh(_edges(xs), _edges(ys), grid, cmap=cmap, norm=BoundaryNorm(np.arange(-0.5, 4), 4))
+        shown = regimes_shown(result["regime"][keep])
+        codes = {r: i for i, r in enumerate(shown)}
+        grid[iy, ix] = [codes[str(r)] for r in result["regime"][keep]]
+        cmap = ListedColormap([regime_color(r) for r in shown])
+        mesh = ax.pcolormesh(_edges(xs), _edges(ys), grid, cmap=cmap,
+                             norm=BoundaryNorm(np.arange(-0.5, len(shown)), len(shown)))
+        mesh.regimes = shown
     elif column.startswith("lambda_"):
         grid[iy, ix] = result[column][keep]
-        finite = np.abs(grid[np.isfinite(grid)])
-        span = float(finite.max()) if finite.size and finite.max() > 0 else 1.0
-        mesh = ax.pcolormesh(_edges(xs), _edges(ys), grid, cmap="RdBu_r", norm=TwoSlopeNorm(0.0, -span, span))
-        if len(xs) > 1 and len(ys) > 1:
-            ax.contour(xs, ys, grid, levels=[0.0], colors="k", linewidths=0.6)
+        mesh = ax.pcolormesh(_edges(xs), _edges(ys), grid, cmap="RdBu_r", norm=exponent_norm(grid))
+        if len(xs) > 1 and len(ys) > 1 and np.nanmin(grid) < 0 < np.nanmax(grid):
+            mesh.zero_contour = ax.contour(xs, ys, grid, levels=[0.0], colors="k", linewidths=0.7)
     else:
         grid[iy, ix] = result[column][keep]
-        mesh = ax.pcolormesh(_edges(xs), _edges(ys), grid, cmap="viridis")
+        finite = grid[np.isfinite(grid)]
+        spread = finite.size and finite.min() > 0 and finite.max() > 100 * finite.min()
+        mesh = ax.pcolormesh(_edges(xs), _edges(ys), grid, cmap="viridis",
+                             norm=LogNorm() if spread else None)  # (decades: a free shaft drifting)
     if _geometric(ys):
         ax.set_yscale("log")
         ax.set_yticks(ys, [f"{v:g}" for v in ys])
@@ -135,6 +166,39 @@ def plot_map(ax, result: SweepResult, column: str = "lambda_1", *, direction: st
     ax.set_xlabel(_axis_label(x, result.units))
     ax.set_ylabel(_axis_label(y, result.units))
     return mesh
+
+
+#: what the black line of an exponent's map is
+ZERO_CONTOUR = "black line: λ₁ = 0"
+
+
+def exponent_norm(values: np.ndarray):
+    """Diverging colours for exponents: zero white, the negative side over the 2nd percentile .. 0 and the
+    positive side over 0 .. the 98th percentile, so that each side uses its whole range of colours."""
+    from matplotlib.colors import TwoSlopeNorm
+    finite = values[np.isfinite(values)]
+    if not finite.size:
+        return TwoSlopeNorm(0.0, -1.0, 1.0)
+    tiny = 1e-3 * max(float(np.max(np.abs(finite))), 1e-12)
+    low = min(float(np.percentile(finite, 2)), -tiny)
+    high = max(float(np.percentile(finite, 98)), tiny)
+    return TwoSlopeNorm(0.0, low, high)
+
+
+def add_colorbar(fig, ax, mesh, label: str, short: dict | None = None):
+    """The colour bar of a map from :func:`plot_map`: a tick per regime drawn (``short`` abbreviates their
+    names), or ``label`` and arrows where the colours are clipped."""
+    regimes = getattr(mesh, "regimes", None)
+    if regimes is not None:
+        bar = fig.colorbar(mesh, ax=ax, ticks=range(len(regimes)))
+        bar.ax.set_yticklabels([(short or {}).get(r, r) for r in regimes], fontsize=7)
+        return bar
+    values = mesh.get_array()
+    values = np.asarray(values[np.isfinite(values)] if values is not None else [])
+    norm = mesh.norm
+    extend = {(False, False): "neither", (True, False): "min", (False, True): "max", (True, True): "both"}[
+        (bool(values.size and values.min() < norm.vmin), bool(values.size and values.max() > norm.vmax))]
+    return fig.colorbar(mesh, ax=ax, label=label, extend=extend)
 
 
 def _edges(v: np.ndarray) -> np.ndarray:
@@ -168,8 +232,12 @@ def _style_legend(result: SweepResult) -> list:
 
 
 def fixed_parameters(result: SweepResult) -> str:
-    """The values of every parameter not swept: those the sweep set first, then the model's defaults."""
+    """The values of every parameter not swept: those the sweep set first, then the model's defaults; for a sweep
+    in physical units, the physical values as the user gave them."""
     swept = {a.name for a in result.axes}
+    physical = result.record.get("physical")
+    if physical:
+        return "values: " + ", ".join(f"{k}={v}" for k, v in physical["inputs"].items() if k not in swept)
     given = {k: v for k, v in result.record.get("settings", {}).items() if k not in swept}
     defaults = {k: v for k, v in result.record.get("parameters", {}).items() if k not in swept and k not in given}
     parts = [*(["set: " + ", ".join(f"{k}={v}" for k, v in given.items())] if given else []),
@@ -179,10 +247,16 @@ def fixed_parameters(result: SweepResult) -> str:
 
 def sweep_title(result: SweepResult, width: int = 110) -> str:
     """The model, the swept ranges and the fixed parameters, wrapped to ``width`` characters."""
-    swept = ", ".join(f"{a.name} = {a.values[0]:g}..{a.values[-1]:g} ({len(a.values)} values)" for a in result.axes)
+    swept = ", ".join(f"{a.name} = {a.values[0]:g}..{a.values[-1]:g}{_unit_text(result, a.name)} ({len(a.values)} values)"
+                      for a in result.axes)
     mode = ("independent points" if result.mode == "independent" else
             _CONTINUATION.get(result.record.get("direction"), "continuation"))
     return textwrap.fill(f"{result.model}: {swept}, {mode}. {fixed_parameters(result)}", width)
+
+
+def _unit_text(result: SweepResult, column: str) -> str:
+    unit = result.units.get(column)
+    return f" {unit}" if unit else ""
 
 
 def _shown_direction(result: SweepResult) -> str | None:
@@ -196,7 +270,8 @@ def _shown_direction(result: SweepResult) -> str | None:
 def plot_sweep(result: SweepResult, path: str | Path | None = None, coordinate: str | None = None):
     """Overview, written to ``path`` (PNG) if given; returns the Figure. For one swept parameter: A of
     ``coordinate`` (default the first), lambda_i, the bifurcation diagram of ``coordinate`` and the regimes
-    against it; for two, maps of lambda_1, the regime and A over both."""
+    against it; for two, maps of lambda_1, the regime and A of every coordinate (``coordinate`` first) over
+    both."""
     plt = pyplot()
     from matplotlib.lines import Line2D
     coordinate = coordinate or result.coordinates[0]
@@ -206,33 +281,42 @@ def plot_sweep(result: SweepResult, path: str | Path | None = None, coordinate: 
     direction = _shown_direction(result)
     run = f" ({direction})" if direction else ""
     if len(result.axes) >= 2:
-        fig, axs = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
+        coordinates = [coordinate, *(c for c in result.coordinates if c != coordinate)]
+        panels = [("lambda_1", r"$\lambda_1$"), ("regime", "regime"),
+                  *((f"A_{c}", f"A ({c})") for c in coordinates)]
+        columns = min(3, len(panels))
+        rows = -(-len(panels) // columns)
+        fig, axs = plt.subplots(rows, columns, figsize=(5 * columns, 4.2 * rows + 0.4), constrained_layout=True,
+                                squeeze=False)
         over = f"over {result.axes[0].name} and {result.axes[1].name}"
-        for ax, column, label in zip(axs, ("lambda_1", "regime", f"A_{coordinate}"),
-                                     (r"$\lambda_1$", "regime", f"A ({coordinate})")):
+        for ax, (column, label) in zip(axs.flat, panels):
             mesh = plot_map(ax, result, column, direction=direction)
-            ax.set_title(f"{label} {over}{run}", fontsize=9)
-            if column != "regime":
-                fig.colorbar(mesh, ax=ax, label=label)
-            else:
-                cbar = fig.colorbar(mesh, ax=ax, ticks=range(4))
-                cbar.ax.set_yticklabels(REGIMES, fontsize=7)
+            unit = (result.units or {}).get(column)
+            named = f"{label} [{unit}]" if unit else label
+            line = f" ({ZERO_CONTOUR})" if getattr(mesh, "zero_contour", None) is not None else ""
+            ax.set_title(f"{named} {over}{run}{line}", fontsize=9)
+            add_colorbar(fig, ax, mesh, named)
+        for ax in list(axs.flat)[len(panels):]:
+            ax.set_visible(False)
         fig.suptitle(sweep_title(result, 160), fontsize=9)
     else:
-        fig, axs = plt.subplots(4, 1, figsize=(8, 10), sharex=True, constrained_layout=True,
+        fig, axs = plt.subplots(4, 1, figsize=(9.5, 10.5), sharex=True, constrained_layout=True,
                                 gridspec_kw={"height_ratios": [3, 3, 3, 1]})
         plot_amplitude(axs[0], result, coordinate)
         plot_exponents(axs[1], result, which=range(1, result.exponent_count + 1), direction=None)
         plot_bifurcation(axs[2], result, coordinate, direction=direction)
         plot_regime_strip(axs[3], result)
-        axs[0].legend(fontsize=7)
+        beside = dict(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, frameon=False)  # off the curves
+        axs[0].legend(**beside)
         handles, labels = axs[1].get_legend_handles_labels()
-        colours = [Line2D([], [], color=h.get_color(), lw=1.0, label=k) for k, h in dict(zip(labels, handles)).items()]
-        axs[1].legend(handles=[*colours, *_style_legend(result)], fontsize=7, ncol=4)
+        colours = [Line2D([], [], color=h.get_color(), marker=h.get_marker(), mfc=h.get_markerfacecolor(),
+                          ms=h.get_markersize(), lw=1.0, label=k) for k, h in dict(zip(labels, handles)).items()]
+        axs[1].legend(handles=[*colours, *_style_legend(result)], **beside)
         axs[2].set_title(f"bifurcation diagram: {coordinate} at t = kT"
                          + (f", the {direction} run" if direction else ", independent points"), fontsize=9)
         axs[3].set_xlabel(_axis_label(result.axes[0].name, result.units))
-        axs[0].set_title(sweep_title(result, 100), fontsize=8)
+        fig.suptitle(sweep_title(result, 100), fontsize=8)
+    fit_texts(fig)
     if path is not None:
         save_figure(fig, path, dpi=120)
     return fig

@@ -7,22 +7,24 @@ add it to the symbolic model, and report the held-out error before and after.
 from ..checks import json_safe
 from ..data import load_measurements
 from ..outputs import check_folder
-from .effects import augment, Effect, effect, effect_terms, EFFECTS, FAMILIES, term_effect
-from .explain import explain, Explanation
-from .prediction import predict_ahead, Prediction
+from .effects import EFFECTS, FAMILIES, Effect, augment, effect, effect_terms, term_effect
+from .explain import Explanation, explain
+from .prediction import Prediction, predict_ahead
 from .report import write_report
-from .shooting import Fit, fit_windows, Segment
+from .result import Fit
+from .segment import Segment
+from .shooting import fit_windows
 
 __all__ = ["EFFECTS", "Effect", "Explanation", "FAMILIES", "Fit", "Prediction", "Segment", "augment", "effect",
            "effect_terms", "explain", "explain_files", "fit_windows", "predict_ahead", "term_effect"]
 
 
 def explain_files(paths, system, fit, *, out=None, time_scale=None, held_out: float = 0.25, candidates=None,
-                  progress=None, options=None, channels=None, bias=(), terms=(), harmonics=None, **values):
+                  progress=None, options=None, channels=None, bias=None, terms=(), harmonics=None, **values):
     """The whole loop from files: load ``paths`` for ``system`` (``values`` fix parameter values; ``channels``
-    declares combinations measured as one column), explain (``bias``: channels with an unknown offset;
-    ``terms``: hand-written terms tried as effects), and with ``out`` write the report there. Returns the
-    report's dict (the keys of report.json)."""
+    declares combinations measured as one column), explain (``bias``: channels with an unknown offset, by default
+    the acceleration channels; ``terms``: hand-written terms tried as effects), and with ``out`` write the report
+    there. Returns the report's dict (the keys of report.json)."""
     if out is not None:
         check_folder(out)
     measurements = load_measurements(paths, system, time_scale=time_scale, channels=channels, **values)

@@ -14,7 +14,8 @@ import numpy as np
 
 from ..analysis.orders import gaps_joined, order_spectrum
 from ..system import FirstOrderSystem
-from .shooting import Fit, Segment
+from .result import Fit
+from .segment import Segment
 
 
 def geared_pairs(system: FirstOrderSystem) -> list[tuple[dict[str, int], float]]:

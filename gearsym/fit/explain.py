@@ -29,31 +29,40 @@ Every candidate is a setting of one system, the declared model with *all* candid
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from pathlib import Path
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..data.measurements import Measurements
-from ..errors import GearsymError
+from ..caller import name as caller_name, on_command_line, option
+from ..checks import whole_number
+from ..data.dataset import Measurements
+from ..errors import GearsymError, suggest
 from ..options import Integration
 from ..system import FirstOrderSystem
 from .canonical import amplitude_phase, canonical
+from .effects import EFFECTS, FAMILIES, Effect, applies_to, augment, bounds_of, effect, site, term_effect
 from .evidence import residual_sidebands
-from .effects import applies_to, augment, bounds_of, Effect, effect, EFFECTS, FAMILIES, site, term_effect
-from .prediction import predict_ahead, Prediction
+from .prediction import Prediction, predict_ahead
 from .proposals import propose_terms
+from .result import Fit
+from .score import score_columns
+from .segment import Segment
 from .shaft_effects import BUILDERS as SHAFT_BUILDERS, DEFAULT_KINDS as SHAFT_DEFAULTS, revolution_length, \
     shaft_effects
-from .shooting import Fit, fit_windows, score_columns, Segment
+from .shooting import fit_windows
 from .tooth_scan import from_record_start, Placement, scan_teeth
 
 MIN_GAIN = 0.2
 MAX_CORRELATION = 0.5
 MAX_EFFECTS = 2
-#: the harmonic families are in the library at orders 1 ... HARMONICS (and the dictionary's harmonics)
+#: the harmonic families are in the library at orders 1 ... HARMONICS (and the dictionary's harmonics) ...
 HARMONICS = 4
+#: ... and at most MAX_HARMONICS: each order adds three families (six parameters) to the one compiled candidate
+#: model, and every fit's tangent is as wide (one_stage at 32 orders: 207 parameters, 18 s to compile)
+MAX_HARMONICS = 32
 #: orders of the forcing shown in the residual's spectrum
 SPECTRUM_ORDERS = 8
 #: at most this many orders that stand out are tried per round
@@ -116,6 +125,7 @@ class Explanation:
     library: dict = field(default_factory=dict)  # name -> Effect of every candidate in the search
     system: FirstOrderSystem | None = None  # the declared model
     bias: tuple[str, ...] = ()
+    bias_by_default: tuple[str, ...] = ()  # the acceleration channels whose offsets were fitted without being asked
 
     @property
     def effects(self) -> list[str]:
@@ -200,6 +210,7 @@ class Explanation:
             "harmonics": self.harmonics(),
             "bias": final.bias,
             "bias_stderr": final.bias_stderr,
+            "bias_by_default": list(self.bias_by_default),
             "parameters_before": self.base.fit.estimates,
             "stderr_before": self.base.fit.stderr,
             "residual_correlation": self.correlation,
@@ -222,9 +233,11 @@ def segments_of(system: FirstOrderSystem, measurements: Measurements) -> tuple[l
     segments, keys = [], []
     for r in measurements:
         values = {**system.parameters, **measurements.parameters(r)}
+        conditions = ", ".join(f"{k}={v:g}" for k, v in r.conditions.items())
+        record = f"{r.label} ({conditions})" if conditions else r.label
         for w in r.windows():
             key = ((str(r.source), r.record), w.index)  # (which record, which period)
-            segments.append(Segment(w.tau, w.observed, values, f"{r.label} period {w.index}", r.channels, key))
+            segments.append(Segment(w.tau, w.observed, values, f"{record} period {w.index}", r.channels, key))
             keys.append(key)
     return segments, keys
 
@@ -262,14 +275,23 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
             candidates: Sequence[str | Effect] | None = None, held_out: float = 0.25,
             min_gain: float = MIN_GAIN, max_effects: int = MAX_EFFECTS,
             max_correlation: float = MAX_CORRELATION, progress=None,
-            options: Integration = Integration(), bias: Sequence[str] = (), terms: Sequence[str] = (),
-            harmonics: int = HARMONICS, propose: bool = True, refits: int = REFITS) -> Explanation:
+            options: Integration = Integration(), bias: Sequence[str] | None = None, terms: Sequence[str] = (),
+            harmonics: int | None = None, propose: bool = True, refits: int = REFITS) -> Explanation:
     """Fit ``fit`` on ``measurements``, then add effects from ``candidates`` (default: the whole library) and the
     hand-written ``terms`` while they lower the held-out error; see the module docstring. ``bias``: channels
-    with an unknown constant offset, fitted with the parameters."""
-    if not fit:
-        raise GearsymError("name the parameters to fit, e.g. --fit zeta,B1")
+    with an unknown constant offset, fitted with the parameters (default: the acceleration channels, whose steady
+    mean is zero for bounded motion, so that a constant offset in one is the sensor's bias; ``()``: none).
+    ``harmonics``: the highest order of the harmonic families (default ``HARMONICS``, or fewer if the data
+    resolve fewer)."""
+    fit = check_fit_names(fit, system)
+    harmonics = check_harmonics(harmonics, measurements)
     _check_one_value_each(measurements, fit)
+    by_default = acceleration_channels(measurements, system) if bias is None else ()
+    bias = list(by_default if bias is None else bias)
+    if by_default:
+        (progress or (lambda message: None))(
+            f"fitting the offset of {', '.join(by_default)} (an acceleration's steady mean is zero for bounded "
+            f"motion, so a constant offset is the sensor's bias; {_no_bias()} fits none)")
     for name in bias:
         if name not in measurements.observed:
             raise GearsymError(f"bias of {name}: no such channel in the data ({', '.join(measurements.observed)})")
@@ -340,7 +362,7 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
             "scans": {name: {"gains": p.gains, "gain": p.gain} for name, p in scanned.items()}}
     ex = Explanation(base, current, tried, unexplained, correlation, tuple(fit), held_out, info,
                      spectrum=spectrum, final_spectrum=current_spectrum, library=library, system=system,
-                     bias=tuple(bias))
+                     bias=tuple(bias), bias_by_default=tuple(by_default))
     if unexplained and propose:
         final_train, final_test = (placed(segs, current.placements, library) for segs in (seg_train, seg_test))
         ex = replace(ex, proposed=propose_terms(ex, superset, final_train, final_test, keys, options, harmonics,
@@ -513,6 +535,69 @@ def residual_spectrum(prediction: Prediction, orders: int = SPECTRUM_ORDERS, str
     return Spectrum(tuple(range(1, orders + 1)), tuple(map(float, amplitude)), noise, tuple(standout[:STANDOUT_ORDERS]))
 
 
+def acceleration_channels(measurements: Measurements, system: FirstOrderSystem) -> tuple[str, ...]:
+    """The channels that measure accelerations alone (``x_ddot``, or a combination such as r1*x1_ddot + x2_ddot,
+    in every record): bounded motion has a zero steady mean acceleration, so a constant offset in one is sensor
+    bias, fitted by default."""
+    return tuple(name for name in measurements.observed
+                 if all(_accelerations_only(r.channels[name], system) for r in measurements if name in r.observed))
+
+
+def _accelerations_only(channel, system: FirstOrderSystem) -> bool:
+    """``channel`` is linear and homogeneous in second derivatives, with parameters (no state, rate, time) beside."""
+    second = {s for s in channel.free_symbols if s.name.endswith("_ddot")}
+    others = {s.name for s in channel.free_symbols - second}
+    if not second or not others <= set(system.parameters):
+        return False
+    return channel.xreplace({s: 0 for s in second}) == 0 and \
+        all(not (channel.diff(s).free_symbols & second) for s in second)
+
+
+def _no_bias() -> str:
+    return "--bias none" if on_command_line() else "bias=()"
+
+
+def check_fit_names(fit: Sequence[str], system: FirstOrderSystem | None = None) -> list[str]:
+    """The parameters to fit: at least one, each named once, and (given the ``system``) each a parameter of the model
+    as declared (an effect's own parameters are fitted when the effect is tried)."""
+    names = [fit] if isinstance(fit, str) else list(fit)
+    if not names:
+        example = "--fit zeta,B1" if on_command_line() else "fit=['zeta', 'B1']"
+        raise GearsymError(f"name the parameters to fit, e.g. {example}")
+    twice = [p for i, p in enumerate(names) if p in names[:i]]
+    if twice:
+        raise GearsymError(f"{caller_name('fit')} names {twice[0]} twice: name each parameter once (a second "
+                           "column of the same parameter leaves the fit no unique answer)")
+    if system is not None:
+        unknown = [p for p in names if p not in system.parameters]
+        if unknown:
+            raise GearsymError(f"cannot fit {unknown[0]}: {system.name} has no parameter {unknown[0]}."
+                               f"{suggest(unknown[0], system.parameters)} Its parameters: "
+                               f"{', '.join(system.parameters)} (an effect's own parameters are fitted when the "
+                               "effect is tried)")
+    return names
+
+
+def check_harmonics(harmonics: int | None, measurements: Measurements | None = None) -> int:
+    """The highest order of the harmonic families: at least 1, at most ``MAX_HARMONICS`` and (with
+    ``measurements``) at most what the sparsest record resolves, an order n taking more than 2n samples a forcing
+    period. None: ``HARMONICS``, or fewer if the data resolve fewer."""
+    resolved = None
+    if measurements is not None and len(measurements):
+        sparsest = min(r.samples_per_period for r in measurements)
+        resolved = max(1, math.ceil(sparsest / 2) - 1)
+    if harmonics is None:
+        return min(HARMONICS, resolved or HARMONICS)
+    order = whole_number(harmonics, caller_name("harmonics"), 1)
+    if order > MAX_HARMONICS:
+        raise GearsymError(f"{option('harmonics', order)}: at most {MAX_HARMONICS} (each order adds three harmonic "
+                           "families, six parameters, to the one compiled model of every candidate)")
+    if resolved is not None and order > resolved:
+        raise GearsymError(f"{option('harmonics', order)}: these data resolve orders up to {resolved} (an order n "
+                           f"takes more than 2n samples a forcing period; the sparsest record has {sparsest:.3g})")
+    return order
+
+
 def _check_one_value_each(measurements: Measurements, fit: Sequence[str]) -> None:
     """A fit estimates one value of each parameter for all records: refuse one the records set differently."""
     for name in fit:
@@ -520,8 +605,8 @@ def _check_one_value_each(measurements: Measurements, fit: Sequence[str]) -> Non
         if len(values) > 1:
             shown = ", ".join(f"{v:g}" for v in sorted(values))
             raise GearsymError(f"cannot fit {name}: the records set it to different values ({shown}) and a fit "
-                               f"estimates one value for all; leave it out of --fit, or explain one record (or "
-                               f"records of one {name}) at a time")
+                               f"estimates one value for all; leave it out of {caller_name('fit')}, or explain one "
+                               f"record (or records of one {name}) at a time")
 
 
 def _lag1(prediction: Prediction) -> float:

@@ -17,7 +17,9 @@ import numpy as np
 
 from ..options import Integration
 from ..system import FirstOrderSystem
-from .shooting import Problem, Segment, fit_windows
+from .problem import Problem
+from .segment import Segment
+from .shooting import fit_windows
 
 
 @dataclass(frozen=True)
@@ -31,6 +33,22 @@ class Prediction:
     states: np.ndarray  # (n, samples): the model's states along the prediction
     pairs: int
     errors: dict[str, float] | None = None  # per channel
+    windows: tuple[tuple[str, int], ...] = ()  # per predicted window, in order: its label and sample count
+
+    def shown(self, limit: int = 3) -> tuple[int, str]:
+        """(samples, what they are) of the first ``limit`` predicted windows of the first record: what a
+        figure of the prediction shows, e.g. 'measured.csv record 1 (omega=1.2), periods 13-15'."""
+        if not self.windows:
+            return min(len(self.tau), limit * len(self.tau) // max(self.pairs, 1)), "the held-out data"
+        record = self.windows[0][0].rpartition(" period ")[0]
+        same = [(label, n) for label, n in self.windows[:limit] if label.rpartition(" period ")[0] == record]
+        first, last = same[0][0].rpartition(" period ")[2], same[-1][0].rpartition(" period ")[2]
+        periods = f"period {first}" if first == last else f"periods {first}-{last}"
+        return sum(n for _, n in same), f"{record}, {periods}"
+
+    def records(self) -> list[str]:
+        """The records whose held-out windows were predicted, in order."""
+        return list(dict.fromkeys(label.rpartition(" period ")[0] for label, _ in self.windows))
 
     @property
     def residual(self) -> dict[str, np.ndarray]:
@@ -115,4 +133,5 @@ def predict_ahead(system: FirstOrderSystem, segments: Sequence[Segment], keys: S
     errors = {k: float(np.sqrt(np.mean((predicted[k] - measured[k]) ** 2)) / (np.std(measured[k]) or 1.0))
               for k in names}
     return Prediction(float(np.mean(list(errors.values()))), np.concatenate(tau), measured, predicted,
-                      np.hstack(states), len(pairs), errors)
+                      np.hstack(states), len(pairs), errors,
+                      tuple((segments[j].label, len(segments[j].tau)) for _, j in pairs))

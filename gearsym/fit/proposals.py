@@ -37,7 +37,9 @@ from ..options import Integration
 from ..system import FirstOrderSystem
 from .effects import augment, bounds_of, own_term, site, term_text
 from .prediction import predict_ahead
-from .shooting import Segment, fit_windows, score_columns
+from .score import score_columns
+from .segment import Segment
+from .shooting import fit_windows
 
 MAX_PROPOSALS = 3
 #: the ridge of STLSQ on unit-norm columns: steadies the fit where dictionary terms are nearly collinear

@@ -15,6 +15,8 @@ import numpy as np
 import sympy as sp
 
 from ..checks import json_safe
+from ..file_sets import written_together
+from ..figures.layout import fit_texts
 from ..figures.save import pyplot, save_figure
 from ..system import FirstOrderSystem
 from .effects import augment, effect_terms
@@ -28,18 +30,25 @@ VERDICTS = {
 }
 
 
+#: the files of a report, replaced together (:func:`~gearsym.file_sets.written_together`)
+REPORT_FILES = ("report.json", "residuals.png", "prediction.png", "derived_model.md", "report.md")
+#: the file that says a report folder is partial (a run killed while it replaced the files)
+PARTIAL_MARKER = "REPORT-INCOMPLETE.txt"
+
+
 def write_report(ex: Explanation, system: FirstOrderSystem, out: str | Path, sources=()) -> dict:
-    """Write DIR/report.md, DIR/report.json, DIR/residuals.png, DIR/prediction.png and DIR/derived_model.md."""
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    data = json_safe(ex.as_dict())
-    (out / "report.json").write_text(json.dumps(data, indent=1, allow_nan=False) + "\n")
-    save_figure(residual_figure(ex, system), out / "residuals.png", dpi=100)
-    _prediction_figure(ex, out / "prediction.png")
-    effects = [ex.library[e] for e in ex.effects]
-    derived = augment(system, effects) if effects else system
-    (out / "derived_model.md").write_text(derived_model_page(system, derived, effects))
-    (out / "report.md").write_text(report_page(ex, system, derived, data, sources))
+    """Write DIR/report.md, DIR/report.json, DIR/residuals.png, DIR/prediction.png and DIR/derived_model.md, all
+    or none: a failure or a kill while they are made leaves the previous report as it was (never a new
+    report.json beside an old report.md)."""
+    with written_together(out, REPORT_FILES, PARTIAL_MARKER, "the report") as stage:
+        data = json_safe(ex.as_dict())
+        (stage / "report.json").write_text(json.dumps(data, indent=1, allow_nan=False) + "\n")
+        save_figure(residual_figure(ex, system), stage / "residuals.png", dpi=100)
+        save_figure(prediction_figure(ex, system.name), stage / "prediction.png", dpi=100)
+        effects = [ex.library[e] for e in ex.effects]
+        derived = augment(system, effects) if effects else system
+        (stage / "derived_model.md").write_text(derived_model_page(system, derived, effects))
+        (stage / "report.md").write_text(report_page(ex, system, derived, data, sources))
     return data
 
 
@@ -81,6 +90,8 @@ def report_page(ex: Explanation, system: FirstOrderSystem, derived: FirstOrderSy
     channels = ", ".join(dict.fromkeys(k for r in after.fit.residuals for k in r))
     lines += [f"Fitted: {', '.join(ex.fitted)} (and every window's start state"
               + (f", and the offsets of {', '.join(ex.bias)}" if ex.bias else "")
+              + (", fitted by default: an acceleration's steady mean is zero for bounded motion, so a constant "
+                 "offset is the sensor's bias" if ex.bias_by_default else "")
               + f"), by multiple shooting over one-forcing-period windows of the channels {channels}; the last "
               f"{ex.held_out:.0%} of each record is held out and judged by the one-period-ahead prediction error "
               "(normalised RMS).", ""]
@@ -295,14 +306,25 @@ def residual_figure(ex: Explanation, system: FirstOrderSystem):
     axs[3].set_ylabel("amplitude / channel spread")
     axs[3].set_title("held-out residual's spectrum (numbers: orders tried)", fontsize=10)
     axs[3].legend(fontsize=8)
+    fig.suptitle(f"{system.name}: the held-out residual of {channel}, {_which(ex.base.prediction)}", fontsize=10)
+    fit_texts(fig)
     return fig
 
 
-def _prediction_figure(ex: Explanation, path: Path) -> None:
+def _which(prediction) -> str:
+    """'every held-out window (12) of measured.csv record 1 (omega=1.2), measured.csv record 2 (omega=1.6)'."""
+    records = prediction.records()
+    return (f"every held-out window ({prediction.pairs}) of " + "; ".join(records) if records
+            else f"every held-out window ({prediction.pairs})")
+
+
+def prediction_figure(ex: Explanation, system_name: str = ""):
+    """The measurement and the predictions of the first three held-out windows of the first record (the
+    title says which)."""
     plt = pyplot()
     p0, p1 = ex.base.prediction, ex.final.prediction
     channel = next(iter(p0.measured))
-    count = min(len(p0.tau), 3 * len(p0.tau) // max(p0.pairs, 1))  # the first three predicted periods
+    count, shown = p0.shown(3)
     idx = np.arange(count)
     fig, ax = plt.subplots(figsize=(11, 3.6), constrained_layout=True)
     ax.plot(idx, p0.measured[channel][:count], ".", ms=3, color="C0", label="measured (held out)")
@@ -313,9 +335,11 @@ def _prediction_figure(ex: Explanation, path: Path) -> None:
                 label=f"+{'+'.join(ex.effects)}: error {ex.final.error:.3g}")
     ax.set_xlabel("held-out sample (one period ahead of each estimated start)")
     ax.set_ylabel(channel)
-    ax.set_title(f"one-period-ahead prediction of {channel} on the held-out data", fontsize=10)
+    ax.set_title(f"{system_name + ': ' if system_name else ''}one-period-ahead prediction of {channel} on the "
+                 f"held-out data: {shown}", fontsize=10)
     ax.legend(fontsize=8)
-    save_figure(fig, path, dpi=100)
+    fit_texts(fig)
+    return fig
 
 
-__all__ = ["derived_model_page", "report_page", "residual_figure", "write_report"]
+__all__ = ["derived_model_page", "prediction_figure", "report_page", "residual_figure", "write_report"]

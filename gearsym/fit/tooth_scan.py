@@ -20,7 +20,9 @@ import numpy as np
 from ..options import Integration
 from ..system import FirstOrderSystem
 from .effect_types import Effect
-from .shooting import Fit, Problem, Segment
+from .problem import Problem
+from .result import Fit
+from .segment import Segment
 
 #: mesh periods beyond a pair's path of contact in which its column is still computed (its window's edges)
 MARGIN = 0.5

@@ -83,7 +83,7 @@ class Drivetrain(Model):
     def set_physical(self, **values) -> "Drivetrain":
         """Physical values of the component parameters, with their units: ``I1="2.1e-3 kg*m^2"``,
         ``kZ="2e8 N/m"``, ``speed="3000 rpm"`` (strings read by the safe quantity parser, or pint Quantities;
-        a plain number is dimensionless). They are turned into SI numbers here (:func:`gearsym.units.measure`);
+        a plain number is dimensionless: for a value that has a unit it is refused when the model is scaled). They are turned into SI numbers here (:func:`gearsym.units.measure`);
         the engine's nondimensional values are derived from them (:class:`gearsym.scales.Scaling`), and its
         results carried back to the units given."""
         self._changed()

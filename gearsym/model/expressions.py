@@ -7,6 +7,7 @@ allowed ones are rejected with the name of the component that used them.
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import Union
 
@@ -28,6 +29,8 @@ def to_expr(value: ExprLike, where: str, extra: Mapping[str, sp.Expr] | None = N
     if isinstance(value, bool) or value is None:
         raise ModelError(f"expected a number, a parameter name or a formula, got {value!r}", where)
     if isinstance(value, (int, float)):
+        if isinstance(value, float) and not math.isfinite(value):
+            raise ModelError(f"{value!r} is not a finite number; give a finite value", where)
         return sp.nsimplify(value) if isinstance(value, int) else sp.Float(value)
     if isinstance(value, str):
         expr = parse_formula(value, where)

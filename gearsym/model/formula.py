@@ -15,7 +15,9 @@ it is called, so ``beta``, ``gamma``, ``E`` or ``I`` are parameters.
 from __future__ import annotations
 
 import ast
+import math
 import operator
+import sys
 from collections.abc import Callable
 
 import sympy as sp
@@ -54,11 +56,27 @@ class _Builder:
     def build(self) -> sp.Basic:
         tree = syntax_tree(self.text, self.where)  # the grammar, checked before anything is built
         try:
-            return self.node(tree, 0)
+            expr = self.node(tree, 0)
         except ModelError:
             raise
         except (TypeError, ValueError, ArithmeticError) as exc:  # SymPy refusing, e.g. sin(x, y) or (x < 1) + 1
             raise self.refuse(f"cannot be built: {exc}") from None
+        self.check_numbers(expr)
+        return expr
+
+    def check_numbers(self, expr: sp.Basic) -> None:
+        """Every number the formula holds (its largest parts without a name) finite and real in double precision:
+        1/0, log(0), 1e400 or exp(exp(exp(exp(10)))) would reach the C as inf or nan, or not at all."""
+        pending = [expr]
+        while pending:
+            part = pending.pop()
+            if not getattr(part, "is_number", False):
+                pending.extend(part.args)
+                continue
+            problem = _number_problem(part)
+            if problem:
+                kind = "is not real" if problem.endswith("is imaginary") else "is not finite"
+                raise ModelError(f"the formula {self.shown} {kind}: {problem}; give a finite real value", self.where)
 
     def node(self, n: ast.AST, depth: int) -> sp.Basic:
         if depth > MAX_DEPTH:
@@ -149,3 +167,24 @@ class _Builder:
         if not (isinstance(n, ast.Tuple) and len(n.elts) == 2):
             raise self.refuse("gives Piecewise an argument that is not a (value, condition) pair")
         return self.node(n.elts[0], depth + 1), self.node(n.elts[1], depth + 1)
+
+
+def _number_problem(part: sp.Basic) -> str:
+    """What keeps a constant expression from being a finite real double, or ''."""
+    if part.has(sp.zoo, sp.nan):
+        return "it divides by zero, or takes the log of 0"
+    text = str(part.evalf(4)) if part.is_Float else str(part)
+    shown = text if len(text) <= 40 else text[:37] + "..."
+    try:
+        value = complex(part.evalf(20))
+    except (OverflowError, MemoryError):
+        return f"{shown} overflows (a double holds at most {sys.float_info.max:.3g})"
+    except (TypeError, ValueError, ArithmeticError):
+        return f"{shown} has no numeric value"
+    if math.isnan(value.real) or math.isnan(value.imag):
+        return f"{shown} is undefined"
+    if math.isinf(value.real) or math.isinf(value.imag):
+        return f"{shown} is infinite or beyond what a double holds ({sys.float_info.max:.3g})"
+    if value.imag:
+        return f"{shown} is imaginary"
+    return ""

@@ -88,6 +88,7 @@ class Continuation:
     branches: tuple[Branch, ...]
     bifurcations: tuple[Bifurcation, ...]
     settings: dict
+    units: dict[str, str] = field(default_factory=dict)  # column -> unit, for a continuation in physical units
 
     def of_kind(self, kind: str) -> list[Bifurcation]:
         return [b for b in self.bifurcations if b.kind == kind]
@@ -136,7 +137,8 @@ def continue_orbits(model: CompiledModel, parameter: str, start: float, stop: fl
     The first orbit is found by Newton at ``start`` from ``y0`` (a state at the section), or from where
     ``options.periods`` periods of simulation end. At each period doubling a branch of twice the period is
     followed too, down to ``switch_depth`` doublings (0: none). ``step``, ``max_step``: in the norm of
-    :mod:`gearsym.periodic.continuation` (default: 1/50 and 1/10 of the range).
+    :mod:`gearsym.periodic.continuation` (default: 1/50 of the range, and the smaller of half the range and
+    ``MAX_STEP_OF_SIZE`` times 1 + the root-mean-square state of the orbit a step starts from).
     """
     options = model.run_options(options)
     segments = model.cycles if segments is None else segments  # (one per mesh period of a revolution)
@@ -153,8 +155,8 @@ def continue_orbits(model: CompiledModel, parameter: str, start: float, stop: fl
     steps = Steps(step=step, max_step=max_step, max_points=whole_number(max_points, "max_points", 2))
     watches = mesh_watches(model)
     started: list[Traced] = []
-    tracer = Tracer(problem, start, stop, steps, watches, started)
     ev, _ = find_orbit(problem, starting_states(model, y0, options, period_multiple, problem.inputs(start)), start)
+    tracer = Tracer(problem, start, stop, steps, watches, started)
     settings = {"integration": options.describe(), "steps_per_period": model.steps_per_period,
                 "locate_crossings": model.options.locate_crossings, "period_multiple": period_multiple,
                 "segments": segments, "transient_periods": None if y0 is not None else options.periods,

@@ -42,6 +42,18 @@ REJOIN = "rejoin"
 
 #: the largest angle (radians, in the weighted norm) between consecutive tangents
 MAX_TURN = 0.3
+#: a step is taken only where Newton contracts from the predictor at once (its second correction at most this
+#: fraction of its first: Deuflhard's a-priori test) and moves the point at most MAX_CORRECTION of the step: else
+#: the predictor lay outside Newton's region of quadratic convergence, and where two parts of a branch come close
+#: (the two sides of a resonance, a fold) the corrector converged onto the other part (measured: one_stage with
+#: k = 1 + 0.2 cos(tau) from omega = 0.1 jumped back past its start, contraction 0.6-1.4, where smooth steps
+#: contract by 0.03 or less); the step is halved instead
+MAX_CONTRACTION, MAX_CORRECTION = 0.25, 0.5
+#: without a ``max_step`` of the caller's, a step is at most this fraction of 1 + the root-mean-square state of
+#: the orbit it starts from (and half the range): the steps move mostly the states, and steps of a few per cent
+#: of the orbit's size crossed from one side of a narrow resonance loop to the other unnoticed (the same model:
+#: steps of 0.3 did, 0.2 = 0.02 (1 + 9.7) did not)
+MAX_STEP_OF_SIZE = 0.02
 #: step growth after an easy correction (at most this many iterations), and shrinkage after a hard one
 GROW, EASY, HARD = 1.5, 3, 5
 #: Newton iterations of a corrector before the step is halved
@@ -83,6 +95,7 @@ class Solution:
     tangent: np.ndarray | None = None
     mu: np.ndarray | None = None
     tests: dict = field(default_factory=dict)
+    contraction: float = 0.0  # the corrector's second Newton step over its first (0: one step or none)
     event: tuple[str, str] | None = None  # (kind, detail) where a bifurcation was located here
     switched_to: int | None = None  # the index of the branch of twice the period started here
     curvature: np.ndarray | None = None  # d tangent / ds, from the step that reached this point
@@ -113,6 +126,7 @@ class Tracer:
 
     def __init__(self, problem: OrbitMap, start: float, stop: float, steps: Steps, watches=(), started=None):
         self.problem, self.steps = problem, steps.resolved(stop - start)
+        self.sized = steps.max_step is None  # the largest step follows the orbits' size
         self.started = started if started is not None else []  # every branch traced, finished or not, in order
         self.lo, self.hi, self.direction = min(start, stop), max(start, stop), (1.0 if stop >= start else -1.0)
         self.watches = watches
@@ -124,6 +138,12 @@ class Tracer:
         """The state after n of the 2n periods minus the state at the start (zero on the period-n branch)."""
         z = s.ev.z
         return z[len(z) // 2] - z[0]
+
+    def largest_step(self, s: "Solution") -> float:
+        """The largest step from ``s`` (see ``MAX_STEP_OF_SIZE``)."""
+        if not self.sized:
+            return self.steps.max_step
+        return min(self.steps.max_step, MAX_STEP_OF_SIZE * (1 + float(np.sqrt(np.mean(np.square(s.ev.z))))))
 
     # ------------------------------------------------------------------ basic operations
     def norm(self, v: np.ndarray) -> float:
@@ -144,6 +164,7 @@ class Tracer:
         if target is not None:
             u[-1] = target
         margin = 0.5 * (self.hi - self.lo)
+        sizes = []  # of the Newton steps, in the weighted norm
         for iteration in range(MAX_CORRECTIONS + 1):
             z, value = self.split(u)
             if not self.lo - margin <= value <= self.hi + margin:
@@ -152,7 +173,7 @@ class Tracer:
             if ev is None:
                 return None
             if ev.error() <= TOLERANCE:
-                return Solution(ev, iteration)
+                return Solution(ev, iteration, contraction=sizes[1] / sizes[0] if len(sizes) > 1 and sizes[0] else 0.0)
             A = np.vstack([np.hstack([ev.jacobian(), ev.d_parameter.reshape(-1, 1)]), a[None, :]])
             try:
                 du = np.linalg.solve(A, -np.append(ev.residual, np.dot(a, u) - b))
@@ -160,6 +181,7 @@ class Tracer:
                 return None
             if not np.all(np.isfinite(du)):
                 return None
+            sizes.append(self.norm(du))
             u = u + du
         return None
 
@@ -245,7 +267,8 @@ class Tracer:
             a = b
             if doubled:
                 self.reference = self.halves(b)
-            ds = min(ds * GROW, steps.max_step) if b.iterations <= EASY else ds / 2 if b.iterations >= HARD else ds
+            ds = min(ds * GROW, self.largest_step(b)) if b.iterations <= EASY else ds / 2 if b.iterations >= HARD \
+                else ds
         return traced
 
     def rejoin(self, located: list, b: Solution) -> Solution | None:
@@ -261,9 +284,13 @@ class Tracer:
     def step(self, a: Solution, ds: float, max_turn: float = MAX_TURN) -> Solution | None:
         """The corrected point ``ds`` along the tangent at ``a``, if the tangent turns by less than ``max_turn``."""
         bent = None if a.curvature is None else a.u + ds * a.tangent + ds * ds / 2 * a.curvature
-        b = self.corrected(a.u + ds * a.tangent, a.tangent, start=bent)
+        predicted = a.u + ds * a.tangent
+        b = self.corrected(predicted, a.tangent, start=bent)
         if b is None:
             return None
+        if max_turn <= MAX_TURN and (b.contraction > MAX_CONTRACTION
+                                     or self.norm(b.u - predicted) > MAX_CORRECTION * ds):
+            return None  # (a hop over a non-smooth spot, with its larger turn, is not held to this)
         b = self.analysed(b, a.tangent)
         cos = np.dot(self.weights * a.tangent, b.tangent)
         if np.arccos(np.clip(cos, -1, 1)) > max_turn:
@@ -275,7 +302,7 @@ class Tracer:
         """The next point from ``a``: the step halved until the corrector converges with little turn; below
         ``HOP_BELOW`` of the range, a hop over the spot (the steps' map jumps there, see ``non_smooth``)."""
         steps, tried = self.steps, ds
-        ds = min(ds, steps.max_parameter_step / max(abs(a.tangent[-1]), 1e-300))
+        ds = min(ds, self.largest_step(a), steps.max_parameter_step / max(abs(a.tangent[-1]), 1e-300))
         if a.curvature is not None:  # a step the last curvature would turn by most of MAX_TURN is not tried
             ds = min(ds, 0.7 * MAX_TURN / max(self.norm(a.curvature), 1e-300))
         while ds >= HOP_BELOW * (self.hi - self.lo):
@@ -284,10 +311,10 @@ class Tracer:
                 return b, ds
             ds /= 2
         for factor in HOPS:
-            b = self.step(a, factor * min(tried, steps.max_step), max_turn=HOP_TURN)
+            b = self.step(a, factor * min(tried, self.largest_step(a)), max_turn=HOP_TURN)
             if b is not None:
                 traced.non_smooth.append((a.value, b.value))
-                return b, min(tried, steps.max_step)
+                return b, min(tried, self.largest_step(a))
         return None, ds
 
     # ------------------------------------------------------------------ bifurcations

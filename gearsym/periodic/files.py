@@ -8,14 +8,16 @@ from pathlib import Path
 
 import numpy as np
 
+from ..checks import json_safe
 from ..files import write_atomically
 from ..sweep.store import number, sidecar
 from .branches import Continuation
 
 
-def write_orbits(result: Continuation, path: str | Path) -> tuple[Path, Path]:
+def write_orbits(result: Continuation, path: str | Path, extra: dict | None = None) -> tuple[Path, Path]:
     """Write the branch points to ``path`` (CSV, floats as ``repr``: they read back to the same bits) and the
-    record with its bifurcations beside it (``.json``); both atomically. Returns the two paths."""
+    record with its bifurcations beside it (``.json``, with ``extra`` keys: the same in physical units); both
+    atomically. Returns the two paths."""
     path = Path(path)
     rows = result.rows()
     out = io.StringIO()
@@ -26,7 +28,8 @@ def write_orbits(result: Continuation, path: str | Path) -> tuple[Path, Path]:
         writer.writerow([_cell(row[k]) for k in header])
     write_atomically(path, out.getvalue())
     record = sidecar(path, ".json")
-    write_atomically(record, json.dumps(result.as_dict(), indent=1, allow_nan=False) + "\n")
+    write_atomically(record, json.dumps({**result.as_dict(), **json_safe(extra or {})}, indent=1, allow_nan=False)
+                     + "\n")
     return path, record
 
 

@@ -1,9 +1,16 @@
 """A scaling that also carries the engine's answers back to the user's units (the face's ``gearsym.scaling``)."""
 from __future__ import annotations
 
+from functools import singledispatchmethod
+
+from ..analysis.lyapunov import LyapunovSpectrum
+from ..analysis.orbits import Trajectory
 from ..errors import GearsymError
+from ..periodic.branches import Continuation
 from ..scales.map import Scaling
+from ..sweep.result import SweepResult
 from . import results
+from .orbits import continuation_to_physical
 from .point import LENGTH_UNIT
 
 
@@ -11,18 +18,35 @@ class PhysicalScaling(Scaling):
     """A :class:`~gearsym.scales.map.Scaling` with :meth:`to_physical`: this stage sits above the analyses whose
     results it converts, the map below them."""
 
-    def to_physical(self, result, length_unit: str = LENGTH_UNIT, *, omega: float | None = None, trajectory=None):
-        """A result of the engine in physical units: a LyapunovSpectrum (optionally with the mesh forces of a
-        ``trajectory`` at the same point), a Trajectory (run at ``omega``, default this scaling's) or a
-        SweepResult along omega (see :mod:`gearsym.physical.results`)."""
-        if hasattr(result, "exponents"):
-            return results.point_to_physical(self, result, length_unit, trajectory)
-        if hasattr(result, "columns"):
-            return results.sweep_to_physical(self, result, length_unit)
-        if hasattr(result, "states") and hasattr(result, "time"):
-            return results.trajectory_to_physical(self, result, self.values["omega"] if omega is None else omega,
-                                                  length_unit)
+    @singledispatchmethod
+    def to_physical(self, result, length_unit: str = LENGTH_UNIT, **options):
+        """A result of the engine in physical units (see :mod:`gearsym.physical.results`):
+
+        * a LyapunovSpectrum: a :class:`~gearsym.physical.point.PhysicalPoint` with the mesh forces and shaft
+          torques of ``trajectory`` (a Trajectory at the same point) or, without one, of a trajectory run from the
+          spectrum's final state on ``model`` (the compiled model it ran on; default this scaling's system);
+        * a Trajectory (run at ``omega``, default this scaling's): a PhysicalTrajectory;
+        * a SweepResult: along the physical values ``given`` (the axes swept before they became the engine's) or
+          the speed for omega, with ``units``;
+        * a Continuation: along the speed (if it ran along omega), with ``units``."""
         raise GearsymError(f"cannot carry a {type(result).__name__} to physical units")
+
+    @to_physical.register
+    def _(self, result: LyapunovSpectrum, length_unit: str = LENGTH_UNIT, *, trajectory=None, model=None):
+        return results.point_to_physical(self, result, length_unit, trajectory, model)
+
+    @to_physical.register
+    def _(self, result: SweepResult, length_unit: str = LENGTH_UNIT, *, given=None):
+        return results.sweep_to_physical(self, result, length_unit, given)
+
+    @to_physical.register
+    def _(self, result: Trajectory, length_unit: str = LENGTH_UNIT, *, omega: float | None = None):
+        return results.trajectory_to_physical(self, result, self.values["omega"] if omega is None else omega,
+                                              length_unit)
+
+    @to_physical.register
+    def _(self, result: Continuation, length_unit: str = LENGTH_UNIT):
+        return continuation_to_physical(self, result, length_unit)
 
     def point_units(self, length_unit: str = LENGTH_UNIT):
         """The numbers that carry a spectrum run back (what the start-up cache keeps: no pint, no SymPy)."""

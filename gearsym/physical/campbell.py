@@ -13,7 +13,8 @@ from ..units import from_si, to_si
 
 @dataclass(frozen=True)
 class Order:
-    """An excitation whose frequency is ``per_speed`` times the operating speed (both in rad/s)."""
+    """An excitation whose frequency is ``per_speed`` times the operating speed (both in rad/s, or both in rev/s:
+    cycles per revolution of the body whose speed is the operating speed, a rotating machine's "order")."""
 
     label: str
     kind: str  # "mesh" | "torque"
@@ -39,6 +40,7 @@ class Campbell:
     natural_frequencies: tuple[float, ...]  # Hz, elastic modes (a repeated one once)
     orders: tuple[Order, ...]
     crossings: tuple[Crossing, ...]
+    speed_body: str = ""  # the body whose speed the axis is (an order counts cycles per its revolution)
 
     def speeds_rad_s(self, speeds=None) -> np.ndarray:
         values = self.speeds if speeds is None else speeds
@@ -47,9 +49,11 @@ class Campbell:
     def as_dict(self) -> dict:
         return {"model": self.model, "speed_unit": self.speed_unit,
                 "natural_frequencies_Hz": list(self.natural_frequencies),
-                "orders": [{"label": o.label, "kind": o.kind, "per_speed": o.per_speed} for o in self.orders],
+                "orders": [{"label": o.label, "kind": o.kind, "cycles_per_revolution": _rounded(o.per_speed)}
+                           for o in self.orders],
                 "crossings": [{"order": c.order, "natural_frequency_Hz": c.natural_frequency,
-                               f"speed_{self.speed_unit}": c.speed} for c in self.crossings]}
+                               f"speed_{self.speed_unit}": c.speed} for c in self.crossings],
+                "speed": f"the speed of {self.speed_body!r}" if self.speed_body else None}
 
 
 def campbell(scaling: Scaling, speeds, speed_unit: str, modes, mesh_orders: int = 3) -> Campbell:
@@ -74,4 +78,9 @@ def campbell(scaling: Scaling, speeds, speed_unit: str, modes, mesh_orders: int 
                 crossings.append(Crossing(order.label, fn, float(from_si(at, speed_unit))))
     crossings.sort(key=lambda c: c.speed)
     return Campbell(scaling.name, speed_unit, np.asarray(speeds, dtype=float), naturals, tuple(orders),
-                    tuple(crossings))
+                    tuple(crossings), scaling.speed.body if scaling.speed else "")
+
+
+def _rounded(x: float) -> float:
+    """A ratio of tooth counts as the number it is (28.0, not 27.999999999999996)."""
+    return float(f"{x:.12g}")

@@ -2,18 +2,24 @@
 
 :func:`gearsym.physical.results.point_units` reads once, with pint, what carrying a
 :class:`~gearsym.analysis.LyapunovSpectrum` back to physical units takes (the time unit, the length unit,
-the unit conversions, each mesh's stiffness, damping, backlash and its variation k(phi) as a CasADi
-function); :class:`PointUnits` keeps those numbers and does the carrying. The start-up cache
+the unit conversions, each mesh's stiffness, damping, backlash and its variation k(tau) as a CasADi
+function, each shaft's stiffness and damping); :class:`PointUnits` keeps those numbers and does the carrying.
+The mesh forces and shaft torques of a point come from a trajectory at that point (:func:`loads_trajectory`:
+``FORCE_PERIODS`` forcing periods from the run's final state), whoever asks (the command line or Python). The start-up cache
 (gearsym/cached.py) stores them, so that ``gearsym lyap`` on a cached model with physical values imports
 neither pint (most of a second with its registry) nor SymPy.
 """
 from __future__ import annotations
 
+import math
+import textwrap
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
+from ..analysis.orbits import phase_trajectory
+from ..errors import GearsymError
 from ..scales.speeds import Speed
 from ..units import shown
 
@@ -21,6 +27,10 @@ from ..units import shown
 LENGTH_UNIT = "um"
 VELOCITY_UNIT = "mm/s"
 SPEED_UNIT = "rpm"
+#: significant digits of a speed (or a mesh frequency) carried back from omega
+SPEED_DIGITS = 12
+#: forcing periods of the trajectory a point's mesh forces and shaft torques are read from (after the run's end)
+FORCE_PERIODS = 20
 
 
 @dataclass(frozen=True)
@@ -39,7 +49,7 @@ class Unit:
 
 @dataclass(frozen=True)
 class Measured:
-    """A number (or array) with its unit, shown as a pint Quantity is (:func:`~gearsym.physical.text.shown`)."""
+    """A number (or array) with its unit, shown as a pint Quantity is (:func:`~gearsym.units.shown`)."""
 
     magnitude: object
     units: Unit
@@ -57,10 +67,11 @@ class PhysicalPoint:
     omega: float
     exponents: object  # 1/s
     stderr: object
-    amplitude: dict
+    amplitude: dict  # a mesh's deflection in the length unit, a shaft's twist in rad
     final_state: dict
     length_unit: object  # the scaling's L
     mesh_force: dict = field(default_factory=dict)  # mesh -> {"mean", "min", "max", "dynamic"} in N
+    shaft_torque: dict = field(default_factory=dict)  # shaft -> {"mean", "min", "max", "dynamic"} in N·m
 
     def as_dict(self) -> dict:
         """JSON-ready: every value as a number with its unit beside it."""
@@ -74,17 +85,21 @@ class PhysicalPoint:
                "final_state": {k: q(v) for k, v in self.final_state.items()}, "length_unit": q(self.length_unit)}
         if self.mesh_force:
             out["mesh_force"] = {m: {k: q(v) for k, v in f.items()} for m, f in self.mesh_force.items()}
+        if self.shaft_torque:
+            out["shaft_torque"] = {m: {k: q(v) for k, v in f.items()} for m, f in self.shaft_torque.items()}
         return out
 
     def lines(self) -> list[str]:
         """The text ``gearsym lyap`` prints for a model with physical values."""
-        out = [f"operating point: {shown(self.speed)}, mesh frequency {shown(self.mesh_frequency)}, "
+        speed = f"{shown(self.speed)}, " if math.isfinite(float(np.asarray(self.speed.magnitude))) else ""
+        out = [f"operating point: {speed}mesh frequency {shown(self.mesh_frequency)}, "
                f"omega_n = {shown(self.natural_frequency)} (omega = {self.omega:.6g})",
                "Lyapunov exponents per second: " + ", ".join(f"{v:+.6g}" for v in self.exponents.magnitude)]
         out += [f"amplitude A_{k} = {shown(v)}" for k, v in self.amplitude.items()]
-        for mesh, f in self.mesh_force.items():
-            out.append(f"mesh force {mesh}: mean {shown(f['mean'])}, {shown(f['min'])} to {shown(f['max'])} "
-                       f"(dynamic amplitude {shown(f['dynamic'])})")
+        for what, table in (("mesh force", self.mesh_force), ("shaft torque", self.shaft_torque)):
+            for name, f in table.items():
+                out.append(f"{what} {name}: mean {shown(f['mean'])}, {shown(f['min'])} to {shown(f['max'])} "
+                           f"(dynamic amplitude {shown(f['dynamic'])})")
         return out
 
 
@@ -92,9 +107,32 @@ def _number(x):
     return x.tolist() if isinstance(x, np.ndarray) else float(x)
 
 
+def _significant(x):
+    """``x`` (a number or array) to ``SPEED_DIGITS`` significant digits."""
+    values = np.asarray(x, dtype=float)
+    rounded = np.array([float(f"{v:.{SPEED_DIGITS}g}") for v in values.ravel()]).reshape(values.shape)
+    return rounded if values.ndim else float(rounded)
+
+
+def whole_period_mean(time, values, period: float) -> float:
+    """The mean of a sampled signal over the whole periods from its first sample: the trapezoidal rule, so a
+    sample that ends one period and starts the next (the same phase) counts once, and for samples evenly spaced
+    over a periodic signal the mean is that of one sample per phase (exact for a Fourier series of lower degree
+    than the samples per period). Samples after the last whole period are left out."""
+    time, values = np.asarray(time, dtype=float), np.asarray(values, dtype=float)
+    span = time[-1] - time[0]
+    whole = math.floor(span / period * (1 + 1e-12)) if period > 0 else 0
+    if whole < 1:  # less than a period: the mean of what there is
+        return float(np.trapezoid(values, time) / span) if span > 0 else float(values[0])
+    end = time[0] + whole * period
+    keep = time <= end + 1e-9 * period
+    return float(np.trapezoid(values[keep], time[keep]) / (time[keep][-1] - time[0]))
+
+
 @dataclass(frozen=True)
 class MeshUnits:
-    """A mesh's law in SI: force = stiffness k(order tau + phase) g(x, eta) + damping dx/dt."""
+    """A mesh's law in SI: force = stiffness k(tau) g(x, eta) + damping dx/dt, where k(tau) is the mesh's
+    stiffness variation (declared, or the formula that replaced it) at the engine's time tau."""
 
     name: str
     coordinate: str
@@ -102,18 +140,31 @@ class MeshUnits:
     stiffness: float  # N/m
     damping: float  # N s/m
     eta: float  # m
-    phase: float
-    order: float
-    variation: str  # k(phi), a serialized CasADi function
+    variation: str  # k(tau), a serialized CasADi function
 
     def force(self, tau, x, v) -> np.ndarray:
         """The force in N along a trajectory (x in m, v in m/s)."""
         import casadi as ca
 
-        phases = np.atleast_1d(self.order * tau + self.phase)
-        k_of_phi = ca.Function.deserialize(self.variation).map(phases.size)
-        k = np.asarray(k_of_phi(phases.reshape(1, -1)), dtype=float).reshape(phases.shape) * np.ones_like(tau)
+        taus = np.atleast_1d(np.asarray(tau, dtype=float))
+        k_of_tau = ca.Function.deserialize(self.variation).map(taus.size)
+        k = np.asarray(k_of_tau(taus.reshape(1, -1)), dtype=float).reshape(taus.shape)
         return self.stiffness * k * contact(x, self.eta) + self.damping * v
+
+
+@dataclass(frozen=True)
+class ShaftUnits:
+    """A shaft's law in SI: torque = stiffness twist + damping d(twist)/dt."""
+
+    name: str
+    coordinate: str
+    velocity: str
+    stiffness: float  # N m/rad
+    damping: float  # N m s/rad
+
+    def torque(self, twist, rate) -> np.ndarray:
+        """The torque in N·m along a trajectory (twist in rad, its rate in rad/s)."""
+        return self.stiffness * np.asarray(twist, dtype=float) + self.damping * np.asarray(rate, dtype=float)
 
 
 def contact(x, eta):
@@ -121,10 +172,20 @@ def contact(x, eta):
     return np.where(x >= 0, x, np.where(x > -eta, 0.0, x + eta))
 
 
+#: what a state is physically: a mesh's deflection (a length) or a shaft's twist (an angle), or their rates
+LENGTH, VELOCITY, ANGLE, ANGULAR_VELOCITY = "length", "velocity", "angle", "angular velocity"
+RATES = (VELOCITY, ANGULAR_VELOCITY)
+
+
 @dataclass(frozen=True)
 class PointUnits:
-    """The numbers that carry a spectrum run of one scaling to physical units (see the module's docstring);
-    factors are pint's own (``rad_s_to_hz``: 1 rad/s in Hz), applied as pint applies them."""
+    """The numbers that carry a run of one scaling to physical units (see the module's docstring);
+    factors are pint's own (``rad_s_to_hz``: 1 rad/s in Hz), applied as pint applies them.
+
+    A state of the engine is a number in the scaled units: a mesh's deflection in L, a shaft's coordinate
+    (its coordinate radius times its twist) in L too, their rates per unit tau. ``per_unit`` gives the SI value
+    of one such unit of each state (L in m for a mesh, L / radius in rad for a shaft), ``kinds`` what it is;
+    a rate is then further times omega omega_n per second."""
 
     name: str
     speed: Speed | None  # (None: no body declares the operating speed)
@@ -142,62 +203,126 @@ class PointUnits:
     m_to_length: float
     velocity_text: Unit
     m_s_to_velocity: float
-    velocity_to_m_s: float
     per_second: Unit
     newton: Unit
     hertz: Unit
-    kinds: dict  # state -> "length" or "velocity"
+    radian: Unit
+    radian_per_second: Unit
+    newton_metre: Unit
+    kinds: dict  # state -> LENGTH, VELOCITY, ANGLE or ANGULAR_VELOCITY
+    per_unit: dict  # state -> SI value (m or rad) of one engine unit of it (of its rate: per unit tau)
     meshes: tuple[MeshUnits, ...]
+    shafts: tuple[ShaftUnits, ...] = ()
+    values: dict = field(default_factory=dict)  # every physical value as the user gave it ('1.27e+08 N/m')
 
     def as_dict(self) -> dict:
         return asdict(self)
 
     @classmethod
     def from_dict(cls, d: dict) -> "PointUnits":
-        units = {k: Unit(str(d[k]["name"]), str(d[k]["text"])) for k in ("speed_unit", "length_text", "velocity_text", "per_second",
-                                                        "newton", "hertz")}
+        units = {k: Unit(str(d[k]["name"]), str(d[k]["text"]))
+                 for k in ("speed_unit", "length_text", "velocity_text", "per_second", "newton", "hertz", "radian",
+                           "radian_per_second", "newton_metre")}
         meshes = tuple(MeshUnits(**m) for m in d["meshes"])
+        shafts = tuple(ShaftUnits(**m) for m in d["shafts"])
         speed = Speed(**d["speed"]) if d["speed"] else None
-        return cls(**{**d, **units, "meshes": meshes, "speed": speed, "kinds": {str(k): str(v) for k, v in d["kinds"].items()}})
+        return cls(**{**d, **units, "meshes": meshes, "shafts": shafts, "speed": speed,
+                      "kinds": {str(k): str(v) for k, v in d["kinds"].items()},
+                      "per_unit": {str(k): float(v) for k, v in d["per_unit"].items()},
+                      "values": {str(k): str(v) for k, v in d["values"].items()}})
 
-    def state(self, name: str, values, omega: float, *, si: bool = False) -> Measured:
-        """A state's values as a coordinate in the length unit or a rate in mm/s (``si``: numbers in m, m/s)."""
+    def unit(self, name: str) -> Unit:
+        """The unit a state is shown in."""
+        return {LENGTH: self.length_text, VELOCITY: self.velocity_text, ANGLE: self.radian,
+                ANGULAR_VELOCITY: self.radian_per_second}[self.kinds[name]]
+
+    def state(self, name: str, values, omega, *, si: bool = False) -> Measured:
+        """A state's values as a mesh deflection in the length unit (its rate in mm/s) or a shaft's twist in rad
+        (its rate in rad/s); ``si``: numbers in m, m/s, rad, rad/s. ``omega`` (a number, or one per value) is
+        the forcing frequency the values were run at (a rate depends on it)."""
         kind = self.kinds[name]
-        if kind == "length":
-            metres = np.asarray(values, dtype=float) * self.length
-            return metres if si else Measured(metres * self.m_to_length, self.length_text)
-        rate = np.asarray(values, dtype=float) * self.length * (float(omega) * self.omega_n)
-        return rate * self.m_s_to_velocity * self.velocity_to_m_s if si else Measured(rate * self.m_s_to_velocity,
-                                                                                     self.velocity_text)
+        value = np.asarray(values, dtype=float) * self.per_unit[name]
+        if kind in RATES:
+            value = value * (np.asarray(omega, dtype=float) * self.omega_n)
+        if si:
+            return value
+        factor = {LENGTH: self.m_to_length, VELOCITY: self.m_s_to_velocity}.get(kind, 1.0)
+        return Measured(value * factor, self.unit(name))
+
+    def speed_of(self, omega) -> np.ndarray:
+        """The operating speed (in its unit) at which the engine's forcing frequency is ``omega``, to
+        ``SPEED_DIGITS`` significant digits: the digits of a speed the user gave survive the round trip through
+        omega, its last bits (6000.000000000001 rpm) do not."""
+        return _significant(np.asarray(omega, dtype=float) * self.omega_n / self.forcing_ratio * self.rad_s_to_speed)
 
     def point(self, result, trajectory=None) -> PhysicalPoint:
-        """A :class:`~gearsym.analysis.LyapunovSpectrum` in physical units (with the mesh forces of
-        ``trajectory``, a :class:`~gearsym.analysis.orbits.Trajectory` at the same point, if given)."""
+        """A :class:`~gearsym.analysis.LyapunovSpectrum` in physical units (with the mesh forces and shaft
+        torques of ``trajectory``, a :class:`~gearsym.analysis.orbits.Trajectory` at the same point, if given)."""
         w = float(result.parameters["omega"])
         per_second = w * self.omega_n
-        speed = (w * self.omega_n / self.forcing_ratio * self.rad_s_to_speed) if self.speed else float("nan")
-        forces = self.mesh_forces(trajectory, w) if trajectory is not None else {}
+        speed = float(self.speed_of(w)) if self.speed else float("nan")
+        forces, torques = self.loads(trajectory, w) if trajectory is not None else ({}, {})
+        period = float(result.period)
+        time = trajectory.time if trajectory is not None else None
         return PhysicalPoint(
             self.name, Measured(speed, self.speed_unit),
-            Measured(w * self.omega_n * self.order * self.rad_s_to_hz, self.hertz),
+            Measured(float(_significant(w * self.omega_n * self.order * self.rad_s_to_hz)), self.hertz),
             Measured(self.natural_frequency, self.hertz), w,
             Measured(np.asarray(result.exponents, dtype=float) * per_second, self.per_second),
             Measured(np.asarray(result.stderr, dtype=float) * per_second, self.per_second),
             {k: self.state(k, v, w) for k, v in result.amplitude.items()},
             {k: self.state(k, v, w) for k, v in result.final_state.items()},
-            Measured(self.length_shown, self.length_text), {m: self._force_summary(f) for m, f in forces.items()})
+            Measured(self.length_shown, self.length_text),
+            {m: self._summary(time, f, period, self.newton) for m, f in forces.items()},
+            {s: self._summary(time, f, period, self.newton_metre) for s, f in torques.items()})
+
+    def figure(self, result, trajectory) -> tuple:
+        """A spectrum run and a trajectory at its point as a figure shows them in physical units
+        (:func:`gearsym.figures.point.plot_point`): the spectrum with its exponents, their running estimates and
+        its Poincaré points converted, the trajectory's states converted, the unit of each, and a title with the
+        physical values as the user gave them."""
+        w = float(result.parameters["omega"])
+        per_second = w * self.omega_n
+
+        def states(names, matrix):
+            return np.vstack([self.state(n, matrix[i], w).magnitude for i, n in enumerate(names)])
+
+        spectrum = replace(result, exponents=np.asarray(result.exponents) * per_second,
+                           stderr=np.asarray(result.stderr) * per_second,
+                           history=np.asarray(result.history) * per_second,
+                           strobe=states(tuple(result.final_state), result.strobe))  # (its keys: the states)
+        converted = states(trajectory.state_names, trajectory.states)
+        every = max(1, (converted.shape[1] - 1) // max(1, trajectory.strobe.shape[1] - 1))
+        shown_trajectory = replace(trajectory, states=converted, strobe=converted[:, ::every])
+        units = {n: self.unit(n).text for n in trajectory.state_names} | {"exponents": self.per_second.text}
+        speed = self.speed.parameter if self.speed else None
+        head = f"{shown(Measured(float(self.speed_of(w)), self.speed_unit))}; " if self.speed else ""
+        values = ", ".join(f"{k}={v}" for k, v in self.values.items() if k != speed)
+        title = (textwrap.fill(f"{self.name}: {head}{values}", 140)
+                 + f"\n{result.regime}, λ₁ = {spectrum.exponents[0]:+.5g} {self.per_second.text}")
+        return spectrum, shown_trajectory, units, title
+
+    def loads(self, trajectory, omega: float) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+        """The force of every mesh (N) and the torque of every shaft (N·m) along a trajectory."""
+        tau = np.asarray(trajectory.time, dtype=float)
+
+        def si(name):
+            return self.state(name, trajectory[name], omega, si=True)
+
+        forces = {m.name: m.force(tau, si(m.coordinate), si(m.velocity)) for m in self.meshes}
+        torques = {s.name: s.torque(si(s.coordinate), si(s.velocity)) for s in self.shafts}
+        return forces, torques
 
     def mesh_forces(self, trajectory, omega: float) -> dict[str, np.ndarray]:
         """The force of every mesh along a trajectory, in N."""
-        tau = np.asarray(trajectory.time, dtype=float)
-        return {m.name: m.force(tau, self.state(m.coordinate, trajectory[m.coordinate], omega, si=True),
-                                self.state(m.velocity, trajectory[m.velocity], omega, si=True))
-                for m in self.meshes}
+        return self.loads(trajectory, omega)[0]
 
-    def _force_summary(self, values: np.ndarray) -> dict:
-        return {"mean": Measured(float(np.mean(values)), self.newton),
-                "min": Measured(float(values.min()), self.newton), "max": Measured(float(values.max()), self.newton),
-                "dynamic": Measured(float(values.max() - values.min()) / 2, self.newton)}
+    @staticmethod
+    def _summary(time, values: np.ndarray, period: float, unit: Unit) -> dict:
+        """Mean (over whole periods), least, greatest and half the swing of a force or torque."""
+        return {"mean": Measured(whole_period_mean(time, values, period), unit),
+                "min": Measured(float(values.min()), unit), "max": Measured(float(values.max()), unit),
+                "dynamic": Measured(float(values.max() - values.min()) / 2, unit)}
 
 
 class CachedScaling:
@@ -213,12 +338,31 @@ class CachedScaling:
             self.__dict__["_full"] = self._load()
         return self.__dict__["_full"]
 
-    def to_physical(self, result, length_unit: str = LENGTH_UNIT, *, omega: float | None = None, trajectory=None):
-        if hasattr(result, "exponents") and length_unit == self.units.length_unit:
+    def to_physical(self, result, length_unit: str = LENGTH_UNIT, *, trajectory=None, model=None, **options):
+        """A spectrum run from the cached numbers (its loads from ``trajectory``, or one run on ``model``);
+        anything else by the full scaling's ``to_physical``."""
+        if hasattr(result, "exponents") and length_unit == self.units.length_unit and not options:
+            if trajectory is None and model is not None:
+                trajectory = loads_trajectory(model, result)
             return self.units.point(result, trajectory)
-        return self.full.to_physical(result, length_unit, omega=omega, trajectory=trajectory)
+        given = {k: v for k, v in (("trajectory", trajectory), ("model", model)) if v is not None}
+        return self.full.to_physical(result, length_unit, **given, **options)
+
+    def point_units(self, length_unit: str = LENGTH_UNIT) -> PointUnits:
+        return self.units if length_unit == self.units.length_unit else self.full.point_units(length_unit)
 
     def __getattr__(self, name: str):
         if name.startswith("__") or name in ("_full", "_load", "units"):
             raise AttributeError(name)
         return getattr(self.full, name)
+
+
+def loads_trajectory(model, result):
+    """The trajectory a spectrum run's mesh forces and shaft torques are read from: ``FORCE_PERIODS`` periods of
+    ``model`` (the compiled model the run was made on) from the run's final state, at the run's parameters."""
+    if result.steps_per_period != model.integration.steps_per_period:
+        raise GearsymError(f"{model.name}: the spectrum ran with {result.steps_per_period} steps per period, the "
+                           f"model given integrates with {model.integration.steps_per_period}: give the compiled "
+                           "model the spectrum ran on")
+    options = model.integration.run(periods=FORCE_PERIODS, discard=0)
+    return phase_trajectory(model, options=options, y0=result.final_state, **result.parameters)

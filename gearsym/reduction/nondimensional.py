@@ -275,15 +275,28 @@ class NondimensionalModel:
             raise ModelError(f"is {meaning} and {must}, got {number:g}", f"parameter {name!r}")
         return number
 
-    def _function_expr(self, f: StiffnessFunction, value: ExprLike) -> sp.Expr:
+    def stiffness_formula(self, f: StiffnessFunction, value: ExprLike) -> sp.Expr:
+        """A formula for the stiffness function ``f`` as a function of tau. It is written in tau (the forcing
+        phase, omega t) or phi (the mesh's phase, its order times tau plus its phase: the variable a declared
+        stiffness variation is written in); t (time in 1/omega_n) is refused, since k(tau) must keep its period
+        whatever omega is."""
         where = f"stiffness function {f.name} (mesh {f.mesh!r})"
         expr = to_expr(value, where)
+        if t in expr.free_symbols:
+            raise ModelError(f"{f.name}={_quoted(value)} uses t, but a mesh stiffness is a function of tau (the "
+                             f"forcing phase omega t) or phi (the mesh phase, {self._mesh_phase(f)}): e.g. "
+                             f"{f.name}=1+0.2*cos(tau)", where)
+        expr = expr.xreplace({phi: self._mesh_phase(f)})
         used_states = sorted({st.name for st in self.states} & {sym.name for sym in expr.free_symbols})
         if used_states:
             raise ModelError(f"a mesh stiffness is a function of tau and parameters, but {value!r} uses the "
                              f"state(s) {', '.join(used_states)}; rename the parameter", where)
         check_periodic(expr, tau, where, period=f.period)
         return expr
+
+    def _mesh_phase(self, f: StiffnessFunction) -> sp.Expr:
+        """phi of the mesh of ``f`` in tau: its order times tau plus its phase."""
+        return sp.expand(self._mesh(f).mesh_phase.subs(t, tau / omega))
 
     def _substituted_rhs(self, functions: Optional[Mapping[str, sp.Expr]]) -> list[sp.Expr]:
         fsub = {}
@@ -342,10 +355,10 @@ class NondimensionalModel:
     def _engine(self, settings: Mapping[str, ExprLike]) -> tuple[tuple[sp.Expr, ...], list[str], dict]:
         """:meth:`engine_equations`, and the stiffness functions written into them."""
         declared = self.drivetrain.defaults
-        functions = {f.name: self._function_expr(f, declared[f.name]) for f in self.functions if f.name in declared}
+        functions = {f.name: self.stiffness_formula(f, declared[f.name]) for f in self.functions if f.name in declared}
         for f in self.functions:
             if f.name in settings:
-                functions[f.name] = self._function_expr(f, settings[f.name])
+                functions[f.name] = self.stiffness_formula(f, settings[f.name])
         rhs = tuple(self._substituted_rhs(functions))
         used = set()
         for expr in rhs:
@@ -610,3 +623,7 @@ def reduce(model: Drivetrain) -> NondimensionalModel:
     nd = nondimensionalize(reduce_drivetrain(model))
     model.__dict__["_reduced"] = (model.version, nd)
     return nd
+
+
+def _quoted(value: ExprLike) -> str:
+    return repr(value) if isinstance(value, str) else str(value)

@@ -19,7 +19,14 @@ from .compute import Computed
 from .plan import CHAOS_BAND, JUMP_TOLERANCE, NEAR_ONE, PAPER_JUMPS
 
 CHAOTIC = ("chaotic", "hyperchaotic")
-REGULAR = ("periodic", "quasi-periodic")
+REGULAR = ("periodic", "quasi-periodic")  # (an undetermined point is neither: its run cannot say)
+
+
+def _undetermined(regimes) -> str:
+    """'; 3 of them undetermined (...)', where some points are neither regular nor chaotic."""
+    count = int(np.sum(np.asarray(regimes) == "undetermined"))
+    return (f"; {count} of them undetermined (λ₁ within its error of 0 and the Poincaré points not settled: "
+            "counted as neither)" if count else "")
 AGREES, PARTLY, DISAGREES, UNTESTABLE = "agrees", "partly", "disagrees", "not testable"
 
 
@@ -104,7 +111,8 @@ def regular_d2(c: Computed, study: dict) -> dict:
     return _claim("regular-D2", "3b", "With D = 2 (curve '2') the motion is regular at most of the points where "
                   "D = 0 is chaotic.",
                   f"regular at {_pct(share)} of the {int(chaotic0.sum())} points where D = 0 is chaotic; D = 2 "
-                  f"chaotic intervals: {_fmt_intervals(intervals(r2['omega'][i2], ~regular2))}",
+                  f"chaotic intervals: {_fmt_intervals(intervals(r2['omega'][i2], np.isin(r2['regime'][i2], CHAOTIC)))}"
+                  + _undetermined(r2["regime"][i2][chaotic0]),
                   _grade(share, 0.5, 0.25), {"regular_share": share, "d0_chaotic_points": int(chaotic0.sum())})
 
 
@@ -198,7 +206,7 @@ def _flex_window_stats(r: SweepResult, **fixed) -> dict[str, float]:
     win = _windows_mask(r["omega"][idx])
     regime = r["regime"][idx][win]
     chaotic = np.isin(regime, CHAOTIC)
-    return {"chaotic": _fraction(chaotic), "regular": _fraction(~chaotic),
+    return {"chaotic": _fraction(chaotic), "regular": _fraction(np.isin(regime, REGULAR)),
             "hyper_of_chaotic": _fraction(regime[chaotic] == "hyperchaotic") if chaotic.any() else float("nan"),
             "single_of_chaotic": _fraction(regime[chaotic] == "chaotic") if chaotic.any() else float("nan")}
 

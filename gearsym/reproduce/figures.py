@@ -16,10 +16,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ..figures.orbits import branch_color, legend_handles, plot_branches, plot_sweep_points
+from ..figures.layout import fit_texts, outside_below
+from ..figures.orbits import legend_handles, plot_branches, plot_sweep_points
 from ..figures.poincare import parameter_text, PhasePanel, plot_attractors, plot_phase_portraits
 from ..figures.save import pyplot, save_figure
-from ..figures.sweep import plot_amplitude, plot_bifurcation, plot_exponents, plot_map, plot_regime_strip
+from ..figures.sweep import (add_colorbar, plot_amplitude, plot_bifurcation, plot_exponents, plot_map,
+                             plot_regime_strip, ZERO_CONTOUR)
 from .compute import Computed
 from .plan import CHAOS_BAND, NEAR_ONE, NOT_IN_PAPER, PAPER_JUMPS
 
@@ -70,6 +72,13 @@ def _letter(ax, letter: str) -> None:
     ax.text(0.01, 0.97, f"({letter})", transform=ax.transAxes, va="top", fontweight="bold")
 
 
+def _legend_below(ax) -> None:
+    """The curves' legend under the panel (in it, it would cover curves)."""
+    handles, labels = ax.get_legend_handles_labels()
+    outside_below(ax, handles=handles, labels=labels, columns=min(len(labels), 4) or 1, fontsize=8,
+                  title="continuation up in ω", title_fontsize=8)
+
+
 def _finish_omega(ax) -> None:
     ax.set_xlabel(r"$\omega$")
     ax.set_xlim(0.1, 2.0)
@@ -78,7 +87,7 @@ def _finish_omega(ax) -> None:
 def figure3(c: Computed):
     plt = pyplot()
     d0, d2 = c.sweeps["fig3_D0"], c.sweeps["fig3_D2"]
-    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4.8), constrained_layout=True)
+    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 5.4), constrained_layout=True)
     for ax in (a, b):
         _paper_chaos(ax)
     for (r, label), color in zip(((d0, "'1'  D = 0"), (d2, "'2'  D = 2")), CURVE_COLORS):
@@ -90,8 +99,9 @@ def figure3(c: Computed):
     a.set_ylabel(r"$A$")
     for ax, letter in ((a, "a"), (b, "b")):
         _finish_omega(ax)
-        ax.legend(fontsize=8, loc="upper right", title="continuation up in ω", title_fontsize=8)
+        _legend_below(ax)
         _letter(ax, letter)
+    a.set_title("grey: the paper's chaotic regions for D = 0; dotted: the jumps it reports for D = 2", fontsize=8)
     b.set_title("grey: the paper's chaotic regions for D = 0", fontsize=8)
     fig.suptitle("Fig. 3: Eq. 2 (D = 0) and Eq. 6 (D = 2) — "
                  + parameter_set(c, _sweep_parameters(c, "fig3_D0", "fig3_D2"), ("omega", "D")), fontsize=8)
@@ -102,24 +112,23 @@ def figure3_orbits(c: Computed):
     """Fig. 3a with the branches of periodic orbits: the sweeps' points (up and down) under the period-1 and
     period-2 branches, stable solid and unstable dashed, their bifurcations marked."""
     plt = pyplot()
-    from matplotlib.lines import Line2D
-
-
-    fig, axs = plt.subplots(1, 2, figsize=(13, 5.4), constrained_layout=True)
+    fig, axs = plt.subplots(1, 2, figsize=(13, 6.4), constrained_layout=True)
     for ax, (name, title), letter in zip(axs, (("fig3_D0", "'1'  D = 0 (Eq. 2)"), ("fig3_D2", "'2'  D = 2 (Eq. 6)")),
                                          "ab"):
         result = c.orbits[name]
+        local = c.local.get(name, ())
         plot_sweep_points(ax, c.sweeps[name], "omega", result.observed[0])
-        for local in c.local.get(name, ()):  # the orbits of other periods a jump left, continued across it
-            plot_branches(ax, local, label_values=False, legend=False)
+        for other in local:  # the orbits of other periods a jump left, continued across it
+            plot_branches(ax, other, label_values=False, legend=False)
         plot_branches(ax, result, label_values=False, legend=False)
-        handles = legend_handles(result, sweep=True)
-        periods = sorted({b.period_multiple for r in c.local.get(name, ()) for b in r.branches} - {1, 2})
-        handles += [Line2D([], [], color=branch_color(n), lw=1.2, label=f"period {n} (a jump's orbit)") for n in periods]
-        ax.legend(handles=handles, fontsize=7, loc="upper right")
+        handles = legend_handles(result, c.sweeps[name], others=local)
+        outside_below(ax, handles=handles, columns=2, fontsize=7)
         for w in PAPER_JUMPS if name == "fig3_D2" else ():
             ax.axvline(w, color="0.4", ls=":", lw=0.9)
-        ax.set_title(f"{title}: periodic orbits over the continuation's points", fontsize=9)
+        jumps = "; dotted: the paper's jumps" if name == "fig3_D2" else ""
+        periods = sorted({b.period_multiple for r in local for b in r.branches} - {1, 2})
+        landed = f"; period {', '.join(map(str, periods))}: the orbits a jump lands on" if periods else ""
+        ax.set_title(f"{title}: periodic orbits over the continuation's points{landed}{jumps}", fontsize=9)
         ax.set_ylabel(r"$A$")
         _finish_omega(ax)
         _letter(ax, letter)
@@ -131,7 +140,7 @@ def figure3_orbits(c: Computed):
 def figure6(c: Computed):
     plt = pyplot()
     r = c.sweeps["fig6"]
-    fig, axs = plt.subplots(2, 2, figsize=(12, 8.4), constrained_layout=True)
+    fig, axs = plt.subplots(2, 2, figsize=(12, 9.6), constrained_layout=True)
     (a, b), (cc, d) = axs
     for ax in (a, b):
         _paper_chaos(ax)
@@ -142,11 +151,13 @@ def figure6(c: Computed):
     for ax, ks in ((cc, 0.1), (d, 1.0)):
         plot_exponents(ax, r, which=range(1, 5), direction="up", kS=ks)
         ax.set_title(f"kS = {ks:g}: the four exponents", fontsize=9)
+    for ax in (a, b):
+        ax.set_title("grey: the paper's chaotic regions for the gear pair (D = 0)", fontsize=8)
     a.set_ylabel(r"$A$ ($x_1$)")
     _clip_peak(a, r["omega"], r["A_x1"])
     for ax, letter in zip((a, b, cc, d), "abcd"):
         _finish_omega(ax)
-        ax.legend(fontsize=8, loc="upper right", title="continuation up in ω", title_fontsize=8)
+        _legend_below(ax)
         _letter(ax, letter)
     for ax, ks in ((cc, 0.1), (d, 1.0)):
         _zoom_near_zero(ax, r, kS=ks)
@@ -234,10 +245,9 @@ def study(c: Computed):
     for row, name in enumerate(names):
         r = c.sweeps[name]
         mesh = plot_map(axs[row, 0], r, "lambda_1", direction="up")
-        fig.colorbar(mesh, ax=axs[row, 0], label=r"$\lambda_1$")
+        add_colorbar(fig, axs[row, 0], mesh, r"$\lambda_1$")
         mesh = plot_map(axs[row, 1], r, "regime", direction="up")
-        bar = fig.colorbar(mesh, ax=axs[row, 1], ticks=range(4))
-        bar.ax.set_yticklabels(["periodic", "quasi-per.", "chaotic", "hyperchaotic"], fontsize=7)
+        add_colorbar(fig, axs[row, 1], mesh, "regime", short={"quasi-periodic": "quasi-per."})
         job = c.plan.sweep(name)
         fixed = open_text(r.record["parameters"], [a.name for a in r.axes])
         axs[row, 0].set_title(f"{job.model}: {job.title}" + (f"; {fixed}" if fixed else ""), fontsize=8, loc="left")
@@ -247,7 +257,8 @@ def study(c: Computed):
                 ax.axvline(hi, color="k", ls=":", lw=0.7)
     swept = {a.name for n in names for a in c.sweeps[n].axes} | {"kS"}
     fig.suptitle(f"Parameter study, continuation up in ω — parameter set: {c.plan.scenario.label} (the values each "
-                 f"row keeps fixed are in its title)\n{paper_text(_sweep_parameters(c, *names), swept)}", fontsize=8)
+                 f"row keeps fixed are in its title); left: λ₁ ({ZERO_CONTOUR}), right: the regime; dotted: the "
+                 f"paper's chaotic bands for D = 0\n{paper_text(_sweep_parameters(c, *names), swept)}", fontsize=8)
     return fig
 
 
@@ -256,8 +267,13 @@ FIGURES = {"fig3": (figure3, DPI), "fig3-orbits": (figure3_orbits, DPI), "fig4":
            "fig6": (figure6, DPI), "fig7": (figure7, FINE_DPI), "hysteresis": (hysteresis, DPI), "study": (study, DPI)}
 
 
+def build(name: str, c: Computed):
+    """The figure ``name`` of :data:`FIGURES`, its titles wrapped to fit, as it is written."""
+    return fit_texts(FIGURES[name][0](c))
+
+
 def draw_all(c: Computed, out: str | Path, suffix: str = "") -> list[Path]:
     """Every figure of one computed plan; ``suffix`` tells the file names of another scenario apart."""
     out = Path(out)
     names = [n for n in FIGURES if (n != "study" or "study_ka" in c.sweeps) and (n != "fig3-orbits" or c.orbits)]
-    return [save_figure(FIGURES[n][0](c), out / f"{n}{suffix}.png", FIGURES[n][1]) for n in names]
+    return [save_figure(build(n, c), out / f"{n}{suffix}.png", FIGURES[n][1]) for n in names]

@@ -166,13 +166,15 @@ class _Classifier:
         folds = [b.value for b in inside if b.kind == FOLD]
         near = (f"beside a periodic fold at ω = {', '.join(f'{f:.4f}' for f in folds)}" if folds else
                 f"no periodic fold within {self.step:g} of it")
-        if regime == "quasi-periodic" and inside:  # lambda_1 ~ 0: the run sits on a bifurcation, not settled
+        if regime in ("quasi-periodic", "undetermined") and inside:  # lambda_1 ~ 0: on a bifurcation, not settled
             b = min(inside, key=lambda b: abs(b.value - (window[0] + window[1]) / 2))
             return {"kind": b.kind, "at": b.value,
                     "text": f"the run sits at a {b.kind} of the period-{b.period_multiple} orbit at ω = {b.value:.4f} "
-                            "(a multiplier on the unit circle: λ₁ ≈ 0, reported quasi-periodic, not settled)"}
+                            f"(a multiplier on the unit circle: λ₁ ≈ 0, reported {regime}, not settled)"}
         if regime in CHAOTIC:
             return {"kind": CRISIS, "at": None, "text": f"a crisis of a {regime} attractor ({near})"}
+        if regime == "undetermined":
+            return {"kind": OTHER, "at": None, "text": f"an attractor whose regime the run cannot decide ({near})"}
         which = f"a period-{period} orbit (from the sweep's Poincaré points)" if period else f"a {regime} attractor"
         return {"kind": OTHER, "at": None, "text": f"{which}, not on the continued period-1 and period-2 branches: "
                                                     f"its own end ({near})"}

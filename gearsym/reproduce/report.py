@@ -245,9 +245,13 @@ def _method(record: dict) -> list[str]:
             "with Gram–Schmidt every period; continuation hands the final state on (start x = −2, v = −0.5 "
             "at ω = 0.1), as in the paper.",
             "- Regimes from the spectrum and its batch-means standard error (`gearsym/analysis/regime.py`): "
-            "an exponent is zero within max(3 σ, 5/T); chaotic = one positive exponent, hyperchaotic = two. "
-            "At kS = 0 the shaft twist is free and adds two exactly zero exponents, so a regular x₁ shows "
-            "as quasi-periodic there.",
+            "an exponent is zero within max(3 σ, 5/T); chaotic = one positive exponent, hyperchaotic = two; "
+            "the two exponents of a complex pair of Floquet multipliers are given as their common real part. "
+            "Where λ₁ is zero within its error, the Poincaré points decide: stationary is quasi-periodic, "
+            "still converging or spreading (a transient) is undetermined, counted neither regular nor chaotic "
+            "(docs/engine.md, 'Verdicts'). At kS = 0 the shaft twist is free and adds two exactly zero "
+            "exponents, and its Poincaré points drift with the free disk: a regular x₁ shows as quasi-periodic "
+            "or undetermined there.",
             "- Jumps: a step in A between neighbouring ω that is 5× the median step around it and 5 % of A "
             "(`gearsym/analysis/jumps.py`).",
             "- The paper's parameters: B0 = 1, B1 = 4, Θ = 0, ζ = 0.08, η = 10, D = 2, Θ' = 0.1. What it leaves "

@@ -27,6 +27,7 @@ from functools import cached_property
 import sympy as sp
 
 from ..errors import GearsymError, ModelError, UnknownParameterError
+from ..model.expressions import parameter_names
 from ..model.length_scale import check_length_scale
 from ..model.resolved_components import ResolvedCoupling
 from ..reduction import NondimensionalModel
@@ -35,6 +36,7 @@ from ..symbols import parameter_symbol
 from ..units import Measure, Quantity, dimension_text, measure, symbol
 from .dimensions import evaluate, same_dimension
 from .roles import SPEED, fields, parameter_roles, physical_parameters
+from .settings import maybe_number
 from .speeds import SpeedRatios, declared_speed
 
 #: how closely the mean torques must balance (a fraction of the largest): see Scaling._check_balance
@@ -64,6 +66,11 @@ class Scaling:
         self.roles = parameter_roles(rd)
         if self.speed:
             self.roles[self.speed.parameter] = (SPEED, self.speed.where)
+        physical = dict(physical)
+        #: stiffness functions replaced by a formula (``k="1+0.2*cos(tau)"``), and the values of the new
+        #: (dimensionless) parameters such a formula brings (``a=0.3`` for ``k="1+a*cos(tau)"``)
+        self.functions: dict[str, object] = {f.name: physical.pop(f.name) for f in nd.functions if f.name in physical}
+        self.formula_values: dict[str, float] = self._formula_values(physical)
         self.inputs: dict[str, Measure] = self._inputs(physical)  # name -> SI value, as the user gave it
         self._check_dimensions()
         self._check_signs()
@@ -71,10 +78,26 @@ class Scaling:
         self._check_balance()
 
     # ------------------------------------------------------------------ inputs
+    def _formula_values(self, given: dict[str, object]) -> dict[str, float]:
+        """The values of the parameters the stiffness formulas bring (removed from ``given``): plain numbers, since
+        a stiffness formula is nondimensional."""
+        new = set()
+        for f in self.model.functions:
+            if f.name in self.functions:
+                new |= parameter_names(self.model.stiffness_formula(f, self.functions[f.name]))
+        new -= set(self.model.parameter_names) | set(physical_parameters(self.model.reduction.resolved))
+        out = {}
+        for name in sorted(new & set(given)):
+            value = maybe_number(given.pop(name))
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise ModelError(f"{value!r} is not a number: a parameter of a stiffness formula is dimensionless",
+                                 f"{self.name}: {name}")
+            out[name] = float(value)
+        return out
+
     def _inputs(self, given: Mapping[str, object]) -> dict[str, Measure]:
         names = physical_parameters(self.model.reduction.resolved)
         known = names + ([self.speed.parameter] if self.speed else [])
-        declared = self.model.drivetrain.physical
         out: dict[str, Measure] = {}
         derived = {gr.name: gr for gr in self.model.groups if gr.kind == "free"}
         for name, value in given.items():
@@ -87,7 +110,7 @@ class Scaling:
                                  f"set {behind} instead", self.name)
             if name not in known:
                 raise UnknownParameterError(name, known, f"{self.name}: physical values")
-            out[name] = self._input(name, value, declared.get(name))
+            out[name] = self._input(name, value)
         defaults = self.model.drivetrain.defaults
         missing = []
         for name in names:
@@ -105,22 +128,38 @@ class Scaling:
                              f"(--set {missing[0]}='...')", self.name)
         return out
 
-    def _input(self, name: str, value, declared: Measure | None) -> Measure:
-        """One physical value in SI; a plain number for a value that has a unit is refused (one rule everywhere:
-        a number is never silently read in some unit)."""
+    def _input(self, name: str, value) -> Measure:
+        """One physical value in SI; a plain number (or text that reads as one) for a value that has a unit is
+        refused (one rule everywhere: a number is never silently read in some unit)."""
         where = f"{self.name}: {name}"
+        out = measure(maybe_number(value), where)
+        if out.dimensionless and not out.unit:  # a number, text that reads as one, a declared plain number
+            unit = self.unit_needed(name)
+            if unit:
+                raise ModelError(self.unitless(name, out.given, f"{name}='{out.given:g} {symbol(unit)}'"), where)
         role = self.roles.get(name, (None, ""))[0]
-        plain = isinstance(value, (int, float)) and not isinstance(value, bool)
-        if plain and role is not None and role.example:
-            unit = declared.unit if declared is not None and declared.unit else role.example
-            raise ModelError(f"{value:g} has no unit, and {role.meaning} needs one: write {name}='{value:g} "
-                             f"{symbol(unit)}'", where)
-        out = measure(value, where)
         if role is SPEED and same_dimension(out.dims, SPEED.dims) and out.unit \
                 and not any(a in out.unit for a in _ANGLES):
             raise ModelError(f"{out.text()} is a frequency without an angle: write '{out.given:g} rev/s' "
                              f"(revolutions) or '{out.given:g} rad/s'", where)
         return out
+
+    def unit_needed(self, name: str) -> str:
+        """The unit a value of ``name`` is shown in (its declared one, else its role's), or "" for a dimensionless
+        value (a plain number is then fine)."""
+        role = self.roles.get(name, (None, ""))[0]
+        if role is None or not role.example:
+            return ""
+        declared = self.model.drivetrain.physical.get(name)
+        if name in getattr(self, "inputs", {}) and self.inputs[name].unit:
+            declared = self.inputs[name]
+        return declared.unit if declared is not None and declared.unit else role.example
+
+    def unitless(self, name: str, number: float, spelled: str) -> str:
+        """The one message for a plain number given to a value that has a unit (``--set``, ``--param``, a keyword,
+        a sweep axis): what is missing and ``spelled``, the value written with its unit as the entry takes it."""
+        role = self.roles[name][0]
+        return f"{number:g} has no unit, and {role.meaning} needs one: write {spelled}"
 
     def _check_dimensions(self) -> None:
         for name, q in self.inputs.items():
@@ -188,7 +227,8 @@ class Scaling:
 
     def with_values(self, **physical) -> "Scaling":
         """The same drivetrain with some physical values changed (``speed="3000 rpm"``)."""
-        return type(self)(self.model, {**self.inputs, **physical}, self.length_scale)
+        return type(self)(self.model, {**self.inputs, **self.functions, **self.formula_values, **physical},
+                          self.length_scale)
 
     # ------------------------------------------------------------------ SI numbers
     @cached_property
@@ -326,7 +366,7 @@ class Scaling:
                 raise GearsymError(f"{self.name}: no value for the speed; give it (--set {self.speed.parameter}="
                                    "'3000 rpm')")
             return self.inputs[self.speed.parameter].si
-        q = self._input(self.speed.parameter, speed, self.inputs.get(self.speed.parameter))
+        q = self._input(self.speed.parameter, speed)
         if not same_dimension(q.dims, SPEED.dims):
             raise ModelError(f"{q.text()} is not {SPEED.describe()}", f"{self.name}: {self.speed.parameter}")
         return q.si
@@ -432,12 +472,9 @@ class Scaling:
 
     def system(self, **settings):
         """The engine's first-order system at these values (``settings``: physical values, or a new stiffness
-        function as a formula in tau)."""
-        functions = {f.name for f in self.model.functions}
-        formulas = {k: v for k, v in settings.items() if k in functions}
-        physical = {k: v for k, v in settings.items() if k not in functions}
-        at = self.with_values(**physical) if physical else self
-        return self.model.system(**at.values, **formulas, initial=at.initial)
+        function as a formula in tau or phi, and its new parameters' values)."""
+        at = self.with_values(**settings) if settings else self
+        return self.model.system(**at.values, **at.functions, **at.formula_values, initial=at.initial)
 
     # ------------------------------------------------------------------ the record
     def summary(self) -> dict:

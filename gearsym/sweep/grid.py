@@ -101,7 +101,7 @@ def _range(text: str, start: Decimal, stop: Decimal, step: Decimal) -> list[Deci
 def axes_from(spec: Mapping[str, Sequence[float]] | Sequence[Axis | str]) -> tuple[Axis, ...]:
     """Axes from a mapping {name: values}, from Axis objects or from --param strings."""
     if isinstance(spec, Mapping):
-        axes = tuple(Axis(n, tuple(sorted(float(v) for v in vals)), f"{n}={','.join(map(repr, vals))}")
+        axes = tuple(Axis(n, tuple(sorted(_number(n, v) for v in vals)), f"{n}={','.join(map(repr, vals))}")
                      for n, vals in spec.items())
     else:
         axes = tuple(a if isinstance(a, Axis) else parse_axis(a) for a in spec)
@@ -111,6 +111,18 @@ def axes_from(spec: Mapping[str, Sequence[float]] | Sequence[Axis | str]) -> tup
     if len(set(names)) != len(names):
         raise GearsymError(f"a parameter is swept twice: {', '.join(names)}")
     return axes
+
+
+def _number(name: str, value) -> float:
+    """A value of a swept parameter given in Python: a number (a value with a unit is a model's scaling's)."""
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        pass
+    hint = (f"; a value with a unit is swept on the model's scaling, gearsym.run_sweep(gearsym.scaling(MODEL), "
+            f"{{{name!r}: [{value!r}, ...]}}), which gives the engine its numbers and the result in these units"
+            if isinstance(value, str) or type(value).__module__.startswith("pint") else "")
+    raise GearsymError(f"run_sweep: {name}={value!r} is not a number{hint}")
 
 
 @dataclass(frozen=True)

@@ -19,18 +19,23 @@ def findings_lines(result: SweepResult, record: str | Path, findings: dict | Non
     """Lines for the jumps and hysteresis intervals of ``result``; ``record`` is where the full list is."""
     findings = result.findings() if findings is None else findings
     first, others = result.axes[0].name, [a.name for a in result.axes[1:]]
+    units = result.units  # (a sweep in physical units: rpm, um)
+
+    def unit(column: str) -> str:
+        return f" {units[column]}" if column in units else ""
 
     def where(item: dict) -> str:
         return ", ".join([*([item["direction"]] if "direction" in item else []),
-                          *(f"{n}={item[n]:g}" for n in others)])
+                          *(f"{n}={item[n]:g}{unit(n)}" for n in others)])
 
     def jump(j: dict) -> str:
-        return (f"jump in A_{j['coordinate']} ({where(j)}): {first} {j['from']:g} -> {j['to']:g}, "
-                f"A {j['A_before']:.4g} -> {j['A_after']:.4g}")
+        return (f"jump in A_{j['coordinate']} ({where(j)}): {first} {j['from']:g} -> {j['to']:g}{unit(first)}, "
+                f"A {j['A_before']:.4g} -> {j['A_after']:.4g}{unit('A_' + j['coordinate'])}")
 
     def hysteresis(h: dict) -> str:
         on = f" ({where(h)})" if others else ""
-        return f"hysteresis in A_{h['coordinate']}{on}: up and down differ for {first} in [{h['from']:g}, {h['to']:g}]"
+        return (f"hysteresis in A_{h['coordinate']}{on}: up and down differ for {first} in "
+                f"[{h['from']:g}, {h['to']:g}]{unit(first)}")
 
     jumps, intervals = findings["jumps"], findings["hysteresis"]
     lines = _listed_or_summary(jumps, jump, where, "jumps", "largest (|change in A|)",

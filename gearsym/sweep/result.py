@@ -71,7 +71,8 @@ class SweepResult:
         jumps, hysteresis = [], []
         if self.mode == INDEPENDENT:
             return {"jumps": jumps, "hysteresis": hysteresis}
-        runs = self.lines()
+        runs = [(d, fixed, idx[self["regime"][idx] != "diverged"]) if "regime" in self.columns else (d, fixed, idx)
+                for d, fixed, idx in self.lines()]  # (a run that grew without bound has no amplitude to jump)
         for direction, fixed, idx in runs:
             for c in self.coordinates:
                 for j in find_jumps(self[first][idx], self[f"A_{c}"][idx]):

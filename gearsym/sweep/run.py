@@ -15,6 +15,7 @@ everything.
 from __future__ import annotations
 
 import ctypes
+import functools
 import math
 import multiprocessing
 import multiprocessing.connection
@@ -31,16 +32,20 @@ from pathlib import Path
 
 import numpy as np
 
+from ..analysis.divergence import counted_coordinates, run_failure, within_bound
 from ..analysis.lyapunov import summarise_runs
-from ..checks import whole_number
-from ..codegen import CompiledModel, engine_verb, TangentRuns
-from ..errors import GearsymError, UnknownParameterError
+from ..analysis.regime import DIVERGED
+from .. import caller
+from ..checks import run_bytes_per_period, whole_number
+from ..codegen import CompiledModel, TangentRuns, engine_verb
+from ..errors import GearsymError, UnknownParameterError, warn
+from ..memory import check_fits
 from ..options import Integration
 from ..version import __version__
 from .distributed import check_scheduler, connect, execute_dask
 from .grid import axes_from, Axis, INDEPENDENT, plan, Point, points
 from .result import SweepResult
-from .store import number, PoincareRows, row_key, SweepStore
+from .store import PoincareRows, SweepStore, number, overwrite_option, row_key, start_again
 
 #: stroboscopic samples kept per point for bifurcation diagrams
 POINCARE_SAMPLES = 50
@@ -60,6 +65,14 @@ class SweepInterrupted(KeyboardInterrupt):
         super().__init__(f"interrupted: kept {done} of {planned} points{where}")
 
 
+def cores() -> int:
+    """The cores this process may run on (its affinity where the OS says it, else every core)."""
+    try:
+        return len(os.sched_getaffinity(0)) or 1
+    except AttributeError:
+        return os.cpu_count() or 1
+
+
 @dataclass(frozen=True)
 class Workers:
     """Where a sweep's points run: ``jobs`` workers (0: one per core) on this machine, as ``"processes"``
@@ -76,15 +89,20 @@ class Workers:
     scheduler: object = None
 
     def __post_init__(self):
-        whole_number(self.jobs, "jobs")
+        jobs = whole_number(self.jobs, "jobs")
         if self.parallel not in PARALLEL:
             raise GearsymError(f"parallel={self.parallel!r}: choose one of {', '.join(PARALLEL)}")
         if self.scheduler is not None:
             check_scheduler(self.scheduler, self.jobs)  # no Dask, a bad address: said before any work
+        here = cores()
+        if jobs > here and self.scheduler in (None, "local"):  # (a cluster elsewhere has cores of its own)
+            warn(f"{caller.option('jobs', jobs)}: this machine has {here} core{'s' if here > 1 else ''}; running "
+                 f"{here} worker{'s' if here > 1 else ''} (more would only share them)")
+            object.__setattr__(self, "jobs", here)
 
     @property
     def count(self) -> int:
-        return self.jobs or os.cpu_count() or 1
+        return self.jobs or cores()
 
     @property
     def mode(self) -> str:
@@ -124,14 +142,21 @@ def run_sweep(
     """
     options = model.run_options(options)
     plan = _SweepPlan.make(model, axes, options, mode, direction, y0, poincare, values)
+    at_once = 1 if workers.scheduler is not None else min(workers.count, len(plan.points))
+    if at_once > 1:  # each worker holds the records of a point
+        check_fits(options.periods, at_once * run_bytes_per_period(model.dimension, len(model.observed)),
+                   asked=caller.option("periods", options.periods), item="period",
+                   what=f"{at_once} workers' states, stretches and extremes of each period")
     store = SweepStore(out, plan.columns, plan.strobe_columns, [*plan.names, "direction"], plan.record) \
         if out else None
+    opened = False
     try:  # the files stay locked against a second writer until this sweep returns or fails
         done, strobes = store.open(overwrite) if store else ({}, {})
+        opened = store is not None
         unknown = set(done) - {p.key for p in plan.points}
         if unknown:
             raise GearsymError(f"{out}: holds points this sweep does not plan, e.g. {sorted(unknown)[0]}; "
-                               "pass --overwrite or choose another --out")
+                               + start_again())
         run = _Run(model, plan.base, plan.names, plan.start, options, plan.poincare, plan.columns,
                    plan.strobe_columns)
         todo = [t for t in (run.remaining(task, done) for task in plan.tasks) if t[0]]
@@ -145,9 +170,28 @@ def run_sweep(
         if store:
             _finish_files(store, result, rows, poincare, len(done) - already, time.perf_counter() - t_start, ran)
         return result
+    except KeyboardInterrupt:
+        raise
+    except BaseException as exc:  # a point that failed, the disk full, ...: the record says so, not "running"
+        error = _one_line(exc, store)
+        if opened:
+            store.write_failure(error, len(plan.points))
+        if error is exc:
+            raise
+        raise error from None
     finally:
         if store:
             store.release()
+
+
+def _one_line(exc: BaseException, store: SweepStore | None) -> BaseException:
+    """A failure to write the sweep's files (the disk full: an OSError) as a one-line error; others as they are."""
+    if store is None or not isinstance(exc, OSError):
+        return exc
+    where = f" ({exc.filename})" if exc.filename else ""
+    return GearsymError(f"writing the sweep {store.path} failed: {exc.strerror or exc}{where}; the points finished "
+                        "before are kept whole: make room (or choose another --out) and run the same command again "
+                        "to resume")
 
 
 @dataclass(frozen=True)
@@ -248,9 +292,10 @@ def _store_as_finished(finished, store: SweepStore | None, plan: _SweepPlan, don
         bar.close()
         if store:
             store.close()
-            store.write_record(status="interrupted", points={"planned": len(plan.points), "done": len(done)},
+            store.write_record(status="interrupted", points={"planned": len(plan.points), "done": store.stored},
                                **({"dask": ran} if ran else {}))
-        raise SweepInterrupted(len(done), len(plan.points), store.path if store else None) from None
+        raise SweepInterrupted(store.stored if store else len(done), len(plan.points),
+                               store.path if store else None) from None
     except BaseException:
         finished.close()
         bar.close()
@@ -293,11 +338,13 @@ class _Run:
         count = sum(finished)
         if not all(finished[:count]) or any(finished[count:]):
             raise GearsymError("the sweep file holds points of a continuation line out of order (not its first "
-                               "points), so it cannot be resumed: pass --overwrite to start again")
-        if count and task[0].direction != INDEPENDENT:
-            state = self.final_state(done[task[count - 1].key], self.compiled.state_names)
-        else:
-            state = self.start
+                               f"points), so it cannot be resumed: pass {overwrite_option()} to start again")
+        state = self.start
+        if task[0].direction != INDEPENDENT:  # from the last point that did not diverge
+            for point in reversed(task[:count]):
+                if done[point.key]["regime"] != DIVERGED:
+                    state = self.final_state(done[point.key], self.compiled.state_names)
+                    break
         return task[count:], state
 
     def task(self, compiled: CompiledModel, points: list[Point], state: np.ndarray):
@@ -306,13 +353,16 @@ class _Run:
         The loops of each point write into a batch's shared records, which are summarised at once
         (:func:`~gearsym.analysis.lyapunov.summarise_runs`) when the batch is full or has taken
         ``BATCH_SECONDS``: the Python around a point is a few array operations shared by the batch, not its
-        own. A point that fails ends the task after the points before it are yielded."""
+        own. A point that fails ends the task after the points before it are yielded; a point that diverged is
+        a row like any other ("diverged"), and a continuation goes on from the last state that stayed within
+        the bound of :mod:`gearsym.analysis.divergence`."""
         periods, n = self.options.periods, compiled.dimension
         size = min(len(points), _batch_size(n, len(compiled.observed), periods))  # (a task of one point: one)
         runs = TangentRuns(n, len(compiled.observed), periods, max(size, 1))
         base = compiled.parameter_vector(self.base)
         swept = [compiled.parameter_names.index(name) for name in self.names]
         batch, started = [], time.perf_counter()
+        counted = functools.partial(counted_coordinates, compiled)
         for point in points:
             p = base.copy()
             p[swept] = point.values
@@ -323,9 +373,10 @@ class _Run:
                 if batch:
                     yield from self.checked_rows(compiled, runs, batch)
                 raise self.failed(point, exc) from None
-            batch.append((point, p, inputs.period))
-            if point.direction != INDEPENDENT:
-                state = runs.strobe[len(batch) - 1, -1].copy()
+            batch.append((point, p, inputs.period, state))
+            final = runs.strobe[len(batch) - 1, -1]
+            if point.direction != INDEPENDENT and within_bound(final, state, compiled.state_names, counted):
+                state = final.copy()
             if len(batch) == runs.size or time.perf_counter() - started >= BATCH_SECONDS:
                 yield from self.checked_rows(compiled, runs, batch)
                 batch, started = [], time.perf_counter()
@@ -333,29 +384,34 @@ class _Run:
             yield from self.checked_rows(compiled, runs, batch)
 
     def checked_rows(self, compiled: CompiledModel, runs: TangentRuns, batch: list):
-        """Yield the rows of ``batch`` once its runs are checked finite, all at once (one sum each for the
-        batch's strobes and log stretches, not two per point); a run that is not ends the task after the rows
-        of the points before it (the points after it, run from its state, are dropped)."""
-        count = len(batch)
-        if not math.isfinite(float(runs.strobe[:count].sum()) + float(runs.log_stretch[:count].sum())):
-            for i, (point, p, _) in enumerate(batch):
-                try:
-                    compiled.check_finite(p, runs.strobe[i].T, runs.log_stretch[i].T)
-                except GearsymError as exc:
-                    if i:
-                        yield self.rows(compiled, runs, batch[:i])
-                    raise self.failed(point, exc) from None
-        yield self.rows(compiled, runs, batch)
+        """Yield the rows of ``batch`` (a point that diverged is a row); a run that failed instead (non-finite
+        tangent vectors, or a step too large for RK4: :func:`~gearsym.analysis.divergence.run_failure`) ends
+        the task after the rows of the points before it (the points after it, run from its state, are
+        dropped)."""
+        rows, failed = self.rows(compiled, runs, batch)
+        if failed is None:
+            yield rows
+            return
+        i, exc = failed
+        if i:
+            yield rows[:i]
+        raise self.failed(batch[i][0], exc) from None
 
     def failed(self, point: Point, exc: GearsymError) -> GearsymError:
         """The error of a point, saying where it is."""
         where = ", ".join(f"{n_}={v:g}" for n_, v in zip(self.names, point.values))
         return GearsymError(f"at {where} ({point.direction}): {exc}")
 
-    def rows(self, compiled: CompiledModel, runs: TangentRuns, batch: list) -> list[tuple[dict, PoincareRows]]:
-        """The table rows and Poincare rows of the runs of ``batch`` ((point, parameters, period) each)."""
-        points, p, period = zip(*batch)
+    def rows(self, compiled: CompiledModel, runs: TangentRuns, batch: list) -> tuple[list, tuple | None]:
+        """The table rows and Poincare rows of the runs of ``batch`` ((point, parameters, period, start) each),
+        and (index, error) of the first that failed (None: none did)."""
+        points, p, period, starts = zip(*batch)
         summary = summarise_runs(compiled, runs, np.array(p), np.array(period), self.options.discard)
+        failed = None
+        if not math.isfinite(float(runs.log_stretch[:len(batch)].sum())) or any(summary.divergences):
+            failed = next(((i, e) for i, e in ((i, run_failure(compiled, p[i], period[i], starts[i], runs.strobe[i],
+                                                                runs.log_stretch[i], summary.divergences[i]))
+                                               for i in range(len(batch))) if e is not None), None)
         count, n = len(batch), compiled.dimension
         numbers = np.hstack([summary.amplitude, summary.exponents, summary.stderr]).tolist()
         finals = runs.strobe[:count, -1].tolist()
@@ -370,7 +426,7 @@ class _Run:
             row["regime"] = regime
             row.update(zip(final_fields, map(repr, final)))
             out.append((row, PoincareRows(where, strobe)))
-        return out
+        return out, failed
 
 
 def _batch_size(n: int, observed: int, periods: int) -> int:
@@ -500,7 +556,9 @@ def _check_alive(procs: list) -> None:
     dead = next((p for p in procs if p.exitcode not in (None, 0)), None)
     if dead is not None:
         raise GearsymError(f"a sweep worker process died (exit code {dead.exitcode}); the points finished so far "
-                           "are kept: run the same command with --parallel threads to resume")
+                           f"are kept: repeat the {'command' if caller.on_command_line() else 'call'} with "
+                           + ("--parallel threads" if caller.on_command_line() else 'workers=Workers(parallel="threads")')
+                           + " to resume")
 
 
 _FORKED = None  # (run, tasks, parent pid) of the sweep being forked, read by _process_worker in the children

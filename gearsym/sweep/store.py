@@ -5,7 +5,12 @@ Three files share a stem: ``FILE.csv`` (one row per point), ``FILE.json``
 ``FILE.poincare.csv`` (the last stroboscopic samples of every point, for
 bifurcation diagrams). Rows are written by a thread of the store's own and flushed after each batch of
 points (at most a fraction of a second of work); a row cut off by a kill
-is dropped when the sweep resumes. Running the same command again resumes:
+is dropped when the sweep resumes, and a point is resumed only if it is whole
+(its row and every one of its Poincare samples). A write that fails (the disk
+full) cuts both files back to the last whole batch and ends the sweep with a
+one-line error; the record then says ``failed`` and why. (The record of a running
+sweep is written with room to spare, so that this can be said in place on a full
+disk.) Running the same command again resumes:
 the record in ``FILE.json`` must match the new command (else the error says
 what differs). When every point is done, both CSV files are rewritten in the
 plan's order, so the result does not depend on which thread finished first or
@@ -23,6 +28,7 @@ import operator
 import os
 import queue
 import socket
+import stat
 import threading
 import time
 from collections.abc import Iterable, Sequence
@@ -31,8 +37,22 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import GearsymError
+from .. import caller
+from ..errors import GearsymError, warn
 from ..files import write_atomically
+
+#: spaces kept in the record of a running sweep, so that a failure can be recorded in place on a full disk
+RECORD_ROOM = 2048
+
+
+def overwrite_option() -> str:
+    """The option that starts a sweep's files again, as the caller writes it (--overwrite, overwrite=True)."""
+    return caller.option("overwrite", True)
+
+
+def start_again() -> str:
+    """The advice 'pass --overwrite or choose another --out', as the caller writes it."""
+    return f"pass {overwrite_option()} or choose another {caller.name('out')}"
 
 
 def number(x: float) -> str:
@@ -53,6 +73,11 @@ class PoincareRows:
         head, n = ",".join(self.where) + ",", self.samples.shape[1]
         reprs = list(map(float.__repr__, self.samples.ravel().tolist()))
         return "".join([f"{head}{j},{','.join(reprs[k:k + n])}\n" for j, k in enumerate(range(0, len(reprs), n))])
+
+    def whole(self, count: int) -> bool:
+        """Whether the point has all its ``count`` samples (a point whose rows were cut off as they were written
+        has fewer, and is not finished)."""
+        return self.samples.shape[0] == count
 
     @classmethod
     def from_fields(cls, rows: Sequence[Sequence[str]], keys: int) -> "PoincareRows":
@@ -91,7 +116,9 @@ class SweepStore:
         self.columns, self.strobe_columns = list(columns), list(strobe_columns)
         self.key_columns = list(key_columns)  # the swept parameters, then "direction"
         self.record = record
-        self._files: list = []
+        self._files: list[int] = []  # the Poincare table's and the table's descriptors, appending
+        self._sizes: list[int] = []  # their sizes after the last batch written whole
+        self.stored = 0  # points on disk, whole
         self._lock_fd: int | None = None
         self._appended: list[dict] | None = None  # the rows appended after a fresh start, in their order
         self._thread: threading.Thread | None = None  # the writer, started by the first append
@@ -119,19 +146,27 @@ class SweepStore:
                 if self.strobe_path.exists() else ([], [])
             strobes = {k: r for r in read if (k := self.key(dict(zip(self.key_columns, r.where)))) in done}
             # (rows written before their main row are dropped)
+            samples = self.record.get("poincare_samples")
             lacking = [k for k in done if k not in strobes]
-            if self.record.get("poincare_samples") and lacking:
+            if samples and lacking:
                 raise GearsymError(f"{self.strobe_path} lacks the Poincare samples of {len(lacking)} finished "
                                    "points (deleted or damaged?), so the sweep cannot be resumed whole: pass "
-                                   "--overwrite to start again")
+                                   f"{overwrite_option()} to start again")
+            partial = [k for k, r in strobes.items() if not r.whole(samples or 0)]
+            for k in partial:  # (cut off as they were written, by an older gearsym: computed again)
+                del done[k], strobes[k]
+            if partial:
+                warn(f"{self.strobe_path}: {len(partial)} point(s) lack some of their {samples} Poincare samples "
+                     "(cut off as they were written); they are computed again")
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._write_table(self.path, self.columns, map(_fields(self.columns), done.values()))  # (drops a row cut off)
         self._write_table(self.strobe_path, self.strobe_columns, (), "".join(r.text() for r in strobes.values()))
-        self.write_record(status="running")
-        self._files = [open(p, "a", newline="") for p in (self.strobe_path, self.path)]
-        self._main_writer = _writer(self._files[1])
+        self.write_record(status="running", room=RECORD_ROOM)
+        self._files = [_append_only(p) for p in (self.strobe_path, self.path)]
+        self._sizes = [os.fstat(fd).st_size for fd in self._files]
         self._main_fields = _fields(self.columns)
         self._appended = None if done else []
+        self.stored = len(done)
         return done, strobes
 
     def key(self, row: dict) -> tuple:
@@ -150,25 +185,25 @@ class SweepStore:
         sweep's), or None."""
         if not self.meta_path.exists():
             return (f"{self.path} exists but {self.meta_path.name} (the record of how it was made) "
-                    "does not, so it cannot be resumed: pass --overwrite or choose another --out")
+                    f"does not, so it cannot be resumed: {start_again()}")
         try:
             old = json.loads(self.meta_path.read_text())["sweep"]
         except (json.JSONDecodeError, KeyError, TypeError) as exc:
-            return f"{self.meta_path}: not a gearsym sweep record ({exc}); pass --overwrite or choose another --out"
+            return f"{self.meta_path}: not a gearsym sweep record ({exc}); {start_again()}"
         new = json.loads(json.dumps(self.record))  # compare as JSON sees them
         differ = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
         if not differ:
             return None
         detail = "; ".join(f"{k}: {_short(old.get(k))} before, {_short(new.get(k))} now" for k in differ)
         return (f"{self.path} was written by a different sweep ({detail}). To resume it, repeat "
-                "the command it came from; to start again pass --overwrite, or choose another --out")
+                f"the {'command' if caller.on_command_line() else 'call'} it came from; to start again {start_again()}")
 
     def _read(self, path: Path, columns: list[str]) -> dict[tuple, dict]:
         rows = {}
         for row in read_rows(path, columns):
             key = self.key(row)
             if key in rows:
-                raise GearsymError(f"{path}: the point {key} appears twice; pass --overwrite to start again")
+                raise GearsymError(f"{path}: the point {key} appears twice; pass {overwrite_option()} to start again")
             rows[key] = row
         return rows
 
@@ -192,8 +227,8 @@ class SweepStore:
         if thread is not None:
             self._queue.put(None)
             thread.join()
-        for f in self._files:
-            f.close()
+        for fd in self._files:
+            os.close(fd)
         self._files = []
         failed, self._failed = self._failed, None
         if failed is not None:
@@ -209,23 +244,51 @@ class SweepStore:
         return self._queue
 
     def _write_appended(self) -> None:
-        strobe_file, main_file = self._files
+        strobes, table, rows = [], io.StringIO(), []  # the batch being formatted
+        writer = _writer(table)
         try:
             while (item := self._queue.get()) is not None:
                 if item is _FLUSH:
-                    strobe_file.flush()
-                    main_file.flush()
+                    self._write_batch(strobes, table, rows)
+                    strobes, table, rows = [], io.StringIO(), []
+                    writer = _writer(table)
                     continue
                 row, poincare = item
-                strobe_file.write(poincare.text())
-                self._main_writer.writerow(self._main_fields(row))
-                if self._appended is not None:
-                    self._appended.append(row)
+                strobes.append(poincare.text())
+                writer.writerow(self._main_fields(row))
+                rows.append(row)
                 time.sleep(0)  # let a loop that has finished its native call have the lock back at once
+            self._write_batch(strobes, table, rows)
         except BaseException as exc:  # (the disk full, ...): said by the next append, flush or close
-            self._failed = exc
+            self._failed = self._cut_back(exc)
             while self._queue.get() is not None:  # the rest is dropped; close() waits for its None
                 pass
+
+    def _write_batch(self, strobes: list[str], table: io.StringIO, rows: list[dict]) -> None:
+        """A batch of points on disk: their Poincare rows, then their rows (whose presence marks them done)."""
+        if not rows:
+            return
+        data = ["".join(strobes).encode(), table.getvalue().encode()]
+        for fd, part in zip(self._files, data):
+            _write_all(fd, part)
+        self._sizes = [size + len(part) for size, part in zip(self._sizes, data)]  # (both written: the batch is)
+        self.stored += len(rows)
+        if self._appended is not None:
+            self._appended.extend(rows)
+
+    def _cut_back(self, exc: BaseException) -> BaseException:
+        """Both tables cut back to their last whole batch (a write that failed may have left part of a line, which
+        would be read as a sample); the error to raise, as one line if it is the system's (the disk full)."""
+        for fd, size in zip(self._files, self._sizes):
+            try:
+                os.ftruncate(fd, size)
+            except OSError:
+                pass
+        if not isinstance(exc, OSError):
+            return exc
+        return GearsymError(f"writing {self.path} failed: {exc.strerror or exc}; the {self.stored} points before "
+                            "are kept whole: make room (or choose another --out) and run the same command again "
+                            "to resume")
 
     def _lock(self) -> None:
         """One writer per sweep file: a second process on the same --out would interleave rows."""
@@ -252,8 +315,32 @@ class SweepStore:
         self._write_table(self.path, self.columns, map(_fields(self.columns), rows))
         self._write_table(self.strobe_path, self.strobe_columns, (), "".join(r.text() for r in strobes))
 
-    def write_record(self, **extra) -> None:
-        write_atomically(self.meta_path, json.dumps({"sweep": self.record, **extra}, indent=2) + "\n")
+    def write_record(self, room: int = 0, **extra) -> None:
+        """The record with ``extra`` (status, ...), written atomically; with ``room`` bytes of spaces kept, so that
+        a failure can be written over it in place on a full disk (:meth:`write_failure`)."""
+        write_atomically(self.meta_path, self._record_text(extra) + " " * room + "\n")
+
+    def write_failure(self, error: BaseException, planned: int) -> None:
+        """The record says the sweep failed and why (the error's message), with the points kept whole: written
+        atomically, else (the disk full) over the record in place, in its room."""
+        self.close_quietly()
+        extra = dict(status="failed", error=str(error) or type(error).__name__,
+                     points={"planned": planned, "done": self.stored})
+        try:
+            self.write_record(**extra)
+        except OSError:
+            if not _write_in_place(self.meta_path, self._record_text(extra)):
+                warn(f"{self.meta_path} could not be updated (it still says the sweep is running)")
+
+    def _record_text(self, extra: dict) -> str:
+        return json.dumps({"sweep": self.record, **extra}, indent=2)
+
+    def close_quietly(self) -> None:
+        """Close the files; an error of the writer (being reported) is not raised again."""
+        try:
+            self.close()
+        except BaseException:
+            pass
 
     def previous_record(self) -> dict:
         """What the last run wrote beside the sweep record (status, points, seconds, ...), or {}."""
@@ -271,6 +358,40 @@ class SweepStore:
         writer.writerows(rows)
         buffer.write(text)
         write_atomically(path, buffer.getvalue())
+
+
+def _append_only(path: Path) -> int:
+    """A descriptor appending to ``path``, never through a symlink (the file was just written in place; one
+    switched for a link meanwhile is refused, not written through)."""
+    try:
+        return os.open(path, os.O_WRONLY | os.O_APPEND | os.O_NOFOLLOW | os.O_CLOEXEC)
+    except OSError as exc:
+        raise GearsymError(f"cannot append to {path} ({exc.strerror}); choose another --out") from None
+
+
+def _write_all(fd: int, data: bytes) -> None:
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view):]
+
+
+def _write_in_place(path: Path, text: str) -> bool:
+    """``text`` over the file ``path`` without taking disk space (padded with spaces to its size; it must fit)."""
+    try:
+        fd = os.open(path, os.O_WRONLY | os.O_NOFOLLOW | os.O_CLOEXEC)
+    except OSError:
+        return False
+    try:
+        size = os.fstat(fd).st_size
+        data = text.encode()
+        if len(data) + 1 > size:
+            return False
+        os.pwrite(fd, data + b" " * (size - len(data) - 1) + b"\n", 0)
+        return True
+    except OSError:
+        return False
+    finally:
+        os.close(fd)
 
 
 def _writer(file):
@@ -302,12 +423,12 @@ def read_rows(path: Path, columns: list[str] | None = None) -> list[dict]:
     columns = header if columns is None else columns
     if header != columns:
         raise GearsymError(f"{path}: its columns ({', '.join(header)}) are not this sweep's "
-                           f"({', '.join(columns)}); pass --overwrite or choose another --out")
+                           f"({', '.join(columns)}); {start_again()}")
     rows = []
     for line, fields in enumerate(reader, start=2):
         if len(fields) != len(columns):
             raise GearsymError(f"{path}, row {line}: {len(fields)} fields, expected {len(columns)}; "
-                               "the file was edited or damaged: fix the row or pass --overwrite")
+                               f"the file was edited or damaged: fix the row or pass {overwrite_option()}")
         rows.append(dict(zip(columns, fields)))
     return rows
 
@@ -338,7 +459,9 @@ def take_lock(path: Path) -> int:
     returns the lock file's descriptor, for :func:`release_lock`."""
     lock = lock_path(path)
     while True:
-        fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
+        fd = _open_lock(lock)
+        if fd is None:
+            continue  # (removed between our two tries: try again)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
@@ -352,6 +475,30 @@ def take_lock(path: Path) -> int:
     holder = {"pid": os.getpid(), "host": socket.gethostname(), "started": time.strftime("%Y-%m-%d %H:%M:%S")}
     os.ftruncate(fd, 0)
     os.pwrite(fd, (json.dumps(holder) + "\n").encode(), 0)
+    return fd
+
+
+def _open_lock(lock: Path) -> int | None:
+    """The lock file's descriptor: made new (``O_EXCL``), else the one there opened; never through a symlink (one
+    planted at the lock's name would have the holder's line written into the file it points at). None if the
+    file went away between the two tries."""
+    flags = os.O_RDWR | os.O_CLOEXEC | os.O_NOFOLLOW | os.O_NONBLOCK
+    try:
+        fd = os.open(lock, flags | os.O_CREAT | os.O_EXCL, 0o666)
+    except FileExistsError:
+        try:
+            fd = os.open(lock, flags)
+        except FileNotFoundError:
+            return None
+        except OSError as exc:
+            if os.path.islink(lock):
+                raise GearsymError(f"{lock}, the sweep's lock file, is a symlink (to {os.readlink(lock)}); gearsym "
+                                   "never writes through one: remove it, or choose another --out") from None
+            raise GearsymError(f"cannot open the sweep's lock file {lock} ({exc.strerror}); remove it, or choose "
+                               "another --out") from None
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise GearsymError(f"{lock}, the sweep's lock file, is not a regular file; remove it, or choose another --out")
     return fd
 
 

@@ -1,0 +1,109 @@
+"""What can be checked of a matplotlib Figure by machine: that nothing in it is clipped or hidden, and that
+its legends name what is drawn. Read from the laid-out Figure (drawn once, as it is saved)."""
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.colors import to_rgba
+from matplotlib.text import Text
+
+
+def laid_out(fig):
+    fig.canvas.draw()
+    return fig.canvas.get_renderer()
+
+
+def _undrawn_tick_labels(fig) -> set[int]:
+    """Tick labels matplotlib keeps but does not draw (their ticks lie outside the axis' view)."""
+    out = set()
+    for ax in fig.findobj(lambda a: hasattr(a, "xaxis") and hasattr(a, "yaxis")):
+        for axis in (ax.xaxis, ax.yaxis):
+            drawn = {id(t) for t in axis._update_ticks()}
+            for tick in [*axis.get_major_ticks(), *axis.get_minor_ticks()]:
+                if id(tick) not in drawn:
+                    out |= {id(tick.label1), id(tick.label2)}
+    return out
+
+
+def clipped_texts(fig) -> list[str]:
+    """Every visible, non-empty text that reaches beyond the figure's edges."""
+    renderer = laid_out(fig)
+    edge = fig.bbox
+    undrawn = _undrawn_tick_labels(fig)
+    out = []
+    for text in fig.findobj(Text):
+        if not text.get_visible() or not text.get_text().strip() or id(text) in undrawn:
+            continue
+        axes = text.axes
+        if axes is not None and not axes.get_visible():
+            continue
+        box = text.get_window_extent(renderer)
+        if box.x0 < edge.x0 - 1 or box.x1 > edge.x1 + 1 or box.y0 < edge.y0 - 1 or box.y1 > edge.y1 + 1:
+            out.append(text.get_text())
+    return out
+
+
+def data_points(ax) -> np.ndarray:
+    """Every drawn data vertex of ``ax`` (lines and scatter points), in pixels."""
+    pts = []
+    for line in ax.lines:
+        if line.get_visible() and len(line.get_xdata()):
+            xy = np.column_stack([np.asarray(line.get_xdata(), float), np.asarray(line.get_ydata(), float)])
+            pts.append(line.get_transform().transform(xy))
+    for coll in ax.collections:
+        offsets = coll.get_offsets()
+        if coll.get_visible() and len(offsets) and hasattr(coll, "get_sizes") and len(coll.get_sizes()):
+            pts.append(coll.get_offset_transform().transform(np.asarray(offsets, float)))
+    return np.vstack(pts) if pts else np.zeros((0, 2))
+
+
+def points_under_legend(ax) -> int:
+    """How many data vertices of ``ax`` its legend covers."""
+    legend = ax.get_legend()
+    if legend is None or not legend.get_visible():
+        return 0
+    renderer = laid_out(ax.figure)
+    box = legend.get_window_extent(renderer)
+    p = data_points(ax)
+    p = p[np.all(np.isfinite(p), axis=1)]
+    return int(np.count_nonzero((p[:, 0] > box.x0) & (p[:, 0] < box.x1) & (p[:, 1] > box.y0) & (p[:, 1] < box.y1)))
+
+
+def _style(artist) -> tuple:
+    """(colour, line style, marker) of a Line2D or the face colour of a patch."""
+    if hasattr(artist, "get_linestyle") and hasattr(artist, "get_marker"):
+        ls = artist.get_linestyle()
+        marker = artist.get_marker()
+        color = artist.get_color() if marker in ("", "None", None) or ls not in ("None", "", " ") \
+            else (artist.get_markeredgecolor() if artist.get_markerfacecolor() in ("none", "None")
+                  else artist.get_markerfacecolor())
+        return (tuple(np.round(to_rgba(color), 3)), ls if ls not in ("", " ") else "None",
+                marker if marker not in ("", None) else "None")
+    return (tuple(np.round(to_rgba(artist.get_facecolor()), 3)), None, None)
+
+
+def unmatched_legend_entries(ax, legend=None) -> list[str]:
+    """Legend entries of ``ax`` with no drawn artist of the same style (colour, line style, marker) in it."""
+    legend = legend or ax.get_legend()
+    if legend is None:
+        return []
+    drawn = {_style(a) for a in [*ax.lines, *ax.patches] if a.get_visible()}
+    for coll in ax.collections:  # broken_barh and the like: their face colours
+        for face in np.atleast_2d(coll.get_facecolor()):
+            drawn.add((tuple(np.round(face, 3)), None, None))
+    out = []
+    for handle, text in zip(legend.legend_handles, legend.get_texts()):
+        style = _style(handle)
+        grey = style[0][0] == style[0][1] == style[0][2] and style[1] is not None
+        if style not in drawn and not (grey and any(d[1:] == style[1:] for d in drawn)):  # a grey key: a style
+            out.append(text.get_text())
+    return out
+
+
+def label_overlaps(boxes) -> list[tuple[int, int]]:
+    """Pairs of boxes (Bbox) that overlap."""
+    out = []
+    for i in range(len(boxes)):
+        for j in range(i + 1, len(boxes)):
+            if boxes[i].overlaps(boxes[j]):
+                out.append((i, j))
+    return out

@@ -1,0 +1,117 @@
+"""``gearsym stiffness``: its text and JSON, its refusals (one line, exit status 2), and the committed figure."""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gearsym.cli import main
+
+REPO = Path(__file__).resolve().parents[1]
+NASA = ["stiffness", "--teeth", "28,28", "--module", "3.175 mm", "--face-width", "6.35 mm", "--pressure-angle",
+        "20 deg"]
+#: how docs/figures/stiffness-nasa-rig.{json,png} are made (docs/geometry.md shows the same command)
+FIGURE = REPO / "docs" / "figures" / "stiffness-nasa-rig"
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_json_has_the_issues_keys_in_si(capsys):
+    code, out, err = run(capsys, *NASA, "--bore", "20 mm", "--format", "json")
+    assert code == 0 and "warning" not in err  # (a bore inside Sainsot's range: nothing to warn about)
+    data = json.loads(out)
+    for key in ("contact_ratio", "mean", "min", "max", "phase", "stiffness", "iso6336"):
+        assert key in data, key
+    assert len(data["phase"]) == len(data["stiffness"]) == 720
+    assert data["phase"][0] == 0.0 and data["phase"][-1] < 2 * math.pi
+    assert data["min"] <= min(data["stiffness"]) <= data["mean"] <= max(data["stiffness"]) <= data["max"]
+    iso = data["iso6336"]
+    assert iso["unit"] == "N/(mm um)" and iso["c_gamma_beta"] == pytest.approx(0.85 * iso["c_gamma_alpha"])
+    assert iso["mean_N_per_m"] == pytest.approx(iso["c_gamma_alpha"] * 6.35 * 1e6)
+    assert data["contact_ratio"] == pytest.approx(1.6380042, rel=1e-7, abs=0)
+    assert data["units"]["mean"] == "N/m"
+    assert data["gears"][0]["base_diameter"] == pytest.approx(0.0889 * math.cos(math.radians(20)), rel=1e-14, abs=0)
+
+
+def test_text_answers_in_the_users_units(capsys):
+    code, out, err = run(capsys, *NASA[:4], "0.125 in", *NASA[5:], "--helix-angle", "10 deg", "--slices", "8")
+    assert code == 0
+    lines = out.splitlines()
+    assert lines[0] == ("28/28 teeth, module 0.125 in, pressure angle 20 deg, face width 6.35 mm, "
+                        "helix angle 10 deg")
+    overlap = 6.35 * math.sin(math.radians(10)) / (math.pi * 3.175)  # b sin(beta) / (pi m_n)
+    assert lines[1].startswith("contact ratio: transverse") and f"overlap {overlap:.6g}" in lines[1]
+    assert "centre distance 3.55" in lines[2] and " in," in lines[2]  # lengths in the module's unit
+    assert any(line.startswith("mesh stiffness (8 slices): mean ") and line.endswith("N/m") for line in lines)
+    assert any(line.startswith("ISO 6336-1 method B, N/(mm um): c'_th ") for line in lines)
+    assert lines.index("curve over one mesh period:") < len(lines) - 30
+    assert "solid" in err  # Sainsot's formula needs a bore: the assumption is said
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--module", "3"], "no unit"),
+    (["--module", "3 s"], "not a length"),
+    (["--module", "3 parsec/"], "quantity"),
+    (["--pressure-angle", "20 mm"], "not an angle"),
+    (["--teeth", "28"], "2 values"),
+    (["--teeth", "28,x"], "whole number"),
+    (["--teeth", "3,28"], "at least 6"),
+    (["--bore", "90 mm"], "root circle"),
+    (["--material", "206 GPa"], "2 values"),
+    (["--material", "206 mm,0.3"], "not a pressure"),
+    (["--material", "206 GPa,0.7"], "Poisson"),
+    (["--slices", "0"], "at least 1"),
+    (["--profile-shift", "0.2"], "2 values"),
+    (["--centre-distance", "80 mm"], "jam"),
+    (["--rack", "1,1.25"], "3 values"),
+    (["--plot", "out.txt"], "must end in"),
+])
+def test_bad_input_is_one_line_and_exit_status_2(capsys, tmp_path, argv, words):
+    args = dict(zip(NASA[1::2], NASA[2::2]))
+    args.update(zip(argv[::2], argv[1::2]))
+    flat = ["stiffness"] + [x for kv in args.items() for x in kv]
+    if "--plot" in args:
+        flat[flat.index("--plot") + 1] = str(tmp_path / args["--plot"])
+    code, out, err = run(capsys, *flat)
+    assert code == 2 and out == ""
+    assert err.count("\n") == 1 and err.startswith("gearsym: error:") and words in err, err
+
+
+def _numbers_close(a, b, path="") -> None:
+    if isinstance(a, dict):
+        assert a.keys() == b.keys(), path
+        for k in a:
+            _numbers_close(a[k], b[k], f"{path}.{k}")
+    elif isinstance(a, list):
+        assert len(a) == len(b), path
+        for i, (x, y) in enumerate(zip(a, b)):
+            _numbers_close(x, y, f"{path}[{i}]")
+    elif isinstance(a, float):
+        assert a == pytest.approx(b, rel=1e-9, abs=1e-12), path
+    else:
+        assert a == b, path
+
+
+def test_the_committed_figure_and_data_regenerate(capsys, tmp_path):
+    """docs/figures/stiffness-nasa-rig.{json,png}: `gearsym stiffness --teeth 28,28 --module "3.175 mm"
+    --face-width "6.35 mm" --pressure-angle "20 deg" --format json --plot docs/figures/stiffness-nasa-rig.png
+    > docs/figures/stiffness-nasa-rig.json`."""
+    code, out, _ = run(capsys, *NASA, "--format", "json", "--plot", str(tmp_path / "k.png"))
+    assert code == 0
+    _numbers_close(json.loads(out), json.loads(FIGURE.with_suffix(".json").read_text()))
+    from matplotlib.image import imread
+
+    new, committed = imread(tmp_path / "k.png"), imread(FIGURE.with_suffix(".png"))
+    # pixels, not bytes (another matplotlib may encode the same picture differently): faint differences of
+    # antialiasing pass, a line or a word that moved does not
+    assert new.shape == committed.shape, "docs/figures/stiffness-nasa-rig.png differs in size"
+    moved = (np.abs(new - committed).max(axis=-1) > 0.25).mean()
+    assert np.abs(new - committed).mean() < 2e-3 and moved < 2e-4, \
+        f"docs/figures/stiffness-nasa-rig.png differs ({moved:.2%} of its pixels): rerun the command in this docstring"

@@ -1,0 +1,67 @@
+"""docs/geometry.md's comparison with ISO 6336-1 is what the code computes now.
+
+The table between the markers ``<!-- iso-table -->`` and ``<!-- /iso-table -->`` is rendered here; after a change
+of the method, ``python tests/test_geometry_docs.py --write`` rewrites it (and this test then passes).
+"""
+from __future__ import annotations
+
+import math
+import sys
+import warnings
+from pathlib import Path
+
+PAGE = Path(__file__).resolve().parents[1] / "docs" / "geometry.md"
+START, END = "<!-- iso-table -->", "<!-- /iso-table -->"
+DEG = math.pi / 180
+
+
+def cases():
+    from gearsym.geometry import GearGeometry, GearPair
+
+    nasa = dict(teeth=28, module=3.175e-3, pressure_angle=20 * DEG, face_width=6.35e-3)
+    yield "NASA rig 28/28, m 3.175 mm, b 6.35 mm, solid", GearPair(GearGeometry(**nasa), GearGeometry(**nasa))
+    bored = dict(nasa, bore_diameter=20e-3)
+    yield "the same, bores 20 mm", GearPair(GearGeometry(**bored), GearGeometry(**bored))
+    ross = dict(teeth=62, module=2e-3, pressure_angle=20 * DEG, face_width=20e-3, bore_diameter=35e-3)
+    yield "62/62, m 2 mm, b 20 mm, bores 35 mm", GearPair(GearGeometry(**ross), GearGeometry(**ross))
+    rack = dict(dedendum_coefficient=1.4, fillet_coefficient=0.39)
+    yield ("ISO/TR 6336-30 Ex. 1: 17/103, m_n 8 mm, beta 15.8 deg, b 100 mm, solid",
+           GearPair(GearGeometry(17, 8e-3, 20 * DEG, 0.1, 0.145, 15.8 * DEG, **rack),
+                    GearGeometry(103, 8e-3, 20 * DEG, 0.1, 0.0, -15.8 * DEG, **rack), 0.5))
+
+
+def render() -> str:
+    from gearsym.geometry import mesh_stiffness
+
+    rows = ["| pair | eps_alpha | eps_beta | k mean [N/m] | k mean | k min-max | rigid body: k mean | ISO c'_th | "
+            "ISO c' | ISO c_gamma_alpha | k mean / c_gamma_alpha |",
+            "|---|---|---|---|---|---|---|---|---|---|---|"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # (the notes on Sainsot's range are in the text)
+        for name, pair in cases():
+            full = mesh_stiffness(pair)
+            rigid = mesh_stiffness(pair, terms=("hertz", "bending", "shear", "axial"))
+            per = pair.face_width * 1e9  # N/m per N/(mm um)
+            iso = full.iso6336
+            rows.append(f"| {name} | {full.contact_ratio:.4f} | {full.overlap_ratio:.3f} | {full.mean:.4g} | "
+                        f"{full.mean / per:.2f} | {full.min / per:.2f}-{full.max / per:.2f} | {rigid.mean / per:.2f} | "
+                        f"{iso.theoretical:.2f} | {iso.single:.2f} | {iso.mesh_alpha:.2f} | "
+                        f"{full.mean / per / iso.mesh_alpha:.2f} |")
+    return "\n".join(rows)
+
+
+def _block(text: str) -> str:
+    return text[text.index(START) + len(START):text.index(END)].strip()
+
+
+def test_the_pages_iso_table_is_what_the_code_computes():
+    assert _block(PAGE.read_text()) == render(), "docs/geometry.md's table is stale: python tests/test_geometry_docs.py --write"
+
+
+if __name__ == "__main__":
+    if "--write" in sys.argv:
+        text = PAGE.read_text()
+        text = text[:text.index(START) + len(START)] + "\n" + render() + "\n" + text[text.index(END):]
+        PAGE.write_text(text)
+    else:
+        print(render())
