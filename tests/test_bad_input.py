@@ -181,7 +181,7 @@ def test_a_pipe_longer_than_the_limit_is_cut_at_the_limit(one_stage, tmp_path, m
     (b"tau;record;omega;x\n0;1;1.2;0.5\n", "the columns are separated by semicolons (;), not commas (the header "
                                           "names tau, record, omega, x)", 1),
     (b"tau\tx\n0\t0.5\n", "the columns are separated by tabs", 1),
-    (b"tau,x\n\xff\xfe,1\n", "is not UTF-8 text", None),
+    (b"tau,x\n\xff\xfe,1\n", "cannot read it as UTF-8 text", None),
 ])
 def test_a_file_that_is_not_a_csv_of_measurements_says_what_it_is(one_stage, tmp_path, content, said, line):
     path = tmp_path / "f.csv"

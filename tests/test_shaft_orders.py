@@ -273,3 +273,31 @@ def test_the_spectrum_command_writes_the_lines_and_the_figure(tmp_path, capsys):
     assert plot.stat().st_size > 10000
     assert main(["spectrum", "one_stage", "--data", str(data)]) == 2
     assert "tooth counts" in capsys.readouterr().err
+
+
+def test_a_sweep_and_a_continuation_of_an_eccentric_pinion_run_on_its_revolution():
+    """The period the model implies, not the user's: a sweep's Poincaré samples of an eccentric pinion (9 teeth) are
+    one revolution apart (SciPy's DOP853 of the equations typed in tests/fault_rig.py carries each sample to the
+    next over 9 mesh periods, at omega = 1.7 a period-2 orbit of the revolution, at 1.8 a period-1 one), and every
+    orbit of a continuation from omega = 1.8 to 1.7 returns to itself over one revolution of the typed flow."""
+    model = eccentric("eccentric_pinion", 0.5, 0.3)
+    compiled = gearsym.compile_model(gearsym.load(model), Integration(periods=30, discard=20))
+    revolution = 2 * math.pi * TEETH[0]
+
+    def flow(omega, y):
+        f = fault_rig.Pair(teeth=TEETH, eccentric=(1, 0.5, 0.3), omega=omega).rhs(omega)
+        return solve_ivp(f, (0, revolution), y, method="DOP853", rtol=1e-11, atol=1e-11, max_step=0.2).y[:, -1]
+
+    sweep = gearsym.run_sweep(compiled, {"omega": [1.7, 1.8]}, mode="independent", progress=False)
+    strobe = sweep.strobe
+    for omega in (1.7, 1.8):
+        points = np.column_stack([strobe["x"], strobe["v"]])[strobe["omega"] == omega]
+        assert len(points) == 10
+        for a, b in zip(points[:3], points[1:4]):
+            np.testing.assert_allclose(flow(omega, a), b, atol=1e-5)
+    distinct = lambda omega: len({round(x, 4) for x in strobe["x"][strobe["omega"] == omega][-4:]})
+    assert distinct(1.7) == 2 and distinct(1.8) == 1
+    branch = gearsym.continue_orbits(compiled, "omega", 1.8, 1.7).branches[0]
+    assert branch.values[-1] == pytest.approx(1.7) and len(branch) > 5
+    for k in (0, len(branch) // 2, len(branch) - 1):
+        np.testing.assert_allclose(flow(branch.values[k], branch.states[k]), branch.states[k], atol=1e-5)

@@ -116,7 +116,7 @@ def _first_bad_byte(path: Path, lines_read: int) -> str:
                 data = carry + block
                 try:
                     data.decode("utf-8")
-                except UnicodeDecodeError:
+                except UnicodeDecodeError as exc:
                     if block and exc.end == len(data):  # (a character cut by the block's end: read on)
                         lines, offset, carry = lines + data[:exc.start].count(b"\n"), offset + exc.start, data[exc.start:]
                         continue
