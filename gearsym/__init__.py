@@ -87,6 +87,8 @@ _LAZY = {
     "MeshStiffness": "gearsym.geometry",
     "StiffnessOptions": "gearsym.geometry",
     "gear_geometry": "gearsym.geometry",
+    "Crack": "gearsym.geometry",
+    "crack_stiffness_loss": "gearsym.geometry",
     "gear_pair": "gearsym.geometry",
     "mesh_stiffness": "gearsym.geometry",
     "iso6336_stiffness": "gearsym.geometry",

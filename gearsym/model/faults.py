@@ -62,7 +62,9 @@ class ToothFault(ShaftOrderTerm):
     """A local fault of tooth ``tooth`` (a crack, a broken corner): the pair it forms loses the fraction
     ``depth`` of its stiffness while it is in mesh, so the mesh stiffness is ``k(phi) (1 - depth s_n(phi))`` with
     ``s_n`` the pair's share (:func:`~.shaft_orders.tooth_share`: over ``contact_ratio`` mesh periods, each
-    edge rising over ``edge`` of them). ``depth`` is a fraction (0: healthy), a number or a parameter."""
+    edge rising over ``edge`` of them). ``depth`` is a fraction (0: healthy), a number or a parameter; for a root
+    crack of a given depth and angle, the fraction its pair loses by the gear geometry's potential-energy method
+    (:func:`gearsym.geometry.crack_stiffness_loss`)."""
 
     tooth: int = 1
     depth: ExprLike = "q"
