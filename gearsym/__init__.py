@@ -9,8 +9,10 @@ One flat public face; the stages behind it, each handing one type to the next:
   :class:`FirstOrderSystem` the engine takes; :func:`load` does name -> system in one call;
 * compile: :func:`compile_model` (FirstOrderSystem, :class:`Integration` -> :class:`CompiledModel`);
 * analyse: :func:`lyapunov_spectrum`, :func:`poincare_samples`, :func:`phase_trajectory`,
-  :func:`find_attractors`, :func:`basin_map` (basins of attraction, many starts at once in the lanes), :func:`continue_basins`
-  (basin fractions along a parameter), :func:`run_sweep` (on a CompiledModel, or on a system, compiled first);
+  :func:`simulated_order_spectrum` (and :func:`order_spectrum` of any signal: mesh orders, shaft-order sidebands),
+  :func:`find_attractors`, :func:`basin_map` (basins of attraction, many starts at once in the lanes),
+  :func:`continue_basins` (basin fractions along a parameter), :func:`run_sweep` (on a CompiledModel, or on a
+  system, compiled first);
   periodic orbits and their branches: :func:`periodic_orbit`, :func:`continue_orbits`;
 * data: :func:`simulate_measurements`, :func:`load_measurements`, :func:`explain`;
 * FMUs: :func:`export_fmu` (a model as an FMI 2.0 FMU, co-simulation and model exchange, for other tools);
@@ -41,6 +43,10 @@ _LAZY = {
     "Planet": "gearsym.model.components",
     "Shaft": "gearsym.model.components",
     "Torque": "gearsym.model.components",
+    "ToothFault": "gearsym.model.faults",
+    "Spall": "gearsym.model.faults",
+    "Eccentricity": "gearsym.model.faults",
+    "SpacingErrors": "gearsym.model.faults",
     "rectangular_mesh_stiffness": "gearsym.model.stiffness",
     "parse_formula": "gearsym.model.formula",
     "NondimensionalModel": "gearsym.reduction",
@@ -67,6 +73,8 @@ _LAZY = {
     "Workers": "gearsym.sweep",
     "SweepInterrupted": "gearsym.sweep",
     "simulate_measurements": "gearsym.verbs",
+    "simulated_order_spectrum": "gearsym.verbs",
+    "order_spectrum": "gearsym.analysis",
     "load_measurements": "gearsym.data",
     "explain": "gearsym.fit",
     "EFFECTS": "gearsym.fit",
@@ -84,6 +92,8 @@ _LAZY = {
     "MeshStiffness": "gearsym.geometry",
     "StiffnessOptions": "gearsym.geometry",
     "gear_geometry": "gearsym.geometry",
+    "Crack": "gearsym.geometry",
+    "crack_stiffness_loss": "gearsym.geometry",
     "gear_pair": "gearsym.geometry",
     "mesh_stiffness": "gearsym.geometry",
     "iso6336_stiffness": "gearsym.geometry",
@@ -106,7 +116,7 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
-    from .analysis import LyapunovSpectrum, classify_regime
+    from .analysis import LyapunovSpectrum, classify_regime, order_spectrum
     from .codegen import CompiledModel
     from .codegen.build import compile_model
     from .data import load_measurements
@@ -116,6 +126,7 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .loading import is_physical, load, natural_modes, scaling
     from .model.components import Disk, Gear, Harmonic, Mesh, Planet, Shaft, Torque
     from .model.drivetrain import Drivetrain
+    from .model.faults import Eccentricity, Spall, SpacingErrors, ToothFault
     from .model.stiffness import rectangular_mesh_stiffness
     from .physical.campbell import campbell
     from .reduction import NondimensionalModel, reduce
@@ -124,4 +135,4 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .system import FirstOrderSystem
     from .sweep import SweepInterrupted, Workers, read_sweep
     from .verbs import (basin_map, continue_basins, continue_orbits, find_attractors, lyapunov_spectrum, periodic_orbit,
-                        phase_trajectory, poincare_samples, run_sweep, simulate_measurements)
+                        phase_trajectory, poincare_samples, run_sweep, simulate_measurements, simulated_order_spectrum)

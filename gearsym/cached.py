@@ -49,7 +49,7 @@ from .private_files import NotPrivate, read_private, write_private
 from .registry import model_file, models_dir
 
 #: bump when what a summary holds changes
-SUMMARY_FORMAT = 3
+SUMMARY_FORMAT = 4
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,6 +69,7 @@ class SystemSummary(ParameterChecks):
     autonomous: bool
     physical: bool  # the model has physical values (its results are also given in its units)
     load: Callable[[], object] = field(repr=False, default=None)  # the full system
+    cycles: int = 1  # forcing periods in one period (a gear's revolution with shaft-order terms)
 
     @property
     def dimension(self) -> int:
@@ -100,7 +101,7 @@ class SystemSummary(ParameterChecks):
                 "initial": dict(self.initial), "coordinates": list(self.coordinates),
                 "descriptions": dict(self.descriptions),
                 "constraints": {k: [c.meaning, c.zero_allowed] for k, c in self.constraints.items()},
-                "autonomous": self.autonomous, "physical": self.physical}
+                "autonomous": self.autonomous, "physical": self.physical, "cycles": self.cycles}
 
     @classmethod
     def from_dict(cls, d: dict, load: Callable[[], object]) -> "SystemSummary":
@@ -109,13 +110,13 @@ class SystemSummary(ParameterChecks):
                    {str(k): float(v) for k, v in d["initial"].items()}, tuple(map(str, d["coordinates"])),
                    {str(k): str(v) for k, v in d["descriptions"].items()},
                    {str(k): Constraint(str(m), bool(z)) for k, (m, z) in d["constraints"].items()},
-                   bool(d["autonomous"]), bool(d["physical"]), load)
+                   bool(d["autonomous"]), bool(d["physical"]), load, int(d["cycles"]))
 
     @classmethod
     def of(cls, system, physical: bool) -> "SystemSummary":
         return cls(system.name, system.title, system.time.name, system.state_names, dict(system.parameters),
                    dict(system.initial), tuple(system.coordinates), dict(system.descriptions),
-                   dict(system.constraints), system.autonomous, physical, lambda: system)
+                   dict(system.constraints), system.autonomous, physical, lambda: system, system.cycles)
 
 
 @lru_cache(maxsize=None)
@@ -277,6 +278,9 @@ def _from_cache(system_file: Path, build_file: Path, options: Integration, loops
     key = (digest, "compiled")
     if key in LOADED:  # (loaded in this process already: its functions with work arrays of their own)
         return replace(LOADED[key].clone(), system=summary, integration=options)
+    if summary.cycles < 1:
+        return None
+    loops = LoopOptions.of(options, summary.cycles)  # (the key's loops count steps per forcing period)
     functions = library_functions(library)
     compiled = LOADED[key] = CompiledModel(summary, loops, digest, functions, "compiled", library, {},
                                            load_native(library, functions), options, timed, texts)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from .analysis.modes import Modes, nondimensional_modes, physical_modes
 from .errors import GearsymError
+from .model.teeth import with_teeth
 from .physical.answers import PhysicalScaling
 from .reduction import NondimensionalModel, reduce
 from .registry import load_model
@@ -17,28 +18,38 @@ from .system import FirstOrderSystem
 from .units import is_quantity
 
 
-def reduced(ref) -> NondimensionalModel:
+def declared(ref, teeth=None):
+    """The declared model of a name, a file or a model, with ``teeth`` = (pinion, wheel) tooth counts given to a
+    drivetrain that declares none (:func:`gearsym.model.teeth.with_teeth`)."""
+    return with_teeth(load_model(ref), teeth)
+
+
+def reduced(ref, teeth=None) -> NondimensionalModel:
     """The reduction of a model (a name, a file, a Drivetrain or its reduction)."""
     if isinstance(ref, NondimensionalModel):
+        if teeth is not None:
+            return reduced(ref.drivetrain, teeth)
         return ref
-    model = load_model(ref)
+    model = declared(ref, teeth)
     if not model.is_drivetrain:
         raise GearsymError(f"{model.name}: a first-order system has no components to reduce (it is one already)")
     return reduce(model)
 
 
-def scaling(model, length_scale=None, **physical) -> PhysicalScaling:
+def scaling(model, length_scale=None, *, teeth=None, **physical) -> PhysicalScaling:
     """The scaling of a model (a name, a file, a Drivetrain or its reduction) at its declared physical values,
     with ``physical`` overriding them (``kZ="3e8 N/m"``, ``speed="3000 rpm"``) or replacing a stiffness function
-    by a formula in tau or phi (``k="1+0.2*cos(tau)"``, with the values of its new parameters)."""
-    declared = model if isinstance(model, NondimensionalModel) else load_model(model)
-    if not isinstance(declared, NondimensionalModel) and not declared.is_drivetrain:
-        raise GearsymError(f"{declared.name}: physical values need a drivetrain model (a FirstOrderSystem has no "
-                           "components to give them units)")
-    return PhysicalScaling.of(reduced(declared), length_scale, **physical)
+    by a formula in tau or phi (``k="1+0.2*cos(tau)"``, with the values of its new parameters); ``teeth``: tooth
+    counts for a model that declares none."""
+    if not isinstance(model, NondimensionalModel):
+        model, teeth = declared(model, teeth), None
+        if not model.is_drivetrain:
+            raise GearsymError(f"{model.name}: physical values need a drivetrain model (a FirstOrderSystem has no "
+                               "components to give them units)")
+    return PhysicalScaling.of(reduced(model, teeth), length_scale, **physical)
 
 
-def load(ref, **values) -> FirstOrderSystem:
+def load(ref, *, teeth=None, **values) -> FirstOrderSystem:
     """The first-order system of a model, ready for the engine: the one place names and files are resolved.
 
     ``ref`` is a model name (``models/<name>.py``), the path of a model file, a Drivetrain, a reduced
@@ -46,9 +57,10 @@ def load(ref, **values) -> FirstOrderSystem:
     drivetrain, a new mesh stiffness as a formula in tau (``k="1 + 0.2*cos(tau)"``). Strings that read as
     numbers are numbers. A drivetrain with physical values (``model.set_physical``), or given one here
     (``kZ="2e8 N/m"``, ``speed="3000 rpm"``, a pint Quantity; ``length_scale="backlash"``), is scaled to its
-    nondimensional values by :class:`gearsym.scales.map.Scaling`.
+    nondimensional values by :class:`gearsym.scales.map.Scaling`. ``teeth`` = (Z1, Z2): the tooth counts of the
+    first mesh's pinion (its driving gear) and wheel, for a model that declares none (``--teeth Z1,Z2``).
     """
-    model = ref if isinstance(ref, NondimensionalModel) else load_model(ref)
+    model = reduced(ref, teeth) if isinstance(ref, NondimensionalModel) else declared(ref, teeth)
     values = {k: maybe_number(v) for k, v in values.items()}
     if isinstance(model, FirstOrderSystem):
         for key, value in values.items():
@@ -66,12 +78,12 @@ def load(ref, **values) -> FirstOrderSystem:
     return nd.system(**values)
 
 
-def natural_modes(model, **settings) -> Modes:
+def natural_modes(model, *, teeth=None, **settings) -> Modes:
     """The natural modes of ``model`` (a name, a file, a Drivetrain or its reduction). ``settings`` are physical
     values (``kZ="2e8 N/m"``: frequencies in Hz; also for a model that declares physical values) or, for a
     model without, nondimensional parameter values (``kS=0.5``); a stiffness formula (``k="1+0.2*cos(tau)"``)
     enters through its mean."""
-    nd = reduced(model)
+    nd = reduced(model, teeth)
     split = physical_settings(nd, dict(settings))
     if split is not None:
         length_scale, physical, formulas = split
@@ -79,11 +91,11 @@ def natural_modes(model, **settings) -> Modes:
     return nondimensional_modes(nd, settings)
 
 
-def is_physical(model, **values) -> bool:
+def is_physical(model, *, teeth=None, **values) -> bool:
     """Whether ``model`` (a name, a file or a model) with ``values`` runs in physical units (it declares
     physical values, or ``values`` give one or a length scale). Nothing is reduced to tell."""
-    declared = model if isinstance(model, NondimensionalModel) else load_model(model)
-    drivetrain = declared.drivetrain if isinstance(declared, NondimensionalModel) else declared
+    found = model if isinstance(model, NondimensionalModel) else load_model(model)
+    drivetrain = found.drivetrain if isinstance(found, NondimensionalModel) else found
     if not drivetrain.is_drivetrain:
         return False
     return bool(drivetrain.physical) or "length_scale" in values or any(is_quantity(v) for v in values.values())

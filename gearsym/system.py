@@ -22,6 +22,15 @@ from .symbols import parameter_symbol
 
 
 @dataclass(frozen=True)
+class Gearing:
+    """One gear of a mesh as the system knows it: its name in the model and its tooth count (None if the model
+    declares none). A gear of Z teeth turns once in Z mesh periods, so its shaft order is 1/Z of the mesh's."""
+
+    gear: str
+    teeth: int | None = None
+
+
+@dataclass(frozen=True)
 class Coupling:
     """A mesh or shaft of a reduced drivetrain, as its first-order system carries it.
 
@@ -44,12 +53,20 @@ class Coupling:
     rows: tuple[tuple[int, sp.Expr], ...] = ()  # (index in rhs of a velocity equation, factor of the law)
     contact: sp.Expr | None = None  # the argument of g: the coordinate (None), a combination, or shifted by an effect
     rate: sp.Expr | None = None  # the deflection's rate: the velocity (None), or the combination of rates
+    gears: tuple[Gearing, ...] = ()  # a mesh's two gears (a, b): names and tooth counts
 
     def __post_init__(self):
         if self.contact is None:
             object.__setattr__(self, "contact", sp.Symbol(self.coordinate, real=True))
         if self.rate is None:
             object.__setattr__(self, "rate", sp.Symbol(self.velocity, real=True))
+
+    def gear(self, name: str) -> Gearing:
+        """The gear of this mesh called ``name``."""
+        for gearing in self.gears:
+            if gearing.gear == name:
+                return gearing
+        raise ModelError(f"{name!r} is not a gear of mesh {self.name!r} ({', '.join(g.gear for g in self.gears)})")
 
     @property
     def closes_loop(self) -> bool:
@@ -61,8 +78,11 @@ class Coupling:
 class FirstOrderSystem(ParameterChecks, Model):
     """dy/d(time) = rhs(time, y, p), with named parameters and their values.
 
-    ``period`` is the forcing period in ``time`` (2*pi for the gear models):
-    the unit of stroboscopic sampling and of tangent-space re-orthonormalisation.
+    ``period`` is the period the system repeats on, in ``time`` (2*pi for the gear models: the forcing period):
+    the unit of stroboscopic sampling and of tangent-space re-orthonormalisation. ``cycles`` is the number of
+    forcing periods in it: 1, or with shaft-order terms (a tooth fault, an eccentric gear) a gear's revolution
+    in mesh periods, or the hunting period; the engine keeps its steps per *forcing* period, so a long period
+    costs time, not accuracy.
     ``coordinates`` names the states whose vibration amplitude is reported (the
     relative coordinates of a drivetrain); empty means every state. ``initial``
     is the default initial state (states not named start at 0). A reduced
@@ -82,8 +102,12 @@ class FirstOrderSystem(ParameterChecks, Model):
     initial: Mapping[str, float] = field(default_factory=dict)
     couplings: tuple[Coupling, ...] = ()
     constraints: Mapping[str, Constraint] = field(default_factory=dict)
+    cycles: int = 1
 
     def __post_init__(self):
+        if isinstance(self.cycles, bool) or not isinstance(self.cycles, int) or self.cycles < 1:
+            raise ModelError(f"cycles (forcing periods per period) must be a whole number of at least 1, got "
+                             f"{self.cycles!r}", self.name)
         if not isinstance(self.period, sp.Basic):  # a number (or a formula) given for the period
             object.__setattr__(self, "period", to_expr(self.period, f"{self.name}: period"))
         if len(self.states) != len(self.rhs):
@@ -158,6 +182,14 @@ class FirstOrderSystem(ParameterChecks, Model):
             raise ModelError(f"the forcing period {self.period} is {period} at these parameter values; it must be a "
                              "positive number", self.name)
         return number
+
+    def cycle_at(self, values: Mapping[str, float] | None = None) -> float:
+        """One forcing period (a mesh period) at these parameter values: the period over ``cycles``."""
+        return self.period_at(values) / self.cycles
+
+    @property
+    def meshes(self) -> tuple[Coupling, ...]:
+        return tuple(c for c in self.couplings if c.kind == "mesh")
 
     @property
     def state_names(self) -> tuple[str, ...]:

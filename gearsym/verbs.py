@@ -15,6 +15,7 @@ from .analysis.attractors import find_attractors as _find_attractors
 from .analysis.basins import basin_map as _basin_map
 from .analysis.lyapunov import lyapunov_spectrum as _lyapunov_spectrum
 from .analysis.orbits import phase_trajectory as _phase_trajectory, poincare_samples as _poincare_samples
+from .analysis.order_run import simulated_order_spectrum as _simulated_order_spectrum
 from .codegen.build import compile_model
 from .codegen.compiled import CompiledModel
 from .data.simulate import simulate_measurements as _simulate_measurements
@@ -101,6 +102,8 @@ def _physical_sweep(model: PhysicalScaling, axes, *, options: Integration | None
 periodic_orbit = high_level(_periodic_orbit)
 continue_orbits = high_level(_continue_orbits)
 simulate_measurements = high_level(_simulate_measurements)
+simulated_order_spectrum = high_level(_simulated_order_spectrum)
 
-__all__ = ["basin_map", "continue_basins", "continue_orbits", "find_attractors", "high_level", "lyapunov_spectrum", "periodic_orbit",
-           "phase_trajectory", "poincare_samples", "run_sweep", "simulate_measurements"]
+__all__ = ["basin_map", "continue_basins", "continue_orbits", "find_attractors", "high_level", "lyapunov_spectrum",
+           "periodic_orbit", "phase_trajectory", "poincare_samples", "run_sweep", "simulate_measurements",
+           "simulated_order_spectrum"]

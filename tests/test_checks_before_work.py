@@ -49,7 +49,7 @@ def no_work(monkeypatch):
     for module, name in ((gearsym.cli.integration, "system_from"), (gearsym.cli.explain, "system_from"),
                          (gearsym, "compile_model"), (gearsym.codegen.build, "compile_model"),
                          (gearsym.cli.sweep, "run_sweep"),
-                         (gearsym.cli.simulate, "_with_effects"),
+                         (gearsym.cli.simulate, "with_effects"),
                          (gearsym, "load"), (gearsym.loading, "load"), (gearsym.codegen.generated, "generate_model"),
                          (gearsym.cli.docs, "page"), (sys.modules["gearsym.reproduce"], "reproduce")):
         monkeypatch.setattr(module, name, work)

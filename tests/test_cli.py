@@ -40,8 +40,8 @@ def run(capsys, *argv: str) -> tuple[int, str, str]:
 
 def test_subcommands_are_registered():
     assert [m.NAME for m in COMMANDS] == ["list", "derive", "docs", "compile", "lyap", "sweep", "orbits", "poincare",
-                                          "basins", "reproduce", "simulate", "explain", "modes", "campbell", "fmu",
-                                          "stiffness"]
+                                          "basins", "reproduce", "simulate", "explain", "spectrum", "modes", "campbell",
+                                          "fmu", "stiffness"]
 
 
 def test_list_shows_every_model_with_its_title(capsys):

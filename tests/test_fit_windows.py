@@ -64,3 +64,21 @@ def test_harmonics_of_time_are_evaluated_exactly(case):
     run = Windows(system, channels, "compiled").run(starts, t0, dt, samples, substeps, p, tangent=False)
     tau = np.concatenate([t + d * np.arange(s) for t, d, s in zip(t0, dt, samples)])
     np.testing.assert_allclose(run.outputs[2], np.cos(7 * tau) * run.states[0], rtol=0, atol=1e-12 * 20)
+
+
+@pytest.mark.parametrize("tangent,columns", [(True, None), (True, [1, 4]), (False, None)])
+def test_windows_shared_between_threads_give_the_bits_of_one_call(case, monkeypatch, tangent, columns):
+    """A large call is split over the cores, each thread writing its windows' columns: the same numbers, bit for
+    bit, as the windows in one call (three pieces of unequal windows, every piece's columns offset)."""
+    import gearsym.codegen.windows as windows
+
+    system, channels, args = case
+    compiled = Windows(system, channels, "compiled")
+    one = compiled.run(*args, tangent=tangent, columns=columns)
+    monkeypatch.setattr(windows, "MIN_SHARED_STEPS", 0)
+    monkeypatch.setattr(windows.os, "cpu_count", lambda: 3)
+    assert len(windows._pieces(args[3], args[4])) == 3
+    shared = compiled.run(*args, tangent=tangent, columns=columns)
+    for a, b in zip((one.states, one.outputs, one.derivatives), (shared.states, shared.outputs, shared.derivatives)):
+        assert (a is None and b is None) or np.array_equal(a, b)
+    assert np.all(shared.outputs[:, -1] != 0)  # the last piece's columns were written

@@ -5,9 +5,12 @@ from .basins import BasinAttractor, BasinMap, basin_map
 from .jumps import Jump, find_jumps, hysteresis_intervals
 from .lyapunov import LyapunovSpectrum, lyapunov_spectrum
 from .orbits import Orbit, Trajectory, phase_trajectory, poincare_samples
+from .order_run import simulated_order_spectrum
+from .orders import OrderSpectrum, order_spectrum
 from .regime import REGIMES, classify_regime
 from .statistics import batch_means_stderr
 
-__all__ = ["Attractor", "AttractorSet", "BasinAttractor", "BasinMap", "Jump", "LyapunovSpectrum", "Orbit", "REGIMES",
-           "Trajectory", "basin_map", "batch_means_stderr", "classify_regime", "find_attractors", "find_jumps", "hysteresis_intervals",
-           "lyapunov_spectrum", "phase_trajectory", "poincare_samples"]
+__all__ = ["Attractor", "AttractorSet", "BasinAttractor", "BasinMap", "Jump", "LyapunovSpectrum", "Orbit",
+           "OrderSpectrum", "REGIMES", "Trajectory", "basin_map", "batch_means_stderr", "classify_regime",
+           "find_attractors", "find_jumps", "hysteresis_intervals", "lyapunov_spectrum", "order_spectrum",
+           "phase_trajectory", "poincare_samples", "simulated_order_spectrum"]

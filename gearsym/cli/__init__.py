@@ -31,7 +31,8 @@ from ..errors import GearsymError, GearsymWarning
 #: them; a run imports the module of its own command only (the others' imports would cost it start-up time)
 MODULES = {"list": "list_models", "derive": "derive", "docs": "docs", "compile": "compile", "lyap": "lyap",
            "sweep": "sweep", "orbits": "orbits", "poincare": "poincare", "basins": "basins", "reproduce": "reproduce",
-           "simulate": "simulate", "explain": "explain", "modes": "modes", "campbell": "campbell",
+           "simulate": "simulate", "explain": "explain", "spectrum": "spectrum", "modes": "modes",
+           "campbell": "campbell",
            "fmu": "fmu", "stiffness": "stiffness"}
 
 #: exit status of a GearsymError (argparse uses the same for bad arguments)

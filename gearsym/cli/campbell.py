@@ -19,7 +19,7 @@ from ..sweep import run_sweep, Workers
 from ..sweep.grid import parse_axis
 from ..sweep.store import sidecar
 from .integration import add_integration_arguments, compiled_from, scaling_from
-from .settings import add_set_argument, parse_settings, refuse_swept_and_set
+from .settings import add_set_argument, model_settings, parse_settings, refuse_swept_and_set
 
 NAME = "campbell"
 HELP = "Campbell diagram (natural frequencies, mesh and torque orders, crossings) beside the amplitude over speed"
@@ -56,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
                            f"({scaling.speed.parameter}=...), not {axis.name}")
     refuse_swept_and_set([(axis.name, args.param)], parse_settings(args.set))
     engine_axis = nondimensional_axis(scaling, axis)  # (a speed without its unit is refused here)
-    modes = natural_modes(scaling.model, **parse_settings(args.set))
+    modes = natural_modes(scaling.model, **model_settings(args))
     diagram = campbell(scaling, axis.values, axis.unit, modes, args.orders)
     write_atomically(sidecar(args.out, ".campbell.json"), json.dumps(diagram.as_dict(), indent=2) + "\n")
     print(f"{diagram.model}: natural frequencies " + ", ".join(f"{f:.6g} Hz" for f in diagram.natural_frequencies))

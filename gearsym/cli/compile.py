@@ -10,7 +10,7 @@ from ..outputs import check_folder
 from ..loading import load
 from ..registry import available_models, output_root
 from .integration import add_integration_arguments, integration_from
-from .settings import add_set_argument, parse_settings
+from .settings import add_set_argument, model_settings
 
 NAME = "compile"
 HELP = "generate the model's C code into generated/<model>/ and compile it (cached)"
@@ -33,7 +33,7 @@ def run(args: argparse.Namespace) -> int:
         print("gearsym compile: error: give model names or --all (not both)", file=sys.stderr)
         return 2
     refs = available_models() if args.all else args.models
-    settings = parse_settings(args.set)
+    settings = model_settings(args)
     options = integration_from(args)
     outs = [args.out or output_root(ref) / "generated" for ref in refs]
     for out in set(outs) if not args.check else ():

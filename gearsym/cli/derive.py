@@ -4,7 +4,8 @@ from __future__ import annotations
 import argparse
 
 from ..derivation import derive, render
-from ..registry import load_model
+from ..loading import declared
+from .settings import add_teeth_argument
 
 
 NAME = "derive"
@@ -18,8 +19,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--full", action="store_true",
                         help="text/latex: show every step, from the components to the first-order system "
                              "(json always has them)")
+    add_teeth_argument(parser)
 
 
 def run(args: argparse.Namespace) -> int:
-    print(render(derive(load_model(args.model)), args.format, full=args.full), end="")
+    print(render(derive(declared(args.model, args.teeth)), args.format, full=args.full), end="")
     return 0

@@ -11,7 +11,9 @@ from pathlib import Path
 
 from ..derivation import derive, render
 from ..outputs import check_folder
-from ..registry import available_models, load_model, output_root
+from ..loading import declared
+from ..registry import available_models, output_root
+from .settings import add_teeth_argument
 
 NAME = "docs"
 HELP = "write the Markdown derivation of models to DIR/<model>.md"
@@ -24,11 +26,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="output folder (default: docs/derivations/ of the current directory)")
     parser.add_argument("--check", action="store_true",
                         help="write nothing; exit 1 and name the pages that differ from what would be written")
+    add_teeth_argument(parser)
 
 
-def page(model: str) -> tuple[str, str]:
-    """(model name, Markdown page) for a model reference."""
-    derivation = derive(load_model(model))
+def page(model: str, teeth=None) -> tuple[str, str]:
+    """(model name, Markdown page) for a model reference (with ``teeth`` for one that declares none)."""
+    derivation = derive(declared(model, teeth))
     return derivation.model, render(derivation, "markdown")
 
 
@@ -48,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
     outs = [args.out or output_root(ref) / "docs" / "derivations" for ref in refs]
     for out in set(outs) if not args.check else ():
         check_folder(out)
-    pages = [page(ref) for ref in refs]
+    pages = [page(ref, args.teeth) for ref in refs]
     if args.check:
         stale = []
         for (name, text), out in zip(pages, outs):

@@ -10,7 +10,7 @@ from ..fmu.export import export_fmu
 from ..outputs import check_folder
 from ..registry import available_models, load_model
 from .integration import add_integration_arguments, integration_from
-from .settings import add_set_argument, parse_settings
+from .settings import add_set_argument, model_settings
 
 NAME = "fmu"
 HELP = "export the model as an FMI 2.0 FMU (co-simulation and model exchange) for Modelica tools, Simulink, FMPy"
@@ -30,7 +30,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     if bool(args.all) == bool(args.model):
         raise GearsymError("give a model or --all (not both), e.g. gearsym fmu one_stage --out one_stage.fmu")
-    settings = parse_settings(args.set)
+    settings = model_settings(args)
     options = integration_from(args)
     if args.all:
         folder = check_folder(args.out)

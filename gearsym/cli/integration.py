@@ -9,7 +9,7 @@ import gearsym  # the face: its verbs load on first use, so a cached model's run
 from ..cached import cached_scaling, load_compiled
 from ..checks import check_run
 from ..options import BACKENDS, STEPS_PER_PERIOD, Integration
-from .settings import parse_settings
+from .settings import model_settings
 
 
 def add_integration_arguments(parser: argparse.ArgumentParser, *, periods: int | None = 400, discard: int = 100,
@@ -47,7 +47,7 @@ def integration_from(args: argparse.Namespace, steps_per_period: int | None = No
 
 def system_from(args: argparse.Namespace):
     """The system of the command's MODEL with its --set values (names and files are resolved here, at the edge)."""
-    return gearsym.load(args.model, **parse_settings(args.set))
+    return gearsym.load(args.model, **model_settings(args))
 
 
 def scaling_of(model, settings: dict):
@@ -62,7 +62,7 @@ def scaling_of(model, settings: dict):
 def scaling_from(args: argparse.Namespace):
     """The scaling of the command's MODEL and --set values (a cached one when the start-up cache has its numbers),
     or None for a model without physical values."""
-    settings = parse_settings(args.set)
+    settings = model_settings(args)
     return cached_scaling(args.model, settings, lambda: scaling_of(args.model, settings))
 
 
@@ -72,7 +72,7 @@ def compiled_from(args: argparse.Namespace, options: Integration | None = None, 
     verbose = not getattr(args, "quiet", False)
     if system is not None:
         return gearsym.compile_model(system, options, verbose=verbose)
-    settings = parse_settings(args.set)
+    settings = model_settings(args)
     return load_compiled(args.model, settings, options, verbose=verbose,
                          compile=lambda: gearsym.compile_model(gearsym.load(args.model, **settings), options,
                                                                verbose=verbose),

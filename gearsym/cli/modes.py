@@ -5,7 +5,7 @@ import argparse
 import json
 
 from ..loading import natural_modes
-from .settings import add_set_argument, parse_settings
+from .settings import add_set_argument, model_settings
 
 NAME = "modes"
 HELP = "natural frequencies and mode shapes (mean mesh stiffness, no backlash); in Hz with physical values"
@@ -18,7 +18,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    result = natural_modes(args.model, **parse_settings(args.set))
+    result = natural_modes(args.model, **model_settings(args))
     if args.format == "json":
         print(json.dumps(result.as_dict(), indent=2))
         return 0

@@ -41,9 +41,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--period-multiple", type=int, default=1, metavar="N",
                         help="the orbit's period in forcing periods (default 1; --periods is the run length of "
                              "the other commands)")
-    parser.add_argument("--segments", type=int, default=1, metavar="M",
-                        help="shooting segments per forcing period (multiple shooting for strongly unstable "
-                             "orbits: 1, 2 or 4; default 1)")
+    parser.add_argument("--segments", type=int, default=None, metavar="M",
+                        help="shooting segments per period (multiple shooting for strongly unstable orbits; 1, 2 "
+                             "or 4 per forcing period; default 1, or for a model whose period is a gear's "
+                             "revolution one per mesh period)")
     parser.add_argument("--y0", metavar="x=-2,v=-0.5",
                         help="Newton's start at the section t = 0 (default: where --transient periods from the "
                              "model's initial state end, or the --sweep's point)")
@@ -102,7 +103,7 @@ def engine_range(args: argparse.Namespace, parameter: tuple, scaling) -> tuple[s
 
 def run(args: argparse.Namespace) -> int:
     parameter = parse_range(args.param) if args.param else None
-    for option, value, least in (("--period-multiple", args.period_multiple, 1), ("--segments", args.segments, 1),
+    for option, value, least in (("--period-multiple", args.period_multiple, 1), ("--segments", args.segments or 1, 1),
                                  ("--transient", args.transient, 1), ("--switch-depth", args.switch_depth, 0),
                                  ("--max-points", args.max_points, 2)):
         whole_number(value, option, least)
@@ -120,8 +121,6 @@ def run(args: argparse.Namespace) -> int:
         sweep = read_sweep(args.sweep)
 
     options = integration_from(args).run(periods=args.transient, discard=0)
-    check_segments(args.segments, pieces_per_period(options.steps_per_period), f"--segments {args.segments}: ",
-                   options.steps_per_period)
     scaling = scaling_from(args)
     physical = scaling  # (None without physical values; else the answers are also in its units)
     if parameter:
@@ -129,6 +128,9 @@ def run(args: argparse.Namespace) -> int:
         parameter = engine_range(args, parameter, scaling)
         refuse_swept_and_set([(given, args.param), (parameter[0], args.param)], parse_settings(args.set))
     system = system_from(args)
+    if args.segments is not None:  # (before the code is compiled: a period of cycles forcing periods has
+        pieces = system.cycles * pieces_per_period(options.steps_per_period)  # pieces in each)
+        check_segments(args.segments, pieces, f"--segments {args.segments}: ", options.steps_per_period * system.cycles)
     if parameter and parameter[0] not in system.parameters:
         raise UnknownParameterError(parameter[0], system.parameters, f"--param {args.param}")
     compiled = compiled_from(args, options, system)

@@ -9,6 +9,7 @@ import gearsym  # the face: SymPy is loaded only when a formula is given
 
 from ..errors import GearsymError
 from ..model.length_scale import check_length_scale
+from ..model.tooth_counts import parse_teeth
 from ..units import looks_like_quantity, parse_quantity
 
 
@@ -19,6 +20,24 @@ def add_set_argument(parser: argparse.ArgumentParser) -> None:
              "length_scale=static|backlash|\"1 um\") or a new mesh stiffness formula in tau "
              "(\"k=1+0.2*cos(tau)\"); repeat for several",
     )
+    add_teeth_argument(parser)
+
+
+def add_teeth_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--teeth", default=None, metavar="Z1,Z2",
+        help="tooth counts of the first mesh's pinion (its driving gear) and wheel, for a model that declares none: "
+             "shaft orders, tooth faults and eccentricity need them (one pinion revolution is Z1 mesh periods)",
+    )
+
+
+def model_settings(args: argparse.Namespace) -> dict:
+    """--set's values and, with --teeth, ``teeth`` = (Z1, Z2): what the face's ``gearsym.load`` takes."""
+    settings: dict = parse_settings(args.set)
+    teeth = parse_teeth(getattr(args, "teeth", None))
+    if teeth is not None:
+        settings["teeth"] = teeth
+    return settings
 
 
 def parse_settings(pairs: list[str]) -> dict[str, str]:
@@ -32,6 +51,8 @@ def parse_settings(pairs: list[str]) -> dict[str, str]:
             raise GearsymError(f"--set {pair!r}: expected NAME=VALUE, e.g. --set omega=1.5 or --set \"k=1+0.2*cos(tau)\"")
         if name in settings:
             raise GearsymError(f"--set gives {name} twice")
+        if name == "teeth":
+            raise GearsymError("--set teeth=...: tooth counts are given with --teeth Z1,Z2")
         if looks_like_quantity(value):
             parse_quantity(value, f"--set {name}")
         elif name == "length_scale":

@@ -7,10 +7,11 @@ from pathlib import Path
 from ..data.simulate import RUN, simulate_measurements, steps_for
 from ..errors import GearsymError
 from ..fit.effects import augment, effect
+from ..fit.shaft_effects import is_shaft_effect
 from ..outputs import check_file
 from ..loading import load
 from .integration import add_integration_arguments, compiled_from, integration_from
-from .settings import add_set_argument, parse_numbers, parse_settings, parse_state
+from .settings import add_set_argument, model_settings, parse_numbers, parse_state
 
 NAME = "simulate"
 HELP = "synthetic measurements of a model (tau, record, conditions, coordinates) with noise, as CSV"
@@ -37,41 +38,50 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="simulate the model with an effect of the library added (coulomb_friction, "
                              "nonlinear_damping, cubic_stiffness, hertzian_contact, coast_side_stiffness, "
                              "shaft_damping, or a harmonic with its order: mesh_stiffness_harmonic_3, "
-                             "torque_harmonic_2, transmission_error_1); set its strength with --set, e.g. "
-                             "--effect cubic_stiffness --set k3=0.02")
+                             "torque_harmonic_2, transmission_error_1, or on a gear with --teeth: tooth_fault_GEAR "
+                             "with --set q_GEAR and tooth_GEAR, eccentricity_GEAR with e_c_GEAR, e_s_GEAR; then "
+                             "--periods and --discard count the gear's revolutions); set its strength with --set, "
+                             "e.g. --effect cubic_stiffness --set k3=0.02")
     parser.add_argument("--out", type=Path, required=True, metavar="FILE.csv", help="where to write the measurements")
 
 
 def run(args: argparse.Namespace) -> int:
     records = [parse_conditions(text) for text in args.record]
-    settings = parse_settings(args.set)
+    settings = model_settings(args)
     options = integration_from(args, steps_for(args.samples_per_period, args.steps_per_period), exponents=False)
     check_file(args.out, (".csv",))
-    check_strengths(args.effect, settings)
-    system = _with_effects(args.model, args.effect, settings) if args.effect else None
+    check_strengths([e for e in args.effect if not is_shaft_effect(e)], settings)  # (shaft-order ones: on the model)
+    system = with_effects(args.model, args.effect, settings) if args.effect else None
     compiled = compiled_from(args, options, system)
     table = simulate_measurements(compiled, samples_per_period=args.samples_per_period,
                                   noise=args.noise, seed=args.seed, records=records or None,
                                   y0=parse_state(args.y0), velocities=args.velocities, out=args.out)
     per_record = table.rows // table.records
     conditions = f"; conditions {', '.join(table.conditions)}" if table.conditions else ""
-    print(f"{table.model}: {table.records} record(s) of {per_record} samples ({table.samples_per_period} per period, "
-          f"{options.measured} periods after {args.discard} discarded, {table.steps_per_period} RK4 steps/period), "
+    cycles = compiled.cycles  # (a period of several forcing periods: a gear's revolution)
+    unit = "period" if cycles == 1 else "forcing period"
+    periods = "periods" if cycles == 1 else f"periods of {cycles} forcing periods"
+    print(f"{table.model}: {table.records} record(s) of {per_record} samples ({table.samples_per_period} per {unit}, "
+          f"{options.measured} {periods} after {args.discard} discarded, {table.steps_per_period} RK4 steps/{unit}), "
           f"noise {args.noise:g}{conditions}; columns {', '.join(table.columns)}")
     print(f"wrote {args.out}")
     return 0
 
 
-def _with_effects(model: str, effects: list[str], settings: dict):
-    """The model's equations with ``effects`` added; ``settings`` set the model's and the effects' parameters."""
-    own = {p for e in map(effect, effects) for p in e.parameters}
+def with_effects(model: str, effects: list[str], settings: dict):
+    """The model's equations with ``effects`` added; ``settings`` set the model's and the effects' parameters (a
+    shaft-order effect is found on the gears of the model, with --teeth's counts)."""
+    geared = load(model, teeth=settings.get("teeth"))
+    chosen = [effect(e, geared) for e in effects]
+    check_strengths(chosen, settings)
+    own = {p for e in chosen for p in e.parameters}
     base = load(model, **{k: v for k, v in settings.items() if k not in own})
-    return augment(base, effects, values={k: v for k, v in settings.items() if k in own})
+    return augment(base, chosen, values={k: v for k, v in settings.items() if k in own})
 
 
 def check_strengths(effects: list[str], settings: dict) -> None:
     """Every effect needs a strength other than 0 (its off value) among ``settings``."""
-    for e in map(effect, effects):
+    for e in (effect(name) for name in effects):
         if not any(_nonzero(settings.get(p)) for p in e.fitted):
             given = " and/or ".join(f"--set {p}=VALUE" for p in e.fitted)
             raise GearsymError(f"--effect {e.name} needs its strength: {given} (the effect is off at 0, which "

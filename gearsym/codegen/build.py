@@ -48,7 +48,7 @@ def compile_model(system: FirstOrderSystem, options: Integration = Integration()
     if not isinstance(options, Integration):
         raise GearsymError(f"options must be a gearsym.Integration, got {type(options).__name__}")
     start = time.perf_counter()
-    loops = LoopOptions.of(options)
+    loops = LoopOptions.of(options, system.cycles)
     digest = code_hash(system, loops)
     timings = {"symbolic": time.perf_counter() - start}
     backend = resolve_backend(options.backend)

@@ -189,7 +189,18 @@ class CompiledModel:
 
     @property
     def steps_per_period(self) -> int:
+        """RK4 steps per period of the loops (the options' steps per forcing period times :attr:`cycles`)."""
         return self.options.steps_per_period
+
+    @property
+    def cycles(self) -> int:
+        """Forcing periods in one period: 1, or a gear's revolution (the hunting period) with shaft-order terms."""
+        return getattr(self.system, "cycles", 1)
+
+    @property
+    def steps_per_cycle(self) -> int:
+        """RK4 steps per forcing period (a mesh period)."""
+        return self.steps_per_period // self.cycles
 
     # ---------------------------------------------------------------- inputs
     def parameter_vector(self, values: Mapping[str, float] | None = None, **more: float) -> np.ndarray:

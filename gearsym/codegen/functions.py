@@ -134,7 +134,7 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
     Yt = state_step.mapaccum("steps", N, 1)(Ym, Tm, Cm)
     trajectory = ca.Function("trajectory", [Ym, Tm, Cm], [Yt], ["y0", "table", "c"], ["states"])
 
-    monodromy_segment, monodromy_period = monodromy(tangent_block, obs0, Ym, Qm, Cm, m, N, K)
+    monodromy_segment, monodromy_period = monodromy(tangent_block, obs0, Ym, Qm, Cm, m, N, K, system.cycles)
 
     table = table_function(constants, table_point, len(sym.params), nc, m, N)
     functions = {f.name(): f for f in (rhs, jacobian, constants, table, lyapunov_chunk, lyapunov_period,

@@ -29,7 +29,7 @@ def generate_model(system: FirstOrderSystem, out: Path, options: Integration = I
                    check: bool = False, compile: bool = True) -> GenerateReport:
     """Write ``out/<model>/<model>.c`` and ``manifest.json`` for ``system`` compiled with ``options``;
     with ``check``, compare instead of writing."""
-    loops = LoopOptions.of(options)
+    loops = LoopOptions.of(options, system.cycles)
     digest = code_hash(system, loops)
     target = Path(out) / system.name
     mf = build_functions(system, loops)

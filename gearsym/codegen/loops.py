@@ -18,9 +18,11 @@ class LoopOptions:
     locate_crossings: bool = False  # split steps at backlash switching surfaces (4th order exponents)
 
     @classmethod
-    def of(cls, options: Integration) -> "LoopOptions":
-        """The part of an :class:`~gearsym.options.Integration` that shapes the generated code."""
-        return cls(steps_per_period=options.steps_per_period, locate_crossings=options.locate_crossings)
+    def of(cls, options: Integration, cycles: int = 1) -> "LoopOptions":
+        """The part of an :class:`~gearsym.options.Integration` that shapes the generated code, for a system whose
+        period is ``cycles`` forcing periods (a gear's revolution): the options' steps per forcing period are
+        kept, so the loops take ``cycles`` times as many per period (a long period costs time, not accuracy)."""
+        return cls(steps_per_period=options.steps_per_period * cycles, locate_crossings=options.locate_crossings)
 
     def __post_init__(self):
         if self.steps_per_period < 1:
@@ -44,7 +46,9 @@ class LoopOptions:
 SHOOTING_SEGMENTS = 4
 
 
-def shooting_segments(N: int, K: int) -> int:
+def shooting_segments(N: int, K: int, cycles: int = 1) -> int:
     """The pieces of a period in ``monodromy_period``: ``SHOOTING_SEGMENTS``, or the largest number below
-    that the period's N // K blocks divide into."""
-    return max(d for d in range(1, SHOOTING_SEGMENTS + 1) if (N // K) % d == 0)
+    that the period's N // K blocks divide into; a period of ``cycles`` forcing periods (a gear's revolution)
+    is cut that way in each forcing period, so that multiple shooting has a piece in every mesh period."""
+    blocks = N // K // cycles
+    return cycles * max(d for d in range(1, SHOOTING_SEGMENTS + 1) if blocks % d == 0)

@@ -9,16 +9,16 @@ from __future__ import annotations
 import casadi as ca
 
 from .casadi_symbols import SX_OPTIONS
-from .loops import shooting_segments
+from .loops import SHOOTING_SEGMENTS, shooting_segments
 from .translate import select_max, select_min
 
 
-def monodromy(tangent_block, obs0, Ym: ca.MX, Qm: ca.MX, Cm: ca.MX, m: int, N: int, K: int):
-    """``monodromy_segment``: one piece of a period (``SHOOTING_SEGMENTS`` of them, or the largest number
-    below that the period's blocks divide into), the state and the raw tangent matrix Phi Q0 (no
+def monodromy(tangent_block, obs0, Ym: ca.MX, Qm: ca.MX, Cm: ca.MX, m: int, N: int, K: int, cycles: int = 1):
+    """``monodromy_segment``: one piece of a period (``SHOOTING_SEGMENTS`` of them per forcing period, or the
+    largest number below that its blocks divide into), the state and the raw tangent matrix Phi Q0 (no
     Gram-Schmidt: the Jacobian of the map, for Newton) with the observed states' min and max over its
     steps; ``monodromy_period``: the pieces of one period in turn (:mod:`gearsym.periodic`)."""
-    S = shooting_segments(N, K)
+    S = shooting_segments(N, K, cycles)
     width = N // S
     Ts = ca.MX.sym("T", 3 * m, width)
     yk, Qk, lk, hk = over_period(tangent_block, [Ym, Qm, obs0, obs0], Ts, Cm, K, "shooting")
@@ -26,9 +26,17 @@ def monodromy(tangent_block, obs0, Ym: ca.MX, Qm: ca.MX, Cm: ca.MX, m: int, N: i
     segment = ca.Function("monodromy_segment", [Ym, Qm, Ts, Cm], [yk, Qk, lk, hk], *names)
     Tm = ca.MX.sym("T", 3 * m, N)
     yk, Qk, lk, hk = Ym, Qm, obs0, obs0
-    for k in range(S):
-        yk, Qk, low, high = segment(yk, Qk, Tm[:, k * width:(k + 1) * width], Cm)
-        lk, hk = select_min(low, lk), select_max(high, hk)
+    if S > SHOOTING_SEGMENTS:  # a revolution of many mesh periods: the pieces as one accumulated map
+        La, Ha = ca.MX.sym("lk", obs0.sparsity()), ca.MX.sym("hk", obs0.sparsity())
+        y1, Q1, low, high = segment(Ym, Qm, Ts, Cm)
+        carried = ca.Function("monodromy_piece", [Ym, Qm, La, Ha, Ts, Cm],
+                              [y1, Q1, select_min(low, La), select_max(high, Ha)])
+        yk, Qk, lk, hk = carried.mapaccum("monodromy_pieces", S, 4)(Ym, Qm, obs0, obs0, Tm, Cm)
+        yk, Qk, lk, hk = (a[:, -b:] for a, b in ((yk, 1), (Qk, Qm.size2()), (lk, 1), (hk, 1)))
+    else:
+        for k in range(S):
+            yk, Qk, low, high = segment(yk, Qk, Tm[:, k * width:(k + 1) * width], Cm)
+            lk, hk = select_min(low, lk), select_max(high, hk)
     period = ca.Function("monodromy_period", [Ym, Qm, Tm, Cm], [yk, Qk, lk, hk], *names)
     return segment, period
 

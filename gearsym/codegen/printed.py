@@ -179,7 +179,7 @@ class _Shape:
         self.step = self.rows * K  # table entries per block
         self.blocks = self.N // K
         self.P = mf.options.chunk_periods
-        self.S = shooting_segments(self.N, K)
+        self.S = shooting_segments(self.N, K, system.cycles)
         self.located = "state_try" in mf.steps
         self.stepwise = "trajectory_step" in mf.steps  # (blocks of several steps: the trajectory steps alone)
         #: the tangent step (or try): the state's step, then each tangent vector's (:func:`_by_vector`)

@@ -10,11 +10,16 @@ state and by the parameters. Here that is one C call for all windows:
 * ``fit_state_step``: the same step without the tangent;
 * ``fit_output``: the observation channels h(tau, y, p) (a state, a derivative dv/dtau = f_v, a
   combination) and dh/d(y0, p) = dh/dy Q + [0 | dh/dp];
-* ``gearsym_fit_windows`` (hand-written C around them): every window from its start state, its
-  samples ``substeps`` RK4 steps apart, the outputs written into the caller's arrays.
+* the same step by columns (:func:`column_functions`): ``fit_stages`` (the state's step, its stage states
+  and Jacobians), ``fit_column`` (a start state's column), ``fit_param_<j>`` (parameter j's), ``fit_channels``;
+* ``gearsym_fit_windows`` (hand-written C around the column functions): every window from its start
+  state, its samples ``substeps`` RK4 steps apart, the outputs and the derivatives by the start state and
+  the parameters asked for written into the caller's arrays.
 
-Derivatives are taken by every parameter: a fit picks the columns it estimates, so the library
-of candidate effects (all parameters at 0 but the tried ones) is compiled once for all candidates.
+Every parameter has its column function, and a fit asks for the columns it estimates, so the library of
+candidate effects (all parameters at 0 but the tried ones) is compiled once for all candidates, and a fit
+of three parameters in a library of forty pays for three (the whole tangent step is what the in-process
+backend evaluates, mapped over the windows, and what the column functions are tested against).
 The C is cached like the engine's (:mod:`.compiler`); without a compiler the same functions run in
 CasADi's virtual machine, mapped over the windows.
 """
@@ -23,6 +28,8 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import json
+import os
+from concurrent.futures import ThreadPoolExecutor
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,8 +49,10 @@ from .translate import to_casadi
 from .trust import record, trusted
 
 #: bump when the generated window code changes for the same system and channels
-WINDOWS_VERSION = 1
+WINDOWS_VERSION = 2
 _OPTS = {"cse": True}
+#: RK4 steps in a call below which its windows run in one thread
+MIN_SHARED_STEPS = 20_000
 
 
 @dataclass(frozen=True)
@@ -111,7 +120,53 @@ def window_functions(system: FirstOrderSystem, channels: Sequence[sp.Expr]) -> d
     out = ca.vertcat(*to_casadi(list(channels), mapping, f"{system.name}: observation channels"))
     dout = ca.mtimes(ca.jacobian(out, y), Q) + ca.horzcat(ca.SX(out.numel(), n), ca.jacobian(out, p))
     output = ca.Function("fit_output", [y, Q, t, p], [out, ca.densify(dout)], _OPTS)
-    return {"fit_step": step, "fit_state_step": state_step, "fit_output": output}
+    return {"fit_step": step, "fit_state_step": state_step, "fit_output": output,
+            **column_functions(system, rhs, out, sym)}
+
+
+def column_functions(system: FirstOrderSystem, rhs: ca.Function, out: ca.SX, sym: SystemSymbols
+                     ) -> dict[str, ca.Function]:
+    """The same tangent step by columns, so that a fit pays only for the columns it estimates: ``fit_stages`` (the
+    state's step, its RK4 stage states and each stage's Jacobian dy), ``fit_column`` (a start state's column:
+    Q' = J Q at those stages), ``fit_param_<j>`` (parameter j's column, with df/dp_j at the stages: the augmented
+    system's RK4, as ``fit_step`` computes it), and ``fit_channels`` (the channels, dh/dy and dh/dp)."""
+    n, m = system.dimension, sym.p.numel()
+    y, t, p, h = sym.y, sym.t, sym.p, ca.SX.sym("h")
+    f = lambda x, time: rhs(time, x, p)[0]  # noqa: E731
+    k1 = f(y, t)
+    y2 = y + h / 2 * k1
+    k2 = f(y2, t + h / 2)
+    y3 = y + h / 2 * k2
+    k3 = f(y3, t + h / 2)
+    y4 = y + h * k3
+    k4 = f(y4, t + h)
+    y_next = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    times = (t, t + h / 2, t + h / 2, t + h)
+    jac = [rhs(time, x, p)[1] for x, time in zip((y, y2, y3, y4), times)]
+    stages = ca.Function("fit_stages", [y, t, h, p], [ca.densify(y_next), ca.densify(ca.horzcat(y, y2, y3, y4)),
+                                                      ca.densify(ca.horzcat(*jac))], _OPTS)  # (dense: C arrays)
+    Y, J, q = ca.SX.sym("Y", n, 4), ca.SX.sym("J", n, 4 * n), ca.SX.sym("q", n)
+
+    def column(forcing):
+        Js = [J[:, i * n:(i + 1) * n] for i in range(4)]
+        K1 = ca.mtimes(Js[0], q) + forcing[0]
+        K2 = ca.mtimes(Js[1], q + h / 2 * K1) + forcing[1]
+        K3 = ca.mtimes(Js[2], q + h / 2 * K2) + forcing[2]
+        K4 = ca.mtimes(Js[3], q + h * K3) + forcing[3]
+        return q + h / 6 * (K1 + 2 * K2 + 2 * K3 + K4)
+
+    zero = [ca.SX(n, 1)] * 4
+    out_fns = {"fit_stages": stages,
+               "fit_column": ca.Function("fit_column", [q, J, h], [ca.densify(column(zero))], _OPTS)}
+    fp = ca.jacobian(f(y, t), p)
+    dfdp = ca.Function("dfdp", [y, t, p], [fp])
+    for j in range(m):
+        forcing = [dfdp(Y[:, i], time, p)[:, j] for i, time in enumerate(times)]
+        out_fns[f"fit_param_{j}"] = ca.Function(f"fit_param_{j}", [q, J, Y, t, h, p], [ca.densify(column(forcing))],
+                                                _OPTS)
+    out_fns["fit_channels"] = ca.Function("fit_channels", [y, t, p], [ca.densify(out), ca.densify(ca.jacobian(out, y)),
+                                                                      ca.densify(ca.jacobian(out, p))], _OPTS)
+    return out_fns
 
 
 class Windows:
@@ -143,40 +198,69 @@ class Windows:
         lib = ctypes.CDLL(str(library.path))
         call = lib.gearsym_fit_windows
         call.restype = ctypes.c_int
-        call.argtypes = [ctypes.c_longlong] + [ctypes.c_void_p] * 6 + [ctypes.c_longlong] + [ctypes.c_void_p] * 3
+        call.argtypes = ([ctypes.c_longlong] + [ctypes.c_void_p] * 6 + [ctypes.c_longlong] * 2
+                         + [ctypes.c_void_p] * 4)
         return call
 
     def _source(self) -> str:
         gen = ca.CodeGenerator("windows.c", {"with_header": False, "verbose": False, "prefix": ""})
-        for f in self.functions.values():
-            gen.add(f)
-        return gen.dump() + _DRIVER.format(n=self.n, p=self.parameters, c=len(self.channels))
+        for name, f in self.functions.items():
+            if name not in _IN_PROCESS_ONLY:
+                gen.add(f)
+        table = ", ".join(f"fit_param_{j}" for j in range(self.parameters)) or "0"
+        works = ", ".join(f"fit_param_{j}_work" for j in range(self.parameters)) or "0"
+        return gen.dump() + _DRIVER.format(n=self.n, p=self.parameters, c=len(self.channels), table=table,
+                                           works=works, p1=max(1, self.parameters))
 
     def run(self, starts: np.ndarray, t0: Sequence[float], dt: Sequence[float], samples: Sequence[int],
-            substeps: Sequence[int], parameters: np.ndarray, tangent: bool = True) -> WindowRun:
+            substeps: Sequence[int], parameters: np.ndarray, tangent: bool = True,
+            columns: Sequence[int] | None = None) -> WindowRun:
         """Every window k from ``starts[:, k]`` at time ``t0[k]``: ``samples[k]`` samples ``dt[k]`` apart,
-        ``substeps[k]`` RK4 steps between samples, parameter vector ``parameters[:, k]``."""
+        ``substeps[k]`` RK4 steps between samples, parameter vector ``parameters[:, k]``. With ``tangent``, the
+        derivatives by the start state and by the parameters ``columns`` (their indices; default every one), in
+        that order: a fit pays only for the columns it asks for."""
         starts = np.asfortranarray(starts, dtype=float)
         parameters = np.asfortranarray(parameters, dtype=float)
-        count = starts.shape[1]
         samples = np.ascontiguousarray(samples, dtype=np.int64)
         substeps = np.ascontiguousarray(substeps, dtype=np.int64)
         t0, dt = np.ascontiguousarray(t0, dtype=float), np.ascontiguousarray(dt, dtype=float)
-        total, c, width = int(samples.sum()), len(self.channels), self.n + self.parameters
+        chosen = np.arange(self.parameters) if columns is None else np.asarray(columns, dtype=np.int64).reshape(-1)
+        if chosen.size and (chosen.min() < 0 or chosen.max() >= self.parameters):
+            raise GearsymError(f"parameter columns {chosen.tolist()} out of range (0 ... {self.parameters - 1})")
+        chosen = np.ascontiguousarray(chosen, dtype=np.int64)
+        total, c, width = int(samples.sum()), len(self.channels), self.n + chosen.size
         states = np.zeros((self.n, total), order="F")
         outputs = np.zeros((c, total), order="F")
         derivatives = np.zeros((c, width, total), order="F") if tangent else None
         if self._library is not None:
-            status = self._library(count, samples.ctypes.data, substeps.ctypes.data, t0.ctypes.data,
-                                   dt.ctypes.data, starts.ctypes.data, parameters.ctypes.data, int(tangent),
-                                   states.ctypes.data, outputs.ctypes.data,
-                                   derivatives.ctypes.data if tangent else None)
-            if status:
+            arrays = (samples, substeps, t0, dt, starts, parameters, chosen, states, outputs, derivatives)
+            pieces = _pieces(samples, substeps)
+            if len(pieces) == 1:
+                status = [self._call(*arrays, *pieces[0], tangent)]
+            else:  # (the call releases the GIL and writes disjoint columns: the same bits as one call)
+                with ThreadPoolExecutor(max_workers=len(pieces), thread_name_prefix="gearsym-windows") as pool:
+                    status = list(pool.map(lambda piece: self._call(*arrays, *piece, tangent), pieces))
+            if any(status):
                 raise GearsymError("the compiled window integrator reported an error")
         else:
-            self._run_in_process(starts, t0, dt, samples, substeps, parameters, tangent, states, outputs,
-                                 derivatives)
+            full = np.zeros((c, self.n + self.parameters, total), order="F") if tangent else None
+            self._run_in_process(starts, t0, dt, samples, substeps, parameters, tangent, states, outputs, full)
+            if tangent:
+                derivatives[...] = full[:, np.concatenate([np.arange(self.n), self.n + chosen]), :]
         return WindowRun(states, outputs, derivatives)
+
+    def _call(self, samples, substeps, t0, dt, starts, parameters, chosen, states, outputs, derivatives,
+              first: int, last: int, column: int, tangent: bool) -> int:
+        """The compiled integrator on windows ``first`` ... ``last - 1``, whose samples start at ``column``."""
+        f8, i8 = 8, 8  # (float64 and int64 arrays, Fortran order: window k's column is k times its height)
+        width = derivatives.shape[1] if tangent else 0
+        return self._library(last - first, samples.ctypes.data + i8 * first, substeps.ctypes.data + i8 * first,
+                             t0.ctypes.data + f8 * first, dt.ctypes.data + f8 * first,
+                             starts.ctypes.data + f8 * self.n * first,
+                             parameters.ctypes.data + f8 * self.parameters * first, int(tangent), chosen.size,
+                             chosen.ctypes.data, states.ctypes.data + f8 * self.n * column,
+                             outputs.ctypes.data + f8 * len(self.channels) * column,
+                             derivatives.ctypes.data + f8 * len(self.channels) * width * column if tangent else None)
 
     def _run_in_process(self, starts, t0, dt, samples, substeps, parameters, tangent, states, outputs, derivatives):
         """The same steps in CasADi's virtual machine, each group of windows with equal substeps mapped."""
@@ -209,6 +293,19 @@ class Windows:
                     derivatives[:, :, cols] = dout.reshape(len(self.channels), width, K, order="F")[:, :, live]
 
 
+def _pieces(samples: np.ndarray, substeps: np.ndarray) -> list[tuple[int, int, int]]:
+    """The windows split into contiguous pieces of about equal work, one per core (first, last, first column),
+    or one piece when there is too little work to share (a thread costs more than a few thousand steps)."""
+    work = np.cumsum(np.maximum(samples - 1, 0) * substeps)
+    cores = min(os.cpu_count() or 1, len(samples))
+    if cores < 2 or work[-1] < MIN_SHARED_STEPS:
+        return [(0, len(samples), 0)]
+    cuts = [0, *(int(np.searchsorted(work, work[-1] * i / cores)) + 1 for i in range(1, cores)), len(samples)]
+    cuts = sorted(set(min(c, len(samples)) for c in cuts))
+    columns = np.concatenate([[0], np.cumsum(samples)])
+    return [(a, b, int(columns[a])) for a, b in zip(cuts, cuts[1:]) if b > a]
+
+
 def windows_hash(system: FirstOrderSystem, channels: Sequence[sp.Expr]) -> str:
     """What determines the window code: the equations, names, channels, this module and the versions."""
     description = {
@@ -226,6 +323,9 @@ def windows_hash(system: FirstOrderSystem, channels: Sequence[sp.Expr]) -> str:
     return hashlib.sha256(json.dumps(description, sort_keys=True).encode()).hexdigest()
 
 
+#: the whole tangent step and output of the in-process backend (the compiled driver goes column by column)
+_IN_PROCESS_ONLY = ("fit_step", "fit_output")
+
 _LOADED: dict[tuple, Windows] = {}
 
 
@@ -240,51 +340,76 @@ def compile_windows(system: FirstOrderSystem, channels: Sequence[sp.Expr], backe
 
 #: the loop over windows, samples and RK4 steps around the generated functions (no per-step Python)
 _DRIVER = r"""
-/* gearsym: the fit's window loop (gearsym/codegen/windows.py) */
+/* gearsym: the fit's window loop (gearsym/codegen/windows.py): the state's RK4 stages once per step, then each
+   asked-for column of the tangent [dy/dy0 | dy/dp] in turn */
 #include <stdlib.h>
 #include <string.h>
 #define GS_N {n}
 #define GS_P {p}
 #define GS_C {c}
-#define GS_W (GS_N + GS_P)
+
+typedef int (*gs_fn)(const casadi_real**, casadi_real**, casadi_int*, casadi_real*, int);
+typedef int (*gs_work_fn)(casadi_int*, casadi_int*, casadi_int*, casadi_int*);
+static const gs_fn gs_param[{p1}] = {{{table}}};
+static const gs_work_fn gs_param_work[{p1}] = {{{works}}};
 
 static casadi_int gs_max(casadi_int a, casadi_int b) {{ return a > b ? a : b; }}
 
+static void gs_grow(gs_work_fn f, casadi_int* sz) {{
+  casadi_int a, r, i, w;
+  if (!f) return;
+  f(&a, &r, &i, &w);
+  sz[0] = gs_max(sz[0], a); sz[1] = gs_max(sz[1], r); sz[2] = gs_max(sz[2], i); sz[3] = gs_max(sz[3], w);
+}}
+
 CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int* samples,
     const casadi_int* substeps, const casadi_real* t0, const casadi_real* dt, const casadi_real* start,
-    const casadi_real* p, casadi_int tangent, casadi_real* states, casadi_real* outputs,
-    casadi_real* derivatives) {{
-  casadi_int sz_arg = 0, sz_res = 0, sz_iw = 0, sz_w = 0, a, r, i, w, k, s, j, col = 0;
-  casadi_real y[GS_N], y1[GS_N], Q[GS_N * GS_W], Q1[GS_N * GS_W], t, h;
+    const casadi_real* p, casadi_int tangent, casadi_int ncols, const casadi_int* cols, casadi_real* states,
+    casadi_real* outputs, casadi_real* derivatives) {{
+  casadi_int sz[4] = {{0, 0, 0, 0}}, i, k, s, j, l, col = 0, width = GS_N + ncols;
+  casadi_real y[GS_N], y1[GS_N], Y[4 * GS_N], J[4 * GS_N * GS_N], q1[GS_N], t, h;
+  casadi_real out[GS_C > 0 ? GS_C : 1], Hy[GS_C * GS_N > 0 ? GS_C * GS_N : 1], Hp[GS_C * GS_P > 0 ? GS_C * GS_P : 1];
+  casadi_real* Q = 0;
   const casadi_real** arg;
   casadi_real** res;
   casadi_int* iw;
   casadi_real* work;
-  fit_step_work(&a, &r, &i, &w);
-  sz_arg = gs_max(sz_arg, a); sz_res = gs_max(sz_res, r); sz_iw = gs_max(sz_iw, i); sz_w = gs_max(sz_w, w);
-  fit_state_step_work(&a, &r, &i, &w);
-  sz_arg = gs_max(sz_arg, a); sz_res = gs_max(sz_res, r); sz_iw = gs_max(sz_iw, i); sz_w = gs_max(sz_w, w);
-  fit_output_work(&a, &r, &i, &w);
-  sz_arg = gs_max(sz_arg, a); sz_res = gs_max(sz_res, r); sz_iw = gs_max(sz_iw, i); sz_w = gs_max(sz_w, w);
-  arg = (const casadi_real**)malloc(sizeof(casadi_real*) * (size_t)gs_max(sz_arg, 1));
-  res = (casadi_real**)malloc(sizeof(casadi_real*) * (size_t)gs_max(sz_res, 1));
-  iw = (casadi_int*)malloc(sizeof(casadi_int) * (size_t)gs_max(sz_iw, 1));
-  work = (casadi_real*)malloc(sizeof(casadi_real) * (size_t)gs_max(sz_w, 1));
-  if (!arg || !res || !iw || !work) {{ free(arg); free(res); free(iw); free(work); return 1; }}
+  gs_grow(fit_state_step_work, sz); gs_grow(fit_stages_work, sz); gs_grow(fit_column_work, sz);
+  gs_grow(fit_channels_work, sz);
+  for (j = 0; j < ncols; ++j) {{
+    if (cols[j] < 0 || cols[j] >= GS_P) return 1;
+    gs_grow(gs_param_work[cols[j]], sz);
+  }}
+  arg = (const casadi_real**)malloc(sizeof(casadi_real*) * (size_t)gs_max(sz[0], 1));
+  res = (casadi_real**)malloc(sizeof(casadi_real*) * (size_t)gs_max(sz[1], 1));
+  iw = (casadi_int*)malloc(sizeof(casadi_int) * (size_t)gs_max(sz[2], 1));
+  work = (casadi_real*)malloc(sizeof(casadi_real) * (size_t)gs_max(sz[3], 1));
+  Q = (casadi_real*)malloc(sizeof(casadi_real) * (size_t)(GS_N * width));
+  if (!arg || !res || !iw || !work || !Q) goto fail;
   for (k = 0; k < count; ++k) {{
     const casadi_real* pk = p + k * GS_P;
     memcpy(y, start + k * GS_N, sizeof(y));
-    memset(Q, 0, sizeof(Q));
+    memset(Q, 0, sizeof(casadi_real) * (size_t)(GS_N * width));
     for (j = 0; j < GS_N; ++j) Q[j * GS_N + j] = 1;
     h = dt[k] / (casadi_real)substeps[k];
     for (s = 0; s < samples[k]; ++s, ++col) {{
       if (s > 0) {{
-        for (j = 0; j < substeps[k]; ++j) {{
-          t = t0[k] + dt[k] * (casadi_real)(s - 1) + h * (casadi_real)j;
+        for (l = 0; l < substeps[k]; ++l) {{
+          t = t0[k] + dt[k] * (casadi_real)(s - 1) + h * (casadi_real)l;
           if (tangent) {{
-            arg[0] = y; arg[1] = Q; arg[2] = &t; arg[3] = &h; arg[4] = pk; res[0] = y1; res[1] = Q1;
-            if (fit_step(arg, res, iw, work, 0)) goto fail;
-            memcpy(Q, Q1, sizeof(Q));
+            arg[0] = y; arg[1] = &t; arg[2] = &h; arg[3] = pk; res[0] = y1; res[1] = Y; res[2] = J;
+            if (fit_stages(arg, res, iw, work, 0)) goto fail;
+            for (j = 0; j < width; ++j) {{
+              casadi_real* qj = Q + j * GS_N;
+              if (j < GS_N) {{
+                arg[0] = qj; arg[1] = J; arg[2] = &h; res[0] = q1;
+                if (fit_column(arg, res, iw, work, 0)) goto fail;
+              }} else {{
+                arg[0] = qj; arg[1] = J; arg[2] = Y; arg[3] = &t; arg[4] = &h; arg[5] = pk; res[0] = q1;
+                if (gs_param[cols[j - GS_N]](arg, res, iw, work, 0)) goto fail;
+              }}
+              memcpy(qj, q1, sizeof(q1));
+            }}
           }} else {{
             arg[0] = y; arg[1] = &t; arg[2] = &h; arg[3] = pk; res[0] = y1;
             if (fit_state_step(arg, res, iw, work, 0)) goto fail;
@@ -294,15 +419,26 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
       }}
       t = t0[k] + dt[k] * (casadi_real)s;
       memcpy(states + col * GS_N, y, sizeof(y));
-      arg[0] = y; arg[1] = Q; arg[2] = &t; arg[3] = pk;
-      res[0] = outputs + col * GS_C; res[1] = tangent ? derivatives + col * GS_C * GS_W : 0;
-      if (fit_output(arg, res, iw, work, 0)) goto fail;
+      arg[0] = y; arg[1] = &t; arg[2] = pk; res[0] = out; res[1] = Hy; res[2] = Hp;
+      if (fit_channels(arg, res, iw, work, 0)) goto fail;
+      for (i = 0; i < GS_C; ++i) outputs[col * GS_C + i] = out[i];
+      if (tangent) {{
+        casadi_real* d = derivatives + col * GS_C * width;
+        for (j = 0; j < width; ++j) {{
+          for (i = 0; i < GS_C; ++i) {{
+            casadi_real sum = j < GS_N ? 0 : Hp[cols[j - GS_N] * GS_C + i];
+            casadi_int r;
+            for (r = 0; r < GS_N; ++r) sum += Hy[r * GS_C + i] * Q[j * GS_N + r];
+            d[j * GS_C + i] = sum;
+          }}
+        }}
+      }}
     }}
   }}
-  free(arg); free(res); free(iw); free(work);
+  free(arg); free(res); free(iw); free(work); free(Q);
   return 0;
 fail:
-  free(arg); free(res); free(iw); free(work);
+  free(arg); free(res); free(iw); free(work); free(Q);
   return 1;
 }}
 """

@@ -37,7 +37,7 @@ def checked_record(path: Path, rows: Rows, layout: Layout, system: FirstOrderSys
     lines, where = rows.lines, f"record {rows.record}"
     conditions = {name: _condition(path, rows, name, system) for name in layout.conditions}
     try:
-        period = system.period_at({**defaults, **conditions})
+        period = system.cycle_at({**defaults, **conditions})  # (a forcing period, if the system's spans several)
     except GearsymError as exc:
         raise DataError(f"{where}: at its conditions: {exc}", path, int(lines[0])) from None
     step = _check_time(path, rows.values[layout.time], lines, layout.time, where, rules)

@@ -115,7 +115,7 @@ def simulate_measurements(
     seed = whole_number(seed, "seed")
     if not (np.isfinite(noise) and noise >= 0):
         raise GearsymError(f"noise must be a relative size of 0 or more (0.01 = 1 % of the signal), got {noise!r}")
-    steps_for(m, model.steps_per_period)
+    steps_for(m, model.steps_per_cycle)
     runs = [dict(r) for r in records] if records else [{}]
     columns = 2 + len(model.parameter_names) + 2 * len(model.state_names)  # at most: tau, record, conditions, states
     check_fits(options.measured, 8 * (model.steps_per_period * (model.dimension + 1) + len(runs) * m * columns),
@@ -134,7 +134,7 @@ def simulate_measurements(
         model.name, columns,
         {c: np.concatenate([p.data[c] for p in pieces]) for c in columns},
         {s: np.concatenate([p.clean[s] for p in pieces]) for s in states},
-        tuple(p.noise_std for p in pieces), tuple(p.parameters for p in pieces), m, model.steps_per_period)
+        tuple(p.noise_std for p in pieces), tuple(p.parameters for p in pieces), m, model.steps_per_cycle)
     if out is not None:
         write_measurements(table, out)
     return table
@@ -169,7 +169,7 @@ class _Piece:
 def _simulate_record(compiled: CompiledModel, options: Integration, record: int, parameters: dict, condition_names,
                      states, samples: int, y0, noise: float, rng: np.random.Generator) -> _Piece:
     trajectory = phase_trajectory(compiled, options=options, y0=y0, **parameters)
-    stride = compiled.steps_per_period // samples
+    stride = compiled.steps_per_cycle // samples  # (samples per forcing period; a period may hold several)
     sampled = trajectory.states[:, ::stride]
     period = compiled.prepare(compiled.parameter_vector(parameters)).period
     tau = (period / compiled.steps_per_period) * stride * np.arange(sampled.shape[1])

@@ -44,7 +44,7 @@ import hashlib
 import math
 import re
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 import sympy as sp
 
@@ -52,94 +52,11 @@ from ..backlash import g
 from ..errors import GearsymError, ModelError, suggest
 from ..model.expressions import to_expr
 from ..symbols import parameter_symbol
-from ..system import Coupling, FirstOrderSystem
+from ..system import FirstOrderSystem
+from .effect_types import Change, Effect, Site, site
+from .shaft_effects import KINDS as SHAFT_KINDS, shaft_effect, with_revolution
 
 INF = math.inf
-
-
-@dataclass(frozen=True)
-class Site:
-    """Where an effect acts: a coupling (its coordinate x, rate v and the rows its law enters with their
-    factors), or the driving torque (the rows where the mean torque enters, with df/dB0)."""
-
-    system: FirstOrderSystem
-    kind: str  # "mesh" | "shaft" | "torque"
-    coupling: Coupling | None
-    rows: tuple[tuple[int, sp.Expr], ...]
-    omega: sp.Expr
-
-    @property
-    def time(self) -> sp.Symbol:
-        return self.system.time
-
-    @property
-    def x(self) -> sp.Symbol:
-        return self.system.states[self.system.state_names.index(self.coupling.coordinate)]
-
-    @property
-    def v(self) -> sp.Symbol:
-        return self.system.states[self.system.state_names.index(self.coupling.velocity)]
-
-    @property
-    def own_row(self) -> int:
-        return self.system.state_names.index(self.coupling.velocity)
-
-    @property
-    def backlash(self) -> sp.Expr:
-        """g(contact, eta) of a mesh (the contact itself for a mesh without backlash)."""
-        return g(self.coupling.contact, self.coupling.backlash)
-
-    @property
-    def stiffness(self) -> sp.Expr:
-        return self.coupling.stiffness
-
-    @property
-    def phase(self) -> sp.Expr:
-        """The mesh phase phi: the mesh order (mesh over forcing frequency) times tau."""
-        return (self.coupling.order or sp.S.One) * self.time
-
-    @staticmethod
-    def parameter(name: str) -> sp.Symbol:
-        return parameter_symbol(name)
-
-
-@dataclass(frozen=True)
-class Change:
-    """What an effect does at its site: a term added to the coupling's law (-factor * law in each of its
-    rows), a new contact (the argument of g), a term added to the driving torque (df/dB0 * torque in each
-    row), or a term added to dv/dtau of the coupling's own velocity only."""
-
-    law: sp.Expr = sp.S.Zero
-    contact: sp.Expr | None = None
-    torque: sp.Expr = sp.S.Zero
-    own: sp.Expr = sp.S.Zero
-
-
-@dataclass(frozen=True)
-class Effect:
-    """One candidate effect: its parameters (0 = off; ``fixed`` ones it needs but does not fit), where it acts,
-    its change there, the physical bounds of its parameters (name -> (low, high, why)) and its (cos, sin)
-    pairs, reported as amplitude and phase."""
-
-    name: str
-    description: str
-    fitted: tuple[str, ...]
-    fixed: Mapping[str, float]
-    build: Callable[[Site], Change]
-    acts_on: str = "mesh"
-    bounds: Mapping[str, tuple[float, float, str]] = field(default_factory=dict)
-    pairs: tuple[tuple[str, str], ...] = ()
-    order: int = 0  # a harmonic's order (0: none)
-    term: sp.Expr | None = None  # a term added by hand or proposed: the expression its coefficient multiplies
-
-    @property
-    def parameters(self) -> dict[str, float]:
-        return {**{p: 0.0 for p in self.fitted}, **self.fixed}
-
-    @property
-    def family(self) -> str:
-        """The name without its order (mesh_stiffness_harmonic for mesh_stiffness_harmonic_3)."""
-        return self.name[: -len(f"_{self.order}")] if self.order else self.name
 
 
 def _p(name: str) -> sp.Symbol:
@@ -233,12 +150,16 @@ FAMILIES: dict[str, Callable[[int], Effect]] = {
 _ORDERED = re.compile(r"^(?P<family>[a-z_]+?)_(?P<order>[0-9]+)$")
 
 
-def effect(name: str | Effect) -> Effect:
-    """The effect called ``name``: one of :data:`EFFECTS`, or a family of :data:`FAMILIES` with its order."""
+def effect(name: str | Effect, system: FirstOrderSystem | None = None) -> Effect:
+    """The effect called ``name``: one of :data:`EFFECTS`, a family of :data:`FAMILIES` with its order, or a
+    shaft-order effect on a gear of ``system`` (``tooth_fault_gear2``, :mod:`.shaft_effects`)."""
     if isinstance(name, Effect):
         return name
     if name in EFFECTS:
         return EFFECTS[name]
+    shaft = shaft_effect(name, system)
+    if shaft is not None:
+        return shaft
     match = _ORDERED.match(str(name))
     if match and match["family"] in FAMILIES:
         order = int(match["order"])
@@ -247,51 +168,13 @@ def effect(name: str | Effect) -> Effect:
         return FAMILIES[match["family"]](order)
     if name in FAMILIES:
         raise GearsymError(f"{name} needs its order: {name}_2 is the second harmonic (any order 1, 2, ...)")
-    known = [*EFFECTS, *(f"{f}_N" for f in FAMILIES)]
+    known = library_names()
     raise GearsymError(f"unknown effect {name!r}.{suggest(str(name), known)} Effects: {', '.join(known)}")
 
 
 def library_names() -> list[str]:
-    """Every effect's name as the user writes it (families with _N)."""
-    return [*EFFECTS, *(f"{f}_N" for f in FAMILIES)]
-
-
-def site(system: FirstOrderSystem, acts_on: str, coordinate: str | None = None) -> Site:
-    """Where an effect acting on ``acts_on`` goes in ``system``: a mesh (``coordinate``, default the first with
-    backlash), a shaft, or the driving torque."""
-    omega = parameter_symbol("omega")
-    if acts_on == "torque":
-        _tau_form(system)
-        return _torque_site(system, omega)
-    # a mesh that closes a kinematic loop has no coordinate (no row) of its own to add an effect to
-    couplings = [c for c in system.couplings if c.kind == acts_on and not c.closes_loop]
-    if acts_on == "mesh":  # the backlash meshes first
-        couplings.sort(key=lambda c: c.backlash == 0)
-    chosen = [c for c in couplings if coordinate in (None, c.coordinate)]
-    if not chosen:
-        where = f"coordinate {coordinate!r}" if coordinate else "any coordinate"
-        known = f" ({acts_on}es act on {', '.join(c.coordinate for c in couplings)})" if couplings else ""
-        force = "mesh force g(x, eta)" if acts_on == "mesh" else f"{acts_on} force"
-        raise ModelError(f"no {force} acting on {where}{known}; these effects act on the {acts_on} of a reduced "
-                         "drivetrain", system.name)
-    _tau_form(system)
-    c = chosen[0]
-    rows = c.rows or ((system.state_names.index(c.velocity), sp.S.One),)
-    return Site(system, acts_on, c, tuple(rows), omega)
-
-
-def _tau_form(system: FirstOrderSystem) -> None:
-    if "omega" not in system.parameters:
-        raise ModelError("the effects library needs the paper's tau-form (a parameter omega)", system.name)
-
-
-def _torque_site(system: FirstOrderSystem, omega: sp.Expr) -> Site:
-    if "B0" not in system.parameters:
-        raise ModelError("a torque harmonic enters where the mean torque B0 does; the model has no B0", system.name)
-    B0 = parameter_symbol("B0")
-    rows = tuple((i, sp.diff(f, B0)) for i, f in enumerate(system.rhs) if f.has(B0))
-    mesh = next((c for c in system.couplings if c.kind == "mesh"), None)
-    return Site(system, "torque", mesh, rows, omega)
+    """Every effect's name as the user writes it (families with _N, shaft-order effects with _GEAR)."""
+    return [*EFFECTS, *(f"{f}_N" for f in FAMILIES), *(f"{k}_GEAR" for k in SHAFT_KINDS)]
 
 
 def applies_to(system: FirstOrderSystem, e: Effect, coordinate: str | None = None) -> bool:
@@ -307,7 +190,7 @@ def augment(system: FirstOrderSystem, effects: Sequence[str | Effect], coordinat
             values: Mapping[str, float] | None = None, name: str | None = None) -> FirstOrderSystem:
     """``system`` with the effects' terms added; their parameters start at 0 (off) or ``values``.
     ``name``: the new system's (default ``<model>_with_<effect>_and_<effect>``)."""
-    chosen = [effect(e) for e in effects]
+    chosen = [effect(e, system) for e in effects]
     if not chosen:
         if values:
             raise GearsymError("values given for effects, but no effect named")
@@ -327,6 +210,10 @@ def augment(system: FirstOrderSystem, effects: Sequence[str | Effect], coordinat
                                f"{', '.join(e.name for e in chosen)}")
         parameters[key] = float(value)
     descriptions = {**system.descriptions, **{p: f"{e.name}: {e.description}" for e in chosen for p in e.parameters}}
+    for e in chosen:
+        if e.shaft_order:  # the system now repeats on the gear's revolution (or the hunting period)
+            period, cycles = with_revolution(out, e)
+            out = replace(out, period=period, cycles=cycles)
     return replace(out, name=name or _name(system.name, [e.name for e in chosen]), parameters=parameters,
                    descriptions=descriptions, title=f"{system.title or system.name}, with "
                                                     f"{', '.join(e.name for e in chosen)}")
@@ -341,7 +228,7 @@ def _name(base: str, effects: list[str]) -> str:
 
 
 def _apply(system: FirstOrderSystem, e: Effect, coordinate: str | None) -> FirstOrderSystem:
-    s = site(system, e.acts_on, coordinate)
+    s = site(system, e.acts_on, e.coordinate or coordinate)
     change = e.build(s)
     rhs, couplings = list(system.rhs), list(system.couplings)
     if change.contact is not None:
@@ -367,16 +254,17 @@ def effect_terms(system: FirstOrderSystem, effects: Sequence[str | Effect], coor
                  ) -> dict[str, dict[str, sp.Expr]]:
     """What each effect adds to each equation of ``system``: effect name -> {state: term of d state/dtau}."""
     out = {}
-    for e in map(effect, effects):
+    for e in (effect(name, system) for name in effects):
         augmented = _apply(system, e, coordinate)
         out[e.name] = {s.name: new - old for s, new, old in zip(system.states, augmented.rhs, system.rhs)
                        if new != old}
     return out
 
 
-def bounds_of(effects: Sequence[str | Effect]) -> dict[str, tuple[float, float, str]]:
+def bounds_of(effects: Sequence[str | Effect], system: FirstOrderSystem | None = None
+              ) -> dict[str, tuple[float, float, str]]:
     """The physical bounds of the effects' parameters, by parameter name."""
-    return {k: v for e in map(effect, effects) for k, v in e.bounds.items()}
+    return {k: v for e in (effect(name, system) for name in effects) for k, v in e.bounds.items()}
 
 
 def term_effect(formula: str, system: FirstOrderSystem, index: int = 1, coordinate: str | None = None) -> Effect:

@@ -100,7 +100,8 @@ class Problem:
         return P
 
     def run(self, theta: np.ndarray, S: np.ndarray, tangent: bool):
-        return self.engine.run(S, self.t0, self.dt, self.samples, self.substeps, self.parameters(theta), tangent)
+        return self.engine.run(S, self.t0, self.dt, self.samples, self.substeps, self.parameters(theta), tangent,
+                               columns=self.index)
 
     def __call__(self, u: np.ndarray, jacobian: bool = True):
         theta, b, S = self.split(u)
@@ -109,8 +110,8 @@ class Problem:
         r = (run.outputs[self.rows] + offset) * self.weight - self.data
         if not jacobian:
             return r, None
-        D = run.derivatives[self.rows[0], :, self.rows[1]] * self.weight[:, None]  # (residuals, n + parameters)
+        D = run.derivatives[self.rows[0], :, self.rows[1]] * self.weight[:, None]  # (residuals, n + fitted)
         offsets = np.stack([np.where(self.bias_of == j, self.weight, 0.0) for j in range(len(self.bias))], axis=1) \
             if self.bias else np.zeros((r.size, 0))
-        return r, Jacobian(np.hstack([D[:, self.n + self.index], offsets]), D[:, :self.n], self.window,
+        return r, Jacobian(np.hstack([D[:, self.n:], offsets]), D[:, :self.n], self.window,
                            self.row_offsets)

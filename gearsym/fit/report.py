@@ -68,6 +68,7 @@ def report_page(ex: Explanation, system: FirstOrderSystem, derived: FirstOrderSy
     else:
         lines += [f"- No effect added: no candidate lowered the held-out error ({before.error:.4g}) by the required "
                   "margin."]
+    lines += fault_lines(data["faults"])
     for name, h in data["harmonics"].items():
         lines += [f"- {name}: order {h['order']}, amplitude {_pm(h['amplitude'], h['amplitude_stderr'])}, phase "
                   f"{_pm(h['phase'], h['phase_stderr'])} rad (the term {h['form'].replace('A', 'amplitude')})."]
@@ -94,7 +95,7 @@ def report_page(ex: Explanation, system: FirstOrderSystem, derived: FirstOrderSy
               + f"), by multiple shooting over one-forcing-period windows of the channels {channels}; the last "
               f"{ex.held_out:.0%} of each record is held out and judged by the one-period-ahead prediction error "
               "(normalised RMS).", ""]
-    lines += _candidates(ex) + _spectrum(ex) + _proposals(ex) + _estimates(ex, data)
+    lines += _candidates(ex) + _spectrum(ex) + _sidebands(data) + _proposals(ex) + _estimates(ex, data)
     lines += ["## The derived model", ""]
     if ex.effects:
         for name, rows in effect_terms(system, [ex.library[e] for e in ex.effects]).items():
@@ -111,6 +112,55 @@ def report_page(ex: Explanation, system: FirstOrderSystem, derived: FirstOrderSy
               "rate, as declared (grey) and after (black); and its spectrum in harmonics of the forcing, with the "
               "level white noise would reach.*", ""]
     return "\n".join(lines)
+
+
+def fault_lines(faults: list[dict]) -> list[str]:
+    """The verdict's lines of the shaft-order effects found: which gear, which tooth, how much."""
+    out = []
+    for f in faults:
+        if f["kind"] == "tooth fault":
+            change = _pm_percent(f["stiffness_change_percent"], f["stiffness_change_stderr_percent"])
+            if f["tooth"] is not None:
+                where = f"tooth {f['tooth']} of {f['gear']}"
+            else:
+                where = f"{f['gear']}, " + ", ".join(f"tooth {n} in {r}" for r, n in f["tooth_by_record"].items())
+            out.append(f"- **{where}: stiffness {change}** (`{f['effect']}`: the pair of that tooth, counted from "
+                       f"the record's start, loses this fraction of its stiffness while in mesh; {f['teeth']} teeth).")
+        elif f["kind"] == "eccentricity":
+            out.append(f"- **eccentricity of {f['gear']}**: amplitude {_pm(f['amplitude'], f['amplitude_stderr'])}, "
+                       f"phase {_pm(f['phase'], f['phase_stderr'])} rad (`{f['effect']}`: the transmission error "
+                       f"{f['form'].replace('A', 'amplitude')}, in the length unit of the mesh coordinate).")
+        else:
+            shown = ", ".join(f"{e:.3g}" for e in f["errors"])
+            out.append(f"- **spacing errors of {f['gear']}** (`{f['effect']}`, tooth 1 ... {f['teeth']} from "
+                       f"tau = 0): {shown}.")
+    return out
+
+
+def _pm_percent(value: float, err: float | None) -> str:
+    sign = "−" if value < 0 else "+"
+    shown = f"{sign}{abs(value):.3g} %"
+    return f"{shown} ± {err:.2g} %" if err is not None and math.isfinite(err) else shown
+
+
+def _sidebands(data: dict) -> list[str]:
+    evidence = data.get("sidebands")
+    notes = [f"- not tried: {name}: {why}." for name, why in (data.get("not_tried") or {}).items()]
+    if not evidence or not evidence.get("before"):
+        return (["## Shaft orders", ""] + notes + [""]) if notes else []
+    before, after = evidence["before"], evidence.get("after") or {}
+    gears = list(before["gears"])
+    lines = ["## The residual's sidebands (shaft orders)", "",
+             "Lines of the training residual at each gear's shaft orders and at the mesh harmonics ± them "
+             f"(relative to each channel's spread, averaged over records; one line of white noise reaches about "
+             f"{before['noise']:.2g}). Gears: " + ", ".join(f"{g} ({z} teeth)" for g, z in before["gears"].items())
+             + ".", "", "| gear | sideband energy as declared | after | strongest lines as declared |", "|---|---|---|---|"]
+    for g in gears:
+        top = sorted(((k, v) for k, v in before["lines"].items() if g in k.split()), key=lambda kv: -kv[1])[:3]
+        shown = ", ".join(f"{k} {v:.2g}" for k, v in top)
+        lines.append(f"| {g} | {before['energy'][g]:.3g} | {after.get('energy', {}).get(g, float('nan')):.3g} | "
+                     f"{shown} |")
+    return lines + [""] + notes + ([""] if notes else [])
 
 
 def _candidates(ex: Explanation) -> list[str]:

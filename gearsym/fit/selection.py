@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from pathlib import Path
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -43,12 +44,16 @@ from ..options import Integration
 from ..system import FirstOrderSystem
 from .canonical import amplitude_phase, canonical
 from .effects import EFFECTS, FAMILIES, Effect, applies_to, augment, bounds_of, effect, site, term_effect
+from .evidence import residual_sidebands
 from .prediction import Prediction, predict_ahead
 from .proposals import propose_terms
 from .result import Fit
 from .score import score_columns
 from .segment import Segment
+from .shaft_effects import BUILDERS as SHAFT_BUILDERS, DEFAULT_KINDS as SHAFT_DEFAULTS, revolution_length, \
+    shaft_effects
 from .shooting import fit_windows
+from .tooth_scan import from_record_start, Placement, scan_teeth
 
 MIN_GAIN = 0.2
 MAX_CORRELATION = 0.5
@@ -81,6 +86,7 @@ class Candidate:
     fit: Fit
     prediction: Prediction
     rejected: str = ""
+    placements: dict = field(default_factory=dict)  # a tooth fault's effect -> record key -> its tooth (from tau 0)
 
     @property
     def error(self) -> float:
@@ -147,6 +153,42 @@ class Explanation:
                              else f"A cos({e.order} tau + phase)"}
         return out
 
+    def shaft_orders(self, c: Candidate | None = None) -> list[dict]:
+        """What a candidate's shaft-order effects say, gear by gear: a tooth fault's tooth (counted from each record's
+        start) and severity, an eccentricity's amplitude and phase, spacing errors."""
+        c = c or self.final
+        fit, out = c.fit, []
+        starts = self.info.get("records", {})
+        for name in c.effects:
+            e = self.library[name]
+            if not e.shaft_order:
+                continue
+            item = {"effect": name, "gear": e.gear, "teeth": e.teeth}
+            if e.scan:
+                q = fit.estimates[e.fitted[0]]
+                sq = fit.stderr.get(e.fitted[0])
+                order = _order_of(self.system, e)
+                by_record = {_record_label(key): from_record_start(int(n), e.teeth, starts.get(key, 0.0), order)
+                             for key, n in c.placements.get(name, {}).items()}
+                common = set(by_record.values())
+                item.update(kind="tooth fault", tooth=common.pop() if len(common) == 1 else None,
+                            tooth_by_record=by_record, severity=q, severity_stderr=sq,
+                            stiffness_change_percent=-100 * q, stiffness_change_stderr_percent=None if sq is None
+                            else 100 * sq)
+            elif e.pairs:
+                a, b = e.pairs[0]
+                cov = fit.covariance
+                C = np.array([[cov[a][a], cov[a][b]], [cov[b][a], cov[b][b]]]) if a in cov and b in cov else None
+                A, theta, sA, st = amplitude_phase(fit.estimates[a], fit.estimates[b], C)
+                item.update(kind="eccentricity", amplitude=A, phase=theta, amplitude_stderr=sA, phase_stderr=st,
+                            form=f"A cos(phi/{e.teeth} + phase)")
+            else:
+                values = [fit.estimates[p] for p in e.fitted]
+                item.update(kind="spacing errors", errors=[*values, -sum(values)],
+                            stderr=[fit.stderr.get(p) for p in e.fitted] + [None])
+            out.append(item)
+        return out
+
     def as_dict(self) -> dict:
         def fit_dict(c: Candidate) -> dict:
             f = c.fit
@@ -180,6 +222,9 @@ class Explanation:
             "candidates": [fit_dict(c) for c in self.tried],
             "screened": self.info.get("screened", []),
             "displaced": self.info.get("displaced"),  # library effects that only stood in for a proposed term
+            "faults": self.shaft_orders(),  # shaft-order effects added: which gear, which tooth, how much
+            "sidebands": self.info.get("evidence"),  # the residual's shaft-order lines, before and after
+            "not_tried": self.info.get("too_short", {}),  # shaft-order effects the records are too short for
         }
 
 
@@ -199,15 +244,22 @@ def segments_of(system: FirstOrderSystem, measurements: Measurements) -> tuple[l
 
 def candidate_library(system: FirstOrderSystem, candidates: Sequence[str | Effect] | None = None,
                       harmonics: int = HARMONICS, terms: Sequence[str] = ()) -> dict[str, Effect]:
-    """The effects a search may try, by name: ``candidates`` (default every effect that applies to ``system``;
-    a family's bare name stands for its orders 1 ... ``harmonics``), then the hand-written ``terms``."""
+    """The effects a search may try, by name: ``candidates`` (default every effect that applies to ``system``,
+    with a tooth fault and an eccentricity on every gear with a tooth count; a family's bare name stands for its
+    orders 1 ... ``harmonics``, a shaft-order kind's (``tooth_fault``) for every gear's), then the hand-written
+    ``terms``."""
     out: dict[str, Effect] = {}
-    names = candidates if candidates is not None else [*EFFECTS, *FAMILIES]
+    names = candidates if candidates is not None else [*EFFECTS, *FAMILIES, *SHAFT_DEFAULTS]
     for name in names:
         if isinstance(name, str) and name in FAMILIES:
             chosen = [FAMILIES[name](n) for n in range(1, harmonics + 1)]
+        elif isinstance(name, str) and name in SHAFT_BUILDERS:
+            chosen = list(shaft_effects(system, (name,)).values())
+            if not chosen and candidates is not None:
+                raise GearsymError(f"{name}: no gear of {system.name} has a tooth count; give a model that declares "
+                                   "Gear(..., teeth=Z), or --teeth Z1,Z2 (teeth=(Z1, Z2) in Python)")
         else:
-            chosen = [effect(name)]
+            chosen = [effect(name, system)]
         for e in chosen:
             if applies_to(system, e):
                 out[e.name] = e
@@ -244,27 +296,33 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
         if name not in measurements.observed:
             raise GearsymError(f"bias of {name}: no such channel in the data ({', '.join(measurements.observed)})")
     library = candidate_library(system, candidates, harmonics, terms)
+    too_short = _too_short(system, measurements, library, named={c for c in candidates or () if isinstance(c, str)})
+    library = {name: e for name, e in library.items() if name not in too_short}
     superset = augment(system, list(library.values()), name=f"{system.name}_candidates") if library else system
     train, test = measurements.split(held_out)
     seg_train, keys_train = segments_of(superset, train)
     seg_test, keys = segments_of(superset, test)
     bounds = bounds_of(list(library.values()))
     say = progress or (lambda message: None)
+    scanned: dict[str, Placement] = {}  # a tooth fault's latest scan
 
     def evaluate(effects: tuple[str, ...], start: Candidate | None) -> Candidate:
         names = list(fit) + [p for e in effects for p in library[e].fitted]
         guess = dict(start.fit.estimates) if start else {}
-        result = fit_windows(superset, seg_train, names, guess=guess, options=options, bias=bias, bounds=bounds,
+        placements = {e: (start.placements[e] if start and e in start.placements else scanned[e].teeth)
+                      for e in effects if library[e].scan}
+        train_here, test_here = (placed(segs, placements, library) for segs in (seg_train, seg_test))
+        result = fit_windows(superset, train_here, names, guess=guess, options=options, bias=bias, bounds=bounds,
                              starts=start.fit.starts if start else None,
                              guess_bias=start.fit.bias if start else None)
         result = replace(result, estimates=canonical(superset, result.estimates))
         anchors = {key[0]: (seg.tau[0], start) for key, seg, start in zip(keys_train, seg_train, result.starts.T)}
-        prediction = predict_ahead(superset, seg_test, keys, result.estimates, options=options, bias=result.bias,
+        prediction = predict_ahead(superset, test_here, keys, result.estimates, options=options, bias=result.bias,
                                    anchors=anchors)  # the last training window of each record
         rejected = _rejection(result, [library[e] for e in effects])
         say(f"{'+'.join(effects) or 'the model as declared'}: held-out error {prediction.error:.4g}"
             + (f" (rejected: {rejected})" if rejected else ""))
-        return Candidate(effects, result, prediction, rejected)
+        return Candidate(effects, result, prediction, rejected, placements)
 
     def spectrum_of(c: Candidate) -> Spectrum:
         return residual_spectrum(c.prediction, structured=_lag1(c.prediction) > max_correlation)
@@ -274,7 +332,12 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
     tried, current, current_spectrum, screened = [base], base, spectrum, []
     while len(current.effects) < max_effects:
         open_ = [name for name in library if name not in current.effects]
-        gains = linearised_gains(superset, seg_train, current.fit, library, open_, bias, options)
+        here = placed(seg_train, current.placements, library)
+        gains = linearised_gains(superset, here, current.fit, library, [n for n in open_ if not library[n].scan],
+                                 bias, options)
+        for name in (n for n in open_ if library[n].scan):  # a tooth fault: its tooth scanned in every record
+            scanned[name] = scan_teeth(superset, here, current.fit, library[name], bias, options)
+            gains[name] = (scanned[name].gain, scanned[name].why)
         names = _round(library, current, current_spectrum, superset, {k: g for k, (g, _) in gains.items()}, refits)
         screened.append({"after": list(current.effects), "gains": {k: g for k, (g, _) in gains.items()},
                          "why_not": {k: why for k, (_, why) in gains.items() if why}, "refitted": names})
@@ -290,11 +353,20 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
         current_spectrum = spectrum_of(current)
     correlation = _lag1(current.prediction)
     unexplained = bool(correlation > max_correlation)
-    ex = Explanation(base, current, tried, unexplained, correlation, tuple(fit), held_out, {"screened": screened},
+    evidence = None
+    if any(e.shaft_order for e in library.values()):
+        evidence = {"before": residual_sidebands(superset, base.fit, seg_train),
+                    "after": residual_sidebands(superset, current.fit, placed(seg_train, current.placements, library))}
+    info = {"screened": screened, "too_short": too_short, "evidence": evidence,
+            "records": _record_starts(keys_train, seg_train),
+            "scans": {name: {"gains": p.gains, "gain": p.gain} for name, p in scanned.items()}}
+    ex = Explanation(base, current, tried, unexplained, correlation, tuple(fit), held_out, info,
                      spectrum=spectrum, final_spectrum=current_spectrum, library=library, system=system,
                      bias=tuple(bias), bias_by_default=tuple(by_default))
     if unexplained and propose:
-        ex = replace(ex, proposed=propose_terms(ex, superset, seg_train, seg_test, keys, options, harmonics, say))
+        final_train, final_test = (placed(segs, current.placements, library) for segs in (seg_train, seg_test))
+        ex = replace(ex, proposed=propose_terms(ex, superset, final_train, final_test, keys, options, harmonics,
+                                                say))
         if ex.effects and ex.proposed:  # do the effects earn their place beside the term the residual asks for?
             alone = replace(ex, final=base)
             alone = replace(alone, proposed=propose_terms(alone, superset, seg_train, seg_test, keys, options,
@@ -306,6 +378,58 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
                 ex = replace(alone, correlation=_lag1(base.prediction), final_spectrum=spectrum,
                              info={**ex.info, "displaced": displaced})
     return ex
+
+
+def _record_starts(keys: Sequence[tuple], segments: Sequence[Segment]) -> dict:
+    """Each record's first sample time (its first window's)."""
+    out: dict = {}
+    for key, seg in zip(keys, segments):
+        out.setdefault(key[0], float(seg.tau[0]))
+    return out
+
+
+def _record_label(key) -> str:
+    """A record's key (its file and id) as the report names it."""
+    if isinstance(key, tuple) and len(key) == 2:
+        return f"{Path(str(key[0])).name} record {key[1]}"
+    return str(key)
+
+
+def _order_of(system: FirstOrderSystem | None, e: Effect) -> float:
+    c = next((c for c in (system.couplings if system else ()) if c.coordinate == e.coordinate), None)
+    return float(c.order or 1) if c is not None else 1.0
+
+
+def placed(segments: Sequence[Segment], placements: dict, library: dict[str, Effect]) -> list[Segment]:
+    """``segments`` with each tooth fault of ``placements`` on its record's tooth (its scanned parameter)."""
+    if not placements:
+        return list(segments)
+    out = []
+    for seg in segments:
+        values = {library[name].scan: float(teeth[seg.key[0]]) for name, teeth in placements.items()
+                  if seg.key and seg.key[0] in teeth}
+        out.append(replace(seg, parameters={**seg.parameters, **values}) if values else seg)
+    return out
+
+
+def _too_short(system: FirstOrderSystem, measurements: Measurements, library: dict[str, Effect],
+               named: set) -> dict[str, str]:
+    """The shaft-order effects a record is too short to show (shorter than one revolution of the gear), with why:
+    refused with an error if they were asked for by their own name (``tooth_fault_gear2``, not ``tooth_fault``)."""
+    out = {}
+    for name, e in library.items():
+        if not e.shaft_order:
+            continue
+        need = revolution_length(e, system)
+        short = [r for r in measurements if r.samples * r.step < need * (1 - 1e-9)]
+        if short:
+            r = short[0]
+            out[name] = (f"{r.label} covers {r.samples * r.step / (2 * np.pi):.4g} mesh periods (tau "
+                         f"{r.samples * r.step:.4g}), shorter than one revolution of {e.gear}: {e.teeth} mesh periods "
+                         f"(tau {need:.4g}); record at least that long to look for {name}")
+            if name in named:
+                raise GearsymError(f"cannot look for {name}: {out[name]}")
+    return out
 
 
 def _round(library: dict[str, Effect], current: Candidate, spectrum: Spectrum, system: FirstOrderSystem,

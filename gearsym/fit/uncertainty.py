@@ -9,6 +9,9 @@ from .jacobian import Jacobian
 #: a parameter whose direction has a singular value below this fraction of the largest (columns
 #: normalised) cannot be told from the others by the data
 NULL_SPACE = 1e-6
+#: a parameter whose weight in the null space is within this of one half shares it with another: both are flagged,
+#: not the one rounding happens to favour
+TIE = 1e-6
 #: correlations of estimates above this (in absolute value) are flagged
 STRONG_CORRELATION = 0.95
 
@@ -31,7 +34,7 @@ def uncertainty(J: Jacobian, r: np.ndarray, sigma2: float, names: list[str], hel
     top = max(float(eigenvalues.max(initial=0.0)), 1e-300)
     null = eigenvalues < NULL_SPACE**2 * top  # the column-normalised J's singular values below NULL_SPACE
     weight = (vectors[:, null] ** 2).sum(axis=1)
-    bad = (norms <= 1e-300) | (weight > 0.5)
+    bad = (norms <= 1e-300) | (weight > 0.5 - TIE)  # (two parameters exactly confounded: neither is determined)
     inverse = np.where(null, 0.0, 1 / np.where(null, 1.0, eigenvalues))
     cov = sigma2 * (vectors * inverse) @ vectors.T / np.outer(scale, scale)
     stderr = {n: None for n in names}

@@ -73,7 +73,7 @@ def build_fmu(system: FirstOrderSystem, path: Path, options: Integration = Integ
     if not identifier.isidentifier():
         raise ModelError("an FMU's model identifier must be a C identifier (letters, digits, _)", identifier)
     folder = binary_folder()
-    loops = LoopOptions.of(options)
+    loops = LoopOptions.of(options, system.cycles)
     if loops.block(system.dimension) != 1:
         raise GearsymError(f"{identifier}: the co-simulation step needs the loops' one-step blocks")
     engine = _engine_source(system, loops)

@@ -36,10 +36,11 @@ def export_fmu(model, path, *, options: Integration | None = None, **values) -> 
     options = options or Integration()
     if isinstance(model, FirstOrderSystem):
         return build_fmu(load(model, **values), path, options)
+    teeth = values.pop("teeth", None)  # (tooth counts for a model that declares none)
     declared = model if isinstance(model, NondimensionalModel) else load_model(model)
     if isinstance(declared, FirstOrderSystem):
-        return build_fmu(load(declared, **values), path, options)
-    nd = reduced(declared)
+        return build_fmu(load(declared, teeth=teeth, **values), path, options)
+    nd = reduced(declared, teeth)
     system = load(nd, **values)
     frame = physical_frame(nd, values, system)
     return build_fmu(system, path, options, frame or Frame())

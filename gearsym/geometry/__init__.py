@@ -14,6 +14,8 @@ The method, its validity and the comparison with ISO 6336: docs/geometry.md.
 from __future__ import annotations
 
 from ..errors import GearsymError
+from .crack import Crack
+from .crack import crack_stiffness_loss as _crack_stiffness_loss
 from .foundation import BODY_RATIO_RANGE, ROOT_ANGLE_RANGE
 from .gear import GearGeometry
 from .iso6336 import Iso6336Stiffness, iso6336_stiffness
@@ -23,7 +25,7 @@ from .meshing import mesh_stiffness as _mesh_stiffness
 from .pair import GearPair
 from .tooth_pair import TERMS, pair_compliances, pair_stiffness
 
-__all__ = ["BODY_RATIO_RANGE", "Fourier", "GearGeometry", "GearPair", "Iso6336Stiffness", "Material",
+__all__ = ["BODY_RATIO_RANGE", "Crack", "crack_stiffness_loss", "Fourier", "GearGeometry", "GearPair", "Iso6336Stiffness", "Material",
            "MeshStiffness", "ROOT_ANGLE_RANGE", "STEEL", "StiffnessOptions", "TERMS", "Zone", "gear_geometry",
            "gear_pair", "iso6336_stiffness", "mesh_stiffness", "pair_compliances", "pair_stiffness"]
 
@@ -77,3 +79,10 @@ def mesh_stiffness(pair: GearPair, options: StiffnessOptions | None = None, *, l
             raise GearsymError(f"mesh stiffness: unknown option among {', '.join(option_values)}; "
                                f"the options are {known}") from None
     return _mesh_stiffness(pair, options, line_load=line_load)
+
+
+def crack_stiffness_loss(pair: GearPair, gear: int, depth, angle) -> float:
+    """The fraction of its pair's stiffness a root crack on a tooth of gear ``gear`` (1: the pair's driving gear, 2)
+    takes away, averaged over the path of contact (:mod:`.crack`): ``depth`` in m and ``angle`` (from the tooth's
+    centre line) in rad, or pint Quantities. It is the depth of a :class:`gearsym.ToothFault` on that tooth."""
+    return _crack_stiffness_loss(pair, gear, _si(depth, "m", "crack depth"), _si(angle, "rad", "crack angle"))

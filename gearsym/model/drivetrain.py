@@ -16,6 +16,7 @@ from ..errors import ModelError
 from ..units import Measure, measure
 from .components import Body, Coupling, Mesh, Shaft, Torque
 from .expressions import ExprLike
+from .faults import ShaftOrderTerm
 from .length_scale import check_length_scale
 from .resolved import ResolvedDrivetrain
 
@@ -36,6 +37,7 @@ class Drivetrain(Model):
         self.bodies: list[Body] = []
         self.couplings: list[Coupling] = []
         self.torques: list[Torque] = []
+        self.shaft_terms: list[ShaftOrderTerm] = []  # eccentricity, tooth faults, ... (:mod:`.faults`)
         self._defaults: dict[str, ExprLike] = {}
         self._descriptions: dict[str, str] = {}
         self._initial: dict[str, float | Measure] = {}
@@ -52,7 +54,7 @@ class Drivetrain(Model):
     def add(self, component):
         """Add a component; returns it, so ``g1 = model.add(Gear(...))`` reads naturally."""
         self._changed()
-        names = {c.name for c in (*self.bodies, *self.couplings, *self.torques)}
+        names = {c.name for c in (*self.bodies, *self.couplings, *self.torques, *self.shaft_terms)}
         if not getattr(component, "name", None) or not isinstance(component.name, str):
             raise ModelError("every component needs a name (a non-empty string)", repr(component))
         if component.name in names:
@@ -64,9 +66,12 @@ class Drivetrain(Model):
             self.couplings.append(component)
         elif isinstance(component, Torque):
             self.torques.append(component)
+        elif isinstance(component, ShaftOrderTerm):
+            self.shaft_terms.append(component)
         else:
             raise ModelError(
-                f"cannot add a {type(component).__name__}; add Gear, Disk, Mesh, Shaft or Torque",
+                f"cannot add a {type(component).__name__}; add Gear, Disk, Mesh, Shaft, Torque or a shaft-order term "
+                "(ToothFault, Spall, Eccentricity, SpacingErrors)",
                 getattr(component, "name", None),
             )
         return component
@@ -170,7 +175,8 @@ class Drivetrain(Model):
         return self.resolved.equations_of_motion
 
     def __repr__(self) -> str:
+        faults = f", {len(self.shaft_terms)} shaft-order terms" if self.shaft_terms else ""
         return (
             f"Drivetrain({self.name!r}: {len(self.bodies)} bodies, "
-            f"{len(self.couplings)} couplings, {len(self.torques)} torques)"
+            f"{len(self.couplings)} couplings, {len(self.torques)} torques{faults})"
         )

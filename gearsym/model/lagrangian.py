@@ -41,13 +41,19 @@ class LagrangianForms:
         return sp.Function(base if plain else f"{base}_{rc.name}", real=True)(t)
 
     def stiffness_definition(self, rc: ResolvedCoupling) -> sp.Expr:
-        """kZ(t) = kZ * k(phi(t)) with the declared variation k and mesh phase phi."""
-        return rc.stiffness * rc.variation.subs(phi, rc.mesh_phase)
+        """kZ(t) = kZ * k(phi(t)) with the declared variation k and mesh phase phi; times (1 - loss(phi(t))) where
+        shaft-order terms take stiffness away (a tooth fault)."""
+        varied = rc.stiffness * rc.variation.subs(phi, rc.mesh_phase)
+        return varied if rc.loss == 0 else varied * (1 - rc.in_time(rc.loss))
+
+    def contact_of(self, rc: ResolvedCoupling) -> sp.Expr:
+        """What the mesh's backlash acts on: the deflection, less the transmission error of shaft-order terms."""
+        return self.deflection(rc) - rc.in_time(rc.error)
 
     def potential_of(self, rc: ResolvedCoupling) -> sp.Expr:
         d = self.deflection(rc)
         if rc.kind == "mesh":
-            return self.stiffness_at(rc) * G(d, rc.backlash)
+            return self.stiffness_at(rc) * G(self.contact_of(rc), rc.backlash)
         return rc.stiffness * d**2 / 2
 
     def dissipation_of(self, rc: ResolvedCoupling) -> sp.Expr:

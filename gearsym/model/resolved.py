@@ -19,11 +19,12 @@ from .components import Body, BodyRef, Coupling, Gear, Harmonic, Mesh, Planet, T
 from .expressions import ExprLike, parameter_names, to_expr
 from .lagrangian import LagrangianForms
 from .planetary import PlanetaryPhasing
+from .resolved_faults import ShaftOrderResolution
 from .resolved_components import ResolvedBody, ResolvedCoupling, ResolvedForcing
 from .stiffness import check_periodic
 
 
-class ResolvedDrivetrain(PlanetaryPhasing, LagrangianForms):
+class ResolvedDrivetrain(PlanetaryPhasing, ShaftOrderResolution, LagrangianForms):
     """The checked, symbolic view of a :class:`Drivetrain`."""
 
     def __init__(self, model: Model):  # (a Drivetrain, which resolves itself here)
@@ -43,6 +44,7 @@ class ResolvedDrivetrain(PlanetaryPhasing, LagrangianForms):
         self._check_connected()
         self.couplings = [self._with_planet_phase(rc) for rc in self.couplings]
         self._check_assembly()
+        self.couplings = self._with_shaft_terms(self.couplings)
 
     # ---- helpers
     def _default_value(self, expr: sp.Expr) -> Optional[float]:

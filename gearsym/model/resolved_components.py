@@ -6,7 +6,7 @@ from typing import Optional
 
 import sympy as sp
 
-from ..symbols import omega, t
+from ..symbols import omega, phi, t
 from .components import Body, Coupling, Torque
 
 
@@ -42,10 +42,24 @@ class ResolvedCoupling:
     carrier: Optional[ResolvedBody] = None  # the carrier of a mesh with a planet
     turning: tuple[tuple[sp.Expr, ...], tuple[sp.Expr, ...]] = ((), ())  # rows: each gear's angle relative to the carrier
     planet_phase: sp.Expr = sp.S.Zero  # the part of the mesh phase a planet's position gives (Parker & Lin 2004)
+    # shaft-order terms (:mod:`.faults`), in the mesh phase phi: the fraction of stiffness lost, the transmission
+    # error (a length), and the tooth counts of the gears whose revolution they repeat on
+    loss: sp.Expr = sp.S.Zero
+    error: sp.Expr = sp.S.Zero
+    revolutions: tuple[int, ...] = ()
 
     @property
     def name(self) -> str:
         return self.component.name
+
+    @property
+    def shaft_frequencies(self) -> tuple[sp.Expr, ...]:
+        """The frequencies (over the forcing's) at which the shaft-order terms repeat: order / Z of each gear."""
+        return tuple(self.order / z for z in self.revolutions)
+
+    def in_time(self, expr: sp.Expr) -> sp.Expr:
+        """A term in the mesh phase written in time t."""
+        return expr.subs(phi, self.mesh_phase) if expr != 0 else sp.S.Zero
 
 
 @dataclass(frozen=True)

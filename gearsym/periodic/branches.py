@@ -127,7 +127,7 @@ class Continuation:
 
 @engine_verb
 def continue_orbits(model: CompiledModel, parameter: str, start: float, stop: float, *, y0=None,
-                    period_multiple: int = 1, segments: int = 1, options: Integration | None = None,
+                    period_multiple: int = 1, segments: int | None = None, options: Integration | None = None,
                     step: float | None = None, max_step: float | None = None, max_points: int = 2000,
                     switch_depth: int = 1, **values: float) -> Continuation:
     """Periodic orbits of ``period_multiple`` forcing periods from ``parameter`` = ``start`` to ``stop``, by
@@ -141,6 +141,7 @@ def continue_orbits(model: CompiledModel, parameter: str, start: float, stop: fl
     ``MAX_STEP_OF_SIZE`` times 1 + the root-mean-square state of the orbit a step starts from).
     """
     options = model.run_options(options)
+    segments = model.cycles if segments is None else segments  # (one per mesh period of a revolution)
     if parameter not in model.parameter_names:
         raise UnknownParameterError(parameter, model.parameter_names, model.name)
     start, stop = float(start), float(stop)

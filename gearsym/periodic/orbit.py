@@ -127,14 +127,17 @@ def find_orbit(problem: OrbitMap, starts: list[np.ndarray], value: float | None 
 
 
 @engine_verb
-def periodic_orbit(model: CompiledModel, *, y0=None, period_multiple: int = 1, segments: int = 1,
+def periodic_orbit(model: CompiledModel, *, y0=None, period_multiple: int = 1, segments: int | None = None,
                    options: Integration | None = None, trajectory: bool = False, **values: float) -> PeriodicOrbit:
-    """The periodic orbit of ``period_multiple`` forcing periods near ``y0`` (a state at the section
+    """The periodic orbit of ``period_multiple`` periods near ``y0`` (a state at the section
     t = 0 mod the period), by Newton on P^n(y) - y = 0 with the exact monodromy matrix, in ``segments``
-    shooting segments per period. Without ``y0`` Newton starts where ``options.periods`` periods of
-    simulation from the model's initial state end (the transient). ``trajectory``: keep every RK4 step.
+    shooting segments per period (default one per forcing period: 1, or for a model with shaft-order terms,
+    whose period is a gear's revolution, one per mesh period). Without ``y0`` Newton starts where
+    ``options.periods`` periods of simulation from the model's initial state end (the transient).
+    ``trajectory``: keep every RK4 step.
     """
     options = model.run_options(options)
+    segments = model.cycles if segments is None else segments
     problem = OrbitMap(model, Shooting(period_multiple, segments), values=values)
     if y0 is not None:
         y0 = model.initial_state(y0)

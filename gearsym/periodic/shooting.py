@@ -33,12 +33,15 @@ from ..errors import GearsymError
 TOLERANCE = 1e-10
 #: relative step of the finite difference in the parameter
 PARAMETER_STEP = 1e-7
+#: shooting systems with more unknowns than this are solved as sparse matrices (a long orbit's)
+SPARSE_ABOVE = 400
 
 
 @dataclass(frozen=True)
 class Shooting:
-    """How an orbit is shot: ``period_multiple`` forcing periods (a period-n orbit), each in ``segments``
-    pieces (multiple shooting; 1, 2 or 4 when the steps per period divide by 4)."""
+    """How an orbit is shot: ``period_multiple`` periods (a period-n orbit), each in ``segments`` pieces
+    (multiple shooting; 1, 2 or 4 when the steps per period divide by 4; for a period of several forcing
+    periods, a gear's revolution, a multiple of them: one or more per mesh period)."""
 
     period_multiple: int = 1
     segments: int = 1
@@ -103,6 +106,32 @@ class Evaluation:
             nxt = (k + 1) % K
             J[k * n:(k + 1) * n, nxt * n:(nxt + 1) * n] -= np.eye(n)
         return J
+
+    def newton_step(self) -> np.ndarray:
+        """The Newton step -J^-1 r (K x n). A long orbit (a revolution of hundreds of mesh periods, shot once per
+        mesh period) has a block-cyclic Jacobian of 2 K n^2 nonzeros: it is solved as the sparse system it is."""
+        K, n = self.z.shape
+        if K * n <= SPARSE_ABOVE:
+            return np.linalg.solve(self.jacobian(), -self.residual).reshape(self.z.shape)
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.linalg import spsolve
+
+        rows, cols, values = [], [], []
+        block_rows, block_cols = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+        for k, M in enumerate(self.blocks):
+            rows.append(k * n + block_rows.ravel())
+            cols.append(k * n + block_cols.ravel())
+            values.append(np.asarray(M).ravel())
+            nxt = (k + 1) % K
+            rows.append(k * n + np.arange(n))
+            cols.append(nxt * n + np.arange(n))
+            values.append(-np.ones(n))
+        J = coo_matrix((np.concatenate(values), (np.concatenate(rows), np.concatenate(cols))),
+                       shape=(K * n, K * n)).tocsc()
+        step = spsolve(J, -self.residual)
+        if not np.all(np.isfinite(step)):
+            raise np.linalg.LinAlgError("singular shooting system")
+        return np.asarray(step).reshape(self.z.shape)
 
     @property
     def monodromy(self) -> np.ndarray:
@@ -202,7 +231,7 @@ def newton(problem: OrbitMap, z: np.ndarray, value: float | None = None, *, max_
         if ev.error() <= tolerance:
             return ev, iteration
         try:
-            step = np.linalg.solve(ev.jacobian(), -ev.residual).reshape(z.shape)
+            step = ev.newton_step()
         except np.linalg.LinAlgError:
             break
         scale, before = 1.0, np.linalg.norm(ev.residual)

@@ -36,7 +36,7 @@ from ..checks import sign_violation
 from ..model.expressions import ExprLike, parameter_names, to_expr
 from ..model.stiffness import check_periodic
 from ..symbols import omega, parameter_symbol, phi, t, tau
-from ..system import Constraint, Coupling, FirstOrderSystem
+from ..system import Constraint, Coupling, FirstOrderSystem, Gearing
 from .coordinates import generic_values
 from .reduction import Reduction, reduce_drivetrain
 
@@ -148,11 +148,26 @@ class NondimensionalModel:
         return tuple(out)
 
     @cached_property
-    def period(self) -> sp.Expr:
-        """The forcing period in tau: 2 pi / gcd of all mesh and torque frequencies."""
+    def forcing_period(self) -> sp.Expr:
+        """The forcing period in tau: 2 pi / gcd of all mesh and torque frequencies (one mesh period of a pair)."""
         freqs = [rc.order for rc in self.reduction.resolved.couplings if rc.kind == "mesh"]
         freqs += [sp.Integer(f.order) for f in self.reduction.resolved.forcing if f.order]
         return 2 * sp.pi / functools.reduce(sp.gcd, freqs, sp.S.Zero) if freqs else 2 * sp.pi
+
+    @cached_property
+    def period(self) -> sp.Expr:
+        """The period the model repeats on, in tau: the forcing period, or with shaft-order terms (a tooth fault,
+        an eccentric gear) 2 pi / gcd of their frequencies too: a gear's revolution, or the hunting period when
+        both gears of a pair have one. Every analysis runs on it."""
+        shaft = [f for rc in self.reduction.resolved.couplings for f in rc.shaft_frequencies]
+        if not shaft:
+            return self.forcing_period
+        return 2 * sp.pi / functools.reduce(sp.gcd, shaft, 2 * sp.pi / self.forcing_period)
+
+    @property
+    def cycles(self) -> int:
+        """Forcing periods in one :attr:`period` (1 without shaft-order terms)."""
+        return int(sp.nsimplify(self.period / self.forcing_period))
 
     # ------------------------------------------------------------- parameters
     @cached_property
@@ -317,7 +332,8 @@ class NondimensionalModel:
                        if name in params}
         return FirstOrderSystem(self.name, tau, self.states, rhs, params, self.period, descriptions,
                                 self.drivetrain.title, tuple(c.name for c in self.coordinates),
-                                self._initial(initial), self._system_couplings(functions), constraints)
+                                self._initial(initial), self._system_couplings(functions), constraints,
+                                cycles=self.cycles)
 
     def _initial(self, initial: Optional[Mapping[str, float]]) -> dict[str, float]:
         """The initial state in the engine's units: ``initial``, or the declared numbers (a physical value needs
@@ -366,9 +382,25 @@ class NondimensionalModel:
             stiffness = own[rc.name] if rc.kind == "mesh" else rc.stiffness
             rows = tuple((2 * r + 1, factor.xreplace(derived)) for r, factor in self.coupling_rows[rc.name])
             contact, rate = c.in_states()
+            error = transmission_error(rc)
             out.append(Coupling(rc.name, rc.kind, c.name, c.velocity_name, rc.backlash, stiffness.xreplace(derived),
-                                rc.order, rows, contact, None if c.independent else rate))
+                                rc.order, rows, None if c.independent and error == 0 else contact - error,
+                                None if c.independent else rate, gears_of(rc)))
         return tuple(out)
+
+
+def transmission_error(rc: ResolvedCoupling) -> sp.Expr:
+    """A mesh's transmission error from shaft-order terms, in tau (0 without)."""
+    if rc.kind != "mesh" or rc.error == 0:
+        return sp.S.Zero
+    return rc.error.subs(phi, sp.expand(rc.mesh_phase.subs(t, tau / omega)))
+
+
+def gears_of(rc: ResolvedCoupling) -> tuple[Gearing, ...]:
+    """The two gears of a mesh, with their tooth counts (none for a shaft)."""
+    if rc.kind != "mesh":
+        return ()
+    return tuple(Gearing(end.body.name, end.body.tooth_count) for end in (rc.a, rc.b))
 
 
 # ============================================================================ construction
@@ -460,7 +492,10 @@ class _Assembly:
         x = cx.contact(tau)
         comp = rc.component
         fname = comp.function or ("k" if rc is reference else f"k{suffix}")
-        varied = rc.variation.subs(phi, sp.expand(rc.mesh_phase.subs(t, tau / omega)))
+        phase = sp.expand(rc.mesh_phase.subs(t, tau / omega))
+        varied = rc.variation.subs(phi, phase)
+        if rc.loss != 0:  # stiffness a shaft-order term takes away (a tooth fault), once per revolution
+            varied = varied * (1 - rc.loss.subs(phi, phase))
         if rc is not reference and _equal(m * rc.stiffness, self.own_factor(reference) * reference.stiffness):
             expression = varied  # as stiff as the first mesh (another planet's): 1 by the time-unit condition
         elif rc is reference:
@@ -476,10 +511,11 @@ class _Assembly:
             K = self.add_group(Group(comp.stiffness_group or f"K{suffix}", m * rc.stiffness, "free",
                                      f"mean stiffness of mesh {rc.name!r} relative to the first mesh", "stiffness"))
             expression = K.symbol * varied
+        repeats = functools.reduce(sp.gcd, (rc.order, *rc.shaft_frequencies)) if rc.loss != 0 else rc.order
         kfun = StiffnessFunction(fname, rc.name, m * red.resolved.stiffness_at(rc).subs(t, tau / omega),
-                                 expression, 2 * sp.pi / rc.order)
+                                 expression, 2 * sp.pi / repeats)
         self.functions.append(kfun)
-        terms = kfun.applied * g(x, rc.backlash) / omega**2
+        terms = kfun.applied * g(x - transmission_error(rc), rc.backlash) / omega**2
         if rc.damping != 0:
             zeta = self.add_group(Group(comp.damping_group or f"zeta{suffix}", m * rc.damping / 2, "free",
                                         f"damping ratio of mesh {rc.name!r}", "damping"))

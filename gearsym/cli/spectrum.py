@@ -1,0 +1,119 @@
+"""``gearsym spectrum MODEL``: the order spectrum of a simulated run or of measured records, with the mesh
+harmonics and each gear's shaft-order sidebands labelled; a figure and JSON.
+
+    gearsym spectrum one_stage --teeth 20,53 --effect tooth_fault_gear2 --set q_gear2=0.3 --set tooth_gear2=7 \\
+        --out spectrum.json --plot spectrum.png
+    gearsym spectrum one_stage --teeth 20,53 --data measured.csv --out spectrum.json --plot spectrum.png
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+
+from ..analysis.order_run import mesh_gears, simulated_order_spectrum
+from ..analysis.orders import MESH_HARMONICS, SIDEBANDS, order_spectrum
+from ..checks import check_run, json_safe
+from ..data.measurements import load_measurements
+from ..errors import GearsymError
+from ..files import write_atomically
+from ..figures.orders import plot_order_spectra
+from ..loading import load
+from ..options import STEPS_PER_PERIOD, Integration
+from ..outputs import check_figure, check_file
+from .integration import add_integration_arguments, compiled_from
+from .settings import add_set_argument, model_settings
+from .simulate import with_effects
+
+NAME = "spectrum"
+HELP = "order spectrum (mesh harmonics and each gear's shaft-order sidebands) of a run or of measured records"
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("model", help="a model name (see `gearsym list`) or the path of a model file")
+    add_set_argument(parser)
+    parser.add_argument("--effect", action="append", default=[], metavar="NAME",
+                        help="simulate with an effect of the library added, as for `gearsym simulate` "
+                             "(tooth_fault_GEAR, eccentricity_GEAR, ...)")
+    parser.add_argument("--data", nargs="+", type=Path, default=None, metavar="FILE.csv",
+                        help="the spectra of measured records instead of a run (every record and channel; tau or t "
+                             "with --time-scale, as for `gearsym explain`)")
+    parser.add_argument("--time-scale", type=float, default=None, help="tau = TIME_SCALE * t for a file with t")
+    parser.add_argument("--coordinate", metavar="NAME", help="the mesh coordinate of a run (default the first "
+                                                             "geared mesh's)")
+    parser.add_argument("--mesh-harmonics", type=int, default=MESH_HARMONICS, metavar="M",
+                        help=f"mesh harmonics labelled (default {MESH_HARMONICS})")
+    parser.add_argument("--sidebands", type=int, default=SIDEBANDS, metavar="K",
+                        help=f"shaft orders labelled on each side of each (default {SIDEBANDS})")
+    add_integration_arguments(parser, periods=None)
+    parser.add_argument("--periods", type=int, default=None,
+                        help="periods of the run in all (default: 4 revolutions of the slower gear after the "
+                             "transient)")
+    parser.add_argument("--discard", type=int, default=None, help="transient periods (default: 100 mesh periods)")
+    parser.add_argument("--out", type=Path, default=None, metavar="FILE.json", help="the spectra and their lines")
+    parser.add_argument("--plot", type=Path, default=None, metavar="FILE.png", help="the figure")
+    parser.add_argument("--quiet", action="store_true")
+
+
+def run(args: argparse.Namespace) -> int:
+    for option, value in (("--mesh-harmonics", args.mesh_harmonics), ("--sidebands", args.sidebands)):
+        if value < 1:
+            raise GearsymError(f"{option} must be at least 1, got {value}")
+    if args.out:
+        check_file(args.out, (".json",))
+    if args.plot:
+        check_figure(args.plot)
+    settings = model_settings(args)
+    if args.data:
+        spectra, what = _measured(args, settings)
+    else:
+        spectra, what = _simulated(args, settings)
+    for s in spectra:
+        strongest = sorted((ln for ln in s.lines if ln.gear and math.isfinite(ln.amplitude)),
+                           key=lambda ln: -ln.amplitude)[:3]
+        energy = ", ".join(f"{g} {s.sideband_energy(g):.3g}" for g in s.gears)
+        print(f"{s.title}: {s.length:.4g} mesh periods; sideband energy {energy}; strongest "
+              + ", ".join(f"{ln.label} ({ln.order:.4g}) {ln.amplitude:.3g}" for ln in strongest))
+    if args.out:
+        write_atomically(args.out, json.dumps(json_safe({"model": args.model, "source": what,
+                                                          "spectra": [s.as_dict() for s in spectra]}), indent=1) + "\n")
+        print(f"wrote {args.out}")
+    if args.plot:
+        gears = ", ".join(f"{g} {z} teeth" for g, z in spectra[0].gears.items())
+        plot_order_spectra(spectra, args.plot, title=f"Order spectrum of {what} (model {args.model}: {gears})",
+                           max_order=args.mesh_harmonics + 0.5)
+        print(f"wrote {args.plot}")
+    return 0
+
+
+def _simulated(args, settings: dict):
+    system = with_effects(args.model, args.effect, settings) if args.effect else load(args.model, **settings)
+    name, gears, _ = mesh_gears(system, args.coordinate)
+    cycles = system.cycles
+    discard = args.discard if args.discard is not None else max(1, math.ceil(100 / cycles))
+    measured = max(1, math.ceil(4 * max(gears.values()) / cycles))
+    periods = args.periods if args.periods is not None else discard + measured
+    steps = args.steps_per_period or STEPS_PER_PERIOD
+    check_run(steps_per_period=steps)
+    options = Integration(periods=periods, discard=discard, steps_per_period=steps, locate_crossings=not args.plain,
+                          backend=args.backend)
+    compiled = compiled_from(args, options, system)
+    s = simulated_order_spectrum(compiled, coordinate=name, mesh_harmonics=args.mesh_harmonics,
+                                 sidebands=args.sidebands)
+    return [s], f"a run of {system.name}" + (f" ({', '.join(args.effect)})" if args.effect else "")
+
+
+def _measured(args, settings: dict):
+    if args.effect:
+        raise GearsymError("--effect simulates a run; --data analyses measured records: give one of them")
+    system = load(args.model, **settings)
+    _, gears, mesh_order = mesh_gears(system)
+    data = load_measurements(args.data, system, time_scale=args.time_scale)
+    spectra = []
+    for r in data:
+        for channel, values in r.observed.items():
+            spectra.append(order_spectrum(r.tau, values, gears, mesh_order=mesh_order, channel=channel,
+                                          mesh_harmonics=args.mesh_harmonics, sidebands=args.sidebands,
+                                          title=f"{r.label}, {channel}"))
+    return spectra, ", ".join(p.name for p in data.sources)

@@ -1,0 +1,135 @@
+"""Which tooth: the scan that places a tooth fault on one tooth of its gear, in every record.
+
+A tooth fault's severity is a parameter like any other, but its tooth is a whole number: for each record and
+each of the gear's Z teeth, the linearised gain of the severity (the score test of :mod:`.explain`: the fraction
+of the training residual its exact sensitivity column would remove, with the fit's own directions projected
+out) is computed, and each record takes the tooth of largest gain whose severity comes out positive (a fault
+takes stiffness away). Records are placed separately, because each may start at another angle of the gear.
+
+The column of tooth n is zero outside the windows where its pair is in mesh (its share of the stiffness is 0
+there to rounding, and every window has its own start state), so each tooth's column is computed on those
+windows only: the whole scan costs about three runs of the record's windows, not Z.
+"""
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..options import Integration
+from ..system import FirstOrderSystem
+from .effect_types import Effect
+from .problem import Problem
+from .result import Fit
+from .segment import Segment
+
+#: mesh periods beyond a pair's path of contact in which its column is still computed (its window's edges)
+MARGIN = 0.5
+#: the contact ratio of the effects' tooth share (:func:`gearsym.model.shaft_orders.tooth_share`)
+CONTACT = 1.6
+
+
+@dataclass(frozen=True)
+class Placement:
+    """Where a tooth fault sits: per record (its key), the tooth counted from tau = 0; the gain of each record's
+    best tooth, and the gain of them all together (what the candidate is ranked by)."""
+
+    teeth: dict  # record key -> tooth (1 ... Z), counted from tau = 0
+    gains: dict  # record key -> the gain of that tooth in that record alone
+    gain: float
+    why: str = ""  # why the effect cannot act (0 gain)
+
+
+def scan_teeth(system: FirstOrderSystem, segments: Sequence[Segment], fit: Fit, e: Effect, bias: Sequence[str],
+               options: Integration) -> Placement:
+    """Place the tooth fault ``e`` in every record of ``segments`` at the fit ``fit`` (see the module docstring)."""
+    fitted = list(fit.estimates)
+    q = e.fitted[0]
+    problem = Problem(system, segments, fitted + [q], list(bias), 2 * np.pi, options)
+    theta = np.array([fit.estimates[p] for p in fitted] + [0.0])
+    b = np.array([fit.bias[c] for c in problem.bias])
+    starts = fit.starts
+    u = np.concatenate([theta, b, starts.reshape(-1, order="F")])
+    r, J = problem(u)
+    m = len(fitted)
+    nuisance = replace(J, P=np.delete(J.P, m, axis=1))
+    y = nuisance.project_out(-r[:, None])[:, 0]
+    total = float(y @ y) or 1.0
+    order = float(next(c.order for c in system.couplings if c.coordinate == e.coordinate) or 1)
+    index_q, index_n = problem.names.index(q), problem.names.index(e.scan)
+    P = problem.parameters(theta)
+    records = list(dict.fromkeys(seg.key[0] if seg.key else k for k, seg in enumerate(segments)))
+    of_record = np.array([records.index(seg.key[0] if seg.key else k) for k, seg in enumerate(segments)])
+    columns, teeth, gains = {}, {}, {}
+    for ri, record in enumerate(records):
+        windows = np.nonzero(of_record == ri)[0]
+        block = _record_columns(problem, J, windows, starts, P, e.teeth, order, index_q, index_n)  # (rows, Z)
+        projected = nuisance.project_out(block)
+        norms = np.einsum("rz,rz->z", projected, projected)
+        dots = projected.T @ y
+        with np.errstate(invalid="ignore", divide="ignore"):
+            coef = np.where(norms > 0, dots / norms, 0.0)
+            gain = np.where((norms > 0) & (coef > 0), dots**2 / (norms * total), 0.0)
+        best = int(np.argmax(gain))
+        teeth[record], gains[record] = best + 1, float(gain[best])
+        columns[record] = projected[:, best]
+    together = sum(columns.values())
+    norm = float(together @ together)
+    if norm <= 0 or not any(g > 0 for g in gains.values()):
+        return Placement(teeth, gains, 0.0, "no tooth of it would need a positive loss of stiffness")
+    coef = float(together @ y) / norm
+    gain = float((together @ y) ** 2 / (norm * total)) if coef > 0 else 0.0
+    return Placement(teeth, gains, gain)
+
+
+def _record_columns(problem: Problem, J, windows: np.ndarray, starts: np.ndarray, P: np.ndarray, teeth: int,
+                    order: float, index_q: int, index_n: int) -> np.ndarray:
+    """The sensitivity column of the severity with the fault on each tooth 1 ... Z in turn, on the windows of one
+    record (rows of the whole problem; zero elsewhere): one compiled call for all teeth, each tooth's windows
+    only."""
+    period = 2 * np.pi / order  # one mesh period in tau
+    runs, which = [], []
+    for n in range(1, teeth + 1):
+        for k in windows:
+            t0 = problem.t0[k]
+            t1 = t0 + problem.dt[k] * (problem.samples[k] - 1)
+            if _meets(t0, t1, n, teeth, period):
+                runs.append(k)
+                which.append(n)
+    out = np.zeros((J.P.shape[0], teeth))
+    if not runs:
+        return out
+    runs, which = np.array(runs), np.array(which)
+    params = P[:, runs].copy()
+    params[index_n, :] = which
+    run = problem.engine.run(starts[:, runs], problem.t0[runs], problem.dt[runs], problem.samples[runs],
+                             problem.substeps[runs], params, True, columns=[index_q])
+    sub_offsets = np.concatenate([[0], np.cumsum(problem.samples[runs])])
+    column = problem.n
+    for i, (k, n) in enumerate(zip(runs, which)):
+        rows = slice(problem.row_offsets[k], problem.row_offsets[k + 1])
+        channels = problem.rows[0][rows]
+        samples = problem.rows[1][rows] - problem.offsets[k] + sub_offsets[i]
+        out[rows, n - 1] = run.derivatives[channels, column, samples] * problem.weight[rows]
+    return out
+
+
+def _meets(t0: float, t1: float, tooth: int, teeth: int, period: float) -> bool:
+    """Whether the pair of ``tooth`` is in mesh (within MARGIN mesh periods) somewhere in [t0, t1]."""
+    revolution = teeth * period
+    centre = (tooth - 0.5) * period
+    reach = (CONTACT / 2 + MARGIN) * period
+    k = np.floor((t0 - centre - reach) / revolution)
+    while centre + k * revolution - reach <= t1:
+        if centre + k * revolution + reach >= t0:
+            return True
+        k += 1
+    return False
+
+
+def from_record_start(tooth: int, teeth: int, start: float, order: float = 1.0) -> int:
+    """A tooth counted from tau = 0 as counted from a record that starts at ``start``: tooth 1 is the one whose pair
+    is in single contact in the mesh period the record starts in."""
+    cycle = int(np.floor(order * start / (2 * np.pi) + 1e-9))
+    return (tooth - 1 - cycle) % teeth + 1

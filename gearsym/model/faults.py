@@ -1,0 +1,130 @@
+"""Shaft-order components: what one gear adds to its mesh once per revolution (eccentricity, a tooth fault,
+pitting, spacing errors).
+
+Each is declared on a gear with its tooth count (``Gear(..., teeth=Z)``, or ``--teeth`` for a model that
+declares none) and added to the drivetrain like any component::
+
+    wheel = model.add(Gear("gear2", inertia="I2", base_radius="r2", teeth=53))
+    model.add(ToothFault("crack", wheel, tooth=7, depth="q_crack"))      # the pair of tooth 7 loses q_crack
+    model.add(Eccentricity("runout", "gear1", amplitude="e_1", phase="theta_1"))
+
+It becomes a term of the gear's mesh (:mod:`.shaft_orders`): a loss of mesh stiffness, ``k(phi) (1 - loss)``,
+or a transmission error, ``g(x - e, eta)``, periodic over the gear's revolution, so that the reduction, the
+derivation pages and the generated C carry it, and the system's period becomes that revolution (or the hunting
+period, when both gears of a pair have one). Teeth are counted from tau = 0 (:mod:`.shaft_orders`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+import sympy as sp
+
+from ..errors import ModelError
+from .components import BodyRef
+from .expressions import ExprLike, to_expr
+from .shaft_orders import DEFAULT_EDGE, path_window, shaft_harmonic, tooth_by_tooth, tooth_share
+from .stiffness import DEFAULT_CONTACT_RATIO
+
+
+@dataclass(frozen=True)
+class MeshTerms:
+    """What shaft-order components add to one mesh, in its mesh phase: the fraction of stiffness lost and the
+    transmission error (a length, in the mesh deflection's unit)."""
+
+    loss: sp.Expr = sp.S.Zero
+    error: sp.Expr = sp.S.Zero
+
+    def __add__(self, other: "MeshTerms") -> "MeshTerms":
+        return MeshTerms(self.loss + other.loss, self.error + other.error)
+
+
+@dataclass(eq=False, frozen=True)
+class ShaftOrderTerm:
+    """A term fixed on one gear, repeating once per revolution. ``mesh`` names the mesh it acts in when the gear
+    has more than one."""
+
+    name: str
+    gear: BodyRef
+    mesh: Optional[str] = field(default=None, kw_only=True)
+
+    def terms(self, phi: sp.Expr, teeth: int, where: str) -> MeshTerms:  # pragma: no cover (every kind has one)
+        raise NotImplementedError
+
+    def _tooth(self, tooth, teeth: int, where: str) -> int:
+        if isinstance(tooth, bool) or not isinstance(tooth, int) or not 1 <= tooth <= teeth:
+            raise ModelError(f"tooth must be a whole number from 1 to the gear's {teeth} teeth, got {tooth!r}", where)
+        return tooth
+
+
+@dataclass(eq=False, frozen=True)
+class ToothFault(ShaftOrderTerm):
+    """A local fault of tooth ``tooth`` (a crack, a broken corner): the pair it forms loses the fraction
+    ``depth`` of its stiffness while it is in mesh, so the mesh stiffness is ``k(phi) (1 - depth s_n(phi))`` with
+    ``s_n`` the pair's share (:func:`~.shaft_orders.tooth_share`: over ``contact_ratio`` mesh periods, each
+    edge rising over ``edge`` of them). ``depth`` is a fraction (0: healthy), a number or a parameter; for a root
+    crack of a given depth and angle, the fraction its pair loses by the gear geometry's potential-energy method
+    (:func:`gearsym.geometry.crack_stiffness_loss`)."""
+
+    tooth: int = 1
+    depth: ExprLike = "q"
+    contact_ratio: float = DEFAULT_CONTACT_RATIO
+    edge: float = DEFAULT_EDGE
+
+    def terms(self, phi: sp.Expr, teeth: int, where: str) -> MeshTerms:
+        tooth = self._tooth(self.tooth, teeth, where)
+        return MeshTerms(loss=to_expr(self.depth, where) * tooth_share(phi, teeth, tooth, self.contact_ratio,
+                                                                       self.edge))
+
+
+@dataclass(eq=False, frozen=True)
+class Spall(ShaftOrderTerm):
+    """Pitting or a spall on tooth ``tooth``: the fraction ``width`` of the face width lost over the part of the
+    tooth's path of contact from ``start`` to ``end`` (fractions of the path, 0 where it comes into mesh): the pair
+    loses that fraction of its stiffness there."""
+
+    tooth: int = 1
+    width: ExprLike = "w_spall"
+    start: float = 0.3
+    end: float = 0.7
+    contact_ratio: float = DEFAULT_CONTACT_RATIO
+    edge: float = DEFAULT_EDGE
+
+    def terms(self, phi: sp.Expr, teeth: int, where: str) -> MeshTerms:
+        tooth = self._tooth(self.tooth, teeth, where)
+        share = tooth_share(phi, teeth, tooth, self.contact_ratio, self.edge)
+        part = path_window(phi, teeth, tooth, self.contact_ratio, self.start, self.end, self.edge)
+        return MeshTerms(loss=to_expr(self.width, where) * share * part)
+
+
+@dataclass(eq=False, frozen=True)
+class Eccentricity(ShaftOrderTerm):
+    """Eccentricity or run-out of the gear: a transmission error ``amplitude cos(order phi/Z + phase)`` at its
+    shaft order ``order`` (1 for eccentricity; run-out also has higher orders), a length."""
+
+    amplitude: ExprLike = "e_ecc"
+    phase: ExprLike = 0
+    order: int = 1
+
+    def terms(self, phi: sp.Expr, teeth: int, where: str) -> MeshTerms:
+        if isinstance(self.order, bool) or not isinstance(self.order, int) or self.order < 1:
+            raise ModelError(f"the shaft order must be a whole number of at least 1, got {self.order!r}", where)
+        return MeshTerms(error=shaft_harmonic(phi, teeth, self.order, to_expr(self.amplitude, where),
+                                              to_expr(self.phase, where)))
+
+
+@dataclass(eq=False, frozen=True)
+class SpacingErrors(ShaftOrderTerm):
+    """Tooth spacing (pitch) errors: a transmission error that is ``errors[n - 1]`` while tooth n carries the
+    load, blended over the double contact; one value (a length, a number or a parameter) per tooth."""
+
+    errors: tuple = ()
+    contact_ratio: float = DEFAULT_CONTACT_RATIO
+
+    def terms(self, phi: sp.Expr, teeth: int, where: str) -> MeshTerms:
+        errors = [to_expr(e, where) for e in self.errors]
+        if len(errors) != teeth:
+            raise ModelError(f"gives {len(errors)} spacing errors for a gear of {teeth} teeth: give one per tooth",
+                             where)
+        edge = (sp.nsimplify(self.contact_ratio) - 1) / 2
+        return MeshTerms(error=tooth_by_tooth(phi, teeth, errors, edge))

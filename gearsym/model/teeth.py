@@ -1,0 +1,86 @@
+"""Tooth counts for a model that declares none: ``--teeth Z1,Z2`` (``teeth=(Z1, Z2)`` in Python).
+
+The counts go to the gears of the model's first mesh: Z1 to its *pinion*, the driving gear (the one a driving
+torque acts on, else the one whose speed is the operating point, else the mesh's first gear), Z2 to its *wheel*.
+The model is not changed: :func:`with_teeth` returns a copy with those two gears declared with their teeth
+(every component that refers to them refers to the copies), made once per model, version and counts.
+"""
+from __future__ import annotations
+
+import dataclasses
+from ..declared import Model
+from ..errors import GearsymError, ModelError
+from .components import Body, Gear, Mesh
+from .drivetrain import Drivetrain
+from .shaft_orders import teeth_of
+from .tooth_counts import parse_teeth
+
+
+def first_mesh_gears(model: Drivetrain) -> tuple[Gear, Gear]:
+    """The pinion (driving gear) and the wheel of the model's first mesh."""
+    meshes = [c for c in model.couplings if isinstance(c, Mesh)]
+    if not meshes:
+        raise ModelError("has no mesh, so there are no gears to give tooth counts to", model.name)
+    mesh = meshes[0]
+    by_name = {b.name: b for b in model.bodies}
+    ends = [end if isinstance(end, Body) else by_name.get(end) for end in mesh.ends]
+    if not all(isinstance(end, Gear) for end in ends):
+        raise ModelError(f"the first mesh {mesh.name!r} does not join two gears of the model", model.name)
+    driven = {t.on.name if isinstance(t.on, Body) else t.on for t in model.torques if not t.load}
+    for rule in (lambda b: b.name in driven, lambda b: bool(b.speed_parameter)):
+        chosen = [end for end in ends if rule(end)]
+        if len(chosen) == 1:
+            pinion = chosen[0]
+            return pinion, ends[1] if pinion is ends[0] else ends[0]
+    return ends[0], ends[1]
+
+
+def with_teeth(model: Model, teeth) -> Model:
+    """``model`` with the tooth counts ``teeth`` = (pinion, wheel) on its first mesh's gears (a copy; the same
+    copy for the same model, version and counts). None: the model itself."""
+    counts = parse_teeth(teeth)
+    if counts is None:
+        return model
+    if not model.is_drivetrain:
+        raise GearsymError(f"{model.name}: --teeth gives tooth counts to the gears of a drivetrain; a first-order "
+                           "system has none")
+    kept = model.__dict__.setdefault("_with_teeth", {})
+    if counts in kept and kept[counts][0] == model.version:
+        return kept[counts][1]
+    pinion, wheel = first_mesh_gears(model)
+    declared = [b.name for b in (pinion, wheel) if b.tooth_count is not None]
+    if declared:
+        told = "declare their tooth counts" if len(declared) > 1 else "declares its tooth count"
+        raise GearsymError(f"{model.name}: {' and '.join(declared)} {told} already (Gear(..., teeth=)); --teeth is "
+                           "for a model that declares none")
+    for z, gear in zip(counts, (pinion, wheel)):
+        teeth_of(z, f"--teeth for {gear.name!r}")
+    copy = _copy(model, {pinion.name: counts[0], wheel.name: counts[1]})
+    kept[counts] = (model.version, copy)
+    return copy
+
+
+def _copy(model: Drivetrain, teeth: dict[str, int]) -> Drivetrain:
+    """A new drivetrain with the same components, the gears named in ``teeth`` declared with those counts."""
+    out = Drivetrain(model.name, model.title, model.description)
+    new: dict[str, Body] = {}
+    for body in model.bodies:
+        new[body.name] = dataclasses.replace(body, teeth=teeth[body.name]) if body.name in teeth else body
+    swapped = {id(old): new[old.name] for old in model.bodies}
+
+    def rewired(component):
+        changes = {f.name: swapped[id(v)] for f in dataclasses.fields(component)
+                   if isinstance(v := getattr(component, f.name), Body) and id(v) in swapped}
+        return dataclasses.replace(component, **changes) if changes else component
+
+    for body in model.bodies:
+        out.add(rewired(new[body.name]))
+    for component in (*model.couplings, *model.torques, *model.shaft_terms):
+        out.add(rewired(component))
+    out.set_defaults(**model.defaults)
+    out.describe(**model.descriptions)
+    if model.physical:
+        out._physical.update(model.physical)  # (SI values already read and checked)
+    out._initial.update(model.initial_state)
+    out._length_scale = model.length_scale
+    return out

@@ -1,0 +1,183 @@
+"""The data loop names shaft-order faults on data from an independent simulator (tests/fault_rig.py: SciPy's
+solve_ivp of the one-stage equations with a tooth fault, an eccentric gear or spacing errors typed in the test):
+which gear, which tooth counted from the record's start, how much, with the held-out error before and after;
+clean data with the same tooth counts get none; a record shorter than a revolution is refused for the effect.
+
+A pinion of 9 and a wheel of 13 teeth keep the records short: each record is 4 revolutions of the wheel (52 mesh
+periods, the last 13 held out), starting 30.3 mesh periods into the run (not at a whole revolution, so the tooth
+counted from the record's start is not the tooth counted from the start of the run).
+"""
+from __future__ import annotations
+
+import json
+import math
+import re
+import shlex
+
+import numpy as np
+import pytest
+
+import fault_rig
+import gearsym
+from gearsym import explain, load_measurements
+from gearsym.cli import main
+from gearsym.errors import GearsymError
+from gearsym.fit.explain import candidate_library
+from gearsym.paths import REPO_ROOT
+
+TEETH = (9, 13)
+OMEGAS = (1.2, 1.6)
+PERIODS, TRANSIENT = 52, 30.3
+#: the truths: the wheel's tooth 9 (counted from tau = 0) loses 30 % of its stiffness; the pinion runs out by 0.4
+#: (in x's unit, the backlash being 10) at phase 0.7; the pinion's spacing errors (zero mean)
+CRACK = (2, 9, 0.3)
+ECCENTRIC = (1, 0.4, 0.7)
+SPACING = (1, [0.2, -0.1, 0.05, -0.25, 0.15, 0.0, 0.1, -0.2, 0.05])
+CASES = {"crack": {"fault": CRACK}, "eccentric": {"eccentric": ECCENTRIC}, "spacing": {"spacing": SPACING},
+         "clean": {}}
+#: what the noise alone leaves: 1 % of each record's spread
+NOISE = 0.01
+#: every test searches the same library (compiled once): the shaft-order effects of both gears (the pinion's
+#: spacing errors too) and the mesh-order effects they could be mistaken for, at orders 1 and 2
+LIBRARY = ["tooth_fault", "eccentricity", "spacing_errors_gear1", "transmission_error", "mesh_stiffness_harmonic"]
+HARMONICS = 2
+
+
+def from_record_start(tooth: int, teeth: int) -> int:
+    """The tooth of the run counted from a record that starts TRANSIENT mesh periods in (typed here)."""
+    return (tooth - 1 - math.floor(TRANSIENT)) % teeth + 1
+
+
+@pytest.fixture(scope="module")
+def data(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("faults")
+    made = {}
+
+    def get(case: str):
+        if case not in made:
+            pair = fault_rig.Pair(teeth=TEETH, **CASES[case])
+            runs = [(w, pair.record(w, periods=PERIODS, transient=TRANSIENT)) for w in OMEGAS]
+            made[case] = fault_rig.write(folder / f"{case}.csv", runs, noise=NOISE)
+        return made[case]
+
+    return get
+
+
+@pytest.fixture(scope="module")
+def geared():
+    return gearsym.load("one_stage", teeth=TEETH)
+
+
+def test_a_cracked_tooth_on_the_wheel_is_named_with_its_tooth_and_severity(data, tmp_path, capsys):
+    """The documented command: the fault found on the wheel (not on the pinion), on its tooth counted from each
+    record's start, with its severity and standard error."""
+    out = tmp_path / "report"
+    assert main(["explain", str(data("crack")), "--model", "one_stage", "--teeth", f"{TEETH[0]},{TEETH[1]}",
+                 "--fit", "zeta,B1", "--effects", ",".join(LIBRARY), "--harmonics", str(HARMONICS),
+                 "--out", str(out), "--quiet"]) == 0
+    report = json.loads((out / "report.json").read_text())
+    assert report["verdict"] == "explained" and report["effects"] == ["tooth_fault_gear2"]
+    (fault,) = report["faults"]
+    gear, tooth, q = CRACK
+    assert fault["gear"] == "gear2" and fault["tooth"] == from_record_start(tooth, TEETH[1]) == 5
+    assert set(fault["tooth_by_record"].values()) == {5}
+    assert fault["severity"] == pytest.approx(q, rel=0.05)  # (the rig's smoothstep edges are not gearsym's tanh)
+    assert 0 < fault["severity_stderr"] < 0.02
+    assert report["error_after"] <= report["error_before"] / 3 and report["error_after"] < 1.5 * NOISE
+    page = (out / "report.md").read_text()
+    assert f"tooth 5 of gear2: stiffness −{100 * fault['severity']:.3g} %" in page
+    sidebands = report["sidebands"]["before"]["energy"]
+    assert sidebands["gear2"] > sidebands["gear1"]  # the evidence points at the wheel
+    assert report["sidebands"]["after"]["energy"]["gear2"] < sidebands["gear2"] / 3
+
+
+def test_an_eccentric_pinion_is_named_with_its_amplitude_and_phase(data, geared):
+    ex = explain(geared, load_measurements([data("eccentric")], geared), ["zeta", "B1"], candidates=LIBRARY,
+                 harmonics=HARMONICS)
+    assert ex.verdict == "explained" and ex.effects == ["eccentricity_gear1"]
+    (found,) = ex.as_dict()["faults"]
+    _, amplitude, phase = ECCENTRIC
+    assert found["amplitude"] == pytest.approx(amplitude, rel=0.03)
+    assert found["phase"] == pytest.approx(phase, abs=0.03)
+    assert found["amplitude_stderr"] < 0.02 and found["phase_stderr"] < 0.05
+    assert ex.final.error <= ex.base.error / 5
+
+
+def test_spacing_errors_of_the_pinion_are_named_tooth_by_tooth(data, geared):
+    """Spacing errors are Z - 1 parameters, so they are tried when named; the tooth faults and eccentricities of
+    both gears and the mesh-order terms compete with them."""
+    ex = explain(geared, load_measurements([data("spacing")], geared), ["zeta", "B1"], candidates=LIBRARY,
+                 harmonics=HARMONICS)
+    assert ex.verdict == "explained" and ex.effects == ["spacing_errors_gear1"]
+    (found,) = ex.as_dict()["faults"]
+    true = np.array(SPACING[1])
+    got = np.array(found["errors"])
+    # teeth are counted from tau = 0 in the model: the records' time is the run's
+    assert np.max(np.abs(got - true)) < 0.05, (got, true)
+    assert ex.final.error <= ex.base.error / 3
+
+
+def test_clean_data_with_the_same_tooth_counts_get_no_fault(data, geared):
+    ex = explain(geared, load_measurements([data("clean")], geared), ["zeta", "B1"], candidates=LIBRARY,
+                 harmonics=HARMONICS)
+    assert ex.effects == [] and ex.verdict == "nothing missing"
+    assert ex.as_dict()["faults"] == []
+    assert ex.base.error < 1.5 * NOISE
+
+
+def test_a_record_shorter_than_a_revolution_is_refused_for_that_effect(tmp_path, geared):
+    pair = fault_rig.Pair(teeth=TEETH)
+    runs = [(1.2, pair.record(1.2, periods=10, transient=5))]
+    data = load_measurements([fault_rig.write(tmp_path / "short.csv", runs)], geared)
+    with pytest.raises(GearsymError, match=r"shorter than one revolution of gear2: 13 mesh periods"):
+        explain(geared, data, ["zeta", "B1"], candidates=["tooth_fault_gear2"])
+    # asked for as a kind (or in the default library) it is not tried on that gear, and the report says why; the
+    # pinion's (9 teeth) fits into the 10 mesh periods
+    ex = explain(geared, data, ["zeta", "B1"], candidates=["tooth_fault"])
+    assert list(ex.as_dict()["not_tried"]) == ["tooth_fault_gear2"] and "tooth_fault_gear1" in ex.library
+    assert "covers 10 mesh periods" in ex.as_dict()["not_tried"]["tooth_fault_gear2"]
+
+
+def test_shaft_order_effects_need_tooth_counts():
+    one_stage = gearsym.load("one_stage")
+    with pytest.raises(GearsymError, match="no gear of one_stage has a tooth count"):
+        candidate_library(one_stage, ["tooth_fault"])
+    with pytest.raises(GearsymError, match="'gear3' is not a gear with a tooth count"):
+        candidate_library(gearsym.load("one_stage", teeth=TEETH), ["eccentricity_gear3"])
+    assert not any(e.shaft_order for e in candidate_library(one_stage).values())  # none in the default library
+
+
+# --------------------------------------------------------------------------- the worked example
+EXAMPLE = REPO_ROOT / "docs" / "examples" / "explain-cracked-tooth"
+
+
+def example_commands() -> dict[str, list[str]]:
+    """The worked example's three commands, as docs/data-loop.md gives them."""
+    page = (REPO_ROOT / "docs" / "data-loop.md").read_text()
+    found = {}
+    for verb in ("simulate", "explain", "spectrum"):
+        line = re.search(rf"^\s*gearsym {verb} .*--teeth 20,53.*$", page, re.M).group(0).strip()
+        found[verb] = shlex.split(line)[1:]
+    return found
+
+
+def test_the_cracked_tooth_example_is_what_its_commands_write(tmp_path, monkeypatch):
+    commands = example_commands()
+    monkeypatch.chdir(tmp_path)
+    for verb in ("simulate", "explain", "spectrum"):
+        assert main([*commands[verb], *(["--quiet"] if verb == "explain" else [])]) == 0
+    assert (tmp_path / "measured.csv").read_bytes() == (EXAMPLE / "measured.csv").read_bytes(), (
+        "docs/examples/explain-cracked-tooth/measured.csv is not what docs/data-loop.md's command writes: rerun it")
+    for name in ("report.md", "derived_model.md"):
+        assert (tmp_path / name).read_text() == (EXAMPLE / name).read_text(), (
+            f"docs/examples/explain-cracked-tooth/{name} is out of date: rerun the commands in docs/data-loop.md")
+    report = json.loads((tmp_path / "report.json").read_text())
+    (fault,) = report["faults"]
+    assert report["effects"] == ["tooth_fault_gear1"] and fault["tooth"] == 7 and fault["gear"] == "gear1"
+    assert fault["severity"] == pytest.approx(0.3, abs=3 * fault["severity_stderr"])
+    assert "**tooth 7 of gear1: stiffness −29.3 % ± 0.42 %**" in (EXAMPLE / "report.md").read_text()
+    made, committed = (json.loads(p.read_text()) for p in (tmp_path / "spectrum.json", EXAMPLE / "spectrum.json"))
+    for a, b in zip(made["spectra"], committed["spectra"]):
+        assert [ln["label"] for ln in a["lines"]] == [ln["label"] for ln in b["lines"]]
+        np.testing.assert_allclose([ln["amplitude"] for ln in a["lines"]], [ln["amplitude"] for ln in b["lines"]],
+                                   rtol=1e-6, atol=1e-12)
