@@ -22,7 +22,7 @@ import gearsym
 from gearsym import explain, load_measurements
 from gearsym.cli import main
 from gearsym.errors import GearsymError
-from gearsym.fit.explain import candidate_library
+from gearsym.fit.selection import candidate_library
 from gearsym.paths import REPO_ROOT
 
 TEETH = (9, 13)
