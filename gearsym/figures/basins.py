@@ -97,7 +97,6 @@ def plot_basin_map(result, path: str | Path | None = None, shown: Shown | None =
     Figure."""
     plt = pyplot()
     from matplotlib.colors import ListedColormap
-    from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
     shown = shown or Shown()
@@ -122,9 +121,7 @@ def plot_basin_map(result, path: str | Path | None = None, shown: Shown | None =
         marker = REGIME_MARKERS.get(a.regime, "o")
         size = 28 if a.points.shape[1] <= 64 else 6
         ax.scatter(px, py, s=size, marker=marker, color=c, edgecolors=[_darker(c)], linewidths=0.9, zorder=3)
-        # (its colour keys the basin, its marker the regime the label names)
-        handles.append(Line2D([], [], ls="none", marker=marker, ms=9, markerfacecolor=c, markeredgecolor=_darker(c),
-                              label=attractor_label(a, shown, omega)))
+        handles.append(Patch(facecolor=c, edgecolor=_darker(c), label=attractor_label(a, shown, omega)))
     empty = []  # (a class no start is in has no colour on the map: the legend's title says so instead)
     for label, share, c in (("diverged", result.diverged, DIVERGED_COLOR), ("undetermined", result.undetermined,
                                                                              UNDETERMINED_COLOR)):
