@@ -1,0 +1,128 @@
+"""Monodromy matrices of many parameter points at once: one per lane, a block of points per native call.
+
+Each point has its own parameter vector; its constants are computed in the lanes from it, its tables of time
+are taken from a pool in which points whose tables are the same (the same values of the parameters that enter
+them: ``CompiledModel.timed_parameters``) share one. A point never runs on another point's table: the pool is
+keyed by those values, not by the order of the points (a chart across Theta or k_a has a table per value). The
+points are ordered by their table so that a block of L lanes mostly shares one (copied once per block).
+
+A model on the in-process backend, or without lanes, runs the scalar loops point by point (``shoot``): the same
+numbers, slower.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ..codegen.compiled import CompiledModel
+from ..codegen.lane_runs import LaneLibrary, chunked, lanes_of, threaded
+from ..errors import GearsymError
+from ..memory import check_fits
+
+#: points per native call (and per task of a threaded run)
+CALL_POINTS = 1024
+
+
+class MonodromyRunner:
+    """The monodromy matrices of ``model`` at many parameter vectors."""
+
+    def __init__(self, model: CompiledModel, *, lanes: bool = True, jobs: int = 0, verbose: bool = False):
+        self.model, self.jobs = model, jobs
+        self.library: LaneLibrary | None = lanes_of(model, verbose) if lanes else None
+        names = model.parameter_names
+        self.timed = [names.index(n) for n in names if n in model.timed_parameters]
+        self._tables: dict[bytes, int] = {}
+        self._pool: list[np.ndarray] = []
+
+    @property
+    def width(self) -> int:
+        return self.library.width if self.library else 1
+
+    def table_indices(self, p: np.ndarray) -> np.ndarray:
+        """The index in the pool of each point's tables (computed, and the period checked, once per distinct
+        value of the timed parameters)."""
+        distinct, first, inverse = distinct_rows(p[:, self.timed])
+        slots = np.empty(len(distinct), dtype=np.int64)
+        for k, row in enumerate(first):
+            key = distinct[k].tobytes()
+            slot = self._tables.get(key)
+            if slot is None:
+                inputs = self.model.prepare(np.array(p[row], dtype=float))
+                slot = self._tables[key] = len(self._pool)
+                self._pool.append(np.ascontiguousarray(inputs.table.reshape(-1, order="F")))
+            slots[k] = slot
+        return slots[inverse]
+
+    def run(self, p: np.ndarray, y0: np.ndarray, periods: int = 1,
+            progress: Callable[[int, int], None] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(state after ``periods`` periods, tangent map from the identity over them) for each row of ``p``
+        (points x parameters) from the row of ``y0`` (points x states)."""
+        model = self.model
+        p, y0 = np.asarray(p, dtype=float), np.asarray(y0, dtype=float)
+        count, n = len(p), model.dimension
+        if p.shape != (count, len(model.parameter_names)) or y0.shape != (count, n):
+            raise GearsymError(f"{model.name}: {p.shape} parameter vectors and {y0.shape} states do not fit "
+                               f"{len(model.parameter_names)} parameters and {n} states")
+        if not np.isfinite(p).all():
+            raise GearsymError(f"{model.name}: every parameter value of a chart must be finite")
+        check_fits(count, 8 * (n * n + 2 * n + p.shape[1]), asked=f"a chart of {count} points", item="point",
+                   what="each point's monodromy matrix, states and parameters")
+        y, M = np.empty((count, n)), np.empty((count, n, n))
+        if count == 0:
+            return y, M
+        tix = self.table_indices(p)
+        if self.library is None:
+            return self._scalar(p, y0, periods, tix, progress)
+        order = np.argsort(tix, kind="stable")  # points that share a table side by side
+        used = np.unique(tix)  # (the tables of these points only: a refinement's pool grows by the round)
+        pool = np.ascontiguousarray(np.stack([self._pool[k] for k in used]))
+        size = pool.shape[1]
+        P, Y = np.ascontiguousarray(p[order]), np.ascontiguousarray(y0[order])
+        T = np.ascontiguousarray(np.searchsorted(used, tix[order]).astype(np.int64))
+        out = np.empty((count, n, n))
+        lib, width = self.library, self.library.width
+        done = [0]
+
+        def work(rows: slice):
+            k = rows.stop - rows.start
+            buffer = np.empty(max(1, size) * width)
+            lib.monodromies(pool.ctypes.data, T[rows].ctypes.data, P[rows].ctypes.data, k, int(periods),
+                            Y[rows].ctypes.data, out[rows].ctypes.data, buffer.ctypes.data)
+            return k
+
+        chunks = [slice(c.start, c.stop) for c in chunked(count, CALL_POINTS)]
+        for finished in threaded(work, chunks, self.jobs):
+            done[0] += finished
+            if progress:
+                progress(done[0], count)
+        y[order], M[order] = Y, out
+        return y, M
+
+    def _scalar(self, p, y0, periods, tix, progress) -> tuple[np.ndarray, np.ndarray]:
+        model = self.model
+        y, M = np.empty_like(y0), np.empty((len(p), model.dimension, model.dimension))
+        for i in range(len(p)):
+            inputs = model.prepare(p[i])
+            shot = model.shoot(y0[i], inputs, pieces=model.shooting_pieces * int(periods))
+            y[i], M[i] = shot.state, shot.M
+            if progress and (i + 1) % 256 == 0:
+                progress(i + 1, len(p))
+        return y, M
+
+
+def distinct_rows(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(the distinct rows of ``keys``, the first row of each, the index of each row's among them): numpy's
+    ``unique(axis=0)`` by numeric sorts (it sorts rows as bytes, 100 times slower on a chart's 160 000 rows)."""
+    count = len(keys)
+    if keys.shape[1] == 0 or count == 0:
+        return keys[:min(1, count)], np.zeros(min(1, count), dtype=np.int64), np.zeros(count, dtype=np.int64)
+    order = np.lexsort(keys.T[::-1])
+    ordered = keys[order]
+    new = np.ones(count, dtype=bool)
+    new[1:] = np.any(ordered[1:] != ordered[:-1], axis=1)
+    group = np.cumsum(new) - 1
+    inverse = np.empty(count, dtype=np.int64)
+    inverse[order] = group
+    first = order[new]
+    return keys[first], first, inverse
