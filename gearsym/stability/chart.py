@@ -10,50 +10,24 @@ from __future__ import annotations
 import time
 from collections import Counter
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..checks import json_safe
-from ..codegen.build import compile_model
 from ..codegen.compiled import CompiledModel
-from ..codegen.verbs import engine_verb
 from ..errors import GearsymError
-from ..options import Integration
 from ..sweep.grid import Axis, axes_from
-from ..system import FirstOrderSystem
 from .boundaries import Boundary, Crossing, curves, grid_crossings, refine
 from .kinds import MARGIN, NO_ORBIT, NO_STATIC_STATE, classify, multipliers
-from .linearised import StaticRecipe, linearise, static_recipe
 from .monodromies import MonodromyRunner
 from .orbits import periodic_orbits
+from .recipe import STATIC_SUFFIX, CompiledLinearisation, StaticRecipe, anchor_parameter
 from .static_states import DRIVE, EDGE, GAP, solve_static
 
 ABOUT = ("static", "orbit")
 #: the default tolerance of a boundary: this fraction of the axis's range
 RELATIVE_TOLERANCE = 1e-7
-
-
-@dataclass(frozen=True)
-class CompiledLinearisation:
-    """A model's linearisation about its static state, compiled: the linear system's compiled model, the static
-    recipe, the states its Jacobian depends on, and the model's own name and parameters (a chart's axes)."""
-
-    model: CompiledModel
-    recipe: StaticRecipe
-    anchors: tuple[str, ...]
-    base: str
-    base_parameters: Mapping[str, float]
-
-
-def compile_linearisation(system: FirstOrderSystem, options: Integration | None = None, *,
-                          verbose: bool = False) -> CompiledLinearisation:
-    """Linearise ``system`` about its static state and compile the linear system (its tables factored: a chart
-    across omega never recomputes them; it has no backlash of the state, so nothing to locate)."""
-    lin = linearise(system)
-    options = replace(options or Integration(), locate_crossings=True)
-    model = compile_model(lin.system, options, verbose=verbose)
-    return CompiledLinearisation(model, lin.static, lin.anchors, system.name, dict(system.parameters))
 
 
 @dataclass(frozen=True)
@@ -158,7 +132,7 @@ class _Static:
         self.runner = MonodromyRunner(lin.model, lanes=lanes, jobs=jobs, verbose=verbose)
         names = lin.model.parameter_names
         self.base_columns = [names.index(n) for n in grid.names]
-        self.anchor_columns = [names.index(f"{s}_static") for s in lin.anchors]
+        self.anchor_columns = [names.index(anchor_parameter(s)) for s in lin.anchors]
         self.anchor_states = [lin.recipe.states.index(s) for s in lin.anchors]
         self.flanks: dict[str, dict[str, int]] = {}
         self.missing = 0
@@ -347,7 +321,7 @@ def chart_axes(model_parameters: Sequence[str], grid) -> tuple[Axis, ...]:
     for ax in axes:
         if ax.name not in model_parameters:
             raise GearsymError(f"{ax.name} is not a parameter of the model (parameters: {', '.join(model_parameters)})")
-        if ax.name.endswith("_static"):
+        if ax.name.endswith(STATIC_SUFFIX):
             raise GearsymError(f"{ax.name} is where the linearisation is taken, not a parameter to chart")
     return axes
 
@@ -384,27 +358,3 @@ def _values(parameters: Mapping[str, float], values: Mapping[str, float], model:
     if unknown:
         raise GearsymError(f"{model}: no parameter {', '.join(unknown)} (parameters: {', '.join(parameters)})")
     return {**{k: float(v) for k, v in parameters.items()}, **{k: float(v) for k, v in values.items()}}
-
-
-@engine_verb
-def stability_chart(model: CompiledModel, grid, *, about: str = "static", options: Integration | None = None,
-                    refine: bool = True, tolerance=None, lanes: bool = True, jobs: int = 0, progress=None,
-                    verbose: bool = False, **values: float) -> StabilityChart:
-    """The stability chart of ``model`` over ``grid`` (``{"omega": values, "k_a": values}``, or ``--param``
-    strings): about its static state (default: the model linearised there, backlash at its static deflection)
-    or about its period-1 orbit (``about="orbit"``: found by shooting from the static state). The other
-    parameters at ``values`` (else the model's). ``tolerance``: the boundaries' (one number, or one per axis;
-    default 1e-7 of each axis's range); ``refine=False``: boundaries at the midpoints of the grid lines."""
-    if about not in ABOUT:
-        raise GearsymError(f"about={about!r}: linearise about 'static' (the static state) or 'orbit' (the "
-                           "period-1 orbit)")
-    system = getattr(model.system, "full", model.system)
-    if about == "static":
-        lin = compile_linearisation(system, options or model.integration, verbose=verbose)
-        defaults = dict(zip(model.parameter_names, model.parameter_vector(values).tolist()))
-        lin = replace(lin, base_parameters=defaults)
-        return static_chart(lin, grid, refine=refine, tolerance=tolerance, lanes=lanes, jobs=jobs,
-                            progress=progress, verbose=verbose)
-    model.run_options(options)
-    return orbit_chart(model, static_recipe(system), grid, refine=refine, tolerance=tolerance, lanes=lanes,
-                       jobs=jobs, progress=progress, verbose=verbose, **values)

@@ -21,44 +21,20 @@ problem as a small CasADi function, so that a chart's static states need no SymP
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, replace
 
 import casadi as ca
 import sympy as sp
 from sympy.simplify.fu import TR8
 
+from ..codegen.build import compile_model
 from ..codegen.translate import to_casadi
 from ..errors import ModelError
+from ..options import Integration
 from ..symbols import parameter_symbol
 from ..system import FirstOrderSystem
+from .recipe import STATIC_SUFFIX, CompiledLinearisation, StaticRecipe, anchor_parameter
 
-#: the suffix of the parameters that carry the static state into the linearised system
-STATIC_SUFFIX = "_static"
-
-
-@dataclass(frozen=True)
-class StaticRecipe:
-    """The static state of a model as a problem in numbers: ``unknowns`` (the states not at rest) solve
-    residual(unknowns, parameters) = 0, the other states being 0 (rates at rest). The residual depends only on
-    the parameters ``depends`` (the rows' own parameter factors taken out: omega in the tau-form does not move
-    the static state), so a chart solves it once per distinct value of those. ``function``: a serialised CasADi
-    function (unknowns, depends) -> (residual, d residual / d unknowns, contact deflection of each mesh with
-    backlash, its backlash); ``meshes``: their names."""
-
-    states: tuple[str, ...]
-    unknowns: tuple[str, ...]
-    depends: tuple[str, ...]
-    meshes: tuple[str, ...]
-    function: str = field(repr=False)
-
-    def as_dict(self) -> dict:
-        return {"states": list(self.states), "unknowns": list(self.unknowns), "depends": list(self.depends),
-                "meshes": list(self.meshes), "function": self.function}
-
-    @classmethod
-    def from_dict(cls, d: dict) -> "StaticRecipe":
-        return cls(tuple(map(str, d["states"])), tuple(map(str, d["unknowns"])), tuple(map(str, d["depends"])),
-                   tuple(map(str, d["meshes"])), str(d["function"]))
 
 
 @dataclass(frozen=True)
@@ -74,10 +50,6 @@ class Linearised:
     @property
     def anchor_parameters(self) -> tuple[str, ...]:
         return tuple(anchor_parameter(s) for s in self.anchors)
-
-
-def anchor_parameter(state: str) -> str:
-    return f"{state}{STATIC_SUFFIX}"
 
 
 def linearise(system: FirstOrderSystem) -> Linearised:
@@ -200,5 +172,15 @@ def normalised(row: sp.Expr, states) -> sp.Expr:
     return numerator
 
 
-__all__ = ["Linearised", "STATIC_SUFFIX", "StaticRecipe", "anchor_parameter", "linearise", "static_recipe",
-           "time_mean"]
+def compile_linearisation(system: FirstOrderSystem, options: Integration | None = None, *,
+                          verbose: bool = False) -> CompiledLinearisation:
+    """Linearise ``system`` about its static state and compile the linear system (its tables factored: a chart
+    across omega never recomputes them; it has no backlash of the state, so nothing to locate)."""
+    lin = linearise(system)
+    options = replace(options or Integration(), locate_crossings=True)
+    model = compile_model(lin.system, options, verbose=verbose)
+    return CompiledLinearisation(model, lin.static, lin.anchors, system.name, dict(system.parameters))
+
+
+__all__ = ["CompiledLinearisation", "Linearised", "STATIC_SUFFIX", "StaticRecipe", "anchor_parameter",
+           "compile_linearisation", "linearise", "static_recipe", "time_mean"]

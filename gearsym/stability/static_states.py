@@ -13,7 +13,7 @@ from functools import lru_cache
 import casadi as ca
 import numpy as np
 
-from .linearised import StaticRecipe
+from .recipe import StaticRecipe
 from .monodromies import distinct_rows
 
 #: Newton steps before a point's static state is declared not found
