@@ -93,10 +93,10 @@ def static_recipe(system: FirstOrderSystem) -> StaticRecipe:
             present = row.free_symbols & set(states)
             if len(present) == 1:
                 s = next(iter(present))
-                if row.xreplace({s: 0}) == 0 and not (sp.diff(row, s).free_symbols & set(states)):
+                if row.xreplace({s: sp.S.Zero}) == 0 and not (sp.diff(row, s).free_symbols & set(states)):
                     resting[s], changed = sp.S.Zero, True
                     used.add(i)
-                    rows = [r.xreplace({s: 0}) for r in rows]
+                    rows = [r.xreplace({s: sp.S.Zero}) for r in rows]
     unknowns = tuple(s for s in states if s not in resting)
     remaining = [normalised(rows[i], states) for i in range(len(rows)) if i not in used]
     if len(remaining) != len(unknowns):
