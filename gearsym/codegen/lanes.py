@@ -97,7 +97,7 @@ def lanes_source(text: str, mf: ModelFunctions) -> str:
                            constants=False))
     out += _lane_steps(s)
     out += _entries(s)
-    out.append(_monodromies(s, len(mf.system.parameters)))
+    out += [_points(s, len(mf.system.parameters), tangent) for tangent in (True, False)]
     return "\n".join(out) + "\n#ifdef __cplusplus\n} /* extern \"C\" */\n#endif\n"
 
 
@@ -249,26 +249,32 @@ def _entries(s: _Shape) -> list[str]:
     ]
 
 
-def _monodromies(s: _Shape, parameters: int) -> str:
-    """The entry point of a chart of many parameter points (:mod:`gearsym.stability`): each point's constants
-    from its own parameters, its tables from a pool of tables (points that share their tables share one), and
-    ``periods`` periods of its state and of the tangent map from the identity, without re-orthonormalisation:
-    the monodromy matrix of one period, L points per pass through the period."""
-    n, o, size = s.n, len(s.observed), s.rows * s.N
+def _points(s: _Shape, parameters: int, tangent: bool) -> str:
+    """The entry points of many parameter points (:mod:`gearsym.stability`): each point's constants from its own
+    parameters, its tables from a pool of tables (points that share their tables share one), and ``periods``
+    periods of its state and (``tangent``) of the tangent map from the identity, without re-orthonormalisation:
+    the monodromy matrix, L points per pass through the period. Without the tangent (``gearsym_lanes_states``),
+    the state alone: for a linear system, whose state is its own tangent, the columns of its monodromy matrix
+    from the columns of the identity, at the cost of one vector each."""
+    n, size = s.n, s.rows * s.N
     observed = " ".join(f"lo[GS_L*{i} + l] = yl[GS_L*{j} + l]; hi[GS_L*{i} + l] = yl[GS_L*{j} + l];"
                         for i, j in enumerate(s.observed))
+    name, extra = ("gearsym_lanes_monodromies", "casadi_real* restrict M, ") if tangent else ("gearsym_lanes_states", "")
+    what = ("the state after them is written over y + n*i, the tangent map to\n"
+            "   M + n*n*i (row r of column j at r*n + j: d y_r / d y0_j)" if tangent else
+            "the state after them is written over y + n*i")
     return (
-        "/* the monodromy matrices of `count` parameter points, GS_L at a time: point i has the parameters\n"
+        f"/* `periods` periods of `count` parameter points{', state and tangent' if tangent else ', the state alone'}, "
+        "GS_L at a time: point i has the parameters\n"
         f"   p + {parameters}*i, its tables at pool + {size}*tix[i] (rows x steps of one period, column-major, as the\n"
-        "   scalar loops read them: points whose tables are the same share one), and starts at y + n*i; `periods`\n"
-        "   periods of its state and of the tangent map from the identity (no re-orthonormalisation), its constants\n"
-        "   computed here from its parameters; the state after them is written over y + n*i, the tangent map to\n"
-        "   M + n*n*i (row r of column j at r*n + j: d y_r / d y0_j). work: room for GS_L tables. */\n"
-        "CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_monodromies(const casadi_real* restrict pool, "
+        "   scalar loops read them: points whose tables are the same share one), and starts at y + n*i; its constants\n"
+        f"   are computed here from its parameters; {what}. work: room for GS_L tables. */\n"
+        f"CASADI_SYMBOL_EXPORT GS_TARGETS int {name}(const casadi_real* restrict pool, "
         "const long long* restrict tix, const casadi_real* restrict p, long long count, long long periods, "
-        "casadi_real* restrict y, casadi_real* restrict M, casadi_real* restrict work) {\n"
+        f"casadi_real* restrict y, {extra}casadi_real* restrict work) {{\n"
         f"  casadi_real pl[{max(1, parameters)}*GS_L], cl[{s.nc}*GS_L], per[GS_L], yl[{s.size('y')}*GS_L], "
-        f"Ql[{s.size('Q')}*GS_L], lo[{s.size('o')}*GS_L], hi[{s.size('o')}*GS_L];\n"
+        + (f"Ql[{s.size('Q')}*GS_L], " if tangent else "")
+        + f"lo[{s.size('o')}*GS_L], hi[{s.size('o')}*GS_L];\n"
         "  long long last[GS_L], b, k, q; casadi_int l, i;\n"
         "  for (l = 0; l < GS_L; ++l) last[l] = -1;\n"
         "  for (b = 0; b < count; b += GS_L) {\n"
@@ -276,8 +282,8 @@ def _monodromies(s: _Shape, parameters: int) -> str:
         "      q = b + l < count ? b + l : count - 1;\n"
         f"      for (i = 0; i < {parameters}; ++i) pl[GS_L*i + l] = p[{parameters}*q + i];\n"
         f"      for (i = 0; i < {n}; ++i) yl[GS_L*i + l] = y[{n}*q + i];\n"
-        f"      for (i = 0; i < {n * n}; ++i) Ql[GS_L*i + l] = i % {n + 1} == 0;\n"
-        f"      if (tix[q] != last[l]) {{  /* a table of another point: copied into this lane */\n"
+        + (f"      for (i = 0; i < {n * n}; ++i) Ql[GS_L*i + l] = i % {n + 1} == 0;\n" if tangent else "")
+        + "      if (tix[q] != last[l]) {  /* a table of another point: copied into this lane */\n"
         f"        const casadi_real* t = pool + {size}*tix[q];\n"
         f"        for (i = 0; i < {size}; ++i) work[GS_L*i + l] = t[i];\n"
         "        last[l] = tix[q];\n"
@@ -286,12 +292,12 @@ def _monodromies(s: _Shape, parameters: int) -> str:
         "    gsl_constants(pl, cl, per);\n"
         "    for (k = 0; k < periods; ++k) {\n"
         + (f"      for (l = 0; l < GS_L; ++l) {{ {observed} }}\n" if observed else "")
-        + f"      gsl_tangent_span(yl, Ql, lo, hi, work, cl, {s.blocks});\n"
-        "    }\n"
+        + (f"      gsl_tangent_span(yl, Ql, lo, hi, work, cl, {s.blocks});\n" if tangent else
+           f"      gsl_state_span(yl, lo, hi, work, cl, {s.blocks});\n")
+        + "    }\n"
         "    for (l = 0; l < GS_L && b + l < count; ++l) {\n"
         f"      for (i = 0; i < {n}; ++i) y[{n}*(b + l) + i] = yl[GS_L*i + l];\n"
-        f"      for (i = 0; i < {n * n}; ++i) M[{n * n}*(b + l) + i] = Ql[GS_L*i + l];\n"
-        "    }\n"
+        + (f"      for (i = 0; i < {n * n}; ++i) M[{n * n}*(b + l) + i] = Ql[GS_L*i + l];\n" if tangent else "")
+        + "    }\n"
         "  }\n"
         "  return 0;\n}\n")
-

@@ -129,7 +129,7 @@ class _Static:
 
     def __init__(self, lin: CompiledLinearisation, grid: _Grid, lanes: bool, jobs: int, verbose: bool):
         self.lin, self.grid = lin, grid
-        self.runner = MonodromyRunner(lin.model, lanes=lanes, jobs=jobs, verbose=verbose)
+        self.runner = MonodromyRunner(lin.model, lanes=lanes, jobs=jobs, verbose=verbose, linear=True)
         names = lin.model.parameter_names
         self.base_columns = [names.index(n) for n in grid.names]
         self.anchor_columns = [names.index(anchor_parameter(s)) for s in lin.anchors]

@@ -29,13 +29,15 @@ REAL = 1e-7
 def multipliers(M: np.ndarray) -> np.ndarray:
     """The multipliers of each matrix of ``M`` (points x n x n), largest modulus first (points x n)."""
     if M.shape[-1] == 2:  # (closed form: numpy's eigvals costs microseconds a matrix, a chart has 10^5)
-        half = ((M[:, 0, 0] + M[:, 1, 1]) / 2).astype(complex)
+        half = (M[:, 0, 0] + M[:, 1, 1]) / 2
         det = M[:, 0, 0] * M[:, 1, 1] - M[:, 0, 1] * M[:, 1, 0]
-        root = np.sqrt(half ** 2 - det)
-        big = half + np.where(half.real >= 0, 1, -1) * root  # (no cancellation: the other is det / big)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            small = np.where(big != 0, det / np.where(big != 0, big, 1), half - root)
-        mu = np.column_stack([big, small])
+        disc = half * half - det
+        real = disc >= 0
+        root = np.sqrt(np.abs(disc))
+        big = np.where(real, half + np.where(half >= 0, 1.0, -1.0) * root, half) + 1j * np.where(real, 0.0, root)
+        with np.errstate(invalid="ignore", divide="ignore"):  # (no cancellation: the other real one is det / big)
+            other = np.where(big.real != 0, det / np.where(big.real != 0, big.real, 1.0), half - root)
+        mu = np.column_stack([big, np.where(real, other + 0j, np.conj(big))])
     else:
         mu = np.linalg.eigvals(M)
     order = np.lexsort((-mu.imag, -np.abs(mu)), axis=-1)

@@ -27,8 +27,10 @@ CALL_POINTS = 1024
 class MonodromyRunner:
     """The monodromy matrices of ``model`` at many parameter vectors."""
 
-    def __init__(self, model: CompiledModel, *, lanes: bool = True, jobs: int = 0, verbose: bool = False):
-        self.model, self.jobs = model, jobs
+    def __init__(self, model: CompiledModel, *, lanes: bool = True, jobs: int = 0, verbose: bool = False,
+                 linear: bool = False):
+        """``linear``: the model is linear and homogeneous (a linearisation): its state alone gives the matrix."""
+        self.model, self.jobs, self.linear = model, jobs, linear
         self.library: LaneLibrary | None = lanes_of(model, verbose) if lanes else None
         names = model.parameter_names
         self.timed = [names.index(n) for n in names if n in model.timed_parameters]
@@ -66,38 +68,52 @@ class MonodromyRunner:
                                f"{len(model.parameter_names)} parameters and {n} states")
         if not np.isfinite(p).all():
             raise GearsymError(f"{model.name}: every parameter value of a chart must be finite")
-        check_fits(count, 8 * (n * n + 2 * n + p.shape[1]), asked=f"a chart of {count} points", item="point",
-                   what="each point's monodromy matrix, states and parameters")
-        y, M = np.empty((count, n)), np.empty((count, n, n))
+        check_fits(count, 8 * (2 * n * n + 2 * n + n * p.shape[1]), asked=f"a chart of {count} points",
+                   item="point", what="each point's monodromy matrix, states and parameters")
         if count == 0:
-            return y, M
+            return np.empty((0, n)), np.empty((0, n, n))
         tix = self.table_indices(p)
         if self.library is None:
             return self._scalar(p, y0, periods, tix, progress)
-        order = np.argsort(tix, kind="stable")  # points that share a table side by side
+        if self.linear:  # the state is its own tangent: the identity's columns, one lane each
+            columns = self._lanes(self.library.states, np.repeat(p, n, axis=0), np.tile(np.eye(n), (count, 1)),
+                                  np.repeat(tix, n), periods, None, progress, n)
+            M = columns.reshape(count, n, n).transpose(0, 2, 1)
+            return np.einsum("kij,kj->ki", M, y0), M
+        M = np.empty((count, n, n))
+        y = self._lanes(self.library.monodromies, p, y0, tix, periods, M, progress, 1)
+        return y, M
+
+    def _lanes(self, entry, p, y, tix, periods, M, progress, per_point: int) -> np.ndarray:
+        """The lanes' ``entry`` on every row, ordered by table (points that share one side by side), in chunks of
+        :data:`CALL_POINTS` rows on up to ``jobs`` threads; returns the final states (and fills ``M``)."""
+        count = len(p)
+        order = np.argsort(tix, kind="stable")
         used = np.unique(tix)  # (the tables of these points only: a refinement's pool grows by the round)
         pool = np.ascontiguousarray(np.stack([self._pool[k] for k in used]))
-        size = pool.shape[1]
-        P, Y = np.ascontiguousarray(p[order]), np.ascontiguousarray(y0[order])
+        size, width = pool.shape[1], self.library.width
+        P, Y = np.ascontiguousarray(p[order]), np.ascontiguousarray(y[order])
         T = np.ascontiguousarray(np.searchsorted(used, tix[order]).astype(np.int64))
-        out = np.empty((count, n, n))
-        lib, width = self.library, self.library.width
-        done = [0]
+        out = None if M is None else np.empty_like(M)
 
         def work(rows: slice):
             k = rows.stop - rows.start
             buffer = np.empty(max(1, size) * width)
-            lib.monodromies(pool.ctypes.data, T[rows].ctypes.data, P[rows].ctypes.data, k, int(periods),
-                            Y[rows].ctypes.data, out[rows].ctypes.data, buffer.ctypes.data)
+            matrices = () if out is None else (out[rows].ctypes.data,)
+            entry(pool.ctypes.data, T[rows].ctypes.data, P[rows].ctypes.data, k, int(periods), Y[rows].ctypes.data,
+                  *matrices, buffer.ctypes.data)
             return k
 
-        chunks = [slice(c.start, c.stop) for c in chunked(count, CALL_POINTS)]
-        for finished in threaded(work, chunks, self.jobs):
-            done[0] += finished
+        done = 0
+        for finished in threaded(work, [slice(c.start, c.stop) for c in chunked(count, CALL_POINTS)], self.jobs):
+            done += finished
             if progress:
-                progress(done[0], count)
-        y[order], M[order] = Y, out
-        return y, M
+                progress(done // per_point, count // per_point)
+        final = np.empty_like(Y)
+        final[order] = Y
+        if M is not None:
+            M[order] = out
+        return final
 
     def _scalar(self, p, y0, periods, tix, progress) -> tuple[np.ndarray, np.ndarray]:
         model = self.model
