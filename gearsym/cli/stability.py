@@ -97,6 +97,10 @@ def run(args: argparse.Namespace) -> int:
         chart = orbit_chart(compiled, recipe, axes, **common)
     if progress:
         progress.done()
+    prediction = None
+    if args.plot and args.about == "static" and len(lin.recipe.meshes) > 1:  # (the phasing rule's panel)
+        factor = given[0].values[0] / axes[0].values[0] if axes[0].values[0] else 1.0
+        prediction = stability.phasing_prediction(chart, lin, factor=factor)
     shown: Shown = Shown()
     if scaling is not None:
         chart = chart_in_units(chart, tuple(given), tuple(axes))
@@ -107,7 +111,6 @@ def run(args: argparse.Namespace) -> int:
         write_atomically(sidecar(args.out, ".json"), json.dumps(chart.as_dict(), indent=1) + "\n")
         print(f"gearsym: wrote {args.out} and {sidecar(args.out, '.json')}", file=sys.stderr)
     if args.plot:
-        prediction = stability.phasing_prediction(chart, lin) if args.about == "static" and _phased(lin) else None
         formula = settings.get("k")
         plot_stability(chart, args.plot, shown=shown, prediction=prediction,
                        title=f"{chart.model} with k(τ) = {formula}" if isinstance(formula, str) else None)
@@ -117,11 +120,6 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(report(chart, shown, seconds))
     return 0
-
-
-def _phased(lin) -> bool:
-    """A chart gets the mesh-phasing panel when the model has several meshes (a planetary set)."""
-    return len(lin.recipe.meshes) > 1
 
 
 def _linearisation(args, settings, options):

@@ -109,24 +109,26 @@ def draw_prediction(ax, prediction, chart: StabilityChart) -> None:
     a, b = chart.values
     for curve in chart.boundaries:
         ax.plot(curve.points[:, 0], curve.points[:, 1], color="0.65", lw=0.7)
-    top = float(np.max(b))
+    top, bottom, span = float(np.max(b)), float(np.min(b)), float(np.ptp(a)) or 1.0
     kept_drawn = suppressed_drawn = False
     for t in prediction.tongues:
         if not (np.min(a) <= t.centre <= np.max(a)):
             continue
         if t.suppressed:
-            ax.plot([t.centre, t.centre], [np.min(b), top], ls=":", color="#b03030", lw=1.0)
-            ax.plot([t.centre], [top], marker="x", color="#b03030", ms=6, clip_on=False,
-                    label=None if suppressed_drawn else "suppressed by the mesh phasing (coupling 0)")
+            ax.plot([t.centre, t.centre], [bottom, top], ls=":", color="#b03030", lw=1.0)
+            ax.plot([t.centre], [bottom], marker="x", color="#b03030", ms=6, ls="none",
+                    label=None if suppressed_drawn else "suppressed by the mesh phasing (its coupling is 0)")
             suppressed_drawn = True
         else:
+            if 2 * t.half_width < 2e-3 * span:  # (too thin to see at this scale: left out, and not labelled)
+                continue
             eps = np.linspace(0, top, 50)
             lo, hi = t.edges(eps, prediction.scale)
-            ax.fill_betweenx(eps, lo, hi, color=KIND_COLORS[t.kind], alpha=0.6, lw=0,
-                             label=None if kept_drawn else "first-order tongue (kept by the phasing)")
+            ax.fill_betweenx(eps, lo, hi, color=KIND_COLORS[t.kind], alpha=0.55, lw=0,
+                             label=None if kept_drawn else "first-order tongue, undamped (kept by the phasing)")
             kept_drawn = True
-        ax.annotate(t.label, (t.centre, top), xytext=(0, 3), textcoords="offset points", fontsize=6,
-                    rotation=90, ha="center", va="bottom", annotation_clip=False)
+        ax.annotate(t.label, (t.centre, bottom), xytext=(2, 4), textcoords="offset points", fontsize=6.5,
+                    rotation=90, ha="left", va="bottom", color="#b03030" if t.suppressed else "black")
     ax.set_xlim(_edges(np.asarray(a))[[0, -1]])
     ax.set_ylim(_edges(np.asarray(b))[[0, -1]])
     ax.set_xlabel(axis_label(chart.names[0], chart.units[0]))

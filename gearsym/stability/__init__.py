@@ -21,7 +21,8 @@ _LAZY = {"ABOUT": "chart", "StabilityChart": "chart", "static_chart": "chart", "
          "FOLD": "kinds", "KINDS": "kinds", "NEIMARK_SACKER": "kinds", "NO_ORBIT": "kinds",
          "NO_STATIC_STATE": "kinds", "PERIOD_DOUBLING": "kinds",
          "Linearised": "linearised", "compile_linearisation": "linearised", "linearise": "linearised",
-         "static_recipe": "linearised", "stability_chart": "verb"}
+         "static_recipe": "linearised", "stability_chart": "verb",
+         "PhasingPrediction": "phasing", "phasing_prediction": "phasing"}
 
 __all__ = sorted(_LAZY)
 

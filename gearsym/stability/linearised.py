@@ -63,7 +63,10 @@ def linearise(system: FirstOrderSystem) -> Linearised:
         raise ModelError(f"cannot linearise: the parameter names {', '.join(clash)} are taken", system.name)
     at = {s: parameter_symbol(anchor_parameter(s.name)) for s in anchors}
     J = jacobian.xreplace(at)
-    rhs = tuple(sp.Add(*(J[i, j] * states[j] for j in range(len(states)) if J[i, j] != 0))
+    # each entry's terms (a mesh's contribution each) times its state: a term's time-free factors then separate
+    # from its k(tau) into a constant (codegen/time_tables.py), so the tables depend on k(tau)'s parameters
+    # alone, not on omega: a chart across omega shares them
+    rhs = tuple(sp.Add(*(t * states[j] for j in range(len(states)) for t in sp.Add.make_args(J[i, j]) if t != 0))
                 for i in range(len(states)))
     recipe = static_recipe(system)
     parameters = {**system.parameters, **{anchor_parameter(s.name): 0.0 for s in anchors}}

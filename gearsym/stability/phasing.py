@@ -28,8 +28,8 @@ from .kinds import FOLD, NEIMARK_SACKER, PERIOD_DOUBLING
 from .recipe import CompiledLinearisation, anchor_parameter
 from .static_states import solve_static
 
-#: harmonics of the mesh frequency looked at
-HARMONICS = 6
+#: harmonics of the mesh frequency looked at (the higher ones' tongues are too thin to see on a chart)
+HARMONICS = 3
 #: samples of a period for the harmonics (exact for the models' Fourier series of lower degree)
 SAMPLES = 64
 #: a coupling below this fraction of the largest is cancelled (by the phasing)
@@ -68,6 +68,8 @@ def phasing_prediction(chart: StabilityChart, lin: CompiledLinearisation, freque
     unit of omega for a chart along the speed). None where the chart's axes are not those."""
     model = lin.model
     names = model.parameter_names
+    if chart.names[0] != frequency_axis:
+        return None
     variation = chart.names[1]
     engine_variation = variation if variation in lin.base_parameters else None
     if engine_variation is None or frequency_axis not in lin.base_parameters:
