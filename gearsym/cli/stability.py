@@ -76,9 +76,10 @@ def run(args: argparse.Namespace) -> int:
         raise GearsymError(f"give two --param axes (got {len(given)}); for a line give the second one value, e.g. "
                            "--param k_a=0.2")
     options = integration_from(args)
+    _formula_axes(args, given)
     scaling = scaling_from(args)
     axes = _engine_axes(given, scaling)
-    refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], parse_settings(args.set))
+    refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], _user_settings(args))
     tolerance = tuple(args.tolerance * (max(a.values) - min(a.values) or max(1.0, abs(a.values[0]))) for a in axes)
     progress = None if args.quiet else _Progress()
     settings = model_settings(args)
@@ -120,6 +121,24 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(report(chart, shown, seconds))
     return 0
+
+
+def _user_settings(args) -> dict:
+    """--set's values as the user gave them (without a swept formula parameter's placeholder)."""
+    return parse_settings(args.set[:len(args.set) - getattr(args, "placeholders", 0)])
+
+
+def _formula_axes(args, given) -> None:
+    """A parameter that a ``--set k=...`` formula introduces (k_a in "1+k_a*cos(tau)") needs a value to load the
+    model; swept, it takes its axis's first value for that (the axis sets every point's own)."""
+    set_names = {pair.partition("=")[0].strip() for pair in args.set}
+    formulas = [value for name, value in parse_settings(args.set).items() if name == "k"]
+    if not formulas:
+        return
+    introduced = {s.name for f in formulas for s in gearsym.parse_formula(f, "--set k").free_symbols}
+    added = [f"{a.name}={a.values[0]!r}" for a in given if a.name in introduced and a.name not in set_names
+             and not a.unit]
+    args.set, args.placeholders = list(args.set) + added, len(added)
 
 
 def _linearisation(args, settings, options):

@@ -54,4 +54,5 @@ def chart_in_units(chart: StabilityChart, given: tuple[Axis, Axis], engine: tupl
                    f"{g.name} in {g.unit}" for g, e in zip(given, engine) if g.name != e.name or g.unit]
     return replace(chart, names=(given[0].name, given[1].name), values=values, crossings=tuple(crossings),
                    boundaries=tuple(boundaries), tolerance=tolerance, units=(given[0].unit, given[1].unit),
+                   engine=(engine[0].name, engine[1].name),
                    notes=chart.notes + tuple(engine_note))

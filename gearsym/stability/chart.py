@@ -55,7 +55,7 @@ class StabilityChart:
     notes: tuple[str, ...] = ()
     timings: dict = field(default_factory=dict)
     units: tuple[str, str] = ("", "")
-    title: str = ""
+    engine: tuple[str, str] = ()  # the engine's parameters the axes move, where they are shown as others (speed)
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -64,7 +64,7 @@ class StabilityChart:
     @property
     def fixed(self) -> dict[str, float]:
         """The parameters held over the chart."""
-        return {k: v for k, v in self.parameters.items() if k not in self.names}
+        return {k: v for k, v in self.parameters.items() if k not in (*self.names, *self.engine)}
 
     def points(self) -> list[dict]:
         a, b = self.values
