@@ -254,35 +254,48 @@ def _points(s: _Shape, parameters: int, tangent: bool) -> str:
     parameters, its tables from a pool of tables (points that share their tables share one), and ``periods``
     periods of its state and (``tangent``) of the tangent map from the identity, without re-orthonormalisation:
     the monodromy matrix, L points per pass through the period. Without the tangent (``gearsym_lanes_states``),
-    the state alone: for a linear system, whose state is its own tangent, the columns of its monodromy matrix
-    from the columns of the identity, at the cost of one vector each."""
-    n, size = s.n, s.rows * s.N
+    the state alone, and with ``columns`` = n the lanes take each point n times from the columns of the identity:
+    for a linear system, whose state is its own tangent, the columns of its monodromy matrix at the cost of one
+    vector each."""
+    n, size, P = s.n, s.rows * s.N, max(1, parameters)
     observed = " ".join(f"lo[GS_L*{i} + l] = yl[GS_L*{j} + l]; hi[GS_L*{i} + l] = yl[GS_L*{j} + l];"
                         for i, j in enumerate(s.observed))
-    name, extra = ("gearsym_lanes_monodromies", "casadi_real* restrict M, ") if tangent else ("gearsym_lanes_states", "")
-    what = ("the state after them is written over y + n*i, the tangent map to\n"
-            "   M + n*n*i (row r of column j at r*n + j: d y_r / d y0_j)" if tangent else
-            "the state after them is written over y + n*i")
+    if tangent:
+        name, args = "gearsym_lanes_monodromies", "casadi_real* restrict y, casadi_real* restrict M, "
+        what = ("the state after them is written over y + n*i, the tangent map to M + n*n*i (row r of column j at\n"
+                "   r*n + j: d y_r / d y0_j)")
+        lanes, start = "count", f"      for (i = 0; i < {n}; ++i) yl[GS_L*i + l] = y[{n}*g + i];\n" \
+            f"      for (i = 0; i < {n * n}; ++i) Ql[GS_L*i + l] = i % {n + 1} == 0;\n"
+        point, span = "g", f"gsl_tangent_span(yl, Ql, lo, hi, work, cl, {s.blocks})"
+        store = (f"      for (i = 0; i < {n}; ++i) y[{n}*(b + l) + i] = yl[GS_L*i + l];\n"
+                 f"      for (i = 0; i < {n * n}; ++i) M[{n * n}*(b + l) + i] = Ql[GS_L*i + l];\n")
+    else:
+        name, args = "gearsym_lanes_states", "long long columns, casadi_real* restrict y, "
+        what = ("with columns = 0 it starts at y + n*i and its state after them is written there; with columns = c,\n"
+                "   lane g runs point g / c from the column g % c of the identity and writes its state to y + n*g")
+        lanes = "(columns ? count * columns : count)"
+        start = (f"      for (i = 0; i < {n}; ++i) yl[GS_L*i + l] = columns ? (i == g % columns) : y[{n}*g + i];\n")
+        point, span = "(columns ? g / columns : g)", f"gsl_state_span(yl, lo, hi, work, cl, {s.blocks})"
+        store = f"      for (i = 0; i < {n}; ++i) y[{n}*(b + l) + i] = yl[GS_L*i + l];\n"
     return (
         f"/* `periods` periods of `count` parameter points{', state and tangent' if tangent else ', the state alone'}, "
-        "GS_L at a time: point i has the parameters\n"
+        "GS_L lanes at a time: point i has the parameters\n"
         f"   p + {parameters}*i, its tables at pool + {size}*tix[i] (rows x steps of one period, column-major, as the\n"
-        "   scalar loops read them: points whose tables are the same share one), and starts at y + n*i; its constants\n"
-        f"   are computed here from its parameters; {what}. work: room for GS_L tables. */\n"
+        "   scalar loops read them: points whose tables are the same share one), its constants computed here from\n"
+        f"   its parameters; {what}. work: room for GS_L tables. */\n"
         f"CASADI_SYMBOL_EXPORT GS_TARGETS int {name}(const casadi_real* restrict pool, "
         "const long long* restrict tix, const casadi_real* restrict p, long long count, long long periods, "
-        f"casadi_real* restrict y, {extra}casadi_real* restrict work) {{\n"
-        f"  casadi_real pl[{max(1, parameters)}*GS_L], cl[{s.nc}*GS_L], per[GS_L], yl[{s.size('y')}*GS_L], "
+        f"{args}casadi_real* restrict work) {{\n"
+        f"  casadi_real pl[{P}*GS_L], cl[{s.nc}*GS_L], per[GS_L], yl[{s.size('y')}*GS_L], "
         + (f"Ql[{s.size('Q')}*GS_L], " if tangent else "")
         + f"lo[{s.size('o')}*GS_L], hi[{s.size('o')}*GS_L];\n"
-        "  long long last[GS_L], b, k, q; casadi_int l, i;\n"
+        f"  long long last[GS_L], b, k, g, q, total = {lanes}; casadi_int l, i;\n"
         "  for (l = 0; l < GS_L; ++l) last[l] = -1;\n"
-        "  for (b = 0; b < count; b += GS_L) {\n"
-        "    for (l = 0; l < GS_L; ++l) {  /* (lanes past the end repeat the last point: finite numbers) */\n"
-        "      q = b + l < count ? b + l : count - 1;\n"
+        "  for (b = 0; b < total; b += GS_L) {\n"
+        "    for (l = 0; l < GS_L; ++l) {  /* (lanes past the end repeat the last one: finite numbers) */\n"
+        f"      g = b + l < total ? b + l : total - 1;\n      q = {point};\n"
         f"      for (i = 0; i < {parameters}; ++i) pl[GS_L*i + l] = p[{parameters}*q + i];\n"
-        f"      for (i = 0; i < {n}; ++i) yl[GS_L*i + l] = y[{n}*q + i];\n"
-        + (f"      for (i = 0; i < {n * n}; ++i) Ql[GS_L*i + l] = i % {n + 1} == 0;\n" if tangent else "")
+        + start
         + "      if (tix[q] != last[l]) {  /* a table of another point: copied into this lane */\n"
         f"        const casadi_real* t = pool + {size}*tix[q];\n"
         f"        for (i = 0; i < {size}; ++i) work[GS_L*i + l] = t[i];\n"
@@ -292,12 +305,10 @@ def _points(s: _Shape, parameters: int, tangent: bool) -> str:
         "    gsl_constants(pl, cl, per);\n"
         "    for (k = 0; k < periods; ++k) {\n"
         + (f"      for (l = 0; l < GS_L; ++l) {{ {observed} }}\n" if observed else "")
-        + (f"      gsl_tangent_span(yl, Ql, lo, hi, work, cl, {s.blocks});\n" if tangent else
-           f"      gsl_state_span(yl, lo, hi, work, cl, {s.blocks});\n")
-        + "    }\n"
-        "    for (l = 0; l < GS_L && b + l < count; ++l) {\n"
-        f"      for (i = 0; i < {n}; ++i) y[{n}*(b + l) + i] = yl[GS_L*i + l];\n"
-        + (f"      for (i = 0; i < {n * n}; ++i) M[{n * n}*(b + l) + i] = Ql[GS_L*i + l];\n" if tangent else "")
+        + f"      {span};\n"
+        "    }\n"
+        "    for (l = 0; l < GS_L && b + l < total; ++l) {\n"
+        + store
         + "    }\n"
         "  }\n"
         "  return 0;\n}\n")

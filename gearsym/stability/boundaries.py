@@ -120,9 +120,10 @@ def curves(crossings: list[Crossing], a: np.ndarray, b: np.ndarray, unstable: np
     cells = set()  # the cells a crossing borders
     for axis, i, j in at:
         cells |= {(i, j), (i - 1, j)} if axis == 0 else {(i, j), (i, j - 1)}
-    whole = valid[:-1, :-1] & valid[1:, :-1] & valid[:-1, 1:] & valid[1:, 1:]
+    whole = (valid[:-1, :-1] & valid[1:, :-1] & valid[:-1, 1:] & valid[1:, 1:]).tolist()
+    corner = unstable.tolist()
     for ci, cj in sorted(cells):
-        if not (0 <= ci < len(b) - 1 and 0 <= cj < len(a) - 1) or not whole[ci, cj]:
+        if not (0 <= ci < len(b) - 1 and 0 <= cj < len(a) - 1) or not whole[ci][cj]:
             continue
         bottom, top, left, right = (0, ci, cj), (0, ci + 1, cj), (1, ci, cj), (1, ci, cj + 1)
         present = [e for e in (bottom, right, top, left) if e in at]
@@ -130,7 +131,7 @@ def curves(crossings: list[Crossing], a: np.ndarray, b: np.ndarray, unstable: np
             pairs = [tuple(present)]
         elif len(present) == 4:
             centre = float(np.mean(largest[ci:ci + 2, cj:cj + 2])) > 1.0
-            if unstable[ci, cj] == centre:  # the corner (ci, cj) joins the centre: cut off the other two
+            if corner[ci][cj] == centre:  # the corner (ci, cj) joins the centre: cut off the other two
                 pairs = [(bottom, right), (top, left)]
             else:
                 pairs = [(bottom, left), (top, right)]

@@ -8,7 +8,6 @@ in the lanes: :mod:`.monodromies`), and log2(step / tolerance) periods per bound
 from __future__ import annotations
 
 import time
-from collections import Counter
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -151,8 +150,7 @@ class _Static:
             mu[rows] = multipliers(M)
         if near is None:  # the grid itself: what the notes say
             self.missing = int((~ok).sum())
-            for mesh, flank in static.flank.items():
-                self.flanks[mesh] = dict(Counter(flank[ok].tolist()))
+            self.flanks = static.flank_counts
         return mu, ok
 
     def notes(self) -> list[str]:
@@ -272,7 +270,8 @@ def chart_of(problem, grid: _Grid, *, model: str, steps: int, parameters: dict, 
         found = refine(edges, grid.a, grid.b, un, kinds, evaluate, tol,
                        (lambda d, t_: progress("boundaries", d, t_)) if progress else None)
     else:
-        found = [Crossing(ax, i, j, *_midpoint(ax, i, j, grid), _unstable_kind(ax, i, j, un, kinds))
+        un_list, kind_list = un.tolist(), kinds.tolist()
+        found = [Crossing(ax, i, j, *_midpoint(ax, i, j, grid), _unstable_kind(ax, i, j, un_list, kind_list))
                  for ax, i, j in edges]
     refine_seconds = time.perf_counter() - t
     boundaries = curves(found, grid.a, grid.b, un, valid, largest)
@@ -292,9 +291,9 @@ def _midpoint(axis, i, j, grid) -> tuple[float, float]:
     return float((lo + hi) / 2), float(abs(hi - lo) / 2)
 
 
-def _unstable_kind(axis, i, j, un, kinds):
+def _unstable_kind(axis, i, j, un: list, kinds: list):
     i2, j2 = i + (axis == 1), j + (axis == 0)
-    return kinds[i, j] if un[i, j] else kinds[i2, j2]
+    return kinds[i][j] if un[i][j] else kinds[i2][j2]
 
 
 def _tolerances(grid: _Grid, tolerance) -> tuple[float, float]:

@@ -76,41 +76,50 @@ class MonodromyRunner:
         if self.library is None:
             return self._scalar(p, y0, periods, tix, progress)
         if self.linear:  # the state is its own tangent: the identity's columns, one lane each
-            columns = self._lanes(self.library.states, np.repeat(p, n, axis=0), np.tile(np.eye(n), (count, 1)),
-                                  np.repeat(tix, n), periods, None, progress, n)
+            columns = self._lanes(p, None, tix, periods, progress, n)
             M = columns.reshape(count, n, n).transpose(0, 2, 1)
             return np.einsum("kij,kj->ki", M, y0), M
         M = np.empty((count, n, n))
-        y = self._lanes(self.library.monodromies, p, y0, tix, periods, M, progress, 1)
-        return y, M
+        return self._lanes(p, y0, tix, periods, progress, 0, M), M
 
-    def _lanes(self, entry, p, y, tix, periods, M, progress, per_point: int) -> np.ndarray:
-        """The lanes' ``entry`` on every row, ordered by table (points that share one side by side), in chunks of
-        :data:`CALL_POINTS` rows on up to ``jobs`` threads; returns the final states (and fills ``M``)."""
-        count = len(p)
-        order = np.argsort(tix, kind="stable")
+    def _lanes(self, p, y, tix, periods, progress, columns: int, M=None) -> np.ndarray:
+        """The lanes on every point, ordered by table (points that share one side by side), in chunks of
+        :data:`CALL_POINTS` points on up to ``jobs`` threads: the final states (``columns``: n of them per point,
+        from the identity's columns, without the tangent) and, with ``M``, the tangent maps."""
+        count, n = len(p), self.model.dimension
+        order = None if np.all(tix[1:] >= tix[:-1]) else np.argsort(tix, kind="stable")  # (a grid's are sorted)
         used = np.unique(tix)  # (the tables of these points only: a refinement's pool grows by the round)
         pool = np.ascontiguousarray(np.stack([self._pool[k] for k in used]))
         size, width = pool.shape[1], self.library.width
-        P, Y = np.ascontiguousarray(p[order]), np.ascontiguousarray(y[order])
-        T = np.ascontiguousarray(np.searchsorted(used, tix[order]).astype(np.int64))
+        P = np.ascontiguousarray(p if order is None else p[order])
+        T = np.ascontiguousarray(np.searchsorted(used, tix if order is None else tix[order]).astype(np.int64))
+        per = max(1, columns)
+        Y = np.empty((count * per, n)) if columns else np.ascontiguousarray(y if order is None else y[order])
         out = None if M is None else np.empty_like(M)
 
         def work(rows: slice):
             k = rows.stop - rows.start
             buffer = np.empty(max(1, size) * width)
-            matrices = () if out is None else (out[rows].ctypes.data,)
-            entry(pool.ctypes.data, T[rows].ctypes.data, P[rows].ctypes.data, k, int(periods), Y[rows].ctypes.data,
-                  *matrices, buffer.ctypes.data)
+            at = slice(rows.start * per, rows.stop * per)
+            if M is None:
+                self.library.states(pool.ctypes.data, T[rows].ctypes.data, P[rows].ctypes.data, k, int(periods),
+                                    columns, Y[at].ctypes.data, buffer.ctypes.data)
+            else:
+                self.library.monodromies(pool.ctypes.data, T[rows].ctypes.data, P[rows].ctypes.data, k, int(periods),
+                                         Y[rows].ctypes.data, out[rows].ctypes.data, buffer.ctypes.data)
             return k
 
         done = 0
         for finished in threaded(work, [slice(c.start, c.stop) for c in chunked(count, CALL_POINTS)], self.jobs):
             done += finished
             if progress:
-                progress(done // per_point, count // per_point)
+                progress(done, count)
+        if order is None:
+            if M is not None:
+                M[...] = out
+            return Y
         final = np.empty_like(Y)
-        final[order] = Y
+        final.reshape(count, per, n)[order] = Y.reshape(count, per, n)
         if M is not None:
             M[order] = out
         return final
@@ -131,8 +140,12 @@ def distinct_rows(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     """(the distinct rows of ``keys``, the first row of each, the index of each row's among them): numpy's
     ``unique(axis=0)`` by numeric sorts (it sorts rows as bytes, 100 times slower on a chart's 160 000 rows)."""
     count = len(keys)
-    if keys.shape[1] == 0 or count == 0:
+    if keys.shape[1] == 0 or count == 0 or (keys == keys[0]).all():  # (one row: a grid across other parameters)
         return keys[:min(1, count)], np.zeros(min(1, count), dtype=np.int64), np.zeros(count, dtype=np.int64)
+    varying = np.nonzero((keys != keys[0]).any(axis=0))[0]
+    if len(varying) == 1:  # (one column: numpy's own unique)
+        _, first, inverse = np.unique(keys[:, varying[0]], return_index=True, return_inverse=True)
+        return keys[first], first, inverse.reshape(-1)
     order = np.lexsort(keys.T[::-1])
     ordered = keys[order]
     new = np.ones(count, dtype=bool)

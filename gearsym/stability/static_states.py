@@ -27,12 +27,14 @@ DRIVE, GAP, BACK, EDGE = "drive flank", "gap", "back flank", "edge of contact"
 @dataclass(frozen=True)
 class StaticStates:
     """Per point: the static state (NaN where none was found), whether it was found, and each mesh's deflection
-    and flank (``EDGE``: the deflection sits on a corner of g, 0 or -eta: linearised with g's slope 1)."""
+    and flank (``EDGE``: the deflection sits on a corner of g, 0 or -eta: linearised with g's slope 1); and how
+    many of the points found are on each flank, per mesh."""
 
     states: np.ndarray  # (points, n)
     found: np.ndarray  # (points,)
     deflection: dict[str, np.ndarray]
     flank: dict[str, np.ndarray]
+    flank_counts: dict[str, dict[str, int]]
 
 
 def solve_static(recipe: StaticRecipe, names: tuple[str, ...], p: np.ndarray) -> StaticStates:
@@ -41,7 +43,7 @@ def solve_static(recipe: StaticRecipe, names: tuple[str, ...], p: np.ndarray) ->
     columns = [names.index(name) for name in recipe.depends]
     distinct, _, index = distinct_rows(p[:, columns])
     if points == 0:
-        return StaticStates(np.zeros((0, len(recipe.states))), np.zeros(0, dtype=bool), {}, {})
+        return StaticStates(np.zeros((0, len(recipe.states))), np.zeros(0, dtype=bool), {}, {}, {})
     u, U = len(recipe.unknowns), distinct.shape[0]
     evaluate = _function(recipe.function).map(U)
     y = np.zeros((U, u))
@@ -67,8 +69,14 @@ def solve_static(recipe: StaticRecipe, names: tuple[str, ...], p: np.ndarray) ->
     contact = np.array(contact).reshape(len(recipe.meshes), U) if recipe.meshes else np.zeros((0, U))
     eta = np.array(eta).reshape(len(recipe.meshes), U) if recipe.meshes else np.zeros((0, U))
     deflection = {m: contact[k][index] for k, m in enumerate(recipe.meshes)}
-    flank = {m: _flanks(contact[k], eta[k])[index] for k, m in enumerate(recipe.meshes)}
-    return StaticStates(states[index], done[index], deflection, flank)
+    flanks = {m: _flanks(contact[k], eta[k]) for k, m in enumerate(recipe.meshes)}
+    weight = np.bincount(index, minlength=U) * done  # (points found, per distinct value)
+    counts = {}
+    for m, f in flanks.items():
+        counts[m] = {}
+        for k in np.nonzero(weight)[0]:
+            counts[m][f[k]] = counts[m].get(f[k], 0) + int(weight[k])
+    return StaticStates(states[index], done[index], deflection, {m: f[index] for m, f in flanks.items()}, counts)
 
 
 @lru_cache(maxsize=16)
