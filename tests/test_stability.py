@@ -21,6 +21,7 @@ from scipy.special import mathieu_a, mathieu_b
 
 import conftest
 import gearsym
+import gearsym.stability
 from gearsym.cli import main
 from gearsym.stability import FOLD, NEIMARK_SACKER, PERIOD_DOUBLING, compile_linearisation, static_chart
 from gearsym.stability.chart import orbit_chart
@@ -185,3 +186,19 @@ def test_bad_requests_are_refused_in_one_line(args, message, capsys):
     assert main(["stability", "one_stage", *args, "--quiet"]) == 2
     err = capsys.readouterr().err
     assert message in err and err.count("\n") == 1
+
+
+def test_the_phasing_prediction_places_the_shafts_tongues_where_its_modes_put_them(shaft):
+    """One mesh, no phasing to cancel anything: the first-order tongues at 2 omega_i / l and (omega_i + omega_j) / l
+    from the mean stiffness matrix's modes (here omega_i^2 = 0.5, 1.5), each where the chart is unstable."""
+    chart = static_chart(shaft, {"omega": np.round(np.arange(1.3, 2.6, 0.05), 10), "k_a": [0.5]}, refine=False)
+    prediction = gearsym.stability.phasing_prediction(chart, shaft)
+    w1, w2 = np.sqrt(0.5), np.sqrt(1.5)
+    first = {t.label: t for t in prediction.tongues if t.label.endswith("/1")}
+    assert np.allclose([first["2ω1/1"].centre, first["(ω1+ω2)/1"].centre, first["2ω2/1"].centre],
+                       [2 * w1, w1 + w2, 2 * w2], atol=1e-9)
+    assert not any(t.suppressed for t in first.values())
+    assert first["(ω1+ω2)/1"].kind == NEIMARK_SACKER and first["2ω1/1"].kind == PERIOD_DOUBLING
+    for t in first.values():
+        j = np.argmin(np.abs(chart.values[0] - t.centre))
+        assert chart.stable[0, j] == False, t.label  # noqa: E712 (an object array: True, False or None)
