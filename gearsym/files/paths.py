@@ -8,6 +8,6 @@ from __future__ import annotations
 from pathlib import Path
 
 #: the repository checkout this package was installed from (editable installs)
-REPO_ROOT = Path(__file__).resolve().parent.parent
+REPO_ROOT = Path(__file__).resolve().parents[2]
 #: the committed C of the shipped models, one folder per model
 GENERATED_DIR = REPO_ROOT / "generated"
