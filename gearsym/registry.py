@@ -9,9 +9,9 @@ import traceback
 from pathlib import Path
 from typing import Union
 
-from .declared import Model
+from .model.declared import Model
 from .errors import GearsymError, ModelError, suggest, warn
-from .paths import MODELS_DIR
+from .files.paths import MODELS_DIR
 
 
 def models_dir() -> Path:

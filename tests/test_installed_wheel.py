@@ -21,7 +21,7 @@ import pytest
 
 from gearsym.cli import main
 from gearsym.codegen import cache_dir
-from gearsym.paths import REPO_ROOT
+from gearsym.files.paths import REPO_ROOT
 
 pytestmark = pytest.mark.slow
 
@@ -93,7 +93,7 @@ def test_the_wheel_carries_the_shipped_models_and_their_c_inside_gearsym(wheel):
 
 def test_an_installed_wheel_lists_and_runs_the_shipped_models_from_another_folder(installed, elsewhere, capsys):
     work, env = elsewhere
-    where = json.loads(run([str(installed / "python"), "-c", "import json, gearsym.paths as p; print(json.dumps("
+    where = json.loads(run([str(installed / "python"), "-c", "import json, gearsym.files.paths as p; print(json.dumps("
                             "[str(p.MODELS_DIR), str(p.GENERATED_DIR)]))"], cwd=work, env=env))
     assert all(Path(w).is_relative_to(installed.parent) for w in where), where
 

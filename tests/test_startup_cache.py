@@ -14,7 +14,7 @@ import gearsym.loading  # noqa: F401 (where the face reduces a model: its reduce
 import gearsym.reduction  # noqa: F401 (the subpackage, whose reduce is counted)
 from gearsym.cli import main
 from gearsym.codegen import cache_dir
-from gearsym.paths import REPO_ROOT
+from gearsym.files.paths import REPO_ROOT
 
 ARGS = ("--periods", "30", "--discard", "10", "--format", "json")
 

@@ -11,8 +11,8 @@ from pathlib import Path
 from ..errors import GearsymError
 from ..figures.stiffness import plot_mesh_stiffness
 from ..geometry import GearGeometry, GearPair, Material, mesh_stiffness, STEEL
+from ..files.outputs import check_figure
 from ..geometry.gear import ISO53_FILLET
-from ..outputs import check_figure
 from ..units import parse_quantity, Quantity, shown
 
 NAME = "stiffness"

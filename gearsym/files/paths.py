@@ -11,15 +11,15 @@ gearsym lands at the top of site-packages. Which of the two this is, is decided 
 not through the import system: an editable install maps packages with an import hook that a
 ``PYTHONPATH=<clone>`` run (as the tests use) does not have, while the files are where they are in every case.
 The models folder keeps its package name, ``models``, wherever it lies (model files import each other as
-``models.<name>``, in a clone, in an installed gearsym and in a user's own ``./models/``; :mod:`.registry`
+``models.<name>``, in a clone, in an installed gearsym and in a user's own ``./models/``; :mod:`gearsym.registry`
 puts its parent folder on the import path while it loads one).
 """
 from __future__ import annotations
 
 from pathlib import Path
 
-#: the folder of gearsym's own code
-PACKAGE_DIR = Path(__file__).resolve().parent
+#: the folder of gearsym's own code (this file is in gearsym/files/)
+PACKAGE_DIR = Path(__file__).resolve().parents[1]
 #: the folder holding gearsym: in a clone, the repository's root (its docs/, tests/, models/ and generated/)
 REPO_ROOT = PACKAGE_DIR.parent
 #: where an installed gearsym (a wheel, a non-editable install) carries its models and their C
