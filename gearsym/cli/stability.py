@@ -4,6 +4,7 @@ parameters; the kind of instability and the boundaries located to a stated toler
 from __future__ import annotations
 
 import argparse
+import ast
 import csv
 import io
 import json
@@ -18,10 +19,11 @@ import gearsym  # the face: its verbs load on first use, so a cached model's cha
 from .. import stability  # (lazy: the linearisation, SymPy and the generator load only on a cache miss)
 from ..cached import load_linearisation, load_static_recipe
 from ..errors import GearsymError
-from ..files import write_atomically
+from ..files.atomic import write_atomically
 from ..figures.basins import Shown
 from ..figures.stability import axis_label, plot_stability
-from ..outputs import check_figure, check_file
+from ..files.outputs import check_figure, check_file
+from ..model.grammar import syntax_tree
 from ..physical.basins import PhysicalShown, units_of
 from ..physical.stability import chart_in_units
 from ..physical.sweeps import nondimensional_axes
@@ -29,7 +31,7 @@ from ..stability.chart import ABOUT, RELATIVE_TOLERANCE, StabilityChart, orbit_c
 from ..sweep.grid import axes_from
 from ..sweep.store import sidecar
 from .integration import add_integration_arguments, compiled_from, integration_from, scaling_from
-from .settings import add_set_argument, model_settings, parse_settings, refuse_swept_and_set
+from .settings import add_set_argument, checked_formulas, model_settings, parse_settings, refuse_swept_and_set
 
 NAME = "stability"
 HELP = ("stability chart: Floquet multipliers of the static state (or the periodic orbit) over a grid of two "
@@ -82,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
     refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], _user_settings(args))
     tolerance = tuple(args.tolerance * (max(a.values) - min(a.values) or max(1.0, abs(a.values[0]))) for a in axes)
     progress = None if args.quiet else _Progress()
-    settings = model_settings(args)
+    settings = model_settings(args, cached=True)  # (a formula's numbers are checked if the model is built)
     start = time.perf_counter()
     common = dict(refine=not args.no_refine, tolerance=tolerance, lanes=not args.no_lanes, jobs=args.jobs,
                   progress=progress, verbose=not args.quiet)
@@ -135,14 +137,14 @@ def _formula_axes(args, given) -> None:
     formulas = [value for name, value in parse_settings(args.set).items() if name == "k"]
     if not formulas:
         return
-    introduced = {s.name for f in formulas for s in gearsym.parse_formula(f, "--set k").free_symbols}
+    introduced = {n.id for f in formulas for n in ast.walk(syntax_tree(f, "--set k")) if isinstance(n, ast.Name)}
     added = [f"{a.name}={a.values[0]!r}" for a in given if a.name in introduced and a.name not in set_names
              and not a.unit]
     args.set, args.placeholders = list(args.set) + added, len(added)
 
 
 def _linearisation(args, settings, options):
-    system = gearsym.load(args.model, **settings)
+    system = gearsym.load(args.model, **checked_formulas(settings))
     return stability.compile_linearisation(system, options, verbose=not args.quiet)
 
 

@@ -12,7 +12,7 @@ import os
 import re
 from pathlib import Path
 
-from ..files import write_atomically
+from ..files.atomic import write_atomically
 from .claims import MIN_CHAOTIC
 from .stability import report_lines as stability_lines
 

@@ -31,7 +31,7 @@ from ..codegen.build import compile_model
 from ..codegen.translate import to_casadi
 from ..errors import ModelError
 from ..options import Integration
-from ..symbols import parameter_symbol
+from ..model.symbols import parameter_symbol
 from ..system import FirstOrderSystem
 from .recipe import STATIC_SUFFIX, CompiledLinearisation, StaticRecipe, anchor_parameter
 
