@@ -310,13 +310,15 @@ def load_linearisation(ref: str, values: Mapping[str, object], options: Integrat
             about = data["linearisation"]
             return CompiledLinearisation(compiled, StaticRecipe.from_dict(about["static"]),
                                          tuple(map(str, about["anchors"])), str(about["base"]),
-                                         {str(k): float(v) for k, v in about["parameters"].items()})
+                                         {str(k): float(v) for k, v in about["parameters"].items()},
+                                         bool(about["physical"]))
         except (KeyError, TypeError, ValueError, AttributeError):
             pass
     lin = derive()
     write_json(system_file, {"system": SystemSummary.of(lin.model.system, False).as_dict(), "physical": None,
                              "linearisation": {"static": lin.recipe.as_dict(), "anchors": list(lin.anchors),
-                                               "base": lin.base, "parameters": dict(lin.base_parameters)}})
+                                               "base": lin.base, "parameters": dict(lin.base_parameters),
+                                               "physical": lin.physical}})
     write_json(build_file, {"hash": lin.model.hash, "library": str(lin.model.library),
                             "timed_parameters": sorted(lin.model.timed_parameters),
                             "table_texts": list(lin.model.table_texts)})

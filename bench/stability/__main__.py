@@ -33,6 +33,7 @@ import numpy as np
 
 import gearsym
 from gearsym.stability import compile_linearisation, static_chart
+from gearsym.stability.monodromies import MonodromyRunner
 
 from bench.machine import REPO, machine_info
 
@@ -92,8 +93,13 @@ def measure(repeats: int, log) -> dict:
     for refine in (True, False):  # (the command's summaries and bytecode cached)
         timed_command(command(refine))
     c = {b: [] for b in binaries}
-    gearsym_runs = {"1 thread": [], "every core": []}
-    gearsym_cpu = {"1 thread": [], "every core": []}
+    gearsym_runs = {"1 thread": [], "every core": [], "monodromies alone, 1 thread": []}
+    gearsym_cpu = {"1 thread": [], "every core": [], "monodromies alone, 1 thread": []}
+    runner = MonodromyRunner(lin.model, jobs=1, linear=True)
+    names = lin.model.parameter_names
+    W, K = np.meshgrid(grid["omega"], grid["k_a"])
+    p = np.tile(lin.model.parameter_vector(), (W.size, 1))
+    p[:, names.index("omega")], p[:, names.index("k_a")] = W.ravel(), K.ravel()
     results = {}
     for rep in range(repeats):
         for b, binary in binaries.items():
@@ -107,6 +113,10 @@ def measure(repeats: int, log) -> dict:
             gearsym_cpu[name].append(time.process_time() - cpu)
             results["gearsym"] = {"unstable": int(np.sum(chart.stable == False)),  # noqa: E712
                                   "sum_max_modulus": float(np.nansum(chart.max_modulus))}
+        t, cpu = time.perf_counter(), time.process_time()
+        runner.run(p, np.zeros((len(p), lin.model.dimension)))
+        gearsym_runs["monodromies alone, 1 thread"].append(time.perf_counter() - t)
+        gearsym_cpu["monodromies alone, 1 thread"].append(time.process_time() - cpu)
         log(f"  repetition {rep + 1}/{repeats}: C " + ", ".join(f"{b}: {v[-1]:.3f}" for b, v in c.items())
             + " s CPU; gearsym " + ", ".join(f"{k}: {gearsym_cpu[k][-1]:.3f} s CPU ({gearsym_runs[k][-1]:.3f} s)"
                                                for k in gearsym_runs) + f"; load {os.getloadavg()[0]:.1f}")
@@ -136,6 +146,7 @@ def summary(record: dict) -> list[str]:
     best = min(record["c_builds"], key=lambda b: np.median(record["c_cpu_seconds"][b]))
     c = float(np.median(record["c_cpu_seconds"][best]))
     one = float(np.median(record["gearsym_cpu_seconds"]["1 thread"]))
+    alone = float(np.median(record["gearsym_cpu_seconds"]["monodromies alone, 1 thread"]))
     every_wall = float(np.median(record["gearsym_seconds"]["every core"]))
     every_cpu = float(np.median(record["gearsym_cpu_seconds"]["every core"]))
     r = record["refinement"]
@@ -145,7 +156,10 @@ def summary(record: dict) -> list[str]:
         f"{record['machine']['loadavg_at_start']} at the start, {record['load_at_end']} at the end",
         f"C yardstick (best build: gcc {best}): {c:.3f} s CPU for {record['points']} monodromies "
         f"({c / record['points'] * 1e6:.2f} us each)",
-        f"gearsym chart, 1 thread: {one:.3f} s CPU = {one / c:.2f} x the C (target <= {TARGET_RATIO})",
+        f"gearsym's monodromies alone (the lanes), 1 thread: {alone:.3f} s CPU = {alone / c:.2f} x the C "
+        f"(target <= {TARGET_RATIO})",
+        f"gearsym chart (monodromies, static states, multipliers, kinds, crossings), 1 thread: {one:.3f} s CPU = "
+        f"{one / c:.2f} x the C",
         f"gearsym chart, every core: {every_wall:.3f} s wall ({every_cpu:.3f} s CPU) = {every_wall / c:.2f} x the "
         "C's time",
         f"agreement: unstable points C {agree['C']['unstable']}, gearsym {agree['gearsym']['unstable']}; sum of "

@@ -10,6 +10,7 @@ import io
 import json
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -79,25 +80,29 @@ def run(args: argparse.Namespace) -> int:
                            "--param k_a=0.2")
     options = integration_from(args)
     _formula_axes(args, given)
-    scaling = scaling_from(args)
-    axes = _engine_axes(given, scaling)
-    refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], _user_settings(args))
-    tolerance = tuple(args.tolerance * (max(a.values) - min(a.values) or max(1.0, abs(a.values[0]))) for a in axes)
+    tolerance_of = lambda axes: tuple(args.tolerance * (max(a.values) - min(a.values) or max(1.0, abs(a.values[0])))
+                                      for a in axes)
     progress = None if args.quiet else _Progress()
     settings = model_settings(args, cached=True)  # (a formula's numbers are checked if the model is built)
     start = time.perf_counter()
-    common = dict(refine=not args.no_refine, tolerance=tolerance, lanes=not args.no_lanes, jobs=args.jobs,
-                  progress=progress, verbose=not args.quiet)
-    if args.about == "static":
+    common = dict(refine=not args.no_refine, lanes=not args.no_lanes, jobs=args.jobs, progress=progress,
+                  verbose=not args.quiet)
+    if args.about == "static":  # (the linearisation's cache says whether the model is physical: no SymPy then)
         lin = load_linearisation(args.model, settings, options, verbose=not args.quiet,
                                  derive=lambda: _linearisation(args, settings, options))
-        chart = static_chart(lin, axes, **common)
+        scaling = scaling_from(args) if lin.physical else None
+        axes = _engine_axes(given, scaling)
+        refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], _user_settings(args))
+        chart = static_chart(lin, axes, tolerance=tolerance_of(axes), **common)
     else:
         compiled = compiled_from(args, options)
+        scaling = scaling_from(args)
+        axes = _engine_axes(given, scaling)
+        refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], _user_settings(args))
         recipe = load_static_recipe(args.model, settings,
                                     derive=lambda: stability.static_recipe(getattr(compiled.system, "full",
                                                                                    compiled.system)))
-        chart = orbit_chart(compiled, recipe, axes, **common)
+        chart = orbit_chart(compiled, recipe, axes, tolerance=tolerance_of(axes), **common)
     if progress:
         progress.done()
     prediction = None
@@ -144,8 +149,10 @@ def _formula_axes(args, given) -> None:
 
 
 def _linearisation(args, settings, options):
-    system = gearsym.load(args.model, **checked_formulas(settings))
-    return stability.compile_linearisation(system, options, verbose=not args.quiet)
+    checked = checked_formulas(settings)
+    system = gearsym.load(args.model, **checked)
+    lin = stability.compile_linearisation(system, options, verbose=not args.quiet)
+    return replace(lin, physical=gearsym.is_physical(args.model, **checked))
 
 
 def _engine_axes(given, scaling):

@@ -52,3 +52,4 @@ class CompiledLinearisation:
     anchors: tuple[str, ...]
     base: str
     base_parameters: Mapping[str, float]
+    physical: bool = False  # the model has physical values (its chart's axes may carry units)
