@@ -21,8 +21,8 @@ from .. import stability  # (lazy: the linearisation, SymPy and the generator lo
 from ..cached import load_linearisation, load_static_recipe
 from ..errors import GearsymError
 from ..files.atomic import write_atomically
-from ..figures.basins import Shown
-from ..figures.stability import axis_label, plot_stability
+from ..figures.basins import Shown, axis_label
+from ..figures.stability import plot_stability
 from ..files.outputs import check_figure, check_file
 from ..model.grammar import syntax_tree
 from ..physical.basins import PhysicalShown, units_of

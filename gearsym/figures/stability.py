@@ -11,9 +11,8 @@ import numpy as np
 
 from ..stability.chart import StabilityChart
 from ..stability.kinds import FOLD, NEIMARK_SACKER, PERIOD_DOUBLING
-from .basins import Shown
+from .basins import Shown, axis_label, cell_edges
 from .layout import fit_texts
-from .poincare import SYMBOLS
 from .save import pyplot, save_figure
 
 #: the colour of each kind (stable: white), and of the points without a result
@@ -22,18 +21,6 @@ NO_RESULT_COLOR = "#9a9a9a"
 KIND_LABELS = {FOLD: "fold: a multiplier through +1 (T-periodic on the boundary)",
                PERIOD_DOUBLING: "period doubling: through -1 (2T-periodic on the boundary)",
                NEIMARK_SACKER: "Neimark-Sacker: a complex pair (combination resonance)"}
-
-
-def axis_label(name: str, unit: str) -> str:
-    symbol = SYMBOLS.get(name, name)
-    return f"{symbol} [{unit}]" if unit else symbol
-
-
-def _edges(v: np.ndarray) -> np.ndarray:
-    if v.size == 1:
-        return np.array([v[0] - 0.5, v[0] + 0.5])
-    mid = (v[1:] + v[:-1]) / 2
-    return np.concatenate([[2 * v[0] - mid[0]], mid, [2 * v[-1] - mid[-1]]])
 
 
 def draw_chart(ax, chart: StabilityChart, *, boundaries: bool = True) -> list:
@@ -46,7 +33,7 @@ def draw_chart(ax, chart: StabilityChart, *, boundaries: bool = True) -> list:
     grid = np.array([[codes.get(k, 4) for k in row] for row in chart.kind], dtype=float)
     cmap = ListedColormap(["white", KIND_COLORS[FOLD], KIND_COLORS[PERIOD_DOUBLING], KIND_COLORS[NEIMARK_SACKER],
                            NO_RESULT_COLOR])
-    ax.pcolormesh(_edges(np.asarray(a)), _edges(np.asarray(b)), grid, cmap=cmap, vmin=-0.5, vmax=4.5,
+    ax.pcolormesh(cell_edges(np.asarray(a)), cell_edges(np.asarray(b)), grid, cmap=cmap, vmin=-0.5, vmax=4.5,
                   shading="flat", rasterized=True)
     present = {k for row in chart.kind for k in row}
     handles = [Patch(facecolor=KIND_COLORS[k], edgecolor="none", label=KIND_LABELS[k]) for k in KIND_COLORS
@@ -61,8 +48,8 @@ def draw_chart(ax, chart: StabilityChart, *, boundaries: bool = True) -> list:
         from matplotlib.lines import Line2D
         tol = ", ".join(f"{axis_label(n, u)} to {t:.2g}" for n, u, t in zip(chart.names, chart.units, chart.tolerance))
         handles.append(Line2D([], [], color="black", lw=0.9, label=f"boundary |μ|max = 1 (located: {tol})"))
-    ax.set_xlim(_edges(np.asarray(a))[[0, -1]])
-    ax.set_ylim(_edges(np.asarray(b))[[0, -1]])
+    ax.set_xlim(cell_edges(np.asarray(a))[[0, -1]])
+    ax.set_ylim(cell_edges(np.asarray(b))[[0, -1]])
     ax.set_xlabel(axis_label(chart.names[0], chart.units[0]))
     ax.set_ylabel(axis_label(chart.names[1], chart.units[1]))
     return handles
@@ -129,8 +116,8 @@ def draw_prediction(ax, prediction, chart: StabilityChart) -> None:
             kept_drawn = True
         ax.annotate(t.label, (t.centre, bottom), xytext=(2, 4), textcoords="offset points", fontsize=6.5,
                     rotation=90, ha="left", va="bottom", color="#b03030" if t.suppressed else "black")
-    ax.set_xlim(_edges(np.asarray(a))[[0, -1]])
-    ax.set_ylim(_edges(np.asarray(b))[[0, -1]])
+    ax.set_xlim(cell_edges(np.asarray(a))[[0, -1]])
+    ax.set_ylim(cell_edges(np.asarray(b))[[0, -1]])
     ax.set_xlabel(axis_label(chart.names[0], chart.units[0]))
     ax.set_ylabel(axis_label(chart.names[1], chart.units[1]))
     ax.set_title(prediction.title, fontsize=9)
