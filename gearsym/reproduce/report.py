@@ -13,7 +13,11 @@ import re
 from pathlib import Path
 
 from ..files import write_atomically
+from ..periodic import FOLD, GRAZING, NEIMARK_SACKER, PERIOD_DOUBLING
 from .claims import MIN_CHAOTIC
+
+#: the order the kinds of bifurcation are counted in (not the order they were found in)
+BIFURCATIONS = (FOLD, PERIOD_DOUBLING, NEIMARK_SACKER, GRAZING)
 
 #: Why a claim comes out as it does, where the numbers alone do not say it. Written by a person
 #: after reading the figures; keyed by claim id. No numbers here: those come from the record.
@@ -187,11 +191,9 @@ def _jumps_explained(record: dict, figures_dir: str) -> list[str]:
             o = s["orbits"].get(name)
             if not o:
                 continue
-            kinds = {}
-            for b in o["bifurcations"]:
-                kinds[b["type"]] = kinds.get(b["type"], 0) + 1
-            lines += [f"{label}: " + ", ".join(f"{b['points']} points of period {b['period']} over "
-                                               f"[{b['from']:.3f}, {b['to']:.3f}]" for b in o["branches"])
+            kinds = {k: n for k in BIFURCATIONS if (n := sum(b["type"] == k for b in o["bifurcations"]))}
+            lines += [f"{label}: branches of " + ", ".join(f"period {b['period']} over [{b['from']:.3f}, {b['to']:.3f}]"
+                                                          for b in o["branches"])
                       + "; " + (", ".join(f"{n} {k}" for k, n in kinds.items()) or "no bifurcations") + ".", ""]
             if o["hysteresis"]:
                 lines += ["| hysteresis (up and down differ) | the up run leaves its attractor by | the down run leaves "
