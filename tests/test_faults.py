@@ -69,6 +69,7 @@ def geared():
     return gearsym.load("one_stage", teeth=TEETH)
 
 
+@pytest.mark.slow
 def test_a_cracked_tooth_on_the_wheel_is_named_with_its_tooth_and_severity(data, tmp_path, capsys):
     """The documented command: the fault found on the wheel (not on the pinion), on its tooth counted from each
     record's start, with its severity and standard error."""
@@ -92,6 +93,7 @@ def test_a_cracked_tooth_on_the_wheel_is_named_with_its_tooth_and_severity(data,
     assert report["sidebands"]["after"]["energy"]["gear2"] < sidebands["gear2"] / 3
 
 
+@pytest.mark.slow
 def test_an_eccentric_pinion_is_named_with_its_amplitude_and_phase(data, geared):
     ex = explain(geared, load_measurements([data("eccentric")], geared), ["zeta", "B1"], candidates=LIBRARY,
                  harmonics=HARMONICS)
@@ -104,6 +106,7 @@ def test_an_eccentric_pinion_is_named_with_its_amplitude_and_phase(data, geared)
     assert ex.final.error <= ex.base.error / 5
 
 
+@pytest.mark.slow
 def test_spacing_errors_of_the_pinion_are_named_tooth_by_tooth(data, geared):
     """Spacing errors are Z - 1 parameters, so they are tried when named; the tooth faults and eccentricities of
     both gears and the mesh-order terms compete with them."""
@@ -118,6 +121,7 @@ def test_spacing_errors_of_the_pinion_are_named_tooth_by_tooth(data, geared):
     assert ex.final.error <= ex.base.error / 3
 
 
+@pytest.mark.slow
 def test_clean_data_with_the_same_tooth_counts_get_no_fault(data, geared):
     ex = explain(geared, load_measurements([data("clean")], geared), ["zeta", "B1"], candidates=LIBRARY,
                  harmonics=HARMONICS)
@@ -126,6 +130,7 @@ def test_clean_data_with_the_same_tooth_counts_get_no_fault(data, geared):
     assert ex.base.error < 1.5 * NOISE
 
 
+@pytest.mark.slow
 def test_a_record_shorter_than_a_revolution_is_refused_for_that_effect(tmp_path, geared):
     pair = fault_rig.Pair(teeth=TEETH)
     runs = [(1.2, pair.record(1.2, periods=10, transient=5))]
@@ -162,6 +167,7 @@ def example_commands() -> dict[str, list[str]]:
     return found
 
 
+@pytest.mark.slow
 def test_the_cracked_tooth_example_is_what_its_commands_write(tmp_path, monkeypatch):
     commands = example_commands()
     monkeypatch.chdir(tmp_path)

@@ -105,6 +105,7 @@ def test_every_paper_jump_and_hysteresis_end_is_a_located_bifurcation_a_crisis_o
     assert all(j["text"] in page for j in paper)
 
 
+@pytest.mark.slow
 def test_a_quick_reproduction_writes_every_output_and_reuses_its_data(tmp_path):
     record = reproduce(tmp_path / "figures", tmp_path / "reproduction.md", quick=True, progress=False)
     for name in ("fig3.png", "fig3-orbits.png", "fig4.png", "fig6.png", "fig7.png", "hysteresis.png", "study.png",
@@ -127,6 +128,7 @@ def test_a_quick_reproduction_writes_every_output_and_reuses_its_data(tmp_path):
     assert again == record
 
 
+@pytest.mark.slow
 def test_a_basin_map_recomputed_matches_the_committed_record(committed):
     """Fig. 4 as basins (D = 2, omega = 1.5, calibrated), again on the committed grid: the same attractors, and
     their shares to a start or two (a start on a basin boundary may go either way on another CPU's rounding)."""
