@@ -193,11 +193,19 @@ def test_a_planet_that_cannot_be_assembled_between_sun_and_ring_is_refused():
         m.resolved
 
 
-@pytest.mark.parametrize("planets", [3, 4, 5])
-def test_equally_spaced_planets_give_rotational_modes_and_planet_modes_of_multiplicity_n_minus_1(planets):
+@functools.cache
+def planets_of(count: int, ring_fixed: bool = True) -> gearsym.NondimensionalModel:
+    """The shipped planetary set with ``count`` planets (models/planetary.py's build), reduced once a session."""
+    if count == 3 and ring_fixed:
+        return reduced("planetary")
     from models.planetary import build
 
-    modes = natural_modes(reduced("planetary") if planets == 3 else build(planets)).elastic
+    return gearsym.reduce(build(count, ring_fixed=ring_fixed))
+
+
+@pytest.mark.parametrize("planets", [3, 4, 5])
+def test_equally_spaced_planets_give_rotational_modes_and_planet_modes_of_multiplicity_n_minus_1(planets):
+    modes = natural_modes(planets_of(planets)).elastic
     planet_modes = [m for m in modes if m.multiplicity == planets - 1]
     rotational = [m for m in modes if m.multiplicity == 1]
     assert len(rotational) == 2 and len(planet_modes) == planets - 1 and len(modes) == planets + 1
@@ -212,9 +220,7 @@ def test_a_repeated_frequencys_modes_are_the_same_whatever_basis_lapack_returns(
     """Any basis of the planet modes' plane is right, and another BLAS kernel (another CPU) returns another:
     docs/planetary.md's listing changed on an AMD EPYC. The modes shown are the plane's reduced row echelon
     basis, so a rotated eigenbasis gives the same shapes."""
-    from models.planetary import build
-
-    model = build(4)
+    model = planets_of(4)
     plain = natural_modes(model)
     eigh = np.linalg.eigh
     turn = np.linalg.qr(np.random.default_rng(1).normal(size=(3, 3)))[0]
@@ -241,9 +247,7 @@ def test_a_repeated_frequencys_modes_are_the_same_whatever_basis_lapack_returns(
 ])
 def test_a_free_ring_or_a_driven_parallel_stage_keeps_the_planet_modes_with_every_other_body_at_rest(
         model, planets, rigid, central):
-    from models.planetary import build
-
-    modes = natural_modes(build(planets, ring_fixed=False) if model.startswith("differential") else reduced(model))
+    modes = natural_modes(planets_of(planets, ring_fixed=False) if model.startswith("differential") else reduced(model))
     assert sum(m.kind == "rigid" for m in modes.modes) == rigid
     planet_modes = [m for m in modes.elastic if m.multiplicity == planets - 1]
     assert len(planet_modes) == planets - 1
