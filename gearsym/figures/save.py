@@ -1,8 +1,10 @@
 """Writing a figure: one place for the PNG settings every figure shares."""
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
+from ..files import write_atomically
 from .layout import fit_texts
 
 
@@ -20,10 +22,13 @@ def pyplot():
 def save_figure(fig, path: str | Path, dpi: int) -> Path:
     """Write ``fig`` to ``path`` (folders made as needed) and close it, its titles wrapped to fit
     (:func:`~.layout.fit_texts`). No 'Software' entry, so the bytes do not depend on the matplotlib version:
-    committed figures are compared as files."""
+    committed figures are compared as files. Written whole or not at all (:func:`~gearsym.files.write_atomically`:
+    a full disk leaves no half a figure)."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     fit_texts(fig)
-    fig.savefig(path, dpi=dpi, metadata={"Software": None})
-    pyplot().close(fig)
-    return path
+    image = io.BytesIO()
+    try:
+        fig.savefig(image, format=path.suffix.lstrip(".").lower() or None, dpi=dpi, metadata={"Software": None})
+    finally:
+        pyplot().close(fig)
+    return write_atomically(path, image.getvalue())
