@@ -20,7 +20,7 @@ BENCH = ROOT.parent / "bench"
 #: the stages from the bottom up (docs/architecture.md): a module may import its own stage and those below
 LAYERS = [
     {"errors", "version", "paths", "files", "outputs", "units", "declared", "symbols", "backlash", "checks",
-     "options", "parameters", "private_files", "file_sets", "caller", "memory"},
+     "options", "parameters", "private_files", "file_sets", "file_kinds", "caller", "memory"},
     {"geometry"},
     {"model"},
     {"system", "registry"},
