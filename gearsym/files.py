@@ -16,16 +16,34 @@ NO_ROOM = (errno.ENOSPC, errno.EDQUOT)
 class WriteError(GearsymError, OSError):
     """A file that could not be written (the disk full, a read-only file system, ...): a one-line error that
     names it and says that nothing of it was written; an :class:`OSError` still (``errno``, ``strerror``,
-    ``filename``), for the callers that keep what they finished when a write fails."""
+    ``filename``), for the callers that keep what they finished when a write fails. ``advice``: what to do, if
+    not to free space or write elsewhere (a cache: point $GEARSYM_CACHE elsewhere)."""
+
+    advice = ""
 
     def __str__(self) -> str:
-        advice = "free some space there or write elsewhere" if self.errno in NO_ROOM else "write elsewhere"
+        advice = self.advice or ("free some space there or write elsewhere" if self.errno in NO_ROOM
+                                 else "write elsewhere")
         return f"writing {self.filename} failed: {self.strerror}; it is left as it was ({advice})"
 
 
-def write_error(exc: OSError, path) -> WriteError:
-    """``exc``, raised while writing ``path``, as a :class:`WriteError`."""
-    return exc if isinstance(exc, WriteError) else WriteError(exc.errno, exc.strerror or str(exc), str(path))
+def write_error(exc: OSError, path, advice: str = "") -> WriteError:
+    """``exc``, raised while writing ``path``, as a :class:`WriteError` (with ``advice``, if given)."""
+    if isinstance(exc, WriteError) and not advice:
+        return exc
+    error = WriteError(exc.errno, exc.strerror or str(exc), str(path))
+    error.advice = advice
+    return error
+
+
+def no_room(folder) -> bool:
+    """Whether the file system of ``folder`` has no space left for an ordinary user (a tool that fails without
+    saying why, such as CasADi's code generator, is then out of disk)."""
+    try:
+        st = os.statvfs(folder)
+    except OSError:
+        return False
+    return st.f_bavail == 0 or st.f_favail == 0
 
 
 def write_atomically(path: str | Path, data: str | bytes) -> Path:

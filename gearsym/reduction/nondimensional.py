@@ -32,6 +32,7 @@ from ..backlash import g
 from ..errors import ModelError, UnknownParameterError
 from ..model.drivetrain import Drivetrain
 from ..model.resolved_components import ResolvedCoupling
+from ..model.roles import parameter_roles
 from ..model.expressions import ExprLike, parameter_names, to_expr
 from ..model.stiffness import check_periodic
 from ..symbols import omega, parameter_symbol, phi, t, tau
@@ -329,6 +330,8 @@ class NondimensionalModel:
         descriptions = dict(self.drivetrain.descriptions)
         for gr in self.groups:
             descriptions.setdefault(gr.name, gr.description)
+        for name, role in parameter_roles(self.reduction.resolved).items():  # (what the model does not describe)
+            descriptions.setdefault(name, role)
         constraints = {name: c for name, c in self._constraints.items() if name in params}
         return FirstOrderSystem(self.name, tau, self.states, rhs, params, self.period, descriptions,
                                 self.drivetrain.title, tuple(c.name for c in self.coordinates),
