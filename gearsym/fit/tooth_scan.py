@@ -61,22 +61,14 @@ def scan_teeth(system: FirstOrderSystem, segments: Sequence[Segment], fit: Fit, 
     P = problem.parameters(theta)
     records = list(dict.fromkeys(seg.key[0] if seg.key else k for k, seg in enumerate(segments)))
     of_record = np.array([records.index(seg.key[0] if seg.key else k) for k, seg in enumerate(segments)])
-    # The fit's directions, projected once: a record's columns are nonzero on its own rows only, so each is
-    # projected there, plus a small dense part along these (memory of one record, whatever their number)
-    fitted_out = nuisance.out_of_starts(nuisance.P)  # (residuals, k)
-    inverse = np.linalg.pinv(fitted_out.T @ fitted_out)
-    along_y = fitted_out.T @ y
+    projection = RecordProjection.of(nuisance, y)
     teeth, gains = {}, {}
-    raw, along = np.zeros_like(y), np.zeros(fitted_out.shape[1])  # the chosen columns' sum: own rows, and along P
+    raw, along = np.zeros_like(y), np.zeros(projection.fitted.shape[1])  # the chosen columns' sum: own rows, along P
     for ri, record in enumerate(records):
         windows = np.nonzero(of_record == ri)[0]
         rows = J.window_rows(windows)
         block = _record_columns(problem, J, windows, rows, starts, P, e.teeth, order, index_q, index_n)  # (rows, Z)
-        own = nuisance.out_of_starts(block, windows)
-        a = fitted_out[rows].T @ own  # (k, Z)
-        c = inverse @ a
-        norms = np.einsum("rz,rz->z", own, own) - np.einsum("kz,kz->z", a, c)
-        dots = own.T @ y[rows] - c.T @ along_y
+        own, c, norms, dots = projection(block, windows, rows)
         with np.errstate(invalid="ignore", divide="ignore"):
             coef = np.where(norms > 0, dots / norms, 0.0)
             gain = np.where((norms > 0) & (coef > 0), dots**2 / (norms * total), 0.0)
@@ -84,13 +76,43 @@ def scan_teeth(system: FirstOrderSystem, segments: Sequence[Segment], fit: Fit, 
         teeth[record], gains[record] = best + 1, float(gain[best])
         raw[rows] += own[:, best]
         along += c[:, best]
-    together = raw - fitted_out @ along
+    together = raw - projection.fitted @ along
     norm = float(together @ together)
     if norm <= 0 or not any(g > 0 for g in gains.values()):
         return Placement(teeth, gains, 0.0, "no tooth of it would need a positive loss of stiffness")
     coef = float(together @ y) / norm
     gain = float((together @ y) ** 2 / (norm * total)) if coef > 0 else 0.0
     return Placement(teeth, gains, gain)
+
+
+@dataclass(frozen=True)
+class RecordProjection:
+    """``nuisance.project_out`` of columns that are nonzero on one record's rows only, in that record's memory: the
+    start states act on their own windows' rows, so that part stays there; the fitted parameters' part is a small
+    dense correction along their projected columns ``fitted`` (never formed per record). With the projected
+    residual ``y``, each column's squared norm and its product with ``y`` (the score test's gain)."""
+
+    fitted: np.ndarray  # the parameters' columns with the starts' part removed (residuals, k)
+    inverse: np.ndarray  # (fitted^T fitted)^+
+    along_y: np.ndarray  # fitted^T y
+    nuisance: object
+    y: np.ndarray
+
+    @classmethod
+    def of(cls, nuisance, y: np.ndarray) -> "RecordProjection":
+        fitted = nuisance.out_of_starts(nuisance.P)
+        return cls(fitted, np.linalg.pinv(fitted.T @ fitted), fitted.T @ y, nuisance, y)
+
+    def __call__(self, block: np.ndarray, windows: np.ndarray, rows: np.ndarray):
+        """For ``block`` (the rows of ``windows``, which are ``rows``): its starts-projected part on those rows, the
+        coefficients ``c`` of its parameters' part (the whole projection is own on the rows minus fitted @ c), and
+        each column's squared norm and product with y."""
+        own = self.nuisance.out_of_starts(block, windows)
+        a = self.fitted[rows].T @ own  # (k, columns)
+        c = self.inverse @ a
+        norms = np.einsum("rz,rz->z", own, own) - np.einsum("kz,kz->z", a, c)
+        dots = own.T @ self.y[rows] - c.T @ self.along_y
+        return own, c, norms, dots
 
 
 def _record_columns(problem: Problem, J, windows: np.ndarray, rows: np.ndarray, starts: np.ndarray, P: np.ndarray,
