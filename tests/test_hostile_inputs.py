@@ -224,17 +224,17 @@ def test_a_negative_number_after_an_option_is_its_value(capsys):
 
 
 @pytest.mark.parametrize("tooth", ["0", "2.5", "21"])
-def test_a_faulty_tooth_that_is_no_tooth_is_refused(capsys, tooth):
+def test_a_faulty_tooth_that_is_no_tooth_is_refused(capsys, tmp_path, tooth):
     err = one_line_error(*run(capsys, "simulate", "one_stage", "--teeth", "20,53", "--effect", "tooth_fault_gear1",
-                              "--set", "q_gear1=0.3", "--set", f"tooth_gear1={tooth}", "--out", "never.csv")[::2])
+                              "--set", "q_gear1=0.3", "--set", f"tooth_gear1={tooth}", "--out", str(tmp_path / "never.csv"))[::2])
     assert f"tooth_gear1': is the faulty tooth of gear1 (counted from tau = 0) and must be a whole number from 1 to 20, " \
            f"got {float(tooth):g}" in err
 
 
 @pytest.mark.parametrize("depth", ["1.5", "-0.2", "1"])
-def test_a_fault_depth_outside_0_to_1_is_refused_wherever_it_is_given(capsys, depth):
+def test_a_fault_depth_outside_0_to_1_is_refused_wherever_it_is_given(capsys, tmp_path, depth):
     err = one_line_error(*run(capsys, "simulate", "one_stage", "--teeth", "20,53", "--effect", "tooth_fault_gear1",
-                              "--set", f"q_gear1={depth}", "--set", "tooth_gear1=3", "--out", "never.csv")[::2])
+                              "--set", f"q_gear1={depth}", "--set", "tooth_gear1=3", "--out", str(tmp_path / "never.csv"))[::2])
     assert f"q_gear1': is the fraction of stiffness a fault of a tooth of gear1 takes from its pair and must be at " \
            f"least 0 and less than 1, got {float(depth):g}" in err
     with pytest.raises(ModelError, match=r"parameter 'q': is the fraction of the stiffness of the pair of tooth 7 of "
@@ -275,8 +275,8 @@ def test_basins_grid_errors_name_grid(capsys, no_work, grid, said):
      "the sweep has 10000200001 points (100001 x 100001), more than the 1000000 one sweep may have"),
     (["--param", "omega=0:1:0.0000000001"], "10000000001 values, more than the 1000000 one --param may have"),
 ])
-def test_a_grid_too_large_is_refused_at_once_with_its_size_and_the_limit(capsys, no_work, argv, said):
-    err = one_line_error(*run(capsys, "sweep", "one_stage", *argv, "--out", "never.csv")[::2])
+def test_a_grid_too_large_is_refused_at_once_with_its_size_and_the_limit(capsys, no_work, tmp_path, argv, said):
+    err = one_line_error(*run(capsys, "sweep", "one_stage", *argv, "--out", str(tmp_path / "never.csv"))[::2])
     assert said in err and "typo" not in err
 
 
