@@ -17,7 +17,7 @@ import gearsym as gearsym_api
 from gearsym import Gear, ToothFault
 from gearsym.cli import main
 from gearsym.errors import GearsymError, GearsymWarning, ModelError
-from gearsym.paths import REPO_ROOT
+from gearsym.files.paths import REPO_ROOT
 from gearsym.registry import model_path
 from test_checks_before_work import no_work  # noqa: F401 (a fixture)
 

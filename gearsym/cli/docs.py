@@ -10,8 +10,8 @@ import sys
 from pathlib import Path
 
 from ..derivation import derive, render
-from ..files import write_atomically
-from ..outputs import check_folder
+from ..files.atomic import write_atomically
+from ..files.outputs import check_folder
 from ..loading import declared
 from ..registry import available_models, output_root
 from .settings import add_teeth_argument

@@ -4,7 +4,7 @@ Libraries live in a cache (``$GEARSYM_CACHE``, else ``$XDG_CACHE_HOME/gearsym``
 or ``~/.cache/gearsym``) under a name that hashes the source, the compiler and
 its flags, so an unchanged model is never compiled twice and a changed one
 never picks up a stale library. A library is code, so the cache is private
-(:mod:`gearsym.private_files`: made 0700, used only while nobody else can write
+(:mod:`gearsym.files.private`: made 0700, used only while nobody else can write
 it) and a library is loaded only if its bytes are those recorded when it was
 compiled (:mod:`.trust`).
 
@@ -46,8 +46,8 @@ from functools import lru_cache
 from pathlib import Path
 
 from ..errors import GearsymError, warn
-from ..files import no_room, write_error
-from ..private_files import CACHE_ADVICE, NotPrivate, private_folder
+from ..files.atomic import no_room, write_error
+from ..files.private import CACHE_ADVICE, NotPrivate, private_folder
 from .trust import record, trusted
 
 DEFAULT_FLAGS = ("-O3", "-march=native", "-mtune=generic", "-fno-tree-partial-pre")

@@ -6,7 +6,6 @@ be consulted before any CasADi graph is built.
 """
 from __future__ import annotations
 
-import errno
 import hashlib
 import json
 import os
@@ -17,8 +16,7 @@ from pathlib import Path
 import casadi as ca
 import sympy as sp
 
-from ..files import no_room, write_atomically, write_error
-from ..private_files import CACHE_ADVICE
+from ..files.atomic import write_atomically
 from ..system import FirstOrderSystem
 from .functions import ModelFunctions
 from .loops import LoopOptions
@@ -41,7 +39,7 @@ def generator_digest() -> str:
     digest = hashlib.sha256()
     for name in _GENERATOR_SOURCES:
         digest.update((here / name).read_bytes())
-    digest.update((here.parent / "backlash.py").read_bytes())
+    digest.update((here.parent / "model" / "backlash.py").read_bytes())
     return digest.hexdigest()
 
 
@@ -97,18 +95,6 @@ def write_code(mf: ModelFunctions, directory: Path, digest: str) -> GeneratedCod
     half-written files): CasADi's C, with the integration loops printed by :mod:`.printed`, and the lanes printed
     from the same C by :mod:`.lanes`."""
     directory = Path(directory)
-    try:
-        return _write_code(mf, directory, digest)
-    except OSError as exc:
-        raise write_error(exc, directory, CACHE_ADVICE) from None
-    except Exception:  # (CasADi's generator fails, or writes half a file, without a word on a full disk)
-        if no_room(directory):
-            raise write_error(OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)), directory, CACHE_ADVICE) from None
-        raise
-
-
-
-def _write_code(mf, directory: Path, digest: str) -> GeneratedCode:
     directory.mkdir(parents=True, exist_ok=True)
     name = mf.system.name
     with tempfile.TemporaryDirectory(dir=directory) as tmp:

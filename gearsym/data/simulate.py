@@ -32,7 +32,7 @@ from ..checks import MAX_STEPS_PER_PERIOD, whole_number
 from ..codegen import CompiledModel, engine_verb
 from ..options import STEPS_PER_PERIOD, Integration
 from ..errors import GearsymError
-from ..files import write_atomically
+from ..files.atomic import write_atomically
 from ..memory import check_fits
 from .columns import RECORD
 

@@ -22,7 +22,7 @@ from ..model.resolved import ResolvedDrivetrain
 from ..model.roles import parameter_roles
 from ..reduction.nondimensional import NondimensionalModel, reduce
 from ..scales.map import Scaling
-from ..symbols import parameter_symbol, tau
+from ..model.symbols import parameter_symbol, tau
 from ..system import FirstOrderSystem
 from ..units import from_si
 from .notes import paper_notes

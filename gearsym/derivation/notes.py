@@ -27,7 +27,7 @@ def paper_notes(nd: NondimensionalModel, groups: Sequence[GroupRecord], defaults
     if any(rc.backlash != 0 for rc in meshes):
         notes.append(
             "Backlash (Eq. 5): the paper prints the third branch of g(x, η) as x ≤ η; the continuous "
-            "function meant, and used here (`gearsym.backlash.g`), has x ≤ −η: g = x for x ≥ 0, "
+            "function meant, and used here (`gearsym.model.backlash.g`), has x ≤ −η: g = x for x ≥ 0, "
             "0 for −η < x < 0, x + η for x ≤ −η."
         )
     waves = [(fn.name, default_wave_amplitude(rc.variation)) for rc, fn in zip(meshes, nd.functions)]

@@ -4,7 +4,7 @@ from __future__ import annotations
 import io
 from pathlib import Path
 
-from ..files import write_atomically
+from ..files.atomic import write_atomically
 from .layout import fit_texts
 
 

@@ -10,10 +10,10 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from ..backlash import g
+from ..model.backlash import g
 from ..errors import ModelError
+from ..model.symbols import parameter_symbol
 from ..parameters import Constraint
-from ..symbols import parameter_symbol
 from ..system import Coupling, FirstOrderSystem
 
 

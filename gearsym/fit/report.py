@@ -15,8 +15,8 @@ import numpy as np
 import sympy as sp
 
 from ..checks import json_safe
-from ..file_sets import written_together
-from ..files import write_atomically
+from ..files.atomic import write_atomically
+from ..files.sets import written_together
 from ..figures.layout import fit_texts
 from ..figures.save import pyplot, save_figure
 from ..system import FirstOrderSystem
@@ -31,7 +31,7 @@ VERDICTS = {
 }
 
 
-#: the files of a report, replaced together (:func:`~gearsym.file_sets.written_together`)
+#: the files of a report, replaced together (:func:`~gearsym.files.sets.written_together`)
 REPORT_FILES = ("report.json", "residuals.png", "prediction.png", "derived_model.md", "report.md")
 #: the file that says a report folder is partial (a run killed while it replaced the files)
 PARTIAL_MARKER = "REPORT-INCOMPLETE.txt"

@@ -31,8 +31,8 @@ import sympy as sp
 from ..errors import GearsymError
 from ..model.shaft_orders import DEFAULT_EDGE, tooth_by_tooth, tooth_share, window
 from ..model.stiffness import DEFAULT_CONTACT_RATIO
+from ..model.symbols import parameter_symbol
 from ..parameters import Constraint
-from ..symbols import parameter_symbol
 from ..system import FirstOrderSystem
 from .effect_types import Change, Effect, Site
 

@@ -21,6 +21,8 @@ from importlib import resources
 from pathlib import Path
 
 from ..codegen.build import cached_code_directory, code_directory
+from ..files.atomic import writing
+from ..files.private import CACHE_ADVICE
 from ..codegen.compiler import CompilerError, compilers_looked_for, find_compiler, INSTALL_HINT
 from ..codegen.functions import build_functions
 from ..codegen.generate import code_hash, read_manifest, write_code
@@ -125,7 +127,8 @@ def _engine_source(system: FirstOrderSystem, loops: LoopOptions) -> Path:
     source = directory / f"{system.name}.c"
     if not ((read_manifest(directory) or {}).get("hash") == digest and source.is_file()):
         directory = cached_code_directory(system.name, digest)
-        write_code(build_functions(system, loops), directory, digest)
+        with writing(directory, CACHE_ADVICE):
+            write_code(build_functions(system, loops), directory, digest)
         source = directory / f"{system.name}.c"
     return source
 

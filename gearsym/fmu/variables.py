@@ -16,7 +16,7 @@ from functools import cached_property
 
 import sympy as sp
 
-from ..symbols import parameter_symbol
+from ..model.symbols import parameter_symbol
 from ..system import Coupling, FirstOrderSystem
 from .frame import Frame, PhysicalParameter, Term, Unit
 

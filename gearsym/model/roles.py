@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ..symbols import parameter_symbol, phi
+from .symbols import parameter_symbol, phi
 from .expressions import parameter_names
 from .resolved import ResolvedDrivetrain
 from .stiffness import rectangular_mesh_stiffness

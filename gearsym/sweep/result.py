@@ -11,7 +11,7 @@ import numpy as np
 
 from ..analysis.jumps import find_jumps, hysteresis_intervals
 from ..errors import GearsymError
-from ..file_kinds import what_is_at
+from ..files.kinds import what_is_at
 from .grid import INDEPENDENT, Axis
 from .store import PoincareRows, read_poincare, read_rows, sidecar
 

@@ -5,9 +5,11 @@ import errno
 import os
 import secrets
 import stat
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
-from .errors import GearsymError
+from ..errors import GearsymError
 
 #: errors of a file system that has no room left (the disk full, a quota reached)
 NO_ROOM = (errno.ENOSPC, errno.EDQUOT)
@@ -34,6 +36,23 @@ def write_error(exc: OSError, path, advice: str = "") -> WriteError:
     error = WriteError(exc.errno, exc.strerror or str(exc), str(path))
     error.advice = advice
     return error
+
+
+@contextmanager
+def writing(folder, advice: str = "") -> Iterator[None]:
+    """Files written into ``folder`` in the block (by gearsym or a tool it calls): an OSError there is a
+    :class:`WriteError` naming the folder; so is any other failure while its disk has no room left (CasADi's code
+    generator fails, or writes half a file, without a word on a full disk)."""
+    try:
+        yield
+    except WriteError:
+        raise
+    except OSError as exc:
+        raise write_error(exc, folder, advice) from None
+    except Exception:
+        if no_room(folder):
+            raise write_error(OSError(errno.ENOSPC, os.strerror(errno.ENOSPC)), folder, advice) from None
+        raise
 
 
 def no_room(folder) -> bool:

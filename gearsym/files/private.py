@@ -27,8 +27,8 @@ import secrets
 import stat
 from pathlib import Path
 
-from .errors import GearsymError
-from .files import write_error
+from ..errors import GearsymError
+from .atomic import write_error
 
 try:
     import grp
