@@ -471,3 +471,78 @@ def test_the_worked_examples_data_are_what_the_fmu_gives(one_stage):
     for name, values in fresh.items():
         tolerance = 1e-6 if name == "x_model_exchange" else 1e-9
         assert np.max(np.abs(committed[name] - values)) < tolerance * max(1.0, np.ptp(values)), name
+
+
+# ------------------------------------------------------------------ issue 35: gearsym's step, descriptions, verdicts
+def test_co_simulation_keeps_gearsyms_step_whatever_the_communication_step(one_stage):
+    """20 communication steps per forcing period (the engine takes 200 RK4 steps per period) give what 400 give:
+    the FMU takes as many substeps as keep each within the engine's step (one RK4 step per communication step
+    was 1.5e-3 of the range off at 20)."""
+    def run(per_period):
+        r = simulate_fmu(str(one_stage), fmi_type="CoSimulation", stop_time=20 * TWO_PI,
+                         output_interval=TWO_PI / per_period, output=["x"])
+        return r["time"], r["x"]
+
+    t20, x20 = run(20)
+    t400, x400 = run(400)
+    coarse_times = np.round(t20 / (TWO_PI / 20)).astype(int) * 20
+    assert np.max(np.abs(x20 - x400[coarse_times])) < 1e-6 * np.ptp(x400)
+
+
+def _layout_of(name: str):
+    """The variables of the FMU of a shipped model (what build_fmu writes, without compiling it)."""
+    from gearsym.fmu.frame import Frame
+    from gearsym.fmu.physical import physical_frame
+    from gearsym.fmu.variables import layout
+    from conftest import load, reduced
+
+    model, sys_ = load(name), system(name)
+    frame = physical_frame(reduced(name), {}, sys_) if isinstance(model, gearsym.Drivetrain) else None
+    return layout(sys_, frame or Frame(), ())
+
+
+def test_every_variable_of_every_shipped_models_fmu_has_a_description():
+    from gearsym.registry import available_models
+
+    missing = {name: [v.name for v in _layout_of(name).variables if not v.description.strip()]
+               for name in available_models()}
+    assert {name: names for name, names in missing.items() if names} == {}
+    planetary = {v.name: v.description for v in _layout_of("planetary").variables}
+    assert planetary["r_r"] == "base radius of 'ring' (held)" and planetary["I_p"] == "moment of inertia of 'planet1'"
+
+
+def _logged(path, **start):
+    """(the error FMPy raised, the FMU's log) of a co-simulation over 60 forcing periods."""
+    log = []
+    with pytest.raises(Exception) as failed:
+        simulate_fmu(str(path), fmi_type="CoSimulation", stop_time=60 * TWO_PI / 1.5, output_interval=TWO_PI / 30,
+                     start_values=start, output=["x"], logger=lambda *a: log.append(" ".join(map(str, a))))
+    return str(failed.value), " ".join(log)
+
+
+@pytest.fixture(scope="module")
+def cracked(built):
+    """An FMU with a tooth fault's depth q and the default stiffness wave's k_a."""
+    path = built / "cracked_pair.fmu"
+    assert main(["fmu", "cracked_pair", "--out", str(path)]) == 0
+    return path
+
+
+def test_a_motion_that_diverges_stops_the_co_simulation_with_an_error_and_says_so(cracked):
+    error, log = _logged(cracked, k_a=5.0)  # (the stiffness goes negative over part of each period: x to 1e69)
+    assert "fmi2DoStep failed with status 3 (error)" in error
+    assert "the motion diverged in the step from" in log and "x reached" in log and "a gearsym run calls diverged" in log
+
+
+def test_a_start_that_is_not_a_number_is_named_as_such(cracked):
+    error, log = _logged(cracked, x=float("nan"))
+    assert "fmi2ExitInitializationMode failed" in error
+    assert "the start value of x is nan: every state needs a finite start value" in log and "step" not in log
+
+
+@pytest.mark.parametrize("q", [1.5, -0.5])
+def test_a_fault_depth_outside_0_to_1_is_refused_by_the_fmu(cracked, q):
+    error, log = _logged(cracked, q=q)
+    assert "failed with status 3 (error)" in error
+    assert (f"the parameter values make the engine's q {q:g}, but it must be at least 0 and less than 1 (the fraction "
+            "of the stiffness of the pair of tooth 7 of 'gear1' that its fault takes away)") in log
