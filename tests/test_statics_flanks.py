@@ -58,10 +58,12 @@ def test_the_mean_of_the_variation_is_the_stiffness_at_rest_on_the_drive_flank(p
     assert rest.mesh_forces["mesh"] == pytest.approx(force, rel=1e-10)  # the harmonic M1a adds nothing at rest
 
 
-def test_a_reversed_load_rests_on_the_back_flank_one_backlash_further(pair):
-    values = loaded(-60.0)
+@pytest.mark.parametrize("M1", [-60.0, -2000.0])
+def test_a_reversed_load_rests_on_the_back_flank_one_backlash_further(pair, M1):
+    """A small load (its deflection F/k within the backlash) and a large one (beyond it)."""
+    values = loaded(M1)
     rest = static_state(pair, values)
-    force = -60.0 / VALUES["r1"]
+    force = M1 / VALUES["r1"]
     d = force / (VALUES["kZ"] * MEAN) - VALUES["eta"]
     assert rest.contact == {"mesh": "back"}
     assert rest.deflections["mesh"] == pytest.approx(d, rel=1e-10)
