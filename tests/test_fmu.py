@@ -308,6 +308,18 @@ def test_a_physical_fmu_agrees_with_the_lagrange_equations_in_si(spur):
     assert np.max(np.abs(exchange["x"] - x)) < 1e-4 * np.ptp(x)
 
 
+def test_a_derivative_read_as_a_variable_is_the_states_rate_in_si(spur):
+    """der(x) and der(v) read through fmi2GetReal (as a tool records or plots them, not only through
+    fmi2GetDerivatives) are rates per second: der(x) is v, and der(v) v's central difference over the steps."""
+    period = spur_period()
+    step = period / STEPS
+    fmu = simulate_fmu(str(spur), fmi_type="CoSimulation", stop_time=2 * period, output_interval=step,
+                       output=["x", "v", "der(x)", "der(v)"])
+    assert np.allclose(fmu["der(x)"], fmu["v"], rtol=1e-9, atol=1e-12 * np.ptp(fmu["v"]))
+    central = (fmu["v"][2:] - fmu["v"][:-2]) / (2 * step)
+    assert np.max(np.abs(fmu["der(v)"][1:-1] - central)) < 1e-3 * np.ptp(fmu["der(v)"])
+
+
 def test_a_physical_value_set_through_fmi_is_gearsyms_run_with_it(spur):
     """The speed, mesh damping, backlash and torque fluctuation are tunable: set in the FMU they give gearsym's own
     run with --set at those values (to rounding), in SI; a value baked into the engine's values is refused."""
@@ -459,7 +471,7 @@ def test_bad_input_gets_one_line_and_exit_status_2(argv, message, tmp_path, caps
 
 
 # ------------------------------------------------------------------ the worked example of docs/fmu.md
-def test_the_worked_examples_data_are_what_the_fmu_gives(one_stage):
+def test_the_worked_examples_data_are_what_the_fmu_gives(one_stage, reference):
     import importlib.util
 
     spec = importlib.util.spec_from_file_location("fmu_example", REPO_ROOT / "docs" / "fmu_example.py")
@@ -471,3 +483,8 @@ def test_the_worked_examples_data_are_what_the_fmu_gives(one_stage):
     for name, values in fresh.items():
         tolerance = 1e-6 if name == "x_model_exchange" else 1e-9
         assert np.max(np.abs(committed[name] - values)) < tolerance * max(1.0, np.ptp(values)), name
+    # and, independently of any regeneration, the committed numbers against SciPy's solution of the equation
+    tau, x, _ = reference
+    assert np.allclose(committed["tau"], tau[::10], rtol=1e-13, atol=1e-12)
+    for name in ("x_gearsym", "x_co_simulation", "x_model_exchange"):
+        assert np.max(np.abs(committed[name] - x[::10])) < 1e-4 * np.ptp(x), name
