@@ -17,7 +17,7 @@ def test_a_file_of_ones_own_that_nobody_else_can_write_is_read(tmp_path):
     assert os.stat(path).st_mode & 0o777 == 0o600
 
 
-@pytest.mark.parametrize("mode", [0o602, 0o606, 0o666, 0o777])
+@pytest.mark.parametrize("mode", [0o602, 0o606, 0o666, 0o777], ids=oct)
 def test_a_file_anyone_can_write_is_refused_with_its_mode(tmp_path, mode):
     path = write_private(tmp_path / "f", b"data")
     os.chmod(path, mode)
