@@ -118,6 +118,16 @@ def test_attractors_with_basins_of_one_size_are_numbered_by_their_points(clocked
     assert found.labels.tolist() == [[2, 1, 1, 3]]
 
 
+def test_a_period_is_read_from_the_end_of_a_run_that_begins_in_its_transient(clocked):
+    """No periods discarded: starts near the unstable points x = +-1 take a few periods to leave them, so only the
+    last points of their runs repeat; they are period 16 all the same, on the attractor their side leads to."""
+    xs, ys = np.array([-1.05, -0.95, 0.95, 1.05]), np.array([0.0])
+    found = basin_map(clocked, {"x": xs, "y": ys}, options=Integration(periods=60, discard=0), K=16.0)
+    assert found.undetermined.starts == 0
+    assert [(a.period, a.basin.starts, round(a.points[0, 0])) for a in found.attractors] == [
+        (16, 2, 0), (16, 1, -2), (16, 1, 2)]
+
+
 # ------------------------------------------------------------------------------------------ along a parameter
 M = -0.05
 #: cos p = 1 (one point, 0), -0.0225 (M +- 0.15: -0.2 and 0.1), 1 (one again), -1 (M +- 1: -1.05, 0.95)

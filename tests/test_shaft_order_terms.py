@@ -18,7 +18,7 @@ import sympy as sp
 import gearsym
 import rig
 from gearsym import Drivetrain, Gear, Harmonic, Mesh, Torque
-from gearsym.model.faults import Eccentricity, Spall
+from gearsym.model.faults import Eccentricity, SpacingErrors, Spall
 from gearsym.model.symbols import parameter_symbol, tau
 
 TEETH = (9, 13)
@@ -51,8 +51,9 @@ def share(phi, teeth, tooth, e=1.6):
     return here / 2 + here * (1 - before) * (1 - after) / 2
 
 
-def typed(t, x, v, order=1, runout=(), spall=None):
-    """x'' typed: ``runout`` [(gear, N, A, psi)], ``spall`` (gear, tooth, w, start, end)."""
+def typed(t, x, v, order=1, runout=(), spall=None, spacing=None):
+    """x'' typed: ``runout`` [(gear, N, A, psi)], ``spall`` (gear, tooth, w, start, end), ``spacing`` (gear,
+    errors): e_n while tooth n carries the load, each over one mesh period with edges over the double contact."""
     phi = order * t
     k = 1 + VALUES["k_a"] * sum(c * math.cos((n + 1) * phi) for n, c in enumerate(rig.STIFFNESS))
     if spall:
@@ -61,6 +62,9 @@ def typed(t, x, v, order=1, runout=(), spall=None):
         part = window(phi, z, tooth - 0.5 - e / 2 + e * (a + b) / 2, e * (b - a))
         k *= 1 - w * share(phi, z, tooth) * part
     error = sum(A * math.cos(N * phi / TEETH[gear - 1] + psi) for gear, N, A, psi in runout)
+    if spacing:
+        gear, errors = spacing
+        error += sum(e * window(phi, TEETH[gear - 1], n - 0.5, 1, edge=(1.6 - 1) / 2) for n, e in enumerate(errors, 1))
     w = VALUES["omega"]
     return (-2 * VALUES["zeta"] * v / w + (VALUES["B0"] + VALUES["B1"] * math.cos(t + VALUES["Theta"])) / w ** 2
             - k * rig.backlash(x - error, VALUES["eta"]) / w ** 2)
@@ -101,3 +105,11 @@ def test_a_spall_over_part_of_the_path_of_contact_takes_its_width_there():
     model = pair("spall", lambda g1, g2: Spall("pit", g2, tooth=5, width="w", start=0.2, end=0.55), w=0.6)
     system, f = acceleration(model)
     compare(f, 2 * math.pi * 117, spall=(2, 5, 0.6, 0.2, 0.55))
+
+
+def test_spacing_errors_are_each_tooths_error_while_it_carries_the_load():
+    errors = [0.3, -0.2, 0.5, 0.0, 0.1, -0.4, 0.25, 0.05, -0.1]
+    model = pair("spacing", lambda g1, g2: SpacingErrors("pitch", g1, errors=tuple(f"s{n}" for n in range(1, 10))),
+                 **{f"s{n}": e for n, e in enumerate(errors, 1)})
+    system, f = acceleration(model)
+    compare(f, 2 * math.pi * 117, spacing=(1, errors))
