@@ -106,6 +106,36 @@ def test_each_attractors_amplitude_is_half_its_range_over_the_measured_periods(p
         assert a.amplitude["c"] == pytest.approx(1.0, rel=1e-5) and a.amplitude["s"] == pytest.approx(1.0, rel=1e-5)
 
 
+def test_the_maps_figure_colours_each_start_by_its_attractor_and_says_what_each_is(period_16):
+    """The figure, read from its artists (not its file size): each cell in its attractor's colour, that colour's
+    legend entry saying the attractor's number, period and share (with its standard error), and the attractor's
+    Poincare points drawn where they are."""
+    from gearsym.figures.basins import plot_basin_map
+    from matplotlib.colors import to_rgba
+    import matplotlib.pyplot as plt
+
+    xs, ys, found = period_16
+    fig = plot_basin_map(found)
+    try:
+        ax = fig.axes[0]
+        mesh, *markers = ax.collections
+        cells = mesh.to_rgba(mesh.get_array()).reshape(len(ys), len(xs), 4)
+        legend = ax.get_legend()
+        entries = [(text.get_text(), to_rgba(handle.get_facecolor()))
+                   for handle, text in zip(legend.legend_handles, legend.get_texts())]
+        assert len(entries) == 3  # (no start diverged or undetermined: no key for them ...)
+        assert "no start diverged or undetermined" in legend.get_title().get_text()  # (... and the title says so)
+        for a, (text, colour), drawn in zip(found.attractors, entries, markers):
+            assert text.startswith(f"{a.number}: {a.description}, {100 * a.fraction:.1f} ± {100 * a.stderr:.1f} % "
+                                   "of starts; A_x = ") and f"A_y = {a.amplitude['y']:.4g}," in text
+            assert np.allclose(cells[found.labels == a.number], colour)
+            assert not np.allclose(cells[found.labels != a.number], colour)
+            assert np.allclose(drawn.get_offsets(), a.points[:2].T)  # (x, y) of its 16 points
+        assert f"{100 * found.attractors[0].fraction:.1f}" == "50.0"  # (9 of 18 starts)
+    finally:
+        plt.close(fig)
+
+
 def test_attractors_with_basins_of_one_size_are_numbered_by_their_points(clocked):
     """Period 3 (the clock at w/3); the two outer attractors have one start each: the one whose points lie lower
     (x* = -2) comes first."""
