@@ -20,6 +20,7 @@ import sympy as sp
 
 fmpy = pytest.importorskip("fmpy")
 from fmpy import read_model_description, simulate_fmu  # noqa: E402
+from fmpy.fmi1 import FMICallException  # noqa: E402
 from fmpy.validation import validate_fmu  # noqa: E402
 
 import gearsym  # noqa: E402
@@ -233,11 +234,25 @@ def test_a_parameter_set_through_fmi_changes_the_result_as_set_does(one_stage):
     assert np.max(np.abs(default["x"] - x)) > 0.1 * np.ptp(x)
 
 
+def refusal(path, **start) -> tuple[str, list[str]]:
+    """What FMPy raises and what the FMU logs when a co-simulation is started with ``start``."""
+    said = []
+
+    def logger(environment, instance, status, category, message):
+        said.append(message.decode() if isinstance(message, bytes) else message)
+
+    with pytest.raises(FMICallException) as err:
+        simulate_fmu(str(path), fmi_type="CoSimulation", stop_time=TWO_PI, output_interval=TWO_PI / STEPS,
+                     start_values=start, logger=logger)
+    return str(err.value), said
+
+
 def test_a_value_the_engine_does_not_take_is_refused(one_stage):
-    with pytest.raises(Exception):
-        cs(one_stage, periods=1, omega=-1.0)
-    with pytest.raises(Exception):
-        cs(one_stage, periods=1, substeps=0)
+    raised, said = refusal(one_stage, omega=-1.0)
+    assert raised.startswith("fmi2ExitInitializationMode failed with status 3")
+    assert said == ["the parameter values make the engine's omega negative or zero, which it may not be"]
+    raised, said = refusal(one_stage, substeps=0)
+    assert raised.startswith("fmi2SetInteger failed with status 3") and said == ["substeps must be at least 1"]
 
 
 # ------------------------------------------------------------------ a physical model: SI
@@ -335,8 +350,10 @@ def test_a_physical_value_set_through_fmi_is_gearsyms_run_with_it(spur):
     assert np.max(np.abs(fmu["x"] - x)) < 1e-9 * np.ptp(x)
     t, reference, _, _ = spur_reference(5 * period, period / STEPS, speed=speed, cZ=500.0, eta=60e-6, M1a=10.0)
     assert np.max(np.abs(fmu["x"] - reference)) < 1e-4 * np.ptp(reference)
-    with pytest.raises(Exception):
-        simulate_fmu(str(spur), fmi_type="CoSimulation", stop_time=period, start_values={"kZ": 2e8})
+    raised, said = refusal(spur, kZ=2e8)
+    assert raised.startswith("fmi2SetReal failed with status 3")
+    assert said == ["kZ is baked into the engine's values of this FMU: export it again with gearsym fmu ... --set to "
+                    "change it"]
 
 
 def test_a_speed_changed_during_a_co_simulation_keeps_the_forcing_phase_continuous(spur):
