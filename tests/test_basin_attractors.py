@@ -224,3 +224,28 @@ def test_the_continuations_files_say_what_it_returned(fork):
     rows = list(csv.DictReader(fork.path.open()))
     attractors = [(float(r["p"]), int(r["attractor"]), r["event"]) for r in rows if r["class"] == "attractor"]
     assert attractors == [(r.value, r.id, r.event) for r in fork.rows if r.kind == "attractor"]
+
+
+def test_the_continuations_figure_draws_each_ids_fractions_and_says_its_events(fork):
+    """Read from its artists: one line per id through its fractions at the values where it exists, keyed in its
+    colour, and each event written at its value."""
+    from gearsym.figures.basins import plot_basin_fractions
+    from matplotlib.colors import to_rgba
+    import matplotlib.pyplot as plt
+
+    fig = plot_basin_fractions(fork)
+    try:
+        top = fig.axes[0]
+        keys = {text.get_text(): to_rgba(handle.get_color())
+                for handle, text in zip(top.get_legend().legend_handles, top.get_legend().get_texts())}
+        assert set(keys) == {f"attractor {i}" for i in fork.ids}
+        drawn = {to_rgba(line.get_color()): (tuple(line.get_xdata()), tuple(line.get_ydata())) for line in top.lines
+                 if len(line.get_xdata()) and line.get_linestyle() == "-"}
+        for aid in fork.ids:
+            rows = [r for r in fork.rows if r.id == aid]
+            assert drawn[keys[f"attractor {aid}"]] == (tuple(r.value for r in rows), tuple(r.fraction for r in rows))
+        said = sorted((round(t.xy[0], 9), t.get_text()) for t in top.texts)
+        assert said == sorted([(round(VALUES[1], 9), "2 appears"), (round(VALUES[2], 9), "2 merges into 1"),
+                               (round(VALUES[3], 9), "3 appears, 4 appears, 1 vanishes")])
+    finally:
+        plt.close(fig)
