@@ -78,6 +78,8 @@ def test_the_hertzian_compliance_of_two_materials_is_the_sum_of_each_ones_share(
     for pair in (GearPair(pinion(ALUMINIUM), wheel(BRONZE)), GearPair(pinion(BRONZE), wheel(ALUMINIUM))):
         hertz = pair_compliances(pair, s, terms="hertz")["hertz"]
         assert hertz == pytest.approx(np.full(3, expected), rel=1e-13)
+        slice_ = pair_compliances(pair, s, width=b / 5, terms="hertz")["hertz"]  # (a slice of a fifth of the face)
+        assert slice_ == pytest.approx(np.full(3, 5 * expected), rel=1e-13)
     steel = pair_compliances(GearPair(pinion(), wheel()), s, terms="hertz")["hertz"]
     assert steel == pytest.approx(np.full(3, 4 / (math.pi * b) * (1 - 0.09) / 206e9), rel=1e-13)
 
