@@ -13,14 +13,19 @@ Two small ODEs are designed for it (compiled once each):
 """
 from __future__ import annotations
 
+import csv
+import json
 import math
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+from matplotlib.colors import to_rgba
 
 import gearsym
 from gearsym import FirstOrderSystem, Integration
 from gearsym.analysis.basins import basin_map
+from gearsym.figures.basins import plot_basin_fractions, plot_basin_map
 from gearsym.sweep.basin_continuation import APPEARS, CONTINUES, MERGES, VANISHES, continue_basins
 
 #: the run of every start: measured periods enough for the tail of 32 points a period of 16 needs
@@ -110,10 +115,6 @@ def test_the_maps_figure_colours_each_start_by_its_attractor_and_says_what_each_
     """The figure, read from its artists (not its file size): each cell in its attractor's colour, that colour's
     legend entry saying the attractor's number, period and share (with its standard error), and the attractor's
     Poincare points drawn where they are."""
-    from gearsym.figures.basins import plot_basin_map
-    from matplotlib.colors import to_rgba
-    import matplotlib.pyplot as plt
-
     xs, ys, found = period_16
     fig = plot_basin_map(found)
     try:
@@ -216,9 +217,6 @@ def test_each_tracked_attractor_sits_at_its_stable_point_with_its_basins_share(f
 
 def test_the_continuations_files_say_what_it_returned(fork):
     """The record's events and the CSV's rows are the result's (read back, not compared as bytes)."""
-    import csv
-    import json
-
     record = json.loads(fork.path.with_suffix(".json").read_text())
     assert record["status"] == "complete" and record["events"] == list(fork.events)
     rows = list(csv.DictReader(fork.path.open()))
@@ -229,10 +227,6 @@ def test_the_continuations_files_say_what_it_returned(fork):
 def test_the_continuations_figure_draws_each_ids_fractions_and_says_its_events(fork):
     """Read from its artists: one line per id through its fractions at the values where it exists, keyed in its
     colour, and each event written at its value."""
-    from gearsym.figures.basins import plot_basin_fractions
-    from matplotlib.colors import to_rgba
-    import matplotlib.pyplot as plt
-
     fig = plot_basin_fractions(fork)
     try:
         top = fig.axes[0]

@@ -18,6 +18,7 @@ import gearsym
 from gearsym import Integration, lyapunov_spectrum
 from gearsym.analysis.lyapunov import lyapunov_spectra
 from gearsym.codegen.compiler import find_compiler
+from gearsym.codegen.lane_runs import LaneRunner
 
 import conftest
 
@@ -36,8 +37,6 @@ def one_stage():
 
 def lanes_width(model) -> int:
     """Trajectories per native call of this build (4 or 8 on x86-64)."""
-    from gearsym.codegen.lane_runs import LaneRunner
-
     return LaneRunner(model, 0, 1).width
 
 
