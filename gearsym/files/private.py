@@ -94,10 +94,11 @@ def read_private(path: str | Path) -> bytes:
         if isinstance(exc, FileNotFoundError):
             raise
         raise NotPrivate(f"{path} cannot be read ({exc.strerror})") from None
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode):  # (before fdopen, which refuses a folder with an error of its own)
+        os.close(fd)
+        raise NotPrivate(f"{path} is not a regular file")
     with os.fdopen(fd, "rb") as f:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode):
-            raise NotPrivate(f"{path} is not a regular file")
         if st.st_uid != owner():
             raise NotPrivate(f"{path} belongs to {_user(st.st_uid)}, not to you")
         if _writable_by_others(st):
