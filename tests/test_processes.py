@@ -22,7 +22,8 @@ from gearsym.cli import main
 from gearsym.errors import GearsymError
 from gearsym.files.atomic import write_atomically
 from gearsym.sweep import SweepInterrupted
-from gearsym.sweep.store import lock_path, release_lock, sidecar, take_lock
+from gearsym.files.lock import lock_path, release_lock, take_lock
+from gearsym.sweep.store import sidecar
 
 ROOT = Path(__file__).resolve().parents[1]
 SHORT = dict(options=Integration(periods=60, discard=20), progress=False)
@@ -189,7 +190,7 @@ def holder(*code: str) -> subprocess.Popen:
 
 def test_a_live_writer_is_named_with_its_pid(tmp_path, one_stage, capsys):
     out = tmp_path / "s.csv"
-    proc = holder("from pathlib import Path", "from gearsym.sweep.store import take_lock",
+    proc = holder("from pathlib import Path", "from gearsym.files.lock import take_lock",
                   f"take_lock(Path({str(out)!r}))")
     try:
         code = main(["sweep", "one_stage", "--param", "omega=1,1.1", "--out", str(out), "--quiet"])

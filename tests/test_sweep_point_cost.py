@@ -140,7 +140,8 @@ def test_a_point_that_fails_keeps_the_points_of_its_batch_before_it(tmp_path):
 
 def test_an_error_of_the_writer_thread_is_raised_not_lost(tmp_path, one_stage, monkeypatch):
     from gearsym.errors import GearsymError
-    from gearsym.sweep.store import PoincareRows, lock_path
+    from gearsym.files.lock import lock_path
+    from gearsym.sweep.store import PoincareRows
 
     import threading
 

@@ -33,7 +33,8 @@ from ..errors import GearsymError, UnknownParameterError
 from ..files.atomic import write_atomically
 from ..options import Integration
 from ..version import __version__
-from .store import number, read_rows, release_lock, sidecar, take_lock
+from ..files.lock import release_lock, take_lock
+from .store import number, read_rows, sidecar
 
 #: two attractors at neighbouring values are one when their Poincare sets are within this distance (in units of
 #: the spread of all points, as the basin maps scale them)
