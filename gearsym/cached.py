@@ -37,7 +37,8 @@ from pathlib import Path
 
 from .codegen.compiled import CompiledModel
 from .codegen.compiler import binary_key, cache_dir, compile_flags
-from .codegen.library import LOADED, library_describes, library_functions, resolve_backend
+from .codegen.library import library_describes, library_functions, model_key, resolve_backend
+from .codegen.loaded import keep, loaded
 from .codegen.loops import LoopOptions
 from .codegen.native import load_native
 from .codegen.trust import check, differences
@@ -275,13 +276,13 @@ def _from_cache(system_file: Path, build_file: Path, options: Integration, loops
     if why is not None:  # (the summaries do not describe the library they point at: edited)
         _distrust(build_file, f"{library.name}, the library it points at, does not match it: {why}")
         return None
-    key = (digest, "compiled")
-    if key in LOADED:  # (loaded in this process already: its functions with work arrays of their own)
-        return replace(LOADED[key].clone(), system=summary, integration=options)
+    key = model_key(digest, "compiled")
+    found = loaded(key)
+    if found is not None:  # (loaded in this process already: its functions with work arrays of their own)
+        return replace(found.clone(), system=summary, integration=options)
     if summary.cycles < 1:
         return None
     loops = LoopOptions.of(options, summary.cycles)  # (the key's loops count steps per forcing period)
     functions = library_functions(library)
-    compiled = LOADED[key] = CompiledModel(summary, loops, digest, functions, "compiled", library, {},
-                                           load_native(library, functions), options, timed, texts)
-    return compiled
+    return keep(key, CompiledModel(summary, loops, digest, functions, "compiled", library, {},
+                                   load_native(library, functions), options, timed, texts))
