@@ -109,7 +109,7 @@ def write_code(mf: ModelFunctions, directory: Path, digest: str) -> GeneratedCod
             os.chdir(cwd)
         source, lanes = Path(tmp) / source_file(name), Path(tmp) / lanes_file(name)
         text = source.read_text()
-        lanes.write_text(lanes_source(text, mf))
+        lanes.write_text(lanes_source(mf))
         source.write_text(print_loops(text, mf))
         os.replace(lanes, directory / lanes.name)
         os.replace(source, directory / source.name)
