@@ -8,7 +8,9 @@ takes the typed object these make; nothing below resolves a name.
 from __future__ import annotations
 
 from .analysis.modes import Modes, nondimensional_modes, physical_modes
+from .codegen.build import compile_model
 from .errors import GearsymError
+from .options import Integration
 from .model.teeth import with_teeth
 from .physical.answers import PhysicalScaling
 from .reduction import NondimensionalModel, reduce
@@ -36,6 +38,14 @@ def reduced(ref, teeth=None) -> NondimensionalModel:
     return reduce(model)
 
 
+class ModelScaling(PhysicalScaling):
+    """The face's scaling: a spectrum carried to physical units without the compiled model it ran on has its mesh
+    forces run on this scaling's system, compiled here (the units stage below compiles nothing)."""
+
+    def compiled_for(self, steps_per_period: int):
+        return compile_model(self.system(), Integration(steps_per_period=steps_per_period))
+
+
 def scaling(model, length_scale=None, *, teeth=None, **physical) -> PhysicalScaling:
     """The scaling of a model (a name, a file, a Drivetrain or its reduction) at its declared physical values,
     with ``physical`` overriding them (``kZ="3e8 N/m"``, ``speed="3000 rpm"``) or replacing a stiffness function
@@ -46,7 +56,7 @@ def scaling(model, length_scale=None, *, teeth=None, **physical) -> PhysicalScal
         if not model.is_drivetrain:
             raise GearsymError(f"{model.name}: physical values need a drivetrain model (a FirstOrderSystem has no "
                                "components to give them units)")
-    return PhysicalScaling.of(reduced(model, teeth), length_scale, **physical)
+    return ModelScaling.of(reduced(model, teeth), length_scale, **physical)
 
 
 def load(ref, *, teeth=None, **values) -> FirstOrderSystem:
