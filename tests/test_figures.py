@@ -131,7 +131,7 @@ from gearsym.figures.orbits import LABELLED, plot_branches, plot_orbits  # noqa:
 from gearsym.figures.poincare import plot_attractors  # noqa: E402
 from gearsym.figures.sweep import BIFURCATION_DOT, ZERO_CONTOUR, plot_bifurcation, plot_map  # noqa: E402
 from gearsym.fit.prediction import Prediction  # noqa: E402
-from gearsym.fit.report import prediction_figure  # noqa: E402
+from gearsym.figures.fit_report import prediction_figure  # noqa: E402
 from gearsym.periodic import FOLD, GRAZING, PERIOD_DOUBLING  # noqa: E402
 from gearsym.periodic.branches import Bifurcation, Branch, Continuation  # noqa: E402
 from gearsym.physical.campbell import Campbell, Crossing, Order  # noqa: E402

@@ -6,7 +6,7 @@ import sys
 from pathlib import Path
 
 from ..errors import GearsymError
-from ..fit import explain_files
+from ..figures.fit_report import explain_files
 from ..fit.selection import check_fit_names, check_harmonics
 from ..files.outputs import check_folder
 from .integration import add_integration_arguments, integration_from, scaling_from, system_from
