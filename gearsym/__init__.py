@@ -7,7 +7,8 @@ One flat public face; the stages behind it, each handing one type to the next:
   the whole file, its builders too);
 * reduce: :func:`reduce` (Drivetrain -> :class:`NondimensionalModel`), whose ``.system(**values)`` is the
   :class:`FirstOrderSystem` the engine takes; :func:`load` does name -> system in one call;
-* compile: :func:`compile_model` (FirstOrderSystem, :class:`Integration` -> :class:`CompiledModel`);
+* compile: :func:`compile_model` (FirstOrderSystem, :class:`Integration` -> :class:`CompiledModel`); how the
+  verbs that run many things run them: :class:`Execution` (threads or workers, the lanes, progress);
 * analyse: :func:`lyapunov_spectrum`, :func:`poincare_samples`, :func:`phase_trajectory`,
   :func:`simulated_order_spectrum` (and :func:`order_spectrum` of any signal: mesh orders, shaft-order sidebands),
   :func:`find_attractors`, :func:`basin_map` (basins of attraction, many starts at once in the lanes),
@@ -28,7 +29,7 @@ import importlib
 from typing import TYPE_CHECKING
 
 from .errors import GearsymError, ModelError, UnknownParameterError
-from .options import Integration
+from .options import Execution, Integration
 from .version import __version__
 
 
@@ -70,7 +71,6 @@ _LAZY = {
     "continue_orbits": "gearsym.verbs",
     "run_sweep": "gearsym.verbs",
     "read_sweep": "gearsym.sweep",
-    "Workers": "gearsym.sweep",
     "SweepInterrupted": "gearsym.sweep",
     "simulate_measurements": "gearsym.verbs",
     "simulated_order_spectrum": "gearsym.verbs",
@@ -99,7 +99,7 @@ _LAZY = {
     "iso6336_stiffness": "gearsym.geometry",
 }
 
-__all__ = ["GearsymError", "Integration", "ModelError", "UnknownParameterError", *_LAZY]
+__all__ = ["Execution", "GearsymError", "Integration", "ModelError", "UnknownParameterError", *_LAZY]
 
 
 def __getattr__(name: str):
@@ -133,6 +133,6 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .registry import available_models, load_model
     from .scales.map import Scaling
     from .system import FirstOrderSystem
-    from .sweep import SweepInterrupted, Workers, read_sweep
+    from .sweep import SweepInterrupted, read_sweep
     from .verbs import (basin_map, continue_basins, continue_orbits, find_attractors, lyapunov_spectrum, periodic_orbit,
                         phase_trajectory, poincare_samples, run_sweep, simulate_measurements, simulated_order_spectrum)

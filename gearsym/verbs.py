@@ -90,7 +90,7 @@ def _physical_sweep(model: PhysicalScaling, axes, *, options: Integration | None
     units (``{"speed": ["1000 rpm", "2000 rpm"]}``, pint Quantities, or ``"speed=1000rpm:3000rpm:500rpm"``) become
     the nondimensional parameters they move, other keywords that are physical values (``kZ="2e8 N/m"``) fix
     them, and the result comes back in physical units (along the values as given)."""
-    engine_keywords = {"mode", "direction", "y0", "out", "overwrite", "poincare", "workers", "progress", "on_point"}
+    engine_keywords = {"mode", "direction", "y0", "out", "overwrite", "poincare", "execution", "on_point"}
     physical = {k: v for k, v in kwargs.items() if k not in engine_keywords}
     at = model.with_values(**physical) if physical else model
     given = axes_with_units(axes)

@@ -169,10 +169,9 @@ def test_an_independent_sweep_in_the_lanes_gives_the_scalar_sweeps_rows(name, ax
     the scalar sweep (periodic points, where a rounding difference would not grow: the lanes may fuse other
     multiply-adds than the scalar loop)."""
     model = conftest.compiled(name)
-    kw = dict(mode="independent", options=Integration(periods=60, discard=20), progress=False,
-              workers=gearsym.Workers(jobs=1))
-    wide = gearsym.run_sweep(model, axes, lanes=True, **kw)
-    one = gearsym.run_sweep(model, axes, **kw)
+    kw = dict(mode="independent", options=Integration(periods=60, discard=20))
+    wide = gearsym.run_sweep(model, axes, execution=gearsym.Execution(jobs=1, lanes=True), **kw)
+    one = gearsym.run_sweep(model, axes, execution=gearsym.Execution(jobs=1), **kw)
     assert len(wide) == len(one) == (5 if name == "one_stage" else 6)
     for column in one.columns:
         a, b = wide[column], one[column]

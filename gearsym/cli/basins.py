@@ -11,10 +11,11 @@ from ..analysis.basins import RUN, basin_map
 from ..errors import GearsymError
 from ..figures.basins import plot_basin_fractions, plot_basin_map
 from ..files.outputs import check_figure, check_file
-from ..physical.basins import ShownBasinMap, ShownFractions, engine_grid, shown_in
+from ..options import Execution
+from ..physical.basins import PhysicalGrid, ShownBasinMap, ShownFractions, engine_grid, shown_in
 from ..physical.files import write_basin_fractions, write_basin_map
 from ..physical.sweeps import nondimensional_axes
-from ..sweep.basin_continuation import MATCH_DISTANCE, continue_basins
+from ..sweep.basin_continuation import MATCH_DISTANCE, StartGrid, continue_basins
 from ..sweep.grid import Axis, axes_from, parse_axis
 from ..sweep.store import sidecar
 from .integration import add_integration_arguments, compiled_from, scaling_from
@@ -82,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
     omega = compiled.parameter_vector()[compiled.parameter_names.index("omega")] \
         if "omega" in compiled.parameter_names else 1.0
     grid = engine_grid(units, grid_axes, omega) if units is not None else {a.name: a.values for a in grid_axes}
-    result = basin_map(compiled, grid, y0=y0, jobs=args.jobs, lanes=not args.no_lanes, verbose=not args.quiet)
+    result = basin_map(compiled, grid, y0=y0, execution=_execution(args))
     shown = ShownBasinMap(result, shown_in(units), tuple(grid_axes))
     if args.out:
         written = write_basin_map(shown, args.out)
@@ -94,17 +95,17 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _execution(args: argparse.Namespace) -> Execution:
+    return Execution(args.jobs, lanes=not args.no_lanes, progress=not args.quiet)
+
+
 def _continuation(args, compiled, grid_axes: list[Axis], axis: Axis, units, y0) -> int:
-    if units is not None:
-        def grid(point):
-            return engine_grid(units, grid_axes, point.get("omega", 1.0))
-    else:
-        grid = {a.name: a.values for a in grid_axes}
+    grid = PhysicalGrid(units, grid_axes) if units is not None else \
+        StartGrid({a.name: a.values for a in grid_axes}, [a.spec for a in grid_axes])
     try:
         result = continue_basins(compiled, grid, axis.name, axis.values, y0=y0, out=args.out,
-                                 overwrite=args.overwrite, jobs=args.jobs, lanes=not args.no_lanes,
-                                 match_distance=args.match_distance, grid_spec=args.grid,
-                                 progress=not args.quiet)
+                                 overwrite=args.overwrite, execution=_execution(args),
+                                 match_distance=args.match_distance)
     except KeyboardInterrupt:
         print(f"gearsym: interrupted; the values finished are in {args.out}: run the same command again to resume",
               file=sys.stderr)

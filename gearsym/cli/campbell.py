@@ -15,7 +15,8 @@ from ..files.outputs import check_figure, check_file
 from ..physical.campbell import campbell
 from ..physical.files import write_physical_table
 from ..physical.sweeps import nondimensional_axis
-from ..sweep import run_sweep, Workers
+from ..options import Execution
+from ..sweep import run_sweep
 from ..sweep.grid import parse_axis
 from ..sweep.store import sidecar
 from .integration import add_integration_arguments, compiled_from, scaling_from
@@ -66,7 +67,7 @@ def run(args: argparse.Namespace) -> int:
     if not args.no_sweep:
         compiled = compiled_from(args)
         result = run_sweep(compiled, [engine_axis], options=compiled.integration,
-                           out=args.out, workers=Workers(args.jobs), progress=not args.quiet)
+                           out=args.out, execution=Execution(args.jobs, progress=not args.quiet))
         sweep = scaling.to_physical(result, given=[axis])
         print(f"in physical units: {write_physical_table(sweep, sidecar(args.out, '.physical.csv'))}")
 

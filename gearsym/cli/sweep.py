@@ -14,7 +14,8 @@ from ..figures.sweep import plot_sweep
 from ..files.outputs import check_figure, check_file
 from ..physical.files import write_physical_record, write_physical_table
 from ..physical.sweeps import nondimensional_axes
-from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, Workers, run_sweep
+from ..options import PARALLEL, Execution
+from ..sweep import DIRECTIONS, MODES, POINCARE_SAMPLES, Workers, run_sweep
 from ..sweep.grid import axes_from
 from ..sweep.report import findings_lines
 from ..sweep.store import sidecar
@@ -72,7 +73,9 @@ def run(args: argparse.Namespace) -> int:
     check_file(args.out, (".csv",))
     if args.plot:
         check_figure(args.plot)
-    workers = Workers(args.jobs, args.parallel, "local" if args.dask else args.scheduler)
+    execution = Execution(args.jobs, args.parallel, "local" if args.dask else args.scheduler, lanes=args.lanes,
+                          progress=not args.quiet)
+    Workers.of(execution)  # (no Dask, a bad address, more jobs than cores: said before the model is compiled)
     y0 = parse_state(args.y0)  # before the model is compiled
     options = integration_from(args)  # (sizes too) before the model is loaded
     given = axes_from(args.param)
@@ -83,8 +86,7 @@ def run(args: argparse.Namespace) -> int:
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     try:
         result = run_sweep(compiled, axes, mode=args.mode, direction=args.direction, y0=y0,
-                           out=args.out, overwrite=args.overwrite, poincare=args.poincare, workers=workers,
-                           progress=not args.quiet, lanes=args.lanes)
+                           out=args.out, overwrite=args.overwrite, poincare=args.poincare, execution=execution)
     except KeyboardInterrupt as exc:  # SweepInterrupted says how many points were kept
         print(f"gearsym: {exc}" if str(exc) else "gearsym: interrupted before any point was finished",
               file=sys.stderr)

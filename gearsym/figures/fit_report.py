@@ -21,7 +21,7 @@ from .save import pyplot, save_figure
 
 
 def explain_files(paths, system, fit, *, out=None, time_scale=None, held_out: float = 0.25, candidates=None,
-                  progress=None, options=None, channels=None, bias=None, terms=(), harmonics=None, **values):
+                  execution=None, options=None, channels=None, bias=None, terms=(), harmonics=None, **values):
     """The whole loop from files: load ``paths`` for ``system`` (``values`` fix parameter values; ``channels``
     declares combinations measured as one column), explain (``bias``: channels with an unknown offset, by default
     the acceleration channels; ``terms``: hand-written terms tried as effects), and with ``out`` write the report
@@ -33,7 +33,7 @@ def explain_files(paths, system, fit, *, out=None, time_scale=None, held_out: fl
     extra = {"options": options} if options else {}
     if harmonics is not None:
         extra["harmonics"] = harmonics
-    ex = explain(system, measurements, fit, held_out=held_out, candidates=candidates, progress=progress,
+    ex = explain(system, measurements, fit, held_out=held_out, candidates=candidates, execution=execution,
                  bias=bias, terms=terms, **extra)
     if out is not None:
         return write_report(ex, system, out, measurements.sources)

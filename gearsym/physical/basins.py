@@ -17,7 +17,7 @@ import numpy as np
 from ..analysis.basins import BasinMap
 from ..checks import json_safe
 from ..errors import GearsymError
-from ..sweep.basin_continuation import BasinContinuation
+from ..sweep.basin_continuation import BasinContinuation, StartGrid
 from ..sweep.grid import Axis
 from ..units import to_si
 from .point import PointUnits
@@ -176,3 +176,15 @@ def engine_grid(units: PointUnits, axes: Sequence[Axis], omega: float) -> dict[s
         per_engine_unit = float(units.state(axis.name, 1.0, omega, si=True))
         grid[axis.name] = to_si(np.asarray(axis.values, dtype=float), axis.unit) / per_engine_unit
     return grid
+
+
+class PhysicalGrid(StartGrid):
+    """A continuation's grid of starts given in physical units: its engine values at each forcing frequency (a
+    rate's unit moves with the speed), and the grid as given in the record."""
+
+    def __init__(self, units: PointUnits, axes: Sequence[Axis]):
+        super().__init__({a.name: a.values for a in axes}, [a.spec for a in axes])
+        self.units, self.axes = units, tuple(axes)
+
+    def at(self, point):
+        return engine_grid(self.units, self.axes, point.get("omega", 1.0))
