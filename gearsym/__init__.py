@@ -33,6 +33,23 @@ from .options import Execution, Integration
 from .version import __version__
 
 
+#: the engine's verbs: each face name -> the module of its low-level verb (on a CompiledModel, ``@engine_verb``);
+#: the face's verb (:mod:`gearsym.verbs`) is made from it, for a CompiledModel or a system. A new analysis is
+#: its module, a line here, and its command (a module of :mod:`gearsym.cli`)
+VERBS = {
+    "lyapunov_spectrum": "gearsym.analysis.lyapunov",
+    "poincare_samples": "gearsym.analysis.poincare",
+    "phase_trajectory": "gearsym.analysis.poincare",
+    "find_attractors": "gearsym.analysis.attractors",
+    "basin_map": "gearsym.analysis.basins",
+    "continue_basins": "gearsym.sweep.basin_continuation",
+    "run_sweep": "gearsym.sweep.run",
+    "periodic_orbit": "gearsym.periodic.orbit",
+    "continue_orbits": "gearsym.periodic.branches",
+    "simulate_measurements": "gearsym.data.simulate",
+    "simulated_order_spectrum": "gearsym.analysis.order_run",
+}
+
 #: public name -> the module that defines it (imported when the name is first used: the declaring and
 #: reducing stages import SymPy, which a command on a cached model never needs)
 _LAZY = {
@@ -60,20 +77,9 @@ _LAZY = {
     "CompiledModel": "gearsym.codegen",
     "compile_model": "gearsym.codegen.build",
     "LyapunovSpectrum": "gearsym.analysis",
-    "lyapunov_spectrum": "gearsym.verbs",
-    "poincare_samples": "gearsym.verbs",
-    "phase_trajectory": "gearsym.verbs",
-    "find_attractors": "gearsym.verbs",
-    "basin_map": "gearsym.verbs",
-    "continue_basins": "gearsym.verbs",
     "classify_regime": "gearsym.analysis",
-    "periodic_orbit": "gearsym.verbs",
-    "continue_orbits": "gearsym.verbs",
-    "run_sweep": "gearsym.verbs",
     "read_sweep": "gearsym.sweep",
     "SweepInterrupted": "gearsym.sweep",
-    "simulate_measurements": "gearsym.verbs",
-    "simulated_order_spectrum": "gearsym.verbs",
     "order_spectrum": "gearsym.analysis",
     "load_measurements": "gearsym.data",
     "explain": "gearsym.fit",
@@ -97,6 +103,7 @@ _LAZY = {
     "gear_pair": "gearsym.geometry",
     "mesh_stiffness": "gearsym.geometry",
     "iso6336_stiffness": "gearsym.geometry",
+    **dict.fromkeys(VERBS, "gearsym.verbs"),
 }
 
 __all__ = ["Execution", "GearsymError", "Integration", "ModelError", "UnknownParameterError", *_LAZY]
@@ -134,5 +141,3 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .scales.map import Scaling
     from .system import FirstOrderSystem
     from .sweep import SweepInterrupted, read_sweep
-    from .verbs import (basin_map, continue_basins, continue_orbits, find_attractors, lyapunov_spectrum, periodic_orbit,
-                        phase_trajectory, poincare_samples, run_sweep, simulate_measurements, simulated_order_spectrum)

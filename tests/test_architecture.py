@@ -165,3 +165,10 @@ def test_no_module_swaps_its_class_and_no_face_name_is_a_subpackage():
     subpackages = {p.name for p in ROOT.iterdir() if (p / "__init__.py").is_file()}
     top_modules = {p.stem for p in ROOT.glob("*.py")}
     assert set(gearsym.__all__) & (subpackages | top_modules) == set()
+
+
+def test_the_faces_verbs_are_made_from_modules_below_them():
+    """gearsym.VERBS names the low-level verbs' modules, which verbs.py imports by name: they sit below it."""
+    for name, module in gearsym.VERBS.items():
+        assert module in modules(ROOT) and RANK[unit(module)] < RANK["verbs"], f"{name}: {module}"
+        assert callable(getattr(gearsym, name)) and name in gearsym.__all__

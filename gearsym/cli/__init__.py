@@ -1,9 +1,9 @@
 """The ``gearsym`` command line.
 
-Each subcommand lives in its own module, which defines ``NAME``, ``HELP``,
-``add_arguments(parser)`` and ``run(args) -> int`` (the exit status). Adding
-a subcommand (``compile``, ``lyap``, ``sweep``, ...) means writing such a
-module and listing it in :data:`MODULES`; :func:`main` does the rest,
+Each subcommand lives in its own module of this package, named as the command, which defines ``NAME``,
+``HELP``, ``add_arguments(parser)`` and ``run(args) -> int`` (the exit status); what the commands share is in
+:mod:`.arguments`. Adding a subcommand (``compile``, ``lyap``, ``sweep``, ...) means writing such a module:
+:data:`MODULES` finds it, :func:`main` does the rest,
 including turning every :class:`~gearsym.errors.GearsymError` into a one-line
 message and exit status 2 (a user's mistake, not a crash: no traceback).
 A plain ``kill`` (SIGTERM) is handled like Ctrl-C: a sweep keeps its finished
@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import pkgutil
 import signal
 import sys
 import threading
@@ -27,13 +28,13 @@ from ..caller import command_line
 from ..version import __version__
 from ..errors import GearsymError, GearsymWarning
 
-#: each subcommand's module (its ``NAME`` -> the module in this package), in the order ``gearsym --help`` lists
-#: them; a run imports the module of its own command only (the others' imports would cost it start-up time)
-MODULES = {"list": "list_models", "derive": "derive", "docs": "docs", "compile": "compile", "lyap": "lyap",
-           "sweep": "sweep", "orbits": "orbits", "poincare": "poincare", "basins": "basins", "reproduce": "reproduce",
-           "simulate": "simulate", "explain": "explain", "spectrum": "spectrum", "modes": "modes",
-           "campbell": "campbell",
-           "fmu": "fmu", "stiffness": "stiffness"}
+#: the commands whose module is named otherwise (a module named ``list`` would hide the builtin in this package)
+_RENAMED = {"list_models": "list"}
+#: every subcommand's name -> its module: the modules of this package but ``__main__``, found without importing
+#: them (a run imports the module of its own command only: the others' imports would cost it start-up time), in
+#: the order ``gearsym --help`` lists them
+MODULES = dict(sorted((_RENAMED.get(m.name, m.name), m.name) for m in pkgutil.iter_modules(__path__)
+                      if not (m.ispkg or m.name.startswith("_"))))
 
 #: exit status of a GearsymError (argparse uses the same for bad arguments)
 USAGE_ERROR = 2

@@ -18,8 +18,8 @@ from ..physical.sweeps import nondimensional_axes
 from ..sweep.basin_continuation import MATCH_DISTANCE, StartGrid, continue_basins
 from ..sweep.grid import Axis, axes_from, parse_axis
 from ..sweep.store import sidecar
-from .integration import add_integration_arguments, compiled_from, scaling_from
-from .settings import add_set_argument, parse_state
+from .arguments.integration import add_integration_arguments, compiled_from, scaling_from
+from .arguments.settings import add_set_argument, parse_state
 
 NAME = "basins"
 HELP = "basins of attraction on a grid of starts (attractors by their Poincare sets), and their fractions along a parameter"

@@ -19,8 +19,8 @@ from ..options import Execution
 from ..sweep import run_sweep
 from ..sweep.grid import parse_axis
 from ..sweep.store import sidecar
-from .integration import add_integration_arguments, compiled_from, scaling_from
-from .settings import add_set_argument, model_settings, parse_settings, refuse_swept_and_set
+from .arguments.integration import add_integration_arguments, compiled_from, scaling_from
+from .arguments.settings import add_set_argument, model_settings, parse_settings, refuse_swept_and_set
 
 NAME = "campbell"
 HELP = "Campbell diagram (natural frequencies, mesh and torque orders, crossings) beside the amplitude over speed"

@@ -13,7 +13,7 @@ from ..derivation import derive, render
 from ..files.outputs import check_folder
 from ..loading import declared
 from ..registry import available_models, output_root
-from .settings import add_teeth_argument
+from .arguments.settings import add_teeth_argument
 
 NAME = "docs"
 HELP = "write the Markdown derivation of models to DIR/<model>.md"

@@ -9,8 +9,8 @@ from ..figures.fit_report import explain_files
 from ..fit.selection import check_fit_names, check_harmonics
 from ..files.outputs import check_folder
 from ..options import Execution
-from .integration import add_integration_arguments, integration_from, scaling_from, system_from
-from .settings import add_set_argument
+from .arguments.integration import add_integration_arguments, integration_from, scaling_from, system_from
+from .arguments.settings import add_set_argument
 
 NAME = "explain"
 HELP = "fit a model to measured data, find the missing physical effect, add it, report the error before and after"

@@ -13,8 +13,8 @@ from ..checks import chosen_coordinate
 from ..errors import GearsymError
 from ..figures import plot_point
 from ..files.outputs import check_figure
-from .integration import add_integration_arguments, compiled_from, scaling_from
-from .settings import add_set_argument, parse_state
+from .arguments.integration import add_integration_arguments, compiled_from, scaling_from
+from .arguments.settings import add_set_argument, parse_state
 
 NAME = "lyap"
 HELP = "Lyapunov spectrum (all exponents, per unit time) at one parameter point"

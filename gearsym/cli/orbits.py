@@ -23,8 +23,8 @@ from ..sweep import read_sweep
 from ..sweep.grid import _numbers_and_unit, Axis
 from ..sweep.store import sidecar
 from ..units import shown
-from .integration import add_integration_arguments, compiled_from, integration_from, scaling_from, system_from
-from .settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
+from .arguments.integration import add_integration_arguments, compiled_from, integration_from, scaling_from, system_from
+from .arguments.settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
 
 NAME = "orbits"
 HELP = "periodic orbits, their Floquet multipliers and stability, and their branches over a parameter with folds, " \

@@ -19,8 +19,8 @@ from ..sweep import DIRECTIONS, MODES, POINCARE_SAMPLES, Workers, run_sweep
 from ..sweep.grid import axes_from
 from ..sweep.report import findings_lines
 from ..sweep.store import sidecar
-from .integration import add_integration_arguments, compiled_from, integration_from, scaling_from
-from .settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
+from .arguments.integration import add_integration_arguments, compiled_from, integration_from, scaling_from
+from .arguments.settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
 
 NAME = "sweep"
 HELP = "Lyapunov spectra, amplitudes and regimes over a 1-D or 2-D parameter grid (resumable)"

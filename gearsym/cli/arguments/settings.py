@@ -7,10 +7,10 @@ import sys
 
 import gearsym  # the face: SymPy is loaded only when a formula is given
 
-from ..errors import GearsymError
-from ..model.length_scale import check_length_scale
-from ..model.tooth_counts import parse_teeth
-from ..units import looks_like_quantity, parse_quantity
+from ...errors import GearsymError
+from ...model.length_scale import check_length_scale
+from ...model.tooth_counts import parse_teeth
+from ...units import looks_like_quantity, parse_quantity
 
 
 def add_set_argument(parser: argparse.ArgumentParser) -> None:
