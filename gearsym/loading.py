@@ -12,6 +12,7 @@ from .codegen.build import compile_model
 from .errors import GearsymError
 from .options import Integration
 from .model.teeth import with_teeth
+from .model.tooth_counts import ToothCounts
 from .physical.answers import PhysicalScaling
 from .reduction import NondimensionalModel, reduce
 from .registry import load_model
@@ -22,8 +23,8 @@ from .units import is_quantity
 
 def declared(ref, teeth=None):
     """The declared model of a name, a file or a model, with ``teeth`` = (pinion, wheel) tooth counts given to a
-    drivetrain that declares none (:func:`gearsym.model.teeth.with_teeth`)."""
-    return with_teeth(load_model(ref), teeth)
+    drivetrain that declares none (:func:`gearsym.model.teeth.with_teeth`; read here, where they enter)."""
+    return with_teeth(load_model(ref), ToothCounts.of(teeth))
 
 
 def reduced(ref, teeth=None) -> NondimensionalModel:
