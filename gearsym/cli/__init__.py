@@ -71,11 +71,12 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``gearsym`` with ``argv`` (default: the process arguments); returns the exit status."""
     argv = sys.argv[1:] if argv is None else list(argv)
-    args = build_parser(argv[0] if argv else None).parse_args(argv)
+    parser = build_parser(argv[0] if argv else None)
     with warnings.catch_warnings(), _sigterm_as_ctrl_c() as terminated, command_line():
         warnings.simplefilter("default", GearsymWarning)
         warnings.showwarning = _one_line
         try:
+            args = parser.parse_args(argv)  # (--set's values are read as they are parsed: their errors are one line)
             status = args.run(args)
             sys.stdout.flush()  # a closed pipe shows here rather than at the interpreter's exit
         except GearsymError as exc:

@@ -20,7 +20,7 @@ from ..sweep import run_sweep
 from ..sweep.grid import parse_axis
 from ..sweep.store import sidecar
 from .arguments.integration import add_integration_arguments, compiled_from, scaling_from
-from .arguments.settings import add_set_argument, model_settings, parse_settings, refuse_swept_and_set
+from .arguments.settings import add_set_argument, model_settings, refuse_swept_and_set
 
 NAME = "campbell"
 HELP = "Campbell diagram (natural frequencies, mesh and torque orders, crossings) beside the amplitude over speed"
@@ -55,7 +55,7 @@ def run(args: argparse.Namespace) -> int:
     if axis.name != scaling.speed.parameter:
         raise GearsymError(f"--param {args.param!r}: the Campbell diagram runs along the speed "
                            f"({scaling.speed.parameter}=...), not {axis.name}")
-    refuse_swept_and_set([(axis.name, args.param)], parse_settings(args.set))
+    refuse_swept_and_set([(axis.name, args.param)], args.set)
     engine_axis = nondimensional_axis(scaling, axis)  # (a speed without its unit is refused here)
     modes = natural_modes(scaling.model, **model_settings(args))
     diagram = campbell(scaling, axis.values, axis.unit, modes, args.orders)
@@ -71,7 +71,7 @@ def run(args: argparse.Namespace) -> int:
         sweep = scaling.to_physical(result, given=[axis])
         print(f"in physical units: {write_physical_table(sweep, sidecar(args.out, '.physical.csv'))}")
 
-    given = dict(setting.split("=", 1) for setting in args.set or () if "=" in setting)
+    given = {name: f"{value:g}" if isinstance(value, float) else str(value) for name, value in args.set.items()}
     plot_campbell(diagram, args.plot, sweep, settings=given)
     print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     return 0

@@ -20,7 +20,7 @@ from ..sweep.grid import axes_from
 from ..sweep.report import findings_lines
 from ..sweep.store import sidecar
 from .arguments.integration import add_integration_arguments, compiled_from, integration_from, scaling_from
-from .arguments.settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
+from .arguments.settings import add_set_argument, parse_state, refuse_swept_and_set
 
 NAME = "sweep"
 HELP = "Lyapunov spectra, amplitudes and regimes over a 1-D or 2-D parameter grid (resumable)"
@@ -81,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
     given = axes_from(args.param)
     scaling = scaling_from(args)
     axes = _engine_axes(given, scaling)
-    refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], parse_settings(args.set))
+    refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], args.set)
     compiled = compiled_from(args, options)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     try:
