@@ -55,8 +55,9 @@ SUMMARY_FORMAT = 4
 
 @dataclass(frozen=True, eq=False)
 class SystemSummary(ParameterChecks):
-    """The part of a :class:`~gearsym.system.FirstOrderSystem` a run reads, without SymPy; anything else
-    (its equations, couplings, period as an expression) comes from the full system, loaded on first use."""
+    """The part of a :class:`~gearsym.system.FirstOrderSystem` a run reads, without SymPy; its symbolic part
+    (equations, couplings, the period as an expression) comes from the full system (:attr:`full`), loaded on
+    first use."""
 
     name: str
     title: str
@@ -91,10 +92,28 @@ class SystemSummary(ParameterChecks):
             object.__setattr__(self, "_full", self.load())
         return self.__dict__["_full"]
 
-    def __getattr__(self, name: str):
-        if name.startswith("__") or name in ("_full", "load"):
-            raise AttributeError(name)
-        return getattr(self.full, name)
+    @property
+    def time(self):
+        """The time symbol (from the full system)."""
+        return self.full.time
+
+    @property
+    def states(self):
+        return self.full.states
+
+    @property
+    def rhs(self):
+        return self.full.rhs
+
+    @property
+    def period(self):
+        """The period as an expression (from the full system)."""
+        return self.full.period
+
+    @property
+    def couplings(self):
+        """The meshes and shafts the reduction handed on (from the full system)."""
+        return self.full.couplings
 
     def as_dict(self) -> dict:
         return {"name": self.name, "title": self.title, "time_name": self.time_name,

@@ -76,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
             raise GearsymError(f"{unit.spec!r} has a unit, but the model has no physical values; give the model's own "
                                "numbers")
     if axis is not None and units is not None:
-        axis = nondimensional_axes(scaling, [axis])[0]
+        axis = nondimensional_axes(scaling.full, [axis])[0]
     compiled = compiled_from(args)
     if axis is not None:
         return _continuation(args, compiled, grid_axes, axis, units, y0)

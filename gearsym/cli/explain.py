@@ -81,7 +81,7 @@ def _time_scale(args: argparse.Namespace) -> float | None:
     if args.time_scale is not None:
         return args.time_scale
     scaling = scaling_from(args)
-    return None if scaling is None else float(scaling.omega_n.to("rad/s").magnitude)
+    return None if scaling is None else float(scaling.full.omega_n.to("rad/s").magnitude)
 
 
 def _channel(text: str) -> tuple[str, str]:

@@ -102,7 +102,7 @@ def _undecided(result) -> list[str]:
 def diverged_message(compiled, result) -> str:
     """One line: how the run diverged, and where a stiffness of the model goes negative (the likely cause)."""
     system = compiled.system
-    time_name = getattr(system, "time_name", None) or getattr(getattr(system, "time", None), "name", "t")
+    time_name = system.time_name
     text = f"{result.model}: the motion diverged: {result.divergence.describe(result.period, time_name)}"
     try:
         notes = stiffness_notes(system, result.parameters)

@@ -94,7 +94,7 @@ def engine_range(args: argparse.Namespace, parameter: tuple, scaling) -> tuple[s
                                "them (model.set_physical) or give them with --set NAME='VALUE UNIT'")
         return name, start, stop
 
-    axis = nondimensional_axis(scaling, Axis(name, (start, stop), args.param, unit))
+    axis = nondimensional_axis(scaling.full, Axis(name, (start, stop), args.param, unit))
     if axis.name != name:
         print(f"{name} {start:g} -> {stop:g}{' ' + unit if unit else ''} is {axis.name} {axis.values[0]:.6g} -> "
               f"{axis.values[1]:.6g}: continued in {axis.name}")

@@ -141,4 +141,4 @@ def _engine_axes(axes, scaling):
                                "them (model.set_physical) or give them with --set NAME='VALUE UNIT'")
         return axes
 
-    return nondimensional_axes(scaling, axes)
+    return nondimensional_axes(scaling.full, axes)

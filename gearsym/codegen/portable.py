@@ -84,7 +84,7 @@ class ShippedModel:
 
 def ship(compiled: CompiledModel) -> ShippedModel:
     """``compiled`` packed for another process or machine (see the module docstring)."""
-    system = getattr(compiled.system, "full", compiled.system)  # a cached model's summary: the system it stands for
+    system = compiled.system.full  # (a cached model's summary: the system it stands for)
     base = dict(system=system, options=compiled.options, integration=compiled.integration,
                 hash=compiled.hash, backend=compiled.backend, versions=_versions(), timed=compiled.timed,
                 table_texts=compiled.table_texts)
