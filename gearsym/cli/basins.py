@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from pathlib import Path
 
 from ..analysis.basins import RUN, basin_map
 from ..errors import GearsymError
@@ -16,7 +15,7 @@ from ..physical.basins import PhysicalGrid, ShownBasinMap, ShownFractions, engin
 from ..physical.files import write_basin_fractions, write_basin_map
 from ..physical.sweeps import nondimensional_axes
 from ..sweep.basin_continuation import MATCH_DISTANCE, StartGrid, continue_basins
-from ..sweep.grid import Axis, axes_from, parse_axis
+from ..sweep.grid import Axis, parse_axis
 from ..sweep.store import sidecar
 from .arguments.integration import add_integration_arguments, compiled_from, scaling_from
 from .arguments.settings import add_set_argument, parse_state
@@ -28,46 +27,43 @@ HELP = "basins of attraction on a grid of starts (attractors by their Poincare s
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("model", help="a model name (see `gearsym list`) or the path of a model file")
     add_set_argument(parser)
-    parser.add_argument("--grid", action="append", required=True, metavar="STATE=START:STOP:STEP",
+    parser.add_argument("--grid", type=parse_axis, action="append", required=True, metavar="STATE=START:STOP:STEP",
                         help="the starts of one state (stop included; V1,V2,... also); give two states, the "
                              "others are held at --y0 (a model with physical values: with units, x=-20um:20um:1um, "
                              "v=-500mm/s:500mm/s:25mm/s)")
-    parser.add_argument("--y0", metavar="x1=0,v1=0", help="where the states off the grid start (default: the model's)")
-    parser.add_argument("--param", metavar="NAME=START:STOP:STEP",
+    parser.add_argument("--y0", type=parse_state, metavar="x1=0,v1=0",
+                        help="where the states off the grid start (default: the model's)")
+    parser.add_argument("--param", type=parse_axis, metavar="NAME=START:STOP:STEP",
                         help="the basin fractions along this parameter, each attractor followed by its Poincare "
                              "set (needs --out; resumable: the same command continues an interrupted run)")
     add_integration_arguments(parser, **RUN)
     parser.add_argument("--jobs", type=int, default=0, help="threads (default 0: one per core)")
     parser.add_argument("--no-lanes", action="store_true",
                         help="the scalar loops, one start at a time (the same numbers, slower)")
-    parser.add_argument("--out", type=Path, metavar="FILE.csv",
+    parser.add_argument("--out", type=lambda text: check_file(text, (".csv",)), metavar="FILE.csv",
                         help="a map: one row per start (its attractor) and FILE.json; with --param: one row per "
                              "attractor and value, FILE.attractors.csv (Poincare points) and FILE.json")
     parser.add_argument("--overwrite", action="store_true", help="with --param: start again instead of resuming")
     parser.add_argument("--match-distance", type=float, default=MATCH_DISTANCE, metavar="D",
                         help=f"with --param: how far (in units of the points' spread) an attractor may move between "
                              f"neighbouring values and still be the same (default {MATCH_DISTANCE})")
-    parser.add_argument("--plot", type=Path, metavar="FILE.png",
+    parser.add_argument("--plot", type=check_figure, metavar="FILE.png",
                         help="the basin map (with --param: the fractions and amplitudes along the parameter)")
     parser.add_argument("--format", choices=("text", "json"), default="text")
     parser.add_argument("--quiet", action="store_true", help="no progress output")
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.out:
-        check_file(args.out, (".csv",))
+    """(The arguments are read and checked as they are parsed: --grid and --param into axes, --y0 into numbers,
+    --out and --plot where they go.)"""
     if args.param and not args.out:
         raise GearsymError("--param follows the basins along a parameter into files: give --out FILE.csv")
-    if args.plot:
-        check_figure(args.plot)
     if args.jobs < 0:
         raise GearsymError(f"--jobs must be 0 (every core) or more, got {args.jobs}")
-    grid_axes = [parse_axis(g) for g in args.grid]
+    grid_axes, y0, axis = args.grid, args.y0, args.param
     if len(grid_axes) != 2 or grid_axes[0].name == grid_axes[1].name:
         raise GearsymError(f"--grid: give two different states (e.g. --grid x=-5:5:0.1 --grid v=-5:5:0.1), got "
                            f"{', '.join(a.name for a in grid_axes) or 'none'}")
-    y0 = parse_state(args.y0)
-    axis = axes_from([args.param])[0] if args.param else None
     scaling = scaling_from(args)
     units = scaling.point_units() if scaling is not None else None
     if units is None:
