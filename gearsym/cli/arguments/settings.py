@@ -9,9 +9,10 @@ import argparse
 import math
 import sys
 
-import gearsym  # the face: SymPy is loaded only when a formula is given
+import gearsym  # the face: SymPy is loaded only when a formula is built
 
 from ...errors import GearsymError
+from ...model.grammar import canonical_formula
 from ...model.length_scale import check_length_scale
 from ...model.tooth_counts import ToothCounts
 from ...units import looks_like_quantity, measure
@@ -49,17 +50,31 @@ class _Teeth(argparse.Action):
         setattr(namespace, self.dest, ToothCounts.of(value))
 
 
-def model_settings(args: argparse.Namespace) -> dict:
-    """--set's values and, with --teeth, ``teeth`` = (Z1, Z2): what the face's ``gearsym.load`` takes."""
+def model_settings(args: argparse.Namespace, *, cached: bool = False) -> dict:
+    """--set's values and, with --teeth, ``teeth`` = (Z1, Z2): what the face's ``gearsym.load`` takes. A formula's
+    numbers are checked here too (:func:`checked_formulas`), unless the caller may find the model in the start-up
+    cache (``cached``): it checks them when it builds the model, and a cached model's run never loads SymPy."""
     teeth = getattr(args, "teeth", None)
-    return {**args.set, **({"teeth": teeth} if teeth is not None else {})}
+    settings = {**args.set, **({"teeth": teeth} if teeth is not None else {})}
+    return settings if cached else checked_formulas(settings)
+
+
+def checked_formulas(settings: dict) -> dict:
+    """``settings``, after each formula among them is built (SymPy) to check its numbers: 1/0, log(0) or
+    exp(1000) are refused with the option that gave them, before the model is loaded. (A model in the start-up
+    cache was built with its formula once: the cache has it only if the formula passed.)"""
+    for name, value in settings.items():
+        if _is_formula(name, value):
+            gearsym.parse_formula(value, f"--set {name}")
+    return settings
 
 
 def parse_settings(pairs: list[str], settings: dict | None = None) -> dict[str, object]:
     """``NAME=VALUE`` pairs added to ``settings`` (a new dict), each value read once into what it is (before any
     work starts; nothing is ever run as Python): a quantity (a number and a unit) becomes a
-    :class:`~gearsym.units.Measure` in SI, a number a float, a length scale's name and a formula stay text (the
-    formula's grammar and numbers checked)."""
+    :class:`~gearsym.units.Measure` in SI, a number a float, a length scale's name stays text, and a formula's
+    grammar is checked without SymPy and kept in one spelling (:func:`~gearsym.model.grammar.canonical_formula`:
+    the start-up cache's key); its numbers are checked when it is built (:func:`checked_formulas`)."""
     settings = dict(settings or {})
     for pair in pairs:
         name, sep, value = pair.partition("=")
@@ -79,10 +94,15 @@ def parse_settings(pairs: list[str], settings: dict | None = None) -> dict[str, 
                 raise GearsymError(f"--set {name}={value}: not a finite number (a double holds at most "
                                    f"{sys.float_info.max:.3g}); give a finite value")
             settings[name] = float(value)
-        else:  # (its grammar and its numbers: 1/0 or 1e400 are refused here, not in the C)
-            gearsym.parse_formula(value, f"--set {name}")
-            settings[name] = value
+        else:  # (its grammar, on Python's syntax tree alone; its numbers when it is built: checked_formulas)
+            settings[name] = canonical_formula(value, f"--set {name}")
     return settings
+
+
+def _is_formula(name: str, value) -> bool:
+    """Whether a --set value is a formula (text :func:`parse_settings` kept: not a quantity, not a number, not a
+    length scale's name)."""
+    return isinstance(value, str) and name != "length_scale"
 
 
 def refuse_swept_and_set(swept: list[tuple[str, str]], settings: dict[str, str]) -> None:
