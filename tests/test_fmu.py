@@ -26,7 +26,7 @@ from fmpy.validation import validate_fmu  # noqa: E402
 import gearsym  # noqa: E402
 from gearsym import Integration  # noqa: E402
 from gearsym.cli import main  # noqa: E402
-from gearsym.codegen.build import code_directory  # noqa: E402
+from gearsym.codegen.code_files import code_directory  # noqa: E402
 from gearsym.codegen.generate import code_hash  # noqa: E402
 from gearsym.codegen.loops import LoopOptions  # noqa: E402
 from gearsym.codegen.surfaces import switching_surfaces  # noqa: E402

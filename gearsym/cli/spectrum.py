@@ -23,8 +23,8 @@ from ..loading import load
 from ..memory import check_fits
 from ..options import STEPS_PER_PERIOD, Integration
 from ..files.outputs import check_figure, check_file
-from .integration import add_integration_arguments, compiled_from
-from .settings import add_set_argument, model_settings
+from .arguments.integration import add_integration_arguments, compiled_from
+from .arguments.settings import add_set_argument, model_settings
 from .simulate import with_effects
 
 NAME = "spectrum"

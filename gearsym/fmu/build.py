@@ -20,12 +20,12 @@ from dataclasses import asdict, dataclass
 from importlib import resources
 from pathlib import Path
 
-from ..codegen.build import cached_code_directory, code_directory
 from ..files.atomic import writing
 from ..files.private import CACHE_ADVICE
+from ..codegen.code_files import cached_code_directory, code_directory, read_manifest
 from ..codegen.compiler import CompilerError, compilers_looked_for, find_compiler, INSTALL_HINT
 from ..codegen.functions import build_functions
-from ..codegen.generate import code_hash, read_manifest, write_code
+from ..codegen.generate import code_hash, write_code
 from ..codegen.loops import LoopOptions
 from ..codegen.surfaces import switching_surfaces
 from ..codegen.time_tables import split_rhs

@@ -496,9 +496,7 @@ class _Assembly:
         comp = rc.component
         fname = comp.function or ("k" if rc is reference else f"k{suffix}")
         phase = sp.expand(rc.mesh_phase.subs(t, tau / omega))
-        varied = rc.variation.subs(phi, phase)
-        if rc.loss != 0:  # stiffness a shaft-order term takes away (a tooth fault), once per revolution
-            varied = varied * (1 - rc.loss.subs(phi, phase))
+        varied = rc.variation_at(phase)
         if rc is not reference and _equal(m * rc.stiffness, self.own_factor(reference) * reference.stiffness):
             expression = varied  # as stiff as the first mesh (another planet's): 1 by the time-unit condition
         elif rc is reference:

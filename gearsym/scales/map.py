@@ -225,6 +225,12 @@ class Scaling:
         scale = nd.drivetrain.length_scale if length_scale is None else length_scale
         return cls(nd, {**nd.drivetrain.physical, **physical}, scale)
 
+    @property
+    def full(self) -> "Scaling":
+        """The scaling itself (the start-up cache's stand-in, :class:`~gearsym.physical.point.CachedScaling`, makes
+        its full scaling here: whatever a caller needs beyond a spectrum's units)."""
+        return self
+
     def with_values(self, **physical) -> "Scaling":
         """The same drivetrain with some physical values changed (``speed="3000 rpm"``)."""
         return type(self)(self.model, {**self.inputs, **self.functions, **self.formula_values, **physical},
