@@ -250,7 +250,7 @@ def refusal(path, **start) -> tuple[str, list[str]]:
 def test_a_value_the_engine_does_not_take_is_refused(one_stage):
     raised, said = refusal(one_stage, omega=-1.0)
     assert raised.startswith("fmi2ExitInitializationMode failed with status 3")
-    assert said == ["the parameter values make the engine's omega negative or zero, which it may not be"]
+    assert said == ["the parameter values make the engine's omega -1, but it must be positive (the forcing frequency)"]
     raised, said = refusal(one_stage, substeps=0)
     assert raised.startswith("fmi2SetInteger failed with status 3") and said == ["substeps must be at least 1"]
 

@@ -78,9 +78,10 @@ def test_a_run_killed_while_the_files_are_renamed_leaves_a_marker_that_says_the_
     replace = os.replace
 
     def killed_after_one(src, dst):
-        if renamed:
-            raise SystemExit("killed")  # (what kill -9 leaves: one file renamed, the rest not)
-        renamed.append(dst)
+        if os.path.dirname(os.fspath(dst)) == os.fspath(tmp_path):  # (a file of the report put in place; each
+            if renamed:                                             # written whole in the staging folder first)
+                raise SystemExit("killed")  # (what kill -9 leaves: one file renamed, the rest not)
+            renamed.append(dst)
         replace(src, dst)
 
     monkeypatch.setattr(os, "replace", killed_after_one)

@@ -24,10 +24,15 @@ NAME = "basins"
 HELP = "basins of attraction on a grid of starts (attractors by their Poincare sets), and their fractions along a parameter"
 
 
+def grid_axis(text: str) -> Axis:
+    """One --grid axis (its errors name --grid)."""
+    return parse_axis(text, "--grid")
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("model", help="a model name (see `gearsym list`) or the path of a model file")
     add_set_argument(parser)
-    parser.add_argument("--grid", type=parse_axis, action="append", required=True, metavar="STATE=START:STOP:STEP",
+    parser.add_argument("--grid", type=grid_axis, action="append", required=True, metavar="STATE=START:STOP:STEP",
                         help="the starts of one state (stop included; V1,V2,... also); give two states, the "
                              "others are held at --y0 (a model with physical values: with units, x=-20um:20um:1um, "
                              "v=-500mm/s:500mm/s:25mm/s)")
