@@ -37,7 +37,8 @@ from pathlib import Path
 
 from .codegen.compiled import CompiledModel
 from .codegen.compiler import binary_key, cache_dir, compile_flags
-from .codegen.library import LOADED, library_describes, library_functions, resolve_backend
+from .codegen.library import library_describes, library_functions, model_key, resolve_backend
+from .codegen.loaded import keep, loaded
 from .codegen.loops import LoopOptions
 from .codegen.native import load_native
 from .codegen.trust import check, differences
@@ -56,8 +57,9 @@ SUMMARY_FORMAT = 4
 
 @dataclass(frozen=True, eq=False)
 class SystemSummary(ParameterChecks):
-    """The part of a :class:`~gearsym.system.FirstOrderSystem` a run reads, without SymPy; anything else
-    (its equations, couplings, period as an expression) comes from the full system, loaded on first use."""
+    """The part of a :class:`~gearsym.system.FirstOrderSystem` a run reads, without SymPy; its symbolic part
+    (equations, couplings, the period as an expression) comes from the full system (:attr:`full`), loaded on
+    first use."""
 
     name: str
     title: str
@@ -92,17 +94,35 @@ class SystemSummary(ParameterChecks):
             object.__setattr__(self, "_full", self.load())
         return self.__dict__["_full"]
 
-    def __getattr__(self, name: str):
-        if name.startswith("__") or name in ("_full", "load"):
-            raise AttributeError(name)
-        return getattr(self.full, name)
+    @property
+    def time(self):
+        """The time symbol (from the full system)."""
+        return self.full.time
+
+    @property
+    def states(self):
+        return self.full.states
+
+    @property
+    def rhs(self):
+        return self.full.rhs
+
+    @property
+    def period(self):
+        """The period as an expression (from the full system)."""
+        return self.full.period
+
+    @property
+    def couplings(self):
+        """The meshes and shafts the reduction handed on (from the full system)."""
+        return self.full.couplings
 
     def as_dict(self) -> dict:
         return {"name": self.name, "title": self.title, "time_name": self.time_name,
                 "state_names": list(self.state_names), "parameters": dict(self.parameters),
                 "initial": dict(self.initial), "coordinates": list(self.coordinates),
                 "descriptions": dict(self.descriptions),
-                "constraints": {k: [c.meaning, c.zero_allowed] for k, c in self.constraints.items()},
+                "constraints": {k: c.as_list() for k, c in self.constraints.items()},
                 "autonomous": self.autonomous, "physical": self.physical, "cycles": self.cycles}
 
     @classmethod
@@ -111,7 +131,7 @@ class SystemSummary(ParameterChecks):
                    {str(k): float(v) for k, v in d["parameters"].items()},
                    {str(k): float(v) for k, v in d["initial"].items()}, tuple(map(str, d["coordinates"])),
                    {str(k): str(v) for k, v in d["descriptions"].items()},
-                   {str(k): Constraint(str(m), bool(z)) for k, (m, z) in d["constraints"].items()},
+                   {str(k): Constraint.from_list(c) for k, c in d["constraints"].items()},
                    bool(d["autonomous"]), bool(d["physical"]), load, int(d["cycles"]))
 
     @classmethod
@@ -277,16 +297,16 @@ def _from_cache(system_file: Path, build_file: Path, options: Integration, loops
     if why is not None:  # (the summaries do not describe the library they point at: edited)
         _distrust(build_file, f"{library.name}, the library it points at, does not match it: {why}")
         return None
-    key = (digest, "compiled")
-    if key in LOADED:  # (loaded in this process already: its functions with work arrays of their own)
-        return replace(LOADED[key].clone(), system=summary, integration=options)
+    key = model_key(digest, "compiled")
+    found = loaded(key)
+    if found is not None:  # (loaded in this process already: its functions with work arrays of their own)
+        return replace(found.clone(), system=summary, integration=options)
     if summary.cycles < 1:
         return None
     loops = LoopOptions.of(options, summary.cycles)  # (the key's loops count steps per forcing period)
     functions = library_functions(library)
-    compiled = LOADED[key] = CompiledModel(summary, loops, digest, functions, "compiled", library, {},
-                                           load_native(library, functions), options, timed, texts)
-    return compiled
+    return keep(key, CompiledModel(summary, loops, digest, functions, "compiled", library, {},
+                                   load_native(library, functions), options, timed, texts))
 
 
 def load_linearisation(ref: str, values: Mapping[str, object], options: Integration, *,

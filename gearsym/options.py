@@ -1,11 +1,16 @@
-"""How a run integrates: one small options object for every analysis, sweep, simulation and fit.
+"""How a run integrates and how it is executed: two small options objects for every verb.
 
 Like diffrax's ``SaveAt`` or step-size controllers, :class:`Integration` is passed to the verbs
 (``lyapunov_spectrum(model, options=Integration(periods=800))``) instead of each verb restating the
 same keywords with its own defaults. The default steps per period lives here and nowhere else.
+:class:`Execution` says how a verb that runs many things runs them (threads or workers, the lanes, progress),
+which never changes its numbers: ``run_sweep``, ``basin_map``, ``continue_basins``, ``explain`` and
+``reproduce`` take it as ``execution=``.
 """
 from __future__ import annotations
 
+import sys
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 from .caller import option
@@ -17,6 +22,52 @@ from .memory import check_fits
 STEPS_PER_PERIOD = 200
 #: where the engine runs: compiled C, CasADi's interpreter, or compiled when a C compiler exists
 BACKENDS = ("auto", "compiled", "in-process")
+#: ways to use more than one core of this machine for a sweep's points (``Execution(parallel=...)``)
+PARALLEL = ("auto", "processes", "threads")
+
+
+@dataclass(frozen=True)
+class Execution:
+    """How a verb runs what it runs; the numbers are the same whatever this says.
+
+    * ``jobs``: threads or worker processes (0: one per core of this machine);
+    * ``parallel``: how a sweep's points use them: ``"processes"`` (this one and ``jobs - 1`` forked from it),
+      ``"threads"``, or ``"auto"`` (processes where the OS can fork);
+    * ``scheduler``: a sweep's points on a Dask cluster (the ``distributed`` extra): ``"local"`` (a cluster of
+      ``jobs`` processes on this machine), ``"tcp://HOST:PORT"``, or a ``distributed.Client``;
+    * ``lanes``: many starts per native call, L at a time in the SIMD lanes (None: the verb's default, on for
+      basins, off for sweeps, whose files then stay those of the scalar loops wherever they run);
+    * ``progress``: what has been done said on stderr as the run goes (a bar, a line per value), or a callable
+      given each line instead; off by default (the command line turns it on; ``--quiet`` off).
+    """
+
+    jobs: int = 0
+    parallel: str = "auto"
+    scheduler: object = None
+    lanes: bool | None = None
+    progress: bool | Callable[[str], None] = False
+
+    def __post_init__(self):
+        object.__setattr__(self, "jobs", whole_number(self.jobs, "jobs"))
+        if self.parallel not in PARALLEL:
+            raise GearsymError(f"parallel={self.parallel!r}: choose one of {', '.join(PARALLEL)}")
+        if self.lanes not in (None, True, False):
+            raise GearsymError(f"lanes must be True, False or None (the verb's default), got {self.lanes!r}")
+        if not (isinstance(self.progress, bool) or callable(self.progress)):
+            raise GearsymError(f"progress must be True, False or a function of one line, got {self.progress!r}")
+
+    def with_lanes(self, default: bool) -> bool:
+        """Whether to run in the lanes: as asked, else the verb's ``default``."""
+        return default if self.lanes is None else self.lanes
+
+    @property
+    def say(self) -> Callable[[str], None]:
+        """A line of progress: to stderr, to the caller's function, or nowhere."""
+        if callable(self.progress):
+            return self.progress
+        if self.progress:
+            return lambda line: print(f"gearsym: {line}", file=sys.stderr, flush=True)
+        return lambda line: None
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import gearsym
-from gearsym import FirstOrderSystem, Integration
+from gearsym import Execution, FirstOrderSystem, Integration
 from gearsym.analysis.basins import DIVERGED, UNDETERMINED, basin_map
 from gearsym.cli import main
 from gearsym.sweep.basin_continuation import APPEARS, VANISHES, continue_basins
@@ -78,13 +78,19 @@ def test_duffing_basins_in_its_hysteresis_window_agree_with_scipy(duffing):
     for a in found.attractors:
         scipy_fraction = np.mean(expected == a.number)
         assert abs(a.fraction - scipy_fraction) <= 2 * a.stderr + 1e-12
+    for a, centre in zip(found.attractors, centres[match]):  # each orbit's amplitude: SciPy's over one period
+        sol = solve_ivp(lambda t, y: [y[1], -2 * ZETA * y[1] - y[0] - BETA * y[0] ** 3 + F * np.cos(WINDOW_OMEGA * t)],
+                        (0.0, 2 * math.pi / WINDOW_OMEGA), centre, method="DOP853", rtol=1e-10, atol=1e-10,
+                        dense_output=True)
+        x = sol.sol(np.linspace(0.0, 2 * math.pi / WINDOW_OMEGA, 4001))[0]
+        assert a.amplitude["x"] == pytest.approx((x.max() - x.min()) / 2, rel=1e-3)
     assert found.attractors[0].amplitude["x"] != pytest.approx(found.attractors[1].amplitude["x"], rel=0.1)
 
 
 def test_the_lanes_and_the_scalar_loops_give_the_same_map(duffing):
     grid = {"x": np.linspace(-4, 4, 7), "v": np.linspace(-4, 4, 5)}
     wide = basin_map(duffing, grid, options=RUN, omega=WINDOW_OMEGA)
-    one = basin_map(duffing, grid, options=RUN, lanes=False, omega=WINDOW_OMEGA)
+    one = basin_map(duffing, grid, options=RUN, execution=Execution(lanes=False), omega=WINDOW_OMEGA)
     assert wide.lanes > 1 and one.lanes == 1
     assert np.array_equal(wide.labels, one.labels)
     assert [a.fraction for a in wide.attractors] == [a.fraction for a in one.attractors]

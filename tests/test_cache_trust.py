@@ -261,11 +261,12 @@ def test_a_changed_constant_in_the_cached_c_is_found_and_the_c_generated_again(c
     assert "6.2831853071795862e+00" in source.read_text()
 
 
-def test_a_changed_lanes_c_in_the_cache_is_never_compiled(cache, clean):
-    """The lanes' C is code too: compiled only as gearsym wrote it; changed, it is refused in one line that says
-    what to do, and no library is made from it."""
-    (source,) = (cache / "code").glob("duffing-*/duffing_lanes.c")
-    source.write_text(source.read_text().replace("GS_LANES {", "GS_LANES { /* planted */", 1))
+@pytest.mark.parametrize("planted, text", [("duffing_lanes.c", "GS_LANES gs_"), ("duffing.c", "GEARSYM_INLINE void")])
+def test_a_changed_lanes_c_in_the_cache_is_never_compiled(cache, clean, planted, text):
+    """The lanes' C is code too, and so is the model's C it includes: compiled only as gearsym wrote them;
+    changed, either is refused in one line that says what to do, and no library is made from it."""
+    (source,) = (cache / "code").glob(f"duffing-*/{planted}")
+    source.write_text(source.read_text().replace(text, text + " /* planted */", 1))
     run = gearsym(cache, "basins", "duffing", "--grid", "x=-1:1:1", "--grid", "v=-1:1:1", *ARGS, *STEPS_150)
     assert run.returncode == 2 and run.stderr.count("gearsym: error:") == 1, run.stderr
     assert f"the C of its lanes ({source}) is not what gearsym wrote" in run.stderr and "delete" in run.stderr
@@ -326,6 +327,28 @@ def test_a_summary_pointing_at_another_models_library_is_not_trusted(cache, clea
     run = gearsym(cache, "lyap", "one_stage", *ARGS)
     assert run.returncode == 0, run.stderr
     assert "model" in one_line_warning(run.stderr, "the cached summary")
+    assert run.stdout == clean["one_stage"]
+
+
+def test_a_summary_pointing_at_a_library_outside_the_caches_lib_folder_never_loads_it(cache, clean, planted,
+                                                                                       tmp_path):
+    """A library beside a record that vouches for it, in a folder of the user's own, but not the cache's lib/: a
+    resealed build summary that points there is not followed (the library is compiled again in the cache)."""
+    data, marker = planted
+    _, build = summaries(cache)
+    lib = library(cache)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir(mode=0o700)
+    outside = elsewhere / lib.name
+    outside.write_bytes(data)
+    outside.chmod(0o600)
+    forge_record(lib, data)  # (the record of the planted bytes, moved beside them)
+    (forged,) = [p for p in lib.parent.glob(f"{lib.name}.*.json") if hashlib.sha256(data).hexdigest()[:16] in p.name]
+    shutil.move(forged, elsewhere / forged.name)
+    reseal(build, {**json.loads(build.read_text()), "library": str(outside)})
+    run = gearsym(cache, "lyap", "one_stage", *ARGS)
+    assert run.returncode == 0, run.stderr
+    assert not marker.exists()
     assert run.stdout == clean["one_stage"]
 
 

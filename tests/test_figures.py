@@ -14,7 +14,7 @@ from gearsym.reproduce import figures as paper_figures
 from conftest import system
 from gearsym import Integration, run_sweep
 
-SHORT = dict(options=Integration(periods=60, discard=20), progress=False)
+SHORT = dict(options=Integration(periods=60, discard=20))
 
 
 @pytest.fixture(autouse=True)
@@ -67,7 +67,7 @@ def test_2d_sweep_maps_name_their_axes_direction_and_fixed_values():
 # ------------------------------------------------------------------ the paper's figures
 @pytest.fixture(scope="module")
 def computed(tmp_path_factory):
-    return compute(paper_plan(quick=True, study=False), tmp_path_factory.mktemp("data"), progress=False)
+    return compute(paper_plan(quick=True, study=False), tmp_path_factory.mktemp("data"))
 
 
 @pytest.mark.parametrize("name", ["fig3", "fig4", "fig6", "fig7", "hysteresis"])
@@ -131,7 +131,7 @@ from gearsym.figures.orbits import LABELLED, plot_branches, plot_orbits  # noqa:
 from gearsym.figures.poincare import plot_attractors  # noqa: E402
 from gearsym.figures.sweep import BIFURCATION_DOT, ZERO_CONTOUR, plot_bifurcation, plot_map  # noqa: E402
 from gearsym.fit.prediction import Prediction  # noqa: E402
-from gearsym.fit.report import prediction_figure  # noqa: E402
+from gearsym.figures.fit_report import prediction_figure  # noqa: E402
 from gearsym.periodic import FOLD, GRAZING, PERIOD_DOUBLING  # noqa: E402
 from gearsym.periodic.branches import Bifurcation, Branch, Continuation  # noqa: E402
 from gearsym.physical.campbell import Campbell, Crossing, Order  # noqa: E402

@@ -12,8 +12,9 @@ import conftest
 from gearsym import Integration, explain, load_measurements, simulate_measurements
 from gearsym.errors import GearsymError
 from gearsym.fit import augment
-from gearsym.fit import report as report_module
-from gearsym.fit.report import PARTIAL_MARKER, REPORT_FILES, write_report
+from gearsym.figures import fit_report as report_module
+from gearsym.figures.fit_report import write_report
+from gearsym.fit.report import PARTIAL_MARKER, REPORT_FILES
 
 RECORD = Integration(periods=116, discard=100, backend="in-process")
 

@@ -286,6 +286,7 @@ def test_the_phasing_panel_draws_each_kept_tongue_as_its_wedge_and_each_suppress
     pyplot().close(fig)
 
 
+@pytest.mark.slow  # (a model of its own compiled: ~4 s of CPU)
 def test_a_point_without_a_periodic_orbit_is_marked_not_guessed():
     """k = k_m (1 + 0.2 cos tau) with a static load: at k_m = 0 there is no stiffness, the load drives the gear
     off at a growing distance and no period-1 orbit exists (nor a static state to start from); Newton from the

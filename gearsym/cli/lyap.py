@@ -13,8 +13,8 @@ from ..checks import chosen_coordinate
 from ..errors import GearsymError
 from ..figures import plot_point
 from ..files.outputs import check_figure
-from .integration import add_integration_arguments, compiled_from, scaling_from
-from .settings import add_set_argument, parse_state
+from .arguments.integration import add_integration_arguments, compiled_from, scaling_from
+from .arguments.settings import add_set_argument, parse_state
 
 NAME = "lyap"
 HELP = "Lyapunov spectrum (all exponents, per unit time) at one parameter point"
@@ -102,7 +102,7 @@ def _undecided(result) -> list[str]:
 def diverged_message(compiled, result) -> str:
     """One line: how the run diverged, and where a stiffness of the model goes negative (the likely cause)."""
     system = compiled.system
-    time_name = getattr(system, "time_name", None) or getattr(getattr(system, "time", None), "name", "t")
+    time_name = system.time_name
     text = f"{result.model}: the motion diverged: {result.divergence.describe(result.period, time_name)}"
     try:
         notes = stiffness_notes(system, result.parameters)

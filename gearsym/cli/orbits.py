@@ -23,8 +23,8 @@ from ..sweep import read_sweep
 from ..sweep.grid import _numbers_and_unit, Axis
 from ..sweep.store import sidecar
 from ..units import shown
-from .integration import add_integration_arguments, compiled_from, integration_from, scaling_from, system_from
-from .settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
+from .arguments.integration import add_integration_arguments, compiled_from, integration_from, scaling_from, system_from
+from .arguments.settings import add_set_argument, parse_state, refuse_swept_and_set
 
 NAME = "orbits"
 HELP = "periodic orbits, their Floquet multipliers and stability, and their branches over a parameter with folds, " \
@@ -94,7 +94,7 @@ def engine_range(args: argparse.Namespace, parameter: tuple, scaling) -> tuple[s
                                "them (model.set_physical) or give them with --set NAME='VALUE UNIT'")
         return name, start, stop
 
-    axis = nondimensional_axis(scaling, Axis(name, (start, stop), args.param, unit))
+    axis = nondimensional_axis(scaling.full, Axis(name, (start, stop), args.param, unit))
     if axis.name != name:
         print(f"{name} {start:g} -> {stop:g}{' ' + unit if unit else ''} is {axis.name} {axis.values[0]:.6g} -> "
               f"{axis.values[1]:.6g}: continued in {axis.name}")
@@ -126,7 +126,7 @@ def run(args: argparse.Namespace) -> int:
     if parameter:
         given = parameter[0]
         parameter = engine_range(args, parameter, scaling)
-        refuse_swept_and_set([(given, args.param), (parameter[0], args.param)], parse_settings(args.set))
+        refuse_swept_and_set([(given, args.param), (parameter[0], args.param)], args.set)
     system = system_from(args)
     if args.segments is not None:  # (before the code is compiled: a period of cycles forcing periods has
         pieces = system.cycles * pieces_per_period(options.steps_per_period)  # pieces in each)

@@ -195,7 +195,7 @@ class CompiledModel:
     @property
     def cycles(self) -> int:
         """Forcing periods in one period: 1, or a gear's revolution (the hunting period) with shaft-order terms."""
-        return getattr(self.system, "cycles", 1)
+        return self.system.cycles
 
     @property
     def steps_per_cycle(self) -> int:

@@ -31,6 +31,7 @@ change rebuilds.
 from __future__ import annotations
 
 import atexit
+import errno
 import hashlib
 import json
 import os
@@ -40,12 +41,14 @@ import shutil
 import subprocess
 import tempfile
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
 from ..errors import GearsymError, warn
-from ..files.private import NotPrivate, private_folder
+from ..files.atomic import no_room, write_error
+from ..files.private import CACHE_ADVICE, NotPrivate, private_folder
 from .trust import record, trusted
 
 DEFAULT_FLAGS = ("-O3", "-march=native", "-mtune=generic", "-fno-tree-partial-pre")
@@ -183,20 +186,23 @@ class Library:
 
 
 def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple[str, ...] | None = None,
-                    announce=None, describes: dict | None = None) -> Library:
+                    announce=None, describes: dict | None = None, includes: Sequence[Path] = ()) -> Library:
     """The shared library of ``source`` for this machine: from the cache, or compiled into it.
 
     ``describes`` says what the library is (the model, its code hash, states, parameters: kept in its record,
     part of its name). A cached library is used only if its bytes are those recorded when it was compiled
     (:func:`.trust.trusted`); one that is not (cut short, damaged, changed) is compiled again, and a warning
     says so. ``announce(message)`` is called before an actual compilation (a few seconds), not on a cache hit.
+    ``includes``: the files ``source`` includes (the lanes' C includes the model's), whose bytes name the library
+    too.
     """
     cc = cc or find_compiler()
     if cc is None:
         raise CompilerError(REQUIRED_NOTE.format(what=compilers_looked_for()))
     flags = compile_flags() if flags is None else tuple(flags)
     described = json.dumps(describes or {}, sort_keys=True).encode()
-    digest = hashlib.sha256(Path(source).read_bytes() + CALL_SOURCE.encode() + described).hexdigest()[:16]
+    included = b"".join(Path(path).read_bytes() for path in includes)
+    digest = hashlib.sha256(Path(source).read_bytes() + CALL_SOURCE.encode() + described + included).hexdigest()[:16]
     target = library_path(f"{name}-{digest}-{_machine_key(cc, flags)}.so")
     if trusted(target, describes) is not None:
         return Library(target, False, 0.0)
@@ -204,6 +210,15 @@ def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple
         kept = "for this run only" if str(configured_cache()) in _BYPASSED else f"once: cached in {target.parent}"
         announce(f"compiling {name} ({' '.join(flags)}; {kept})")
     start = time.perf_counter()
+    try:
+        _compile_into(cc, flags, source, target, describes)
+    except OSError as exc:  # (the cache's disk full: not the compiler's fault)
+        raise write_error(exc, target, CACHE_ADVICE) from None
+    return Library(target, True, time.perf_counter() - start)
+
+
+def _compile_into(cc: str, flags: tuple, source: Path, target: Path, describes) -> None:
+    """Compile ``source`` into the library ``target`` through a temporary folder beside it and a rename."""
     with tempfile.TemporaryDirectory(dir=target.parent) as tmp:
         out, call = Path(tmp) / target.name, Path(tmp) / "gearsym_call.c"
         call.write_text(CALL_SOURCE)
@@ -213,6 +228,8 @@ def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple
         except OSError as exc:
             raise CompilerError(f"could not run the C compiler {cc!r}: {exc}. Set $CC to a working compiler.") from exc
         if proc.returncode != 0:
+            if no_room(tmp):  # (the compiler could not write its output: the disk, not $CC)
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
             raise CompilerError(
                 f"compiling {source} failed ({' '.join(cmd)}):\n{proc.stderr.strip()[-2000:]}\n"
                 "Check $CC and $GEARSYM_CFLAGS, or report the model that caused it."
@@ -220,7 +237,6 @@ def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple
         os.chmod(out, 0o700)  # (whatever the umask)
         record(target, out.read_bytes(), describes)  # (before the rename: the library in place always has one)
         os.replace(out, target)  # atomic: concurrent compilers of the same model do not collide
-    return Library(target, True, time.perf_counter() - start)
 
 
 def library_path(file_name: str) -> Path:

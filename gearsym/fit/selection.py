@@ -40,7 +40,7 @@ from ..caller import name as caller_name, on_command_line, option
 from ..checks import whole_number
 from ..data.dataset import Measurements
 from ..errors import GearsymError, suggest
-from ..options import Integration
+from ..options import Execution, Integration
 from ..system import FirstOrderSystem
 from .canonical import amplitude_phase, canonical
 from .effects import EFFECTS, FAMILIES, Effect, applies_to, augment, bounds_of, effect, site, term_effect
@@ -274,7 +274,7 @@ def candidate_library(system: FirstOrderSystem, candidates: Sequence[str | Effec
 def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[str], *,
             candidates: Sequence[str | Effect] | None = None, held_out: float = 0.25,
             min_gain: float = MIN_GAIN, max_effects: int = MAX_EFFECTS,
-            max_correlation: float = MAX_CORRELATION, progress=None,
+            max_correlation: float = MAX_CORRELATION, execution: Execution | None = None,
             options: Integration = Integration(), bias: Sequence[str] | None = None, terms: Sequence[str] = (),
             harmonics: int | None = None, propose: bool = True, refits: int = REFITS) -> Explanation:
     """Fit ``fit`` on ``measurements``, then add effects from ``candidates`` (default: the whole library) and the
@@ -283,14 +283,14 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
     mean is zero for bounded motion, so that a constant offset in one is the sensor's bias; ``()``: none).
     ``harmonics``: the highest order of the harmonic families (default ``HARMONICS``, or fewer if the data
     resolve fewer)."""
+    say = (execution or Execution()).say
     fit = check_fit_names(fit, system)
     harmonics = check_harmonics(harmonics, measurements)
     _check_one_value_each(measurements, fit)
     by_default = acceleration_channels(measurements, system) if bias is None else ()
     bias = list(by_default if bias is None else bias)
     if by_default:
-        (progress or (lambda message: None))(
-            f"fitting the offset of {', '.join(by_default)} (an acceleration's steady mean is zero for bounded "
+        say(f"fitting the offset of {', '.join(by_default)} (an acceleration's steady mean is zero for bounded "
             f"motion, so a constant offset is the sensor's bias; {_no_bias()} fits none)")
     for name in bias:
         if name not in measurements.observed:
@@ -303,7 +303,6 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
     seg_train, keys_train = segments_of(superset, train)
     seg_test, keys = segments_of(superset, test)
     bounds = bounds_of(list(library.values()))
-    say = progress or (lambda message: None)
     scanned: dict[str, Placement] = {}  # a tooth fault's latest scan
 
     def evaluate(effects: tuple[str, ...], start: Candidate | None) -> Candidate:

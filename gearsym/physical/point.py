@@ -18,6 +18,7 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
+from ..analysis.lyapunov import LyapunovSpectrum
 from ..analysis.poincare import phase_trajectory
 from ..errors import GearsymError
 from ..scales.speeds import Speed
@@ -326,8 +327,9 @@ class PointUnits:
 
 
 class CachedScaling:
-    """A :class:`~gearsym.scales.map.Scaling` as far as a spectrum run needs it, from cached :class:`PointUnits`;
-    anything else comes from the full scaling, made on first use (the model reduced: seconds)."""
+    """A :class:`~gearsym.scales.map.Scaling` as far as a spectrum run needs it, from cached :class:`PointUnits`
+    (its name, speed, units and :meth:`to_physical` of a spectrum); what else a caller needs is the full scaling's
+    (:attr:`full`, made on first use: the model reduced, seconds)."""
 
     def __init__(self, units: PointUnits, load: Callable[[], object]):
         self.units, self._load, self.name, self.speed = units, load, units.name, units.speed
@@ -341,7 +343,7 @@ class CachedScaling:
     def to_physical(self, result, length_unit: str = LENGTH_UNIT, *, trajectory=None, model=None, **options):
         """A spectrum run from the cached numbers (its loads from ``trajectory``, or one run on ``model``);
         anything else by the full scaling's ``to_physical``."""
-        if hasattr(result, "exponents") and length_unit == self.units.length_unit and not options:
+        if isinstance(result, LyapunovSpectrum) and length_unit == self.units.length_unit and not options:
             if trajectory is None and model is not None:
                 trajectory = loads_trajectory(model, result)
             return self.units.point(result, trajectory)
@@ -350,11 +352,6 @@ class CachedScaling:
 
     def point_units(self, length_unit: str = LENGTH_UNIT) -> PointUnits:
         return self.units if length_unit == self.units.length_unit else self.full.point_units(length_unit)
-
-    def __getattr__(self, name: str):
-        if name.startswith("__") or name in ("_full", "_load", "units"):
-            raise AttributeError(name)
-        return getattr(self.full, name)
 
 
 def loads_trajectory(model, result):

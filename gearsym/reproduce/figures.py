@@ -20,7 +20,8 @@ import numpy as np
 from ..figures.basins import plot_basin_fractions, plot_basin_map, run_text
 from ..figures.layout import fit_texts, outside_below
 from ..figures.orbits import legend_handles, plot_branches, plot_sweep_points
-from ..figures.poincare import parameter_text, PhasePanel, plot_attractors, plot_phase_portraits
+from ..figures.poincare import PhasePanel, plot_attractors, plot_phase_portraits
+from ..physical.text import parameter_text
 from ..figures.save import pyplot, save_figure
 from ..figures.sweep import (add_colorbar, plot_amplitude, plot_bifurcation, plot_exponents, plot_map,
                              plot_regime_strip, ZERO_CONTOUR)
@@ -323,4 +324,4 @@ def draw_all(c: Computed, out: str | Path, suffix: str = "") -> list[Path]:
     out = Path(out)
     names = [n for n in FIGURES if (n != "study" or "study_ka" in c.sweeps) and (n != "fig3-orbits" or c.orbits)
              and (n != "basins" or c.basins) and (n != "basin-fractions" or c.fractions)]
-    return [save_figure(build(n, c), out / f"{n}{suffix}.png", FIGURES[n][1]) for n in names]
+    return [save_figure(build(n, c), out / f"{n}{suffix}.png", FIGURES[n][1], keep_same=True) for n in names]

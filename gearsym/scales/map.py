@@ -180,12 +180,12 @@ class Scaling:
         units, before anything is divided by it."""
         constraints = self.model._constraints
         for name, q in self.inputs.items():
-            zero_ok, meaning = constraints.get(name, (True, None))
-            if meaning is None or name == "omega":
+            constraint = constraints.get(name)
+            if constraint is None or name == "omega":
                 continue
-            if q.si < 0 or (q.si == 0 and not zero_ok):
-                must = "must not be negative" if zero_ok else "must be positive"
-                raise ModelError(f"{q.text()} is {meaning} and {must}", f"{self.name}: {name}")
+            must = constraint.violation(q.si)
+            if must:
+                raise ModelError(f"{q.text()} is {constraint.meaning} and {must}", f"{self.name}: {name}")
         if self.speed and self.speed.parameter in self.inputs and not self.inputs[self.speed.parameter].si > 0:
             raise ModelError(f"{self.inputs[self.speed.parameter].text()} is the operating speed and must be "
                              "positive", f"{self.name}: {self.speed.parameter}")
@@ -224,6 +224,12 @@ class Scaling:
         length unit unless ``length_scale`` is given."""
         scale = nd.drivetrain.length_scale if length_scale is None else length_scale
         return cls(nd, {**nd.drivetrain.physical, **physical}, scale)
+
+    @property
+    def full(self) -> "Scaling":
+        """The scaling itself (the start-up cache's stand-in, :class:`~gearsym.physical.point.CachedScaling`, makes
+        its full scaling here: whatever a caller needs beyond a spectrum's units)."""
+        return self
 
     def with_values(self, **physical) -> "Scaling":
         """The same drivetrain with some physical values changed (``speed="3000 rpm"``)."""

@@ -7,9 +7,9 @@ from collections.abc import Callable
 
 import gearsym  # the face: its verbs load on first use, so a cached model's run never loads the generator
 
-from ..cached import cached_scaling, load_compiled
-from ..checks import check_run
-from ..options import BACKENDS, STEPS_PER_PERIOD, Integration
+from ...cached import cached_scaling, load_compiled
+from ...checks import check_run
+from ...options import BACKENDS, STEPS_PER_PERIOD, Integration
 from .settings import checked_formulas, model_settings
 
 
