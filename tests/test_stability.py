@@ -255,7 +255,8 @@ def test_the_phasing_panel_draws_each_kept_tongue_as_its_wedge_and_each_suppress
     from matplotlib.collections import PolyCollection
     from matplotlib.colors import to_rgb
 
-    chart = static_chart(shaft, {"omega": np.round(np.arange(1.3, 2.6, 0.05), 10), "k_a": [0.2, 0.5]}, refine=False)
+    chart = static_chart(shaft, {"omega": np.round(np.arange(1.3, 2.6, 0.05), 10), "k_a": [0.2, 0.5]}, refine=False,
+                         lanes=False)  # (the scalar loops: no lanes to compile for a few points)
     prediction = gearsym.stability.phasing_prediction(chart, shaft)
     tongues = list(prediction.tongues)
     combination = next(k for k, t in enumerate(tongues) if t.label == "(ω1+ω2)/1")
