@@ -28,7 +28,7 @@ from ..model.grammar import syntax_tree
 from ..physical.basins import OwnNumbers, shown_in
 from ..physical.stability import chart_in_units
 from ..physical.sweeps import nondimensional_axes
-from ..stability.chart import ABOUT, RELATIVE_TOLERANCE, StabilityChart, orbit_chart, static_chart
+from ..stability.chart import ABOUT, RELATIVE_TOLERANCE, StabilityChart, chart_axes, orbit_chart, static_chart
 from ..sweep.grid import axes_from
 from ..sweep.store import sidecar
 from .arguments.integration import add_integration_arguments, compiled_from, integration_from, scaling_from
@@ -89,16 +89,15 @@ def run(args: argparse.Namespace) -> int:
                   verbose=not args.quiet)
     if args.about == "static":  # (the linearisation's cache says whether the model is physical: no SymPy then)
         lin = load_linearisation(args.model, settings, options, verbose=not args.quiet,
-                                 derive=lambda: _linearisation(args, settings, options))
+                                 derive=lambda: _linearisation(args, settings, options, given, user))
         scaling = scaling_from(args) if lin.physical else None
-        axes = _engine_axes(given, scaling)
-        refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], user)
+        axes = _checked_axes(user, given, tuple(lin.base_parameters), scaling)
         chart = static_chart(lin, axes, tolerance=tolerance_of(axes), **common)
     else:
-        compiled = compiled_from(args, options)
+        compiled = compiled_from(args, options, before=lambda system: _checked_axes(
+            user, given, tuple(system.parameters), scaling_from(args)))
         scaling = scaling_from(args)
-        axes = _engine_axes(given, scaling)
-        refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], user)
+        axes = _checked_axes(user, given, compiled.parameter_names, scaling)
         recipe = load_static_recipe(args.model, settings,
                                     derive=lambda: stability.static_recipe(getattr(compiled.system, "full",
                                                                                    compiled.system)))
@@ -144,11 +143,24 @@ def _formula_axes(args, given) -> dict:
     return user
 
 
-def _linearisation(args, settings, options):
+def _linearisation(args, settings, options, given, user):
+    """The model loaded, the axes checked against it, then linearised and compiled (a wrong --param is said before
+    the compiler's seconds)."""
     checked = checked_formulas(settings)
     system = gearsym.load(args.model, **checked)
+    physical = gearsym.is_physical(args.model, **checked)
+    _checked_axes(user, given, tuple(system.parameters), scaling_from(args) if physical else None)
     lin = stability.compile_linearisation(system, options, verbose=not args.quiet)
-    return replace(lin, physical=gearsym.is_physical(args.model, **checked))
+    return replace(lin, physical=physical)
+
+
+def _checked_axes(user: dict, given, parameters: tuple[str, ...], scaling) -> tuple:
+    """The engine's axes of the --param axes ``given`` (physical ones in the model's nondimensional parameters),
+    each checked to be a parameter of the model (``parameters``) and not also given with --set (``user``: its
+    values as the user gave them)."""
+    axes = _engine_axes(given, scaling)
+    refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], user)
+    return chart_axes(parameters, axes)
 
 
 def _engine_axes(given, scaling):

@@ -254,6 +254,37 @@ class CompiledModel:
         inputs.__dict__["addresses"] = (at + 8 * table_at, at + 8 * c_at)  # (the cached property, known already)
         return inputs
 
+    def tables(self, P: np.ndarray, t0: float = 0.0) -> np.ndarray:
+        """The tables of time of each parameter vector (row) of ``P``, each flattened as the loops read it
+        (column-major), its period checked: what the many points of a chart share, two native calls a row straight
+        into the rows of one array (no :class:`RunInputs`: :meth:`prepare` costs twice as much a table), the
+        periods and the probes checked at once after them."""
+        P = np.ascontiguousarray(P, dtype=np.float64)
+        if P.ndim != 2 or P.shape[1] != len(self.parameter_names) or not np.isfinite(P).all():
+            raise GearsymError(f"{self.name}: expected rows of {len(self.parameter_names)} finite parameter values "
+                               f"({', '.join(self.parameter_names)}), got an array of shape {P.shape}")
+        if not self.native:
+            return np.array([self._tables(p, float(t0)).table.reshape(-1, order="F") for p in P]).reshape(len(P), -1)
+        k, (rows, steps), (probe_rows, _), size = self._table_layout
+        count = len(P)
+        out = np.zeros((count, rows * steps))  # (zeros: what the library leaves unwritten reads as CasADi's)
+        probes = np.zeros((count, 2, probe_rows))  # (each row's probe column-major: its two columns)
+        periods = np.zeros(count)
+        scratch = np.zeros(size + 1)  # t0, then the constants (not kept)
+        scratch[0] = t0
+        constants, table = self.native["constants"].call, self.native["table"].call
+        t_at, c_at = scratch.ctypes.data, scratch.ctypes.data + 8
+        p_at, out_at, probe_at, period_at = P.ctypes.data, out.ctypes.data, probes.ctypes.data, periods.ctypes.data
+        for r in range(count):
+            p = p_at + 8 * k * r
+            constants((p,), (c_at, period_at + 8 * r))
+            table((t_at, p), (out_at + 8 * rows * steps * r, probe_at + 16 * probe_rows * r))
+        a, b = probes[:, 0], probes[:, 1]
+        wrong = ~(np.isfinite(periods) & (periods > 0)) | ~(np.abs(a - b) <= 1e-9 * (1 + np.abs(a))).all(axis=1)
+        for r in np.flatnonzero(wrong)[:1]:  # (the first one wrong, said as a single point's would be)
+            self._checked_period(P[r], float(t0), float(periods[r]), probes[r].T)
+        return out
+
     @cached_property
     def _table_layout(self) -> tuple[int, tuple[int, int], tuple[int, int], int]:
         """Parameters, the shapes of the tables and of the probe, and the number of constants."""

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Callable
 
 import gearsym  # the face: its verbs load on first use, so a cached model's run never loads the generator
 
@@ -66,14 +67,21 @@ def scaling_from(args: argparse.Namespace):
     return cached_scaling(args.model, settings, lambda: scaling_of(args.model, checked_formulas(settings)))
 
 
-def compiled_from(args: argparse.Namespace, options: Integration | None = None, system=None):
-    """The compiled model of the command's MODEL with its --set values (or of ``system``)."""
+def compiled_from(args: argparse.Namespace, options: Integration | None = None, system=None,
+                  before: Callable[[object], object] | None = None):
+    """The compiled model of the command's MODEL with its --set values (or of ``system``); ``before(system)``:
+    the command's checks of its request against the loaded system, made before it is compiled (seconds)."""
     options = options or integration_from(args)  # checked before the model is reduced (seconds)
     verbose = not getattr(args, "quiet", False)
-    if system is not None:
+
+    def checked_and_compiled(system):
+        if before is not None:
+            before(system)
         return gearsym.compile_model(system, options, verbose=verbose)
+
+    if system is not None:
+        return checked_and_compiled(system)
     settings = model_settings(args, cached=True)  # (a formula's numbers are checked if the model is built)
     return load_compiled(args.model, settings, options, verbose=verbose,
-                         compile=lambda: gearsym.compile_model(gearsym.load(args.model, **checked_formulas(settings)),
-                                                               options, verbose=verbose),
+                         compile=lambda: checked_and_compiled(gearsym.load(args.model, **checked_formulas(settings))),
                          scaling=lambda: scaling_of(args.model, settings))
