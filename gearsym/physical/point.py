@@ -360,9 +360,9 @@ class CachedScaling:
 def loads_trajectory(model, result):
     """The trajectory a spectrum run's mesh forces and shaft torques are read from: ``FORCE_PERIODS`` periods of
     ``model`` (the compiled model the run was made on) from the run's final state, at the run's parameters."""
-    if result.steps_per_period != model.integration.steps_per_period:
+    if result.steps_per_period != model.steps_per_period:
         raise GearsymError(f"{model.name}: the spectrum ran with {result.steps_per_period} steps per period, the "
-                           f"model given integrates with {model.integration.steps_per_period}: give the compiled "
+                           f"model given integrates with {model.steps_per_period}: give the compiled "
                            "model the spectrum ran on")
     options = model.integration.run(periods=FORCE_PERIODS, discard=0)
     return phase_trajectory(model, options=options, y0=result.final_state, **result.parameters)
