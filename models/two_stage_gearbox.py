@@ -14,8 +14,8 @@ every 61 mesh periods of the first stage, and the engine counts its steps per me
 From the issue: the tooth counts, modules, face widths, the shaft stiffnesses (coupling 5e4, intermediate 2e5,
 output 5e5 N m/rad), the torque and the speed. Our assumptions (typical values, not from a source): the bores
 (25, 40, 30 and 50 mm), the motor's rotor inertia (0.2 kg m^2, an IEC 4-pole motor of this power) and the load's
-(2 kg m^2 at the output shaft), a damping ratio of 0.05 in each mesh and 0.02 in each shaft's own torsional mode
-(the shaft between its two neighbouring inertias), and the backlash (80 um in the first stage, 120 um in the
+(2 kg m^2 at the output shaft), a damping ratio of 0.05 in each mesh and in the (elastomer) coupling and 0.02 in
+each steel shaft, each in its own torsional mode (the train on either side of it rigid), and the backlash (80 um in the first stage, 120 um in the
 second: ISO 21771 normal backlash of the order of 0.04 modules).
 """
 import math
@@ -27,7 +27,7 @@ STAGE1 = dict(module="2 mm", pressure_angle="20 deg", face_width="20 mm")
 STAGE2 = dict(module="3 mm", pressure_angle="20 deg", face_width="30 mm")
 MOTOR_INERTIA, LOAD_INERTIA = 0.2, 2.0  # kg m^2 (assumed)
 SHAFTS = {"coupling": 5e4, "intermediate": 2e5, "output": 5e5}  # N m/rad (the issue's)
-MESH_DAMPING, SHAFT_DAMPING = 0.05, 0.02  # damping ratios (assumed)
+MESH_DAMPING, COUPLING_DAMPING, SHAFT_DAMPING = 0.05, 0.05, 0.02  # damping ratios (assumed)
 
 model = Drivetrain("two_stage_gearbox", title="Motor, flexible coupling and a two-stage spur gearbox (23/61, 19/47)")
 motor = model.add(Disk("motor", inertia="I_m", speed="speed"))
@@ -55,9 +55,21 @@ def _mesh_damping(mesh, a, b) -> float:
     return 2 * MESH_DAMPING * math.sqrt(model.physical[str(mesh.stiffness)].si * mass)
 
 
-def _shaft_damping(stiffness: float, inertia_a: float, inertia_b: float) -> float:
-    """The damping for the shaft's damping ratio in the torsional mode of its two end inertias alone."""
-    return 2 * SHAFT_DAMPING * math.sqrt(stiffness * inertia_a * inertia_b / (inertia_a + inertia_b))
+def _shaft_damping(ratio: float, stiffness: float, before: float, after: float) -> float:
+    """The damping for the damping ratio ``ratio`` in the shaft's own torsional mode: the train on either side
+    of it held rigid, ``before`` and ``after`` its inertias reflected to the shaft's speed."""
+    return 2 * ratio * math.sqrt(stiffness * before * after / (before + after))
+
+
+I1, I2, I3, I4 = (_inertia(g) for g in (gear1, gear2, gear3, gear4))
+R1, R2 = 23 / 61, 19 / 47  # the stages' speed ratios
+SIDES = {  # each shaft's two sides, reflected to its speed
+    "coupling": (MOTOR_INERTIA, I1 + (I2 + I3) * R1**2 + (I4 + LOAD_INERTIA) * (R1 * R2)**2),
+    "intermediate": ((MOTOR_INERTIA + I1) / R1**2 + I2, I3 + (I4 + LOAD_INERTIA) * R2**2),
+    "output": ((MOTOR_INERTIA + I1) / (R1 * R2)**2 + (I2 + I3) / R2**2 + I4, LOAD_INERTIA),
+}
+DAMPING = {name: _shaft_damping(COUPLING_DAMPING if name == "coupling" else SHAFT_DAMPING, SHAFTS[name], *SIDES[name])
+           for name in SHAFTS}
 
 
 RATIO = 61 / 23 * 47 / 19  # the gearbox's: the load torque balances the motor's through the tooth counts
@@ -65,9 +77,8 @@ model.set_physical(
     I_m=f"{MOTOR_INERTIA} kg*m^2", I_L=f"{LOAD_INERTIA} kg*m^2",
     k_c=f"{SHAFTS['coupling']:g} N*m/rad", k_i=f"{SHAFTS['intermediate']:g} N*m/rad",
     k_o=f"{SHAFTS['output']:g} N*m/rad",
-    c_c=f"{_shaft_damping(SHAFTS['coupling'], MOTOR_INERTIA, _inertia(gear1)):.6g} N*m*s/rad",
-    c_i=f"{_shaft_damping(SHAFTS['intermediate'], _inertia(gear2), _inertia(gear3)):.6g} N*m*s/rad",
-    c_o=f"{_shaft_damping(SHAFTS['output'], _inertia(gear4), LOAD_INERTIA):.6g} N*m*s/rad",
+    c_c=f"{DAMPING['coupling']:.6g} N*m*s/rad", c_i=f"{DAMPING['intermediate']:.6g} N*m*s/rad",
+    c_o=f"{DAMPING['output']:.6g} N*m*s/rad",
     cZ1=f"{_mesh_damping(stage1, gear1, gear2):.6g} N*s/m", cZ2=f"{_mesh_damping(stage2, gear3, gear4):.6g} N*s/m",
     eta1="80 um", eta2="120 um",
     M_m=f"{TORQUE} N*m", M_L=f"{TORQUE * RATIO!r} N*m", speed=SPEED,
@@ -79,9 +90,9 @@ model.describe(
     k_c="torsional stiffness of the flexible coupling",
     k_i="torsional stiffness of the intermediate shaft",
     k_o="torsional stiffness of the output shaft",
-    c_c="damping of the coupling (0.02 of critical in its own mode)",
-    c_i="damping of the intermediate shaft (as the coupling's)",
-    c_o="damping of the output shaft (as the coupling's)",
+    c_c="damping of the coupling (an elastomer: 0.05 of critical in its own mode, the rest of the train rigid)",
+    c_i="damping of the intermediate shaft (0.02 of critical in its own mode)",
+    c_o="damping of the output shaft (0.02 of critical in its own mode)",
     kZ1="mean stiffness of the first mesh, from its geometry (potential-energy method)",
     kZ2="mean stiffness of the second mesh, from its geometry",
     cZ1="damping of the first mesh (damping ratio 0.05)",

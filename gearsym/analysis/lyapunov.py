@@ -176,7 +176,7 @@ def lyapunov_spectrum(model: CompiledModel, *, options: Integration | None = Non
         period=inputs.period,
         backend=model.backend,
         autonomous=model.system.autonomous,
-        info={"Q": run.Q, "locate_crossings": model.options.locate_crossings},
+        info={"Q": run.Q, "locate_crossings": model.options.locate_crossings, "integration": model.integration},
         eigenvalues=summary.eigenvalues[0],
         regime=summary.regimes[0],
         pairs=tuple(summary.pairs[0]),
@@ -219,7 +219,8 @@ def lyapunov_spectra(model: CompiledModel, starts: np.ndarray, options: Integrat
             strobe=runs.strobe[i].T[:, options.discard:], periods=options.periods, discard=options.discard,
             steps_per_period=model.steps_per_period, period=inputs.period, backend=model.backend,
             autonomous=model.system.autonomous,
-            info={"Q": records.Q[i], "locate_crossings": model.options.locate_crossings},
+            info={"Q": records.Q[i], "locate_crossings": model.options.locate_crossings,
+                  "integration": model.integration},
             eigenvalues=summary.eigenvalues[i], regime=summary.regimes[i], pairs=tuple(summary.pairs[i]),
             divergence=summary.divergences[i], settling=summary.settlings[i]))
     return out

@@ -13,7 +13,7 @@ from ..checks import chosen_coordinate
 from ..errors import GearsymError
 from ..figures import plot_point
 from ..outputs import check_figure
-from .integration import add_integration_arguments, compiled_from, scaling_from
+from .integration import add_integration_arguments, compiled_from, scaling_from, step_line
 from .settings import add_set_argument, parse_state
 
 NAME = "lyap"
@@ -57,8 +57,9 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps({**result.as_dict(), **({"physical": physical.as_dict()} if physical else {})}, indent=2))
         return 0
     print(f"{result.model}: {result.periods} periods ({result.discard} discarded), "
-          f"{result.steps_per_period} RK4 steps/period, {'plain RK4' if args.plain else 'crossings located'}, "
-          f"{result.backend}")
+          f"{result.steps_per_period} {compiled.integration.method_name} steps/period, "
+          f"{'plain' if args.plain else 'crossings located'}, {result.backend}")
+    print(step_line(compiled, scaling))
     print("parameters: " + ", ".join(f"{k}={v:g}" for k, v in result.parameters.items()))
     print("Lyapunov exponents (per unit time, +- standard error):")
     paired = {j: i for i, j in result.pairs}

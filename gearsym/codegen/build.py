@@ -27,6 +27,7 @@ from .lane_runs import lanes_describes, lanes_file
 from .library import LOADED, library_describes, library_functions, resolve_backend
 from .loops import LoopOptions
 from .native import load_native
+from .step_choice import chosen_for
 from .time_tables import split_rhs
 from .trust import record, trusted
 
@@ -48,6 +49,7 @@ def compile_model(system: FirstOrderSystem, options: Integration = Integration()
     if not isinstance(options, Integration):
         raise GearsymError(f"options must be a gearsym.Integration, got {type(options).__name__}")
     start = time.perf_counter()
+    options = chosen_for(options, system)  # the integrator and steps, from the fastest linearised mode
     loops = LoopOptions.of(options, system.cycles)
     digest = code_hash(system, loops)
     timings = {"symbolic": time.perf_counter() - start}

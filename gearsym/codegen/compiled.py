@@ -149,14 +149,19 @@ class CompiledModel:
         if not isinstance(options, Integration):
             raise GearsymError(f"options must be a gearsym.Integration, got {type(options).__name__}")
         mine = self.integration
+        if options.integrator == "auto" and options.steps_per_period <= mine.steps_per_period:
+            options = replace(options, integrator=mine.integrator, steps_per_period=mine.steps_per_period,
+                              choice=mine.choice)  # (the model's choice for at least the steps asked)
         same = (options.steps_per_period == mine.steps_per_period
                 and options.locate_crossings == mine.locate_crossings
+                and options.integrator == mine.integrator
                 and options.backend in ("auto", self.backend))
         if not same:
             raise GearsymError(
-                f"{self.name}: this compiled model integrates with {mine.steps_per_period} steps per period, "
-                f"{'crossings located' if mine.locate_crossings else 'plain RK4'}, {self.backend}; the options ask "
-                f"for {options.steps_per_period}, {'crossings located' if options.locate_crossings else 'plain RK4'}"
+                f"{self.name}: this compiled model integrates with {mine.steps_per_period} {mine.method_name} steps per "
+                f"period, {'crossings located' if mine.locate_crossings else 'plain'}, {self.backend}; the options "
+                f"ask for {options.steps_per_period} {options.method_name}, "
+                f"{'crossings located' if options.locate_crossings else 'plain'}"
                 f", {options.backend}: compile the system with these options (compile_model(system, options))")
         return options
 

@@ -70,7 +70,9 @@ def point_to_physical(scaling: Scaling, result, length_unit: str = LENGTH_UNIT, 
     ``model`` (the compiled model the spectrum ran on; by default this scaling's system, compiled)."""
     if trajectory is None:
         if model is None:
-            model = compile_model(scaling.system(), Integration(steps_per_period=result.steps_per_period))
+            system = scaling.system()
+            model = compile_model(system, result.info.get("integration") or Integration(
+                steps_per_period=result.steps_per_period // system.cycles))
         _check_point(scaling, model, result)
         trajectory = loads_trajectory(model, result)
     point = point_units(scaling, length_unit).point(result, trajectory)
