@@ -63,7 +63,11 @@ def run(args: argparse.Namespace) -> int:
     print("parameters: " + ", ".join(f"{k}={v:g}" for k, v in result.parameters.items()))
     print("Lyapunov exponents (per unit time, +- standard error):")
     paired = {j: i for i, j in result.pairs}
+    known = result.resolution
     for i, (lam, err) in enumerate(zip(result.exponents, result.stderr), 1):
+        if known is not None and not known.resolved[i - 1]:
+            print(f"  lambda_{i}: {known.note(i - 1)}")
+            continue
         same = (f"  (= lambda_{paired[i - 1] + 1}: one complex pair of Floquet multipliers, its common real part)"
                 if i - 1 in paired else "")
         print(f"  lambda_{i} = {lam:+.6f} +- {err:.6f}{same}")

@@ -50,9 +50,6 @@ C = ((), (-5.6688,), (-2.430093356833875, -0.2063599157091915),
 D = (0.25, -0.1043, 0.1035, -0.0362, 0.0, 0.0)
 #: the method's order (for the step-halving tests and reports)
 ORDER = 4
-#: |h lambda| up to which the method resolves a linear mode's decay: the relative error of its exponent,
-#: |ln|R(h lambda)|/(h lambda) - 1|, stays below 1e-3 (measured on the real axis; RK4's bound is 0.5 there)
-RESOLVED = 0.6
 
 
 def with_rates(split: SplitRHS, time: sp.Symbol) -> SplitRHS:

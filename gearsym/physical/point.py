@@ -72,6 +72,14 @@ class PhysicalPoint:
     length_unit: object  # the scaling's L
     mesh_force: dict = field(default_factory=dict)  # mesh -> {"mean", "min", "max", "dynamic"} in N
     shaft_torque: dict = field(default_factory=dict)  # shaft -> {"mean", "min", "max", "dynamic"} in N·m
+    #: per exponent: "" (resolved) or what is known of one the run did not resolve (never its value)
+    unresolved: tuple[str, ...] = ()
+
+    def exponent_texts(self) -> list[str]:
+        """Each exponent as text: its value, or what is known of it where the run did not resolve it."""
+        notes = self.unresolved or ("",) * len(self.exponents.magnitude)
+        return [f"{v:+.6g}" if not note else f"λ{_subscript(i + 1)} {note}"
+                for i, (v, note) in enumerate(zip(self.exponents.magnitude, notes))]
 
     def as_dict(self) -> dict:
         """JSON-ready: every value as a number with its unit beside it."""
@@ -83,6 +91,8 @@ class PhysicalPoint:
                "exponents": q(self.exponents), "stderr": q(self.stderr),
                "amplitude": {k: q(v) for k, v in self.amplitude.items()},
                "final_state": {k: q(v) for k, v in self.final_state.items()}, "length_unit": q(self.length_unit)}
+        if any(self.unresolved):
+            out["unresolved"] = {str(i + 1): note for i, note in enumerate(self.unresolved) if note}
         if self.mesh_force:
             out["mesh_force"] = {m: {k: q(v) for k, v in f.items()} for m, f in self.mesh_force.items()}
         if self.shaft_torque:
@@ -94,13 +104,18 @@ class PhysicalPoint:
         speed = f"{shown(self.speed)}, " if math.isfinite(float(np.asarray(self.speed.magnitude))) else ""
         out = [f"operating point: {speed}mesh frequency {shown(self.mesh_frequency)}, "
                f"omega_n = {shown(self.natural_frequency)} (omega = {self.omega:.6g})",
-               "Lyapunov exponents per second: " + ", ".join(f"{v:+.6g}" for v in self.exponents.magnitude)]
+               "Lyapunov exponents per second: " + ", ".join(self.exponent_texts())]
         out += [f"amplitude A_{k} = {shown(v)}" for k, v in self.amplitude.items()]
         for what, table in (("mesh force", self.mesh_force), ("shaft torque", self.shaft_torque)):
             for name, f in table.items():
                 out.append(f"{what} {name}: mean {shown(f['mean'])}, {shown(f['min'])} to {shown(f['max'])} "
                            f"(dynamic amplitude {shown(f['dynamic'])})")
         return out
+
+
+def _subscript(k: int) -> str:
+    """k in subscript digits (λ₁₀, not λ₁0)."""
+    return str(k).translate(str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉"))
 
 
 def _number(x):
@@ -274,7 +289,14 @@ class PointUnits:
             {k: self.state(k, v, w) for k, v in result.final_state.items()},
             Measured(self.length_shown, self.length_text),
             {m: self._summary(time, f, period, self.newton) for m, f in forces.items()},
-            {s: self._summary(time, f, period, self.newton_metre) for s, f in torques.items()})
+            {s: self._summary(time, f, period, self.newton_metre) for s, f in torques.items()},
+            self._unresolved(result, per_second))
+
+    def _unresolved(self, result, per_second: float) -> tuple[str, ...]:
+        known = getattr(result, "resolution", None)
+        if known is None or known.all_resolved:
+            return ()
+        return tuple(known.note(i, per_second, f" {self.per_second.text}") for i in range(len(result.exponents)))
 
     def figure(self, result, trajectory) -> tuple:
         """A spectrum run and a trajectory at its point as a figure shows them in physical units
