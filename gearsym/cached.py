@@ -39,7 +39,7 @@ from .codegen.compiled import CompiledModel
 from .codegen.compiler import binary_key, cache_dir, compile_flags
 from .codegen.library import LOADED, library_describes, library_functions, resolve_backend
 from .codegen.loops import LoopOptions
-from .codegen.step_choice import chosen, fastest_rate
+from .codegen.step_choice import chosen
 from .codegen.native import load_native
 from .codegen.trust import check, differences
 from .errors import warn
@@ -118,11 +118,12 @@ class SystemSummary(ParameterChecks):
                    float(d["cycle"]))
 
     @classmethod
-    def of(cls, system, physical: bool) -> "SystemSummary":
+    def of(cls, system, physical: bool, fastest: float = 0.0) -> "SystemSummary":
+        """The summary of ``system`` (``fastest``: its fastest linearised mode's rate, for the step's choice)."""
         return cls(system.name, system.title, system.time.name, system.state_names, dict(system.parameters),
                    dict(system.initial), tuple(system.coordinates), dict(system.descriptions),
                    dict(system.constraints), system.autonomous, physical, lambda: system, system.cycles,
-                   fastest_rate(system), system.cycle_at())
+                   fastest, system.cycle_at())
 
 
 @lru_cache(maxsize=None)
@@ -247,7 +248,8 @@ def _compiled_and_kept(name: str, key: str, compile: Callable[[], object], scali
     build_file = summary_path(name, f"{key}-{loops_key(LoopOptions.of(compiled.integration))}")
     physical = scaling()
     units = None if physical is None else physical.point_units()
-    write_json(system_file, {"system": SystemSummary.of(compiled.system, physical is not None).as_dict(),
+    summary = SystemSummary.of(compiled.system, physical is not None, compiled.fastest)
+    write_json(system_file, {"system": summary.as_dict(),
                              "physical": units and units.as_dict()})
     write_json(build_file, {"hash": compiled.hash, "library": str(compiled.library),
                             "timed_parameters": sorted(compiled.timed_parameters),
@@ -304,5 +306,5 @@ def _from_cache(system_file: Path, build_file: Path, options: Integration, loops
     loops = LoopOptions.of(options, summary.cycles)  # (the key's loops count steps per forcing period)
     functions = library_functions(library)
     compiled = LOADED[key] = CompiledModel(summary, loops, digest, functions, "compiled", library, {},
-                                           load_native(library, functions), options, timed, texts)
+                                           load_native(library, functions), options, timed, texts, summary.fastest)
     return compiled

@@ -18,7 +18,8 @@ import gearsym
 from conftest import system
 from gearsym import FirstOrderSystem, Integration, compile_model, lyapunov_spectrum, phase_trajectory
 from gearsym.codegen.rosenbrock import rosenbrock_state
-from gearsym.codegen.step_choice import RK4_RESOLVED, chosen, fastest_rate, round_steps
+from gearsym.codegen.fastest_mode import fastest_rate
+from gearsym.codegen.step_choice import RK4_RESOLVED, chosen, round_steps
 
 
 # ------------------------------------------------------------------ a linear damped chain, modes far apart

@@ -27,7 +27,8 @@ from .lane_runs import lanes_describes, lanes_file
 from .library import LOADED, library_describes, library_functions, resolve_backend
 from .loops import LoopOptions
 from .native import load_native
-from .step_choice import chosen_for
+from .fastest_mode import fastest_rate
+from .step_choice import chosen
 from .time_tables import split_rhs
 from .trust import record, trusted
 
@@ -49,14 +50,15 @@ def compile_model(system: FirstOrderSystem, options: Integration = Integration()
     if not isinstance(options, Integration):
         raise GearsymError(f"options must be a gearsym.Integration, got {type(options).__name__}")
     start = time.perf_counter()
-    options = chosen_for(options, system)  # the integrator and steps, from the fastest linearised mode
+    fastest = fastest_rate(system)
+    options = chosen(options, fastest, system.cycle_at())  # the integrator and steps, from the fastest mode
     loops = LoopOptions.of(options, system.cycles)
     digest = code_hash(system, loops)
     timings = {"symbolic": time.perf_counter() - start}
     backend = resolve_backend(options.backend)
     key = (digest, backend)
     if key in LOADED:  # same code: reuse the loaded functions, with this system's values and these options
-        return replace(LOADED[key].clone(), system=system, integration=options)
+        return replace(LOADED[key].clone(), system=system, integration=options, fastest=fastest)
     if backend == "in-process":
         t = time.perf_counter()
         functions, library = build_functions(system, loops).functions, None
@@ -66,7 +68,7 @@ def compile_model(system: FirstOrderSystem, options: Integration = Integration()
     native = load_native(library, functions) if library else None
     timed, texts = timed_tables(system, loops)
     compiled = CompiledModel(system, loops, digest, functions, backend, library, timings, native, options,
-                             timed, texts)
+                             timed, texts, fastest)
     LOADED[key] = compiled
     return compiled
 

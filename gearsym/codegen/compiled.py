@@ -135,6 +135,7 @@ class CompiledModel:
     integration: Integration = field(default_factory=Integration)  # the options it was compiled with
     timed: frozenset[str] = frozenset()  # the parameters in the tables of time or the period (the generator's)
     table_texts: tuple[str, ...] = ()  # the tables of time, as text (for the error of one that does not repeat)
+    fastest: float = 0.0  # the rate of the system's fastest linearised mode (what the step was chosen from)
 
     def run_options(self, options: Integration | None) -> Integration:
         """The options a run on this model uses: its own, or ``options`` if they need the same code; a run longer

@@ -12,7 +12,7 @@ from .compiler import compile_library
 from .functions import build_functions
 from .loops import LoopOptions
 from .generate import code_hash, write_code
-from .step_choice import chosen_for
+from .fastest_mode import chosen_for
 
 
 @dataclass

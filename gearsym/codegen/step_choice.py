@@ -25,7 +25,6 @@ from dataclasses import replace
 import numpy as np
 
 from ..options import Integration
-from ..system import FirstOrderSystem
 
 #: h |lambda| up to which RK4 resolves a mode: the real part of ln R(h lambda)/h, the exponent the step gives a
 #: linear mode, within 5e-4 of the mode's own for damping ratios from 0.02 to 1 (1.3e-3 at 0.01): its error
@@ -47,28 +46,6 @@ def round_steps(steps: float) -> int:
     return int(next(r * scale for r in (*_ROUND, 10) if r * scale >= steps - 1e-9))
 
 
-def fastest_rate(system: FirstOrderSystem, values=None) -> float:
-    """rho: the largest |eigenvalue| of the Jacobian per unit of the system's time, over a forcing period, at the
-    initial state and at rest (zero state)."""
-    import casadi as ca
-
-    from .casadi_symbols import SystemSymbols
-
-    symbols = SystemSymbols.of(system)
-    jacobian = ca.Function("J", [symbols.t, symbols.y, symbols.p], [ca.densify(ca.jacobian(symbols.rhs(system),
-                                                                                          symbols.y))])
-    merged = system.parameter_values(values)
-    p = [merged[name] for name in system.parameters]
-    cycle = system.cycle_at(values)
-    rho = 0.0
-    for y in (system.initial_vector, [0.0] * system.dimension):
-        for k in range(8):
-            J = np.array(jacobian(cycle * k / 8, y, p), dtype=float)
-            if np.all(np.isfinite(J)):
-                rho = max(rho, float(np.max(np.abs(np.linalg.eigvals(J)))))
-    return rho
-
-
 def chosen(options: Integration, rho: float, cycle: float, unit: str = "") -> Integration:
     """``options`` with its integrator and steps chosen for a model whose fastest linearised mode has the rate
     ``rho`` (per unit time), its forcing period ``cycle``; ``unit`` names the time unit for the note."""
@@ -87,10 +64,3 @@ def chosen(options: Integration, rho: float, cycle: float, unit: str = "") -> In
     return replace(options, integrator="stiff",
                    choice=f"stiff RODAS4 at {asked} steps ({mode}: h|lambda| = {z:.3g}; RK4 would need "
                           f"{needed} steps per forcing period to resolve it)")
-
-
-def chosen_for(options: Integration, system: FirstOrderSystem) -> Integration:
-    """``options`` with the integrator and steps chosen for ``system`` at its values (:func:`chosen`)."""
-    if options.integrator != "auto":
-        return options
-    return chosen(options, fastest_rate(system), system.cycle_at())
