@@ -151,7 +151,7 @@ static const casadi_int casadi_s1[3] = {12, 1, 1};
 static const casadi_int casadi_s2[3] = {24, 1, 1};
 static const casadi_int casadi_s3[3] = {12, 12, 1};
 static const casadi_int casadi_s4[3] = {39, 1, 1};
-static const casadi_int casadi_s5[3] = {15, 200, 1};
+static const casadi_int casadi_s5[3] = {15, 400, 1};
 static const casadi_int casadi_s6[3] = {5, 2, 1};
 static const casadi_int casadi_s7[12] = 
   {0};
@@ -173,10 +173,10 @@ static const casadi_int casadi_s15[144] =
 static const casadi_int casadi_s16[3] = {12, 50, 1};
 static const casadi_int casadi_s17[3] = {6, 50, 1};
 static const casadi_int casadi_s18[3] = {6, 1, 1};
-static const casadi_int casadi_s19[3] = {12, 200, 1};
+static const casadi_int casadi_s19[3] = {12, 400, 1};
 static const casadi_int casadi_s20[3] = {15, 50, 1};
 
-static const casadi_real casadi_c0[401] = 
+static const casadi_real casadi_c0[801] = 
   {0., 1., 2., 3., 4., 5., 6., 7.,
   8., 9., 10., 11., 12., 13., 14., 15.,
   16., 17., 18., 19., 20., 21., 22., 23.,
@@ -227,7 +227,57 @@ static const casadi_real casadi_c0[401] =
   376., 377., 378., 379., 380., 381., 382., 383.,
   384., 385., 386., 387., 388., 389., 390., 391.,
   392., 393., 394., 395., 396., 397., 398., 399.,
-  400.};
+  400., 401., 402., 403., 404., 405., 406., 407.,
+  408., 409., 410., 411., 412., 413., 414., 415.,
+  416., 417., 418., 419., 420., 421., 422., 423.,
+  424., 425., 426., 427., 428., 429., 430., 431.,
+  432., 433., 434., 435., 436., 437., 438., 439.,
+  440., 441., 442., 443., 444., 445., 446., 447.,
+  448., 449., 450., 451., 452., 453., 454., 455.,
+  456., 457., 458., 459., 460., 461., 462., 463.,
+  464., 465., 466., 467., 468., 469., 470., 471.,
+  472., 473., 474., 475., 476., 477., 478., 479.,
+  480., 481., 482., 483., 484., 485., 486., 487.,
+  488., 489., 490., 491., 492., 493., 494., 495.,
+  496., 497., 498., 499., 500., 501., 502., 503.,
+  504., 505., 506., 507., 508., 509., 510., 511.,
+  512., 513., 514., 515., 516., 517., 518., 519.,
+  520., 521., 522., 523., 524., 525., 526., 527.,
+  528., 529., 530., 531., 532., 533., 534., 535.,
+  536., 537., 538., 539., 540., 541., 542., 543.,
+  544., 545., 546., 547., 548., 549., 550., 551.,
+  552., 553., 554., 555., 556., 557., 558., 559.,
+  560., 561., 562., 563., 564., 565., 566., 567.,
+  568., 569., 570., 571., 572., 573., 574., 575.,
+  576., 577., 578., 579., 580., 581., 582., 583.,
+  584., 585., 586., 587., 588., 589., 590., 591.,
+  592., 593., 594., 595., 596., 597., 598., 599.,
+  600., 601., 602., 603., 604., 605., 606., 607.,
+  608., 609., 610., 611., 612., 613., 614., 615.,
+  616., 617., 618., 619., 620., 621., 622., 623.,
+  624., 625., 626., 627., 628., 629., 630., 631.,
+  632., 633., 634., 635., 636., 637., 638., 639.,
+  640., 641., 642., 643., 644., 645., 646., 647.,
+  648., 649., 650., 651., 652., 653., 654., 655.,
+  656., 657., 658., 659., 660., 661., 662., 663.,
+  664., 665., 666., 667., 668., 669., 670., 671.,
+  672., 673., 674., 675., 676., 677., 678., 679.,
+  680., 681., 682., 683., 684., 685., 686., 687.,
+  688., 689., 690., 691., 692., 693., 694., 695.,
+  696., 697., 698., 699., 700., 701., 702., 703.,
+  704., 705., 706., 707., 708., 709., 710., 711.,
+  712., 713., 714., 715., 716., 717., 718., 719.,
+  720., 721., 722., 723., 724., 725., 726., 727.,
+  728., 729., 730., 731., 732., 733., 734., 735.,
+  736., 737., 738., 739., 740., 741., 742., 743.,
+  744., 745., 746., 747., 748., 749., 750., 751.,
+  752., 753., 754., 755., 756., 757., 758., 759.,
+  760., 761., 762., 763., 764., 765., 766., 767.,
+  768., 769., 770., 771., 772., 773., 774., 775.,
+  776., 777., 778., 779., 780., 781., 782., 783.,
+  784., 785., 786., 787., 788., 789., 790., 791.,
+  792., 793., 794., 795., 796., 797., 798., 799.,
+  800.};
 
 static const casadi_real casadi_zeros[24] = 
   {0.};
@@ -1749,7 +1799,7 @@ static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a05=arg[0]? arg[0][8] : 0;
   a05=(a05/a01);
   if (res[0]!=0) res[0][37]=a05;
-  a05=6.2831853071795868e-02;
+  a05=3.1415926535897934e-02;
   if (res[0]!=0) res[0][38]=a05;
   a05=1.2566370614359172e+01;
   if (res[1]!=0) res[1][0]=a05;
@@ -1950,7 +2000,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   return 0;
 }
 
-/* map401_table_point:(t[1x401],p[24x401])->(values[5x401]) */
+/* map801_table_point:(t[1x801],p[24x801])->(values[5x801]) */
 static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_int i;
   casadi_real* *res1;
@@ -1959,7 +2009,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   for (i=0; i<2; ++i) arg1[i]=arg[i];
   res1 = res+1;
   for (i=0; i<1; ++i) res1[i]=res[i];
-  for (i=0; i<401; ++i) {
+  for (i=0; i<801; ++i) {
     if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
     if (arg1[0]) arg1[0]+=1;
     if (arg1[1]) arg1[1]+=24;
@@ -1968,11 +2018,11 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   return 0;
 }
 
-/* table:(t0,p[24])->(table[15x200],probe[5x2]) */
+/* table:(t0,p[24])->(table[15x400],probe[5x2]) */
 static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_int i, j;
-  casadi_real **res1=res+2, *rr, w00, *w01=w+27, *w03=w+428, w04, w05, w06, *w07=w+467, *w08=w+10091, *w09=w+12096, *w10=w+13096;
-  casadi_real *w11=w+14096, *w12=w+15096, *w13=w+16096, *w14=w+19096, *w15=w+22096;
+  casadi_real **res1=res+2, *rr, w00, *w01=w+27, *w03=w+828, w04, w05, w06, *w07=w+867, *w08=w+20091, *w09=w+24096, *w10=w+26096;
+  casadi_real *w11=w+28096, *w12=w+30096, *w13=w+32096, *w14=w+38096, *w15=w+44096;
   const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
   w00 = arg[0] ? arg[0][0] : 0;
   wr01 = casadi_c0;
@@ -1984,27 +2034,27 @@ static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   for (rr=(&w05), cs=w03+38; cs!=w03+39; cs+=1) *rr++ = *cs;
   w06 = 2.;
   w05 /= w06;
-  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w05);
-  for (i=0, rr=w01, cs=w01; i<401; ++i) (*rr++)  = (w00+(*cs++));
-  for (i=0;i<401;++i) {
+  for (i=0, rr=w01, cr=wr01; i<801; ++i) (*rr++)  = ((*cr++)*w05);
+  for (i=0, rr=w01, cs=w01; i<801; ++i) (*rr++)  = (w00+(*cs++));
+  for (i=0;i<801;++i) {
     casadi_copy(wr02, 24, w07+ i*24);
   }
   arg1[0]=w01;
   arg1[1]=w07;
   res1[0]=w08;
   if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
-  for (rr=w09, cs=w08+0; cs!=w08+2000; cs+=10) for (ct=cs+0; ct!=cs+5; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w10, cs=w09; i<200; ++i) for (j=0; j<5; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+2000; cs+=10) for (ct=cs+5; ct!=cs+10; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w11, cs=w09; i<200; ++i) for (j=0; j<5; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+2000; cs+=10) for (ct=cs+10; ct!=cs+15; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w12, cs=w09; i<200; ++i) for (j=0; j<5; ++j) rr[i+j*200] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+4000; cs+=10) for (ct=cs+0; ct!=cs+5; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w10, cs=w09; i<400; ++i) for (j=0; j<5; ++j) rr[i+j*400] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+4000; cs+=10) for (ct=cs+5; ct!=cs+10; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w11, cs=w09; i<400; ++i) for (j=0; j<5; ++j) rr[i+j*400] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+4000; cs+=10) for (ct=cs+10; ct!=cs+15; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w12, cs=w09; i<400; ++i) for (j=0; j<5; ++j) rr[i+j*400] = *cs++;
   rr=w13;
-  for (i=0, cs=w10; i<1000; ++i) *rr++ = *cs++;
-  for (i=0, cs=w11; i<1000; ++i) *rr++ = *cs++;
-  for (i=0, cs=w12; i<1000; ++i) *rr++ = *cs++;
-  for (i=0, rr=w14, cs=w13; i<15; ++i) for (j=0; j<200; ++j) rr[i+j*15] = *cs++;
-  casadi_copy(w14, 3000, res[0]);
+  for (i=0, cs=w10; i<2000; ++i) *rr++ = *cs++;
+  for (i=0, cs=w11; i<2000; ++i) *rr++ = *cs++;
+  for (i=0, cs=w12; i<2000; ++i) *rr++ = *cs++;
+  for (i=0, rr=w14, cs=w13; i<15; ++i) for (j=0; j<400; ++j) rr[i+j*15] = *cs++;
+  casadi_copy(w14, 6000, res[0]);
   w05 = 3.7000000000000000e-01;
   w05 *= w04;
   w05  = (w00+w05);
@@ -2087,7 +2137,7 @@ CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casa
   if (sz_arg) *sz_arg = 6;
   if (sz_res) *sz_res = 4;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 22101;
+  if (sz_w) *sz_w = 44101;
   return 0;
 }
 
@@ -2095,7 +2145,7 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
   if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 4*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 22101*sizeof(casadi_real);
+  if (sz_w) *sz_w = 44101*sizeof(casadi_real);
   return 0;
 }
 
@@ -2113,7 +2163,7 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
 #define GEARSYM_NOT_UNROLLED
 #endif
 
-static const casadi_real gs_zeros[3000] = {0.};
+static const casadi_real gs_zeros[6000] = {0.};
 
 /* an input as CasADi passes it (a null pointer: zeros) into a local array */
 static inline void gs_load(const casadi_real* x, casadi_int n, casadi_real* y) {
@@ -19919,18 +19969,17 @@ static GEARSYM_NOINLINE void gs_state_span(casadi_real* restrict y, casadi_real*
   gs_copy(ya, 12, y); gs_copy(loa, 6, lo); gs_copy(hia, 6, hi);
 }
 
-/* lyapunov_chunk:(y0[12],Q0[12x12],table[15x200],c[39])->(strobe[12x50],Q[12x12],log_stretch[12x50],low[6x50],high[6x50]) */
+/* lyapunov_chunk:(y0[12],Q0[12x12],table[15x400],c[39])->(strobe[12x50],Q[12x12],log_stretch[12x50],low[6x50],high[6x50]) */
 static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[12], lo[6], hi[6], c[39]; casadi_real Q[144];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 12, y); gs_load(arg[1], 144, Q); gs_load(arg[3], 39, c);
-  casadi_real Qn[144], logs[12];
+  casadi_real Qn[144], logs[12]; casadi_real piece[12]; casadi_int g, i;
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6]; lo[4] = y[8]; hi[4] = y[8]; lo[5] = y[10]; hi[5] = y[10];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 144, Q);
+    for (i = 0; i < 12; ++i) logs[i] = 0;
+    for (g = 0; g < 16; ++g) { gs_tangent_span(y, Q, lo, hi, T + 15*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 144, Q); for (i = 0; i < 12; ++i) logs[i] += piece[i]; }
     gs_store(y, 12, res[0], 12*p); gs_store(logs, 12, res[2], 12*p);
     gs_store(lo, 6, res[3], 6*p); gs_store(hi, 6, res[4], 6*p);
   }
@@ -20023,18 +20072,17 @@ CASADI_SYMBOL_EXPORT int lyapunov_chunk_work_bytes(casadi_int *sz_arg, casadi_in
   return 0;
 }
 
-/* lyapunov_period:(y0[12],Q0[12x12],table[15x200],c[39])->(strobe[12],Q[12x12],log_stretch[12],low[6],high[6]) */
+/* lyapunov_period:(y0[12],Q0[12x12],table[15x400],c[39])->(strobe[12],Q[12x12],log_stretch[12],low[6],high[6]) */
 static int casadi_f19(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[12], lo[6], hi[6], c[39]; casadi_real Q[144];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 12, y); gs_load(arg[1], 144, Q); gs_load(arg[3], 39, c);
-  casadi_real Qn[144], logs[12];
+  casadi_real Qn[144], logs[12]; casadi_real piece[12]; casadi_int g, i;
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6]; lo[4] = y[8]; hi[4] = y[8]; lo[5] = y[10]; hi[5] = y[10];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 144, Q);
+    for (i = 0; i < 12; ++i) logs[i] = 0;
+    for (g = 0; g < 16; ++g) { gs_tangent_span(y, Q, lo, hi, T + 15*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 144, Q); for (i = 0; i < 12; ++i) logs[i] += piece[i]; }
     gs_store(y, 12, res[0], 12*p); gs_store(logs, 12, res[2], 12*p);
     gs_store(lo, 6, res[3], 6*p); gs_store(hi, 6, res[4], 6*p);
   }
@@ -20127,7 +20175,7 @@ CASADI_SYMBOL_EXPORT int lyapunov_period_work_bytes(casadi_int *sz_arg, casadi_i
   return 0;
 }
 
-/* orbit_chunk:(y0[12],table[15x200],c[39])->(strobe[12x50],low[6x50],high[6x50]) */
+/* orbit_chunk:(y0[12],table[15x400],c[39])->(strobe[12x50],low[6x50],high[6x50]) */
 static int casadi_f20(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[12], lo[6], hi[6], c[39];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
@@ -20135,7 +20183,7 @@ static int casadi_f20(const casadi_real** arg, casadi_real** res, casadi_int* iw
   gs_load(arg[0], 12, y); gs_load(arg[2], 39, c);
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6]; lo[4] = y[8]; hi[4] = y[8]; lo[5] = y[10]; hi[5] = y[10];
-    gs_state_span(y, lo, hi, T, c, 200);
+    gs_state_span(y, lo, hi, T, c, 400);
     gs_store(y, 12, res[0], 12*p); gs_store(lo, 6, res[1], 6*p); gs_store(hi, 6, res[2], 6*p);
   }
   return 0;
@@ -20220,7 +20268,7 @@ CASADI_SYMBOL_EXPORT int orbit_chunk_work_bytes(casadi_int *sz_arg, casadi_int* 
   return 0;
 }
 
-/* orbit_period:(y0[12],table[15x200],c[39])->(strobe[12],low[6],high[6]) */
+/* orbit_period:(y0[12],table[15x400],c[39])->(strobe[12],low[6],high[6]) */
 static int casadi_f22(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[12], lo[6], hi[6], c[39];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
@@ -20228,7 +20276,7 @@ static int casadi_f22(const casadi_real** arg, casadi_real** res, casadi_int* iw
   gs_load(arg[0], 12, y); gs_load(arg[2], 39, c);
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6]; lo[4] = y[8]; hi[4] = y[8]; lo[5] = y[10]; hi[5] = y[10];
-    gs_state_span(y, lo, hi, T, c, 200);
+    gs_state_span(y, lo, hi, T, c, 400);
     gs_store(y, 12, res[0], 12*p); gs_store(lo, 6, res[1], 6*p); gs_store(hi, 6, res[2], 6*p);
   }
   return 0;
@@ -20313,14 +20361,14 @@ CASADI_SYMBOL_EXPORT int orbit_period_work_bytes(casadi_int *sz_arg, casadi_int*
   return 0;
 }
 
-/* trajectory:(y0[12],table[15x200],c[39])->(states[12x200]) */
+/* trajectory:(y0[12],table[15x400],c[39])->(states[12x400]) */
 static int casadi_f23(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[12], lo[6], hi[6], c[39];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 12, y); gs_load(arg[2], 39, c);
   lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6]; lo[4] = y[8]; hi[4] = y[8]; lo[5] = y[10]; hi[5] = y[10];
-  for (p = 0; p < 200; ++p) {
+  for (p = 0; p < 400; ++p) {
     gs_state_span(y, lo, hi, T + 15*p, c, 1);
     gs_store(y, 12, res[0], 12*p);
   }
@@ -20390,7 +20438,7 @@ CASADI_SYMBOL_EXPORT int trajectory_work(casadi_int *sz_arg, casadi_int* sz_res,
   if (sz_arg) *sz_arg = 9;
   if (sz_res) *sz_res = 4;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 2841;
+  if (sz_w) *sz_w = 5241;
   return 0;
 }
 
@@ -20398,7 +20446,7 @@ CASADI_SYMBOL_EXPORT int trajectory_work_bytes(casadi_int *sz_arg, casadi_int* s
   if (sz_arg) *sz_arg = 9*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 4*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 2841*sizeof(casadi_real);
+  if (sz_w) *sz_w = 5241*sizeof(casadi_real);
   return 0;
 }
 
@@ -20499,7 +20547,7 @@ CASADI_SYMBOL_EXPORT int monodromy_segment_work_bytes(casadi_int *sz_arg, casadi
   return 0;
 }
 
-/* monodromy_period:(y0[12],Q0[12x12],table[15x200],c[39])->(strobe[12],M[12x12],low[6],high[6]) */
+/* monodromy_period:(y0[12],Q0[12x12],table[15x400],c[39])->(strobe[12],M[12x12],low[6],high[6]) */
 static int casadi_f25(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[12], lo[6], hi[6], c[39]; casadi_real Q[144];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
@@ -20507,7 +20555,7 @@ static int casadi_f25(const casadi_real** arg, casadi_real** res, casadi_int* iw
   gs_load(arg[0], 12, y); gs_load(arg[1], 144, Q); gs_load(arg[3], 39, c);
   casadi_real lk[6], hk[6];
   lk[0] = y[0]; hk[0] = y[0]; lk[1] = y[2]; hk[1] = y[2]; lk[2] = y[4]; hk[2] = y[4]; lk[3] = y[6]; hk[3] = y[6]; lk[4] = y[8]; hk[4] = y[8]; lk[5] = y[10]; hk[5] = y[10];
-  for (p = 0; p < 4; ++p) {
+  for (p = 0; p < 8; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6]; lo[4] = y[8]; hi[4] = y[8]; lo[5] = y[10]; hi[5] = y[10];
     gs_tangent_span(y, Q, lo, hi, T + 750*p, c, 50);
     lk[0] = (lo[0] < lk[0] ? lo[0] : 0) + (lo[0] < lk[0] ? 0 : lk[0]);

@@ -151,7 +151,7 @@ static const casadi_int casadi_s1[3] = {12, 1, 1};
 static const casadi_int casadi_s2[3] = {24, 1, 1};
 static const casadi_int casadi_s3[3] = {12, 12, 1};
 static const casadi_int casadi_s4[3] = {39, 1, 1};
-static const casadi_int casadi_s5[3] = {15, 200, 1};
+static const casadi_int casadi_s5[3] = {15, 400, 1};
 static const casadi_int casadi_s6[3] = {5, 2, 1};
 static const casadi_int casadi_s7[12] = 
   {0};
@@ -173,10 +173,10 @@ static const casadi_int casadi_s15[144] =
 static const casadi_int casadi_s16[3] = {12, 50, 1};
 static const casadi_int casadi_s17[3] = {6, 50, 1};
 static const casadi_int casadi_s18[3] = {6, 1, 1};
-static const casadi_int casadi_s19[3] = {12, 200, 1};
+static const casadi_int casadi_s19[3] = {12, 400, 1};
 static const casadi_int casadi_s20[3] = {15, 50, 1};
 
-static const casadi_real casadi_c0[401] = 
+static const casadi_real casadi_c0[801] = 
   {0., 1., 2., 3., 4., 5., 6., 7.,
   8., 9., 10., 11., 12., 13., 14., 15.,
   16., 17., 18., 19., 20., 21., 22., 23.,
@@ -227,7 +227,57 @@ static const casadi_real casadi_c0[401] =
   376., 377., 378., 379., 380., 381., 382., 383.,
   384., 385., 386., 387., 388., 389., 390., 391.,
   392., 393., 394., 395., 396., 397., 398., 399.,
-  400.};
+  400., 401., 402., 403., 404., 405., 406., 407.,
+  408., 409., 410., 411., 412., 413., 414., 415.,
+  416., 417., 418., 419., 420., 421., 422., 423.,
+  424., 425., 426., 427., 428., 429., 430., 431.,
+  432., 433., 434., 435., 436., 437., 438., 439.,
+  440., 441., 442., 443., 444., 445., 446., 447.,
+  448., 449., 450., 451., 452., 453., 454., 455.,
+  456., 457., 458., 459., 460., 461., 462., 463.,
+  464., 465., 466., 467., 468., 469., 470., 471.,
+  472., 473., 474., 475., 476., 477., 478., 479.,
+  480., 481., 482., 483., 484., 485., 486., 487.,
+  488., 489., 490., 491., 492., 493., 494., 495.,
+  496., 497., 498., 499., 500., 501., 502., 503.,
+  504., 505., 506., 507., 508., 509., 510., 511.,
+  512., 513., 514., 515., 516., 517., 518., 519.,
+  520., 521., 522., 523., 524., 525., 526., 527.,
+  528., 529., 530., 531., 532., 533., 534., 535.,
+  536., 537., 538., 539., 540., 541., 542., 543.,
+  544., 545., 546., 547., 548., 549., 550., 551.,
+  552., 553., 554., 555., 556., 557., 558., 559.,
+  560., 561., 562., 563., 564., 565., 566., 567.,
+  568., 569., 570., 571., 572., 573., 574., 575.,
+  576., 577., 578., 579., 580., 581., 582., 583.,
+  584., 585., 586., 587., 588., 589., 590., 591.,
+  592., 593., 594., 595., 596., 597., 598., 599.,
+  600., 601., 602., 603., 604., 605., 606., 607.,
+  608., 609., 610., 611., 612., 613., 614., 615.,
+  616., 617., 618., 619., 620., 621., 622., 623.,
+  624., 625., 626., 627., 628., 629., 630., 631.,
+  632., 633., 634., 635., 636., 637., 638., 639.,
+  640., 641., 642., 643., 644., 645., 646., 647.,
+  648., 649., 650., 651., 652., 653., 654., 655.,
+  656., 657., 658., 659., 660., 661., 662., 663.,
+  664., 665., 666., 667., 668., 669., 670., 671.,
+  672., 673., 674., 675., 676., 677., 678., 679.,
+  680., 681., 682., 683., 684., 685., 686., 687.,
+  688., 689., 690., 691., 692., 693., 694., 695.,
+  696., 697., 698., 699., 700., 701., 702., 703.,
+  704., 705., 706., 707., 708., 709., 710., 711.,
+  712., 713., 714., 715., 716., 717., 718., 719.,
+  720., 721., 722., 723., 724., 725., 726., 727.,
+  728., 729., 730., 731., 732., 733., 734., 735.,
+  736., 737., 738., 739., 740., 741., 742., 743.,
+  744., 745., 746., 747., 748., 749., 750., 751.,
+  752., 753., 754., 755., 756., 757., 758., 759.,
+  760., 761., 762., 763., 764., 765., 766., 767.,
+  768., 769., 770., 771., 772., 773., 774., 775.,
+  776., 777., 778., 779., 780., 781., 782., 783.,
+  784., 785., 786., 787., 788., 789., 790., 791.,
+  792., 793., 794., 795., 796., 797., 798., 799.,
+  800.};
 
 static const casadi_real casadi_zeros[24] = 
   {0.};
@@ -246,7 +296,7 @@ static const casadi_real casadi_zeros[24] =
 #define GEARSYM_NOT_UNROLLED
 #endif
 
-static const casadi_real gs_zeros[3000] = {0.};
+static const casadi_real gs_zeros[6000] = {0.};
 
 /* an input as CasADi passes it (a null pointer: zeros) into a local array */
 static inline void gs_load(const casadi_real* x, casadi_int n, casadi_real* y) {
@@ -21739,7 +21789,7 @@ CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_orbit(const casadi_real* restr
   casadi_real lo[6*GS_L], hi[6*GS_L]; casadi_int p, l;
   for (p = 0; p < periods; ++p) {
     for (l = 0; l < GS_L; ++l) { lo[GS_L*0 + l] = y[GS_L*0 + l]; hi[GS_L*0 + l] = y[GS_L*0 + l]; lo[GS_L*1 + l] = y[GS_L*2 + l]; hi[GS_L*1 + l] = y[GS_L*2 + l]; lo[GS_L*2 + l] = y[GS_L*4 + l]; hi[GS_L*2 + l] = y[GS_L*4 + l]; lo[GS_L*3 + l] = y[GS_L*6 + l]; hi[GS_L*3 + l] = y[GS_L*6 + l]; lo[GS_L*4 + l] = y[GS_L*8 + l]; hi[GS_L*4 + l] = y[GS_L*8 + l]; lo[GS_L*5 + l] = y[GS_L*10 + l]; hi[GS_L*5 + l] = y[GS_L*10 + l]; }
-    gsl_state_span(y, lo, hi, T, c, 200);
+    gsl_state_span(y, lo, hi, T, c, 400);
     if (strobe) gs_copy(y, 12*GS_L, strobe + 12*GS_L*p);
     if (low) gs_copy(lo, 6*GS_L, low + 6*GS_L*p);
     if (high) gs_copy(hi, 6*GS_L, high + 6*GS_L*p);
@@ -21751,17 +21801,21 @@ CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_orbit(const casadi_real* restr
    re-orthonormalised every period per lane (the scalar loops' Gram-Schmidt); each period's log
    stretches written where given (periods x n x GS_L) */
 CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_lyapunov(const casadi_real* restrict T, const casadi_real* restrict c, casadi_int periods, casadi_real* restrict y, casadi_real* restrict Q, casadi_real* strobe, casadi_real* logs, casadi_real* low, casadi_real* high) {
-  casadi_real lo[6*GS_L], hi[6*GS_L], Qc[144], Qn[144], lg[12];
-  casadi_int p, l, i;
+  casadi_real lo[6*GS_L], hi[6*GS_L], Qc[144], Qn[144], lg[12], acc[12*GS_L];
+  casadi_int p, l, i, g;
   for (p = 0; p < periods; ++p) {
     for (l = 0; l < GS_L; ++l) { lo[GS_L*0 + l] = y[GS_L*0 + l]; hi[GS_L*0 + l] = y[GS_L*0 + l]; lo[GS_L*1 + l] = y[GS_L*2 + l]; hi[GS_L*1 + l] = y[GS_L*2 + l]; lo[GS_L*2 + l] = y[GS_L*4 + l]; hi[GS_L*2 + l] = y[GS_L*4 + l]; lo[GS_L*3 + l] = y[GS_L*6 + l]; hi[GS_L*3 + l] = y[GS_L*6 + l]; lo[GS_L*4 + l] = y[GS_L*8 + l]; hi[GS_L*4 + l] = y[GS_L*8 + l]; lo[GS_L*5 + l] = y[GS_L*10 + l]; hi[GS_L*5 + l] = y[GS_L*10 + l]; }
-    gsl_tangent_span(y, Q, lo, hi, T, c, 200);
-    for (l = 0; l < GS_L; ++l) {  /* Gram-Schmidt of each lane's vectors, as columns */
-      for (i = 0; i < 144; ++i) Qc[(i % 12)*12 + i / 12] = Q[GS_L*i + l];
-      gs_gram_schmidt(Qc, Qn, lg);
-      for (i = 0; i < 144; ++i) Q[GS_L*i + l] = Qn[(i % 12)*12 + i / 12];
-      if (logs) for (i = 0; i < 12; ++i) logs[12*GS_L*p + GS_L*i + l] = lg[i];
+    for (i = 0; i < 12*GS_L; ++i) acc[i] = 0;
+    for (g = 0; g < 16; ++g) {
+      gsl_tangent_span(y, Q, lo, hi, T + 15*GS_L*(25*g), c, 25);
+      for (l = 0; l < GS_L; ++l) {  /* Gram-Schmidt of each lane's vectors, as columns */
+        for (i = 0; i < 144; ++i) Qc[(i % 12)*12 + i / 12] = Q[GS_L*i + l];
+        gs_gram_schmidt(Qc, Qn, lg);
+        for (i = 0; i < 144; ++i) Q[GS_L*i + l] = Qn[(i % 12)*12 + i / 12];
+        for (i = 0; i < 12; ++i) acc[GS_L*i + l] += lg[i];
+      }
     }
+    if (logs) for (i = 0; i < 12*GS_L; ++i) logs[12*GS_L*p + i] = acc[i];
     if (strobe) gs_copy(y, 12*GS_L, strobe + 12*GS_L*p);
     if (low) gs_copy(lo, 6*GS_L, low + 6*GS_L*p);
     if (high) gs_copy(hi, 6*GS_L, high + 6*GS_L*p);

@@ -151,7 +151,7 @@ static const casadi_int casadi_s1[3] = {6, 1, 1};
 static const casadi_int casadi_s2[3] = {21, 1, 1};
 static const casadi_int casadi_s3[3] = {6, 6, 1};
 static const casadi_int casadi_s4[3] = {16, 1, 1};
-static const casadi_int casadi_s5[3] = {9, 200, 1};
+static const casadi_int casadi_s5[3] = {9, 400, 1};
 static const casadi_int casadi_s6[3] = {3, 2, 1};
 static const casadi_int casadi_s7[6] = {0};
 static const casadi_int casadi_s8[9] = 
@@ -170,10 +170,10 @@ static const casadi_int casadi_s15[36] =
 static const casadi_int casadi_s16[3] = {6, 50, 1};
 static const casadi_int casadi_s17[3] = {3, 50, 1};
 static const casadi_int casadi_s18[3] = {3, 1, 1};
-static const casadi_int casadi_s19[3] = {6, 200, 1};
+static const casadi_int casadi_s19[3] = {6, 400, 1};
 static const casadi_int casadi_s20[3] = {9, 50, 1};
 
-static const casadi_real casadi_c0[401] = 
+static const casadi_real casadi_c0[801] = 
   {0., 1., 2., 3., 4., 5., 6., 7.,
   8., 9., 10., 11., 12., 13., 14., 15.,
   16., 17., 18., 19., 20., 21., 22., 23.,
@@ -224,7 +224,57 @@ static const casadi_real casadi_c0[401] =
   376., 377., 378., 379., 380., 381., 382., 383.,
   384., 385., 386., 387., 388., 389., 390., 391.,
   392., 393., 394., 395., 396., 397., 398., 399.,
-  400.};
+  400., 401., 402., 403., 404., 405., 406., 407.,
+  408., 409., 410., 411., 412., 413., 414., 415.,
+  416., 417., 418., 419., 420., 421., 422., 423.,
+  424., 425., 426., 427., 428., 429., 430., 431.,
+  432., 433., 434., 435., 436., 437., 438., 439.,
+  440., 441., 442., 443., 444., 445., 446., 447.,
+  448., 449., 450., 451., 452., 453., 454., 455.,
+  456., 457., 458., 459., 460., 461., 462., 463.,
+  464., 465., 466., 467., 468., 469., 470., 471.,
+  472., 473., 474., 475., 476., 477., 478., 479.,
+  480., 481., 482., 483., 484., 485., 486., 487.,
+  488., 489., 490., 491., 492., 493., 494., 495.,
+  496., 497., 498., 499., 500., 501., 502., 503.,
+  504., 505., 506., 507., 508., 509., 510., 511.,
+  512., 513., 514., 515., 516., 517., 518., 519.,
+  520., 521., 522., 523., 524., 525., 526., 527.,
+  528., 529., 530., 531., 532., 533., 534., 535.,
+  536., 537., 538., 539., 540., 541., 542., 543.,
+  544., 545., 546., 547., 548., 549., 550., 551.,
+  552., 553., 554., 555., 556., 557., 558., 559.,
+  560., 561., 562., 563., 564., 565., 566., 567.,
+  568., 569., 570., 571., 572., 573., 574., 575.,
+  576., 577., 578., 579., 580., 581., 582., 583.,
+  584., 585., 586., 587., 588., 589., 590., 591.,
+  592., 593., 594., 595., 596., 597., 598., 599.,
+  600., 601., 602., 603., 604., 605., 606., 607.,
+  608., 609., 610., 611., 612., 613., 614., 615.,
+  616., 617., 618., 619., 620., 621., 622., 623.,
+  624., 625., 626., 627., 628., 629., 630., 631.,
+  632., 633., 634., 635., 636., 637., 638., 639.,
+  640., 641., 642., 643., 644., 645., 646., 647.,
+  648., 649., 650., 651., 652., 653., 654., 655.,
+  656., 657., 658., 659., 660., 661., 662., 663.,
+  664., 665., 666., 667., 668., 669., 670., 671.,
+  672., 673., 674., 675., 676., 677., 678., 679.,
+  680., 681., 682., 683., 684., 685., 686., 687.,
+  688., 689., 690., 691., 692., 693., 694., 695.,
+  696., 697., 698., 699., 700., 701., 702., 703.,
+  704., 705., 706., 707., 708., 709., 710., 711.,
+  712., 713., 714., 715., 716., 717., 718., 719.,
+  720., 721., 722., 723., 724., 725., 726., 727.,
+  728., 729., 730., 731., 732., 733., 734., 735.,
+  736., 737., 738., 739., 740., 741., 742., 743.,
+  744., 745., 746., 747., 748., 749., 750., 751.,
+  752., 753., 754., 755., 756., 757., 758., 759.,
+  760., 761., 762., 763., 764., 765., 766., 767.,
+  768., 769., 770., 771., 772., 773., 774., 775.,
+  776., 777., 778., 779., 780., 781., 782., 783.,
+  784., 785., 786., 787., 788., 789., 790., 791.,
+  792., 793., 794., 795., 796., 797., 798., 799.,
+  800.};
 
 static const casadi_real casadi_zeros[21] = 
   {0.};
@@ -849,7 +899,7 @@ static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   a05=arg[0]? arg[0][6] : 0;
   a05=(a05/a01);
   if (res[0]!=0) res[0][14]=a05;
-  a05=6.2831853071795868e-02;
+  a05=3.1415926535897934e-02;
   if (res[0]!=0) res[0][15]=a05;
   a05=1.2566370614359172e+01;
   if (res[1]!=0) res[1][0]=a05;
@@ -1006,7 +1056,7 @@ static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   return 0;
 }
 
-/* map401_table_point:(t[1x401],p[21x401])->(values[3x401]) */
+/* map801_table_point:(t[1x801],p[21x801])->(values[3x801]) */
 static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_int i;
   casadi_real* *res1;
@@ -1015,7 +1065,7 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   for (i=0; i<2; ++i) arg1[i]=arg[i];
   res1 = res+1;
   for (i=0; i<1; ++i) res1[i]=res[i];
-  for (i=0; i<401; ++i) {
+  for (i=0; i<801; ++i) {
     if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
     if (arg1[0]) arg1[0]+=1;
     if (arg1[1]) arg1[1]+=21;
@@ -1024,11 +1074,11 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   return 0;
 }
 
-/* table:(t0,p[21])->(table[9x200],probe[3x2]) */
+/* table:(t0,p[21])->(table[9x400],probe[3x2]) */
 static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_int i, j;
-  casadi_real **res1=res+2, *rr, w00, *w01=w+14, *w03=w+415, w04, w05, w06, *w07=w+431, *w08=w+8852, *w09=w+10055, *w10=w+10655;
-  casadi_real *w11=w+11255, *w12=w+11855, *w13=w+12455, *w14=w+14255, *w15=w+16055;
+  casadi_real **res1=res+2, *rr, w00, *w01=w+14, *w03=w+815, w04, w05, w06, *w07=w+831, *w08=w+17652, *w09=w+20055, *w10=w+21255;
+  casadi_real *w11=w+22455, *w12=w+23655, *w13=w+24855, *w14=w+28455, *w15=w+32055;
   const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
   w00 = arg[0] ? arg[0][0] : 0;
   wr01 = casadi_c0;
@@ -1040,27 +1090,27 @@ static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   for (rr=(&w05), cs=w03+15; cs!=w03+16; cs+=1) *rr++ = *cs;
   w06 = 2.;
   w05 /= w06;
-  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w05);
-  for (i=0, rr=w01, cs=w01; i<401; ++i) (*rr++)  = (w00+(*cs++));
-  for (i=0;i<401;++i) {
+  for (i=0, rr=w01, cr=wr01; i<801; ++i) (*rr++)  = ((*cr++)*w05);
+  for (i=0, rr=w01, cs=w01; i<801; ++i) (*rr++)  = (w00+(*cs++));
+  for (i=0;i<801;++i) {
     casadi_copy(wr02, 21, w07+ i*21);
   }
   arg1[0]=w01;
   arg1[1]=w07;
   res1[0]=w08;
   if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
-  for (rr=w09, cs=w08+0; cs!=w08+1200; cs+=6) for (ct=cs+0; ct!=cs+3; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w10, cs=w09; i<200; ++i) for (j=0; j<3; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+1200; cs+=6) for (ct=cs+3; ct!=cs+6; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w11, cs=w09; i<200; ++i) for (j=0; j<3; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+1200; cs+=6) for (ct=cs+6; ct!=cs+9; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w12, cs=w09; i<200; ++i) for (j=0; j<3; ++j) rr[i+j*200] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+2400; cs+=6) for (ct=cs+0; ct!=cs+3; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w10, cs=w09; i<400; ++i) for (j=0; j<3; ++j) rr[i+j*400] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+2400; cs+=6) for (ct=cs+3; ct!=cs+6; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w11, cs=w09; i<400; ++i) for (j=0; j<3; ++j) rr[i+j*400] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+2400; cs+=6) for (ct=cs+6; ct!=cs+9; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w12, cs=w09; i<400; ++i) for (j=0; j<3; ++j) rr[i+j*400] = *cs++;
   rr=w13;
-  for (i=0, cs=w10; i<600; ++i) *rr++ = *cs++;
-  for (i=0, cs=w11; i<600; ++i) *rr++ = *cs++;
-  for (i=0, cs=w12; i<600; ++i) *rr++ = *cs++;
-  for (i=0, rr=w14, cs=w13; i<9; ++i) for (j=0; j<200; ++j) rr[i+j*9] = *cs++;
-  casadi_copy(w14, 1800, res[0]);
+  for (i=0, cs=w10; i<1200; ++i) *rr++ = *cs++;
+  for (i=0, cs=w11; i<1200; ++i) *rr++ = *cs++;
+  for (i=0, cs=w12; i<1200; ++i) *rr++ = *cs++;
+  for (i=0, rr=w14, cs=w13; i<9; ++i) for (j=0; j<400; ++j) rr[i+j*9] = *cs++;
+  casadi_copy(w14, 3600, res[0]);
   w05 = 3.7000000000000000e-01;
   w05 *= w04;
   w05  = (w00+w05);
@@ -1143,7 +1193,7 @@ CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casa
   if (sz_arg) *sz_arg = 6;
   if (sz_res) *sz_res = 4;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 16058;
+  if (sz_w) *sz_w = 32058;
   return 0;
 }
 
@@ -1151,7 +1201,7 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
   if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 4*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 16058*sizeof(casadi_real);
+  if (sz_w) *sz_w = 32058*sizeof(casadi_real);
   return 0;
 }
 
@@ -1169,7 +1219,7 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
 #define GEARSYM_NOT_UNROLLED
 #endif
 
-static const casadi_real gs_zeros[1800] = {0.};
+static const casadi_real gs_zeros[3600] = {0.};
 
 /* an input as CasADi passes it (a null pointer: zeros) into a local array */
 static inline void gs_load(const casadi_real* x, casadi_int n, casadi_real* y) {
@@ -5362,18 +5412,17 @@ static GEARSYM_NOINLINE void gs_state_span(casadi_real* restrict y, casadi_real*
   gs_copy(ya, 6, y); gs_copy(loa, 3, lo); gs_copy(hia, 3, hi);
 }
 
-/* lyapunov_chunk:(y0[6],Q0[6x6],table[9x200],c[16])->(strobe[6x50],Q[6x6],log_stretch[6x50],low[3x50],high[3x50]) */
+/* lyapunov_chunk:(y0[6],Q0[6x6],table[9x400],c[16])->(strobe[6x50],Q[6x6],log_stretch[6x50],low[3x50],high[3x50]) */
 static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[6], lo[3], hi[3], c[16]; casadi_real Q[36];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 6, y); gs_load(arg[1], 36, Q); gs_load(arg[3], 16, c);
-  casadi_real Qn[36], logs[6];
+  casadi_real Qn[36], logs[6]; casadi_real piece[6]; casadi_int g, i;
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 36, Q);
+    for (i = 0; i < 6; ++i) logs[i] = 0;
+    for (g = 0; g < 16; ++g) { gs_tangent_span(y, Q, lo, hi, T + 9*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 36, Q); for (i = 0; i < 6; ++i) logs[i] += piece[i]; }
     gs_store(y, 6, res[0], 6*p); gs_store(logs, 6, res[2], 6*p);
     gs_store(lo, 3, res[3], 3*p); gs_store(hi, 3, res[4], 3*p);
   }
@@ -5466,18 +5515,17 @@ CASADI_SYMBOL_EXPORT int lyapunov_chunk_work_bytes(casadi_int *sz_arg, casadi_in
   return 0;
 }
 
-/* lyapunov_period:(y0[6],Q0[6x6],table[9x200],c[16])->(strobe[6],Q[6x6],log_stretch[6],low[3],high[3]) */
+/* lyapunov_period:(y0[6],Q0[6x6],table[9x400],c[16])->(strobe[6],Q[6x6],log_stretch[6],low[3],high[3]) */
 static int casadi_f19(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[6], lo[3], hi[3], c[16]; casadi_real Q[36];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 6, y); gs_load(arg[1], 36, Q); gs_load(arg[3], 16, c);
-  casadi_real Qn[36], logs[6];
+  casadi_real Qn[36], logs[6]; casadi_real piece[6]; casadi_int g, i;
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 36, Q);
+    for (i = 0; i < 6; ++i) logs[i] = 0;
+    for (g = 0; g < 16; ++g) { gs_tangent_span(y, Q, lo, hi, T + 9*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 36, Q); for (i = 0; i < 6; ++i) logs[i] += piece[i]; }
     gs_store(y, 6, res[0], 6*p); gs_store(logs, 6, res[2], 6*p);
     gs_store(lo, 3, res[3], 3*p); gs_store(hi, 3, res[4], 3*p);
   }
@@ -5570,7 +5618,7 @@ CASADI_SYMBOL_EXPORT int lyapunov_period_work_bytes(casadi_int *sz_arg, casadi_i
   return 0;
 }
 
-/* orbit_chunk:(y0[6],table[9x200],c[16])->(strobe[6x50],low[3x50],high[3x50]) */
+/* orbit_chunk:(y0[6],table[9x400],c[16])->(strobe[6x50],low[3x50],high[3x50]) */
 static int casadi_f20(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[6], lo[3], hi[3], c[16];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
@@ -5578,7 +5626,7 @@ static int casadi_f20(const casadi_real** arg, casadi_real** res, casadi_int* iw
   gs_load(arg[0], 6, y); gs_load(arg[2], 16, c);
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4];
-    gs_state_span(y, lo, hi, T, c, 200);
+    gs_state_span(y, lo, hi, T, c, 400);
     gs_store(y, 6, res[0], 6*p); gs_store(lo, 3, res[1], 3*p); gs_store(hi, 3, res[2], 3*p);
   }
   return 0;
@@ -5663,7 +5711,7 @@ CASADI_SYMBOL_EXPORT int orbit_chunk_work_bytes(casadi_int *sz_arg, casadi_int* 
   return 0;
 }
 
-/* orbit_period:(y0[6],table[9x200],c[16])->(strobe[6],low[3],high[3]) */
+/* orbit_period:(y0[6],table[9x400],c[16])->(strobe[6],low[3],high[3]) */
 static int casadi_f22(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[6], lo[3], hi[3], c[16];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
@@ -5671,7 +5719,7 @@ static int casadi_f22(const casadi_real** arg, casadi_real** res, casadi_int* iw
   gs_load(arg[0], 6, y); gs_load(arg[2], 16, c);
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4];
-    gs_state_span(y, lo, hi, T, c, 200);
+    gs_state_span(y, lo, hi, T, c, 400);
     gs_store(y, 6, res[0], 6*p); gs_store(lo, 3, res[1], 3*p); gs_store(hi, 3, res[2], 3*p);
   }
   return 0;
@@ -5756,14 +5804,14 @@ CASADI_SYMBOL_EXPORT int orbit_period_work_bytes(casadi_int *sz_arg, casadi_int*
   return 0;
 }
 
-/* trajectory:(y0[6],table[9x200],c[16])->(states[6x200]) */
+/* trajectory:(y0[6],table[9x400],c[16])->(states[6x400]) */
 static int casadi_f23(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[6], lo[3], hi[3], c[16];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 6, y); gs_load(arg[2], 16, c);
   lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4];
-  for (p = 0; p < 200; ++p) {
+  for (p = 0; p < 400; ++p) {
     gs_state_span(y, lo, hi, T + 9*p, c, 1);
     gs_store(y, 6, res[0], 6*p);
   }
@@ -5833,7 +5881,7 @@ CASADI_SYMBOL_EXPORT int trajectory_work(casadi_int *sz_arg, casadi_int* sz_res,
   if (sz_arg) *sz_arg = 9;
   if (sz_res) *sz_res = 4;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 1367;
+  if (sz_w) *sz_w = 2567;
   return 0;
 }
 
@@ -5841,7 +5889,7 @@ CASADI_SYMBOL_EXPORT int trajectory_work_bytes(casadi_int *sz_arg, casadi_int* s
   if (sz_arg) *sz_arg = 9*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 4*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 1367*sizeof(casadi_real);
+  if (sz_w) *sz_w = 2567*sizeof(casadi_real);
   return 0;
 }
 
@@ -5942,7 +5990,7 @@ CASADI_SYMBOL_EXPORT int monodromy_segment_work_bytes(casadi_int *sz_arg, casadi
   return 0;
 }
 
-/* monodromy_period:(y0[6],Q0[6x6],table[9x200],c[16])->(strobe[6],M[6x6],low[3],high[3]) */
+/* monodromy_period:(y0[6],Q0[6x6],table[9x400],c[16])->(strobe[6],M[6x6],low[3],high[3]) */
 static int casadi_f25(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[6], lo[3], hi[3], c[16]; casadi_real Q[36];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
@@ -5950,7 +5998,7 @@ static int casadi_f25(const casadi_real** arg, casadi_real** res, casadi_int* iw
   gs_load(arg[0], 6, y); gs_load(arg[1], 36, Q); gs_load(arg[3], 16, c);
   casadi_real lk[3], hk[3];
   lk[0] = y[0]; hk[0] = y[0]; lk[1] = y[2]; hk[1] = y[2]; lk[2] = y[4]; hk[2] = y[4];
-  for (p = 0; p < 4; ++p) {
+  for (p = 0; p < 8; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4];
     gs_tangent_span(y, Q, lo, hi, T + 450*p, c, 50);
     lk[0] = (lo[0] < lk[0] ? lo[0] : 0) + (lo[0] < lk[0] ? 0 : lk[0]);
