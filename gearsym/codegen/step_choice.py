@@ -64,3 +64,13 @@ def chosen(options: Integration, rho: float, cycle: float, unit: str = "") -> In
     return replace(options, integrator="stiff",
                    choice=f"stiff RODAS4 at {asked} steps ({mode}: h|lambda| = {z:.3g}; RK4 would need "
                           f"{needed} steps per forcing period to resolve it)")
+
+
+def explicit(options: Integration, rho: float, cycle: float) -> Integration:
+    """``options`` with RK4 at the steps that resolve ``rho`` (at least those asked): what a consumer with only the
+    explicit step takes (an FMU's co-simulation step)."""
+    if options.integrator == "rk4":
+        return options
+    steps = max(options.steps_per_period, round_steps(rho * cycle / RK4_RESOLVED))
+    return replace(options, integrator="rk4", steps_per_period=steps,
+                   choice=f"RK4 at {steps} steps per forcing period (fastest linearised mode {rho:.4g})")
