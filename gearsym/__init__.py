@@ -58,6 +58,7 @@ _LAZY = {
     "model_module": "gearsym.registry",
     "CompiledModel": "gearsym.codegen",
     "compile_model": "gearsym.codegen.build",
+    "chosen_integration": "gearsym.codegen.fastest_mode",
     "LyapunovSpectrum": "gearsym.analysis",
     "lyapunov_spectrum": "gearsym.verbs",
     "poincare_samples": "gearsym.verbs",

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import itertools
 
 import gearsym  # the face: its verbs load on first use, so a cached model's run never loads the generator
 
@@ -49,6 +50,17 @@ def integration_from(args: argparse.Namespace, steps_per_period: int | None = No
         check_run(steps_per_period=steps)
     return Integration(**run, steps_per_period=steps, locate_crossings=not args.plain, backend=args.backend,
                        integrator=getattr(args, "integrator", "auto"))
+
+
+def chosen_over(args: argparse.Namespace, options: Integration, axes) -> Integration:
+    """``options`` with the step chosen for every point of the engine's ``axes`` (name -> values: their ends
+    decide; an integrator asked is kept): a sweep or a continuation compiles once, at the step its fastest point
+    needs."""
+    if options.integrator != "auto" or not axes:
+        return options
+    ends = [{name: float(v) for name, v in zip(axes, point)}
+            for point in itertools.product(*[(min(v), max(v)) for v in axes.values()])]
+    return gearsym.chosen_integration(options, system_from(args), ends)
 
 
 def system_from(args: argparse.Namespace):

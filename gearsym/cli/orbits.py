@@ -23,7 +23,8 @@ from ..sweep import read_sweep
 from ..sweep.grid import _numbers_and_unit, Axis
 from ..sweep.store import sidecar
 from ..units import shown
-from .integration import add_integration_arguments, compiled_from, integration_from, scaling_from, system_from
+from .integration import (add_integration_arguments, chosen_over, compiled_from, integration_from, scaling_from,
+                          step_line, system_from)
 from .settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
 
 NAME = "orbits"
@@ -133,8 +134,11 @@ def run(args: argparse.Namespace) -> int:
         check_segments(args.segments, pieces, f"--segments {args.segments}: ", options.steps_per_period * system.cycles)
     if parameter and parameter[0] not in system.parameters:
         raise UnknownParameterError(parameter[0], system.parameters, f"--param {args.param}")
+    if parameter:  # (the step the range's fastest point needs)
+        options = chosen_over(args, options, {parameter[0]: (parameter[1], parameter[2])})
     compiled = compiled_from(args, options, system)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
+    print(f"gearsym: {step_line(compiled, scaling)}", file=sys.stderr)
     if parameter is None:
         return _one_orbit(compiled, args, y0, physical)
     name, start, stop = parameter

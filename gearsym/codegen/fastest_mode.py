@@ -33,3 +33,13 @@ def chosen_for(options: Integration, system: FirstOrderSystem) -> Integration:
     if options.integrator != "auto":
         return options
     return chosen(options, fastest_rate(system), system.cycle_at())
+
+
+def chosen_integration(options: Integration, system: FirstOrderSystem, points=()) -> Integration:
+    """``options`` with the integrator and steps chosen for ``system`` at its values and at each of ``points``
+    (mappings of parameter values: the ends of a sweep's axes), the fastest of them deciding: one library runs
+    every point at a step that resolves its fastest mode."""
+    if options.integrator != "auto":
+        return options
+    rho = max([fastest_rate(system)] + [fastest_rate(system, values) for values in points])
+    return chosen(options, rho, system.cycle_at())
