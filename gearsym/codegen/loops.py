@@ -29,12 +29,11 @@ class LoopOptions:
         """The part of an :class:`~gearsym.options.Integration` that shapes the generated code, for a system whose
         period is ``cycles`` forcing periods (a gear's revolution): the options' steps per forcing period are
         kept, so the loops take ``cycles`` times as many per period (a long period costs time, not accuracy)."""
-        if options.integrator not in METHODS:
-            raise ModelError(f"the integrator of {options.describe()} is not chosen yet (auto): choose it for the model "
-                             "first (gearsym.codegen.step_choice.chosen)")
+        # (an integrator not chosen yet is RK4 at the steps asked: compile_model chooses it for a model first)
+        method = options.integrator if options.integrator in METHODS else "rk4"
         paper = options.integrator == "rk4" and not options.locate_crossings
         return cls(steps_per_period=options.steps_per_period * cycles, locate_crossings=options.locate_crossings,
-                   method=options.integrator, reorthonormalise=0 if paper else REORTHONORMALISE)
+                   method=method, reorthonormalise=0 if paper else REORTHONORMALISE)
 
     def __post_init__(self):
         if self.steps_per_period < 1:
