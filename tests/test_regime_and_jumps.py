@@ -86,3 +86,14 @@ def test_a_tiny_step_on_a_flat_curve_is_not_a_jump():
     assert find_jumps(OMEGA, a) == []
     up, down = a.copy(), a + 1e-6
     assert hysteresis_intervals(OMEGA, up, down) == []
+
+
+def test_a_smooth_decay_from_the_first_point_is_not_a_jump():
+    """The issue's sweep: 7.956, 7.559, 7.307 um at 800, 850, 900 rpm and flatter beyond: a slope that goes on is no
+    jump, however it compares with the flat curve further on; a step at the first point that stands alone is."""
+    speed = np.arange(800.0, 1801.0, 50.0)
+    decay = 6.9 + 1.056 * np.exp(-(speed - 800) / 110)  # 7.956, 7.570, 7.325, ...
+    assert find_jumps(speed, decay) == []
+    alone = np.where(speed > 800, 6.9, 9.0)
+    (jump,) = find_jumps(speed, alone)
+    assert (jump.start, jump.end) == (800.0, 850.0)
