@@ -11,10 +11,11 @@ from ..analysis.divergence import stiffness_notes
 from ..analysis.regime import describe_regime, zero_band
 from ..checks import chosen_coordinate
 from ..errors import GearsymError
+from ..files import write_atomically
 from ..figures import plot_point
 from ..outputs import check_figure
 from .integration import add_integration_arguments, compiled_from, scaling_from, step_line
-from .settings import add_set_argument, parse_state
+from .settings import add_set_argument, model_settings, parse_state
 
 NAME = "lyap"
 HELP = "Lyapunov spectrum (all exponents, per unit time) at one parameter point"
@@ -48,8 +49,12 @@ def run(args: argparse.Namespace) -> int:
         trajectory = phase_trajectory(compiled, options=compiled.integration.run(discard=result.periods - shown),
                                       y0=parse_state(args.y0))
         if physical is not None:  # in the model's units: exponents per second, um, mm/s, rad
-            spectrum, shown_trajectory, units, title = scaling.point_units().figure(result, trajectory)
+            point_units = scaling.point_units()
+            spectrum, shown_trajectory, units, title = point_units.figure(result, trajectory, model_settings(args))
             plot_point(spectrum, shown_trajectory, args.plot, x=coordinate, units=units, title=title)
+            caption = args.plot.with_suffix(".caption.txt")  # (the values the title leaves out)
+            write_atomically(caption, f"{scaling.name}: the figure {args.plot.name}'s values\n"
+                             + point_units.caption())
         else:
             plot_point(result, trajectory, args.plot, x=coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)

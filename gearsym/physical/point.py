@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 import textwrap
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
@@ -298,11 +298,12 @@ class PointUnits:
             return ()
         return tuple(known.note(i, per_second, f" {self.per_second.text}") for i in range(len(result.exponents)))
 
-    def figure(self, result, trajectory) -> tuple:
+    def figure(self, result, trajectory, given: Mapping[str, str] | None = None) -> tuple:
         """A spectrum run and a trajectory at its point as a figure shows them in physical units
         (:func:`gearsym.figures.point.plot_point`): the spectrum with its exponents, their running estimates and
         its Poincaré points converted, the trajectory's states converted, the unit of each, and a title with the
-        physical values as the user gave them."""
+        physical values as the user gave them: those of ``given`` (the values a command set) if given, else every
+        one (a model's own values then go in the figure's caption file, :meth:`caption`)."""
         w = float(result.parameters["omega"])
         per_second = w * self.omega_n
 
@@ -319,10 +320,18 @@ class PointUnits:
         units = {n: self.unit(n).text for n in trajectory.state_names} | {"exponents": self.per_second.text}
         speed = self.speed.parameter if self.speed else None
         head = f"{shown(Measured(float(self.speed_of(w)), self.speed_unit))}; " if self.speed else ""
-        values = ", ".join(f"{k}={v}" for k, v in self.values.items() if k != speed)
+        chosen = self.values if given is None else {k: v for k, v in given.items()}
+        values = ", ".join(f"{k}={v}" for k, v in chosen.items() if k != speed)
+        if given is not None:
+            values = (values + "; " if values else "") + "the model's other values in the caption file"
         title = (textwrap.fill(f"{self.name}: {head}{values}", 140)
                  + f"\n{result.regime}, λ₁ = {spectrum.exponents[0]:+.5g} {self.per_second.text}")
         return spectrum, shown_trajectory, units, title
+
+    def caption(self) -> str:
+        """Every physical value of the point as the model or the user gave it, one a line: what a figure's title
+        leaves to its caption file."""
+        return "".join(f"{k} = {v}\n" for k, v in self.values.items())
 
     def loads(self, trajectory, omega: float) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
         """The force of every mesh (N) and the torque of every shaft (N·m) along a trajectory."""
