@@ -11,9 +11,9 @@ from ..analysis.divergence import stiffness_notes
 from ..analysis.regime import describe_regime, zero_band
 from ..checks import chosen_coordinate
 from ..errors import GearsymError
-from ..files import write_atomically
+from ..files.atomic import write_atomically
 from ..figures import plot_point
-from ..outputs import check_figure
+from ..files.outputs import check_figure
 from .integration import add_integration_arguments, compiled_from, scaling_from, step_line
 from .settings import add_set_argument, model_settings, parse_state
 

@@ -16,7 +16,7 @@ from typing import Optional
 import sympy as sp
 
 from ..errors import ModelError
-from ..symbols import omega, t
+from .symbols import omega, t
 from .resolved_components import ResolvedCoupling
 
 
