@@ -16,6 +16,8 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 
+import numpy as np
+
 from ..errors import GearsymError
 from ..physical.results import point_units
 from ..scales.map import Scaling
@@ -102,7 +104,6 @@ def engine_mean_stiffness(system, mesh: str, values: Mapping[str, float]) -> flo
     """The mean over the system's period of a mesh's stiffness in the engine (1 for the first mesh: the time
     unit's condition; K2, its mean relative to the first's, for a second): sampled at 4096 points, which is its
     exact mean for any series of fewer harmonics."""
-    import numpy as np
     import sympy as sp
 
     coupling = next(c for c in system.couplings if c.name == mesh)
