@@ -106,7 +106,8 @@ def lyap_rows(system, scaling) -> tuple[list[dict], dict]:
         if reference is None:
             reference = (model, result)
     model, result = reference
-    mu = linearised_eigenvalues(model, np.array(list(result.final_state.values())), model.parameter_vector())
+    mu = linearised_eigenvalues(model, np.array(list(result.final_state.values())), model.parameter_vector(),
+                                result.period / model.cycles)
     linear = {"decay_rates_per_second": sorted((float(m.real * per_second) for m in mu), reverse=True)}
     rows.append(radau_row(model, result, per_second))
     return rows, linear

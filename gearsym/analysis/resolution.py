@@ -60,10 +60,9 @@ class Resolution:
                 "linearised_estimate": [float(e) for e in self.estimate], "step": self.step, "limit": self.limit}
 
 
-def linearised_eigenvalues(model, state, p: np.ndarray) -> np.ndarray:
-    """The eigenvalues of the Jacobian averaged over a forcing period (8 times) at ``state``."""
+def linearised_eigenvalues(model, state, p: np.ndarray, cycle: float) -> np.ndarray:
+    """The eigenvalues of the Jacobian averaged over a forcing period ``cycle`` (8 times) at ``state``."""
     jacobian = model.functions["jacobian"]
-    cycle = model.system.cycle_at(dict(zip(model.parameter_names, map(float, p))))
     mean = sum(np.array(jacobian(cycle * k / 8, state, p), dtype=float) for k in range(8)) / 8
     return np.linalg.eigvals(mean) if np.all(np.isfinite(mean)) else np.full(len(state), np.nan)
 
@@ -74,7 +73,7 @@ def resolution(model, exponents: np.ndarray, p: np.ndarray, state, period: float
     n = len(exponents)
     h = period / model.steps_per_period
     limit = RK4_RESOLVED if model.options.method == "rk4" else STIFF_RESOLVED
-    mu = linearised_eigenvalues(model, np.asarray(state, dtype=float), p)
+    mu = linearised_eigenvalues(model, np.asarray(state, dtype=float), p, period / model.cycles)
     fast = int(np.sum(np.abs(mu) * h > limit)) if np.all(np.isfinite(mu)) else 0
     fast = max(fast, int(np.sum(np.abs(exponents) * h > limit)))
     interval = h * (model.options.reorthonormalise or model.steps_per_period)

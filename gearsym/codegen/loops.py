@@ -22,7 +22,7 @@ class LoopOptions:
     #: than e^36 between two falls below the rounding of the others and its exponent is lost: over 25 steps
     #: that is a spread of 1.4 per step, beyond what RK4 resolves (h|lambda| <= 0.5) and near its stability
     #: limit; the analyses check the spread they measured (gearsym.analysis.resolution)
-    reorthonormalise: int = 0
+    reorthonormalise: int = 25  # (REORTHONORMALISE)
 
     @classmethod
     def of(cls, options: Integration, cycles: int = 1) -> "LoopOptions":
