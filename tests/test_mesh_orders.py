@@ -67,3 +67,19 @@ def test_the_gearbox_repeats_on_61_mesh_periods_and_names_its_second_mesh_itself
     assert any(n.startswith("zeta_") for n in names)
     system = gearsym.scaling(nd).system()
     assert system.cycles == 61 and float(system.period) == pytest.approx(122 * 3.141592653589793)
+
+
+def test_an_order_spectrum_labels_every_meshs_lines_at_their_orders_of_the_first():
+    from gearsym.analysis.orders import order_lines, order_spectrum
+
+    import numpy as np
+
+    others = {"stage2": (19 / 61, {"gear3": 19, "gear4": 47})}
+    lines = {ln.label: ln.order for ln in order_lines({"gear1": 23, "gear2": 61}, 2, 1, others)}
+    assert lines["stage2 x1"] == pytest.approx(19 / 61) and lines["stage2 x2"] == pytest.approx(38 / 61)
+    assert lines["stage2 x1 + gear4 x1"] == pytest.approx(19 / 61 * (1 + 1 / 47))
+    tau = np.linspace(0, 2 * np.pi * 61, 61 * 50, endpoint=False)  # one period of the box, 50 samples a mesh period
+    signal = 2.0 * np.cos(tau) + 0.5 * np.cos(19 / 61 * tau)  # the first mesh's harmonic and the second's
+    s = order_spectrum(tau, signal, {"gear1": 23, "gear2": 61}, meshes=others, unit="µm")
+    assert s.line("mesh x1").amplitude == pytest.approx(2.0, rel=1e-6)
+    assert s.line("stage2 x1").amplitude == pytest.approx(0.5, rel=1e-6) and s.unit == "µm"

@@ -101,9 +101,9 @@ def step_line(compiled, scaling=None) -> str:
     """One line: the step the run takes and why (the choice from the fastest linearised mode), in seconds and Hz
     for a model with physical values."""
     integration = compiled.integration
-    cycle = compiled.system.cycle_at()
+    cycle = getattr(compiled.system, "cycle", 0.0) or compiled.system.cycle_at()  # (a cached model's: its summary's)
     steps = compiled.steps_per_cycle
-    first = next((c.name for c in getattr(compiled.system, "couplings", ()) if c.kind == "mesh"), None)
+    first = scaling.point_units().meshes[0].name if scaling is not None and scaling.point_units().meshes else None
     per = f"mesh period of {first!r}" if first else "forcing period"
     span = (f", {compiled.steps_per_period} per period of {compiled.cycles} of them" if compiled.cycles > 1 else "")
     if scaling is not None:
