@@ -81,5 +81,5 @@ def test_an_order_spectrum_labels_every_meshs_lines_at_their_orders_of_the_first
     tau = np.linspace(0, 2 * np.pi * 61, 61 * 50, endpoint=False)  # one period of the box, 50 samples a mesh period
     signal = 2.0 * np.cos(tau) + 0.5 * np.cos(19 / 61 * tau)  # the first mesh's harmonic and the second's
     s = order_spectrum(tau, signal, {"gear1": 23, "gear2": 61}, meshes=others, unit="µm")
-    assert s.line("mesh x1").amplitude == pytest.approx(2.0, rel=1e-6)
-    assert s.line("stage2 x1").amplitude == pytest.approx(0.5, rel=1e-6) and s.unit == "µm"
+    assert s.line("mesh x1").amplitude == pytest.approx(2.0, rel=1e-3)
+    assert s.line("stage2 x1").amplitude == pytest.approx(0.5, rel=1e-3) and s.unit == "µm"
