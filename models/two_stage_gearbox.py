@@ -83,6 +83,17 @@ model.set_physical(
     eta1="80 um", eta2="120 um",
     M_m=f"{TORQUE} N*m", M_L=f"{TORQUE * RATIO!r} N*m", speed=SPEED,
 )
+# the train at rest under the mean torques (each coupling carries its torque: its twist or deflection is that over
+# its stiffness), so that a run starts on the operating point: shafts twist backwards (psi_b - psi_a < 0), meshes
+# deflect forwards
+T_INPUT, T_MIDDLE = TORQUE, TORQUE * 61 / 23
+model.set_initial_state(
+    x1=f"{-T_INPUT / SHAFTS['coupling']!r} rad",
+    x2=f"{T_INPUT / gear1.geometry.base_radius / model.physical['kZ1'].si!r} m",
+    x3=f"{-T_MIDDLE / SHAFTS['intermediate']!r} rad",
+    x4=f"{T_MIDDLE / gear3.geometry.base_radius / model.physical['kZ2'].si!r} m",
+    x5=f"{-TORQUE * RATIO / SHAFTS['output']!r} rad",
+)
 model.describe(
     speed="speed of the motor",
     I_m="rotor inertia of the motor (assumed)",

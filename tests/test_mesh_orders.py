@@ -65,8 +65,14 @@ def test_the_gearbox_repeats_on_61_mesh_periods_and_names_its_second_mesh_itself
     second = {f.name for f in nd.functions} - {"k"}
     assert second and {"zeta", "B0"} <= names and any(n.startswith("K_") for n in names)
     assert any(n.startswith("zeta_") for n in names)
-    system = gearsym.scaling(nd).system()
+    scaling = gearsym.scaling(nd)
+    system = scaling.system()
     assert system.cycles == 61 and float(system.period) == pytest.approx(122 * 3.141592653589793)
+    # it starts at rest under its torques, its shafts' twists declared in rad: the first mesh at its static
+    # deflection (the length unit), the coupling's twist -150 N m / 5e4 N m/rad as radius x twist
+    assert system.initial["x2"] == pytest.approx(1.0, rel=1e-9)
+    radius = scaling.si_values["r_gear1"]
+    assert system.initial["x1"] * scaling.length_si / radius == pytest.approx(-150 / 5e4, rel=1e-12)
 
 
 def test_an_order_spectrum_labels_every_meshs_lines_at_their_orders_of_the_first():
