@@ -79,6 +79,7 @@ _LAZY = {
     "model_module": "gearsym.registry",
     "CompiledModel": "gearsym.codegen",
     "compile_model": "gearsym.codegen.build",
+    "chosen_integration": "gearsym.codegen.fastest_mode",
     "LyapunovSpectrum": "gearsym.analysis",
     "classify_regime": "gearsym.analysis",
     "StabilityChart": "gearsym.stability",

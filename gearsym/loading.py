@@ -43,8 +43,10 @@ class ModelScaling(PhysicalScaling):
     """The face's scaling: a spectrum carried to physical units without the compiled model it ran on has its mesh
     forces run on this scaling's system, compiled here (the units stage below compiles nothing)."""
 
-    def compiled_for(self, steps_per_period: int):
-        return compile_model(self.system(), Integration(steps_per_period=steps_per_period))
+    def compiled_for(self, result):
+        system = self.system()
+        return compile_model(system, result.info.get("integration") or Integration(
+            steps_per_period=result.steps_per_period // system.cycles))
 
 
 def scaling(model, length_scale=None, *, teeth=None, **physical) -> PhysicalScaling:

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 from .caller import option
 from .checks import MAX_STEPS_PER_PERIOD, RUN_BYTES_PER_PERIOD, TABLE_BYTES_PER_STEP, whole_number
@@ -68,6 +68,10 @@ class Execution:
         if self.progress:
             return lambda line: print(f"gearsym: {line}", file=sys.stderr, flush=True)
         return lambda line: None
+#: the steps the loops take: explicit RK4, or the stiff RODAS4 with the exact Jacobian (codegen/rosenbrock.py)
+METHODS = ("rk4", "stiff")
+#: what a run asks for: one of METHODS, or "auto": chosen from the model's fastest linearised mode
+INTEGRATORS = ("auto", *METHODS)
 
 
 @dataclass(frozen=True)
@@ -83,6 +87,11 @@ class Integration:
       :meth:`paper` is the paper's plain scheme.
     * ``backend``: ``"compiled"`` (fail without a C compiler), ``"in-process"`` (CasADi's virtual
       machine) or ``"auto"`` (compiled where a C compiler exists).
+    * ``integrator``: ``"rk4"`` (explicit, 4th order), ``"stiff"`` (RODAS4: linearly implicit, L-stable, 4th
+      order, its W-matrix from the exact Jacobian) or ``"auto"`` (the default): chosen, with the steps, from the
+      model's fastest linearised mode when the model is compiled (``step_choice.py``): RK4 with at least
+      ``steps_per_period`` steps, as many as resolve that mode, or the stiff step where RK4 would need many
+      times more. ``choice`` says what was chosen and why (set by the choice; not part of the comparison).
 
     ``steps_per_period``, ``locate_crossings`` and ``backend`` shape the compiled code; ``periods`` and
     ``discard`` only the run, so a compiled model runs with any of them.
@@ -93,6 +102,8 @@ class Integration:
     steps_per_period: int = STEPS_PER_PERIOD
     locate_crossings: bool = True
     backend: str = "auto"
+    integrator: str = "auto"
+    choice: str = field(default="", compare=False)
 
     def __post_init__(self):
         periods = whole_number(self.periods, "periods", 1)
@@ -111,6 +122,8 @@ class Integration:
                    what="each period's state, stretch and extremes, at least")
         if not isinstance(self.locate_crossings, bool):
             raise GearsymError(f"locate_crossings must be True or False, got {self.locate_crossings!r}")
+        if self.integrator not in INTEGRATORS:
+            raise GearsymError(f"unknown integrator {self.integrator!r}; choose one of {', '.join(INTEGRATORS)}")
         if self.backend not in BACKENDS:
             raise GearsymError(f"unknown backend {self.backend!r}; choose one of {', '.join(BACKENDS)}")
         object.__setattr__(self, "periods", periods)
@@ -121,7 +134,7 @@ class Integration:
     def paper(cls, **changes) -> "Integration":
         """The paper's scheme: plain RK4 at 200 steps per period, 400 periods with 100 discarded
         (what ``gearsym reproduce`` and the comparisons with hand-written C use, like for like)."""
-        return cls(**{"locate_crossings": False, **changes})
+        return cls(**{"locate_crossings": False, "integrator": "rk4", **changes})
 
     @property
     def measured(self) -> int:
@@ -133,8 +146,14 @@ class Integration:
         return replace(self, periods=self.periods if periods is None else periods,
                        discard=self.discard if discard is None else discard)
 
+    @property
+    def method_name(self) -> str:
+        """The step's name in reports: RK4, RODAS4 (stiff), or 'auto' before the choice."""
+        return {"rk4": "RK4", "stiff": "RODAS4 (stiff)"}.get(self.integrator, "auto")
+
     def describe(self) -> str:
         """One line for reports: '400 periods (100 discarded), 200 RK4 steps/period, crossings located'."""
-        scheme = "crossings located" if self.locate_crossings else "plain RK4 (the paper's scheme)"
-        return (f"{self.periods} periods ({self.discard} discarded), {self.steps_per_period} RK4 steps/period, "
-                f"{scheme}")
+        scheme = ("crossings located" if self.locate_crossings else
+                  "plain RK4 (the paper's scheme)" if self.integrator == "rk4" else "crossings not located")
+        return (f"{self.periods} periods ({self.discard} discarded), {self.steps_per_period} {self.method_name} "
+                f"steps/period, {scheme}")

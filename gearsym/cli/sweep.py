@@ -19,7 +19,8 @@ from ..sweep import DIRECTIONS, MODES, POINCARE_SAMPLES, Workers, run_sweep
 from ..sweep.grid import axes_from
 from ..sweep.report import findings_lines
 from ..sweep.store import sidecar
-from .arguments.integration import add_integration_arguments, compiled_from, integration_from, scaling_from
+from .arguments.integration import (add_integration_arguments, chosen_over, compiled_from, integration_from, scaling_from,
+                          step_line)
 from .arguments.settings import add_set_argument, parse_state, refuse_swept_and_set
 
 NAME = "sweep"
@@ -82,8 +83,11 @@ def run(args: argparse.Namespace) -> int:
     scaling = scaling_from(args)
     axes = _engine_axes(given, scaling)
     refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], args.set)
+    options = chosen_over(args, options, {a.name: a.values for a in axes})  # (the step its fastest point needs)
     compiled = compiled_from(args, options)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
+    if not args.quiet:
+        print(f"gearsym: {step_line(compiled, scaling)}", file=sys.stderr)
     try:
         result = run_sweep(compiled, axes, mode=args.mode, direction=args.direction, y0=y0,
                            out=args.out, overwrite=args.overwrite, poincare=args.poincare, execution=execution)

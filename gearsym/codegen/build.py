@@ -29,6 +29,8 @@ from .library import library_describes, library_functions, model_key, resolve_ba
 from .loaded import keep, loaded
 from .loops import LoopOptions
 from .native import load_native
+from .fastest_mode import fastest_rate
+from .step_choice import chosen
 from .time_tables import split_rhs
 from .trust import record, trusted
 
@@ -50,6 +52,8 @@ def compile_model(system: FirstOrderSystem, options: Integration = Integration()
     if not isinstance(options, Integration):
         raise GearsymError(f"options must be a gearsym.Integration, got {type(options).__name__}")
     start = time.perf_counter()
+    fastest = fastest_rate(system)
+    options = chosen(options, fastest, system.cycle_at())  # the integrator and steps, from the fastest mode
     loops = LoopOptions.of(options, system.cycles)
     digest = code_hash(system, loops)
     timings = {"symbolic": time.perf_counter() - start}
@@ -57,7 +61,7 @@ def compile_model(system: FirstOrderSystem, options: Integration = Integration()
     key = model_key(digest, backend)
     found = loaded(key)
     if found is not None:  # same code: reuse the loaded functions, with this system's values and these options
-        return replace(found.clone(), system=system, integration=options)
+        return replace(found.clone(), system=system, integration=options, fastest=fastest)
     if backend == "in-process":
         t = time.perf_counter()
         functions, library = build_functions(system, loops).functions, None
@@ -67,7 +71,7 @@ def compile_model(system: FirstOrderSystem, options: Integration = Integration()
     native = load_native(library, functions) if library else None
     timed, texts = timed_tables(system, loops)
     compiled = CompiledModel(system, loops, digest, functions, backend, library, timings, native, options,
-                             timed, texts)
+                             timed, texts, fastest)
     return keep(key, compiled)
 
 

@@ -135,6 +135,7 @@ class CompiledModel:
     integration: Integration = field(default_factory=Integration)  # the options it was compiled with
     timed: frozenset[str] = frozenset()  # the parameters in the tables of time or the period (the generator's)
     table_texts: tuple[str, ...] = ()  # the tables of time, as text (for the error of one that does not repeat)
+    fastest: float = 0.0  # the rate of the system's fastest linearised mode (what the step was chosen from)
 
     def run_options(self, options: Integration | None) -> Integration:
         """The options a run on this model uses: its own, or ``options`` if they need the same code; a run longer
@@ -149,14 +150,19 @@ class CompiledModel:
         if not isinstance(options, Integration):
             raise GearsymError(f"options must be a gearsym.Integration, got {type(options).__name__}")
         mine = self.integration
+        if options.integrator == "auto" and options.steps_per_period <= mine.steps_per_period:
+            options = replace(options, integrator=mine.integrator, steps_per_period=mine.steps_per_period,
+                              choice=mine.choice)  # (the model's choice for at least the steps asked)
         same = (options.steps_per_period == mine.steps_per_period
                 and options.locate_crossings == mine.locate_crossings
+                and options.integrator == mine.integrator
                 and options.backend in ("auto", self.backend))
         if not same:
             raise GearsymError(
-                f"{self.name}: this compiled model integrates with {mine.steps_per_period} steps per period, "
-                f"{'crossings located' if mine.locate_crossings else 'plain RK4'}, {self.backend}; the options ask "
-                f"for {options.steps_per_period}, {'crossings located' if options.locate_crossings else 'plain RK4'}"
+                f"{self.name}: this compiled model integrates with {mine.steps_per_period} {mine.method_name} steps per "
+                f"period, {'crossings located' if mine.locate_crossings else 'plain'}, {self.backend}; the options "
+                f"ask for {options.steps_per_period} {options.method_name}, "
+                f"{'crossings located' if options.locate_crossings else 'plain'}"
                 f", {options.backend}: compile the system with these options (compile_model(system, options))")
         return options
 

@@ -213,16 +213,21 @@ def _entries(s: _Shape) -> list[str]:
         "CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_lyapunov(const casadi_real* restrict T, "
         "const casadi_real* restrict c, casadi_int periods, casadi_real* restrict y, casadi_real* restrict Q, "
         "casadi_real* strobe, casadi_real* logs, casadi_real* low, casadi_real* high) {\n"
-        f"  casadi_real lo[{O}*GS_L], hi[{O}*GS_L], Qc[{s.size('Q')}], Qn[{s.size('Q')}], lg[{s.size('y')}];\n"
-        "  casadi_int p, l, i;\n"
+        f"  casadi_real lo[{O}*GS_L], hi[{O}*GS_L], Qc[{s.size('Q')}], Qn[{s.size('Q')}], lg[{s.size('y')}], "
+        f"acc[{s.size('y')}*GS_L];\n"
+        "  casadi_int p, l, i, g;\n"
         "  for (p = 0; p < periods; ++p) {\n" + start
-        + f"    gsl_tangent_span(y, Q, lo, hi, T, c, {s.blocks});\n"
-        "    for (l = 0; l < GS_L; ++l) {  /* Gram-Schmidt of each lane's vectors, as columns */\n"
-        f"      for (i = 0; i < {n * n}; ++i) Qc[(i % {n})*{n} + i / {n}] = Q[GS_L*i + l];\n"
-        "      gs_gram_schmidt(Qc, Qn, lg);\n"
-        f"      for (i = 0; i < {n * n}; ++i) Q[GS_L*i + l] = Qn[(i % {n})*{n} + i / {n}];\n"
-        f"      if (logs) for (i = 0; i < {n}; ++i) logs[{n}*GS_L*p + GS_L*i + l] = lg[i];\n"
-        "    }\n" + store + "  }\n  return 0;\n}\n",
+        + f"    for (i = 0; i < {n}*GS_L; ++i) acc[i] = 0;\n"
+        + "".join(f"    {loop}{{\n"
+                  f"      gsl_tangent_span(y, Q, lo, hi, {table}, c, {blocks});\n"
+                  "      for (l = 0; l < GS_L; ++l) {  /* Gram-Schmidt of each lane's vectors, as columns */\n"
+                  f"        for (i = 0; i < {n * n}; ++i) Qc[(i % {n})*{n} + i / {n}] = Q[GS_L*i + l];\n"
+                  "        gs_gram_schmidt(Qc, Qn, lg);\n"
+                  f"        for (i = 0; i < {n * n}; ++i) Q[GS_L*i + l] = Qn[(i % {n})*{n} + i / {n}];\n"
+                  f"        for (i = 0; i < {n}; ++i) acc[GS_L*i + l] += lg[i];\n"
+                  "      }\n    }\n" for loop, table, blocks in _pieces(s))
+        + f"    if (logs) for (i = 0; i < {n}*GS_L; ++i) logs[{n}*GS_L*p + i] = acc[i];\n"
+        + store + "  }\n  return 0;\n}\n",
     ]
 
 
@@ -289,3 +294,17 @@ def _points(s: _Shape, parameters: int, tangent: bool) -> str:
         + "    }\n"
         "  }\n"
         "  return 0;\n}\n")
+
+
+def _pieces(s: _Shape) -> list[tuple[str, str, int]]:
+    """The pieces of a period between Gram-Schmidt steps (the scalar loops' :func:`.printed._orthonormalised`):
+    (the C loop over them, the table at each one's start, its blocks)."""
+    table = (lambda at: f"T + {s.step}*GS_L*({at})") if s.step else (lambda at: "T")
+    if not s.every:
+        return [("", "T", s.blocks)]
+    whole = s.blocks // s.every
+    out = [(f"for (g = 0; g < {whole}; ++g) ", table(f"{s.every}*g"), s.every)]
+    if s.rest:
+        out.append(("", table(whole * s.every), s.rest))
+    return out
+

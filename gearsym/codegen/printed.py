@@ -206,6 +206,8 @@ class _Shape:
         self.blocks = self.N // K
         self.P = mf.options.chunk_periods
         self.S = shooting_segments(self.N, K, system.cycles)
+        #: blocks between two Gram-Schmidt steps and in the last piece of a period ((0, 0): once per period)
+        self.every, self.rest = mf.options.orthonormalised(self.n)
         self.located = "state_try" in mf.steps
         self.stepwise = "trajectory_step" in mf.steps  # (blocks of several steps: the trajectory steps alone)
         #: the tangent step (or try): the state's step, then each tangent vector's (:func:`_by_vector`)
@@ -354,15 +356,31 @@ def _locals(s: _Shape, tangent: bool) -> str:
             f"  gs_load(arg[0], {s.n}, y);{load_q} gs_load(arg[{c}], {s.nc}, c);\n")
 
 
+def _orthonormalised(s: _Shape) -> str:
+    """A period of tangent steps, Gram-Schmidt every ``s.every`` blocks (and after the rest), the logs summed in
+    ``logs`` (as :func:`.period_loops.orthonormalised_period`: 0 + the first piece's, then each in turn)."""
+    if not s.every:
+        return (f"    gs_tangent_span(y, Q, lo, hi, T, c, {s.blocks});\n"
+                "    gs_gram_schmidt(Q, Qn, logs);\n"
+                f"    gs_copy(Qn, {s.n * s.n}, Q);\n")
+    whole = s.blocks // s.every
+    table = (lambda at: f"T + {s.step}*({at})") if s.step else (lambda at: "T")
+    piece = lambda at, blocks: (f"gs_tangent_span(y, Q, lo, hi, {table(at)}, c, {blocks}); "
+                                f"gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, {s.n * s.n}, Q); "
+                                f"for (i = 0; i < {s.n}; ++i) logs[i] += piece[i];")
+    rest = f"    {piece(whole * s.every, s.rest)}\n" if s.rest else ""
+    return (f"    for (i = 0; i < {s.n}; ++i) logs[i] = 0;\n"
+            f"    for (g = 0; g < {whole}; ++g) {{ {piece(f'{s.every}*g', s.every)} }}\n" + rest)
+
+
 def _lyapunov(s: _Shape, periods: int) -> str:
     o = len(s.observed)
+    pieces = f" casadi_real piece[{s.size('y')}]; casadi_int g, i;" if s.every else ""
     return (_locals(s, True)
-            + f"  casadi_real Qn[{s.size('Q')}], logs[{s.size('y')}];\n"
+            + f"  casadi_real Qn[{s.size('Q')}], logs[{s.size('y')}];{pieces}\n"
             f"  for (p = 0; p < {periods}; ++p) {{\n"
             f"    {_observed_start(s)}\n"
-            f"    gs_tangent_span(y, Q, lo, hi, T, c, {s.blocks});\n"
-            "    gs_gram_schmidt(Q, Qn, logs);\n"
-            f"    gs_copy(Qn, {s.n * s.n}, Q);\n"
+            + _orthonormalised(s) +
             f"    gs_store(y, {s.n}, res[0], {s.n}*p); gs_store(logs, {s.n}, res[2], {s.n}*p);\n"
             f"    gs_store(lo, {o}, res[3], {o}*p); gs_store(hi, {o}, res[4], {o}*p);\n"
             "  }\n"

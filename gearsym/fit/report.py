@@ -121,6 +121,11 @@ def _pm_percent(value: float, err: float | None) -> str:
     return f"{shown} ± {err:.2g} %" if err is not None and math.isfinite(err) else shown
 
 
+def _number(value) -> str:
+    """A number of the report's JSON (None where it was not finite) as the page shows it."""
+    return "—" if value is None else f"{value:.3g}"
+
+
 def _sidebands(data: dict) -> list[str]:
     evidence = data.get("sidebands")
     notes = [f"- not tried: {name}: {why}." for name, why in (data.get("not_tried") or {}).items()]
@@ -136,7 +141,7 @@ def _sidebands(data: dict) -> list[str]:
     for g in gears:
         top = sorted(((k, v) for k, v in before["lines"].items() if g in k.split()), key=lambda kv: -kv[1])[:3]
         shown = ", ".join(f"{k} {v:.2g}" for k, v in top)
-        lines.append(f"| {g} | {before['energy'][g]:.3g} | {after.get('energy', {}).get(g, float('nan')):.3g} | "
+        lines.append(f"| {g} | {_number(before['energy'].get(g))} | {_number(after.get('energy', {}).get(g))} | "
                      f"{shown} |")
     return lines + [""] + notes + ([""] if notes else [])
 

@@ -48,8 +48,9 @@ class PhysicalScaling(Scaling):
     def _(self, result: Continuation, length_unit: str = LENGTH_UNIT):
         return continuation_to_physical(self, result, length_unit)
 
-    def compiled_for(self, steps_per_period: int):
-        """The compiled model a spectrum's mesh forces are run on when the caller gives none: the face's scaling
+    def compiled_for(self, result):
+        """The compiled model the spectrum ``result``'s mesh forces are run on when the caller gives none (its
+        integration, as it ran): the face's scaling
         (:func:`gearsym.scaling`) compiles this scaling's system; this stage compiles nothing."""
         raise GearsymError(f"{self.name}: give the compiled model the spectrum ran on, to_physical(result, "
                            "model=...), or its trajectory (trajectory=...)")

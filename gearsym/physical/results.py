@@ -68,7 +68,7 @@ def point_to_physical(scaling: Scaling, result, length_unit: str = LENGTH_UNIT, 
     ``model`` (the compiled model the spectrum ran on; by default the scaling's :meth:`compiled_for` it)."""
     if trajectory is None:
         if model is None:
-            model = scaling.compiled_for(result.steps_per_period)
+            model = scaling.compiled_for(result)
         _check_point(scaling, model, result)
         trajectory = loads_trajectory(model, result)
     point = point_units(scaling, length_unit).point(result, trajectory)

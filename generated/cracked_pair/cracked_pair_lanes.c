@@ -170,17 +170,21 @@ CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_orbit(const casadi_real* restr
    re-orthonormalised every period per lane (the scalar loops' Gram-Schmidt); each period's log
    stretches written where given (periods x n x GS_L) */
 CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_lyapunov(const casadi_real* restrict T, const casadi_real* restrict c, casadi_int periods, casadi_real* restrict y, casadi_real* restrict Q, casadi_real* strobe, casadi_real* logs, casadi_real* low, casadi_real* high) {
-  casadi_real lo[1*GS_L], hi[1*GS_L], Qc[4], Qn[4], lg[2];
-  casadi_int p, l, i;
+  casadi_real lo[1*GS_L], hi[1*GS_L], Qc[4], Qn[4], lg[2], acc[2*GS_L];
+  casadi_int p, l, i, g;
   for (p = 0; p < periods; ++p) {
     for (l = 0; l < GS_L; ++l) { lo[GS_L*0 + l] = y[GS_L*0 + l]; hi[GS_L*0 + l] = y[GS_L*0 + l]; }
-    gsl_tangent_span(y, Q, lo, hi, T, c, 4000);
-    for (l = 0; l < GS_L; ++l) {  /* Gram-Schmidt of each lane's vectors, as columns */
-      for (i = 0; i < 4; ++i) Qc[(i % 2)*2 + i / 2] = Q[GS_L*i + l];
-      gs_gram_schmidt(Qc, Qn, lg);
-      for (i = 0; i < 4; ++i) Q[GS_L*i + l] = Qn[(i % 2)*2 + i / 2];
-      if (logs) for (i = 0; i < 2; ++i) logs[2*GS_L*p + GS_L*i + l] = lg[i];
+    for (i = 0; i < 2*GS_L; ++i) acc[i] = 0;
+    for (g = 0; g < 160; ++g) {
+      gsl_tangent_span(y, Q, lo, hi, T + 9*GS_L*(25*g), c, 25);
+      for (l = 0; l < GS_L; ++l) {  /* Gram-Schmidt of each lane's vectors, as columns */
+        for (i = 0; i < 4; ++i) Qc[(i % 2)*2 + i / 2] = Q[GS_L*i + l];
+        gs_gram_schmidt(Qc, Qn, lg);
+        for (i = 0; i < 4; ++i) Q[GS_L*i + l] = Qn[(i % 2)*2 + i / 2];
+        for (i = 0; i < 2; ++i) acc[GS_L*i + l] += lg[i];
+      }
     }
+    if (logs) for (i = 0; i < 2*GS_L; ++i) logs[2*GS_L*p + i] = acc[i];
     if (strobe) gs_copy(y, 2*GS_L, strobe + 2*GS_L*p);
     if (low) gs_copy(lo, 1*GS_L, low + 1*GS_L*p);
     if (high) gs_copy(hi, 1*GS_L, high + 1*GS_L*p);

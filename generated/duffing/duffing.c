@@ -1069,12 +1069,11 @@ static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 2, y); gs_load(arg[1], 4, Q); gs_load(arg[3], 4, c);
-  casadi_real Qn[4], logs[2];
+  casadi_real Qn[4], logs[2]; casadi_real piece[2]; casadi_int g, i;
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[1]; hi[1] = y[1];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 4, Q);
+    for (i = 0; i < 2; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T + 3*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 4, Q); for (i = 0; i < 2; ++i) logs[i] += piece[i]; }
     gs_store(y, 2, res[0], 2*p); gs_store(logs, 2, res[2], 2*p);
     gs_store(lo, 2, res[3], 2*p); gs_store(hi, 2, res[4], 2*p);
   }
@@ -1173,12 +1172,11 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 2, y); gs_load(arg[1], 4, Q); gs_load(arg[3], 4, c);
-  casadi_real Qn[4], logs[2];
+  casadi_real Qn[4], logs[2]; casadi_real piece[2]; casadi_int g, i;
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[1]; hi[1] = y[1];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 4, Q);
+    for (i = 0; i < 2; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T + 3*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 4, Q); for (i = 0; i < 2; ++i) logs[i] += piece[i]; }
     gs_store(y, 2, res[0], 2*p); gs_store(logs, 2, res[2], 2*p);
     gs_store(lo, 2, res[3], 2*p); gs_store(hi, 2, res[4], 2*p);
   }

@@ -170,17 +170,21 @@ CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_orbit(const casadi_real* restr
    re-orthonormalised every period per lane (the scalar loops' Gram-Schmidt); each period's log
    stretches written where given (periods x n x GS_L) */
 CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_lyapunov(const casadi_real* restrict T, const casadi_real* restrict c, casadi_int periods, casadi_real* restrict y, casadi_real* restrict Q, casadi_real* strobe, casadi_real* logs, casadi_real* low, casadi_real* high) {
-  casadi_real lo[2*GS_L], hi[2*GS_L], Qc[16], Qn[16], lg[4];
-  casadi_int p, l, i;
+  casadi_real lo[2*GS_L], hi[2*GS_L], Qc[16], Qn[16], lg[4], acc[4*GS_L];
+  casadi_int p, l, i, g;
   for (p = 0; p < periods; ++p) {
     for (l = 0; l < GS_L; ++l) { lo[GS_L*0 + l] = y[GS_L*0 + l]; hi[GS_L*0 + l] = y[GS_L*0 + l]; lo[GS_L*1 + l] = y[GS_L*2 + l]; hi[GS_L*1 + l] = y[GS_L*2 + l]; }
-    gsl_tangent_span(y, Q, lo, hi, T, c, 200);
-    for (l = 0; l < GS_L; ++l) {  /* Gram-Schmidt of each lane's vectors, as columns */
-      for (i = 0; i < 16; ++i) Qc[(i % 4)*4 + i / 4] = Q[GS_L*i + l];
-      gs_gram_schmidt(Qc, Qn, lg);
-      for (i = 0; i < 16; ++i) Q[GS_L*i + l] = Qn[(i % 4)*4 + i / 4];
-      if (logs) for (i = 0; i < 4; ++i) logs[4*GS_L*p + GS_L*i + l] = lg[i];
+    for (i = 0; i < 4*GS_L; ++i) acc[i] = 0;
+    for (g = 0; g < 8; ++g) {
+      gsl_tangent_span(y, Q, lo, hi, T + 6*GS_L*(25*g), c, 25);
+      for (l = 0; l < GS_L; ++l) {  /* Gram-Schmidt of each lane's vectors, as columns */
+        for (i = 0; i < 16; ++i) Qc[(i % 4)*4 + i / 4] = Q[GS_L*i + l];
+        gs_gram_schmidt(Qc, Qn, lg);
+        for (i = 0; i < 16; ++i) Q[GS_L*i + l] = Qn[(i % 4)*4 + i / 4];
+        for (i = 0; i < 4; ++i) acc[GS_L*i + l] += lg[i];
+      }
     }
+    if (logs) for (i = 0; i < 4*GS_L; ++i) logs[4*GS_L*p + i] = acc[i];
     if (strobe) gs_copy(y, 4*GS_L, strobe + 4*GS_L*p);
     if (low) gs_copy(lo, 2*GS_L, low + 2*GS_L*p);
     if (high) gs_copy(hi, 2*GS_L, high + 2*GS_L*p);

@@ -1100,12 +1100,11 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 3, y); gs_load(arg[1], 9, Q); gs_load(arg[3], 4, c);
-  casadi_real Qn[9], logs[3];
+  casadi_real Qn[9], logs[3]; casadi_real piece[3]; casadi_int g, i;
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[1]; hi[1] = y[1]; lo[2] = y[2]; hi[2] = y[2];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 9, Q);
+    for (i = 0; i < 3; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T, c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 9, Q); for (i = 0; i < 3; ++i) logs[i] += piece[i]; }
     gs_store(y, 3, res[0], 3*p); gs_store(logs, 3, res[2], 3*p);
     gs_store(lo, 3, res[3], 3*p); gs_store(hi, 3, res[4], 3*p);
   }
@@ -1204,12 +1203,11 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 3, y); gs_load(arg[1], 9, Q); gs_load(arg[3], 4, c);
-  casadi_real Qn[9], logs[3];
+  casadi_real Qn[9], logs[3]; casadi_real piece[3]; casadi_int g, i;
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[1]; hi[1] = y[1]; lo[2] = y[2]; hi[2] = y[2];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 9, Q);
+    for (i = 0; i < 3; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T, c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 9, Q); for (i = 0; i < 3; ++i) logs[i] += piece[i]; }
     gs_store(y, 3, res[0], 3*p); gs_store(logs, 3, res[2], 3*p);
     gs_store(lo, 3, res[3], 3*p); gs_store(hi, 3, res[4], 3*p);
   }

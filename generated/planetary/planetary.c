@@ -11428,12 +11428,11 @@ static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 8, y); gs_load(arg[1], 64, Q); gs_load(arg[3], 24, c);
-  casadi_real Qn[64], logs[8];
+  casadi_real Qn[64], logs[8]; casadi_real piece[8]; casadi_int g, i;
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 64, Q);
+    for (i = 0; i < 8; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T + 12*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 64, Q); for (i = 0; i < 8; ++i) logs[i] += piece[i]; }
     gs_store(y, 8, res[0], 8*p); gs_store(logs, 8, res[2], 8*p);
     gs_store(lo, 4, res[3], 4*p); gs_store(hi, 4, res[4], 4*p);
   }
@@ -11532,12 +11531,11 @@ static int casadi_f19(const casadi_real** arg, casadi_real** res, casadi_int* iw
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 8, y); gs_load(arg[1], 64, Q); gs_load(arg[3], 24, c);
-  casadi_real Qn[64], logs[8];
+  casadi_real Qn[64], logs[8]; casadi_real piece[8]; casadi_int g, i;
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 64, Q);
+    for (i = 0; i < 8; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T + 12*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 64, Q); for (i = 0; i < 8; ++i) logs[i] += piece[i]; }
     gs_store(y, 8, res[0], 8*p); gs_store(logs, 8, res[2], 8*p);
     gs_store(lo, 4, res[3], 4*p); gs_store(hi, 4, res[4], 4*p);
   }
