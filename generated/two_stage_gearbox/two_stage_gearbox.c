@@ -6279,1449 +6279,6 @@ static const casadi_real casadi_c0[48801] =
 static const casadi_real casadi_zeros[24] = 
   {0.};
 
-/* rhs:(t,y[10],p[24])->(dy[10]) */
-static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
-  casadi_real a24, a25, a26, a27, a28;
-  a00=arg[1]? arg[1][1] : 0;
-  if (res[0]!=0) res[0][0]=a00;
-  a01=arg[2]? arg[2][4] : 0;
-  a02=arg[2]? arg[2][0] : 0;
-  a03=casadi_sq(a02);
-  a01=(a01/a03);
-  a04=arg[2]? arg[2][12] : 0;
-  a04=(a04*a00);
-  a00=(a04/a02);
-  a05=arg[2]? arg[2][7] : 0;
-  a06=(1./a05);
-  a07=arg[2]? arg[2][11] : 0;
-  a07=(1./a07);
-  a06=(a06+a07);
-  a00=(a00*a06);
-  a01=(a01-a00);
-  a00=arg[2]? arg[2][17] : 0;
-  a07=arg[1]? arg[1][0] : 0;
-  a00=(a00*a07);
-  a07=(a00/a03);
-  a07=(a07*a06);
-  a01=(a01-a07);
-  a07=arg[2]? arg[2][20] : 0;
-  a07=casadi_sq(a07);
-  a06=(a07/a05);
-  a08=(a06/a03);
-  a09=0.;
-  a10=arg[1]? arg[1][2] : 0;
-  a11=(a09<=a10);
-  a11=(a11?a10:0);
-  a12=arg[2]? arg[2][15] : 0;
-  a13=(-a12);
-  a13=(a10<=a13);
-  a10=(a10+a12);
-  a13=(a13?a10:0);
-  a11=(a11+a13);
-  a08=(a08*a11);
-  a13=arg[2]? arg[2][21] : 0;
-  a10=casadi_sq(a13);
-  a12=arg[2]? arg[2][8] : 0;
-  a14=(a10/a12);
-  a06=(a06+a14);
-  a08=(a08/a06);
-  a15=1.;
-  a16=2.1984919300000000e-01;
-  a17=arg[0]? arg[0][0] : 0;
-  a18=sin(a17);
-  a16=(a16*a18);
-  a16=(a15+a16);
-  a18=-1.4648076380000000e-01;
-  a19=cos(a17);
-  a18=(a18*a19);
-  a16=(a16+a18);
-  a18=2.3399851510000000e-03;
-  a19=3.;
-  a19=(a19*a17);
-  a20=sin(a19);
-  a18=(a18*a20);
-  a16=(a16+a18);
-  a18=5.2571706769999997e-03;
-  a20=6.;
-  a20=(a20*a17);
-  a21=cos(a20);
-  a18=(a18*a21);
-  a16=(a16+a18);
-  a18=1.2362118350000000e-02;
-  a19=cos(a19);
-  a18=(a18*a19);
-  a16=(a16+a18);
-  a18=2.6627245229999999e-02;
-  a19=5.;
-  a19=(a19*a17);
-  a21=sin(a19);
-  a18=(a18*a21);
-  a16=(a16+a18);
-  a18=1.1011287700000000e-01;
-  a21=(2.*a17);
-  a22=sin(a21);
-  a18=(a18*a22);
-  a16=(a16+a18);
-  a18=4.5469359220000000e-03;
-  a19=cos(a19);
-  a18=(a18*a19);
-  a16=(a16+a18);
-  a18=2.3457193629999999e-03;
-  a20=sin(a20);
-  a18=(a18*a20);
-  a16=(a16+a18);
-  a18=4.5160754929999998e-02;
-  a21=cos(a21);
-  a18=(a18*a21);
-  a16=(a16+a18);
-  a18=2.3017182309999999e-02;
-  a21=4.;
-  a21=(a21*a17);
-  a20=sin(a21);
-  a18=(a18*a20);
-  a16=(a16+a18);
-  a18=1.6171101790000001e-03;
-  a20=7.;
-  a20=(a20*a17);
-  a19=sin(a20);
-  a18=(a18*a19);
-  a16=(a16+a18);
-  a18=-2.6772198850000001e-03;
-  a20=cos(a20);
-  a18=(a18*a20);
-  a16=(a16+a18);
-  a18=-2.4174349450000000e-02;
-  a21=cos(a21);
-  a18=(a18*a21);
-  a16=(a16+a18);
-  a08=(a08*a16);
-  a01=(a01-a08);
-  a08=-2.;
-  a18=arg[1]? arg[1][3] : 0;
-  a21=(a08*a18);
-  a20=arg[2]? arg[2][1] : 0;
-  a21=(a21*a20);
-  a20=(a21/a05);
-  a20=(a20*a07);
-  a20=(a20/a02);
-  a20=(a20/a06);
-  a01=(a01+a20);
-  if (res[0]!=0) res[0][1]=a01;
-  if (res[0]!=0) res[0][2]=a18;
-  a18=(a21/a02);
-  a04=(a04/a05);
-  a04=(a04/a02);
-  a18=(a18-a04);
-  a04=arg[2]? arg[2][13] : 0;
-  a01=arg[1]? arg[1][5] : 0;
-  a20=(a04*a01);
-  a07=(a20/a12);
-  a07=(a07/a02);
-  a18=(a18-a07);
-  a00=(a00/a05);
-  a00=(a00/a03);
-  a18=(a18-a00);
-  a00=arg[2]? arg[2][18] : 0;
-  a05=arg[1]? arg[1][4] : 0;
-  a07=(a00*a05);
-  a19=(a07/a12);
-  a19=(a19/a03);
-  a18=(a18-a19);
-  a19=(a11/a03);
-  a19=(a19*a16);
-  a18=(a18-a19);
-  if (res[0]!=0) res[0][3]=a18;
-  if (res[0]!=0) res[0][4]=a01;
-  a21=(a21/a12);
-  a21=(a21*a10);
-  a21=(a21/a02);
-  a21=(a21/a06);
-  a20=(a20/a02);
-  a12=(1./a12);
-  a10=arg[2]? arg[2][9] : 0;
-  a18=(1./a10);
-  a12=(a12+a18);
-  a20=(a20*a12);
-  a07=(a07/a03);
-  a07=(a07*a12);
-  a20=(a20+a07);
-  a14=(a14/a03);
-  a14=(a14*a11);
-  a14=(a14/a06);
-  a14=(a14*a16);
-  a20=(a20+a14);
-  a21=(a21-a20);
-  a20=(a08*a13);
-  a14=arg[2]? arg[2][22] : 0;
-  a20=(a20*a14);
-  a16=arg[1]? arg[1][7] : 0;
-  a20=(a20*a16);
-  a06=arg[2]? arg[2][3] : 0;
-  a20=(a20*a06);
-  a20=(a20/a10);
-  a20=(a20/a02);
-  a11=casadi_sq(a14);
-  a11=(a11/a10);
-  a07=arg[2]? arg[2][23] : 0;
-  a07=casadi_sq(a07);
-  a12=arg[2]? arg[2][10] : 0;
-  a18=(a07/a12);
-  a11=(a11+a18);
-  a20=(a20/a11);
-  a21=(a21+a20);
-  a20=arg[2]? arg[2][2] : 0;
-  a18=(a20*a13);
-  a18=(a18*a14);
-  a18=(a18/a10);
-  a18=(a18/a03);
-  a19=arg[1]? arg[1][6] : 0;
-  a09=(a09<=a19);
-  a09=(a09?a19:0);
-  a22=arg[2]? arg[2][16] : 0;
-  a23=(-a22);
-  a23=(a19<=a23);
-  a19=(a19+a22);
-  a23=(a23?a19:0);
-  a09=(a09+a23);
-  a18=(a18*a09);
-  a18=(a18/a11);
-  a23=4.5350021439999999e-02;
-  a19=1.2459016393442623e+00;
-  a19=(a19*a17);
-  a22=sin(a19);
-  a23=(a23*a22);
-  a15=(a15+a23);
-  a23=5.9288166009999997e-03;
-  a22=2.1803278688524590e+00;
-  a22=(a22*a17);
-  a24=sin(a22);
-  a23=(a23*a24);
-  a15=(a15+a23);
-  a23=2.5895748289999998e-01;
-  a24=3.1147540983606559e-01;
-  a24=(a24*a17);
-  a25=sin(a24);
-  a23=(a23*a25);
-  a15=(a15+a23);
-  a23=4.1311748459999997e-03;
-  a25=9.3442622950819676e-01;
-  a25=(a25*a17);
-  a26=sin(a25);
-  a23=(a23*a26);
-  a15=(a15+a23);
-  a23=7.7092779900000005e-02;
-  a26=6.2295081967213117e-01;
-  a26=(a26*a17);
-  a27=sin(a26);
-  a23=(a23*a27);
-  a15=(a15+a23);
-  a23=1.0731786070000001e-02;
-  a27=1.5573770491803278e+00;
-  a27=(a27*a17);
-  a28=sin(a27);
-  a23=(a23*a28);
-  a15=(a15+a23);
-  a23=2.7203068860000000e-03;
-  a28=1.8688524590163935e+00;
-  a28=(a28*a17);
-  a17=sin(a28);
-  a23=(a23*a17);
-  a15=(a15+a23);
-  a23=1.3325609489999999e-02;
-  a27=cos(a27);
-  a23=(a23*a27);
-  a15=(a15+a23);
-  a23=6.2394082849999997e-02;
-  a26=cos(a26);
-  a23=(a23*a26);
-  a15=(a15+a23);
-  a23=-1.2277882320000000e-01;
-  a24=cos(a24);
-  a23=(a23*a24);
-  a15=(a15+a23);
-  a23=-6.0179578089999998e-03;
-  a28=cos(a28);
-  a23=(a23*a28);
-  a15=(a15+a23);
-  a23=-2.0371871579999999e-02;
-  a25=cos(a25);
-  a23=(a23*a25);
-  a15=(a15+a23);
-  a23=-1.0772115660000000e-02;
-  a19=cos(a19);
-  a23=(a23*a19);
-  a15=(a15+a23);
-  a23=-1.0423630300000001e-04;
-  a22=cos(a22);
-  a23=(a23*a22);
-  a15=(a15+a23);
-  a18=(a18*a15);
-  a21=(a21-a18);
-  if (res[0]!=0) res[0][5]=a21;
-  if (res[0]!=0) res[0][6]=a16;
-  a08=(a08*a16);
-  a08=(a08*a06);
-  a06=(a08/a02);
-  a16=arg[2]? arg[2][14] : 0;
-  a21=arg[1]? arg[1][9] : 0;
-  a16=(a16*a21);
-  a18=(a16/a12);
-  a18=(a18/a02);
-  a06=(a06-a18);
-  a18=arg[2]? arg[2][19] : 0;
-  a23=arg[1]? arg[1][8] : 0;
-  a18=(a18*a23);
-  a23=(a18/a12);
-  a23=(a23/a03);
-  a06=(a06-a23);
-  a04=(a04*a14);
-  a04=(a04*a01);
-  a04=(a04/a10);
-  a04=(a04/a13);
-  a04=(a04/a02);
-  a06=(a06-a04);
-  a00=(a00*a14);
-  a00=(a00*a05);
-  a00=(a00/a10);
-  a00=(a00/a13);
-  a00=(a00/a03);
-  a06=(a06-a00);
-  a00=(a20/a03);
-  a00=(a00*a09);
-  a00=(a00*a15);
-  a06=(a06-a00);
-  if (res[0]!=0) res[0][7]=a06;
-  if (res[0]!=0) res[0][8]=a21;
-  a21=arg[2]? arg[2][5] : 0;
-  a21=(a21/a03);
-  a16=(a16/a02);
-  a06=arg[2]? arg[2][6] : 0;
-  a06=(1./a06);
-  a00=(1./a12);
-  a06=(a06+a00);
-  a16=(a16*a06);
-  a21=(a21-a16);
-  a18=(a18/a03);
-  a18=(a18*a06);
-  a21=(a21-a18);
-  a08=(a08/a12);
-  a08=(a08*a07);
-  a08=(a08/a02);
-  a08=(a08/a11);
-  a21=(a21+a08);
-  a20=(a20/a12);
-  a20=(a20*a07);
-  a20=(a20/a03);
-  a20=(a20*a09);
-  a20=(a20/a11);
-  a20=(a20*a15);
-  a21=(a21-a20);
-  if (res[0]!=0) res[0][9]=a21;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int rhs(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f0(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int rhs_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void rhs_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void rhs_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void rhs_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int rhs_n_in(void) { return 3;}
-
-CASADI_SYMBOL_EXPORT casadi_int rhs_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real rhs_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* rhs_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "y";
-    case 2: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* rhs_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "dy";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s1;
-    case 2: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s1;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int rhs_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int rhs_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* jacobian:(t,y[10],p[24])->(J[10x10]) */
-static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17;
-  a00=0.;
-  if (res[0]!=0) res[0][0]=a00;
-  a01=arg[2]? arg[2][7] : 0;
-  a02=(1./a01);
-  a03=arg[2]? arg[2][11] : 0;
-  a03=(1./a03);
-  a02=(a02+a03);
-  a03=arg[2]? arg[2][17] : 0;
-  a04=arg[2]? arg[2][0] : 0;
-  a05=casadi_sq(a04);
-  a06=(a03/a05);
-  a06=(a02*a06);
-  a06=(-a06);
-  if (res[0]!=0) res[0][1]=a06;
-  if (res[0]!=0) res[0][2]=a00;
-  a03=(a03/a01);
-  a03=(a03/a05);
-  a03=(-a03);
-  if (res[0]!=0) res[0][3]=a03;
-  if (res[0]!=0) res[0][4]=a00;
-  if (res[0]!=0) res[0][5]=a00;
-  if (res[0]!=0) res[0][6]=a00;
-  if (res[0]!=0) res[0][7]=a00;
-  if (res[0]!=0) res[0][8]=a00;
-  if (res[0]!=0) res[0][9]=a00;
-  a03=1.;
-  if (res[0]!=0) res[0][10]=a03;
-  a06=arg[2]? arg[2][12] : 0;
-  a07=(a06/a04);
-  a02=(a02*a07);
-  a02=(-a02);
-  if (res[0]!=0) res[0][11]=a02;
-  if (res[0]!=0) res[0][12]=a00;
-  a06=(a06/a01);
-  a06=(a06/a04);
-  a06=(-a06);
-  if (res[0]!=0) res[0][13]=a06;
-  if (res[0]!=0) res[0][14]=a00;
-  if (res[0]!=0) res[0][15]=a00;
-  if (res[0]!=0) res[0][16]=a00;
-  if (res[0]!=0) res[0][17]=a00;
-  if (res[0]!=0) res[0][18]=a00;
-  if (res[0]!=0) res[0][19]=a00;
-  if (res[0]!=0) res[0][20]=a00;
-  a06=2.1984919300000000e-01;
-  a02=arg[0]? arg[0][0] : 0;
-  a07=sin(a02);
-  a06=(a06*a07);
-  a06=(a03+a06);
-  a07=-1.4648076380000000e-01;
-  a08=cos(a02);
-  a07=(a07*a08);
-  a06=(a06+a07);
-  a07=2.3399851510000000e-03;
-  a08=3.;
-  a08=(a08*a02);
-  a09=sin(a08);
-  a07=(a07*a09);
-  a06=(a06+a07);
-  a07=5.2571706769999997e-03;
-  a09=6.;
-  a09=(a09*a02);
-  a10=cos(a09);
-  a07=(a07*a10);
-  a06=(a06+a07);
-  a07=1.2362118350000000e-02;
-  a08=cos(a08);
-  a07=(a07*a08);
-  a06=(a06+a07);
-  a07=2.6627245229999999e-02;
-  a08=5.;
-  a08=(a08*a02);
-  a10=sin(a08);
-  a07=(a07*a10);
-  a06=(a06+a07);
-  a07=1.1011287700000000e-01;
-  a10=(2.*a02);
-  a11=sin(a10);
-  a07=(a07*a11);
-  a06=(a06+a07);
-  a07=4.5469359220000000e-03;
-  a08=cos(a08);
-  a07=(a07*a08);
-  a06=(a06+a07);
-  a07=2.3457193629999999e-03;
-  a09=sin(a09);
-  a07=(a07*a09);
-  a06=(a06+a07);
-  a07=4.5160754929999998e-02;
-  a10=cos(a10);
-  a07=(a07*a10);
-  a06=(a06+a07);
-  a07=2.3017182309999999e-02;
-  a10=4.;
-  a10=(a10*a02);
-  a09=sin(a10);
-  a07=(a07*a09);
-  a06=(a06+a07);
-  a07=1.6171101790000001e-03;
-  a09=7.;
-  a09=(a09*a02);
-  a08=sin(a09);
-  a07=(a07*a08);
-  a06=(a06+a07);
-  a07=-2.6772198850000001e-03;
-  a09=cos(a09);
-  a07=(a07*a09);
-  a06=(a06+a07);
-  a07=-2.4174349450000000e-02;
-  a10=cos(a10);
-  a07=(a07*a10);
-  a06=(a06+a07);
-  a07=arg[2]? arg[2][20] : 0;
-  a07=casadi_sq(a07);
-  a10=(a07/a01);
-  a09=(a10/a05);
-  a08=arg[1]? arg[1][2] : 0;
-  a11=(a00<=a08);
-  a11=(a11?a03:0);
-  a12=arg[2]? arg[2][15] : 0;
-  a12=(-a12);
-  a08=(a08<=a12);
-  a08=(a08?a03:0);
-  a11=(a11+a08);
-  a09=(a09*a11);
-  a08=arg[2]? arg[2][21] : 0;
-  a12=casadi_sq(a08);
-  a13=arg[2]? arg[2][8] : 0;
-  a14=(a12/a13);
-  a10=(a10+a14);
-  a09=(a09/a10);
-  a09=(a06*a09);
-  a09=(-a09);
-  if (res[0]!=0) res[0][21]=a09;
-  if (res[0]!=0) res[0][22]=a00;
-  a09=(a11/a05);
-  a09=(a06*a09);
-  a09=(-a09);
-  if (res[0]!=0) res[0][23]=a09;
-  if (res[0]!=0) res[0][24]=a00;
-  a14=(a14/a05);
-  a14=(a14*a11);
-  a14=(a14/a10);
-  a06=(a06*a14);
-  a06=(-a06);
-  if (res[0]!=0) res[0][25]=a06;
-  if (res[0]!=0) res[0][26]=a00;
-  if (res[0]!=0) res[0][27]=a00;
-  if (res[0]!=0) res[0][28]=a00;
-  if (res[0]!=0) res[0][29]=a00;
-  if (res[0]!=0) res[0][30]=a00;
-  a06=-2.;
-  a14=arg[2]? arg[2][1] : 0;
-  a14=(a06*a14);
-  a01=(a14/a01);
-  a07=(a07*a01);
-  a07=(a07/a04);
-  a07=(a07/a10);
-  if (res[0]!=0) res[0][31]=a07;
-  if (res[0]!=0) res[0][32]=a03;
-  a07=(a14/a04);
-  if (res[0]!=0) res[0][33]=a07;
-  if (res[0]!=0) res[0][34]=a00;
-  a14=(a14/a13);
-  a12=(a12*a14);
-  a12=(a12/a04);
-  a12=(a12/a10);
-  if (res[0]!=0) res[0][35]=a12;
-  if (res[0]!=0) res[0][36]=a00;
-  if (res[0]!=0) res[0][37]=a00;
-  if (res[0]!=0) res[0][38]=a00;
-  if (res[0]!=0) res[0][39]=a00;
-  if (res[0]!=0) res[0][40]=a00;
-  if (res[0]!=0) res[0][41]=a00;
-  if (res[0]!=0) res[0][42]=a00;
-  a12=arg[2]? arg[2][18] : 0;
-  a10=(a12/a13);
-  a10=(a10/a05);
-  a10=(-a10);
-  if (res[0]!=0) res[0][43]=a10;
-  if (res[0]!=0) res[0][44]=a00;
-  a10=(1./a13);
-  a14=arg[2]? arg[2][9] : 0;
-  a07=(1./a14);
-  a10=(a10+a07);
-  a07=(a12/a05);
-  a07=(a10*a07);
-  a07=(-a07);
-  if (res[0]!=0) res[0][45]=a07;
-  if (res[0]!=0) res[0][46]=a00;
-  a07=arg[2]? arg[2][22] : 0;
-  a12=(a12*a07);
-  a12=(a12/a14);
-  a12=(a12/a08);
-  a12=(a12/a05);
-  a12=(-a12);
-  if (res[0]!=0) res[0][47]=a12;
-  if (res[0]!=0) res[0][48]=a00;
-  if (res[0]!=0) res[0][49]=a00;
-  if (res[0]!=0) res[0][50]=a00;
-  if (res[0]!=0) res[0][51]=a00;
-  if (res[0]!=0) res[0][52]=a00;
-  a12=arg[2]? arg[2][13] : 0;
-  a13=(a12/a13);
-  a13=(a13/a04);
-  a13=(-a13);
-  if (res[0]!=0) res[0][53]=a13;
-  if (res[0]!=0) res[0][54]=a03;
-  a13=(a12/a04);
-  a10=(a10*a13);
-  a10=(-a10);
-  if (res[0]!=0) res[0][55]=a10;
-  if (res[0]!=0) res[0][56]=a00;
-  a12=(a12*a07);
-  a12=(a12/a14);
-  a12=(a12/a08);
-  a12=(a12/a04);
-  a12=(-a12);
-  if (res[0]!=0) res[0][57]=a12;
-  if (res[0]!=0) res[0][58]=a00;
-  if (res[0]!=0) res[0][59]=a00;
-  if (res[0]!=0) res[0][60]=a00;
-  if (res[0]!=0) res[0][61]=a00;
-  if (res[0]!=0) res[0][62]=a00;
-  if (res[0]!=0) res[0][63]=a00;
-  if (res[0]!=0) res[0][64]=a00;
-  a12=4.5350021439999999e-02;
-  a10=1.2459016393442623e+00;
-  a10=(a10*a02);
-  a13=sin(a10);
-  a12=(a12*a13);
-  a12=(a03+a12);
-  a13=5.9288166009999997e-03;
-  a01=2.1803278688524590e+00;
-  a01=(a01*a02);
-  a11=sin(a01);
-  a13=(a13*a11);
-  a12=(a12+a13);
-  a13=2.5895748289999998e-01;
-  a11=3.1147540983606559e-01;
-  a11=(a11*a02);
-  a09=sin(a11);
-  a13=(a13*a09);
-  a12=(a12+a13);
-  a13=4.1311748459999997e-03;
-  a09=9.3442622950819676e-01;
-  a09=(a09*a02);
-  a15=sin(a09);
-  a13=(a13*a15);
-  a12=(a12+a13);
-  a13=7.7092779900000005e-02;
-  a15=6.2295081967213117e-01;
-  a15=(a15*a02);
-  a16=sin(a15);
-  a13=(a13*a16);
-  a12=(a12+a13);
-  a13=1.0731786070000001e-02;
-  a16=1.5573770491803278e+00;
-  a16=(a16*a02);
-  a17=sin(a16);
-  a13=(a13*a17);
-  a12=(a12+a13);
-  a13=2.7203068860000000e-03;
-  a17=1.8688524590163935e+00;
-  a17=(a17*a02);
-  a02=sin(a17);
-  a13=(a13*a02);
-  a12=(a12+a13);
-  a13=1.3325609489999999e-02;
-  a16=cos(a16);
-  a13=(a13*a16);
-  a12=(a12+a13);
-  a13=6.2394082849999997e-02;
-  a15=cos(a15);
-  a13=(a13*a15);
-  a12=(a12+a13);
-  a13=-1.2277882320000000e-01;
-  a11=cos(a11);
-  a13=(a13*a11);
-  a12=(a12+a13);
-  a13=-6.0179578089999998e-03;
-  a17=cos(a17);
-  a13=(a13*a17);
-  a12=(a12+a13);
-  a13=-2.0371871579999999e-02;
-  a09=cos(a09);
-  a13=(a13*a09);
-  a12=(a12+a13);
-  a13=-1.0772115660000000e-02;
-  a10=cos(a10);
-  a13=(a13*a10);
-  a12=(a12+a13);
-  a13=-1.0423630300000001e-04;
-  a01=cos(a01);
-  a13=(a13*a01);
-  a12=(a12+a13);
-  a13=arg[2]? arg[2][2] : 0;
-  a01=(a13*a08);
-  a01=(a01*a07);
-  a01=(a01/a14);
-  a01=(a01/a05);
-  a10=arg[1]? arg[1][6] : 0;
-  a09=(a00<=a10);
-  a09=(a09?a03:0);
-  a17=arg[2]? arg[2][16] : 0;
-  a17=(-a17);
-  a10=(a10<=a17);
-  a10=(a10?a03:0);
-  a09=(a09+a10);
-  a01=(a01*a09);
-  a10=casadi_sq(a07);
-  a10=(a10/a14);
-  a17=arg[2]? arg[2][23] : 0;
-  a17=casadi_sq(a17);
-  a11=arg[2]? arg[2][10] : 0;
-  a15=(a17/a11);
-  a10=(a10+a15);
-  a01=(a01/a10);
-  a01=(a12*a01);
-  a01=(-a01);
-  if (res[0]!=0) res[0][65]=a01;
-  if (res[0]!=0) res[0][66]=a00;
-  a01=(a13/a05);
-  a01=(a01*a09);
-  a01=(a12*a01);
-  a01=(-a01);
-  if (res[0]!=0) res[0][67]=a01;
-  if (res[0]!=0) res[0][68]=a00;
-  a13=(a13/a11);
-  a13=(a13*a17);
-  a13=(a13/a05);
-  a13=(a13*a09);
-  a13=(a13/a10);
-  a12=(a12*a13);
-  a12=(-a12);
-  if (res[0]!=0) res[0][69]=a12;
-  if (res[0]!=0) res[0][70]=a00;
-  if (res[0]!=0) res[0][71]=a00;
-  if (res[0]!=0) res[0][72]=a00;
-  if (res[0]!=0) res[0][73]=a00;
-  if (res[0]!=0) res[0][74]=a00;
-  a12=arg[2]? arg[2][3] : 0;
-  a08=(a06*a08);
-  a08=(a08*a07);
-  a08=(a12*a08);
-  a08=(a08/a14);
-  a08=(a08/a04);
-  a08=(a08/a10);
-  if (res[0]!=0) res[0][75]=a08;
-  if (res[0]!=0) res[0][76]=a03;
-  a06=(a06*a12);
-  a12=(a06/a04);
-  if (res[0]!=0) res[0][77]=a12;
-  if (res[0]!=0) res[0][78]=a00;
-  a06=(a06/a11);
-  a17=(a17*a06);
-  a17=(a17/a04);
-  a17=(a17/a10);
-  if (res[0]!=0) res[0][79]=a17;
-  if (res[0]!=0) res[0][80]=a00;
-  if (res[0]!=0) res[0][81]=a00;
-  if (res[0]!=0) res[0][82]=a00;
-  if (res[0]!=0) res[0][83]=a00;
-  if (res[0]!=0) res[0][84]=a00;
-  if (res[0]!=0) res[0][85]=a00;
-  if (res[0]!=0) res[0][86]=a00;
-  a17=arg[2]? arg[2][19] : 0;
-  a10=(a17/a11);
-  a10=(a10/a05);
-  a10=(-a10);
-  if (res[0]!=0) res[0][87]=a10;
-  if (res[0]!=0) res[0][88]=a00;
-  a10=arg[2]? arg[2][6] : 0;
-  a10=(1./a10);
-  a06=(1./a11);
-  a10=(a10+a06);
-  a17=(a17/a05);
-  a17=(a10*a17);
-  a17=(-a17);
-  if (res[0]!=0) res[0][89]=a17;
-  if (res[0]!=0) res[0][90]=a00;
-  if (res[0]!=0) res[0][91]=a00;
-  if (res[0]!=0) res[0][92]=a00;
-  if (res[0]!=0) res[0][93]=a00;
-  if (res[0]!=0) res[0][94]=a00;
-  if (res[0]!=0) res[0][95]=a00;
-  if (res[0]!=0) res[0][96]=a00;
-  a00=arg[2]? arg[2][14] : 0;
-  a11=(a00/a11);
-  a11=(a11/a04);
-  a11=(-a11);
-  if (res[0]!=0) res[0][97]=a11;
-  if (res[0]!=0) res[0][98]=a03;
-  a00=(a00/a04);
-  a10=(a10*a00);
-  a10=(-a10);
-  if (res[0]!=0) res[0][99]=a10;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int jacobian(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f1(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int jacobian_n_in(void) { return 3;}
-
-CASADI_SYMBOL_EXPORT casadi_int jacobian_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real jacobian_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* jacobian_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "y";
-    case 2: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* jacobian_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "J";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s1;
-    case 2: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s3;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* constants:(p[24])->(c[31],period) */
-static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14;
-  a00=arg[0]? arg[0][12] : 0;
-  a01=arg[0]? arg[0][0] : 0;
-  a02=(a00/a01);
-  a03=arg[0]? arg[0][7] : 0;
-  a04=(1./a03);
-  a05=arg[0]? arg[0][11] : 0;
-  a05=(1./a05);
-  a04=(a04+a05);
-  a02=(a02*a04);
-  a02=(-a02);
-  if (res[0]!=0) res[0][0]=a02;
-  a02=arg[0]? arg[0][17] : 0;
-  a05=casadi_sq(a01);
-  a06=(a02/a05);
-  a06=(a06*a04);
-  a06=(-a06);
-  if (res[0]!=0) res[0][1]=a06;
-  a06=arg[0]? arg[0][15] : 0;
-  if (res[0]!=0) res[0][2]=a06;
-  a06=arg[0]? arg[0][20] : 0;
-  a06=casadi_sq(a06);
-  a04=(a06/a03);
-  a07=(a04/a05);
-  a08=arg[0]? arg[0][21] : 0;
-  a09=casadi_sq(a08);
-  a10=arg[0]? arg[0][8] : 0;
-  a11=(a09/a10);
-  a04=(a04+a11);
-  a07=(a07/a04);
-  a07=(-a07);
-  if (res[0]!=0) res[0][3]=a07;
-  a07=-2.;
-  a12=arg[0]? arg[0][1] : 0;
-  a12=(a07*a12);
-  a13=(a12/a03);
-  a13=(a13*a06);
-  a13=(a13/a01);
-  a13=(a13/a04);
-  if (res[0]!=0) res[0][4]=a13;
-  a13=arg[0]? arg[0][4] : 0;
-  a13=(a13/a05);
-  if (res[0]!=0) res[0][5]=a13;
-  a13=(1./a05);
-  a13=(-a13);
-  if (res[0]!=0) res[0][6]=a13;
-  a13=(a12/a01);
-  if (res[0]!=0) res[0][7]=a13;
-  a00=(a00/a03);
-  a00=(a00/a01);
-  a00=(-a00);
-  if (res[0]!=0) res[0][8]=a00;
-  a00=arg[0]? arg[0][13] : 0;
-  a13=(a00/a10);
-  a13=(a13/a01);
-  a13=(-a13);
-  if (res[0]!=0) res[0][9]=a13;
-  a02=(a02/a03);
-  a02=(a02/a05);
-  a02=(-a02);
-  if (res[0]!=0) res[0][10]=a02;
-  a02=arg[0]? arg[0][18] : 0;
-  a03=(a02/a10);
-  a03=(a03/a05);
-  a03=(-a03);
-  if (res[0]!=0) res[0][11]=a03;
-  a03=(a00/a01);
-  a13=(1./a10);
-  a06=arg[0]? arg[0][9] : 0;
-  a14=(1./a06);
-  a13=(a13+a14);
-  a03=(a03*a13);
-  a03=(-a03);
-  if (res[0]!=0) res[0][12]=a03;
-  a03=(a02/a05);
-  a03=(a03*a13);
-  a03=(-a03);
-  if (res[0]!=0) res[0][13]=a03;
-  a11=(a11/a05);
-  a11=(a11/a04);
-  a11=(-a11);
-  if (res[0]!=0) res[0][14]=a11;
-  a12=(a12/a10);
-  a12=(a12*a09);
-  a12=(a12/a01);
-  a12=(a12/a04);
-  if (res[0]!=0) res[0][15]=a12;
-  a12=(a07*a08);
-  a04=arg[0]? arg[0][22] : 0;
-  a12=(a12*a04);
-  a09=arg[0]? arg[0][3] : 0;
-  a12=(a12*a09);
-  a12=(a12/a06);
-  a12=(a12/a01);
-  a10=casadi_sq(a04);
-  a10=(a10/a06);
-  a11=arg[0]? arg[0][23] : 0;
-  a11=casadi_sq(a11);
-  a03=arg[0]? arg[0][10] : 0;
-  a13=(a11/a03);
-  a10=(a10+a13);
-  a12=(a12/a10);
-  if (res[0]!=0) res[0][16]=a12;
-  a12=arg[0]? arg[0][16] : 0;
-  if (res[0]!=0) res[0][17]=a12;
-  a12=arg[0]? arg[0][2] : 0;
-  a13=(a12*a08);
-  a13=(a13*a04);
-  a13=(a13/a06);
-  a13=(a13/a05);
-  a13=(a13/a10);
-  a13=(-a13);
-  if (res[0]!=0) res[0][18]=a13;
-  a07=(a07*a09);
-  a09=(a07/a01);
-  if (res[0]!=0) res[0][19]=a09;
-  a09=(a12/a05);
-  a09=(-a09);
-  if (res[0]!=0) res[0][20]=a09;
-  a09=arg[0]? arg[0][14] : 0;
-  a13=(a09/a03);
-  a13=(a13/a01);
-  a13=(-a13);
-  if (res[0]!=0) res[0][21]=a13;
-  a13=arg[0]? arg[0][19] : 0;
-  a14=(a13/a03);
-  a14=(a14/a05);
-  a14=(-a14);
-  if (res[0]!=0) res[0][22]=a14;
-  a00=(a00*a04);
-  a00=(a00/a06);
-  a00=(a00/a08);
-  a00=(a00/a01);
-  a00=(-a00);
-  if (res[0]!=0) res[0][23]=a00;
-  a02=(a02*a04);
-  a02=(a02/a06);
-  a02=(a02/a08);
-  a02=(a02/a05);
-  a02=(-a02);
-  if (res[0]!=0) res[0][24]=a02;
-  a09=(a09/a01);
-  a02=arg[0]? arg[0][6] : 0;
-  a02=(1./a02);
-  a08=(1./a03);
-  a02=(a02+a08);
-  a09=(a09*a02);
-  a09=(-a09);
-  if (res[0]!=0) res[0][25]=a09;
-  a13=(a13/a05);
-  a13=(a13*a02);
-  a13=(-a13);
-  if (res[0]!=0) res[0][26]=a13;
-  a07=(a07/a03);
-  a07=(a07*a11);
-  a07=(a07/a01);
-  a07=(a07/a10);
-  if (res[0]!=0) res[0][27]=a07;
-  a12=(a12/a03);
-  a12=(a12*a11);
-  a12=(a12/a05);
-  a12=(a12/a10);
-  a12=(-a12);
-  if (res[0]!=0) res[0][28]=a12;
-  a12=arg[0]? arg[0][5] : 0;
-  a12=(a12/a05);
-  if (res[0]!=0) res[0][29]=a12;
-  a12=1.5707963267948967e-02;
-  if (res[0]!=0) res[0][30]=a12;
-  a12=3.8327430373795477e+02;
-  if (res[1]!=0) res[1][0]=a12;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int constants(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f2(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int constants_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void constants_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void constants_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void constants_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int constants_n_in(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_int constants_n_out(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_real constants_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* constants_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* constants_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "c";
-    case 1: return "period";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s4;
-    case 1: return casadi_s0;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int constants_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 1;
-  if (sz_res) *sz_res = 2;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 1*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 2*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* table_point:(t,p[24])->(values[2]) */
-static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a0, a1, a2, a3, a4, a5, a6, a7, a8, a9;
-  a0=1.;
-  a1=2.1984919300000000e-01;
-  a2=arg[0]? arg[0][0] : 0;
-  a3=sin(a2);
-  a1=(a1*a3);
-  a1=(a0+a1);
-  a3=-1.4648076380000000e-01;
-  a4=cos(a2);
-  a3=(a3*a4);
-  a1=(a1+a3);
-  a3=2.3399851510000000e-03;
-  a4=3.;
-  a4=(a4*a2);
-  a5=sin(a4);
-  a3=(a3*a5);
-  a1=(a1+a3);
-  a3=5.2571706769999997e-03;
-  a5=6.;
-  a5=(a5*a2);
-  a6=cos(a5);
-  a3=(a3*a6);
-  a1=(a1+a3);
-  a3=1.2362118350000000e-02;
-  a4=cos(a4);
-  a3=(a3*a4);
-  a1=(a1+a3);
-  a3=2.6627245229999999e-02;
-  a4=5.;
-  a4=(a4*a2);
-  a6=sin(a4);
-  a3=(a3*a6);
-  a1=(a1+a3);
-  a3=1.1011287700000000e-01;
-  a6=(2.*a2);
-  a7=sin(a6);
-  a3=(a3*a7);
-  a1=(a1+a3);
-  a3=4.5469359220000000e-03;
-  a4=cos(a4);
-  a3=(a3*a4);
-  a1=(a1+a3);
-  a3=2.3457193629999999e-03;
-  a5=sin(a5);
-  a3=(a3*a5);
-  a1=(a1+a3);
-  a3=4.5160754929999998e-02;
-  a6=cos(a6);
-  a3=(a3*a6);
-  a1=(a1+a3);
-  a3=2.3017182309999999e-02;
-  a6=4.;
-  a6=(a6*a2);
-  a5=sin(a6);
-  a3=(a3*a5);
-  a1=(a1+a3);
-  a3=1.6171101790000001e-03;
-  a5=7.;
-  a5=(a5*a2);
-  a4=sin(a5);
-  a3=(a3*a4);
-  a1=(a1+a3);
-  a3=-2.6772198850000001e-03;
-  a5=cos(a5);
-  a3=(a3*a5);
-  a1=(a1+a3);
-  a3=-2.4174349450000000e-02;
-  a6=cos(a6);
-  a3=(a3*a6);
-  a1=(a1+a3);
-  if (res[0]!=0) res[0][0]=a1;
-  a1=4.5350021439999999e-02;
-  a3=1.2459016393442623e+00;
-  a3=(a3*a2);
-  a6=sin(a3);
-  a1=(a1*a6);
-  a0=(a0+a1);
-  a1=5.9288166009999997e-03;
-  a6=2.1803278688524590e+00;
-  a6=(a6*a2);
-  a5=sin(a6);
-  a1=(a1*a5);
-  a0=(a0+a1);
-  a1=2.5895748289999998e-01;
-  a5=3.1147540983606559e-01;
-  a5=(a5*a2);
-  a4=sin(a5);
-  a1=(a1*a4);
-  a0=(a0+a1);
-  a1=4.1311748459999997e-03;
-  a4=9.3442622950819676e-01;
-  a4=(a4*a2);
-  a7=sin(a4);
-  a1=(a1*a7);
-  a0=(a0+a1);
-  a1=7.7092779900000005e-02;
-  a7=6.2295081967213117e-01;
-  a7=(a7*a2);
-  a8=sin(a7);
-  a1=(a1*a8);
-  a0=(a0+a1);
-  a1=1.0731786070000001e-02;
-  a8=1.5573770491803278e+00;
-  a8=(a8*a2);
-  a9=sin(a8);
-  a1=(a1*a9);
-  a0=(a0+a1);
-  a1=2.7203068860000000e-03;
-  a9=1.8688524590163935e+00;
-  a9=(a9*a2);
-  a2=sin(a9);
-  a1=(a1*a2);
-  a0=(a0+a1);
-  a1=1.3325609489999999e-02;
-  a8=cos(a8);
-  a1=(a1*a8);
-  a0=(a0+a1);
-  a1=6.2394082849999997e-02;
-  a7=cos(a7);
-  a1=(a1*a7);
-  a0=(a0+a1);
-  a1=-1.2277882320000000e-01;
-  a5=cos(a5);
-  a1=(a1*a5);
-  a0=(a0+a1);
-  a1=-6.0179578089999998e-03;
-  a9=cos(a9);
-  a1=(a1*a9);
-  a0=(a0+a1);
-  a1=-2.0371871579999999e-02;
-  a4=cos(a4);
-  a1=(a1*a4);
-  a0=(a0+a1);
-  a1=-1.0772115660000000e-02;
-  a3=cos(a3);
-  a1=(a1*a3);
-  a0=(a0+a1);
-  a1=-1.0423630300000001e-04;
-  a6=cos(a6);
-  a1=(a1*a6);
-  a0=(a0+a1);
-  if (res[0]!=0) res[0][1]=a0;
-  return 0;
-}
-
-/* map48801_table_point:(t[1x48801],p[24x48801])->(values[2x48801]) */
-static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i;
-  casadi_real* *res1;
-  const casadi_real* *arg1;
-  arg1 = arg+2;
-  for (i=0; i<2; ++i) arg1[i]=arg[i];
-  res1 = res+1;
-  for (i=0; i<1; ++i) res1[i]=res[i];
-  for (i=0; i<48801; ++i) {
-    if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-    if (arg1[0]) arg1[0]+=1;
-    if (arg1[1]) arg1[1]+=24;
-    if (res1[0]) res1[0]+=2;
-  }
-  return 0;
-}
-
-/* table:(t0,p[24])->(table[6x24400],probe[2x2]) */
-static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i, j;
-  casadi_real **res1=res+2, *rr, w00, *w01=w+15, *w03=w+48816, w04, w05, w06, *w07=w+48847, *w08=w+1220071, *w09=w+1317673, *w10=w+1366473;
-  casadi_real *w11=w+1415273, *w12=w+1464073, *w13=w+1512873, *w14=w+1659273, *w15=w+1805673;
-  const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
-  w00 = arg[0] ? arg[0][0] : 0;
-  wr01 = casadi_c0;
-  wr02 = arg[1] ? arg[1] : casadi_zeros;
-  arg1[0]=wr02;
-  res1[0]=w03;
-  res1[1]=(&w04);
-  if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
-  for (rr=(&w05), cs=w03+30; cs!=w03+31; cs+=1) *rr++ = *cs;
-  w06 = 2.;
-  w05 /= w06;
-  for (i=0, rr=w01, cr=wr01; i<48801; ++i) (*rr++)  = ((*cr++)*w05);
-  for (i=0, rr=w01, cs=w01; i<48801; ++i) (*rr++)  = (w00+(*cs++));
-  for (i=0;i<48801;++i) {
-    casadi_copy(wr02, 24, w07+ i*24);
-  }
-  arg1[0]=w01;
-  arg1[1]=w07;
-  res1[0]=w08;
-  if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
-  for (rr=w09, cs=w08+0; cs!=w08+97600; cs+=4) for (ct=cs+0; ct!=cs+2; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w10, cs=w09; i<24400; ++i) for (j=0; j<2; ++j) rr[i+j*24400] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+97600; cs+=4) for (ct=cs+2; ct!=cs+4; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w11, cs=w09; i<24400; ++i) for (j=0; j<2; ++j) rr[i+j*24400] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+97600; cs+=4) for (ct=cs+4; ct!=cs+6; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w12, cs=w09; i<24400; ++i) for (j=0; j<2; ++j) rr[i+j*24400] = *cs++;
-  rr=w13;
-  for (i=0, cs=w10; i<48800; ++i) *rr++ = *cs++;
-  for (i=0, cs=w11; i<48800; ++i) *rr++ = *cs++;
-  for (i=0, cs=w12; i<48800; ++i) *rr++ = *cs++;
-  for (i=0, rr=w14, cs=w13; i<6; ++i) for (j=0; j<24400; ++j) rr[i+j*6] = *cs++;
-  casadi_copy(w14, 146400, res[0]);
-  w05 = 3.7000000000000000e-01;
-  w05 *= w04;
-  w05  = (w00+w05);
-  arg1[0]=(&w05);
-  arg1[1]=wr02;
-  res1[0]=w15;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-  casadi_copy(w15, 2, res[1]);
-  w05 = 1.3700000000000001e+00;
-  w05 *= w04;
-  w00 += w05;
-  arg1[0]=(&w00);
-  arg1[1]=wr02;
-  res1[0]=w15;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-  if (res[1]) casadi_copy(w15, 2, res[1]+2);
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f3(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int table_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void table_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void table_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void table_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t0";
-    case 1: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "table";
-    case 1: return "probe";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s5;
-    case 1: return casadi_s6;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 6;
-  if (sz_res) *sz_res = 4;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 1805675;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 1805675*sizeof(casadi_real);
-  return 0;
-}
-
 /* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
 #if defined(__GNUC__)
 #define GEARSYM_INLINE inline __attribute__((always_inline))
@@ -8056,8 +6613,8 @@ static GEARSYM_INLINE void gs_tangent_keep(const casadi_real* restrict A0, const
   R3[4]=a4;
 }
 
-/* state_try, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1) {
+/* state_try, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_try_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
@@ -8066,29 +6623,29 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   casadi_real a60, a61, a62, a63, a64, a65, a66, a67, a68, a69, a70, a71;
   casadi_real a72;
   a00=A0[0];
-  a01=A2[30];
+  a01=A2[S*30];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[1];
+  a03=A0[S*1];
   a04=2.;
   a04=(a01/a04);
-  a05=A2[5];
+  a05=A2[S*5];
   a06=A2[0];
   a07=(a03*a06);
   a07=(a05+a07);
-  a08=A0[3];
-  a09=A2[4];
+  a08=A0[S*3];
+  a09=A2[S*4];
   a10=(a08*a09);
   a07=(a07+a10);
-  a10=A2[1];
+  a10=A2[S*1];
   a11=(a00*a10);
   a07=(a07+a11);
-  a11=A2[3];
+  a11=A2[S*3];
   a12=A1[0];
   a13=(a11*a12);
-  a14=A2[2];
+  a14=A2[S*2];
   a15=0.;
-  a16=A0[2];
+  a16=A0[S*2];
   a17=(a16+a14);
   a18=(-a17);
   a18=(a15<=a18);
@@ -8105,23 +6662,23 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a23=(a03+a23);
   a24=(a13*a06);
   a24=(a05+a24);
-  a25=A2[8];
+  a25=A2[S*8];
   a26=(a03*a25);
-  a27=A2[7];
+  a27=A2[S*7];
   a28=(a08*a27);
   a26=(a26+a28);
-  a28=A0[5];
-  a29=A2[9];
+  a28=A0[S*5];
+  a29=A2[S*9];
   a30=(a28*a29);
   a26=(a26+a30);
-  a30=A2[10];
+  a30=A2[S*10];
   a31=(a00*a30);
   a26=(a26+a31);
-  a31=A0[4];
-  a32=A2[11];
+  a31=A0[S*4];
+  a32=A2[S*11];
   a33=(a31*a32);
   a26=(a26+a33);
-  a33=A2[6];
+  a33=A2[S*6];
   a34=(a33*a12);
   a34=(a34*a22);
   a26=(a26+a34);
@@ -8133,7 +6690,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a35=(a00+a35);
   a36=(a35*a10);
   a24=(a24+a36);
-  a36=A1[2];
+  a36=A1[S*2];
   a37=(a11*a36);
   a38=(a04*a08);
   a38=(a16+a38);
@@ -8150,27 +6707,27 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a41=(a13*a25);
   a42=(a34*a27);
   a41=(a41+a42);
-  a42=A2[15];
+  a42=A2[S*15];
   a43=(a08*a42);
-  a44=A2[12];
+  a44=A2[S*12];
   a45=(a28*a44);
   a43=(a43+a45);
-  a45=A0[7];
-  a46=A2[16];
+  a45=A0[S*7];
+  a46=A2[S*16];
   a47=(a45*a46);
   a43=(a43+a47);
-  a47=A2[13];
+  a47=A2[S*13];
   a48=(a31*a47);
   a43=(a43+a48);
-  a48=A2[14];
+  a48=A2[S*14];
   a12=(a48*a12);
   a12=(a12*a22);
   a43=(a43+a12);
-  a12=A2[18];
-  a22=A1[1];
+  a12=A2[S*18];
+  a22=A1[S*1];
   a49=(a12*a22);
-  a50=A2[17];
-  a51=A0[6];
+  a50=A2[S*17];
+  a51=A0[S*6];
   a52=(a51+a50);
   a53=(-a52);
   a53=(a15<=a53);
@@ -8226,23 +6783,23 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a40=(a34*a42);
   a24=(a49*a44);
   a40=(a40+a24);
-  a24=A2[23];
+  a24=A2[S*23];
   a23=(a28*a24);
-  a61=A2[19];
+  a61=A2[S*19];
   a62=(a45*a61);
   a23=(a23+a62);
-  a62=A0[9];
-  a63=A2[21];
+  a62=A0[S*9];
+  a63=A2[S*21];
   a64=(a62*a63);
   a23=(a23+a64);
-  a64=A2[24];
+  a64=A2[S*24];
   a65=(a31*a64);
   a23=(a23+a65);
-  a65=A0[8];
-  a66=A2[22];
+  a65=A0[S*8];
+  a66=A2[S*22];
   a67=(a65*a66);
   a23=(a23+a67);
-  a67=A2[20];
+  a67=A2[S*20];
   a68=(a67*a22);
   a68=(a68*a57);
   a23=(a23+a68);
@@ -8255,7 +6812,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a36=(a48*a36);
   a38=(a36*a38);
   a40=(a40+a38);
-  a38=A1[3];
+  a38=A1[S*3];
   a69=(a12*a38);
   a70=(a04*a45);
   a70=(a51+a70);
@@ -8283,7 +6840,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a00=(a00+a39);
   a10=(a00*a10);
   a05=(a05+a10);
-  a10=A1[4];
+  a10=A1[S*4];
   a11=(a11*a10);
   a39=(a01*a59);
   a39=(a16+a39);
@@ -8294,7 +6851,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a07=(a07+a05);
   a07=(a02*a07);
   a03=(a03+a07);
-  R0[1]=a03;
+  R0[S*1]=a03;
   a34=(2.*a34);
   a34=(a08+a34);
   a03=(2.*a59);
@@ -8302,7 +6859,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a34=(a34+a58);
   a34=(a02*a34);
   a34=(a16+a34);
-  R0[2]=a34;
+  R0[S*2]=a34;
   a41=(2.*a41);
   a26=(a26+a41);
   a06=(2.*a06);
@@ -8316,17 +6873,17 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a27=(a49*a24);
   a25=(a68*a61);
   a27=(a27+a25);
-  a25=A2[29];
-  a06=A2[27];
+  a25=A2[S*29];
+  a06=A2[S*27];
   a41=(a45*a06);
   a41=(a25+a41);
-  a03=A2[25];
+  a03=A2[S*25];
   a07=(a62*a03);
   a41=(a41+a07);
-  a07=A2[26];
+  a07=A2[S*26];
   a05=(a65*a07);
   a41=(a41+a05);
-  a05=A2[28];
+  a05=A2[S*28];
   a22=(a05*a22);
   a22=(a22*a57);
   a41=(a41+a22);
@@ -8373,7 +6930,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a26=(a26+a37);
   a26=(a02*a26);
   a26=(a08+a26);
-  R0[3]=a26;
+  R0[S*3]=a26;
   a49=(2.*a49);
   a49=(a28+a49);
   a37=(2.*a71);
@@ -8381,7 +6938,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a49=(a49+a69);
   a49=(a02*a49);
   a31=(a31+a49);
-  R0[4]=a31;
+  R0[S*4]=a31;
   a40=(2.*a40);
   a43=(a43+a40);
   a59=(2.*a59);
@@ -8422,7 +6979,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a48=(a48*a10);
   a48=(a48*a19);
   a58=(a58+a48);
-  a48=A1[5];
+  a48=A1[S*5];
   a12=(a12*a48);
   a19=(a01*a11);
   a19=(a51+a19);
@@ -8433,7 +6990,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a43=(a43+a58);
   a43=(a02*a43);
   a28=(a28+a43);
-  R0[5]=a28;
+  R0[S*5]=a28;
   a68=(2.*a68);
   a68=(a45+a68);
   a28=(2.*a11);
@@ -8441,7 +6998,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a68=(a68+a57);
   a68=(a02*a68);
   a68=(a51+a68);
-  R0[6]=a68;
+  R0[S*6]=a68;
   a27=(2.*a27);
   a23=(a23+a27);
   a71=(2.*a71);
@@ -8473,7 +7030,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a23=(a23+a69);
   a23=(a02*a23);
   a23=(a45+a23);
-  R0[7]=a23;
+  R0[S*7]=a23;
   a22=(2.*a22);
   a22=(a62+a22);
   a70=(2.*a70);
@@ -8481,7 +7038,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a22=(a22+a38);
   a22=(a02*a22);
   a65=(a65+a22);
-  R0[8]=a65;
+  R0[S*8]=a65;
   a44=(2.*a44);
   a41=(a41+a44);
   a11=(2.*a11);
@@ -8498,7 +7055,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a41=(a41+a25);
   a02=(a02*a41);
   a62=(a62+a02);
-  R0[9]=a62;
+  R0[S*9]=a62;
   a20=(2.*a20);
   a62=1.;
   a20=(a20-a62);
@@ -8573,30 +7130,31 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a15=(a15<a02);
   R1[0]=a15;
 }
+static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1) { gs_state_try_strided(A0, A1, A2, R0, R1, 1); }
 
-/* state_keep, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+/* state_keep, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_keep_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
   casadi_real a0, a1, a2, a3, a4, a5, a6, a7;
   a0=A3[0];
   R0[0]=a0;
-  a1=A3[1];
-  R0[1]=a1;
-  a1=A3[2];
-  R0[2]=a1;
-  a2=A3[3];
-  R0[3]=a2;
-  a2=A3[4];
-  R0[4]=a2;
-  a3=A3[5];
-  R0[5]=a3;
-  a3=A3[6];
-  R0[6]=a3;
-  a4=A3[7];
-  R0[7]=a4;
-  a4=A3[8];
-  R0[8]=a4;
-  a5=A3[9];
-  R0[9]=a5;
+  a1=A3[S*1];
+  R0[S*1]=a1;
+  a1=A3[S*2];
+  R0[S*2]=a1;
+  a2=A3[S*3];
+  R0[S*3]=a2;
+  a2=A3[S*4];
+  R0[S*4]=a2;
+  a3=A3[S*5];
+  R0[S*5]=a3;
+  a3=A3[S*6];
+  R0[S*6]=a3;
+  a4=A3[S*7];
+  R0[S*7]=a4;
+  a4=A3[S*8];
+  R0[S*8]=a4;
+  a5=A3[S*9];
+  R0[S*9]=a5;
   a5=A1[0];
   a6=(a0<a5);
   a7=(a6?a0:0);
@@ -8604,34 +7162,34 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
   a6=(a6?a5:0);
   a7=(a7+a6);
   R1[0]=a7;
-  a7=A1[1];
+  a7=A1[S*1];
   a6=(a1<a7);
   a5=(a6?a1:0);
   a6=(!a6);
   a6=(a6?a7:0);
   a5=(a5+a6);
-  R1[1]=a5;
-  a5=A1[2];
+  R1[S*1]=a5;
+  a5=A1[S*2];
   a6=(a2<a5);
   a7=(a6?a2:0);
   a6=(!a6);
   a6=(a6?a5:0);
   a7=(a7+a6);
-  R1[2]=a7;
-  a7=A1[3];
+  R1[S*2]=a7;
+  a7=A1[S*3];
   a6=(a3<a7);
   a5=(a6?a3:0);
   a6=(!a6);
   a6=(a6?a7:0);
   a5=(a5+a6);
-  R1[3]=a5;
-  a5=A1[4];
+  R1[S*3]=a5;
+  a5=A1[S*4];
   a6=(a4<a5);
   a7=(a6?a4:0);
   a6=(!a6);
   a6=(a6?a5:0);
   a7=(a7+a6);
-  R1[4]=a7;
+  R1[S*4]=a7;
   a7=A2[0];
   a6=(a7<a0);
   a0=(a6?a0:0);
@@ -8639,35 +7197,36 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
   a6=(a6?a7:0);
   a0=(a0+a6);
   R2[0]=a0;
-  a0=A2[1];
+  a0=A2[S*1];
   a6=(a0<a1);
   a1=(a6?a1:0);
   a6=(!a6);
   a6=(a6?a0:0);
   a1=(a1+a6);
-  R2[1]=a1;
-  a1=A2[2];
+  R2[S*1]=a1;
+  a1=A2[S*2];
   a6=(a1<a2);
   a2=(a6?a2:0);
   a6=(!a6);
   a6=(a6?a1:0);
   a2=(a2+a6);
-  R2[2]=a2;
-  a2=A2[3];
+  R2[S*2]=a2;
+  a2=A2[S*3];
   a6=(a2<a3);
   a3=(a6?a3:0);
   a6=(!a6);
   a6=(a6?a2:0);
   a3=(a3+a6);
-  R2[3]=a3;
-  a3=A2[4];
+  R2[S*3]=a3;
+  a3=A2[S*4];
   a6=(a3<a4);
   a4=(a6?a4:0);
   a6=(!a6);
   a6=(a6?a3:0);
   a4=(a4+a6);
-  R2[4]=a4;
+  R2[S*4]=a4;
 }
+static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_state_keep_strided(A0, A1, A2, A3, A4, A5, R0, R1, R2, 1); }
 
 /* split_start, from CasADi's C of it */
 static GEARSYM_NOINLINE void gs_split_start(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
@@ -13849,8 +12408,8 @@ static GEARSYM_NOINLINE void gs_state_mode_step(const casadi_real* restrict A0, 
   R0[9]=a53;
 }
 
-/* tangent_state, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+/* tangent_state, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_state_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
@@ -13860,29 +12419,29 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   casadi_real a72, a73, a74, a75, a76, a77, a78, a79, a80, a81, a82, a83;
   casadi_real a84, a85;
   a00=A0[0];
-  a01=A2[30];
+  a01=A2[S*30];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[1];
+  a03=A0[S*1];
   a04=2.;
   a04=(a01/a04);
-  a05=A2[5];
+  a05=A2[S*5];
   a06=A2[0];
   a07=(a03*a06);
   a07=(a05+a07);
-  a08=A0[3];
-  a09=A2[4];
+  a08=A0[S*3];
+  a09=A2[S*4];
   a10=(a08*a09);
   a07=(a07+a10);
-  a10=A2[1];
+  a10=A2[S*1];
   a11=(a00*a10);
   a07=(a07+a11);
-  a11=A2[3];
+  a11=A2[S*3];
   a12=A1[0];
   a13=(a11*a12);
-  a14=A2[2];
+  a14=A2[S*2];
   a15=0.;
-  a16=A0[2];
+  a16=A0[S*2];
   a17=(a16+a14);
   a18=(-a17);
   a18=(a15<=a18);
@@ -13899,23 +12458,23 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a24=(a03+a24);
   a25=(a23*a06);
   a25=(a05+a25);
-  a26=A2[8];
+  a26=A2[S*8];
   a27=(a03*a26);
-  a28=A2[7];
+  a28=A2[S*7];
   a29=(a08*a28);
   a27=(a27+a29);
-  a29=A0[5];
-  a30=A2[9];
+  a29=A0[S*5];
+  a30=A2[S*9];
   a31=(a29*a30);
   a27=(a27+a31);
-  a31=A2[10];
+  a31=A2[S*10];
   a32=(a00*a31);
   a27=(a27+a32);
-  a32=A0[4];
-  a33=A2[11];
+  a32=A0[S*4];
+  a33=A2[S*11];
   a34=(a32*a33);
   a27=(a27+a34);
-  a34=A2[6];
+  a34=A2[S*6];
   a35=(a34*a12);
   a36=(a35*a22);
   a27=(a27+a36);
@@ -13927,7 +12486,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a37=(a00+a37);
   a38=(a37*a10);
   a25=(a25+a38);
-  a38=A1[2];
+  a38=A1[S*2];
   a39=(a11*a38);
   a40=(a04*a08);
   a40=(a16+a40);
@@ -13944,27 +12503,27 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a43=(a23*a26);
   a44=(a36*a28);
   a43=(a43+a44);
-  a44=A2[15];
+  a44=A2[S*15];
   a45=(a08*a44);
-  a46=A2[12];
+  a46=A2[S*12];
   a47=(a29*a46);
   a45=(a45+a47);
-  a47=A0[7];
-  a48=A2[16];
+  a47=A0[S*7];
+  a48=A2[S*16];
   a49=(a47*a48);
   a45=(a45+a49);
-  a49=A2[13];
+  a49=A2[S*13];
   a50=(a32*a49);
   a45=(a45+a50);
-  a50=A2[14];
+  a50=A2[S*14];
   a12=(a50*a12);
   a22=(a12*a22);
   a45=(a45+a22);
-  a22=A2[18];
-  a51=A1[1];
+  a22=A2[S*18];
+  a51=A1[S*1];
   a52=(a22*a51);
-  a53=A2[17];
-  a54=A0[6];
+  a53=A2[S*17];
+  a54=A0[S*6];
   a55=(a54+a53);
   a56=(-a55);
   a56=(a15<=a56);
@@ -14020,23 +12579,23 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a25=(a36*a44);
   a24=(a61*a46);
   a25=(a25+a24);
-  a24=A2[23];
+  a24=A2[S*23];
   a66=(a29*a24);
-  a67=A2[19];
+  a67=A2[S*19];
   a68=(a47*a67);
   a66=(a66+a68);
-  a68=A0[9];
-  a69=A2[21];
+  a68=A0[S*9];
+  a69=A2[S*21];
   a70=(a68*a69);
   a66=(a66+a70);
-  a70=A2[24];
+  a70=A2[S*24];
   a71=(a32*a70);
   a66=(a66+a71);
-  a71=A0[8];
-  a72=A2[22];
+  a71=A0[S*8];
+  a72=A2[S*22];
   a73=(a71*a72);
   a66=(a66+a73);
-  a73=A2[20];
+  a73=A2[S*20];
   a74=(a73*a51);
   a75=(a74*a60);
   a66=(a66+a75);
@@ -14049,7 +12608,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a38=(a50*a38);
   a40=(a38*a40);
   a25=(a25+a40);
-  a40=A1[3];
+  a40=A1[S*3];
   a76=(a22*a40);
   a77=(a04*a47);
   a77=(a54+a77);
@@ -14077,7 +12636,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a00=(a00+a41);
   a41=(a00*a10);
   a05=(a05+a41);
-  a41=A1[4];
+  a41=A1[S*4];
   a11=(a11*a41);
   a80=(a01*a63);
   a80=(a16+a80);
@@ -14088,7 +12647,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a07=(a07+a05);
   a07=(a02*a07);
   a03=(a03+a07);
-  R0[1]=a03;
+  R0[S*1]=a03;
   a36=(2.*a36);
   a36=(a08+a36);
   a03=(2.*a63);
@@ -14096,7 +12655,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a36=(a36+a79);
   a36=(a02*a36);
   a36=(a16+a36);
-  R0[2]=a36;
+  R0[S*2]=a36;
   a43=(2.*a43);
   a27=(a27+a43);
   a42=(2.*a42);
@@ -14110,17 +12669,17 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a42=(a61*a24);
   a43=(a75*a67);
   a42=(a42+a43);
-  a43=A2[29];
-  a03=A2[27];
+  a43=A2[S*29];
+  a03=A2[S*27];
   a07=(a47*a03);
   a07=(a43+a07);
-  a05=A2[25];
+  a05=A2[S*25];
   a80=(a68*a05);
   a07=(a07+a80);
-  a80=A2[26];
+  a80=A2[S*26];
   a81=(a71*a80);
   a07=(a07+a81);
-  a81=A2[28];
+  a81=A2[S*28];
   a51=(a81*a51);
   a60=(a51*a60);
   a07=(a07+a60);
@@ -14167,7 +12726,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a27=(a27+a65);
   a27=(a02*a27);
   a27=(a08+a27);
-  R0[3]=a27;
+  R0[S*3]=a27;
   a61=(2.*a61);
   a61=(a29+a61);
   a65=(2.*a78);
@@ -14175,7 +12734,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a61=(a61+a84);
   a61=(a02*a61);
   a32=(a32+a61);
-  R0[4]=a32;
+  R0[S*4]=a32;
   a25=(2.*a25);
   a45=(a45+a25);
   a63=(2.*a63);
@@ -14216,7 +12775,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a50=(a50*a41);
   a19=(a50*a19);
   a79=(a79+a19);
-  a19=A1[5];
+  a19=A1[S*5];
   a22=(a22*a19);
   a41=(a01*a83);
   a41=(a54+a41);
@@ -14227,7 +12786,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a45=(a45+a79);
   a45=(a02*a45);
   a29=(a29+a45);
-  R0[5]=a29;
+  R0[S*5]=a29;
   a75=(2.*a75);
   a75=(a47+a75);
   a29=(2.*a83);
@@ -14235,7 +12794,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a75=(a75+a23);
   a75=(a02*a75);
   a75=(a54+a75);
-  R0[6]=a75;
+  R0[S*6]=a75;
   a42=(2.*a42);
   a66=(a66+a42);
   a78=(2.*a78);
@@ -14267,7 +12826,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a66=(a66+a84);
   a66=(a02*a66);
   a66=(a47+a66);
-  R0[7]=a66;
+  R0[S*7]=a66;
   a60=(2.*a60);
   a60=(a68+a60);
   a77=(2.*a77);
@@ -14275,7 +12834,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a60=(a60+a64);
   a60=(a02*a60);
   a71=(a71+a60);
-  R0[8]=a71;
+  R0[S*8]=a71;
   a63=(2.*a63);
   a07=(a07+a63);
   a83=(2.*a83);
@@ -14292,7 +12851,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a07=(a07+a43);
   a02=(a02*a07);
   a68=(a68+a02);
-  R0[9]=a68;
+  R0[S*9]=a68;
   a20=(2.*a20);
   a68=1.;
   a20=(a20-a68);
@@ -14367,93 +12926,94 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a15=(a15<a02);
   R1[0]=a15;
   R2[0]=a10;
-  R2[1]=a31;
-  R2[2]=a06;
-  R2[3]=a26;
+  R2[S*1]=a31;
+  R2[S*2]=a06;
+  R2[S*3]=a26;
   a13=(a13*a21);
-  R2[4]=a13;
+  R2[S*4]=a13;
   a35=(a35*a21);
-  R2[5]=a35;
+  R2[S*5]=a35;
   a12=(a12*a21);
-  R2[6]=a12;
-  R2[7]=a09;
-  R2[8]=a28;
-  R2[9]=a44;
-  R2[10]=a33;
-  R2[11]=a49;
-  R2[12]=a70;
-  R2[13]=a30;
-  R2[14]=a46;
-  R2[15]=a24;
+  R2[S*6]=a12;
+  R2[S*7]=a09;
+  R2[S*8]=a28;
+  R2[S*9]=a44;
+  R2[S*10]=a33;
+  R2[S*11]=a49;
+  R2[S*12]=a70;
+  R2[S*13]=a30;
+  R2[S*14]=a46;
+  R2[S*15]=a24;
   a52=(a52*a59);
-  R2[16]=a52;
+  R2[S*16]=a52;
   a74=(a74*a59);
-  R2[17]=a74;
+  R2[S*17]=a74;
   a51=(a51*a59);
-  R2[18]=a51;
-  R2[19]=a48;
-  R2[20]=a67;
-  R2[21]=a03;
-  R2[22]=a72;
-  R2[23]=a80;
-  R2[24]=a69;
-  R2[25]=a05;
+  R2[S*18]=a51;
+  R2[S*19]=a48;
+  R2[S*20]=a67;
+  R2[S*21]=a03;
+  R2[S*22]=a72;
+  R2[S*23]=a80;
+  R2[S*24]=a69;
+  R2[S*25]=a05;
   a39=(a39*a21);
-  R2[26]=a39;
+  R2[S*26]=a39;
   a62=(a62*a21);
-  R2[27]=a62;
+  R2[S*27]=a62;
   a38=(a38*a21);
-  R2[28]=a38;
+  R2[S*28]=a38;
   a76=(a76*a59);
-  R2[29]=a76;
+  R2[S*29]=a76;
   a82=(a82*a59);
-  R2[30]=a82;
+  R2[S*30]=a82;
   a40=(a40*a59);
-  R2[31]=a40;
-  R2[32]=a39;
-  R2[33]=a62;
-  R2[34]=a38;
-  R2[35]=a76;
-  R2[36]=a82;
-  R2[37]=a40;
+  R2[S*31]=a40;
+  R2[S*32]=a39;
+  R2[S*33]=a62;
+  R2[S*34]=a38;
+  R2[S*35]=a76;
+  R2[S*36]=a82;
+  R2[S*37]=a40;
   a11=(a11*a21);
-  R2[38]=a11;
+  R2[S*38]=a11;
   a34=(a34*a21);
-  R2[39]=a34;
+  R2[S*39]=a34;
   a50=(a50*a21);
-  R2[40]=a50;
+  R2[S*40]=a50;
   a22=(a22*a59);
-  R2[41]=a22;
+  R2[S*41]=a22;
   a73=(a73*a59);
-  R2[42]=a73;
+  R2[S*42]=a73;
   a81=(a81*a59);
-  R2[43]=a81;
+  R2[S*43]=a81;
 }
+static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_tangent_state_strided(A0, A1, A2, R0, R1, R2, 1); }
 
-/* tangent_vector, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) {
+/* tangent_vector, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_vector_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
   casadi_real a36, a37, a38, a39, a40, a41, a42, a43, a44, a45, a46, a47;
   a00=A0[0];
-  a01=A2[30];
+  a01=A2[S*30];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[10];
+  a03=A0[S*10];
   a04=2.;
   a04=(a01/a04);
   a05=A1[0];
   a06=(a05*a00);
-  a07=A1[2];
+  a07=A1[S*2];
   a08=(a07*a03);
   a06=(a06+a08);
-  a08=A1[4];
-  a09=A0[20];
+  a08=A1[S*4];
+  a09=A0[S*20];
   a08=(a08*a09);
   a06=(a06+a08);
-  a08=A1[7];
-  a10=A0[30];
+  a08=A1[S*7];
+  a10=A0[S*30];
   a11=(a08*a10);
   a06=(a06+a11);
   a11=(a04*a06);
@@ -14465,28 +13025,28 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a14=(a05*a13);
   a15=(a07*a11);
   a14=(a14+a15);
-  a15=A1[26];
+  a15=A1[S*26];
   a16=(a04*a10);
   a16=(a09+a16);
   a15=(a15*a16);
   a14=(a14+a15);
-  a15=A1[1];
+  a15=A1[S*1];
   a17=(a15*a00);
-  a18=A1[3];
+  a18=A1[S*3];
   a19=(a18*a03);
   a17=(a17+a19);
-  a19=A1[5];
+  a19=A1[S*5];
   a19=(a19*a09);
   a17=(a17+a19);
-  a19=A1[8];
+  a19=A1[S*8];
   a20=(a19*a10);
   a17=(a17+a20);
-  a20=A1[10];
-  a21=A0[40];
+  a20=A1[S*10];
+  a21=A0[S*40];
   a22=(a20*a21);
   a17=(a17+a22);
-  a22=A1[13];
-  a23=A0[50];
+  a22=A1[S*13];
+  a23=A0[S*50];
   a24=(a22*a23);
   a17=(a17+a24);
   a24=(a04*a17);
@@ -14502,7 +13062,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a27=(a05*a26);
   a28=(a07*a25);
   a27=(a27+a28);
-  a28=A1[32];
+  a28=A1[S*32];
   a29=(a04*a24);
   a29=(a09+a29);
   a28=(a28*a29);
@@ -14510,7 +13070,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a13=(a15*a13);
   a11=(a18*a11);
   a13=(a13+a11);
-  a11=A1[27];
+  a11=A1[S*27];
   a11=(a11*a16);
   a13=(a13+a11);
   a11=(a19*a24);
@@ -14519,23 +13079,23 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a11=(a21+a11);
   a28=(a20*a11);
   a13=(a13+a28);
-  a28=A1[6];
+  a28=A1[S*6];
   a28=(a28*a09);
-  a30=A1[9];
+  a30=A1[S*9];
   a31=(a30*a10);
   a28=(a28+a31);
-  a31=A1[11];
+  a31=A1[S*11];
   a32=(a31*a21);
   a28=(a28+a32);
-  a32=A1[14];
+  a32=A1[S*14];
   a33=(a32*a23);
   a28=(a28+a33);
-  a33=A1[16];
-  a34=A0[60];
+  a33=A1[S*16];
+  a34=A0[S*60];
   a33=(a33*a34);
   a28=(a28+a33);
-  a33=A1[19];
-  a35=A0[70];
+  a33=A1[S*19];
+  a35=A0[S*70];
   a36=(a33*a35);
   a28=(a28+a36);
   a36=(a04*a28);
@@ -14561,7 +13121,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a05=(a05*a00);
   a07=(a07*a38);
   a05=(a05+a07);
-  a07=A1[38];
+  a07=A1[S*38];
   a27=(a01*a37);
   a27=(a09+a27);
   a07=(a07*a27);
@@ -14569,7 +13129,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a26=(a15*a26);
   a25=(a18*a25);
   a26=(a26+a25);
-  a25=A1[33];
+  a25=A1[S*33];
   a25=(a25*a29);
   a26=(a26+a25);
   a25=(a19*a37);
@@ -14578,7 +13138,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a25=(a21+a25);
   a07=(a20*a25);
   a26=(a26+a07);
-  a07=A1[28];
+  a07=A1[S*28];
   a07=(a07*a16);
   a16=(a30*a24);
   a07=(a07+a16);
@@ -14586,28 +13146,28 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a07=(a07+a16);
   a16=(a32*a36);
   a07=(a07+a16);
-  a16=A1[29];
+  a16=A1[S*29];
   a14=(a04*a35);
   a14=(a34+a14);
   a16=(a16*a14);
   a07=(a07+a16);
-  a16=A1[12];
+  a16=A1[S*12];
   a12=(a16*a21);
-  a39=A1[15];
+  a39=A1[S*15];
   a40=(a39*a23);
   a12=(a12+a40);
-  a40=A1[17];
+  a40=A1[S*17];
   a40=(a40*a34);
   a12=(a12+a40);
-  a40=A1[20];
+  a40=A1[S*20];
   a41=(a40*a35);
   a12=(a12+a41);
-  a41=A1[22];
-  a42=A0[80];
+  a41=A1[S*22];
+  a42=A0[S*80];
   a43=(a41*a42);
   a12=(a12+a43);
-  a43=A1[24];
-  a44=A0[90];
+  a43=A1[S*24];
+  a44=A0[S*90];
   a45=(a43*a44);
   a12=(a12+a45);
   a45=(a04*a12);
@@ -14625,7 +13185,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a06=(a06+a05);
   a06=(a02*a06);
   a03=(a03+a06);
-  R0[10]=a03;
+  R0[S*10]=a03;
   a24=(2.*a24);
   a24=(a10+a24);
   a03=(2.*a37);
@@ -14633,7 +13193,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a24=(a24+a47);
   a24=(a02*a24);
   a09=(a09+a24);
-  R0[20]=a09;
+  R0[S*20]=a09;
   a13=(2.*a13);
   a17=(a17+a13);
   a26=(2.*a26);
@@ -14641,7 +13201,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a15=(a15*a00);
   a18=(a18*a38);
   a15=(a15+a18);
-  a18=A1[39];
+  a18=A1[S*39];
   a18=(a18*a27);
   a15=(a15+a18);
   a19=(a19*a47);
@@ -14650,7 +13210,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a19=(a21+a19);
   a20=(a20*a19);
   a15=(a15+a20);
-  a20=A1[34];
+  a20=A1[S*34];
   a20=(a20*a29);
   a37=(a30*a37);
   a20=(a20+a37);
@@ -14658,7 +13218,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a20=(a20+a37);
   a37=(a32*a46);
   a20=(a20+a37);
-  a37=A1[35];
+  a37=A1[S*35];
   a29=(a04*a45);
   a29=(a34+a29);
   a37=(a37*a29);
@@ -14666,7 +13226,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a11=(a16*a11);
   a37=(a39*a36);
   a11=(a11+a37);
-  a37=A1[30];
+  a37=A1[S*30];
   a37=(a37*a14);
   a11=(a11+a37);
   a37=(a40*a45);
@@ -14675,15 +13235,15 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a37=(a42+a37);
   a18=(a41*a37);
   a11=(a11+a18);
-  a18=A1[18];
+  a18=A1[S*18];
   a18=(a18*a34);
-  a38=A1[21];
+  a38=A1[S*21];
   a00=(a38*a35);
   a18=(a18+a00);
-  a00=A1[23];
+  a00=A1[S*23];
   a26=(a00*a42);
   a18=(a18+a26);
-  a26=A1[25];
+  a26=A1[S*25];
   a13=(a26*a44);
   a18=(a18+a13);
   a13=(a04*a18);
@@ -14701,7 +13261,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a17=(a17+a15);
   a17=(a02*a17);
   a10=(a10+a17);
-  R0[30]=a10;
+  R0[S*30]=a10;
   a36=(2.*a36);
   a36=(a23+a36);
   a10=(2.*a46);
@@ -14709,12 +13269,12 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a36=(a36+a24);
   a36=(a02*a36);
   a21=(a21+a36);
-  R0[40]=a21;
+  R0[S*40]=a21;
   a07=(2.*a07);
   a28=(a28+a07);
   a20=(2.*a20);
   a28=(a28+a20);
-  a20=A1[40];
+  a20=A1[S*40];
   a20=(a20*a27);
   a30=(a30*a47);
   a20=(a20+a30);
@@ -14722,7 +13282,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a20=(a20+a31);
   a32=(a32*a24);
   a20=(a20+a32);
-  a32=A1[41];
+  a32=A1[S*41];
   a31=(a01*a09);
   a31=(a34+a31);
   a32=(a32*a31);
@@ -14730,7 +13290,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a25=(a16*a25);
   a46=(a39*a46);
   a25=(a25+a46);
-  a46=A1[36];
+  a46=A1[S*36];
   a46=(a46*a29);
   a25=(a25+a46);
   a46=(a40*a09);
@@ -14739,7 +13299,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a46=(a42+a46);
   a32=(a41*a46);
   a25=(a25+a32);
-  a32=A1[31];
+  a32=A1[S*31];
   a32=(a32*a14);
   a14=(a38*a45);
   a32=(a32+a14);
@@ -14758,7 +13318,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a28=(a28+a20);
   a28=(a02*a28);
   a23=(a23+a28);
-  R0[50]=a23;
+  R0[S*50]=a23;
   a45=(2.*a45);
   a45=(a35+a45);
   a23=(2.*a09);
@@ -14766,7 +13326,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a45=(a45+a37);
   a45=(a02*a45);
   a34=(a34+a45);
-  R0[60]=a34;
+  R0[S*60]=a34;
   a11=(2.*a11);
   a12=(a12+a11);
   a25=(2.*a25);
@@ -14774,7 +13334,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a16=(a16*a19);
   a39=(a39*a24);
   a16=(a16+a39);
-  a39=A1[42];
+  a39=A1[S*42];
   a39=(a39*a31);
   a16=(a16+a39);
   a40=(a40*a37);
@@ -14783,7 +13343,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a40=(a42+a40);
   a41=(a41*a40);
   a16=(a16+a41);
-  a41=A1[37];
+  a41=A1[S*37];
   a41=(a41*a29);
   a09=(a38*a09);
   a41=(a41+a09);
@@ -14798,7 +13358,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a12=(a12+a16);
   a12=(a02*a12);
   a35=(a35+a12);
-  R0[70]=a35;
+  R0[S*70]=a35;
   a13=(2.*a13);
   a13=(a44+a13);
   a04=(2.*a04);
@@ -14806,12 +13366,12 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a13=(a13+a01);
   a13=(a02*a13);
   a42=(a42+a13);
-  R0[80]=a42;
+  R0[S*80]=a42;
   a32=(2.*a32);
   a18=(a18+a32);
   a41=(2.*a41);
   a18=(a18+a41);
-  a41=A1[43];
+  a41=A1[S*43];
   a41=(a41*a31);
   a38=(a38*a37);
   a41=(a41+a38);
@@ -14822,8 +13382,9 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a18=(a18+a41);
   a02=(a02*a18);
   a44=(a44+a02);
-  R0[90]=a44;
+  R0[S*90]=a44;
 }
+static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) { gs_tangent_vector_strided(A0, A1, A2, R0, 1); }
 
 /* gram_schmidt, from CasADi's C of it */
 static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
@@ -17114,6 +15675,183 @@ static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casad
   R1[9]=a078;
 }
 
+/* constants, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_constants_strided(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14;
+  a00=A0[S*12];
+  a01=A0[0];
+  a02=(a00/a01);
+  a03=A0[S*7];
+  a04=(1./a03);
+  a05=A0[S*11];
+  a05=(1./a05);
+  a04=(a04+a05);
+  a02=(a02*a04);
+  a02=(-a02);
+  R0[0]=a02;
+  a02=A0[S*17];
+  a05=casadi_sq(a01);
+  a06=(a02/a05);
+  a06=(a06*a04);
+  a06=(-a06);
+  R0[S*1]=a06;
+  a06=A0[S*15];
+  R0[S*2]=a06;
+  a06=A0[S*20];
+  a06=casadi_sq(a06);
+  a04=(a06/a03);
+  a07=(a04/a05);
+  a08=A0[S*21];
+  a09=casadi_sq(a08);
+  a10=A0[S*8];
+  a11=(a09/a10);
+  a04=(a04+a11);
+  a07=(a07/a04);
+  a07=(-a07);
+  R0[S*3]=a07;
+  a07=-2.;
+  a12=A0[S*1];
+  a12=(a07*a12);
+  a13=(a12/a03);
+  a13=(a13*a06);
+  a13=(a13/a01);
+  a13=(a13/a04);
+  R0[S*4]=a13;
+  a13=A0[S*4];
+  a13=(a13/a05);
+  R0[S*5]=a13;
+  a13=(1./a05);
+  a13=(-a13);
+  R0[S*6]=a13;
+  a13=(a12/a01);
+  R0[S*7]=a13;
+  a00=(a00/a03);
+  a00=(a00/a01);
+  a00=(-a00);
+  R0[S*8]=a00;
+  a00=A0[S*13];
+  a13=(a00/a10);
+  a13=(a13/a01);
+  a13=(-a13);
+  R0[S*9]=a13;
+  a02=(a02/a03);
+  a02=(a02/a05);
+  a02=(-a02);
+  R0[S*10]=a02;
+  a02=A0[S*18];
+  a03=(a02/a10);
+  a03=(a03/a05);
+  a03=(-a03);
+  R0[S*11]=a03;
+  a03=(a00/a01);
+  a13=(1./a10);
+  a06=A0[S*9];
+  a14=(1./a06);
+  a13=(a13+a14);
+  a03=(a03*a13);
+  a03=(-a03);
+  R0[S*12]=a03;
+  a03=(a02/a05);
+  a03=(a03*a13);
+  a03=(-a03);
+  R0[S*13]=a03;
+  a11=(a11/a05);
+  a11=(a11/a04);
+  a11=(-a11);
+  R0[S*14]=a11;
+  a12=(a12/a10);
+  a12=(a12*a09);
+  a12=(a12/a01);
+  a12=(a12/a04);
+  R0[S*15]=a12;
+  a12=(a07*a08);
+  a04=A0[S*22];
+  a12=(a12*a04);
+  a09=A0[S*3];
+  a12=(a12*a09);
+  a12=(a12/a06);
+  a12=(a12/a01);
+  a10=casadi_sq(a04);
+  a10=(a10/a06);
+  a11=A0[S*23];
+  a11=casadi_sq(a11);
+  a03=A0[S*10];
+  a13=(a11/a03);
+  a10=(a10+a13);
+  a12=(a12/a10);
+  R0[S*16]=a12;
+  a12=A0[S*16];
+  R0[S*17]=a12;
+  a12=A0[S*2];
+  a13=(a12*a08);
+  a13=(a13*a04);
+  a13=(a13/a06);
+  a13=(a13/a05);
+  a13=(a13/a10);
+  a13=(-a13);
+  R0[S*18]=a13;
+  a07=(a07*a09);
+  a09=(a07/a01);
+  R0[S*19]=a09;
+  a09=(a12/a05);
+  a09=(-a09);
+  R0[S*20]=a09;
+  a09=A0[S*14];
+  a13=(a09/a03);
+  a13=(a13/a01);
+  a13=(-a13);
+  R0[S*21]=a13;
+  a13=A0[S*19];
+  a14=(a13/a03);
+  a14=(a14/a05);
+  a14=(-a14);
+  R0[S*22]=a14;
+  a00=(a00*a04);
+  a00=(a00/a06);
+  a00=(a00/a08);
+  a00=(a00/a01);
+  a00=(-a00);
+  R0[S*23]=a00;
+  a02=(a02*a04);
+  a02=(a02/a06);
+  a02=(a02/a08);
+  a02=(a02/a05);
+  a02=(-a02);
+  R0[S*24]=a02;
+  a09=(a09/a01);
+  a02=A0[S*6];
+  a02=(1./a02);
+  a08=(1./a03);
+  a02=(a02+a08);
+  a09=(a09*a02);
+  a09=(-a09);
+  R0[S*25]=a09;
+  a13=(a13/a05);
+  a13=(a13*a02);
+  a13=(-a13);
+  R0[S*26]=a13;
+  a07=(a07/a03);
+  a07=(a07*a11);
+  a07=(a07/a01);
+  a07=(a07/a10);
+  R0[S*27]=a07;
+  a12=(a12/a03);
+  a12=(a12*a11);
+  a12=(a12/a05);
+  a12=(a12/a10);
+  a12=(-a12);
+  R0[S*28]=a12;
+  a12=A0[S*5];
+  a12=(a12/a05);
+  R0[S*29]=a12;
+  a12=1.5707963267948967e-02;
+  R0[S*30]=a12;
+  a12=3.8327430373795477e+02;
+  R1[0]=a12;
+}
+static GEARSYM_INLINE void gs_constants(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) { gs_constants_strided(A0, R0, R1, 1); }
+
 /* the located step that crosses: its legs, RK4 of the sides held fixed on each (calls of one
    mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/crossing.py) */
 static GEARSYM_NOINLINE void gs_tangent_split(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict yt, const casadi_real* restrict Qt, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
@@ -17154,6 +15892,1451 @@ static GEARSYM_NOINLINE void gs_state_split(const casadi_real* restrict y, const
   gs_state_mode_step(yb, leg_b, c, yc);
   gs_state_mode_step(yc, leg_c, c, yn);
   gs_state_keep(y, lo, hi, yn, T, c, y1, lo1, hi1);
+}
+
+#ifndef GEARSYM_STEP_PIECES_ONLY  /* (the lanes' C includes the pieces above) */
+
+/* rhs:(t,y[10],p[24])->(dy[10]) */
+static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+  casadi_real a24, a25, a26, a27, a28;
+  a00=arg[1]? arg[1][1] : 0;
+  if (res[0]!=0) res[0][0]=a00;
+  a01=arg[2]? arg[2][4] : 0;
+  a02=arg[2]? arg[2][0] : 0;
+  a03=casadi_sq(a02);
+  a01=(a01/a03);
+  a04=arg[2]? arg[2][12] : 0;
+  a04=(a04*a00);
+  a00=(a04/a02);
+  a05=arg[2]? arg[2][7] : 0;
+  a06=(1./a05);
+  a07=arg[2]? arg[2][11] : 0;
+  a07=(1./a07);
+  a06=(a06+a07);
+  a00=(a00*a06);
+  a01=(a01-a00);
+  a00=arg[2]? arg[2][17] : 0;
+  a07=arg[1]? arg[1][0] : 0;
+  a00=(a00*a07);
+  a07=(a00/a03);
+  a07=(a07*a06);
+  a01=(a01-a07);
+  a07=arg[2]? arg[2][20] : 0;
+  a07=casadi_sq(a07);
+  a06=(a07/a05);
+  a08=(a06/a03);
+  a09=0.;
+  a10=arg[1]? arg[1][2] : 0;
+  a11=(a09<=a10);
+  a11=(a11?a10:0);
+  a12=arg[2]? arg[2][15] : 0;
+  a13=(-a12);
+  a13=(a10<=a13);
+  a10=(a10+a12);
+  a13=(a13?a10:0);
+  a11=(a11+a13);
+  a08=(a08*a11);
+  a13=arg[2]? arg[2][21] : 0;
+  a10=casadi_sq(a13);
+  a12=arg[2]? arg[2][8] : 0;
+  a14=(a10/a12);
+  a06=(a06+a14);
+  a08=(a08/a06);
+  a15=1.;
+  a16=2.1984919300000000e-01;
+  a17=arg[0]? arg[0][0] : 0;
+  a18=sin(a17);
+  a16=(a16*a18);
+  a16=(a15+a16);
+  a18=-1.4648076380000000e-01;
+  a19=cos(a17);
+  a18=(a18*a19);
+  a16=(a16+a18);
+  a18=2.3399851510000000e-03;
+  a19=3.;
+  a19=(a19*a17);
+  a20=sin(a19);
+  a18=(a18*a20);
+  a16=(a16+a18);
+  a18=5.2571706769999997e-03;
+  a20=6.;
+  a20=(a20*a17);
+  a21=cos(a20);
+  a18=(a18*a21);
+  a16=(a16+a18);
+  a18=1.2362118350000000e-02;
+  a19=cos(a19);
+  a18=(a18*a19);
+  a16=(a16+a18);
+  a18=2.6627245229999999e-02;
+  a19=5.;
+  a19=(a19*a17);
+  a21=sin(a19);
+  a18=(a18*a21);
+  a16=(a16+a18);
+  a18=1.1011287700000000e-01;
+  a21=(2.*a17);
+  a22=sin(a21);
+  a18=(a18*a22);
+  a16=(a16+a18);
+  a18=4.5469359220000000e-03;
+  a19=cos(a19);
+  a18=(a18*a19);
+  a16=(a16+a18);
+  a18=2.3457193629999999e-03;
+  a20=sin(a20);
+  a18=(a18*a20);
+  a16=(a16+a18);
+  a18=4.5160754929999998e-02;
+  a21=cos(a21);
+  a18=(a18*a21);
+  a16=(a16+a18);
+  a18=2.3017182309999999e-02;
+  a21=4.;
+  a21=(a21*a17);
+  a20=sin(a21);
+  a18=(a18*a20);
+  a16=(a16+a18);
+  a18=1.6171101790000001e-03;
+  a20=7.;
+  a20=(a20*a17);
+  a19=sin(a20);
+  a18=(a18*a19);
+  a16=(a16+a18);
+  a18=-2.6772198850000001e-03;
+  a20=cos(a20);
+  a18=(a18*a20);
+  a16=(a16+a18);
+  a18=-2.4174349450000000e-02;
+  a21=cos(a21);
+  a18=(a18*a21);
+  a16=(a16+a18);
+  a08=(a08*a16);
+  a01=(a01-a08);
+  a08=-2.;
+  a18=arg[1]? arg[1][3] : 0;
+  a21=(a08*a18);
+  a20=arg[2]? arg[2][1] : 0;
+  a21=(a21*a20);
+  a20=(a21/a05);
+  a20=(a20*a07);
+  a20=(a20/a02);
+  a20=(a20/a06);
+  a01=(a01+a20);
+  if (res[0]!=0) res[0][1]=a01;
+  if (res[0]!=0) res[0][2]=a18;
+  a18=(a21/a02);
+  a04=(a04/a05);
+  a04=(a04/a02);
+  a18=(a18-a04);
+  a04=arg[2]? arg[2][13] : 0;
+  a01=arg[1]? arg[1][5] : 0;
+  a20=(a04*a01);
+  a07=(a20/a12);
+  a07=(a07/a02);
+  a18=(a18-a07);
+  a00=(a00/a05);
+  a00=(a00/a03);
+  a18=(a18-a00);
+  a00=arg[2]? arg[2][18] : 0;
+  a05=arg[1]? arg[1][4] : 0;
+  a07=(a00*a05);
+  a19=(a07/a12);
+  a19=(a19/a03);
+  a18=(a18-a19);
+  a19=(a11/a03);
+  a19=(a19*a16);
+  a18=(a18-a19);
+  if (res[0]!=0) res[0][3]=a18;
+  if (res[0]!=0) res[0][4]=a01;
+  a21=(a21/a12);
+  a21=(a21*a10);
+  a21=(a21/a02);
+  a21=(a21/a06);
+  a20=(a20/a02);
+  a12=(1./a12);
+  a10=arg[2]? arg[2][9] : 0;
+  a18=(1./a10);
+  a12=(a12+a18);
+  a20=(a20*a12);
+  a07=(a07/a03);
+  a07=(a07*a12);
+  a20=(a20+a07);
+  a14=(a14/a03);
+  a14=(a14*a11);
+  a14=(a14/a06);
+  a14=(a14*a16);
+  a20=(a20+a14);
+  a21=(a21-a20);
+  a20=(a08*a13);
+  a14=arg[2]? arg[2][22] : 0;
+  a20=(a20*a14);
+  a16=arg[1]? arg[1][7] : 0;
+  a20=(a20*a16);
+  a06=arg[2]? arg[2][3] : 0;
+  a20=(a20*a06);
+  a20=(a20/a10);
+  a20=(a20/a02);
+  a11=casadi_sq(a14);
+  a11=(a11/a10);
+  a07=arg[2]? arg[2][23] : 0;
+  a07=casadi_sq(a07);
+  a12=arg[2]? arg[2][10] : 0;
+  a18=(a07/a12);
+  a11=(a11+a18);
+  a20=(a20/a11);
+  a21=(a21+a20);
+  a20=arg[2]? arg[2][2] : 0;
+  a18=(a20*a13);
+  a18=(a18*a14);
+  a18=(a18/a10);
+  a18=(a18/a03);
+  a19=arg[1]? arg[1][6] : 0;
+  a09=(a09<=a19);
+  a09=(a09?a19:0);
+  a22=arg[2]? arg[2][16] : 0;
+  a23=(-a22);
+  a23=(a19<=a23);
+  a19=(a19+a22);
+  a23=(a23?a19:0);
+  a09=(a09+a23);
+  a18=(a18*a09);
+  a18=(a18/a11);
+  a23=4.5350021439999999e-02;
+  a19=1.2459016393442623e+00;
+  a19=(a19*a17);
+  a22=sin(a19);
+  a23=(a23*a22);
+  a15=(a15+a23);
+  a23=5.9288166009999997e-03;
+  a22=2.1803278688524590e+00;
+  a22=(a22*a17);
+  a24=sin(a22);
+  a23=(a23*a24);
+  a15=(a15+a23);
+  a23=2.5895748289999998e-01;
+  a24=3.1147540983606559e-01;
+  a24=(a24*a17);
+  a25=sin(a24);
+  a23=(a23*a25);
+  a15=(a15+a23);
+  a23=4.1311748459999997e-03;
+  a25=9.3442622950819676e-01;
+  a25=(a25*a17);
+  a26=sin(a25);
+  a23=(a23*a26);
+  a15=(a15+a23);
+  a23=7.7092779900000005e-02;
+  a26=6.2295081967213117e-01;
+  a26=(a26*a17);
+  a27=sin(a26);
+  a23=(a23*a27);
+  a15=(a15+a23);
+  a23=1.0731786070000001e-02;
+  a27=1.5573770491803278e+00;
+  a27=(a27*a17);
+  a28=sin(a27);
+  a23=(a23*a28);
+  a15=(a15+a23);
+  a23=2.7203068860000000e-03;
+  a28=1.8688524590163935e+00;
+  a28=(a28*a17);
+  a17=sin(a28);
+  a23=(a23*a17);
+  a15=(a15+a23);
+  a23=1.3325609489999999e-02;
+  a27=cos(a27);
+  a23=(a23*a27);
+  a15=(a15+a23);
+  a23=6.2394082849999997e-02;
+  a26=cos(a26);
+  a23=(a23*a26);
+  a15=(a15+a23);
+  a23=-1.2277882320000000e-01;
+  a24=cos(a24);
+  a23=(a23*a24);
+  a15=(a15+a23);
+  a23=-6.0179578089999998e-03;
+  a28=cos(a28);
+  a23=(a23*a28);
+  a15=(a15+a23);
+  a23=-2.0371871579999999e-02;
+  a25=cos(a25);
+  a23=(a23*a25);
+  a15=(a15+a23);
+  a23=-1.0772115660000000e-02;
+  a19=cos(a19);
+  a23=(a23*a19);
+  a15=(a15+a23);
+  a23=-1.0423630300000001e-04;
+  a22=cos(a22);
+  a23=(a23*a22);
+  a15=(a15+a23);
+  a18=(a18*a15);
+  a21=(a21-a18);
+  if (res[0]!=0) res[0][5]=a21;
+  if (res[0]!=0) res[0][6]=a16;
+  a08=(a08*a16);
+  a08=(a08*a06);
+  a06=(a08/a02);
+  a16=arg[2]? arg[2][14] : 0;
+  a21=arg[1]? arg[1][9] : 0;
+  a16=(a16*a21);
+  a18=(a16/a12);
+  a18=(a18/a02);
+  a06=(a06-a18);
+  a18=arg[2]? arg[2][19] : 0;
+  a23=arg[1]? arg[1][8] : 0;
+  a18=(a18*a23);
+  a23=(a18/a12);
+  a23=(a23/a03);
+  a06=(a06-a23);
+  a04=(a04*a14);
+  a04=(a04*a01);
+  a04=(a04/a10);
+  a04=(a04/a13);
+  a04=(a04/a02);
+  a06=(a06-a04);
+  a00=(a00*a14);
+  a00=(a00*a05);
+  a00=(a00/a10);
+  a00=(a00/a13);
+  a00=(a00/a03);
+  a06=(a06-a00);
+  a00=(a20/a03);
+  a00=(a00*a09);
+  a00=(a00*a15);
+  a06=(a06-a00);
+  if (res[0]!=0) res[0][7]=a06;
+  if (res[0]!=0) res[0][8]=a21;
+  a21=arg[2]? arg[2][5] : 0;
+  a21=(a21/a03);
+  a16=(a16/a02);
+  a06=arg[2]? arg[2][6] : 0;
+  a06=(1./a06);
+  a00=(1./a12);
+  a06=(a06+a00);
+  a16=(a16*a06);
+  a21=(a21-a16);
+  a18=(a18/a03);
+  a18=(a18*a06);
+  a21=(a21-a18);
+  a08=(a08/a12);
+  a08=(a08*a07);
+  a08=(a08/a02);
+  a08=(a08/a11);
+  a21=(a21+a08);
+  a20=(a20/a12);
+  a20=(a20*a07);
+  a20=(a20/a03);
+  a20=(a20*a09);
+  a20=(a20/a11);
+  a20=(a20*a15);
+  a21=(a21-a20);
+  if (res[0]!=0) res[0][9]=a21;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int rhs(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f0(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int rhs_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void rhs_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void rhs_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void rhs_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int rhs_n_in(void) { return 3;}
+
+CASADI_SYMBOL_EXPORT casadi_int rhs_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real rhs_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* rhs_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "y";
+    case 2: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* rhs_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "dy";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s1;
+    case 2: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s1;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int rhs_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int rhs_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* jacobian:(t,y[10],p[24])->(J[10x10]) */
+static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17;
+  a00=0.;
+  if (res[0]!=0) res[0][0]=a00;
+  a01=arg[2]? arg[2][7] : 0;
+  a02=(1./a01);
+  a03=arg[2]? arg[2][11] : 0;
+  a03=(1./a03);
+  a02=(a02+a03);
+  a03=arg[2]? arg[2][17] : 0;
+  a04=arg[2]? arg[2][0] : 0;
+  a05=casadi_sq(a04);
+  a06=(a03/a05);
+  a06=(a02*a06);
+  a06=(-a06);
+  if (res[0]!=0) res[0][1]=a06;
+  if (res[0]!=0) res[0][2]=a00;
+  a03=(a03/a01);
+  a03=(a03/a05);
+  a03=(-a03);
+  if (res[0]!=0) res[0][3]=a03;
+  if (res[0]!=0) res[0][4]=a00;
+  if (res[0]!=0) res[0][5]=a00;
+  if (res[0]!=0) res[0][6]=a00;
+  if (res[0]!=0) res[0][7]=a00;
+  if (res[0]!=0) res[0][8]=a00;
+  if (res[0]!=0) res[0][9]=a00;
+  a03=1.;
+  if (res[0]!=0) res[0][10]=a03;
+  a06=arg[2]? arg[2][12] : 0;
+  a07=(a06/a04);
+  a02=(a02*a07);
+  a02=(-a02);
+  if (res[0]!=0) res[0][11]=a02;
+  if (res[0]!=0) res[0][12]=a00;
+  a06=(a06/a01);
+  a06=(a06/a04);
+  a06=(-a06);
+  if (res[0]!=0) res[0][13]=a06;
+  if (res[0]!=0) res[0][14]=a00;
+  if (res[0]!=0) res[0][15]=a00;
+  if (res[0]!=0) res[0][16]=a00;
+  if (res[0]!=0) res[0][17]=a00;
+  if (res[0]!=0) res[0][18]=a00;
+  if (res[0]!=0) res[0][19]=a00;
+  if (res[0]!=0) res[0][20]=a00;
+  a06=2.1984919300000000e-01;
+  a02=arg[0]? arg[0][0] : 0;
+  a07=sin(a02);
+  a06=(a06*a07);
+  a06=(a03+a06);
+  a07=-1.4648076380000000e-01;
+  a08=cos(a02);
+  a07=(a07*a08);
+  a06=(a06+a07);
+  a07=2.3399851510000000e-03;
+  a08=3.;
+  a08=(a08*a02);
+  a09=sin(a08);
+  a07=(a07*a09);
+  a06=(a06+a07);
+  a07=5.2571706769999997e-03;
+  a09=6.;
+  a09=(a09*a02);
+  a10=cos(a09);
+  a07=(a07*a10);
+  a06=(a06+a07);
+  a07=1.2362118350000000e-02;
+  a08=cos(a08);
+  a07=(a07*a08);
+  a06=(a06+a07);
+  a07=2.6627245229999999e-02;
+  a08=5.;
+  a08=(a08*a02);
+  a10=sin(a08);
+  a07=(a07*a10);
+  a06=(a06+a07);
+  a07=1.1011287700000000e-01;
+  a10=(2.*a02);
+  a11=sin(a10);
+  a07=(a07*a11);
+  a06=(a06+a07);
+  a07=4.5469359220000000e-03;
+  a08=cos(a08);
+  a07=(a07*a08);
+  a06=(a06+a07);
+  a07=2.3457193629999999e-03;
+  a09=sin(a09);
+  a07=(a07*a09);
+  a06=(a06+a07);
+  a07=4.5160754929999998e-02;
+  a10=cos(a10);
+  a07=(a07*a10);
+  a06=(a06+a07);
+  a07=2.3017182309999999e-02;
+  a10=4.;
+  a10=(a10*a02);
+  a09=sin(a10);
+  a07=(a07*a09);
+  a06=(a06+a07);
+  a07=1.6171101790000001e-03;
+  a09=7.;
+  a09=(a09*a02);
+  a08=sin(a09);
+  a07=(a07*a08);
+  a06=(a06+a07);
+  a07=-2.6772198850000001e-03;
+  a09=cos(a09);
+  a07=(a07*a09);
+  a06=(a06+a07);
+  a07=-2.4174349450000000e-02;
+  a10=cos(a10);
+  a07=(a07*a10);
+  a06=(a06+a07);
+  a07=arg[2]? arg[2][20] : 0;
+  a07=casadi_sq(a07);
+  a10=(a07/a01);
+  a09=(a10/a05);
+  a08=arg[1]? arg[1][2] : 0;
+  a11=(a00<=a08);
+  a11=(a11?a03:0);
+  a12=arg[2]? arg[2][15] : 0;
+  a12=(-a12);
+  a08=(a08<=a12);
+  a08=(a08?a03:0);
+  a11=(a11+a08);
+  a09=(a09*a11);
+  a08=arg[2]? arg[2][21] : 0;
+  a12=casadi_sq(a08);
+  a13=arg[2]? arg[2][8] : 0;
+  a14=(a12/a13);
+  a10=(a10+a14);
+  a09=(a09/a10);
+  a09=(a06*a09);
+  a09=(-a09);
+  if (res[0]!=0) res[0][21]=a09;
+  if (res[0]!=0) res[0][22]=a00;
+  a09=(a11/a05);
+  a09=(a06*a09);
+  a09=(-a09);
+  if (res[0]!=0) res[0][23]=a09;
+  if (res[0]!=0) res[0][24]=a00;
+  a14=(a14/a05);
+  a14=(a14*a11);
+  a14=(a14/a10);
+  a06=(a06*a14);
+  a06=(-a06);
+  if (res[0]!=0) res[0][25]=a06;
+  if (res[0]!=0) res[0][26]=a00;
+  if (res[0]!=0) res[0][27]=a00;
+  if (res[0]!=0) res[0][28]=a00;
+  if (res[0]!=0) res[0][29]=a00;
+  if (res[0]!=0) res[0][30]=a00;
+  a06=-2.;
+  a14=arg[2]? arg[2][1] : 0;
+  a14=(a06*a14);
+  a01=(a14/a01);
+  a07=(a07*a01);
+  a07=(a07/a04);
+  a07=(a07/a10);
+  if (res[0]!=0) res[0][31]=a07;
+  if (res[0]!=0) res[0][32]=a03;
+  a07=(a14/a04);
+  if (res[0]!=0) res[0][33]=a07;
+  if (res[0]!=0) res[0][34]=a00;
+  a14=(a14/a13);
+  a12=(a12*a14);
+  a12=(a12/a04);
+  a12=(a12/a10);
+  if (res[0]!=0) res[0][35]=a12;
+  if (res[0]!=0) res[0][36]=a00;
+  if (res[0]!=0) res[0][37]=a00;
+  if (res[0]!=0) res[0][38]=a00;
+  if (res[0]!=0) res[0][39]=a00;
+  if (res[0]!=0) res[0][40]=a00;
+  if (res[0]!=0) res[0][41]=a00;
+  if (res[0]!=0) res[0][42]=a00;
+  a12=arg[2]? arg[2][18] : 0;
+  a10=(a12/a13);
+  a10=(a10/a05);
+  a10=(-a10);
+  if (res[0]!=0) res[0][43]=a10;
+  if (res[0]!=0) res[0][44]=a00;
+  a10=(1./a13);
+  a14=arg[2]? arg[2][9] : 0;
+  a07=(1./a14);
+  a10=(a10+a07);
+  a07=(a12/a05);
+  a07=(a10*a07);
+  a07=(-a07);
+  if (res[0]!=0) res[0][45]=a07;
+  if (res[0]!=0) res[0][46]=a00;
+  a07=arg[2]? arg[2][22] : 0;
+  a12=(a12*a07);
+  a12=(a12/a14);
+  a12=(a12/a08);
+  a12=(a12/a05);
+  a12=(-a12);
+  if (res[0]!=0) res[0][47]=a12;
+  if (res[0]!=0) res[0][48]=a00;
+  if (res[0]!=0) res[0][49]=a00;
+  if (res[0]!=0) res[0][50]=a00;
+  if (res[0]!=0) res[0][51]=a00;
+  if (res[0]!=0) res[0][52]=a00;
+  a12=arg[2]? arg[2][13] : 0;
+  a13=(a12/a13);
+  a13=(a13/a04);
+  a13=(-a13);
+  if (res[0]!=0) res[0][53]=a13;
+  if (res[0]!=0) res[0][54]=a03;
+  a13=(a12/a04);
+  a10=(a10*a13);
+  a10=(-a10);
+  if (res[0]!=0) res[0][55]=a10;
+  if (res[0]!=0) res[0][56]=a00;
+  a12=(a12*a07);
+  a12=(a12/a14);
+  a12=(a12/a08);
+  a12=(a12/a04);
+  a12=(-a12);
+  if (res[0]!=0) res[0][57]=a12;
+  if (res[0]!=0) res[0][58]=a00;
+  if (res[0]!=0) res[0][59]=a00;
+  if (res[0]!=0) res[0][60]=a00;
+  if (res[0]!=0) res[0][61]=a00;
+  if (res[0]!=0) res[0][62]=a00;
+  if (res[0]!=0) res[0][63]=a00;
+  if (res[0]!=0) res[0][64]=a00;
+  a12=4.5350021439999999e-02;
+  a10=1.2459016393442623e+00;
+  a10=(a10*a02);
+  a13=sin(a10);
+  a12=(a12*a13);
+  a12=(a03+a12);
+  a13=5.9288166009999997e-03;
+  a01=2.1803278688524590e+00;
+  a01=(a01*a02);
+  a11=sin(a01);
+  a13=(a13*a11);
+  a12=(a12+a13);
+  a13=2.5895748289999998e-01;
+  a11=3.1147540983606559e-01;
+  a11=(a11*a02);
+  a09=sin(a11);
+  a13=(a13*a09);
+  a12=(a12+a13);
+  a13=4.1311748459999997e-03;
+  a09=9.3442622950819676e-01;
+  a09=(a09*a02);
+  a15=sin(a09);
+  a13=(a13*a15);
+  a12=(a12+a13);
+  a13=7.7092779900000005e-02;
+  a15=6.2295081967213117e-01;
+  a15=(a15*a02);
+  a16=sin(a15);
+  a13=(a13*a16);
+  a12=(a12+a13);
+  a13=1.0731786070000001e-02;
+  a16=1.5573770491803278e+00;
+  a16=(a16*a02);
+  a17=sin(a16);
+  a13=(a13*a17);
+  a12=(a12+a13);
+  a13=2.7203068860000000e-03;
+  a17=1.8688524590163935e+00;
+  a17=(a17*a02);
+  a02=sin(a17);
+  a13=(a13*a02);
+  a12=(a12+a13);
+  a13=1.3325609489999999e-02;
+  a16=cos(a16);
+  a13=(a13*a16);
+  a12=(a12+a13);
+  a13=6.2394082849999997e-02;
+  a15=cos(a15);
+  a13=(a13*a15);
+  a12=(a12+a13);
+  a13=-1.2277882320000000e-01;
+  a11=cos(a11);
+  a13=(a13*a11);
+  a12=(a12+a13);
+  a13=-6.0179578089999998e-03;
+  a17=cos(a17);
+  a13=(a13*a17);
+  a12=(a12+a13);
+  a13=-2.0371871579999999e-02;
+  a09=cos(a09);
+  a13=(a13*a09);
+  a12=(a12+a13);
+  a13=-1.0772115660000000e-02;
+  a10=cos(a10);
+  a13=(a13*a10);
+  a12=(a12+a13);
+  a13=-1.0423630300000001e-04;
+  a01=cos(a01);
+  a13=(a13*a01);
+  a12=(a12+a13);
+  a13=arg[2]? arg[2][2] : 0;
+  a01=(a13*a08);
+  a01=(a01*a07);
+  a01=(a01/a14);
+  a01=(a01/a05);
+  a10=arg[1]? arg[1][6] : 0;
+  a09=(a00<=a10);
+  a09=(a09?a03:0);
+  a17=arg[2]? arg[2][16] : 0;
+  a17=(-a17);
+  a10=(a10<=a17);
+  a10=(a10?a03:0);
+  a09=(a09+a10);
+  a01=(a01*a09);
+  a10=casadi_sq(a07);
+  a10=(a10/a14);
+  a17=arg[2]? arg[2][23] : 0;
+  a17=casadi_sq(a17);
+  a11=arg[2]? arg[2][10] : 0;
+  a15=(a17/a11);
+  a10=(a10+a15);
+  a01=(a01/a10);
+  a01=(a12*a01);
+  a01=(-a01);
+  if (res[0]!=0) res[0][65]=a01;
+  if (res[0]!=0) res[0][66]=a00;
+  a01=(a13/a05);
+  a01=(a01*a09);
+  a01=(a12*a01);
+  a01=(-a01);
+  if (res[0]!=0) res[0][67]=a01;
+  if (res[0]!=0) res[0][68]=a00;
+  a13=(a13/a11);
+  a13=(a13*a17);
+  a13=(a13/a05);
+  a13=(a13*a09);
+  a13=(a13/a10);
+  a12=(a12*a13);
+  a12=(-a12);
+  if (res[0]!=0) res[0][69]=a12;
+  if (res[0]!=0) res[0][70]=a00;
+  if (res[0]!=0) res[0][71]=a00;
+  if (res[0]!=0) res[0][72]=a00;
+  if (res[0]!=0) res[0][73]=a00;
+  if (res[0]!=0) res[0][74]=a00;
+  a12=arg[2]? arg[2][3] : 0;
+  a08=(a06*a08);
+  a08=(a08*a07);
+  a08=(a12*a08);
+  a08=(a08/a14);
+  a08=(a08/a04);
+  a08=(a08/a10);
+  if (res[0]!=0) res[0][75]=a08;
+  if (res[0]!=0) res[0][76]=a03;
+  a06=(a06*a12);
+  a12=(a06/a04);
+  if (res[0]!=0) res[0][77]=a12;
+  if (res[0]!=0) res[0][78]=a00;
+  a06=(a06/a11);
+  a17=(a17*a06);
+  a17=(a17/a04);
+  a17=(a17/a10);
+  if (res[0]!=0) res[0][79]=a17;
+  if (res[0]!=0) res[0][80]=a00;
+  if (res[0]!=0) res[0][81]=a00;
+  if (res[0]!=0) res[0][82]=a00;
+  if (res[0]!=0) res[0][83]=a00;
+  if (res[0]!=0) res[0][84]=a00;
+  if (res[0]!=0) res[0][85]=a00;
+  if (res[0]!=0) res[0][86]=a00;
+  a17=arg[2]? arg[2][19] : 0;
+  a10=(a17/a11);
+  a10=(a10/a05);
+  a10=(-a10);
+  if (res[0]!=0) res[0][87]=a10;
+  if (res[0]!=0) res[0][88]=a00;
+  a10=arg[2]? arg[2][6] : 0;
+  a10=(1./a10);
+  a06=(1./a11);
+  a10=(a10+a06);
+  a17=(a17/a05);
+  a17=(a10*a17);
+  a17=(-a17);
+  if (res[0]!=0) res[0][89]=a17;
+  if (res[0]!=0) res[0][90]=a00;
+  if (res[0]!=0) res[0][91]=a00;
+  if (res[0]!=0) res[0][92]=a00;
+  if (res[0]!=0) res[0][93]=a00;
+  if (res[0]!=0) res[0][94]=a00;
+  if (res[0]!=0) res[0][95]=a00;
+  if (res[0]!=0) res[0][96]=a00;
+  a00=arg[2]? arg[2][14] : 0;
+  a11=(a00/a11);
+  a11=(a11/a04);
+  a11=(-a11);
+  if (res[0]!=0) res[0][97]=a11;
+  if (res[0]!=0) res[0][98]=a03;
+  a00=(a00/a04);
+  a10=(a10*a00);
+  a10=(-a10);
+  if (res[0]!=0) res[0][99]=a10;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int jacobian(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f1(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int jacobian_n_in(void) { return 3;}
+
+CASADI_SYMBOL_EXPORT casadi_int jacobian_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real jacobian_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* jacobian_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "y";
+    case 2: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* jacobian_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "J";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s1;
+    case 2: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s3;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* constants:(p[24])->(c[31],period) */
+static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14;
+  a00=arg[0]? arg[0][12] : 0;
+  a01=arg[0]? arg[0][0] : 0;
+  a02=(a00/a01);
+  a03=arg[0]? arg[0][7] : 0;
+  a04=(1./a03);
+  a05=arg[0]? arg[0][11] : 0;
+  a05=(1./a05);
+  a04=(a04+a05);
+  a02=(a02*a04);
+  a02=(-a02);
+  if (res[0]!=0) res[0][0]=a02;
+  a02=arg[0]? arg[0][17] : 0;
+  a05=casadi_sq(a01);
+  a06=(a02/a05);
+  a06=(a06*a04);
+  a06=(-a06);
+  if (res[0]!=0) res[0][1]=a06;
+  a06=arg[0]? arg[0][15] : 0;
+  if (res[0]!=0) res[0][2]=a06;
+  a06=arg[0]? arg[0][20] : 0;
+  a06=casadi_sq(a06);
+  a04=(a06/a03);
+  a07=(a04/a05);
+  a08=arg[0]? arg[0][21] : 0;
+  a09=casadi_sq(a08);
+  a10=arg[0]? arg[0][8] : 0;
+  a11=(a09/a10);
+  a04=(a04+a11);
+  a07=(a07/a04);
+  a07=(-a07);
+  if (res[0]!=0) res[0][3]=a07;
+  a07=-2.;
+  a12=arg[0]? arg[0][1] : 0;
+  a12=(a07*a12);
+  a13=(a12/a03);
+  a13=(a13*a06);
+  a13=(a13/a01);
+  a13=(a13/a04);
+  if (res[0]!=0) res[0][4]=a13;
+  a13=arg[0]? arg[0][4] : 0;
+  a13=(a13/a05);
+  if (res[0]!=0) res[0][5]=a13;
+  a13=(1./a05);
+  a13=(-a13);
+  if (res[0]!=0) res[0][6]=a13;
+  a13=(a12/a01);
+  if (res[0]!=0) res[0][7]=a13;
+  a00=(a00/a03);
+  a00=(a00/a01);
+  a00=(-a00);
+  if (res[0]!=0) res[0][8]=a00;
+  a00=arg[0]? arg[0][13] : 0;
+  a13=(a00/a10);
+  a13=(a13/a01);
+  a13=(-a13);
+  if (res[0]!=0) res[0][9]=a13;
+  a02=(a02/a03);
+  a02=(a02/a05);
+  a02=(-a02);
+  if (res[0]!=0) res[0][10]=a02;
+  a02=arg[0]? arg[0][18] : 0;
+  a03=(a02/a10);
+  a03=(a03/a05);
+  a03=(-a03);
+  if (res[0]!=0) res[0][11]=a03;
+  a03=(a00/a01);
+  a13=(1./a10);
+  a06=arg[0]? arg[0][9] : 0;
+  a14=(1./a06);
+  a13=(a13+a14);
+  a03=(a03*a13);
+  a03=(-a03);
+  if (res[0]!=0) res[0][12]=a03;
+  a03=(a02/a05);
+  a03=(a03*a13);
+  a03=(-a03);
+  if (res[0]!=0) res[0][13]=a03;
+  a11=(a11/a05);
+  a11=(a11/a04);
+  a11=(-a11);
+  if (res[0]!=0) res[0][14]=a11;
+  a12=(a12/a10);
+  a12=(a12*a09);
+  a12=(a12/a01);
+  a12=(a12/a04);
+  if (res[0]!=0) res[0][15]=a12;
+  a12=(a07*a08);
+  a04=arg[0]? arg[0][22] : 0;
+  a12=(a12*a04);
+  a09=arg[0]? arg[0][3] : 0;
+  a12=(a12*a09);
+  a12=(a12/a06);
+  a12=(a12/a01);
+  a10=casadi_sq(a04);
+  a10=(a10/a06);
+  a11=arg[0]? arg[0][23] : 0;
+  a11=casadi_sq(a11);
+  a03=arg[0]? arg[0][10] : 0;
+  a13=(a11/a03);
+  a10=(a10+a13);
+  a12=(a12/a10);
+  if (res[0]!=0) res[0][16]=a12;
+  a12=arg[0]? arg[0][16] : 0;
+  if (res[0]!=0) res[0][17]=a12;
+  a12=arg[0]? arg[0][2] : 0;
+  a13=(a12*a08);
+  a13=(a13*a04);
+  a13=(a13/a06);
+  a13=(a13/a05);
+  a13=(a13/a10);
+  a13=(-a13);
+  if (res[0]!=0) res[0][18]=a13;
+  a07=(a07*a09);
+  a09=(a07/a01);
+  if (res[0]!=0) res[0][19]=a09;
+  a09=(a12/a05);
+  a09=(-a09);
+  if (res[0]!=0) res[0][20]=a09;
+  a09=arg[0]? arg[0][14] : 0;
+  a13=(a09/a03);
+  a13=(a13/a01);
+  a13=(-a13);
+  if (res[0]!=0) res[0][21]=a13;
+  a13=arg[0]? arg[0][19] : 0;
+  a14=(a13/a03);
+  a14=(a14/a05);
+  a14=(-a14);
+  if (res[0]!=0) res[0][22]=a14;
+  a00=(a00*a04);
+  a00=(a00/a06);
+  a00=(a00/a08);
+  a00=(a00/a01);
+  a00=(-a00);
+  if (res[0]!=0) res[0][23]=a00;
+  a02=(a02*a04);
+  a02=(a02/a06);
+  a02=(a02/a08);
+  a02=(a02/a05);
+  a02=(-a02);
+  if (res[0]!=0) res[0][24]=a02;
+  a09=(a09/a01);
+  a02=arg[0]? arg[0][6] : 0;
+  a02=(1./a02);
+  a08=(1./a03);
+  a02=(a02+a08);
+  a09=(a09*a02);
+  a09=(-a09);
+  if (res[0]!=0) res[0][25]=a09;
+  a13=(a13/a05);
+  a13=(a13*a02);
+  a13=(-a13);
+  if (res[0]!=0) res[0][26]=a13;
+  a07=(a07/a03);
+  a07=(a07*a11);
+  a07=(a07/a01);
+  a07=(a07/a10);
+  if (res[0]!=0) res[0][27]=a07;
+  a12=(a12/a03);
+  a12=(a12*a11);
+  a12=(a12/a05);
+  a12=(a12/a10);
+  a12=(-a12);
+  if (res[0]!=0) res[0][28]=a12;
+  a12=arg[0]? arg[0][5] : 0;
+  a12=(a12/a05);
+  if (res[0]!=0) res[0][29]=a12;
+  a12=1.5707963267948967e-02;
+  if (res[0]!=0) res[0][30]=a12;
+  a12=3.8327430373795477e+02;
+  if (res[1]!=0) res[1][0]=a12;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int constants(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f2(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int constants_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void constants_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void constants_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void constants_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int constants_n_in(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_int constants_n_out(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_real constants_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* constants_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* constants_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "c";
+    case 1: return "period";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s4;
+    case 1: return casadi_s0;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int constants_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 1;
+  if (sz_res) *sz_res = 2;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 1*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 2*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* table_point:(t,p[24])->(values[2]) */
+static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a0, a1, a2, a3, a4, a5, a6, a7, a8, a9;
+  a0=1.;
+  a1=2.1984919300000000e-01;
+  a2=arg[0]? arg[0][0] : 0;
+  a3=sin(a2);
+  a1=(a1*a3);
+  a1=(a0+a1);
+  a3=-1.4648076380000000e-01;
+  a4=cos(a2);
+  a3=(a3*a4);
+  a1=(a1+a3);
+  a3=2.3399851510000000e-03;
+  a4=3.;
+  a4=(a4*a2);
+  a5=sin(a4);
+  a3=(a3*a5);
+  a1=(a1+a3);
+  a3=5.2571706769999997e-03;
+  a5=6.;
+  a5=(a5*a2);
+  a6=cos(a5);
+  a3=(a3*a6);
+  a1=(a1+a3);
+  a3=1.2362118350000000e-02;
+  a4=cos(a4);
+  a3=(a3*a4);
+  a1=(a1+a3);
+  a3=2.6627245229999999e-02;
+  a4=5.;
+  a4=(a4*a2);
+  a6=sin(a4);
+  a3=(a3*a6);
+  a1=(a1+a3);
+  a3=1.1011287700000000e-01;
+  a6=(2.*a2);
+  a7=sin(a6);
+  a3=(a3*a7);
+  a1=(a1+a3);
+  a3=4.5469359220000000e-03;
+  a4=cos(a4);
+  a3=(a3*a4);
+  a1=(a1+a3);
+  a3=2.3457193629999999e-03;
+  a5=sin(a5);
+  a3=(a3*a5);
+  a1=(a1+a3);
+  a3=4.5160754929999998e-02;
+  a6=cos(a6);
+  a3=(a3*a6);
+  a1=(a1+a3);
+  a3=2.3017182309999999e-02;
+  a6=4.;
+  a6=(a6*a2);
+  a5=sin(a6);
+  a3=(a3*a5);
+  a1=(a1+a3);
+  a3=1.6171101790000001e-03;
+  a5=7.;
+  a5=(a5*a2);
+  a4=sin(a5);
+  a3=(a3*a4);
+  a1=(a1+a3);
+  a3=-2.6772198850000001e-03;
+  a5=cos(a5);
+  a3=(a3*a5);
+  a1=(a1+a3);
+  a3=-2.4174349450000000e-02;
+  a6=cos(a6);
+  a3=(a3*a6);
+  a1=(a1+a3);
+  if (res[0]!=0) res[0][0]=a1;
+  a1=4.5350021439999999e-02;
+  a3=1.2459016393442623e+00;
+  a3=(a3*a2);
+  a6=sin(a3);
+  a1=(a1*a6);
+  a0=(a0+a1);
+  a1=5.9288166009999997e-03;
+  a6=2.1803278688524590e+00;
+  a6=(a6*a2);
+  a5=sin(a6);
+  a1=(a1*a5);
+  a0=(a0+a1);
+  a1=2.5895748289999998e-01;
+  a5=3.1147540983606559e-01;
+  a5=(a5*a2);
+  a4=sin(a5);
+  a1=(a1*a4);
+  a0=(a0+a1);
+  a1=4.1311748459999997e-03;
+  a4=9.3442622950819676e-01;
+  a4=(a4*a2);
+  a7=sin(a4);
+  a1=(a1*a7);
+  a0=(a0+a1);
+  a1=7.7092779900000005e-02;
+  a7=6.2295081967213117e-01;
+  a7=(a7*a2);
+  a8=sin(a7);
+  a1=(a1*a8);
+  a0=(a0+a1);
+  a1=1.0731786070000001e-02;
+  a8=1.5573770491803278e+00;
+  a8=(a8*a2);
+  a9=sin(a8);
+  a1=(a1*a9);
+  a0=(a0+a1);
+  a1=2.7203068860000000e-03;
+  a9=1.8688524590163935e+00;
+  a9=(a9*a2);
+  a2=sin(a9);
+  a1=(a1*a2);
+  a0=(a0+a1);
+  a1=1.3325609489999999e-02;
+  a8=cos(a8);
+  a1=(a1*a8);
+  a0=(a0+a1);
+  a1=6.2394082849999997e-02;
+  a7=cos(a7);
+  a1=(a1*a7);
+  a0=(a0+a1);
+  a1=-1.2277882320000000e-01;
+  a5=cos(a5);
+  a1=(a1*a5);
+  a0=(a0+a1);
+  a1=-6.0179578089999998e-03;
+  a9=cos(a9);
+  a1=(a1*a9);
+  a0=(a0+a1);
+  a1=-2.0371871579999999e-02;
+  a4=cos(a4);
+  a1=(a1*a4);
+  a0=(a0+a1);
+  a1=-1.0772115660000000e-02;
+  a3=cos(a3);
+  a1=(a1*a3);
+  a0=(a0+a1);
+  a1=-1.0423630300000001e-04;
+  a6=cos(a6);
+  a1=(a1*a6);
+  a0=(a0+a1);
+  if (res[0]!=0) res[0][1]=a0;
+  return 0;
+}
+
+/* map48801_table_point:(t[1x48801],p[24x48801])->(values[2x48801]) */
+static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_int i;
+  casadi_real* *res1;
+  const casadi_real* *arg1;
+  arg1 = arg+2;
+  for (i=0; i<2; ++i) arg1[i]=arg[i];
+  res1 = res+1;
+  for (i=0; i<1; ++i) res1[i]=res[i];
+  for (i=0; i<48801; ++i) {
+    if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+    if (arg1[0]) arg1[0]+=1;
+    if (arg1[1]) arg1[1]+=24;
+    if (res1[0]) res1[0]+=2;
+  }
+  return 0;
+}
+
+/* table:(t0,p[24])->(table[6x24400],probe[2x2]) */
+static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_int i, j;
+  casadi_real **res1=res+2, *rr, w00, *w01=w+15, *w03=w+48816, w04, w05, w06, *w07=w+48847, *w08=w+1220071, *w09=w+1317673, *w10=w+1366473;
+  casadi_real *w11=w+1415273, *w12=w+1464073, *w13=w+1512873, *w14=w+1659273, *w15=w+1805673;
+  const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
+  w00 = arg[0] ? arg[0][0] : 0;
+  wr01 = casadi_c0;
+  wr02 = arg[1] ? arg[1] : casadi_zeros;
+  arg1[0]=wr02;
+  res1[0]=w03;
+  res1[1]=(&w04);
+  if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
+  for (rr=(&w05), cs=w03+30; cs!=w03+31; cs+=1) *rr++ = *cs;
+  w06 = 2.;
+  w05 /= w06;
+  for (i=0, rr=w01, cr=wr01; i<48801; ++i) (*rr++)  = ((*cr++)*w05);
+  for (i=0, rr=w01, cs=w01; i<48801; ++i) (*rr++)  = (w00+(*cs++));
+  for (i=0;i<48801;++i) {
+    casadi_copy(wr02, 24, w07+ i*24);
+  }
+  arg1[0]=w01;
+  arg1[1]=w07;
+  res1[0]=w08;
+  if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
+  for (rr=w09, cs=w08+0; cs!=w08+97600; cs+=4) for (ct=cs+0; ct!=cs+2; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w10, cs=w09; i<24400; ++i) for (j=0; j<2; ++j) rr[i+j*24400] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+97600; cs+=4) for (ct=cs+2; ct!=cs+4; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w11, cs=w09; i<24400; ++i) for (j=0; j<2; ++j) rr[i+j*24400] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+97600; cs+=4) for (ct=cs+4; ct!=cs+6; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w12, cs=w09; i<24400; ++i) for (j=0; j<2; ++j) rr[i+j*24400] = *cs++;
+  rr=w13;
+  for (i=0, cs=w10; i<48800; ++i) *rr++ = *cs++;
+  for (i=0, cs=w11; i<48800; ++i) *rr++ = *cs++;
+  for (i=0, cs=w12; i<48800; ++i) *rr++ = *cs++;
+  for (i=0, rr=w14, cs=w13; i<6; ++i) for (j=0; j<24400; ++j) rr[i+j*6] = *cs++;
+  casadi_copy(w14, 146400, res[0]);
+  w05 = 3.7000000000000000e-01;
+  w05 *= w04;
+  w05  = (w00+w05);
+  arg1[0]=(&w05);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  casadi_copy(w15, 2, res[1]);
+  w05 = 1.3700000000000001e+00;
+  w05 *= w04;
+  w00 += w05;
+  arg1[0]=(&w00);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (res[1]) casadi_copy(w15, 2, res[1]+2);
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f3(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int table_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void table_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void table_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void table_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t0";
+    case 1: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "table";
+    case 1: return "probe";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s5;
+    case 1: return casadi_s6;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 6;
+  if (sz_res) *sz_res = 4;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 1805675;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 1805675*sizeof(casadi_real);
+  return 0;
 }
 
 /* one block of tangent steps (the SX functions' step, as CasADi's Switch runs it) */
@@ -17894,6 +18077,8 @@ CASADI_SYMBOL_EXPORT int monodromy_period_work_bytes(casadi_int *sz_arg, casadi_
   return 0;
 }
 
+
+#endif  /* GEARSYM_STEP_PIECES_ONLY */
 
 #ifdef __cplusplus
 } /* extern "C" */
