@@ -43,8 +43,9 @@ def test_integration_counts_every_period_and_the_paper_scheme_is_plain_rk4():
     assert Integration() == Integration(periods=400, discard=100, steps_per_period=200, locate_crossings=True,
                                         backend="auto")
     assert Integration(periods=140, discard=100).measured == 40
-    assert Integration.paper(periods=160) == Integration(periods=160, locate_crossings=False)
-    assert Integration.paper().run(periods=30, discard=10) == Integration(30, 10, locate_crossings=False)
+    assert Integration.paper(periods=160) == Integration(periods=160, locate_crossings=False, integrator="rk4")
+    assert Integration.paper().run(periods=30, discard=10) == Integration(30, 10, locate_crossings=False,
+                                                                          integrator="rk4")
 
 
 # ------------------------------------------------------------------ names are resolved by gearsym.load
@@ -73,8 +74,10 @@ def test_a_compiled_model_runs_any_length_but_refuses_options_that_need_other_co
     r = gearsym.lyapunov_spectrum(cm, options=Integration(periods=30, discard=10, backend="auto"), omega=1.3)
     assert (r.periods, r.discard, r.strobe.shape) == (30, 10, (2, 20))
     assert gearsym.lyapunov_spectrum(cm, omega=1.3).periods == 400  # no options: the ones it was compiled with
-    for other in (Integration.paper(periods=30, discard=10), Integration(30, 10, steps_per_period=100),
-                  Integration(periods=30, discard=10, backend="in-process")):
+    # an integrator left to choose ("auto") with fewer steps than the model's takes the model's own choice
+    assert gearsym.poincare_samples(cm, options=Integration(30, 10, steps_per_period=100)).strobe.shape[-1] == 20
+    for other in (Integration.paper(periods=30, discard=10), Integration(30, 10, steps_per_period=100, integrator="rk4"),
+                  Integration(30, 10, steps_per_period=400), Integration(periods=30, discard=10, backend="in-process")):
         with pytest.raises(GearsymError, match=r"compile the system with these options "
                                                r"\(compile_model\(system, options\)\)") as caught:
             gearsym.poincare_samples(cm, options=other)

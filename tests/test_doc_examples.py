@@ -37,7 +37,7 @@ def test_the_pages_have_examples_and_only_a_few_are_not_run():
     assert sum(b.runs for b in BLOCKS) >= 20
     assert sum(b.language == "python" and b.runs for b in BLOCKS) >= 6
     not_run = [b for b in BLOCKS if b.not_run is not None]
-    assert len(not_run) <= 8, [f"{b.name}: {b.not_run}" for b in not_run]  # few, each with its reason
+    assert len(not_run) <= 10, [f"{b.name}: {b.not_run}" for b in not_run]  # few, each with its reason
 
 
 @pytest.mark.parametrize("block", BLOCKS, ids=lambda b: b.name)

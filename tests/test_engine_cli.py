@@ -46,7 +46,7 @@ def test_lyap_locates_the_crossings_unless_told_plain_as_the_python_api_does(cap
         expected = gearsym.lyapunov_spectrum(system("one_stage"), options=options, omega=1.5)
         assert json.loads(out)["exponents"] == list(expected.exponents), flags
     code, out, _ = run(capsys, *argv, "--plain")
-    assert "200 RK4 steps/period, plain RK4" in out
+    assert "200 RK4 steps/period, plain, compiled" in out
     code, out, _ = run(capsys, *argv)
     assert "200 RK4 steps/period, crossings located" in out
 

@@ -17,6 +17,7 @@ from ..physical.sweeps import nondimensional_axes
 from ..options import PARALLEL, Execution
 from ..sweep import DIRECTIONS, MODES, POINCARE_SAMPLES, Workers, run_sweep
 from ..sweep.grid import axes_from
+from ..sweep.run import poincare_samples_of
 from ..sweep.report import findings_lines
 from ..sweep.store import sidecar
 from .arguments.integration import (add_integration_arguments, chosen_over, compiled_from, integration_from, scaling_from,
@@ -79,6 +80,7 @@ def run(args: argparse.Namespace) -> int:
     Workers.of(execution)  # (no Dask, a bad address, more jobs than cores: said before the model is compiled)
     y0 = parse_state(args.y0)  # before the model is compiled
     options = integration_from(args)  # (sizes too) before the model is loaded
+    poincare_samples_of(args.poincare, options)
     given = axes_from(args.param)
     scaling = scaling_from(args)
     axes = _engine_axes(given, scaling)

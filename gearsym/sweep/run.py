@@ -132,6 +132,18 @@ def _one_line(exc: BaseException, store: SweepStore | None) -> BaseException:
                         "to resume")
 
 
+def poincare_samples_of(poincare: int, options: Integration) -> int:
+    """The Poincare samples a sweep's point keeps: ``poincare``, checked against the periods ``options`` measure
+    (the default: as many as they measure, up to POINCARE_SAMPLES)."""
+    poincare = whole_number(poincare, "poincare samples")
+    if poincare > options.measured and poincare != POINCARE_SAMPLES:  # (the default fits what a run measures)
+        raise GearsymError(f"{caller.option('poincare', poincare)}: a point has one Poincare sample per measured "
+                           f"period, {options.measured} here ({caller.option('periods', options.periods)} minus "
+                           f"{caller.option('discard', options.discard)}): give at most {options.measured}, or "
+                           "more periods")
+    return min(poincare, options.measured)
+
+
 @dataclass(frozen=True)
 class _SweepPlan:
     """Everything a sweep decides before its first point: the checked grid, the start, columns and record."""
@@ -150,13 +162,7 @@ class _SweepPlan:
     @classmethod
     def make(cls, compiled: CompiledModel, axes, options: Integration, mode: str, direction: str, y0, poincare: int,
              values: dict) -> "_SweepPlan":
-        poincare = whole_number(poincare, "poincare samples")
-        if poincare > options.measured and poincare != POINCARE_SAMPLES:  # (the default fits what a run measures)
-            raise GearsymError(f"{caller.option('poincare', poincare)}: a point has one Poincare sample per measured "
-                               f"period, {options.measured} here ({caller.option('periods', options.periods)} minus "
-                               f"{caller.option('discard', options.discard)}): give at most {options.measured}, or "
-                               "more periods")
-        poincare = min(poincare, options.measured)
+        poincare = poincare_samples_of(poincare, options)
         if mode == INDEPENDENT and direction != "up":
             raise GearsymError(f"--direction {direction} applies to a continuation; independent points have no "
                                "direction")
