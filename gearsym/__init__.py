@@ -35,6 +35,7 @@ from .version import __version__
 #: public name -> the module that defines it (imported when the name is first used: the declaring and
 #: reducing stages import SymPy, which a command on a cached model never needs)
 _LAZY = {
+    "Bearing": "gearsym.model.components",
     "Disk": "gearsym.model.components",
     "Drivetrain": "gearsym.model.drivetrain",
     "Gear": "gearsym.model.components",
@@ -124,7 +125,7 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .fit import EFFECTS, explain
     from .fmu.export import export_fmu
     from .loading import is_physical, load, natural_modes, scaling
-    from .model.components import Disk, Gear, Harmonic, Mesh, Planet, Shaft, Torque
+    from .model.components import Bearing, Disk, Gear, Harmonic, Mesh, Planet, Shaft, Torque
     from .model.drivetrain import Drivetrain
     from .model.faults import Eccentricity, Spall, SpacingErrors, ToothFault
     from .model.stiffness import rectangular_mesh_stiffness

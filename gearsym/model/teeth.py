@@ -75,8 +75,9 @@ def _copy(model: Drivetrain, teeth: dict[str, int]) -> Drivetrain:
 
     for body in model.bodies:
         out.add(rewired(new[body.name]))
-    for component in (*model.couplings, *model.torques, *model.shaft_terms):
+    for component in (*model.joints, *model.torques, *model.shaft_terms):
         out.add(rewired(component))
+    out._frame_terms = model.frame_terms
     out.set_defaults(**model.defaults)
     out.describe(**model.descriptions)
     if model.physical:
