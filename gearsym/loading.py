@@ -9,13 +9,14 @@ from __future__ import annotations
 
 import os
 
-from .analysis.modes import Modes, nondimensional_modes, physical_modes
+from .analysis.modes import Modes, drivetrain_modes, nondimensional_modes, physical_modes
 from .errors import GearsymError
 from .model.teeth import with_teeth
 from .physical.answers import PhysicalScaling
 from .reduction import NondimensionalModel, reduce
 from .registry import load_model, model_options
 from .scales.settings import maybe_number, physical_settings
+from .scales.si_values import si_values
 from .system import FirstOrderSystem
 from .units import is_quantity
 
@@ -97,6 +98,12 @@ def natural_modes(model, *, teeth=None, **settings) -> Modes:
     model without, nondimensional parameter values (``kS=0.5``); a stiffness formula (``k="1+0.2*cos(tau)"``)
     enters through its mean."""
     options, settings = split_options(model, settings)
+    found = declared(model, teeth, options) if not isinstance(model, NondimensionalModel) else model.drivetrain
+    plain = all(is_quantity(v) or isinstance(maybe_number(v), (int, float)) for v in settings.values())
+    if getattr(found, "is_drivetrain", False) and getattr(found, "bearings", None) and found.physical \
+            and "length_scale" not in settings and plain:
+        # (a drivetrain on bearings: its modes from its kinematics, without the long reduction)
+        return drivetrain_modes(found, si_values(found, settings))
     nd = reduced(model, teeth, options)
     split = physical_settings(nd, dict(settings))
     if split is not None:

@@ -80,7 +80,7 @@ class Modes:
 
     @property
     def elastic(self) -> tuple[Mode, ...]:
-        return tuple(m for m in self.modes if m.kind == "elastic")
+        return tuple(m for m in self.modes if m.kind != "rigid")
 
     def as_dict(self) -> dict:
         """JSON-ready: the keys of ``gearsym modes --format json`` (each mode's frequency as value and unit)."""

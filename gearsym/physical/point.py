@@ -72,6 +72,7 @@ class PhysicalPoint:
     length_unit: object  # the scaling's L
     mesh_force: dict = field(default_factory=dict)  # mesh -> {"mean", "min", "max", "dynamic"} in N
     shaft_torque: dict = field(default_factory=dict)  # shaft -> {"mean", "min", "max", "dynamic"} in N·m
+    bearing_force: dict = field(default_factory=dict)  # bearing direction -> {"mean", ...} in N
 
     def as_dict(self) -> dict:
         """JSON-ready: every value as a number with its unit beside it."""
@@ -87,6 +88,8 @@ class PhysicalPoint:
             out["mesh_force"] = {m: {k: q(v) for k, v in f.items()} for m, f in self.mesh_force.items()}
         if self.shaft_torque:
             out["shaft_torque"] = {m: {k: q(v) for k, v in f.items()} for m, f in self.shaft_torque.items()}
+        if self.bearing_force:
+            out["bearing_force"] = {m: {k: q(v) for k, v in f.items()} for m, f in self.bearing_force.items()}
         return out
 
     def lines(self) -> list[str]:
@@ -96,7 +99,8 @@ class PhysicalPoint:
                f"omega_n = {shown(self.natural_frequency)} (omega = {self.omega:.6g})",
                "Lyapunov exponents per second: " + ", ".join(f"{v:+.6g}" for v in self.exponents.magnitude)]
         out += [f"amplitude A_{k} = {shown(v)}" for k, v in self.amplitude.items()]
-        for what, table in (("mesh force", self.mesh_force), ("shaft torque", self.shaft_torque)):
+        for what, table in (("mesh force", self.mesh_force), ("shaft torque", self.shaft_torque),
+                            ("bearing force", self.bearing_force)):
             for name, f in table.items():
                 out.append(f"{what} {name}: mean {shown(f['mean'])}, {shown(f['min'])} to {shown(f['max'])} "
                            f"(dynamic amplitude {shown(f['dynamic'])})")
@@ -154,13 +158,15 @@ class MeshUnits:
 
 @dataclass(frozen=True)
 class ShaftUnits:
-    """A shaft's law in SI: torque = stiffness twist + damping d(twist)/dt."""
+    """A shaft's law in SI: torque = stiffness twist + damping d(twist)/dt; a bearing's (``kind`` "bearing"): its
+    force = stiffness deflection + damping d(deflection)/dt (N/m and N s/m, a deflection in m)."""
 
     name: str
     coordinate: str
     velocity: str
-    stiffness: float  # N m/rad
-    damping: float  # N m s/rad
+    stiffness: float  # N m/rad (a bearing's N/m)
+    damping: float  # N m s/rad (a bearing's N s/m)
+    kind: str = "shaft"
 
     def torque(self, twist, rate) -> np.ndarray:
         """The torque in N·m along a trajectory (twist in rad, its rate in rad/s)."""
@@ -274,7 +280,12 @@ class PointUnits:
             {k: self.state(k, v, w) for k, v in result.final_state.items()},
             Measured(self.length_shown, self.length_text),
             {m: self._summary(time, f, period, self.newton) for m, f in forces.items()},
-            {s: self._summary(time, f, period, self.newton_metre) for s, f in torques.items()})
+            {s: self._summary(time, f, period, self.newton_metre) for s, f in torques.items() if s in self._shafts},
+            {s: self._summary(time, f, period, self.newton) for s, f in torques.items() if s not in self._shafts})
+
+    @property
+    def _shafts(self) -> set[str]:
+        return {s.name for s in self.shafts if s.kind == "shaft"}
 
     def figure(self, result, trajectory) -> tuple:
         """A spectrum run and a trajectory at its point as a figure shows them in physical units

@@ -1,0 +1,187 @@
+"""Gears on bearings (issue 39): Lin & Parker's translational planetary model against its mass and stiffness
+matrices typed from the paper in NumPy (tests/lin_parker.py), the lateral-torsional pair against its equations
+typed here in SciPy, and the torsional limit (very stiff bearings) against spur_pair.
+"""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import gearsym
+from gearsym import Integration
+from gearsym.analysis.modes import drivetrain_modes
+from gearsym.cli import main
+from gearsym.registry import load_model
+from gearsym.scales.si_values import si_values
+from lin_parker import matrices, natural_frequencies
+
+CENTRAL = ("sun", "ring", "carrier")
+
+
+def lin_parker_parameters(values: dict) -> dict:
+    """The paper's parameters (masses, I/r^2, stiffnesses on u = r theta) from the model's SI values."""
+    r = {k: values[f"r_{k}"] for k in "sprc"}
+    return dict(m_s=values["m_s"], m_r=values["m_r"], m_c=values["m_c"], m_p=values["m_p"],
+                j_s=values["I_s"] / r["s"] ** 2, j_r=values["I_r"] / r["r"] ** 2, j_c=values["I_c"] / r["c"] ** 2,
+                j_p=values["I_p"] / r["p"] ** 2, k_s=values["k_s"], k_r=values["k_r"], k_c=values["k_c"],
+                k_su=0.0, k_cu=0.0, k_ru=values["k_ru"] / r["r"] ** 2, k_p=values["k_p"], k_sp=values["k_sp"],
+                k_rp=values["k_rp"], alpha_s=values["alpha_s"], alpha_r=values["alpha_r"])
+
+
+@pytest.fixture(scope="module", params=[3, 4, pytest.param(5, marks=pytest.mark.slow)], ids=lambda n: f"N={n}")
+def planetary(request):
+    """gearsym's modes of the translational planetary set with N planets and the paper's matrices' frequencies."""
+    planets = request.param
+    model = load_model("planetary_translational", {"planets": planets, "stationary": 1})
+    values = si_values(model, {})
+    mass, stiffness, _, _ = matrices(lin_parker_parameters(values), planets)
+    frequencies, _ = natural_frequencies(mass, stiffness)
+    return planets, drivetrain_modes(model, values), frequencies
+
+
+def test_the_translational_planetary_set_has_the_frequencies_of_lin_and_parkers_matrices(planetary):
+    planets, modes, expected = planetary
+    got = np.array(modes.frequencies)
+    assert len(got) == len(expected) == 3 * (planets + 3)
+    assert got[0] == 0.0 and expected[0] < 1e-3  # the rigid-body mode (the ring held, sun and carrier free)
+    assert np.max(np.abs(got[1:] - expected[1:]) / expected[1:]) < 1e-9
+
+
+def test_its_modes_fall_into_lin_and_parkers_three_classes_with_their_multiplicities(planetary):
+    planets, modes, _ = planetary
+    elastic = [m for m in modes.modes if m.kind != "rigid"]
+    by_kind = {kind: [m for m in elastic if m.kind == kind] for kind in ("rotational", "translational", "planet")}
+    assert len(elastic) == sum(len(v) for v in by_kind.values())  # nothing else ("mixed")
+    assert len(by_kind["rotational"]) == 5 and all(m.multiplicity == 1 for m in by_kind["rotational"])
+    assert len(by_kind["translational"]) == 12 and all(m.multiplicity == 2 for m in by_kind["translational"])
+    assert len(by_kind["planet"]) == 3 * (planets - 3)
+    assert all(m.multiplicity == planets - 3 for m in by_kind["planet"])
+    # a multiplicity is the number of modes at that frequency
+    for m in elastic:
+        assert sum(1 for o in elastic if abs(o.frequency - m.frequency) < 1e-6 * m.frequency) == m.multiplicity
+
+
+def test_its_mode_shapes_have_lin_and_parkers_properties(planetary):
+    """Rotational modes: the central members only turn and every planet moves alike; translational modes: the
+    central members only translate; planet modes: the central members do not move and the planets' motions sum to
+    zero, as do their first harmonics in the planet positions (Lin & Parker 1999, Sections 3-5)."""
+    planets, modes, _ = planetary
+    positions = [2 * math.pi * n / planets for n in range(planets)]
+    for m in modes.modes:
+        shape = m.shape
+        moves = [f"{b}.{d}" for b in CENTRAL for d in "xy" if f"{b}.{d}" in shape]
+        planet = {what: np.array([shape[f"planet{n + 1}{what}"] for n in range(planets)])
+                  for what in ("", ".radial", ".tangential")}
+        if m.kind == "rotational":
+            assert max(abs(shape[k]) for k in moves) < 1e-9
+            assert all(np.ptp(v) < 1e-9 for v in planet.values())
+        elif m.kind == "translational":
+            assert max(abs(shape[b]) for b in CENTRAL) < 1e-9
+            assert max(abs(shape[k]) for k in moves) > 1e-3
+        elif m.kind == "planet":
+            assert max(abs(shape[k]) for k in (*CENTRAL, *moves)) < 1e-9
+            for v in planet.values():
+                assert abs(v.sum()) < 1e-9
+                assert abs(v @ np.cos(positions)) < 1e-9 and abs(v @ np.sin(positions)) < 1e-9
+
+
+def test_gearsym_modes_gives_the_planetary_sets_modes_as_json_with_kind_and_multiplicity(capsys):
+    assert main(["modes", "planetary_translational", "--set", "planets=4", "--set", "stationary=1",
+                 "--format", "json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert len(out["modes"]) == 21
+    first = out["modes"][1]
+    assert set(first) >= {"frequency", "multiplicity", "kind", "shape"}
+    assert first["frequency"]["unit"] == "Hz" and first["frequency"]["value"] > 0
+    assert {m["kind"] for m in out["modes"]} == {"rigid", "rotational", "translational", "planet"}
+    assert [m["multiplicity"] for m in out["modes"] if m["kind"] == "planet"] == [1, 1, 1]
+    assert "planet3.radial" in first["shape"] and "sun.x" in first["shape"]
+
+
+# ----------------------------------------------------------------------------- the lateral-torsional pair
+
+#: a periodic point with tooth separations (single-sided impacts): near the pair's mesh resonance, light load
+PAIR = dict(k="1+0.3*cos(tau)", M1="20 N*m", M2="20 N*m", M1a="10 N*m", speed="4700 rpm")
+PAIR_RUN = Integration(steps_per_period=1024, periods=300, discard=250)
+
+
+@pytest.fixture(scope="module")
+def pair():
+    """The 4-degree-of-freedom pair at PAIR, compiled, and its periodic orbit with every RK4 step."""
+    scaling = gearsym.scaling("spur_pair_bearings", **PAIR)
+    model = gearsym.compile_model(scaling.system(), PAIR_RUN)
+    return scaling, gearsym.periodic_orbit(model, options=PAIR_RUN, trajectory=True)
+
+
+def kahraman_singh(p: dict, forcing: float):
+    """Kahraman & Singh's lateral-torsional pair, typed here in SI (y along the line of action):
+    m1 y1'' + c_b1 y1' + k_b1 y1 + F = 0, m2 y2'' + c_b2 y2' + k_b2 y2 - F = 0,
+    I1 th1'' + r1 F = M1 + M1a cos(w t + Theta), I2 th2'' - r2 F = -M2,
+    F = kZ (1 + 0.3 cos w t) g(d, eta) + cZ d', d = r1 th1 - r2 th2 + y1 - y2."""
+    eta = p["eta"]
+
+    def g(d):
+        return d if d >= 0 else (d + eta if d <= -eta else 0.0)
+
+    def rhs(t, s):
+        th1, th2, y1, y2, w1, w2, v1, v2 = s
+        d = p["r1"] * th1 - p["r2"] * th2 + y1 - y2
+        dd = p["r1"] * w1 - p["r2"] * w2 + v1 - v2
+        force = p["kZ"] * (1 + 0.3 * math.cos(forcing * t)) * g(d) + p["cZ"] * dd
+        return [w1, w2, v1, v2,
+                (p["M1"] + p["M1a"] * math.cos(forcing * t + p["Theta"]) - p["r1"] * force) / p["I1"],
+                (-p["M2"] + p["r2"] * force) / p["I2"],
+                (-p["c_b1"] * v1 - p["k_b1"] * y1 - force) / p["m1"],
+                (-p["c_b2"] * v2 - p["k_b2"] * y2 + force) / p["m2"]]
+
+    return rhs
+
+
+def test_the_pair_on_bearings_follows_its_typed_equations_at_a_periodic_point_with_tooth_separations(pair):
+    from scipy.integrate import solve_ivp
+
+    scaling, orbit = pair
+    assert orbit.stable and orbit.contact["mesh"] == "single-sided impact"
+    p = dict(scaling.si_values)
+    length, forcing = scaling.length_si, orbit.parameters["omega"] * scaling.omega_n_si
+    names = list(orbit.state_names)
+    states = dict(zip(names, orbit.trajectory))
+    tau = np.linspace(0.0, orbit.forcing_period, orbit.trajectory.shape[1])
+    x, y1, y2 = (states[n] * length for n in ("x", "y_pinion", "y_wheel"))
+    v, v1, v2 = (states[n] * length * forcing for n in ("v", "dy_pinion", "dy_wheel"))
+    # the absolute angles from the deflection (the rigid rotation is free: the pinion starts at 0)
+    start = [0.0, (y1[0] - y2[0] - x[0]) / p["r2"], y1[0], y2[0], 0.0, (v1[0] - v2[0] - v[0]) / p["r2"], v1[0], v2[0]]
+    t = tau / forcing
+    sol = solve_ivp(kahraman_singh(p, forcing), (0.0, t[-1]), start, method="DOP853", t_eval=t, rtol=1e-12,
+                    atol=1e-18, max_step=t[-1] / 400)
+    th1, th2, sy1, sy2 = sol.y[:4]
+    typed = {"x": p["r1"] * th1 - p["r2"] * th2 + sy1 - sy2, "y_pinion": sy1, "y_wheel": sy2}
+    for name, got in (("x", x), ("y_pinion", y1), ("y_wheel", y2)):
+        size = np.ptp(got)
+        assert np.max(np.abs(typed[name] - got)) < 1e-6 * size, name
+        assert abs(typed[name][-1] - typed[name][0]) < 1e-6 * size, name  # periodic in the typed equations too
+
+
+def test_the_pair_on_stiff_bearings_has_the_torsional_pairs_frequency():
+    torsional = gearsym.natural_modes("spur_pair").elastic[0].frequency
+    model = load_model("spur_pair_bearings")
+    stiff = drivetrain_modes(model, si_values(model, dict(k_b1="1e14 N/m", k_b2="1e14 N/m")))
+    nearest = min(stiff.elastic, key=lambda m: abs(m.frequency - torsional))
+    assert nearest.frequency == pytest.approx(torsional, rel=1e-5)
+    soft = drivetrain_modes(model, si_values(model, {}))  # on its real bearings the mesh mode moves away
+    assert min(abs(m.frequency - torsional) for m in soft.elastic) > 1e-3 * torsional
+
+
+def test_the_pair_on_stiff_bearings_responds_as_the_torsional_pair(pair):
+    """With bearings 1e4 times stiffer than the mesh the periodic orbit's mesh deflection is spur_pair's."""
+    run = Integration(steps_per_period=2048, periods=300, discard=250)
+    answers = {}
+    for name, extra in (("spur_pair", {}), ("spur_pair_bearings", dict(k_b1="1e12 N/m", k_b2="1e12 N/m"))):
+        scaling = gearsym.scaling(name, **PAIR, **extra)
+        orbit = gearsym.periodic_orbit(gearsym.compile_model(scaling.system(), run), options=run)
+        answers[name] = np.array(orbit.extremes["x"]) * scaling.length_si
+    torsional, lateral = answers["spur_pair"], answers["spur_pair_bearings"]
+    assert np.max(np.abs(lateral - torsional)) < 2e-3 * np.ptp(torsional)
