@@ -69,8 +69,7 @@ def build(planets: int = 3, stationary: int = 0, k_su: int = 0, k_cu: int = 0) -
                    coordinate=f"x{n + 1}", damping_group="zeta"))
     for n, planet in enumerate(gears):
         m.add(Mesh(f"ring_planet{n + 1}", ring, planet, stiffness="k_rp", damping="c_rp", pressure_angle="alpha_r",
-                   coordinate=f"y{n + 1}", damping_group="zeta_r", stiffness_group="K_r",
-                   function="k_r" if n == 0 else None))
+                   coordinate=f"y{n + 1}", damping_group="zeta_r", stiffness_group="K_r"))
     m.add(Bearing("sun_bearing", sun, stiffness="k_s", torsional="k_su" if k_su else None))
     m.add(Bearing("ring_bearing", ring, stiffness="k_r", torsional="k_ru"))
     m.add(Bearing("carrier_bearing", carrier, stiffness="k_c", torsional="k_cu" if k_cu else None))

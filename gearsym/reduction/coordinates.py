@@ -118,7 +118,7 @@ def coupling_deflections(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.M
         if i in kept:
             deflections.append(coords[kept.index(i)])
             continue
-        solve = solve or _combination_solver(transform)
+        solve = solve or combination_solver(transform)
         coefficients = solve(sp.Matrix([scaled[i]]))
         combination = tuple((c, a) for c, a in zip(coords, coefficients) if a != 0)
         deflections.append(Coordinate(names[i], rc, _definition(rd, i), combination))
@@ -130,7 +130,7 @@ def _definition(rd: ResolvedDrivetrain, i: int) -> sp.Expr:
     return sp.Add(*(rc.scale * c * a for c, a in zip(rc.row, rd.angles)))
 
 
-def _combination_solver(transform: sp.Matrix):
+def combination_solver(transform: sp.Matrix):
     """A function giving the coefficients J with ``row = J T`` exactly, for a row in the span of T: solved on
     columns where T is invertible (found at generic values), then checked on every column."""
     k = transform.rows

@@ -36,10 +36,11 @@ from ..model.resolved_components import ResolvedCoupling
 from ..checks import sign_violation
 from ..model.expressions import ExprLike, parameter_names, to_expr
 from ..model.stiffness import check_periodic
-from ..model.linear_algebra import simplified
+from ..model.linear_algebra import numeric_rank, simplified
 from ..model.translations import CARRIER_SPEED
 from ..symbols import omega, parameter_symbol, phi, t, tau
 from ..system import Constraint, Coupling, FirstOrderSystem, Gearing
+from .coordinates import combination_solver
 from .reduction import Reduction, reduce_drivetrain, sub_frame, with_geometry
 
 
@@ -338,7 +339,37 @@ class NondimensionalModel:
         return FirstOrderSystem(self.name, tau, self.states, rhs, params, self.period, descriptions,
                                 self.drivetrain.title, tuple(c.name for c in self.coordinates),
                                 self._initial(initial), self._system_couplings(functions), constraints,
-                                cycles=self.cycles)
+                                cycles=self.cycles, translations=self.translations)
+
+    @cached_property
+    def translations(self) -> dict[str, sp.Expr]:
+        """Each translation of a body centre on a bearing in the states (``pinion_y`` -> y_pinion), where the
+        coordinates determine it (a planet's tangential translation moves with the rigid-body rotation: none)."""
+        red = self.reduction
+        rd = red.resolved
+        out = {}
+        if not rd.translations:
+            return out
+        by_row = {}
+        for c in red.coordinates:
+            row = [e for e in red.transform.row(red.coordinates.index(c))]
+            nonzero = [i for i, e in enumerate(row) if e != 0]
+            if len(nonzero) == 1 and row[nonzero[0]] == 1:
+                by_row[nonzero[0]] = sp.Symbol(c.name, real=True)
+        solve = None
+        for d in rd.translations:
+            name = d.label.replace(".", "_")
+            if d.index in by_row:
+                out[name] = by_row[d.index]
+                continue
+            target = sp.zeros(1, red.transform.cols)
+            target[d.index] = 1
+            if numeric_rank(sp.Matrix.vstack(red.transform, target)) > red.transform.rows:
+                continue  # (not determined by the coordinates)
+            solve = solve or combination_solver(red.transform)
+            weights = solve(target)
+            out[name] = sp.Add(*(w * sp.Symbol(c.name, real=True) for w, c in zip(weights, red.coordinates)))
+        return out
 
     def _initial(self, initial: Optional[Mapping[str, float]]) -> dict[str, float]:
         """The initial state in the engine's units: ``initial``, or the declared numbers (a physical value needs
