@@ -687,6 +687,16 @@ def _nondimensionalize(red: Reduction) -> NondimensionalModel:
         if rc.kind != "mesh":
             build.add_shaft(rc)
     laws = {rc.name: build.mesh_law(rc, meshes[0]) for rc in meshes}
+    taken = set()
+    for rc in red.resolved.couplings:
+        taken |= parameter_names(rc.stiffness) | parameter_names(rc.damping) | parameter_names(rc.backlash)
+    for rb in red.resolved.dofs:
+        taken |= parameter_names(rb.inertia)
+    for f in build.functions:
+        if f.name in taken:
+            raise ModelError(f"the stiffness function of mesh {f.mesh!r} would be named {f.name!r}, which is a "
+                             "parameter of the model too; name it otherwise: Mesh(..., function='k_...')",
+                             red.drivetrain.name)
     for rc in meshes:
         build.add_mesh_rows(rc, laws[rc.name])
     for row in range(len(red.coordinates)):
