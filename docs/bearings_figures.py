@@ -38,21 +38,24 @@ def line_of_action(path: Path) -> None:
     pitch = c1 + np.array([r1, 0.0])
     t1 = c1 + r1 * math.cos(alpha) * np.array([math.cos(alpha), -math.sin(alpha)])
     t2 = c2 - r2 * math.cos(alpha) * np.array([math.cos(alpha), -math.sin(alpha)])
-    ax.plot(*zip(t1 - 0.4 * n, t2 + 0.4 * n), color="C1", lw=2.2, label="line of action n (drive flank)")
+    ax.plot(*zip(t1 - 1.3 * n, t2 + 1.1 * n), color="C1", lw=2.2, label="line of action, direction n (drive flank)")
+    ax.annotate("", xy=pitch + 1.0 * n, xytext=pitch, arrowprops=dict(arrowstyle="->", color="C1", lw=2.0))
+    ax.text(*(pitch + 1.05 * n + np.array([0.05, 0.0])), "n", color="C1", fontsize=12)
     ax.plot(*zip(c1, c2), color="0.6", lw=0.8, ls="--", label="line of centres")
     ax.annotate("", xy=pitch + 0.9 * np.array([0, 1]), xytext=pitch, arrowprops=dict(arrowstyle="-", color="0.6",
                                                                                    ls=":"))
-    ax.text(pitch[0] + 0.08, pitch[1] + 0.55, "α", fontsize=12, color="C1")
-    ax.annotate("", xy=c1 + np.array([0.35, 0.5]), xytext=c1 + np.array([0.5, 0.15]),
-                arrowprops=dict(arrowstyle="->", connectionstyle="arc3,rad=0.4", color="k"))
-    ax.text(c1[0] + 0.55, c1[1] + 0.45, "ψ_a", fontsize=10)
-    for c, d, name, color in ((c1, np.array([0.45, 0.35]), "d_a", "C0"), (c2, np.array([-0.2, -0.5]), "d_b", "C2")):
-        ax.annotate("", xy=c + d, xytext=c, arrowprops=dict(arrowstyle="->", color=color, lw=1.8))
-        ax.text(*(c + d + np.array([0.05, 0.05])), name, color=color, fontsize=10)
+    ax.text(pitch[0] + 0.1, pitch[1] + 0.75, "α", fontsize=13, color="C1")
+    ax.annotate("", xy=c1 + np.array([-0.45, 0.55]), xytext=c1 + np.array([-0.65, 0.1]),
+                arrowprops=dict(arrowstyle="->", connectionstyle="arc3,rad=-0.4", color="k"))
+    ax.text(c1[0] - 0.95, c1[1] + 0.55, "ψ_a", fontsize=11)
+    for c, d, name, color, side in ((c1, np.array([0.55, 0.15]), "d_a", "C0", 1),
+                                    (c2, np.array([-0.15, -0.75]), "d_b", "C2", -1)):
+        ax.annotate("", xy=c + d, xytext=c, arrowprops=dict(arrowstyle="->", color=color, lw=2.0))
+        ax.text(*(c + d + np.array([0.05, -0.12 * side])), name, color=color, fontsize=11)
         foot = c + (d @ n) * n
-        ax.plot(*zip(c + d, foot), color=color, lw=0.8, ls=":")
-        ax.annotate("", xy=foot, xytext=c, arrowprops=dict(arrowstyle="->", color=color, lw=1.0, ls="--"))
-        ax.text(*(foot + np.array([0.05, -0.12])), f"n·{name}", color=color, fontsize=9)
+        ax.plot(*zip(c + d, foot), color=color, lw=0.9, ls=":")
+        ax.annotate("", xy=foot, xytext=c, arrowprops=dict(arrowstyle="->", color=color, lw=1.2, ls="--"))
+        ax.text(*(foot + np.array([-0.55, 0.02 * side])), f"(n·{name}) n", color=color, fontsize=10)
     ax.set_title("A mesh of gears on bearings: δ = r_a ψ_a − r_b ψ_b + n·(d_a − d_b)\n"
                  "(pressure angle α = 20°; dotted circles: base circles; solid: pitch circles)", fontsize=10)
     ax.set_aspect("equal")

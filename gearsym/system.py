@@ -135,7 +135,8 @@ class FirstOrderSystem(ParameterChecks, Model):
             raise ModelError(f"names used both as state and parameter: {sorted(clash)}", self.name)
         names = {s.name for s in self.states}
         for c in self.couplings:
-            used = {c.coordinate, c.velocity} if not c.closes_loop else {s.name for s in c.rate.free_symbols}
+            used = {c.coordinate, c.velocity} if not c.closes_loop else \
+                {s.name for s in c.rate.free_symbols} - set(self.parameters)  # (its coefficients: parameters)
             if not used <= names:
                 raise ModelError(f"coupling {c.name!r} acts on {', '.join(sorted(used - names))}, which are not states",
                                  self.name)

@@ -220,3 +220,44 @@ def test_a_bearing_accelerometer_is_a_channel_and_its_record_gives_the_mesh_damp
     ex = explain(system.with_values(zeta=1.3 * truth), measurements, ["zeta"], candidates=(), propose=False,
                  options=run)
     assert ex.final.fit.estimates["zeta"] == pytest.approx(truth, rel=1e-3)
+
+
+def test_the_carrier_frames_coriolis_and_centripetal_terms_are_lin_and_parkers():
+    """With the frame's terms kept, each translating body's generalized forces are Lin & Parker's
+    -(Omega_c G q' - Omega_c^2 K_Omega q) with G = [[0, -2m], [2m, 0]] and K_Omega = diag(m, m) on its (x, y) or
+    (radial, tangential); the carrier turns at 1/94 of the mesh frequency (26/34/94 teeth, the ring held)."""
+    import sympy as sp
+
+    from gearsym.model.translations import CARRIER_SPEED
+    from gearsym.symbols import t
+
+    rd = load_model("planetary_translational").resolved
+    assert rd.frame_turns and rd.carrier_speed_ratio() == sp.Rational(1, 94)
+    speed = sp.Symbol(CARRIER_SPEED, real=True)
+    forces = rd.frame_forces
+    for centre in rd.centres.values():
+        (i, u), (j, v) = [(d.index, d.angle) for d in centre.translations]
+        m = centre.translations[0].inertia
+        gyroscopic = sp.Matrix([[0, -2 * m], [2 * m, 0]])
+        for row, k in enumerate((i, j)):
+            for col, q in enumerate((u, v)):
+                assert sp.expand(forces[k].diff(sp.diff(q, t)) + speed * gyroscopic[row, col]) == 0
+                assert sp.expand(forces[k].diff(q) - speed**2 * (m if row == col else 0)) == 0
+    stationary = load_model("planetary_translational", {"stationary": 1}).resolved
+    assert not stationary.frame_turns and all(f == 0 for f in stationary.frame_forces)
+
+
+@pytest.mark.parametrize("dof", [4, 6])
+def test_the_pair_at_rest_loads_each_bearing_with_the_mesh_force_along_the_line_of_action(dof):
+    """At rest under the mean torques each bearing carries the mesh force, in the line of action's direction:
+    along y for 4 degrees of freedom, split into F sin(alpha), F cos(alpha) in x and y for 6 (line of centres
+    along x); the mesh force is the torque over the base radius."""
+    scaling = gearsym.scaling(load_model("spur_pair_bearings", {"dof": dof}))
+    statics, si = scaling.statics, scaling.si_values
+    force = statics.mesh_forces["mesh"]
+    assert force == pytest.approx(si["M1"] / si["r1"], rel=1e-9)
+    alpha = si["alpha"]
+    expected = {"y": force} if dof == 4 else {"x": force * math.sin(alpha), "y": force * math.cos(alpha)}
+    for direction, value in expected.items():
+        assert statics.bearing_forces[f"bearing1_{direction}"] == pytest.approx(-value, rel=1e-9)
+        assert statics.bearing_forces[f"bearing2_{direction}"] == pytest.approx(value, rel=1e-9)
