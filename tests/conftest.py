@@ -17,6 +17,16 @@ import gearsym
 from gearsym.symbols import parameter_symbol, t
 
 GEAR_MODELS = ("one_stage", "one_stage_resonant", "flexible_shaft", "two_stage")
+#: models whose reduction and C take minutes (Lin & Parker's 18 degrees of freedom): their byte-for-byte checks of
+#: generated/ and docs/derivations/ run with -m slow
+SLOW_MODELS = ("planetary_translational",)
+
+
+def model_params(names):
+    """Model names as test parameters, the slow ones marked slow."""
+    import pytest
+
+    return [pytest.param(n, marks=pytest.mark.slow) if n in SLOW_MODELS else n for n in names]
 
 
 @functools.cache

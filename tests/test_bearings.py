@@ -261,3 +261,20 @@ def test_the_pair_at_rest_loads_each_bearing_with_the_mesh_force_along_the_line_
     for direction, value in expected.items():
         assert statics.bearing_forces[f"bearing1_{direction}"] == pytest.approx(-value, rel=1e-9)
         assert statics.bearing_forces[f"bearing2_{direction}"] == pytest.approx(value, rel=1e-9)
+
+
+def test_the_translational_sets_mesh_phases_are_the_rotational_sets():
+    """Parker & Lin's phases follow from the teeth and the planet positions whether the planets translate or not."""
+    translational = {rc.name: rc.planet_phase for rc in load_model("planetary_translational").resolved.couplings
+                     if rc.kind == "mesh"}
+    rotational = {rc.name: rc.planet_phase for rc in load_model("planetary").resolved.couplings}
+    assert translational == rotational
+    assert len(set(translational.values())) == 3  # 26/94 teeth, three planets: 0, 2 pi/3, 4 pi/3
+
+
+def test_gearsym_lyap_answers_bearing_deflections_in_um_and_bearing_forces_in_newtons(capsys):
+    assert main(["lyap", "spur_pair_bearings", "--periods", "16", "--discard", "6"]) == 0
+    out = capsys.readouterr().out
+    assert "amplitude A_y_pinion" in out and "rad" not in out.split("amplitude A_y_pinion")[1].splitlines()[0]
+    forces = [line for line in out.splitlines() if line.startswith("bearing force bearing1_y")]
+    assert forces and forces[0].split("mean ")[1].split()[1] == "N,"

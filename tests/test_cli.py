@@ -13,6 +13,7 @@ from gearsym import available_models
 from gearsym.cli import COMMANDS, main
 from gearsym.derivation import derive
 from gearsym.paths import REPO_ROOT
+from conftest import SLOW_MODELS
 
 
 @pytest.fixture(autouse=True, scope="module")
@@ -127,6 +128,15 @@ def test_errors_exit_2_without_traceback_in_a_real_process():
 
 def test_docs_check_passes_on_the_committed_pages(capsys, monkeypatch):
     monkeypatch.chdir(REPO_ROOT)  # (the pages are checked where they would be written: the current folder's)
+    fast = [m for m in available_models() if m not in SLOW_MODELS]
+    code, out, err = run(capsys, "docs", *fast, "--check")
+    assert code == 0, err
+    assert f"{len(fast)} page(s) up to date" in out
+
+
+@pytest.mark.slow
+def test_docs_check_all_passes_on_the_committed_pages(capsys, monkeypatch):
+    monkeypatch.chdir(REPO_ROOT)
     code, out, err = run(capsys, "docs", "--all", "--check")
     assert code == 0, err
     assert f"{len(available_models())} page(s) up to date" in out

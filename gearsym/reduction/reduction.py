@@ -24,7 +24,7 @@ from ..model.linear_algebra import numeric_rank, simplified, solve_rows
 from ..model.resolved import ResolvedDrivetrain
 from ..model.resolved_components import ResolvedCoupling, ResolvedForcing
 from ..symbols import t
-from .coordinates import Coordinate, coupling_deflections, generic_rank, rigid_body_modes
+from .coordinates import Coordinate, combination_solver, coupling_deflections, generic_rank, rigid_body_modes
 
 
 class ReductionError(GearsymError):
@@ -233,9 +233,29 @@ def _frame_rows(red: Reduction, forces: sp.Matrix) -> list[sp.Expr]:
     rd = red.resolved
     moving = sorted({i for f in forces for i, d in enumerate(rd.dofs) if d.motion != "rotation"
                      and f.has(d.angle)})
+    weights_of: dict[int, list[sp.Expr]] = {}
+    held = [i for i in moving if any(u[i] != 0 for u in red.rigid_modes)]  # (a rigid-body mode moves it too)
+    solve = None
+    itself = {}  # dof -> the coordinate that is it (a bearing to the ground: x_sun = X_sun)
+    for k in range(red.transform.rows):
+        nonzero = [j for j, e in enumerate(red.transform.row(k)) if e != 0]
+        if len(nonzero) == 1 and red.transform[k, nonzero[0]] == 1:
+            itself[nonzero[0]] = k
+    for i in moving:
+        if i in held:
+            continue
+        if i in itself:
+            weights_of[i] = [sp.S.One if k == itself[i] else sp.S.Zero for k in range(len(red.coordinates))]
+            continue
+        solve = solve or combination_solver(red.transform)
+        target = sp.zeros(1, red.transform.cols)
+        target[i] = 1
+        weights_of[i] = list(solve(target))
+    if held:
+        weights_of.update(zip(held, translations_in_coordinates(red, held)))
     sub = {}
-    for i, weights in zip(moving, translations_in_coordinates(red, moving)):
-        q = sp.Add(*(w * c.of(t) for w, c in zip(weights, red.coordinates)))
+    for i in moving:
+        q = sp.Add(*(w * c.of(t) for w, c in zip(weights_of[i], red.coordinates)))
         sub[sp.Derivative(rd.dofs[i].angle, t)] = sp.diff(q, t)
         sub[rd.dofs[i].angle] = q
     return [sp.expand(f.xreplace({k: v for k, v in sub.items() if isinstance(k, sp.Derivative)}).xreplace(
@@ -302,6 +322,8 @@ def _check_against_lagrange(red: Reduction, eom_forces: list[sp.Expr]) -> None:
     functions -= set(rd.angles) | {c.of(t) for c in red.coordinates}
     for _ in range(CHECK_POINTS):
         values = {s: sp.Rational(rng.randint(5, 40), rng.randint(5, 20)) for s in sorted(symbols - {t}, key=str)}
+        if rd.translations:  # (numbers of 30 digits: exact rationals swell in the many terms of gears on bearings)
+            values = {s: sp.Float(v, CHECK_DIGITS + 5) for s, v in values.items()}
         values[t] = sp.Rational(rng.randint(0, 100), 7)
         values |= {f: sp.Rational(rng.randint(5, 40), 10) for f in sorted(functions, key=str)}
         psi = [sp.Rational(rng.randint(-60, 60), 20) for _ in range(n)]
