@@ -20,7 +20,7 @@ import sympy as sp
 from ..backlash import g
 from ..errors import GearsymError
 from ..model.drivetrain import Drivetrain
-from ..model.linear_algebra import numeric_rank, simplified, solve_rows
+from ..model.linear_algebra import numeric_rank, pivot_columns, simplified, solve_rows
 from ..model.resolved import ResolvedDrivetrain
 from ..model.resolved_components import ResolvedCoupling, ResolvedForcing
 from ..symbols import t
@@ -264,17 +264,35 @@ def _frame_rows(red: Reduction, forces: sp.Matrix) -> list[sp.Expr]:
 
 def translations_in_coordinates(red: Reduction, indices: list[int]) -> list[list[sp.Expr]]:
     """For each degree of freedom of ``indices``, the weights w with dof = w . q for the motion M-orthogonal to the
-    rigid-body modes (T psi = q, U^T M psi = 0): its row of the inverse of [T; U^T M], the columns of q."""
+    rigid-body modes (T psi = q, U^T M psi = 0): with R a right inverse of T (the inverse of T's pivot columns, in
+    their rows), W = (I - U (U^T M U)^-1 U^T M) R; only the rows of R the result needs are solved for, without the
+    masses (they enter at the end)."""
     rd = red.resolved
-    n = len(rd.dofs)
-    M = sp.diag(*[d.inertia for d in rd.dofs])
-    rows = [red.transform] + [sp.Matrix([list(u)]) * M for u in red.rigid_modes]
-    system = sp.Matrix.vstack(*rows)
-    targets = sp.zeros(len(indices), n)
-    for k, i in enumerate(indices):
-        targets[k, i] = 1
-    z = solve_rows(system, targets)
-    return [[sp.factor(z[k, j]) for j in range(red.transform.rows)] for k in range(len(indices))]
+    transform = red.transform
+    pivots = pivot_columns(transform)
+    square = transform.extract(list(range(transform.rows)), pivots)
+    modes = sp.Matrix.hstack(*red.rigid_modes)
+    masses = [d.inertia for d in rd.dofs]
+    needed = sorted(set(indices) | {j for j in range(len(masses)) if any(modes[j, m] != 0 for m in range(modes.cols))})
+    needed = [j for j in needed if j in pivots]
+    targets = sp.zeros(len(needed), transform.rows)
+    for k, j in enumerate(needed):
+        targets[k, pivots.index(j)] = 1
+    solved = solve_rows(square, targets) if needed else sp.zeros(0, transform.rows)
+    right = {j: solved.row(k) for k, j in enumerate(needed)}
+    zero = sp.zeros(1, transform.rows)
+    gram = (modes.T * sp.diag(*masses) * modes).inv()
+    weighted = [sum((modes[j, m] * masses[j] * right.get(j, zero) for j in range(len(masses))), zero)
+                for m in range(modes.cols)]
+    out = []
+    for i in indices:
+        w = right.get(i, zero)
+        for a in range(modes.cols):
+            for b in range(modes.cols):
+                if modes[i, a] != 0:
+                    w = w - modes[i, a] * gram[a, b] * weighted[b]
+        out.append([sp.factor(e) for e in w])
+    return out
 
 
 def _law_in_angles(rd: ResolvedDrivetrain, rc: ResolvedCoupling) -> sp.Expr:
