@@ -229,7 +229,7 @@ def test_the_carrier_frames_coriolis_and_centripetal_terms_are_lin_and_parkers()
     import sympy as sp
 
     from gearsym.model.translations import CARRIER_SPEED
-    from gearsym.symbols import t
+    from gearsym.model.symbols import t
 
     rd = load_model("planetary_translational").resolved
     assert rd.frame_turns and rd.carrier_speed_ratio() == sp.Rational(1, 94)

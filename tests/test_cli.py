@@ -12,7 +12,7 @@ import gearsym.derivation
 from gearsym import available_models
 from gearsym.cli import COMMANDS, main
 from gearsym.derivation import derive
-from gearsym.paths import REPO_ROOT
+from gearsym.files.paths import REPO_ROOT
 from conftest import SLOW_MODELS
 
 
@@ -40,7 +40,8 @@ def run(capsys, *argv: str) -> tuple[int, str, str]:
 
 
 def test_subcommands_are_registered():
-    assert [m.NAME for m in COMMANDS] == ["list", "derive", "docs", "compile", "lyap", "sweep", "orbits", "poincare",
+    assert [m.NAME for m in COMMANDS] == ["list", "derive", "docs", "compile", "lyap", "sweep", "orbits", "stability",
+                                          "poincare",
                                           "basins", "reproduce", "simulate", "explain", "spectrum", "modes", "campbell",
                                           "fmu", "stiffness"]
 

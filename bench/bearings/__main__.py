@@ -79,7 +79,7 @@ def c_input(scaling, steps: int, periods: int) -> str:
     import sympy as sp
 
     from gearsym.model.translations import CARRIER_SPEED
-    from gearsym.symbols import parameter_symbol, t
+    from gearsym.model.symbols import parameter_symbol, t
 
     rd = scaling.model.reduction.resolved
     si = dict(scaling.si_values)

@@ -27,7 +27,7 @@ from ..errors import GearsymError
 from ..model.components import Planet
 from ..reduction.coordinates import coupling_deflections, rigid_body_modes
 from ..reduction.statics import mean_over, mean_stiffness, number as _number
-from ..symbols import parameter_symbol, tau
+from ..model.symbols import parameter_symbol, tau
 
 #: eigenvalues within this fraction of the largest count as one (a degenerate frequency)
 DEGENERATE = 1e-8

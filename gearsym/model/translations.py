@@ -30,7 +30,7 @@ from typing import Optional
 import sympy as sp
 
 from ..errors import ModelError
-from ..symbols import t
+from .symbols import t
 from .components import Bearing, Body, Gear, Mesh, Planet, Shaft
 from .expressions import to_expr
 from .linear_algebra import named_generators

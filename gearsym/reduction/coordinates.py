@@ -23,7 +23,7 @@ from ..errors import ModelError
 from ..model.linear_algebra import is_zero, nullspace, numeric_rank, pivot_columns, solve_rows
 from ..model.resolved import ResolvedDrivetrain
 from ..model.resolved_components import ResolvedCoupling
-from ..symbols import t
+from ..model.symbols import t
 
 
 @dataclass(frozen=True)

@@ -29,7 +29,7 @@ from typing import Optional
 import sympy as sp
 from sympy.core.function import AppliedUndef
 
-from ..backlash import g
+from ..model.backlash import g
 from ..errors import ModelError, UnknownParameterError
 from ..model.drivetrain import Drivetrain
 from ..model.resolved_components import ResolvedCoupling
@@ -38,7 +38,7 @@ from ..model.expressions import ExprLike, parameter_names, to_expr
 from ..model.stiffness import check_periodic
 from ..model.linear_algebra import numeric_rank, simplified
 from ..model.translations import CARRIER_SPEED
-from ..symbols import omega, parameter_symbol, phi, t, tau
+from ..model.symbols import omega, parameter_symbol, phi, t, tau
 from ..system import Constraint, Coupling, FirstOrderSystem, Gearing
 from .coordinates import combination_solver
 from .reduction import Reduction, reduce_drivetrain, sub_frame, with_geometry

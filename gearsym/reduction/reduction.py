@@ -17,13 +17,13 @@ from functools import cached_property
 
 import sympy as sp
 
-from ..backlash import g
+from ..model.backlash import g
 from ..errors import GearsymError
 from ..model.drivetrain import Drivetrain
 from ..model.linear_algebra import numeric_rank, pivot_columns, simplified, solve_rows
 from ..model.resolved import ResolvedDrivetrain
 from ..model.resolved_components import ResolvedCoupling, ResolvedForcing
-from ..symbols import t
+from ..model.symbols import t
 from .coordinates import Coordinate, combination_solver, coupling_deflections, generic_rank, rigid_body_modes
 
 
