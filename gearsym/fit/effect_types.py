@@ -13,6 +13,7 @@ import sympy as sp
 from ..model.backlash import g
 from ..errors import ModelError
 from ..model.symbols import parameter_symbol
+from ..parameters import Constraint
 from ..system import Coupling, FirstOrderSystem
 
 
@@ -94,6 +95,7 @@ class Effect:
     gear: str = ""  # a shaft-order effect's gear (:mod:`.shaft_effects`) and its tooth count
     teeth: int = 0
     scan: str = ""  # a fixed parameter found by a scan over the gear's teeth (the faulty tooth)
+    constraints: Mapping[str, Constraint] = field(default_factory=dict)  # what its parameters may be, physically
 
     @property
     def parameters(self) -> dict[str, float]:
