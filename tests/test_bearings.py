@@ -202,7 +202,7 @@ def test_a_bearing_accelerometer_is_a_channel_and_its_record_gives_the_mesh_damp
     scaling, _ = pair
     system = scaling.system()
     assert {k: str(v) for k, v in system.translations.items()} == {"pinion_y": "y_pinion", "wheel_y": "y_wheel"}
-    run = Integration(steps_per_period=200, periods=70, discard=40)
+    run = Integration(steps_per_period=PAIR_RUN.steps_per_period, periods=40, discard=20)  # (the pair's library)
     model = gearsym.compile_model(system, run)
     trajectory = gearsym.phase_trajectory(model, options=run)
     states = list(system.states)
@@ -210,7 +210,7 @@ def test_a_bearing_accelerometer_is_a_channel_and_its_record_gives_the_mesh_damp
     acceleration = sp.lambdify([system.time, *states, *system.parameter_symbols],
                                system.rhs[states.index(sp.Symbol("dy_pinion", real=True))], [backlash, "numpy"])
     p = [system.parameters[s.name] for s in system.parameter_symbols]
-    every = 4  # 50 samples per period
+    every = 16  # 64 samples per period
     tau = trajectory.time[::every]
     a = acceleration(tau, *trajectory.states[:, ::every], *p)
     path = tmp_path / "housing.csv"
