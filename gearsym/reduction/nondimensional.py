@@ -607,11 +607,12 @@ class _Assembly:
         ``Omega_c^2 x`` becomes ``ratio^2 x``: the frame's terms do not depend on omega in tau."""
         red = self.red
         speed = sp.Symbol(CARRIER_SPEED, real=True)
-        rates = {sp.Derivative(c.of(t), t): omega * sp.diff(c.of(tau), tau) for c in red.coordinates}
+        # every term is Omega_c x' or Omega_c^2 x: omega^2 in tau, which the division by omega^2 takes out; so
+        # omega is left out of the substitution instead (the rows stay unexpanded: see _frame_rows)
+        rates = {sp.Derivative(c.of(t), t): sp.diff(c.of(tau), tau) for c in red.coordinates}
         values = {c.of(t): c.of(tau) for c in red.coordinates}
         for row, force in enumerate(red.frame_rows):
-            in_tau = force.xreplace(rates).xreplace(values).xreplace({speed: ratio * omega})
-            self.lhs[row] -= sp.expand(in_tau / omega**2)
+            self.lhs[row] -= force.xreplace(rates).xreplace(values).xreplace({speed: ratio})
 
     def add_forcing(self, row: int) -> None:
         """The forcing of one row, grouped by harmonic into B0, B1, D, ...; an unforced shaft's constant

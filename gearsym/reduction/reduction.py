@@ -160,7 +160,7 @@ def reduce_drivetrain(model: Drivetrain, numbers: bool = True) -> Reduction:
                 red.coupling_terms.append(CouplingTerm(i, rc, factor))
     frame = sp.Matrix(rd.frame_forces)
     if frame != sp.zeros(n, 1):
-        red.frame_rows = _frame_rows(red, TMinv * frame)
+        red.frame_rows = _frame_rows(red, TMinv, frame)
     eom_forces = [sp.expand(eq.rhs - (eq.lhs - sum(M[i, j] * sp.diff(rd.angles[j], t, 2) for j in range(n))))
                   for i, eq in enumerate(rd.equations_of_motion)]
     for i in range(n):
@@ -227,13 +227,15 @@ def sub_frame(expr: sp.Expr, geometry) -> sp.Expr:
     return sp.Add(*(simplified(c.xreplace(geometry)) * k for k, c in collected.items()))
 
 
-def _frame_rows(red: Reduction, forces: sp.Matrix) -> list[sp.Expr]:
-    """The frame's forces of each row, T M^-1 Q_f, with every translation written in the coordinates (its
-    combination of them; for a translation a rigid-body mode moves too, a planet's tangential one, the motion
-    M-orthogonal to the rigid-body modes: the rigid coordinates are the nominal rotation the frame turns with)."""
+def _frame_rows(red: Reduction, weights_rows: sp.Matrix, forces: sp.Matrix) -> list[sp.Expr]:
+    """The frame's forces of each row, T M^-1 Q_f (``weights_rows`` T M^-1, ``forces`` Q_f), with every translation
+    written in the coordinates (its combination of them; for a translation a rigid-body mode moves too, a planet's
+    tangential one, the motion M-orthogonal to the rigid-body modes: the rigid coordinates are the nominal rotation
+    the frame turns with)."""
     rd = red.resolved
     moving = sorted({i for f in forces for i, d in enumerate(rd.dofs) if d.motion != "rotation"
                      and f.has(d.angle)})
+    weights_rows = [list(weights_rows.row(k)) for k in range(weights_rows.rows)]
     weights_of: dict[int, list[sp.Expr]] = {}
     held = [i for i in moving if any(u[i] != 0 for u in red.rigid_modes)]  # (a rigid-body mode moves it too)
     solve = None
@@ -254,13 +256,18 @@ def _frame_rows(red: Reduction, forces: sp.Matrix) -> list[sp.Expr]:
         weights_of[i] = list(solve(target))
     if held:
         weights_of.update(zip(held, translations_in_coordinates(red, held)))
-    sub = {}
+    rates, positions = {}, {}
     for i in moving:
         q = sp.Add(*(w * c.of(t) for w, c in zip(weights_of[i], red.coordinates)))
-        sub[sp.Derivative(rd.dofs[i].angle, t)] = sp.diff(q, t)
-        sub[rd.dofs[i].angle] = q
-    return [sp.expand(f.xreplace({k: v for k, v in sub.items() if isinstance(k, sp.Derivative)}).xreplace(
-        {k: v for k, v in sub.items() if not isinstance(k, sp.Derivative)})) for f in forces]
+        rates[sp.Derivative(rd.dofs[i].angle, t)] = sp.diff(q, t)
+        positions[rd.dofs[i].angle] = q
+    # Each row is kept as T M^-1 times the frame's force on each body, the body's translation a combination of the
+    # coordinates (its weights factored, over the rigid-body modes' Gram determinant): expanded, the combinations'
+    # rational weights multiply out into every row (Lin & Parker's set: 10^5 characters a row, a C file of megabytes
+    # gcc does not finish); kept, each combination is one subexpression the generated code computes once.
+    return [sp.Add(*(weight * sp.factor_terms(force).xreplace(rates).xreplace(positions)
+                     for weight, force in zip(weights, forces) if weight != 0 and force != 0))
+            for weights in weights_rows]
 
 
 def translations_in_coordinates(red: Reduction, indices: list[int]) -> list[list[sp.Expr]]:
