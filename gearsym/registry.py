@@ -33,6 +33,14 @@ def available_models() -> list[str]:
     return sorted(p.stem for p in d.glob("*.py") if not p.stem.startswith("_") and p.is_file())
 
 
+def pregenerated_models() -> list[str]:
+    """The models whose C and derivation page are committed (``generated/``, ``docs/derivations/``): what
+    ``gearsym compile --all``, ``gearsym docs --all`` and ``gearsym fmu --all`` make. A model file that sets
+    ``PREGENERATED = False`` is shipped and runs by name, but is derived and compiled on its first use only (one
+    too large to compile within a test run: Lin & Parker's translational set)."""
+    return [name for name in available_models() if getattr(_module(name), "PREGENERATED", True) is not False]
+
+
 def model_path(ref: str) -> Path | None:
     """The file (resolved) of a model name or path; None if there is none (:func:`load_model` says why). A name
     that the working directory's ``models/`` gives another file than the shipped model of that name is said

@@ -51,6 +51,7 @@ BEARING_STIFFNESS = Role("a bearing stiffness", "N/m")
 BEARING_DAMPING = Role("a bearing damping", "N*s/m")
 ANGLE = Role("an angle", "")
 ORBIT = Role("a carrier radius", "mm")
+TRANSMISSION_ERROR = Role("a transmission error", "um")
 
 
 @dataclass(frozen=True)
@@ -93,6 +94,15 @@ def fields(rd: ResolvedDrivetrain) -> list[Field]:
                     Field(rc.mesh_phase.xreplace({omega: 0, t: 0}), PHASE, f"{where} phase")]
             out += [Field(sp.Symbol(name, real=True), RATIO, f"{where} stiffness variation")
                     for name in sorted(parameter_names(rc.variation) - {phi.name})]
+            # shaft-order terms (a tooth fault's depth, its tooth; an eccentricity's amplitudes and phase): the
+            # fraction of stiffness lost is dimensionless, a transmission error a length where it enters linearly
+            out += [Field(sp.Symbol(name, real=True), RATIO, f"{where} shaft-order term (stiffness lost)")
+                    for name in sorted(parameter_names(rc.loss) - {phi.name})]
+            for name in sorted(parameter_names(rc.error) - {phi.name}):
+                s = sp.Symbol(name, real=True)
+                linear = s not in sp.diff(rc.error.xreplace({x: sp.Symbol(x.name, real=True)
+                                                             for x in rc.error.free_symbols}), s).free_symbols
+                out.append(Field(s, TRANSMISSION_ERROR if linear else PHASE, f"{where} shaft-order term"))
         else:
             out += [Field(rc.stiffness, SHAFT_STIFFNESS, f"{where} stiffness"),
                     Field(rc.damping, SHAFT_DAMPING, f"{where} damping"),

@@ -222,889 +222,6 @@ static const casadi_real casadi_c0[401] =
 static const casadi_real casadi_zeros[16] = 
   {0.};
 
-/* rhs:(t,y[6],p[16])->(dy[6]) */
-static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
-  a00=arg[1]? arg[1][1] : 0;
-  if (res[0]!=0) res[0][0]=a00;
-  a01=-2.;
-  a01=(a01*a00);
-  a02=arg[2]? arg[2][1] : 0;
-  a01=(a01*a02);
-  a03=arg[2]? arg[2][0] : 0;
-  a04=(a01/a03);
-  a05=arg[2]? arg[2][8] : 0;
-  a06=arg[1]? arg[1][5] : 0;
-  a05=(a05*a06);
-  a07=arg[2]? arg[2][13] : 0;
-  a05=(a05/a07);
-  a05=(a05/a03);
-  a04=(a04+a05);
-  a08=arg[2]? arg[2][11] : 0;
-  a09=arg[1]? arg[1][4] : 0;
-  a08=(a08*a09);
-  a08=(a08/a07);
-  a09=casadi_sq(a03);
-  a08=(a08/a09);
-  a04=(a04+a08);
-  a10=arg[2]? arg[2][7] : 0;
-  a11=arg[1]? arg[1][3] : 0;
-  a10=(a10*a11);
-  a12=arg[2]? arg[2][12] : 0;
-  a10=(a10/a12);
-  a10=(a10/a03);
-  a04=(a04-a10);
-  a13=arg[2]? arg[2][10] : 0;
-  a14=arg[1]? arg[1][2] : 0;
-  a13=(a13*a14);
-  a13=(a13/a12);
-  a13=(a13/a09);
-  a04=(a04-a13);
-  a14=arg[2]? arg[2][2] : 0;
-  a15=arg[2]? arg[2][3] : 0;
-  a16=arg[2]? arg[2][6] : 0;
-  a17=arg[0]? arg[0][0] : 0;
-  a16=(a16+a17);
-  a16=cos(a16);
-  a15=(a15*a16);
-  a14=(a14+a15);
-  a14=(a14/a09);
-  a04=(a04+a14);
-  a14=0.;
-  a15=arg[1]? arg[1][0] : 0;
-  a14=(a14<=a15);
-  a14=(a14?a15:0);
-  a16=arg[2]? arg[2][9] : 0;
-  a18=(-a16);
-  a18=(a15<=a18);
-  a15=(a15+a16);
-  a18=(a18?a15:0);
-  a14=(a14+a18);
-  a18=(a14/a09);
-  a15=1.;
-  a16=2.7661221359999999e-01;
-  a19=sin(a17);
-  a16=(a16*a19);
-  a15=(a15+a16);
-  a16=-1.2805164159999999e-01;
-  a19=cos(a17);
-  a16=(a16*a19);
-  a15=(a15+a16);
-  a16=6.2617029230000003e-03;
-  a19=7.;
-  a19=(a19*a17);
-  a20=sin(a19);
-  a16=(a16*a20);
-  a15=(a15+a16);
-  a16=1.3450290380000000e-02;
-  a20=5.;
-  a20=(a20*a17);
-  a21=cos(a20);
-  a16=(a16*a21);
-  a15=(a15+a16);
-  a16=6.7468832359999995e-02;
-  a21=(2.*a17);
-  a22=cos(a21);
-  a16=(a16*a22);
-  a15=(a15+a16);
-  a16=4.3708772070000000e-03;
-  a22=6.;
-  a22=(a22*a17);
-  a23=sin(a22);
-  a16=(a16*a23);
-  a15=(a15+a16);
-  a16=9.1421067960000008e-03;
-  a20=sin(a20);
-  a16=(a16*a20);
-  a15=(a15+a16);
-  a16=7.9504500709999995e-02;
-  a21=sin(a21);
-  a16=(a16*a21);
-  a15=(a15+a16);
-  a16=6.7080805820000000e-04;
-  a19=cos(a19);
-  a16=(a16*a19);
-  a15=(a15+a16);
-  a16=4.9745246999999999e-02;
-  a19=4.;
-  a19=(a19*a17);
-  a21=sin(a19);
-  a16=(a16*a21);
-  a15=(a15+a16);
-  a16=6.8506266280000004e-03;
-  a21=3.;
-  a21=(a21*a17);
-  a17=sin(a21);
-  a16=(a16*a17);
-  a15=(a15+a16);
-  a16=-2.4739900039999999e-02;
-  a21=cos(a21);
-  a16=(a16*a21);
-  a15=(a15+a16);
-  a16=-8.2022960919999992e-03;
-  a19=cos(a19);
-  a16=(a16*a19);
-  a15=(a15+a16);
-  a16=-7.2871874210000001e-03;
-  a22=cos(a22);
-  a16=(a16*a22);
-  a15=(a15+a16);
-  a18=(a18*a15);
-  a04=(a04-a18);
-  if (res[0]!=0) res[0][1]=a04;
-  if (res[0]!=0) res[0][2]=a11;
-  a01=(a01/a12);
-  a01=(a01/a03);
-  a12=(1./a12);
-  a11=(1./a07);
-  a04=(a12+a11);
-  a18=arg[2]? arg[2][14] : 0;
-  a18=casadi_sq(a18);
-  a16=arg[2]? arg[2][4] : 0;
-  a18=(a18/a16);
-  a04=(a04+a18);
-  a18=arg[2]? arg[2][15] : 0;
-  a18=casadi_sq(a18);
-  a16=arg[2]? arg[2][5] : 0;
-  a18=(a18/a16);
-  a04=(a04+a18);
-  a01=(a01/a04);
-  a10=(a10+a13);
-  a12=(a12/a09);
-  a12=(a12*a14);
-  a12=(a12/a04);
-  a12=(a12*a15);
-  a10=(a10+a12);
-  a01=(a01-a10);
-  if (res[0]!=0) res[0][3]=a01;
-  if (res[0]!=0) res[0][4]=a06;
-  a11=(a11/a09);
-  a11=(a11*a14);
-  a11=(a11/a04);
-  a11=(a11*a15);
-  a05=(a05+a08);
-  a11=(a11-a05);
-  a00=(2.*a00);
-  a00=(a00*a02);
-  a00=(a00/a07);
-  a00=(a00/a03);
-  a00=(a00/a04);
-  a11=(a11+a00);
-  if (res[0]!=0) res[0][5]=a11;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int rhs(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f0(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int rhs_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void rhs_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void rhs_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void rhs_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int rhs_n_in(void) { return 3;}
-
-CASADI_SYMBOL_EXPORT casadi_int rhs_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real rhs_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* rhs_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "y";
-    case 2: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* rhs_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "dy";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s1;
-    case 2: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s1;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int rhs_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int rhs_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* jacobian:(t,y[6],p[16])->(J[6x6]) */
-static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12;
-  a00=0.;
-  if (res[0]!=0) res[0][0]=a00;
-  a01=1.;
-  a02=2.7661221359999999e-01;
-  a03=arg[0]? arg[0][0] : 0;
-  a04=sin(a03);
-  a02=(a02*a04);
-  a02=(a01+a02);
-  a04=-1.2805164159999999e-01;
-  a05=cos(a03);
-  a04=(a04*a05);
-  a02=(a02+a04);
-  a04=6.2617029230000003e-03;
-  a05=7.;
-  a05=(a05*a03);
-  a06=sin(a05);
-  a04=(a04*a06);
-  a02=(a02+a04);
-  a04=1.3450290380000000e-02;
-  a06=5.;
-  a06=(a06*a03);
-  a07=cos(a06);
-  a04=(a04*a07);
-  a02=(a02+a04);
-  a04=6.7468832359999995e-02;
-  a07=(2.*a03);
-  a08=cos(a07);
-  a04=(a04*a08);
-  a02=(a02+a04);
-  a04=4.3708772070000000e-03;
-  a08=6.;
-  a08=(a08*a03);
-  a09=sin(a08);
-  a04=(a04*a09);
-  a02=(a02+a04);
-  a04=9.1421067960000008e-03;
-  a06=sin(a06);
-  a04=(a04*a06);
-  a02=(a02+a04);
-  a04=7.9504500709999995e-02;
-  a07=sin(a07);
-  a04=(a04*a07);
-  a02=(a02+a04);
-  a04=6.7080805820000000e-04;
-  a05=cos(a05);
-  a04=(a04*a05);
-  a02=(a02+a04);
-  a04=4.9745246999999999e-02;
-  a05=4.;
-  a05=(a05*a03);
-  a07=sin(a05);
-  a04=(a04*a07);
-  a02=(a02+a04);
-  a04=6.8506266280000004e-03;
-  a07=3.;
-  a07=(a07*a03);
-  a03=sin(a07);
-  a04=(a04*a03);
-  a02=(a02+a04);
-  a04=-2.4739900039999999e-02;
-  a07=cos(a07);
-  a04=(a04*a07);
-  a02=(a02+a04);
-  a04=-8.2022960919999992e-03;
-  a05=cos(a05);
-  a04=(a04*a05);
-  a02=(a02+a04);
-  a04=-7.2871874210000001e-03;
-  a08=cos(a08);
-  a04=(a04*a08);
-  a02=(a02+a04);
-  a04=arg[1]? arg[1][0] : 0;
-  a08=(a00<=a04);
-  a08=(a08?a01:0);
-  a05=arg[2]? arg[2][9] : 0;
-  a05=(-a05);
-  a04=(a04<=a05);
-  a04=(a04?a01:0);
-  a08=(a08+a04);
-  a04=arg[2]? arg[2][0] : 0;
-  a05=casadi_sq(a04);
-  a07=(a08/a05);
-  a07=(a02*a07);
-  a07=(-a07);
-  if (res[0]!=0) res[0][1]=a07;
-  if (res[0]!=0) res[0][2]=a00;
-  a07=arg[2]? arg[2][12] : 0;
-  a03=(1./a07);
-  a06=(a03/a05);
-  a06=(a06*a08);
-  a09=arg[2]? arg[2][13] : 0;
-  a10=(1./a09);
-  a03=(a03+a10);
-  a11=arg[2]? arg[2][14] : 0;
-  a11=casadi_sq(a11);
-  a12=arg[2]? arg[2][4] : 0;
-  a11=(a11/a12);
-  a03=(a03+a11);
-  a11=arg[2]? arg[2][15] : 0;
-  a11=casadi_sq(a11);
-  a12=arg[2]? arg[2][5] : 0;
-  a11=(a11/a12);
-  a03=(a03+a11);
-  a06=(a06/a03);
-  a06=(a02*a06);
-  a06=(-a06);
-  if (res[0]!=0) res[0][3]=a06;
-  if (res[0]!=0) res[0][4]=a00;
-  a10=(a10/a05);
-  a10=(a10*a08);
-  a10=(a10/a03);
-  a02=(a02*a10);
-  if (res[0]!=0) res[0][5]=a02;
-  if (res[0]!=0) res[0][6]=a01;
-  a02=-2.;
-  a10=arg[2]? arg[2][1] : 0;
-  a02=(a02*a10);
-  a08=(a02/a04);
-  if (res[0]!=0) res[0][7]=a08;
-  if (res[0]!=0) res[0][8]=a00;
-  a02=(a02/a07);
-  a02=(a02/a04);
-  a02=(a02/a03);
-  if (res[0]!=0) res[0][9]=a02;
-  if (res[0]!=0) res[0][10]=a00;
-  a10=(2.*a10);
-  a10=(a10/a09);
-  a10=(a10/a04);
-  a10=(a10/a03);
-  if (res[0]!=0) res[0][11]=a10;
-  if (res[0]!=0) res[0][12]=a00;
-  a10=arg[2]? arg[2][10] : 0;
-  a10=(a10/a07);
-  a10=(a10/a05);
-  a10=(-a10);
-  if (res[0]!=0) res[0][13]=a10;
-  if (res[0]!=0) res[0][14]=a00;
-  if (res[0]!=0) res[0][15]=a10;
-  if (res[0]!=0) res[0][16]=a00;
-  if (res[0]!=0) res[0][17]=a00;
-  if (res[0]!=0) res[0][18]=a00;
-  a10=arg[2]? arg[2][7] : 0;
-  a10=(a10/a07);
-  a10=(a10/a04);
-  a10=(-a10);
-  if (res[0]!=0) res[0][19]=a10;
-  if (res[0]!=0) res[0][20]=a01;
-  if (res[0]!=0) res[0][21]=a10;
-  if (res[0]!=0) res[0][22]=a00;
-  if (res[0]!=0) res[0][23]=a00;
-  if (res[0]!=0) res[0][24]=a00;
-  a10=arg[2]? arg[2][11] : 0;
-  a10=(a10/a09);
-  a10=(a10/a05);
-  if (res[0]!=0) res[0][25]=a10;
-  if (res[0]!=0) res[0][26]=a00;
-  if (res[0]!=0) res[0][27]=a00;
-  if (res[0]!=0) res[0][28]=a00;
-  a10=(-a10);
-  if (res[0]!=0) res[0][29]=a10;
-  if (res[0]!=0) res[0][30]=a00;
-  a10=arg[2]? arg[2][8] : 0;
-  a10=(a10/a09);
-  a10=(a10/a04);
-  if (res[0]!=0) res[0][31]=a10;
-  if (res[0]!=0) res[0][32]=a00;
-  if (res[0]!=0) res[0][33]=a00;
-  if (res[0]!=0) res[0][34]=a01;
-  a10=(-a10);
-  if (res[0]!=0) res[0][35]=a10;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int jacobian(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f1(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int jacobian_n_in(void) { return 3;}
-
-CASADI_SYMBOL_EXPORT casadi_int jacobian_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real jacobian_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* jacobian_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "y";
-    case 2: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* jacobian_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "J";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s1;
-    case 2: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s3;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* constants:(p[16])->(c[15],period) */
-static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12;
-  a00=arg[0]? arg[0][9] : 0;
-  if (res[0]!=0) res[0][0]=a00;
-  a00=arg[0]? arg[0][0] : 0;
-  a01=casadi_sq(a00);
-  a02=(1./a01);
-  a03=(-a02);
-  if (res[0]!=0) res[0][1]=a03;
-  a03=-2.;
-  a04=arg[0]? arg[0][1] : 0;
-  a03=(a03*a04);
-  a05=(a03/a00);
-  if (res[0]!=0) res[0][2]=a05;
-  a05=arg[0]? arg[0][8] : 0;
-  a06=arg[0]? arg[0][13] : 0;
-  a05=(a05/a06);
-  a05=(a05/a00);
-  if (res[0]!=0) res[0][3]=a05;
-  a07=arg[0]? arg[0][11] : 0;
-  a07=(a07/a06);
-  a07=(a07/a01);
-  if (res[0]!=0) res[0][4]=a07;
-  a08=arg[0]? arg[0][7] : 0;
-  a09=arg[0]? arg[0][12] : 0;
-  a08=(a08/a09);
-  a08=(a08/a00);
-  a08=(-a08);
-  if (res[0]!=0) res[0][5]=a08;
-  a08=arg[0]? arg[0][10] : 0;
-  a08=(a08/a09);
-  a08=(a08/a01);
-  a08=(-a08);
-  if (res[0]!=0) res[0][6]=a08;
-  if (res[0]!=0) res[0][7]=a02;
-  a02=(1./a09);
-  a08=(a02/a01);
-  a10=(1./a06);
-  a02=(a02+a10);
-  a11=arg[0]? arg[0][14] : 0;
-  a11=casadi_sq(a11);
-  a12=arg[0]? arg[0][4] : 0;
-  a11=(a11/a12);
-  a02=(a02+a11);
-  a11=arg[0]? arg[0][15] : 0;
-  a11=casadi_sq(a11);
-  a12=arg[0]? arg[0][5] : 0;
-  a11=(a11/a12);
-  a02=(a02+a11);
-  a08=(a08/a02);
-  a08=(-a08);
-  if (res[0]!=0) res[0][8]=a08;
-  a03=(a03/a09);
-  a03=(a03/a00);
-  a03=(a03/a02);
-  if (res[0]!=0) res[0][9]=a03;
-  a05=(-a05);
-  if (res[0]!=0) res[0][10]=a05;
-  a07=(-a07);
-  if (res[0]!=0) res[0][11]=a07;
-  a10=(a10/a01);
-  a10=(a10/a02);
-  if (res[0]!=0) res[0][12]=a10;
-  a04=(2.*a04);
-  a04=(a04/a06);
-  a04=(a04/a00);
-  a04=(a04/a02);
-  if (res[0]!=0) res[0][13]=a04;
-  a04=3.1415926535897934e-02;
-  if (res[0]!=0) res[0][14]=a04;
-  a04=6.2831853071795862e+00;
-  if (res[1]!=0) res[1][0]=a04;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int constants(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f2(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int constants_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void constants_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void constants_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void constants_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int constants_n_in(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_int constants_n_out(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_real constants_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* constants_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* constants_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "c";
-    case 1: return "period";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s4;
-    case 1: return casadi_s0;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int constants_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 1;
-  if (sz_res) *sz_res = 2;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 1*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 2*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* table_point:(t,p[16])->(values[2]) */
-static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a0, a1, a2, a3, a4, a5, a6, a7;
-  a0=1.;
-  a1=2.7661221359999999e-01;
-  a2=arg[0]? arg[0][0] : 0;
-  a3=sin(a2);
-  a1=(a1*a3);
-  a0=(a0+a1);
-  a1=-1.2805164159999999e-01;
-  a3=cos(a2);
-  a1=(a1*a3);
-  a0=(a0+a1);
-  a1=6.2617029230000003e-03;
-  a3=7.;
-  a3=(a3*a2);
-  a4=sin(a3);
-  a1=(a1*a4);
-  a0=(a0+a1);
-  a1=1.3450290380000000e-02;
-  a4=5.;
-  a4=(a4*a2);
-  a5=cos(a4);
-  a1=(a1*a5);
-  a0=(a0+a1);
-  a1=6.7468832359999995e-02;
-  a5=(2.*a2);
-  a6=cos(a5);
-  a1=(a1*a6);
-  a0=(a0+a1);
-  a1=4.3708772070000000e-03;
-  a6=6.;
-  a6=(a6*a2);
-  a7=sin(a6);
-  a1=(a1*a7);
-  a0=(a0+a1);
-  a1=9.1421067960000008e-03;
-  a4=sin(a4);
-  a1=(a1*a4);
-  a0=(a0+a1);
-  a1=7.9504500709999995e-02;
-  a5=sin(a5);
-  a1=(a1*a5);
-  a0=(a0+a1);
-  a1=6.7080805820000000e-04;
-  a3=cos(a3);
-  a1=(a1*a3);
-  a0=(a0+a1);
-  a1=4.9745246999999999e-02;
-  a3=4.;
-  a3=(a3*a2);
-  a5=sin(a3);
-  a1=(a1*a5);
-  a0=(a0+a1);
-  a1=6.8506266280000004e-03;
-  a5=3.;
-  a5=(a5*a2);
-  a4=sin(a5);
-  a1=(a1*a4);
-  a0=(a0+a1);
-  a1=-2.4739900039999999e-02;
-  a5=cos(a5);
-  a1=(a1*a5);
-  a0=(a0+a1);
-  a1=-8.2022960919999992e-03;
-  a3=cos(a3);
-  a1=(a1*a3);
-  a0=(a0+a1);
-  a1=-7.2871874210000001e-03;
-  a6=cos(a6);
-  a1=(a1*a6);
-  a0=(a0+a1);
-  if (res[0]!=0) res[0][0]=a0;
-  a0=arg[1]? arg[1][2] : 0;
-  a1=arg[1]? arg[1][3] : 0;
-  a6=arg[1]? arg[1][6] : 0;
-  a6=(a6+a2);
-  a6=cos(a6);
-  a1=(a1*a6);
-  a0=(a0+a1);
-  if (res[0]!=0) res[0][1]=a0;
-  return 0;
-}
-
-/* map401_table_point:(t[1x401],p[16x401])->(values[2x401]) */
-static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i;
-  casadi_real* *res1;
-  const casadi_real* *arg1;
-  arg1 = arg+2;
-  for (i=0; i<2; ++i) arg1[i]=arg[i];
-  res1 = res+1;
-  for (i=0; i<1; ++i) res1[i]=res[i];
-  for (i=0; i<401; ++i) {
-    if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-    if (arg1[0]) arg1[0]+=1;
-    if (arg1[1]) arg1[1]+=16;
-    if (res1[0]) res1[0]+=2;
-  }
-  return 0;
-}
-
-/* table:(t0,p[16])->(table[6x200],probe[2x2]) */
-static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i, j;
-  casadi_real **res1=res+2, *rr, w00, *w01=w+13, *w03=w+414, w04, w05, w06, *w07=w+429, *w08=w+6845, *w09=w+7647, *w10=w+8047;
-  casadi_real *w11=w+8447, *w12=w+8847, *w13=w+9247, *w14=w+10447, *w15=w+11647;
-  const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
-  w00 = arg[0] ? arg[0][0] : 0;
-  wr01 = casadi_c0;
-  wr02 = arg[1] ? arg[1] : casadi_zeros;
-  arg1[0]=wr02;
-  res1[0]=w03;
-  res1[1]=(&w04);
-  if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
-  for (rr=(&w05), cs=w03+14; cs!=w03+15; cs+=1) *rr++ = *cs;
-  w06 = 2.;
-  w05 /= w06;
-  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w05);
-  for (i=0, rr=w01, cs=w01; i<401; ++i) (*rr++)  = (w00+(*cs++));
-  for (i=0;i<401;++i) {
-    casadi_copy(wr02, 16, w07+ i*16);
-  }
-  arg1[0]=w01;
-  arg1[1]=w07;
-  res1[0]=w08;
-  if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
-  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+0; ct!=cs+2; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w10, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+2; ct!=cs+4; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w11, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+4; ct!=cs+6; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w12, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
-  rr=w13;
-  for (i=0, cs=w10; i<400; ++i) *rr++ = *cs++;
-  for (i=0, cs=w11; i<400; ++i) *rr++ = *cs++;
-  for (i=0, cs=w12; i<400; ++i) *rr++ = *cs++;
-  for (i=0, rr=w14, cs=w13; i<6; ++i) for (j=0; j<200; ++j) rr[i+j*6] = *cs++;
-  casadi_copy(w14, 1200, res[0]);
-  w05 = 3.7000000000000000e-01;
-  w05 *= w04;
-  w05  = (w00+w05);
-  arg1[0]=(&w05);
-  arg1[1]=wr02;
-  res1[0]=w15;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-  casadi_copy(w15, 2, res[1]);
-  w05 = 1.3700000000000001e+00;
-  w05 *= w04;
-  w00 += w05;
-  arg1[0]=(&w00);
-  arg1[1]=wr02;
-  res1[0]=w15;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-  if (res[1]) casadi_copy(w15, 2, res[1]+2);
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f3(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int table_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void table_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void table_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void table_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t0";
-    case 1: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "table";
-    case 1: return "probe";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s5;
-    case 1: return casadi_s6;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 6;
-  if (sz_res) *sz_res = 4;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 11649;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 11649*sizeof(casadi_real);
-  return 0;
-}
-
 /* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
 #if defined(__GNUC__)
 #define GEARSYM_INLINE inline __attribute__((always_inline))
@@ -1275,43 +392,43 @@ static GEARSYM_INLINE void gs_tangent_keep(const casadi_real* restrict A0, const
   R3[2]=a2;
 }
 
-/* state_try, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1) {
+/* state_try, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_try_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
   casadi_real a36, a37, a38, a39, a40, a41, a42, a43, a44, a45, a46, a47;
   casadi_real a48, a49, a50;
   a00=A0[0];
-  a01=A2[14];
+  a01=A2[S*14];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[1];
+  a03=A0[S*1];
   a04=2.;
   a04=(a01/a04);
-  a05=A0[3];
-  a06=A2[5];
+  a05=A0[S*3];
+  a06=A2[S*5];
   a07=(a05*a06);
-  a08=A0[5];
-  a09=A2[3];
+  a08=A0[S*5];
+  a09=A2[S*3];
   a10=(a08*a09);
   a10=(a07+a10);
-  a11=A2[2];
+  a11=A2[S*2];
   a12=(a03*a11);
   a10=(a10+a12);
-  a12=A0[2];
-  a13=A2[6];
+  a12=A0[S*2];
+  a13=A2[S*6];
   a14=(a12*a13);
   a10=(a10+a14);
-  a15=A0[4];
-  a16=A2[4];
+  a15=A0[S*4];
+  a16=A2[S*4];
   a17=(a15*a16);
   a10=(a10+a17);
-  a17=A2[7];
-  a18=A1[1];
+  a17=A2[S*7];
+  a18=A1[S*1];
   a18=(a17*a18);
   a10=(a10+a18);
-  a18=A2[1];
+  a18=A2[S*1];
   a19=A1[0];
   a20=(a18*a19);
   a21=A2[0];
@@ -1330,26 +447,26 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a20=(a03+a20);
   a29=(2.*a20);
   a29=(a03+a29);
-  a30=A2[9];
+  a30=A2[S*9];
   a31=(a03*a30);
   a07=(a07+a31);
   a07=(a07+a14);
-  a14=A2[8];
+  a14=A2[S*8];
   a31=(a14*a19);
   a31=(a31*a28);
   a07=(a07+a31);
   a31=(a04*a07);
   a31=(a05+a31);
   a32=(a31*a06);
-  a33=A2[10];
+  a33=A2[S*10];
   a34=(a08*a33);
-  a35=A2[13];
+  a35=A2[S*13];
   a36=(a03*a35);
   a34=(a34+a36);
-  a36=A2[11];
+  a36=A2[S*11];
   a37=(a15*a36);
   a34=(a34+a37);
-  a37=A2[12];
+  a37=A2[S*12];
   a19=(a37*a19);
   a19=(a19*a28);
   a34=(a34+a19);
@@ -1367,10 +484,10 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a39=(a15+a39);
   a40=(a39*a16);
   a28=(a28+a40);
-  a40=A1[3];
+  a40=A1[S*3];
   a40=(a17*a40);
   a28=(a28+a40);
-  a41=A1[2];
+  a41=A1[S*2];
   a42=(a18*a41);
   a43=(a04*a03);
   a43=(a00+a43);
@@ -1459,10 +576,10 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a13=(a15+a13);
   a16=(a13*a16);
   a09=(a09+a16);
-  a16=A1[5];
+  a16=A1[S*5];
   a17=(a17*a16);
   a09=(a09+a17);
-  a17=A1[4];
+  a17=A1[S*4];
   a18=(a18*a17);
   a44=(a01*a44);
   a44=(a00+a44);
@@ -1473,7 +590,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a10=(a10+a09);
   a10=(a02*a10);
   a10=(a03+a10);
-  R0[1]=a10;
+  R0[S*1]=a10;
   a31=(2.*a31);
   a31=(a05+a31);
   a45=(2.*a45);
@@ -1481,7 +598,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a31=(a31+a38);
   a31=(a02*a31);
   a12=(a12+a31);
-  R0[2]=a12;
+  R0[S*2]=a12;
   a32=(2.*a32);
   a07=(a07+a32);
   a46=(2.*a46);
@@ -1495,7 +612,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a07=(a07+a06);
   a07=(a02*a07);
   a05=(a05+a07);
-  R0[3]=a05;
+  R0[S*3]=a05;
   a19=(2.*a19);
   a19=(a08+a19);
   a43=(2.*a43);
@@ -1503,7 +620,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a19=(a19+a41);
   a19=(a02*a19);
   a15=(a15+a19);
-  R0[4]=a15;
+  R0[S*4]=a15;
   a47=(2.*a47);
   a34=(a34+a47);
   a48=(2.*a48);
@@ -1519,7 +636,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a34=(a34+a41);
   a02=(a02*a34);
   a08=(a08+a02);
-  R0[5]=a08;
+  R0[S*5]=a08;
   a26=(2.*a26);
   a08=1.;
   a26=(a26-a08);
@@ -1559,22 +676,23 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a22=(a22<a02);
   R1[0]=a22;
 }
+static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1) { gs_state_try_strided(A0, A1, A2, R0, R1, 1); }
 
-/* state_keep, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+/* state_keep, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_keep_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
   casadi_real a0, a1, a2, a3, a4, a5;
   a0=A3[0];
   R0[0]=a0;
-  a1=A3[1];
-  R0[1]=a1;
-  a1=A3[2];
-  R0[2]=a1;
-  a2=A3[3];
-  R0[3]=a2;
-  a2=A3[4];
-  R0[4]=a2;
-  a3=A3[5];
-  R0[5]=a3;
+  a1=A3[S*1];
+  R0[S*1]=a1;
+  a1=A3[S*2];
+  R0[S*2]=a1;
+  a2=A3[S*3];
+  R0[S*3]=a2;
+  a2=A3[S*4];
+  R0[S*4]=a2;
+  a3=A3[S*5];
+  R0[S*5]=a3;
   a3=A1[0];
   a4=(a0<a3);
   a5=(a4?a0:0);
@@ -1582,20 +700,20 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
   a4=(a4?a3:0);
   a5=(a5+a4);
   R1[0]=a5;
-  a5=A1[1];
+  a5=A1[S*1];
   a4=(a1<a5);
   a3=(a4?a1:0);
   a4=(!a4);
   a4=(a4?a5:0);
   a3=(a3+a4);
-  R1[1]=a3;
-  a3=A1[2];
+  R1[S*1]=a3;
+  a3=A1[S*2];
   a4=(a2<a3);
   a5=(a4?a2:0);
   a4=(!a4);
   a4=(a4?a3:0);
   a5=(a5+a4);
-  R1[2]=a5;
+  R1[S*2]=a5;
   a5=A2[0];
   a4=(a5<a0);
   a0=(a4?a0:0);
@@ -1603,21 +721,22 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
   a4=(a4?a5:0);
   a0=(a0+a4);
   R2[0]=a0;
-  a0=A2[1];
+  a0=A2[S*1];
   a4=(a0<a1);
   a1=(a4?a1:0);
   a4=(!a4);
   a4=(a4?a0:0);
   a1=(a1+a4);
-  R2[1]=a1;
-  a1=A2[2];
+  R2[S*1]=a1;
+  a1=A2[S*2];
   a4=(a1<a2);
   a2=(a4?a2:0);
   a4=(!a4);
   a4=(a4?a1:0);
   a2=(a2+a4);
-  R2[2]=a2;
+  R2[S*2]=a2;
 }
+static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_state_keep_strided(A0, A1, A2, A3, A4, A5, R0, R1, R2, 1); }
 
 /* split_start, from CasADi's C of it */
 static GEARSYM_NOINLINE void gs_split_start(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
@@ -4021,43 +3140,43 @@ static GEARSYM_NOINLINE void gs_state_mode_step(const casadi_real* restrict A0, 
   R0[5]=a08;
 }
 
-/* tangent_state, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+/* tangent_state, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_state_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
   casadi_real a36, a37, a38, a39, a40, a41, a42, a43, a44, a45, a46, a47;
   casadi_real a48, a49, a50, a51, a52, a53, a54;
   a00=A0[0];
-  a01=A2[14];
+  a01=A2[S*14];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[1];
+  a03=A0[S*1];
   a04=2.;
   a04=(a01/a04);
-  a05=A0[3];
-  a06=A2[5];
+  a05=A0[S*3];
+  a06=A2[S*5];
   a07=(a05*a06);
-  a08=A0[5];
-  a09=A2[3];
+  a08=A0[S*5];
+  a09=A2[S*3];
   a10=(a08*a09);
   a10=(a07+a10);
-  a11=A2[2];
+  a11=A2[S*2];
   a12=(a03*a11);
   a10=(a10+a12);
-  a12=A0[2];
-  a13=A2[6];
+  a12=A0[S*2];
+  a13=A2[S*6];
   a14=(a12*a13);
   a10=(a10+a14);
-  a15=A0[4];
-  a16=A2[4];
+  a15=A0[S*4];
+  a16=A2[S*4];
   a17=(a15*a16);
   a10=(a10+a17);
-  a17=A2[7];
-  a18=A1[1];
+  a17=A2[S*7];
+  a18=A1[S*1];
   a18=(a17*a18);
   a10=(a10+a18);
-  a18=A2[1];
+  a18=A2[S*1];
   a19=A1[0];
   a20=(a18*a19);
   a21=A2[0];
@@ -4076,26 +3195,26 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a29=(a03+a29);
   a30=(2.*a29);
   a30=(a03+a30);
-  a31=A2[9];
+  a31=A2[S*9];
   a32=(a03*a31);
   a07=(a07+a32);
   a07=(a07+a14);
-  a14=A2[8];
+  a14=A2[S*8];
   a32=(a14*a19);
   a33=(a32*a28);
   a07=(a07+a33);
   a33=(a04*a07);
   a33=(a05+a33);
   a34=(a33*a06);
-  a35=A2[10];
+  a35=A2[S*10];
   a36=(a08*a35);
-  a37=A2[13];
+  a37=A2[S*13];
   a38=(a03*a37);
   a36=(a36+a38);
-  a38=A2[11];
+  a38=A2[S*11];
   a39=(a15*a38);
   a36=(a36+a39);
-  a39=A2[12];
+  a39=A2[S*12];
   a19=(a39*a19);
   a28=(a19*a28);
   a36=(a36+a28);
@@ -4113,10 +3232,10 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a42=(a15+a42);
   a43=(a42*a16);
   a40=(a40+a43);
-  a43=A1[3];
+  a43=A1[S*3];
   a43=(a17*a43);
   a40=(a40+a43);
-  a44=A1[2];
+  a44=A1[S*2];
   a45=(a18*a44);
   a46=(a04*a03);
   a46=(a00+a46);
@@ -4205,10 +3324,10 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a53=(a15+a53);
   a54=(a53*a16);
   a52=(a52+a54);
-  a54=A1[5];
+  a54=A1[S*5];
   a17=(a17*a54);
   a52=(a52+a17);
-  a17=A1[4];
+  a17=A1[S*4];
   a18=(a18*a17);
   a47=(a01*a47);
   a47=(a00+a47);
@@ -4219,7 +3338,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a10=(a10+a52);
   a10=(a02*a10);
   a10=(a03+a10);
-  R0[1]=a10;
+  R0[S*1]=a10;
   a33=(2.*a33);
   a33=(a05+a33);
   a48=(2.*a48);
@@ -4227,7 +3346,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a33=(a33+a51);
   a33=(a02*a33);
   a12=(a12+a33);
-  R0[2]=a12;
+  R0[S*2]=a12;
   a34=(2.*a34);
   a07=(a07+a34);
   a49=(2.*a49);
@@ -4241,7 +3360,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a07=(a07+a42);
   a07=(a02*a07);
   a05=(a05+a07);
-  R0[3]=a05;
+  R0[S*3]=a05;
   a28=(2.*a28);
   a28=(a08+a28);
   a46=(2.*a46);
@@ -4249,7 +3368,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a28=(a28+a04);
   a28=(a02*a28);
   a15=(a15+a28);
-  R0[4]=a15;
+  R0[S*4]=a15;
   a50=(2.*a50);
   a36=(a36+a50);
   a40=(2.*a40);
@@ -4265,7 +3384,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a36=(a36+a04);
   a02=(a02*a36);
   a08=(a08+a02);
-  R0[5]=a08;
+  R0[S*5]=a08;
   a26=(2.*a26);
   a08=1.;
   a26=(a26-a08);
@@ -4307,74 +3426,75 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a20=(a20*a27);
   R2[0]=a20;
   a32=(a32*a27);
-  R2[1]=a32;
+  R2[S*1]=a32;
   a19=(a19*a27);
-  R2[2]=a19;
-  R2[3]=a11;
-  R2[4]=a31;
-  R2[5]=a37;
-  R2[6]=a13;
-  R2[7]=a06;
-  R2[8]=a16;
-  R2[9]=a38;
-  R2[10]=a09;
-  R2[11]=a35;
+  R2[S*2]=a19;
+  R2[S*3]=a11;
+  R2[S*4]=a31;
+  R2[S*5]=a37;
+  R2[S*6]=a13;
+  R2[S*7]=a06;
+  R2[S*8]=a16;
+  R2[S*9]=a38;
+  R2[S*10]=a09;
+  R2[S*11]=a35;
   a45=(a45*a27);
-  R2[12]=a45;
+  R2[S*12]=a45;
   a41=(a41*a27);
-  R2[13]=a41;
+  R2[S*13]=a41;
   a44=(a44*a27);
-  R2[14]=a44;
-  R2[15]=a45;
-  R2[16]=a41;
-  R2[17]=a44;
+  R2[S*14]=a44;
+  R2[S*15]=a45;
+  R2[S*16]=a41;
+  R2[S*17]=a44;
   a18=(a18*a27);
-  R2[18]=a18;
+  R2[S*18]=a18;
   a14=(a14*a27);
-  R2[19]=a14;
+  R2[S*19]=a14;
   a39=(a39*a27);
-  R2[20]=a39;
+  R2[S*20]=a39;
 }
+static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_tangent_state_strided(A0, A1, A2, R0, R1, R2, 1); }
 
-/* tangent_vector, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) {
+/* tangent_vector, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_vector_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
   casadi_real a36;
   a00=A0[0];
-  a01=A2[14];
+  a01=A2[S*14];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[6];
+  a03=A0[S*6];
   a04=2.;
   a04=(a01/a04);
   a05=A1[0];
   a05=(a05*a00);
-  a06=A1[3];
+  a06=A1[S*3];
   a07=(a06*a03);
   a05=(a05+a07);
-  a07=A1[6];
-  a08=A0[12];
+  a07=A1[S*6];
+  a08=A0[S*12];
   a09=(a07*a08);
   a05=(a05+a09);
-  a10=A1[7];
-  a11=A0[18];
+  a10=A1[S*7];
+  a11=A0[S*18];
   a12=(a10*a11);
   a05=(a05+a12);
-  a13=A1[8];
-  a14=A0[24];
+  a13=A1[S*8];
+  a14=A0[S*24];
   a15=(a13*a14);
   a05=(a05+a15);
-  a15=A1[10];
-  a16=A0[30];
+  a15=A1[S*10];
+  a16=A0[S*30];
   a17=(a15*a16);
   a05=(a05+a17);
   a17=(a04*a05);
   a17=(a03+a17);
   a18=(2.*a17);
   a18=(a03+a18);
-  a19=A1[12];
+  a19=A1[S*12];
   a20=(a04*a03);
   a20=(a00+a20);
   a19=(a19*a20);
@@ -4384,9 +3504,9 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a21=(a08+a21);
   a21=(a07*a21);
   a19=(a19+a21);
-  a22=A1[1];
+  a22=A1[S*1];
   a22=(a22*a00);
-  a23=A1[4];
+  a23=A1[S*4];
   a24=(a23*a03);
   a22=(a22+a24);
   a22=(a22+a09);
@@ -4399,15 +3519,15 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a24=(a14+a24);
   a25=(a13*a24);
   a19=(a19+a25);
-  a25=A1[2];
+  a25=A1[S*2];
   a25=(a25*a00);
-  a26=A1[5];
+  a26=A1[S*5];
   a27=(a26*a03);
   a25=(a25+a27);
-  a27=A1[9];
+  a27=A1[S*9];
   a28=(a27*a14);
   a25=(a25+a28);
-  a28=A1[11];
+  a28=A1[S*11];
   a29=(a28*a16);
   a25=(a25+a29);
   a29=(a04*a25);
@@ -4418,7 +3538,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a30=(a03+a30);
   a31=(2.*a30);
   a18=(a18+a31);
-  a31=A1[15];
+  a31=A1[S*15];
   a32=(a04*a17);
   a32=(a00+a32);
   a31=(a31*a32);
@@ -4428,7 +3548,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a33=(a08+a33);
   a33=(a07*a33);
   a31=(a31+a33);
-  a34=A1[13];
+  a34=A1[S*13];
   a34=(a34*a20);
   a35=(a23*a17);
   a34=(a34+a35);
@@ -4442,7 +3562,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a35=(a14+a35);
   a36=(a13*a35);
   a31=(a31+a36);
-  a36=A1[14];
+  a36=A1[S*14];
   a36=(a36*a20);
   a17=(a26*a17);
   a36=(a36+a17);
@@ -4464,7 +3584,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a05=(a05+a19);
   a31=(2.*a31);
   a05=(a05+a31);
-  a31=A1[18];
+  a31=A1[S*18];
   a19=(a01*a30);
   a00=(a00+a19);
   a31=(a31*a00);
@@ -4474,7 +3594,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a06=(a08+a06);
   a07=(a07*a06);
   a31=(a31+a07);
-  a06=A1[16];
+  a06=A1[S*16];
   a06=(a06*a32);
   a19=(a23*a30);
   a06=(a06+a19);
@@ -4488,7 +3608,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a33=(a14+a33);
   a13=(a13*a33);
   a31=(a31+a13);
-  a13=A1[17];
+  a13=A1[S*17];
   a13=(a13*a32);
   a30=(a26*a30);
   a13=(a13+a30);
@@ -4503,7 +3623,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a05=(a05+a31);
   a05=(a02*a05);
   a03=(a03+a05);
-  R0[6]=a03;
+  R0[S*6]=a03;
   a12=(2.*a12);
   a12=(a11+a12);
   a09=(2.*a09);
@@ -4511,12 +3631,12 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a12=(a12+a21);
   a12=(a02*a12);
   a08=(a08+a12);
-  R0[12]=a08;
+  R0[S*12]=a08;
   a34=(2.*a34);
   a22=(a22+a34);
   a06=(2.*a06);
   a22=(a22+a06);
-  a06=A1[19];
+  a06=A1[S*19];
   a06=(a06*a00);
   a23=(a23*a24);
   a06=(a06+a23);
@@ -4525,7 +3645,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a22=(a22+a06);
   a22=(a02*a22);
   a11=(a11+a22);
-  R0[18]=a11;
+  R0[S*18]=a11;
   a29=(2.*a29);
   a29=(a16+a29);
   a04=(2.*a04);
@@ -4533,12 +3653,12 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a29=(a29+a01);
   a29=(a02*a29);
   a14=(a14+a29);
-  R0[24]=a14;
+  R0[S*24]=a14;
   a36=(2.*a36);
   a25=(a25+a36);
   a13=(2.*a13);
   a25=(a25+a13);
-  a13=A1[20];
+  a13=A1[S*20];
   a13=(a13*a00);
   a26=(a26*a24);
   a13=(a13+a26);
@@ -4549,8 +3669,9 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a25=(a25+a13);
   a02=(a02*a25);
   a16=(a16+a02);
-  R0[30]=a16;
+  R0[S*30]=a16;
 }
+static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) { gs_tangent_vector_strided(A0, A1, A2, R0, 1); }
 
 /* gram_schmidt, from CasADi's C of it */
 static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
@@ -5097,6 +4218,83 @@ static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casad
   R1[5]=a22;
 }
 
+/* constants, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_constants_strided(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12;
+  a00=A0[S*9];
+  R0[0]=a00;
+  a00=A0[0];
+  a01=casadi_sq(a00);
+  a02=(1./a01);
+  a03=(-a02);
+  R0[S*1]=a03;
+  a03=-2.;
+  a04=A0[S*1];
+  a03=(a03*a04);
+  a05=(a03/a00);
+  R0[S*2]=a05;
+  a05=A0[S*8];
+  a06=A0[S*13];
+  a05=(a05/a06);
+  a05=(a05/a00);
+  R0[S*3]=a05;
+  a07=A0[S*11];
+  a07=(a07/a06);
+  a07=(a07/a01);
+  R0[S*4]=a07;
+  a08=A0[S*7];
+  a09=A0[S*12];
+  a08=(a08/a09);
+  a08=(a08/a00);
+  a08=(-a08);
+  R0[S*5]=a08;
+  a08=A0[S*10];
+  a08=(a08/a09);
+  a08=(a08/a01);
+  a08=(-a08);
+  R0[S*6]=a08;
+  R0[S*7]=a02;
+  a02=(1./a09);
+  a08=(a02/a01);
+  a10=(1./a06);
+  a02=(a02+a10);
+  a11=A0[S*14];
+  a11=casadi_sq(a11);
+  a12=A0[S*4];
+  a11=(a11/a12);
+  a02=(a02+a11);
+  a11=A0[S*15];
+  a11=casadi_sq(a11);
+  a12=A0[S*5];
+  a11=(a11/a12);
+  a02=(a02+a11);
+  a08=(a08/a02);
+  a08=(-a08);
+  R0[S*8]=a08;
+  a03=(a03/a09);
+  a03=(a03/a00);
+  a03=(a03/a02);
+  R0[S*9]=a03;
+  a05=(-a05);
+  R0[S*10]=a05;
+  a07=(-a07);
+  R0[S*11]=a07;
+  a10=(a10/a01);
+  a10=(a10/a02);
+  R0[S*12]=a10;
+  a04=(2.*a04);
+  a04=(a04/a06);
+  a04=(a04/a00);
+  a04=(a04/a02);
+  R0[S*13]=a04;
+  a04=3.1415926535897934e-02;
+  R0[S*14]=a04;
+  a04=6.2831853071795862e+00;
+  R1[0]=a04;
+}
+static GEARSYM_INLINE void gs_constants(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) { gs_constants_strided(A0, R0, R1, 1); }
+
 /* the located step that crosses: its legs, RK4 of the sides held fixed on each (calls of one
    mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/crossing.py) */
 static GEARSYM_NOINLINE void gs_tangent_split(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict yt, const casadi_real* restrict Qt, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
@@ -5137,6 +4335,891 @@ static GEARSYM_NOINLINE void gs_state_split(const casadi_real* restrict y, const
   gs_state_mode_step(yb, leg_b, c, yc);
   gs_state_mode_step(yc, leg_c, c, yn);
   gs_state_keep(y, lo, hi, yn, T, c, y1, lo1, hi1);
+}
+
+#ifndef GEARSYM_STEP_PIECES_ONLY  /* (the lanes' C includes the pieces above) */
+
+/* rhs:(t,y[6],p[16])->(dy[6]) */
+static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+  a00=arg[1]? arg[1][1] : 0;
+  if (res[0]!=0) res[0][0]=a00;
+  a01=-2.;
+  a01=(a01*a00);
+  a02=arg[2]? arg[2][1] : 0;
+  a01=(a01*a02);
+  a03=arg[2]? arg[2][0] : 0;
+  a04=(a01/a03);
+  a05=arg[2]? arg[2][8] : 0;
+  a06=arg[1]? arg[1][5] : 0;
+  a05=(a05*a06);
+  a07=arg[2]? arg[2][13] : 0;
+  a05=(a05/a07);
+  a05=(a05/a03);
+  a04=(a04+a05);
+  a08=arg[2]? arg[2][11] : 0;
+  a09=arg[1]? arg[1][4] : 0;
+  a08=(a08*a09);
+  a08=(a08/a07);
+  a09=casadi_sq(a03);
+  a08=(a08/a09);
+  a04=(a04+a08);
+  a10=arg[2]? arg[2][7] : 0;
+  a11=arg[1]? arg[1][3] : 0;
+  a10=(a10*a11);
+  a12=arg[2]? arg[2][12] : 0;
+  a10=(a10/a12);
+  a10=(a10/a03);
+  a04=(a04-a10);
+  a13=arg[2]? arg[2][10] : 0;
+  a14=arg[1]? arg[1][2] : 0;
+  a13=(a13*a14);
+  a13=(a13/a12);
+  a13=(a13/a09);
+  a04=(a04-a13);
+  a14=arg[2]? arg[2][2] : 0;
+  a15=arg[2]? arg[2][3] : 0;
+  a16=arg[2]? arg[2][6] : 0;
+  a17=arg[0]? arg[0][0] : 0;
+  a16=(a16+a17);
+  a16=cos(a16);
+  a15=(a15*a16);
+  a14=(a14+a15);
+  a14=(a14/a09);
+  a04=(a04+a14);
+  a14=0.;
+  a15=arg[1]? arg[1][0] : 0;
+  a14=(a14<=a15);
+  a14=(a14?a15:0);
+  a16=arg[2]? arg[2][9] : 0;
+  a18=(-a16);
+  a18=(a15<=a18);
+  a15=(a15+a16);
+  a18=(a18?a15:0);
+  a14=(a14+a18);
+  a18=(a14/a09);
+  a15=1.;
+  a16=2.7661221359999999e-01;
+  a19=sin(a17);
+  a16=(a16*a19);
+  a15=(a15+a16);
+  a16=-1.2805164159999999e-01;
+  a19=cos(a17);
+  a16=(a16*a19);
+  a15=(a15+a16);
+  a16=6.2617029230000003e-03;
+  a19=7.;
+  a19=(a19*a17);
+  a20=sin(a19);
+  a16=(a16*a20);
+  a15=(a15+a16);
+  a16=1.3450290380000000e-02;
+  a20=5.;
+  a20=(a20*a17);
+  a21=cos(a20);
+  a16=(a16*a21);
+  a15=(a15+a16);
+  a16=6.7468832359999995e-02;
+  a21=(2.*a17);
+  a22=cos(a21);
+  a16=(a16*a22);
+  a15=(a15+a16);
+  a16=4.3708772070000000e-03;
+  a22=6.;
+  a22=(a22*a17);
+  a23=sin(a22);
+  a16=(a16*a23);
+  a15=(a15+a16);
+  a16=9.1421067960000008e-03;
+  a20=sin(a20);
+  a16=(a16*a20);
+  a15=(a15+a16);
+  a16=7.9504500709999995e-02;
+  a21=sin(a21);
+  a16=(a16*a21);
+  a15=(a15+a16);
+  a16=6.7080805820000000e-04;
+  a19=cos(a19);
+  a16=(a16*a19);
+  a15=(a15+a16);
+  a16=4.9745246999999999e-02;
+  a19=4.;
+  a19=(a19*a17);
+  a21=sin(a19);
+  a16=(a16*a21);
+  a15=(a15+a16);
+  a16=6.8506266280000004e-03;
+  a21=3.;
+  a21=(a21*a17);
+  a17=sin(a21);
+  a16=(a16*a17);
+  a15=(a15+a16);
+  a16=-2.4739900039999999e-02;
+  a21=cos(a21);
+  a16=(a16*a21);
+  a15=(a15+a16);
+  a16=-8.2022960919999992e-03;
+  a19=cos(a19);
+  a16=(a16*a19);
+  a15=(a15+a16);
+  a16=-7.2871874210000001e-03;
+  a22=cos(a22);
+  a16=(a16*a22);
+  a15=(a15+a16);
+  a18=(a18*a15);
+  a04=(a04-a18);
+  if (res[0]!=0) res[0][1]=a04;
+  if (res[0]!=0) res[0][2]=a11;
+  a01=(a01/a12);
+  a01=(a01/a03);
+  a12=(1./a12);
+  a11=(1./a07);
+  a04=(a12+a11);
+  a18=arg[2]? arg[2][14] : 0;
+  a18=casadi_sq(a18);
+  a16=arg[2]? arg[2][4] : 0;
+  a18=(a18/a16);
+  a04=(a04+a18);
+  a18=arg[2]? arg[2][15] : 0;
+  a18=casadi_sq(a18);
+  a16=arg[2]? arg[2][5] : 0;
+  a18=(a18/a16);
+  a04=(a04+a18);
+  a01=(a01/a04);
+  a10=(a10+a13);
+  a12=(a12/a09);
+  a12=(a12*a14);
+  a12=(a12/a04);
+  a12=(a12*a15);
+  a10=(a10+a12);
+  a01=(a01-a10);
+  if (res[0]!=0) res[0][3]=a01;
+  if (res[0]!=0) res[0][4]=a06;
+  a11=(a11/a09);
+  a11=(a11*a14);
+  a11=(a11/a04);
+  a11=(a11*a15);
+  a05=(a05+a08);
+  a11=(a11-a05);
+  a00=(2.*a00);
+  a00=(a00*a02);
+  a00=(a00/a07);
+  a00=(a00/a03);
+  a00=(a00/a04);
+  a11=(a11+a00);
+  if (res[0]!=0) res[0][5]=a11;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int rhs(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f0(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int rhs_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void rhs_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void rhs_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void rhs_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int rhs_n_in(void) { return 3;}
+
+CASADI_SYMBOL_EXPORT casadi_int rhs_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real rhs_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* rhs_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "y";
+    case 2: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* rhs_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "dy";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s1;
+    case 2: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s1;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int rhs_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int rhs_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* jacobian:(t,y[6],p[16])->(J[6x6]) */
+static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12;
+  a00=0.;
+  if (res[0]!=0) res[0][0]=a00;
+  a01=1.;
+  a02=2.7661221359999999e-01;
+  a03=arg[0]? arg[0][0] : 0;
+  a04=sin(a03);
+  a02=(a02*a04);
+  a02=(a01+a02);
+  a04=-1.2805164159999999e-01;
+  a05=cos(a03);
+  a04=(a04*a05);
+  a02=(a02+a04);
+  a04=6.2617029230000003e-03;
+  a05=7.;
+  a05=(a05*a03);
+  a06=sin(a05);
+  a04=(a04*a06);
+  a02=(a02+a04);
+  a04=1.3450290380000000e-02;
+  a06=5.;
+  a06=(a06*a03);
+  a07=cos(a06);
+  a04=(a04*a07);
+  a02=(a02+a04);
+  a04=6.7468832359999995e-02;
+  a07=(2.*a03);
+  a08=cos(a07);
+  a04=(a04*a08);
+  a02=(a02+a04);
+  a04=4.3708772070000000e-03;
+  a08=6.;
+  a08=(a08*a03);
+  a09=sin(a08);
+  a04=(a04*a09);
+  a02=(a02+a04);
+  a04=9.1421067960000008e-03;
+  a06=sin(a06);
+  a04=(a04*a06);
+  a02=(a02+a04);
+  a04=7.9504500709999995e-02;
+  a07=sin(a07);
+  a04=(a04*a07);
+  a02=(a02+a04);
+  a04=6.7080805820000000e-04;
+  a05=cos(a05);
+  a04=(a04*a05);
+  a02=(a02+a04);
+  a04=4.9745246999999999e-02;
+  a05=4.;
+  a05=(a05*a03);
+  a07=sin(a05);
+  a04=(a04*a07);
+  a02=(a02+a04);
+  a04=6.8506266280000004e-03;
+  a07=3.;
+  a07=(a07*a03);
+  a03=sin(a07);
+  a04=(a04*a03);
+  a02=(a02+a04);
+  a04=-2.4739900039999999e-02;
+  a07=cos(a07);
+  a04=(a04*a07);
+  a02=(a02+a04);
+  a04=-8.2022960919999992e-03;
+  a05=cos(a05);
+  a04=(a04*a05);
+  a02=(a02+a04);
+  a04=-7.2871874210000001e-03;
+  a08=cos(a08);
+  a04=(a04*a08);
+  a02=(a02+a04);
+  a04=arg[1]? arg[1][0] : 0;
+  a08=(a00<=a04);
+  a08=(a08?a01:0);
+  a05=arg[2]? arg[2][9] : 0;
+  a05=(-a05);
+  a04=(a04<=a05);
+  a04=(a04?a01:0);
+  a08=(a08+a04);
+  a04=arg[2]? arg[2][0] : 0;
+  a05=casadi_sq(a04);
+  a07=(a08/a05);
+  a07=(a02*a07);
+  a07=(-a07);
+  if (res[0]!=0) res[0][1]=a07;
+  if (res[0]!=0) res[0][2]=a00;
+  a07=arg[2]? arg[2][12] : 0;
+  a03=(1./a07);
+  a06=(a03/a05);
+  a06=(a06*a08);
+  a09=arg[2]? arg[2][13] : 0;
+  a10=(1./a09);
+  a03=(a03+a10);
+  a11=arg[2]? arg[2][14] : 0;
+  a11=casadi_sq(a11);
+  a12=arg[2]? arg[2][4] : 0;
+  a11=(a11/a12);
+  a03=(a03+a11);
+  a11=arg[2]? arg[2][15] : 0;
+  a11=casadi_sq(a11);
+  a12=arg[2]? arg[2][5] : 0;
+  a11=(a11/a12);
+  a03=(a03+a11);
+  a06=(a06/a03);
+  a06=(a02*a06);
+  a06=(-a06);
+  if (res[0]!=0) res[0][3]=a06;
+  if (res[0]!=0) res[0][4]=a00;
+  a10=(a10/a05);
+  a10=(a10*a08);
+  a10=(a10/a03);
+  a02=(a02*a10);
+  if (res[0]!=0) res[0][5]=a02;
+  if (res[0]!=0) res[0][6]=a01;
+  a02=-2.;
+  a10=arg[2]? arg[2][1] : 0;
+  a02=(a02*a10);
+  a08=(a02/a04);
+  if (res[0]!=0) res[0][7]=a08;
+  if (res[0]!=0) res[0][8]=a00;
+  a02=(a02/a07);
+  a02=(a02/a04);
+  a02=(a02/a03);
+  if (res[0]!=0) res[0][9]=a02;
+  if (res[0]!=0) res[0][10]=a00;
+  a10=(2.*a10);
+  a10=(a10/a09);
+  a10=(a10/a04);
+  a10=(a10/a03);
+  if (res[0]!=0) res[0][11]=a10;
+  if (res[0]!=0) res[0][12]=a00;
+  a10=arg[2]? arg[2][10] : 0;
+  a10=(a10/a07);
+  a10=(a10/a05);
+  a10=(-a10);
+  if (res[0]!=0) res[0][13]=a10;
+  if (res[0]!=0) res[0][14]=a00;
+  if (res[0]!=0) res[0][15]=a10;
+  if (res[0]!=0) res[0][16]=a00;
+  if (res[0]!=0) res[0][17]=a00;
+  if (res[0]!=0) res[0][18]=a00;
+  a10=arg[2]? arg[2][7] : 0;
+  a10=(a10/a07);
+  a10=(a10/a04);
+  a10=(-a10);
+  if (res[0]!=0) res[0][19]=a10;
+  if (res[0]!=0) res[0][20]=a01;
+  if (res[0]!=0) res[0][21]=a10;
+  if (res[0]!=0) res[0][22]=a00;
+  if (res[0]!=0) res[0][23]=a00;
+  if (res[0]!=0) res[0][24]=a00;
+  a10=arg[2]? arg[2][11] : 0;
+  a10=(a10/a09);
+  a10=(a10/a05);
+  if (res[0]!=0) res[0][25]=a10;
+  if (res[0]!=0) res[0][26]=a00;
+  if (res[0]!=0) res[0][27]=a00;
+  if (res[0]!=0) res[0][28]=a00;
+  a10=(-a10);
+  if (res[0]!=0) res[0][29]=a10;
+  if (res[0]!=0) res[0][30]=a00;
+  a10=arg[2]? arg[2][8] : 0;
+  a10=(a10/a09);
+  a10=(a10/a04);
+  if (res[0]!=0) res[0][31]=a10;
+  if (res[0]!=0) res[0][32]=a00;
+  if (res[0]!=0) res[0][33]=a00;
+  if (res[0]!=0) res[0][34]=a01;
+  a10=(-a10);
+  if (res[0]!=0) res[0][35]=a10;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int jacobian(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f1(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int jacobian_n_in(void) { return 3;}
+
+CASADI_SYMBOL_EXPORT casadi_int jacobian_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real jacobian_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* jacobian_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "y";
+    case 2: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* jacobian_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "J";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s1;
+    case 2: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s3;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* constants:(p[16])->(c[15],period) */
+static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12;
+  a00=arg[0]? arg[0][9] : 0;
+  if (res[0]!=0) res[0][0]=a00;
+  a00=arg[0]? arg[0][0] : 0;
+  a01=casadi_sq(a00);
+  a02=(1./a01);
+  a03=(-a02);
+  if (res[0]!=0) res[0][1]=a03;
+  a03=-2.;
+  a04=arg[0]? arg[0][1] : 0;
+  a03=(a03*a04);
+  a05=(a03/a00);
+  if (res[0]!=0) res[0][2]=a05;
+  a05=arg[0]? arg[0][8] : 0;
+  a06=arg[0]? arg[0][13] : 0;
+  a05=(a05/a06);
+  a05=(a05/a00);
+  if (res[0]!=0) res[0][3]=a05;
+  a07=arg[0]? arg[0][11] : 0;
+  a07=(a07/a06);
+  a07=(a07/a01);
+  if (res[0]!=0) res[0][4]=a07;
+  a08=arg[0]? arg[0][7] : 0;
+  a09=arg[0]? arg[0][12] : 0;
+  a08=(a08/a09);
+  a08=(a08/a00);
+  a08=(-a08);
+  if (res[0]!=0) res[0][5]=a08;
+  a08=arg[0]? arg[0][10] : 0;
+  a08=(a08/a09);
+  a08=(a08/a01);
+  a08=(-a08);
+  if (res[0]!=0) res[0][6]=a08;
+  if (res[0]!=0) res[0][7]=a02;
+  a02=(1./a09);
+  a08=(a02/a01);
+  a10=(1./a06);
+  a02=(a02+a10);
+  a11=arg[0]? arg[0][14] : 0;
+  a11=casadi_sq(a11);
+  a12=arg[0]? arg[0][4] : 0;
+  a11=(a11/a12);
+  a02=(a02+a11);
+  a11=arg[0]? arg[0][15] : 0;
+  a11=casadi_sq(a11);
+  a12=arg[0]? arg[0][5] : 0;
+  a11=(a11/a12);
+  a02=(a02+a11);
+  a08=(a08/a02);
+  a08=(-a08);
+  if (res[0]!=0) res[0][8]=a08;
+  a03=(a03/a09);
+  a03=(a03/a00);
+  a03=(a03/a02);
+  if (res[0]!=0) res[0][9]=a03;
+  a05=(-a05);
+  if (res[0]!=0) res[0][10]=a05;
+  a07=(-a07);
+  if (res[0]!=0) res[0][11]=a07;
+  a10=(a10/a01);
+  a10=(a10/a02);
+  if (res[0]!=0) res[0][12]=a10;
+  a04=(2.*a04);
+  a04=(a04/a06);
+  a04=(a04/a00);
+  a04=(a04/a02);
+  if (res[0]!=0) res[0][13]=a04;
+  a04=3.1415926535897934e-02;
+  if (res[0]!=0) res[0][14]=a04;
+  a04=6.2831853071795862e+00;
+  if (res[1]!=0) res[1][0]=a04;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int constants(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f2(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int constants_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void constants_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void constants_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void constants_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int constants_n_in(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_int constants_n_out(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_real constants_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* constants_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* constants_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "c";
+    case 1: return "period";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s4;
+    case 1: return casadi_s0;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int constants_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 1;
+  if (sz_res) *sz_res = 2;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 1*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 2*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* table_point:(t,p[16])->(values[2]) */
+static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a0, a1, a2, a3, a4, a5, a6, a7;
+  a0=1.;
+  a1=2.7661221359999999e-01;
+  a2=arg[0]? arg[0][0] : 0;
+  a3=sin(a2);
+  a1=(a1*a3);
+  a0=(a0+a1);
+  a1=-1.2805164159999999e-01;
+  a3=cos(a2);
+  a1=(a1*a3);
+  a0=(a0+a1);
+  a1=6.2617029230000003e-03;
+  a3=7.;
+  a3=(a3*a2);
+  a4=sin(a3);
+  a1=(a1*a4);
+  a0=(a0+a1);
+  a1=1.3450290380000000e-02;
+  a4=5.;
+  a4=(a4*a2);
+  a5=cos(a4);
+  a1=(a1*a5);
+  a0=(a0+a1);
+  a1=6.7468832359999995e-02;
+  a5=(2.*a2);
+  a6=cos(a5);
+  a1=(a1*a6);
+  a0=(a0+a1);
+  a1=4.3708772070000000e-03;
+  a6=6.;
+  a6=(a6*a2);
+  a7=sin(a6);
+  a1=(a1*a7);
+  a0=(a0+a1);
+  a1=9.1421067960000008e-03;
+  a4=sin(a4);
+  a1=(a1*a4);
+  a0=(a0+a1);
+  a1=7.9504500709999995e-02;
+  a5=sin(a5);
+  a1=(a1*a5);
+  a0=(a0+a1);
+  a1=6.7080805820000000e-04;
+  a3=cos(a3);
+  a1=(a1*a3);
+  a0=(a0+a1);
+  a1=4.9745246999999999e-02;
+  a3=4.;
+  a3=(a3*a2);
+  a5=sin(a3);
+  a1=(a1*a5);
+  a0=(a0+a1);
+  a1=6.8506266280000004e-03;
+  a5=3.;
+  a5=(a5*a2);
+  a4=sin(a5);
+  a1=(a1*a4);
+  a0=(a0+a1);
+  a1=-2.4739900039999999e-02;
+  a5=cos(a5);
+  a1=(a1*a5);
+  a0=(a0+a1);
+  a1=-8.2022960919999992e-03;
+  a3=cos(a3);
+  a1=(a1*a3);
+  a0=(a0+a1);
+  a1=-7.2871874210000001e-03;
+  a6=cos(a6);
+  a1=(a1*a6);
+  a0=(a0+a1);
+  if (res[0]!=0) res[0][0]=a0;
+  a0=arg[1]? arg[1][2] : 0;
+  a1=arg[1]? arg[1][3] : 0;
+  a6=arg[1]? arg[1][6] : 0;
+  a6=(a6+a2);
+  a6=cos(a6);
+  a1=(a1*a6);
+  a0=(a0+a1);
+  if (res[0]!=0) res[0][1]=a0;
+  return 0;
+}
+
+/* map401_table_point:(t[1x401],p[16x401])->(values[2x401]) */
+static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_int i;
+  casadi_real* *res1;
+  const casadi_real* *arg1;
+  arg1 = arg+2;
+  for (i=0; i<2; ++i) arg1[i]=arg[i];
+  res1 = res+1;
+  for (i=0; i<1; ++i) res1[i]=res[i];
+  for (i=0; i<401; ++i) {
+    if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+    if (arg1[0]) arg1[0]+=1;
+    if (arg1[1]) arg1[1]+=16;
+    if (res1[0]) res1[0]+=2;
+  }
+  return 0;
+}
+
+/* table:(t0,p[16])->(table[6x200],probe[2x2]) */
+static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_int i, j;
+  casadi_real **res1=res+2, *rr, w00, *w01=w+13, *w03=w+414, w04, w05, w06, *w07=w+429, *w08=w+6845, *w09=w+7647, *w10=w+8047;
+  casadi_real *w11=w+8447, *w12=w+8847, *w13=w+9247, *w14=w+10447, *w15=w+11647;
+  const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
+  w00 = arg[0] ? arg[0][0] : 0;
+  wr01 = casadi_c0;
+  wr02 = arg[1] ? arg[1] : casadi_zeros;
+  arg1[0]=wr02;
+  res1[0]=w03;
+  res1[1]=(&w04);
+  if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
+  for (rr=(&w05), cs=w03+14; cs!=w03+15; cs+=1) *rr++ = *cs;
+  w06 = 2.;
+  w05 /= w06;
+  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w05);
+  for (i=0, rr=w01, cs=w01; i<401; ++i) (*rr++)  = (w00+(*cs++));
+  for (i=0;i<401;++i) {
+    casadi_copy(wr02, 16, w07+ i*16);
+  }
+  arg1[0]=w01;
+  arg1[1]=w07;
+  res1[0]=w08;
+  if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
+  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+0; ct!=cs+2; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w10, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+2; ct!=cs+4; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w11, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+4; ct!=cs+6; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w12, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
+  rr=w13;
+  for (i=0, cs=w10; i<400; ++i) *rr++ = *cs++;
+  for (i=0, cs=w11; i<400; ++i) *rr++ = *cs++;
+  for (i=0, cs=w12; i<400; ++i) *rr++ = *cs++;
+  for (i=0, rr=w14, cs=w13; i<6; ++i) for (j=0; j<200; ++j) rr[i+j*6] = *cs++;
+  casadi_copy(w14, 1200, res[0]);
+  w05 = 3.7000000000000000e-01;
+  w05 *= w04;
+  w05  = (w00+w05);
+  arg1[0]=(&w05);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  casadi_copy(w15, 2, res[1]);
+  w05 = 1.3700000000000001e+00;
+  w05 *= w04;
+  w00 += w05;
+  arg1[0]=(&w00);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (res[1]) casadi_copy(w15, 2, res[1]+2);
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f3(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int table_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void table_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void table_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void table_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t0";
+    case 1: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "table";
+    case 1: return "probe";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s5;
+    case 1: return casadi_s6;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 6;
+  if (sz_res) *sz_res = 4;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 11649;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 11649*sizeof(casadi_real);
+  return 0;
 }
 
 /* one block of tangent steps (the SX functions' step, as CasADi's Switch runs it) */
@@ -5194,12 +5277,11 @@ static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 6, y); gs_load(arg[1], 36, Q); gs_load(arg[3], 15, c);
-  casadi_real Qn[36], logs[6];
+  casadi_real Qn[36], logs[6]; casadi_real piece[6]; casadi_int g, i;
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 36, Q);
+    for (i = 0; i < 6; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T + 6*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 36, Q); for (i = 0; i < 6; ++i) logs[i] += piece[i]; }
     gs_store(y, 6, res[0], 6*p); gs_store(logs, 6, res[2], 6*p);
     gs_store(lo, 3, res[3], 3*p); gs_store(hi, 3, res[4], 3*p);
   }
@@ -5298,12 +5380,11 @@ static int casadi_f19(const casadi_real** arg, casadi_real** res, casadi_int* iw
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 6, y); gs_load(arg[1], 36, Q); gs_load(arg[3], 15, c);
-  casadi_real Qn[36], logs[6];
+  casadi_real Qn[36], logs[6]; casadi_real piece[6]; casadi_int g, i;
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 36, Q);
+    for (i = 0; i < 6; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T + 6*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 36, Q); for (i = 0; i < 6; ++i) logs[i] += piece[i]; }
     gs_store(y, 6, res[0], 6*p); gs_store(logs, 6, res[2], 6*p);
     gs_store(lo, 3, res[3], 3*p); gs_store(hi, 3, res[4], 3*p);
   }
@@ -5875,6 +5956,8 @@ CASADI_SYMBOL_EXPORT int monodromy_period_work_bytes(casadi_int *sz_arg, casadi_
   return 0;
 }
 
+
+#endif  /* GEARSYM_STEP_PIECES_ONLY */
 
 #ifdef __cplusplus
 } /* extern "C" */
