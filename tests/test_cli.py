@@ -174,3 +174,10 @@ def test_docs_unknown_model(capsys, tmp_path):
     code, _, err = run(capsys, "docs", "one_stag", "--out", str(tmp_path))
     assert code == 2 and "Did you mean 'one_stage'" in err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_model_that_is_not_pre_generated_is_listed_but_left_out_of_every_all():
+    # Lin & Parker's set declares PREGENERATED = False: `gearsym list` and its name find it, --all does not
+    assert "planetary_translational" in available_models()
+    assert "planetary_translational" not in pregenerated_models()
+    assert set(pregenerated_models()) == set(available_models()) - {"planetary_translational"}
