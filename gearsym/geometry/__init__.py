@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from ..errors import GearsymError
 from .crack import LIMIT_LINES, ORIGINS, Crack
-from .crack_loss import CrackLoss, cracked_mesh_stiffness
+from .crack_loss import CrackLoss, cracked_mesh_stiffness, loss_against_depth
 from .crack_loss import crack_loss_along_path as _crack_loss_along_path
 from .crack_loss import crack_stiffness_loss as _crack_stiffness_loss
 from .foundation import BODY_RATIO_RANGE, ROOT_ANGLE_RANGE
@@ -28,7 +28,7 @@ from .pair import GearPair
 from .tooth_pair import TERMS, pair_compliances, pair_stiffness
 
 __all__ = ["BODY_RATIO_RANGE", "Crack", "CrackLoss", "LIMIT_LINES", "ORIGINS", "crack_loss_along_path",
-           "crack_stiffness_loss", "cracked_mesh_stiffness", "root_crack", "Fourier", "GearGeometry", "GearPair", "Iso6336Stiffness", "Material",
+           "crack_stiffness_loss", "cracked_mesh_stiffness", "loss_against_depth", "root_crack", "Fourier", "GearGeometry", "GearPair", "Iso6336Stiffness", "Material",
            "MeshStiffness", "ROOT_ANGLE_RANGE", "STEEL", "StiffnessOptions", "TERMS", "Zone", "gear_geometry",
            "gear_pair", "iso6336_stiffness", "mesh_stiffness", "pair_compliances", "pair_stiffness"]
 
