@@ -201,7 +201,7 @@ def _cracked(pair, gear: int, crack) -> dict:
     depths, means, crossing = loss_against_depth(pair, gear, crack, _DEPTHS)
     return {"depth": crack.depth, "angle": crack.angle, "origin": crack.origin, "limit_line": crack.limit_line,
             "gear": gear, "mean_loss": loss.mean, "path_fraction": loss.fraction.tolist(), "loss": loss.loss.tolist(),
-            "phase": phase.tolist(), "healthy": cracked.tolist(), "cracked": healthy.tolist(),
+            "phase": phase.tolist(), "healthy": healthy.tolist(), "cracked": cracked.tolist(),
             "depths": depths.tolist(), "mean_losses": means.tolist(), "centre_line_depth": crossing}
 
 

@@ -98,7 +98,7 @@ class Crack:
                          sloped=self.limit_line == "to_top" or h_q < 0)
         if h_q < 0:
             other = half_thickness(profile, y_q)
-            if False:
+            if -h_q >= other:
                 raise GearsymError(f"crack: {self.depth * 1e3:.4g} mm at {math.degrees(self.angle):.4g} deg from "
                                    f"{self.origin.replace('_', ' ')} ({h_c * 1e3:.4g} mm from the centre line) reaches "
                                    f"the other flank of the tooth ({other * 1e3:.4g} mm beyond the centre line at the "
