@@ -20,7 +20,9 @@ from ..figures.layout import fit_texts
 from ..figures.save import pyplot, save_figure
 from ..system import FirstOrderSystem
 from .effects import augment, effect_terms
-from .selection import MIN_SCORE, Candidate, Explanation
+from .selection import MIN_SCORE, Candidate, Explanation, record_label
+from .tooth_scan import from_record_start
+from .tooth_forms import standing_out, tooth_values
 
 VERDICTS = {
     "explained": "the effects added explain the data: what is left looks like measurement noise",
@@ -32,6 +34,8 @@ VERDICTS = {
 
 #: the files of a report, replaced together (:func:`~gearsym.file_sets.written_together`)
 REPORT_FILES = ("report.json", "residuals.png", "prediction.png", "derived_model.md", "report.md")
+#: the figure of a tooth-by-tooth form's values, tooth by tooth, written beside them when one was tried
+TEETH_FIGURE = "teeth.png"
 #: the file that says a report folder is partial (a run killed while it replaced the files)
 PARTIAL_MARKER = "REPORT-INCOMPLETE.txt"
 
@@ -40,15 +44,22 @@ def write_report(ex: Explanation, system: FirstOrderSystem, out: str | Path, sou
     """Write DIR/report.md, DIR/report.json, DIR/residuals.png, DIR/prediction.png and DIR/derived_model.md, all
     or none: a failure or a kill while they are made leaves the previous report as it was (never a new
     report.json beside an old report.md)."""
-    with written_together(out, REPORT_FILES, PARTIAL_MARKER, "the report") as stage:
+    teeth = _tooth_candidate(ex)
+    names = REPORT_FILES + ((TEETH_FIGURE,) if teeth is not None else ())
+    with written_together(out, names, PARTIAL_MARKER, "the report") as stage:
         data = json_safe(ex.as_dict())
         (stage / "report.json").write_text(json.dumps(data, indent=1, allow_nan=False) + "\n")
         save_figure(residual_figure(ex, system), stage / "residuals.png", dpi=100)
         save_figure(prediction_figure(ex, system.name), stage / "prediction.png", dpi=100)
+        if teeth is not None:
+            save_figure(tooth_figure(ex, teeth, system.name, sources), stage / TEETH_FIGURE, dpi=100)
         effects = [ex.library[e] for e in ex.effects]
         derived = augment(system, effects) if effects else system
         (stage / "derived_model.md").write_text(derived_model_page(system, derived, effects))
         (stage / "report.md").write_text(report_page(ex, system, derived, data, sources))
+    stale = Path(out) / TEETH_FIGURE
+    if teeth is None and stale.is_file() and not stale.is_symlink():  # (a previous run's, not this report's)
+        stale.unlink()
     return data
 
 
@@ -98,7 +109,9 @@ def report_page(ex: Explanation, system: FirstOrderSystem, derived: FirstOrderSy
     lines += _candidates(ex) + _spectrum(ex) + _sidebands(data) + _proposals(ex) + _estimates(ex, data)
     lines += ["## The derived model", ""]
     if ex.effects:
-        for name, rows in effect_terms(system, [ex.library[e] for e in ex.effects]).items():
+        for name in (e for e in ex.effects if ex.library[e].gears):
+            lines += [f"- **{name}**: {ex.library[name].description}; the teeth that do not stand out at 0.", ""]
+        for name, rows in effect_terms(system, [ex.library[e] for e in ex.effects if not ex.library[e].gears]).items():
             lines += [f"- **{name}** ({ex.library[name].description}) adds:", ""]
             for state, term in rows.items():
                 lines += [f"$$ \\frac{{d{sp.latex(sp.Symbol(state))}}}{{d\\tau}} \\mathrel{{+}}= {sp.latex(term)} $$", ""]
@@ -118,7 +131,16 @@ def fault_lines(faults: list[dict]) -> list[str]:
     """The verdict's lines of the shaft-order effects found: which gear, which tooth, how much."""
     out = []
     for f in faults:
-        if f["kind"] == "tooth fault":
+        if f["kind"] in ("tooth stiffness", "tooth profile"):
+            out += _tooth_lines(f)
+        elif f["kind"] == "spall":
+            change = _pm_percent(f["stiffness_change_percent"], f["stiffness_change_stderr_percent"])
+            where = f"tooth {f['tooth']} of {f['gear']}" if f["tooth"] is not None else \
+                f"{f['gear']}, " + ", ".join(f"tooth {n} in {r}" for r, n in f["tooth_by_record"].items())
+            out.append(f"- **{where}: a spall, face width {change}** (`{f['effect']}`: the pair of that tooth, counted "
+                       f"from the record's start, loses this fraction of its width over the middle of its path of "
+                       f"contact; {f['teeth']} teeth).")
+        elif f["kind"] == "tooth fault":
             change = _pm_percent(f["stiffness_change_percent"], f["stiffness_change_stderr_percent"])
             if f["tooth"] is not None:
                 where = f"tooth {f['tooth']} of {f['gear']}"
@@ -134,6 +156,32 @@ def fault_lines(faults: list[dict]) -> list[str]:
             shown = ", ".join(f"{e:.3g}" for e in f["errors"])
             out.append(f"- **spacing errors of {f['gear']}** (`{f['effect']}`, tooth 1 ... {f['teeth']} from "
                        f"tau = 0): {shown}.")
+    return out
+
+
+def _tooth_lines(f: dict) -> list[str]:
+    """A tooth-by-tooth form's verdict lines: the teeth that stand out, gear by gear, counted from each record's
+    start, with their refitted values; or that none does."""
+    stiffness = f["kind"] == "tooth stiffness"
+    out = []
+    for gear, teeth in f["standing_out"].items():
+        if not teeth:
+            continue
+        by_record = {r: g[gear] for r, g in f["standing_out_by_record"].items()}
+        counted = set(map(tuple, by_record.values()))
+        numbers = (", ".join(map(str, counted.pop())) if len(counted) == 1 else
+                   "; ".join(f"{', '.join(map(str, n))} in {r}" for r, n in by_record.items()))
+        values = []
+        for n in teeth:
+            value, err = f["refitted"][gear][n] if n in f["refitted"][gear] else f["refitted"][gear][str(n)]
+            values.append(_pm_percent(-100 * value, None if err is None else 100 * err) if stiffness
+                          else _pm(value, err))
+        what = "mesh stiffness while in mesh" if stiffness else "profile error"
+        out.append(f"- **{gear}, tooth {numbers}: {what} {', '.join(values)}** (`{f['effect']}`: every tooth of "
+                   f"both gears fitted, {sum(f['gears'].values())} parameters; the teeth that stand out, counted from "
+                   "the record's start, refitted; see teeth.png).")
+    if not out:
+        out.append(f"- `{f['effect']}`: no tooth stands out (every tooth of both gears fitted; see teeth.png).")
     return out
 
 
@@ -167,8 +215,10 @@ def _candidates(ex: Explanation) -> list[str]:
     lines = ["## Candidates (held-out error, lower is better)", "",
              "| model | held-out error | training σ | its estimates | note |", "|---|---|---|---|---|"]
     for c in ex.tried:
-        own = [p for e in c.effects for p in ex.library[e].fitted] or list(ex.fitted)
+        own = [p for e in c.effects for p in ex.library[e].fitted if p in c.fit.estimates] or list(ex.fitted)
         shown = ", ".join(f"{p} = {_estimate(c, p)}" for p in own)
+        if any(ex.library[e].gears for e in c.effects) and not shown:
+            shown = "no tooth stands out"
         note = f"rejected: {c.rejected}" if c.rejected else ("**chosen**" if c is ex.final and c.effects else "")
         lines.append(f"| {'+'.join(c.effects) or 'as declared'} | {c.error:.4g} | {c.fit.sigma:.4g} | {shown} | {note} |")
     lines.append("")
@@ -269,6 +319,57 @@ def _views(c: Candidate, system: FirstOrderSystem):
     v = names.index(mesh.velocity) if mesh else min(1, len(names) - 1)
     channel = next(iter(p.residual))
     return np.mod(p.tau, 2 * np.pi), p.states[x], p.states[v], p.residual[channel], channel, names[x], names[v]
+
+
+def _tooth_candidate(ex: Explanation) -> Candidate | None:
+    """The tooth-by-tooth candidate a report draws: the chosen one, else the best tried."""
+    tried = [c for c in ex.tried if c.regularised is not None or any(ex.library[e].gears for e in c.effects)]
+    chosen = [c for c in tried if c is ex.final]
+    return (chosen or sorted(tried, key=lambda c: c.error))[0] if tried else None
+
+
+def tooth_figure(ex: Explanation, c: Candidate, system_name: str = "", sources=()):
+    """Every tooth's value of a tooth-by-tooth form (its regularised fit, ± one standard error), gear by gear,
+    counted from the first record's start; the teeth that stand out in red, each gear's median dashed (a level
+    shared by every tooth of one gear and taken back by every tooth of the other is one no record can tell from
+    nothing: compare a tooth with its gear's median)."""
+    plt = pyplot()
+    e = next(ex.library[name] for name in c.effects if ex.library[name].gears)
+    every = c.regularised or c.fit
+    values = tooth_values(e, every.estimates, every.stderr)
+    out = standing_out(values)
+    stiffness = e.name.startswith("tooth_stiffness")
+    starts = ex.info.get("records", {})
+    first_key = next(iter(starts), None)
+    start = starts.get(first_key, 0.0)
+    order = next((float(cp.order or 1) for cp in (ex.system.couplings if ex.system else ())
+                  if cp.coordinate == e.coordinate), 1.0)
+    fig, axs = plt.subplots(1, len(values), figsize=(5 + 0.12 * sum(len(v) for v in values.values()), 4.0),
+                            constrained_layout=True, squeeze=False, sharey=True,
+                            gridspec_kw={"width_ratios": [len(v) for v in values.values()]})
+    scale = 100 if stiffness else 1
+    for ax, (gear, vs) in zip(axs[0], values.items()):
+        Z = len(vs)
+        counted = np.array([from_record_start(n, Z, start, order) for n in range(1, Z + 1)])
+        shown = np.array([-v * scale if stiffness else v for v, _ in vs])
+        errs = np.array([(err or 0.0) * scale for _, err in vs])
+        colours = ["C3" if n in out[gear] else "0.55" for n in range(1, Z + 1)]
+        ax.bar(counted, shown, color=colours, yerr=errs, capsize=2, error_kw={"lw": 0.8})
+        ax.axhline(0, color="k", lw=0.6)
+        ax.axhline(np.median(shown), color="0.3", lw=0.8, ls="--")
+        ax.set_xticks(np.arange(1, Z + 1)[:: max(1, Z // 20)])
+        ax.set_xlabel(f"tooth of {gear} ({Z} teeth)")
+        named = sorted(from_record_start(n, Z, start, order) for n in out[gear])
+        ax.set_title(f"{gear}: standing out (red): {', '.join(map(str, named)) or 'none'}", fontsize=9)
+    axs[0][0].set_ylabel("mesh stiffness change while in mesh [%]" if stiffness else
+                         "profile error while carrying the load\n[length unit of the mesh coordinate]")
+    state = "chosen" if c is ex.final else f"tried, not chosen (held-out error {c.error:.3g})"
+    data = f"; data {', '.join(Path(str(s)).name for s in sources)}" if sources else ""
+    record = f" ({record_label(first_key)})" if first_key is not None else ""
+    fig.suptitle(f"{system_name}: {e.name}, every tooth of both gears fitted together (regularised; bars ± one "
+                 f"standard error, dashed: the gear's median) — {state}{data}; teeth counted from the first "
+                 f"record's start{record}", fontsize=8.5)
+    return fig
 
 
 def residual_figure(ex: Explanation, system: FirstOrderSystem):

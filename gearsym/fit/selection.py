@@ -186,13 +186,13 @@ class Explanation:
                             median={g: float(np.median([v for v, _ in vs])) for g, vs in values.items()},
                             standing_out=out_, refitted=refit,
                             standing_out_by_record={
-                                _record_label(key): {g: [from_record_start(n, z, start, order) for n in out_[g]]
+                                record_label(key): {g: [from_record_start(n, z, start, order) for n in out_[g]]
                                                      for g, z in e.gears}
                                 for key, start in starts.items()})
             elif e.scan:
                 q = fit.estimates[e.fitted[0]]
                 sq = fit.stderr.get(e.fitted[0])
-                by_record = {_record_label(key): from_record_start(int(n), e.teeth, starts.get(key, 0.0), order)
+                by_record = {record_label(key): from_record_start(int(n), e.teeth, starts.get(key, 0.0), order)
                              for key, n in c.placements.get(name, {}).items()}
                 common = set(by_record.values())
                 item.update(kind="spall" if name.startswith("spall_") else "tooth fault",
@@ -489,7 +489,7 @@ def _record_starts(keys: Sequence[tuple], segments: Sequence[Segment]) -> dict:
     return out
 
 
-def _record_label(key) -> str:
+def record_label(key) -> str:
     """A record's key (its file and id) as the report names it."""
     if isinstance(key, tuple) and len(key) == 2:
         return f"{Path(str(key[0])).name} record {key[1]}"
