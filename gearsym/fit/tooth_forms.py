@@ -53,9 +53,9 @@ PROFILE_PRIOR = 0.1
 STANDOUT_SIGMAS = 5.0
 #: ... and is at least this fraction of the largest departure from the median among all teeth of the mesh
 STANDOUT_FRACTION = 0.3
-#: mesh periods beyond a tooth's window (past the middle of its edge) where it still counts: the tanh edge is down to
+#: edge widths beyond a tooth's window (past the middle of its edge) where it still counts: the tanh edge is down to
 #: 5e-5 there
-REACH = 0.25
+REACH = 2.5
 _BOUND = "a tooth's stiffness factor 1 - q stays positive and below twice the mesh's: -0.95 <= q <= 0.95"
 
 
@@ -173,21 +173,25 @@ class Slots:
         return (first + np.arange(len(self.slots)) - 1) % self.teeth
 
 
-def slot_count(order: float, period: float) -> int:
-    """Slots a gear needs so that every tooth in mesh within two fitting windows has one."""
-    contact = float(DEFAULT_CONTACT_RATIO)
-    reach = contact / 2 + REACH
+def slot_count(order: float, period: float, reach: float) -> int:
+    """Slots a gear needs so that every tooth in mesh within two fitting windows has one, its window reaching
+    ``reach`` mesh periods from its middle."""
     span = 2 * order * period / (2 * math.pi)
     return math.ceil(span + 2 * reach) + 1
 
 
 def local_effect(e: Effect, order: float, period: float) -> tuple[Effect, tuple[Slots, ...]]:
     """The form the fit compiles for the tooth-by-tooth form ``e`` (see the module docstring) and its slots."""
-    count = slot_count(order, period)
-    reach = float(DEFAULT_CONTACT_RATIO) / 2 + REACH
+    stiffness = e.name.startswith("tooth_stiffness")
+    profile_edge = (float(DEFAULT_CONTACT_RATIO) - 1) / 2
+    reach = (float(DEFAULT_CONTACT_RATIO) / 2 + REACH * float(DEFAULT_EDGE) if stiffness
+             else 0.5 + REACH * profile_edge)
+    count = slot_count(order, period, reach)
     stiffness = e.name.startswith("tooth_stiffness")
     prefix = "kt" if stiffness else "te"
-    slots = tuple(Slots(gear, teeth, f"{prefix}first_{gear}", tuple(f"{prefix}slot{j}_{gear}" for j in range(count)),
+    # (a gear of no more teeth than slots has each tooth once: its windows repeat every revolution)
+    slots = tuple(Slots(gear, teeth, f"{prefix}first_{gear}",
+                        tuple(f"{prefix}slot{j}_{gear}" for j in range(min(count, teeth))),
                         (stiffness_names if stiffness else profile_names)(gear, teeth), order, period, reach)
                   for gear, teeth in e.gears)
 
