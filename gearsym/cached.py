@@ -18,7 +18,7 @@ it does not keep (a SymPy expression). A summary that is missing, unreadable, no
 library that is gone is ignored and rewritten; files are written atomically. Only JSON is read.
 
 A summary is trusted no more than the library: it is read as a private file
-(:func:`~gearsym.private_files.read_private`), its content must match the seal written with it (a hash of the
+(:func:`~gearsym.files.private.read_private`), its content must match the seal written with it (a hash of the
 content and the file's name, which hashes the model and values it is for), and what it says must match what
 it describes: the library's record (:mod:`gearsym.codegen.trust`) must name the same model, code hash, states
 and parameters. A summary that does not (edited: states swapped, values changed, another model's library) is
@@ -45,7 +45,7 @@ from .errors import warn
 from .options import Integration
 from .parameters import Constraint, ParameterChecks
 from .physical.point import CachedScaling, PointUnits
-from .private_files import NotPrivate, read_private, write_private
+from .files.private import NotPrivate, read_private, write_private
 from .registry import model_file, models_dir
 
 #: bump when what a summary holds changes

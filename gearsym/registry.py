@@ -9,15 +9,15 @@ import traceback
 from pathlib import Path
 from typing import Union
 
-from .declared import Model
+from .model.declared import Model
 from .errors import GearsymError, ModelError, suggest, warn
-from .paths import REPO_ROOT
+from .files.paths import MODELS_DIR
 
 
 def models_dir() -> Path:
-    """``./models`` if the working directory has one, else the repository's ``models/``."""
+    """``./models`` if the working directory has one, else the shipped models (:data:`~.paths.MODELS_DIR`)."""
     local = Path.cwd() / "models"
-    return local if (local / "__init__.py").is_file() else REPO_ROOT / "models"
+    return local if (local / "__init__.py").is_file() else MODELS_DIR
 
 
 def output_root(ref) -> Path:
@@ -53,7 +53,7 @@ _SHADOWED: set[Path] = set()  # said already
 
 
 def _say_if_shadowed(name: str, path: Path) -> None:
-    shipped = REPO_ROOT / "models" / f"{name}.py"
+    shipped = MODELS_DIR / f"{name}.py"
     if path.parent.resolve() == shipped.parent.resolve() or not shipped.is_file() or path in _SHADOWED:
         return
     _SHADOWED.add(path)

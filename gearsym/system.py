@@ -14,11 +14,11 @@ from functools import cached_property
 
 import sympy as sp
 
-from .declared import Model
+from .model.declared import Model
 from .errors import ModelError, UnknownParameterError
 from .model.expressions import ExprLike, to_expr
 from .parameters import Constraint, ParameterChecks
-from .symbols import parameter_symbol
+from .model.symbols import parameter_symbol
 
 
 @dataclass(frozen=True)

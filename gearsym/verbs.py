@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from .analysis.attractors import find_attractors as _find_attractors
 from .analysis.basins import basin_map as _basin_map
 from .analysis.lyapunov import lyapunov_spectrum as _lyapunov_spectrum
-from .analysis.orbits import phase_trajectory as _phase_trajectory, poincare_samples as _poincare_samples
+from .analysis.poincare import phase_trajectory as _phase_trajectory, poincare_samples as _poincare_samples
 from .analysis.order_run import simulated_order_spectrum as _simulated_order_spectrum
 from .codegen.build import compile_model
 from .codegen.compiled import CompiledModel

@@ -14,7 +14,7 @@ import numpy as np
 import sympy as sp
 
 import gearsym
-from gearsym.symbols import parameter_symbol, t
+from gearsym.model.symbols import parameter_symbol, t
 
 GEAR_MODELS = ("one_stage", "one_stage_resonant", "flexible_shaft", "two_stage")
 

@@ -14,9 +14,9 @@ import sympy as sp
 import gearsym
 from conftest import compiled, system
 from gearsym import FirstOrderSystem, GearsymError, Integration
-from gearsym.backlash import g
-from gearsym.paths import REPO_ROOT
-from gearsym.symbols import parameter_symbol
+from gearsym.model.backlash import g
+from gearsym.files.paths import REPO_ROOT
+from gearsym.model.symbols import parameter_symbol
 
 SHORT = Integration(periods=40, discard=10)
 

@@ -19,8 +19,7 @@ BENCH = ROOT.parent / "bench"
 
 #: the stages from the bottom up (docs/architecture.md): a module may import its own stage and those below
 LAYERS = [
-    {"errors", "version", "paths", "files", "outputs", "units", "declared", "symbols", "backlash", "checks",
-     "options", "parameters", "private_files", "file_sets", "caller", "memory"},
+    {"errors", "version", "files", "units", "checks", "options", "parameters", "caller", "memory"},
     {"geometry"},
     {"model"},
     {"system", "registry"},

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from gearsym.backlash import G, g, g_slope
+from gearsym.model.backlash import G, g, g_slope
 
 x = sp.Symbol("x", real=True)
 eta = sp.Symbol("eta", real=True)

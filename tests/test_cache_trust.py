@@ -21,7 +21,7 @@ import pytest
 
 from gearsym.codegen import compiler
 from gearsym.errors import GearsymWarning
-from gearsym.paths import REPO_ROOT
+from gearsym.files.paths import REPO_ROOT
 
 ARGS = ("--periods", "70", "--discard", "10", "--format", "json")
 #: the levels of the cache path that gearsym makes (missing when it first runs)

@@ -31,7 +31,7 @@ import gearsym.reproduce
 from gearsym.cli import main
 from conftest import compiled
 from gearsym.errors import GearsymError, GearsymWarning
-from gearsym.paths import REPO_ROOT
+from gearsym.files.paths import REPO_ROOT
 
 
 def run(capsys, *argv: str) -> tuple[int, str, str]:
@@ -126,7 +126,7 @@ def test_explain_refuses_an_existing_file_as_its_report_folder_before_fitting(ca
 
 
 def test_a_writable_output_leaves_nothing_behind_when_checked(tmp_path):
-    from gearsym.outputs import check_figure, check_folder
+    from gearsym.files.outputs import check_figure, check_folder
 
     check_figure(tmp_path / "new" / "p.png")
     check_folder(tmp_path / "out")

@@ -12,7 +12,7 @@ import gearsym.derivation
 from gearsym import available_models
 from gearsym.cli import COMMANDS, main
 from gearsym.derivation import derive
-from gearsym.paths import REPO_ROOT
+from gearsym.files.paths import REPO_ROOT
 
 
 @pytest.fixture(autouse=True, scope="module")

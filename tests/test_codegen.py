@@ -18,12 +18,12 @@ import gearsym.codegen.compiler as compiler
 import gearsym.codegen.functions
 from conftest import system
 from gearsym import FirstOrderSystem, GearsymError, Integration, ModelError, UnknownParameterError, compile_model
-from gearsym.backlash import G, g, g_slope
+from gearsym.model.backlash import G, g, g_slope
 from gearsym.codegen import CompilerError
 from gearsym.codegen.generated import generate_model
 from gearsym.codegen.time_tables import split_rhs
 from gearsym.codegen.translate import to_casadi
-from gearsym.paths import REPO_ROOT
+from gearsym.files.paths import REPO_ROOT
 from gearsym.registry import available_models
 
 

@@ -18,12 +18,12 @@ import gearsym
 import rig
 from conftest import system
 from gearsym import FirstOrderSystem, Integration, ModelError, compile_model
-from gearsym.backlash import g
+from gearsym.model.backlash import g
 from gearsym.codegen.functions import LoopOptions, build_functions
 from gearsym.codegen.generate import code_hash, write_code
 from gearsym.model.stiffness import rectangular_mesh_stiffness
-from gearsym.paths import REPO_ROOT
-from gearsym.symbols import parameter_symbol, phi
+from gearsym.files.paths import REPO_ROOT
+from gearsym.model.symbols import parameter_symbol, phi
 
 PERIODS, DISCARD = 80, 30
 STEPS = (100, 200, 400, 800)

@@ -18,10 +18,10 @@ import sympy as sp
 
 import conftest
 from gearsym import Drivetrain, GearsymError, available_models, load_model
-from gearsym.backlash import g
+from gearsym.model.backlash import g
 from gearsym.derivation import FORMATS, Derivation, derive, render
-from gearsym.paths import REPO_ROOT
-from gearsym.symbols import parameter_symbol
+from gearsym.files.paths import REPO_ROOT
+from gearsym.model.symbols import parameter_symbol
 
 DOCS = REPO_ROOT / "docs" / "derivations"
 MODELS = available_models()

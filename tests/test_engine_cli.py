@@ -9,7 +9,7 @@ import pytest
 from conftest import compiled, paper_rk4_spectrum
 from gearsym import Integration, available_models, lyapunov_spectrum
 from gearsym.cli import main
-from gearsym.paths import REPO_ROOT
+from gearsym.files.paths import REPO_ROOT
 
 
 def run(capsys, *argv: str) -> tuple[int, str, str]:

@@ -20,7 +20,7 @@ import sympy as sp
 import conftest
 import rig
 from gearsym import EFFECTS, Integration, explain, load_measurements, simulate_measurements
-from gearsym.backlash import g
+from gearsym.model.backlash import g
 from gearsym.cli import main
 from gearsym.errors import GearsymError, ModelError
 from gearsym.fit import Effect, augment, effect_terms, fit_windows, term_effect
@@ -29,8 +29,8 @@ from gearsym.fit.effects import Change
 from gearsym.fit.selection import segments_of
 from gearsym.checks import json_safe
 from gearsym.fit.report import report_page, residual_figure
-from gearsym.paths import REPO_ROOT
-from gearsym.symbols import parameter_symbol
+from gearsym.files.paths import REPO_ROOT
+from gearsym.model.symbols import parameter_symbol
 
 RECORDS = [{"omega": 1.2}, {"omega": 1.6}]
 #: the true strengths: large enough to stand out of 1 % noise

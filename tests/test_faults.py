@@ -23,7 +23,7 @@ from gearsym import explain, load_measurements
 from gearsym.cli import main
 from gearsym.errors import GearsymError
 from gearsym.fit.selection import candidate_library
-from gearsym.paths import REPO_ROOT
+from gearsym.files.paths import REPO_ROOT
 
 TEETH = (9, 13)
 OMEGAS = (1.2, 1.6)

@@ -124,7 +124,7 @@ import figure_checks as fc  # noqa: E402
 from matplotlib.text import Text  # noqa: E402
 
 from gearsym import find_attractors, lyapunov_spectrum  # noqa: E402
-from gearsym.analysis.orbits import phase_trajectory  # noqa: E402
+from gearsym.analysis.poincare import phase_trajectory  # noqa: E402
 from gearsym.figures import plot_point  # noqa: E402
 from gearsym.figures.campbell import plot_campbell  # noqa: E402
 from gearsym.figures.orbits import LABELLED, plot_branches, plot_orbits  # noqa: E402

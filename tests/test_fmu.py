@@ -30,7 +30,7 @@ from gearsym.codegen.generate import code_hash  # noqa: E402
 from gearsym.codegen.loops import LoopOptions  # noqa: E402
 from gearsym.codegen.surfaces import switching_surfaces  # noqa: E402
 from gearsym.fmu.functions import indicators  # noqa: E402
-from gearsym.paths import REPO_ROOT  # noqa: E402
+from gearsym.files.paths import REPO_ROOT  # noqa: E402
 from conftest import system  # noqa: E402
 
 K = "1+0.2*cos(tau)"  # the issue's stiffness formula
@@ -366,7 +366,7 @@ def planetary_reference(s, periods=PERIODS):
     """The planetary set's equations as SymPy derived them, lambdified (no CasADi, no C) and solved by SciPy."""
     from scipy.integrate import solve_ivp
 
-    from gearsym.backlash import g
+    from gearsym.model.backlash import g
 
     def backlash(x, eta):
         return x if x >= 0 else (0.0 if x > -eta else x + eta)

@@ -145,3 +145,47 @@ def test_the_committed_crack_figure_and_data_regenerate(capsys, tmp_path):
 def test_a_crack_through_the_tooth_is_refused_before_any_work(capsys):
     code, _, err = run(capsys, *TIAN, "--crack", "9 mm,80 deg", "--cracked-gear", "1")
     assert code == 2 and "reaches the other flank of the tooth" in err and "Traceback" not in err
+
+
+# --------------------------------------------------------------------------- the basic rack
+HIGH = NASA[:-1] + ["25 deg"]
+
+
+def test_a_25_degree_pair_is_cut_by_the_largest_rounding_that_fits_and_says_so(capsys):
+    """ISO 53's 0.38 does not fit a 25 deg rack: the default is the full-round tip, computed, and said."""
+    code, out, err = run(capsys, *HIGH, "--format", "json")
+    assert code == 0, err
+    rack = json.loads(out)["rack"]
+    alpha, rho, hf = math.radians(25), rack["tip_rounding"], rack["dedendum"]
+    # the tool's tip, in modules: the line y = 0 from -w to w, flanks down and outwards at alpha from the vertical.
+    # A full-round tip's circle is centred on the axis, touches the tip line and both flanks
+    w = math.pi / 4 - hf * math.tan(alpha)
+    corner, down = np.array([w, 0.0]), np.array([math.sin(alpha), -math.cos(alpha)])
+    centre = np.array([0.0, -rho])
+    to_flank = (centre - corner) - np.dot(centre - corner, down) * down
+    assert np.linalg.norm(to_flank) == pytest.approx(rho, rel=1e-12)
+    assert 0.3178 < rho < 0.3179 and rack["addendum"] == 1.0
+    code, out, err = run(capsys, *HIGH)
+    assert code == 0
+    assert out.splitlines()[0].endswith("pressure angle 25 deg, face width 6.35 mm, rack 1/1.25/0.318 (full-round tip)")
+    assert ("basic rack (both gears): addendum 1, dedendum 1.25, tip rounding 0.318 (in modules): a full-round tip, the "
+            "largest rounding that fits this 25 deg rack; ISO 53's 0.38 does not fit it") in out.splitlines()
+    code, same, _ = run(capsys, *HIGH, "--rack", f"1,1.25,{rho!r}")
+    assert code == 0 and same.splitlines()[1:] == out.splitlines()[1:]  # the default is that rack, given
+
+
+def test_a_20_degree_pair_keeps_iso_53_profile_a(capsys):
+    code, out, _ = run(capsys, *NASA)
+    assert code == 0
+    assert "basic rack (both gears): ISO 53 profile A: addendum 1, dedendum 1.25, tip rounding 0.38 (in modules)" \
+        in out.splitlines() and "rack" not in out.splitlines()[0]
+
+
+@pytest.mark.parametrize("angle, rack, words", [
+    ("25 deg", "1,1.25,0.38", "fillet radius coefficient 0.38 must lie in 0-0.318 on a 25 deg rack of dedendum 1.25"),
+    ("33 deg", None, "dedendum coefficient 1.25 is too deep for a 33 deg rack"),
+])
+def test_a_rack_that_does_not_fit_its_pressure_angle_is_refused_in_one_line(capsys, angle, rack, words):
+    code, out, err = run(capsys, *NASA[:-1], angle, *(["--rack", rack] if rack else []))
+    assert code == 2 and out == ""
+    assert err.count("\n") == 1 and err.startswith("gearsym: error:") and words in err, err

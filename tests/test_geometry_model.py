@@ -20,7 +20,7 @@ import gearsym
 from conftest import reduced
 from gearsym import Drivetrain, Gear, Integration, Mesh, ModelError, Torque
 from gearsym.geometry import gear_geometry
-from gearsym.symbols import phi
+from gearsym.model.symbols import phi
 
 STEEL_DENSITY = 7850.0  # kg/m^3
 

@@ -12,7 +12,7 @@ import pytest
 
 from gearsym.cli import main
 from gearsym.errors import GearsymWarning
-from gearsym.paths import REPO_ROOT
+from gearsym.files.paths import REPO_ROOT
 from gearsym.registry import model_path
 
 ARGS = ("--periods", "70", "--discard", "10", "--format", "json")

@@ -17,9 +17,9 @@ from gearsym import (Disk, Drivetrain, FirstOrderSystem, Gear, Integration, Mesh
                      reduce)
 from gearsym.cli import main
 from gearsym.errors import GearsymWarning, ModelError
-from gearsym.paths import REPO_ROOT
+from gearsym.files.paths import REPO_ROOT
 from gearsym.registry import output_root
-from gearsym.symbols import parameter_symbol
+from gearsym.model.symbols import parameter_symbol
 
 LORENZ = (["x", "y", "z"], ["sigma*(y - x)", "x*(rho - z) - y", "x*y - beta*z"],
           {"sigma": 10.0, "rho": 28.0, "beta": 8.0 / 3.0})

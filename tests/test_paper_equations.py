@@ -15,8 +15,8 @@ import pytest
 import sympy as sp
 
 from conftest import GEAR_MODELS, P, coord, load, psi, reduced
-from gearsym.backlash import g
-from gearsym.symbols import omega, t, tau
+from gearsym.model.backlash import g
+from gearsym.model.symbols import omega, t, tau
 
 I1, I2, I3 = P("I1"), P("I2"), P("I3")
 r1, r2 = P("r1"), P("r2")

@@ -19,7 +19,7 @@ import pytest
 import gearsym
 from conftest import reduced
 from gearsym import Disk, Drivetrain, Gear, GearsymError, Integration, Mesh, Shaft, Torque
-from gearsym.analysis.orbits import Trajectory
+from gearsym.analysis.poincare import Trajectory
 from gearsym.cli import main
 from gearsym.physical.point import whole_period_mean
 
@@ -275,7 +275,7 @@ def test_a_stiffness_formula_may_be_written_in_the_mesh_phase_phi():
     nd = reduced("idler")
     f = next(f for f in nd.functions if f.mesh == "m2")
     import sympy as sp
-    from gearsym.symbols import omega, parameter_symbol, tau
+    from gearsym.model.symbols import omega, parameter_symbol, tau
 
     rc = nd._mesh(f)
     expected = sp.cos(sp.expand(rc.mesh_phase.subs(sp.Symbol("t", real=True), tau / omega)))

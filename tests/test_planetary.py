@@ -18,7 +18,7 @@ import gearsym
 from conftest import reduced, system
 from gearsym import Disk, Drivetrain, Gear, Harmonic, Mesh, ModelError, Planet, Torque
 from gearsym import natural_modes
-from gearsym.symbols import parameter_symbol, tau
+from gearsym.model.symbols import parameter_symbol, tau
 
 TEETH = dict(sun=26, ring=94)
 PLANETS = 3

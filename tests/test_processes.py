@@ -20,7 +20,7 @@ from conftest import interrupt_after
 from gearsym import Integration, run_sweep
 from gearsym.cli import main
 from gearsym.errors import GearsymError
-from gearsym.files import write_atomically
+from gearsym.files.atomic import write_atomically
 from gearsym.sweep import SweepInterrupted
 from gearsym.sweep.store import lock_path, release_lock, sidecar, take_lock
 

@@ -17,8 +17,8 @@ from sympy.core.function import AppliedUndef
 
 import gearsym
 from conftest import P, coord, load, psi, reduced
-from gearsym.backlash import g
-from gearsym.symbols import omega, t, tau
+from gearsym.model.backlash import g
+from gearsym.model.symbols import omega, t, tau
 
 r1, r2, r3, r4 = P("r1"), P("r2"), P("r3"), P("r4")
 I1, I2, I3, I4 = P("I1"), P("I2"), P("I3"), P("I4")

@@ -12,7 +12,7 @@ import gearsym
 from gearsym import Integration
 from gearsym.analysis.basins import basin_map
 from gearsym.checks import json_safe
-from gearsym.paths import REPO_ROOT
+from gearsym.files.paths import REPO_ROOT
 from gearsym.periodic import FOLD, GRAZING, NEIMARK_SACKER, PERIOD_DOUBLING
 from gearsym.reproduce import jumps
 from gearsym.reproduce.plan import PAPER_JUMPS

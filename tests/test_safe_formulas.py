@@ -18,7 +18,7 @@ from gearsym.cli import main
 from gearsym.codegen.translate import to_casadi
 from gearsym.model.expressions import to_expr
 from gearsym.model.stiffness import rectangular_mesh_stiffness
-from gearsym.symbols import omega, parameter_symbol, phi, t, tau
+from gearsym.model.symbols import omega, parameter_symbol, phi, t, tau
 
 TOUCH = "__import__('os').system('touch PWNED')"
 ECHO = "__import__('os').system('echo PWNED')"

@@ -24,7 +24,7 @@ from gearsym.errors import GearsymError, ModelError
 from gearsym.fit.effects import augment
 from gearsym.model.faults import Eccentricity, Spall, SpacingErrors, ToothFault
 from gearsym.model.shaft_orders import tooth_share
-from gearsym.symbols import parameter_symbol, tau
+from gearsym.model.symbols import parameter_symbol, tau
 
 TEETH = (9, 13)
 

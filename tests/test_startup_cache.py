@@ -14,7 +14,7 @@ import gearsym.loading  # noqa: F401 (where the face reduces a model: its reduce
 import gearsym.reduction  # noqa: F401 (the subpackage, whose reduce is counted)
 from gearsym.cli import main
 from gearsym.codegen import cache_dir
-from gearsym.paths import REPO_ROOT
+from gearsym.files.paths import REPO_ROOT
 
 ARGS = ("--periods", "30", "--discard", "10", "--format", "json")
 
@@ -126,11 +126,16 @@ def test_a_changed_physical_value_is_carried_back_with_the_new_value(model_copy,
     assert lyap_text(capsys, spur, "--set", fourfold) == stiffer
 
 
-@pytest.mark.parametrize("name", ["one_stage", "spur_pair"])
-def test_a_command_on_a_cached_model_imports_neither_sympy_nor_pint(model_copy, name, capsys):
+FORMULA = ("--set", "k=1+0.2*cos(tau)")
+
+
+@pytest.mark.parametrize("name, settings", [("one_stage", ()), ("spur_pair", ()), ("one_stage", FORMULA)],
+                         ids=["one_stage", "spur_pair", "a stiffness formula"])
+def test_a_command_on_a_cached_model_imports_neither_sympy_nor_pint(model_copy, name, settings, capsys):
     model_file = model_copy(name)
+    argv = [str(model_file), *settings, *ARGS]
     script = ("import sys; from gearsym.cli import main; "
-              f"main(['lyap', {str(model_file)!r}, *{list(ARGS)!r}]); "
+              f"main(['lyap', *{argv!r}]); "
               "print(sorted(m for m in ('sympy', 'pint') if m in sys.modules), file=sys.stderr)")
 
     def command():  # a user's command: a process of its own, as the first run (which fills the cache) was
@@ -142,7 +147,16 @@ def test_a_command_on_a_cached_model_imports_neither_sympy_nor_pint(model_copy, 
     run = command()
     assert run.returncode == 0, run.stderr
     assert run.stderr.strip().splitlines()[-1] == "[]", run.stderr[-3000:]
-    assert json.loads(run.stdout) == json.loads(first.stdout) == lyap(capsys, str(model_file))
+    assert json.loads(run.stdout) == json.loads(first.stdout) == lyap(capsys, *argv[:-len(ARGS)])
+
+
+def test_a_formula_spelt_another_way_is_the_same_cached_model(model_file, reductions, capsys):
+    first = lyap(capsys, str(model_file), *FORMULA)
+    assert len(reductions) == 1
+    assert lyap(capsys, str(model_file), "--set", " k =  1 + 0.2 * cos( tau ) ") == first
+    assert len(reductions) == 1
+    other = lyap(capsys, str(model_file), "--set", "k=1+0.25*cos(tau)")  # another formula: another model
+    assert len(reductions) == 2 and other["exponents"] != first["exponents"]
 
 
 def test_a_sweep_of_a_cached_physical_model_is_carried_to_physical_units(model_copy, tmp_path, capsys):

@@ -23,7 +23,7 @@ from conftest import load
 from gearsym import Disk, Drivetrain, Gear, Mesh, Shaft, Torque
 from gearsym.errors import ModelError
 from gearsym.reduction.statics import static_state, torque_imbalance
-from gearsym.symbols import parameter_symbol, phi, t
+from gearsym.model.symbols import parameter_symbol, phi, t
 
 DRIVETRAINS = ("one_stage", "one_stage_resonant", "flexible_shaft", "two_stage", "planetary",
                "planetary_differential", "planetary_two_stage", "spur_pair")

@@ -14,7 +14,7 @@ import pytest
 import conftest
 from gearsym import Integration, Workers, run_sweep
 from gearsym.errors import GearsymError
-from gearsym.paths import REPO_ROOT
+from gearsym.files.paths import REPO_ROOT
 from gearsym.sweep import store as store_module
 
 RUN = Integration(periods=70, discard=20)

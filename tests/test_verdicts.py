@@ -25,7 +25,7 @@ from gearsym.analysis.pairs import finite_time_bias
 from gearsym.cli import main
 from gearsym.errors import GearsymError
 from gearsym.model.stiffness import rectangular_mesh_stiffness
-from gearsym.symbols import phi
+from gearsym.model.symbols import phi
 
 #: the damped linear oscillator: duffing without its cubic term, forced off resonance, started off its response
 LINEAR = dict(beta=0.0, omega=1.3, F=0.3)

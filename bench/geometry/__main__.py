@@ -23,7 +23,7 @@ import warnings
 from pathlib import Path
 
 from bench.machine import machine_info
-from gearsym.files import write_atomically
+from gearsym.files.atomic import write_atomically
 from gearsym.geometry import GearGeometry, GearPair, mesh_stiffness, StiffnessOptions
 
 REPO = Path(__file__).resolve().parents[2]

@@ -4,7 +4,7 @@ from .attractors import Attractor, AttractorSet, find_attractors
 from .basins import BasinAttractor, BasinMap, basin_map
 from .jumps import Jump, find_jumps, hysteresis_intervals
 from .lyapunov import LyapunovSpectrum, lyapunov_spectrum
-from .orbits import Orbit, Trajectory, phase_trajectory, poincare_samples
+from .poincare import Orbit, Trajectory, phase_trajectory, poincare_samples
 from .order_run import simulated_order_spectrum
 from .orders import OrderSpectrum, order_spectrum
 from .regime import REGIMES, classify_regime

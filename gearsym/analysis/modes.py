@@ -25,7 +25,7 @@ import sympy as sp
 
 from ..errors import GearsymError
 from ..reduction.statics import mean_over, mean_stiffness, number as _number
-from ..symbols import parameter_symbol, tau
+from ..model.symbols import parameter_symbol, tau
 
 #: eigenvalues within this fraction of the largest count as one (a degenerate frequency)
 DEGENERATE = 1e-8

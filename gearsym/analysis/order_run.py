@@ -7,7 +7,7 @@ from __future__ import annotations
 from ..codegen import CompiledModel, engine_verb
 from ..errors import GearsymError
 from ..options import Integration
-from .orbits import phase_trajectory
+from .poincare import phase_trajectory
 from .orders import MESH_HARMONICS, SIDEBANDS, OrderSpectrum, order_spectrum
 
 #: samples per mesh period kept for the spectrum (every RK4 step is more than the mesh harmonics need)

@@ -12,8 +12,8 @@ from pathlib import Path
 from ..analysis.basins import CLASSES, RUN, BasinMap, basin_map
 from ..errors import GearsymError
 from ..figures.basins import Shown, plot_basin_fractions, plot_basin_map
-from ..files import write_atomically
-from ..outputs import check_figure, check_file
+from ..files.atomic import write_atomically
+from ..files.outputs import check_figure, check_file
 from ..physical.basins import PhysicalShown, engine_grid, physical_dict, units_of
 from ..physical.sweeps import nondimensional_axes
 from ..sweep.basin_continuation import MATCH_DISTANCE, continue_basins

@@ -10,8 +10,8 @@ from pathlib import Path
 from ..loading import natural_modes
 from ..errors import GearsymError
 from ..figures.campbell import plot_campbell
-from ..files import write_atomically
-from ..outputs import check_figure, check_file
+from ..files.atomic import write_atomically
+from ..files.outputs import check_figure, check_file
 from ..physical.campbell import campbell
 from ..physical.files import write_physical_table
 from ..physical.sweeps import nondimensional_axis

@@ -6,7 +6,7 @@ import sys
 from pathlib import Path
 
 from ..codegen.generated import generate_model
-from ..outputs import check_folder
+from ..files.outputs import check_folder
 from ..loading import load
 from ..registry import available_models, output_root
 from .integration import add_integration_arguments, integration_from

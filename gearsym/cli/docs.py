@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 
 from ..derivation import derive, render
-from ..outputs import check_folder
+from ..files.outputs import check_folder
 from ..loading import declared
 from ..registry import available_models, output_root
 from .settings import add_teeth_argument

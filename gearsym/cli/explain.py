@@ -8,7 +8,7 @@ from pathlib import Path
 from ..errors import GearsymError
 from ..fit import explain_files
 from ..fit.selection import check_fit_names, check_harmonics
-from ..outputs import check_folder
+from ..files.outputs import check_folder
 from .integration import add_integration_arguments, integration_from, scaling_from, system_from
 from .settings import add_set_argument
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..errors import GearsymError
 from ..fmu.export import export_fmu
-from ..outputs import check_folder
+from ..files.outputs import check_folder
 from ..registry import available_models, load_model
 from .integration import add_integration_arguments, integration_from
 from .settings import add_set_argument, model_settings

@@ -9,7 +9,7 @@ import gearsym  # the face: its verbs load on first use, so a cached model's run
 from ..cached import cached_scaling, load_compiled
 from ..checks import check_run
 from ..options import BACKENDS, STEPS_PER_PERIOD, Integration
-from .settings import model_settings
+from .settings import checked_formulas, model_settings
 
 
 def add_integration_arguments(parser: argparse.ArgumentParser, *, periods: int | None = 400, discard: int = 100,
@@ -62,8 +62,8 @@ def scaling_of(model, settings: dict):
 def scaling_from(args: argparse.Namespace):
     """The scaling of the command's MODEL and --set values (a cached one when the start-up cache has its numbers),
     or None for a model without physical values."""
-    settings = model_settings(args)
-    return cached_scaling(args.model, settings, lambda: scaling_of(args.model, settings))
+    settings = model_settings(args, cached=True)
+    return cached_scaling(args.model, settings, lambda: scaling_of(args.model, checked_formulas(settings)))
 
 
 def compiled_from(args: argparse.Namespace, options: Integration | None = None, system=None):
@@ -72,8 +72,8 @@ def compiled_from(args: argparse.Namespace, options: Integration | None = None, 
     verbose = not getattr(args, "quiet", False)
     if system is not None:
         return gearsym.compile_model(system, options, verbose=verbose)
-    settings = model_settings(args)
+    settings = model_settings(args, cached=True)  # (a formula's numbers are checked if the model is built)
     return load_compiled(args.model, settings, options, verbose=verbose,
-                         compile=lambda: gearsym.compile_model(gearsym.load(args.model, **settings), options,
-                                                               verbose=verbose),
+                         compile=lambda: gearsym.compile_model(gearsym.load(args.model, **checked_formulas(settings)),
+                                                               options, verbose=verbose),
                          scaling=lambda: scaling_of(args.model, settings))

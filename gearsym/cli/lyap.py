@@ -12,7 +12,7 @@ from ..analysis.regime import describe_regime, zero_band
 from ..checks import chosen_coordinate
 from ..errors import GearsymError
 from ..figures import plot_point
-from ..outputs import check_figure
+from ..files.outputs import check_figure
 from .integration import add_integration_arguments, compiled_from, scaling_from
 from .settings import add_set_argument, parse_state
 

@@ -10,8 +10,8 @@ from pathlib import Path
 from ..checks import chosen_coordinate, whole_number
 from ..errors import GearsymError, UnknownParameterError
 from ..figures.orbits import plot_orbits
-from ..files import write_atomically
-from ..outputs import check_figure, check_file
+from ..files.atomic import write_atomically
+from ..files.outputs import check_figure, check_file
 from ..periodic import ContinuationInterrupted, continue_orbits, periodic_orbit
 from ..periodic.files import write_orbits
 from ..periodic.orbit import sweep_start

@@ -10,7 +10,7 @@ from ..analysis.attractors import DEFAULT_BOX, RUN, AttractorSet, check_ics, fin
 from ..checks import chosen_coordinate
 from ..errors import GearsymError
 from ..figures.poincare import plot_attractors
-from ..outputs import check_figure
+from ..files.outputs import check_figure
 from .integration import add_integration_arguments, compiled_from, integration_from
 from .settings import add_set_argument
 

@@ -5,7 +5,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..outputs import check_file, check_folder
+from ..files.outputs import check_file, check_folder
 from ..reproduce import reproduce
 
 NAME = "reproduce"

@@ -5,9 +5,10 @@ import argparse
 import math
 import sys
 
-import gearsym  # the face: SymPy is loaded only when a formula is given
+import gearsym  # the face: SymPy is loaded only when a formula is built
 
 from ..errors import GearsymError
+from ..model.grammar import canonical_formula
 from ..model.length_scale import check_length_scale
 from ..model.tooth_counts import parse_teeth
 from ..units import looks_like_quantity, parse_quantity
@@ -31,18 +32,32 @@ def add_teeth_argument(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def model_settings(args: argparse.Namespace) -> dict:
-    """--set's values and, with --teeth, ``teeth`` = (Z1, Z2): what the face's ``gearsym.load`` takes."""
+def model_settings(args: argparse.Namespace, *, cached: bool = False) -> dict:
+    """--set's values and, with --teeth, ``teeth`` = (Z1, Z2): what the face's ``gearsym.load`` takes. A formula's
+    numbers are checked here too (:func:`checked_formulas`), unless the caller may find the model in the start-up
+    cache (``cached``): it checks them when it builds the model, and a cached model's run never loads SymPy."""
     settings: dict = parse_settings(args.set)
     teeth = parse_teeth(getattr(args, "teeth", None))
     if teeth is not None:
         settings["teeth"] = teeth
+    return settings if cached else checked_formulas(settings)
+
+
+def checked_formulas(settings: dict) -> dict:
+    """``settings``, after each formula among them is built (SymPy) to check its numbers: 1/0, log(0) or
+    exp(1000) are refused with the option that gave them, before the model is loaded. (A model in the start-up
+    cache was built with its formula once: the cache has it only if the formula passed.)"""
+    for name, value in settings.items():
+        if _is_formula(name, value):
+            gearsym.parse_formula(value, f"--set {name}")
     return settings
 
 
 def parse_settings(pairs: list[str]) -> dict[str, str]:
     """``NAME=VALUE`` pairs; every value reads as a quantity (a number and a unit) or a safe formula (checked here,
-    before any work starts; neither is ever run as Python)."""
+    before any work starts; neither is ever run as Python). A formula's grammar is checked here without SymPy, and
+    it is kept in one spelling (:func:`~gearsym.model.grammar.canonical_formula`: the start-up cache's key); its
+    numbers are checked when it is built (:func:`checked_formulas`)."""
     settings = {}
     for pair in pairs:
         name, sep, value = pair.partition("=")
@@ -61,10 +76,17 @@ def parse_settings(pairs: list[str]) -> dict[str, str]:
             if not math.isfinite(float(value)):
                 raise GearsymError(f"--set {name}={value}: not a finite number (a double holds at most "
                                    f"{sys.float_info.max:.3g}); give a finite value")
-        else:  # (its grammar and its numbers: 1/0 or 1e400 are refused here, not in the C)
-            gearsym.parse_formula(value, f"--set {name}")
+        else:  # (its grammar, on Python's syntax tree alone; its numbers when it is built: checked_formulas)
+            value = canonical_formula(value, f"--set {name}")
         settings[name] = value
     return settings
+
+
+def _is_formula(name: str, value) -> bool:
+    """Whether a --set value is a formula (what :func:`parse_settings` neither reads as a quantity, a length scale
+    nor a number)."""
+    return (isinstance(value, str) and name != "length_scale" and not looks_like_quantity(value)
+            and not _is_number(value))
 
 
 def refuse_swept_and_set(swept: list[tuple[str, str]], settings: dict[str, str]) -> None:

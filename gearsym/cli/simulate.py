@@ -8,7 +8,7 @@ from ..data.simulate import RUN, simulate_measurements, steps_for
 from ..errors import GearsymError
 from ..fit.effects import augment, effect
 from ..fit.shaft_effects import is_shaft_effect
-from ..outputs import check_file
+from ..files.outputs import check_file
 from ..loading import load
 from .integration import add_integration_arguments, compiled_from, integration_from
 from .settings import add_set_argument, model_settings, parse_numbers, parse_state

@@ -17,11 +17,11 @@ from ..analysis.orders import MESH_HARMONICS, SIDEBANDS, order_spectrum
 from ..checks import check_run, json_safe
 from ..data.measurements import load_measurements
 from ..errors import GearsymError
-from ..files import write_atomically
+from ..files.atomic import write_atomically
 from ..figures.orders import plot_order_spectra
 from ..loading import load
 from ..options import STEPS_PER_PERIOD, Integration
-from ..outputs import check_figure, check_file
+from ..files.outputs import check_figure, check_file
 from .integration import add_integration_arguments, compiled_from
 from .settings import add_set_argument, model_settings
 from .simulate import with_effects

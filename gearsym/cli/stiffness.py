@@ -14,7 +14,8 @@ from ..errors import GearsymError
 from ..figures.stiffness import plot_cracked_mesh, plot_mesh_stiffness
 from ..geometry import (ORIGINS, GearGeometry, GearPair, Material, crack_loss_along_path, cracked_mesh_stiffness,
                         loss_against_depth, mesh_stiffness, root_crack, STEEL)
-from ..outputs import check_figure
+from ..files.outputs import check_figure
+from ..geometry.gear import ISO53_FILLET
 from ..units import parse_quantity, Quantity, shown
 
 NAME = "stiffness"
@@ -37,9 +38,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help='bore diameters, e.g. "20 mm,30 mm" or one for both (default: solid gears)')
     parser.add_argument("--centre-distance", default=None, metavar="A",
                         help="working centre distance (default: no backlash at the profile shifts' distance)")
-    parser.add_argument("--rack", default="1,1.25,0.38", metavar="HA,HF,RHO",
+    parser.add_argument("--rack", default=None, metavar="HA,HF,RHO",
                         help="the basic rack's addendum, dedendum and tip-rounding radius in modules (default "
-                             "1,1.25,0.38: ISO 53 profile A; profile D is 1,1.4,0.39)")
+                             "1,1.25,0.38: ISO 53 profile A, where its rounding fits the pressure angle; else, as "
+                             "at 25 deg, the largest rounding that fits, a full-round tip; profile D is 1,1.4,0.39)")
     parser.add_argument("--material", default=None, metavar="E,NU",
                         help='Young\'s modulus and Poisson\'s ratio of both gears, e.g. "206 GPa,0.3" (default steel)')
     parser.add_argument("--slices", type=int, default=None, help="slices of a helical pair's face width (default 20)")
@@ -117,7 +119,8 @@ def _geometry(args):
     centre = _quantity(args.centre_distance, "--centre-distance", "m", '"100 mm"').to("m").magnitude \
         if args.centre_distance else None
     helix = beta.to("rad").magnitude if beta is not None else 0.0
-    ha, hf, rho = (_number(t, "--rack") for t in _split(args.rack, "--rack", 3))
+    # (no --rack: ISO 53 profile A, or the largest rounding that fits where 0.38 does not: GearGeometry's default)
+    ha, hf, rho = (_number(t, "--rack") for t in _split(args.rack, "--rack", 3)) if args.rack else (1.0, 1.25, None)
     common = dict(module=module.to("m").magnitude, pressure_angle=alpha.to("rad").magnitude,
                   face_width=face.to("m").magnitude, material=material, addendum_coefficient=ha,
                   dedendum_coefficient=hf, fillet_coefficient=rho)
@@ -129,8 +132,10 @@ def _geometry(args):
         described.append(f"profile shift {x1:g}/{x2:g}")
     if beta is not None and helix:
         described.append(f"helix angle {_shown(beta)}")
-    if (ha, hf, rho) != (1.0, 1.25, 0.38):
-        described.append(f"rack {ha:g}/{hf:g}/{rho:g}")
+    rho = gear1.fillet_coefficient
+    if (ha, hf, rho) != (1.0, 1.25, ISO53_FILLET):
+        full_round = math.isclose(rho, gear1.largest_fillet_coefficient, rel_tol=1e-9)
+        described.append(f"rack {ha:g}/{hf:g}/{rho:.3g}{' (full-round tip)' if full_round else ''}")
     if args.bore:
         described.append("bore " + "/".join(_shown(_quantity(t, '--bore', 'm', '"20 mm"')) for t in _split(args.bore, "--bore", None)))
     return GearPair(gear1, gear2, centre), ", ".join(described), module.units
@@ -150,8 +155,10 @@ def run(args: argparse.Namespace) -> int:
     if args.format == "json":
         data = result.as_dict()
         data["pair"] = title
+        data["rack"] = _rack_dict(pair.gear1)
         data["gears"] = [_gear_dict(g) for g in (pair.gear1, pair.gear2)]
         data["units"]["gears"] = "m, kg, kg m^2"
+        data["units"]["rack"] = "modules"
         if cracked is not None:
             data["crack"] = cracked
             data["units"]["crack"] = "m, rad, fractions of the pair's stiffness; phase in rad"
@@ -212,6 +219,11 @@ def _print_crack(cracked: dict, text: str, length_unit) -> None:
           f"({100 * loss.min():.3g} % to {100 * loss.max():.3g} % along it)")
 
 
+def _rack_dict(gear) -> dict:
+    return {"addendum": gear.addendum_coefficient, "dedendum": gear.dedendum_coefficient,
+            "tip_rounding": gear.fillet_coefficient, "said": gear.rack}
+
+
 def _gear_dict(gear) -> dict:
     return {"teeth": gear.teeth, "base_diameter": 2 * gear.base_radius, "tip_diameter": 2 * gear.tip_radius,
             "root_diameter": 2 * gear.root_radius, "mass": gear.mass, "polar_inertia": gear.polar_inertia}
@@ -229,6 +241,7 @@ def _print_text(result, pair, title: str, length_unit) -> None:
     for i, gear in enumerate((pair.gear1, pair.gear2), 1):
         print(f"gear {i}: base diameter {length(2 * gear.base_radius)}, tip {length(2 * gear.tip_radius)}, "
               f"root {length(2 * gear.root_radius)}; body {gear.mass:.6g} kg, {gear.polar_inertia:.6g} kg m^2")
+    print(f"basic rack (both gears): {pair.gear1.rack}")
     sliced = f" ({result.slices} slices)" if result.slices > 1 else ""
     print(f"mesh stiffness{sliced}: mean {result.mean:.6g} N/m, min {result.min:.6g} N/m, max {result.max:.6g} N/m")
     zones = "; ".join(f"{z.pairs} pair{'s' if z.pairs != 1 else ''} for phase {z.start:.4g}-{z.end:.4g} rad"

@@ -11,7 +11,7 @@ import numpy as np
 from ..checks import chosen_coordinate
 from ..errors import GearsymError
 from ..figures.sweep import plot_sweep
-from ..outputs import check_figure, check_file
+from ..files.outputs import check_figure, check_file
 from ..physical.files import write_physical_record, write_physical_table
 from ..physical.sweeps import nondimensional_axes
 from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, Workers, run_sweep

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from ..errors import GearsymError
 from ..options import Integration
-from ..paths import GENERATED_DIR
+from ..files.paths import GENERATED_DIR
 from ..system import FirstOrderSystem
 from .compiled import CompiledModel
 from .compiler import cache_dir, compile_library

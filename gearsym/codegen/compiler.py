@@ -4,7 +4,7 @@ Libraries live in a cache (``$GEARSYM_CACHE``, else ``$XDG_CACHE_HOME/gearsym``
 or ``~/.cache/gearsym``) under a name that hashes the source, the compiler and
 its flags, so an unchanged model is never compiled twice and a changed one
 never picks up a stale library. A library is code, so the cache is private
-(:mod:`gearsym.private_files`: made 0700, used only while nobody else can write
+(:mod:`gearsym.files.private`: made 0700, used only while nobody else can write
 it) and a library is loaded only if its bytes are those recorded when it was
 compiled (:mod:`.trust`).
 
@@ -45,7 +45,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from ..errors import GearsymError, warn
-from ..private_files import NotPrivate, private_folder
+from ..files.private import NotPrivate, private_folder
 from .trust import record, trusted
 
 DEFAULT_FLAGS = ("-O3", "-march=native", "-mtune=generic", "-fno-tree-partial-pre")

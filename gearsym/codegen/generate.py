@@ -16,7 +16,7 @@ from pathlib import Path
 import casadi as ca
 import sympy as sp
 
-from ..files import write_atomically
+from ..files.atomic import write_atomically
 from ..system import FirstOrderSystem
 from .functions import ModelFunctions
 from .loops import LoopOptions
@@ -39,7 +39,7 @@ def generator_digest() -> str:
     digest = hashlib.sha256()
     for name in _GENERATOR_SOURCES:
         digest.update((here / name).read_bytes())
-    digest.update((here.parent / "backlash.py").read_bytes())
+    digest.update((here.parent / "model" / "backlash.py").read_bytes())
     return digest.hexdigest()
 
 

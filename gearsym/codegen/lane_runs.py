@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import GearsymError
-from ..paths import GENERATED_DIR
+from ..files.paths import GENERATED_DIR
 from .compiled import CompiledModel, RunInputs
 from .compiler import cache_dir, compile_library
 from .trust import trusted

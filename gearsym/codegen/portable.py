@@ -38,8 +38,8 @@ import casadi as ca
 
 from ..errors import GearsymError
 from ..options import Integration
-from ..paths import GENERATED_DIR
-from ..private_files import write_private
+from ..files.paths import GENERATED_DIR
+from ..files.private import write_private
 from ..system import FirstOrderSystem
 from ..version import __version__
 from .build import cached_code_directory, code_directory, keep_generated, source_describes

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import sympy as sp
 
-from ..backlash import G, g, g_slope
+from ..model.backlash import G, g, g_slope
 from ..errors import ModelError
 from ..system import FirstOrderSystem
 from .time_tables import SplitRHS

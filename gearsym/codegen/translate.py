@@ -19,7 +19,7 @@ from collections.abc import Mapping
 import casadi as ca
 import sympy as sp
 
-from ..backlash import G, g, g_slope
+from ..model.backlash import G, g, g_slope
 from ..errors import ModelError
 
 

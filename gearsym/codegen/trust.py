@@ -4,7 +4,7 @@ A library (or the C it is compiled from) is loaded only if its bytes are those g
 wrote them: a record beside it, ``<file>.<sha256 prefix>.json``, holding the SHA-256 of the bytes, their
 size and what they are (``describes``: the model, its code hash, states and parameters, so that a summary
 pointing at a library can be checked against it). Both are read as private files
-(:func:`~gearsym.private_files.read_private`: this user's, writable by nobody else, no symlink). A library
+(:func:`~gearsym.files.private.read_private`: this user's, writable by nobody else, no symlink). A library
 cut short (which crashed the process with SIGBUS when loaded), overwritten with garbage, or with one
 constant changed, no longer matches: it is compiled again, and a warning says so in one line.
 
@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import warn
-from ..private_files import NotPrivate, read_private, write_private
+from ..files.private import NotPrivate, read_private, write_private
 
 #: bump when what a record holds changes
 RECORD_FORMAT = 1

@@ -39,7 +39,7 @@ import numpy as np
 import sympy as sp
 
 from ..errors import GearsymError
-from ..private_files import write_private
+from ..files.private import write_private
 from ..system import FirstOrderSystem
 from .compiler import cache_dir, compile_library, find_compiler
 from .casadi_symbols import SystemSymbols

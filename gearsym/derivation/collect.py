@@ -21,7 +21,7 @@ from ..model.drivetrain import Drivetrain
 from ..model.resolved import ResolvedDrivetrain
 from ..reduction.nondimensional import NondimensionalModel, reduce
 from ..scales.map import Scaling
-from ..symbols import parameter_symbol, tau
+from ..model.symbols import parameter_symbol, tau
 from ..system import FirstOrderSystem
 from ..units import from_si
 from .notes import default_wave_amplitude, paper_notes

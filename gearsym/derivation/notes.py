@@ -17,7 +17,7 @@ import sympy as sp
 from ..model.expressions import parameter_names
 from ..model.stiffness import DEFAULT_CONTACT_RATIO, DEFAULT_HARMONICS, rectangular_mesh_stiffness
 from ..reduction.nondimensional import NondimensionalModel
-from ..symbols import phi
+from ..model.symbols import phi
 from .printing import number
 from .records import GroupRecord
 
@@ -38,7 +38,7 @@ def paper_notes(nd: NondimensionalModel, groups: Sequence[GroupRecord], defaults
     if any(rc.backlash != 0 for rc in meshes):
         notes.append(
             "Backlash (Eq. 5): the paper prints the third branch of g(x, η) as x ≤ η; the continuous "
-            "function meant, and used here (`gearsym.backlash.g`), has x ≤ −η: g = x for x ≥ 0, "
+            "function meant, and used here (`gearsym.model.backlash.g`), has x ≤ −η: g = x for x ≥ 0, "
             "0 for −η < x < 0, x + η for x ≤ −η."
         )
     waves = [(fn.name, default_wave_amplitude(rc.variation)) for rc, fn in zip(meshes, nd.functions)]

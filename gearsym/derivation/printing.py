@@ -26,7 +26,7 @@ from sympy.core.function import AppliedUndef
 from sympy.printing.latex import LatexPrinter
 from sympy.printing.pretty import pretty
 
-from ..symbols import t, tau
+from ..model.symbols import t, tau
 
 #: width at which the text renderer wraps pretty-printed formulas (fixed, so output is reproducible)
 TEXT_COLUMNS = 100

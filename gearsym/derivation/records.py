@@ -12,7 +12,7 @@ from typing import Optional
 
 import sympy as sp
 
-from ..symbols import parameter_symbol, tau
+from ..model.symbols import parameter_symbol, tau
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.attractors import Attractor, AttractorSet
-from ..analysis.orbits import Trajectory, phase_trajectory
+from ..analysis.poincare import Trajectory, phase_trajectory
 from ..errors import GearsymError
 from .layout import fit_texts
 from .save import pyplot, save_figure

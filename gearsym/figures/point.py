@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.lyapunov import LyapunovSpectrum
-from ..analysis.orbits import Trajectory
+from ..analysis.poincare import Trajectory
 from .layout import fit_texts, line_style, outside_below
 from .poincare import phase_axes
 from .save import pyplot, save_figure

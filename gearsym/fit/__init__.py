@@ -6,7 +6,7 @@ add it to the symbolic model, and report the held-out error before and after.
 """
 from ..checks import json_safe
 from ..data import load_measurements
-from ..outputs import check_folder
+from ..files.outputs import check_folder
 from .effects import EFFECTS, FAMILIES, Effect, augment, effect, effect_terms, term_effect
 from .selection import Explanation, explain
 from .prediction import Prediction, predict_ahead

@@ -17,7 +17,7 @@ from functools import lru_cache
 import numpy as np
 import sympy as sp
 
-from ..symbols import parameter_symbol
+from ..model.symbols import parameter_symbol
 from ..system import FirstOrderSystem
 
 

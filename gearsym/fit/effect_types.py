@@ -10,9 +10,9 @@ from dataclasses import dataclass, field
 
 import sympy as sp
 
-from ..backlash import g
+from ..model.backlash import g
 from ..errors import ModelError
-from ..symbols import parameter_symbol
+from ..model.symbols import parameter_symbol
 from ..system import Coupling, FirstOrderSystem
 
 

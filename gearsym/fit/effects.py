@@ -48,10 +48,10 @@ from dataclasses import replace
 
 import sympy as sp
 
-from ..backlash import g
+from ..model.backlash import g
 from ..errors import GearsymError, ModelError, suggest
 from ..model.expressions import to_expr
-from ..symbols import parameter_symbol
+from ..model.symbols import parameter_symbol
 from ..system import FirstOrderSystem
 from .effect_types import Change, Effect, Site, site
 from .shaft_effects import KINDS as SHAFT_KINDS, shaft_effect, with_revolution

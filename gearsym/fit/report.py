@@ -15,7 +15,7 @@ import numpy as np
 import sympy as sp
 
 from ..checks import json_safe
-from ..file_sets import written_together
+from ..files.sets import written_together
 from ..figures.layout import fit_texts
 from ..figures.save import pyplot, save_figure
 from ..system import FirstOrderSystem
@@ -32,7 +32,7 @@ VERDICTS = {
 }
 
 
-#: the files of a report, replaced together (:func:`~gearsym.file_sets.written_together`)
+#: the files of a report, replaced together (:func:`~gearsym.files.sets.written_together`)
 REPORT_FILES = ("report.json", "residuals.png", "prediction.png", "derived_model.md", "report.md")
 #: the figure of a tooth-by-tooth form's values, tooth by tooth, written beside them when one was tried
 TEETH_FIGURE = "teeth.png"

@@ -35,7 +35,7 @@ import sympy as sp
 from ..errors import GearsymError
 from ..model.shaft_orders import DEFAULT_EDGE, path_window, tooth_by_tooth, tooth_share, window
 from ..model.stiffness import DEFAULT_CONTACT_RATIO
-from ..symbols import parameter_symbol
+from ..model.symbols import parameter_symbol
 from ..system import FirstOrderSystem
 from .effect_types import Change, Effect, Site
 

@@ -40,7 +40,7 @@ from dataclasses import dataclass, replace
 
 from ..model.shaft_orders import DEFAULT_EDGE, tooth_by_tooth, window
 from ..model.stiffness import DEFAULT_CONTACT_RATIO
-from ..symbols import parameter_symbol
+from ..model.symbols import parameter_symbol
 from .effect_types import Change, Effect, Site
 
 #: the general forms, by the prefix of their names

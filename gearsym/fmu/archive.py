@@ -7,7 +7,7 @@ import zipfile
 from collections.abc import Mapping
 from pathlib import Path
 
-from ..files import write_atomically
+from ..files.atomic import write_atomically
 
 #: the time stamp of every entry (zip's epoch: no build date in the archive)
 STAMP = (1980, 1, 1, 0, 0, 0)

@@ -17,7 +17,7 @@ from pathlib import Path
 import casadi as ca
 import sympy as sp
 
-from ..backlash import g
+from ..model.backlash import g
 from ..codegen.casadi_symbols import SystemSymbols
 from ..codegen.time_tables import SplitRHS
 from ..codegen.translate import to_casadi

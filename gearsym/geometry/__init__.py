@@ -51,7 +51,7 @@ def _si(value, unit: str, name: str):
 
 def gear_geometry(*, teeth: int, module, pressure_angle, face_width, profile_shift: float = 0.0, helix_angle=0.0,
                   addendum_coefficient: float = 1.0, dedendum_coefficient: float = 1.25,
-                  fillet_coefficient: float = 0.38, bore_diameter=0.0, material: Material = STEEL) -> GearGeometry:
+                  fillet_coefficient: float | None = None, bore_diameter=0.0, material: Material = STEEL) -> GearGeometry:
     """A :class:`GearGeometry`; lengths in m and angles in rad, or pint Quantities in any unit of the kind."""
     values = {"module": module, "face_width": face_width, "bore_diameter": bore_diameter,
               "pressure_angle": pressure_angle, "helix_angle": helix_angle}

@@ -31,11 +31,31 @@ PRESSURE_ANGLE_RANGE = (math.radians(10.0), math.radians(35.0))
 MAX_HELIX_ANGLE = math.radians(45.0)
 #: a tip thinner than this (in modules) is warned about: ISO 21771 / common practice ask s_a >= 0.2-0.4 m_n
 THIN_TIP = 0.2
+#: ISO 53 profile A's tool tip rounding rho_fP / m_n: the default wherever it fits (a 20 deg rack; not above ~22.6 deg)
+ISO53_FILLET = 0.38
 
 
 def involute(angle):
     """inv(alpha) = tan(alpha) - alpha."""
     return math.tan(angle) - angle
+
+
+def largest_fillet_coefficient(pressure_angle: float, dedendum_coefficient: float) -> float:
+    """The largest rho_fP / m_n whose two roundings fit on the tool's tip, of width pi/2 - 2 h_fP tan(alpha) (in
+    modules), where they meet at its middle (a full-round tip)."""
+    alpha = pressure_angle
+    return (0.25 * math.pi - dedendum_coefficient * math.tan(alpha)) * math.cos(alpha) / (1.0 - math.sin(alpha))
+
+
+def largest_dedendum(pressure_angle: float) -> float:
+    """The dedendum coefficient h_fP / m_n at which the tool's flanks meet at its tip: pi / (4 tan(alpha))."""
+    return 0.25 * math.pi / math.tan(pressure_angle)
+
+
+def default_fillet_coefficient(pressure_angle: float, dedendum_coefficient: float) -> float:
+    """The tool tip's rounding of the default rack: ISO 53 profile A's 0.38 where it fits, else the largest that
+    fits (a full-round tip; ISO 53 has no rack of 25 deg, whose largest rounding is 0.318)."""
+    return min(ISO53_FILLET, largest_fillet_coefficient(pressure_angle, dedendum_coefficient))
 
 
 def _finite(value, what: str) -> float:
@@ -57,7 +77,9 @@ class GearGeometry:
     * ``addendum_coefficient``: h_aP / m_n of the basic rack, the gear's addendum (1.0).
     * ``dedendum_coefficient``: h_fP / m_n, the gear's dedendum and the tool's addendum (1.25).
     * ``fillet_coefficient``: rho_fP / m_n, the radius of the tool tip's rounding, which cuts the root
-      fillet (0.38: ISO 53 profile A; B has 0.30, C 0.25, D 0.39 with a dedendum of 1.4).
+      fillet (0.38: ISO 53 profile A; B has 0.30, C 0.25, D 0.39 with a dedendum of 1.4). By default ISO 53's
+      0.38 where it fits on the tool's tip, else the largest that fits (a full-round tip: 0.318 on a 25 deg
+      rack, which ISO 53 does not cover): :func:`default_fillet_coefficient`.
     * ``bore_diameter``: d_i (m); 0 for a solid gear.
     * ``material``: :class:`Material` (steel by default).
     """
@@ -70,7 +92,7 @@ class GearGeometry:
     helix_angle: float = 0.0
     addendum_coefficient: float = 1.0
     dedendum_coefficient: float = 1.25
-    fillet_coefficient: float = 0.38
+    fillet_coefficient: float | None = None
     bore_diameter: float = 0.0
     material: Material = field(default=STEEL)
 
@@ -86,7 +108,8 @@ class GearGeometry:
                            ("dedendum_coefficient", "gear: dedendum coefficient"),
                            ("fillet_coefficient", "gear: fillet radius coefficient"),
                            ("bore_diameter", "gear: bore diameter (m)")):
-            object.__setattr__(self, name, _finite(getattr(self, name), what))
+            if getattr(self, name) is not None or name != "fillet_coefficient":
+                object.__setattr__(self, name, _finite(getattr(self, name), what))
         if not isinstance(self.material, Material):
             raise GearsymError(f"gear: material must be a Material(E, nu, rho), got {type(self.material).__name__}")
         if self.module <= 0:
@@ -111,13 +134,23 @@ class GearGeometry:
             raise GearsymError(f"gear: dedendum coefficient {self.dedendum_coefficient:g} must exceed the addendum "
                                f"coefficient {self.addendum_coefficient:g} (a tip clearance) and be at most 2.5 "
                                "(1.25 for ISO 53's basic rack)")
+        deepest = largest_dedendum(self.pressure_angle)
+        if self.dedendum_coefficient >= deepest:
+            raise GearsymError(f"gear: dedendum coefficient {self.dedendum_coefficient:g} is too deep for a "
+                               f"{math.degrees(self.pressure_angle):.4g} deg rack: the tool's flanks meet before its "
+                               f"tip (keep it below {deepest:.3g}, or take a smaller pressure angle)")
+        if self.fillet_coefficient is None:
+            object.__setattr__(self, "fillet_coefficient",
+                               default_fillet_coefficient(self.pressure_angle, self.dedendum_coefficient))
         if self.root_radius <= 0:
             raise GearsymError(f"gear: the root circle has no radius ({self.root_radius:g} m): {self.teeth} teeth are "
                                "too few for this dedendum and profile shift")
         fillet_max = self.largest_fillet_coefficient
         if not 0.0 <= self.fillet_coefficient <= fillet_max:
-            raise GearsymError(f"gear: fillet radius coefficient {self.fillet_coefficient:g} must lie in 0-{fillet_max:.3f}: "
-                               "the tool tip's rounding must fit on its tip (0.38 is ISO 53's profile A)")
+            raise GearsymError(f"gear: fillet radius coefficient {self.fillet_coefficient:g} must lie in 0-{fillet_max:.3f} "
+                               f"on a {math.degrees(self.pressure_angle):.4g} deg rack of dedendum "
+                               f"{self.dedendum_coefficient:g}: the tool tip's roundings must fit on its tip "
+                               f"({ISO53_FILLET} is ISO 53's profile A, a 20 deg rack; leave it out for the default)")
         if self.dedendum_coefficient - self.profile_shift - self.fillet_coefficient < 0:
             raise GearsymError(f"gear: profile shift {self.profile_shift:g} is too large for this basic rack: the tool "
                                "tip's rounding would lie above the generating line (keep x below "
@@ -207,8 +240,21 @@ class GearGeometry:
     @property
     def largest_fillet_coefficient(self) -> float:
         """The largest rho_fP / m_n whose roundings fit on the tool's tip (they meet at its middle)."""
-        alpha = self.pressure_angle
-        return (0.25 * math.pi - self.dedendum_coefficient * math.tan(alpha)) * math.cos(alpha) / (1.0 - math.sin(alpha))
+        return largest_fillet_coefficient(self.pressure_angle, self.dedendum_coefficient)
+
+    @property
+    def rack(self) -> str:
+        """The basic rack in words: ISO 53's profile A, a full-round tip (the largest rounding that fits), or its
+        numbers."""
+        ha, hf, rho = self.addendum_coefficient, self.dedendum_coefficient, self.fillet_coefficient
+        numbers = f"addendum {ha:g}, dedendum {hf:g}, tip rounding {rho:.3g} (in modules)"
+        if (ha, hf, rho) == (1.0, 1.25, ISO53_FILLET):
+            return f"ISO 53 profile A: {numbers}"
+        if math.isclose(rho, self.largest_fillet_coefficient, rel_tol=1e-9):
+            too_large = f"; ISO 53's {ISO53_FILLET} does not fit it" if rho < ISO53_FILLET else ""
+            return (f"{numbers}: a full-round tip, the largest rounding that fits this "
+                    f"{math.degrees(self.pressure_angle):.4g} deg rack{too_large}")
+        return numbers
 
     @property
     def undercut_free_shift(self) -> float:

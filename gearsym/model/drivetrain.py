@@ -11,7 +11,7 @@ from functools import cached_property
 
 import sympy as sp
 
-from ..declared import Model
+from .declared import Model
 from ..errors import ModelError
 from ..units import Measure, measure
 from .components import Body, Coupling, Mesh, Shaft, Torque

@@ -15,7 +15,7 @@ import sympy as sp
 from sympy.core.function import AppliedUndef
 
 from ..errors import ModelError
-from ..symbols import RESERVED, parameter_symbol
+from .symbols import RESERVED, parameter_symbol
 from .formula import parse_formula
 
 ExprLike = Union[str, int, float, sp.Expr]

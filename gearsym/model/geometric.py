@@ -20,7 +20,7 @@ import sympy as sp
 
 from ..errors import GearsymError, ModelError
 from ..geometry import GearGeometry, MeshStiffness, StiffnessOptions, gear_pair, mesh_stiffness
-from ..symbols import phi
+from .symbols import phi
 from ..units import Measure, measure
 
 #: harmonics of the computed stiffness a mesh from geometry keeps unless told. Seven, as gearsym's default

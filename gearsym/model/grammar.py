@@ -121,3 +121,17 @@ def _call(n: ast.Call, depth: int, text: str, where: str) -> list:
 def check_formula(text: str, where: str) -> None:
     """A one-line error if ``text`` is not a formula of the grammar (nothing is built, SymPy is not needed)."""
     syntax_tree(text.strip(), where)
+
+
+def canonical_formula(text: str, where: str) -> str:
+    """``text`` checked against the grammar (as :func:`check_formula`, without SymPy) and written without its
+    spaces: one spelling per formula, so that ``1 + 0.2*cos(tau)`` and ``1+0.2*cos(tau)`` are the same model to
+    the start-up cache, whose key hashes the text. Its digits stay as written (a float is built from its digits);
+    a text whose compact spelling would read as another tree keeps its spaces."""
+    tree = syntax_tree(text.strip(), where)
+    compact = "".join(text.split())
+    try:
+        same = ast.dump(ast.parse(compact, mode="eval").body) == ast.dump(tree)
+    except SyntaxError:
+        same = False
+    return compact if same else text.strip()

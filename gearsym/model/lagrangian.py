@@ -10,8 +10,8 @@ from functools import cached_property
 
 import sympy as sp
 
-from ..backlash import G
-from ..symbols import phi, t
+from .backlash import G
+from .symbols import phi, t
 from .resolved_components import ResolvedCoupling
 
 

@@ -12,9 +12,9 @@ from typing import Optional
 import sympy as sp
 
 from ..checks import sign_violation
-from ..declared import Model
+from .declared import Model
 from ..errors import ModelError, suggest
-from ..symbols import omega, parameter_symbol, phi, t
+from .symbols import omega, parameter_symbol, phi, t
 from .components import Body, BodyRef, Coupling, Gear, Harmonic, Mesh, Planet, Torque
 from .expressions import ExprLike, parameter_names, to_expr
 from .lagrangian import LagrangianForms

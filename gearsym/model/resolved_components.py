@@ -6,7 +6,7 @@ from typing import Optional
 
 import sympy as sp
 
-from ..symbols import omega, phi, t
+from .symbols import omega, phi, t
 from .components import Body, Coupling, Torque
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from ..errors import ModelError
-from ..symbols import phi
+from .symbols import phi
 from .faults import MeshTerms, ShaftOrderTerm
 from .resolved_components import ResolvedCoupling
 from .shaft_orders import teeth_of

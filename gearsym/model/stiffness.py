@@ -18,7 +18,7 @@ import numpy as np
 import sympy as sp
 
 from ..errors import ModelError
-from ..symbols import phi, parameter_symbol
+from .symbols import phi, parameter_symbol
 
 #: documented defaults of the stiffness variation
 DEFAULT_CONTACT_RATIO = 1.6

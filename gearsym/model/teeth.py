@@ -8,7 +8,7 @@ The model is not changed: :func:`with_teeth` returns a copy with those two gears
 from __future__ import annotations
 
 import dataclasses
-from ..declared import Model
+from .declared import Model
 from ..errors import GearsymError, ModelError
 from .components import Body, Gear, Mesh
 from .drivetrain import Drivetrain

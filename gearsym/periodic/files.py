@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from ..checks import json_safe
-from ..files import write_atomically
+from ..files.atomic import write_atomically
 from ..sweep.store import number, sidecar
 from .branches import Continuation
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 from functools import singledispatchmethod
 
 from ..analysis.lyapunov import LyapunovSpectrum
-from ..analysis.orbits import Trajectory
+from ..analysis.poincare import Trajectory
 from ..errors import GearsymError
 from ..periodic.branches import Continuation
 from ..scales.map import Scaling

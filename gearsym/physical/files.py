@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..checks import json_safe
-from ..files import write_atomically
+from ..files.atomic import write_atomically
 
 
 def write_physical_table(result, path: Path) -> Path:

@@ -18,7 +18,7 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
-from ..analysis.orbits import phase_trajectory
+from ..analysis.poincare import phase_trajectory
 from ..errors import GearsymError
 from ..scales.speeds import Speed
 from ..units import shown
@@ -168,7 +168,7 @@ class ShaftUnits:
 
 
 def contact(x, eta):
-    """g(x, eta) of gearsym.backlash, on arrays."""
+    """g(x, eta) of gearsym.model.backlash, on arrays."""
     return np.where(x >= 0, x, np.where(x > -eta, 0.0, x + eta))
 
 
@@ -257,7 +257,7 @@ class PointUnits:
 
     def point(self, result, trajectory=None) -> PhysicalPoint:
         """A :class:`~gearsym.analysis.LyapunovSpectrum` in physical units (with the mesh forces and shaft
-        torques of ``trajectory``, a :class:`~gearsym.analysis.orbits.Trajectory` at the same point, if given)."""
+        torques of ``trajectory``, a :class:`~gearsym.analysis.poincare.Trajectory` at the same point, if given)."""
         w = float(result.parameters["omega"])
         per_second = w * self.omega_n
         speed = float(self.speed_of(w)) if self.speed else float("nan")

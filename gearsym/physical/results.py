@@ -23,7 +23,7 @@ from ..options import Integration
 from ..scales.dimensions import evaluate
 from ..scales.map import Scaling
 from ..sweep.grid import Axis
-from ..symbols import parameter_symbol, phi, tau
+from ..model.symbols import parameter_symbol, phi, tau
 from ..units import Quantity, from_si, symbol
 from .point import (ANGLE, ANGULAR_VELOCITY, LENGTH, LENGTH_UNIT, VELOCITY, VELOCITY_UNIT, Measured,
                     MeshUnits, PhysicalPoint, PointUnits, ShaftUnits, Unit, loads_trajectory)
@@ -171,7 +171,7 @@ class PhysicalTrajectory:
 
 def trajectory_to_physical(scaling: Scaling, trajectory, omega: float,
                            length_unit: str = LENGTH_UNIT) -> PhysicalTrajectory:
-    """A :class:`~gearsym.analysis.orbits.Trajectory` (run at forcing frequency ``omega``) in physical units."""
+    """A :class:`~gearsym.analysis.poincare.Trajectory` (run at forcing frequency ``omega``) in physical units."""
     units = point_units(scaling, length_unit)
     seconds = np.asarray(trajectory.time, dtype=float) / rate(scaling, omega)
     states = {n: _quantity(units.state(n, trajectory[n], omega)) for n in trajectory.state_names}

@@ -22,7 +22,7 @@ import sympy as sp
 from ..errors import ModelError
 from ..model.resolved import ResolvedDrivetrain
 from ..model.resolved_components import ResolvedCoupling
-from ..symbols import t
+from ..model.symbols import t
 
 
 @dataclass(frozen=True)

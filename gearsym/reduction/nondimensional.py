@@ -28,14 +28,14 @@ from typing import Optional
 import sympy as sp
 from sympy.core.function import AppliedUndef
 
-from ..backlash import g
+from ..model.backlash import g
 from ..errors import ModelError, UnknownParameterError
 from ..model.drivetrain import Drivetrain
 from ..model.resolved_components import ResolvedCoupling
 from ..checks import sign_violation
 from ..model.expressions import ExprLike, parameter_names, to_expr
 from ..model.stiffness import check_periodic
-from ..symbols import omega, parameter_symbol, phi, t, tau
+from ..model.symbols import omega, parameter_symbol, phi, t, tau
 from ..system import Constraint, Coupling, FirstOrderSystem, Gearing
 from .coordinates import generic_values
 from .reduction import Reduction, reduce_drivetrain

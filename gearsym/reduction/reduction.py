@@ -17,12 +17,12 @@ from functools import cached_property
 
 import sympy as sp
 
-from ..backlash import g
+from ..model.backlash import g
 from ..errors import GearsymError
 from ..model.drivetrain import Drivetrain
 from ..model.resolved import ResolvedDrivetrain
 from ..model.resolved_components import ResolvedCoupling, ResolvedForcing
-from ..symbols import t
+from ..model.symbols import t
 from .coordinates import Coordinate, coupling_deflections, rigid_body_modes
 
 

@@ -24,7 +24,7 @@ import sympy as sp
 
 from ..errors import GearsymError
 from ..model.resolved_components import ResolvedCoupling
-from ..symbols import parameter_symbol, phi
+from ..model.symbols import parameter_symbol, phi
 from .reduction import Reduction
 
 #: samples of a mesh period for the mean of its stiffness variation (exact for Fourier series of lower degree)

@@ -21,7 +21,7 @@ from ..options import Integration
 from ..periodic import Continuation, continue_orbits
 from ..periodic.orbit import sweep_start
 from ..loading import load
-from ..files import write_atomically
+from ..files.atomic import write_atomically
 from ..sweep import SweepResult, Workers, parse_axis, run_sweep
 from ..sweep.basin_continuation import BasinContinuation, continue_basins
 from .jumps import jump_records

@@ -12,7 +12,7 @@ import os
 import re
 from pathlib import Path
 
-from ..files import write_atomically
+from ..files.atomic import write_atomically
 from .claims import MIN_CHAOTIC
 
 #: Why a claim comes out as it does, where the numbers alone do not say it. Written by a person

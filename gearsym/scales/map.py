@@ -32,7 +32,7 @@ from ..model.length_scale import check_length_scale
 from ..model.resolved_components import ResolvedCoupling
 from ..reduction import NondimensionalModel
 from ..reduction.statics import StaticState, static_state, torque_imbalance
-from ..symbols import parameter_symbol
+from ..model.symbols import parameter_symbol
 from ..units import Measure, Quantity, dimension_text, measure, symbol
 from .dimensions import evaluate, same_dimension
 from .roles import SPEED, fields, parameter_roles, physical_parameters

@@ -13,7 +13,7 @@ import sympy as sp
 
 from ..model.resolved import ResolvedDrivetrain
 from ..model.expressions import parameter_names
-from ..symbols import omega, phi, t
+from ..model.symbols import omega, phi, t
 from ..units import dimension_text, unit_dims
 
 

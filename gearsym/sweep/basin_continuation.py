@@ -30,7 +30,7 @@ from ..analysis.basins import RUN, BasinMap, basin_map, method
 from ..checks import json_safe
 from ..codegen import CompiledModel, engine_verb
 from ..errors import GearsymError, UnknownParameterError
-from ..files import write_atomically
+from ..files.atomic import write_atomically
 from ..options import Integration
 from ..version import __version__
 from .store import number, read_rows, release_lock, sidecar, take_lock

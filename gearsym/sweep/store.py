@@ -39,7 +39,7 @@ import numpy as np
 
 from .. import caller
 from ..errors import GearsymError, warn
-from ..files import write_atomically
+from ..files.atomic import write_atomically
 
 #: spaces kept in the record of a running sweep, so that a failure can be recorded in place on a full disk
 RECORD_ROOM = 2048

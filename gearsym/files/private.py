@@ -27,7 +27,7 @@ import secrets
 import stat
 from pathlib import Path
 
-from .errors import GearsymError
+from ..errors import GearsymError
 
 try:
     import grp

@@ -11,7 +11,7 @@ import tempfile
 from functools import cache
 from pathlib import Path
 
-from .errors import GearsymError
+from ..errors import GearsymError
 
 
 @cache

@@ -1,6 +1,6 @@
 """Files that belong together (a report's page, its data and figures), replaced together or not at all.
 
-One file is written whole by a rename (:func:`gearsym.files.write_atomically`); a set of them cannot be
+One file is written whole by a rename (:func:`gearsym.files.atomic.write_atomically`); a set of them cannot be
 renamed at once. So the new set is written into a staging folder beside the old one first, where a failure
 or a kill leaves the old set as it was. Then a marker file is put in the folder, saying that it holds a mix
 of two runs; the files are renamed into place with Ctrl-C and SIGTERM held back (they take effect after);
@@ -18,8 +18,8 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
-from .errors import GearsymError
-from .files import write_atomically
+from ..errors import GearsymError
+from .atomic import write_atomically
 
 _STAGING = ".gearsym-staging-"
 

@@ -1,0 +1,3 @@
+"""Files and folders: written whole (:mod:`.atomic`) or as a set (:mod:`.sets`), kept private where they hold
+code (:mod:`.private`), an output's place checked before work starts (:mod:`.outputs`), and the package's own
+folders (:mod:`.paths`)."""
