@@ -135,3 +135,16 @@ def test_a_spall_is_in_the_library_of_a_model_with_teeth(geared):
     assert not any(name.startswith(("spall", "tooth_stiffness")) for name in candidate_library(gearsym.load("one_stage")))
     # the tooth-by-tooth forms are tried after the named faults (in explain), not refitted among them
     assert not any(e.gears for e in library.values())
+
+
+def test_the_tooth_by_tooth_forms_need_tooth_counts(tmp_path):
+    """Asked for on a model whose gears have no tooth counts: one line that says what to give."""
+    from gearsym import explain, load_measurements
+    from gearsym.errors import GearsymError
+
+    tau = np.linspace(0, 8 * math.pi, 100, endpoint=False)
+    path = tmp_path / "m.csv"
+    path.write_text("tau,x\n" + "".join(f"{t!r},{math.sin(t)!r}\n" for t in tau))
+    one_stage = gearsym.load("one_stage")
+    with pytest.raises(GearsymError, match="tooth_stiffness: no mesh of one_stage has two gears with tooth counts"):
+        explain(one_stage, load_measurements([path], one_stage), ["zeta"], candidates=["tooth_stiffness"])

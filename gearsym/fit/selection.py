@@ -326,6 +326,9 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
                                 [c for c in candidates if c not in named_forms], harmonics, terms)
     general = {name: e for name, e in forms.items()
                if candidates is None or name in named_forms or any(name.startswith(k + "_") for k in named_forms)}
+    if named_forms and not general:
+        raise GearsymError(f"{named_forms[0]}: no mesh of {system.name} has two gears with tooth counts; give a model "
+                           "that declares Gear(..., teeth=Z), or --teeth Z1,Z2 (teeth=(Z1, Z2) in Python)")
     named = {c for c in candidates or () if isinstance(c, str)}
     too_short = _too_short(system, measurements, {**library, **general}, named=named)
     library = {name: e for name, e in library.items() if name not in too_short}
