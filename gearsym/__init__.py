@@ -13,7 +13,9 @@ One flat public face; the stages behind it, each handing one type to the next:
   :func:`find_attractors`, :func:`basin_map` (basins of attraction, many starts at once in the lanes),
   :func:`continue_basins` (basin fractions along a parameter), :func:`run_sweep` (on a CompiledModel, or on a
   system, compiled first);
-  periodic orbits and their branches: :func:`periodic_orbit`, :func:`continue_orbits`;
+  periodic orbits and their branches: :func:`periodic_orbit`, :func:`continue_orbits`; parametric
+  instability: :func:`stability_chart` (Floquet multipliers over a grid of two parameters, the tongues' kinds and
+  boundaries);
 * data: :func:`simulate_measurements`, :func:`load_measurements`, :func:`explain`;
 * FMUs: :func:`export_fmu` (a model as an FMI 2.0 FMU, co-simulation and model exchange, for other tools);
 * physical units: :func:`scaling` (a drivetrain with values in units -> its nondimensional values, and results
@@ -69,6 +71,8 @@ _LAZY = {
     "classify_regime": "gearsym.analysis",
     "periodic_orbit": "gearsym.verbs",
     "continue_orbits": "gearsym.verbs",
+    "stability_chart": "gearsym.verbs",
+    "StabilityChart": "gearsym.stability",
     "run_sweep": "gearsym.verbs",
     "read_sweep": "gearsym.sweep",
     "Workers": "gearsym.sweep",
@@ -136,5 +140,7 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .scales.map import Scaling
     from .system import FirstOrderSystem
     from .sweep import SweepInterrupted, Workers, read_sweep
+    from .stability import StabilityChart
     from .verbs import (basin_map, continue_basins, continue_orbits, find_attractors, lyapunov_spectrum, periodic_orbit,
-                        phase_trajectory, poincare_samples, run_sweep, simulate_measurements, simulated_order_spectrum)
+                        phase_trajectory, poincare_samples, run_sweep, simulate_measurements, simulated_order_spectrum,
+                        stability_chart)

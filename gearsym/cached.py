@@ -47,6 +47,8 @@ from .parameters import Constraint, ParameterChecks
 from .physical.point import CachedScaling, PointUnits
 from .files.private import NotPrivate, read_private, write_private
 from .registry import model_file, models_dir
+from .stability.recipe import CompiledLinearisation
+from .stability.recipe import StaticRecipe
 
 #: bump when what a summary holds changes
 SUMMARY_FORMAT = 4
@@ -285,3 +287,57 @@ def _from_cache(system_file: Path, build_file: Path, options: Integration, loops
     compiled = LOADED[key] = CompiledModel(summary, loops, digest, functions, "compiled", library, {},
                                            load_native(library, functions), options, timed, texts)
     return compiled
+
+
+def load_linearisation(ref: str, values: Mapping[str, object], options: Integration, *,
+                       derive: Callable[[], CompiledLinearisation], verbose: bool = False) -> CompiledLinearisation:
+    """The compiled linearisation about its static state of the model ``ref`` with ``values`` (a stability
+    chart's): from the cache as :func:`load_compiled` keeps a model (its summaries beside the linear system's
+    library, with the static recipe and the model's own parameters), else ``derive()`` (the model loaded,
+    linearised and compiled) and the summaries written."""
+    path = model_file(ref) if isinstance(ref, str) else None
+    if path is None or resolve_backend(options.backend) != "compiled":
+        return derive()
+    options = replace(options, locate_crossings=True)  # (the linear system's tables are factored)
+    key, loops = system_key(path, values), LoopOptions.of(options)
+    name = f"{path.stem}_linearised"
+    system_file = summary_path(name, key)
+    build_file = summary_path(name, f"{key}-{loops_key(loops)}")
+    compiled = _from_cache(system_file, build_file, options, loops, lambda: derive().model.system)
+    data = read_json(system_file) if compiled is not None else None
+    if data is not None:
+        try:
+            about = data["linearisation"]
+            return CompiledLinearisation(compiled, StaticRecipe.from_dict(about["static"]),
+                                         tuple(map(str, about["anchors"])), str(about["base"]),
+                                         {str(k): float(v) for k, v in about["parameters"].items()},
+                                         bool(about["physical"]))
+        except (KeyError, TypeError, ValueError, AttributeError):
+            pass
+    lin = derive()
+    write_json(system_file, {"system": SystemSummary.of(lin.model.system, False).as_dict(), "physical": None,
+                             "linearisation": {"static": lin.recipe.as_dict(), "anchors": list(lin.anchors),
+                                               "base": lin.base, "parameters": dict(lin.base_parameters),
+                                               "physical": lin.physical}})
+    write_json(build_file, {"hash": lin.model.hash, "library": str(lin.model.library),
+                            "timed_parameters": sorted(lin.model.timed_parameters),
+                            "table_texts": list(lin.model.table_texts)})
+    return lin
+
+
+def load_static_recipe(ref: str, values: Mapping[str, object], *, derive: Callable[[], StaticRecipe]) -> StaticRecipe:
+    """The static problem of the model ``ref`` with ``values`` (the start of a chart about the periodic orbits):
+    from the cache, else ``derive()`` and kept."""
+    path = model_file(ref) if isinstance(ref, str) else None
+    if path is None:
+        return derive()
+    file = summary_path(f"{path.stem}_static", system_key(path, values))
+    data = read_json(file)
+    if data is not None:
+        try:
+            return StaticRecipe.from_dict(data["static"])
+        except (KeyError, TypeError, ValueError, AttributeError):
+            pass
+    recipe = derive()
+    write_json(file, {"static": recipe.as_dict()})
+    return recipe

@@ -24,7 +24,11 @@ from .options import Integration
 from .periodic.branches import continue_orbits as _continue_orbits
 from .periodic.orbit import periodic_orbit as _periodic_orbit
 from .physical.answers import PhysicalScaling
+from .physical.stability import chart_in_units
 from .physical.sweeps import axes_with_units, nondimensional_axes
+from .stability.chart import static_chart
+from .stability.linearised import compile_linearisation
+from .stability.verb import stability_chart as _stability_chart
 from .sweep.basin_continuation import continue_basins as _continue_basins
 from .sweep.run import run_sweep as _run_sweep
 from .system import FirstOrderSystem
@@ -103,7 +107,28 @@ periodic_orbit = high_level(_periodic_orbit)
 continue_orbits = high_level(_continue_orbits)
 simulate_measurements = high_level(_simulate_measurements)
 simulated_order_spectrum = high_level(_simulated_order_spectrum)
+stability_chart = high_level(_stability_chart)
+
+
+@stability_chart.register
+def _system_chart(model: FirstOrderSystem, grid, *, about: str = "static", options: Integration | None = None,
+                  verbose: bool = False, **kwargs):
+    """About the static state only the linearisation is compiled (the model's own loops are not needed)."""
+    if about == "static":
+        return static_chart(compile_linearisation(model, options, verbose=verbose), grid, verbose=verbose, **kwargs)
+    return _stability_chart(compile_model(model, options or Integration()), grid, about=about, verbose=verbose,
+                            **kwargs)
+
+
+@stability_chart.register
+def _physical_chart(model: PhysicalScaling, grid, *, options: Integration | None = None, **kwargs):
+    """A chart of a model with physical values (``gearsym.scaling(...)``): axes with units (``{"speed":
+    ["1000 rpm", ...]}``) become the nondimensional parameters they move; the chart comes back along them."""
+    given = axes_with_units(grid)
+    engine_axes = nondimensional_axes(model, given, "stability_chart")
+    chart = _system_chart(model.system(), engine_axes, options=options, **kwargs)
+    return chart_in_units(chart, tuple(given), tuple(engine_axes))
 
 __all__ = ["basin_map", "continue_basins", "continue_orbits", "find_attractors", "high_level", "lyapunov_spectrum",
            "periodic_orbit", "phase_trajectory", "poincare_samples", "run_sweep", "simulate_measurements",
-           "simulated_order_spectrum"]
+           "simulated_order_spectrum", "stability_chart"]

@@ -27,7 +27,7 @@ LAYERS = [
     {"scales"},
     {"codegen", "derivation"},
     {"analysis", "data"},
-    {"sweep", "periodic"},
+    {"sweep", "periodic", "stability"},
     {"figures"},
     {"fit", "physical"},
     {"verbs", "loading", "cached", "fmu"},

@@ -39,7 +39,8 @@ def run(capsys, *argv: str) -> tuple[int, str, str]:
 
 
 def test_subcommands_are_registered():
-    assert [m.NAME for m in COMMANDS] == ["list", "derive", "docs", "compile", "lyap", "sweep", "orbits", "poincare",
+    assert [m.NAME for m in COMMANDS] == ["list", "derive", "docs", "compile", "lyap", "sweep", "orbits", "stability",
+                                          "poincare",
                                           "basins", "reproduce", "simulate", "explain", "spectrum", "modes", "campbell",
                                           "fmu", "stiffness"]
 

@@ -94,7 +94,7 @@ def test_a_quick_reproduction_writes_every_output_and_reuses_its_data(tmp_path):
     record = reproduce(tmp_path / "figures", tmp_path / "reproduction.md", quick=True, progress=False)
     for name in ("fig3.png", "fig3-orbits.png", "fig4.png", "fig6.png", "fig7.png", "hysteresis.png", "study.png",
                  "basins.png", "basin-fractions.png", "basins-defaults.png", "basin-fractions-defaults.png",
-                 "claims.json"):
+                 "stability.png", "claims.json"):
         assert (tmp_path / "figures" / name).stat().st_size > 1000, name
     page = (tmp_path / "reproduction.md").read_text()
     for scenario in record["scenarios"]:

@@ -30,7 +30,7 @@ from ..errors import GearsymError, GearsymWarning
 #: each subcommand's module (its ``NAME`` -> the module in this package), in the order ``gearsym --help`` lists
 #: them; a run imports the module of its own command only (the others' imports would cost it start-up time)
 MODULES = {"list": "list_models", "derive": "derive", "docs": "docs", "compile": "compile", "lyap": "lyap",
-           "sweep": "sweep", "orbits": "orbits", "poincare": "poincare", "basins": "basins", "reproduce": "reproduce",
+           "sweep": "sweep", "orbits": "orbits", "stability": "stability", "poincare": "poincare", "basins": "basins", "reproduce": "reproduce",
            "simulate": "simulate", "explain": "explain", "spectrum": "spectrum", "modes": "modes",
            "campbell": "campbell",
            "fmu": "fmu", "stiffness": "stiffness"}

@@ -68,7 +68,12 @@ class LaneLibrary:
         self.orbit.argtypes = [_ptr, _ptr, ctypes.c_longlong, _ptr, _ptr, _ptr, _ptr]
         self.lyapunov = library.gearsym_lanes_lyapunov
         self.lyapunov.argtypes = [_ptr, _ptr, ctypes.c_longlong, _ptr, _ptr, _ptr, _ptr, _ptr, _ptr]
-        for f in (self.orbit, self.lyapunov):
+        self.monodromies = library.gearsym_lanes_monodromies  # (pool, tix, p, count, periods, y, M, work)
+        self.monodromies.argtypes = [_ptr, _ptr, _ptr, ctypes.c_longlong, ctypes.c_longlong, _ptr, _ptr, _ptr]
+        self.states = library.gearsym_lanes_states  # (pool, tix, p, count, periods, columns, y, work)
+        self.states.argtypes = [_ptr, _ptr, _ptr, ctypes.c_longlong, ctypes.c_longlong, ctypes.c_longlong, _ptr,
+                                _ptr]
+        for f in (self.orbit, self.lyapunov, self.monodromies, self.states):
             f.restype = ctypes.c_int
 
 

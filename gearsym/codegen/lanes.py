@@ -91,17 +91,22 @@ def lanes_source(text: str, mf: ModelFunctions) -> str:
     out += [_inline(name, definitions[name].group("body"), mf.steps[name], s.n if name == "tangent_vector" else 1)
             for name in mf.steps]
     out += [_split(mf, kind) for kind in ("tangent", "state") if s.located]
-    out += [_lane_piece(name, definitions[name].group("body"), mf, s) for name in LANE_PIECES if name in mf.steps]
+    out += [_lane_piece(name, definitions[name].group("body"), mf.steps[name], s) for name in LANE_PIECES
+            if name in mf.steps]
+    out.append(_lane_piece("constants", definitions["constants"].group("body"), mf.functions["constants"], s,
+                           constants=False))
     out += _lane_steps(s)
     out += _entries(s)
+    out += [_points(s, len(mf.system.parameters), tangent) for tangent in (True, False)]
     return "\n".join(out) + "\n#ifdef __cplusplus\n} /* extern \"C\" */\n#endif\n"
 
 
-def _lane_piece(name: str, body: str, mf: ModelFunctions, s: _Shape) -> str:
-    """``gsl_<name>``: the SX piece's C body in a loop over the lanes; every input and output (the table of time
-    and the constants too) one value per lane, ``GS_L`` apart (a tangent vector's rows ``n*GS_L`` apart)."""
-    f = mf.steps[name]
-    if f.numel_in(f.n_in() - 1) != s.nc:
+def _lane_piece(name: str, body: str, f, s: _Shape, constants: bool = True) -> str:
+    """``gsl_<name>``: the SX function ``f``'s C body in a loop over the lanes; every input and output (the table
+    of time and the constants too) one value per lane, ``GS_L`` apart (a tangent vector's rows ``n*GS_L`` apart).
+    ``constants``: a step piece, whose last input is the constants (``False``: the constants function itself,
+    parameters in, constants out, which the chart of many parameter points evaluates per lane)."""
+    if constants and f.numel_in(f.n_in() - 1) != s.nc:
         raise AssertionError(f"{name}: the last input is not the constants")
     stride = s.n if name == "tangent_vector" else 1
 
@@ -243,3 +248,67 @@ def _entries(s: _Shape) -> list[str]:
         "    }\n" + store + "  }\n  return 0;\n}\n",
     ]
 
+
+def _points(s: _Shape, parameters: int, tangent: bool) -> str:
+    """The entry points of many parameter points (:mod:`gearsym.stability`): each point's constants from its own
+    parameters, its tables from a pool of tables (points that share their tables share one), and ``periods``
+    periods of its state and (``tangent``) of the tangent map from the identity, without re-orthonormalisation:
+    the monodromy matrix, L points per pass through the period. Without the tangent (``gearsym_lanes_states``),
+    the state alone, and with ``columns`` = n the lanes take each point n times from the columns of the identity:
+    for a linear system, whose state is its own tangent, the columns of its monodromy matrix at the cost of one
+    vector each."""
+    n, size, P = s.n, s.rows * s.N, max(1, parameters)
+    observed = " ".join(f"lo[GS_L*{i} + l] = yl[GS_L*{j} + l]; hi[GS_L*{i} + l] = yl[GS_L*{j} + l];"
+                        for i, j in enumerate(s.observed))
+    if tangent:
+        name, args = "gearsym_lanes_monodromies", "casadi_real* restrict y, casadi_real* restrict M, "
+        what = ("the state after them is written over y + n*i, the tangent map to M + n*n*i (row r of column j at\n"
+                "   r*n + j: d y_r / d y0_j)")
+        lanes, start = "count", f"      for (i = 0; i < {n}; ++i) yl[GS_L*i + l] = y[{n}*g + i];\n" \
+            f"      for (i = 0; i < {n * n}; ++i) Ql[GS_L*i + l] = i % {n + 1} == 0;\n"
+        point, span = "g", f"gsl_tangent_span(yl, Ql, lo, hi, work, cl, {s.blocks})"
+        store = (f"      for (i = 0; i < {n}; ++i) y[{n}*(b + l) + i] = yl[GS_L*i + l];\n"
+                 f"      for (i = 0; i < {n * n}; ++i) M[{n * n}*(b + l) + i] = Ql[GS_L*i + l];\n")
+    else:
+        name, args = "gearsym_lanes_states", "long long columns, casadi_real* restrict y, "
+        what = ("with columns = 0 it starts at y + n*i and its state after them is written there; with columns = c,\n"
+                "   lane g runs point g / c from the column g % c of the identity and writes its state to y + n*g")
+        lanes = "(columns ? count * columns : count)"
+        start = (f"      for (i = 0; i < {n}; ++i) yl[GS_L*i + l] = columns ? (i == g % columns) : y[{n}*g + i];\n")
+        point, span = "(columns ? g / columns : g)", f"gsl_state_span(yl, lo, hi, work, cl, {s.blocks})"
+        store = f"      for (i = 0; i < {n}; ++i) y[{n}*(b + l) + i] = yl[GS_L*i + l];\n"
+    return (
+        f"/* `periods` periods of `count` parameter points{', state and tangent' if tangent else ', the state alone'}, "
+        "GS_L lanes at a time: point i has the parameters\n"
+        f"   p + {parameters}*i, its tables at pool + {size}*tix[i] (rows x steps of one period, column-major, as the\n"
+        "   scalar loops read them: points whose tables are the same share one), its constants computed here from\n"
+        f"   its parameters; {what}. work: room for GS_L tables. */\n"
+        f"CASADI_SYMBOL_EXPORT GS_TARGETS int {name}(const casadi_real* restrict pool, "
+        "const long long* restrict tix, const casadi_real* restrict p, long long count, long long periods, "
+        f"{args}casadi_real* restrict work) {{\n"
+        f"  casadi_real pl[{P}*GS_L], cl[{s.nc}*GS_L], per[GS_L], yl[{s.size('y')}*GS_L], "
+        + (f"Ql[{s.size('Q')}*GS_L], " if tangent else "")
+        + f"lo[{s.size('o')}*GS_L], hi[{s.size('o')}*GS_L];\n"
+        f"  long long last[GS_L], b, k, g, q, total = {lanes}; casadi_int l, i;\n"
+        "  for (l = 0; l < GS_L; ++l) last[l] = -1;\n"
+        "  for (b = 0; b < total; b += GS_L) {\n"
+        "    for (l = 0; l < GS_L; ++l) {  /* (lanes past the end repeat the last one: finite numbers) */\n"
+        f"      g = b + l < total ? b + l : total - 1;\n      q = {point};\n"
+        f"      for (i = 0; i < {parameters}; ++i) pl[GS_L*i + l] = p[{parameters}*q + i];\n"
+        + start
+        + "      if (tix[q] != last[l]) {  /* a table of another point: copied into this lane */\n"
+        f"        const casadi_real* t = pool + {size}*tix[q];\n"
+        f"        for (i = 0; i < {size}; ++i) work[GS_L*i + l] = t[i];\n"
+        "        last[l] = tix[q];\n"
+        "      }\n"
+        "    }\n"
+        "    gsl_constants(pl, cl, per);\n"
+        "    for (k = 0; k < periods; ++k) {\n"
+        + (f"      for (l = 0; l < GS_L; ++l) {{ {observed} }}\n" if observed else "")
+        + f"      {span};\n"
+        "    }\n"
+        "    for (l = 0; l < GS_L && b + l < total; ++l) {\n"
+        + store
+        + "    }\n"
+        "  }\n"
+        "  return 0;\n}\n")

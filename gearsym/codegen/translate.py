@@ -28,7 +28,9 @@ def _backlash(x, eta):
 
 
 def _backlash_slope(x, eta):
-    return ca.if_else(x >= 0, 1, 0) + ca.if_else(x <= -eta, 1, 0)
+    # nested, not a sum: with eta = 0 both sides hold at x = 0, where the slope is 1, not 2 (a linearisation at a
+    # static deflection of 0, Mathieu's case, sits exactly there)
+    return ca.if_else(x >= 0, 1, ca.if_else(x <= -eta, 1, 0))
 
 
 def _backlash_potential(x, eta):

@@ -47,12 +47,12 @@ def color(number: int) -> str:
     return COLORS[(number - 1) % len(COLORS)]
 
 
-def _label(name: str, unit: str) -> str:
+def axis_label(name: str, unit: str) -> str:
     symbol = SYMBOLS.get(name, name)
     return f"{symbol} [{unit}]" if unit else symbol
 
 
-def _edges(v: np.ndarray) -> np.ndarray:
+def cell_edges(v: np.ndarray) -> np.ndarray:
     if v.size == 1:
         return np.array([v[0] - 0.5, v[0] + 0.5])
     mid = (v[1:] + v[:-1]) / 2
@@ -110,7 +110,7 @@ def plot_basin_map(result, path: str | Path | None = None, shown: Shown | None =
     index = np.searchsorted(classes, result.labels)  # (classes are sorted: -1, 0, 1, 2, ...)
     own = ax is None
     fig, ax = (plt.subplots(figsize=(10.5, 6.2), constrained_layout=True) if own else (ax.figure, ax))
-    ax.pcolormesh(_edges(sx), _edges(sy), index, cmap=cmap, vmin=-0.5, vmax=len(classes) - 0.5, shading="flat",
+    ax.pcolormesh(cell_edges(sx), cell_edges(sy), index, cmap=cmap, vmin=-0.5, vmax=len(classes) - 0.5, shading="flat",
                   rasterized=True)
     ix, iy = result.state_names.index(x), result.state_names.index(y)
     handles = []
@@ -130,8 +130,8 @@ def plot_basin_map(result, path: str | Path | None = None, shown: Shown | None =
                                  label=f"{label}: {100 * share.fraction:.1f} ± {100 * share.stderr:.1f} % of starts"))
         else:
             empty.append(label)
-    ax.set_xlabel(_label(x, ux))
-    ax.set_ylabel(_label(y, uy))
+    ax.set_xlabel(axis_label(x, ux))
+    ax.set_ylabel(axis_label(y, uy))
     ax.margins(0.02)
     title = "attractor: what it is, its basin (the markers: its Poincaré points)" + (
         "\nno start " + " or ".join(empty) if empty else "")
@@ -203,7 +203,7 @@ def plot_basin_fractions(result, path: str | Path | None = None, shown: Shown | 
     bottom.legend(handles=[Line2D([], [], marker=m, ls="none", color="0.3", label=k) for k, m in REGIME_MARKERS.items()
                            if k in regimes],
                   fontsize=7, ncol=4, loc="best", title="regime (from the exponents)", title_fontsize=7)
-    bottom.set_xlabel(_label(name, unit))
+    bottom.set_xlabel(axis_label(name, unit))
     record = result.record
     fixed = {k: v for k, v in record.get("settings", {}).items()}
     grid = record.get("grid")

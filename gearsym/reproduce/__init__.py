@@ -12,12 +12,15 @@ import time
 from pathlib import Path
 
 from ..checks import json_safe
+from ..loading import load
+from ..stability.linearised import compile_linearisation
 from .basins import basins_record
 from .claims import evaluate
 from .compute import Computed, compute
 from .figures import draw_all
 from .plan import NOT_IN_PAPER, SCENARIOS, Plan, Scenario, paper_plan
 from .report import render, write
+from .stability import MODEL as STABILITY_MODEL, stability_record
 
 __all__ = ["SCENARIOS", "Computed", "Plan", "Scenario", "compute", "evaluate", "paper_plan", "record_of", "render",
            "reproduce"]
@@ -63,6 +66,7 @@ def reproduce(out: str | Path = "docs/figures", doc: str | Path | None = None, *
         computed.append(compute(plan, data / scenario.name, jobs=jobs, progress=progress))
         draw_all(computed[-1], out, "" if i == 0 else f"-{scenario.name}")
     record = record_of(computed)
+    record["stability"] = stability_record(compile_linearisation(load(STABILITY_MODEL)), out, quick)
     write(record, out / "claims.json", Path(doc) if doc else out.parent / "reproduction.md")
     if progress:
         for s in record["scenarios"]:

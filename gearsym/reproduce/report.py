@@ -14,6 +14,7 @@ from pathlib import Path
 
 from ..files.atomic import write_atomically
 from .claims import MIN_CHAOTIC
+from .stability import report_lines as stability_lines
 
 #: Why a claim comes out as it does, where the numbers alone do not say it. Written by a person
 #: after reading the figures; keyed by claim id. No numbers here: those come from the record.
@@ -141,6 +142,7 @@ def render(record: dict, figures_dir: str = "figures") -> str:
             lines += [f"![Fig. 4 as basins of attraction]({figures_dir}/basins-{s['name']}.png)", "",
                       f"![The jumps of Fig. 3a as basin fractions]({figures_dir}/basin-fractions-{s['name']}.png)", ""]
             lines += _basin_tables(s["basins"])
+    lines += stability_lines(record, figures_dir)
     lines += _study(main, figures_dir)
     lines += _method(record)
     return "\n".join(lines).rstrip() + "\n"

@@ -2161,6 +2161,31 @@ static GEARSYM_INLINE void gsl_state_keep(const casadi_real* restrict A0, const 
   }
 }
 
+/* constants on every lane, from CasADi's C of it */
+static GEARSYM_INLINE void gsl_constants(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
+  casadi_int l;
+  GS_LANES {
+    casadi_real a0, a1, a2, a3;
+    a0=A0[GS_L*7 + l];
+    R0[GS_L*0 + l]=a0;
+    a0=A0[GS_L*0 + l];
+    a1=casadi_sq(a0);
+    a1=(1./a1);
+    a2=(-a1);
+    R0[GS_L*1 + l]=a2;
+    a2=-2.;
+    a3=A0[GS_L*1 + l];
+    a2=(a2*a3);
+    a2=(a2/a0);
+    R0[GS_L*2 + l]=a2;
+    R0[GS_L*3 + l]=a1;
+    a1=3.1415926535897934e-02;
+    R0[GS_L*4 + l]=a1;
+    a1=6.2831853071795862e+00;
+    R1[GS_L*0 + l]=a1;
+  }
+}
+
 /* one block of tangent steps of every lane */
 static GEARSYM_INLINE void gsl_tangent_step(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real yt[2*GS_L], flag[GS_L], J[5*GS_L]; casadi_int j, l, i; int any, finite;
@@ -2276,6 +2301,74 @@ CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_lyapunov(const casadi_real* re
     if (strobe) gs_copy(y, 2*GS_L, strobe + 2*GS_L*p);
     if (low) gs_copy(lo, 1*GS_L, low + 1*GS_L*p);
     if (high) gs_copy(hi, 1*GS_L, high + 1*GS_L*p);
+  }
+  return 0;
+}
+
+/* `periods` periods of `count` parameter points, state and tangent, GS_L lanes at a time: point i has the parameters
+   p + 9*i, its tables at pool + 1200*tix[i] (rows x steps of one period, column-major, as the
+   scalar loops read them: points whose tables are the same share one), its constants computed here from
+   its parameters; the state after them is written over y + n*i, the tangent map to M + n*n*i (row r of column j at
+   r*n + j: d y_r / d y0_j). work: room for GS_L tables. */
+CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_monodromies(const casadi_real* restrict pool, const long long* restrict tix, const casadi_real* restrict p, long long count, long long periods, casadi_real* restrict y, casadi_real* restrict M, casadi_real* restrict work) {
+  casadi_real pl[9*GS_L], cl[5*GS_L], per[GS_L], yl[2*GS_L], Ql[4*GS_L], lo[1*GS_L], hi[1*GS_L];
+  long long last[GS_L], b, k, g, q, total = count; casadi_int l, i;
+  for (l = 0; l < GS_L; ++l) last[l] = -1;
+  for (b = 0; b < total; b += GS_L) {
+    for (l = 0; l < GS_L; ++l) {  /* (lanes past the end repeat the last one: finite numbers) */
+      g = b + l < total ? b + l : total - 1;
+      q = g;
+      for (i = 0; i < 9; ++i) pl[GS_L*i + l] = p[9*q + i];
+      for (i = 0; i < 2; ++i) yl[GS_L*i + l] = y[2*g + i];
+      for (i = 0; i < 4; ++i) Ql[GS_L*i + l] = i % 3 == 0;
+      if (tix[q] != last[l]) {  /* a table of another point: copied into this lane */
+        const casadi_real* t = pool + 1200*tix[q];
+        for (i = 0; i < 1200; ++i) work[GS_L*i + l] = t[i];
+        last[l] = tix[q];
+      }
+    }
+    gsl_constants(pl, cl, per);
+    for (k = 0; k < periods; ++k) {
+      for (l = 0; l < GS_L; ++l) { lo[GS_L*0 + l] = yl[GS_L*0 + l]; hi[GS_L*0 + l] = yl[GS_L*0 + l]; }
+      gsl_tangent_span(yl, Ql, lo, hi, work, cl, 200);
+    }
+    for (l = 0; l < GS_L && b + l < total; ++l) {
+      for (i = 0; i < 2; ++i) y[2*(b + l) + i] = yl[GS_L*i + l];
+      for (i = 0; i < 4; ++i) M[4*(b + l) + i] = Ql[GS_L*i + l];
+    }
+  }
+  return 0;
+}
+
+/* `periods` periods of `count` parameter points, the state alone, GS_L lanes at a time: point i has the parameters
+   p + 9*i, its tables at pool + 1200*tix[i] (rows x steps of one period, column-major, as the
+   scalar loops read them: points whose tables are the same share one), its constants computed here from
+   its parameters; with columns = 0 it starts at y + n*i and its state after them is written there; with columns = c,
+   lane g runs point g / c from the column g % c of the identity and writes its state to y + n*g. work: room for GS_L tables. */
+CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_states(const casadi_real* restrict pool, const long long* restrict tix, const casadi_real* restrict p, long long count, long long periods, long long columns, casadi_real* restrict y, casadi_real* restrict work) {
+  casadi_real pl[9*GS_L], cl[5*GS_L], per[GS_L], yl[2*GS_L], lo[1*GS_L], hi[1*GS_L];
+  long long last[GS_L], b, k, g, q, total = (columns ? count * columns : count); casadi_int l, i;
+  for (l = 0; l < GS_L; ++l) last[l] = -1;
+  for (b = 0; b < total; b += GS_L) {
+    for (l = 0; l < GS_L; ++l) {  /* (lanes past the end repeat the last one: finite numbers) */
+      g = b + l < total ? b + l : total - 1;
+      q = (columns ? g / columns : g);
+      for (i = 0; i < 9; ++i) pl[GS_L*i + l] = p[9*q + i];
+      for (i = 0; i < 2; ++i) yl[GS_L*i + l] = columns ? (i == g % columns) : y[2*g + i];
+      if (tix[q] != last[l]) {  /* a table of another point: copied into this lane */
+        const casadi_real* t = pool + 1200*tix[q];
+        for (i = 0; i < 1200; ++i) work[GS_L*i + l] = t[i];
+        last[l] = tix[q];
+      }
+    }
+    gsl_constants(pl, cl, per);
+    for (k = 0; k < periods; ++k) {
+      for (l = 0; l < GS_L; ++l) { lo[GS_L*0 + l] = yl[GS_L*0 + l]; hi[GS_L*0 + l] = yl[GS_L*0 + l]; }
+      gsl_state_span(yl, lo, hi, work, cl, 200);
+    }
+    for (l = 0; l < GS_L && b + l < total; ++l) {
+      for (i = 0; i < 2; ++i) y[2*(b + l) + i] = yl[GS_L*i + l];
+    }
   }
   return 0;
 }

@@ -12507,6 +12507,145 @@ static GEARSYM_INLINE void gsl_state_keep(const casadi_real* restrict A0, const 
   }
 }
 
+/* constants on every lane, from CasADi's C of it */
+static GEARSYM_INLINE void gsl_constants(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
+  casadi_int l;
+  GS_LANES {
+    casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+    casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20;
+    a00=A0[GS_L*11 + l];
+    R0[GS_L*0 + l]=a00;
+    a00=A0[GS_L*0 + l];
+    a01=casadi_sq(a00);
+    a02=(1./a01);
+    a03=(-a02);
+    R0[GS_L*1 + l]=a03;
+    a03=-2.;
+    a04=A0[GS_L*1 + l];
+    a04=(a03*a04);
+    a04=(a04/a00);
+    R0[GS_L*2 + l]=a04;
+    a05=A0[GS_L*13 + l];
+    a06=casadi_sq(a05);
+    a07=A0[GS_L*7 + l];
+    a08=(a06/a07);
+    a09=A0[GS_L*15 + l];
+    a10=casadi_sq(a09);
+    a11=(a10/a07);
+    a11=(a08+a11);
+    a12=A0[GS_L*9 + l];
+    a10=(a10/a12);
+    a12=(a11+a10);
+    a13=(2.*a05);
+    a13=(a13*a09);
+    a13=(a13/a07);
+    a12=(a12+a13);
+    a14=(a12/a01);
+    a15=A0[GS_L*8 + l];
+    a06=(a06/a15);
+    a11=(a11+a06);
+    a11=(a11+a10);
+    a11=(a11+a13);
+    a14=(a14/a11);
+    a14=(-a14);
+    R0[GS_L*3 + l]=a14;
+    a14=-4.;
+    a13=A0[GS_L*3 + l];
+    a14=(a14*a13);
+    a14=(a14/a00);
+    a10=A0[GS_L*14 + l];
+    a15=(a05*a10);
+    a15=(a15/a07);
+    a16=(a15-a08);
+    a17=(a10*a09);
+    a17=(a17/a07);
+    a16=(a16+a17);
+    a09=(a05*a09);
+    a09=(a09/a07);
+    a16=(a16-a09);
+    a18=(a14*a16);
+    a19=casadi_sq(a10);
+    a19=(a19/a07);
+    a19=(a08+a19);
+    a20=(a19+a06);
+    a05=(a03*a05);
+    a05=(a05*a10);
+    a05=(a05/a07);
+    a20=(a20+a05);
+    a18=(a18/a20);
+    R0[GS_L*4 + l]=a18;
+    a03=(a03*a13);
+    a03=(a03/a00);
+    a08=(a08+a06);
+    a15=(a15-a08);
+    a15=(a15+a17);
+    a15=(a15-a09);
+    a09=(a03*a15);
+    a09=(a09/a20);
+    R0[GS_L*5 + l]=a09;
+    a12=(a04*a12);
+    a12=(a12/a11);
+    R0[GS_L*6 + l]=a12;
+    a13=(2.*a13);
+    a13=(a13/a00);
+    a00=(a13*a16);
+    a00=(a00/a20);
+    R0[GS_L*7 + l]=a00;
+    a00=A0[GS_L*2 + l];
+    a00=(a00/a01);
+    a12=(a00*a15);
+    a12=(a12/a20);
+    a12=(-a12);
+    R0[GS_L*8 + l]=a12;
+    a12=(a00*a16);
+    a12=(a12/a20);
+    a12=(-a12);
+    R0[GS_L*9 + l]=a12;
+    R0[GS_L*10 + l]=a02;
+    a02=(a03*a16);
+    a02=(a02/a20);
+    R0[GS_L*11 + l]=a02;
+    a02=(a13*a15);
+    a02=(a02/a20);
+    R0[GS_L*12 + l]=a02;
+    R0[GS_L*13 + l]=a03;
+    a03=(-a00);
+    R0[GS_L*14 + l]=a03;
+    a03=(a15/a01);
+    a03=(a03/a11);
+    a03=(-a03);
+    R0[GS_L*15 + l]=a03;
+    a03=(a16/a01);
+    a03=(a03/a11);
+    a03=(-a03);
+    R0[GS_L*16 + l]=a03;
+    a19=(a19+a05);
+    a14=(a14*a19);
+    a14=(a14/a20);
+    R0[GS_L*17 + l]=a14;
+    a15=(a04*a15);
+    a15=(a15/a11);
+    R0[GS_L*18 + l]=a15;
+    a04=(a04*a16);
+    a04=(a04/a11);
+    R0[GS_L*19 + l]=a04;
+    a13=(a13*a19);
+    a13=(a13/a20);
+    R0[GS_L*20 + l]=a13;
+    a00=(a00*a19);
+    a00=(a00/a20);
+    a00=(-a00);
+    R0[GS_L*21 + l]=a00;
+    a00=A0[GS_L*6 + l];
+    a00=(a00/a01);
+    R0[GS_L*22 + l]=a00;
+    a00=3.1415926535897934e-02;
+    R0[GS_L*23 + l]=a00;
+    a00=6.2831853071795862e+00;
+    R1[GS_L*0 + l]=a00;
+  }
+}
+
 /* one block of tangent steps of every lane */
 static GEARSYM_INLINE void gsl_tangent_step(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real yt[8*GS_L], flag[GS_L], J[80*GS_L]; casadi_int j, l, i; int any, finite;
@@ -12622,6 +12761,74 @@ CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_lyapunov(const casadi_real* re
     if (strobe) gs_copy(y, 8*GS_L, strobe + 8*GS_L*p);
     if (low) gs_copy(lo, 4*GS_L, low + 4*GS_L*p);
     if (high) gs_copy(hi, 4*GS_L, high + 4*GS_L*p);
+  }
+  return 0;
+}
+
+/* `periods` periods of `count` parameter points, state and tangent, GS_L lanes at a time: point i has the parameters
+   p + 16*i, its tables at pool + 2400*tix[i] (rows x steps of one period, column-major, as the
+   scalar loops read them: points whose tables are the same share one), its constants computed here from
+   its parameters; the state after them is written over y + n*i, the tangent map to M + n*n*i (row r of column j at
+   r*n + j: d y_r / d y0_j). work: room for GS_L tables. */
+CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_monodromies(const casadi_real* restrict pool, const long long* restrict tix, const casadi_real* restrict p, long long count, long long periods, casadi_real* restrict y, casadi_real* restrict M, casadi_real* restrict work) {
+  casadi_real pl[16*GS_L], cl[24*GS_L], per[GS_L], yl[8*GS_L], Ql[64*GS_L], lo[4*GS_L], hi[4*GS_L];
+  long long last[GS_L], b, k, g, q, total = count; casadi_int l, i;
+  for (l = 0; l < GS_L; ++l) last[l] = -1;
+  for (b = 0; b < total; b += GS_L) {
+    for (l = 0; l < GS_L; ++l) {  /* (lanes past the end repeat the last one: finite numbers) */
+      g = b + l < total ? b + l : total - 1;
+      q = g;
+      for (i = 0; i < 16; ++i) pl[GS_L*i + l] = p[16*q + i];
+      for (i = 0; i < 8; ++i) yl[GS_L*i + l] = y[8*g + i];
+      for (i = 0; i < 64; ++i) Ql[GS_L*i + l] = i % 9 == 0;
+      if (tix[q] != last[l]) {  /* a table of another point: copied into this lane */
+        const casadi_real* t = pool + 2400*tix[q];
+        for (i = 0; i < 2400; ++i) work[GS_L*i + l] = t[i];
+        last[l] = tix[q];
+      }
+    }
+    gsl_constants(pl, cl, per);
+    for (k = 0; k < periods; ++k) {
+      for (l = 0; l < GS_L; ++l) { lo[GS_L*0 + l] = yl[GS_L*0 + l]; hi[GS_L*0 + l] = yl[GS_L*0 + l]; lo[GS_L*1 + l] = yl[GS_L*2 + l]; hi[GS_L*1 + l] = yl[GS_L*2 + l]; lo[GS_L*2 + l] = yl[GS_L*4 + l]; hi[GS_L*2 + l] = yl[GS_L*4 + l]; lo[GS_L*3 + l] = yl[GS_L*6 + l]; hi[GS_L*3 + l] = yl[GS_L*6 + l]; }
+      gsl_tangent_span(yl, Ql, lo, hi, work, cl, 200);
+    }
+    for (l = 0; l < GS_L && b + l < total; ++l) {
+      for (i = 0; i < 8; ++i) y[8*(b + l) + i] = yl[GS_L*i + l];
+      for (i = 0; i < 64; ++i) M[64*(b + l) + i] = Ql[GS_L*i + l];
+    }
+  }
+  return 0;
+}
+
+/* `periods` periods of `count` parameter points, the state alone, GS_L lanes at a time: point i has the parameters
+   p + 16*i, its tables at pool + 2400*tix[i] (rows x steps of one period, column-major, as the
+   scalar loops read them: points whose tables are the same share one), its constants computed here from
+   its parameters; with columns = 0 it starts at y + n*i and its state after them is written there; with columns = c,
+   lane g runs point g / c from the column g % c of the identity and writes its state to y + n*g. work: room for GS_L tables. */
+CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_states(const casadi_real* restrict pool, const long long* restrict tix, const casadi_real* restrict p, long long count, long long periods, long long columns, casadi_real* restrict y, casadi_real* restrict work) {
+  casadi_real pl[16*GS_L], cl[24*GS_L], per[GS_L], yl[8*GS_L], lo[4*GS_L], hi[4*GS_L];
+  long long last[GS_L], b, k, g, q, total = (columns ? count * columns : count); casadi_int l, i;
+  for (l = 0; l < GS_L; ++l) last[l] = -1;
+  for (b = 0; b < total; b += GS_L) {
+    for (l = 0; l < GS_L; ++l) {  /* (lanes past the end repeat the last one: finite numbers) */
+      g = b + l < total ? b + l : total - 1;
+      q = (columns ? g / columns : g);
+      for (i = 0; i < 16; ++i) pl[GS_L*i + l] = p[16*q + i];
+      for (i = 0; i < 8; ++i) yl[GS_L*i + l] = columns ? (i == g % columns) : y[8*g + i];
+      if (tix[q] != last[l]) {  /* a table of another point: copied into this lane */
+        const casadi_real* t = pool + 2400*tix[q];
+        for (i = 0; i < 2400; ++i) work[GS_L*i + l] = t[i];
+        last[l] = tix[q];
+      }
+    }
+    gsl_constants(pl, cl, per);
+    for (k = 0; k < periods; ++k) {
+      for (l = 0; l < GS_L; ++l) { lo[GS_L*0 + l] = yl[GS_L*0 + l]; hi[GS_L*0 + l] = yl[GS_L*0 + l]; lo[GS_L*1 + l] = yl[GS_L*2 + l]; hi[GS_L*1 + l] = yl[GS_L*2 + l]; lo[GS_L*2 + l] = yl[GS_L*4 + l]; hi[GS_L*2 + l] = yl[GS_L*4 + l]; lo[GS_L*3 + l] = yl[GS_L*6 + l]; hi[GS_L*3 + l] = yl[GS_L*6 + l]; }
+      gsl_state_span(yl, lo, hi, work, cl, 200);
+    }
+    for (l = 0; l < GS_L && b + l < total; ++l) {
+      for (i = 0; i < 8; ++i) y[8*(b + l) + i] = yl[GS_L*i + l];
+    }
   }
   return 0;
 }

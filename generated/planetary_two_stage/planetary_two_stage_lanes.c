@@ -21650,6 +21650,233 @@ static GEARSYM_INLINE void gsl_state_keep(const casadi_real* restrict A0, const 
   }
 }
 
+/* constants on every lane, from CasADi's C of it */
+static GEARSYM_INLINE void gsl_constants(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
+  casadi_int l;
+  GS_LANES {
+    casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+    casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+    casadi_real a24, a25, a26;
+    a00=A0[GS_L*15 + l];
+    R0[GS_L*0 + l]=a00;
+    a00=A0[GS_L*0 + l];
+    a01=casadi_sq(a00);
+    a02=(1./a01);
+    a03=(-a02);
+    R0[GS_L*1 + l]=a03;
+    a03=-2.;
+    a04=A0[GS_L*1 + l];
+    a04=(a03*a04);
+    a04=(a04/a00);
+    R0[GS_L*2 + l]=a04;
+    a05=A0[GS_L*17 + l];
+    a06=(a05/a01);
+    a07=A0[GS_L*21 + l];
+    a08=A0[GS_L*11 + l];
+    a09=(a07/a08);
+    a10=A0[GS_L*19 + l];
+    a09=(a09/a10);
+    a11=A0[GS_L*23 + l];
+    a12=(a11/a08);
+    a12=(a12/a10);
+    a12=(a09+a12);
+    a12=(a06*a12);
+    a12=(-a12);
+    R0[GS_L*3 + l]=a12;
+    a12=casadi_sq(a07);
+    a13=(a12/a08);
+    a14=casadi_sq(a11);
+    a15=(a14/a08);
+    a15=(a13+a15);
+    a16=A0[GS_L*13 + l];
+    a14=(a14/a16);
+    a16=(a15+a14);
+    a17=(2.*a07);
+    a17=(a17*a11);
+    a17=(a17/a08);
+    a16=(a16+a17);
+    a18=(a16/a01);
+    a19=A0[GS_L*12 + l];
+    a12=(a12/a19);
+    a15=(a15+a12);
+    a15=(a15+a14);
+    a15=(a15+a17);
+    a18=(a18/a15);
+    a18=(-a18);
+    R0[GS_L*4 + l]=a18;
+    a18=-4.;
+    a17=A0[GS_L*3 + l];
+    a18=(a18*a17);
+    a18=(a18/a00);
+    a14=A0[GS_L*22 + l];
+    a19=(a07*a14);
+    a19=(a19/a08);
+    a20=(a19-a13);
+    a21=(a14*a11);
+    a21=(a21/a08);
+    a20=(a20+a21);
+    a22=(a07*a11);
+    a22=(a22/a08);
+    a20=(a20-a22);
+    a23=(a18*a20);
+    a24=casadi_sq(a14);
+    a24=(a24/a08);
+    a24=(a13+a24);
+    a25=(a24+a12);
+    a26=(a03*a07);
+    a26=(a26*a14);
+    a26=(a26/a08);
+    a25=(a25+a26);
+    a23=(a23/a25);
+    R0[GS_L*5 + l]=a23;
+    a23=(a03*a17);
+    a23=(a23/a00);
+    a13=(a13+a12);
+    a19=(a19-a13);
+    a19=(a19+a21);
+    a19=(a19-a22);
+    a22=(a23*a19);
+    a22=(a22/a25);
+    R0[GS_L*6 + l]=a22;
+    a16=(a04*a16);
+    a16=(a16/a15);
+    R0[GS_L*7 + l]=a16;
+    a16=(2.*a17);
+    a16=(a16/a00);
+    a22=(a16*a20);
+    a22=(a22/a25);
+    R0[GS_L*8 + l]=a22;
+    a22=A0[GS_L*2 + l];
+    a22=(a22/a01);
+    a21=(a22*a19);
+    a21=(a21/a25);
+    a21=(-a21);
+    R0[GS_L*9 + l]=a21;
+    a21=(a22*a20);
+    a21=(a21/a25);
+    a21=(-a21);
+    R0[GS_L*10 + l]=a21;
+    R0[GS_L*11 + l]=a02;
+    a02=(a23*a20);
+    a02=(a02/a25);
+    R0[GS_L*12 + l]=a02;
+    a02=(a16*a19);
+    a02=(a02/a25);
+    R0[GS_L*13 + l]=a02;
+    R0[GS_L*14 + l]=a23;
+    a23=(-a22);
+    R0[GS_L*15 + l]=a23;
+    a23=(a14/a08);
+    a23=(a23/a10);
+    a23=(a23-a09);
+    a23=(a06*a23);
+    a23=(-a23);
+    R0[GS_L*16 + l]=a23;
+    a23=(a19/a01);
+    a23=(a23/a15);
+    a23=(-a23);
+    R0[GS_L*17 + l]=a23;
+    a23=(a20/a01);
+    a23=(a23/a15);
+    a23=(-a23);
+    R0[GS_L*18 + l]=a23;
+    a24=(a24+a26);
+    a26=(a18*a24);
+    a26=(a26/a25);
+    R0[GS_L*19 + l]=a26;
+    a19=(a04*a19);
+    a19=(a19/a15);
+    R0[GS_L*20 + l]=a19;
+    a20=(a04*a20);
+    a20=(a20/a15);
+    R0[GS_L*21 + l]=a20;
+    a20=(a16*a24);
+    a20=(a20/a25);
+    R0[GS_L*22 + l]=a20;
+    a24=(a22*a24);
+    a24=(a24/a25);
+    a24=(-a24);
+    R0[GS_L*23 + l]=a24;
+    a24=A0[GS_L*9 + l];
+    a20=(1./a24);
+    a19=(1./a08);
+    a20=(a20+a19);
+    a06=(a06*a20);
+    a06=(-a06);
+    R0[GS_L*24 + l]=a06;
+    a07=(a10*a07);
+    a07=(a07/a08);
+    a11=(a10*a11);
+    a11=(a11/a08);
+    a11=(a07+a11);
+    a06=(a11/a01);
+    a06=(a06/a15);
+    a06=(-a06);
+    R0[GS_L*25 + l]=a06;
+    a06=-6.;
+    a06=(a06*a17);
+    a06=(a06/a00);
+    a14=(a10*a14);
+    a14=(a14/a08);
+    a14=(a14-a07);
+    a06=(a06*a14);
+    a06=(a06/a25);
+    R0[GS_L*26 + l]=a06;
+    a18=(a18*a14);
+    a18=(a18/a25);
+    R0[GS_L*27 + l]=a18;
+    a04=(a04*a11);
+    a04=(a04/a15);
+    R0[GS_L*28 + l]=a04;
+    a16=(a16*a14);
+    a16=(a16/a25);
+    R0[GS_L*29 + l]=a16;
+    a22=(a22*a14);
+    a22=(a22/a25);
+    a22=(-a22);
+    R0[GS_L*30 + l]=a22;
+    a22=A0[GS_L*5 + l];
+    a03=(a03*a22);
+    a22=(a03/a24);
+    a10=casadi_sq(a10);
+    a22=(a22*a10);
+    a22=(a22/a00);
+    a25=(a10/a24);
+    a14=A0[GS_L*20 + l];
+    a14=casadi_sq(a14);
+    a16=A0[GS_L*10 + l];
+    a14=(a14/a16);
+    a25=(a25+a14);
+    a22=(a22/a25);
+    R0[GS_L*31 + l]=a22;
+    a22=A0[GS_L*16 + l];
+    R0[GS_L*32 + l]=a22;
+    a22=A0[GS_L*4 + l];
+    a14=(a22/a24);
+    a14=(a14*a10);
+    a14=(a14/a01);
+    a14=(a14/a25);
+    a14=(-a14);
+    R0[GS_L*33 + l]=a14;
+    a03=(a03/a00);
+    R0[GS_L*34 + l]=a03;
+    a22=(a22/a01);
+    a22=(-a22);
+    R0[GS_L*35 + l]=a22;
+    a05=(a05/a24);
+    a05=(a05/a01);
+    a05=(-a05);
+    R0[GS_L*36 + l]=a05;
+    a05=A0[GS_L*8 + l];
+    a05=(a05/a01);
+    R0[GS_L*37 + l]=a05;
+    a05=6.2831853071795868e-02;
+    R0[GS_L*38 + l]=a05;
+    a05=1.2566370614359172e+01;
+    R1[GS_L*0 + l]=a05;
+  }
+}
+
 /* one block of tangent steps of every lane */
 static GEARSYM_INLINE void gsl_tangent_step(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real yt[12*GS_L], flag[GS_L], J[114*GS_L]; casadi_int j, l, i; int any, finite;
@@ -21765,6 +21992,74 @@ CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_lyapunov(const casadi_real* re
     if (strobe) gs_copy(y, 12*GS_L, strobe + 12*GS_L*p);
     if (low) gs_copy(lo, 6*GS_L, low + 6*GS_L*p);
     if (high) gs_copy(hi, 6*GS_L, high + 6*GS_L*p);
+  }
+  return 0;
+}
+
+/* `periods` periods of `count` parameter points, state and tangent, GS_L lanes at a time: point i has the parameters
+   p + 24*i, its tables at pool + 3000*tix[i] (rows x steps of one period, column-major, as the
+   scalar loops read them: points whose tables are the same share one), its constants computed here from
+   its parameters; the state after them is written over y + n*i, the tangent map to M + n*n*i (row r of column j at
+   r*n + j: d y_r / d y0_j). work: room for GS_L tables. */
+CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_monodromies(const casadi_real* restrict pool, const long long* restrict tix, const casadi_real* restrict p, long long count, long long periods, casadi_real* restrict y, casadi_real* restrict M, casadi_real* restrict work) {
+  casadi_real pl[24*GS_L], cl[39*GS_L], per[GS_L], yl[12*GS_L], Ql[144*GS_L], lo[6*GS_L], hi[6*GS_L];
+  long long last[GS_L], b, k, g, q, total = count; casadi_int l, i;
+  for (l = 0; l < GS_L; ++l) last[l] = -1;
+  for (b = 0; b < total; b += GS_L) {
+    for (l = 0; l < GS_L; ++l) {  /* (lanes past the end repeat the last one: finite numbers) */
+      g = b + l < total ? b + l : total - 1;
+      q = g;
+      for (i = 0; i < 24; ++i) pl[GS_L*i + l] = p[24*q + i];
+      for (i = 0; i < 12; ++i) yl[GS_L*i + l] = y[12*g + i];
+      for (i = 0; i < 144; ++i) Ql[GS_L*i + l] = i % 13 == 0;
+      if (tix[q] != last[l]) {  /* a table of another point: copied into this lane */
+        const casadi_real* t = pool + 3000*tix[q];
+        for (i = 0; i < 3000; ++i) work[GS_L*i + l] = t[i];
+        last[l] = tix[q];
+      }
+    }
+    gsl_constants(pl, cl, per);
+    for (k = 0; k < periods; ++k) {
+      for (l = 0; l < GS_L; ++l) { lo[GS_L*0 + l] = yl[GS_L*0 + l]; hi[GS_L*0 + l] = yl[GS_L*0 + l]; lo[GS_L*1 + l] = yl[GS_L*2 + l]; hi[GS_L*1 + l] = yl[GS_L*2 + l]; lo[GS_L*2 + l] = yl[GS_L*4 + l]; hi[GS_L*2 + l] = yl[GS_L*4 + l]; lo[GS_L*3 + l] = yl[GS_L*6 + l]; hi[GS_L*3 + l] = yl[GS_L*6 + l]; lo[GS_L*4 + l] = yl[GS_L*8 + l]; hi[GS_L*4 + l] = yl[GS_L*8 + l]; lo[GS_L*5 + l] = yl[GS_L*10 + l]; hi[GS_L*5 + l] = yl[GS_L*10 + l]; }
+      gsl_tangent_span(yl, Ql, lo, hi, work, cl, 200);
+    }
+    for (l = 0; l < GS_L && b + l < total; ++l) {
+      for (i = 0; i < 12; ++i) y[12*(b + l) + i] = yl[GS_L*i + l];
+      for (i = 0; i < 144; ++i) M[144*(b + l) + i] = Ql[GS_L*i + l];
+    }
+  }
+  return 0;
+}
+
+/* `periods` periods of `count` parameter points, the state alone, GS_L lanes at a time: point i has the parameters
+   p + 24*i, its tables at pool + 3000*tix[i] (rows x steps of one period, column-major, as the
+   scalar loops read them: points whose tables are the same share one), its constants computed here from
+   its parameters; with columns = 0 it starts at y + n*i and its state after them is written there; with columns = c,
+   lane g runs point g / c from the column g % c of the identity and writes its state to y + n*g. work: room for GS_L tables. */
+CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_states(const casadi_real* restrict pool, const long long* restrict tix, const casadi_real* restrict p, long long count, long long periods, long long columns, casadi_real* restrict y, casadi_real* restrict work) {
+  casadi_real pl[24*GS_L], cl[39*GS_L], per[GS_L], yl[12*GS_L], lo[6*GS_L], hi[6*GS_L];
+  long long last[GS_L], b, k, g, q, total = (columns ? count * columns : count); casadi_int l, i;
+  for (l = 0; l < GS_L; ++l) last[l] = -1;
+  for (b = 0; b < total; b += GS_L) {
+    for (l = 0; l < GS_L; ++l) {  /* (lanes past the end repeat the last one: finite numbers) */
+      g = b + l < total ? b + l : total - 1;
+      q = (columns ? g / columns : g);
+      for (i = 0; i < 24; ++i) pl[GS_L*i + l] = p[24*q + i];
+      for (i = 0; i < 12; ++i) yl[GS_L*i + l] = columns ? (i == g % columns) : y[12*g + i];
+      if (tix[q] != last[l]) {  /* a table of another point: copied into this lane */
+        const casadi_real* t = pool + 3000*tix[q];
+        for (i = 0; i < 3000; ++i) work[GS_L*i + l] = t[i];
+        last[l] = tix[q];
+      }
+    }
+    gsl_constants(pl, cl, per);
+    for (k = 0; k < periods; ++k) {
+      for (l = 0; l < GS_L; ++l) { lo[GS_L*0 + l] = yl[GS_L*0 + l]; hi[GS_L*0 + l] = yl[GS_L*0 + l]; lo[GS_L*1 + l] = yl[GS_L*2 + l]; hi[GS_L*1 + l] = yl[GS_L*2 + l]; lo[GS_L*2 + l] = yl[GS_L*4 + l]; hi[GS_L*2 + l] = yl[GS_L*4 + l]; lo[GS_L*3 + l] = yl[GS_L*6 + l]; hi[GS_L*3 + l] = yl[GS_L*6 + l]; lo[GS_L*4 + l] = yl[GS_L*8 + l]; hi[GS_L*4 + l] = yl[GS_L*8 + l]; lo[GS_L*5 + l] = yl[GS_L*10 + l]; hi[GS_L*5 + l] = yl[GS_L*10 + l]; }
+      gsl_state_span(yl, lo, hi, work, cl, 200);
+    }
+    for (l = 0; l < GS_L && b + l < total; ++l) {
+      for (i = 0; i < 12; ++i) y[12*(b + l) + i] = yl[GS_L*i + l];
+    }
   }
   return 0;
 }

@@ -5389,6 +5389,104 @@ static GEARSYM_INLINE void gsl_state_keep(const casadi_real* restrict A0, const 
   }
 }
 
+/* constants on every lane, from CasADi's C of it */
+static GEARSYM_INLINE void gsl_constants(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
+  casadi_int l;
+  GS_LANES {
+    casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+    casadi_real a12;
+    a00=A0[GS_L*12 + l];
+    R0[GS_L*0 + l]=a00;
+    a00=A0[GS_L*0 + l];
+    a01=casadi_sq(a00);
+    a02=(1./a01);
+    a03=(-a02);
+    R0[GS_L*1 + l]=a03;
+    a03=-2.;
+    a04=A0[GS_L*1 + l];
+    a04=(a03*a04);
+    a05=(a04/a00);
+    R0[GS_L*2 + l]=a05;
+    a05=A0[GS_L*14 + l];
+    a06=A0[GS_L*8 + l];
+    a07=(a05/a06);
+    a07=(a07/a01);
+    a07=(-a07);
+    R0[GS_L*3 + l]=a07;
+    R0[GS_L*4 + l]=a02;
+    a02=(a05/a01);
+    a07=(1./a06);
+    a08=A0[GS_L*9 + l];
+    a09=(1./a08);
+    a07=(a07+a09);
+    a02=(a02*a07);
+    a02=(-a02);
+    R0[GS_L*5 + l]=a02;
+    a02=A0[GS_L*18 + l];
+    a07=casadi_sq(a02);
+    a09=(a07/a06);
+    a10=(a09/a01);
+    a11=A0[GS_L*17 + l];
+    a11=casadi_sq(a11);
+    a12=A0[GS_L*7 + l];
+    a11=(a11/a12);
+    a11=(a11+a09);
+    a10=(a10/a11);
+    a10=(-a10);
+    R0[GS_L*6 + l]=a10;
+    a04=(a04/a06);
+    a04=(a04*a07);
+    a04=(a04/a00);
+    a04=(a04/a11);
+    R0[GS_L*7 + l]=a04;
+    a04=(a03*a02);
+    a11=A0[GS_L*19 + l];
+    a04=(a04*a11);
+    a07=A0[GS_L*3 + l];
+    a04=(a04*a07);
+    a04=(a04/a08);
+    a04=(a04/a00);
+    a06=casadi_sq(a11);
+    a06=(a06/a08);
+    a10=A0[GS_L*20 + l];
+    a10=casadi_sq(a10);
+    a09=A0[GS_L*10 + l];
+    a10=(a10/a09);
+    a06=(a06+a10);
+    a04=(a04/a06);
+    R0[GS_L*8 + l]=a04;
+    a04=A0[GS_L*13 + l];
+    R0[GS_L*9 + l]=a04;
+    a04=A0[GS_L*2 + l];
+    a10=(a04*a02);
+    a10=(a10*a11);
+    a10=(a10/a08);
+    a10=(a10/a01);
+    a10=(a10/a06);
+    a10=(-a10);
+    R0[GS_L*10 + l]=a10;
+    a03=(a03*a07);
+    a03=(a03/a00);
+    R0[GS_L*11 + l]=a03;
+    a04=(a04/a01);
+    a04=(-a04);
+    R0[GS_L*12 + l]=a04;
+    a05=(a05*a11);
+    a05=(a05/a08);
+    a05=(a05/a02);
+    a05=(a05/a01);
+    a05=(-a05);
+    R0[GS_L*13 + l]=a05;
+    a05=A0[GS_L*6 + l];
+    a05=(a05/a01);
+    R0[GS_L*14 + l]=a05;
+    a05=6.2831853071795868e-02;
+    R0[GS_L*15 + l]=a05;
+    a05=1.2566370614359172e+01;
+    R1[GS_L*0 + l]=a05;
+  }
+}
+
 /* one block of tangent steps of every lane */
 static GEARSYM_INLINE void gsl_tangent_step(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real yt[6*GS_L], flag[GS_L], J[23*GS_L]; casadi_int j, l, i; int any, finite;
@@ -5504,6 +5602,74 @@ CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_lyapunov(const casadi_real* re
     if (strobe) gs_copy(y, 6*GS_L, strobe + 6*GS_L*p);
     if (low) gs_copy(lo, 3*GS_L, low + 3*GS_L*p);
     if (high) gs_copy(hi, 3*GS_L, high + 3*GS_L*p);
+  }
+  return 0;
+}
+
+/* `periods` periods of `count` parameter points, state and tangent, GS_L lanes at a time: point i has the parameters
+   p + 21*i, its tables at pool + 1800*tix[i] (rows x steps of one period, column-major, as the
+   scalar loops read them: points whose tables are the same share one), its constants computed here from
+   its parameters; the state after them is written over y + n*i, the tangent map to M + n*n*i (row r of column j at
+   r*n + j: d y_r / d y0_j). work: room for GS_L tables. */
+CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_monodromies(const casadi_real* restrict pool, const long long* restrict tix, const casadi_real* restrict p, long long count, long long periods, casadi_real* restrict y, casadi_real* restrict M, casadi_real* restrict work) {
+  casadi_real pl[21*GS_L], cl[16*GS_L], per[GS_L], yl[6*GS_L], Ql[36*GS_L], lo[3*GS_L], hi[3*GS_L];
+  long long last[GS_L], b, k, g, q, total = count; casadi_int l, i;
+  for (l = 0; l < GS_L; ++l) last[l] = -1;
+  for (b = 0; b < total; b += GS_L) {
+    for (l = 0; l < GS_L; ++l) {  /* (lanes past the end repeat the last one: finite numbers) */
+      g = b + l < total ? b + l : total - 1;
+      q = g;
+      for (i = 0; i < 21; ++i) pl[GS_L*i + l] = p[21*q + i];
+      for (i = 0; i < 6; ++i) yl[GS_L*i + l] = y[6*g + i];
+      for (i = 0; i < 36; ++i) Ql[GS_L*i + l] = i % 7 == 0;
+      if (tix[q] != last[l]) {  /* a table of another point: copied into this lane */
+        const casadi_real* t = pool + 1800*tix[q];
+        for (i = 0; i < 1800; ++i) work[GS_L*i + l] = t[i];
+        last[l] = tix[q];
+      }
+    }
+    gsl_constants(pl, cl, per);
+    for (k = 0; k < periods; ++k) {
+      for (l = 0; l < GS_L; ++l) { lo[GS_L*0 + l] = yl[GS_L*0 + l]; hi[GS_L*0 + l] = yl[GS_L*0 + l]; lo[GS_L*1 + l] = yl[GS_L*2 + l]; hi[GS_L*1 + l] = yl[GS_L*2 + l]; lo[GS_L*2 + l] = yl[GS_L*4 + l]; hi[GS_L*2 + l] = yl[GS_L*4 + l]; }
+      gsl_tangent_span(yl, Ql, lo, hi, work, cl, 200);
+    }
+    for (l = 0; l < GS_L && b + l < total; ++l) {
+      for (i = 0; i < 6; ++i) y[6*(b + l) + i] = yl[GS_L*i + l];
+      for (i = 0; i < 36; ++i) M[36*(b + l) + i] = Ql[GS_L*i + l];
+    }
+  }
+  return 0;
+}
+
+/* `periods` periods of `count` parameter points, the state alone, GS_L lanes at a time: point i has the parameters
+   p + 21*i, its tables at pool + 1800*tix[i] (rows x steps of one period, column-major, as the
+   scalar loops read them: points whose tables are the same share one), its constants computed here from
+   its parameters; with columns = 0 it starts at y + n*i and its state after them is written there; with columns = c,
+   lane g runs point g / c from the column g % c of the identity and writes its state to y + n*g. work: room for GS_L tables. */
+CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_states(const casadi_real* restrict pool, const long long* restrict tix, const casadi_real* restrict p, long long count, long long periods, long long columns, casadi_real* restrict y, casadi_real* restrict work) {
+  casadi_real pl[21*GS_L], cl[16*GS_L], per[GS_L], yl[6*GS_L], lo[3*GS_L], hi[3*GS_L];
+  long long last[GS_L], b, k, g, q, total = (columns ? count * columns : count); casadi_int l, i;
+  for (l = 0; l < GS_L; ++l) last[l] = -1;
+  for (b = 0; b < total; b += GS_L) {
+    for (l = 0; l < GS_L; ++l) {  /* (lanes past the end repeat the last one: finite numbers) */
+      g = b + l < total ? b + l : total - 1;
+      q = (columns ? g / columns : g);
+      for (i = 0; i < 21; ++i) pl[GS_L*i + l] = p[21*q + i];
+      for (i = 0; i < 6; ++i) yl[GS_L*i + l] = columns ? (i == g % columns) : y[6*g + i];
+      if (tix[q] != last[l]) {  /* a table of another point: copied into this lane */
+        const casadi_real* t = pool + 1800*tix[q];
+        for (i = 0; i < 1800; ++i) work[GS_L*i + l] = t[i];
+        last[l] = tix[q];
+      }
+    }
+    gsl_constants(pl, cl, per);
+    for (k = 0; k < periods; ++k) {
+      for (l = 0; l < GS_L; ++l) { lo[GS_L*0 + l] = yl[GS_L*0 + l]; hi[GS_L*0 + l] = yl[GS_L*0 + l]; lo[GS_L*1 + l] = yl[GS_L*2 + l]; hi[GS_L*1 + l] = yl[GS_L*2 + l]; lo[GS_L*2 + l] = yl[GS_L*4 + l]; hi[GS_L*2 + l] = yl[GS_L*4 + l]; }
+      gsl_state_span(yl, lo, hi, work, cl, 200);
+    }
+    for (l = 0; l < GS_L && b + l < total; ++l) {
+      for (i = 0; i < 6; ++i) y[6*(b + l) + i] = yl[GS_L*i + l];
+    }
   }
   return 0;
 }
