@@ -21,7 +21,7 @@ import numpy as np
 
 import gearsym
 from gearsym import Integration
-from gearsym.files import write_atomically
+from gearsym.files.atomic import write_atomically
 
 HERE = Path(__file__).resolve().parent
 DATA = HERE / "figures" / "fmu-one_stage.csv"

@@ -102,7 +102,7 @@ class SystemSummary(ParameterChecks):
                 "state_names": list(self.state_names), "parameters": dict(self.parameters),
                 "initial": dict(self.initial), "coordinates": list(self.coordinates),
                 "descriptions": dict(self.descriptions),
-                "constraints": {k: [c.meaning, c.zero_allowed] for k, c in self.constraints.items()},
+                "constraints": {k: c.as_list() for k, c in self.constraints.items()},
                 "autonomous": self.autonomous, "physical": self.physical, "cycles": self.cycles}
 
     @classmethod
@@ -111,7 +111,7 @@ class SystemSummary(ParameterChecks):
                    {str(k): float(v) for k, v in d["parameters"].items()},
                    {str(k): float(v) for k, v in d["initial"].items()}, tuple(map(str, d["coordinates"])),
                    {str(k): str(v) for k, v in d["descriptions"].items()},
-                   {str(k): Constraint(str(m), bool(z)) for k, (m, z) in d["constraints"].items()},
+                   {str(k): Constraint.from_list(c) for k, c in d["constraints"].items()},
                    bool(d["autonomous"]), bool(d["physical"]), load, int(d["cycles"]))
 
     @classmethod

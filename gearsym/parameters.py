@@ -19,10 +19,36 @@ _RUN_OPTIONS = tuple(f.name for f in fields(Integration))
 
 @dataclass(frozen=True)
 class Constraint:
-    """What a parameter is physically, and so which sign it must have."""
+    """What a parameter is physically, and so which values it may take: its sign; for a fraction of stiffness
+    lost, ``below`` 1 (exclusive: at 1 the tooth pair carries nothing, beyond it pulls); for a tooth, a whole
+    number from ``whole[0]`` to ``whole[1]``."""
 
     meaning: str  # "an inertia", "a damping ratio", ...
     zero_allowed: bool = True
+    below: float | None = None
+    whole: tuple[int, int] | None = None
+
+    def violation(self, number: float) -> str | None:
+        """What is wrong with ``number`` as this parameter's value ('must be positive', ...), or None."""
+        if self.whole is not None:
+            first, last = self.whole
+            if not (number == math.floor(number) and first <= number <= last):
+                return f"must be a whole number from {first} to {last}"
+            return None
+        if self.below is not None and not (0 <= number < self.below if self.zero_allowed else 0 < number < self.below):
+            return f"must be at least 0 and less than {self.below:g}" if self.zero_allowed else \
+                f"must be more than 0 and less than {self.below:g}"
+        return sign_violation(number, self.zero_allowed)
+
+    def as_list(self) -> list:
+        """As JSON holds it (the start-up cache): [meaning, zero allowed, below, whole]."""
+        return [self.meaning, self.zero_allowed, self.below, list(self.whole) if self.whole else None]
+
+    @classmethod
+    def from_list(cls, items) -> "Constraint":
+        meaning, zero, below, whole = (list(items) + [None, None])[:4]
+        return cls(str(meaning), bool(zero), None if below is None else float(below),
+                   None if whole is None else (int(whole[0]), int(whole[1])))
 
 
 class ParameterChecks:
@@ -64,7 +90,7 @@ class ParameterChecks:
         except (TypeError, ValueError):
             raise GearsymError(f"{self.name}: {name} must be a number, got {value!r}") from None
         constraint = self.constraints.get(name)
-        must = sign_violation(number, constraint.zero_allowed) if constraint else None
+        must = constraint.violation(number) if constraint else None
         if must:
             raise ModelError(f"is {constraint.meaning} and {must}, got {number:g}", f"parameter {name!r}")
         return number

@@ -11,6 +11,7 @@ from typing import Union
 
 from .model.declared import Model
 from .errors import GearsymError, ModelError, suggest, warn
+from .files.kinds import what_is_at
 from .files.paths import MODELS_DIR
 
 
@@ -77,8 +78,7 @@ def load_model(ref: Union[str, Path, Model]) -> Model:
     path = model_path(ref)
     if _is_path(ref):
         if path is None:
-            why = "is a folder" if _exists(ref) else "does not exist"
-            raise GearsymError(f"model file {_shown(ref)} {why}")
+            raise GearsymError(f"model file {_shown(ref)} {_what_is_there(ref)}")
         if path.suffix != ".py":
             raise GearsymError(f"{ref} is not a model file: a model file is Python, named *.py (e.g. models/"
                                "one_stage.py), and a model name is one of `gearsym list`")
@@ -147,8 +147,7 @@ def model_file(ref: str) -> Path | None:
     return path if path is not None and path.suffix == ".py" else None
 
 
-def _exists(ref: str) -> bool:
-    try:
-        return Path(ref).exists()
-    except OSError:
-        return False
+def _what_is_there(ref: str) -> str:
+    """Why ``ref`` is no model file: what stands at that path instead (a folder, a pipe, a device), or nothing."""
+    return what_is_at(Path(ref), "a model file is a Python file (*.py)")
+

@@ -157,13 +157,18 @@ import pytest  # noqa: E402
 
 
 @pytest.fixture(scope="session", autouse=True)
-def _private_library_cache(tmp_path_factory):
+def _private_library_cache(tmp_path_factory, pytestconfig):
     """Compiled libraries go to a fresh cache per session: the tests compile for real and see cache hits
-    they caused themselves, never a stale library from an earlier checkout."""
+    they caused themselves, never a stale library from an earlier checkout. The workers of a parallel run
+    (pytest -n) share it, as a user's processes share theirs: each model is compiled once, and two workers
+    compiling the same one meanwhile is a case the cache handles (its libraries land whole, by rename)."""
     import os
 
     old = os.environ.get("GEARSYM_CACHE")
-    os.environ["GEARSYM_CACHE"] = str(tmp_path_factory.mktemp("gearsym-cache"))
+    if not hasattr(pytestconfig, "workerinput"):  # (what pytest-xdist gives its workers)
+        os.environ["GEARSYM_CACHE"] = str(tmp_path_factory.mktemp("gearsym-cache"))
+    else:  # the session's folder, beside the workers' own (pytest-N/popen-gw0, ...)
+        os.environ["GEARSYM_CACHE"] = str(tmp_path_factory.getbasetemp().parent / "gearsym-cache")
     yield
     if old is None:
         os.environ.pop("GEARSYM_CACHE", None)
@@ -193,3 +198,12 @@ def interrupt_after(count):
             raise KeyboardInterrupt
 
     return on_point
+
+
+def pytest_collection_modifyitems(config, items):
+    """For a parallel run (pytest -n auto --dist loadgroup): every test file is a group that runs on one worker, so
+    that its module fixtures (a compiled model, simulated data) are made once, as in a serial run; the docs' pages
+    are groups of their own (tests/test_doc_examples.py), so that the pages run in parallel."""
+    for item in items:
+        if item.get_closest_marker("xdist_group") is None:
+            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))

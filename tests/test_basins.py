@@ -78,6 +78,12 @@ def test_duffing_basins_in_its_hysteresis_window_agree_with_scipy(duffing):
     for a in found.attractors:
         scipy_fraction = np.mean(expected == a.number)
         assert abs(a.fraction - scipy_fraction) <= 2 * a.stderr + 1e-12
+    for a, centre in zip(found.attractors, centres[match]):  # each orbit's amplitude: SciPy's over one period
+        sol = solve_ivp(lambda t, y: [y[1], -2 * ZETA * y[1] - y[0] - BETA * y[0] ** 3 + F * np.cos(WINDOW_OMEGA * t)],
+                        (0.0, 2 * math.pi / WINDOW_OMEGA), centre, method="DOP853", rtol=1e-10, atol=1e-10,
+                        dense_output=True)
+        x = sol.sol(np.linspace(0.0, 2 * math.pi / WINDOW_OMEGA, 4001))[0]
+        assert a.amplitude["x"] == pytest.approx((x.max() - x.min()) / 2, rel=1e-3)
     assert found.attractors[0].amplitude["x"] != pytest.approx(found.attractors[1].amplitude["x"], rel=0.1)
 
 

@@ -329,6 +329,28 @@ def test_a_summary_pointing_at_another_models_library_is_not_trusted(cache, clea
     assert run.stdout == clean["one_stage"]
 
 
+def test_a_summary_pointing_at_a_library_outside_the_caches_lib_folder_never_loads_it(cache, clean, planted,
+                                                                                       tmp_path):
+    """A library beside a record that vouches for it, in a folder of the user's own, but not the cache's lib/: a
+    resealed build summary that points there is not followed (the library is compiled again in the cache)."""
+    data, marker = planted
+    _, build = summaries(cache)
+    lib = library(cache)
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir(mode=0o700)
+    outside = elsewhere / lib.name
+    outside.write_bytes(data)
+    outside.chmod(0o600)
+    forge_record(lib, data)  # (the record of the planted bytes, moved beside them)
+    (forged,) = [p for p in lib.parent.glob(f"{lib.name}.*.json") if hashlib.sha256(data).hexdigest()[:16] in p.name]
+    shutil.move(forged, elsewhere / forged.name)
+    reseal(build, {**json.loads(build.read_text()), "library": str(outside)})
+    run = gearsym(cache, "lyap", "one_stage", *ARGS)
+    assert run.returncode == 0, run.stderr
+    assert not marker.exists()
+    assert run.stdout == clean["one_stage"]
+
+
 # ------------------------------------------------------------------ a cache path that cannot be one
 @pytest.mark.parametrize("where", ["/dev/null", "a file", "below a file"])
 def test_a_cache_path_that_is_no_folder_is_a_one_line_error_before_any_work(tmp_path, where):

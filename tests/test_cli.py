@@ -126,6 +126,7 @@ def test_errors_exit_2_without_traceback_in_a_real_process():
     assert "Traceback" not in proc.stderr
 
 
+@pytest.mark.slow
 def test_docs_check_passes_on_the_committed_pages(capsys, monkeypatch):
     monkeypatch.chdir(REPO_ROOT)  # (the pages are checked where they would be written: the current folder's)
     code, out, err = run(capsys, "docs", "--all", "--check")

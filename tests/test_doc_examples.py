@@ -1,14 +1,15 @@
 """Every shell and Python block of README.md and docs/*.md runs as printed, from an empty folder, with nothing
 but the installed gearsym (`tests/doc_blocks.py` says how blocks are found, marked and run).
 
-The pages run in parallel (two at a time), each in a folder of its own, their blocks in order; the compiled
-libraries are shared through the session's cache. A page added later is picked up by itself.
+Each page's blocks run once, in order, in a folder of its own, when the first of its blocks is tested; the
+compiled libraries are shared through the session's cache. The blocks of a page are one group for pytest-xdist
+(``--dist loadgroup``): the pages run in parallel, each on one worker. A page added later is picked up by itself.
 """
 from __future__ import annotations
 
 import json
 import re
-from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
 
 import pytest
 
@@ -17,19 +18,19 @@ from doc_blocks import REPO
 
 PAGES = doc_blocks.pages()
 BLOCKS = [b for page in PAGES for b in doc_blocks.blocks(page)]
+_RAN: dict[str, dict[str, doc_blocks.Ran]] = {}  # page -> block name -> what happened (this worker's pages)
 
 
-@pytest.fixture(scope="module")
-def ran(tmp_path_factory) -> dict[str, doc_blocks.Ran]:
-    """Every page's blocks, run: block name -> what happened."""
-    scratch = tmp_path_factory.mktemp("user")
-    runnable = [p for p in PAGES if any(b.runs or b.output_of for b in doc_blocks.blocks(p))]
-    # the longest pages first, so that two workers finish together
-    runnable.sort(key=lambda p: -sum(b.code.count("gearsym ") + 3 * (b.language == "python")
-                                     for b in doc_blocks.blocks(p) if b.runs))
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        results = pool.map(lambda page: doc_blocks.run_page(page, scratch), runnable)
-        return {r.block.name: r for page in results for r in page}
+@pytest.fixture(scope="session")
+def user_folders(tmp_path_factory) -> Path:
+    return tmp_path_factory.mktemp("user")
+
+
+def ran(page: str, scratch: Path) -> dict[str, doc_blocks.Ran]:
+    """The page's blocks, run (once per process): block name -> what happened."""
+    if page not in _RAN:
+        _RAN[page] = {r.block.name: r for r in doc_blocks.run_page(REPO / page, scratch)}
+    return _RAN[page]
 
 
 def test_the_pages_have_examples_and_only_a_few_are_not_run():
@@ -44,10 +45,12 @@ def test_every_block_runs_or_says_why_not(block):
     assert doc_blocks.unmarked(block) is None, f"{block.name}: {doc_blocks.unmarked(block)}"
 
 
-@pytest.mark.parametrize("block", [b for b in BLOCKS if b.runs or b.output_of], ids=lambda b: b.name)
-def test_a_block_runs_as_printed(block, ran):
-    assert block.name in ran, f"{block.name} did not run: a block before it on its page failed"
-    r = ran[block.name]
+@pytest.mark.parametrize("block", [pytest.param(b, marks=(pytest.mark.xdist_group(b.page), pytest.mark.slow))
+                                   for b in BLOCKS if b.runs or b.output_of], ids=lambda b: b.name)
+def test_a_block_runs_as_printed(block, user_folders):
+    page = ran(block.page, user_folders)
+    assert block.name in page, f"{block.name} did not run: a block before it on its page failed"
+    r = page[block.name]
     assert r.status == 0, f"{block.name} failed (exit {r.status}):\n{block.code}\n---\n{r.output[-4000:]}"
     assert r.listing_missing == [], (f"{block.name}: `{block.output_of}` no longer prints these lines of the "
                                      f"listing: {r.listing_missing}")

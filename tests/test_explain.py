@@ -19,6 +19,7 @@ import sympy as sp
 
 import conftest
 import rig
+from same_numbers import csv_differences, differences
 from gearsym import EFFECTS, Integration, explain, load_measurements, simulate_measurements
 from gearsym.model.backlash import g
 from gearsym.cli import main
@@ -414,7 +415,7 @@ def test_the_worked_example_data_are_what_the_documented_command_writes(tmp_path
     command = re.search(r"^gearsym simulate .*$", page, re.M).group(0)
     monkeypatch.chdir(tmp_path)
     assert main(shlex.split(command)[1:]) == 0
-    assert (tmp_path / "measured.csv").read_bytes() == (EXAMPLE / "measured.csv").read_bytes(), (
+    assert not csv_differences((tmp_path / "measured.csv").read_text(), (EXAMPLE / "measured.csv").read_text()), (
         "docs/examples/explain-cubic-stiffness/measured.csv is not what docs/data-loop.md's command writes: rerun it")
 
 
@@ -426,9 +427,9 @@ def test_the_committed_worked_example_is_what_explain_writes(tmp_path):
     out.mkdir()
     (out / "measured.csv").write_bytes((example / "measured.csv").read_bytes())
     report = explain_files([out / "measured.csv"], conftest.system("one_stage"), ["zeta", "B1"], out=out)
-    assert (out / "report.md").read_text() == (example / "report.md").read_text(), (
-        "docs/examples/explain-cubic-stiffness is out of date: rerun the commands in docs/data-loop.md there")
-    assert (out / "derived_model.md").read_text() == (example / "derived_model.md").read_text()
+    for name in ("report.md", "derived_model.md"):
+        assert not differences((out / name).read_text(), (example / name).read_text()), (
+            f"docs/examples/explain-cubic-stiffness/{name} is out of date: rerun the commands in docs/data-loop.md there")
     committed = json.loads((example / "report.json").read_text())
     assert report["effects"] == committed["effects"] == ["cubic_stiffness"]
     assert report["error_after"] == pytest.approx(committed["error_after"], rel=1e-6)
@@ -441,7 +442,7 @@ def test_the_rig_example_data_are_what_the_documented_command_writes(tmp_path):
     page = (REPO_ROOT / "docs" / "data-loop.md").read_text()
     assert "python tests/rig.py measured.csv" in page
     rig.example(tmp_path / "measured.csv")
-    assert (tmp_path / "measured.csv").read_bytes() == (RIG_EXAMPLE / "measured.csv").read_bytes(), (
+    assert not csv_differences((tmp_path / "measured.csv").read_text(), (RIG_EXAMPLE / "measured.csv").read_text()), (
         "docs/examples/explain-rig-accelerometer/measured.csv is not what `python tests/rig.py` writes: rerun it")
 
 
@@ -452,7 +453,7 @@ def test_the_committed_rig_example_is_what_explain_writes(tmp_path, monkeypatch,
     monkeypatch.chdir(tmp_path)
     assert main([*shlex.split(command)[1:], "--quiet"]) == 0
     for name in ("report.md", "derived_model.md"):
-        assert (tmp_path / name).read_text() == (RIG_EXAMPLE / name).read_text(), (
+        assert not differences((tmp_path / name).read_text(), (RIG_EXAMPLE / name).read_text()), (
             f"docs/examples/explain-rig-accelerometer/{name} is out of date: rerun the commands in docs/data-loop.md")
     report = json.loads((tmp_path / "report.json").read_text())
     assert report["verdict"] == "explained" and report["effects"] == ["torque_harmonic_2"]

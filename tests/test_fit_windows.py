@@ -82,3 +82,31 @@ def test_windows_shared_between_threads_give_the_bits_of_one_call(case, monkeypa
     for a, b in zip((one.states, one.outputs, one.derivatives), (shared.states, shared.outputs, shared.derivatives)):
         assert (a is None and b is None) or np.array_equal(a, b)
     assert np.all(shared.outputs[:, -1] != 0)  # the last piece's columns were written
+
+
+def test_a_records_columns_are_projected_in_its_own_rows_as_the_whole_problem_projects_them():
+    """The tooth scan's projection (issue 35: 250 records of 5000 samples took 7.5 GB as whole-problem columns per
+    record) equals Jacobian.project_out of the same columns laid out over every row, in the norm and product the
+    scan ranks teeth by, and in the column itself."""
+    from gearsym.fit.jacobian import Jacobian
+    from gearsym.fit.tooth_scan import RecordProjection
+
+    rng = np.random.default_rng(7)
+    lengths = rng.integers(5, 12, size=9)  # 9 windows: records of 3 windows each
+    rows = np.concatenate([[0], np.cumsum(lengths)])
+    window = np.repeat(np.arange(9), lengths)
+    J = Jacobian(rng.normal(size=(rows[-1], 3)), rng.normal(size=(rows[-1], 2)), window, rows)
+    y = J.project_out(rng.normal(size=(rows[-1], 1)))[:, 0]
+    projection = RecordProjection.of(J, y)
+    windows = np.array([3, 4, 5])
+    own_rows = J.window_rows(windows)
+    block = rng.normal(size=(len(own_rows), 4))
+    full = np.zeros((rows[-1], 4))
+    full[own_rows] = block
+    dense = J.project_out(full)
+    own, c, norms, dots = projection(block, windows, own_rows)
+    column = -projection.fitted @ c
+    column[own_rows] += own
+    np.testing.assert_allclose(column, dense, atol=1e-12)
+    np.testing.assert_allclose(norms, np.einsum("rz,rz->z", dense, dense), rtol=1e-10)
+    np.testing.assert_allclose(dots, dense.T @ y, atol=1e-10)

@@ -20,6 +20,7 @@ import sympy as sp
 
 fmpy = pytest.importorskip("fmpy")
 from fmpy import read_model_description, simulate_fmu  # noqa: E402
+from fmpy.fmi1 import FMICallException  # noqa: E402
 from fmpy.validation import validate_fmu  # noqa: E402
 
 import gearsym  # noqa: E402
@@ -233,11 +234,25 @@ def test_a_parameter_set_through_fmi_changes_the_result_as_set_does(one_stage):
     assert np.max(np.abs(default["x"] - x)) > 0.1 * np.ptp(x)
 
 
+def refusal(path, **start) -> tuple[str, list[str]]:
+    """What FMPy raises and what the FMU logs when a co-simulation is started with ``start``."""
+    said = []
+
+    def logger(environment, instance, status, category, message):
+        said.append(message.decode() if isinstance(message, bytes) else message)
+
+    with pytest.raises(FMICallException) as err:
+        simulate_fmu(str(path), fmi_type="CoSimulation", stop_time=TWO_PI, output_interval=TWO_PI / STEPS,
+                     start_values=start, logger=logger)
+    return str(err.value), said
+
+
 def test_a_value_the_engine_does_not_take_is_refused(one_stage):
-    with pytest.raises(Exception):
-        cs(one_stage, periods=1, omega=-1.0)
-    with pytest.raises(Exception):
-        cs(one_stage, periods=1, substeps=0)
+    raised, said = refusal(one_stage, omega=-1.0)
+    assert raised.startswith("fmi2ExitInitializationMode failed with status 3")
+    assert said == ["the parameter values make the engine's omega negative or zero, which it may not be"]
+    raised, said = refusal(one_stage, substeps=0)
+    assert raised.startswith("fmi2SetInteger failed with status 3") and said == ["substeps must be at least 1"]
 
 
 # ------------------------------------------------------------------ a physical model: SI
@@ -308,6 +323,18 @@ def test_a_physical_fmu_agrees_with_the_lagrange_equations_in_si(spur):
     assert np.max(np.abs(exchange["x"] - x)) < 1e-4 * np.ptp(x)
 
 
+def test_a_derivative_read_as_a_variable_is_the_states_rate_in_si(spur):
+    """der(x) and der(v) read through fmi2GetReal (as a tool records or plots them, not only through
+    fmi2GetDerivatives) are rates per second: der(x) is v, and der(v) v's central difference over the steps."""
+    period = spur_period()
+    step = period / STEPS
+    fmu = simulate_fmu(str(spur), fmi_type="CoSimulation", stop_time=2 * period, output_interval=step,
+                       output=["x", "v", "der(x)", "der(v)"])
+    assert np.allclose(fmu["der(x)"], fmu["v"], rtol=1e-9, atol=1e-12 * np.ptp(fmu["v"]))
+    central = (fmu["v"][2:] - fmu["v"][:-2]) / (2 * step)
+    assert np.max(np.abs(fmu["der(v)"][1:-1] - central)) < 1e-3 * np.ptp(fmu["der(v)"])
+
+
 def test_a_physical_value_set_through_fmi_is_gearsyms_run_with_it(spur):
     """The speed, mesh damping, backlash and torque fluctuation are tunable: set in the FMU they give gearsym's own
     run with --set at those values (to rounding), in SI; a value baked into the engine's values is refused."""
@@ -323,8 +350,10 @@ def test_a_physical_value_set_through_fmi_is_gearsyms_run_with_it(spur):
     assert np.max(np.abs(fmu["x"] - x)) < 1e-9 * np.ptp(x)
     t, reference, _, _ = spur_reference(5 * period, period / STEPS, speed=speed, cZ=500.0, eta=60e-6, M1a=10.0)
     assert np.max(np.abs(fmu["x"] - reference)) < 1e-4 * np.ptp(reference)
-    with pytest.raises(Exception):
-        simulate_fmu(str(spur), fmi_type="CoSimulation", stop_time=period, start_values={"kZ": 2e8})
+    raised, said = refusal(spur, kZ=2e8)
+    assert raised.startswith("fmi2SetReal failed with status 3")
+    assert said == ["kZ is baked into the engine's values of this FMU: export it again with gearsym fmu ... --set to "
+                    "change it"]
 
 
 def test_a_speed_changed_during_a_co_simulation_keeps_the_forcing_phase_continuous(spur):
@@ -459,7 +488,7 @@ def test_bad_input_gets_one_line_and_exit_status_2(argv, message, tmp_path, caps
 
 
 # ------------------------------------------------------------------ the worked example of docs/fmu.md
-def test_the_worked_examples_data_are_what_the_fmu_gives(one_stage):
+def test_the_worked_examples_data_are_what_the_fmu_gives(one_stage, reference):
     import importlib.util
 
     spec = importlib.util.spec_from_file_location("fmu_example", REPO_ROOT / "docs" / "fmu_example.py")
@@ -471,3 +500,83 @@ def test_the_worked_examples_data_are_what_the_fmu_gives(one_stage):
     for name, values in fresh.items():
         tolerance = 1e-6 if name == "x_model_exchange" else 1e-9
         assert np.max(np.abs(committed[name] - values)) < tolerance * max(1.0, np.ptp(values)), name
+    # and, independently of any regeneration, the committed numbers against SciPy's solution of the equation
+    tau, x, _ = reference
+    assert np.allclose(committed["tau"], tau[::10], rtol=1e-13, atol=1e-12)
+    for name in ("x_gearsym", "x_co_simulation", "x_model_exchange"):
+        assert np.max(np.abs(committed[name] - x[::10])) < 1e-4 * np.ptp(x), name
+
+
+# ------------------------------------------------------------------ issue 35: gearsym's step, descriptions, verdicts
+def test_co_simulation_keeps_gearsyms_step_whatever_the_communication_step(one_stage):
+    """20 communication steps per forcing period (the engine takes 200 RK4 steps per period) give what 400 give:
+    the FMU takes as many substeps as keep each within the engine's step (one RK4 step per communication step
+    was 1.5e-3 of the range off at 20)."""
+    def run(per_period):
+        r = simulate_fmu(str(one_stage), fmi_type="CoSimulation", stop_time=20 * TWO_PI,
+                         output_interval=TWO_PI / per_period, output=["x"])
+        return r["time"], r["x"]
+
+    t20, x20 = run(20)
+    t400, x400 = run(400)
+    coarse_times = np.round(t20 / (TWO_PI / 20)).astype(int) * 20
+    assert np.max(np.abs(x20 - x400[coarse_times])) < 1e-6 * np.ptp(x400)
+
+
+def _layout_of(name: str):
+    """The variables of the FMU of a shipped model (what build_fmu writes, without compiling it)."""
+    from gearsym.fmu.frame import Frame
+    from gearsym.fmu.physical import physical_frame
+    from gearsym.fmu.variables import layout
+    from conftest import load, reduced
+
+    model, sys_ = load(name), system(name)
+    frame = physical_frame(reduced(name), {}, sys_) if isinstance(model, gearsym.Drivetrain) else None
+    return layout(sys_, frame or Frame(), ())
+
+
+def test_every_variable_of_every_shipped_models_fmu_has_a_description():
+    from gearsym.registry import available_models
+
+    missing = {name: [v.name for v in _layout_of(name).variables if not v.description.strip()]
+               for name in available_models()}
+    assert {name: names for name, names in missing.items() if names} == {}
+    planetary = {v.name: v.description for v in _layout_of("planetary").variables}
+    assert planetary["r_r"] == "base radius of 'ring' (held)" and planetary["I_p"] == "moment of inertia of 'planet1'"
+
+
+def _logged(path, **start):
+    """(the error FMPy raised, the FMU's log) of a co-simulation over 60 forcing periods."""
+    log = []
+    with pytest.raises(Exception) as failed:
+        simulate_fmu(str(path), fmi_type="CoSimulation", stop_time=60 * TWO_PI / 1.5, output_interval=TWO_PI / 30,
+                     start_values=start, output=["x"], logger=lambda *a: log.append(" ".join(map(str, a))))
+    return str(failed.value), " ".join(log)
+
+
+@pytest.fixture(scope="module")
+def cracked(built):
+    """An FMU with a tooth fault's depth q and the default stiffness wave's k_a."""
+    path = built / "cracked_pair.fmu"
+    assert main(["fmu", "cracked_pair", "--out", str(path)]) == 0
+    return path
+
+
+def test_a_motion_that_diverges_stops_the_co_simulation_with_an_error_and_says_so(cracked):
+    error, log = _logged(cracked, k_a=5.0)  # (the stiffness goes negative over part of each period: x to 1e69)
+    assert "fmi2DoStep failed with status 3 (error)" in error
+    assert "the motion diverged in the step from" in log and "x reached" in log and "a gearsym run calls diverged" in log
+
+
+def test_a_start_that_is_not_a_number_is_named_as_such(cracked):
+    error, log = _logged(cracked, x=float("nan"))
+    assert "fmi2ExitInitializationMode failed" in error
+    assert "the start value of x is nan: every state needs a finite start value" in log and "step" not in log
+
+
+@pytest.mark.parametrize("q", [1.5, -0.5])
+def test_a_fault_depth_outside_0_to_1_is_refused_by_the_fmu(cracked, q):
+    error, log = _logged(cracked, q=q)
+    assert "failed with status 3 (error)" in error
+    assert (f"the parameter values make the engine's q {q:g}, but it must be at least 0 and less than 1 (the fraction "
+            "of the stiffness of the pair of tooth 7 of 'gear1' that its fault takes away)") in log

@@ -115,6 +115,29 @@ def test_the_committed_figure_and_data_regenerate(capsys, tmp_path):
     moved = (np.abs(new - committed).max(axis=-1) > 0.25).mean()
     assert np.abs(new - committed).mean() < 2e-3 and moved < 2e-4, \
         f"docs/figures/stiffness-nasa-rig.png differs ({moved:.2%} of its pixels): rerun the command in this docstring"
+    committed_numbers_are_the_formulas(json.loads(FIGURE.with_suffix(".json").read_text()))
+
+
+def committed_numbers_are_the_formulas(data: dict) -> None:
+    """The committed JSON checked against what does not come from regenerating it: ISO 21771's contact ratio and
+    ISO 6336-1's q', c'_th, c', c_gamma_alpha typed here for the 28/28 pair (x = 0, rack h_fP = 1.25 m), and its
+    mean, minimum and maximum against its own curve."""
+    m, z, alpha = 3.175e-3, 28, math.radians(20)
+    d, db, da = z * m, z * m * math.cos(alpha), z * m + 2 * m
+    a = d  # (two equal gears, no shift: the reference centre distance)
+    eps = (math.sqrt(da ** 2 - db ** 2) - a * math.sin(alpha)) / (math.pi * m * math.cos(alpha))
+    assert data["contact_ratio"] == pytest.approx(eps, rel=1e-12)
+    iso = data["iso6336"]
+    q = 0.04723 + 0.15551 / z + 0.25791 / z
+    c_th, C_B = 1 / q, 1 + 0.5 * (1.2 - 1.25)
+    assert (iso["q_prime"], iso["c_th"], iso["C_B"]) == pytest.approx((q, c_th, C_B), rel=1e-12)
+    assert iso["c_prime"] == pytest.approx(c_th * 0.8 * C_B, rel=1e-12)
+    assert iso["c_gamma_alpha"] == pytest.approx(c_th * 0.8 * C_B * (0.75 * eps + 0.25), rel=1e-12)
+    assert iso["mean_N_per_m"] == pytest.approx(iso["c_gamma_alpha"] * 6.35e-3 * 1e9, rel=1e-12)
+    k = np.array(data["stiffness"])
+    assert np.diff(data["phase"]) == pytest.approx(np.full(len(k) - 1, 2 * math.pi / len(k)), rel=1e-9)
+    assert data["mean"] == pytest.approx(k.mean(), rel=1e-3)  # (the samples straddle the contact's jumps)
+    assert data["min"] == pytest.approx(k.min(), rel=1e-3) and data["max"] == pytest.approx(k.max(), rel=1e-9)
 
 
 CRACKED = REPO / "docs" / "figures" / "stiffness-cracked-tian"

@@ -10,6 +10,8 @@ import sys
 import warnings
 from pathlib import Path
 
+from same_numbers import differences
+
 PAGE = Path(__file__).resolve().parents[1] / "docs" / "geometry.md"
 START, END = "<!-- iso-table -->", "<!-- /iso-table -->"
 DEG = math.pi / 180
@@ -55,7 +57,25 @@ def _block(text: str) -> str:
 
 
 def test_the_pages_iso_table_is_what_the_code_computes():
-    assert _block(PAGE.read_text()) == render(), "docs/geometry.md's table is stale: python tests/test_geometry_docs.py --write"
+    assert not differences(render(), _block(PAGE.read_text())), (
+        "docs/geometry.md's table is stale: python tests/test_geometry_docs.py --write")
+
+
+def test_the_pages_iso_columns_are_the_standards_numbers():
+    """Not from regenerating the page: its ISO columns against ISO 6336-1 typed here for the three spur pairs
+    (x = 0, h_fP = 1.25 m: C_B = 0.975), and against ISO/TR 6336-30's printed c'_th and c' for its example."""
+    rows = [[cell.strip() for cell in line.strip("|").split("|")] for line in _block(PAGE.read_text()).splitlines()[2:]]
+    assert len(rows) == 4
+    for row, (z, m) in zip(rows[:3], [(28, 3.175e-3), (28, 3.175e-3), (62, 2e-3)]):
+        alpha = 20 * DEG
+        d, db = z * m, z * m * math.cos(alpha)
+        eps = (math.sqrt((d + 2 * m) ** 2 - db ** 2) - d * math.sin(alpha)) / (math.pi * m * math.cos(alpha))
+        c_th = 1 / (0.04723 + (0.15551 + 0.25791) / z)
+        c_prime = c_th * 0.8 * 0.975
+        expected = (f"{eps:.4f}", f"{c_th:.2f}", f"{c_prime:.2f}", f"{c_prime * (0.75 * eps + 0.25):.2f}")
+        assert (row[1], row[7], row[8], row[9]) == expected, row[0]
+    assert (float(rows[3][7]), float(rows[3][8])) == (17.86, 12.37)  # ISO/TR 6336-30: 17.85584, 12.37047
+    assert abs(float(rows[3][9]) - 17.46485) < 0.01  # (its printed c_gamma_alpha, from rounded tip diameters)
 
 
 if __name__ == "__main__":

@@ -145,3 +145,38 @@ def test_a_pair_that_cannot_mesh_is_refused_with_one_line():
     with pytest.warns(GearsymWarning, match="undercut"):
         small = GearGeometry(9, 3e-3, 20 * DEG, 10e-3)
     assert "below its involute" in _pair_error(small, GearGeometry(90, 3e-3, 20 * DEG, 10e-3))
+
+
+def test_helices_of_the_same_hand_do_not_mesh_externally():
+    right = GearGeometry(28, 3e-3, 20 * DEG, 20e-3, helix_angle=15 * DEG)
+    error = _pair_error(right, GearGeometry(40, 3e-3, 20 * DEG, 20e-3, helix_angle=15 * DEG))
+    assert error == ("gear pair: the helices have the same hand (15 and 15 deg: the sign is the hand); an external "
+                     "pair meshes with opposite hands: give gear 2 -15 deg")
+    GearPair(right, GearGeometry(40, 3e-3, 20 * DEG, 20e-3, helix_angle=-15 * DEG))  # (opposite hands: a pair)
+
+
+def test_a_bore_that_leaves_no_rim_is_refused_and_a_pinhole_bore_is_a_solid_body():
+    """A rim under half the tooth height is refused (ISO 6336-3's rim factor ends there); a bore so small that
+    Sainsot's root-to-bore ratio passes the fit's 7 is taken at 7, as a solid gear is (the fit's h^2 terms made a
+    1e-9 mm bore's mesh stiffness 1.6e-31 N/m, and 1 mm's a 178 Hz mode where the solid pair has 5174 Hz)."""
+    from gearsym.geometry import mesh_stiffness
+
+    nasa = dict(teeth=28, module=3.175e-3, pressure_angle=20 * DEG, face_width=6.35e-3)
+    with pytest.raises(GearsymError, match=r"the bore \(75 mm\) leaves a rim of 2.98 mm under the teeth, less than "
+                                           r"0.5 of their height \(7.14 mm; .*give a bore of at most 73.82 mm"):
+        GearGeometry(**nasa, bore_diameter=75e-3)
+
+    def mean(bore):
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            gear = GearGeometry(**nasa, bore_diameter=bore)
+            value = mesh_stiffness(GearPair(gear, gear)).mean
+        return value, " ".join(str(w.message) for w in said)
+
+    solid, _ = mean(0.0)
+    for bore, ratio in ((1e-12, "8.1e+10"), (1e-3, "81")):
+        value, said = mean(bore)
+        assert value == pytest.approx(solid, rel=1e-12)
+        assert f"root radius / bore radius = {ratio}, beyond the 1.4-7 of Sainsot's body formula" in said
+    within, said = mean(20e-3)
+    assert "Sainsot" not in said and within > solid  # (h = 4: a body held nearer the teeth is stiffer)

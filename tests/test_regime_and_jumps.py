@@ -8,6 +8,7 @@ from conftest import compiled
 from gearsym import Integration, lyapunov_spectrum
 from gearsym.analysis.jumps import find_jumps, hysteresis_intervals
 from gearsym.analysis.regime import classify_regime
+from gearsym.errors import GearsymError
 
 
 # ------------------------------------------------------------------ regimes
@@ -86,3 +87,20 @@ def test_a_tiny_step_on_a_flat_curve_is_not_a_jump():
     assert find_jumps(OMEGA, a) == []
     up, down = a.copy(), a + 1e-6
     assert hysteresis_intervals(OMEGA, up, down) == []
+
+
+def test_a_forcing_too_fast_for_the_run_is_no_torus():
+    """At omega = 1e308 the tau-form's forces (over omega^2) underflow to zero: x drifts at a constant rate, its
+    Poincare points step evenly, which looked stationary (a torus). The run lasts 1e-306 of a period of the
+    model's own fastest motion: undetermined, and the settling says why."""
+    result = lyapunov_spectrum(compiled("one_stage"), omega=1e308, options=Integration(periods=70, discard=10))
+    assert result.regime == "undetermined"
+    assert result.settling.state == "brief" and "too short for its Poincare points to show" in result.settling.describe()
+    assert lyapunov_spectrum(compiled("one_stage"), omega=1.5, options=Integration(periods=70, discard=10)).regime \
+        != "undetermined"  # (a run long enough is judged as before)
+
+
+def test_a_forcing_frequency_that_overflows_the_equations_is_one_line():
+    with pytest.raises(GearsymError, match=r"omega=1e-308.*the equations are not finite at the start with these "
+                                           r"values: a value overflows the engine's doubles"):
+        lyapunov_spectrum(compiled("one_stage"), omega=1e-308, options=Integration(periods=70, discard=10))

@@ -6,6 +6,7 @@ import dataclasses
 import json
 import re
 
+import numpy as np
 import pytest
 
 import gearsym
@@ -20,6 +21,7 @@ from gearsym.reproduce import claims as claim_checks
 from gearsym.reproduce import SCENARIOS, compute, paper_plan, render, reproduce
 from gearsym.reproduce.compute import box_grid
 from gearsym.reproduce.report import VERDICT_MARK
+from same_numbers import differences, json_differences
 
 DOCS = REPO_ROOT / "docs"
 RECORD = DOCS / "figures" / "claims.json"
@@ -54,8 +56,15 @@ def test_every_claim_has_a_verdict_by_its_rule_in_every_scenario(committed):
     assert set(committed["scenarios"][0]["study"]) == {"k_a", "kS", "I2"}
 
 
+@pytest.mark.slow
 def test_figure_3_claims_recomputed_match_the_committed_record(tmp_path, committed):
-    """The Fig. 3 sweeps again, on the paper's grid: the measured sentences must come out the same."""
+    """The Fig. 3 sweeps again, on the paper's grid: the same verdicts, the same measured sentences with their
+    numbers to 2 % (the share of chaotic points, the ends of chaotic intervals), and the same branches, bifurcations
+    and paper's jumps to 1e-5 of omega. With the C compiled without FMA contraction the chaotic points are other
+    realizations of their attractors: the list of the up run's jumps (one of eight, at a chaotic point, comes and
+    goes) and the ends of the hysteresis intervals between chaotic attractors moved; the verdicts, the periodic
+    branches and what the paper's jumps are did not. So the jumps' list is compared only when the C rounds as the
+    committed run's did (the sweeps' amplitudes at the periodic points are the test of that)."""
     full = paper_plan(scenario=SCENARIOS[0])
     plan = dataclasses.replace(full, sweeps=tuple(s for s in full.sweeps if s.name.startswith("fig3")),
                                attractors=(), portraits=())
@@ -63,9 +72,15 @@ def test_figure_3_claims_recomputed_match_the_committed_record(tmp_path, committ
     recorded = {c["id"]: c for c in committed["scenarios"][0]["claims"]}
     for check in (claim_checks.chaos_d0, claim_checks.regular_d2, claim_checks.amplitude_d2, claim_checks.jumps_d2):
         claim = check(computed, {})
-        assert claim["measured"] == recorded[claim["id"]]["measured"]
-        assert claim["verdict"] == recorded[claim["id"]]["verdict"]
-    assert json_safe(computed.jumps) == committed["scenarios"][0]["orbits"]  # the branches, and what each jump is
+        assert claim["verdict"] == recorded[claim["id"]]["verdict"], claim["id"]
+        if check is not claim_checks.jumps_d2:
+            assert not differences(claim["measured"], recorded[claim["id"]]["measured"], rel=0.02), claim["id"]
+        else:
+            assert claim["values"]["matched"] == recorded[claim["id"]]["values"]["matched"]
+    made, orbits = json_safe(computed.jumps), committed["scenarios"][0]["orbits"]
+    for sweep in orbits:  # the branches, their bifurcations and what the paper's jumps are
+        for key in ("branches", "bifurcations", "paper_jumps"):
+            assert not json_differences(made[sweep].get(key), orbits[sweep].get(key), rel=1e-5), (sweep, key)
 
 
 def test_every_paper_jump_and_hysteresis_end_is_a_located_bifurcation_a_crisis_or_said_undecided(committed):
@@ -90,6 +105,7 @@ def test_every_paper_jump_and_hysteresis_end_is_a_located_bifurcation_a_crisis_o
     assert all(j["text"] in page for j in paper)
 
 
+@pytest.mark.slow
 def test_a_quick_reproduction_writes_every_output_and_reuses_its_data(tmp_path):
     record = reproduce(tmp_path / "figures", tmp_path / "reproduction.md", quick=True, progress=False)
     for name in ("fig3.png", "fig3-orbits.png", "fig4.png", "fig6.png", "fig7.png", "hysteresis.png", "study.png",
@@ -112,6 +128,7 @@ def test_a_quick_reproduction_writes_every_output_and_reuses_its_data(tmp_path):
     assert again == record
 
 
+@pytest.mark.slow
 def test_a_basin_map_recomputed_matches_the_committed_record(committed):
     """Fig. 4 as basins (D = 2, omega = 1.5, calibrated), again on the committed grid: the same attractors, and
     their shares to a start or two (a start on a basin boundary may go either way on another CPU's rounding)."""
@@ -126,3 +143,40 @@ def test_a_basin_map_recomputed_matches_the_committed_record(committed):
         [(a["description"], a["period"]) for a in recorded["attractors"]]
     for a, r in zip(found.attractors, recorded["attractors"]):
         assert abs(a.basin.starts - r["starts"]) <= 2
+
+
+def test_a_record_equal_to_the_committed_one_within_rounding_leaves_the_files_as_they_are(tmp_path, committed):
+    """Another machine rounds the continuation's located values otherwise (the last digits of claims.json): the
+    committed record and report stay, byte for byte; a result that differs is written."""
+    from gearsym.reproduce.report import write
+
+    record, page = tmp_path / "figures" / "claims.json", tmp_path / "reproduction.md"
+    record.parent.mkdir()
+    record.write_text((DOCS / "figures" / "claims.json").read_text())
+    page.write_text((DOCS / "reproduction.md").read_text())
+    before = (record.read_bytes(), page.read_bytes())
+    rounded = json.loads(json.dumps(committed))
+    fold = rounded["scenarios"][0]["orbits"]["fig3_D2"]["bifurcations"][0]
+    fold["omega"] *= 1 + 3e-7
+    assert write(rounded, record, page) == committed
+    assert (record.read_bytes(), page.read_bytes()) == before
+    fold["omega"] *= 1 + 1e-3
+    assert write(rounded, record, page) == rounded
+    assert json.loads(record.read_text()) == rounded
+
+
+def test_a_figure_redrawn_with_a_line_moved_by_rounding_is_kept_and_a_changed_one_replaced(tmp_path):
+    from gearsym.figures.save import pyplot, save_figure
+
+    def draw(shift: float):
+        fig, ax = pyplot().subplots(figsize=(4, 3))
+        x = np.linspace(0, 2, 200)
+        ax.plot(x, np.sin(3 * x) + shift)
+        ax.set_title("sin 3x")
+        return fig
+
+    path = save_figure(draw(0.0), tmp_path / "f.png", dpi=80)
+    first = path.read_bytes()
+    assert save_figure(draw(2e-3), tmp_path / "g.png", dpi=80).read_bytes() != first  # other antialiasing
+    assert save_figure(draw(2e-3), path, dpi=80, keep_same=True).read_bytes() == first
+    assert save_figure(draw(0.3), path, dpi=80, keep_same=True).read_bytes() != first

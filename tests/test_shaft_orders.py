@@ -17,6 +17,8 @@ from scipy.integrate import solve_ivp
 import conftest
 import fault_rig
 import gearsym
+import gearsym.cli.spectrum
+import gearsym.memory
 import rig
 from gearsym import Drivetrain, Gear, Harmonic, Integration, Mesh, Torque
 from gearsym.cli import main
@@ -301,3 +303,65 @@ def test_a_sweep_and_a_continuation_of_an_eccentric_pinion_run_on_its_revolution
     assert branch.values[-1] == pytest.approx(1.7) and len(branch) > 5
     for k in (0, len(branch) // 2, len(branch) - 1):
         np.testing.assert_allclose(flow(branch.values[k], branch.states[k]), branch.states[k], atol=1e-5)
+
+
+# ------------------------------------------------------------------ issue 35: spectra of healthy gears, bad input
+def _energy(capsys, *argv) -> dict:
+    assert main(["spectrum", *argv, "--quiet"]) == 0
+    out = capsys.readouterr().out
+    said = out.split("sideband energy ")[1].split(";")[0]
+    return {g: float(v) for g, v in (part.split() for part in said.split(", "))}
+
+
+def test_a_healthy_pair_shows_no_sidebands_and_a_cracked_one_does(capsys):
+    """one_stage with 20/53 teeth at omega = 1.5 answers with period 2 (half orders, no shaft order): over the
+    default 212 mesh periods (10.6 pinion revolutions) the unwindowed fit gave the pinion 0.034 of sidebands, the
+    windowed one 1e-7 (its mesh line is 2.2); the cracked pinion of cracked_pair shows 0.18."""
+    healthy = _energy(capsys, "one_stage", "--teeth", "20,53")
+    assert max(healthy.values()) < 1e-5
+    cracked = _energy(capsys, "cracked_pair")
+    assert cracked["gear1"] > 0.1 and cracked["gear1"] > 1e4 * healthy["gear1"]
+    tiny = _energy(capsys, "one_stage", "--teeth", "3,5")  # (k < Z/2 only: no line at a mesh harmonic, no NaN)
+    assert all(math.isfinite(v) for v in tiny.values()) and max(tiny.values()) < 1e-4
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["cracked_pair", "--periods", "1", "--discard", "0"],
+     "the run of --periods 1 minus --discard 0 (20 mesh periods each) holds 20 mesh periods, less than the 2 "
+     "revolutions of gear2 (53 teeth: 106 mesh periods) its sidebands need; give at least --periods 6"),
+    (["cracked_pair", "--sidebands", "100000"], "--sidebands 100000: a gear of Z teeth has Z/2 sidebands of its own"),
+    (["one_stage", "--teeth", "1000000000,3"], "the default run of gear1 1000000000 teeth, gear2 3 teeth (4 revolutions "
+                                               "of the larger gear, 4000000000 mesh periods, after the transient) needs"),
+])
+def test_a_spectrum_that_cannot_show_sidebands_is_refused_before_the_run(capsys, monkeypatch, argv, said):
+    monkeypatch.setattr(gearsym.memory, "available", lambda: 2**30)  # (a machine of 1 GiB: the same on any)
+    monkeypatch.setattr(gearsym.cli.spectrum, "simulated_order_spectrum", lambda *a, **k: pytest.fail("ran"))
+    assert main(["spectrum", *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("gearsym: error: ") and err.count("\n") == 1 and said in err, err
+    assert "--periods" not in err or "--periods" in argv
+
+
+def test_a_record_shorter_than_two_revolutions_is_refused(tmp_path, capsys):
+    runs = [(1.8, fault_rig.Pair(teeth=TEETH, eccentric=(1, 0.5, 0.3)).record(1.8, periods=20, transient=20))]
+    data = fault_rig.write(tmp_path / "short.csv", runs, noise=0.0)
+    assert main(["spectrum", "one_stage", "--teeth", "9,13", "--data", str(data)]) == 2
+    err = capsys.readouterr().err
+    assert "less than the 2 revolutions of gear2 (13 teeth: 26 mesh periods) its sidebands need" in err
+
+
+def test_numeric_spacing_errors_reduce_to_the_equations_of_the_same_errors_as_parameters():
+    """The reduction's self-check compares 30 digits; a model file's 0.1 is a double, whose products the two sides
+    round differently (equal to 18 digits): it refused every numeric SpacingErrors. Now they reduce, to the
+    equations the same errors give as parameters."""
+    errors = (0.1, -0.05, 0.0, 0.02, -0.07)
+    numeric = pair("spacing_numeric", lambda g1, g2: SpacingErrors("pitch", g1, errors=errors), teeth=(5, 11))
+    named = pair("spacing_named", lambda g1, g2: SpacingErrors("pitch", g1, errors=tuple(f"s{i}" for i in range(5))),
+                 teeth=(5, 11), **{f"s{i}": e for i, e in enumerate(errors)})
+    run = Integration(periods=2, discard=0, backend="in-process")
+    a, b = (gearsym.compile_model(gearsym.load(m), run) for m in (numeric, named))
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        t, y = rng.uniform(0, 60), rng.uniform(-12, 3, 2)  # (both flanks of the backlash and its gap)
+        np.testing.assert_allclose(np.asarray(a.rhs(t, y, a.parameter_vector())).ravel(),
+                                   np.asarray(b.rhs(t, y, b.parameter_vector())).ravel(), rtol=1e-13, atol=1e-13)

@@ -119,14 +119,23 @@ def find_divergence(strobe: np.ndarray, low: np.ndarray, high: np.ndarray, state
 RK4_LIMIT = 2.78
 
 
+def own_rate(model, y: np.ndarray, p: np.ndarray, period: float, samples: int = 16) -> float:
+    """The largest |eigenvalue| of the Jacobian at the state ``y`` over one forcing period: the rate of the model's
+    fastest own motion there (inf where the Jacobian is not finite: a parameter value overflows the equations)."""
+    largest = 0.0
+    for t in np.linspace(0.0, period, samples, endpoint=False):
+        J = np.asarray(model.jacobian(t, y, p), dtype=float)
+        if not np.all(np.isfinite(J)):
+            return np.inf
+        largest = max(largest, float(np.max(np.abs(np.linalg.eigvals(J)))))
+    return largest
+
+
 def step_ratio(model, p: np.ndarray, y: np.ndarray, period: float, samples: int = 16) -> float:
     """h times the largest |eigenvalue| of the Jacobian at the state ``y`` over one forcing period (h = the
     period over the model's steps): above RK4_LIMIT the integrator itself blows up, whatever the motion does
     (one_stage at omega = 1e-8: 3e6)."""
-    h = period / model.steps_per_period
-    largest = max(float(np.max(np.abs(np.linalg.eigvals(model.jacobian(t, y, p)))))
-                  for t in np.linspace(0.0, period, samples, endpoint=False))
-    return h * largest
+    return period / model.steps_per_period * own_rate(model, y, p, period, samples)
 
 
 def run_failure(model, p: np.ndarray, period: float, start: np.ndarray, strobe: np.ndarray,
@@ -145,6 +154,9 @@ def run_failure(model, p: np.ndarray, period: float, start: np.ndarray, strobe: 
         return None
     why = (f"h times the largest eigenvalue of the Jacobian is {ratio:.3g} at the start, and RK4 is stable only below "
            f"{RK4_LIMIT:g}: the integrator blew up, not (necessarily) the motion; give more --steps-per-period")
+    if not np.isfinite(ratio):
+        why = ("the equations are not finite at the start with these values: a value overflows the engine's "
+               "doubles (a forcing frequency near 0 divides by omega squared); give values nearer the model's own")
     if not state_finite:
         return _failed(model, p, strobe, log_stretch, why)
     values = ", ".join(f"{n}={v:g}" for n, v in zip(model.parameter_names, p))

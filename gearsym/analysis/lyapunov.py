@@ -29,10 +29,10 @@ from ..codegen import CompiledModel, TangentRuns, engine_verb
 from ..codegen.lane_runs import LaneRunner
 from ..errors import GearsymError, warn
 from ..options import Integration
-from .divergence import Divergence, counted_coordinates, find_divergence, run_failure
+from .divergence import Divergence, counted_coordinates, find_divergence, own_rate, run_failure
 from .pairs import merge_pairs
 from .regime import DIVERGED, EQUILIBRIUM, UNDETERMINED, classify_regimes, periods_to_decide, zero_band
-from .settling import Settling, poincare_settling
+from .settling import Settling, brief_run, poincare_settling
 from .statistics import batch_means_stderr
 
 #: a run rests on a fixed point when, over the measured periods, the state moves by no more than this and
@@ -278,7 +278,8 @@ def summarise_runs(model: CompiledModel, runs: TangentRuns, p: np.ndarray, perio
         exps = classify_regimes(exponents[live], stderr[live], measured_time[live], autonomous)
         for i, r in zip(live, exps):
             if r == "quasi-periodic" and not autonomous and eigenvalues[i] is None:
-                settlings[i] = poincare_settling(runs.strobe[i, discard:], period[i])
+                settlings[i] = brief_run(own_rate(model, runs.strobe[i, -1], p[i], period[i]), measured_time[i]) \
+                    or poincare_settling(runs.strobe[i, discard:], period[i])
         regimes_live = classify_regimes(exponents[live], stderr[live], measured_time[live], autonomous,
                                         [settlings[i] for i in live])
         for i, r in zip(live, regimes_live):

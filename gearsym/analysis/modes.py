@@ -6,7 +6,9 @@ coupling's deflection row ``J_c`` (``r_a psi_a - r_b psi_b`` for a mesh, ``psi_b
 with its mean stiffness ``k_c`` (the declared stiffness times the mean of its variation over a mesh
 period). ``K phi = w^2 M phi`` is solved through ``M^(-1/2) K M^(-1/2)`` (M is diagonal), which stays
 symmetric, so repeated eigenvalues (the planet modes of a planetary set) come out with an orthonormal
-basis of their eigenspace and are reported with their multiplicity.
+basis of their eigenspace and are reported with their multiplicity. Any basis of that eigenspace is right, and
+LAPACK's depends on the BLAS kernel (the CPU): the shapes shown are its canonical basis
+(:func:`canonical_basis`), the same on every machine.
 
 Rigid-body modes are those of the reduction (the null space of the deflection rows): as many zero
 frequencies as it finds, with its shapes. With physical values (:mod:`gearsym.physical`) frequencies
@@ -161,14 +163,14 @@ def _solve(nd, values: dict[str, float], unit: str, assumed: tuple[str, ...],
         raise GearsymError(f"{nd.name}: {len(rigid)} rigid-body mode(s) but the stiffness matrix has no such zero "
                            "eigenvalues (a coupling with zero stiffness?)")
     order = np.argsort(eigenvalues)
-    elastic = [i for i in order[len(rigid):]]
+    elastic = [int(i) for i in order[len(rigid):]]
     to_unit = (lambda w: w / (2 * math.pi)) if unit == "Hz" else (lambda w: w)
     coordinates = [c.name for c in nd.coordinates]
     modes = [_mode(0.0, "rigid", len(rigid), u, names, transform, coordinates) for u in rigid]
-    for i in elastic:
-        w2 = max(float(eigenvalues[i]), 0.0)
-        same = sum(1 for j in elastic if abs(float(eigenvalues[j]) - w2) <= DEGENERATE * top)
-        modes.append(_mode(to_unit(math.sqrt(w2)), "elastic", same, shapes[:, i], names, transform, coordinates))
+    for group in _repeated(elastic, eigenvalues, DEGENERATE * top):
+        w = to_unit(math.sqrt(max(float(np.mean(eigenvalues[group])), 0.0)))
+        for shape in canonical_basis(shapes[:, group].T):
+            modes.append(_mode(w, "elastic", len(group), shape, names, transform, coordinates))
     used = set()
     for rb in rd.bodies:
         used |= rb.inertia.free_symbols | (rb.radius.free_symbols if rb.radius is not None else set())
@@ -176,6 +178,50 @@ def _solve(nd, values: dict[str, float], unit: str, assumed: tuple[str, ...],
         used |= rc.stiffness.free_symbols | rc.variation.free_symbols | sp.Matrix(rc.row).free_symbols
     shown = {n: v for n, v in values.items() if parameter_symbol(n) in used}
     return Modes(nd.name, unit, tuple(modes), shown, assumed)
+
+
+def _repeated(order: list[int], eigenvalues: np.ndarray, within: float) -> list[list[int]]:
+    """The indices ``order`` (ascending eigenvalues) in groups of one frequency: each eigenvalue within ``within``
+    of the group's first."""
+    groups: list[list[int]] = []
+    for i in order:
+        if groups and abs(float(eigenvalues[i]) - float(eigenvalues[groups[-1][0]])) <= within:
+            groups[-1].append(i)
+        else:
+            groups.append([i])
+    return groups
+
+
+#: a component below this fraction of a basis's largest is rounding (a body at rest in the subspace)
+AT_REST = 1e-9
+
+
+def canonical_basis(rows: np.ndarray) -> list[np.ndarray]:
+    """The basis of the span of ``rows`` that does not depend on which basis LAPACK returned: its reduced row
+    echelon form (the first body that moves in the subspace is 1 in the first vector and 0 in the others, the
+    next such body likewise in the second, ...). A repeated frequency's eigenvectors are any basis of their
+    plane: another BLAS kernel (another CPU) rotates them, this form does not. One row is returned as it is."""
+    rows = np.array(rows, dtype=float)
+    if len(rows) == 1:
+        return [rows[0]]
+    scale = float(np.max(np.abs(rows)))
+    rows[np.abs(rows) <= AT_REST * scale] = 0.0
+    pivot_row = 0
+    for column in range(rows.shape[1]):
+        if pivot_row == len(rows):
+            break
+        below = np.abs(rows[pivot_row:, column])
+        if below.max() <= AT_REST * scale:
+            continue
+        best = pivot_row + int(np.argmax(below))
+        rows[[pivot_row, best]] = rows[[best, pivot_row]]
+        rows[pivot_row] /= rows[pivot_row, column]
+        for other in range(len(rows)):
+            if other != pivot_row:
+                rows[other] -= rows[other, column] * rows[pivot_row]
+        rows[np.abs(rows) <= AT_REST * max(1.0, float(np.max(np.abs(rows))))] = 0.0
+        pivot_row += 1
+    return list(rows)
 
 
 def _mode(frequency: float, kind: str, multiplicity: int, shape: np.ndarray, names: list[str],

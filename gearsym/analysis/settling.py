@@ -45,6 +45,8 @@ MIN_PERIODS = 4 * CHUNKS
 
 SETTLED_STATE, STATIONARY_STATE, CONVERGING, SPREADING, IRREGULAR = (
     "settled", "stationary", "converging", "spreading", "irregular")
+#: the run is shorter than one period of the model's own fastest motion: its points cannot show anything
+BRIEF = "brief"
 
 
 @dataclass(frozen=True)
@@ -67,6 +69,10 @@ class Settling:
         return self.state in (SETTLED_STATE, STATIONARY_STATE)
 
     def describe(self, time_unit: str = "unit time") -> str:
+        if self.state == BRIEF:
+            return (f"the measured periods last {self.change:.3g} of a period of the model's fastest own motion (its "
+                    f"Jacobian's largest |eigenvalue| is {self.rate:.3g} per {time_unit}), too short for its Poincare "
+                    "points to show an attractor (the forcing is too fast for the run, or the motion too slow)")
         if self.state == SETTLED_STATE:
             return f"the Poincare points repeat every {self.lag} period(s)"
         if self.state == STATIONARY_STATE:
@@ -78,6 +84,15 @@ class Settling:
         how = "converge" if self.state == CONVERGING else "spread"
         return (f"the Poincare points still {how} (their distance at a return changed {self.change:.3g}x over the "
                 f"measured periods, rate {self.rate:+.3g} +- {self.rate_stderr:.2g} per {time_unit}): a transient")
+
+
+def brief_run(own_rate: float, measured_time: float) -> Settling | None:
+    """A run whose ``measured_time`` is less than one period of the model's fastest own motion (``own_rate``, the
+    largest |eigenvalue| of its Jacobian): a Settling that decides nothing (one_stage at omega = 1e308, whose
+    forces underflow to zero in the tau-form: its points drift at a constant step, which looks stationary);
+    None for a run long enough."""
+    coverage = measured_time * own_rate / (2 * np.pi)
+    return Settling(BRIEF, 0, float(own_rate), 0.0, float(coverage)) if not coverage >= 1 else None
 
 
 def poincare_settling(strobe: np.ndarray, period: float) -> Settling | None:

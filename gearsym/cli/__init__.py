@@ -13,8 +13,10 @@ Ctrl-C, 143 after SIGTERM (128 + the signal, as a shell reports either).
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import os
+import re
 import signal
 import sys
 import threading
@@ -26,6 +28,7 @@ from types import ModuleType
 from ..caller import command_line
 from ..version import __version__
 from ..errors import GearsymError, GearsymWarning
+from ..files.atomic import NO_ROOM
 
 #: each subcommand's module (its ``NAME`` -> the module in this package), in the order ``gearsym --help`` lists
 #: them; a run imports the module of its own command only (the others' imports would cost it start-up time)
@@ -53,9 +56,21 @@ def _modules(names) -> tuple[ModuleType, ...]:
     return tuple(importlib.import_module(f"{__name__}.{MODULES[name]}") for name in names)
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser, but a value that starts with a minus and is a number or numbers separated by commas
+    (``--profile-shift -0.3,0.3``, ``--teeth -3,5``) is an option's value, not an option: argparse knows only a
+    lone negative number as one."""
+
+    NEGATIVE = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?(,\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?)*$")
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = self.NEGATIVE
+
+
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """The parser of every subcommand, or of ``command`` alone (a name in :data:`MODULES`)."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="gearsym", description="Symbolic drivetrain models, reduced and nondimensionalised automatically."
     )
     parser.add_argument("--version", action="version", version=f"gearsym {__version__}")
@@ -70,23 +85,114 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``gearsym`` with ``argv`` (default: the process arguments); returns the exit status."""
     argv = sys.argv[1:] if argv is None else list(argv)
+    closed = _closed_standard_streams()
     args = build_parser(argv[0] if argv else None).parse_args(argv)
-    with warnings.catch_warnings(), _sigterm_as_ctrl_c() as terminated, command_line():
+    if closed:
+        print(f"gearsym: error: {closed}", file=sys.stderr)
+        return USAGE_ERROR
+    with warnings.catch_warnings(), _sigterm_as_ctrl_c() as terminated, command_line(), _guarded_stdout():
         warnings.simplefilter("default", GearsymWarning)
         warnings.showwarning = _one_line
         try:
             status = args.run(args)
             sys.stdout.flush()  # a closed pipe shows here rather than at the interpreter's exit
+        except BrokenPipeError:
+            _discard_stdout()  # nobody reads the rest
+            return CLOSED_PIPE
         except GearsymError as exc:
+            if isinstance(exc, StdoutError):
+                _discard_stdout()
             print(f"gearsym: error: {exc}", file=sys.stderr)
             return USAGE_ERROR
-        except BrokenPipeError:
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nobody reads the rest
-            return CLOSED_PIPE
+        except OSError as exc:
+            if exc.errno not in NO_ROOM:
+                raise
+            where = f" (writing {exc.filename})" if exc.filename else ""
+            print(f"gearsym: error: {exc.strerror}{where}: free some space there, or write elsewhere (--out, "
+                  "$GEARSYM_CACHE)", file=sys.stderr)
+            return USAGE_ERROR
         except KeyboardInterrupt:  # a command with nothing to keep, or to say about it
             print("gearsym: interrupted", file=sys.stderr)
             status = INTERRUPTED
     return 128 + signal.SIGTERM if status == INTERRUPTED and terminated else status
+
+
+class StdoutError(GearsymError):
+    """Standard output that cannot be written (``> /dev/full``, a full disk): said in one line on stderr."""
+
+
+class _GuardedStream:
+    """sys.stdout, but a failure to write it (other than a closed pipe, which :func:`main` ends quietly) is a
+    :class:`StdoutError`, said in one line like any other error, not a traceback."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def _guarded(self, call, *args):
+        try:
+            return call(*args)
+        except BrokenPipeError:
+            raise
+        except OSError as exc:
+            raise StdoutError(f"cannot write to standard output: {exc.strerror or exc}; its output is lost (redirect "
+                              "it to a file on a disk with room, or to /dev/null)") from None
+
+    def write(self, text):
+        return self._guarded(self._stream.write, text)
+
+    def writelines(self, lines):
+        return self._guarded(self._stream.writelines, lines)
+
+    def flush(self):
+        return self._guarded(self._stream.flush)
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
+@contextmanager
+def _guarded_stdout() -> Iterator[None]:
+    """sys.stdout guarded (:class:`_GuardedStream`) while a command runs."""
+    stream = sys.stdout
+    sys.stdout = _GuardedStream(stream)
+    try:
+        yield
+    finally:
+        if sys.stdout is not None and getattr(sys.stdout, "_stream", None) is stream:
+            sys.stdout = stream
+
+
+def _discard_stdout() -> None:
+    """What is left to print goes nowhere (a closed pipe, a full disk): the interpreter's last flush cannot fail."""
+    try:
+        fd = sys.__stdout__.fileno() if sys.__stdout__ is not None else 1
+        os.dup2(os.open(os.devnull, os.O_WRONLY), fd)
+    except (OSError, ValueError):
+        pass
+
+
+def _closed_standard_streams() -> str | None:
+    """What is wrong if gearsym was started with stdout closed (``>&-``), else None. A closed descriptor 0, 1
+    or 2 is given /dev/null first, so that no file gearsym opens later takes its number (and gets its output,
+    or a compiler's)."""
+    closed = []
+    for fd in (0, 1, 2):
+        try:
+            os.fstat(fd)
+        except OSError:
+            closed.append(fd)
+            opened = os.open(os.devnull, os.O_RDWR)
+            if opened != fd:
+                os.dup2(opened, fd)
+                os.close(opened)
+    if 2 in closed and sys.stderr is None:
+        sys.stderr = open(os.devnull, "w")
+    if 1 in closed or sys.stdout is None:
+        if sys.stdout is None:
+            sys.stdout = open(os.devnull, "w")
+        return ("standard output is closed (>&-): gearsym prints its results there; redirect it instead (> FILE, "
+                "or > /dev/null to drop them)")
+    return None
 
 
 def _one_line(message, category, filename, lineno, file=None, line=None):

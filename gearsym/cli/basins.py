@@ -14,7 +14,7 @@ from ..errors import GearsymError
 from ..figures.basins import Shown, plot_basin_fractions, plot_basin_map
 from ..files.atomic import write_atomically
 from ..files.outputs import check_figure, check_file
-from ..physical.basins import PhysicalShown, engine_grid, physical_dict, units_of
+from ..physical.basins import PhysicalShown, check_grid_units, engine_grid, physical_dict, units_of
 from ..physical.sweeps import nondimensional_axes
 from ..sweep.basin_continuation import MATCH_DISTANCE, continue_basins
 from ..sweep.grid import Axis, axes_from, parse_axis
@@ -63,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
         check_figure(args.plot)
     if args.jobs < 0:
         raise GearsymError(f"--jobs must be 0 (every core) or more, got {args.jobs}")
-    grid_axes = [parse_axis(g) for g in args.grid]
+    grid_axes = [parse_axis(g, "--grid") for g in args.grid]
     if len(grid_axes) != 2 or grid_axes[0].name == grid_axes[1].name:
         raise GearsymError(f"--grid: give two different states (e.g. --grid x=-5:5:0.1 --grid v=-5:5:0.1), got "
                            f"{', '.join(a.name for a in grid_axes) or 'none'}")
@@ -76,6 +76,8 @@ def run(args: argparse.Namespace) -> int:
         if unit:
             raise GearsymError(f"{unit.spec!r} has a unit, but the model has no physical values; give the model's own "
                                "numbers")
+    if units is not None:
+        check_grid_units(units, grid_axes)  # (before the model is compiled)
     if axis is not None and units is not None:
         axis = nondimensional_axes(scaling, [axis])[0]
     compiled = compiled_from(args)

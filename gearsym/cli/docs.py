@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 
 from ..derivation import derive, render
+from ..files.atomic import write_atomically
 from ..files.outputs import check_folder
 from ..loading import declared
 from ..registry import available_models, output_root
@@ -65,7 +66,6 @@ def run(args: argparse.Namespace) -> int:
         return 1 if stale else 0
     for (name, text), out in zip(pages, outs):
         path = out / f"{name}.md"
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_bytes(text.encode("utf-8"))
+        write_atomically(path, text.encode("utf-8"))
         print(shown(path))
     return 0

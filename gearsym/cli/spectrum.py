@@ -12,14 +12,15 @@ import json
 import math
 from pathlib import Path
 
-from ..analysis.order_run import mesh_gears, simulated_order_spectrum
-from ..analysis.orders import MESH_HARMONICS, SIDEBANDS, order_spectrum
+from ..analysis.order_run import SAMPLES_PER_CYCLE, mesh_gears, simulated_order_spectrum
+from ..analysis.orders import MESH_HARMONICS, MIN_REVOLUTIONS, SIDEBANDS, check_length, most_sidebands, order_spectrum
 from ..checks import check_run, json_safe
 from ..data.measurements import load_measurements
 from ..errors import GearsymError
 from ..files.atomic import write_atomically
 from ..figures.orders import plot_order_spectra
 from ..loading import load
+from ..memory import check_fits
 from ..options import STEPS_PER_PERIOD, Integration
 from ..files.outputs import check_figure, check_file
 from .integration import add_integration_arguments, compiled_from
@@ -27,6 +28,9 @@ from .settings import add_set_argument, model_settings
 from .simulate import with_effects
 
 NAME = "spectrum"
+#: the shortest default run, in mesh periods (small gears: 4 revolutions would not part a period-2 response's half
+#: orders from their sidebands)
+MIN_MESH_PERIODS = 200
 HELP = "order spectrum (mesh harmonics and each gear's shaft-order sidebands) of a run or of measured records"
 
 
@@ -48,8 +52,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"shaft orders labelled on each side of each (default {SIDEBANDS})")
     add_integration_arguments(parser, periods=None)
     parser.add_argument("--periods", type=int, default=None,
-                        help="periods of the run in all (default: 4 revolutions of the slower gear after the "
-                             "transient)")
+                        help="periods of the run in all (default: 4 revolutions of the slower gear, and at least "
+                             f"{MIN_MESH_PERIODS} mesh periods, after the transient)")
     parser.add_argument("--discard", type=int, default=None, help="transient periods (default: 100 mesh periods)")
     parser.add_argument("--out", type=Path, default=None, metavar="FILE.json", help="the spectra and their lines")
     parser.add_argument("--plot", type=Path, default=None, metavar="FILE.png", help="the figure")
@@ -87,14 +91,43 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_sidebands(args, gears: dict) -> None:
+    """--sidebands K: at most the sidebands a gear has of its own (k < Z/2; the default is cut to them per gear)."""
+    most = max(most_sidebands(z) for z in gears.values())
+    if args.sidebands > most and args.sidebands != SIDEBANDS:
+        raise GearsymError(f"--sidebands {args.sidebands}: a gear of Z teeth has Z/2 sidebands of its own on each side "
+                           f"of a mesh harmonic (beyond, they are the next harmonic's); here at most {most} "
+                           f"({', '.join(f'{g} {z} teeth' for g, z in gears.items())})")
+
+
+#: memory per sample of a run's order spectrum: the samples and the windowed fit's columns (two copies)
+def _spectrum_bytes(lines: int) -> int:
+    return 8 * (2 + 2 * (1 + 2 * lines))
+
+
 def _simulated(args, settings: dict):
     system = with_effects(args.model, args.effect, settings) if args.effect else load(args.model, **settings)
     name, gears, _ = mesh_gears(system, args.coordinate)
+    _check_sidebands(args, gears)
     cycles = system.cycles
     discard = args.discard if args.discard is not None else max(1, math.ceil(100 / cycles))
-    measured = max(1, math.ceil(4 * max(gears.values()) / cycles))
+    measured = max(1, math.ceil(max(4 * max(gears.values()), MIN_MESH_PERIODS) / cycles))
     periods = args.periods if args.periods is not None else discard + measured
     steps = args.steps_per_period or STEPS_PER_PERIOD
+    teeth = ", ".join(f"{g} {z} teeth" for g, z in gears.items())
+    if args.periods is None:  # (the run's length comes from the tooth counts: say so, not --periods)
+        asked = (f"the default run of {teeth} (4 revolutions of the larger gear, {measured * cycles} mesh periods, "
+                 "after the transient)")
+    else:
+        asked = f"--periods {args.periods}"
+        check_length((periods - discard) * cycles, gears, f"the run of --periods {args.periods} minus --discard "
+                     f"{discard} ({cycles} mesh period{'s' if cycles > 1 else ''} each)",
+                     f"give at least --periods {discard + math.ceil(MIN_REVOLUTIONS * max(gears.values()) / cycles)}")
+    lines = args.mesh_harmonics * (1 + 2 * len(gears) * args.sidebands) + len(gears) * args.sidebands
+    samples = SAMPLES_PER_CYCLE * cycles
+    check_fits(periods, 16 * steps * cycles * (len(system.states) + 1) + (periods - discard) / periods * samples
+               * _spectrum_bytes(lines), asked=asked, item="period", what="the run's every step, its samples and the "
+               "fit of the lines")
     check_run(steps_per_period=steps)
     options = Integration(periods=periods, discard=discard, steps_per_period=steps, locate_crossings=not args.plain,
                           backend=args.backend)
@@ -109,7 +142,11 @@ def _measured(args, settings: dict):
         raise GearsymError("--effect simulates a run; --data analyses measured records: give one of them")
     system = load(args.model, **settings)
     _, gears, mesh_order = mesh_gears(system)
+    _check_sidebands(args, gears)
     data = load_measurements(args.data, system, time_scale=args.time_scale)
+    for r in data:  # (every record checked before any is analysed)
+        length = mesh_order * float(r.tau[-1] - r.tau[0]) / (2 * math.pi)
+        check_length(length, gears, f"{r.label}", "give a longer record, or leave its gears' sidebands to a longer one")
     spectra = []
     for r in data:
         for channel, values in r.observed.items():

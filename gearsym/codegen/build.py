@@ -17,7 +17,9 @@ from pathlib import Path
 
 from ..errors import GearsymError
 from ..options import Integration
+from ..files.atomic import writing
 from ..files.paths import GENERATED_DIR
+from ..files.private import CACHE_ADVICE
 from ..system import FirstOrderSystem
 from .compiled import CompiledModel
 from .compiler import cache_dir, compile_library
@@ -89,7 +91,8 @@ def _compiled_functions(system: FirstOrderSystem, loops: LoopOptions, digest: st
         mf = build_functions(system, loops)
         timings["build"] = time.perf_counter() - t
         t = time.perf_counter()
-        keep_generated(write_code(mf, code_dir, digest))
+        with writing(code_dir, CACHE_ADVICE):  # (the cache's disk full: said as such)
+            keep_generated(write_code(mf, code_dir, digest))
         timings["generate"] = time.perf_counter() - t
     lib = compile_library(source, system.name, announce=_to_stderr if verbose else None,
                           describes=library_describes(system, digest))

@@ -31,6 +31,7 @@ change rebuilds.
 from __future__ import annotations
 
 import atexit
+import errno
 import hashlib
 import json
 import os
@@ -45,7 +46,8 @@ from functools import lru_cache
 from pathlib import Path
 
 from ..errors import GearsymError, warn
-from ..files.private import NotPrivate, private_folder
+from ..files.atomic import no_room, write_error
+from ..files.private import CACHE_ADVICE, NotPrivate, private_folder
 from .trust import record, trusted
 
 DEFAULT_FLAGS = ("-O3", "-march=native", "-mtune=generic", "-fno-tree-partial-pre")
@@ -204,6 +206,15 @@ def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple
         kept = "for this run only" if str(configured_cache()) in _BYPASSED else f"once: cached in {target.parent}"
         announce(f"compiling {name} ({' '.join(flags)}; {kept})")
     start = time.perf_counter()
+    try:
+        _compile_into(cc, flags, source, target, describes)
+    except OSError as exc:  # (the cache's disk full: not the compiler's fault)
+        raise write_error(exc, target, CACHE_ADVICE) from None
+    return Library(target, True, time.perf_counter() - start)
+
+
+def _compile_into(cc: str, flags: tuple, source: Path, target: Path, describes) -> None:
+    """Compile ``source`` into the library ``target`` through a temporary folder beside it and a rename."""
     with tempfile.TemporaryDirectory(dir=target.parent) as tmp:
         out, call = Path(tmp) / target.name, Path(tmp) / "gearsym_call.c"
         call.write_text(CALL_SOURCE)
@@ -213,6 +224,8 @@ def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple
         except OSError as exc:
             raise CompilerError(f"could not run the C compiler {cc!r}: {exc}. Set $CC to a working compiler.") from exc
         if proc.returncode != 0:
+            if no_room(tmp):  # (the compiler could not write its output: the disk, not $CC)
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
             raise CompilerError(
                 f"compiling {source} failed ({' '.join(cmd)}):\n{proc.stderr.strip()[-2000:]}\n"
                 "Check $CC and $GEARSYM_CFLAGS, or report the model that caused it."
@@ -220,7 +233,6 @@ def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple
         os.chmod(out, 0o700)  # (whatever the umask)
         record(target, out.read_bytes(), describes)  # (before the rename: the library in place always has one)
         os.replace(out, target)  # atomic: concurrent compilers of the same model do not collide
-    return Library(target, True, time.perf_counter() - start)
 
 
 def library_path(file_name: str) -> Path:

@@ -5,6 +5,7 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..files.atomic import writing
 from ..options import Integration
 from ..system import FirstOrderSystem
 from .library import library_describes
@@ -40,7 +41,8 @@ def generate_model(system: FirstOrderSystem, out: Path, options: Integration = I
                      if not (target / p.name).is_file() or (target / p.name).read_bytes() != p.read_bytes()]
             return GenerateReport(system.name, target / fresh.source.name, digest, fresh.source.stat().st_size,
                                   stale=stale)
-    code = write_code(mf, target, digest)
+    with writing(target):
+        code = write_code(mf, target, digest)
     report = GenerateReport(system.name, code.source, digest, code.source.stat().st_size)
     if compile:
         # (described as compile_model describes it: the library runs load)

@@ -38,8 +38,9 @@ import casadi as ca
 
 from ..errors import GearsymError
 from ..options import Integration
+from ..files.atomic import writing
 from ..files.paths import GENERATED_DIR
-from ..files.private import write_private
+from ..files.private import CACHE_ADVICE, write_private
 from ..system import FirstOrderSystem
 from ..version import __version__
 from .build import cached_code_directory, code_directory, keep_generated, source_describes
@@ -95,7 +96,8 @@ def ship(compiled: CompiledModel) -> ShippedModel:
     source = code_dir / f"{name}.c"
     if code_dir != GENERATED_DIR / name and trusted(source, source_describes(name, compiled.hash)) is None:
         # (the cache was cleaned since the library was built, or its C is not what gearsym wrote: generate it)
-        keep_generated(write_code(build_functions(system, compiled.options), code_dir, compiled.hash))
+        with writing(code_dir, CACHE_ADVICE):
+            keep_generated(write_code(build_functions(system, compiled.options), code_dir, compiled.hash))
     library = trusted(compiled.library, library_describes(system, compiled.hash))
     if library is None:
         raise GearsymError(f"{compiled.library} changed since it was loaded; run again to compile it anew")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import os
+import select
 import stat
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -32,7 +33,7 @@ def csv_rows(path: Path) -> Iterator[tuple[int, list[str], Iterator[tuple[int, l
     """While open: the header's line number and names, and an iterator of the non-blank rows after it as (line
     number, cells), each row with as many cells as the header names."""
     try:
-        handle = open(path, encoding="utf-8-sig")  # (universal newlines: \r\n and \r read as \n)
+        handle = _open_text(path)
     except FileNotFoundError:
         raise DataError("no such file", path) from None
     except IsADirectoryError:
@@ -55,6 +56,36 @@ def csv_rows(path: Path) -> Iterator[tuple[int, list[str], Iterator[tuple[int, l
             raise DataError("the file is empty; expected a header line naming the columns, e.g. tau,x", path)
         _check_separator(header, path, header_line)
         yield header_line, header, _rows(reader, path, header_line, len(header))
+
+
+#: seconds a named pipe (FIFO) is waited on for its writer's first text before it is refused (opening one with no
+#: writer would wait for ever)
+FIFO_WAIT = 10.0
+
+
+def _open_text(path: Path) -> IO[str]:
+    """``path`` opened as UTF-8 text (universal newlines: \\r\\n and \\r read as \\n); a named pipe is opened
+    without waiting for a writer, then given ``FIFO_WAIT`` seconds for its first text."""
+    try:
+        fifo = stat.S_ISFIFO(os.stat(path).st_mode)
+    except FileNotFoundError:
+        raise
+    except OSError:
+        fifo = False
+    if not fifo:
+        return open(path, encoding="utf-8-sig")
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    try:
+        waiting = select.poll()
+        waiting.register(fd, select.POLLIN)
+        if not waiting.poll(int(FIFO_WAIT * 1000)):
+            raise DataError(f"is a named pipe (FIFO) that nothing wrote to in {FIFO_WAIT:g} s: start its writer "
+                            "first (or give a file)", path)
+        os.set_blocking(fd, True)
+        return open(fd, encoding="utf-8-sig", closefd=True)
+    except BaseException:
+        os.close(fd)
+        raise
 
 
 def _rows(reader, path: Path, header_line: int = 0, cells: int | None = None) -> Iterator[tuple[int, list[str]]]:

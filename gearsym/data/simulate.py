@@ -32,6 +32,7 @@ from ..checks import MAX_STEPS_PER_PERIOD, whole_number
 from ..codegen import CompiledModel, engine_verb
 from ..options import STEPS_PER_PERIOD, Integration
 from ..errors import GearsymError
+from ..files.atomic import write_atomically
 from ..memory import check_fits
 from .columns import RECORD
 
@@ -195,6 +196,4 @@ def write_measurements(table: MeasurementTable, path: str | Path) -> Path:
     for i in range(table.rows):
         text.append(",".join(str(int(col[i])) if name == RECORD else repr(float(col[i]))
                              for name, col in zip(table.columns, columns)))
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join(text) + "\n", encoding="utf-8")
-    return path
+    return write_atomically(path, "\n".join(text) + "\n")  # (whole or not at all; a symlink is not written through)

@@ -19,12 +19,13 @@ import sympy as sp
 from ..errors import GearsymError
 from ..model.drivetrain import Drivetrain
 from ..model.resolved import ResolvedDrivetrain
+from ..model.roles import parameter_roles
 from ..reduction.nondimensional import NondimensionalModel, reduce
 from ..scales.map import Scaling
 from ..model.symbols import parameter_symbol, tau
 from ..system import FirstOrderSystem
 from ..units import from_si
-from .notes import default_wave_amplitude, paper_notes
+from .notes import paper_notes
 from .records import (
     BodyRecord, ClosingRecord, ConditionRecord, CoordinateRecord, CouplingRecord, Derivation, FunctionRecord, GroupRecord,
     Mechanics, ParameterRecord, ScalingRecord, TorqueRecord,
@@ -54,32 +55,6 @@ def _parameters(names, values: Mapping[str, float], descriptions: Mapping[str, s
                         descriptions.get(name) or roles.get(name, ""))
         for name in names
     )
-
-
-def _roles(rd: ResolvedDrivetrain) -> dict[str, str]:
-    """What each parameter declared as a bare name is in the drivetrain (the docs' fallback descriptions)."""
-    roles: dict[str, str] = {"omega": "forcing frequency (tau = omega t)"}
-
-    def put(expr: sp.Expr, text: str) -> None:
-        if isinstance(expr, sp.Symbol):
-            roles.setdefault(expr.name, text)
-
-    for rb in rd.bodies:
-        put(rb.inertia, f"moment of inertia of {rb.body.name!r}")
-        if rb.radius is not None:
-            put(rb.radius, f"base radius of {rb.body.name!r}")
-    for rc in rd.couplings:
-        put(rc.stiffness, f"{'mean mesh' if rc.kind == 'mesh' else 'torsional'} stiffness of {rc.kind} {rc.name!r}")
-        put(rc.damping, f"damping of {rc.kind} {rc.name!r}")
-        if rc.kind == "mesh":
-            put(rc.backlash, f"backlash (clearance) of mesh {rc.name!r}")
-            amplitude = default_wave_amplitude(rc.variation)
-            if amplitude is not None:
-                put(parameter_symbol(amplitude), f"relative amplitude of the stiffness variation of mesh {rc.name!r}")
-    for f in rd.forcing:
-        if f.order:
-            put(f.phase, f"phase of the order-{f.order} harmonic of torque {f.torque.name!r}")
-    return roles
 
 
 @derive.register
@@ -156,7 +131,7 @@ def _derive_reduced(nd: NondimensionalModel) -> Derivation:
     )
     return Derivation(
         model=model.name, title=model.title, description=model.description, time=tau,
-        states=tuple(nd.states), rhs=tuple(nd.rhs), parameters=_parameters(names, values, descriptions, _roles(rd)),
+        states=tuple(nd.states), rhs=tuple(nd.rhs), parameters=_parameters(names, values, descriptions, parameter_roles(rd)),
         period=nd.period,
         mechanics=mechanics, notes=paper_notes(nd, groups, values),
         scaling=_scaling_record(scaling) if scaling is not None else None,

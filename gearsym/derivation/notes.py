@@ -12,23 +12,12 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
-import sympy as sp
-
 from ..model.expressions import parameter_names
-from ..model.stiffness import DEFAULT_CONTACT_RATIO, DEFAULT_HARMONICS, rectangular_mesh_stiffness
+from ..model.roles import default_wave_amplitude
+from ..model.stiffness import DEFAULT_CONTACT_RATIO, DEFAULT_HARMONICS
 from ..reduction.nondimensional import NondimensionalModel
-from ..model.symbols import phi
 from .printing import number
 from .records import GroupRecord
-
-
-
-def default_wave_amplitude(variation: sp.Expr) -> str | None:
-    """The amplitude parameter if ``variation`` is the default stiffness wave, else None."""
-    names = sorted(parameter_names(variation) - {phi.name})
-    if len(names) != 1:
-        return None
-    return names[0] if sp.expand(variation - rectangular_mesh_stiffness(names[0])) == 0 else None
 
 
 def paper_notes(nd: NondimensionalModel, groups: Sequence[GroupRecord], defaults: Mapping[str, float]) -> tuple[str, ...]:

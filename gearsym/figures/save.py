@@ -1,8 +1,12 @@
 """Writing a figure: one place for the PNG settings every figure shares."""
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
+import numpy as np
+
+from ..files.atomic import write_atomically
 from .layout import fit_texts
 
 
@@ -17,13 +21,42 @@ def pyplot():
     return plt
 
 
-def save_figure(fig, path: str | Path, dpi: int) -> Path:
+#: a new picture is the one on disk if its pixels differ by at most this on average (0..1 per channel) and at most
+#: this share of them by more than a quarter: antialiasing of a line moved by rounding passes, a moved marker, line
+#: or word does not
+SAME_MEAN, SAME_MOVED = 2e-3, 2e-4
+
+
+def save_figure(fig, path: str | Path, dpi: int, keep_same: bool = False) -> Path:
     """Write ``fig`` to ``path`` (folders made as needed) and close it, its titles wrapped to fit
     (:func:`~.layout.fit_texts`). No 'Software' entry, so the bytes do not depend on the matplotlib version:
-    committed figures are compared as files."""
+    committed figures are compared as files. Written whole or not at all (:func:`~gearsym.files.atomic.write_atomically`:
+    a full disk leaves no half a figure). ``keep_same``: a file already there that shows the same picture
+    (:func:`same_picture`) is left as it is (a committed figure redrawn on another machine, whose rounding moved
+    a line by a fraction of a pixel)."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     fit_texts(fig)
-    fig.savefig(path, dpi=dpi, metadata={"Software": None})
-    pyplot().close(fig)
-    return path
+    image = io.BytesIO()
+    try:
+        fig.savefig(image, format=path.suffix.lstrip(".").lower() or None, dpi=dpi, metadata={"Software": None})
+    finally:
+        pyplot().close(fig)
+    if keep_same and path.is_file() and same_picture(io.BytesIO(image.getvalue()), path):
+        return path
+    return write_atomically(path, image.getvalue())
+
+
+def same_picture(a, b: str | Path) -> bool:
+    """Whether two PNG images (files or file objects) show the same picture (their pixels, not their bytes; see
+    ``SAME_MEAN``)."""
+    from matplotlib.image import imread
+
+    try:
+        x, y = imread(a, format="png"), imread(b, format="png")
+    except (OSError, ValueError, SyntaxError):
+        return False
+    if x.shape != y.shape:
+        return False
+    difference = np.abs(x.astype(float) - y.astype(float))
+    moved = (difference.max(axis=-1) if difference.ndim == 3 else difference) > 0.25
+    return float(difference.mean()) <= SAME_MEAN and float(moved.mean()) <= SAME_MOVED

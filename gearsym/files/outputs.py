@@ -37,6 +37,9 @@ def check_file(path: str | Path, suffixes: tuple[str, ...], what: str = "--out")
         raise GearsymError(f"{what} {path}: the file name must end in {shown} ({got})")
     if path.is_dir():
         raise GearsymError(f"{what} {path} is a folder; give a file name ending in {suffixes[0]}")
+    if path.is_symlink():  # (writing through it would change the file it points at, whoever's it is)
+        raise GearsymError(f"{what} {path} is a symlink (to {os.readlink(path)}); gearsym never writes through one: "
+                           "give the file's own path, or remove the link")
     _check_writable(path.parent, f"{what} {path}")
     return path
 

@@ -28,6 +28,7 @@ import stat
 from pathlib import Path
 
 from ..errors import GearsymError
+from .atomic import write_error
 
 try:
     import grp
@@ -41,6 +42,10 @@ _MAX_LINKS = 40
 
 class NotPrivate(GearsymError):
     """A folder or file that someone else could have written, or that is not this user's."""
+
+
+#: what to do when the cache (generated code, a compiled library) cannot be written
+CACHE_ADVICE = "free some space there, or write elsewhere: $GEARSYM_CACHE for the cache, --out for gearsym compile"
 
 
 def owner() -> int:
@@ -89,10 +94,11 @@ def read_private(path: str | Path) -> bytes:
         if isinstance(exc, FileNotFoundError):
             raise
         raise NotPrivate(f"{path} cannot be read ({exc.strerror})") from None
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode):  # (before fdopen, which refuses a folder with an error of its own)
+        os.close(fd)
+        raise NotPrivate(f"{path} is not a regular file")
     with os.fdopen(fd, "rb") as f:
-        st = os.fstat(fd)
-        if not stat.S_ISREG(st.st_mode):
-            raise NotPrivate(f"{path} is not a regular file")
         if st.st_uid != owner():
             raise NotPrivate(f"{path} belongs to {_user(st.st_uid)}, not to you")
         if _writable_by_others(st):
@@ -112,11 +118,16 @@ def write_private(path: str | Path, data: bytes, mode: int = 0o600) -> Path:
             break
         except FileExistsError:
             continue
+        except OSError as exc:
+            raise write_error(exc, path, CACHE_ADVICE) from None
     try:
         os.fchmod(fd, mode)  # (the umask may have taken bits away; none is added beyond ``mode``)
         with os.fdopen(fd, "wb") as f:
             f.write(data)
         os.replace(tmp, path)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        raise write_error(exc, path, CACHE_ADVICE) from None
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise

@@ -13,6 +13,7 @@ import sympy as sp
 from ..model.backlash import g
 from ..errors import ModelError
 from ..model.symbols import parameter_symbol
+from ..parameters import Constraint
 from ..system import Coupling, FirstOrderSystem
 
 
@@ -97,6 +98,7 @@ class Effect:
     gears: tuple[tuple[str, int], ...] = ()  # a tooth-by-tooth form's gears and tooth counts (both gears of a mesh)
     prior: float = 0.0  # a tooth-by-tooth form's prior spread of each parameter (regularised: 0 for none) ...
     prior_unit: str = ""  # ... in the parameter's units ("") or times the mesh coordinate's spread ("displacement")
+    constraints: Mapping[str, Constraint] = field(default_factory=dict)  # what its parameters may be, physically
 
     @property
     def parameters(self) -> dict[str, float]:

@@ -205,11 +205,16 @@ def augment(system: FirstOrderSystem, effects: Sequence[str | Effect], coordinat
             raise ModelError(f"effect {e.name}: the model already has parameters {sorted(clash)}", system.name)
         out = _apply(out, e, coordinate)
     parameters = dict(out.parameters)
+    out = replace(out, constraints={**out.constraints, **{k: c for e in chosen for k, c in e.constraints.items()}})
     for key, value in (values or {}).items():
         if key not in parameters:
             raise GearsymError(f"{key} is not a parameter of {system.name} or of the effects "
                                f"{', '.join(e.name for e in chosen)}")
-        parameters[key] = float(value)
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            raise GearsymError(f"{key}={value!r}: an effect's parameter takes a number") from None
+        parameters[key] = out.check_value(key, number)  # (a tooth fault's depth below 1, its tooth a tooth)
     descriptions = {**system.descriptions, **{p: f"{e.name}: {e.description}" for e in chosen for p in e.parameters}}
     for e in chosen:
         if e.shaft_order:  # the system now repeats on the gear's revolution (or the hunting period)

@@ -56,7 +56,8 @@ def residual_sidebands(system: FirstOrderSystem, fit: Fit, segments: Sequence[Se
             if np.isfinite(ln.amplitude):
                 amplitudes.setdefault(ln.label, []).append(ln.amplitude)
         for g in gears:
-            energy[g].append(spectrum.sideband_energy(g))
+            if np.isfinite(spectrum.sideband_energy(g)):  # (a record shorter than two of its revolutions: none)
+                energy[g].append(spectrum.sideband_energy(g))
         noise.append(spectrum.noise)
     if not amplitudes:
         return None

@@ -35,6 +35,28 @@ class Jacobian:
                 self.blocks(np.einsum("ri,rj->rij", S, S)), np.einsum("ri,r->i", P, r),
                 self.blocks(S * r[:, None]))
 
+    def window_rows(self, windows: np.ndarray) -> np.ndarray:
+        """The rows of ``windows`` (in their order)."""
+        return np.concatenate([np.arange(self.rows[k], self.rows[k + 1]) for k in windows]) if len(windows) \
+            else np.zeros(0, dtype=int)
+
+    def out_of_starts(self, X: np.ndarray, windows: np.ndarray | None = None) -> np.ndarray:
+        """``X`` (residuals x q) with what the start states can make removed; with ``windows``, ``X`` holds the rows
+        of those windows only (:meth:`window_rows`), zero elsewhere, and so does the result (each window's start
+        acts on its own rows only): the work and memory of those windows, not of them all."""
+        if windows is None:
+            S, rows, window = self.S, self.rows[:-1], self.window
+        else:
+            lengths = self.rows[np.asarray(windows) + 1] - self.rows[np.asarray(windows)]
+            S = self.S[self.window_rows(windows)]
+            rows = np.concatenate([[0], np.cumsum(lengths)[:-1]]).astype(int)
+            window = np.repeat(np.arange(len(lengths)), lengths)
+        if not len(S):
+            return X
+        V = np.linalg.pinv(np.add.reduceat(np.einsum("rn,rm->rnm", S, S), rows, axis=0))
+        SX = np.add.reduceat(np.einsum("rn,rq->rnq", S, X), rows, axis=0)
+        return X - np.einsum("rn,rnq->rq", S, np.einsum("knm,kmq->knq", V, SX)[window])
+
     def project_out(self, Y: np.ndarray) -> np.ndarray:
         """``Y`` (residuals x q) with what the start states and then the parameters' columns can make removed."""
         def out_of_starts(X):

@@ -15,6 +15,7 @@ import numpy as np
 import sympy as sp
 
 from ..checks import json_safe
+from ..files.atomic import write_atomically
 from ..files.sets import written_together
 from ..figures.layout import fit_texts
 from ..figures.save import pyplot, save_figure
@@ -48,15 +49,15 @@ def write_report(ex: Explanation, system: FirstOrderSystem, out: str | Path, sou
     names = REPORT_FILES + ((TEETH_FIGURE,) if teeth is not None else ())
     with written_together(out, names, PARTIAL_MARKER, "the report") as stage:
         data = json_safe(ex.as_dict())
-        (stage / "report.json").write_text(json.dumps(data, indent=1, allow_nan=False) + "\n")
+        write_atomically(stage / "report.json", json.dumps(data, indent=1, allow_nan=False) + "\n")
         save_figure(residual_figure(ex, system), stage / "residuals.png", dpi=100)
         save_figure(prediction_figure(ex, system.name), stage / "prediction.png", dpi=100)
         if teeth is not None:
             save_figure(tooth_figure(ex, teeth, system.name, sources), stage / TEETH_FIGURE, dpi=100)
         effects = [ex.library[e] for e in ex.effects]
         derived = augment(system, effects) if effects else system
-        (stage / "derived_model.md").write_text(derived_model_page(system, derived, effects))
-        (stage / "report.md").write_text(report_page(ex, system, derived, data, sources))
+        write_atomically(stage / "derived_model.md", derived_model_page(system, derived, effects))
+        write_atomically(stage / "report.md", report_page(ex, system, derived, data, sources))
     stale = Path(out) / TEETH_FIGURE
     if teeth is None and stale.is_file() and not stale.is_symlink():  # (a previous run's, not this report's)
         stale.unlink()

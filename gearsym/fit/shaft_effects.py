@@ -36,6 +36,7 @@ from ..errors import GearsymError
 from ..model.shaft_orders import DEFAULT_EDGE, path_window, tooth_by_tooth, tooth_share, window
 from ..model.stiffness import DEFAULT_CONTACT_RATIO
 from ..model.symbols import parameter_symbol
+from ..parameters import Constraint
 from ..system import FirstOrderSystem
 from .effect_types import Change, Effect, Site
 
@@ -63,7 +64,10 @@ def tooth_fault(gear: str, teeth: int, coordinate: str) -> Effect:
 
     return Effect(f"tooth_fault_{gear}", f"a local fault of one tooth of {gear} ({teeth} teeth): its pair loses the "
                   f"fraction {q} of its stiffness while in mesh, k(1 - {q} s_{n}(phi))", (q,), {n: 1.0}, build,
-                  bounds={q: (0.0, 0.95, _TAKES)}, coordinate=coordinate, gear=gear, teeth=teeth, scan=n)
+                  bounds={q: (0.0, 0.95, _TAKES)}, coordinate=coordinate, gear=gear, teeth=teeth, scan=n,
+                  constraints={q: Constraint(f"the fraction of stiffness a fault of a tooth of {gear} takes from its "
+                                             "pair", True, below=1.0),
+                               n: Constraint(f"the faulty tooth of {gear} (counted from tau = 0)", whole=(1, teeth))})
 
 
 def spall(gear: str, teeth: int, coordinate: str) -> Effect:

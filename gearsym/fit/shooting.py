@@ -99,8 +99,11 @@ def _bounds(system: FirstOrderSystem, fit: Sequence[str], given: Mapping[str, tu
             low[i], high[i] = lo, hi
             why[name] = reason[0] if reason else "bounded"
         elif name in system.constraints:
+            constraint = system.constraints[name]
             low[i] = 0.0
-            why[name] = f"{name} is {system.constraints[name].meaning}"
+            if constraint.below is not None:  # (exclusive: the largest double below it)
+                high[i] = np.nextafter(constraint.below, 0.0)
+            why[name] = f"{name} is {constraint.meaning}"
     return low, high, why
 
 

@@ -61,20 +61,22 @@ def scan_teeth(system: FirstOrderSystem, segments: Sequence[Segment], fit: Fit, 
     P = problem.parameters(theta)
     records = list(dict.fromkeys(seg.key[0] if seg.key else k for k, seg in enumerate(segments)))
     of_record = np.array([records.index(seg.key[0] if seg.key else k) for k, seg in enumerate(segments)])
-    columns, teeth, gains = {}, {}, {}
+    projection = RecordProjection.of(nuisance, y)
+    teeth, gains = {}, {}
+    raw, along = np.zeros_like(y), np.zeros(projection.fitted.shape[1])  # the chosen columns' sum: own rows, along P
     for ri, record in enumerate(records):
         windows = np.nonzero(of_record == ri)[0]
-        block = _record_columns(problem, J, windows, starts, P, e.teeth, order, index_q, index_n)  # (rows, Z)
-        projected = nuisance.project_out(block)
-        norms = np.einsum("rz,rz->z", projected, projected)
-        dots = projected.T @ y
+        rows = J.window_rows(windows)
+        block = _record_columns(problem, J, windows, rows, starts, P, e.teeth, order, index_q, index_n)  # (rows, Z)
+        own, c, norms, dots = projection(block, windows, rows)
         with np.errstate(invalid="ignore", divide="ignore"):
             coef = np.where(norms > 0, dots / norms, 0.0)
             gain = np.where((norms > 0) & (coef > 0), dots**2 / (norms * total), 0.0)
         best = int(np.argmax(gain))
         teeth[record], gains[record] = best + 1, float(gain[best])
-        columns[record] = projected[:, best]
-    together = sum(columns.values())
+        raw[rows] += own[:, best]
+        along += c[:, best]
+    together = raw - projection.fitted @ along
     norm = float(together @ together)
     if norm <= 0 or not any(g > 0 for g in gains.values()):
         return Placement(teeth, gains, 0.0, "no tooth of it would need a positive loss of stiffness")
@@ -83,11 +85,41 @@ def scan_teeth(system: FirstOrderSystem, segments: Sequence[Segment], fit: Fit, 
     return Placement(teeth, gains, gain)
 
 
-def _record_columns(problem: Problem, J, windows: np.ndarray, starts: np.ndarray, P: np.ndarray, teeth: int,
-                    order: float, index_q: int, index_n: int) -> np.ndarray:
+@dataclass(frozen=True)
+class RecordProjection:
+    """``nuisance.project_out`` of columns that are nonzero on one record's rows only, in that record's memory: the
+    start states act on their own windows' rows, so that part stays there; the fitted parameters' part is a small
+    dense correction along their projected columns ``fitted`` (never formed per record). With the projected
+    residual ``y``, each column's squared norm and its product with ``y`` (the score test's gain)."""
+
+    fitted: np.ndarray  # the parameters' columns with the starts' part removed (residuals, k)
+    inverse: np.ndarray  # (fitted^T fitted)^+
+    along_y: np.ndarray  # fitted^T y
+    nuisance: object
+    y: np.ndarray
+
+    @classmethod
+    def of(cls, nuisance, y: np.ndarray) -> "RecordProjection":
+        fitted = nuisance.out_of_starts(nuisance.P)
+        return cls(fitted, np.linalg.pinv(fitted.T @ fitted), fitted.T @ y, nuisance, y)
+
+    def __call__(self, block: np.ndarray, windows: np.ndarray, rows: np.ndarray):
+        """For ``block`` (the rows of ``windows``, which are ``rows``): its starts-projected part on those rows, the
+        coefficients ``c`` of its parameters' part (the whole projection is own on the rows minus fitted @ c), and
+        each column's squared norm and product with y."""
+        own = self.nuisance.out_of_starts(block, windows)
+        a = self.fitted[rows].T @ own  # (k, columns)
+        c = self.inverse @ a
+        norms = np.einsum("rz,rz->z", own, own) - np.einsum("kz,kz->z", a, c)
+        dots = own.T @ self.y[rows] - c.T @ self.along_y
+        return own, c, norms, dots
+
+
+def _record_columns(problem: Problem, J, windows: np.ndarray, rows: np.ndarray, starts: np.ndarray, P: np.ndarray,
+                    teeth: int, order: float, index_q: int, index_n: int) -> np.ndarray:
     """The sensitivity column of the severity with the fault on each tooth 1 ... Z in turn, on the windows of one
-    record (rows of the whole problem; zero elsewhere): one compiled call for all teeth, each tooth's windows
-    only."""
+    record (its ``rows`` of the whole problem only: zero elsewhere): one compiled call for all teeth, each tooth's
+    windows only."""
     period = 2 * np.pi / order  # one mesh period in tau
     runs, which = [], []
     for n in range(1, teeth + 1):
@@ -97,7 +129,7 @@ def _record_columns(problem: Problem, J, windows: np.ndarray, starts: np.ndarray
             if _meets(t0, t1, n, teeth, period):
                 runs.append(k)
                 which.append(n)
-    out = np.zeros((J.P.shape[0], teeth))
+    out = np.zeros((len(rows), teeth))
     if not runs:
         return out
     runs, which = np.array(runs), np.array(which)
@@ -107,11 +139,13 @@ def _record_columns(problem: Problem, J, windows: np.ndarray, starts: np.ndarray
                              problem.substeps[runs], params, True, columns=[index_q])
     sub_offsets = np.concatenate([[0], np.cumsum(problem.samples[runs])])
     column = problem.n
+    first = {k: int(np.searchsorted(rows, problem.row_offsets[k])) for k in windows}  # (where window k starts)
     for i, (k, n) in enumerate(zip(runs, which)):
-        rows = slice(problem.row_offsets[k], problem.row_offsets[k + 1])
-        channels = problem.rows[0][rows]
-        samples = problem.rows[1][rows] - problem.offsets[k] + sub_offsets[i]
-        out[rows, n - 1] = run.derivatives[channels, column, samples] * problem.weight[rows]
+        these = slice(problem.row_offsets[k], problem.row_offsets[k + 1])
+        channels = problem.rows[0][these]
+        samples = problem.rows[1][these] - problem.offsets[k] + sub_offsets[i]
+        at = slice(first[k], first[k] + these.stop - these.start)
+        out[at, n - 1] = run.derivatives[channels, column, samples] * problem.weight[these]
     return out
 
 

@@ -21,6 +21,8 @@ from importlib import resources
 from pathlib import Path
 
 from ..codegen.build import cached_code_directory, code_directory
+from ..files.atomic import writing
+from ..files.private import CACHE_ADVICE
 from ..codegen.compiler import CompilerError, compilers_looked_for, find_compiler, INSTALL_HINT
 from ..codegen.functions import build_functions
 from ..codegen.generate import code_hash, read_manifest, write_code
@@ -84,7 +86,8 @@ def build_fmu(system: FirstOrderSystem, path: Path, options: Integration = Integ
         tmp = Path(tmp)
         functions_c = write_functions(fmu_functions(lay, split), tmp).read_bytes()
         wrapper = wrapper_source()
-        header = model_header(lay, engine.name, len(split.constants) + 1, len(split.tables))
+        header = model_header(lay, engine.name, len(split.constants) + 1, len(split.tables),
+                              steps_per_period=loops.steps_per_period)
         guid = _guid(engine.read_bytes(), functions_c, wrapper + header, lay)
         header = header.replace(GUID_MARK, guid)
         sources = {name: resources.files(__package__).joinpath("headers", name).read_bytes() for name in FMI_HEADERS}
@@ -124,7 +127,8 @@ def _engine_source(system: FirstOrderSystem, loops: LoopOptions) -> Path:
     source = directory / f"{system.name}.c"
     if not ((read_manifest(directory) or {}).get("hash") == digest and source.is_file()):
         directory = cached_code_directory(system.name, digest)
-        write_code(build_functions(system, loops), directory, digest)
+        with writing(directory, CACHE_ADVICE):
+            write_code(build_functions(system, loops), directory, digest)
         source = directory / f"{system.name}.c"
     return source
 

@@ -21,6 +21,7 @@ from ..scales.map import Scaling
 from ..scales.settings import physical_settings
 from ..units import Measure, Quantity, measure, si_factor
 from .frame import Frame, PhysicalParameter, Term, Unit
+from .variables import undescribed
 
 #: SI units by the exponents of (mass, length, time) of a value (angles are dimensionless: rad/s is 1/s)
 _NAMES = {(1, 0, -2): "N/m", (1, 0, -1): "N.s/m", (1, 2, -2): "N.m", (1, 2, 0): "kg.m2", (0, 1, 0): "m",
@@ -68,7 +69,7 @@ def physical_frame(nd, values: Mapping[str, object], system) -> Frame | None:
             if term.reference != q.si:  # (a value of 0: the engine's at one unit)
                 engine_base[term.engine] = at[term.engine]
         parameters.append(PhysicalParameter(name, q.si, unit, display,
-                                            descriptions.get(name, ""), tuple(terms)))
+                                            descriptions.get(name) or undescribed(system, name), tuple(terms)))
     kinds = {}
     for c in system.couplings:
         if not c.closes_loop:

@@ -16,6 +16,7 @@ from functools import cached_property
 
 import sympy as sp
 
+from ..model.symbols import parameter_symbol
 from ..system import Coupling, FirstOrderSystem
 from .frame import Frame, PhysicalParameter, Term, Unit
 
@@ -39,7 +40,8 @@ class Variable:
     minimum: float | None = None
 
 
-#: the value of ``substeps`` before a user sets it: one RK4 step per communication step
+#: the value of ``substeps`` before a user sets it: the fewest RK4 steps per communication step (more are taken
+#: wherever the communication step is longer than the engine's step: the importer's step never sets the accuracy)
 SUBSTEPS = 1
 
 
@@ -117,7 +119,8 @@ def _variables(lay: Layout):
                        + "baked into the engine's values: export the FMU again with --set to change it",
                        "parameter", p.unit, p.display, minimum=0.0 if constraint else None)
     yield Variable("substeps", "Integer", integer(), "parameter", "tunable", "exact", SUBSTEPS,
-                   "RK4 steps per co-simulation communication step (crossings of the backlash located in each)",
+                   "the fewest RK4 steps per co-simulation communication step: more are taken wherever needed to keep "
+                   "each within the engine's own step (crossings of the backlash located in each)",
                    "substeps", minimum=1)
     for c in lay.meshes:
         yield Variable(f"{c.name}.deflection", "Real", real(), "output", "continuous", "calculated", None,
@@ -155,7 +158,15 @@ def _start(lay: Layout, kind: str | None, value: float) -> float:
 
 
 def _parameter_text(system: FirstOrderSystem, name: str) -> str:
-    return system.descriptions.get(name, "")
+    return system.descriptions.get(name) or undescribed(system, name)
+
+
+def undescribed(system: FirstOrderSystem, name: str) -> str:
+    """The description of a parameter that neither the model nor its drivetrain's roles describe (a parameter of a
+    stiffness formula given with --set, of an added effect): where it enters."""
+    rows = [s.name for s, f in zip(system.states, system.rhs) if parameter_symbol(name) in f.free_symbols]
+    where = f"the equations of {', '.join(rows)}" if rows else "the model's tables of time"
+    return f"parameter {name} of {system.name}, in {where} (the model gives it no description)"
 
 
 def _state_text(system: FirstOrderSystem, name: str, frame: Frame) -> str:

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from importlib import resources
 
+from ..analysis.divergence import BOUND
+from ..options import STEPS_PER_PERIOD
 from ..system import FirstOrderSystem
 from .functions import INDICATORS, OUTPUTS, TABLE
 from .variables import SUBSTEPS, Layout
@@ -21,9 +23,12 @@ def wrapper_source() -> str:
 GUID_MARK = "@GUID@"
 
 
-def model_header(lay: Layout, engine_source: str, constants: int, tables: int, guid: str = GUID_MARK) -> str:
+def model_header(lay: Layout, engine_source: str, constants: int, tables: int, guid: str = GUID_MARK,
+                 steps_per_period: int = STEPS_PER_PERIOD) -> str:
     """``gearsym_model.h`` of the FMU laid out as ``lay`` around the engine's C file ``engine_source``, whose
-    constants function gives ``constants`` values (the step last) and whose tables have ``tables`` rows."""
+    constants function gives ``constants`` values (the step last) and whose tables have ``tables`` rows;
+    ``steps_per_period``: the engine's RK4 steps per period of the system (its longest step: a co-simulation takes
+    as many substeps as keep each within it, whatever the communication step)."""
     system, frame = lay.system, lay.frame
     n, nq, nm, ns, nk, nz = (len(system.states), len(lay.parameters), len(lay.meshes), len(lay.shafts),
                              len(lay.contacts), len(lay.indicators))
@@ -31,6 +36,8 @@ def model_header(lay: Layout, engine_source: str, constants: int, tables: int, g
     terms = [(engine.index(t.engine), i, t.exponent, t.reference)
              for i, p in enumerate(lay.parameters) for t in p.terms]
     observed = system.observed_indices
+    meshes = {c.coordinate for c in system.couplings if c.kind == "mesh"}
+    bounded = meshes if system.couplings else set(system.state_names)  # (as a run's divergence counts them)
     reals = [v for v in lay.variables if v.type == "Real"]
     first_output = 1 + 2 * n + nq  # (after time, the states, their derivatives and the parameters)
     tau = next((v.reference for v in reals if v.role == "tau"), len(reals))
@@ -52,6 +59,8 @@ def model_header(lay: Layout, engine_source: str, constants: int, tables: int, g
         f"#define GS_LENGTH_UNIT {frame.length_unit!r}",
         f"#define GS_FORCE_UNIT {frame.mesh_stiffness * frame.length_unit!r}",
         f"#define GS_SUBSTEPS {SUBSTEPS}",
+        f"#define GS_STEPS_PER_PERIOD {int(steps_per_period)}",
+        f"#define GS_BOUND {BOUND!r}",
         "/* value references: Real */",
         "#define GS_VR_TIME 0",
         "#define GS_VR_STATES 1",
@@ -74,13 +83,18 @@ def model_header(lay: Layout, engine_source: str, constants: int, tables: int, g
         _array("const char* const", "gs_parameter_names", [_c_string(p.name) for p in lay.parameters], raw=True),
         _array("const double", "gs_engine_base", [lay.engine_base[name] for name in engine]),
         _array("const char* const", "gs_engine_names", [_c_string(name) for name in engine], raw=True),
-        _array("const int", "gs_engine_sign", [_sign(system, name) for name in engine]),
+        _array("const int", "gs_engine_rule", [_rule(system, name)[0] for name in engine]),
+        _array("const double", "gs_engine_low", [_rule(system, name)[1] for name in engine]),
+        _array("const double", "gs_engine_high", [_rule(system, name)[2] for name in engine]),
+        _array("const char* const", "gs_engine_must", [_c_string(_rule(system, name)[3]) for name in engine], raw=True),
         _array("const int", "gs_term_engine", [t[0] for t in terms]),
         _array("const int", "gs_term_parameter", [t[1] for t in terms]),
         _array("const int", "gs_term_exponent", [t[2] for t in terms]),
         _array("const double", "gs_term_reference", [t[3] for t in terms]),
         _array("const double", "gs_state_start", starts),
         _array("const int", "gs_state_kind", kinds),
+        _array("const char* const", "gs_state_names", [_c_string(s) for s in system.state_names], raw=True),
+        _array("const int", "gs_state_bounded", [int(s in bounded) for s in system.state_names]),
         _array("const int", "gs_observed", observed),
         _array("const int", "gs_mesh_damping", damping),
         _array("const int", "gs_contact_mesh", [lay.meshes.index(c) for c in lay.contacts]),
@@ -97,12 +111,22 @@ def _index(lay: Layout, parameter: str | None) -> int:
     return names.index(parameter) if parameter in names else -1
 
 
-def _sign(system: FirstOrderSystem, name: str) -> int:
-    """0: any value; 1: not negative; 2: positive (the parameter's constraint)."""
+def _rule(system: FirstOrderSystem, name: str) -> tuple[int, float, float, str]:
+    """What values the engine's parameter ``name`` may take (its constraint), as the wrapper checks them:
+    (0 any, 1 not negative, 2 positive, 3 in [low, high), 4 a whole number in [low, high]; low, high; the rule in
+    words, for the message)."""
     constraint = system.constraints.get(name)
     if constraint is None:
-        return 2 if name == "omega" else 0
-    return 1 if constraint.zero_allowed else 2
+        return (2, 0.0, 0.0, "must be positive") if name == "omega" else (0, 0.0, 0.0, "")
+    if constraint.whole is not None:
+        first, last = constraint.whole
+        return 4, float(first), float(last), f"must be a whole number from {first} to {last} ({constraint.meaning})"
+    if constraint.below is not None:
+        return 3, 0.0, float(constraint.below), (f"must be at least 0 and less than {constraint.below:g} "
+                                                 f"({constraint.meaning})")
+    if constraint.zero_allowed:
+        return 1, 0.0, 0.0, f"must not be negative ({constraint.meaning})"
+    return 2, 0.0, 0.0, f"must be positive ({constraint.meaning})"
 
 
 def _c_string(text: str) -> str:

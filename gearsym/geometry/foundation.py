@@ -19,9 +19,12 @@ the coefficients of :data:`COEFFICIENTS` (as in Chaari et al. 2009 and ROSS's ``
 **Validity.** The finite-element cases behind the fit span h_fi in [1.4, 7] and theta_f in [0.01, 0.12] rad
 (:data:`BODY_RATIO_RANGE`, :data:`ROOT_ANGLE_RANGE`; the bounds ROSS's implementation checks). theta_f is about
 3.0 / z for an ISO 53 rack, so gears of fewer than 25 teeth lie outside; a gear with a large bore (a thin rim,
-h_fi < 1.4) too. Outside, the polynomial is extrapolated and a warning says so. A solid gear has no inner
-radius (h_fi infinite, where the fit has no value): it is evaluated at h_fi = 7, the edge of the fitted range,
-and a warning names that assumption (give the bore, or the shaft's diameter, for the gear's own value).
+h_fi < 1.4) too; there the polynomial is extrapolated and a warning says so (a rim thinner than half the tooth
+height is refused by :class:`~.gear.GearGeometry`). A solid gear has no inner radius (h_fi infinite, where the
+fit has no value): it is evaluated at h_fi = 7, the edge of the fitted range, and a warning names that
+assumption (give the bore, or the shaft's diameter, for the gear's own value). So is a bore small enough to put
+h_fi beyond 7: the fit's h_fi^2 terms grow without bound (at a bore of 1 um the body alone would make the mesh
+stiffness 1e-30 N/m), while a body held at a smaller bore is only closer to a solid one.
 """
 from __future__ import annotations
 
@@ -60,9 +63,15 @@ def body_ratio(gear: GearGeometry) -> tuple[float, list[str]]:
                      f"as the thickest the fit covers (root radius / bore radius = {high:g}); give its bore for its own")
     else:
         ratio = gear.root_radius / (0.5 * gear.bore_diameter)
-        if not low <= ratio <= high:
-            notes.append(f"the {gear.teeth}-tooth gear's root radius / bore radius = {ratio:.3g} is outside the "
-                         f"{low:g}-{high:g} of Sainsot's body formula: its deflection is extrapolated")
+        if ratio > high:  # (the fit's h^2 terms grow without bound: a body held at a pinhole bore is not that soft)
+            notes.append(f"the {gear.teeth}-tooth gear's bore ({gear.bore_diameter * 1e3:.3g} mm) gives root radius / "
+                         f"bore radius = {ratio:.3g}, beyond the {low:g}-{high:g} of Sainsot's body formula, whose "
+                         f"terms grow without bound there: the body is taken as the thickest the fit covers "
+                         f"({high:g}, as for a solid gear)")
+            ratio = high
+        elif ratio < low:
+            notes.append(f"the {gear.teeth}-tooth gear's root radius / bore radius = {ratio:.3g} is below the "
+                         f"{low:g}-{high:g} of Sainsot's body formula (a thin rim): its deflection is extrapolated")
     theta = gear.profile.root_angle
     lo, hi = ROOT_ANGLE_RANGE
     if not lo <= theta <= hi:

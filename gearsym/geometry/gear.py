@@ -27,6 +27,8 @@ MIN_TEETH = 6
 MAX_TEETH = 10000
 #: the pressure angles of the basic racks in use (ISO 53: 20 deg; older 14.5 deg; high 25-30 deg)
 PRESSURE_ANGLE_RANGE = (math.radians(10.0), math.radians(35.0))
+#: the thinnest rim under the teeth, in tooth heights: ISO 6336-3's rim thickness factor Y_B covers s_R / h_t >= 0.5
+MIN_RIM = 0.5
 #: helix angles beyond this are not cylindrical gears for power transmission
 MAX_HELIX_ANGLE = math.radians(45.0)
 #: a tip thinner than this (in modules) is warned about: ISO 21771 / common practice ask s_a >= 0.2-0.4 m_n
@@ -160,6 +162,13 @@ class GearGeometry:
         if self.bore_diameter >= 2.0 * self.root_radius:
             raise GearsymError(f"gear: the bore ({self.bore_diameter * 1e3:.4g} mm) is not smaller than the root "
                                f"circle ({2e3 * self.root_radius:.4g} mm): nothing would carry the teeth")
+        rim, height = self.root_radius - self.bore_diameter / 2, self.tip_radius - self.root_radius
+        if self.bore_diameter and rim < MIN_RIM * height:
+            raise GearsymError(f"gear ({self.teeth} teeth): the bore ({self.bore_diameter * 1e3:.4g} mm) leaves a rim "
+                               f"of {rim * 1e3:.3g} mm under the teeth, less than {MIN_RIM:g} of their height "
+                               f"({height * 1e3:.3g} mm; ISO 6336-3's rim factor ends there): such a rim bends as a "
+                               f"ring, which no formula here holds; give a bore of at most "
+                               f"{2e3 * (self.root_radius - MIN_RIM * height):.4g} mm")
         if self.tip_thickness <= 0:
             raise GearsymError(f"gear: the teeth come to a point below the tip circle ({self.teeth} teeth, profile shift "
                                f"{self.profile_shift:g}): lower the profile shift or the addendum")

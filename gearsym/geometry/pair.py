@@ -57,6 +57,10 @@ class GearPair:
             raise GearsymError(f"gear pair: the helix angles differ in size ({math.degrees(g1.helix_angle):g} and "
                                f"{math.degrees(g2.helix_angle):g} deg); an external pair has equal helix angles of "
                                "opposite hands")
+        if g1.helix_angle and (g1.helix_angle > 0) == (g2.helix_angle > 0):
+            raise GearsymError(f"gear pair: the helices have the same hand ({math.degrees(g1.helix_angle):g} and "
+                               f"{math.degrees(g2.helix_angle):g} deg: the sign is the hand); an external pair meshes "
+                               f"with opposite hands: give gear 2 {-math.degrees(g2.helix_angle):g} deg")
         zero_backlash = (g1.base_radius + g2.base_radius) / math.cos(self._tight_angle)
         if self.centre_distance is None:
             object.__setattr__(self, "centre_distance", zero_backlash)

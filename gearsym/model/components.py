@@ -37,6 +37,7 @@ from typing import Optional, Union
 from ..geometry import GearGeometry, StiffnessOptions
 from ..units import Measure
 from .expressions import ExprLike
+from .shaft_orders import teeth_of
 from .geometric import GEOMETRY_HARMONICS, ComputedStiffness, body_values, computed_stiffness, geometry_from
 from .stiffness import rectangular_mesh_stiffness
 
@@ -88,6 +89,10 @@ class Gear(Body):
     speed: Optional[str] = None
     internal: bool = field(default=False, kw_only=True)
     geometry: Optional[GearGeometry] = field(default=None, kw_only=True)
+
+    def __post_init__(self):
+        if self.teeth is not None:  # (a count that is no count is wrong whether or not a fault needs it yet)
+            teeth_of(self.teeth, f"Gear {self.name!r}")
 
     @classmethod
     def from_geometry(cls, name: str, geometry: Optional[GearGeometry] = None, *, inertia: Optional[str] = None,

@@ -22,6 +22,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from ..geometry import GearPair, crack_loss_along_path
+from ..parameters import Constraint
 from .components import BodyRef
 from .expressions import ExprLike, to_expr
 from .shaft_orders import DEFAULT_EDGE, path_coordinate, path_window, shaft_harmonic, tooth_by_tooth, tooth_share
@@ -52,6 +53,10 @@ class ShaftOrderTerm:
     def terms(self, phi: sp.Expr, teeth: int, where: str) -> MeshTerms:  # pragma: no cover (every kind has one)
         raise NotImplementedError
 
+    def constraints(self) -> dict[str, Constraint]:
+        """What the term's parameters may be (a depth that is a parameter: a fraction below 1), by name."""
+        return {}
+
     def _tooth(self, tooth, teeth: int, where: str) -> int:
         if isinstance(tooth, bool) or not isinstance(tooth, int) or not 1 <= tooth <= teeth:
             raise ModelError(f"tooth must be a whole number from 1 to the gear's {teeth} teeth, got {tooth!r}", where)
@@ -76,6 +81,13 @@ class ToothFault(ShaftOrderTerm):
     contact_ratio: float = DEFAULT_CONTACT_RATIO
     edge: float = DEFAULT_EDGE
     along_path: tuple = ()
+
+    def __post_init__(self):
+        _check_fraction(self.depth, "depth", f"ToothFault {self.name!r}")
+
+    def constraints(self) -> dict[str, Constraint]:
+        return _fraction_parameter(self.depth, f"the fraction of the stiffness of the pair of tooth {self.tooth} of "
+                                               f"{_gear_name(self.gear)} that its fault takes away")
 
     def terms(self, phi: sp.Expr, teeth: int, where: str) -> MeshTerms:
         tooth = self._tooth(self.tooth, teeth, where)
@@ -132,6 +144,13 @@ class Spall(ShaftOrderTerm):
     contact_ratio: float = DEFAULT_CONTACT_RATIO
     edge: float = DEFAULT_EDGE
 
+    def __post_init__(self):
+        _check_fraction(self.width, "width", f"Spall {self.name!r}")
+
+    def constraints(self) -> dict[str, Constraint]:
+        return _fraction_parameter(self.width, f"the fraction of the face width of tooth {self.tooth} of "
+                                               f"{_gear_name(self.gear)} that its spall takes away")
+
     def terms(self, phi: sp.Expr, teeth: int, where: str) -> MeshTerms:
         tooth = self._tooth(self.tooth, teeth, where)
         share = tooth_share(phi, teeth, tooth, self.contact_ratio, self.edge)
@@ -170,3 +189,26 @@ class SpacingErrors(ShaftOrderTerm):
                              where)
         edge = (sp.nsimplify(self.contact_ratio) - 1) / 2
         return MeshTerms(error=tooth_by_tooth(phi, teeth, errors, edge))
+
+
+#: why a fraction of stiffness lost is below 1: at 1 the pair carries nothing, beyond it it pulls (a negative tooth
+#: stiffness, a tensile contact force)
+_FRACTION = "0 <= {what} < 1 (0: healthy; at 1 the pair would carry nothing, beyond 1 it would pull)"
+
+
+def _check_fraction(value: ExprLike, what: str, where: str) -> None:
+    """A fraction of stiffness lost given as a number must be in [0, 1)."""
+    expr = to_expr(value, where)
+    if expr.is_number and not (expr.is_real and 0 <= float(expr) < 1):
+        raise ModelError(f"{what} {value!r} is a fraction of the pair's stiffness lost: " + _FRACTION.format(what=what),
+                         where)
+
+
+def _fraction_parameter(value: ExprLike, meaning: str) -> dict[str, Constraint]:
+    """A fraction lost given as a parameter: that parameter must be in [0, 1)."""
+    expr = to_expr(value, meaning)
+    return {expr.name: Constraint(meaning, True, below=1.0)} if isinstance(expr, sp.Symbol) else {}
+
+
+def _gear_name(gear: BodyRef) -> str:
+    return repr(gear if isinstance(gear, str) else gear.name)

@@ -237,6 +237,9 @@ def _doubled_branch(model, parameter: str, parent: Traced, pd: Solution, start, 
     mu, vectors = np.linalg.eig(pd.ev.monodromy)
     k = int(np.argmin(np.abs(mu + 1)))
     direction = np.real(vectors[:, k])
+    # LAPACK's eigenvector has either sign (the BLAS kernel decides): the branch would start on either half of the
+    # pitchfork, the same orbits shifted by n periods but other points. Its largest component is made positive.
+    direction = direction * np.sign(direction[np.argmax(np.abs(direction) >= np.max(np.abs(direction)) * (1 - 1e-9))])
     doubled = np.vstack([base, base])
     carried = np.empty_like(doubled)
     carried[0] = direction

@@ -16,8 +16,8 @@ from ..errors import GearsymError
 from ..figures.basins import Shown
 from ..figures.poincare import parameter_text
 from ..sweep.grid import Axis
-from ..units import to_si
-from .point import PointUnits
+from ..units import dimension_text, to_si, unit_dims
+from .point import ANGLE, ANGULAR_VELOCITY, LENGTH, VELOCITY, PointUnits
 
 
 def units_of(scaling) -> PointUnits:
@@ -61,18 +61,39 @@ class PhysicalShown(Shown):
         return ", ".join(parts)
 
 
+#: the dimension (exponents of mass, length, time) of each kind of state, and a grid of it in its unit
+_DIMENSIONS = {LENGTH: ((0.0, 1.0, 0.0), "-20um:20um:1um"), VELOCITY: ((0.0, 1.0, -1.0), "-500mm/s:500mm/s:25mm/s"),
+               ANGLE: ((0.0, 0.0, 0.0), "-0.01rad:0.01rad:0.001rad"),
+               ANGULAR_VELOCITY: ((0.0, 0.0, -1.0), "-10rad/s:10rad/s:1rad/s")}
+
+
+def check_grid_units(units: PointUnits, axes: Sequence[Axis]) -> None:
+    """Every grid axis of a state with a physical kind has a unit of that kind's dimension (a length, a rate)."""
+    for axis in axes:
+        kind = units.kinds.get(axis.name)
+        if kind is None:  # a state without a physical kind: the model's own numbers
+            continue
+        expected, grid = _DIMENSIONS[kind]
+        example = f"{axis.name}={grid}"
+        if not axis.unit:
+            raise GearsymError(f"--grid {axis.spec!r}: {axis.name} is a {kind} of {units.name}, which has physical "
+                               f"values: give the grid with its unit, e.g. {example}")
+        got = unit_dims(axis.unit)
+        if got != expected:
+            raise GearsymError(f"--grid {axis.spec!r}: {axis.name} is a {kind} of {units.name} "
+                               f"({dimension_text(expected)}), but {axis.unit} is {dimension_text(got)}; give it in "
+                               f"a unit of a {kind}, e.g. {example}")
+
+
 def engine_grid(units: PointUnits, axes: Sequence[Axis], omega: float) -> dict[str, np.ndarray]:
     """The engine's values of grid ``axes`` given in physical units, at the forcing frequency ``omega``."""
+    check_grid_units(units, axes)
     grid = {}
     for axis in axes:
         kind = units.kinds.get(axis.name)
         if kind is None:  # a state without a physical kind: the model's own numbers
             grid[axis.name] = np.asarray(axis.values, dtype=float)
             continue
-        if not axis.unit:
-            example = "x=-20um:20um:1um" if kind == "length" else "v=-500mm/s:500mm/s:25mm/s"
-            raise GearsymError(f"--grid {axis.spec!r}: {axis.name} is a {kind} of {units.name}, which has physical "
-                               f"values: give the grid with its unit, e.g. {example}")
         per_engine_unit = float(units.state(axis.name, 1.0, omega, si=True))
         grid[axis.name] = to_si(np.asarray(axis.values, dtype=float), axis.unit) / per_engine_unit
     return grid

@@ -32,7 +32,7 @@ from ..model.backlash import g
 from ..errors import ModelError, UnknownParameterError
 from ..model.drivetrain import Drivetrain
 from ..model.resolved_components import ResolvedCoupling
-from ..checks import sign_violation
+from ..model.roles import parameter_roles
 from ..model.expressions import ExprLike, parameter_names, to_expr
 from ..model.stiffness import check_periodic
 from ..model.symbols import omega, parameter_symbol, phi, t, tau
@@ -238,23 +238,25 @@ class NondimensionalModel:
         return out
 
     @cached_property
-    def _constraints(self) -> dict[str, tuple[bool, str]]:
-        """name -> (zero allowed, what it is) for parameters that have a physical sign."""
+    def _constraints(self) -> dict[str, Constraint]:
+        """name -> what it is and which values it may take, for parameters that have a physical sign or range."""
         rd = self.reduction.resolved
-        out: dict[str, tuple[bool, str]] = {"omega": (False, "the forcing frequency")}
+        out: dict[str, Constraint] = {"omega": Constraint("the forcing frequency", False)}
         for rb in rd.bodies:
             for value, what in ((rb.inertia, "an inertia"), (rb.radius, "a radius")):
                 if isinstance(value, sp.Symbol):
-                    out[value.name] = (False, what)
+                    out[value.name] = Constraint(what, False)
         for rc in rd.couplings:
             for value, what in ((rc.backlash, "a backlash"), (rc.damping, "a damping"), (rc.stiffness, "a stiffness")):
                 if isinstance(value, sp.Symbol):
-                    out.setdefault(value.name, (True, what))
+                    out.setdefault(value.name, Constraint(what, True))
         for gr in self.groups:
             if gr.role == "damping":
-                out[gr.name] = (True, "a damping ratio")
+                out[gr.name] = Constraint("a damping ratio", True)
             elif gr.role == "stiffness":
-                out[gr.name] = (False, "a relative mesh stiffness")
+                out[gr.name] = Constraint("a relative mesh stiffness", False)
+        for term in self.drivetrain.shaft_terms:  # (a tooth fault's depth: a fraction below 1)
+            out.update(term.constraints())
         return out
 
     def check_value(self, name: str, value: ExprLike) -> float:
@@ -269,10 +271,10 @@ class NondimensionalModel:
             if not expr.is_number:
                 raise ModelError(f"the {what} must be a number, got {value!r}", f"parameter {name!r}")
             number = float(expr)
-        zero_ok, meaning = self._constraints.get(name, (True, None))
-        must = sign_violation(number, zero_ok) if meaning else None
+        constraint = self._constraints.get(name)
+        must = constraint.violation(number) if constraint else None
         if must:
-            raise ModelError(f"is {meaning} and {must}, got {number:g}", f"parameter {name!r}")
+            raise ModelError(f"is {constraint.meaning} and {must}, got {number:g}", f"parameter {name!r}")
         return number
 
     def stiffness_formula(self, f: StiffnessFunction, value: ExprLike) -> sp.Expr:
@@ -328,8 +330,9 @@ class NondimensionalModel:
         descriptions = dict(self.drivetrain.descriptions)
         for gr in self.groups:
             descriptions.setdefault(gr.name, gr.description)
-        constraints = {name: Constraint(meaning, zero_ok) for name, (zero_ok, meaning) in self._constraints.items()
-                       if name in params}
+        for name, role in parameter_roles(self.reduction.resolved).items():  # (what the model does not describe)
+            descriptions.setdefault(name, role)
+        constraints = {name: c for name, c in self._constraints.items() if name in params}
         return FirstOrderSystem(self.name, tau, self.states, rhs, params, self.period, descriptions,
                                 self.drivetrain.title, tuple(c.name for c in self.coordinates),
                                 self._initial(initial), self._system_couplings(functions), constraints,

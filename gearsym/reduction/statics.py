@@ -151,16 +151,38 @@ def _solve(laws: list[_Law], factors: np.ndarray, load: np.ndarray, model: str) 
     r = residual(x)
     for _ in range(MAX_STEPS):
         jacobian = factors @ np.array([law.slope(float(law.row @ x)) * law.row for law in laws])
-        try:
-            step = np.linalg.solve(jacobian, -r)
-        except np.linalg.LinAlgError:
-            step = np.linalg.lstsq(jacobian, -r, rcond=None)[0]
+        if np.linalg.matrix_rank(jacobian) < n and any(law.flank(float(law.row @ x)) == "gap" for law in laws
+                                                        if law.kind == "mesh"):
+            step = _closing_step(laws, factors, load, x)
+        else:
+            try:
+                step = np.linalg.solve(jacobian, -r)
+            except np.linalg.LinAlgError:
+                step = np.linalg.lstsq(jacobian, -r, rcond=None)[0]
         x = x + step
         r = residual(x)
         if float(np.max(np.abs(r))) <= 1e-12 * scale or not np.any(load):
             return x
     raise GearsymError(f"{model}: the drivetrain has no static equilibrium under its mean loads (a mesh that "
                        "never closes, or a coupling without stiffness, leaves a load nothing holds)")
+
+
+def _closing_step(laws: list[_Law], factors: np.ndarray, load: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """The step from ``x`` when meshes in their backlash gap leave nothing to hold the load (the Jacobian is
+    singular, and Newton's step would not move them): each such mesh is taken to close on the flank the load
+    pushes it toward (the back flank if the step with its stiffness restored opens it further, else the drive
+    flank), and the step is the one to the solution of those flanks' linear laws (exact if they are the right
+    ones; the next steps correct them if not)."""
+    d = [float(law.row @ x) for law in laws]
+    gap = [law.kind == "mesh" and law.flank(di) == "gap" for law, di in zip(laws, d)]
+    slopes = [law.stiffness if closing else law.slope(di) for law, di, closing in zip(laws, d, gap)]
+    stiff = factors @ np.array([s * law.row for s, law in zip(slopes, laws)])
+    forces = np.array([law.force(di) for law, di in zip(laws, d)])
+    toward = np.linalg.lstsq(stiff, load - factors @ forces, rcond=None)[0]
+    for k, (law, di, closing) in enumerate(zip(laws, d, gap)):
+        if closing:  # the linear law of the flank it closes on, at its deflection now
+            forces[k] = law.stiffness * (di + law.backlash if float(law.row @ toward) < 0 else di)
+    return np.linalg.lstsq(stiff, load - factors @ forces, rcond=None)[0]
 
 
 @dataclass(frozen=True)

@@ -52,7 +52,9 @@ def record_of(computed: list[Computed]) -> dict:
 def reproduce(out: str | Path = "docs/figures", doc: str | Path | None = None, *,
               quick: bool = False, jobs: int = 0, progress: bool = True, data: str | Path | None = None) -> dict:
     """Compute everything, draw the figures into ``out``, write ``out/claims.json`` and ``doc``
-    (default: ``reproduction.md`` beside ``out``, i.e. docs/reproduction.md for docs/figures).
+    (default: ``reproduction.md`` beside ``out``, i.e. docs/reproduction.md for docs/figures). A record, report or
+    figure already there that the new one equals to within rounding is left as it is (another machine rounds
+    otherwise: the committed files stay unchanged).
 
     Sweep data go to ``data`` (default ``out/data``), which is also the cache a
     rerun reads and the place an interrupted run resumes from. Returns the record.
@@ -67,7 +69,7 @@ def reproduce(out: str | Path = "docs/figures", doc: str | Path | None = None, *
         draw_all(computed[-1], out, "" if i == 0 else f"-{scenario.name}")
     record = record_of(computed)
     record["stability"] = stability_record(compile_linearisation(load(STABILITY_MODEL)), out, quick)
-    write(record, out / "claims.json", Path(doc) if doc else out.parent / "reproduction.md")
+    record = write(record, out / "claims.json", Path(doc) if doc else out.parent / "reproduction.md")
     if progress:
         for s in record["scenarios"]:
             verdicts = [c["verdict"] for c in s["claims"]]

@@ -323,4 +323,4 @@ def draw_all(c: Computed, out: str | Path, suffix: str = "") -> list[Path]:
     out = Path(out)
     names = [n for n in FIGURES if (n != "study" or "study_ka" in c.sweeps) and (n != "fig3-orbits" or c.orbits)
              and (n != "basins" or c.basins) and (n != "basin-fractions" or c.fractions)]
-    return [save_figure(build(n, c), out / f"{n}{suffix}.png", FIGURES[n][1]) for n in names]
+    return [save_figure(build(n, c), out / f"{n}{suffix}.png", FIGURES[n][1], keep_same=True) for n in names]

@@ -62,8 +62,9 @@ def explain_jumps(model: CompiledModel, result: Continuation, sweep: SweepResult
     up = [j for j in findings["jumps"] if j["direction"] == "up"]
     jumps = [{**j, **classify(runs["up"], j["from"], +1, j["to"])} for j in up]
     record = {"parameter": result.parameter, "step": step,
-              "branches": [{"period": b.period_multiple, "points": len(b), "from": float(b.values.min()),
-                            "to": float(b.values.max())} for b in result.branches],
+              # (not the number of points: it follows from the step control's decisions, which rounding changes)
+              "branches": [{"period": b.period_multiple, "from": float(b.values.min()), "to": float(b.values.max())}
+                           for b in result.branches],
               "bifurcations": [{"type": b.kind, "omega": b.value, "period": b.period_multiple, "detail": b.detail}
                                for b in result.bifurcations],
               "hysteresis": hysteresis, "jumps_up": jumps}

@@ -13,8 +13,13 @@ import re
 from pathlib import Path
 
 from ..files.atomic import write_atomically
+from ..periodic import FOLD, GRAZING, NEIMARK_SACKER, PERIOD_DOUBLING
+from ..rounding import record_differences
 from .claims import MIN_CHAOTIC
 from .stability import report_lines as stability_lines
+
+#: the order the kinds of bifurcation are counted in (not the order they were found in)
+BIFURCATIONS = (FOLD, PERIOD_DOUBLING, NEIMARK_SACKER, GRAZING)
 
 #: Why a claim comes out as it does, where the numbers alone do not say it. Written by a person
 #: after reading the figures; keyed by claim id. No numbers here: those come from the record.
@@ -189,11 +194,9 @@ def _jumps_explained(record: dict, figures_dir: str) -> list[str]:
             o = s["orbits"].get(name)
             if not o:
                 continue
-            kinds = {}
-            for b in o["bifurcations"]:
-                kinds[b["type"]] = kinds.get(b["type"], 0) + 1
-            lines += [f"{label}: " + ", ".join(f"{b['points']} points of period {b['period']} over "
-                                               f"[{b['from']:.3f}, {b['to']:.3f}]" for b in o["branches"])
+            kinds = {k: n for k in BIFURCATIONS if (n := sum(b["type"] == k for b in o["bifurcations"]))}
+            lines += [f"{label}: branches of " + ", ".join(f"period {b['period']} over [{b['from']:.3f}, {b['to']:.3f}]"
+                                                          for b in o["branches"])
                       + "; " + (", ".join(f"{n} {k}" for k, n in kinds.items()) or "no bifurcations") + ".", ""]
             if o["hysteresis"]:
                 lines += ["| hysteresis (up and down differ) | the up run leaves its attractor by | the down run leaves "
@@ -328,7 +331,29 @@ def _method(record: dict) -> list[str]:
             "open, and why the defaults are what they are: `docs/paper-notes.md`.", ""]
 
 
-def write(record: dict, json_path: Path, doc_path: Path) -> None:
-    write_atomically(json_path, json.dumps(record, indent=1, sort_keys=False, allow_nan=False) + "\n")
+#: floats of a record within this fraction of the committed ones are the same result (the continuation's located
+#: ends move by 5e-7 of omega with the BLAS kernel; 1e-5 of omega is finer than any claim reads)
+SAME_RECORD = 1e-5
+
+
+def write(record: dict, json_path: Path, doc_path: Path) -> dict:
+    """``json_path`` and ``doc_path`` from ``record``; an existing record that ``record`` equals to within rounding
+    (:data:`SAME_RECORD`, texts to the last printed digit: ``gearsym.rounding``) is kept as it is, with its report,
+    so that another machine's run leaves committed files unchanged. Returns the record written or kept."""
+    try:
+        old = json.loads(Path(json_path).read_text())
+    except (OSError, ValueError):
+        old = None
+    if old is not None and not record_differences(record, old, rel=SAME_RECORD):
+        record = old
+    else:
+        write_atomically(json_path, json.dumps(record, indent=1, sort_keys=False, allow_nan=False) + "\n")
     figures_dir = os.path.relpath(json_path.parent, doc_path.parent).replace(os.sep, "/")
-    write_atomically(doc_path, render(record, figures_dir))
+    page = render(record, figures_dir)
+    try:
+        unchanged = Path(doc_path).read_text() == page
+    except OSError:
+        unchanged = False
+    if not unchanged:
+        write_atomically(doc_path, page)
+    return record

@@ -180,12 +180,12 @@ class Scaling:
         units, before anything is divided by it."""
         constraints = self.model._constraints
         for name, q in self.inputs.items():
-            zero_ok, meaning = constraints.get(name, (True, None))
-            if meaning is None or name == "omega":
+            constraint = constraints.get(name)
+            if constraint is None or name == "omega":
                 continue
-            if q.si < 0 or (q.si == 0 and not zero_ok):
-                must = "must not be negative" if zero_ok else "must be positive"
-                raise ModelError(f"{q.text()} is {meaning} and {must}", f"{self.name}: {name}")
+            must = constraint.violation(q.si)
+            if must:
+                raise ModelError(f"{q.text()} is {constraint.meaning} and {must}", f"{self.name}: {name}")
         if self.speed and self.speed.parameter in self.inputs and not self.inputs[self.speed.parameter].si > 0:
             raise ModelError(f"{self.inputs[self.speed.parameter].text()} is the operating speed and must be "
                              "positive", f"{self.name}: {self.speed.parameter}")

@@ -26,6 +26,7 @@ from ..units import QUANTITY, parse_quantity
 MODES = ("continuation", "independent")
 DIRECTIONS = ("up", "down", "both")
 INDEPENDENT = "independent"  # the direction column of independent points
+#: the most points of one sweep (an axis, or all axes together): a million runs is days of work, more is a step mistyped
 MAX_POINTS = 1_000_000
 
 
@@ -37,39 +38,42 @@ class Axis:
     values: tuple[float, ...]
     spec: str  # as written, for the record
     unit: str = ""  # a physical unit of the values ("rpm"), or "" for the model's own numbers
+    option: str = "--param"  # the option it was given with, for the messages (basins' --grid)
 
     def __post_init__(self):
         if not self.values:
-            raise GearsymError(f"--param {self.spec!r}: no values")
+            raise GearsymError(f"{self.option} {self.spec!r}: no values")
         if len(set(self.values)) != len(self.values):
-            raise GearsymError(f"--param {self.spec!r}: values repeat")
+            raise GearsymError(f"{self.option} {self.spec!r}: values repeat")
 
 
-def parse_axis(text: str) -> Axis:
-    """``NAME=START:STOP:STEP``, ``NAME=V1,V2,...`` or ``NAME=VALUE``."""
-    usage = (f"--param {text!r}: expected NAME=START:STOP:STEP (e.g. omega=0.1:2.0:0.01), "
-             "NAME=V1,V2,... (e.g. kS=0,0.1,1.0) or NAME=VALUE")
+def parse_axis(text: str, option: str = "--param") -> Axis:
+    """``NAME=START:STOP:STEP``, ``NAME=V1,V2,...`` or ``NAME=VALUE``; ``option``: how the caller gave it (for
+    the messages)."""
+    example = "x=-5:5:0.1" if option == "--grid" else "omega=0.1:2.0:0.01"
+    usage = (f"{option} {text!r}: expected NAME=START:STOP:STEP (e.g. {example}), "
+             f"NAME=V1,V2,... (e.g. {'x=-1,0,1' if option == '--grid' else 'kS=0,0.1,1.0'}) or NAME=VALUE")
     name, sep, body = (part.strip() for part in text.partition("="))
     if not sep or not name or not body:
         raise GearsymError(usage)
     ranged = ":" in body
-    texts, unit = _numbers_and_unit(text, body.split(":" if ranged else ","))
+    texts, unit = _numbers_and_unit(text, body.split(":" if ranged else ","), option)
     try:
         if ranged:
             parts = [Decimal(p) for p in texts]
             if len(parts) != 3:
                 raise GearsymError(usage)
-            values = _range(text, *parts)
+            values = _range(text, *parts, option=option)
         else:
             values = [Decimal(p) for p in texts]
     except InvalidOperation:
         raise GearsymError(usage) from None
     if not all(v.is_finite() for v in values):
-        raise GearsymError(f"--param {text!r}: values must be finite numbers")
-    return Axis(name, tuple(sorted(float(v) for v in values)), text, unit)
+        raise GearsymError(f"{option} {text!r}: values must be finite numbers")
+    return Axis(name, tuple(sorted(float(v) for v in values)), text, unit, option)
 
 
-def _numbers_and_unit(text: str, parts: list[str]) -> tuple[list[str], str]:
+def _numbers_and_unit(text: str, parts: list[str], option: str = "--param") -> tuple[list[str], str]:
     """The numbers of ``parts`` as written, in the unit of the first part that has one (converted by pint if
     another part has another unit), and that unit ("" if none has one). The units are checked by the safe
     quantity parser."""
@@ -79,23 +83,36 @@ def _numbers_and_unit(text: str, parts: list[str]) -> tuple[list[str], str]:
     unit = next(u for u in units if u)
     numbers = []
     for part, own in zip(parts, units):
-        q = parse_quantity(part if own else f"{part} {unit}", f"--param {text!r}")
+        q = parse_quantity(part if own else f"{part} {unit}", f"{option} {text!r}")
         try:
             numbers.append(repr(q.to(unit).magnitude) if own != unit else QUANTITY.fullmatch(part)["number"])
         except Exception:
-            raise GearsymError(f"--param {text!r}: {part.strip()} cannot be converted to {unit}") from None
+            raise GearsymError(f"{option} {text!r}: {part.strip()} cannot be converted to {unit}") from None
     return numbers, unit
 
 
-def _range(text: str, start: Decimal, stop: Decimal, step: Decimal) -> list[Decimal]:
+def _range(text: str, start: Decimal, stop: Decimal, step: Decimal, option: str = "--param") -> list[Decimal]:
     if not (start.is_finite() and stop.is_finite() and step.is_finite()):
-        raise GearsymError(f"--param {text!r}: start, stop and step must be finite")
+        raise GearsymError(f"{option} {text!r}: start, stop and step must be finite")
     if step == 0 or (stop - start) * step < 0:
-        raise GearsymError(f"--param {text!r}: the step must be nonzero and lead from start to stop")
+        raise GearsymError(f"{option} {text!r}: the step must be nonzero and lead from start to stop")
     count = int((stop - start) / step) + 1  # stop included when the steps land on it
     if count > MAX_POINTS:
-        raise GearsymError(f"--param {text!r}: {count} values; that many points is surely a typo in the step")
+        raise GearsymError(f"{option} {text!r}: {count} values, more than the {MAX_POINTS} one {option} may have; "
+                           "give a larger step")
     return [start + i * step for i in range(count)]
+
+
+def check_points(axes: Sequence[Axis], runs: int = 1) -> None:
+    """Refuse a grid of ``axes`` (each point run ``runs`` times: up and down) of more than MAX_POINTS, saying its
+    size and the limit, before any point list is made."""
+    count = runs
+    for a in axes:
+        count *= len(a.values)
+    if count > MAX_POINTS:
+        sizes = " x ".join(str(len(a.values)) for a in axes) + (f" x {runs} directions" if runs > 1 else "")
+        raise GearsymError(f"the sweep has {count} points ({sizes}), more than the {MAX_POINTS} one sweep may have; "
+                           "give larger steps or fewer values")
 
 
 def axes_from(spec: Mapping[str, Sequence[float]] | Sequence[Axis | str]) -> tuple[Axis, ...]:
@@ -110,6 +127,7 @@ def axes_from(spec: Mapping[str, Sequence[float]] | Sequence[Axis | str]) -> tup
     names = [a.name for a in axes]
     if len(set(names)) != len(names):
         raise GearsymError(f"a parameter is swept twice: {', '.join(names)}")
+    check_points(axes)
     return axes
 
 
@@ -147,6 +165,7 @@ def plan(axes: Sequence[Axis], mode: str, direction: str) -> list[list[Point]]:
         raise GearsymError(f"unknown mode {mode!r}; choose {' or '.join(MODES)}")
     if direction not in DIRECTIONS:
         raise GearsymError(f"unknown direction {direction!r}; choose one of {', '.join(DIRECTIONS)}")
+    check_points(axes, 2 if mode != INDEPENDENT and direction == "both" else 1)
     first, others = axes[0], [a.values for a in axes[1:]]
     tasks = []
     for rest in itertools.product(*others):
@@ -156,8 +175,6 @@ def plan(axes: Sequence[Axis], mode: str, direction: str) -> list[list[Point]]:
         up = [Point("up", (v, *rest)) for v in first.values]
         down = [Point("down", (v, *rest)) for v in reversed(first.values)]
         tasks.append({"up": up, "down": down, "both": up + down}[direction])
-    if sum(map(len, tasks)) > MAX_POINTS:
-        raise GearsymError(f"the sweep has {sum(map(len, tasks))} points; more than {MAX_POINTS} is surely a typo")
     return tasks
 
 

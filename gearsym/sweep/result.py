@@ -11,6 +11,7 @@ import numpy as np
 
 from ..analysis.jumps import find_jumps, hysteresis_intervals
 from ..errors import GearsymError
+from ..files.kinds import what_is_at
 from .grid import INDEPENDENT, Axis
 from .store import PoincareRows, read_poincare, read_rows, sidecar
 
@@ -125,7 +126,8 @@ def read_sweep(path: str | Path) -> SweepResult:
     meta = sidecar(path, ".json")
     for p in (path, meta):
         if not p.is_file():
-            raise GearsymError(f"{p}: no such file; a sweep is written by `gearsym sweep ... --out {path.name}`")
+            said = "no such file" if not p.exists() and not p.is_symlink() else what_is_at(p, "a sweep is a CSV file")
+            raise GearsymError(f"{p}: {said}; a sweep is written by `gearsym sweep ... --out {path.name}`")
     try:
         record = json.loads(meta.read_text())["sweep"]
         axes = tuple(Axis(n, tuple(v), f"{n}=...") for n, v in record["axes"].items())

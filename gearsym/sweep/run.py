@@ -150,7 +150,13 @@ class _SweepPlan:
     @classmethod
     def make(cls, compiled: CompiledModel, axes, options: Integration, mode: str, direction: str, y0, poincare: int,
              values: dict) -> "_SweepPlan":
-        poincare = min(whole_number(poincare, "poincare samples"), options.measured)
+        poincare = whole_number(poincare, "poincare samples")
+        if poincare > options.measured and poincare != POINCARE_SAMPLES:  # (the default fits what a run measures)
+            raise GearsymError(f"{caller.option('poincare', poincare)}: a point has one Poincare sample per measured "
+                               f"period, {options.measured} here ({caller.option('periods', options.periods)} minus "
+                               f"{caller.option('discard', options.discard)}): give at most {options.measured}, or "
+                               "more periods")
+        poincare = min(poincare, options.measured)
         if mode == INDEPENDENT and direction != "up":
             raise GearsymError(f"--direction {direction} applies to a continuation; independent points have no "
                                "direction")
@@ -186,7 +192,7 @@ class _SweepPlan:
 def _execute_on(workers: Workers, run: PointRuns, todo: list, ran: dict):
     """The rows of ``todo`` as they finish, from wherever ``workers`` says the points run."""
     if workers.scheduler is not None:
-        return execute_on_dask(run, todo, workers.scheduler, workers.jobs, ran)
+        return execute_on_dask(run, todo, workers.scheduler, workers.count, ran)  # (0 jobs: one per core)
     todo = guided(todo, min(workers.count, len(todo)))
     if workers.mode == "processes" and workers.count > 1 and len(todo) > 1:
         return execute_processes(run, todo, workers.count)

@@ -39,7 +39,7 @@ import numpy as np
 
 from .. import caller
 from ..errors import GearsymError, warn
-from ..files.atomic import write_atomically
+from ..files.atomic import write_atomically, write_error
 
 #: spaces kept in the record of a running sweep, so that a failure can be recorded in place on a full disk
 RECORD_ROOM = 2048
@@ -473,8 +473,12 @@ def take_lock(path: Path) -> int:
         os.close(fd)  # its holder removed the file as we locked it: lock the one now at the path
     _HELD_LOCKS.add(fd)
     holder = {"pid": os.getpid(), "host": socket.gethostname(), "started": time.strftime("%Y-%m-%d %H:%M:%S")}
-    os.ftruncate(fd, 0)
-    os.pwrite(fd, (json.dumps(holder) + "\n").encode(), 0)
+    try:
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, (json.dumps(holder) + "\n").encode(), 0)
+    except OSError as exc:  # (the disk full: the lock holds, but the sweep cannot start)
+        release_lock(path, fd)
+        raise write_error(exc, lock) from None
     return fd
 
 

@@ -6,9 +6,13 @@
 
    - model exchange: the derivatives are the engine's right-hand side rhs(tau, y, p); the event indicators are
      each mesh's deflection x and -(x + eta), where the backlash g(x, eta) changes slope;
-   - co-simulation: doStep runs `substeps` RK4 steps of the engine's own step (gs_state_span: the step whose
-     crossings of the backlash are located and split, as in every gearsym run), with the tables of time at
-     the steps' times (gearsym_fmu_table) and the step length in the constants' last entry.
+   - co-simulation: doStep runs RK4 steps of the engine's own kind (gs_state_span: the step whose crossings of
+     the backlash are located and split, as in every gearsym run), as many as keep each within the engine's
+     step (a period over GS_STEPS_PER_PERIOD) and at least `substeps`, whatever the communication step the
+     importer asks: its accuracy is gearsym's, not the importer's. The tables of time are taken at the steps'
+     times (gearsym_fmu_table) and the step length in the constants' last entry. A motion that leaves the bound
+     a gearsym run calls diverged (GS_BOUND times the start's scale, on the meshes' deflections) or becomes
+     non-finite ends the simulation with fmi2Error and a logged message, as the command line stops there.
 
    The FMU's variables are in its own units (SI for a model with physical values): a state is
    scale x the engine's, where scale is L for a length, L d(tau)/dt for a rate (L the length unit); time
@@ -44,6 +48,8 @@ typedef struct {
   double p[GS_NP_A];       /* the engine's parameters, made from P */
   double c[GS_NC];         /* the engine's constants; the last is the RK4 step */
   double rate;             /* d tau / d time */
+  double longest;          /* the engine's step: the longest RK4 step a co-simulation takes (tau) */
+  double bound;            /* a bounded state beyond this (engine units) has diverged */
   double t_ref, tau_ref;   /* tau = tau_ref + rate (time - t_ref) */
   int stale;               /* p, c and rate must be made again from P */
   int side[GS_NZ_A];       /* model exchange: each indicator's side (1: >= 0) since the last event */
@@ -110,13 +116,21 @@ static fmi2Status gs_engine(Instance* m) {
     m->p[gs_term_engine[k]] *= gs_term_exponent[k] == 1 ? ratio : pow(ratio, gs_term_exponent[k]);
   }
   for (j = 0; j < GS_NP; ++j) {
-    if (!isfinite(m->p[j])) return gs_error(m, "the parameter values give the engine's %s no finite value",
-                                            gs_engine_names[j]);
-    if ((gs_engine_sign[j] == 1 && m->p[j] < 0) || (gs_engine_sign[j] == 2 && !(m->p[j] > 0)))
-      return gs_error(m, "the parameter values make the engine's %s negative or zero, which it may not be",
-                      gs_engine_names[j]);
+    double v = m->p[j];
+    int rule = gs_engine_rule[j], bad;
+    if (!isfinite(v)) return gs_error(m, "the parameter values give the engine's %s no finite value",
+                                      gs_engine_names[j]);
+    bad = (rule == 1 && v < 0) || (rule == 2 && !(v > 0))
+          || (rule == 3 && !(v >= gs_engine_low[j] && v < gs_engine_high[j]))
+          || (rule == 4 && !(v == floor(v) && v >= gs_engine_low[j] && v <= gs_engine_high[j]));
+    if (bad) {
+      gs_log(m, fmi2Error, "logStatusError", "the parameter values make the engine's %s %g, but it %s",
+             gs_engine_names[j], v, gs_engine_must[j]);
+      return fmi2Error;
+    }
   }
   if (gs_call(m, constants, m->p, 0, 0, m->c, &period)) return gs_error(m, "%s: constants failed", m->name);
+  m->longest = period / GS_STEPS_PER_PERIOD;
   m->rate = GS_OMEGA >= 0 ? m->p[GS_OMEGA] / GS_TIME_UNIT : 1.0;
   m->stale = 0;
   return fmi2OK;
@@ -132,6 +146,32 @@ static double gs_scale(const Instance* m, int i) {
 static void gs_engine_state(const Instance* m, double* y) {
   int i;
   for (i = 0; i < GS_NX; ++i) y[i] = m->x[i] / gs_scale(m, i);
+}
+
+/* the first state that is not finite, or (bounded states) beyond the bound, in the engine's units; -1 if none */
+static int gs_escaped(const Instance* m, const double* y) {
+  int i;
+  for (i = 0; i < GS_NX; ++i)
+    if (!isfinite(y[i]) || (gs_state_bounded[i] && fabs(y[i]) > m->bound)) return i;
+  return -1;
+}
+
+/* the run's bound from its start (as gearsym's: GS_BOUND times the larger of 1 and the start's largest value);
+   a start that is not finite is named */
+static fmi2Status gs_start_bound(Instance* m) {
+  double y[GS_NX_A], scale = 1.0;
+  int i;
+  gs_engine_state(m, y);
+  for (i = 0; i < GS_NX; ++i) {
+    if (!isfinite(m->x[i])) {
+      gs_log(m, fmi2Error, "logStatusError", "the start value of %s is %g: every state needs a finite start "
+             "value", gs_state_names[i], m->x[i]);
+      return fmi2Error;
+    }
+    if (fabs(y[i]) > scale) scale = fabs(y[i]);
+  }
+  m->bound = GS_BOUND * scale;
+  return fmi2OK;
 }
 
 static int gs_contact_of(double deflection, double backlash) {
@@ -305,6 +345,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
   Instance* m = (Instance*) c;
   if (!gs_in(m, "fmi2ExitInitializationMode", GS_MODES(GS_INITIALIZING))) return fmi2Error;
   if (gs_engine(m) != fmi2OK) { m->mode = GS_FAILED; return fmi2Error; }
+  if (gs_start_bound(m) != fmi2OK) { m->mode = GS_FAILED; return fmi2Error; }
   if (gs_update_sides(m, 1) != fmi2OK) { m->mode = GS_FAILED; return fmi2Error; }
   m->mode = m->type == fmi2ModelExchange ? GS_EVENT : GS_RUNNING;
   return fmi2OK;
@@ -487,9 +528,21 @@ fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetFMUStat
                                        fmi2Boolean* enterEventMode, fmi2Boolean* terminateSimulation) {
   Instance* m = (Instance*) c;
   (void) noSetFMUStatePriorToCurrentPoint;
+  double y[GS_NX_A];
+  int i;
   if (!gs_in(m, "fmi2CompletedIntegratorStep", GS_MODES(GS_RUNNING))) return fmi2Error;
   *enterEventMode = fmi2False;
   *terminateSimulation = fmi2False;
+  gs_engine_state(m, y);
+  i = gs_escaped(m, y);
+  if (i >= 0) {
+    *terminateSimulation = fmi2True;
+    m->mode = GS_FAILED;
+    gs_log(m, fmi2Error, "logStatusError", "%s: the motion diverged at time %g: %s reached %g, beyond the bound "
+           "%g a gearsym run calls diverged (no bounded motion at these parameter values)", m->name, m->time,
+           gs_state_names[i], m->x[i], m->bound * gs_scale(m, i));
+    return fmi2Error;
+  }
   return fmi2OK;
 }
 
@@ -580,6 +633,12 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
   if (communicationStepSize == 0) return fmi2OK;
   if (gs_engine(m) != fmi2OK) return fmi2Error;
   n = m->substeps;
+  {  /* as many steps as keep each within the engine's (a hair over: rounding of the importer's step) */
+    double needed = ceil(fabs(m->rate * communicationStepSize) / m->longest * (1.0 - 1e-9));
+    if (!(needed < 1e9)) return gs_error(m, "%s: the communication step is more than a billion of the engine's "
+                                         "steps; take shorter communication steps", m->name);
+    if (needed > n) n = (long) needed;
+  }
   if (GS_NT && m->table_size < rows * n) {
     if (m->table) m->release(m->table);
     m->table = (double*) m->allocate((size_t) (rows * n), sizeof(double));
@@ -600,13 +659,18 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
   for (i = 0; i < GS_NOBS; ++i) lo[i] = hi[i] = y[gs_observed[i]];
   m->c[GS_NC - 1] = step;
   gs_state_span(y, lo, hi, GS_NT ? m->table : gs_zeros, m->c, (casadi_int) n);
-  for (i = 0; i < GS_NX; ++i) {
-    if (!isfinite(y[i])) {
-      m->mode = GS_FAILED;
-      gs_log(m, fmi2Error, "logStatusError", "%s: the solution became non-finite in the step from %g: the orbit "
-             "diverges or the step is too large for it (set more substeps)", m->name, currentCommunicationPoint);
-      return fmi2Error;
-    }
+  i = gs_escaped(m, y);
+  if (i >= 0) {
+    m->mode = GS_FAILED;
+    if (isfinite(y[i]))
+      gs_log(m, fmi2Error, "logStatusError", "%s: the motion diverged in the step from %g: %s reached %g, beyond "
+             "the bound %g a gearsym run calls diverged (no bounded motion at these parameter values)", m->name,
+             currentCommunicationPoint, gs_state_names[i], gs_scale(m, (int) i) * y[i],
+             gs_scale(m, (int) i) * m->bound);
+    else
+      gs_log(m, fmi2Error, "logStatusError", "%s: the motion diverged in the step from %g: %s became non-finite "
+             "(no bounded motion at these parameter values)", m->name, currentCommunicationPoint, gs_state_names[i]);
+    return fmi2Error;
   }
   m->time = currentCommunicationPoint + communicationStepSize;
   for (i = 0; i < GS_NX; ++i) m->x[i] = gs_scale(m, (int) i) * y[i];
