@@ -12,7 +12,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pint
 import pytest
+import sympy as sp
 from scipy.integrate import quad
 from scipy.optimize import brentq
 
@@ -240,8 +242,6 @@ def model_with(fault, *, teeth=(20, 53)) -> gearsym.FirstOrderSystem:
 
 
 def stiffness_of(system):
-    import sympy as sp
-
     (mesh,) = system.meshes
     k = mesh.stiffness.xreplace({p: system.parameters[p.name] for p in mesh.stiffness.free_symbols
                                  if p.name in system.parameters})
@@ -272,8 +272,6 @@ def test_the_model_takes_the_cracked_pairs_stiffness_phase_by_phase(bored):
 def test_the_cracks_mean_loss_is_the_depth_of_a_constant_tooth_fault(pair):
     """Through the face, in the user's units: the mean loss of a 3 mm crack at 70 degrees on the wheel's tooth becomes
     a constant ToothFault's depth, so the model's mesh stiffness while that pair alone is in mesh is k (1 - loss)."""
-    import pint
-
     units = pint.UnitRegistry()
     loss = gearsym.crack_stiffness_loss(pair, 2, 3 * units.mm, 70 * units.deg)
     assert loss == loss_in_si(pair, 2, 3e-3, math.radians(70)) and 0.1 < loss < 0.2

@@ -11,6 +11,8 @@ import pytest
 import sympy as sp
 
 import gearsym
+from gearsym import explain, load_measurements
+from gearsym.errors import GearsymError
 from gearsym.fit.effect_types import site
 from gearsym.fit.effects import augment
 from gearsym.fit.jacobian import Jacobian
@@ -139,12 +141,9 @@ def test_a_spall_is_in_the_library_of_a_model_with_teeth(geared):
 
 def test_the_tooth_by_tooth_forms_need_tooth_counts(tmp_path):
     """Asked for on a model whose gears have no tooth counts: one line that says what to give."""
-    from gearsym import explain, load_measurements
-    from gearsym.errors import GearsymError
-
     tau = np.linspace(0, 8 * math.pi, 100, endpoint=False)
     path = tmp_path / "m.csv"
-    path.write_text("tau,x\n" + "".join(f"{t!r},{math.sin(t)!r}\n" for t in tau))
+    path.write_text("tau,x\n" + "".join(f"{float(t)!r},{math.sin(t)!r}\n" for t in tau))
     one_stage = gearsym.load("one_stage")
     with pytest.raises(GearsymError, match="tooth_stiffness: no mesh of one_stage has two gears with tooth counts"):
         explain(one_stage, load_measurements([path], one_stage), ["zeta"], candidates=["tooth_stiffness"])
