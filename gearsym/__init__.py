@@ -7,7 +7,8 @@ One flat public face; the stages behind it, each handing one type to the next:
   the whole file, its builders too);
 * reduce: :func:`reduce` (Drivetrain -> :class:`NondimensionalModel`), whose ``.system(**values)`` is the
   :class:`FirstOrderSystem` the engine takes; :func:`load` does name -> system in one call;
-* compile: :func:`compile_model` (FirstOrderSystem, :class:`Integration` -> :class:`CompiledModel`);
+* compile: :func:`compile_model` (FirstOrderSystem, :class:`Integration` -> :class:`CompiledModel`); how the
+  verbs that run many things run them: :class:`Execution` (threads or workers, the lanes, progress);
 * analyse: :func:`lyapunov_spectrum`, :func:`poincare_samples`, :func:`phase_trajectory`,
   :func:`simulated_order_spectrum` (and :func:`order_spectrum` of any signal: mesh orders, shaft-order sidebands),
   :func:`find_attractors`, :func:`basin_map` (basins of attraction, many starts at once in the lanes),
@@ -30,9 +31,27 @@ import importlib
 from typing import TYPE_CHECKING
 
 from .errors import GearsymError, ModelError, UnknownParameterError
-from .options import Integration
+from .options import Execution, Integration
 from .version import __version__
 
+
+#: the engine's verbs: each face name -> the module of its low-level verb (on a CompiledModel, ``@engine_verb``);
+#: the face's verb (:mod:`gearsym.verbs`) is made from it, for a CompiledModel or a system. A new analysis is
+#: its module, a line here, and its command (a module of :mod:`gearsym.cli`)
+VERBS = {
+    "lyapunov_spectrum": "gearsym.analysis.lyapunov",
+    "poincare_samples": "gearsym.analysis.poincare",
+    "phase_trajectory": "gearsym.analysis.poincare",
+    "find_attractors": "gearsym.analysis.attractors",
+    "basin_map": "gearsym.analysis.basins",
+    "continue_basins": "gearsym.sweep.basin_continuation",
+    "run_sweep": "gearsym.sweep.run",
+    "periodic_orbit": "gearsym.periodic.orbit",
+    "continue_orbits": "gearsym.periodic.branches",
+    "simulate_measurements": "gearsym.data.simulate",
+    "simulated_order_spectrum": "gearsym.analysis.order_run",
+    "stability_chart": "gearsym.stability.verb",
+}
 
 #: public name -> the module that defines it (imported when the name is first used: the declaring and
 #: reducing stages import SymPy, which a command on a cached model never needs)
@@ -61,24 +80,12 @@ _LAZY = {
     "model_module": "gearsym.registry",
     "CompiledModel": "gearsym.codegen",
     "compile_model": "gearsym.codegen.build",
+    "chosen_integration": "gearsym.codegen.fastest_mode",
     "LyapunovSpectrum": "gearsym.analysis",
-    "lyapunov_spectrum": "gearsym.verbs",
-    "poincare_samples": "gearsym.verbs",
-    "phase_trajectory": "gearsym.verbs",
-    "find_attractors": "gearsym.verbs",
-    "basin_map": "gearsym.verbs",
-    "continue_basins": "gearsym.verbs",
     "classify_regime": "gearsym.analysis",
-    "periodic_orbit": "gearsym.verbs",
-    "continue_orbits": "gearsym.verbs",
-    "stability_chart": "gearsym.verbs",
     "StabilityChart": "gearsym.stability",
-    "run_sweep": "gearsym.verbs",
     "read_sweep": "gearsym.sweep",
-    "Workers": "gearsym.sweep",
     "SweepInterrupted": "gearsym.sweep",
-    "simulate_measurements": "gearsym.verbs",
-    "simulated_order_spectrum": "gearsym.verbs",
     "order_spectrum": "gearsym.analysis",
     "load_measurements": "gearsym.data",
     "explain": "gearsym.fit",
@@ -103,9 +110,10 @@ _LAZY = {
     "gear_pair": "gearsym.geometry",
     "mesh_stiffness": "gearsym.geometry",
     "iso6336_stiffness": "gearsym.geometry",
+    **dict.fromkeys(VERBS, "gearsym.verbs"),
 }
 
-__all__ = ["GearsymError", "Integration", "ModelError", "UnknownParameterError", *_LAZY]
+__all__ = ["Execution", "GearsymError", "Integration", "ModelError", "UnknownParameterError", *_LAZY]
 
 
 def __getattr__(name: str):
@@ -139,8 +147,5 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .registry import available_models, load_model
     from .scales.map import Scaling
     from .system import FirstOrderSystem
-    from .sweep import SweepInterrupted, Workers, read_sweep
+    from .sweep import SweepInterrupted, read_sweep
     from .stability import StabilityChart
-    from .verbs import (basin_map, continue_basins, continue_orbits, find_attractors, lyapunov_spectrum, periodic_orbit,
-                        phase_trajectory, poincare_samples, run_sweep, simulate_measurements, simulated_order_spectrum,
-                        stability_chart)

@@ -37,8 +37,10 @@ from pathlib import Path
 
 from .codegen.compiled import CompiledModel
 from .codegen.compiler import binary_key, cache_dir, compile_flags
-from .codegen.library import LOADED, library_describes, library_functions, resolve_backend
+from .codegen.library import library_describes, library_functions, model_key, resolve_backend
+from .codegen.loaded import keep, loaded
 from .codegen.loops import LoopOptions
+from .codegen.step_choice import chosen
 from .codegen.native import load_native
 from .codegen.trust import check, differences
 from .errors import warn
@@ -56,8 +58,9 @@ SUMMARY_FORMAT = 4
 
 @dataclass(frozen=True, eq=False)
 class SystemSummary(ParameterChecks):
-    """The part of a :class:`~gearsym.system.FirstOrderSystem` a run reads, without SymPy; anything else
-    (its equations, couplings, period as an expression) comes from the full system, loaded on first use."""
+    """The part of a :class:`~gearsym.system.FirstOrderSystem` a run reads, without SymPy; its symbolic part
+    (equations, couplings, the period as an expression) comes from the full system (:attr:`full`), loaded on
+    first use."""
 
     name: str
     title: str
@@ -72,6 +75,8 @@ class SystemSummary(ParameterChecks):
     physical: bool  # the model has physical values (its results are also given in its units)
     load: Callable[[], object] = field(repr=False, default=None)  # the full system
     cycles: int = 1  # forcing periods in one period (a gear's revolution with shaft-order terms)
+    fastest: float = 0.0  # the fastest linearised mode's rate and the forcing period at these values: the step's
+    cycle: float = 0.0  # choice (codegen/step_choice.py) without the model
 
     @property
     def dimension(self) -> int:
@@ -92,10 +97,28 @@ class SystemSummary(ParameterChecks):
             object.__setattr__(self, "_full", self.load())
         return self.__dict__["_full"]
 
-    def __getattr__(self, name: str):
-        if name.startswith("__") or name in ("_full", "load"):
-            raise AttributeError(name)
-        return getattr(self.full, name)
+    @property
+    def time(self):
+        """The time symbol (from the full system)."""
+        return self.full.time
+
+    @property
+    def states(self):
+        return self.full.states
+
+    @property
+    def rhs(self):
+        return self.full.rhs
+
+    @property
+    def period(self):
+        """The period as an expression (from the full system)."""
+        return self.full.period
+
+    @property
+    def couplings(self):
+        """The meshes and shafts the reduction handed on (from the full system)."""
+        return self.full.couplings
 
     def as_dict(self) -> dict:
         return {"name": self.name, "title": self.title, "time_name": self.time_name,
@@ -103,7 +126,8 @@ class SystemSummary(ParameterChecks):
                 "initial": dict(self.initial), "coordinates": list(self.coordinates),
                 "descriptions": dict(self.descriptions),
                 "constraints": {k: c.as_list() for k, c in self.constraints.items()},
-                "autonomous": self.autonomous, "physical": self.physical, "cycles": self.cycles}
+                "autonomous": self.autonomous, "physical": self.physical, "cycles": self.cycles,
+                "fastest": self.fastest, "cycle": self.cycle}
 
     @classmethod
     def from_dict(cls, d: dict, load: Callable[[], object]) -> "SystemSummary":
@@ -112,13 +136,16 @@ class SystemSummary(ParameterChecks):
                    {str(k): float(v) for k, v in d["initial"].items()}, tuple(map(str, d["coordinates"])),
                    {str(k): str(v) for k, v in d["descriptions"].items()},
                    {str(k): Constraint.from_list(c) for k, c in d["constraints"].items()},
-                   bool(d["autonomous"]), bool(d["physical"]), load, int(d["cycles"]))
+                   bool(d["autonomous"]), bool(d["physical"]), load, int(d["cycles"]), float(d["fastest"]),
+                   float(d["cycle"]))
 
     @classmethod
-    def of(cls, system, physical: bool) -> "SystemSummary":
+    def of(cls, system, physical: bool, fastest: float = 0.0) -> "SystemSummary":
+        """The summary of ``system`` (``fastest``: its fastest linearised mode's rate, for the step's choice)."""
         return cls(system.name, system.title, system.time.name, system.state_names, dict(system.parameters),
                    dict(system.initial), tuple(system.coordinates), dict(system.descriptions),
-                   dict(system.constraints), system.autonomous, physical, lambda: system, system.cycles)
+                   dict(system.constraints), system.autonomous, physical, lambda: system, system.cycles,
+                   fastest, system.cycle_at())
 
 
 @lru_cache(maxsize=None)
@@ -219,16 +246,32 @@ def load_compiled(ref: str, values: Mapping[str, object], options: Integration, 
     path = model_file(ref) if isinstance(ref, str) else None
     if path is None or resolve_backend(options.backend) != "compiled":
         return compile()
-    key, loops = system_key(path, values), LoopOptions.of(options)
+    key = system_key(path, values)
     system_file = summary_path(path.stem, key)
-    build_file = summary_path(path.stem, f"{key}-{loops_key(loops)}")
-    compiled = _from_cache(system_file, build_file, options, loops, lambda: compile().system)
-    if compiled is not None:
-        return compiled
+    if options.integrator == "auto":  # (chosen from the model's fastest mode, which its summary keeps)
+        try:
+            known = read_json(system_file)["system"]
+            options = chosen(options, float(known["fastest"]), float(known["cycle"]))
+        except (KeyError, TypeError, ValueError):
+            options = None
+    if options is not None:
+        loops = LoopOptions.of(options)
+        build_file = summary_path(path.stem, f"{key}-{loops_key(loops)}")
+        compiled = _from_cache(system_file, build_file, options, loops, lambda: compile().system)
+        if compiled is not None:
+            return compiled
+    return _compiled_and_kept(path.stem, key, compile, scaling)
+
+
+def _compiled_and_kept(name: str, key: str, compile: Callable[[], object], scaling: Callable[[], object]):
+    """``compile()``, and its summaries written (the build's under the loops it was compiled with)."""
     compiled = compile()
+    system_file = summary_path(name, key)
+    build_file = summary_path(name, f"{key}-{loops_key(LoopOptions.of(compiled.integration))}")
     physical = scaling()
     units = None if physical is None else physical.point_units()
-    write_json(system_file, {"system": SystemSummary.of(compiled.system, physical is not None).as_dict(),
+    summary = SystemSummary.of(compiled.system, physical is not None, compiled.fastest)
+    write_json(system_file, {"system": summary.as_dict(),
                              "physical": units and units.as_dict()})
     write_json(build_file, {"hash": compiled.hash, "library": str(compiled.library),
                             "timed_parameters": sorted(compiled.timed_parameters),
@@ -277,16 +320,16 @@ def _from_cache(system_file: Path, build_file: Path, options: Integration, loops
     if why is not None:  # (the summaries do not describe the library they point at: edited)
         _distrust(build_file, f"{library.name}, the library it points at, does not match it: {why}")
         return None
-    key = (digest, "compiled")
-    if key in LOADED:  # (loaded in this process already: its functions with work arrays of their own)
-        return replace(LOADED[key].clone(), system=summary, integration=options)
+    key = model_key(digest, "compiled")
+    found = loaded(key)
+    if found is not None:  # (loaded in this process already: its functions with work arrays of their own)
+        return replace(found.clone(), system=summary, integration=options)
     if summary.cycles < 1:
         return None
     loops = LoopOptions.of(options, summary.cycles)  # (the key's loops count steps per forcing period)
     functions = library_functions(library)
-    compiled = LOADED[key] = CompiledModel(summary, loops, digest, functions, "compiled", library, {},
-                                           load_native(library, functions), options, timed, texts)
-    return compiled
+    return keep(key, CompiledModel(summary, loops, digest, functions, "compiled", library, {},
+                                   load_native(library, functions), options, timed, texts, summary.fastest))
 
 
 def load_linearisation(ref: str, values: Mapping[str, object], options: Integration, *,

@@ -8,8 +8,11 @@ takes the typed object these make; nothing below resolves a name.
 from __future__ import annotations
 
 from .analysis.modes import Modes, nondimensional_modes, physical_modes
+from .codegen.build import compile_model
 from .errors import GearsymError
+from .options import Integration
 from .model.teeth import with_teeth
+from .model.tooth_counts import ToothCounts
 from .physical.answers import PhysicalScaling
 from .reduction import NondimensionalModel, reduce
 from .registry import load_model
@@ -20,8 +23,8 @@ from .units import is_quantity
 
 def declared(ref, teeth=None):
     """The declared model of a name, a file or a model, with ``teeth`` = (pinion, wheel) tooth counts given to a
-    drivetrain that declares none (:func:`gearsym.model.teeth.with_teeth`)."""
-    return with_teeth(load_model(ref), teeth)
+    drivetrain that declares none (:func:`gearsym.model.teeth.with_teeth`; read here, where they enter)."""
+    return with_teeth(load_model(ref), ToothCounts.of(teeth))
 
 
 def reduced(ref, teeth=None) -> NondimensionalModel:
@@ -36,6 +39,16 @@ def reduced(ref, teeth=None) -> NondimensionalModel:
     return reduce(model)
 
 
+class ModelScaling(PhysicalScaling):
+    """The face's scaling: a spectrum carried to physical units without the compiled model it ran on has its mesh
+    forces run on this scaling's system, compiled here (the units stage below compiles nothing)."""
+
+    def compiled_for(self, result):
+        system = self.system()
+        return compile_model(system, result.info.get("integration") or Integration(
+            steps_per_period=result.steps_per_period // system.cycles))
+
+
 def scaling(model, length_scale=None, *, teeth=None, **physical) -> PhysicalScaling:
     """The scaling of a model (a name, a file, a Drivetrain or its reduction) at its declared physical values,
     with ``physical`` overriding them (``kZ="3e8 N/m"``, ``speed="3000 rpm"``) or replacing a stiffness function
@@ -46,7 +59,7 @@ def scaling(model, length_scale=None, *, teeth=None, **physical) -> PhysicalScal
         if not model.is_drivetrain:
             raise GearsymError(f"{model.name}: physical values need a drivetrain model (a FirstOrderSystem has no "
                                "components to give them units)")
-    return PhysicalScaling.of(reduced(model, teeth), length_scale, **physical)
+    return ModelScaling.of(reduced(model, teeth), length_scale, **physical)
 
 
 def load(ref, *, teeth=None, **values) -> FirstOrderSystem:

@@ -196,6 +196,12 @@ class FirstOrderSystem(ParameterChecks, Model):
         return tuple(s.name for s in self.states)
 
     @property
+    def full(self) -> "FirstOrderSystem":
+        """The system itself (the start-up cache's summary of one, :class:`~gearsym.cached.SystemSummary`, loads
+        the full system here)."""
+        return self
+
+    @property
     def time_name(self) -> str:
         return self.time.name
 

@@ -9,27 +9,20 @@ options (else the verb's own default, else ``Integration()``).
 from __future__ import annotations
 
 import functools
+import importlib
 from collections.abc import Mapping
 
-from .analysis.attractors import find_attractors as _find_attractors
-from .analysis.basins import basin_map as _basin_map
-from .analysis.lyapunov import lyapunov_spectrum as _lyapunov_spectrum
-from .analysis.poincare import phase_trajectory as _phase_trajectory, poincare_samples as _poincare_samples
-from .analysis.order_run import simulated_order_spectrum as _simulated_order_spectrum
+from . import VERBS
 from .codegen.build import compile_model
 from .codegen.compiled import CompiledModel
-from .data.simulate import simulate_measurements as _simulate_measurements
 from .errors import GearsymError
 from .options import Integration
-from .periodic.branches import continue_orbits as _continue_orbits
-from .periodic.orbit import periodic_orbit as _periodic_orbit
 from .physical.answers import PhysicalScaling
 from .physical.stability import chart_in_units
 from .physical.sweeps import axes_with_units, nondimensional_axes
 from .stability.chart import static_chart
 from .stability.linearised import compile_linearisation
 from .stability.verb import stability_chart as _stability_chart
-from .sweep.basin_continuation import continue_basins as _continue_basins
 from .sweep.run import run_sweep as _run_sweep
 from .system import FirstOrderSystem
 from .units import is_quantity
@@ -58,13 +51,10 @@ def high_level(verb):
     return functools.update_wrapper(call, verb)
 
 
-lyapunov_spectrum = high_level(_lyapunov_spectrum)
-poincare_samples = high_level(_poincare_samples)
-phase_trajectory = high_level(_phase_trajectory)
-find_attractors = high_level(_find_attractors)
-basin_map = high_level(_basin_map)
-continue_basins = high_level(_continue_basins)
-run_sweep = high_level(_run_sweep)
+#: the face's verbs, made from the low-level verbs the face lists (gearsym.VERBS)
+_made = {name: high_level(getattr(importlib.import_module(module), name)) for name, module in VERBS.items()}
+globals().update(_made)
+run_sweep = _made["run_sweep"]
 
 
 def _numbers_only(engine):
@@ -94,7 +84,7 @@ def _physical_sweep(model: PhysicalScaling, axes, *, options: Integration | None
     units (``{"speed": ["1000 rpm", "2000 rpm"]}``, pint Quantities, or ``"speed=1000rpm:3000rpm:500rpm"``) become
     the nondimensional parameters they move, other keywords that are physical values (``kZ="2e8 N/m"``) fix
     them, and the result comes back in physical units (along the values as given)."""
-    engine_keywords = {"mode", "direction", "y0", "out", "overwrite", "poincare", "workers", "progress", "on_point"}
+    engine_keywords = {"mode", "direction", "y0", "out", "overwrite", "poincare", "execution", "on_point"}
     physical = {k: v for k, v in kwargs.items() if k not in engine_keywords}
     at = model.with_values(**physical) if physical else model
     given = axes_with_units(axes)
@@ -103,11 +93,7 @@ def _physical_sweep(model: PhysicalScaling, axes, *, options: Integration | None
     result = _run_sweep(compiled, engine_axes, options=options,
                         **{k: v for k, v in kwargs.items() if k in engine_keywords})
     return at.to_physical(result, given=given)
-periodic_orbit = high_level(_periodic_orbit)
-continue_orbits = high_level(_continue_orbits)
-simulate_measurements = high_level(_simulate_measurements)
-simulated_order_spectrum = high_level(_simulated_order_spectrum)
-stability_chart = high_level(_stability_chart)
+stability_chart = _made["stability_chart"]
 
 
 @stability_chart.register
@@ -129,6 +115,5 @@ def _physical_chart(model: PhysicalScaling, grid, *, options: Integration | None
     chart = _system_chart(model.system(), engine_axes, options=options, **kwargs)
     return chart_in_units(chart, tuple(given), tuple(engine_axes))
 
-__all__ = ["basin_map", "continue_basins", "continue_orbits", "find_attractors", "high_level", "lyapunov_spectrum",
-           "periodic_orbit", "phase_trajectory", "poincare_samples", "run_sweep", "simulate_measurements",
-           "simulated_order_spectrum", "stability_chart"]
+
+__all__ = ["high_level", *VERBS]

@@ -28,8 +28,8 @@ LAYERS = [
     {"codegen", "derivation"},
     {"analysis", "data"},
     {"sweep", "periodic", "stability"},
-    {"figures"},
     {"fit", "physical"},
+    {"figures"},
     {"verbs", "loading", "cached", "fmu"},
     {"reproduce"},
     {"cli", "__init__"},
@@ -165,3 +165,46 @@ def test_no_module_swaps_its_class_and_no_face_name_is_a_subpackage():
     subpackages = {p.name for p in ROOT.iterdir() if (p / "__init__.py").is_file()}
     top_modules = {p.stem for p in ROOT.glob("*.py")}
     assert set(gearsym.__all__) & (subpackages | top_modules) == set()
+
+
+def test_the_faces_verbs_are_made_from_modules_below_them():
+    """gearsym.VERBS names the low-level verbs' modules, which verbs.py imports by name: they sit below it."""
+    for name, module in gearsym.VERBS.items():
+        assert module in modules(ROOT) and RANK[unit(module)] < RANK["verbs"], f"{name}: {module}"
+        assert callable(getattr(gearsym, name)) and name in gearsym.__all__
+
+
+DOC = ROOT.parent / "docs" / "architecture.md"
+#: the picture's name of a unit whose module name is no mermaid id
+PICTURE_NAMES = {"face": "__init__"}
+
+
+def picture(text: str) -> tuple[list[set[str]], list[tuple[str, str]]]:
+    """The stages (subgraph sN, bottom up) and the arrows of docs/architecture.md's picture of the stages."""
+    block = next(b for b in text.split("```mermaid")[1:] if "%% the stages" in b).split("```")[0]
+    stages: dict[int, set[str]] = {}
+    arrows, inside = [], None
+    for line in block.splitlines():
+        line = line.strip()
+        if line.startswith("subgraph "):
+            inside = int(line.split()[1].removeprefix("s"))
+            stages[inside] = set()
+        elif line == "end":
+            inside = None
+        elif "-->" in line:
+            a, b = (part.strip() for part in line.split("-->"))
+            arrows.append((PICTURE_NAMES.get(a, a), PICTURE_NAMES.get(b, b)))
+        elif inside is not None and line:
+            node = line.split("[")[0].strip()
+            stages[inside].add(PICTURE_NAMES.get(node, node))
+    return [stages[i] for i in sorted(stages)], arrows
+
+
+def test_the_picture_of_the_stages_is_the_code():
+    """docs/architecture.md draws LAYERS (its stages, bottom up, with the same units) and only arrows that are
+    imports the code makes, none of them up the picture."""
+    stages, arrows = picture(DOC.read_text())
+    assert stages == LAYERS
+    made = {(unit(a), unit(b)) for a, b, _ in imports(ROOT)}
+    assert [f"{a} --> {b}" for a, b in arrows if (a, b) not in made] == [], "an arrow no import makes"
+    assert [f"{a} --> {b}" for a, b in arrows if RANK[a] < RANK[b]] == [], "an arrow up the picture"

@@ -23,7 +23,8 @@ import gearsym.data.csvtext as csvtext
 import gearsym.data.grouping as grouping
 import gearsym.memory
 import gearsym.sweep.workers
-from gearsym import Integration, Workers, explain, find_attractors, load_measurements, run_sweep, simulate_measurements
+from gearsym.sweep.workers import Workers
+from gearsym import Execution, Integration, explain, find_attractors, load_measurements, run_sweep, simulate_measurements
 from gearsym.cli import main
 from gearsym.codegen.compiled import CompiledModel
 from gearsym.data import DataError
@@ -112,8 +113,7 @@ def test_a_sweep_counts_the_memory_of_every_worker(one_gib, one_stage, monkeypat
     monkeypatch.setattr(CompiledModel, "tangent_run_into", lambda *a, **k: pytest.fail("the run started"))
     options = Integration(periods=5_000_000, discard=100)  # 0.37 GiB for one point's records, 1.49 GiB for four
     with pytest.raises(GearsymError, match=r"^periods=5000000 needs 1.49 GiB .*4 workers'"):
-        run_sweep(one_stage, ["omega=1:1.3:0.1"], options=options, workers=Workers(jobs=4, parallel="threads"),
-                  progress=False)
+        run_sweep(one_stage, ["omega=1:1.3:0.1"], options=options, execution=Execution(jobs=4, parallel="threads"))
 
 
 def test_more_than_any_machine_has_is_refused_on_this_one():
@@ -297,11 +297,11 @@ def test_zero_steps_per_period_are_refused_not_replaced_by_the_default(capsys, n
 def test_more_jobs_than_cores_run_on_the_cores_and_say_so(capsys, one_stage, tmp_path, monkeypatch):
     monkeypatch.setattr(gearsym.sweep.workers, "cores", lambda: 2)
     with pytest.warns(GearsymWarning, match=r"^jobs=1000: this machine has 2 cores; running 2 workers"):
-        workers = Workers(jobs=1000)
+        workers = Workers.of(Execution(jobs=1000))
     assert workers.count == 2
     with warnings.catch_warnings():
         warnings.simplefilter("error", GearsymWarning)
-        assert Workers(jobs=2).count == 2 and Workers().count == 2
+        assert Workers.of(Execution(jobs=2)).count == 2 and Workers.of(Execution()).count == 2
     monkeypatch.chdir(tmp_path)
     assert main(["sweep", "one_stage", "--param", "omega=1,1.1", "--out", "s.csv", "--jobs", "1000", "--periods",
                  "60", "--discard", "20", "--quiet"]) == 0
@@ -318,8 +318,7 @@ def test_a_sweep_says_how_to_start_again_as_the_caller_writes_it(capsys, one_sta
                "20", "--quiet"]
     assert main(command) == 0
     with pytest.raises(GearsymError, match=r"pass overwrite=True or choose another out$"):
-        run_sweep(one_stage, {"omega": [1.2]}, out="d.csv", options=Integration(periods=70, discard=20),
-                  progress=False)
+        run_sweep(one_stage, {"omega": [1.2]}, out="d.csv", options=Integration(periods=70, discard=20))
     capsys.readouterr()
     command[3] = "omega=1.2"
     err = error_line(capsys, *command)

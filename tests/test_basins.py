@@ -10,7 +10,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import gearsym
-from gearsym import FirstOrderSystem, Integration
+from gearsym import Execution, FirstOrderSystem, Integration
 from gearsym.analysis.basins import DIVERGED, UNDETERMINED, basin_map
 from gearsym.cli import main
 from gearsym.sweep.basin_continuation import APPEARS, VANISHES, continue_basins
@@ -90,7 +90,7 @@ def test_duffing_basins_in_its_hysteresis_window_agree_with_scipy(duffing):
 def test_the_lanes_and_the_scalar_loops_give_the_same_map(duffing):
     grid = {"x": np.linspace(-4, 4, 7), "v": np.linspace(-4, 4, 5)}
     wide = basin_map(duffing, grid, options=RUN, omega=WINDOW_OMEGA)
-    one = basin_map(duffing, grid, options=RUN, lanes=False, omega=WINDOW_OMEGA)
+    one = basin_map(duffing, grid, options=RUN, execution=Execution(lanes=False), omega=WINDOW_OMEGA)
     assert wide.lanes > 1 and one.lanes == 1
     assert np.array_equal(wide.labels, one.labels)
     assert [a.fraction for a in wide.attractors] == [a.fraction for a in one.attractors]

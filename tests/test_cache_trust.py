@@ -261,11 +261,12 @@ def test_a_changed_constant_in_the_cached_c_is_found_and_the_c_generated_again(c
     assert "6.2831853071795862e+00" in source.read_text()
 
 
-def test_a_changed_lanes_c_in_the_cache_is_never_compiled(cache, clean):
-    """The lanes' C is code too: compiled only as gearsym wrote it; changed, it is refused in one line that says
-    what to do, and no library is made from it."""
-    (source,) = (cache / "code").glob("duffing-*/duffing_lanes.c")
-    source.write_text(source.read_text().replace("GS_LANES {", "GS_LANES { /* planted */", 1))
+@pytest.mark.parametrize("planted, text", [("duffing_lanes.c", "GS_LANES gs_"), ("duffing.c", "GEARSYM_INLINE void")])
+def test_a_changed_lanes_c_in_the_cache_is_never_compiled(cache, clean, planted, text):
+    """The lanes' C is code too, and so is the model's C it includes: compiled only as gearsym wrote them;
+    changed, either is refused in one line that says what to do, and no library is made from it."""
+    (source,) = (cache / "code").glob(f"duffing-*/{planted}")
+    source.write_text(source.read_text().replace(text, text + " /* planted */", 1))
     run = gearsym(cache, "basins", "duffing", "--grid", "x=-1:1:1", "--grid", "v=-1:1:1", *ARGS, *STEPS_150)
     assert run.returncode == 2 and run.stderr.count("gearsym: error:") == 1, run.stderr
     assert f"the C of its lanes ({source}) is not what gearsym wrote" in run.stderr and "delete" in run.stderr

@@ -21,7 +21,7 @@ import gearsym.registry
 import gearsym.reproduce.compute  # likewise
 import gearsym.cli.docs
 import gearsym.cli.explain
-import gearsym.cli.integration
+import gearsym.cli.arguments.integration
 import gearsym.cli.lyap
 import gearsym.cli.poincare
 import gearsym.cli.simulate
@@ -46,7 +46,7 @@ def no_work(monkeypatch):
     def work(*args, **kwargs):
         raise AssertionError("the work started before the input was checked")
 
-    for module, name in ((gearsym.cli.integration, "system_from"), (gearsym.cli.explain, "system_from"),
+    for module, name in ((gearsym.cli.arguments.integration, "system_from"), (gearsym.cli.explain, "system_from"),
                          (gearsym, "compile_model"), (gearsym.codegen.build, "compile_model"),
                          (gearsym.cli.sweep, "run_sweep"),
                          (gearsym.cli.simulate, "with_effects"),

@@ -38,11 +38,12 @@ def run(capsys, *argv: str) -> tuple[int, str, str]:
     return code, out, err
 
 
-def test_subcommands_are_registered():
-    assert [m.NAME for m in COMMANDS] == ["list", "derive", "docs", "compile", "lyap", "sweep", "orbits", "stability",
-                                          "poincare",
-                                          "basins", "reproduce", "simulate", "explain", "spectrum", "modes", "campbell",
-                                          "fmu", "stiffness"]
+def test_every_module_of_the_cli_is_a_subcommand_named_as_its_module():
+    assert [m.NAME for m in COMMANDS] == ["basins", "campbell", "compile", "derive", "docs", "explain", "fmu", "list",
+                                          "lyap", "modes", "orbits", "poincare", "reproduce", "simulate", "spectrum",
+                                          "stability", "stiffness", "sweep"]
+    assert [m.NAME for m in COMMANDS] == [{"list_models": "list"}.get(m.__name__.rpartition(".")[2], m.__name__.rpartition(".")[2])
+                                          for m in COMMANDS]
 
 
 def test_list_shows_every_model_with_its_title(capsys):

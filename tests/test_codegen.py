@@ -13,6 +13,7 @@ import sympy as sp
 
 import gearsym
 import gearsym.codegen.build as build_module
+import gearsym.codegen.loaded as loaded_module
 import gearsym.codegen.library as library_module
 import gearsym.codegen.compiler as compiler
 import gearsym.codegen.functions
@@ -154,7 +155,7 @@ def test_changing_parameters_never_rebuilds(monkeypatch):
 
 def test_library_cache_survives_a_new_process_and_misses_on_a_new_model(monkeypatch):
     compile_model(system("lorenz"))
-    monkeypatch.setattr(build_module, "LOADED", {})  # as in a fresh process
+    monkeypatch.setattr(loaded_module, "LOADED", {})  # as in a fresh process
     again = compile_model(system("lorenz"))
     assert "compile" not in again.timings and again.library.is_file()
     other = compile_model(system("lorenz"), Integration(steps_per_period=100))
@@ -178,7 +179,7 @@ def test_without_a_compiler_auto_falls_back_and_compiled_explains(monkeypatch, c
         assert cm.backend == "in-process"
         assert "no C compiler found" in capsys.readouterr().err
         assert gearsym.lyapunov_spectrum(cm, options=cm.integration.run(20, 5)).sum == pytest.approx(-13.6667, abs=1e-3)
-        monkeypatch.setattr(build_module, "LOADED", {})
+        monkeypatch.setattr(loaded_module, "LOADED", {})
         with pytest.raises(CompilerError, match="apt install gcc"):
             compile_model(system("lorenz"), Integration(backend="compiled", steps_per_period=100))
     finally:

@@ -248,7 +248,7 @@ def test_the_default_options_generate_the_committed_c_and_the_paper_scheme_other
     assert default.hash == compile_model(one_stage, Integration(locate_crossings=True, backend="in-process")).hash
     assert default.options == options
     plain = compile_model(one_stage, Integration.paper(backend="in-process"))
-    assert plain.hash != default.hash and plain.options == LoopOptions(locate_crossings=False)
+    assert plain.hash != default.hash and plain.options == LoopOptions(locate_crossings=False, reorthonormalise=0)
 
 
 def test_split_runs_behind_a_real_branch_in_the_c(tmp_path):

@@ -14,7 +14,7 @@ import pytest
 
 import conftest
 from conftest import interrupt_after
-from gearsym import Integration, ModelError, Workers, lyapunov_spectrum, read_sweep, run_sweep
+from gearsym import Execution, Integration, ModelError, lyapunov_spectrum, read_sweep, run_sweep
 from gearsym.cli import main
 from gearsym.codegen import CompilerError
 from gearsym.codegen import compiler, portable
@@ -25,7 +25,7 @@ from gearsym.sweep import distributed as dsweep
 
 distributed = pytest.importorskip("distributed")
 
-SHORT = dict(options=Integration(periods=60, discard=20), progress=False)
+SHORT = dict(options=Integration(periods=60, discard=20))
 
 
 @pytest.fixture(scope="module")
@@ -64,8 +64,8 @@ def test_a_cluster_sweep_equals_the_single_process_sweep_bit_for_bit(tmp_path, c
     monkeypatch.setattr(dsweep, "POINTS_PER_TASK", 3)  # several chunks, and lines handed from task to task
     kw = dict(mode=mode, direction=direction, **SHORT)
     system = conftest.system(model)
-    run_sweep(system, axes, workers=Workers(jobs=1), out=tmp_path / "one.csv", **kw)
-    result = run_sweep(system, axes, workers=Workers(scheduler=cluster), out=tmp_path / "dask.csv", **kw)
+    run_sweep(system, axes, execution=Execution(jobs=1), out=tmp_path / "one.csv", **kw)
+    result = run_sweep(system, axes, execution=Execution(scheduler=cluster), out=tmp_path / "dask.csv", **kw)
     _same_files(tmp_path / "one.csv", tmp_path / "dask.csv")
     assert len(result) == 10 * (2 if direction == "both" else 1)
     assert read_sweep(tmp_path / "dask.csv").record == read_sweep(tmp_path / "one.csv").record
@@ -75,10 +75,10 @@ def test_a_cluster_sweep_equals_the_single_process_sweep_bit_for_bit(tmp_path, c
 
 
 def test_the_in_process_backend_runs_on_workers_too(tmp_path, cluster):
-    kw = dict(mode="independent", options=Integration(periods=20, discard=5, backend="in-process"), progress=False)
+    kw = dict(mode="independent", options=Integration(periods=20, discard=5, backend="in-process"))
     system = conftest.system("one_stage")
-    run_sweep(system, ["omega=1.0,1.2,1.4"], workers=Workers(jobs=1), out=tmp_path / "one.csv", **kw)
-    run_sweep(system, ["omega=1.0,1.2,1.4"], workers=Workers(scheduler=cluster), out=tmp_path / "dask.csv", **kw)
+    run_sweep(system, ["omega=1.0,1.2,1.4"], execution=Execution(jobs=1), out=tmp_path / "one.csv", **kw)
+    run_sweep(system, ["omega=1.0,1.2,1.4"], execution=Execution(scheduler=cluster), out=tmp_path / "dask.csv", **kw)
     _same_files(tmp_path / "one.csv", tmp_path / "dask.csv")
 
 
@@ -86,16 +86,16 @@ def test_interrupted_on_the_cluster_cancels_its_tasks_and_resumes_to_the_same_fi
                                                                                   monkeypatch):
     monkeypatch.setattr(dsweep, "POINTS_PER_TASK", 2)
     axes = ["omega=0.9:1.3:0.1", "B1=3.5,4"]
-    run_sweep(one_stage, axes, workers=Workers(jobs=1), out=tmp_path / "whole.csv", **SHORT)
+    run_sweep(one_stage, axes, execution=Execution(jobs=1), out=tmp_path / "whole.csv", **SHORT)
     part = tmp_path / "part.csv"
     with pytest.raises(SweepInterrupted) as info:
-        run_sweep(one_stage, axes, workers=Workers(scheduler=cluster), out=part, on_point=interrupt_after(3), **SHORT)
+        run_sweep(one_stage, axes, execution=Execution(scheduler=cluster), out=part, on_point=interrupt_after(3), **SHORT)
     assert len(part.read_text().splitlines()) - 1 == info.value.done >= 3
     deadline = time.monotonic() + 10
     while cluster.run_on_scheduler(lambda dask_scheduler: len(dask_scheduler.tasks)) and time.monotonic() < deadline:
         time.sleep(0.05)
     assert cluster.run_on_scheduler(lambda dask_scheduler: len(dask_scheduler.tasks)) == 0  # nothing left behind
-    run_sweep(one_stage, axes, workers=Workers(scheduler=cluster), out=part, **SHORT)  # the client is still usable
+    run_sweep(one_stage, axes, execution=Execution(scheduler=cluster), out=part, **SHORT)  # the client is still usable
     _same_files(tmp_path / "whole.csv", part)
 
 
@@ -111,9 +111,9 @@ def test_sweep_command_with_a_local_cluster(tmp_path, capsys):
 
 def test_an_error_on_a_worker_reaches_the_client_as_it_would_on_a_thread(tmp_path, cluster, one_stage):
     with pytest.raises(GearsymError, match=r"at omega=1e-08 \(independent\): one_stage: the solution became non-finite"):
-        run_sweep(one_stage, ["omega=1e-8,1.1,1.2"], mode="independent", workers=Workers(scheduler=cluster),
+        run_sweep(one_stage, ["omega=1e-8,1.1,1.2"], mode="independent", execution=Execution(scheduler=cluster),
                   out=tmp_path / "s.csv", **SHORT)
-    run_sweep(one_stage, ["omega=1.1,1.2"], mode="independent", workers=Workers(scheduler=cluster), **SHORT)  # goes on
+    run_sweep(one_stage, ["omega=1.1,1.2"], mode="independent", execution=Execution(scheduler=cluster), **SHORT)  # goes on
 
 
 # ------------------------------------------------------------------ what a worker does with the shipped model
@@ -174,7 +174,7 @@ def test_workers_keep_one_model_per_process_and_a_clone_per_thread(one_stage):
 def test_without_dask_the_error_names_the_extra(monkeypatch, capsys, tmp_path, one_stage):
     monkeypatch.setitem(sys.modules, "distributed", None)  # as if not installed
     with pytest.raises(GearsymError, match=r'needs the distributed extra: pip install "gearsym\[distributed\]"'):
-        run_sweep(one_stage, ["omega=1,1.1"], workers=Workers(scheduler="local"), **SHORT)
+        run_sweep(one_stage, ["omega=1,1.1"], execution=Execution(scheduler="local"), **SHORT)
     code = main(["sweep", "one_stage", "--param", "omega=1,1.1", "--dask", "--out", str(tmp_path / "s.csv")])
     assert code == 2 and 'pip install "gearsym[distributed]"' in capsys.readouterr().err
     assert not (tmp_path / "s.csv").exists()  # refused before any work
@@ -187,7 +187,7 @@ def test_an_unreachable_scheduler_is_named(monkeypatch, one_stage):
     monkeypatch.setattr(dsweep, "CONNECT_TIMEOUT", 0.5)
     with pytest.raises(GearsymError, match=rf"could not reach a Dask scheduler at tcp://127\.0\.0\.1:{port} "
                                            r"within 0\.5 s.*dask scheduler"):
-        run_sweep(one_stage, ["omega=1,1.1"], workers=Workers(scheduler=f"tcp://127.0.0.1:{port}"), **SHORT)
+        run_sweep(one_stage, ["omega=1,1.1"], execution=Execution(scheduler=f"tcp://127.0.0.1:{port}"), **SHORT)
 
 
 @pytest.mark.parametrize("scheduler, jobs, words", [
@@ -196,4 +196,4 @@ def test_an_unreachable_scheduler_is_named(monkeypatch, one_stage):
 ])
 def test_bad_scheduler_arguments_are_refused_before_any_work(one_stage, scheduler, jobs, words):
     with pytest.raises(GearsymError, match=words):
-        run_sweep(one_stage, ["omega=1,1.1"], workers=Workers(scheduler=scheduler, jobs=jobs), **SHORT)
+        run_sweep(one_stage, ["omega=1,1.1"], execution=Execution(scheduler=scheduler, jobs=jobs), **SHORT)

@@ -29,7 +29,8 @@ from gearsym.fit.canonical import amplitude_phase, canonical, wrap_phase
 from gearsym.fit.effects import Change
 from gearsym.fit.selection import segments_of
 from gearsym.checks import json_safe
-from gearsym.fit.report import report_page, residual_figure
+from gearsym.figures.fit_report import residual_figure
+from gearsym.fit.report import report_page
 from gearsym.files.paths import REPO_ROOT
 from gearsym.model.symbols import parameter_symbol
 
@@ -420,7 +421,7 @@ def test_the_worked_example_data_are_what_the_documented_command_writes(tmp_path
 
 
 def test_the_committed_worked_example_is_what_explain_writes(tmp_path):
-    from gearsym.fit import explain_files
+    from gearsym.figures.fit_report import explain_files
 
     example = EXAMPLE
     out = tmp_path / "example"

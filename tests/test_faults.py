@@ -25,8 +25,9 @@ import gearsym
 from gearsym import explain, load_measurements
 from gearsym.cli import main
 from gearsym.errors import GearsymError
+from gearsym.figures.fit_report import tooth_figure, write_report
 from gearsym.figures.save import pyplot
-from gearsym.fit.report import TEETH_FIGURE, tooth_figure, write_report
+from gearsym.fit.report import TEETH_FIGURE
 from gearsym.fit.selection import candidate_library
 from gearsym.files.paths import REPO_ROOT
 

@@ -14,7 +14,7 @@ from gearsym.reproduce import figures as paper_figures
 from conftest import system
 from gearsym import Integration, run_sweep
 
-SHORT = dict(options=Integration(periods=60, discard=20), progress=False)
+SHORT = dict(options=Integration(periods=60, discard=20))
 
 
 @pytest.fixture(autouse=True)
@@ -67,7 +67,7 @@ def test_2d_sweep_maps_name_their_axes_direction_and_fixed_values():
 # ------------------------------------------------------------------ the paper's figures
 @pytest.fixture(scope="module")
 def computed(tmp_path_factory):
-    return compute(paper_plan(quick=True, study=False), tmp_path_factory.mktemp("data"), progress=False)
+    return compute(paper_plan(quick=True, study=False), tmp_path_factory.mktemp("data"))
 
 
 @pytest.mark.parametrize("name", ["fig3", "fig4", "fig6", "fig7", "hysteresis"])
@@ -131,7 +131,7 @@ from gearsym.figures.orbits import LABELLED, plot_branches, plot_orbits  # noqa:
 from gearsym.figures.poincare import plot_attractors  # noqa: E402
 from gearsym.figures.sweep import BIFURCATION_DOT, ZERO_CONTOUR, plot_bifurcation, plot_map  # noqa: E402
 from gearsym.fit.prediction import Prediction  # noqa: E402
-from gearsym.fit.report import prediction_figure  # noqa: E402
+from gearsym.figures.fit_report import prediction_figure  # noqa: E402
 from gearsym.periodic import FOLD, GRAZING, PERIOD_DOUBLING  # noqa: E402
 from gearsym.periodic.branches import Bifurcation, Branch, Continuation  # noqa: E402
 from gearsym.physical.campbell import Campbell, Crossing, Order  # noqa: E402
@@ -195,6 +195,25 @@ def test_campbell_panels_span_the_same_speeds_and_mark_every_crossing_in_both():
         assert fc.points_under_legend(ax) == 0
         assert all(p.get_label() in [t.get_text() for t in ax.get_legend().get_texts()] for p in ax.patches), (
             "a band or patch the legend does not explain")
+    assert fc.clipped_texts(fig) == []
+
+
+def test_campbell_frequencies_span_the_crossings_and_name_the_modes_above():
+    """A two-stage box: modes up to 10.7 kHz, mesh orders reaching 3.6 kHz over 500-3000 rpm; the axis ran to 16 kHz
+    with the labels of 9107 and 10654 Hz on top of each other."""
+    orders = (Order("1x mesh", "mesh", 23.0), Order("2x mesh", "mesh", 46.0), Order("stage2 1x", "mesh", 23 * 19 / 61))
+    natural = (64.4, 1313.8, 2208.9, 9107.2, 10653.5)
+    crossings = tuple(sorted((Crossing(o.label, fn, 60 * fn / o.per_speed) for o in orders for fn in natural
+                              if 500 <= 60 * fn / o.per_speed <= 3000), key=lambda c: c.speed))
+    diagram = Campbell("two_stage_gearbox", "rpm", np.arange(500.0, 3001.0, 100.0), natural, orders, crossings)
+    assert max(c.natural_frequency for c in crossings) == 2208.9
+    fig = plot_campbell(diagram)
+    left = fig.axes[0]
+    assert left.get_ylim()[1] == pytest.approx(1.25 * 2208.9)
+    drawn = sorted(round(float(ln.get_ydata()[0]), 1) for ln in left.lines
+                   if len(ln.get_ydata()) == 2 and ln.get_ydata()[0] == ln.get_ydata()[1])
+    assert drawn == [64.4, 1313.8, 2208.9]
+    assert any("9107 Hz" in t.get_text() and "10654 Hz" in t.get_text() for t in left.texts)
     assert fc.clipped_texts(fig) == []
 
 

@@ -26,7 +26,7 @@ from fmpy.validation import validate_fmu  # noqa: E402
 import gearsym  # noqa: E402
 from gearsym import Integration  # noqa: E402
 from gearsym.cli import main  # noqa: E402
-from gearsym.codegen.build import code_directory  # noqa: E402
+from gearsym.codegen.code_files import code_directory  # noqa: E402
 from gearsym.codegen.generate import code_hash  # noqa: E402
 from gearsym.codegen.loops import LoopOptions  # noqa: E402
 from gearsym.codegen.surfaces import switching_surfaces  # noqa: E402
@@ -250,7 +250,7 @@ def refusal(path, **start) -> tuple[str, list[str]]:
 def test_a_value_the_engine_does_not_take_is_refused(one_stage):
     raised, said = refusal(one_stage, omega=-1.0)
     assert raised.startswith("fmi2ExitInitializationMode failed with status 3")
-    assert said == ["the parameter values make the engine's omega negative or zero, which it may not be"]
+    assert said == ["the parameter values make the engine's omega -1, but it must be positive (the forcing frequency)"]
     raised, said = refusal(one_stage, substeps=0)
     assert raised.startswith("fmi2SetInteger failed with status 3") and said == ["substeps must be at least 1"]
 

@@ -195,8 +195,7 @@ def test_a_pair_declared_from_geometry_derives_compiles_and_runs_in_physical_uni
     assert np.all(point.exponents.magnitude < 0)  # damped, periodic
     # on a periodic orbit in contact the pinion does not accelerate on average: mean mesh force M1 / r1
     assert point.mesh_force["mesh"]["mean"].to("N").magnitude == pytest.approx(40.0 / p["r1"].si, rel=1e-6)
-    sweep = gearsym.run_sweep(s, {"speed": ["2000 rpm", "3000 rpm"]}, options=options, progress=False,
-                              workers=gearsym.Workers(1, "threads"))
+    sweep = gearsym.run_sweep(s, {"speed": ["2000 rpm", "3000 rpm"]}, options=options, execution=gearsym.Execution(1, "threads"))
     assert list(sweep["speed"]) == [2000.0, 3000.0] and sweep.units["A_x"] == "µm"
     assert np.all(np.isfinite(sweep["A_x"])) and np.all(sweep["A_x"] > 0)
     orbits = s.to_physical(gearsym.continue_orbits(compiled, "omega", s.omega("2000 rpm"), s.omega("2200 rpm")))

@@ -328,7 +328,7 @@ def test_a_pipe_or_a_device_given_as_a_model_file_or_a_sweep_is_named_as_what_it
 
 def test_a_local_dask_cluster_with_the_default_jobs_has_a_worker_per_core(tmp_path, monkeypatch):
     import gearsym.sweep.run as sweep_run
-    from gearsym import Workers, run_sweep
+    from gearsym import Execution, run_sweep
     from gearsym.sweep.workers import cores
 
     pytest.importorskip("distributed")
@@ -341,6 +341,6 @@ def test_a_local_dask_cluster_with_the_default_jobs_has_a_worker_per_core(tmp_pa
     monkeypatch.setattr(sweep_run, "execute_on_dask", cluster)
     with pytest.raises(BaseException):
         run_sweep(conftest.compiled("one_stage"), {"omega": [1.0, 1.1]}, options=gearsym_api.Integration(
-            periods=70, discard=10), mode="independent", workers=Workers(scheduler="local"), progress=False,
+            periods=70, discard=10), mode="independent", execution=Execution(scheduler="local"),
             out=tmp_path / "s.csv")
     assert asked == [cores()] and cores() >= 1

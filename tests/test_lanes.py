@@ -52,7 +52,7 @@ def _build(name: str, options: LoopOptions, tmp_path: Path, flags) -> tuple[Comp
     digest = code_hash(system, options)
     code = write_code(mf, tmp_path / name, digest)
     main = compile_library(code.source, name, flags=flags).path
-    lanes = compile_library(code.lanes, f"{name}_lanes", flags=flags).path
+    lanes = compile_library(code.lanes, f"{name}_lanes", flags=flags, includes=(code.source,)).path
     functions = library_functions(main)
     integration = Integration(steps_per_period=options.steps_per_period, locate_crossings=options.locate_crossings)
     model = CompiledModel(system, options, digest, functions, "compiled", main, {}, load_native(main, functions),
@@ -139,15 +139,23 @@ def test_under_the_default_flags_the_lanes_agree_with_the_scalar_loop_to_roundin
 
 
 @needs_cc
-def test_every_per_step_piece_is_printed_as_a_loop_over_the_lanes(tmp_path):
-    """The lanes' C (as the generator writes it): each per-step piece in a loop over the lanes with every input
-    indexed by lane (the tables of time too), the split and Gram-Schmidt the scalar loops' own functions."""
+def test_every_per_step_piece_is_the_models_own_called_in_a_loop_over_the_lanes(tmp_path):
+    """The lanes' C (as the generator writes it) includes the model's up to its step pieces and holds no copy
+    of them: each per-step piece is the model's, its entries a stride apart, called in a loop over the lanes on
+    lane l's entries (the tables of time too); the split and Gram-Schmidt are the scalar loops' own functions."""
     options = LoopOptions(steps_per_period=90, block_steps=3, locate_crossings=True)
     _built("one_stage", options, tmp_path)
-    source = _BUILT[("one_stage", options, PORTABLE)][2].read_text()
+    lanes = _BUILT[("one_stage", options, PORTABLE)][2]
+    source, model = lanes.read_text(), (lanes.parent / "one_stage.c").read_text()
+    assert '#define GEARSYM_STEP_PIECES_ONLY\n#include "one_stage.c"' in source
+    assert not re.search(r"^\s*a\d+=", source, re.M), "no line of CasADi's step bodies in the lanes' C"
     for piece in ("tangent_state", "tangent_vector", "state_try", "state_keep"):
         body = re.search(rf"static GEARSYM_INLINE void gsl_{piece}\(.*?\n}}\n", source, re.S).group(0)
-        assert "GS_LANES {" in body and "[GS_L*" in body and not re.search(r"\b[AR]\d\[\d+\]", body), piece
+        assert re.search(rf"GS_LANES gs_{piece}_strided\(A0 \+ l, .*, GS_L\);", body), piece
+        strided = re.search(rf"void gs_{piece}_strided\(.*?\n}}\n", model, re.S).group(0)
+        assert "[S*" in strided and not re.search(r"\b[AR]\d\[[1-9]\d*\]", strided), piece
+    assert model.index("gs_state_try_strided") < model.index("#ifndef GEARSYM_STEP_PIECES_ONLY") \
+        < model.index("gs_state_span")
     assert "gs_state_split(ys, los, his, yts, Ts, cs, y1s, lo1s, hi1s);" in source
     assert "gs_gram_schmidt(Qc, Qn, lg);" in source
     assert 'target_clones("avx2", "default")' in source
@@ -161,10 +169,9 @@ def test_an_independent_sweep_in_the_lanes_gives_the_scalar_sweeps_rows(name, ax
     the scalar sweep (periodic points, where a rounding difference would not grow: the lanes may fuse other
     multiply-adds than the scalar loop)."""
     model = conftest.compiled(name)
-    kw = dict(mode="independent", options=Integration(periods=60, discard=20), progress=False,
-              workers=gearsym.Workers(jobs=1))
-    wide = gearsym.run_sweep(model, axes, lanes=True, **kw)
-    one = gearsym.run_sweep(model, axes, **kw)
+    kw = dict(mode="independent", options=Integration(periods=60, discard=20))
+    wide = gearsym.run_sweep(model, axes, execution=gearsym.Execution(jobs=1, lanes=True), **kw)
+    one = gearsym.run_sweep(model, axes, execution=gearsym.Execution(jobs=1), **kw)
     assert len(wide) == len(one) == (5 if name == "one_stage" else 6)
     for column in one.columns:
         a, b = wide[column], one[column]

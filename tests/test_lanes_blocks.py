@@ -26,8 +26,8 @@ pytestmark = pytest.mark.skipif(find_compiler() is None, reason="the lanes need 
 
 #: the paper's one-stage values (models/one_stage.py)
 ZETA, B0, B1, ETA, K_A = 0.08, 1.0, 4.0, 10.0, 0.2
-SWEEP = dict(mode="independent", options=Integration(periods=60, discard=20), progress=False,
-             workers=gearsym.Workers(jobs=1))
+SWEEP = dict(mode="independent", options=Integration(periods=60, discard=20))
+LANES, SCALAR = gearsym.Execution(jobs=1, lanes=True), gearsym.Execution(jobs=1)
 
 
 @pytest.fixture(scope="module")
@@ -87,8 +87,8 @@ def test_a_lanes_sweep_over_a_phase_gives_each_point_its_own_tables(one_stage):
     """Theta moves the forcing's table of time, so every lane of the call has a table of its own: the issue's
     sweep gives the scalar sweep's A_x = 4.65, 5.30, 5.76, 6.29, not one value four times."""
     axes = ["Theta=0,0.5,1,1.5"]
-    wide = gearsym.run_sweep(one_stage, axes, lanes=True, **SWEEP)
-    one = gearsym.run_sweep(one_stage, axes, **SWEEP)
+    wide = gearsym.run_sweep(one_stage, axes, execution=LANES, **SWEEP)
+    one = gearsym.run_sweep(one_stage, axes, execution=SCALAR, **SWEEP)
     assert np.allclose(wide["A_x"], one["A_x"], rtol=0, atol=1e-3)
     assert np.allclose(wide["A_x"], [4.65, 5.30, 5.76, 6.29], rtol=0, atol=0.01)
     assert np.min(np.diff(wide["A_x"])) > 0.3  # four different motions
@@ -105,8 +105,8 @@ def test_a_lanes_sweep_longer_than_a_block_gives_the_scalar_sweeps_rows(one_stag
     width = lanes_width(one_stage)
     omegas = np.round(np.linspace(1.5, 1.95, width + 2), 6)
     axes = {"omega": omegas}
-    wide = gearsym.run_sweep(one_stage, axes, lanes=True, **SWEEP)
-    one = gearsym.run_sweep(one_stage, axes, **SWEEP)
+    wide = gearsym.run_sweep(one_stage, axes, execution=LANES, **SWEEP)
+    one = gearsym.run_sweep(one_stage, axes, execution=SCALAR, **SWEEP)
     assert len(wide) == len(one) == width + 2
     assert list(wide["regime"]) == list(one["regime"])
     for column in ("A_x", "A_v", "lambda_1", "lambda_2", "final_x", "final_v"):
@@ -122,8 +122,8 @@ def test_blocks_of_shared_tables_then_others_each_use_their_own(one_stage):
     width = lanes_width(one_stage)
     omegas = np.round(np.linspace(1.5, 1.85, width), 6)
     axes = {"omega": omegas, "Theta": [0.0, 1.0, 2.0]}
-    wide = gearsym.run_sweep(one_stage, axes, lanes=True, **SWEEP)
-    one = gearsym.run_sweep(one_stage, axes, **SWEEP)
+    wide = gearsym.run_sweep(one_stage, axes, execution=LANES, **SWEEP)
+    one = gearsym.run_sweep(one_stage, axes, execution=SCALAR, **SWEEP)
     assert len(wide) == 3 * width
     assert list(wide["Theta"]) == list(one["Theta"]) and list(wide["omega"]) == list(one["omega"])
     periodic = np.array([r == "periodic" for r in one["regime"]])

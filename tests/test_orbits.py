@@ -34,7 +34,7 @@ def one_stage():
 
 # ------------------------------------------------------------------ (a) a brute-force sweep's periodic points
 def test_the_stable_branch_passes_through_a_periodic_sweeps_points_with_its_exponents(one_stage):
-    sweep = gearsym.run_sweep(one_stage, ["omega=0.5:0.6:0.05"], progress=False)
+    sweep = gearsym.run_sweep(one_stage, ["omega=0.5:0.6:0.05"])
     assert set(sweep["regime"]) == {"periodic"}
     branch = continue_orbits(one_stage, "omega", 0.5, 0.6, switch_depth=0).branches[0]
     assert branch.stable.all() and branch.values[0] == 0.5 and branch.values[-1] == 0.6

@@ -78,14 +78,18 @@ def test_the_noise_level_is_what_one_line_of_white_noise_reaches():
     assert spectrum.line("mesh x1").amplitude == pytest.approx(2.0, abs=5 * spectrum.noise)
 
 
-def test_a_record_shorter_than_a_line_s_cycle_leaves_it_unresolved():
-    """Over 30 mesh periods a wheel's revolution (53) is not one cycle: its shaft orders below 1/30 are left out
-    (their amplitude NaN) and said; the lines it resolves still read their amplitudes."""
-    tau, x = signal(30)
+def test_a_record_shorter_than_two_of_a_gears_revolutions_leaves_its_lines_unresolved():
+    """Over 60 mesh periods the pinion (20 a revolution) turns three times, the wheel (53) not twice: every line of
+    the wheel's shaft orders (its harmonics and sidebands) is left out (amplitude NaN) and said, however long its
+    own cycle; the pinion's and the mesh's lines still read their amplitudes."""
+    tau, x = signal(60)
     short = gearsym.order_spectrum(tau, x, GEARS, mesh_order=MESH_ORDER)
-    assert short.length == pytest.approx(30.0, rel=1e-12)
-    assert set(short.info["unresolved"]) == {"wheel x1"}
-    assert math.isnan(short.line("wheel x1").amplitude)
+    assert short.length == pytest.approx(60.0, rel=1e-12)
+    wheel = {ln.label for ln in short.lines if ln.gear == "wheel"}
+    assert "wheel x1" in wheel and "mesh x2 + wheel x2" in wheel and len(wheel) == 21
+    assert set(short.info["unresolved"]) == wheel
+    assert all(math.isnan(short.line(label).amplitude) for label in wheel)
     assert short.line("mesh x1").amplitude == pytest.approx(2.0, rel=0.02)
+    assert short.line("mesh x1 - pinion x1").amplitude == pytest.approx(0.5, rel=0.1)
     data = short.as_dict()
-    assert data["length_mesh_periods"] == pytest.approx(30.0) and data["unresolved"] == ["wheel x1"]
+    assert data["length_mesh_periods"] == pytest.approx(60.0) and set(data["unresolved"]) == wheel

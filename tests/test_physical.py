@@ -256,8 +256,7 @@ def test_a_speed_axis_becomes_omega_and_comes_back_in_rpm(tmp_path):
     axis = nondimensional_axis(s, parse_axis("speed=8000rpm:12000rpm:2000rpm"))
     assert axis.name == "omega"
     assert axis.values == tuple(s.omega(Quantity(v, "rpm")) for v in (8000.0, 10000.0, 12000.0))
-    result = gearsym.run_sweep(s.system(), [axis], options=Integration(periods=30, discard=20), progress=False,
-                               workers=gearsym.Workers(1, "threads"))
+    result = gearsym.run_sweep(s.system(), [axis], options=Integration(periods=30, discard=20), execution=gearsym.Execution(1, "threads"))
     physical = s.to_physical(result)
     assert physical["speed"] == pytest.approx([8000.0, 10000.0, 12000.0], rel=1e-12)
     assert physical["A_x"] == pytest.approx(result["A_x"] * s.length.to("um").magnitude, rel=1e-12)

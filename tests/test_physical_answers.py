@@ -162,12 +162,11 @@ def test_python_and_the_command_line_give_the_mean_mesh_force_of_a_periodic_orbi
 def test_a_speed_sweep_in_python_runs_along_the_speeds_given_and_answers_in_their_units(spur):
     speeds = ["9000 rpm", "10000 rpm", "1.2e4 rpm"]
     options = Integration(periods=30, discard=20)
-    result = gearsym.run_sweep(spur, {"speed": speeds}, options=options, progress=False,
-                               workers=gearsym.Workers(1, "threads"))
+    result = gearsym.run_sweep(spur, {"speed": speeds}, options=options, execution=gearsym.Execution(1, "threads"))
     assert result.axes[0].name == "speed" and list(result["speed"]) == [9000.0, 10000.0, 12000.0]
     assert result.units["speed"] == "rpm" and result.units["A_x"] == "µm" and result.units["lambda_1"] == "1/s"
     engine = gearsym.run_sweep(spur.system(), {"omega": [spur.omega(v) for v in speeds]}, options=options,
-                               progress=False, workers=gearsym.Workers(1, "threads"))
+                               execution=gearsym.Execution(1, "threads"))
     assert result["A_x"] == pytest.approx(engine["A_x"] * spur.length.to("um").magnitude, rel=1e-12)
     back = spur.to_physical(engine)  # (an omega sweep alone: the speeds to their significant digits)
     assert list(back["speed"]) == [9000.0, 10000.0, 12000.0] and back.units["speed"] == "rpm"
@@ -340,8 +339,7 @@ def test_the_figures_of_a_physical_model_are_titled_and_labelled_in_its_units(sp
     from gearsym.figures.sweep import sweep_title
 
     options = Integration(periods=30, discard=20)
-    result = gearsym.run_sweep(spur, {"speed": ["9000 rpm", "9500 rpm"]}, options=options, progress=False,
-                               workers=gearsym.Workers(1, "threads"))
+    result = gearsym.run_sweep(spur, {"speed": ["9000 rpm", "9500 rpm"]}, options=options, execution=gearsym.Execution(1, "threads"))
     title = sweep_title(result, 1000)
     kZ = reduced("spur_pair").drivetrain.physical["kZ"].text()  # the mean of the computed stiffness
     assert "speed = 9000..9500 rpm" in title and f"kZ={kZ}" in title and "M1=71.8 N·m" in title
@@ -397,8 +395,7 @@ def test_a_two_dimensional_physical_sweep_is_drawn_in_its_units(spur):
     from gearsym.figures.sweep import plot_sweep
 
     result = gearsym.run_sweep(spur, {"speed": ["9000 rpm", "9500 rpm"], "cZ": ["200 N*s/m", "500 N*s/m"]},
-                               options=Integration(periods=30, discard=20), progress=False,
-                               workers=gearsym.Workers(1, "threads"))
+                               options=Integration(periods=30, discard=20), execution=gearsym.Execution(1, "threads"))
     assert sorted(set(result["cZ"])) == [200.0, 500.0] and result.units["cZ"] == "N·s/m"
     labels = [a.get_ylabel() for a in plot_sweep(result).axes] + [a.get_xlabel() for a in plot_sweep(result).axes]
     assert "speed [rpm]" in labels and "cZ [N·s/m]" in labels

@@ -108,9 +108,12 @@ def test_the_plain_tangent_step_is_the_states_step_then_a_loop_over_the_tangent_
     step = re.search(r"void gs_tangent_step\(.*?\n}\n", text, re.S).group(0)
     assert "gs_tangent_state(y, lo, hi, T, c, y1, lo1, hi1, J);" in step
     assert "for (j = 0; j < 2; ++j) gs_tangent_vector(Q + j, J, c, Q1 + j);" in step
-    # in the span the vectors are side by side: a vector's second entry is 2 further on
-    vector = re.search(r"void gs_tangent_vector\(.*?\n}\n", text, re.S).group(0)
-    assert re.findall(r"A0\[(\d+)\]", vector) == ["0", "2"] and sorted(re.findall(r"R0\[(\d+)\]", vector)) == ["0", "2"]
+    # in the span the vectors are side by side: a vector's second entry is 2 further on (S: 1 here, the lanes'
+    # width on a lane of the lanes' arrays)
+    vector = re.search(r"void gs_tangent_vector_strided\(.*?\n}\n", text, re.S).group(0)
+    assert re.findall(r"A0\[(?:S\*)?(\d+)\]", vector) == ["0", "2"]
+    assert sorted(re.findall(r"R0\[(?:S\*)?(\d+)\]", vector)) == ["0", "2"]
+    assert "gs_tangent_vector_strided(A0, A1, A2, R0, 1);" in text
     span = re.search(r"void gs_tangent_span\(.*?\n}\n", text, re.S).group(0)
     assert "gs_transpose(Q, 2, Qa);" in span and span.count("gs_transpose(Qa, 2, Q);") == 1
     assert span.count("gs_transpose(Qb, 2, Q);") == 1

@@ -15,17 +15,18 @@ from pathlib import Path
 import pytest
 
 import conftest
-import gearsym.sweep.store as store
+import gearsym.files.lock as lock_module
 from conftest import interrupt_after
 from gearsym import Integration, run_sweep
 from gearsym.cli import main
 from gearsym.errors import GearsymError
 from gearsym.files.atomic import write_atomically
 from gearsym.sweep import SweepInterrupted
-from gearsym.sweep.store import lock_path, release_lock, sidecar, take_lock
+from gearsym.files.lock import lock_path, release_lock, take_lock
+from gearsym.sweep.store import sidecar
 
 ROOT = Path(__file__).resolve().parents[1]
-SHORT = dict(options=Integration(periods=60, discard=20), progress=False)
+SHORT = dict(options=Integration(periods=60, discard=20))
 #: three continuation lines of 27 points, one per worker (the sweep's process and two forked from it), about 1 s in
 #: all: time to kill it half-way
 SLOW = ["one_stage", "--param", "omega=0.8:1.06:0.01", "--param", "B1=3.5,3.75,4", "--periods", "1500", "--discard",
@@ -189,7 +190,7 @@ def holder(*code: str) -> subprocess.Popen:
 
 def test_a_live_writer_is_named_with_its_pid(tmp_path, one_stage, capsys):
     out = tmp_path / "s.csv"
-    proc = holder("from pathlib import Path", "from gearsym.sweep.store import take_lock",
+    proc = holder("from pathlib import Path", "from gearsym.files.lock import take_lock",
                   f"take_lock(Path({str(out)!r}))")
     try:
         code = main(["sweep", "one_stage", "--param", "omega=1,1.1", "--out", str(out), "--quiet"])
@@ -240,7 +241,7 @@ def test_the_lock_file_is_removed_when_a_sweep_ends_in_any_way(tmp_path, one_sta
     assert not lock_path(tmp_path / "i.csv").exists()  # interrupted
     with pytest.raises(GearsymError, match="non-finite"):
         run_sweep(conftest.system("lorenz"), ["sigma=1000"], out=tmp_path / "f.csv",
-                  options=Integration(periods=10, discard=2), progress=False)
+                  options=Integration(periods=10, discard=2))
     assert not lock_path(tmp_path / "f.csv").exists()  # failed
 
 
@@ -248,14 +249,14 @@ def test_a_lock_file_removed_as_it_is_taken_is_taken_again_at_its_path(tmp_path,
     """The holder removes the file between our open and our lock: what we locked is no longer the lock."""
     sweep = tmp_path / "s.csv"
     first = take_lock(sweep)
-    real_flock = store.fcntl.flock
+    real_flock = lock_module.fcntl.flock
 
     def holder_finishes_first(fd, operation):
-        monkeypatch.setattr(store.fcntl, "flock", real_flock)
+        monkeypatch.setattr(lock_module.fcntl, "flock", real_flock)
         release_lock(sweep, first)
         return real_flock(fd, operation)
 
-    monkeypatch.setattr(store.fcntl, "flock", holder_finishes_first)
+    monkeypatch.setattr(lock_module.fcntl, "flock", holder_finishes_first)
     second = take_lock(sweep)
     assert os.path.samestat(os.fstat(second), os.stat(lock_path(sweep)))
     with pytest.raises(GearsymError, match=f"being written by gearsym process {os.getpid()}"):
@@ -279,7 +280,7 @@ def test_a_forked_child_does_not_keep_the_lock(tmp_path):
     try:
         assert running.wait(30)
         os.close(fd)  # as if this process died: only the child could still hold it
-        store._HELD_LOCKS.discard(fd)
+        lock_module._HELD_LOCKS.discard(fd)
         release_lock(sweep, take_lock(sweep))
     finally:
         child.kill()

@@ -104,3 +104,14 @@ def test_a_forcing_frequency_that_overflows_the_equations_is_one_line():
     with pytest.raises(GearsymError, match=r"omega=1e-308.*the equations are not finite at the start with these "
                                            r"values: a value overflows the engine's doubles"):
         lyapunov_spectrum(compiled("one_stage"), omega=1e-308, options=Integration(periods=70, discard=10))
+
+
+def test_a_smooth_decay_from_the_first_point_is_not_a_jump():
+    """The issue's sweep: 7.956, 7.559, 7.307 um at 800, 850, 900 rpm and flatter beyond: a slope that goes on is no
+    jump, however it compares with the flat curve further on; a step at the first point that stands alone is."""
+    speed = np.arange(800.0, 1801.0, 50.0)
+    decay = 6.9 + 1.056 * np.exp(-(speed - 800) / 110)  # 7.956, 7.570, 7.325, ...
+    assert find_jumps(speed, decay) == []
+    alone = np.where(speed > 800, 6.9, 9.0)
+    (jump,) = find_jumps(speed, alone)
+    assert (jump.start, jump.end) == (800.0, 850.0)

@@ -12,8 +12,9 @@ import conftest
 from gearsym import Integration, explain, load_measurements, simulate_measurements
 from gearsym.errors import GearsymError
 from gearsym.fit import augment
-from gearsym.fit import report as report_module
-from gearsym.fit.report import PARTIAL_MARKER, REPORT_FILES, write_report
+from gearsym.figures import fit_report as report_module
+from gearsym.figures.fit_report import write_report
+from gearsym.fit.report import PARTIAL_MARKER, REPORT_FILES
 
 RECORD = Integration(periods=116, discard=100, backend="in-process")
 
@@ -77,9 +78,10 @@ def test_a_run_killed_while_the_files_are_renamed_leaves_a_marker_that_says_the_
     replace = os.replace
 
     def killed_after_one(src, dst):
-        if renamed:
-            raise SystemExit("killed")  # (what kill -9 leaves: one file renamed, the rest not)
-        renamed.append(dst)
+        if os.path.dirname(os.fspath(dst)) == os.fspath(tmp_path):  # (a file of the report put in place; each
+            if renamed:                                             # written whole in the staging folder first)
+                raise SystemExit("killed")  # (what kill -9 leaves: one file renamed, the rest not)
+            renamed.append(dst)
         replace(src, dst)
 
     monkeypatch.setattr(os, "replace", killed_after_one)

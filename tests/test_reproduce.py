@@ -68,7 +68,7 @@ def test_figure_3_claims_recomputed_match_the_committed_record(tmp_path, committ
     full = paper_plan(scenario=SCENARIOS[0])
     plan = dataclasses.replace(full, sweeps=tuple(s for s in full.sweeps if s.name.startswith("fig3")),
                                attractors=(), portraits=())
-    computed = compute(plan, tmp_path, progress=False)
+    computed = compute(plan, tmp_path)
     recorded = {c["id"]: c for c in committed["scenarios"][0]["claims"]}
     for check in (claim_checks.chaos_d0, claim_checks.regular_d2, claim_checks.amplitude_d2, claim_checks.jumps_d2):
         claim = check(computed, {})
@@ -107,7 +107,7 @@ def test_every_paper_jump_and_hysteresis_end_is_a_located_bifurcation_a_crisis_o
 
 @pytest.mark.slow
 def test_a_quick_reproduction_writes_every_output_and_reuses_its_data(tmp_path):
-    record = reproduce(tmp_path / "figures", tmp_path / "reproduction.md", quick=True, progress=False)
+    record = reproduce(tmp_path / "figures", tmp_path / "reproduction.md", quick=True)
     for name in ("fig3.png", "fig3-orbits.png", "fig4.png", "fig6.png", "fig7.png", "hysteresis.png", "study.png",
                  "basins.png", "basin-fractions.png", "basins-defaults.png", "basin-fractions-defaults.png",
                  "stability.png", "claims.json"):
@@ -122,7 +122,7 @@ def test_a_quick_reproduction_writes_every_output_and_reuses_its_data(tmp_path):
     maps = sorted((tmp_path / "figures" / "data").glob("*/basins/map-*.json"))
     assert len(maps) == 2 * len(paper_plan(True).basins)
     stamps = {p: p.stat().st_mtime_ns for p in (*maps, *(tmp_path / "figures" / "data").glob("*/basins/*.csv"))}
-    again = reproduce(tmp_path / "figures", tmp_path / "reproduction.md", quick=True, progress=False)
+    again = reproduce(tmp_path / "figures", tmp_path / "reproduction.md", quick=True)
     assert all(json.loads(p.read_text())["points"]["computed"] == 0 for p in records)  # the data were reused
     assert {p: p.stat().st_mtime_ns for p in stamps} == stamps  # the basins' too: read, not written again
     assert again == record

@@ -290,7 +290,7 @@ def test_a_sweep_and_a_continuation_of_an_eccentric_pinion_run_on_its_revolution
         f = fault_rig.Pair(teeth=TEETH, eccentric=(1, 0.5, 0.3), omega=omega).rhs(omega)
         return solve_ivp(f, (0, revolution), y, method="DOP853", rtol=1e-11, atol=1e-11, max_step=0.2).y[:, -1]
 
-    sweep = gearsym.run_sweep(compiled, {"omega": [1.7, 1.8]}, mode="independent", progress=False)
+    sweep = gearsym.run_sweep(compiled, {"omega": [1.7, 1.8]}, mode="independent")
     strobe = sweep.strobe
     for omega in (1.7, 1.8):
         points = np.column_stack([strobe["x"], strobe["v"]])[strobe["omega"] == omega]

@@ -24,7 +24,8 @@ import conftest
 import gearsym
 import gearsym.stability
 from gearsym.cli import main
-from gearsym.stability import FOLD, NEIMARK_SACKER, PERIOD_DOUBLING, compile_linearisation, static_chart
+from gearsym.stability import (ABOUT, FOLD, NEIMARK_SACKER, NO_ORBIT, PERIOD_DOUBLING, compile_linearisation,
+                               static_chart)
 from gearsym.stability.chart import orbit_chart
 from gearsym.stability.linearised import static_recipe
 
@@ -218,3 +219,89 @@ def test_the_reproductions_stability_chart_recomputed_matches_the_committed_reco
         assert abs(t["opens_at_k_a"] - c["opens_at_k_a"]) < 1e-5 and abs(t["omega"] - c["omega"]) < 1e-9
     assert again["scenarios"] == committed["scenarios"]
     assert abs(again["counts"]["stable"] - committed["counts"]["stable"]) <= 2
+
+
+@pytest.mark.parametrize("about", ABOUT)
+@pytest.mark.parametrize("args, message", [
+    (["--param", "nope=1,2"], "nope is not a parameter"),
+    (["--param", "k_a=1N/m:2N/m:1N/m"], "has a unit, but the model has no physical values"),
+    (["--param", "k_a=0.1,0.2", "--set", "k_a=0.3"], "k_a is both swept"),
+])
+def test_a_wrong_axis_is_refused_in_one_line_before_anything_is_compiled(about, args, message, capsys, monkeypatch):
+    """A --set value no other run uses: the cache cannot hold this model, so the command would have to compile it
+    (and fails the test) if it checked the axes only after compiling."""
+    def compiling(*_, **__):
+        raise AssertionError("compiling started before the axes were checked")
+
+    monkeypatch.setattr(gearsym.stability, "compile_linearisation", compiling)
+    monkeypatch.setattr(gearsym, "compile_model", compiling)
+    argv = ["stability", "one_stage", "--set", "zeta=0.0123457", "--about", about, "--param", "omega=1:2:0.5", *args,
+            "--quiet"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.startswith("gearsym: error: ") and err.count("\n") == 1, err
+
+
+def test_the_phasing_panel_draws_each_kept_tongue_as_its_wedge_and_each_suppressed_one_as_a_cross(shaft):
+    """The second panel of the figure: a kept first-order tongue is a wedge of its kind's colour from its centre
+    on the frequency axis to its edges at the top of the variation axis; a suppressed one a dotted line and a
+    cross at its centre (the shaft has one mesh, nothing suppressed: one tongue is marked so here to draw both);
+    each is named, the chart's boundaries are drawn beside them, and no text leaves the figure."""
+    from dataclasses import replace
+
+    from figure_checks import clipped_texts
+    from gearsym.figures.save import pyplot
+    from gearsym.figures.stability import KIND_COLORS, plot_stability
+    from matplotlib.collections import PolyCollection
+    from matplotlib.colors import to_rgb
+
+    chart = static_chart(shaft, {"omega": np.round(np.arange(1.3, 2.6, 0.05), 10), "k_a": [0.2, 0.5]}, refine=False,
+                         lanes=False)  # (the scalar loops: no lanes to compile for a few points)
+    prediction = gearsym.stability.phasing_prediction(chart, shaft)
+    tongues = list(prediction.tongues)
+    combination = next(k for k, t in enumerate(tongues) if t.label == "(ω1+ω2)/1")
+    tongues[combination] = replace(tongues[combination], suppressed=True)
+    prediction = replace(prediction, tongues=tuple(tongues))
+    fig = plot_stability(chart, prediction=prediction)
+    assert len(fig.axes) == 2
+    panel = fig.axes[1]
+    assert panel.get_title().split() == prediction.title.split()  # (wrapped to fit)
+    a, b = chart.values
+    shown = [t for t in tongues if a.min() <= t.centre <= a.max()]
+    kept = [t for t in shown if not t.suppressed and 2 * t.half_width >= 2e-3 * np.ptp(a)]
+    wedges = [c for c in panel.collections if isinstance(c, PolyCollection)]
+    assert len(wedges) == len(kept) and kept
+    for t, wedge in zip(kept, wedges):
+        x, y = wedge.get_paths()[0].vertices.T
+        lo, hi = t.edges(np.array([b.max()]), prediction.scale)
+        assert np.isclose(x[y == 0].mean(), t.centre) and np.isclose(x.min(), lo[0]) and np.isclose(x.max(), hi[0])
+        assert np.allclose(wedge.get_facecolor()[0][:3], to_rgb(KIND_COLORS[t.kind]))
+    crosses = [line for line in panel.lines if line.get_marker() == "x"]
+    dotted = [line for line in panel.lines if line.get_linestyle() == ":"]
+    assert [float(c.get_xdata()[0]) for c in crosses] == [tongues[combination].centre]
+    assert [float(d.get_xdata()[0]) for d in dotted] == [tongues[combination].centre]
+    grey = [line for line in panel.lines if to_rgb(line.get_color()) == to_rgb("0.65")]
+    assert len(grey) == len(chart.boundaries) > 0
+    assert sorted(t.get_text() for t in panel.texts) == sorted(t.label for t in shown)
+    assert clipped_texts(fig) == []
+    pyplot().close(fig)
+
+
+@pytest.mark.slow  # (a model of its own compiled: ~4 s of CPU)
+def test_a_point_without_a_periodic_orbit_is_marked_not_guessed():
+    """k = k_m (1 + 0.2 cos tau) with a static load: at k_m = 0 there is no stiffness, the load drives the gear
+    off at a growing distance and no period-1 orbit exists (nor a static state to start from); Newton from the
+    neighbours' orbits cannot converge. Those points are marked, with no multipliers, and said in a note; the
+    others have the orbits' multipliers, whose product is Liouville's exp(-4 pi zeta / omega)."""
+    zeta = 0.05
+    values = dict(k="k_m*(1+0.2*cos(tau))", k_m=1.0, zeta=zeta, eta=0, B0=1.0, B1=0.5)
+    system = conftest.system("one_stage", **values)
+    model = gearsym.compile_model(system, gearsym.Integration())
+    chart = orbit_chart(model, static_recipe(system), {"omega": [0.8, 1.3], "k_m": [0.0, 0.5, 1.0]}, refine=False,
+                        lanes=False)
+    assert (chart.stable[0] == None).all() and (chart.kind[0] == NO_ORBIT).all()  # noqa: E711
+    assert np.isnan(chart.multipliers[0]).all() and np.isnan(chart.max_modulus[0]).all()
+    assert (chart.stable[1:] != None).all() and chart.counts()[NO_ORBIT] == 2  # noqa: E711
+    product = np.prod(chart.multipliers[1:], axis=-1)
+    assert np.allclose(product, np.exp(-4 * np.pi * zeta / chart.values[0])[None, :], rtol=1e-6, atol=0)  # (RK4)
+    assert any("2 point(s): no periodic orbit found" in n and NO_ORBIT in n for n in chart.notes), chart.notes

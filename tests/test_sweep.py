@@ -11,13 +11,13 @@ import pytest
 
 import conftest
 from conftest import interrupt_after
-from gearsym import Integration, Workers, lyapunov_spectrum, read_sweep, run_sweep
+from gearsym import Execution, Integration, lyapunov_spectrum, read_sweep, run_sweep
 from gearsym.cli import main
 from gearsym.errors import GearsymError
 from gearsym.sweep import SweepInterrupted, parse_axis
 
 RUN = Integration(periods=60, discard=20)
-SHORT = dict(options=RUN, progress=False)
+SHORT = dict(options=RUN)
 
 
 @pytest.fixture(scope="module")
@@ -37,7 +37,7 @@ def test_ranges_are_counted_in_decimal_and_include_stop():
 @pytest.mark.parametrize("text, words", [
     ("omega", "NAME=START:STOP:STEP"), ("omega=1:2", "NAME=START:STOP:STEP"), ("omega=a,b", "NAME=V1"),
     ("omega=1:2:0", "step must be nonzero"), ("omega=2:1:0.1", "lead from start to stop"),
-    ("kS=0,0.1,0", "repeat"), ("omega=0:1e9:1e-9", "typo"),
+    ("kS=0,0.1,0", "repeat"), ("omega=0:1e9:1e-9", "more than the 1000000 one --param may have; give a larger step"),
 ])
 def test_bad_axes_say_what_is_expected(text, words):
     with pytest.raises(GearsymError, match=words):
@@ -83,7 +83,7 @@ def test_both_directions_go_up_then_back_down_from_where_up_ended(one_stage):
 
 def test_regime_column_names_the_motion(one_stage):
     result = run_sweep(one_stage, {"omega": [1.2, 1.6]}, mode="independent",
-                       options=Integration(periods=400, discard=100), progress=False)
+                       options=Integration(periods=400, discard=100))
     assert result["regime"].tolist() == ["chaotic", "periodic"]
 
 
@@ -122,21 +122,21 @@ def share_with_a_forked_worker(monkeypatch, in_the_worker=None) -> list:
 @pytest.mark.parametrize("mode, jobs", [("continuation", 2), ("independent", 2), ("continuation", 1)])
 def test_an_interrupted_sweep_resumes_to_the_same_files(tmp_path, one_stage, mode, jobs):
     axes = ["omega=0.9:1.3:0.1", "B1=3.5,4"]
-    whole = run_sweep(one_stage, axes, mode=mode, workers=Workers(jobs=jobs), out=tmp_path / "whole.csv", **SHORT)
+    whole = run_sweep(one_stage, axes, mode=mode, execution=Execution(jobs=jobs), out=tmp_path / "whole.csv", **SHORT)
     assert len(whole) == 10
     part = tmp_path / "part.csv"
     with pytest.raises(SweepInterrupted) as info:
-        run_sweep(one_stage, axes, mode=mode, workers=Workers(jobs=jobs), out=part, on_point=interrupt_after(4),
+        run_sweep(one_stage, axes, mode=mode, execution=Execution(jobs=jobs), out=part, on_point=interrupt_after(4),
                   **SHORT)
     assert info.value.done >= 4 and "run the same command again" in str(info.value)
     kept = part.read_text().splitlines()
     assert len(kept) - 1 == info.value.done  # every finished point is on disk
     part.write_text(part.read_text() + kept[-1][:10])  # as if killed while writing a row
-    resumed = run_sweep(one_stage, axes, mode=mode, workers=Workers(jobs=jobs), out=part, **SHORT)
+    resumed = run_sweep(one_stage, axes, mode=mode, execution=Execution(jobs=jobs), out=part, **SHORT)
     assert part.read_bytes() == (tmp_path / "whole.csv").read_bytes()
     assert (tmp_path / "part.poincare.csv").read_bytes() == (tmp_path / "whole.poincare.csv").read_bytes()
     assert np.array_equal(resumed["lambda_1"], whole["lambda_1"])
-    again = run_sweep(one_stage, axes, mode=mode, workers=Workers(jobs=jobs), out=part, on_point=interrupt_after(1),
+    again = run_sweep(one_stage, axes, mode=mode, execution=Execution(jobs=jobs), out=part, on_point=interrupt_after(1),
                       **SHORT)
     assert len(again) == 10  # complete: nothing left to run, nothing recomputed
 
@@ -144,10 +144,10 @@ def test_an_interrupted_sweep_resumes_to_the_same_files(tmp_path, one_stage, mod
 @pytest.mark.parametrize("parallel", ["threads", "processes"])
 def test_threads_and_processes_do_not_change_a_single_bit(tmp_path, one_stage, parallel, monkeypatch):
     axes = ["omega=0.9:1.4:0.1", "B1=3.5,4"]
-    run_sweep(one_stage, axes, mode="independent", workers=Workers(jobs=1, parallel=parallel),
+    run_sweep(one_stage, axes, mode="independent", execution=Execution(jobs=1, parallel=parallel),
               out=tmp_path / "j1.csv", **SHORT)
     computed_here = share_with_a_forked_worker(monkeypatch) if parallel == "processes" else None
-    run_sweep(one_stage, axes, mode="independent", workers=Workers(jobs=2, parallel=parallel),
+    run_sweep(one_stage, axes, mode="independent", execution=Execution(jobs=2, parallel=parallel),
               out=tmp_path / "j2.csv", **SHORT)
     if parallel == "processes":  # the two processes both computed
         assert 0 < len(computed_here) < 12
@@ -158,7 +158,7 @@ def test_threads_and_processes_do_not_change_a_single_bit(tmp_path, one_stage, p
 def test_the_sweeps_own_process_computes_beside_the_processes_it_forks(one_stage, monkeypatch):
     computed_here = share_with_a_forked_worker(monkeypatch)
     result = run_sweep(one_stage, ["omega=0.9:1.4:0.1"], mode="independent",
-                       workers=Workers(jobs=2, parallel="processes"), **SHORT)
+                       execution=Execution(jobs=2, parallel="processes"), **SHORT)
     assert len(result) == 6 and 0 < len(computed_here) < 6  # the rest came from the forked worker
 
 
@@ -168,7 +168,7 @@ def test_a_worker_process_that_dies_is_reported_and_the_points_finished_here_are
     out, axes = tmp_path / "s.csv", ["omega=0.9:1.4:0.1"]
     with pytest.raises(GearsymError, match=r"a sweep worker process died \(exit code 3\); the points finished so far "
                                            "are kept"):
-        run_sweep(one_stage, axes, mode="independent", workers=Workers(jobs=2, parallel="processes"), out=out,
+        run_sweep(one_stage, axes, mode="independent", execution=Execution(jobs=2, parallel="processes"), out=out,
                   **SHORT)
     assert 0 < len(out.read_text().splitlines()) - 1 < 6
     monkeypatch.undo()
@@ -179,23 +179,22 @@ def test_a_worker_process_that_dies_is_reported_and_the_points_finished_here_are
 def test_an_error_in_a_worker_process_names_the_point():
     with pytest.raises(GearsymError, match=r"at sigma=1000 \(independent\): .*non-finite"):  # the orbit diverges
         run_sweep(conftest.system("lorenz"), ["sigma=10,1000"], mode="independent",
-                  workers=Workers(jobs=2, parallel="processes"), options=Integration(periods=10, discard=2),
-                  progress=False)
+                  execution=Execution(jobs=2, parallel="processes"), options=Integration(periods=10, discard=2))
 
 
 def test_an_unknown_way_to_run_in_parallel_is_refused(one_stage):
     with pytest.raises(GearsymError, match="parallel='gpu'.*processes, threads"):
-        run_sweep(one_stage, ["omega=1.1,1.2"], workers=Workers(parallel="gpu"), **SHORT)
+        run_sweep(one_stage, ["omega=1.1,1.2"], execution=Execution(parallel="gpu"), **SHORT)
 
 
 def test_resuming_with_other_options_says_what_differs(tmp_path, one_stage):
     out = tmp_path / "s.csv"
     run_sweep(one_stage, ["omega=1,1.1"], out=out, **SHORT)
     with pytest.raises(GearsymError, match="different sweep.*periods: 60 before, 80 now") as refused:
-        run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80), progress=False)
+        run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80))
     assert str(refused.value).endswith("repeat the call it came from; to start again pass overwrite=True or choose "
                                        "another out")  # (Python's spelling: no --flags)
-    run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80), progress=False, overwrite=True)
+    run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80), overwrite=True)
     assert read_sweep(out).record["periods"] == 80
 
 
@@ -215,7 +214,7 @@ def test_a_cache_of_sweeps_starts_again_what_another_sweep_wrote_and_resumes_its
     run_sweep(one_stage, ["omega=1,1.1"], out=out, **SHORT)
     run_sweep(one_stage, ["omega=1,1.1"], out=out, **SHORT, overwrite="stale", on_point=computed.append)
     assert computed == []  # the same sweep: resumed, nothing to do
-    run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80), progress=False, overwrite="stale",
+    run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80), overwrite="stale",
               on_point=computed.append)
     assert len(computed) == 2 and read_sweep(out).record["periods"] == 80
     with pytest.raises(GearsymError, match="overwrite must be False, True or 'stale', not 'yes'"):
@@ -250,7 +249,7 @@ def test_the_record_lists_the_jumps_and_hysteresis_found(tmp_path, one_stage):
     """one_stage falls off its resonance peak between omega 0.88 and 0.9 going up, and
     earlier going down (the up and down branches coexist there)."""
     out = tmp_path / "j.csv"
-    result = run_sweep(one_stage, ["omega=0.8:1.0:0.01"], direction="both", out=out, progress=False)
+    result = run_sweep(one_stage, ["omega=0.8:1.0:0.01"], direction="both", out=out)
     record = json.loads((tmp_path / "j.json").read_text())
     assert record["status"] == "complete" and record["jumps"] == json.loads(json.dumps(result.findings()["jumps"]))
     up = [j for j in record["jumps"] if j["direction"] == "up"]
@@ -261,10 +260,10 @@ def test_the_record_lists_the_jumps_and_hysteresis_found(tmp_path, one_stage):
 @pytest.mark.parametrize("parallel", ["threads", "processes"])
 def test_continuation_lines_in_parallel_do_not_change_a_single_bit(tmp_path, one_stage, parallel, monkeypatch):
     axes = ["omega=0.9:1.3:0.1", "B1=3.5,4"]
-    run_sweep(one_stage, axes, direction="both", workers=Workers(jobs=1, parallel=parallel),
+    run_sweep(one_stage, axes, direction="both", execution=Execution(jobs=1, parallel=parallel),
               out=tmp_path / "c1.csv", **SHORT)
     computed_here = share_with_a_forked_worker(monkeypatch) if parallel == "processes" else None
-    run_sweep(one_stage, axes, direction="both", workers=Workers(jobs=2, parallel=parallel),
+    run_sweep(one_stage, axes, direction="both", execution=Execution(jobs=2, parallel=parallel),
               out=tmp_path / "c2.csv", **SHORT)
     if parallel == "processes":  # one line here, the other in the forked worker
         assert len(computed_here) == 10
@@ -303,7 +302,7 @@ def test_a_sweep_that_finished_no_point_starts_again_with_new_options(tmp_path, 
     with pytest.raises(SweepInterrupted):
         run_sweep(one_stage, ["omega=1,1.1"], out=out, on_point=interrupt_after(1), **SHORT)
     out.write_text(out.read_text().splitlines()[0] + "\n")  # as if stopped before the first point was written
-    result = run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80), progress=False)
+    result = run_sweep(one_stage, ["omega=1,1.1"], out=out, options=RUN.run(periods=80))
     assert len(result) == 2 and read_sweep(out).record["periods"] == 80
 
 

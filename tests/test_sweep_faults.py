@@ -12,14 +12,14 @@ import sys
 import pytest
 
 import conftest
-from gearsym import Integration, Workers, run_sweep
+from gearsym import Execution, Integration, run_sweep
 from gearsym.errors import GearsymError
 from gearsym.files.paths import REPO_ROOT
 from gearsym.sweep import store as store_module
 
 RUN = Integration(periods=70, discard=20)
 SAMPLES = 50  # Poincare samples per point
-SHORT = dict(options=RUN, progress=False, mode="independent", workers=Workers(jobs=1))
+SHORT = dict(options=RUN, execution=Execution(jobs=1), mode="independent")
 AXES = ["omega=0.6:1.38:0.02"]  # 40 points: more than one batch of 32
 PLANNED = 40
 

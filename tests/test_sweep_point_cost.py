@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import conftest
-from gearsym import Integration, run_sweep
+from gearsym import Execution, Integration, run_sweep
 from gearsym.sweep.store import SweepStore
 
 RUN = Integration(periods=30, discard=10)
@@ -42,7 +42,7 @@ def test_a_fresh_sweep_whose_points_finish_in_order_writes_its_tables_once(tmp_p
         return original(path, columns, rows, text)
 
     monkeypatch.setattr(SweepStore, "_write_table", staticmethod(counting))
-    run_sweep(one_stage, {"omega": [1.0, 1.2, 1.4]}, options=RUN, progress=False, out=tmp_path / "s.csv")
+    run_sweep(one_stage, {"omega": [1.0, 1.2, 1.4]}, options=RUN, out=tmp_path / "s.csv")
     assert sorted(written) == ["s.csv", "s.poincare.csv"]  # started, then appended to; not rewritten at the end
     rows = (tmp_path / "s.csv").read_text().splitlines()
     assert len(rows) == 4 and rows[0].startswith("omega,direction")
@@ -120,9 +120,9 @@ def test_batches_of_any_size_write_the_same_files(tmp_path, one_stage, monkeypat
     import gearsym.sweep.point_runs as point_runs
 
     axes = {"omega": [0.8, 0.9, 1.0, 1.1, 1.2]}
-    run_sweep(one_stage, axes, direction="both", options=RUN, progress=False, out=tmp_path / "a.csv")
+    run_sweep(one_stage, axes, direction="both", options=RUN, out=tmp_path / "a.csv")
     monkeypatch.setattr(point_runs, "POINTS_PER_BATCH", 2)  # batches of 2, 2, 1 each way
-    run_sweep(one_stage, axes, direction="both", options=RUN, progress=False, out=tmp_path / "b.csv")
+    run_sweep(one_stage, axes, direction="both", options=RUN, out=tmp_path / "b.csv")
     for name in ("{}.csv", "{}.poincare.csv"):
         assert (tmp_path / name.format("a")).read_bytes() == (tmp_path / name.format("b")).read_bytes()
 
@@ -134,13 +134,14 @@ def test_a_point_that_fails_keeps_the_points_of_its_batch_before_it(tmp_path):
     out = tmp_path / "s.csv"
     with pytest.raises(GearsymError, match=r"at sigma=1000 \(up\): .*non-finite"):
         run_sweep(conftest.compiled("lorenz"), ["sigma=8,10,1000,12"], options=Integration(periods=10, discard=2),
-                  progress=False, out=out, workers=gearsym_workers(1))
+                  execution=Execution(jobs=1), out=out)
     assert read_sweep(out)["sigma"].tolist() == [8.0, 10.0, 12.0]  # (the grid runs in ascending order)
 
 
 def test_an_error_of_the_writer_thread_is_raised_not_lost(tmp_path, one_stage, monkeypatch):
     from gearsym.errors import GearsymError
-    from gearsym.sweep.store import PoincareRows, lock_path
+    from gearsym.files.lock import lock_path
+    from gearsym.sweep.store import PoincareRows
 
     import threading
 
@@ -153,14 +154,8 @@ def test_an_error_of_the_writer_thread_is_raised_not_lost(tmp_path, one_stage, m
 
     monkeypatch.setattr(PoincareRows, "text", full_disk)
     with pytest.raises(GearsymError, match="No space left on device; the 0 points before are kept whole"):
-        run_sweep(one_stage, {"omega": [1.0, 1.2]}, options=RUN, progress=False, out=tmp_path / "s.csv")  # (one line)
+        run_sweep(one_stage, {"omega": [1.0, 1.2]}, options=RUN, out=tmp_path / "s.csv")  # (one line)
     assert not lock_path(tmp_path / "s.csv").exists()  # the lock is let go all the same
-
-
-def gearsym_workers(jobs: int):
-    from gearsym import Workers
-
-    return Workers(jobs=jobs)
 
 
 def test_independent_points_are_dealt_out_in_shrinking_tasks_that_cover_them_in_order():
@@ -197,5 +192,5 @@ def test_a_batch_checked_at_once_names_the_point_and_period_that_became_non_fini
     out = tmp_path / "s.csv"
     with pytest.raises(GearsymError, match=r"at omega=1.2 \(up\): one_stage: the solution became non-finite in "
                                            r"period 7 "):
-        run_sweep(one_stage, {"omega": [1.0, 1.1, 1.2, 1.3]}, options=RUN, progress=False, out=out)
+        run_sweep(one_stage, {"omega": [1.0, 1.1, 1.2, 1.3]}, options=RUN, out=out)
     assert read_sweep(out)["omega"].tolist() == [1.0, 1.1]

@@ -192,7 +192,7 @@ def test_a_step_too_large_for_rk4_is_an_error_not_a_verdict(one_stage):
 
 
 def test_a_sweep_marks_diverged_points_and_goes_on_from_the_last_good_state(one_stage, tmp_path, capsys):
-    result = run_sweep(one_stage, {"k_a": [0.2, 1.4, 3.0]}, progress=False, out=tmp_path / "s.csv")
+    result = run_sweep(one_stage, {"k_a": [0.2, 1.4, 3.0]}, out=tmp_path / "s.csv")
     assert result["regime"].tolist() == ["periodic", "diverged", "periodic"]
     first = lyapunov_spectrum(one_stage, k_a=0.2)
     after = lyapunov_spectrum(one_stage, y0=list(first.final_state.values()), k_a=3.0)

@@ -186,8 +186,7 @@ def _sweep_map(repeats: int, log) -> dict:
     for rep in range(repeats + 1):  # (the first: a warm-up, not counted)
         for name, (jobs, lanes) in configs.items():
             t = time.perf_counter()
-            result = gearsym.run_sweep(model, SWEEP_AXES, mode="independent", lanes=lanes, progress=False,
-                                       workers=gearsym.Workers(jobs=jobs))
+            result = gearsym.run_sweep(model, SWEEP_AXES, mode="independent", execution=gearsym.Execution(jobs=jobs, lanes=lanes))
             if rep:
                 seconds[name].append(time.perf_counter() - t)
             rows[name] = [float(x) for x in result["lambda_1"]]

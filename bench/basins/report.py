@@ -107,7 +107,7 @@ def section(record: dict) -> list[str]:
         "(its CPU over its wall time): what 2 cores give is measured only on an idle machine.",
         "",
         f"The 2-D map of the scaling stage above ({sm['model']}, `{' '.join(sm['axes'])}`, {sm['points']} independent "
-        f"points, the paper's scheme, {record['periods']} periods) through `run_sweep(..., lanes=True)` (`gearsym "
+        f"points, the paper's scheme, {record['periods']} periods) through `run_sweep(..., execution=Execution(lanes=True))` (`gearsym "
         f"sweep --lanes`: each lane with its point's tables and constants), medians of "
         f"{len(next(iter(sm['seconds'].values())))} interleaved repetitions (wall):", "",
         "| workers | seconds |", "|---|---|", *[f"| {k} | {v:.2f} |" for k, v in smed.items()], "",

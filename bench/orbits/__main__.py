@@ -19,7 +19,7 @@ import time
 from pathlib import Path
 
 import gearsym
-from gearsym import Integration, Workers, continue_orbits
+from gearsym import Execution, Integration, continue_orbits
 
 from bench.orbits.report import summary
 from bench.machine import REPO, machine_info
@@ -39,8 +39,8 @@ def measure(repeats: int, log=lambda s: print(s, file=sys.stderr, flush=True)) -
     plain = gearsym.compile_model(gearsym.load(MODEL), Integration.paper())
     jobs = {
         "curve": lambda: continue_orbits(located, "omega", START, STOP, switch_depth=0),
-        "sweep": lambda: gearsym.run_sweep(located, [GRID], workers=Workers(1), progress=False),
-        "sweep (paper's scheme)": lambda: gearsym.run_sweep(plain, [GRID], workers=Workers(1), progress=False),
+        "sweep": lambda: gearsym.run_sweep(located, [GRID], execution=Execution(1)),
+        "sweep (paper's scheme)": lambda: gearsym.run_sweep(plain, [GRID], execution=Execution(1)),
     }
     for call in jobs.values():  # warm-up: libraries loaded, caches filled
         call()

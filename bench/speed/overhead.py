@@ -53,7 +53,7 @@ def measure(repeats: int = REPEATS, log=lambda s: print(s, file=sys.stderr, flus
             try:
                 t = time.perf_counter()
                 gearsym.run_sweep(compiled, {"omega": grid}, out=Path(tmp) / "sweep.csv",
-                                  workers=gearsym.Workers(jobs=1), progress=False)
+                                  execution=gearsym.Execution(jobs=1))
                 total = time.perf_counter() - t
             finally:
                 undo()

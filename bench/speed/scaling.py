@@ -29,7 +29,7 @@ from collections.abc import Callable
 from dataclasses import replace
 
 import gearsym
-from gearsym import Workers
+from gearsym import Execution
 from gearsym.sweep.distributed import connect
 
 WORKLOADS = {
@@ -49,9 +49,9 @@ def measure(model: str, scheme, repeats: int, dask: bool = True, workloads=None,
     """``scheme``: the :class:`gearsym.Integration` of every sweep (periods, discard, steps, crossings)."""
     compiled = gearsym.compile_model(gearsym.load(model), replace(scheme, backend="compiled"))
     cores = os.cpu_count() or 1
-    configs: dict[str, Workers] = {"1 thread": Workers(jobs=1),
-                                   f"{cores} threads": Workers(jobs=cores, parallel="threads"),
-                                   f"{cores} processes": Workers(jobs=cores, parallel="processes")}  # the default
+    configs: dict[str, Execution] = {"1 thread": Execution(jobs=1),
+                                   f"{cores} threads": Execution(jobs=cores, parallel="threads"),
+                                   f"{cores} processes": Execution(jobs=cores, parallel="processes")}  # the default
     out: dict = {"cores": cores, "periods": scheme.periods, "discard": scheme.discard,
                  "locate_crossings": scheme.locate_crossings, "workloads": {}}
     names = list(workloads or WORKLOADS)
@@ -67,7 +67,7 @@ def measure(model: str, scheme, repeats: int, dask: bool = True, workloads=None,
                 out["dask_startup_seconds"] = time.perf_counter() - t
                 label = f"Dask LocalCluster, {cores} workers"
                 for name in names:
-                    entry, _ = _time_configs(compiled, scheme, name, {label: Workers(scheduler=client)}, repeats,
+                    entry, _ = _time_configs(compiled, scheme, name, {label: Execution(scheduler=client)}, repeats,
                                              baselines[name], log)
                     for key in ("seconds", "cpu_seconds", "steal_seconds", "identical"):
                         out["workloads"][name][key][label] = entry[key][label]
@@ -87,7 +87,7 @@ def _time_configs(compiled, scheme, name: str, configs: dict, repeats: int, base
     for rep in range(repeats + 1):
         for label, workers in configs.items():
             before, t = _cpu_and_steal(), time.perf_counter()
-            res = gearsym.run_sweep(compiled, spec, options=scheme, mode=mode, workers=workers, progress=False)
+            res = gearsym.run_sweep(compiled, spec, options=scheme, mode=mode, execution=workers)
             seconds = time.perf_counter() - t
             after = _cpu_and_steal()
             cpu = after[0] - before[0]

@@ -36,11 +36,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..checks import json_safe, whole_number
+from ..checks import json_safe
 from ..codegen import CompiledModel, engine_verb
 from ..codegen.lane_runs import CHUNK, LaneRunner, chunked, finite_rows, threaded
 from ..errors import GearsymError, suggest
-from ..options import Integration
+from ..options import Execution, Integration
 from .attractors import MERGE_FACTOR, MERGE_FLOOR, RESOLUTION
 from .lyapunov import lyapunov_spectrum
 from .regime import DIVERGED as DIVERGED_VERDICT, UNDETERMINED as UNDETERMINED_VERDICT
@@ -203,22 +203,24 @@ class BasinMap:
 # ------------------------------------------------------------------------------------------ entry point
 @engine_verb(default=Integration(**RUN))
 def basin_map(model: CompiledModel, grid: Mapping[str, Sequence[float]], *, options: Integration | None = None,
-           y0=None, jobs: int = 0, lanes: bool = True, verbose: bool = False, **values: float) -> BasinMap:
+              y0=None, execution: Execution | None = None, **values: float) -> BasinMap:
     """The basin map of ``model`` on ``grid`` ({state: values} for two states, e.g. ``{"x": xs, "v": vs}``; the
     other states start where ``y0`` says, default the model's initial state) at the parameter ``values``.
 
     Every start runs ``options.discard`` periods and is classified from the ``options.measured`` after them
-    (module docstring); ``jobs`` threads run the lanes (0: one per core); ``lanes=False`` runs the scalar
-    loops start by start (the same numbers, slower)."""
+    (module docstring); ``execution``: its ``jobs`` threads run the lanes (0: one per core); ``lanes=False`` runs
+    the scalar loops start by start (the same numbers, slower); with ``progress`` a first compile of the lanes is
+    said."""
     options = model.run_options(options)
-    whole_number(jobs, "jobs")
+    execution = execution or Execution()
     p = model.parameter_vector(values)  # names and values checked before any run
     axes, held, starts = grid_starts(model, grid, y0)
     inputs = model.prepare(p)
-    runner = LaneRunner(model, options.discard, options.measured, lanes=lanes, verbose=verbose)
+    runner = LaneRunner(model, options.discard, options.measured, lanes=execution.with_lanes(True),
+                        verbose=bool(execution.progress))
     chunks = chunked(len(starts), CHUNK * runner.width)
     summary = Summary.join(list(threaded(lambda rows: Summary.of(runner.orbits(starts[rows], inputs)), chunks,
-                                         jobs)))
+                                         execution.jobs)))
     labels, groups, scale = classify(summary, starts)
     values = dict(zip(model.parameter_names, map(float, p)))
     attractors = _attractors(model, options, values, summary, starts, labels, groups)

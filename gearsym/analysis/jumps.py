@@ -6,7 +6,10 @@ median |dA| over ``window`` neighbouring steps on either side, and larger than
 ``min_fraction`` of the amplitude there (the larger of the two). The first rule
 keeps a steep but smooth slope (or a noisy chaotic window) from counting; the
 second keeps numerical wobble on a flat curve from counting. A cliff that
-takes a few grid steps is one jump. This is what one sees by eye in the
+takes a few grid steps is one jump, and it must be steep beside its own
+neighbours too (the steps just before and after it at most a third of its
+own): a slope that goes on, as the smooth decay from a sweep's first point,
+is no jump however it compares with the flat curve further on. This is what one sees by eye in the
 paper's Fig. 3a (jumps near omega = 1.36 and 1.70 for D = 2); the scale is
 local because a jump of 1 next to a resonance peak of 40 is still a jump.
 
@@ -24,6 +27,8 @@ import numpy as np
 RATIO = 5.0
 WINDOW = 5
 MIN_FRACTION = 0.05
+#: a jump's steps over the steps just beside it, at least
+SIDE_RATIO = 3.0
 
 
 @dataclass(frozen=True)
@@ -54,17 +59,25 @@ def find_jumps(values: Sequence[float], amplitude: Sequence[float], *, ratio: fl
     signed = np.diff(a)
     step = np.abs(signed)
     level = np.maximum(np.abs(a[:-1]), np.abs(a[1:]))
-    jumps: list[Jump] = []
-    last = -2
+    cliffs: list[list[int]] = []  # runs of neighbouring steps that stand out, of one sign
     for i, d in enumerate(step):
         around = np.concatenate([step[max(0, i - window):i], step[i + 1:i + 1 + window]])
         if not (d > min_fraction * level[i] and d > ratio * float(np.median(around))):
             continue
-        if jumps and last == i - 1 and np.sign(signed[i]) == np.sign(jumps[-1].size):
-            jumps[-1] = Jump(jumps[-1].start, float(x[i + 1]), jumps[-1].before, float(a[i + 1]))  # same cliff
+        if cliffs and cliffs[-1][-1] == i - 1 and np.sign(signed[i]) == np.sign(signed[i - 1]):
+            cliffs[-1].append(i)  # the same cliff
         else:
-            jumps.append(Jump(float(x[i]), float(x[i + 1]), float(a[i]), float(a[i + 1])))
-        last = i
+            cliffs.append([i])
+    jumps = []
+    for run in cliffs:
+        first, last = run[0], run[-1]
+        # a jump is steep next to both of its sides: the step just before and the step just after it (those that
+        # exist) are small beside its own; a slope that goes on (a smooth decay from the sweep's first point,
+        # 7.956, 7.559, 7.307 um) does not
+        beside = [step[k] for k in (first - 1, last + 1) if 0 <= k < step.size]
+        if any(b > min(step[first], step[last]) / SIDE_RATIO for b in beside):
+            continue
+        jumps.append(Jump(float(x[first]), float(x[last + 1]), float(a[first]), float(a[last + 1])))
     return jumps
 
 

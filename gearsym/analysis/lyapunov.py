@@ -31,6 +31,7 @@ from ..errors import GearsymError, warn
 from ..options import Integration
 from .divergence import Divergence, counted_coordinates, find_divergence, own_rate, run_failure
 from .pairs import merge_pairs
+from .resolution import Resolution, resolution
 from .regime import DIVERGED, EQUILIBRIUM, UNDETERMINED, classify_regimes, periods_to_decide, zero_band
 from .settling import Settling, brief_run, poincare_settling
 from .statistics import batch_means_stderr
@@ -67,6 +68,9 @@ class LyapunovSpectrum:
     pairs: tuple[tuple[int, int], ...] = ()  # (0-based) exponents reported as one rotating pair's real part
     divergence: Divergence | None = None
     settling: Settling | None = None  # what the Poincare points did, where the exponents needed them
+    #: which exponents the step and the re-orthonormalisation resolved (:mod:`.resolution`); one not resolved is
+    #: reported as such, never as a value
+    resolution: Resolution | None = None
 
     @property
     def at_rest(self) -> bool:
@@ -115,6 +119,7 @@ class LyapunovSpectrum:
             "regime": self.regime,
             "pairs": [[i + 1, j + 1] for i, j in self.pairs],  # lambda_i = lambda_j: one complex pair's real part
             "divergence": None if self.divergence is None else self.divergence.as_dict(),
+            "resolution": None if self.resolution is None else self.resolution.as_dict(),
             "periods_to_decide": self.periods_to_decide,
             "equilibrium": None if not self.at_rest else {  # the exponents are the real parts of these
                 "state": self.final_state,
@@ -176,13 +181,22 @@ def lyapunov_spectrum(model: CompiledModel, *, options: Integration | None = Non
         period=inputs.period,
         backend=model.backend,
         autonomous=model.system.autonomous,
-        info={"Q": run.Q, "locate_crossings": model.options.locate_crossings},
+        info={"Q": run.Q, "locate_crossings": model.options.locate_crossings, "integration": model.integration},
         eigenvalues=summary.eigenvalues[0],
         regime=summary.regimes[0],
         pairs=tuple(summary.pairs[0]),
         divergence=summary.divergences[0],
         settling=summary.settlings[0],
+        resolution=_resolution(model, summary.exponents[0], p, runs.strobe[0, -1], inputs.period,
+                               summary.divergences[0]),
     )
+
+
+def _resolution(model, exponents, p, state, period, divergence) -> Resolution | None:
+    """What the run resolved (none for a run that diverged)."""
+    if divergence is not None or not np.all(np.isfinite(state)):
+        return None
+    return resolution(model, exponents, p, state, period)
 
 
 def lyapunov_spectra(model: CompiledModel, starts: np.ndarray, options: Integration, p: np.ndarray, *,
@@ -219,9 +233,12 @@ def lyapunov_spectra(model: CompiledModel, starts: np.ndarray, options: Integrat
             strobe=runs.strobe[i].T[:, options.discard:], periods=options.periods, discard=options.discard,
             steps_per_period=model.steps_per_period, period=inputs.period, backend=model.backend,
             autonomous=model.system.autonomous,
-            info={"Q": records.Q[i], "locate_crossings": model.options.locate_crossings},
+            info={"Q": records.Q[i], "locate_crossings": model.options.locate_crossings,
+                  "integration": model.integration},
             eigenvalues=summary.eigenvalues[i], regime=summary.regimes[i], pairs=tuple(summary.pairs[i]),
-            divergence=summary.divergences[i], settling=summary.settlings[i]))
+            divergence=summary.divergences[i], settling=summary.settlings[i],
+            resolution=_resolution(model, summary.exponents[i], p, records.final[i], inputs.period,
+                                   summary.divergences[i])))
     return out
 
 

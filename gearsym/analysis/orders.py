@@ -82,6 +82,9 @@ class OrderSpectrum:
     noise: float = 0.0  # the amplitude one line of white noise of the residual's size would reach
     title: str = ""
     info: dict = field(default_factory=dict)
+    unit: str = ""  # the amplitudes' unit ("" in the model's own; µm, rad for a model with physical values)
+    #: the other meshes of the train: name -> (its frequency in orders of this mesh, its gears' names and teeth)
+    meshes: Mapping[str, tuple[float, Mapping[str, int]]] = field(default_factory=dict)
 
     def line(self, label: str) -> OrderLine:
         for ln in self.lines:
@@ -96,6 +99,8 @@ class OrderSpectrum:
 
     def as_dict(self) -> dict:
         return json_safe({"channel": self.channel, "gears": dict(self.gears), "length_mesh_periods": self.length,
+                          "unit": self.unit, "other_meshes": {k: {"order": o, "gears": dict(g)}
+                                                              for k, (o, g) in self.meshes.items()},
                           "noise": self.noise, "title": self.title,
                           "lines": [ln.as_dict() for ln in self.lines],
                           "sideband_energy": {g: self.sideband_energy(g) for g in self.gears},
@@ -103,19 +108,25 @@ class OrderSpectrum:
 
 
 def order_lines(gears: Mapping[str, int], mesh_harmonics: int = MESH_HARMONICS,
-                sidebands: int = SIDEBANDS) -> list[OrderLine]:
+                sidebands: int = SIDEBANDS, meshes: Mapping[str, tuple[float, Mapping[str, int]]] | None = None,
+                ) -> list[OrderLine]:
     """The lines an order spectrum labels: the mesh harmonics 1 ... ``mesh_harmonics``; for each gear its shaft
-    orders 1 ... ``sidebands`` and the sidebands m +- k/Z of every mesh harmonic. Lines of two gears at the same
-    order (a 1:1 pair) are labelled once, with both names."""
-    out: list[OrderLine] = [OrderLine(f"mesh x{m}", float(m), m, None, 0) for m in range(1, mesh_harmonics + 1)]
-    for gear, teeth in gears.items():
-        for k in range(1, min(sidebands, most_sidebands(teeth)) + 1):
-            if k < teeth:
-                out.append(OrderLine(f"{gear} x{k}", k / teeth, 0, gear, k))
-            for m in range(1, mesh_harmonics + 1):
-                for sign in (-1, 1):
-                    out.append(OrderLine(f"mesh x{m} {'+' if sign > 0 else '-'} {gear} x{k}", m + sign * k / teeth,
-                                         m, gear, sign * k))
+    orders 1 ... ``sidebands`` and the sidebands m +- k/Z of every mesh harmonic; the same for every other mesh
+    of ``meshes`` (name -> its frequency r in orders of this mesh and its gears: its harmonics m r, labelled
+    '<name> x<m>', and its gears' sidebands m r +- k r/Z). Lines of two gears at the same order (a 1:1 pair, a
+    gear in two meshes) are labelled once, with the first name."""
+    out: list[OrderLine] = []
+    for mesh, (rate, mesh_gears) in {"mesh": (1.0, gears), **(meshes or {})}.items():
+        out += [OrderLine(f"{mesh} x{m}", m * rate, m, None if mesh == "mesh" else mesh, 0)
+                for m in range(1, mesh_harmonics + 1)]
+        for gear, teeth in mesh_gears.items():
+            for k in range(1, min(sidebands, most_sidebands(teeth)) + 1):
+                if k < teeth:
+                    out.append(OrderLine(f"{gear} x{k}", k * rate / teeth, 0, gear, k))
+                for m in range(1, mesh_harmonics + 1):
+                    for sign in (-1, 1):
+                        out.append(OrderLine(f"{mesh} x{m} {'+' if sign > 0 else '-'} {gear} x{k}",
+                                             (m + sign * k / teeth) * rate, m, gear, sign * k))
     seen: dict[float, OrderLine] = {}
     kept = []
     for ln in out:
@@ -129,9 +140,11 @@ def order_lines(gears: Mapping[str, int], mesh_harmonics: int = MESH_HARMONICS,
 
 def order_spectrum(tau: np.ndarray, signal: np.ndarray, gears: Mapping[str, int], *, mesh_order: float = 1.0,
                    channel: str = "x", mesh_harmonics: int = MESH_HARMONICS, sidebands: int = SIDEBANDS,
-                   title: str = "") -> OrderSpectrum:
+                   title: str = "", meshes: Mapping[str, tuple[float, Mapping[str, int]]] | None = None,
+                   unit: str = "") -> OrderSpectrum:
     """The order spectrum of ``signal`` sampled at ``tau`` (the model's time) for a pair with ``gears`` (name ->
-    teeth); see the module docstring."""
+    teeth), the lines of the train's other ``meshes`` labelled too (:func:`order_lines`), amplitudes in ``unit``
+    (the signal's); see the module docstring."""
     tau, x = np.asarray(tau, dtype=float).reshape(-1), np.asarray(signal, dtype=float).reshape(-1)
     if tau.size != x.size or tau.size < 8:
         raise GearsymError(f"an order spectrum needs at least 8 samples of {channel} with their times")
@@ -139,9 +152,12 @@ def order_spectrum(tau: np.ndarray, signal: np.ndarray, gears: Mapping[str, int]
         raise GearsymError(f"the samples of {channel} must be finite for an order spectrum")
     phase = mesh_order * tau / (2 * np.pi)  # in mesh periods
     length = float(phase[-1] - phase[0] + np.median(np.diff(phase)))
-    lines = order_lines(gears, mesh_harmonics, sidebands)
+    lines = order_lines(gears, mesh_harmonics, sidebands, meshes)
     x0 = x - x.mean()
-    short = {g for g, z in gears.items() if length < MIN_REVOLUTIONS * z}  # (their lines: not resolved, NaN)
+    # (gears turning less than MIN_REVOLUTIONS times in the record: their lines not resolved, NaN; a gear of
+    # another mesh of relative frequency r turns once in z / r periods of this one)
+    short = {g for rate, mesh_gears in [(1.0, gears), *(meshes or {}).values()] for g, z in mesh_gears.items()
+             if length * rate < MIN_REVOLUTIONS * z}
     resolvable = [ln for ln in lines if ln.order * length >= 1.0 and ln.gear not in short]
     columns = [np.ones_like(phase)]
     for ln in resolvable:
@@ -158,7 +174,7 @@ def order_spectrum(tau: np.ndarray, signal: np.ndarray, gears: Mapping[str, int]
                  for ln in lines)
     orders, amplitude = _fft(phase, x0)
     return OrderSpectrum(channel, orders, amplitude, kept, dict(gears), length, noise, title,
-                         {"unresolved": [ln.label for ln in lines if ln not in resolvable]})
+                         {"unresolved": [ln.label for ln in lines if ln not in resolvable]}, unit, dict(meshes or {}))
 
 
 def _hann(phase: np.ndarray) -> np.ndarray:

@@ -1,9 +1,9 @@
 """The ``gearsym`` command line.
 
-Each subcommand lives in its own module, which defines ``NAME``, ``HELP``,
-``add_arguments(parser)`` and ``run(args) -> int`` (the exit status). Adding
-a subcommand (``compile``, ``lyap``, ``sweep``, ...) means writing such a
-module and listing it in :data:`MODULES`; :func:`main` does the rest,
+Each subcommand lives in its own module of this package, named as the command, which defines ``NAME``,
+``HELP``, ``add_arguments(parser)`` and ``run(args) -> int`` (the exit status); what the commands share is in
+:mod:`.arguments`. Adding a subcommand (``compile``, ``lyap``, ``sweep``, ...) means writing such a module:
+:data:`MODULES` finds it, :func:`main` does the rest,
 including turning every :class:`~gearsym.errors.GearsymError` into a one-line
 message and exit status 2 (a user's mistake, not a crash: no traceback).
 A plain ``kill`` (SIGTERM) is handled like Ctrl-C: a sweep keeps its finished
@@ -16,6 +16,7 @@ import argparse
 import errno
 import importlib
 import os
+import pkgutil
 import re
 import signal
 import sys
@@ -30,13 +31,13 @@ from ..version import __version__
 from ..errors import GearsymError, GearsymWarning
 from ..files.atomic import NO_ROOM
 
-#: each subcommand's module (its ``NAME`` -> the module in this package), in the order ``gearsym --help`` lists
-#: them; a run imports the module of its own command only (the others' imports would cost it start-up time)
-MODULES = {"list": "list_models", "derive": "derive", "docs": "docs", "compile": "compile", "lyap": "lyap",
-           "sweep": "sweep", "orbits": "orbits", "stability": "stability", "poincare": "poincare", "basins": "basins", "reproduce": "reproduce",
-           "simulate": "simulate", "explain": "explain", "spectrum": "spectrum", "modes": "modes",
-           "campbell": "campbell",
-           "fmu": "fmu", "stiffness": "stiffness"}
+#: the commands whose module is named otherwise (a module named ``list`` would hide the builtin in this package)
+_RENAMED = {"list_models": "list"}
+#: every subcommand's name -> its module: the modules of this package but ``__main__``, found without importing
+#: them (a run imports the module of its own command only: the others' imports would cost it start-up time), in
+#: the order ``gearsym --help`` lists them
+MODULES = dict(sorted((_RENAMED.get(m.name, m.name), m.name) for m in pkgutil.iter_modules(__path__)
+                      if not (m.ispkg or m.name.startswith("_"))))
 
 #: exit status of a GearsymError (argparse uses the same for bad arguments)
 USAGE_ERROR = 2
@@ -86,7 +87,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run ``gearsym`` with ``argv`` (default: the process arguments); returns the exit status."""
     argv = sys.argv[1:] if argv is None else list(argv)
     closed = _closed_standard_streams()
-    args = build_parser(argv[0] if argv else None).parse_args(argv)
+    parser = build_parser(argv[0] if argv else None)
     if closed:
         print(f"gearsym: error: {closed}", file=sys.stderr)
         return USAGE_ERROR
@@ -94,6 +95,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         warnings.simplefilter("default", GearsymWarning)
         warnings.showwarning = _one_line
         try:
+            args = parser.parse_args(argv)  # (--set's values are read as they are parsed: their errors are one line)
             status = args.run(args)
             sys.stdout.flush()  # a closed pipe shows here rather than at the interpreter's exit
         except BrokenPipeError:

@@ -15,11 +15,12 @@ from ..files.outputs import check_figure, check_file
 from ..physical.campbell import campbell
 from ..physical.files import write_physical_table
 from ..physical.sweeps import nondimensional_axis
-from ..sweep import run_sweep, Workers
+from ..options import Execution
+from ..sweep import run_sweep
 from ..sweep.grid import parse_axis
 from ..sweep.store import sidecar
-from .integration import add_integration_arguments, compiled_from, scaling_from
-from .settings import add_set_argument, model_settings, parse_settings, refuse_swept_and_set
+from .arguments.integration import add_integration_arguments, compiled_from, scaling_from
+from .arguments.settings import add_set_argument, model_settings, refuse_swept_and_set
 
 NAME = "campbell"
 HELP = "Campbell diagram (natural frequencies, mesh and torque orders, crossings) beside the amplitude over speed"
@@ -54,10 +55,10 @@ def run(args: argparse.Namespace) -> int:
     if axis.name != scaling.speed.parameter:
         raise GearsymError(f"--param {args.param!r}: the Campbell diagram runs along the speed "
                            f"({scaling.speed.parameter}=...), not {axis.name}")
-    refuse_swept_and_set([(axis.name, args.param)], parse_settings(args.set))
-    engine_axis = nondimensional_axis(scaling, axis)  # (a speed without its unit is refused here)
-    modes = natural_modes(scaling.model, **model_settings(args))
-    diagram = campbell(scaling, axis.values, axis.unit, modes, args.orders)
+    refuse_swept_and_set([(axis.name, args.param)], args.set)
+    engine_axis = nondimensional_axis(scaling.full, axis)  # (a speed without its unit is refused here)
+    modes = natural_modes(scaling.full.model, **model_settings(args))
+    diagram = campbell(scaling.full, axis.values, axis.unit, modes, args.orders)
     write_atomically(sidecar(args.out, ".campbell.json"), json.dumps(diagram.as_dict(), indent=2) + "\n")
     print(f"{diagram.model}: natural frequencies " + ", ".join(f"{f:.6g} Hz" for f in diagram.natural_frequencies))
     for c in diagram.crossings:
@@ -66,11 +67,11 @@ def run(args: argparse.Namespace) -> int:
     if not args.no_sweep:
         compiled = compiled_from(args)
         result = run_sweep(compiled, [engine_axis], options=compiled.integration,
-                           out=args.out, workers=Workers(args.jobs), progress=not args.quiet)
+                           out=args.out, execution=Execution(args.jobs, progress=not args.quiet))
         sweep = scaling.to_physical(result, given=[axis])
         print(f"in physical units: {write_physical_table(sweep, sidecar(args.out, '.physical.csv'))}")
 
-    given = dict(setting.split("=", 1) for setting in args.set or () if "=" in setting)
+    given = {name: f"{value:g}" if isinstance(value, float) else str(value) for name, value in args.set.items()}
     plot_campbell(diagram, args.plot, sweep, settings=given)
     print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     return 0

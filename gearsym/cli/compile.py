@@ -9,8 +9,8 @@ from ..codegen.generated import generate_model
 from ..files.outputs import check_folder
 from ..loading import load
 from ..registry import available_models, output_root
-from .integration import add_integration_arguments, integration_from
-from .settings import add_set_argument, model_settings
+from .arguments.integration import add_integration_arguments, integration_from
+from .arguments.settings import add_set_argument, model_settings
 
 NAME = "compile"
 HELP = "generate the model's C code into generated/<model>/ and compile it (cached)"

@@ -5,7 +5,7 @@ import argparse
 
 from ..derivation import derive, render
 from ..loading import declared
-from .settings import add_teeth_argument
+from .arguments.settings import add_teeth_argument
 
 
 NAME = "derive"

@@ -14,7 +14,7 @@ from ..files.atomic import write_atomically
 from ..files.outputs import check_folder
 from ..loading import declared
 from ..registry import available_models, output_root
-from .settings import add_teeth_argument
+from .arguments.settings import add_teeth_argument
 
 NAME = "docs"
 HELP = "write the Markdown derivation of models to DIR/<model>.md"

@@ -2,15 +2,15 @@
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 from ..errors import GearsymError
-from ..fit import explain_files
+from ..figures.fit_report import explain_files
 from ..fit.selection import check_fit_names, check_harmonics
 from ..files.outputs import check_folder
-from .integration import add_integration_arguments, integration_from, scaling_from, system_from
-from .settings import add_set_argument
+from ..options import Execution
+from .arguments.integration import add_integration_arguments, integration_from, scaling_from, system_from
+from .arguments.settings import add_set_argument
 
 NAME = "explain"
 HELP = "fit a model to measured data, find the missing physical effect, add it, report the error before and after"
@@ -58,11 +58,11 @@ def run(args: argparse.Namespace) -> int:
     candidates = [e.strip() for e in args.effects.split(",")] if args.effects else None
     bias = None if args.bias is None else [c.strip() for c in args.bias.split(",") if c.strip() not in ("", "none")]
     channels = dict(_channel(text) for text in args.channel)
-    say = None if args.quiet else (lambda m: print(f"gearsym: {m}", file=sys.stderr, flush=True))
     options = integration_from(args)
     check_folder(args.out)  # before the model is reduced (seconds)
     report = explain_files(args.data, system_from(args), fit, out=args.out, time_scale=_time_scale(args),
-                           held_out=args.held_out, candidates=candidates, progress=say, options=options,
+                           held_out=args.held_out, candidates=candidates, execution=Execution(progress=not args.quiet),
+                           options=options,
                            channels=channels, bias=bias, terms=args.add_term, harmonics=args.harmonics)
     added = ", ".join(report["effects"]) or "none"
     print(f"{report['verdict']}: effects added: {added}; held-out error {report['error_before']:.4g} -> "
@@ -83,7 +83,7 @@ def _time_scale(args: argparse.Namespace) -> float | None:
     if args.time_scale is not None:
         return args.time_scale
     scaling = scaling_from(args)
-    return None if scaling is None else float(scaling.omega_n.to("rad/s").magnitude)
+    return None if scaling is None else float(scaling.full.omega_n.to("rad/s").magnitude)
 
 
 def _channel(text: str) -> tuple[str, str]:

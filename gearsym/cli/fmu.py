@@ -9,8 +9,8 @@ from ..errors import GearsymError
 from ..fmu.export import export_fmu
 from ..files.outputs import check_folder
 from ..registry import available_models, load_model
-from .integration import add_integration_arguments, integration_from
-from .settings import add_set_argument, model_settings
+from .arguments.integration import add_integration_arguments, integration_from
+from .arguments.settings import add_set_argument, model_settings
 
 NAME = "fmu"
 HELP = "export the model as an FMI 2.0 FMU (co-simulation and model exchange) for Modelica tools, Simulink, FMPy"

@@ -11,10 +11,11 @@ from ..analysis.divergence import stiffness_notes
 from ..analysis.regime import describe_regime, zero_band
 from ..checks import chosen_coordinate
 from ..errors import GearsymError
+from ..files.atomic import write_atomically
 from ..figures import plot_point
 from ..files.outputs import check_figure
-from .integration import add_integration_arguments, compiled_from, scaling_from
-from .settings import add_set_argument, parse_state
+from .arguments.integration import add_integration_arguments, compiled_from, scaling_from, step_line
+from .arguments.settings import add_set_argument, model_settings, parse_state
 
 NAME = "lyap"
 HELP = "Lyapunov spectrum (all exponents, per unit time) at one parameter point"
@@ -48,8 +49,12 @@ def run(args: argparse.Namespace) -> int:
         trajectory = phase_trajectory(compiled, options=compiled.integration.run(discard=result.periods - shown),
                                       y0=parse_state(args.y0))
         if physical is not None:  # in the model's units: exponents per second, um, mm/s, rad
-            spectrum, shown_trajectory, units, title = scaling.point_units().figure(result, trajectory)
+            point_units = scaling.point_units()
+            spectrum, shown_trajectory, units, title = point_units.figure(result, trajectory, model_settings(args))
             plot_point(spectrum, shown_trajectory, args.plot, x=coordinate, units=units, title=title)
+            caption = args.plot.with_suffix(".caption.txt")  # (the values the title leaves out)
+            write_atomically(caption, f"{scaling.name}: the figure {args.plot.name}'s values\n"
+                             + point_units.caption())
         else:
             plot_point(result, trajectory, args.plot, x=coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
@@ -57,12 +62,17 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps({**result.as_dict(), **({"physical": physical.as_dict()} if physical else {})}, indent=2))
         return 0
     print(f"{result.model}: {result.periods} periods ({result.discard} discarded), "
-          f"{result.steps_per_period} RK4 steps/period, {'plain RK4' if args.plain else 'crossings located'}, "
-          f"{result.backend}")
+          f"{result.steps_per_period} {compiled.integration.method_name} steps/period, "
+          f"{'plain' if args.plain else 'crossings located'}, {result.backend}")
+    print(step_line(compiled, scaling))
     print("parameters: " + ", ".join(f"{k}={v:g}" for k, v in result.parameters.items()))
     print("Lyapunov exponents (per unit time, +- standard error):")
     paired = {j: i for i, j in result.pairs}
+    known = result.resolution
     for i, (lam, err) in enumerate(zip(result.exponents, result.stderr), 1):
+        if known is not None and not known.resolved[i - 1]:
+            print(f"  lambda_{i}: {known.note(i - 1)}")
+            continue
         same = (f"  (= lambda_{paired[i - 1] + 1}: one complex pair of Floquet multipliers, its common real part)"
                 if i - 1 in paired else "")
         print(f"  lambda_{i} = {lam:+.6f} +- {err:.6f}{same}")
@@ -102,7 +112,7 @@ def _undecided(result) -> list[str]:
 def diverged_message(compiled, result) -> str:
     """One line: how the run diverged, and where a stiffness of the model goes negative (the likely cause)."""
     system = compiled.system
-    time_name = getattr(system, "time_name", None) or getattr(getattr(system, "time", None), "name", "t")
+    time_name = system.time_name
     text = f"{result.model}: the motion diverged: {result.divergence.describe(result.period, time_name)}"
     try:
         notes = stiffness_notes(system, result.parameters)

@@ -5,7 +5,7 @@ import argparse
 import json
 
 from ..loading import natural_modes
-from .settings import add_set_argument, model_settings
+from .arguments.settings import add_set_argument, model_settings
 
 NAME = "modes"
 HELP = "natural frequencies and mode shapes (mean mesh stiffness, no backlash); in Hz with physical values"

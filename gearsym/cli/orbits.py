@@ -7,6 +7,8 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from ..checks import chosen_coordinate, whole_number
 from ..errors import GearsymError, UnknownParameterError
 from ..figures.orbits import plot_orbits
@@ -23,13 +25,16 @@ from ..sweep import read_sweep
 from ..sweep.grid import _numbers_and_unit, Axis
 from ..sweep.store import sidecar
 from ..units import shown
-from .integration import add_integration_arguments, compiled_from, integration_from, scaling_from, system_from
-from .settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
+from .arguments.integration import (add_integration_arguments, chosen_over, compiled_from, integration_from, scaling_from,
+                          step_line, system_from)
+from .arguments.settings import add_set_argument, parse_state, refuse_swept_and_set
 
 NAME = "orbits"
 HELP = "periodic orbits, their Floquet multipliers and stability, and their branches over a parameter with folds, " \
        "period doublings, Neimark-Sacker and grazing bifurcations located"
 TRANSIENT = 300
+#: multipliers below this fraction of the largest are the monodromy matrix's rounding, not values
+ROUNDED = 1e-12
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -94,7 +99,7 @@ def engine_range(args: argparse.Namespace, parameter: tuple, scaling) -> tuple[s
                                "them (model.set_physical) or give them with --set NAME='VALUE UNIT'")
         return name, start, stop
 
-    axis = nondimensional_axis(scaling, Axis(name, (start, stop), args.param, unit))
+    axis = nondimensional_axis(scaling.full, Axis(name, (start, stop), args.param, unit))
     if axis.name != name:
         print(f"{name} {start:g} -> {stop:g}{' ' + unit if unit else ''} is {axis.name} {axis.values[0]:.6g} -> "
               f"{axis.values[1]:.6g}: continued in {axis.name}")
@@ -126,15 +131,18 @@ def run(args: argparse.Namespace) -> int:
     if parameter:
         given = parameter[0]
         parameter = engine_range(args, parameter, scaling)
-        refuse_swept_and_set([(given, args.param), (parameter[0], args.param)], parse_settings(args.set))
+        refuse_swept_and_set([(given, args.param), (parameter[0], args.param)], args.set)
     system = system_from(args)
     if args.segments is not None:  # (before the code is compiled: a period of cycles forcing periods has
         pieces = system.cycles * pieces_per_period(options.steps_per_period)  # pieces in each)
         check_segments(args.segments, pieces, f"--segments {args.segments}: ", options.steps_per_period * system.cycles)
     if parameter and parameter[0] not in system.parameters:
         raise UnknownParameterError(parameter[0], system.parameters, f"--param {args.param}")
+    if parameter:  # (the step the range's fastest point needs)
+        options = chosen_over(args, options, {parameter[0]: (parameter[1], parameter[2])})
     compiled = compiled_from(args, options, system)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
+    print(f"gearsym: {step_line(compiled, scaling)}", file=sys.stderr)
     if parameter is None:
         return _one_orbit(compiled, args, y0, physical)
     name, start, stop = parameter
@@ -149,8 +157,16 @@ def _one_orbit(compiled, args, y0, physical) -> int:
           f"{orbit.iterations} iterations, {'stable' if orbit.stable else 'unstable'}")
     print("parameters: " + ", ".join(f"{k}={v:g}" for k, v in orbit.parameters.items()))
     print("state at the section: " + ", ".join(f"{k}={v:.10g}" for k, v in zip(orbit.state_names, orbit.state)))
-    print("Floquet multipliers: " + ", ".join(_complex(m) for m in orbit.multipliers)
-          + "  (|mu|: " + ", ".join(f"{abs(m):.6g}" for m in orbit.multipliers) + ")")
+    largest = float(np.max(np.abs(orbit.multipliers)))
+    held = [m for m in orbit.multipliers if abs(m) > ROUNDED * largest]  # (the rest is the product's rounding)
+    rest = len(orbit.multipliers) - len(held)
+    print("Floquet multipliers: " + ", ".join(_complex(m) for m in held)
+          + "  (|mu|: " + ", ".join(f"{abs(m):.6g}" for m in held) + ")"
+          + (f"; {rest} more below the monodromy matrix's rounding" if rest else ""))
+    if orbit.log_moduli is not None and rest:  # (what the monodromy matrix rounds away, from the segments' maps)
+        print("their moduli from the segments' maps: " + ", ".join(
+            f"|mu_{i + 1}| = e^{v:.6g}" if ok else f"|mu_{i + 1}| <= e^{v:.4g} (lost in rounding: a bound)"
+            for i, (v, ok) in enumerate(zip(orbit.log_moduli, orbit.resolved))))
     for name, a in orbit.amplitude.items():
         print(f"amplitude A_{name} = {a:.6g}")
     for mesh, regime in orbit.contact.items():

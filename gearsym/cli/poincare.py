@@ -11,8 +11,8 @@ from ..checks import chosen_coordinate
 from ..errors import GearsymError
 from ..figures.poincare import plot_attractors
 from ..files.outputs import check_figure
-from .integration import add_integration_arguments, compiled_from, integration_from
-from .settings import add_set_argument
+from .arguments.integration import add_integration_arguments, compiled_from, integration_from
+from .arguments.settings import add_set_argument
 
 NAME = "poincare"
 HELP = "Poincare maps from many random initial states, grouped into coexisting attractors"

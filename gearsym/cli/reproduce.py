@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 from ..files.outputs import check_file, check_folder
+from ..options import Execution
 from ..reproduce import reproduce
 
 NAME = "reproduce"
@@ -31,7 +32,8 @@ def run(args: argparse.Namespace) -> int:
     if args.data:
         check_folder(args.data, "--data")
     try:
-        reproduce(args.out, doc, quick=args.quick, jobs=args.jobs, progress=not args.quiet, data=args.data)
+        reproduce(args.out, doc, quick=args.quick, execution=Execution(args.jobs, progress=not args.quiet),
+                  data=args.data)
     except KeyboardInterrupt as exc:
         print(f"gearsym: {exc}" if str(exc) else "gearsym: interrupted; run the same command again to resume",
               file=sys.stderr)

@@ -10,8 +10,8 @@ from ..fit.effects import augment, effect
 from ..fit.shaft_effects import is_shaft_effect
 from ..files.outputs import check_file
 from ..loading import load
-from .integration import add_integration_arguments, compiled_from, integration_from
-from .settings import add_set_argument, model_settings, parse_numbers, parse_state
+from .arguments.integration import add_integration_arguments, compiled_from, integration_from
+from .arguments.settings import add_set_argument, model_settings, parse_numbers, parse_state
 
 NAME = "simulate"
 HELP = "synthetic measurements of a model (tau, record, conditions, coordinates) with noise, as CSV"

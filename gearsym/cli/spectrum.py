@@ -23,8 +23,9 @@ from ..loading import load
 from ..memory import check_fits
 from ..options import STEPS_PER_PERIOD, Integration
 from ..files.outputs import check_figure, check_file
-from .integration import add_integration_arguments, compiled_from
-from .settings import add_set_argument, model_settings
+from ..physical.point import LENGTH
+from .arguments.integration import add_integration_arguments, compiled_from, scaling_from
+from .arguments.settings import add_set_argument, model_settings
 from .simulate import with_effects
 
 NAME = "spectrum"
@@ -85,8 +86,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"wrote {args.out}")
     if args.plot:
         gears = ", ".join(f"{g} {z} teeth" for g, z in spectra[0].gears.items())
+        labels = [s.info.get("label", "") for s in spectra]
         plot_order_spectra(spectra, args.plot, title=f"Order spectrum of {what} (model {args.model}: {gears})",
-                           max_order=args.mesh_harmonics + 0.5)
+                           labels=labels if any(labels) else None, max_order=args.mesh_harmonics + 0.5)
         print(f"wrote {args.plot}")
     return 0
 
@@ -132,9 +134,27 @@ def _simulated(args, settings: dict):
     options = Integration(periods=periods, discard=discard, steps_per_period=steps, locate_crossings=not args.plain,
                           backend=args.backend)
     compiled = compiled_from(args, options, system)
+    scale, unit = _unit(args, name)
     s = simulated_order_spectrum(compiled, coordinate=name, mesh_harmonics=args.mesh_harmonics,
-                                 sidebands=args.sidebands)
+                                 sidebands=args.sidebands, scale=scale, unit=unit)
+    if unit:  # a physical model: its title in the user's values (the engine's numbers stay in the JSON's title)
+        given = ", ".join(f"{k}={v}" for k, v in settings.items()) or "its declared values"
+        span = s.title.split(";")[0].split(": ", 1)[1]
+        s.info["label"] = (f"{system.name} at {given}: {span}, {compiled.steps_per_cycle} "
+                           f"{compiled.integration.method_name} steps per mesh period")
     return [s], f"a run of {system.name}" + (f" ({', '.join(args.effect)})" if args.effect else "")
+
+
+def _unit(args, name: str) -> tuple[float, str]:
+    """The factor and unit of a run's coordinate in the model's physical units (µm for a mesh's deflection, rad
+    for a shaft's twist), or (1, "") for a model without physical values."""
+    scaling = scaling_from(args)
+    if scaling is None:
+        return 1.0, ""
+    units = scaling.point_units()
+    if units.kinds.get(name) == LENGTH:
+        return units.per_unit[name] * units.m_to_length, units.length_text.text
+    return units.per_unit.get(name, 1.0), units.radian.text
 
 
 def _measured(args, settings: dict):

@@ -21,18 +21,18 @@ from .. import stability  # (lazy: the linearisation, SymPy and the generator lo
 from ..cached import load_linearisation, load_static_recipe
 from ..errors import GearsymError
 from ..files.atomic import write_atomically
-from ..figures.basins import Shown, axis_label
+from ..figures.basins import axis_label
 from ..figures.stability import plot_stability
 from ..files.outputs import check_figure, check_file
 from ..model.grammar import syntax_tree
-from ..physical.basins import PhysicalShown, units_of
+from ..physical.basins import OwnNumbers, shown_in
 from ..physical.stability import chart_in_units
 from ..physical.sweeps import nondimensional_axes
-from ..stability.chart import ABOUT, RELATIVE_TOLERANCE, StabilityChart, orbit_chart, static_chart
+from ..stability.chart import ABOUT, RELATIVE_TOLERANCE, StabilityChart, chart_axes, orbit_chart, static_chart
 from ..sweep.grid import axes_from
 from ..sweep.store import sidecar
-from .integration import add_integration_arguments, compiled_from, integration_from, scaling_from
-from .settings import add_set_argument, checked_formulas, model_settings, parse_settings, refuse_swept_and_set
+from .arguments.integration import add_integration_arguments, compiled_from, integration_from, scaling_from
+from .arguments.settings import add_set_argument, checked_formulas, model_settings, refuse_swept_and_set
 
 NAME = "stability"
 HELP = ("stability chart: Floquet multipliers of the static state (or the periodic orbit) over a grid of two "
@@ -79,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
         raise GearsymError(f"give two --param axes (got {len(given)}); for a line give the second one value, e.g. "
                            "--param k_a=0.2")
     options = integration_from(args)
-    _formula_axes(args, given)
+    user = _formula_axes(args, given)
     tolerance_of = lambda axes: tuple(args.tolerance * (max(a.values) - min(a.values) or max(1.0, abs(a.values[0])))
                                       for a in axes)
     progress = None if args.quiet else _Progress()
@@ -89,16 +89,15 @@ def run(args: argparse.Namespace) -> int:
                   verbose=not args.quiet)
     if args.about == "static":  # (the linearisation's cache says whether the model is physical: no SymPy then)
         lin = load_linearisation(args.model, settings, options, verbose=not args.quiet,
-                                 derive=lambda: _linearisation(args, settings, options))
+                                 derive=lambda: _linearisation(args, settings, options, given, user))
         scaling = scaling_from(args) if lin.physical else None
-        axes = _engine_axes(given, scaling)
-        refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], _user_settings(args))
+        axes = _checked_axes(user, given, tuple(lin.base_parameters), scaling)
         chart = static_chart(lin, axes, tolerance=tolerance_of(axes), **common)
     else:
-        compiled = compiled_from(args, options)
+        compiled = compiled_from(args, options, before=lambda system: _checked_axes(
+            user, given, tuple(system.parameters), scaling_from(args)))
         scaling = scaling_from(args)
-        axes = _engine_axes(given, scaling)
-        refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], _user_settings(args))
+        axes = _checked_axes(user, given, compiled.parameter_names, scaling)
         recipe = load_static_recipe(args.model, settings,
                                     derive=lambda: stability.static_recipe(getattr(compiled.system, "full",
                                                                                    compiled.system)))
@@ -109,10 +108,10 @@ def run(args: argparse.Namespace) -> int:
     if args.plot and args.about == "static" and len(lin.recipe.meshes) > 1:  # (the phasing rule's panel)
         factor = given[0].values[0] / axes[0].values[0] if axes[0].values[0] else 1.0
         prediction = stability.phasing_prediction(chart, lin, factor=factor)
-    shown: Shown = Shown()
+    shown = OwnNumbers()
     if scaling is not None:
         chart = chart_in_units(chart, tuple(given), tuple(axes))
-        shown = PhysicalShown(units_of(scaling))
+        shown = shown_in(scaling.point_units())
     seconds = time.perf_counter() - start
     if args.out:
         write_table(args.out, chart)
@@ -130,29 +129,38 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _user_settings(args) -> dict:
-    """--set's values as the user gave them (without a swept formula parameter's placeholder)."""
-    return parse_settings(args.set[:len(args.set) - getattr(args, "placeholders", 0)])
-
-
-def _formula_axes(args, given) -> None:
+def _formula_axes(args, given) -> dict:
     """A parameter that a ``--set k=...`` formula introduces (k_a in "1+k_a*cos(tau)") needs a value to load the
-    model; swept, it takes its axis's first value for that (the axis sets every point's own)."""
-    set_names = {pair.partition("=")[0].strip() for pair in args.set}
-    formulas = [value for name, value in parse_settings(args.set).items() if name == "k"]
-    if not formulas:
-        return
-    introduced = {n.id for f in formulas for n in ast.walk(syntax_tree(f, "--set k")) if isinstance(n, ast.Name)}
-    added = [f"{a.name}={a.values[0]!r}" for a in given if a.name in introduced and a.name not in set_names
-             and not a.unit]
-    args.set, args.placeholders = list(args.set) + added, len(added)
+    model; swept, it takes its axis's first value for that (the axis sets every point's own), added to
+    ``args.set``. Returns --set's values as the user gave them (without those placeholders)."""
+    user = dict(args.set)
+    formula = user.get("k")
+    if not isinstance(formula, str):
+        return user
+    introduced = {n.id for n in ast.walk(syntax_tree(formula, "--set k")) if isinstance(n, ast.Name)}
+    args.set = {**user, **{a.name: float(a.values[0]) for a in given
+                           if a.name in introduced and a.name not in user and not a.unit}}
+    return user
 
 
-def _linearisation(args, settings, options):
+def _linearisation(args, settings, options, given, user):
+    """The model loaded, the axes checked against it, then linearised and compiled (a wrong --param is said before
+    the compiler's seconds)."""
     checked = checked_formulas(settings)
     system = gearsym.load(args.model, **checked)
+    physical = gearsym.is_physical(args.model, **checked)
+    _checked_axes(user, given, tuple(system.parameters), scaling_from(args) if physical else None)
     lin = stability.compile_linearisation(system, options, verbose=not args.quiet)
-    return replace(lin, physical=gearsym.is_physical(args.model, **checked))
+    return replace(lin, physical=physical)
+
+
+def _checked_axes(user: dict, given, parameters: tuple[str, ...], scaling) -> tuple:
+    """The engine's axes of the --param axes ``given`` (physical ones in the model's nondimensional parameters),
+    each checked to be a parameter of the model (``parameters``) and not also given with --set (``user``: its
+    values as the user gave them)."""
+    axes = _engine_axes(given, scaling)
+    refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], user)
+    return chart_axes(parameters, axes)
 
 
 def _engine_axes(given, scaling):
@@ -189,7 +197,7 @@ def _number(x: float) -> str:
     return repr(float(x)) if np.isfinite(x) else ""
 
 
-def report(chart: StabilityChart, shown: Shown, seconds: float) -> str:
+def report(chart: StabilityChart, shown: OwnNumbers, seconds: float) -> str:
     (na, nb), (ua, ub) = chart.names, chart.units
     a, b = chart.values
     lines = [f"{chart.model}: stability of its {'static state' if chart.about == 'static' else 'period-1 orbit'} "

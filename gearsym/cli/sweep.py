@@ -14,12 +14,14 @@ from ..figures.sweep import plot_sweep
 from ..files.outputs import check_figure, check_file
 from ..physical.files import write_physical_record, write_physical_table
 from ..physical.sweeps import nondimensional_axes
-from ..sweep import DIRECTIONS, MODES, PARALLEL, POINCARE_SAMPLES, Workers, run_sweep
+from ..options import PARALLEL, Execution
+from ..sweep import DIRECTIONS, MODES, POINCARE_SAMPLES, Workers, run_sweep
 from ..sweep.grid import axes_from
 from ..sweep.report import findings_lines
 from ..sweep.store import sidecar
-from .integration import add_integration_arguments, compiled_from, integration_from, scaling_from
-from .settings import add_set_argument, parse_settings, parse_state, refuse_swept_and_set
+from .arguments.integration import (add_integration_arguments, chosen_over, compiled_from, integration_from, scaling_from,
+                          step_line)
+from .arguments.settings import add_set_argument, parse_state, refuse_swept_and_set
 
 NAME = "sweep"
 HELP = "Lyapunov spectra, amplitudes and regimes over a 1-D or 2-D parameter grid (resumable)"
@@ -72,19 +74,23 @@ def run(args: argparse.Namespace) -> int:
     check_file(args.out, (".csv",))
     if args.plot:
         check_figure(args.plot)
-    workers = Workers(args.jobs, args.parallel, "local" if args.dask else args.scheduler)
+    execution = Execution(args.jobs, args.parallel, "local" if args.dask else args.scheduler, lanes=args.lanes,
+                          progress=not args.quiet)
+    Workers.of(execution)  # (no Dask, a bad address, more jobs than cores: said before the model is compiled)
     y0 = parse_state(args.y0)  # before the model is compiled
     options = integration_from(args)  # (sizes too) before the model is loaded
     given = axes_from(args.param)
     scaling = scaling_from(args)
     axes = _engine_axes(given, scaling)
-    refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], parse_settings(args.set))
+    refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], args.set)
+    options = chosen_over(args, options, {a.name: a.values for a in axes})  # (the step its fastest point needs)
     compiled = compiled_from(args, options)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
+    if not args.quiet:
+        print(f"gearsym: {step_line(compiled, scaling)}", file=sys.stderr)
     try:
         result = run_sweep(compiled, axes, mode=args.mode, direction=args.direction, y0=y0,
-                           out=args.out, overwrite=args.overwrite, poincare=args.poincare, workers=workers,
-                           progress=not args.quiet, lanes=args.lanes)
+                           out=args.out, overwrite=args.overwrite, poincare=args.poincare, execution=execution)
     except KeyboardInterrupt as exc:  # SweepInterrupted says how many points were kept
         print(f"gearsym: {exc}" if str(exc) else "gearsym: interrupted before any point was finished",
               file=sys.stderr)
@@ -139,4 +145,4 @@ def _engine_axes(axes, scaling):
                                "them (model.set_physical) or give them with --set NAME='VALUE UNIT'")
         return axes
 
-    return nondimensional_axes(scaling, axes)
+    return nondimensional_axes(scaling.full, axes)

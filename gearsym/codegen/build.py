@@ -18,17 +18,19 @@ from pathlib import Path
 from ..errors import GearsymError
 from ..options import Integration
 from ..files.atomic import writing
-from ..files.paths import GENERATED_DIR
 from ..files.private import CACHE_ADVICE
 from ..system import FirstOrderSystem
+from .code_files import code_directory, is_committed, lanes_describes, lanes_file, source_describes, source_file
 from .compiled import CompiledModel
-from .compiler import cache_dir, compile_library
+from .compiler import compile_library
 from .functions import build_functions
-from .generate import code_hash, read_manifest, write_code
-from .lane_runs import lanes_describes, lanes_file
-from .library import LOADED, library_describes, library_functions, resolve_backend
+from .generate import code_hash, write_code
+from .library import library_describes, library_functions, model_key, resolve_backend
+from .loaded import keep, loaded
 from .loops import LoopOptions
 from .native import load_native
+from .fastest_mode import fastest_rate
+from .step_choice import chosen
 from .time_tables import split_rhs
 from .trust import record, trusted
 
@@ -50,13 +52,16 @@ def compile_model(system: FirstOrderSystem, options: Integration = Integration()
     if not isinstance(options, Integration):
         raise GearsymError(f"options must be a gearsym.Integration, got {type(options).__name__}")
     start = time.perf_counter()
+    fastest = fastest_rate(system)
+    options = chosen(options, fastest, system.cycle_at())  # the integrator and steps, from the fastest mode
     loops = LoopOptions.of(options, system.cycles)
     digest = code_hash(system, loops)
     timings = {"symbolic": time.perf_counter() - start}
     backend = resolve_backend(options.backend)
-    key = (digest, backend)
-    if key in LOADED:  # same code: reuse the loaded functions, with this system's values and these options
-        return replace(LOADED[key].clone(), system=system, integration=options)
+    key = model_key(digest, backend)
+    found = loaded(key)
+    if found is not None:  # same code: reuse the loaded functions, with this system's values and these options
+        return replace(found.clone(), system=system, integration=options, fastest=fastest)
     if backend == "in-process":
         t = time.perf_counter()
         functions, library = build_functions(system, loops).functions, None
@@ -66,9 +71,8 @@ def compile_model(system: FirstOrderSystem, options: Integration = Integration()
     native = load_native(library, functions) if library else None
     timed, texts = timed_tables(system, loops)
     compiled = CompiledModel(system, loops, digest, functions, backend, library, timings, native, options,
-                             timed, texts)
-    LOADED[key] = compiled
-    return compiled
+                             timed, texts, fastest)
+    return keep(key, compiled)
 
 
 def timed_tables(system: FirstOrderSystem, loops: LoopOptions) -> tuple[frozenset[str], tuple[str, ...]]:
@@ -83,9 +87,9 @@ def _compiled_functions(system: FirstOrderSystem, loops: LoopOptions, digest: st
     """The library of ``digest``: C from generated/ or the cache (generated here if missing or not the C gearsym
     wrote), compiled once."""
     code_dir = code_directory(system.name, digest)
-    source = code_dir / f"{system.name}.c"
+    source = code_dir / source_file(system.name)
     lanes = code_dir / lanes_file(system.name)
-    if code_dir != GENERATED_DIR / system.name and (trusted(source, source_describes(system.name, digest)) is None
+    if not is_committed(code_dir, system.name) and (trusted(source, source_describes(system.name, digest)) is None
                                                     or trusted(lanes, lanes_describes(system.name, digest)) is None):
         t = time.perf_counter()
         mf = build_functions(system, loops)
@@ -101,11 +105,6 @@ def _compiled_functions(system: FirstOrderSystem, loops: LoopOptions, digest: st
     return library_functions(lib.path), lib.path
 
 
-def source_describes(name: str, digest: str) -> dict:
-    """What the generated C of a model is, as its record in the cache keeps it."""
-    return {"model": name, "code": digest}
-
-
 def keep_generated(code) -> None:
     """Generated C just written into the cache (a :class:`~.generate.GeneratedCode`): made private and recorded."""
     for path in (code.manifest, code.source, code.lanes):
@@ -116,20 +115,6 @@ def keep_generated(code) -> None:
 
 def _kind(value) -> str:
     return f"the string {value!r}" if isinstance(value, str) else f"a {type(value).__name__}"
-
-
-def code_directory(name: str, digest: str) -> Path:
-    """Where the C of the code ``digest`` is: the committed ``generated/<model>/`` if its manifest carries
-    this hash (no need to generate it again), else the cache."""
-    committed = GENERATED_DIR / name
-    if (read_manifest(committed) or {}).get("hash") == digest:
-        return committed
-    return cached_code_directory(name, digest)
-
-
-def cached_code_directory(name: str, digest: str) -> Path:
-    """Where the cache keeps the C of the code ``digest`` when it is generated (or received) here (made private)."""
-    return cache_dir("code", f"{name}-{digest[:16]}")
 
 
 def _to_stderr(message: str) -> None:

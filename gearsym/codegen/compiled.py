@@ -135,6 +135,7 @@ class CompiledModel:
     integration: Integration = field(default_factory=Integration)  # the options it was compiled with
     timed: frozenset[str] = frozenset()  # the parameters in the tables of time or the period (the generator's)
     table_texts: tuple[str, ...] = ()  # the tables of time, as text (for the error of one that does not repeat)
+    fastest: float = 0.0  # the rate of the system's fastest linearised mode (what the step was chosen from)
 
     def run_options(self, options: Integration | None) -> Integration:
         """The options a run on this model uses: its own, or ``options`` if they need the same code; a run longer
@@ -149,14 +150,19 @@ class CompiledModel:
         if not isinstance(options, Integration):
             raise GearsymError(f"options must be a gearsym.Integration, got {type(options).__name__}")
         mine = self.integration
+        if options.integrator == "auto" and options.steps_per_period <= mine.steps_per_period:
+            options = replace(options, integrator=mine.integrator, steps_per_period=mine.steps_per_period,
+                              choice=mine.choice)  # (the model's choice for at least the steps asked)
         same = (options.steps_per_period == mine.steps_per_period
                 and options.locate_crossings == mine.locate_crossings
+                and options.integrator == mine.integrator
                 and options.backend in ("auto", self.backend))
         if not same:
             raise GearsymError(
-                f"{self.name}: this compiled model integrates with {mine.steps_per_period} steps per period, "
-                f"{'crossings located' if mine.locate_crossings else 'plain RK4'}, {self.backend}; the options ask "
-                f"for {options.steps_per_period}, {'crossings located' if options.locate_crossings else 'plain RK4'}"
+                f"{self.name}: this compiled model integrates with {mine.steps_per_period} {mine.method_name} steps per "
+                f"period, {'crossings located' if mine.locate_crossings else 'plain'}, {self.backend}; the options "
+                f"ask for {options.steps_per_period} {options.method_name}, "
+                f"{'crossings located' if options.locate_crossings else 'plain'}"
                 f", {options.backend}: compile the system with these options (compile_model(system, options))")
         return options
 
@@ -195,7 +201,7 @@ class CompiledModel:
     @property
     def cycles(self) -> int:
         """Forcing periods in one period: 1, or a gear's revolution (the hunting period) with shaft-order terms."""
-        return getattr(self.system, "cycles", 1)
+        return self.system.cycles
 
     @property
     def steps_per_cycle(self) -> int:
@@ -253,6 +259,37 @@ class CompiledModel:
                            block[c_at:c_at + size], period, t0, self.hash)
         inputs.__dict__["addresses"] = (at + 8 * table_at, at + 8 * c_at)  # (the cached property, known already)
         return inputs
+
+    def tables(self, P: np.ndarray, t0: float = 0.0) -> np.ndarray:
+        """The tables of time of each parameter vector (row) of ``P``, each flattened as the loops read it
+        (column-major), its period checked: what the many points of a chart share, two native calls a row straight
+        into the rows of one array (no :class:`RunInputs`: :meth:`prepare` costs twice as much a table), the
+        periods and the probes checked at once after them."""
+        P = np.ascontiguousarray(P, dtype=np.float64)
+        if P.ndim != 2 or P.shape[1] != len(self.parameter_names) or not np.isfinite(P).all():
+            raise GearsymError(f"{self.name}: expected rows of {len(self.parameter_names)} finite parameter values "
+                               f"({', '.join(self.parameter_names)}), got an array of shape {P.shape}")
+        if not self.native:
+            return np.array([self._tables(p, float(t0)).table.reshape(-1, order="F") for p in P]).reshape(len(P), -1)
+        k, (rows, steps), (probe_rows, _), size = self._table_layout
+        count = len(P)
+        out = np.zeros((count, rows * steps))  # (zeros: what the library leaves unwritten reads as CasADi's)
+        probes = np.zeros((count, 2, probe_rows))  # (each row's probe column-major: its two columns)
+        periods = np.zeros(count)
+        scratch = np.zeros(size + 1)  # t0, then the constants (not kept)
+        scratch[0] = t0
+        constants, table = self.native["constants"].call, self.native["table"].call
+        t_at, c_at = scratch.ctypes.data, scratch.ctypes.data + 8
+        p_at, out_at, probe_at, period_at = P.ctypes.data, out.ctypes.data, probes.ctypes.data, periods.ctypes.data
+        for r in range(count):
+            p = p_at + 8 * k * r
+            constants((p,), (c_at, period_at + 8 * r))
+            table((t_at, p), (out_at + 8 * rows * steps * r, probe_at + 16 * probe_rows * r))
+        a, b = probes[:, 0], probes[:, 1]
+        wrong = ~(np.isfinite(periods) & (periods > 0)) | ~(np.abs(a - b) <= 1e-9 * (1 + np.abs(a))).all(axis=1)
+        for r in np.flatnonzero(wrong)[:1]:  # (the first one wrong, said as a single point's would be)
+            self._checked_period(P[r], float(t0), float(periods[r]), probes[r].T)
+        return out
 
     @cached_property
     def _table_layout(self) -> tuple[int, tuple[int, int], tuple[int, int], int]:

@@ -41,6 +41,7 @@ import shutil
 import subprocess
 import tempfile
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -185,20 +186,23 @@ class Library:
 
 
 def compile_library(source: Path, name: str, cc: str | None = None, flags: tuple[str, ...] | None = None,
-                    announce=None, describes: dict | None = None) -> Library:
+                    announce=None, describes: dict | None = None, includes: Sequence[Path] = ()) -> Library:
     """The shared library of ``source`` for this machine: from the cache, or compiled into it.
 
     ``describes`` says what the library is (the model, its code hash, states, parameters: kept in its record,
     part of its name). A cached library is used only if its bytes are those recorded when it was compiled
     (:func:`.trust.trusted`); one that is not (cut short, damaged, changed) is compiled again, and a warning
     says so. ``announce(message)`` is called before an actual compilation (a few seconds), not on a cache hit.
+    ``includes``: the files ``source`` includes (the lanes' C includes the model's), whose bytes name the library
+    too.
     """
     cc = cc or find_compiler()
     if cc is None:
         raise CompilerError(REQUIRED_NOTE.format(what=compilers_looked_for()))
     flags = compile_flags() if flags is None else tuple(flags)
     described = json.dumps(describes or {}, sort_keys=True).encode()
-    digest = hashlib.sha256(Path(source).read_bytes() + CALL_SOURCE.encode() + described).hexdigest()[:16]
+    included = b"".join(Path(path).read_bytes() for path in includes)
+    digest = hashlib.sha256(Path(source).read_bytes() + CALL_SOURCE.encode() + described + included).hexdigest()[:16]
     target = library_path(f"{name}-{digest}-{_machine_key(cc, flags)}.so")
     if trusted(target, describes) is not None:
         return Library(target, False, 0.0)

@@ -16,7 +16,7 @@ from .time_tables import SplitRHS
 from .translate import select_max, select_min, to_casadi
 
 
-def crossing_steps(sym: LoopSymbols, split: SplitRHS, switching: Switching, where: str):
+def crossing_steps(sym: LoopSymbols, split: SplitRHS, switching: Switching, where: str, kind: type | None = None):
     """``tangent_block``, ``state_block`` and ``state_step`` (one step each) that split a step at a crossing,
     and the SX pieces they call, by name (the printed loops call them directly, :mod:`.printed`).
 
@@ -50,7 +50,7 @@ def crossing_steps(sym: LoopSymbols, split: SplitRHS, switching: Switching, wher
     integrated on the extension of the mode before it (first order there). The min/max of the observed
     states are taken after the step, as in the plain loops.
     """
-    step = CrossingStep(sym, split, switching, where)
+    step = (kind or CrossingStep)(sym, split, switching, where)  # (kind: the stiff step's, stiff_crossing.py)
     pieces = {f.name(): f for f in step.pieces()}
     # try, then Switch(keep | split), emitted straight into the caller's MX graph (a Function around the two
     # calls would copy its inputs once more at every step)

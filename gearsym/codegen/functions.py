@@ -41,8 +41,10 @@ from ..system import FirstOrderSystem
 from .casadi_symbols import SX_OPTIONS, LoopSymbols
 from .crossing import crossing_steps
 from .loops import LoopOptions
-from .period_loops import gram_schmidt_function, monodromy, over_period
+from .period_loops import gram_schmidt_function, monodromy, orthonormalised_period, over_period
 from .rk4 import rk4_functions, tangent_by_vector
+from .rosenbrock import rosenbrock_functions, with_rates
+from .stiff_crossing import RosenbrockCrossingStep
 from .switching import find_switching
 from .tables import table_function
 from .time_tables import SplitRHS, split_rhs
@@ -70,6 +72,9 @@ class ModelFunctions:
 def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions()) -> ModelFunctions:
     """Every function the engine generates for ``system`` (see the module docstring)."""
     split = split_rhs(system, factored=options.locate_crossings)
+    stiff = options.method == "stiff"
+    if stiff:  # the stiff step reads the tables' rates too (df/dt and its stage times)
+        split = with_rates(split, system.time)
     sym = LoopSymbols(system, split)
     n, m, nc = system.dimension, len(split.tables), len(split.constants)
     N, K = options.steps_per_period, options.block(n)
@@ -93,7 +98,13 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
                               ["t", "p"], ["values"], SX_OPTIONS)
 
     switching = find_switching(system, split) if options.locate_crossings else None
-    if switching is None or not switching.surfaces:  # nothing switches (Lorenz): the plain loops
+    if stiff and (switching is None or not switching.surfaces):
+        tangent_block, state_block, state_step, steps = rosenbrock_functions(sym, split, where)
+        steps["state_block"] = state_block
+    elif stiff:
+        tangent_block, state_block, state_step, steps = crossing_steps(sym, split, switching, where,
+                                                                       RosenbrockCrossingStep)
+    elif switching is None or not switching.surfaces:  # nothing switches (Lorenz): the plain loops
         tangent_block, state_block, state_step = rk4_functions(sym, split, K, where)
         steps = {**tangent_by_vector(sym, split, K, where), "state_block": state_block}
         if K > 1:  # the trajectory's steps one at a time
@@ -108,8 +119,13 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
     Tm = ca.MX.sym("T", 3 * m, N)
     obs0 = ca.vertcat(*[Ym[j] for j in sym.observed])
 
-    yk, Qk, lk, hk = over_period(tangent_block, [Ym, Qm, obs0, obs0], Tm, Cm, K, "tangent")
-    Qn, logr = gram_schmidt(Qk)
+    every, rest = options.orthonormalised(n)
+    if every:  # Gram-Schmidt every few steps (LoopOptions.reorthonormalise), the logs summed over the period
+        yk, Qn, lk, hk, logr = orthonormalised_period(tangent_block, gram_schmidt, [Ym, Qm, obs0, obs0], Tm, Cm, K,
+                                                      every, rest)
+    else:
+        yk, Qk, lk, hk = over_period(tangent_block, [Ym, Qm, obs0, obs0], Tm, Cm, K, "tangent")
+        Qn, logr = gram_schmidt(Qk)
     lyapunov_period = ca.Function("lyapunov_period", [Ym, Qm, Tm, Cm], [yk, Qn, logr, lk, hk],
                                   ["y0", "Q0", "table", "c"], ["strobe", "Q", "log_stretch", "low", "high"])
     yk, Qk, rows = Ym, Qm, []

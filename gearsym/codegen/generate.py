@@ -20,7 +20,7 @@ from ..files.atomic import write_atomically
 from ..system import FirstOrderSystem
 from .functions import ModelFunctions
 from .loops import LoopOptions
-from .lane_runs import lanes_file
+from .code_files import lanes_file, source_file
 from .lanes import lanes_source
 from .printed import LOOP_NAMES, pieces, print_loops, stand_in
 
@@ -31,7 +31,7 @@ CODEGEN_VERSION = 2
 #: can never leave a stale library or committed C in use (the tests then ask to regenerate)
 _GENERATOR_SOURCES = ("translate.py", "time_tables.py", "casadi_symbols.py", "rk4.py", "switching.py", "crossing.py",
                       "period_loops.py", "tables.py", "functions.py", "loops.py", "generate.py", "printed.py",
-                      "lanes.py")
+                      "lanes.py", "rosenbrock.py", "stiff_crossing.py")
 
 
 def generator_digest() -> str:
@@ -98,7 +98,7 @@ def write_code(mf: ModelFunctions, directory: Path, digest: str) -> GeneratedCod
     directory.mkdir(parents=True, exist_ok=True)
     name = mf.system.name
     with tempfile.TemporaryDirectory(dir=directory) as tmp:
-        gen = ca.CodeGenerator(f"{name}.c", {"with_header": False, "verbose": False, "prefix": ""})
+        gen = ca.CodeGenerator(source_file(name), {"with_header": False, "verbose": False, "prefix": ""})
         for fname, f in mf.functions.items():
             gen.add(stand_in(f, pieces(mf, fname)) if fname in LOOP_NAMES else f)
         cwd = os.getcwd()
@@ -107,21 +107,15 @@ def write_code(mf: ModelFunctions, directory: Path, digest: str) -> GeneratedCod
             gen.generate()
         finally:
             os.chdir(cwd)
-        source, lanes = Path(tmp) / f"{name}.c", Path(tmp) / lanes_file(name)
+        source, lanes = Path(tmp) / source_file(name), Path(tmp) / lanes_file(name)
         text = source.read_text()
-        lanes.write_text(lanes_source(text, mf))
+        lanes.write_text(lanes_source(mf))
         source.write_text(print_loops(text, mf))
         os.replace(lanes, directory / lanes.name)
-        os.replace(source, directory / f"{name}.c")
+        os.replace(source, directory / source.name)
     text = json.dumps(manifest(mf, digest), indent=2, sort_keys=True) + "\n"
     write_atomically(directory / "manifest.json", text)
-    return GeneratedCode(directory, directory / f"{name}.c", directory / "manifest.json", digest,
+    return GeneratedCode(directory, directory / source_file(name), directory / "manifest.json", digest,
                          directory / lanes_file(name))
 
 
-def read_manifest(directory: Path) -> dict | None:
-    path = Path(directory) / "manifest.json"
-    try:
-        return json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None

@@ -13,6 +13,7 @@ from .compiler import compile_library
 from .functions import build_functions
 from .loops import LoopOptions
 from .generate import code_hash, write_code
+from .fastest_mode import chosen_for
 
 
 @dataclass
@@ -30,6 +31,7 @@ def generate_model(system: FirstOrderSystem, out: Path, options: Integration = I
                    check: bool = False, compile: bool = True) -> GenerateReport:
     """Write ``out/<model>/<model>.c`` and ``manifest.json`` for ``system`` compiled with ``options``;
     with ``check``, compare instead of writing."""
+    options = chosen_for(options, system)
     loops = LoopOptions.of(options, system.cycles)
     digest = code_hash(system, loops)
     target = Path(out) / system.name

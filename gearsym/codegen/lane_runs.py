@@ -13,7 +13,6 @@ Nothing here needs SymPy or the code generator: a cached model's lanes are found
 from __future__ import annotations
 
 import ctypes
-import json
 import os
 import sys
 import threading
@@ -25,9 +24,10 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import GearsymError
-from ..files.paths import GENERATED_DIR
+from .code_files import code_directory, is_committed, lanes_describes, lanes_file, source_describes, source_file
 from .compiled import CompiledModel, RunInputs
-from .compiler import cache_dir, compile_library
+from .compiler import compile_library
+from .loaded import load_once, open_library
 from .trust import trusted
 
 _ptr = ctypes.c_void_p
@@ -35,34 +35,12 @@ _ptr = ctypes.c_void_p
 CHUNK = 64
 
 
-def lanes_describes(name: str, digest: str) -> dict:
-    """What the lanes' C of a model is, as its record in the cache keeps it."""
-    return {"model": f"{name}_lanes", "code": digest}
-
-
-def lanes_file(name: str) -> str:
-    """The file name of a model's lanes' C, beside its ``<model>.c``."""
-    return f"{name}_lanes.c"
-
-
-def code_directory(name: str, digest: str) -> Path:
-    """Where the C of the code ``digest`` is (the rule of :func:`.build.code_directory`, without the generator):
-    the committed ``generated/<model>/`` if its manifest carries the hash, else the cache."""
-    committed = GENERATED_DIR / name
-    try:
-        if json.loads((committed / "manifest.json").read_text()).get("hash") == digest:
-            return committed
-    except (OSError, ValueError, AttributeError):
-        pass
-    return cache_dir() / "code" / f"{name}-{digest[:16]}"
-
-
 class LaneLibrary:
     """The entry points of one lanes library (plain C, called through ctypes: they release Python's lock)."""
 
     def __init__(self, path: Path):
         self.path = path
-        library = ctypes.CDLL(str(path))
+        library = open_library(path)
         self.width = int(library.gearsym_lanes())
         self.orbit = library.gearsym_lanes_orbit
         self.orbit.argtypes = [_ptr, _ptr, ctypes.c_longlong, _ptr, _ptr, _ptr, _ptr]
@@ -77,9 +55,8 @@ class LaneLibrary:
             f.restype = ctypes.c_int
 
 
-#: (code hash, library path) -> the loaded lanes of this process
-_LOADED: dict[tuple[str, str], LaneLibrary] = {}
-_LOCK = threading.Lock()
+#: one compile of a model's lanes at a time (threads asking at once wait for the first)
+_COMPILING = threading.Lock()
 
 
 def lanes_of(model: CompiledModel, verbose: bool = False) -> LaneLibrary | None:
@@ -87,22 +64,20 @@ def lanes_of(model: CompiledModel, verbose: bool = False) -> LaneLibrary | None:
     in-process backend (its scalar loops run start by start instead)."""
     if model.backend != "compiled" or model.library is None:
         return None
-    source = code_directory(model.name, model.hash) / lanes_file(model.name)
-    with _LOCK:
-        if not source.is_file():
-            raise GearsymError(f"{model.name}: the C of its lanes ({source}) is missing; generate it again: "
-                               f"`gearsym compile {model.name}` (or delete {source.parent} and rerun)")
-        # (C in the cache is code: compiled only if it is what gearsym wrote there, as the model's own C)
-        if source.parent != GENERATED_DIR / model.name and \
-                trusted(source, lanes_describes(model.name, model.hash)) is None:
-            raise GearsymError(f"{model.name}: the C of its lanes ({source}) is not what gearsym wrote for this "
-                               f"model; delete {source.parent} and rerun: gearsym makes it again")
+    folder = code_directory(model.name, model.hash)
+    source, included = folder / lanes_file(model.name), folder / source_file(model.name)
+    with _COMPILING:
+        for path, describes in ((source, lanes_describes), (included, source_describes)):
+            if not path.is_file():
+                raise GearsymError(f"{model.name}: the C of its lanes ({path}) is missing; generate it again: "
+                                   f"`gearsym compile {model.name}` (or delete {folder} and rerun)")
+            # (C in the cache is code: compiled only if it is what gearsym wrote there, as the model's own C)
+            if not is_committed(folder, model.name) and trusted(path, describes(model.name, model.hash)) is None:
+                raise GearsymError(f"{model.name}: the C of its lanes ({path}) is not what gearsym wrote for this "
+                                   f"model; delete {folder} and rerun: gearsym makes it again")
         announce = (lambda message: print(f"gearsym: {message}", file=sys.stderr, flush=True)) if verbose else None
-        library = compile_library(source, f"{model.name}_lanes", announce=announce)
-        key = (model.hash, str(library.path))
-        if key not in _LOADED:
-            _LOADED[key] = LaneLibrary(library.path)
-        return _LOADED[key]
+        library = compile_library(source, f"{model.name}_lanes", announce=announce, includes=(included,))
+    return load_once(("lanes", model.hash, str(library.path)), lambda: LaneLibrary(library.path))
 
 
 @dataclass(frozen=True)

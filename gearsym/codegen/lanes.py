@@ -5,10 +5,10 @@ starts. The scalar loops (:mod:`.printed`) keep one trajectory in registers and 
 the chain from one RK4 stage to the next; here L trajectories sit in the lanes of SIMD registers (structure of
 arrays: entry k of lane l at ``k*GS_L + l``), and every operation of CasADi's step runs on all of them at once:
 
-* each per-step SX piece's C body (the same text the scalar loops inline) is wrapped in a ``for`` over the
-  lanes, every input and output indexed by lane (``A0[j]`` -> ``A0[GS_L*j + l]``: the tables of time too, so
-  that the lanes may be points of a sweep whose tables differ); gcc vectorises that loop across the lanes (the
-  bodies are arithmetic, comparisons and selects);
+* each per-step SX piece of the model's C (``gs_<piece>_strided``, :data:`.printed.LANE_PIECES`: its entries a
+  stride apart) is called in a ``for`` over the lanes, on lane l's entries (``A0[S*j]`` -> ``A0[GS_L*j + l]``:
+  the tables of time too, so that the lanes may be points of a sweep whose tables differ); inlined, gcc
+  vectorises that loop across the lanes (the bodies are arithmetic, comparisons and selects);
 * with crossings located, the try runs on every lane; a lane whose try flags a crossing takes the split,
   scalar (``gs_{kind}_split``, the scalar loops' own function), and its results replace the kept try's in
   that lane; the other lanes go on;
@@ -22,18 +22,15 @@ arrays: entry k of lane l at ``k*GS_L + l``), and every operation of CasADi's st
 Each lane computes the scalar loop's operations in the scalar loop's order: the same bits, as long as the
 compiler contracts the same multiply-adds in both (``-ffp-contract``; the tests compare the lanes with the
 scalar loop to the bit under the default flags and without FMA). The file stands beside the model's C
-(``<model>_lanes.c``) and is compiled into a library of its own the first time lanes are asked for, so that
-no other command pays its compile time.
+(``<model>_lanes.c``) and includes it up to its step pieces (``GEARSYM_STEP_PIECES_ONLY``: CasADi's helpers,
+the pieces, the splits; not its loops and functions), so that generated/ holds each piece once; it is compiled
+into a library of its own the first time lanes are asked for, so that no other command pays its compile time.
 """
 from __future__ import annotations
 
-import re
-
+from .code_files import source_file
 from .functions import ModelFunctions
-from .printed import _DEFINITION, _PREAMBLE, _Shape, _inline, _split
-
-#: the per-step pieces that run on all lanes at once; every other piece is scalar (the split, Gram-Schmidt)
-LANE_PIECES = ("tangent_state", "tangent_vector", "state_try", "state_keep", "state_block")
+from .printed import _CLOSING, LANE_PIECES, PIECES_ONLY, _Shape
 
 #: the entry points of a lanes library (plain C, called through ctypes)
 ENTRY_POINTS = ("gearsym_lanes", "gearsym_lanes_orbit", "gearsym_lanes_lyapunov")
@@ -77,55 +74,35 @@ _LANES_PREAMBLE = r"""
 """
 
 
-def lanes_source(text: str, mf: ModelFunctions) -> str:
-    """The C of the lanes of the model of ``mf``: from CasADi's C ``text`` of its functions (as
-    :func:`.generate.write_code` writes it with the stand-ins, before :func:`.printed.print_loops`), its helpers
-    and the SX pieces' bodies, with the lane loops printed around them."""
-    definitions = {m.group("name"): m for m in _DEFINITION.finditer(text)}
-    missing = [name for name in mf.steps if name not in definitions]
-    if missing:
-        raise AssertionError(f"no C definition of {', '.join(missing)} in the generated code")
+def lanes_source(mf: ModelFunctions) -> str:
+    """The C of the lanes of the model of ``mf``: the model's C (:func:`.printed.print_loops`) included up to its
+    step pieces, and the lane loops printed around those."""
     s = _Shape(mf)
-    head = text[:min(m.start() for m in definitions.values())]
-    out = [head.rstrip() + "\n", _PREAMBLE.format(zeros=max(1, s.rows * s.N)), _LANES_PREAMBLE]
-    out += [_inline(name, definitions[name].group("body"), mf.steps[name], s.n if name == "tangent_vector" else 1)
-            for name in mf.steps]
-    out += [_split(mf, kind) for kind in ("tangent", "state") if s.located]
-    out += [_lane_piece(name, definitions[name].group("body"), mf.steps[name], s) for name in LANE_PIECES
-            if name in mf.steps]
-    out.append(_lane_piece("constants", definitions["constants"].group("body"), mf.functions["constants"], s,
-                           constants=False))
+    out = [f"/* gearsym: the lanes of {mf.system.name}, L trajectories at once (see gearsym/codegen/lanes.py), "
+           f"around the step pieces of {source_file(mf.system.name)} */", _LANES_PREAMBLE,
+           f"#define {PIECES_ONLY}\n#include \"{source_file(mf.system.name)}\"\n"]
+    out += [_lane_piece(name, mf.steps[name], s) for name in LANE_PIECES if name in mf.steps]
+    out.append(_lane_piece("constants", mf.functions["constants"], s, constants=False))
     out += _lane_steps(s)
     out += _entries(s)
     out += [_points(s, len(mf.system.parameters), tangent) for tangent in (True, False)]
-    return "\n".join(out) + "\n#ifdef __cplusplus\n} /* extern \"C\" */\n#endif\n"
+    return "\n".join(out) + "\n" + _CLOSING
 
 
-def _lane_piece(name: str, body: str, f, s: _Shape, constants: bool = True) -> str:
-    """``gsl_<name>``: the SX function ``f``'s C body in a loop over the lanes; every input and output (the table
-    of time and the constants too) one value per lane, ``GS_L`` apart (a tangent vector's rows ``n*GS_L`` apart).
-    ``constants``: a step piece, whose last input is the constants (``False``: the constants function itself,
-    parameters in, constants out, which the chart of many parameter points evaluates per lane)."""
+def _lane_piece(name: str, f, s: _Shape, constants: bool = True) -> str:
+    """``gsl_<name>``: the model's SX function ``f`` called in a loop over the lanes, on lane l's entries; every
+    input and output (the table of time and the constants too) one value per lane, ``GS_L`` apart (a tangent
+    vector's rows ``n*GS_L`` apart). ``constants``: a step piece, whose last input is the constants (``False``: the
+    constants function itself, parameters in, constants out, which a chart of many parameter points evaluates per
+    lane)."""
     if constants and f.numel_in(f.n_in() - 1) != s.nc:
         raise AssertionError(f"{name}: the last input is not the constants")
-    stride = s.n if name == "tangent_vector" else 1
-
-    def lane(kind: str, i: int, j: int) -> str:
-        k = j * stride if i == 0 else j
-        return f"{kind}{i}[GS_L*{k} + l]"
-
-    body = re.sub(r"arg\[(\d+)\]\? arg\[\1\]\[(\d+)\] : 0", lambda m: lane("A", int(m[1]), int(m[2])), body)
-    body = re.sub(r"if \(res\[(\d+)\]!=0\) res\[\1\]\[(\d+)\]=", lambda m: lane("R", int(m[1]), int(m[2])) + "=", body)
-    body = re.sub(r"\n  return 0;$", "", body)
-    left = [line for line in body.splitlines() if re.search(r"\b(arg|res|iw|w)\[|\breturn\b|\bmem\b", line)]
-    if left:
-        raise AssertionError(f"{name}: CasADi's C has a form the lanes' printer does not rewrite: {left[:3]}")
     args = [f"const casadi_real* restrict A{i}" for i in range(f.n_in())]
     args += [f"casadi_real* restrict R{i}" for i in range(f.n_out())]
-    inner = "\n".join("  " + line if line else line for line in body.splitlines())
-    return (f"/* {name} on every lane, from CasADi's C of it */\n"
+    lanes = [f"A{i} + l" for i in range(f.n_in())] + [f"R{i} + l" for i in range(f.n_out())]
+    return (f"/* {name} on every lane: the model's piece on lane l's entries */\n"
             f"static GEARSYM_INLINE void gsl_{name}({', '.join(args)}) {{\n"
-            "  casadi_int l;\n  GS_LANES {\n" + inner + "\n  }\n}\n")
+            f"  casadi_int l;\n  GS_LANES gs_{name}_strided({', '.join(lanes)}, GS_L);\n}}\n")
 
 
 def _lane_steps(s: _Shape) -> list[str]:
@@ -236,16 +213,21 @@ def _entries(s: _Shape) -> list[str]:
         "CASADI_SYMBOL_EXPORT GS_TARGETS int gearsym_lanes_lyapunov(const casadi_real* restrict T, "
         "const casadi_real* restrict c, casadi_int periods, casadi_real* restrict y, casadi_real* restrict Q, "
         "casadi_real* strobe, casadi_real* logs, casadi_real* low, casadi_real* high) {\n"
-        f"  casadi_real lo[{O}*GS_L], hi[{O}*GS_L], Qc[{s.size('Q')}], Qn[{s.size('Q')}], lg[{s.size('y')}];\n"
-        "  casadi_int p, l, i;\n"
+        f"  casadi_real lo[{O}*GS_L], hi[{O}*GS_L], Qc[{s.size('Q')}], Qn[{s.size('Q')}], lg[{s.size('y')}], "
+        f"acc[{s.size('y')}*GS_L];\n"
+        "  casadi_int p, l, i, g;\n"
         "  for (p = 0; p < periods; ++p) {\n" + start
-        + f"    gsl_tangent_span(y, Q, lo, hi, T, c, {s.blocks});\n"
-        "    for (l = 0; l < GS_L; ++l) {  /* Gram-Schmidt of each lane's vectors, as columns */\n"
-        f"      for (i = 0; i < {n * n}; ++i) Qc[(i % {n})*{n} + i / {n}] = Q[GS_L*i + l];\n"
-        "      gs_gram_schmidt(Qc, Qn, lg);\n"
-        f"      for (i = 0; i < {n * n}; ++i) Q[GS_L*i + l] = Qn[(i % {n})*{n} + i / {n}];\n"
-        f"      if (logs) for (i = 0; i < {n}; ++i) logs[{n}*GS_L*p + GS_L*i + l] = lg[i];\n"
-        "    }\n" + store + "  }\n  return 0;\n}\n",
+        + f"    for (i = 0; i < {n}*GS_L; ++i) acc[i] = 0;\n"
+        + "".join(f"    {loop}{{\n"
+                  f"      gsl_tangent_span(y, Q, lo, hi, {table}, c, {blocks});\n"
+                  "      for (l = 0; l < GS_L; ++l) {  /* Gram-Schmidt of each lane's vectors, as columns */\n"
+                  f"        for (i = 0; i < {n * n}; ++i) Qc[(i % {n})*{n} + i / {n}] = Q[GS_L*i + l];\n"
+                  "        gs_gram_schmidt(Qc, Qn, lg);\n"
+                  f"        for (i = 0; i < {n * n}; ++i) Q[GS_L*i + l] = Qn[(i % {n})*{n} + i / {n}];\n"
+                  f"        for (i = 0; i < {n}; ++i) acc[GS_L*i + l] += lg[i];\n"
+                  "      }\n    }\n" for loop, table, blocks in _pieces(s))
+        + f"    if (logs) for (i = 0; i < {n}*GS_L; ++i) logs[{n}*GS_L*p + i] = acc[i];\n"
+        + store + "  }\n  return 0;\n}\n",
     ]
 
 
@@ -312,3 +294,17 @@ def _points(s: _Shape, parameters: int, tangent: bool) -> str:
         + "    }\n"
         "  }\n"
         "  return 0;\n}\n")
+
+
+def _pieces(s: _Shape) -> list[tuple[str, str, int]]:
+    """The pieces of a period between Gram-Schmidt steps (the scalar loops' :func:`.printed._orthonormalised`):
+    (the C loop over them, the table at each one's start, its blocks)."""
+    table = (lambda at: f"T + {s.step}*GS_L*({at})") if s.step else (lambda at: "T")
+    if not s.every:
+        return [("", "T", s.blocks)]
+    whole = s.blocks // s.every
+    out = [(f"for (g = 0; g < {whole}; ++g) ", table(f"{s.every}*g"), s.every)]
+    if s.rest:
+        out.append(("", table(whole * s.every), s.rest))
+    return out
+

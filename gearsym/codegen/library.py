@@ -1,8 +1,6 @@
-"""The compiled models of this process and the backend a run asks for: what a cached start-up needs.
+"""A model's library through CasADi and the backend a run asks for: what a cached start-up needs.
 
-A :class:`~gearsym.codegen.compiled.CompiledModel` is kept here by its code hash and backend once loaded,
-so that a second compile of the same code (another model object, other values) reuses its functions; the
-start-up cache (:mod:`gearsym.cached`) loads a library into the same table without generating anything.
+The models this process loaded are kept in the one table of :mod:`.loaded`, under :func:`model_key`.
 Nothing here needs SymPy.
 """
 from __future__ import annotations
@@ -12,16 +10,18 @@ from pathlib import Path
 
 import casadi as ca
 
-from .compiled import CompiledModel
 from .compiler import FALLBACK_NOTE, compilers_looked_for, find_compiler
 
 #: every function the generated library exports
 FUNCTION_NAMES = ("rhs", "jacobian", "constants", "table", "lyapunov_chunk", "lyapunov_period",
                   "orbit_chunk", "orbit_period", "trajectory", "monodromy_segment", "monodromy_period")
 
-#: (code hash, backend) -> the model loaded in this process
-LOADED: dict[tuple[str, str], CompiledModel] = {}
 _WARNED = set()
+
+
+def model_key(digest: str, backend: str) -> tuple:
+    """The key of a compiled model in the process's table (:mod:`.loaded`): its code and its backend."""
+    return ("model", digest, backend)
 
 
 def resolve_backend(asked: str) -> str:

@@ -35,6 +35,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import GearsymError
+from .loaded import open_library
 
 _ptr = ctypes.c_void_p
 PAGE = 4096
@@ -107,5 +108,5 @@ def _stack_aligned_call(library: ctypes.CDLL):
 
 
 def load_native(path, functions: dict[str, ca.Function]) -> dict[str, NativeFunction]:
-    library = ctypes.CDLL(str(path))
+    library = open_library(path)
     return {name: NativeFunction(library, name, f) for name, f in functions.items()}

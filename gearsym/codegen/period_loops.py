@@ -82,3 +82,27 @@ def gram_schmidt_function(n: int) -> ca.Function:
         cols.append(v / norm)
         logs.append(ca.log(norm))
     return ca.Function("gram_schmidt", [Q], [ca.horzcat(*cols), ca.vertcat(*logs)], SX_OPTIONS)
+
+
+def orthonormalised_period(tangent_block, gram_schmidt, carry: list, T: ca.MX, C: ca.MX, K: int, every: int,
+                           rest: int) -> list:
+    """A period of tangent steps re-orthonormalised every ``every`` blocks (and after the ``rest`` at its end):
+    the state, the orthonormal vectors, the sum of each vector's log stretches over the period, the extremes.
+    Each piece is a function (the tangent steps of ``every`` blocks, Gram-Schmidt, the logs added), applied along
+    the table as :func:`over_period` applies a block."""
+    y, Q, lo, hi = carry
+
+    def piece(blocks: int) -> ca.Function:
+        args = [ca.MX.sym(name, x.sparsity()) for name, x in (("y", y), ("Q", Q), ("lo", lo), ("hi", hi))]
+        logs = ca.MX.sym("logs", y.size1())
+        Ts, Cs = ca.MX.sym("T", T.size1(), blocks * K), ca.MX.sym("c", C.sparsity())
+        yk, Qk, lk, hk = over_period(tangent_block, args, Ts, Cs, K, "tangent")
+        Qn, logr = gram_schmidt(Qk)
+        return ca.Function(f"orthonormalised_{blocks * K}", [*args, logs, Ts, Cs], [yk, Qn, lk, hk, logs + logr])
+
+    zero = ca.MX.zeros(y.size1())
+    whole = (T.size2() // K // every) * every * K
+    out = over_period(piece(every), [y, Q, lo, hi, zero], T[:, :whole], C, every * K, "orthonormalised")
+    if rest:
+        out = list(piece(rest)(*out, T[:, whole:], C))
+    return out

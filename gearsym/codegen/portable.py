@@ -39,11 +39,11 @@ import casadi as ca
 from ..errors import GearsymError
 from ..options import Integration
 from ..files.atomic import writing
-from ..files.paths import GENERATED_DIR
 from ..files.private import CACHE_ADVICE, write_private
 from ..system import FirstOrderSystem
 from ..version import __version__
-from .build import cached_code_directory, code_directory, keep_generated, source_describes
+from .build import keep_generated
+from .code_files import cached_code_directory, code_directory, is_committed, source_describes, source_file
 from .compiled import CompiledModel
 from .compiler import CompilerError, binary_key, compile_flags, compile_library, library_path
 from .functions import build_functions
@@ -85,7 +85,7 @@ class ShippedModel:
 
 def ship(compiled: CompiledModel) -> ShippedModel:
     """``compiled`` packed for another process or machine (see the module docstring)."""
-    system = getattr(compiled.system, "full", compiled.system)  # a cached model's summary: the system it stands for
+    system = compiled.system.full  # (a cached model's summary: the system it stands for)
     base = dict(system=system, options=compiled.options, integration=compiled.integration,
                 hash=compiled.hash, backend=compiled.backend, versions=_versions(), timed=compiled.timed,
                 table_texts=compiled.table_texts)
@@ -93,8 +93,8 @@ def ship(compiled: CompiledModel) -> ShippedModel:
         return ShippedModel(**base)
     name = compiled.name
     code_dir = code_directory(name, compiled.hash)
-    source = code_dir / f"{name}.c"
-    if code_dir != GENERATED_DIR / name and trusted(source, source_describes(name, compiled.hash)) is None:
+    source = code_dir / source_file(name)
+    if not is_committed(code_dir, name) and trusted(source, source_describes(name, compiled.hash)) is None:
         # (the cache was cleaned since the library was built, or its C is not what gearsym wrote: generate it)
         with writing(code_dir, CACHE_ADVICE):
             keep_generated(write_code(build_functions(system, compiled.options), code_dir, compiled.hash))
@@ -146,7 +146,7 @@ def _write_library(shipped: ShippedModel) -> Path:
 
 def _rebuild(shipped: ShippedModel, timings: dict) -> Path:
     """The shipped C compiled here (the library was built for another system, CPU or C library)."""
-    source = cached_code_directory(shipped.name, shipped.hash) / f"{shipped.name}.c"
+    source = cached_code_directory(shipped.name, shipped.hash) / source_file(shipped.name)
     if trusted(source, source_describes(shipped.name, shipped.hash)) != shipped.source:
         record(source, shipped.source, source_describes(shipped.name, shipped.hash))
         write_private(source, shipped.source)

@@ -43,6 +43,14 @@ from .loops import shooting_segments
 #: the loop functions printed here (everything else in the file is CasADi's)
 LOOP_NAMES = ("lyapunov_chunk", "lyapunov_period", "orbit_chunk", "orbit_period", "monodromy_segment",
               "monodromy_period", "trajectory")
+#: the per-step pieces the lanes (:mod:`.lanes`) run on all lanes at once: printed with their entries a stride
+#: apart (``gs_<piece>_strided``: 1 for one trajectory, the lanes' width on one lane of the lanes' arrays)
+LANE_PIECES = ("tangent_state", "tangent_vector", "state_try", "state_keep", "state_block")
+#: what the lanes also run on each lane beside the step pieces: the constants from each lane's own parameters
+#: (a stability chart's points), printed strided with them
+LANE_FUNCTIONS = ("constants",)
+#: defined by the lanes' C before it includes the model's: the file then ends after its step pieces
+PIECES_ONLY = "GEARSYM_STEP_PIECES_ONLY"
 
 _HEADER = r"/\* (?P<name>\w+):\(.*?\)->\(.*?\) \*/\n"
 _SIGNATURE = (r"static int (?P<c>casadi_f\d+)\(const casadi_real\*\* arg, casadi_real\*\* res, casadi_int\* iw, "
@@ -89,23 +97,33 @@ def stand_in(f: ca.Function, calls: list[ca.Function]) -> ca.Function:
 def print_loops(text: str, mf: ModelFunctions) -> str:
     """CasADi's C ``text`` (written with :func:`stand_in` for the :data:`LOOP_NAMES`) with the loops printed."""
     definitions = {m.group("name"): m for m in _DEFINITION.finditer(text)}
-    missing = [name for name in (*LOOP_NAMES, *mf.steps) if name not in definitions]
+    missing = [name for name in (*LOOP_NAMES, *mf.steps, *LANE_FUNCTIONS) if name not in definitions]
     if missing:
         raise AssertionError(f"no C definition of {', '.join(missing)} in the generated code")
     shape = _Shape(mf)
-    printed = [_PREAMBLE.format(zeros=max(1, shape.rows * shape.N))]
-    printed += [_inline(name, definitions[name].group("body"), mf.steps[name],
-                        shape.n if name == "tangent_vector" else 1) for name in mf.steps]
-    printed += [_split(mf, kind) for kind in ("tangent", "state") if shape.located]
-    printed += _spans(mf, shape)
-    # the printed C goes before the first stand-in; each stand-in's body becomes its loop
+    steps = [_PREAMBLE.format(zeros=max(1, shape.rows * shape.N))]
+    steps += [_inline(name, definitions[name].group("body"), mf.steps[name],
+                      shape.n if name == "tangent_vector" else 1) for name in mf.steps]
+    steps += [_inline(name, definitions[name].group("body"), mf.functions[name]) for name in LANE_FUNCTIONS]
+    steps += [_split(mf, kind) for kind in ("tangent", "state") if shape.located]
+    # the spans go before the first stand-in; each stand-in's body becomes its loop
     first = min(definitions[name].start() for name in LOOP_NAMES)
     for name in sorted(LOOP_NAMES, key=lambda name: -definitions[name].start()):
         d = definitions[name]
         loop = _LOOPS[name](shape)
         text = text[:d.start()] + d.group(0)[:d.start("body") - d.start()] + loop + "\n}\n\n" + text[d.end():]
-    text = text[:first] + "\n".join(printed) + "\n" + text[first:]
+    text = text[:first] + "\n".join(_spans(mf, shape)) + "\n" + text[first:]
+    # the step pieces right after CasADi's helpers, and what follows them behind PIECES_ONLY (the lanes' C
+    # includes this file up to its step pieces: one copy of each in generated/)
+    head = min(m.start() for m in definitions.values())
+    end = text.rindex(_CLOSING)
+    text = (text[:head] + "\n".join(steps) + f"\n#ifndef {PIECES_ONLY}  /* (the lanes' C includes the pieces above) */\n\n"
+            + text[head:end] + f"#endif  /* {PIECES_ONLY} */\n\n" + text[end:])
     return _without_unused(text)
+
+
+#: the end of CasADi's file (the lanes' C, which includes the model's up to its step pieces, ends alike)
+_CLOSING = "#ifdef __cplusplus\n} /* extern \"C\" */\n#endif\n"
 
 
 def _without_unused(text: str) -> str:
@@ -125,6 +143,9 @@ def _inline(name: str, body: str, f: ca.Function, stride: int = 1) -> str:
     body = re.sub(r"if \(res\[(\d+)\]!=0\) res\[\1\]\[(\d+)\]=", r"R\1[\2]=", body)
     if stride != 1:
         body = re.sub(r"\b([AR])0\[(\d+)\]", lambda m: f"{m.group(1)}0[{int(m.group(2)) * stride}]", body)
+    strided = name in LANE_PIECES or name in LANE_FUNCTIONS
+    if strided:  # (entry k at S*k: S = 1 for one trajectory, the lanes' width for one lane of the lanes' arrays)
+        body = re.sub(r"\b([AR]\d+)\[(\d+)\]", lambda m: f"{m[1]}[S*{m[2]}]" if m[2] != "0" else m[0], body)
     body = re.sub(r"\n  return 0;$", "", body)
     left = [line for line in body.splitlines() if re.search(r"\b(arg|res|iw|w)\[|\breturn\b|\bmem\b", line)]
     if left:
@@ -134,7 +155,12 @@ def _inline(name: str, body: str, f: ca.Function, stride: int = 1) -> str:
     # the split's pieces (about 1 % of steps) stay calls, each compiled once: not `cold`, whose size
     # optimisation (code hoisting) took gcc 20 s more on the largest model
     where = "GEARSYM_NOINLINE" if name in _OUT_OF_LINE else "GEARSYM_INLINE"
-    return f"/* {name}, from CasADi's C of it */\nstatic {where} void gs_{name}({', '.join(args)}) {{\n{body}\n}}\n"
+    if not strided:
+        return f"/* {name}, from CasADi's C of it */\nstatic {where} void gs_{name}({', '.join(args)}) {{\n{body}\n}}\n"
+    names = [f"A{i}" for i in range(f.n_in())] + [f"R{i}" for i in range(f.n_out())]
+    return (f"/* {name}, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */\n"
+            f"static GEARSYM_INLINE void gs_{name}_strided({', '.join(args)}, casadi_int S) {{\n{body}\n}}\n"
+            f"static {where} void gs_{name}({', '.join(args)}) {{ gs_{name}_strided({', '.join(names)}, 1); }}\n")
 
 
 #: the split's pieces that are calls (the keep, also on the steps that do not cross, is inline)
@@ -180,6 +206,8 @@ class _Shape:
         self.blocks = self.N // K
         self.P = mf.options.chunk_periods
         self.S = shooting_segments(self.N, K, system.cycles)
+        #: blocks between two Gram-Schmidt steps and in the last piece of a period ((0, 0): once per period)
+        self.every, self.rest = mf.options.orthonormalised(self.n)
         self.located = "state_try" in mf.steps
         self.stepwise = "trajectory_step" in mf.steps  # (blocks of several steps: the trajectory steps alone)
         #: the tangent step (or try): the state's step, then each tangent vector's (:func:`_by_vector`)
@@ -328,15 +356,31 @@ def _locals(s: _Shape, tangent: bool) -> str:
             f"  gs_load(arg[0], {s.n}, y);{load_q} gs_load(arg[{c}], {s.nc}, c);\n")
 
 
+def _orthonormalised(s: _Shape) -> str:
+    """A period of tangent steps, Gram-Schmidt every ``s.every`` blocks (and after the rest), the logs summed in
+    ``logs`` (as :func:`.period_loops.orthonormalised_period`: 0 + the first piece's, then each in turn)."""
+    if not s.every:
+        return (f"    gs_tangent_span(y, Q, lo, hi, T, c, {s.blocks});\n"
+                "    gs_gram_schmidt(Q, Qn, logs);\n"
+                f"    gs_copy(Qn, {s.n * s.n}, Q);\n")
+    whole = s.blocks // s.every
+    table = (lambda at: f"T + {s.step}*({at})") if s.step else (lambda at: "T")
+    piece = lambda at, blocks: (f"gs_tangent_span(y, Q, lo, hi, {table(at)}, c, {blocks}); "
+                                f"gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, {s.n * s.n}, Q); "
+                                f"for (i = 0; i < {s.n}; ++i) logs[i] += piece[i];")
+    rest = f"    {piece(whole * s.every, s.rest)}\n" if s.rest else ""
+    return (f"    for (i = 0; i < {s.n}; ++i) logs[i] = 0;\n"
+            f"    for (g = 0; g < {whole}; ++g) {{ {piece(f'{s.every}*g', s.every)} }}\n" + rest)
+
+
 def _lyapunov(s: _Shape, periods: int) -> str:
     o = len(s.observed)
+    pieces = f" casadi_real piece[{s.size('y')}]; casadi_int g, i;" if s.every else ""
     return (_locals(s, True)
-            + f"  casadi_real Qn[{s.size('Q')}], logs[{s.size('y')}];\n"
+            + f"  casadi_real Qn[{s.size('Q')}], logs[{s.size('y')}];{pieces}\n"
             f"  for (p = 0; p < {periods}; ++p) {{\n"
             f"    {_observed_start(s)}\n"
-            f"    gs_tangent_span(y, Q, lo, hi, T, c, {s.blocks});\n"
-            "    gs_gram_schmidt(Q, Qn, logs);\n"
-            f"    gs_copy(Qn, {s.n * s.n}, Q);\n"
+            + _orthonormalised(s) +
             f"    gs_store(y, {s.n}, res[0], {s.n}*p); gs_store(logs, {s.n}, res[2], {s.n}*p);\n"
             f"    gs_store(lo, {o}, res[3], {o}*p); gs_store(hi, {o}, res[4], {o}*p);\n"
             "  }\n"

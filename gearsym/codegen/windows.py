@@ -42,6 +42,7 @@ from ..errors import GearsymError
 from ..files.private import write_private
 from ..system import FirstOrderSystem
 from .compiler import cache_dir, compile_library, find_compiler
+from .loaded import load_once, open_library
 from .casadi_symbols import SystemSymbols
 from .rk4 import rk4_step
 from .generate import generator_digest
@@ -195,7 +196,7 @@ class Windows:
             record(source, text, describes)
             write_private(source, text)
         library = compile_library(source, f"{self.system.name}_windows", describes=describes)
-        lib = ctypes.CDLL(str(library.path))
+        lib = open_library(library.path)
         call = lib.gearsym_fit_windows
         call.restype = ctypes.c_int
         call.argtypes = ([ctypes.c_longlong] + [ctypes.c_void_p] * 6 + [ctypes.c_longlong] * 2
@@ -326,16 +327,12 @@ def windows_hash(system: FirstOrderSystem, channels: Sequence[sp.Expr]) -> str:
 #: the whole tangent step and output of the in-process backend (the compiled driver goes column by column)
 _IN_PROCESS_ONLY = ("fit_step", "fit_output")
 
-_LOADED: dict[tuple, Windows] = {}
-
-
 def compile_windows(system: FirstOrderSystem, channels: Sequence[sp.Expr], backend: str = "auto") -> Windows:
     """The window integrator of ``system`` observed through ``channels``: built once per process (found again by
     the equations themselves, whose hashes SymPy keeps), compiled once per machine (the C is cached by its hash)."""
-    key = (system.name, system.time, system.states, system.rhs, tuple(system.parameters), tuple(channels), backend)
-    if key not in _LOADED:
-        _LOADED[key] = Windows(system, channels, backend)
-    return _LOADED[key]
+    key = ("windows", system.name, system.time, system.states, system.rhs, tuple(system.parameters),
+           tuple(channels), backend)
+    return load_once(key, lambda: Windows(system, channels, backend))
 
 
 #: the loop over windows, samples and RK4 steps around the generated functions (no per-step Python)

@@ -132,7 +132,7 @@ def _derive_reduced(nd: NondimensionalModel) -> Derivation:
     return Derivation(
         model=model.name, title=model.title, description=model.description, time=tau,
         states=tuple(nd.states), rhs=tuple(nd.rhs), parameters=_parameters(names, values, descriptions, parameter_roles(rd)),
-        period=nd.period,
+        period=nd.period, cycles=nd.cycles,
         mechanics=mechanics, notes=paper_notes(nd, groups, values),
         scaling=_scaling_record(scaling) if scaling is not None else None,
     )

@@ -150,8 +150,9 @@ def _mechanics(d: Derivation, m: Mechanics) -> list[str]:
     out += ["Nondimensional mesh stiffness: its definition in the declared parameters, and its formula in $\\tau$:"]
     out += display(blocks.function_rows(d, m))
     out += _section("Nondimensional equations")
+    repeats = (f"; the model repeats every ${to_latex(d.period)}$, {d.cycles} of them" if d.cycles > 1 else "")
     out += ["In the nondimensional time $\\tau = \\omega t$ (one forcing period is "
-            f"${to_latex(d.period)}$):"]
+            f"${to_latex(d.forcing_period)}${repeats}):"]
     out += display(blocks.equation_rows(d, m.equations))
     return out
 
@@ -180,8 +181,10 @@ def _scaling(d: Derivation) -> list[str]:
 def _first_order(d: Derivation) -> list[str]:
     out = _section("First-order system")
     states = ", ".join(latex_name(s.name) for s in d.states)
-    period = "forcing period" if d.mechanics is not None else "period (of stroboscopic sampling)"
-    out += [f"States $({states})$, time ${to_latex(d.time)}$, {period} ${to_latex(d.period)}$."]
+    period = ("period (of stroboscopic sampling)" if d.mechanics is None else
+              "forcing period" if d.cycles == 1 else "period")
+    of = f" ({d.cycles} forcing periods of ${to_latex(d.forcing_period)}$)" if d.cycles > 1 else ""
+    out += [f"States $({states})$, time ${to_latex(d.time)}$, {period} ${to_latex(d.period)}${of}."]
     if d.mechanics is not None:
         out[-1] += (" The engine integrates this system with the stiffness functions and the derived groups "
                     "replaced by their formulas.")

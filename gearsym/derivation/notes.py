@@ -56,7 +56,7 @@ def paper_notes(nd: NondimensionalModel, groups: Sequence[GroupRecord], defaults
                 "Fourier series over that mean."
             )
     derived = [gr for gr in groups if gr.kind == "derived"]
-    if derived:
+    if derived and not nd.drivetrain.physical:  # (a model with physical values gives them: its scaling's section)
         behind = sorted(set().union(*(parameter_names(gr.definition) for gr in derived)))
         values = ", ".join(f"{n} = {number(defaults[n])}" for n in behind if n in defaults)
         results = ", ".join(f"{gr.name} = {number(gr.value)}" for gr in derived if gr.value is not None)

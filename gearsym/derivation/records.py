@@ -182,6 +182,11 @@ class Derivation:
     mechanics: Optional[Mechanics]
     notes: tuple[str, ...]
     scaling: Optional[ScalingRecord] = None  # a drivetrain with physical values
+    cycles: int = 1  # forcing periods (mesh periods of the first mesh) in one period
+
+    @property
+    def forcing_period(self) -> sp.Expr:
+        return self.period / self.cycles
 
     @property
     def is_drivetrain(self) -> bool:

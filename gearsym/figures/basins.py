@@ -7,8 +7,9 @@ is (period, regime, amplitude) and how much of the grid its basin covers. :func:
 fraction of every attractor (by its id along the parameter) with its standard error, and its amplitude, against
 the parameter, with the appearances, merges and vanishings marked.
 
-Values are shown in the units a :class:`Shown` gives (a model with physical values: µm, mm/s, rpm), by default
-the model's own.
+Each takes the result it draws as it is shown (:class:`~gearsym.physical.basins.ShownBasinMap`,
+:class:`~gearsym.physical.basins.ShownFractions`: a model with physical values in µm, mm/s, rpm), or the engine's
+result, drawn in the model's own numbers.
 """
 from __future__ import annotations
 
@@ -17,7 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .poincare import SYMBOLS, parameter_text
+from ..analysis.basins import BasinMap
+from ..physical.basins import ShownBasinMap, ShownFractions
+from ..physical.text import SYMBOLS
+from ..sweep.basin_continuation import BasinContinuation
 from .save import pyplot, save_figure
 
 #: colours of the attractors by number (or id), then of the two other classes
@@ -25,22 +29,6 @@ COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e3
           "#7f7f7f")
 DIVERGED_COLOR, UNDETERMINED_COLOR = "#000000", "#dddddd"
 REGIME_MARKERS = {"periodic": "o", "quasi-periodic": "s", "chaotic": "^", "hyperchaotic": "D", "undetermined": "v"}
-
-
-class Shown:
-    """How values are shown: the model's own numbers (a model with physical values overrides it)."""
-
-    def state(self, name: str, values, omega: float | None = None) -> tuple[np.ndarray, str]:
-        """A state's values as shown, and their unit ('' for the model's own)."""
-        return np.asarray(values, dtype=float), ""
-
-    def parameter(self, name: str, values) -> tuple[str, np.ndarray, str]:
-        """A parameter's values as shown: (name, values, unit)."""
-        return name, np.asarray(values, dtype=float), ""
-
-    def parameters(self, values: dict) -> str:
-        """The parameter values of a run, as a title shows them."""
-        return ", ".join(parameter_text(k, v) for k, v in values.items())
 
 
 def color(number: int) -> str:
@@ -70,40 +58,39 @@ def run_text(result) -> str:
             f"RK4 steps/period, {scheme}")
 
 
-def map_title(result, shown: Shown, width: int = 100) -> str:
-    held = ", ".join(f"{n} = {_shown_number(shown, n, v, result.parameters)}" for n, v in result.held.items())
+def map_title(shown: ShownBasinMap, width: int = 100) -> str:
+    result = shown.result
+    held = ", ".join(f"{n} = {_shown_number(shown, n, v)}" for n, v in result.held.items())
     (x, xs), (y, ys) = result.axes
     text = (f"{result.model}: basins of attraction over {x} and {y} ({xs.size} x {ys.size} starts"
-            + (f"; held: {held}" if held else "") + f") at {shown.parameters(result.parameters)}")
+            + (f"; held: {held}" if held else "") + f") at {shown.parameters_text()}")
     return textwrap.fill(text, width)
 
 
-def _shown_number(shown: Shown, name: str, value: float, parameters: dict) -> str:
-    v, unit = shown.state(name, [value], parameters.get("omega"))
-    return f"{float(v[0]):.4g}" + (f" {unit}" if unit else "")
+def _shown_number(shown: ShownBasinMap, name: str, value: float) -> str:
+    v, unit = shown.number(name, value)
+    return f"{v:.4g}" + (f" {unit}" if unit else "")
 
 
-def attractor_label(a, shown: Shown, omega: float | None = None) -> str:
-    amplitude = ", ".join(f"A_{k} = {float(shown.state(k, [v], omega)[0][0]):.4g}"
-                          + (f" {shown.state(k, [v], omega)[1]}" if shown.state(k, [v], omega)[1] else "")
-                          for k, v in a.amplitude.items())
+def attractor_label(a, shown: ShownBasinMap) -> str:
+    amplitude = ", ".join(f"A_{k} = {_shown_number(shown, k, v)}" for k, v in a.amplitude.items())
     lam = f", λ₁ = {a.exponents[0]:+.4f}" if len(a.exponents) and np.isfinite(a.exponents[0]) else ""
     return (f"{a.number}: {a.description}, {100 * a.fraction:.1f} ± {100 * a.stderr:.1f} % of starts; "
             f"{amplitude}{lam}")
 
 
-def plot_basin_map(result, path: str | Path | None = None, shown: Shown | None = None, ax=None):
-    """The basin map of a :class:`~gearsym.analysis.basins.BasinMap` (written to ``path`` if given); returns the
-    Figure."""
+def plot_basin_map(shown: ShownBasinMap | BasinMap, path: str | Path | None = None, ax=None):
+    """The basin map (as shown, or a :class:`~gearsym.analysis.basins.BasinMap` in the model's own numbers),
+    written to ``path`` if given; returns the Figure."""
     plt = pyplot()
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
-    shown = shown or Shown()
-    omega = result.parameters.get("omega")
+    shown = ShownBasinMap.of(shown)
+    result = shown.result
     (x, xs), (y, ys) = result.axes
-    sx, ux = shown.state(x, xs, omega)
-    sy, uy = shown.state(y, ys, omega)
+    sx, ux = shown.state(x, xs)
+    sy, uy = shown.state(y, ys)
     numbers = [a.number for a in result.attractors]
     classes = [-1, 0, *numbers]
     cmap = ListedColormap([DIVERGED_COLOR, UNDETERMINED_COLOR, *(color(k) for k in numbers)])
@@ -116,12 +103,12 @@ def plot_basin_map(result, path: str | Path | None = None, shown: Shown | None =
     handles = []
     for a in result.attractors:
         c = color(a.number)
-        px, _ = shown.state(x, a.points[ix], omega)
-        py, _ = shown.state(y, a.points[iy], omega)
+        px, _ = shown.state(x, a.points[ix])
+        py, _ = shown.state(y, a.points[iy])
         marker = REGIME_MARKERS.get(a.regime, "o")
         size = 28 if a.points.shape[1] <= 64 else 6
         ax.scatter(px, py, s=size, marker=marker, color=c, edgecolors=[_darker(c)], linewidths=0.9, zorder=3)
-        handles.append(Patch(facecolor=c, edgecolor=_darker(c), label=attractor_label(a, shown, omega)))
+        handles.append(Patch(facecolor=c, edgecolor=_darker(c), label=attractor_label(a, shown)))
     empty = []  # (a class no start is in has no colour on the map: the legend's title says so instead)
     for label, share, c in (("diverged", result.diverged, DIVERGED_COLOR), ("undetermined", result.undetermined,
                                                                              UNDETERMINED_COLOR)):
@@ -142,7 +129,7 @@ def plot_basin_map(result, path: str | Path | None = None, shown: Shown | None =
         ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.14), fontsize=6.5, frameon=False,
                   title=title, title_fontsize=6.5)
     if own:
-        ax.set_title(map_title(result, shown), fontsize=8.5)
+        ax.set_title(map_title(shown), fontsize=8.5)
         fig.supxlabel(textwrap.fill(run_text(result) + ". Each attractor's exponents from one tangent run on it; a "
                                     "basin's ± is the binomial standard error of the fraction.", 150),
                       fontsize=7, color="0.35")
@@ -151,12 +138,14 @@ def plot_basin_map(result, path: str | Path | None = None, shown: Shown | None =
     return fig
 
 
-def plot_basin_fractions(result, path: str | Path | None = None, shown: Shown | None = None):
-    """The fractions and amplitudes of a :class:`~gearsym.sweep.basin_continuation.BasinContinuation` against its
-    parameter (written to ``path`` if given); returns the Figure."""
+def plot_basin_fractions(shown: ShownFractions | BasinContinuation, path: str | Path | None = None):
+    """The fractions and amplitudes of a basin continuation (as shown, or a
+    :class:`~gearsym.sweep.basin_continuation.BasinContinuation` in the model's own numbers) against its parameter,
+    written to ``path`` if given; returns the Figure."""
     plt = pyplot()
-    shown = shown or Shown()
-    name, values, unit = shown.parameter(result.parameter, result.values)
+    shown = ShownFractions.of(shown)
+    result = shown.result
+    name, values, unit = shown.parameter()
     where = dict(zip(result.values, values))
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(10, 7.5), sharex=True, constrained_layout=True,
                                       gridspec_kw={"height_ratios": [3, 2]})
@@ -171,13 +160,12 @@ def plot_basin_fractions(result, path: str | Path | None = None, shown: Shown | 
         keys.append(Line2D([], [], color=color(aid), lw=1.2, marker="o", ms=3.5, label=f"attractor {aid}"))
         for r, xv in zip(rows, px):
             for k, amp in r.amplitude.items():
-                shown_amp, _ = shown.state(k, [amp], r.value if result.parameter == "omega" else None)
-                bottom.plot(xv, shown_amp[0], marker=REGIME_MARKERS.get(r.regime, "o"), color=color(aid), ms=4.5,
+                shown_amp, _ = shown.amplitude(k, amp, r.value)
+                bottom.plot(xv, shown_amp, marker=REGIME_MARKERS.get(r.regime, "o"), color=color(aid), ms=4.5,
                             ls="none")
         first = next(iter(rows[0].amplitude), None)
         if first is not None:
-            amps = [shown.state(first, [r.amplitude[first]], r.value if result.parameter == "omega" else None)[0][0]
-                    for r in rows]
+            amps = [shown.amplitude(first, r.amplitude[first], r.value)[0] for r in rows]
             bottom.plot(px, amps, color=color(aid), lw=0.8, alpha=0.6)
     for kind, c in (("diverged", DIVERGED_COLOR), ("undetermined", UNDETERMINED_COLOR)):
         f = result.fractions(kind)
@@ -197,7 +185,7 @@ def plot_basin_fractions(result, path: str | Path | None = None, shown: Shown | 
     top.legend(handles=[*keys, *top.get_legend_handles_labels()[0]], fontsize=7, ncol=4, loc="lower left",
                bbox_to_anchor=(0.0, 1.0), frameon=False)
     coordinate = next((k for r in result.rows for k in r.amplitude), "")
-    _, unit_a = shown.state(coordinate, [0.0], None) if coordinate else (None, "")
+    unit_a = shown.unit(coordinate) if coordinate else ""
     bottom.set_ylabel(f"A ({coordinate})" + (f" [{unit_a}]" if unit_a else ""))
     regimes = {r.regime for r in result.rows}  # (a key for each regime drawn, none for the others)
     bottom.legend(handles=[Line2D([], [], marker=m, ls="none", color="0.3", label=k) for k, m in REGIME_MARKERS.items()
@@ -211,7 +199,7 @@ def plot_basin_fractions(result, path: str | Path | None = None, shown: Shown | 
         f"{k} in [{min(v):g}, {max(v):g}] ({len(v)})" for k, v in grid.items())
     title = (f"{result.model}: basin fractions along {SYMBOLS.get(name, name)} (each attractor by its id, matched "
              f"from one value to the next by its Poincaré set); grid {grid_text}"
-             + (f"; {shown.parameters(fixed)} (the rest: the model's declared values)" if fixed
+             + (f"; {shown.parameters_text(fixed)} (the rest: the model's declared values)" if fixed
                 else "; the other parameters: the model's declared values")
              + f"; {record['periods']} periods per start, {record['discard']} discarded, "
              + ("crossings located" if record.get("locate_crossings") else "plain RK4"))

@@ -33,6 +33,19 @@ def crossings_at(crossings) -> dict[tuple[float, float], list[str]]:
     return at
 
 
+def frequency_range(diagram) -> float:
+    """The top of the frequency axis: the range that holds the crossings (a quarter above the highest), or
+    without any, what the orders reach over the speeds and the lowest natural frequency; natural frequencies above
+    it are named, not drawn."""
+    fastest = max((per_speed for _, _, per_speed in coinciding_orders(diagram.orders)), default=0.0)
+    reached = fastest * float(np.max(diagram.speeds_rad_s(np.array([diagram.speeds.max()])))) / (2 * np.pi)
+    crossed = [c.natural_frequency for c in diagram.crossings]
+    if crossed:
+        return 1.25 * max(crossed)
+    lowest = min(diagram.natural_frequencies, default=1.0)
+    return 1.25 * max(min(reached, lowest), 1.0) if reached else 1.6 * lowest
+
+
 def plot_campbell(diagram, path: str | Path | None = None, sweep=None, coordinate: str | None = None, *,
                   settings: Mapping[str, str] | None = None):
     """Left: natural frequencies (horizontal), excitation orders (through the origin), their crossings.
@@ -45,16 +58,22 @@ def plot_campbell(diagram, path: str | Path | None = None, sweep=None, coordinat
     ax = axs[0, 0]
     low, high = float(diagram.speeds.min()), float(diagram.speeds.max())
     speeds = np.linspace(low, high, 200)
-    top = max([*diagram.natural_frequencies, 1.0]) * 1.6
+    top = frequency_range(diagram)
     unit = diagram.speed_unit
     for i, (label, kind, per_speed) in enumerate(coinciding_orders(diagram.orders)):
         hz = per_speed * diagram.speeds_rad_s(speeds) / (2 * np.pi)
         ax.plot(speeds, hz, "-" if kind == "mesh" else ":", color=LINE_COLORS[i % len(LINE_COLORS)],
                 lw=1.4 if kind == "mesh" else 1.8, label=label, zorder=3)
-    for fn in diagram.natural_frequencies:
+    shown = [fn for fn in diagram.natural_frequencies if fn <= top]
+    for k, fn in enumerate(shown):
         ax.axhline(fn, color="k", lw=1.0, zorder=2)
-        ax.text(0.01, fn, f"natural frequency {fn:.0f} Hz", transform=ax.get_yaxis_transform(), va="bottom",
-                ha="left", fontsize=7.5)  # (at the low speeds, where the orders are lowest)
+        close = k > 0 and fn - shown[k - 1] < 0.04 * top  # (labels of close frequencies: one above, one below)
+        ax.text(0.01, fn, f"natural frequency {fn:.0f} Hz", transform=ax.get_yaxis_transform(),
+                va="top" if close else "bottom", ha="left", fontsize=7.5)  # (at the low speeds)
+    above = [fn for fn in diagram.natural_frequencies if fn > top]
+    if above:  # (no order reaches them over these speeds: named, not drawn)
+        ax.text(0.99, 0.99, "above, not reached: " + ", ".join(f"{fn:.0f} Hz" for fn in above),
+                transform=ax.transAxes, ha="right", va="top", fontsize=7)
     at = crossings_at(diagram.crossings)
     for k, ((speed, fn), names) in enumerate(at.items()):
         ax.plot(speed, fn, **CROSSING, label="crossing: an order meets a natural frequency"

@@ -22,11 +22,10 @@ import numpy as np
 from ..analysis.attractors import Attractor, AttractorSet
 from ..analysis.poincare import Trajectory, phase_trajectory
 from ..errors import GearsymError
+from ..physical.text import parameter_text
 from .layout import fit_texts
 from .save import pyplot, save_figure
 
-#: how parameter names are written in titles and labels
-SYMBOLS = {"omega": "ω", "zeta": "ζ", "eta": "η", "Theta": "Θ", "Theta_p": "Θ'", "kS": "$k_S$", "k_a": "$k_a$"}
 #: overlaid layers: gray first, then black, as the paper's Fig. 4; then colours
 LAYER_COLORS = ("0.55", "k", "C3", "C0", "C2", "C1")
 #: one set alone: a colour per class of attractor, the paper's '1' (regular) and '2' (chaotic)
@@ -43,11 +42,6 @@ SHORT = {"periodic": "P", "quasi-periodic": "QP", "chaotic": "chaotic", "hyperch
 _STYLE = {"font.size": 9, "axes.titlesize": 10, "axes.labelsize": 10, "legend.fontsize": 8,
           "axes.linewidth": 0.8, "xtick.direction": "in", "ytick.direction": "in",
           "xtick.top": True, "ytick.right": True}
-
-
-def parameter_text(name: str, value: float) -> str:
-    """'ω=1.5', 'k_S=0.1': a parameter as titles show it."""
-    return f"{SYMBOLS.get(name, name)}={value:g}"
 
 
 # ------------------------------------------------------------------------------------ Fig. 4: attractors

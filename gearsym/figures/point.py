@@ -35,9 +35,11 @@ def plot_point(spectrum: LyapunovSpectrum, trajectory: Trajectory, path: str | P
     units = units or {}
     per = units.get("exponents")
     count = len(spectrum.exponents)
+    known = getattr(spectrum, "resolution", None)
     for i, (lam, err) in enumerate(zip(spectrum.exponents, spectrum.stderr)):
-        text = rf"$\lambda_{i + 1}$ = {lam:+.5g} ± {err:.3g} {per}" if per else \
-            rf"$\lambda_{i + 1}$ = {lam:+.4f} ± {err:.4f}"
+        name = rf"$\lambda_{{{i + 1}}}$"  # (braced: lambda_10 is "λ₁₀", not "λ₁0")
+        text = (f"{name}: not resolved ({known.reasons[i]})" if known is not None and not known.resolved[i] else
+                rf"{name} = {lam:+.5g} ± {err:.3g} {per}" if per else rf"{name} = {lam:+.4f} ± {err:.4f}")
         line, = ax_l.plot(periods, spectrum.history[:, i], lw=1.2, **line_style(i, count, len(periods)), label=text)
         ax_l.axhspan(lam - err, lam + err, color=line.get_color(), alpha=0.15, lw=0)
     ax_l.axhline(0, color="k", lw=0.6)

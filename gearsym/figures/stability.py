@@ -11,7 +11,8 @@ import numpy as np
 
 from ..stability.chart import StabilityChart
 from ..stability.kinds import FOLD, NEIMARK_SACKER, PERIOD_DOUBLING
-from .basins import Shown, axis_label, cell_edges
+from ..physical.basins import OwnNumbers
+from .basins import axis_label, cell_edges
 from .layout import fit_texts
 from .save import pyplot, save_figure
 
@@ -55,15 +56,15 @@ def draw_chart(ax, chart: StabilityChart, *, boundaries: bool = True) -> list:
     return handles
 
 
-def chart_title(chart: StabilityChart, shown: Shown | None = None, title: str | None = None) -> str:
-    shown = shown or Shown()
+def chart_title(chart: StabilityChart, shown: OwnNumbers | None = None, title: str | None = None) -> str:
+    shown = shown or OwnNumbers()
     about = "its static state" if chart.about == "static" else "its period-1 orbit"
     fixed = shown.parameters(chart.fixed)
     return (f"{title or chart.model}: Floquet stability of {about}, {chart.steps_per_period} RK4 steps/period\n"
             f"{fixed}")
 
 
-def plot_stability(chart: StabilityChart, path: str | Path | None = None, *, shown: Shown | None = None,
+def plot_stability(chart: StabilityChart, path: str | Path | None = None, *, shown: OwnNumbers | None = None,
                    prediction=None, exact: Sequence[tuple[str, np.ndarray]] = (), title: str | None = None):
     """The chart (and, with ``prediction``, the phasing rule's panel beside it); ``exact``: curves (label,
     points k x 2) drawn dashed over the chart (a check against known transition curves). Written to ``path`` if

@@ -20,6 +20,7 @@ from pathlib import Path
 
 from ..errors import GearsymError
 from .atomic import write_atomically
+from .lock import process_alive
 
 _STAGING = ".gearsym-staging-"
 
@@ -84,15 +85,5 @@ def _remove_abandoned(folder: Path) -> None:
             pid = int(path.name[len(_STAGING):].split("-")[0])
         except ValueError:
             continue
-        if pid != os.getpid() and not _alive(pid) and path.is_dir() and not path.is_symlink():
+        if pid != os.getpid() and not process_alive(pid) and path.is_dir() and not path.is_symlink():
             shutil.rmtree(path, ignore_errors=True)
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        pass
-    return True

@@ -30,6 +30,7 @@ Every candidate is a setting of one system, the declared model with *all* candid
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Sequence
 from pathlib import Path
 from dataclasses import dataclass, field, replace
@@ -40,7 +41,7 @@ from ..caller import name as caller_name, on_command_line, option
 from ..checks import whole_number
 from ..data.dataset import Measurements
 from ..errors import GearsymError, suggest
-from ..options import Integration
+from ..options import Execution, Integration
 from ..system import FirstOrderSystem
 from .canonical import amplitude_phase, canonical
 from .effects import EFFECTS, FAMILIES, Effect, applies_to, augment, bounds_of, effect, site, term_effect
@@ -299,7 +300,7 @@ def candidate_library(system: FirstOrderSystem, candidates: Sequence[str | Effec
 def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[str], *,
             candidates: Sequence[str | Effect] | None = None, held_out: float = 0.25,
             min_gain: float = MIN_GAIN, max_effects: int = MAX_EFFECTS,
-            max_correlation: float = MAX_CORRELATION, progress=None,
+            max_correlation: float = MAX_CORRELATION, execution: Execution | None = None,
             options: Integration = Integration(), bias: Sequence[str] | None = None, terms: Sequence[str] = (),
             harmonics: int | None = None, propose: bool = True, refits: int = REFITS) -> Explanation:
     """Fit ``fit`` on ``measurements``, then add effects from ``candidates`` (default: the whole library) and the
@@ -308,14 +309,14 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
     mean is zero for bounded motion, so that a constant offset in one is the sensor's bias; ``()``: none).
     ``harmonics``: the highest order of the harmonic families (default ``HARMONICS``, or fewer if the data
     resolve fewer)."""
+    say = (execution or Execution()).say
     fit = check_fit_names(fit, system)
     harmonics = check_harmonics(harmonics, measurements)
     _check_one_value_each(measurements, fit)
     by_default = acceleration_channels(measurements, system) if bias is None else ()
     bias = list(by_default if bias is None else bias)
     if by_default:
-        (progress or (lambda message: None))(
-            f"fitting the offset of {', '.join(by_default)} (an acceleration's steady mean is zero for bounded "
+        say(f"fitting the offset of {', '.join(by_default)} (an acceleration's steady mean is zero for bounded "
             f"motion, so a constant offset is the sensor's bias; {_no_bias()} fits none)")
     for name in bias:
         if name not in measurements.observed:
@@ -338,8 +339,11 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
     seg_train, keys_train = segments_of(superset, train)
     seg_test, keys = segments_of(superset, test)
     bounds = bounds_of(list(library.values()))
-    say = progress or (lambda message: None)
     scanned: dict[str, Placement] = {}  # a tooth fault's latest scan
+    clock = Clock(1 + max_effects * refits)  # fits at most: the model as declared, then up to refits a round
+    say(f"{len(seg_train)} training windows of {len(seg_train[0].tau) if seg_train else 0} samples, "
+        f"{len(library)} candidate effects; the first fit compiles the windows of the model with every "
+        "candidate (once: cached for the next run)")
 
     def evaluate(effects: tuple[str, ...], start: Candidate | None) -> Candidate:
         names = list(fit) + [p for e in effects for p in library[e].fitted]
@@ -356,7 +360,7 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
                                    anchors=anchors)  # the last training window of each record
         rejected = _rejection(result, [library[e] for e in effects])
         say(f"{'+'.join(effects) or 'the model as declared'}: held-out error {prediction.error:.4g}"
-            + (f" (rejected: {rejected})" if rejected else ""))
+            + (f" (rejected: {rejected})" if rejected else "") + f"; {clock.tick()}")
         return Candidate(effects, result, prediction, rejected, placements)
 
     def spectrum_of(c: Candidate) -> Spectrum:
@@ -376,6 +380,8 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
         names = _round(library, current, current_spectrum, superset, {k: g for k, (g, _) in gains.items()}, refits)
         screened.append({"after": list(current.effects), "gains": {k: g for k, (g, _) in gains.items()},
                          "why_not": {k: why for k, (_, why) in gains.items() if why}, "refitted": names})
+        clock.plan(len(names) + max(0, max_effects - len(current.effects) - 1) * refits)
+        say(f"round {len(screened)}: {len(names)} candidate(s) to fit ({', '.join(names) or 'none'})")
         round_ = [evaluate(current.effects + (name,), current) for name in names]
         tried.extend(round_)
         eligible = [c for c in round_ if not c.rejected and np.isfinite(c.error)]
@@ -393,9 +399,10 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
         others = tuple(e for e in current.effects if not library[e].scan)
         start = next((c for c in tried if c.effects == others), base)
         round_ = []
+        clock.plan(len(general))
         for e in general.values():
             round_.append(_general_candidate(system, library, e, others, start, list(fit), train, test, bounds,
-                                             options, bias, say))
+                                             options, bias, say, clock))
             library[e.name] = e
             if not round_[-1].rejected and _lag1(round_[-1].prediction) <= max_correlation:
                 break  # (explained: the next form would only cost its compilation)
@@ -438,7 +445,7 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
 
 def _general_candidate(system: FirstOrderSystem, library: dict[str, Effect], e: Effect, others: tuple[str, ...],
                        start: Candidate, fit: list[str], train, test, bounds: dict, options: Integration,
-                       bias: Sequence[str], say) -> Candidate:
+                       bias: Sequence[str], say, clock: Clock) -> Candidate:
     """The tooth-by-tooth form ``e`` beside the effects ``others``, fitted (regularised, from the fit ``start``) and
     its held-out prediction, on a compiled model of its own: the declared one with ``others`` and ``e``'s slots
     (:func:`.tooth_forms.local_effect`)."""
@@ -474,7 +481,8 @@ def _general_candidate(system: FirstOrderSystem, library: dict[str, Effect], e: 
                                bias=result.bias, anchors=anchors)
     rejected = _rejection(result, [*(library[o] for o in others)]) or _rejection(regularised, [e])
     effects = others + (e.name,)
-    say(f"{'+'.join(effects)}: held-out error {prediction.error:.4g}" + (f" (rejected: {rejected})" if rejected else ""))
+    say(f"{'+'.join(effects)}: held-out error {prediction.error:.4g}" + (f" (rejected: {rejected})" if rejected else "")
+        + f"; {clock.tick()}")
     return Candidate(effects, result, prediction, rejected, {}, model, slots, regularised)
 
 
@@ -482,6 +490,29 @@ def _tooth_names(e: Effect, gear: str, teeth: Sequence[int]) -> list[str]:
     """The parameter names of ``teeth`` (1 ... Z) of ``gear`` in the tooth-by-tooth form ``e``."""
     prefix = "kt" if e.name.startswith("tooth_stiffness") else "te"
     return [f"{prefix}{n}_{gear}" for n in teeth]
+
+
+class Clock:
+    """The fits done, the time they took and what is left at most: the progress ``explain`` shows."""
+
+    def __init__(self, planned: int):
+        self.start, self.done, self.left = time.perf_counter(), 0, planned
+
+    def plan(self, left: int) -> None:
+        """At most ``left`` more fits from here."""
+        self.left = left
+
+    def tick(self) -> str:
+        self.done += 1
+        self.left = max(0, self.left - 1)
+        spent = time.perf_counter() - self.start
+        each = spent / self.done
+        return (f"fit {self.done} done, {spent:.0f} s so far ({each:.0f} s a fit); at most {self.left} more, "
+                f"about {_duration(self.left * each)} left at most")
+
+
+def _duration(seconds: float) -> str:
+    return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.1f} min"
 
 
 def _record_starts(keys: Sequence[tuple], segments: Sequence[Segment]) -> dict:

@@ -20,13 +20,15 @@ from dataclasses import asdict, dataclass
 from importlib import resources
 from pathlib import Path
 
-from ..codegen.build import cached_code_directory, code_directory
 from ..files.atomic import writing
 from ..files.private import CACHE_ADVICE
+from ..codegen.code_files import cached_code_directory, code_directory, read_manifest
 from ..codegen.compiler import CompilerError, compilers_looked_for, find_compiler, INSTALL_HINT
 from ..codegen.functions import build_functions
-from ..codegen.generate import code_hash, read_manifest, write_code
+from ..codegen.generate import code_hash, write_code
+from ..codegen.fastest_mode import fastest_rate
 from ..codegen.loops import LoopOptions
+from ..codegen.step_choice import explicit
 from ..codegen.surfaces import switching_surfaces
 from ..codegen.time_tables import split_rhs
 from ..errors import GearsymError, ModelError
@@ -75,6 +77,8 @@ def build_fmu(system: FirstOrderSystem, path: Path, options: Integration = Integ
     if not identifier.isidentifier():
         raise ModelError("an FMU's model identifier must be a C identifier (letters, digits, _)", identifier)
     folder = binary_folder()
+    # the co-simulation step is RK4's, at as many steps as resolve the fastest mode (no stiff FMU yet)
+    options = explicit(options, fastest_rate(system), system.cycle_at())
     loops = LoopOptions.of(options, system.cycles)
     if loops.block(system.dimension) != 1:
         raise GearsymError(f"{identifier}: the co-simulation step needs the loops' one-step blocks")
@@ -158,19 +162,21 @@ def _described(lay: Layout) -> dict:
     f = lay.frame
     return {"variables": [[v.name, v.type, v.reference, v.causality, v.variability, v.start,
                            v.unit.name if v.unit else None] for v in lay.variables],
-            "frame": [f.physical, f.time_unit, f.length_unit, f.omega, f.mesh_stiffness, sorted(f.mesh_damping.items()),
+            "frame": [f.physical, f.time_unit, f.length_unit, f.omega, sorted(f.mesh_stiffness.items()),
+                      sorted(f.scales.items()), sorted(f.mesh_damping.items()),
                       sorted(f.kinds.items()), sorted(lay.engine_base.items()),
                       [[p.name, [[t.engine, t.exponent, t.reference] for t in p.terms]] for p in lay.parameters]],
             "indicators": [str(e) for e in lay.indicators]}
 
 
 def _experiment(lay: Layout, loops: LoopOptions) -> tuple[float, float, float]:
-    """Start, stop and step of the default experiment: EXPERIMENT_PERIODS forcing periods, the engine's step."""
-    period = lay.system.period_at()
+    """Start, stop and step of the default experiment: EXPERIMENT_PERIODS forcing periods (mesh periods of the
+    first mesh), the engine's step (as many per forcing period as resolve the fastest mode: stable)."""
+    cycle = lay.system.cycle_at()
     frame = lay.frame
     if frame.physical:  # seconds: tau runs at omega / T
-        period *= frame.time_unit / lay.engine_base[frame.omega]
-    return 0.0, EXPERIMENT_PERIODS * period, period / loops.steps_per_period
+        cycle *= frame.time_unit / lay.engine_base[frame.omega]
+    return 0.0, EXPERIMENT_PERIODS * cycle, cycle / (loops.steps_per_period // lay.system.cycles)
 
 
 def _compile(folder: Path, identifier: str, sources: tuple[str, ...]) -> tuple[Path, float]:

@@ -31,7 +31,7 @@ def export_fmu(model, path, *, options: Integration | None = None, **values) -> 
     if path.suffix.lower() != ".fmu":
         raise GearsymError(f"{path}: an FMU's file name ends in .fmu")
     if isinstance(model, CompiledModel):
-        system = getattr(model.system, "full", model.system)  # (a model from the start-up cache: its system)
+        system = model.system.full  # (a model from the start-up cache: the system its summary stands for)
         return build_fmu(system.with_values(**values) if values else system, path, options or model.integration)
     options = options or Integration()
     if isinstance(model, FirstOrderSystem):

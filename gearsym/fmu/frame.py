@@ -63,9 +63,14 @@ class Frame:
     omega: str | None = None  # the engine parameter omega (tau = omega t: d tau/d seconds = omega / time_unit)
     parameters: tuple[PhysicalParameter, ...] = ()
     engine_base: Mapping[str, float] = field(default_factory=dict)  # engine values at the terms' references
-    kinds: Mapping[str, str] = field(default_factory=dict)  # state -> "length" | "rate"
-    mesh_stiffness: float = 1.0  # N/m: the first mesh's mean stiffness, the force of unit stiffness per metre
+    kinds: Mapping[str, str] = field(default_factory=dict)  # state -> "length" | "rate" | "angle" | "angular_rate"
+    #: per mesh: N/m of one unit of its stiffness in the engine (its own mean stiffness over its relative mean
+    #: there, K2 for a second mesh: each mesh's force from its own stiffness); a mesh not named: 1
+    mesh_stiffness: Mapping[str, float] = field(default_factory=dict)
     mesh_damping: Mapping[str, str] = field(default_factory=dict)  # mesh -> the physical parameter of its damping
     time_name: str = "time"
     units: Mapping[str, Unit] = field(default_factory=dict)  # "time", "length", "rate", "force" -> their SI unit
     displays: Mapping[str, str] = field(default_factory=dict)  # the same -> the display unit shown by default
+    #: per state: its SI value per unit of the length unit (1 for a mesh's deflection and rate, 1/radius for a
+    #: shaft's coordinate, which is its radius times its twist: the twist in rad); a state not named: 1
+    scales: Mapping[str, float] = field(default_factory=dict)

@@ -16,7 +16,10 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 
+import numpy as np
+
 from ..errors import GearsymError
+from ..physical.results import point_units
 from ..scales.map import Scaling
 from ..scales.settings import physical_settings
 from ..units import Measure, Quantity, measure, si_factor
@@ -24,7 +27,8 @@ from .frame import Frame, PhysicalParameter, Term, Unit
 from .variables import undescribed
 
 #: SI units by the exponents of (mass, length, time) of a value (angles are dimensionless: rad/s is 1/s)
-_NAMES = {(1, 0, -2): "N/m", (1, 0, -1): "N.s/m", (1, 2, -2): "N.m", (1, 2, 0): "kg.m2", (0, 1, 0): "m",
+_NAMES = {(1, 0, -2): "N/m", (1, 0, -1): "N.s/m", (1, 2, -2): "N.m", (1, 2, -1): "N.m.s", (1, 2, 0): "kg.m2",
+          (0, 1, 0): "m",
           (0, 0, -1): "rad/s", (1, 1, -2): "N", (0, 0, 1): "s", (1, 0, 0): "kg", (0, 1, -1): "m/s",
           (0, 1, -2): "m/s2"}
 #: the FMU's own quantities: their SI unit and the display unit shown by default
@@ -32,9 +36,12 @@ _OWN = {"time": Unit("s", (("s", 1),), (("ms", 1e3),)),
         "length": Unit("m", (("m", 1),), (("mm", 1e3), ("um", 1e6))),
         "rate": Unit("m/s", (("m", 1), ("s", -1)), (("mm/s", 1e3),)),
         "acceleration": Unit("m/s2", (("m", 1), ("s", -2))),
+        "angular_rate": Unit("rad/s", (("rad", 1), ("s", -1))),
+        "angular_acceleration": Unit("rad/s2", (("rad", 1), ("s", -2))),
         "force": Unit("N", (("kg", 1), ("m", 1), ("s", -2)), (("kN", 1e-3),)),
         "angle": Unit("rad", (("rad", 1),))}
 _DISPLAYS = {"length": "um", "rate": "mm/s"}
+
 #: how closely a probed engine value must follow a power of the physical value (and the units stay put)
 TOLERANCE = 1e-11
 #: the powers looked for
@@ -73,19 +80,38 @@ def physical_frame(nd, values: Mapping[str, object], system) -> Frame | None:
     kinds = {}
     for c in system.couplings:
         if not c.closes_loop:
-            kinds[c.coordinate], kinds[c.velocity] = "length", "rate"
+            kinds[c.coordinate], kinds[c.velocity] = (("length", "rate") if c.kind == "mesh" else
+                                                      ("angle", "angular_rate"))
+    per_unit = point_units(base).per_unit  # (a shaft's coordinate: L / its radius in rad per unit)
+    scales = {name: per_unit[name] / L for name in kinds if name in per_unit}
     missing = [s for s in system.state_names if s not in kinds]
     if missing:
         raise GearsymError(f"{nd.name}: the states {', '.join(missing)} are no coupling's coordinate or rate, so "
                            "the FMU cannot give them SI units")
     meshes = [c for c in drivetrain.couplings if type(c).__name__ == "Mesh"]
-    stiffness = _si(inputs, getattr(meshes[0], "stiffness", None)) if meshes else None
-    if meshes and stiffness is None:
-        raise GearsymError(f"{nd.name}: the first mesh's stiffness must be a physical value (e.g. stiffness='kZ' "
-                           "with kZ in N/m) for the FMU's mesh forces in N")
+    stiffness = {}
+    for mesh in meshes:
+        own = _si(inputs, getattr(mesh, "stiffness", None))
+        if own is None:
+            raise GearsymError(f"{nd.name}: the stiffness of mesh {mesh.name!r} must be a physical value (e.g. "
+                               "stiffness='kZ' with kZ in N/m) for the FMU's mesh forces in N")
+        stiffness[mesh.name] = own / engine_mean_stiffness(system, mesh.name, engine)
     damping = {c.name: c.damping for c in meshes if isinstance(c.damping, str) and c.damping in inputs}
-    return Frame(True, T, L, "omega", tuple(parameters), engine_base, kinds, stiffness or 1.0, damping,
-                 units=_OWN, displays=_DISPLAYS)
+    return Frame(True, T, L, "omega", tuple(parameters), engine_base, kinds, stiffness, damping,
+                 units=_OWN, displays=_DISPLAYS, scales=scales)
+
+
+def engine_mean_stiffness(system, mesh: str, values: Mapping[str, float]) -> float:
+    """The mean over the system's period of a mesh's stiffness in the engine (1 for the first mesh: the time
+    unit's condition; K2, its mean relative to the first's, for a second): sampled at 4096 points, which is its
+    exact mean for any series of fewer harmonics."""
+    import sympy as sp
+
+    coupling = next(c for c in system.couplings if c.name == mesh)
+    numbers = {s: values[s.name] for s in sp.sympify(coupling.stiffness).free_symbols if s.name in values}
+    k = sp.lambdify(system.time, sp.sympify(coupling.stiffness).xreplace(numbers), "numpy")
+    tau = np.linspace(0.0, float(system.period_at(values)), 4096, endpoint=False)
+    return float(np.mean(np.broadcast_to(np.asarray(k(tau), dtype=float), tau.shape)))
 
 
 def _si(inputs, name) -> float | None:
@@ -140,7 +166,8 @@ def _unit(q: Measure) -> tuple[Unit | None, str | None]:
                            "and time)")
     if not any(exponents):
         return None, None
-    name = _NAMES.get(exponents) or ".".join(f"{b}{e}" for b, e in zip(("kg", "m", "s"), exponents) if e)
+    name = _NAMES.get(exponents) or ".".join(f"{b}{e if e != 1 else ''}" for b, e in zip(("kg", "m", "s"), exponents)
+                                             if e)
     base = tuple((b, e) for b, e in zip(("kg", "m", "s"), exponents) if e)
     if name == "rad/s":
         base += (("rad", 1),)

@@ -104,11 +104,12 @@ def _variables(lay: Layout):
     first_state = 2
     for name, value in zip(system.state_names, system.initial_vector):
         kind = frame.kinds.get(name)
-        yield Variable(name, "Real", real(), "output", "continuous", "exact", _start(lay, kind, value),
+        yield Variable(name, "Real", real(), "output", "continuous", "exact", _start(lay, name, kind, value),
                        _state_text(system, name, frame), "state", units.get(kind), frame.displays.get(kind))
     for i, name in enumerate(system.state_names):
         kind = frame.kinds.get(name)
-        derivative_kind = {"length": "rate", "rate": "acceleration"}.get(kind)
+        derivative_kind = {"length": "rate", "rate": "acceleration", "angle": "angular_rate",
+                           "angular_rate": "angular_acceleration"}.get(kind)
         yield Variable(f"der({name})", "Real", real(), "local", "continuous", "calculated", None,
                        f"time derivative of {name}", "derivative", units.get(derivative_kind),
                        frame.displays.get(derivative_kind), derivative=first_state + i)
@@ -130,8 +131,10 @@ def _variables(lay: Layout):
                        _force_text(lay, c), "force", units.get("force"), frame.displays.get("force"))
     for c in lay.shafts:
         yield Variable(f"{c.name}.twist", "Real", real(), "output", "continuous", "calculated", None,
-                       f"twist of shaft {c.name!r} ({c.contact})", "twist", units.get("length"),
-                       frame.displays.get("length"))
+                       f"twist of shaft {c.name!r} (its coordinate {c.contact} over its radius)" if frame.physical
+                       else f"twist of shaft {c.name!r} ({c.contact})", "twist",
+                       units.get("angle" if frame.physical else "length"),
+                       None if frame.physical else frame.displays.get("length"))
     if frame.physical:
         yield Variable(system.time.name, "Real", real(), "output", "continuous", "calculated", None,
                        f"the forcing phase {system.time.name} of the engine (one forcing period is {system.period})",
@@ -147,13 +150,14 @@ def _counter():
     return lambda: next(count)
 
 
-def _start(lay: Layout, kind: str | None, value: float) -> float:
+def _start(lay: Layout, name: str, kind: str | None, value: float) -> float:
     """A state's start value in the FMU's units."""
     frame = lay.frame
-    if kind == "length":
-        return value * frame.length_unit
-    if kind == "rate":
-        return value * frame.length_unit * frame.engine_base[frame.omega] / frame.time_unit
+    scale = frame.scales.get(name, 1.0)
+    if kind in ("length", "angle"):
+        return value * frame.length_unit * scale
+    if kind in ("rate", "angular_rate"):
+        return value * frame.length_unit * scale * frame.engine_base[frame.omega] / frame.time_unit
     return value
 
 

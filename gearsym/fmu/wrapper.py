@@ -43,7 +43,8 @@ def model_header(lay: Layout, engine_source: str, constants: int, tables: int, g
     tau = next((v.reference for v in reals if v.role == "tau"), len(reals))
     sizes = {"NX": n, "NQ": nq, "NP": len(engine), "NZ": nz, "NK": nk, "NM": nm, "NOBS": len(observed),
              "NOUT": 4 * nm + ns, "NTERMS": len(terms)}
-    kinds = [{"length": 1, "rate": 2}.get(frame.kinds.get(s), 0) for s in system.state_names]
+    kinds = [{"length": 1, "rate": 2, "angle": 1, "angular_rate": 2}.get(frame.kinds.get(s), 0)
+             for s in system.state_names]
     starts = [next(v.start for v in lay.variables if v.name == s) for s in system.state_names]
     damping = [_index(lay, frame.mesh_damping.get(c.name)) for c in lay.meshes]
     lines = [
@@ -57,7 +58,6 @@ def model_header(lay: Layout, engine_source: str, constants: int, tables: int, g
         f"#define GS_OMEGA {engine.index(frame.omega) if frame.physical else -1}",
         f"#define GS_TIME_UNIT {frame.time_unit!r}",
         f"#define GS_LENGTH_UNIT {frame.length_unit!r}",
-        f"#define GS_FORCE_UNIT {frame.mesh_stiffness * frame.length_unit!r}",
         f"#define GS_SUBSTEPS {SUBSTEPS}",
         f"#define GS_STEPS_PER_PERIOD {int(steps_per_period)}",
         f"#define GS_BOUND {BOUND!r}",
@@ -95,6 +95,10 @@ def model_header(lay: Layout, engine_source: str, constants: int, tables: int, g
         _array("const int", "gs_state_kind", kinds),
         _array("const char* const", "gs_state_names", [_c_string(s) for s in system.state_names], raw=True),
         _array("const int", "gs_state_bounded", [int(s in bounded) for s in system.state_names]),
+        _array("const double", "gs_state_scale", [frame.scales.get(s, 1.0) for s in system.state_names]),
+        _array("const double", "gs_mesh_force_unit",  # N of one unit of each mesh's engine force (its own stiffness)
+               [frame.mesh_stiffness.get(c.name, 1.0) * frame.length_unit for c in lay.meshes]),
+        _array("const double", "gs_shaft_scale", [frame.scales.get(c.coordinate, 1.0) for c in lay.shafts]),
         _array("const int", "gs_observed", observed),
         _array("const int", "gs_mesh_damping", damping),
         _array("const int", "gs_contact_mesh", [lay.meshes.index(c) for c in lay.contacts]),

@@ -151,9 +151,15 @@ class Mesh:
 
     * ``variation``: dimensionless, 2*pi-periodic in ``phi`` (default: the documented
       smoothed rectangular wave, :func:`rectangular_mesh_stiffness`).
+    * ``order``: the mesh frequency over the forcing frequency (the first mesh's). Leave it out: with the
+      tooth counts of the gears it is derived from them (``19/61`` for the 19/47 stage behind a 23/61 one,
+      :mod:`.mesh_orders`), without them it is 1; one given that the teeth contradict is refused.
     * ``coordinate``: name of the relative coordinate (the mesh deflection).
-    * ``function``: name under which the nondimensional stiffness k(tau) appears.
-    * ``damping_group``: name of the damping ratio group (the paper's zeta).
+    * ``function``: name under which the nondimensional stiffness k(tau) appears (default ``k`` for the first
+      mesh, ``k_<coordinate>`` for the others).
+    * ``damping_group``, ``stiffness_group``: names of the damping ratio group (the paper's zeta) and, for a
+      mesh after the first, of its mean stiffness relative to the first's (default ``zeta_<coordinate>``,
+      ``K_<coordinate>``).
     * ``backlash``: the clearance eta; 0 gives a linear mesh.
     * ``phase``: added to the mesh phase; a planet's position adds its own (see :class:`Planet`).
     * ``computed``: the stiffness of a mesh declared from its gears' geometry (:meth:`from_gears`).
@@ -166,7 +172,7 @@ class Mesh:
     damping: ExprLike = "cZ"
     backlash: ExprLike = "eta"
     variation: ExprLike = field(default_factory=rectangular_mesh_stiffness)
-    order: ExprLike = 1
+    order: Optional[ExprLike] = None
     phase: ExprLike = 0
     coordinate: Optional[str] = None
     function: Optional[str] = None

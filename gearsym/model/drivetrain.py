@@ -7,6 +7,8 @@ components in any order; every error names the component to fix.
 """
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Mapping
 from functools import cached_property
 
 import sympy as sp
@@ -159,6 +161,30 @@ class Drivetrain(Model):
     @property
     def descriptions(self) -> dict[str, str]:
         return dict(self._descriptions)
+
+    def with_bodies(self, bodies: Mapping[str, Body]) -> "Drivetrain":
+        """A new drivetrain with the same components and values, the bodies named in ``bodies`` replaced by those
+        given (every component that refers to one refers to its replacement)."""
+        out = Drivetrain(self.name, self.title, self.description)
+        new = {body.name: bodies.get(body.name, body) for body in self.bodies}
+        swapped = {id(old): new[old.name] for old in self.bodies}
+
+        def rewired(component):
+            changes = {f.name: swapped[id(v)] for f in dataclasses.fields(component)
+                       if isinstance(v := getattr(component, f.name), Body) and id(v) in swapped}
+            return dataclasses.replace(component, **changes) if changes else component
+
+        for body in self.bodies:
+            out.add(rewired(new[body.name]))
+        for component in (*self.couplings, *self.torques, *self.shaft_terms):
+            out.add(rewired(component))
+        out._defaults.update(self._defaults)
+        out._descriptions.update(self._descriptions)
+        out._physical.update(self._physical)  # (SI values already read and checked)
+        out._initial.update(self._initial)
+        out._length_scale = self._length_scale
+        out._changed()
+        return out
 
     # ----------------------------------------------------------------- resolving
     @cached_property

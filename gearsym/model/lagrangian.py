@@ -11,7 +11,7 @@ from functools import cached_property
 import sympy as sp
 
 from .backlash import G
-from .symbols import phi, t
+from .symbols import t
 from .resolved_components import ResolvedCoupling
 
 
@@ -43,8 +43,7 @@ class LagrangianForms:
     def stiffness_definition(self, rc: ResolvedCoupling) -> sp.Expr:
         """kZ(t) = kZ * k(phi(t)) with the declared variation k and mesh phase phi; times (1 - loss(phi(t))) where
         shaft-order terms take stiffness away (a tooth fault)."""
-        varied = rc.stiffness * rc.variation.subs(phi, rc.mesh_phase)
-        return varied if rc.loss == 0 else varied * (1 - rc.in_time(rc.loss))
+        return rc.stiffness * rc.variation_at(rc.mesh_phase)
 
     def contact_of(self, rc: ResolvedCoupling) -> sp.Expr:
         """What the mesh's backlash acts on: the deflection, less the transmission error of shaft-order terms."""

@@ -18,13 +18,14 @@ from .symbols import omega, parameter_symbol, phi, t
 from .components import Body, BodyRef, Coupling, Gear, Harmonic, Mesh, Planet, Torque
 from .expressions import ExprLike, parameter_names, to_expr
 from .lagrangian import LagrangianForms
+from .mesh_orders import MeshOrders
 from .planetary import PlanetaryPhasing
 from .resolved_faults import ShaftOrderResolution
 from .resolved_components import ResolvedBody, ResolvedCoupling, ResolvedForcing
 from .stiffness import check_periodic
 
 
-class ResolvedDrivetrain(PlanetaryPhasing, ShaftOrderResolution, LagrangianForms):
+class ResolvedDrivetrain(MeshOrders, PlanetaryPhasing, ShaftOrderResolution, LagrangianForms):
     """The checked, symbolic view of a :class:`Drivetrain`."""
 
     def __init__(self, model: Model):  # (a Drivetrain, which resolves itself here)
@@ -42,6 +43,7 @@ class ResolvedDrivetrain(PlanetaryPhasing, ShaftOrderResolution, LagrangianForms
         self.couplings = [self._resolve_coupling(c) for c in model.couplings]
         self.forcing = [f for tq in model.torques for f in self._resolve_torque(tq)]
         self._check_connected()
+        self.couplings = self._with_orders(self.couplings)
         self.couplings = [self._with_planet_phase(rc) for rc in self.couplings]
         self._check_assembly()
         self.couplings = self._with_shaft_terms(self.couplings)
@@ -165,9 +167,10 @@ class ResolvedDrivetrain(PlanetaryPhasing, ShaftOrderResolution, LagrangianForms
             raise ModelError(f"joins body {a.body.name!r} to itself; a {kind} must join two different bodies", where)
         if isinstance(c, Mesh):
             row, carrier, turning = self._mesh_rows(a, b, where)
-            order = to_expr(c.order, where)
-            if not (order.is_number and order.is_positive and order.is_rational):
-                raise ModelError(f"the mesh order must be a positive rational number, got {order}", where)
+            order = None if c.order is None else to_expr(c.order, where)  # None: from the teeth (mesh_orders.py)
+            if order is not None and not (order.is_number and order.is_positive and order.is_rational):
+                raise ModelError(f"the mesh order must be a positive rational number (e.g. order=sp.Rational(19, 61)), "
+                                 f"got {order}; leave it out to derive it from the tooth counts", where)
             variation = to_expr(c.variation, where)
             if variation.free_symbols & {t}:
                 raise ModelError("the stiffness variation must be written in the mesh phase phi, not in t", where)
@@ -182,8 +185,8 @@ class ResolvedDrivetrain(PlanetaryPhasing, ShaftOrderResolution, LagrangianForms
                 damping=self._positive(c.damping, "the mesh damping", where, allow_zero=True),
                 backlash=self._positive(c.backlash, "the backlash", where, allow_zero=True),
                 variation=variation,
-                mesh_phase=order * omega * t + to_expr(c.phase, where),
-                order=order, carrier=carrier, turning=turning,
+                mesh_phase=(0 if order is None else order * omega * t) + to_expr(c.phase, where),
+                order=sp.S.Zero if order is None else order, carrier=carrier, turning=turning,
             )
         if a.fixed and b.fixed:
             raise ModelError(f"joins two fixed bodies ({a.body.name!r}, {b.body.name!r}); it could never twist", where)

@@ -61,6 +61,13 @@ class ResolvedCoupling:
         """A term in the mesh phase written in time t."""
         return expr.subs(phi, self.mesh_phase) if expr != 0 else sp.S.Zero
 
+    def variation_at(self, phase: sp.Expr) -> sp.Expr:
+        """The stiffness variation k at the mesh phase ``phase`` (an expression in t or tau), times the factor
+        (1 - loss) where shaft-order terms take stiffness away (a tooth fault, once per revolution): the one
+        place that factor is applied, for the Lagrangian and the reduction alike."""
+        varied = self.variation.subs(phi, phase)
+        return varied if self.loss == 0 else varied * (1 - self.loss.subs(phi, phase))
+
 
 @dataclass(frozen=True)
 class ResolvedForcing:

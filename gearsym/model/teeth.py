@@ -8,12 +8,18 @@ The model is not changed: :func:`with_teeth` returns a copy with those two gears
 from __future__ import annotations
 
 import dataclasses
+import weakref
+
 from .declared import Model
 from ..errors import GearsymError, ModelError
 from .components import Body, Gear, Mesh
 from .drivetrain import Drivetrain
 from .shaft_orders import teeth_of
-from .tooth_counts import parse_teeth
+from .tooth_counts import ToothCounts
+
+
+#: model -> counts -> (the model's version, its copy with those counts), for as long as the model lives
+_WITH_TEETH: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def first_mesh_gears(model: Drivetrain) -> tuple[Gear, Gear]:
@@ -35,16 +41,15 @@ def first_mesh_gears(model: Drivetrain) -> tuple[Gear, Gear]:
     return ends[0], ends[1]
 
 
-def with_teeth(model: Model, teeth) -> Model:
-    """``model`` with the tooth counts ``teeth`` = (pinion, wheel) on its first mesh's gears (a copy; the same
-    copy for the same model, version and counts). None: the model itself."""
-    counts = parse_teeth(teeth)
+def with_teeth(model: Model, counts: ToothCounts | None) -> Model:
+    """``model`` with the tooth ``counts`` on its first mesh's gears (a copy; the same copy for the same model,
+    version and counts). None: the model itself."""
     if counts is None:
         return model
     if not model.is_drivetrain:
         raise GearsymError(f"{model.name}: --teeth gives tooth counts to the gears of a drivetrain; a first-order "
                            "system has none")
-    kept = model.__dict__.setdefault("_with_teeth", {})
+    kept = _WITH_TEETH.setdefault(model, {})
     if counts in kept and kept[counts][0] == model.version:
         return kept[counts][1]
     pinion, wheel = first_mesh_gears(model)
@@ -55,32 +60,7 @@ def with_teeth(model: Model, teeth) -> Model:
                            "for a model that declares none")
     for z, gear in zip(counts, (pinion, wheel)):
         teeth_of(z, f"--teeth for {gear.name!r}")
-    copy = _copy(model, {pinion.name: counts[0], wheel.name: counts[1]})
+    copy = model.with_bodies({gear.name: dataclasses.replace(gear, teeth=z)
+                              for gear, z in zip((pinion, wheel), counts)})
     kept[counts] = (model.version, copy)
     return copy
-
-
-def _copy(model: Drivetrain, teeth: dict[str, int]) -> Drivetrain:
-    """A new drivetrain with the same components, the gears named in ``teeth`` declared with those counts."""
-    out = Drivetrain(model.name, model.title, model.description)
-    new: dict[str, Body] = {}
-    for body in model.bodies:
-        new[body.name] = dataclasses.replace(body, teeth=teeth[body.name]) if body.name in teeth else body
-    swapped = {id(old): new[old.name] for old in model.bodies}
-
-    def rewired(component):
-        changes = {f.name: swapped[id(v)] for f in dataclasses.fields(component)
-                   if isinstance(v := getattr(component, f.name), Body) and id(v) in swapped}
-        return dataclasses.replace(component, **changes) if changes else component
-
-    for body in model.bodies:
-        out.add(rewired(new[body.name]))
-    for component in (*model.couplings, *model.torques, *model.shaft_terms):
-        out.add(rewired(component))
-    out.set_defaults(**model.defaults)
-    out.describe(**model.descriptions)
-    if model.physical:
-        out._physical.update(model.physical)  # (SI values already read and checked)
-    out._initial.update(model.initial_state)
-    out._length_scale = model.length_scale
-    return out

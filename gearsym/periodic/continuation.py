@@ -248,7 +248,8 @@ class Tracer:
     def follow(self, start: Solution, *, ds: float | None, doubled: bool) -> Traced:
         steps = self.steps
         ds = ds or steps.step
-        traced = Traced([start], f"{steps.max_points} points reached (max_points)",
+        traced = Traced([start], f"{steps.max_points} points reached before the end of the range (give more: "
+                                 f"max_points=, --max-points on the command line)",
                         self.problem.shooting.period_multiple)
         self.started.append(traced)  # its points so far are kept if the run is interrupted
         a = start

@@ -9,6 +9,7 @@ from ..checks import json_safe
 from ..codegen import CompiledModel, engine_verb
 from ..errors import GearsymError
 from ..options import Integration
+from .moduli import log_moduli
 from .floquet import contact_regime, mesh_watches, multipliers, stable
 from .shooting import Evaluation, NotConverged, OrbitMap, Shooting, newton
 
@@ -44,6 +45,10 @@ class PeriodicOrbit:
     steps_per_period: int = 0
     locate_crossings: bool = True
     trajectory: np.ndarray | None = None
+    #: log|mu_i| from the segments' maps (:mod:`.moduli`: what the monodromy matrix rounds away), largest first,
+    #: and whether each was resolved (one that was not is at most that: a bound)
+    log_moduli: np.ndarray | None = None
+    resolved: np.ndarray | None = None
 
     @property
     def stable(self) -> bool:
@@ -67,6 +72,7 @@ class PeriodicOrbit:
             "multipliers": [{"re": float(m.real), "im": float(m.imag), "abs": float(abs(m))}
                             for m in self.multipliers],
             "stable": self.stable, "exponents": self.exponents, "residual": self.residual,
+            "log_moduli": self.log_moduli, "moduli_resolved": self.resolved,
             "iterations": self.iterations, "amplitude": self.amplitude,
             "extremes": {k: {"min": lo, "max": hi} for k, (lo, hi) in self.extremes.items()},
             "contact": self.contact, "segments": self.segments, "steps_per_period": self.steps_per_period,
@@ -98,7 +104,7 @@ def orbit_from(problem: OrbitMap, ev: Evaluation, iterations: int, trajectory: b
         forcing_period=ev.inputs.period, multipliers=multipliers(ev.monodromy), residual=ev.error(),
         iterations=iterations, **describe_evaluation(problem, ev), segments=shooting.segments,
         steps_per_period=model.steps_per_period, locate_crossings=model.options.locate_crossings,
-        trajectory=states)
+        trajectory=states, **dict(zip(("log_moduli", "resolved"), log_moduli(ev.blocks))))
 
 
 def starting_states(model: CompiledModel, y0, options: Integration, period_multiple: int,

@@ -48,6 +48,13 @@ class PhysicalScaling(Scaling):
     def _(self, result: Continuation, length_unit: str = LENGTH_UNIT):
         return continuation_to_physical(self, result, length_unit)
 
+    def compiled_for(self, result):
+        """The compiled model the spectrum ``result``'s mesh forces are run on when the caller gives none (its
+        integration, as it ran): the face's scaling
+        (:func:`gearsym.scaling`) compiles this scaling's system; this stage compiles nothing."""
+        raise GearsymError(f"{self.name}: give the compiled model the spectrum ran on, to_physical(result, "
+                           "model=...), or its trajectory (trajectory=...)")
+
     def point_units(self, length_unit: str = LENGTH_UNIT):
         """The numbers that carry a spectrum run back (what the start-up cache keeps: no pint, no SymPy)."""
         return results.point_units(self, length_unit)

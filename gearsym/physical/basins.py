@@ -1,32 +1,46 @@
-"""Basin maps of a model with physical values, in its units: a grid in µm and mm/s, the speed in rpm.
+"""Basin maps and basin fractions as they are shown: in a model's units when it has physical values (a grid in
+µm and mm/s, the speed in rpm), else in its own numbers.
 
 A grid given in physical units is turned into the engine's nondimensional starts at each forcing frequency (a
-rate's unit, L omega omega_n per second, moves with the speed); the results come back through the same
-numbers (:class:`~gearsym.physical.point.PointUnits`: the length unit L, omega_n, the speed's ratio), so that
-the tables, the JSON, the text and the figures say µm, mm/s and rpm.
+rate's unit, L omega omega_n per second, moves with the speed: :func:`engine_grid`); the results come back through
+the same numbers (:class:`~gearsym.physical.point.PointUnits`: the length unit L, omega_n, the speed's ratio).
+:class:`ShownBasinMap` and :class:`ShownFractions` are the results in those units, which the files
+(:mod:`.files`), the command's text and the figures (:mod:`gearsym.figures.basins`) take.
 """
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
+from ..analysis.basins import BasinMap
 from ..checks import json_safe
 from ..errors import GearsymError
-from ..figures.basins import Shown
-from ..figures.poincare import parameter_text
+from ..sweep.basin_continuation import BasinContinuation, StartGrid
 from ..sweep.grid import Axis
 from ..units import dimension_text, to_si, unit_dims
 from .point import ANGLE, ANGULAR_VELOCITY, LENGTH, VELOCITY, PointUnits
+from .text import parameter_text
 
 
-def units_of(scaling) -> PointUnits:
-    """The numbers that carry results of ``scaling`` (a full scaling, or the start-up cache's) to its units."""
-    return scaling.units if hasattr(scaling, "units") and isinstance(scaling.units, PointUnits) \
-        else scaling.point_units()
+class OwnNumbers:
+    """How a model without physical values shows its values: its own numbers, no unit."""
+
+    def state(self, name: str, values, omega: float | None = None) -> tuple[np.ndarray, str]:
+        """A state's values as shown, and their unit ('' for the model's own)."""
+        return np.asarray(values, dtype=float), ""
+
+    def parameter(self, name: str, values) -> tuple[str, np.ndarray, str]:
+        """A parameter's values as shown: (name, values, unit)."""
+        return name, np.asarray(values, dtype=float), ""
+
+    def parameters(self, values: dict) -> str:
+        """The parameter values of a run, as a title shows them."""
+        return ", ".join(parameter_text(k, v) for k, v in values.items())
 
 
-class PhysicalShown(Shown):
+class PhysicalUnits(OwnNumbers):
     """States in the length unit and mm/s, omega as the speed (in its unit), other parameters as they are."""
 
     def __init__(self, units: PointUnits):
@@ -85,6 +99,92 @@ def check_grid_units(units: PointUnits, axes: Sequence[Axis]) -> None:
                                f"a unit of a {kind}, e.g. {example}")
 
 
+def shown_in(units: PointUnits | None) -> OwnNumbers:
+    """How results are shown for a model with these ``units`` (None: a model without physical values)."""
+    return OwnNumbers() if units is None else PhysicalUnits(units)
+
+
+@dataclass(frozen=True)
+class ShownBasinMap:
+    """A :class:`~gearsym.analysis.basins.BasinMap` with the units it is shown in, and its grid as given."""
+
+    result: BasinMap
+    units: OwnNumbers = OwnNumbers()
+    axes: tuple[Axis, ...] = ()  # the grid as the caller gave it (with its units), if it was given so
+
+    @classmethod
+    def of(cls, result: "BasinMap | ShownBasinMap") -> "ShownBasinMap":
+        return result if isinstance(result, cls) else cls(result)
+
+    @property
+    def omega(self) -> float | None:
+        return self.result.parameters.get("omega")
+
+    def state(self, name: str, values) -> tuple[np.ndarray, str]:
+        """A state's values (at the map's forcing frequency) as shown, and their unit."""
+        return self.units.state(name, values, self.omega)
+
+    def number(self, name: str, value: float) -> tuple[float, str]:
+        """One value of a state as shown, and its unit."""
+        values, unit = self.state(name, [value])
+        return float(values[0]), unit
+
+    def parameters_text(self) -> str:
+        return self.units.parameters(self.result.parameters)
+
+    def as_dict(self) -> dict:
+        """The map's record: in the model's units when it has physical values (the grid as given, amplitudes,
+        points and the start in the length unit and mm/s, the speed beside omega), else the engine's."""
+        result, units = self.result, self.units
+        if not isinstance(units, PhysicalUnits):
+            return result.as_dict()
+        data = result.as_dict(labels=True)
+
+        def measured(name, values):
+            v, unit = self.state(name, values)
+            return {"value": json_safe(float(v) if np.ndim(v) == 0 else v), "unit": unit}
+
+        data["grid"] = {**{a.name: {"values": list(a.values), "unit": a.unit} for a in self.axes},
+                        "held": {k: measured(k, v) for k, v in result.held.items()}, "starts": result.starts}
+        for a, out in zip(result.attractors, data["attractors"]):
+            out["amplitude"] = {k: measured(k, v) for k, v in a.amplitude.items()}
+            out["points"] = {n: measured(n, row) for n, row in zip(result.state_names, a.points)}
+            out["representative"] = {k: measured(k, v) for k, v in a.representative.items()}
+            out["exponents_per_second"] = json_safe(np.asarray(a.exponents) * self.omega * units.units.omega_n)
+        if units.units.speed is not None and self.omega is not None:
+            data["speed"] = {"value": float(units.speed(self.omega)), "unit": units.units.speed_unit.text}
+        return data
+
+
+@dataclass(frozen=True)
+class ShownFractions:
+    """A :class:`~gearsym.sweep.basin_continuation.BasinContinuation` with the units it is shown in."""
+
+    result: BasinContinuation
+    units: OwnNumbers = OwnNumbers()
+
+    @classmethod
+    def of(cls, result: "BasinContinuation | ShownFractions") -> "ShownFractions":
+        return result if isinstance(result, cls) else cls(result)
+
+    def parameter(self) -> tuple[str, np.ndarray, str]:
+        """The parameter as shown: (name, values, unit) (omega as the speed for a model with physical values)."""
+        return self.units.parameter(self.result.parameter, self.result.values)
+
+    def amplitude(self, name: str, value: float, at: float) -> tuple[float, str]:
+        """An amplitude of state ``name`` at the parameter's value ``at`` as shown, and its unit."""
+        omega = at if self.result.parameter == "omega" else self.result.record.get("settings", {}).get("omega")
+        values, unit = self.units.state(name, [value], omega)
+        return float(values[0]), unit
+
+    def unit(self, name: str) -> str:
+        """The unit a state's amplitudes are shown in."""
+        return self.units.state(name, [0.0], 1.0)[1]
+
+    def parameters_text(self, values: dict) -> str:
+        return self.units.parameters(values)
+
+
 def engine_grid(units: PointUnits, axes: Sequence[Axis], omega: float) -> dict[str, np.ndarray]:
     """The engine's values of grid ``axes`` given in physical units, at the forcing frequency ``omega``."""
     check_grid_units(units, axes)
@@ -99,23 +199,13 @@ def engine_grid(units: PointUnits, axes: Sequence[Axis], omega: float) -> dict[s
     return grid
 
 
-def physical_dict(result, shown: PhysicalShown, axes: Sequence[Axis]) -> dict:
-    """A basin map's JSON in the model's units: the grid as given, amplitudes, points and the start in the
-    length unit and mm/s, the speed beside omega."""
-    data = result.as_dict(labels=True)
-    omega = result.parameters.get("omega")
+class PhysicalGrid(StartGrid):
+    """A continuation's grid of starts given in physical units: its engine values at each forcing frequency (a
+    rate's unit moves with the speed), and the grid as given in the record."""
 
-    def measured(name, values):
-        v, unit = shown.state(name, values, omega)
-        return {"value": json_safe(float(v) if np.ndim(v) == 0 else v), "unit": unit}
+    def __init__(self, units: PointUnits, axes: Sequence[Axis]):
+        super().__init__({a.name: a.values for a in axes}, [a.spec for a in axes])
+        self.units, self.axes = units, tuple(axes)
 
-    data["grid"] = {**{a.name: {"values": list(a.values), "unit": a.unit} for a in axes},
-                    "held": {k: measured(k, v) for k, v in result.held.items()}, "starts": result.starts}
-    for a, out in zip(result.attractors, data["attractors"]):
-        out["amplitude"] = {k: measured(k, v) for k, v in a.amplitude.items()}
-        out["points"] = {n: measured(n, row) for n, row in zip(result.state_names, a.points)}
-        out["representative"] = {k: measured(k, v) for k, v in a.representative.items()}
-        out["exponents_per_second"] = json_safe(np.asarray(a.exponents) * omega * shown.units.omega_n)
-    if shown.units.speed is not None and omega is not None:
-        data["speed"] = {"value": float(shown.speed(omega)), "unit": shown.units.speed_unit.text}
-    return data
+    def at(self, point):
+        return engine_grid(self.units, self.axes, point.get("omega", 1.0))

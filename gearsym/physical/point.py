@@ -13,11 +13,12 @@ from __future__ import annotations
 
 import math
 import textwrap
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
+from ..analysis.lyapunov import LyapunovSpectrum
 from ..analysis.poincare import phase_trajectory
 from ..errors import GearsymError
 from ..scales.speeds import Speed
@@ -72,6 +73,14 @@ class PhysicalPoint:
     length_unit: object  # the scaling's L
     mesh_force: dict = field(default_factory=dict)  # mesh -> {"mean", "min", "max", "dynamic"} in N
     shaft_torque: dict = field(default_factory=dict)  # shaft -> {"mean", "min", "max", "dynamic"} in N·m
+    #: per exponent: "" (resolved) or what is known of one the run did not resolve (never its value)
+    unresolved: tuple[str, ...] = ()
+
+    def exponent_texts(self) -> list[str]:
+        """Each exponent as text: its value, or what is known of it where the run did not resolve it."""
+        notes = self.unresolved or ("",) * len(self.exponents.magnitude)
+        return [f"{v:+.6g}" if not note else f"λ{_subscript(i + 1)} {note}"
+                for i, (v, note) in enumerate(zip(self.exponents.magnitude, notes))]
 
     def as_dict(self) -> dict:
         """JSON-ready: every value as a number with its unit beside it."""
@@ -83,6 +92,8 @@ class PhysicalPoint:
                "exponents": q(self.exponents), "stderr": q(self.stderr),
                "amplitude": {k: q(v) for k, v in self.amplitude.items()},
                "final_state": {k: q(v) for k, v in self.final_state.items()}, "length_unit": q(self.length_unit)}
+        if any(self.unresolved):
+            out["unresolved"] = {str(i + 1): note for i, note in enumerate(self.unresolved) if note}
         if self.mesh_force:
             out["mesh_force"] = {m: {k: q(v) for k, v in f.items()} for m, f in self.mesh_force.items()}
         if self.shaft_torque:
@@ -94,13 +105,18 @@ class PhysicalPoint:
         speed = f"{shown(self.speed)}, " if math.isfinite(float(np.asarray(self.speed.magnitude))) else ""
         out = [f"operating point: {speed}mesh frequency {shown(self.mesh_frequency)}, "
                f"omega_n = {shown(self.natural_frequency)} (omega = {self.omega:.6g})",
-               "Lyapunov exponents per second: " + ", ".join(f"{v:+.6g}" for v in self.exponents.magnitude)]
+               "Lyapunov exponents per second: " + ", ".join(self.exponent_texts())]
         out += [f"amplitude A_{k} = {shown(v)}" for k, v in self.amplitude.items()]
         for what, table in (("mesh force", self.mesh_force), ("shaft torque", self.shaft_torque)):
             for name, f in table.items():
                 out.append(f"{what} {name}: mean {shown(f['mean'])}, {shown(f['min'])} to {shown(f['max'])} "
                            f"(dynamic amplitude {shown(f['dynamic'])})")
         return out
+
+
+def _subscript(k: int) -> str:
+    """k in subscript digits (λ₁₀, not λ₁0)."""
+    return str(k).translate(str.maketrans("0123456789", "₀₁₂₃₄₅₆₇₈₉"))
 
 
 def _number(x):
@@ -274,13 +290,21 @@ class PointUnits:
             {k: self.state(k, v, w) for k, v in result.final_state.items()},
             Measured(self.length_shown, self.length_text),
             {m: self._summary(time, f, period, self.newton) for m, f in forces.items()},
-            {s: self._summary(time, f, period, self.newton_metre) for s, f in torques.items()})
+            {s: self._summary(time, f, period, self.newton_metre) for s, f in torques.items()},
+            self._unresolved(result, per_second))
 
-    def figure(self, result, trajectory) -> tuple:
+    def _unresolved(self, result, per_second: float) -> tuple[str, ...]:
+        known = getattr(result, "resolution", None)
+        if known is None or known.all_resolved:
+            return ()
+        return tuple(known.note(i, per_second, f" {self.per_second.text}") for i in range(len(result.exponents)))
+
+    def figure(self, result, trajectory, given: Mapping[str, str] | None = None) -> tuple:
         """A spectrum run and a trajectory at its point as a figure shows them in physical units
         (:func:`gearsym.figures.point.plot_point`): the spectrum with its exponents, their running estimates and
         its Poincaré points converted, the trajectory's states converted, the unit of each, and a title with the
-        physical values as the user gave them."""
+        physical values as the user gave them: those of ``given`` (the values a command set) if given, else every
+        one (a model's own values then go in the figure's caption file, :meth:`caption`)."""
         w = float(result.parameters["omega"])
         per_second = w * self.omega_n
 
@@ -297,10 +321,18 @@ class PointUnits:
         units = {n: self.unit(n).text for n in trajectory.state_names} | {"exponents": self.per_second.text}
         speed = self.speed.parameter if self.speed else None
         head = f"{shown(Measured(float(self.speed_of(w)), self.speed_unit))}; " if self.speed else ""
-        values = ", ".join(f"{k}={v}" for k, v in self.values.items() if k != speed)
+        chosen = self.values if given is None else {k: v for k, v in given.items()}
+        values = ", ".join(f"{k}={v}" for k, v in chosen.items() if k != speed)
+        if given is not None:
+            values = (values + "; " if values else "") + "the model's other values in the caption file"
         title = (textwrap.fill(f"{self.name}: {head}{values}", 140)
                  + f"\n{result.regime}, λ₁ = {spectrum.exponents[0]:+.5g} {self.per_second.text}")
         return spectrum, shown_trajectory, units, title
+
+    def caption(self) -> str:
+        """Every physical value of the point as the model or the user gave it, one a line: what a figure's title
+        leaves to its caption file."""
+        return "".join(f"{k} = {v}\n" for k, v in self.values.items())
 
     def loads(self, trajectory, omega: float) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
         """The force of every mesh (N) and the torque of every shaft (N·m) along a trajectory."""
@@ -326,8 +358,9 @@ class PointUnits:
 
 
 class CachedScaling:
-    """A :class:`~gearsym.scales.map.Scaling` as far as a spectrum run needs it, from cached :class:`PointUnits`;
-    anything else comes from the full scaling, made on first use (the model reduced: seconds)."""
+    """A :class:`~gearsym.scales.map.Scaling` as far as a spectrum run needs it, from cached :class:`PointUnits`
+    (its name, speed, units and :meth:`to_physical` of a spectrum); what else a caller needs is the full scaling's
+    (:attr:`full`, made on first use: the model reduced, seconds)."""
 
     def __init__(self, units: PointUnits, load: Callable[[], object]):
         self.units, self._load, self.name, self.speed = units, load, units.name, units.speed
@@ -341,7 +374,7 @@ class CachedScaling:
     def to_physical(self, result, length_unit: str = LENGTH_UNIT, *, trajectory=None, model=None, **options):
         """A spectrum run from the cached numbers (its loads from ``trajectory``, or one run on ``model``);
         anything else by the full scaling's ``to_physical``."""
-        if hasattr(result, "exponents") and length_unit == self.units.length_unit and not options:
+        if isinstance(result, LyapunovSpectrum) and length_unit == self.units.length_unit and not options:
             if trajectory is None and model is not None:
                 trajectory = loads_trajectory(model, result)
             return self.units.point(result, trajectory)
@@ -351,18 +384,13 @@ class CachedScaling:
     def point_units(self, length_unit: str = LENGTH_UNIT) -> PointUnits:
         return self.units if length_unit == self.units.length_unit else self.full.point_units(length_unit)
 
-    def __getattr__(self, name: str):
-        if name.startswith("__") or name in ("_full", "_load", "units"):
-            raise AttributeError(name)
-        return getattr(self.full, name)
-
 
 def loads_trajectory(model, result):
     """The trajectory a spectrum run's mesh forces and shaft torques are read from: ``FORCE_PERIODS`` periods of
     ``model`` (the compiled model the run was made on) from the run's final state, at the run's parameters."""
-    if result.steps_per_period != model.integration.steps_per_period:
+    if result.steps_per_period != model.steps_per_period:
         raise GearsymError(f"{model.name}: the spectrum ran with {result.steps_per_period} steps per period, the "
-                           f"model given integrates with {model.integration.steps_per_period}: give the compiled "
+                           f"model given integrates with {model.steps_per_period}: give the compiled "
                            "model the spectrum ran on")
     options = model.integration.run(periods=FORCE_PERIODS, discard=0)
     return phase_trajectory(model, options=options, y0=result.final_state, **result.parameters)

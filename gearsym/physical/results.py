@@ -16,10 +16,8 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 import sympy as sp
 
-from ..codegen.build import compile_model
 from ..codegen.translate import to_casadi
 from ..errors import GearsymError
-from ..options import Integration
 from ..scales.dimensions import evaluate
 from ..scales.map import Scaling
 from ..sweep.grid import Axis
@@ -67,10 +65,10 @@ def point_to_physical(scaling: Scaling, result, length_unit: str = LENGTH_UNIT, 
                       model=None) -> PhysicalPoint:
     """A :class:`~gearsym.analysis.LyapunovSpectrum` in physical units, with the mesh forces and shaft torques
     of a trajectory at the same point: ``trajectory`` if given, else one run from the spectrum's final state on
-    ``model`` (the compiled model the spectrum ran on; by default this scaling's system, compiled)."""
+    ``model`` (the compiled model the spectrum ran on; by default the scaling's :meth:`compiled_for` it)."""
     if trajectory is None:
         if model is None:
-            model = compile_model(scaling.system(), Integration(steps_per_period=result.steps_per_period))
+            model = scaling.compiled_for(result)
         _check_point(scaling, model, result)
         trajectory = loads_trajectory(model, result)
     point = point_units(scaling, length_unit).point(result, trajectory)

@@ -45,7 +45,7 @@ def chart_in_units(chart: StabilityChart, given: tuple[Axis, Axis], engine: tupl
         f = maps[c.axis]
         value = float(f(c.value))
         error = float(abs(f(c.value + c.error) - value)) if c.error else 0.0
-        crossings.append(replace(c, value=value, error=error))
+        crossings.append(c._replace(value=value, error=error))
     boundaries = [Boundary(np.column_stack([maps[0](b.points[:, 0]), maps[1](b.points[:, 1])]), b.closed, b.kind,
                            b.kinds) for b in chart.boundaries]
     tolerance = tuple(float(abs(maps[k](chart.values[k][0] + chart.tolerance[k]) - maps[k](chart.values[k][0])))

@@ -149,24 +149,27 @@ class NondimensionalModel:
 
     @cached_property
     def forcing_period(self) -> sp.Expr:
-        """The forcing period in tau: 2 pi / gcd of all mesh and torque frequencies (one mesh period of a pair)."""
-        freqs = [rc.order for rc in self.reduction.resolved.couplings if rc.kind == "mesh"]
-        freqs += [sp.Integer(f.order) for f in self.reduction.resolved.forcing if f.order]
-        return 2 * sp.pi / functools.reduce(sp.gcd, freqs, sp.S.Zero) if freqs else 2 * sp.pi
+        """The forcing period in tau: one mesh period of the first mesh (2 pi / its order; 2 pi without a mesh).
+        Steps are counted per forcing period, so that a mesh of another order (a second stage) costs periods,
+        not accuracy."""
+        meshes = [rc.order for rc in self.reduction.resolved.couplings if rc.kind == "mesh"]
+        return 2 * sp.pi / meshes[0] if meshes else 2 * sp.pi
 
     @cached_property
     def period(self) -> sp.Expr:
-        """The period the model repeats on, in tau: the forcing period, or with shaft-order terms (a tooth fault,
-        an eccentric gear) 2 pi / gcd of their frequencies too: a gear's revolution, or the hunting period when
-        both gears of a pair have one. Every analysis runs on it."""
-        shaft = [f for rc in self.reduction.resolved.couplings for f in rc.shaft_frequencies]
-        if not shaft:
-            return self.forcing_period
-        return 2 * sp.pi / functools.reduce(sp.gcd, shaft, 2 * sp.pi / self.forcing_period)
+        """The period the model repeats on, in tau: 2 pi / the greatest common divisor of every frequency in it
+        (every mesh's order, the torques' harmonics, and with shaft-order terms, a tooth fault or an eccentric
+        gear, theirs): the forcing period for a single pair, the common period of the meshes of a multi-stage
+        box (61 mesh periods of a 23/61 first stage), a gear's revolution or the hunting period. Every analysis
+        runs on it."""
+        freqs = [rc.order for rc in self.reduction.resolved.couplings if rc.kind == "mesh"]
+        freqs += [sp.Integer(f.order) for f in self.reduction.resolved.forcing if f.order]
+        freqs += [f for rc in self.reduction.resolved.couplings for f in rc.shaft_frequencies]
+        return 2 * sp.pi / functools.reduce(sp.gcd, freqs, sp.S.Zero) if freqs else 2 * sp.pi
 
     @property
     def cycles(self) -> int:
-        """Forcing periods in one :attr:`period` (1 without shaft-order terms)."""
+        """Forcing periods (mesh periods of the first mesh) in one :attr:`period`: 1 for a single pair."""
         return int(sp.nsimplify(self.period / self.forcing_period))
 
     # ------------------------------------------------------------- parameters
@@ -496,9 +499,7 @@ class _Assembly:
         comp = rc.component
         fname = comp.function or ("k" if rc is reference else f"k{suffix}")
         phase = sp.expand(rc.mesh_phase.subs(t, tau / omega))
-        varied = rc.variation.subs(phi, phase)
-        if rc.loss != 0:  # stiffness a shaft-order term takes away (a tooth fault), once per revolution
-            varied = varied * (1 - rc.loss.subs(phi, phase))
+        varied = rc.variation_at(phase)
         if rc is not reference and _equal(m * rc.stiffness, self.own_factor(reference) * reference.stiffness):
             expression = varied  # as stiff as the first mesh (another planet's): 1 by the time-unit condition
         elif rc is reference:

@@ -7,13 +7,13 @@ portraits, periodic branches) -> :mod:`.claims` (each claim measured and judged)
 """
 from __future__ import annotations
 
-import sys
 import time
 from pathlib import Path
 
 from ..checks import json_safe
 from ..loading import load
 from ..stability.linearised import compile_linearisation
+from ..options import Execution
 from .basins import basins_record
 from .claims import evaluate
 from .compute import Computed, compute
@@ -50,30 +50,30 @@ def record_of(computed: list[Computed]) -> dict:
 
 
 def reproduce(out: str | Path = "docs/figures", doc: str | Path | None = None, *,
-              quick: bool = False, jobs: int = 0, progress: bool = True, data: str | Path | None = None) -> dict:
+              quick: bool = False, execution: Execution | None = None, data: str | Path | None = None) -> dict:
     """Compute everything, draw the figures into ``out``, write ``out/claims.json`` and ``doc``
     (default: ``reproduction.md`` beside ``out``, i.e. docs/reproduction.md for docs/figures). A record, report or
     figure already there that the new one equals to within rounding is left as it is (another machine rounds
     otherwise: the committed files stay unchanged).
 
     Sweep data go to ``data`` (default ``out/data``), which is also the cache a
-    rerun reads and the place an interrupted run resumes from. Returns the record.
+    rerun reads and the place an interrupted run resumes from. ``execution``: threads or workers, and what is
+    done said as it goes. Returns the record.
     """
+    execution = execution or Execution()
     out = Path(out)
     data = Path(data) if data else out / "data"
     start = time.perf_counter()
     computed = []
     for i, scenario in enumerate(SCENARIOS):  # the first is the main one, with the parameter study
         plan = paper_plan(quick, scenario, study=i == 0)
-        computed.append(compute(plan, data / scenario.name, jobs=jobs, progress=progress))
+        computed.append(compute(plan, data / scenario.name, execution=execution))
         draw_all(computed[-1], out, "" if i == 0 else f"-{scenario.name}")
     record = record_of(computed)
     record["stability"] = stability_record(compile_linearisation(load(STABILITY_MODEL)), out, quick)
     record = write(record, out / "claims.json", Path(doc) if doc else out.parent / "reproduction.md")
-    if progress:
-        for s in record["scenarios"]:
-            verdicts = [c["verdict"] for c in s["claims"]]
-            summary = ", ".join(f"{verdicts.count(v)} {v}" for v in dict.fromkeys(verdicts))
-            print(f"gearsym: {s['label']}: {summary}", file=sys.stderr)
-        print(f"gearsym: reproduced in {time.perf_counter() - start:.0f} s", file=sys.stderr)
+    for s in record["scenarios"]:
+        verdicts = [c["verdict"] for c in s["claims"]]
+        execution.say(f"{s['label']}: " + ", ".join(f"{verdicts.count(v)} {v}" for v in dict.fromkeys(verdicts)))
+    execution.say(f"reproduced in {time.perf_counter() - start:.0f} s")
     return record

@@ -20,7 +20,8 @@ import numpy as np
 from ..figures.basins import plot_basin_fractions, plot_basin_map, run_text
 from ..figures.layout import fit_texts, outside_below
 from ..figures.orbits import legend_handles, plot_branches, plot_sweep_points
-from ..figures.poincare import parameter_text, PhasePanel, plot_attractors, plot_phase_portraits
+from ..figures.poincare import PhasePanel, plot_attractors, plot_phase_portraits
+from ..physical.text import parameter_text
 from ..figures.save import pyplot, save_figure
 from ..figures.sweep import (add_colorbar, plot_amplitude, plot_bifurcation, plot_exponents, plot_map,
                              plot_regime_strip, ZERO_CONTOUR)

@@ -225,6 +225,12 @@ class Scaling:
         scale = nd.drivetrain.length_scale if length_scale is None else length_scale
         return cls(nd, {**nd.drivetrain.physical, **physical}, scale)
 
+    @property
+    def full(self) -> "Scaling":
+        """The scaling itself (the start-up cache's stand-in, :class:`~gearsym.physical.point.CachedScaling`, makes
+        its full scaling here: whatever a caller needs beyond a spectrum's units)."""
+        return self
+
     def with_values(self, **physical) -> "Scaling":
         """The same drivetrain with some physical values changed (``speed="3000 rpm"``)."""
         return type(self)(self.model, {**self.inputs, **self.functions, **self.formula_values, **physical},
@@ -444,19 +450,28 @@ class Scaling:
         (so another length scale starts from the same physical state), physical values are converted."""
         declared = self.model.drivetrain.length_scale
         ratio = 1.0 if declared == self.length_scale else self._declared_length() / self.length_si
-        kinds = {}
+        kinds, radius = {}, {}
         for c in self.model.coordinates:
             kinds[c.name], kinds[c.velocity_name] = "length", "rate"
+            if c.coupling.kind != "mesh":  # a shaft's coordinate is its radius times its twist
+                radius[c.name] = radius[c.velocity_name] = c.coupling.scale
         out = {}
         for name, value in self.model.drivetrain.initial_state.items():
             if name not in kinds:
                 raise UnknownParameterError(name, kinds, f"{self.name}: initial state")
             if isinstance(value, Measure):
-                wanted = (0.0, 1.0, 0.0) if kinds[name] == "length" else (0.0, 1.0, -1.0)
+                rate = kinds[name] == "rate"
+                per = self.length_si * (self.omega_n_si * self.values["omega"] if rate else 1.0)
+                if name in radius and same_dimension(value.dims, (0.0, 0.0, -1.0 if rate else 0.0)):
+                    # a shaft's twist (rate) in rad (rad/s), as gearsym gives it back
+                    r = evaluate(radius[name], self.inputs, f"{self.name}: shaft coordinate radius").si
+                    out[name] = value.si * r / per
+                    continue
+                wanted = (0.0, 1.0, -1.0) if rate else (0.0, 1.0, 0.0)
                 if not same_dimension(value.dims, wanted):
-                    raise ModelError(f"{value.text()} is not a {'length' if kinds[name] == 'length' else 'velocity'}",
-                                     f"{self.name}: initial state {name}")
-                per = self.length_si if kinds[name] == "length" else self.length_si * self.omega_n_si * self.values["omega"]
+                    what = ("a twist rate (rad/s) or a velocity" if rate else "a twist (rad) or a length") \
+                        if name in radius else ("a velocity" if rate else "a length")
+                    raise ModelError(f"{value.text()} is not {what}", f"{self.name}: initial state {name}")
                 out[name] = value.si / per
             else:
                 out[name] = value * ratio

@@ -46,6 +46,7 @@ TORQUE = Role("a torque", "N*m")
 PHASE = Role("a phase angle", "")
 RATIO = Role("a dimensionless ratio", "")
 SPEED = Role("a rotational speed", "rpm")
+TRANSMISSION_ERROR = Role("a transmission error", "um")
 
 
 @dataclass(frozen=True)
@@ -74,6 +75,15 @@ def fields(rd: ResolvedDrivetrain) -> list[Field]:
                     Field(rc.mesh_phase.xreplace({omega: 0, t: 0}), PHASE, f"{where} phase")]
             out += [Field(sp.Symbol(name, real=True), RATIO, f"{where} stiffness variation")
                     for name in sorted(parameter_names(rc.variation) - {phi.name})]
+            # shaft-order terms (a tooth fault's depth, its tooth; an eccentricity's amplitudes and phase): the
+            # fraction of stiffness lost is dimensionless, a transmission error a length where it enters linearly
+            out += [Field(sp.Symbol(name, real=True), RATIO, f"{where} shaft-order term (stiffness lost)")
+                    for name in sorted(parameter_names(rc.loss) - {phi.name})]
+            for name in sorted(parameter_names(rc.error) - {phi.name}):
+                s = sp.Symbol(name, real=True)
+                linear = s not in sp.diff(rc.error.xreplace({x: sp.Symbol(x.name, real=True)
+                                                             for x in rc.error.free_symbols}), s).free_symbols
+                out.append(Field(s, TRANSMISSION_ERROR if linear else PHASE, f"{where} shaft-order term"))
         else:
             out += [Field(rc.stiffness, SHAFT_STIFFNESS, f"{where} stiffness"),
                     Field(rc.damping, SHAFT_DAMPING, f"{where} damping"),

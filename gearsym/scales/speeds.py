@@ -7,6 +7,7 @@ gears of a mesh must agree (base radii in the ratio of the teeth).
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -91,6 +92,10 @@ class SpeedRatios:
                 continue
             got = self.mesh(rc) / ratio
             if not math.isclose(got, float(rc.order), rel_tol=RATIO_TOLERANCE):
+                fraction = Fraction(got).limit_denominator(10000)
+                written = (str(fraction.numerator) if fraction.denominator == 1 else
+                           f"sp.Rational({fraction.numerator}, {fraction.denominator})")
                 raise GearsymError(f"{self.model.name}: mesh {rc.name!r} is declared with order {rc.order} of the "
-                                   f"forcing frequency, but its tooth counts give {got:.6g}")
+                                   f"forcing frequency, but its tooth counts give {got:.6g}: leave order= out (with "
+                                   f"teeth on both gears it is derived) or write order={written}")
         return ratio

@@ -13,18 +13,20 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Callable
+from itertools import repeat
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from ..checks import json_safe
 
 
-@dataclass(frozen=True)
-class Crossing:
+class Crossing(NamedTuple):
     """A boundary point on a grid line: along the first axis (``axis`` 0: between columns j and j + 1 of row i)
     or the second (``axis`` 1: between rows i and i + 1 of column j); ``value`` on that axis, located to within
-    ``error``; ``kind``: the instability on its unstable side (at the last unstable point evaluated)."""
+    ``error``; ``kind``: the instability on its unstable side (at the last unstable point evaluated). (A named
+    tuple: a chart has thousands, made in a fraction of a dataclass's time.)"""
 
     axis: int
     i: int
@@ -55,26 +57,36 @@ class Boundary:
 Evaluate = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]
 
 
-def grid_crossings(unstable: np.ndarray, valid: np.ndarray) -> list[tuple[int, int, int]]:
-    """The grid lines' neighbours that differ in stability: (axis, i, j) as in :class:`Crossing`."""
-    out = []
+def grid_crossings(unstable: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    """The grid lines' neighbours that differ in stability: rows (axis, i, j) as in :class:`Crossing`."""
     along = valid[:, :-1] & valid[:, 1:] & (unstable[:, :-1] != unstable[:, 1:])
-    out += [(0, int(i), int(j)) for i, j in zip(*np.nonzero(along))]
     across = valid[:-1, :] & valid[1:, :] & (unstable[:-1, :] != unstable[1:, :])
-    out += [(1, int(i), int(j)) for i, j in zip(*np.nonzero(across))]
-    return out
+    (i0, j0), (i1, j1) = np.nonzero(along), np.nonzero(across)
+    return np.column_stack([np.repeat([0, 1], [len(i0), len(i1)]), np.concatenate([i0, i1]),
+                            np.concatenate([j0, j1])]).astype(np.int64)
 
 
-def refine(edges: list[tuple[int, int, int]], a: np.ndarray, b: np.ndarray, unstable: np.ndarray,
+def midpoints(edges: np.ndarray, a: np.ndarray, b: np.ndarray, unstable: np.ndarray,
+              kind: np.ndarray) -> list[Crossing]:
+    """The crossings of ``edges`` at the midpoints of their grid lines (not located), each with the kind of its
+    unstable end."""
+    axis, i, j = edges.T
+    i2, j2 = i + (axis == 1), j + (axis == 0)
+    lo, hi = np.where(axis == 0, a[j], b[i]), np.where(axis == 0, a[j2], b[i2])
+    kinds = np.where(unstable[i, j], kind[i, j], kind[i2, j2]).tolist()
+    return list(map(Crossing._make, zip(axis.tolist(), i.tolist(), j.tolist(), ((lo + hi) / 2).tolist(),
+                                        (np.abs(hi - lo) / 2).tolist(), kinds, repeat(True))))
+
+
+def refine(edges: np.ndarray, a: np.ndarray, b: np.ndarray, unstable: np.ndarray,
            kind: np.ndarray, evaluate: Evaluate, tolerance: tuple[float, float],
            progress: Callable[[int, int], None] | None = None) -> list[Crossing]:
-    """Bisect every edge to ``tolerance`` (per axis), all edges of a round at once."""
-    if not edges:
+    """Bisect every edge (rows of :func:`grid_crossings`) to ``tolerance`` (per axis), all edges of a round at
+    once."""
+    if not len(edges):
         return []
     E = len(edges)
-    axis = np.array([e[0] for e in edges])
-    i = np.array([e[1] for e in edges])
-    j = np.array([e[2] for e in edges])
+    axis, i, j = edges.T
     i2, j2 = i + (axis == 1), j + (axis == 0)
     first = np.where(axis == 0, a[j], b[i])
     second = np.where(axis == 0, a[j2], b[i2])
@@ -105,63 +117,90 @@ def refine(edges: list[tuple[int, int, int]], a: np.ndarray, b: np.ndarray, unst
         kinds[go[up]] = k[up]
         stable_end[go[~up]] = mid[valid][~up]
         rounds += 1
-    return [Crossing(int(axis[e]), int(i[e]), int(j[e]), float((stable_end[e] + unstable_end[e]) / 2),
-                     float(abs(unstable_end[e] - stable_end[e]) / 2), kinds[e], bool(located[e])) for e in range(E)]
+    return list(map(Crossing._make, zip(axis.tolist(), i.tolist(), j.tolist(),
+                                        ((stable_end + unstable_end) / 2).tolist(),
+                                        (np.abs(unstable_end - stable_end) / 2).tolist(), kinds.tolist(),
+                                        located.tolist())))
 
 
 def curves(crossings: list[Crossing], a: np.ndarray, b: np.ndarray, unstable: np.ndarray, valid: np.ndarray,
            largest: np.ndarray) -> list[Boundary]:
     """The crossings joined into curves (see the module docstring); with one grid line (a 1-D chart) each
-    crossing is a boundary of one point."""
-    at = {(c.axis, c.i, c.j): c for c in crossings}
+    crossing is a boundary of one point. The cells are scanned at once (numpy); the walk along the links is
+    the only loop, one step a crossing."""
     if len(b) == 1 or len(a) == 1:
         return [Boundary(np.array([_position(c, a, b)]), False, c.kind, (c.kind,)) for c in crossings]
-    links: dict[tuple, list[tuple]] = {key: [] for key in at}
-    cells = set()  # the cells a crossing borders
-    for axis, i, j in at:
-        cells |= {(i, j), (i - 1, j)} if axis == 0 else {(i, j), (i, j - 1)}
-    whole = (valid[:-1, :-1] & valid[1:, :-1] & valid[:-1, 1:] & valid[1:, 1:]).tolist()
-    corner = unstable.tolist()
-    for ci, cj in sorted(cells):
-        if not (0 <= ci < len(b) - 1 and 0 <= cj < len(a) - 1) or not whole[ci][cj]:
+    K, na, nb = len(crossings), len(a), len(b)
+    if not K:
+        return []
+    columns = list(zip(*crossings))  # (the fields of every crossing, a tuple each)
+    axis, i, j = (np.array(columns[k], dtype=np.int64) for k in range(3))
+    value, kinds_of = np.array(columns[3], dtype=float), columns[5]
+    # each grid line's crossing (its index, -1 where none): along the first axis (nb x na-1), the second (nb-1 x na)
+    along = np.full((nb, na - 1), -1, dtype=np.int64)
+    across = np.full((nb - 1, na), -1, dtype=np.int64)
+    first = axis == 0
+    along[i[first], j[first]] = np.nonzero(first)[0]
+    across[i[~first], j[~first]] = np.nonzero(~first)[0]
+    # the cells a crossing borders (row by row), each one's sides in the order bottom, right, top, left
+    ci = np.concatenate([i, np.where(first, i - 1, i)])
+    cj = np.concatenate([j, np.where(first, j, j - 1)])
+    inside = (ci >= 0) & (ci < nb - 1) & (cj >= 0) & (cj < na - 1)
+    cell = np.unique(ci[inside] * (na - 1) + cj[inside])
+    ci, cj = cell // (na - 1), cell % (na - 1)
+    whole = valid[ci, cj] & valid[ci + 1, cj] & valid[ci, cj + 1] & valid[ci + 1, cj + 1]
+    sides = np.column_stack([along[ci, cj], across[ci, cj + 1], along[ci + 1, cj], across[ci, cj]])
+    present = sides >= 0
+    count = present.sum(axis=1)
+    two, four = whole & (count == 2), whole & (count == 4)
+    ps = sides[two]  # (cells, 4): the two present sides first, in their order
+    ps = np.take_along_axis(ps, np.argsort(~present[two], axis=1, kind="stable"), axis=1)[:, :2]
+    pair_cells = (ci[two], cj[two])
+    ci, cj = ci[four], cj[four]
+    centre = (largest[ci, cj] + largest[ci, cj + 1] + largest[ci + 1, cj] + largest[ci + 1, cj + 1]) / 4 > 1.0
+    joins = unstable[ci, cj] == centre  # the corner (ci, cj) joins the centre: cut off the other two
+    s4 = sides[four]
+    bottom, right, top, left = s4[:, 0], s4[:, 1], s4[:, 2], s4[:, 3]
+    saddles = np.stack([np.column_stack([bottom, np.where(joins, right, left)]),
+                        np.column_stack([top, np.where(joins, left, right)])], axis=1)  # (cells, 2 pairs, 2)
+    # the pairs in the order of their cells (row by row), each link in both directions in that order
+    cell = np.concatenate([pair_cells[0] * na + pair_cells[1], np.repeat(ci * na + cj, 2)])
+    pairs = np.concatenate([ps, saddles.reshape(-1, 2)])
+    pairs = pairs[np.argsort(cell, kind="stable")]
+    source = pairs.reshape(-1)  # (p, q), (q, p) of each pair, in order
+    target = pairs[:, ::-1].reshape(-1)
+    order = np.argsort(source, kind="stable")
+    source, target = source[order], target[order]
+    # each crossing's links (two at most: a crossing borders two cells, each links it once), in that order
+    degree = np.bincount(source, minlength=K)
+    at = np.cumsum(degree) - degree
+    one, two = np.full(K, -1, dtype=np.int64), np.full(K, -1, dtype=np.int64)
+    one[degree >= 1] = target[at[degree >= 1]]
+    two[degree == 2] = target[at[degree == 2] + 1]
+    positions = np.column_stack([np.where(first, value, a[j]), np.where(first, b[i], value)])
+    one_of, two_of = one.tolist(), two.tolist()
+    seen = [False] * K
+    out = []
+    for start in np.concatenate([np.flatnonzero(degree == 1), np.flatnonzero(degree != 1)]).tolist():
+        if seen[start]:
             continue
-        bottom, top, left, right = (0, ci, cj), (0, ci + 1, cj), (1, ci, cj), (1, ci, cj + 1)
-        present = [e for e in (bottom, right, top, left) if e in at]
-        if len(present) == 2:
-            pairs = [tuple(present)]
-        elif len(present) == 4:
-            centre = float(np.mean(largest[ci:ci + 2, cj:cj + 2])) > 1.0
-            if corner[ci][cj] == centre:  # the corner (ci, cj) joins the centre: cut off the other two
-                pairs = [(bottom, right), (top, left)]
-            else:
-                pairs = [(bottom, left), (top, right)]
-        else:
-            continue
-        for p, q in pairs:
-            links[p].append(q)
-            links[q].append(p)
-    seen, out = set(), []
-    starts = [k for k, v in links.items() if len(v) == 1] + [k for k, v in links.items() if len(v) != 1]
-    for start in starts:
-        if start in seen:
-            continue
-        chain, previous, node = [start], None, start
-        seen.add(start)
-        while True:
-            following = [n for n in links[node] if n != previous and n not in seen]
-            if not following:
-                break
-            previous, node = node, following[0]
+        chain, previous, node = [start], -1, start
+        seen[start] = True
+        while True:  # (to the first link not yet walked)
+            n = one_of[node]
+            if n < 0 or n == previous or seen[n]:
+                n = two_of[node]
+                if n < 0 or n == previous or seen[n]:
+                    break
+            previous, node = node, n
             chain.append(node)
-            seen.add(node)
-        closed = len(chain) > 2 and start in links[chain[-1]]
-        kinds = tuple(at[k].kind for k in chain)
-        points = np.array([_position(at[k], a, b) for k in chain])
+            seen[node] = True
+        closed = len(chain) > 2 and start in (one_of[chain[-1]], two_of[chain[-1]])
         if closed:
-            points = np.vstack([points, points[:1]])
-            kinds = kinds + kinds[:1]
+            chain.append(start)
+        kinds = tuple(kinds_of[k] for k in chain)
         common = Counter(k for k in kinds if k is not None).most_common(1)
-        out.append(Boundary(points, closed, common[0][0] if common else None, kinds))
+        out.append(Boundary(positions[chain], closed, common[0][0] if common else None, kinds))
     return out
 
 

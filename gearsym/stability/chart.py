@@ -17,7 +17,7 @@ from ..checks import json_safe
 from ..codegen.compiled import CompiledModel
 from ..errors import GearsymError
 from ..sweep.grid import Axis, axes_from
-from .boundaries import Boundary, Crossing, curves, grid_crossings, refine
+from .boundaries import Boundary, Crossing, curves, grid_crossings, midpoints, refine
 from .kinds import MARGIN, NO_ORBIT, NO_STATIC_STATE, classify, multipliers
 from .monodromies import MonodromyRunner
 from .orbits import periodic_orbits
@@ -110,15 +110,23 @@ class _Grid:
         self.b = np.array(axes[1].values, dtype=float)
         self.columns = [names.index(ax.name) for ax in axes]
 
-    def vectors(self, points: np.ndarray) -> np.ndarray:
-        p = np.tile(self.base, (len(points), 1))
-        for k, column in enumerate(self.columns):
+    def vectors(self, points: np.ndarray, base: np.ndarray | None = None,
+                columns: Sequence[int] | None = None) -> np.ndarray:
+        """The parameter vectors of ``points``: ``base`` (default: the grid's) with the axes' values in
+        ``columns`` (default: the axes' columns in the grid's names)."""
+        base = self.base if base is None else base
+        p = np.empty((len(points), len(base)))
+        p[:] = base
+        for k, column in enumerate(self.columns if columns is None else columns):
             p[:, column] = points[:, k]
         return p
 
     def all_points(self) -> np.ndarray:
-        A, B = np.meshgrid(self.a, self.b)
-        return np.column_stack([A.reshape(-1), B.reshape(-1)])
+        """Every point of the grid, row by row (the first axis fastest)."""
+        points = np.empty((len(self.a) * len(self.b), 2))
+        points.reshape(len(self.b), len(self.a), 2)[:, :, 0] = self.a
+        points.reshape(len(self.b), len(self.a), 2)[:, :, 1] = self.b[:, None]
+        return points
 
 
 class _Static:
@@ -129,25 +137,29 @@ class _Static:
     def __init__(self, lin: CompiledLinearisation, grid: _Grid, lanes: bool, jobs: int, verbose: bool):
         self.lin, self.grid = lin, grid
         self.runner = MonodromyRunner(lin.model, lanes=lanes, jobs=jobs, verbose=verbose, linear=True)
-        names = lin.model.parameter_names
-        self.base_columns = [names.index(n) for n in grid.names]
+        self.names = names = lin.model.parameter_names  # (the model's parameters, then the anchors)
+        self.base = np.zeros(len(names))
+        self.base[[names.index(n) for n in grid.names]] = grid.base
+        self.axis_columns = [names.index(n) for n in (grid.axes[0].name, grid.axes[1].name)]
         self.anchor_columns = [names.index(anchor_parameter(s)) for s in lin.anchors]
         self.anchor_states = [lin.recipe.states.index(s) for s in lin.anchors]
         self.flanks: dict[str, dict[str, int]] = {}
         self.missing = 0
 
     def evaluate(self, points: np.ndarray, near=None, progress=None) -> tuple[np.ndarray, np.ndarray]:
-        base = self.grid.vectors(points)
-        static = solve_static(self.lin.recipe, self.grid.names, base)
-        p = np.zeros((len(points), len(self.lin.model.parameter_names)))
-        p[:, self.base_columns] = base
-        p[:, self.anchor_columns] = static.states[:, self.anchor_states] if self.anchor_states else p[:, []]
-        mu = np.full((len(points), self.lin.model.dimension), np.nan + 0j)
+        p = self.grid.vectors(points, self.base, self.axis_columns)
+        static = solve_static(self.lin.recipe, self.names, p)
+        if self.anchor_states:  # (one static state for every point where it depends on none of the axes)
+            anchors = static.distinct_states[:, self.anchor_states]
+            p[:, self.anchor_columns] = anchors[0] if len(anchors) == 1 else anchors[static.index]
         ok = static.found
-        if ok.any():
-            rows = np.nonzero(ok)[0]
-            _, M = self.runner.run(p[rows], np.zeros((len(rows), self.lin.model.dimension)), progress=progress)
-            mu[rows] = multipliers(M)
+        if ok.all():
+            mu = multipliers(self.runner.run(p, None, progress=progress)[1])
+        else:
+            mu = np.full((len(points), self.lin.model.dimension), np.nan + 0j)
+            if ok.any():
+                rows = np.nonzero(ok)[0]
+                mu[rows] = multipliers(self.runner.run(p[rows], None, progress=progress)[1])
         if near is None:  # the grid itself: what the notes say
             self.missing = int((~ok).sum())
             self.flanks = static.flank_counts
@@ -246,15 +258,17 @@ def chart_of(problem, grid: _Grid, *, model: str, steps: int, parameters: dict, 
     na, nb = len(grid.a), len(grid.b)
     points = grid.all_points()
     mu, ok = problem.evaluate(points, progress=(lambda d, t: progress("grid", d, t)) if progress else None)
-    largest, unstable, kind = classify(np.where(ok[:, None], mu, 0))
-    kind[~ok] = problem.missing_kind
-    stable = np.where(ok, ~unstable, None).astype(object)
+    everywhere = ok.all()
+    largest, unstable, kind = classify(mu if everywhere else np.where(ok[:, None], mu, 0))
+    if not everywhere:
+        kind[~ok] = problem.missing_kind
+    stable = _VERDICTS[np.where(ok, ~unstable, 2) if not everywhere else ~unstable + 0]
     shape = (nb, na)
     grid_seconds = time.perf_counter() - start
     tol = _tolerances(grid, tolerance)
     valid = ok.reshape(shape)
     un = unstable.reshape(shape)
-    largest = np.where(ok, largest, np.nan).reshape(shape)
+    largest = (largest if everywhere else np.where(ok, largest, np.nan)).reshape(shape)
     kinds = kind.reshape(shape)
     t = time.perf_counter()
     edges = grid_crossings(un, valid)
@@ -270,9 +284,7 @@ def chart_of(problem, grid: _Grid, *, model: str, steps: int, parameters: dict, 
         found = refine(edges, grid.a, grid.b, un, kinds, evaluate, tol,
                        (lambda d, t_: progress("boundaries", d, t_)) if progress else None)
     else:
-        un_list, kind_list = un.tolist(), kinds.tolist()
-        found = [Crossing(ax, i, j, *_midpoint(ax, i, j, grid), _unstable_kind(ax, i, j, un_list, kind_list))
-                 for ax, i, j in edges]
+        found = midpoints(edges, grid.a, grid.b, un, kinds)
     refine_seconds = time.perf_counter() - t
     boundaries = curves(found, grid.a, grid.b, un, valid, largest)
     timings = {"grid_seconds": grid_seconds, "grid_points": int(na * nb), "boundary_points": len(found),
@@ -286,14 +298,8 @@ def chart_of(problem, grid: _Grid, *, model: str, steps: int, parameters: dict, 
         notes=tuple(problem.notes()), timings=timings)
 
 
-def _midpoint(axis, i, j, grid) -> tuple[float, float]:
-    lo, hi = (grid.a[j], grid.a[j + 1]) if axis == 0 else (grid.b[i], grid.b[i + 1])
-    return float((lo + hi) / 2), float(abs(hi - lo) / 2)
-
-
-def _unstable_kind(axis, i, j, un: list, kinds: list):
-    i2, j2 = i + (axis == 1), j + (axis == 0)
-    return kinds[i][j] if un[i][j] else kinds[i2][j2]
+#: a point's verdict (``stable``) by its code: unstable, stable, no result
+_VERDICTS = np.array([False, True, None], dtype=object)
 
 
 def _tolerances(grid: _Grid, tolerance) -> tuple[float, float]:

@@ -28,31 +28,50 @@ REAL = 1e-7
 
 def multipliers(M: np.ndarray) -> np.ndarray:
     """The multipliers of each matrix of ``M`` (points x n x n), largest modulus first (points x n)."""
-    if M.shape[-1] == 2:  # (closed form: numpy's eigvals costs microseconds a matrix, a chart has 10^5)
-        half = (M[:, 0, 0] + M[:, 1, 1]) / 2
-        det = M[:, 0, 0] * M[:, 1, 1] - M[:, 0, 1] * M[:, 1, 0]
-        disc = half * half - det
-        real = disc >= 0
-        root = np.sqrt(np.abs(disc))
-        big = np.where(real, half + np.where(half >= 0, 1.0, -1.0) * root, half) + 1j * np.where(real, 0.0, root)
-        with np.errstate(invalid="ignore", divide="ignore"):  # (no cancellation: the other real one is det / big)
-            other = np.where(big.real != 0, det / np.where(big.real != 0, big.real, 1.0), half - root)
-        mu = np.column_stack([big, np.where(real, other + 0j, np.conj(big))])
-    else:
-        mu = np.linalg.eigvals(M)
+    if M.shape[-1] == 2:
+        return _pairs(M)
+    mu = np.linalg.eigvals(M)
     order = np.lexsort((-mu.imag, -np.abs(mu)), axis=-1)
     return np.take_along_axis(mu, order, axis=-1)
+
+
+def _pairs(M: np.ndarray) -> np.ndarray:
+    """The two multipliers of 2 x 2 matrices in closed form, already in order (numpy's eigvals and a sort cost
+    microseconds a matrix, a chart has 10^5): a real pair as half +- root (the larger modulus first, the other as
+    det / it: no cancellation), a complex pair as half +- i root (positive imaginary part first)."""
+    a, b, c, d = M[:, 0, 0], M[:, 0, 1], M[:, 1, 0], M[:, 1, 1]
+    half = a + d
+    half *= 0.5
+    det = a * d
+    det -= b * c
+    disc = half * half
+    disc -= det
+    real = disc >= 0
+    root = np.abs(disc, out=disc)
+    np.sqrt(root, out=root)
+    big = np.copysign(root, half)
+    big += half
+    other = np.divide(det, big, out=np.zeros_like(big), where=big != 0)  # (big = 0: both are 0)
+    mu = np.empty((len(M), 2), dtype=complex)
+    mu.real[:, 0] = np.where(real, big, half)
+    mu.real[:, 1] = np.where(real, other, half)
+    mu.imag[:, 0] = np.where(real, 0.0, root)
+    mu.imag[:, 1] = -mu.imag[:, 0]
+    return mu
+
+
+#: a point's kind by its code (:func:`classify`): stable, the three kinds of instability
+_KIND_OF_CODE = np.array([None, FOLD, PERIOD_DOUBLING, NEIMARK_SACKER], dtype=object)
 
 
 def classify(mu: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(largest modulus, unstable, kind) per point of ``mu`` (points x n, largest first; NaN rows: no result);
     the kind is None where the point is stable."""
-    largest = np.abs(mu[:, 0]) if mu.shape[1] else np.zeros(len(mu))
+    if not mu.shape[1]:
+        return np.zeros(len(mu)), np.zeros(len(mu), dtype=bool), np.full(len(mu), None, dtype=object)
+    first = mu[:, 0]
+    largest = np.abs(first)
     unstable = largest > 1.0 + MARGIN
-    first = mu[:, 0] if mu.shape[1] else np.zeros(len(mu), dtype=complex)
-    real = np.abs(first.imag) <= REAL * np.abs(first)
-    kind = np.full(len(mu), None, dtype=object)
-    kind[unstable & real & (first.real > 0)] = FOLD
-    kind[unstable & real & (first.real < 0)] = PERIOD_DOUBLING
-    kind[unstable & ~real] = NEIMARK_SACKER
-    return largest, unstable, kind
+    real = np.abs(first.imag) <= REAL * largest
+    code = np.where(real, np.where(first.real > 0, 1, 2), 3) * unstable
+    return largest, unstable, _KIND_OF_CODE[code]

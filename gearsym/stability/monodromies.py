@@ -11,6 +11,7 @@ numbers, slower.
 """
 from __future__ import annotations
 
+import ctypes
 from collections.abc import Callable
 
 import numpy as np
@@ -45,24 +46,23 @@ class MonodromyRunner:
         """The index in the pool of each point's tables (computed, and the period checked, once per distinct
         value of the timed parameters)."""
         distinct, first, inverse = distinct_rows(p[:, self.timed])
-        slots = np.empty(len(distinct), dtype=np.int64)
-        for k, row in enumerate(first):
-            key = distinct[k].tobytes()
-            slot = self._tables.get(key)
-            if slot is None:
-                inputs = self.model.prepare(np.array(p[row], dtype=float))
-                slot = self._tables[key] = len(self._pool)
-                self._pool.append(np.ascontiguousarray(inputs.table.reshape(-1, order="F")))
-            slots[k] = slot
-        return slots[inverse]
+        keys = [row.tobytes() for row in distinct]
+        new = [k for k, key in enumerate(keys) if key not in self._tables]
+        if new:
+            tables = self.model.tables(p[first[new]])
+            for k, table in zip(new, tables):
+                self._tables[keys[k]] = len(self._pool)
+                self._pool.append(table)
+        return np.array([self._tables[key] for key in keys], dtype=np.int64)[inverse]
 
-    def run(self, p: np.ndarray, y0: np.ndarray, periods: int = 1,
+    def run(self, p: np.ndarray, y0: np.ndarray | None, periods: int = 1,
             progress: Callable[[int, int], None] | None = None) -> tuple[np.ndarray, np.ndarray]:
         """(state after ``periods`` periods, tangent map from the identity over them) for each row of ``p``
-        (points x parameters) from the row of ``y0`` (points x states)."""
+        (points x parameters) from the row of ``y0`` (points x states; None: every state 0)."""
         model = self.model
-        p, y0 = np.asarray(p, dtype=float), np.asarray(y0, dtype=float)
         count, n = len(p), model.dimension
+        zero = y0 is None
+        p, y0 = np.asarray(p, dtype=float), np.zeros((count, n)) if zero else np.asarray(y0, dtype=float)
         if p.shape != (count, len(model.parameter_names)) or y0.shape != (count, n):
             raise GearsymError(f"{model.name}: {p.shape} parameter vectors and {y0.shape} states do not fit "
                                f"{len(model.parameter_names)} parameters and {n} states")
@@ -78,7 +78,7 @@ class MonodromyRunner:
         if self.linear:  # the state is its own tangent: the identity's columns, one lane each
             columns = self._lanes(p, None, tix, periods, progress, n)
             M = columns.reshape(count, n, n).transpose(0, 2, 1)
-            return np.einsum("kij,kj->ki", M, y0), M
+            return (y0 if zero else np.einsum("kij,kj->ki", M, y0)), M
         M = np.empty((count, n, n))
         return self._lanes(p, y0, tix, periods, progress, 0, M), M
 
@@ -88,35 +88,39 @@ class MonodromyRunner:
         from the identity's columns, without the tangent) and, with ``M``, the tangent maps."""
         count, n = len(p), self.model.dimension
         order = None if np.all(tix[1:] >= tix[:-1]) else np.argsort(tix, kind="stable")  # (a grid's are sorted)
-        used = np.unique(tix)  # (the tables of these points only: a refinement's pool grows by the round)
-        pool = np.ascontiguousarray(np.stack([self._pool[k] for k in used]))
+        ordered = tix if order is None else tix[order]
+        used = ordered[np.append(True, ordered[1:] != ordered[:-1])]  # (the tables of these points only: a
+        pool = np.ascontiguousarray(np.stack([self._pool[k] for k in used]))  # refinement's pool grows by round)
         size, width = pool.shape[1], self.library.width
         P = np.ascontiguousarray(p if order is None else p[order])
-        T = np.ascontiguousarray(np.searchsorted(used, tix if order is None else tix[order]).astype(np.int64))
+        slot = np.empty(used[-1] + 1, dtype=np.int64)
+        slot[used] = np.arange(len(used))
+        T = slot[ordered]
         per = max(1, columns)
         Y = np.empty((count * per, n)) if columns else np.ascontiguousarray(y if order is None else y[order])
-        out = None if M is None else np.empty_like(M)
+        out = None if M is None else M if order is None else np.empty_like(M)
+        # the arrays' addresses once (numpy's .ctypes costs microseconds, a chart makes hundreds of calls); each
+        # chunk's its rows' offsets from them, its work room a ctypes array of its own
+        at = [pool.ctypes.data, T.ctypes.data, P.ctypes.data, Y.ctypes.data, 0 if out is None else out.ctypes.data]
+        rows_of = [0, 8, 8 * P.shape[1], 8 * n * per, 8 * n * n]
+        room = ctypes.c_double * (max(1, size) * width)
 
         def work(rows: slice):
-            k = rows.stop - rows.start
-            buffer = np.empty(max(1, size) * width)
-            at = slice(rows.start * per, rows.stop * per)
+            k, first = rows.stop - rows.start, rows.start
+            buffer = room()
+            _, t, q, yy, mm = (a + first * r for a, r in zip(at, rows_of))
             if M is None:
-                self.library.states(pool.ctypes.data, T[rows].ctypes.data, P[rows].ctypes.data, k, int(periods),
-                                    columns, Y[at].ctypes.data, buffer.ctypes.data)
+                self.library.states(at[0], t, q, k, int(periods), columns, yy, ctypes.addressof(buffer))
             else:
-                self.library.monodromies(pool.ctypes.data, T[rows].ctypes.data, P[rows].ctypes.data, k, int(periods),
-                                         Y[rows].ctypes.data, out[rows].ctypes.data, buffer.ctypes.data)
+                self.library.monodromies(at[0], t, q, k, int(periods), yy, mm, ctypes.addressof(buffer))
             return k
 
         done = 0
-        for finished in threaded(work, [slice(c.start, c.stop) for c in chunked(count, CALL_POINTS)], self.jobs):
+        for finished in threaded(work, chunked(count, CALL_POINTS), self.jobs):
             done += finished
             if progress:
                 progress(done, count)
         if order is None:
-            if M is not None:
-                M[...] = out
             return Y
         final = np.empty_like(Y)
         final.reshape(count, per, n)[order] = Y.reshape(count, per, n)
@@ -137,11 +141,26 @@ class MonodromyRunner:
 
 
 def distinct_rows(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(the distinct rows of ``keys``, the first row of each, the index of each row's among them): numpy's
-    ``unique(axis=0)`` by numeric sorts (it sorts rows as bytes, 100 times slower on a chart's 160 000 rows)."""
+    """(the distinct rows of ``keys`` in sorted order, the first row of each, the index of each row's among them):
+    numpy's ``unique(axis=0)`` by numeric sorts (it sorts rows as bytes, 100 times slower on a chart's 160 000
+    rows), on the runs of equal rows (a grid's points come row by row: the values of its second axis in runs)."""
     count = len(keys)
-    if keys.shape[1] == 0 or count == 0 or (keys == keys[0]).all():  # (one row: a grid across other parameters)
+    if keys.shape[1] == 0 or count == 0:
         return keys[:min(1, count)], np.zeros(min(1, count), dtype=np.int64), np.zeros(count, dtype=np.int64)
+    change = np.empty(count, dtype=bool)
+    change[0] = True
+    np.any(keys[1:] != keys[:-1], axis=1, out=change[1:])
+    starts = np.flatnonzero(change)
+    if len(starts) == 1:  # (one row: a grid across other parameters)
+        return keys[:1], np.zeros(1, dtype=np.int64), np.zeros(count, dtype=np.int64)
+    if len(starts) < count:  # (the distinct rows of the runs' first rows, each row its run's)
+        distinct, first, inverse = _distinct_sorted(keys[starts])
+        return distinct, starts[first], np.repeat(inverse, np.diff(np.append(starts, count)))
+    return _distinct_sorted(keys)
+
+
+def _distinct_sorted(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    count = len(keys)
     varying = np.nonzero((keys != keys[0]).any(axis=0))[0]
     if len(varying) == 1:  # (one column: numpy's own unique)
         _, first, inverse = np.unique(keys[:, varying[0]], return_index=True, return_inverse=True)

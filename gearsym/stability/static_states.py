@@ -26,15 +26,36 @@ DRIVE, GAP, BACK, EDGE = "drive flank", "gap", "back flank", "edge of contact"
 
 @dataclass(frozen=True)
 class StaticStates:
-    """Per point: the static state (NaN where none was found), whether it was found, and each mesh's deflection
-    and flank (``EDGE``: the deflection sits on a corner of g, 0 or -eta: linearised with g's slope 1); and how
-    many of the points found are on each flank, per mesh."""
+    """The static states of many points, solved once per distinct value of the parameters they depend on: per
+    distinct value (``index``: each point's), the static state (NaN where none was found), whether it was found,
+    and each mesh's deflection and flank (``EDGE``: the deflection sits on a corner of g, 0 or -eta: linearised
+    with g's slope 1); and how many of the points found are on each flank, per mesh. Per point: :attr:`states`,
+    :attr:`found`, :meth:`deflection`, :meth:`flank`."""
 
-    states: np.ndarray  # (points, n)
-    found: np.ndarray  # (points,)
-    deflection: dict[str, np.ndarray]
-    flank: dict[str, np.ndarray]
+    distinct_states: np.ndarray  # (distinct values, n)
+    distinct_found: np.ndarray  # (distinct values,)
+    index: np.ndarray  # (points,)
+    distinct_deflection: dict[str, np.ndarray]
+    distinct_flank: dict[str, np.ndarray]
     flank_counts: dict[str, dict[str, int]]
+
+    @property
+    def states(self) -> np.ndarray:
+        """(points, n)"""
+        return self.distinct_states[self.index]
+
+    @property
+    def found(self) -> np.ndarray:
+        """(points,)"""
+        if len(self.distinct_found) == 1:  # (a chart across parameters the static state does not depend on)
+            return np.full(len(self.index), bool(self.distinct_found[0]))
+        return self.distinct_found[self.index]
+
+    def deflection(self, mesh: str) -> np.ndarray:
+        return self.distinct_deflection[mesh][self.index]
+
+    def flank(self, mesh: str) -> np.ndarray:
+        return self.distinct_flank[mesh][self.index]
 
 
 def solve_static(recipe: StaticRecipe, names: tuple[str, ...], p: np.ndarray) -> StaticStates:
@@ -43,7 +64,7 @@ def solve_static(recipe: StaticRecipe, names: tuple[str, ...], p: np.ndarray) ->
     columns = [names.index(name) for name in recipe.depends]
     distinct, _, index = distinct_rows(p[:, columns])
     if points == 0:
-        return StaticStates(np.zeros((0, len(recipe.states))), np.zeros(0, dtype=bool), {}, {}, {})
+        return StaticStates(np.zeros((0, len(recipe.states))), np.zeros(0, dtype=bool), index, {}, {}, {})
     u, U = len(recipe.unknowns), distinct.shape[0]
     evaluate = _function(recipe.function).map(U)
     y = np.zeros((U, u))
@@ -68,7 +89,7 @@ def solve_static(recipe: StaticRecipe, names: tuple[str, ...], p: np.ndarray) ->
     states[~done] = np.nan
     contact = np.array(contact).reshape(len(recipe.meshes), U) if recipe.meshes else np.zeros((0, U))
     eta = np.array(eta).reshape(len(recipe.meshes), U) if recipe.meshes else np.zeros((0, U))
-    deflection = {m: contact[k][index] for k, m in enumerate(recipe.meshes)}
+    deflection = {m: contact[k] for k, m in enumerate(recipe.meshes)}
     flanks = {m: _flanks(contact[k], eta[k]) for k, m in enumerate(recipe.meshes)}
     weight = np.bincount(index, minlength=U) * done  # (points found, per distinct value)
     counts = {}
@@ -76,7 +97,7 @@ def solve_static(recipe: StaticRecipe, names: tuple[str, ...], p: np.ndarray) ->
         counts[m] = {}
         for k in np.nonzero(weight)[0]:
             counts[m][f[k]] = counts[m].get(f[k], 0) + int(weight[k])
-    return StaticStates(states[index], done[index], deflection, {m: f[index] for m, f in flanks.items()}, counts)
+    return StaticStates(states, done, index, deflection, flanks, counts)
 
 
 @lru_cache(maxsize=16)

@@ -19,8 +19,8 @@ from __future__ import annotations
 import csv
 import io
 import json
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -31,15 +31,36 @@ from ..checks import json_safe
 from ..codegen import CompiledModel, engine_verb
 from ..errors import GearsymError, UnknownParameterError
 from ..files.atomic import write_atomically
-from ..options import Integration
+from ..options import Execution, Integration
 from ..version import __version__
-from .store import number, read_rows, release_lock, sidecar, take_lock
+from ..files.lock import release_lock, take_lock
+from .store import number, read_rows, sidecar
 
 #: two attractors at neighbouring values are one when their Poincare sets are within this distance (in units of
 #: the spread of all points, as the basin maps scale them)
 MATCH_DISTANCE = 0.5
 #: what happens to an attractor at a value
 CONTINUES, APPEARS, MERGES, VANISHES = "continues", "appears", "merges", "vanishes"
+
+
+class StartGrid:
+    """The starts of a continuation's basin maps: ``values`` ({state: values} for two states) at every value of
+    the parameter, and how they were ``given`` (for the record: e.g. the command line's ``x=-5:5:0.1``; by
+    default the values themselves). A grid whose engine values move with the parameter (a grid in physical
+    units, whose rates' unit moves with the speed) is a subclass that overrides :meth:`at`."""
+
+    def __init__(self, values: Mapping[str, Sequence[float]], given: Sequence[str] = ()):
+        self.values, self.given = values, tuple(given)
+
+    def at(self, point: Mapping[str, float]) -> Mapping[str, Sequence[float]]:
+        """The grid at the parameter values ``point``."""
+        return self.values
+
+    def record(self, point: Mapping[str, float]) -> list | dict:
+        """How the grid stands in the continuation's record (at the first value ``point``)."""
+        if self.given:
+            return list(self.given)
+        return {k: np.asarray(v, dtype=float).tolist() for k, v in self.at(point).items()}
 
 
 @dataclass(frozen=True)
@@ -104,17 +125,19 @@ def _row_dict(r: Tracked, parameter: str) -> dict:
 
 
 @engine_verb(default=Integration(**RUN))
-def continue_basins(model: CompiledModel, grid, parameter: str, values: Sequence[float], *,
-                    options: Integration | None = None, y0=None, out: str | Path | None = None,
-                    overwrite: bool | str = False, jobs: int = 0, lanes: bool = True,
-                    match_distance: float = MATCH_DISTANCE, grid_spec: Sequence[str] = (), progress: bool = False,
-                    on_value: Callable[[BasinMap], None] | None = None, **fixed: float) -> BasinContinuation:
+def continue_basins(model: CompiledModel, grid: Mapping[str, Sequence[float]] | StartGrid, parameter: str,
+                    values: Sequence[float], *, options: Integration | None = None, y0=None,
+                    out: str | Path | None = None, overwrite: bool | str = False, execution: Execution | None = None,
+                    match_distance: float = MATCH_DISTANCE, on_value: Callable[[BasinMap], None] | None = None,
+                    **fixed: float) -> BasinContinuation:
     """Basin maps of ``model`` on ``grid`` at each of ``values`` of ``parameter`` (ascending), their attractors
     matched from one value to the next (module docstring). ``grid``: {state: values} for two states, or a
-    function of the parameter values giving it (a grid in physical units whose engine values move with the
-    speed); ``grid_spec``: how the grid was given, for the record. ``out``: write the files as values finish and
-    resume them (``overwrite``: start again). ``on_value(map)`` is called after each value is stored."""
+    :class:`StartGrid` (one that moves with the parameter, or says how it was given). ``out``: write the files as
+    values finish and resume them (``overwrite``: start again). ``execution``: the maps' threads and lanes, and
+    with ``progress`` a line per value. ``on_value(map)`` is called after each value is stored."""
     options = model.run_options(options)
+    execution = execution or Execution()
+    grid = grid if isinstance(grid, StartGrid) else StartGrid(grid)
     if parameter not in model.parameter_names:
         raise UnknownParameterError(parameter, model.parameter_names, f"{model.name}: --param")
     if parameter in fixed:
@@ -126,11 +149,9 @@ def continue_basins(model: CompiledModel, grid, parameter: str, values: Sequence
         model.parameter_vector(fixed, **{parameter: v})  # every value checked before any run
     if not (np.isfinite(match_distance) and match_distance > 0):
         raise GearsymError(f"match_distance must be a positive number, got {match_distance!r}")
-    grid_at = grid if callable(grid) else (lambda point: grid)
-    first = {k: np.asarray(v, dtype=float).tolist() for k, v in grid_at({**fixed, parameter: values[0]}).items()}
     record = {"model": model.name, "model_hash": model.hash, "backend": model.backend, "parameter": parameter,
               "values": list(values), "settings": {k: float(v) for k, v in fixed.items()},
-              "grid": grid_spec and list(grid_spec) or first, "initial_state": dict(zip(
+              "grid": grid.record({**fixed, parameter: values[0]}), "initial_state": dict(zip(
                   model.state_names, map(float, model.initial_state(y0)))), "periods": options.periods,
               "discard": options.discard, "steps_per_period": model.steps_per_period,
               "locate_crossings": model.options.locate_crossings, "match_distance": float(match_distance),
@@ -144,10 +165,10 @@ def continue_basins(model: CompiledModel, grid, parameter: str, values: Sequence
         for value in values:
             if value in done:
                 continue
-            if progress:
-                print(f"gearsym: basins at {parameter}={value:g}", flush=True)
+            execution.say(f"basins at {parameter}={value:g}")
             point = {**fixed, parameter: value}
-            found = basin_map(model, grid_at(point), options=options, y0=y0, jobs=jobs, lanes=lanes, **point)
+            found = basin_map(model, grid.at(point), options=options, y0=y0,
+                              execution=replace(execution, progress=False), **point)
             tracked = track(found, value, previous, match_distance, _next_id(rows))
             rows += tracked
             done.append(value)

@@ -101,7 +101,7 @@ def _check_alive(procs: list) -> None:
         raise GearsymError(f"a sweep worker process died (exit code {dead.exitcode}); the points finished so far "
                            f"are kept: repeat the {'command' if caller.on_command_line() else 'call'} with "
                            + ("--parallel threads" if caller.on_command_line()
-                              else 'workers=Workers(parallel="threads")')
+                              else 'execution=Execution(parallel="threads")')
                            + " to resume")
 
 

@@ -21,7 +21,7 @@ from ..checks import run_bytes_per_period, whole_number
 from ..codegen import CompiledModel, engine_verb
 from ..errors import GearsymError, UnknownParameterError
 from ..memory import check_fits
-from ..options import Integration
+from ..options import Execution, Integration
 from ..version import __version__
 from .distributed import execute_on_dask
 from .grid import axes_from, Axis, INDEPENDENT, plan, Point, points
@@ -57,10 +57,8 @@ def run_sweep(
     out: str | Path | None = None,
     overwrite: bool | str = False,
     poincare: int = POINCARE_SAMPLES,
-    workers: Workers = Workers(),
-    progress: bool = True,
+    execution: Execution | None = None,
     on_point: Callable[[dict], None] | None = None,
-    lanes: bool = False,
     **values: float,
 ) -> SweepResult:
     """Sweep ``model`` over ``axes`` (``{"omega": values}`` or ``["omega=0.1:2.0:0.01", ...]``).
@@ -71,14 +69,16 @@ def run_sweep(
     along the first axis (the paper's procedure), ``"independent"`` starts every point from ``y0``
     (default: the model's declared initial state). ``out``: write ``out`` (CSV), its ``.json`` record and
     ``.poincare.csv`` as points finish, resuming if they exist (``overwrite=True``: starting again;
-    ``"stale"``: starting again only files another sweep or model wrote). ``workers``: where the points run
-    (:class:`Workers`). ``on_point(row)`` is called in the main thread after each point is stored.
-    ``lanes``: independent points run L at a time in the lanes (:mod:`gearsym.codegen.lane_runs`: each lane with
-    its point's tables and constants), each giving the scalar loop's numbers (to the bit without fused
-    multiply-adds; with them, to rounding); off by default, so that a sweep's files stay those of the scalar loops
-    wherever it runs.
+    ``"stale"``: starting again only files another sweep or model wrote). ``execution``: where the points run
+    (its jobs, parallel, scheduler), a progress bar, and with ``lanes`` independent points L at a time in the lanes
+    (:mod:`gearsym.codegen.lane_runs`: each lane with its point's tables and constants), each giving the scalar
+    loop's numbers (to the bit without fused multiply-adds; with them, to rounding); off by default, so that a
+    sweep's files stay those of the scalar loops wherever it runs. ``on_point(row)`` is called in the main thread
+    after each point is stored.
     """
     options = model.run_options(options)
+    execution = execution or Execution()
+    workers, lanes, progress = Workers.of(execution), execution.with_lanes(False), bool(execution.progress)
     plan = _SweepPlan.make(model, axes, options, mode, direction, y0, poincare, values)
     at_once = 1 if workers.scheduler is not None else min(workers.count, len(plan.points))
     if at_once > 1:  # each worker holds the records of a point

@@ -1,5 +1,5 @@
-"""Where a sweep's points run: :class:`Workers` (processes, threads or a Dask cluster) and the cores this
-process may use."""
+"""Where a sweep's points run: :class:`Workers` (processes, threads or a Dask cluster, as the call's
+:class:`~gearsym.options.Execution` says) and the cores this process may use."""
 from __future__ import annotations
 
 import multiprocessing
@@ -9,10 +9,8 @@ from dataclasses import dataclass
 from .. import caller
 from ..checks import whole_number
 from ..errors import GearsymError, warn
+from ..options import PARALLEL, Execution
 from .distributed import check_scheduler
-
-#: ways to use more than one core of this machine (``run_sweep(parallel=...)``)
-PARALLEL = ("auto", "processes", "threads")
 
 
 def cores() -> int:
@@ -49,6 +47,12 @@ class Workers:
             warn(f"{caller.option('jobs', jobs)}: this machine has {here} core{'s' if here > 1 else ''}; running "
                  f"{here} worker{'s' if here > 1 else ''} (more would only share them)")
             object.__setattr__(self, "jobs", here)
+
+    @classmethod
+    def of(cls, execution: Execution) -> "Workers":
+        """Where the points of a sweep run with ``execution``: its jobs, parallel and scheduler (checked here,
+        before any work: no Dask, a bad address, more jobs than cores)."""
+        return cls(execution.jobs, execution.parallel, execution.scheduler)
 
     @property
     def count(self) -> int:

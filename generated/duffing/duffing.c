@@ -175,6 +175,403 @@ static const casadi_real casadi_c0[401] =
   392., 393., 394., 395., 396., 397., 398., 399.,
   400.};
 
+/* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
+#if defined(__GNUC__)
+#define GEARSYM_INLINE inline __attribute__((always_inline))
+#define GEARSYM_NOINLINE __attribute__((noinline))
+#define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
+/* a loop left to the vectoriser (gcc unrolls a loop of 2 iterations before it, which then stays scalar) */
+#define GEARSYM_NOT_UNROLLED _Pragma("GCC unroll 1")
+#else
+#define GEARSYM_INLINE inline
+#define GEARSYM_NOINLINE
+#define GEARSYM_UNLIKELY(x) (x)
+#define GEARSYM_NOT_UNROLLED
+#endif
+
+static const casadi_real gs_zeros[600] = {0.};
+
+/* an input as CasADi passes it (a null pointer: zeros) into a local array */
+static inline void gs_load(const casadi_real* x, casadi_int n, casadi_real* y) {
+  casadi_int i;
+  for (i = 0; i < n; ++i) y[i] = x ? x[i] : 0;
+}
+
+static inline void gs_copy(const casadi_real* restrict x, casadi_int n, casadi_real* restrict y) {
+  casadi_int i;
+  for (i = 0; i < n; ++i) y[i] = x[i];
+}
+
+/* the n x n matrix x transposed into y (tangent vectors: from columns to side by side and back) */
+static inline void gs_transpose(const casadi_real* restrict x, casadi_int n, casadi_real* restrict y) {
+  casadi_int i, j;
+  for (i = 0; i < n; ++i) for (j = 0; j < n; ++j) y[j * n + i] = x[i * n + j];
+}
+
+/* an output column (none if the caller passes a null pointer) */
+static inline void gs_store(const casadi_real* x, casadi_int n, casadi_real* y, casadi_int at) {
+  casadi_int i;
+  if (y) for (i = 0; i < n; ++i) y[at + i] = x[i];
+}
+
+/* tangent_state, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_state_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3, casadi_int S) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17;
+  a00=A0[0];
+  a01=A4[S*3];
+  a02=6.;
+  a02=(a01/a02);
+  a03=A0[S*1];
+  a04=2.;
+  a04=(a01/a04);
+  a05=A4[S*1];
+  a06=(a03*a05);
+  a06=(a06-a00);
+  a07=A4[S*2];
+  a08=A3[0];
+  a08=(a07*a08);
+  a06=(a06+a08);
+  a08=A4[0];
+  a09=casadi_sq(a00);
+  a10=(a00*a09);
+  a10=(a08*a10);
+  a06=(a06+a10);
+  a10=(a04*a06);
+  a10=(a03+a10);
+  a11=(2.*a10);
+  a11=(a03+a11);
+  a12=(a10*a05);
+  a13=(a04*a03);
+  a13=(a00+a13);
+  a12=(a12-a13);
+  a14=A3[S*1];
+  a14=(a07*a14);
+  a12=(a12+a14);
+  a15=casadi_sq(a13);
+  a16=(a13*a15);
+  a16=(a08*a16);
+  a12=(a12+a16);
+  a16=(a04*a12);
+  a16=(a03+a16);
+  a17=(2.*a16);
+  a11=(a11+a17);
+  a17=(a16*a05);
+  a04=(a04*a10);
+  a04=(a00+a04);
+  a17=(a17-a04);
+  a17=(a17+a14);
+  a14=casadi_sq(a04);
+  a10=(a04*a14);
+  a10=(a08*a10);
+  a17=(a17+a10);
+  a10=(a01*a17);
+  a10=(a03+a10);
+  a11=(a11+a10);
+  a11=(a02*a11);
+  a11=(a00+a11);
+  R0[0]=a11;
+  a12=(2.*a12);
+  a06=(a06+a12);
+  a17=(2.*a17);
+  a06=(a06+a17);
+  a10=(a10*a05);
+  a01=(a01*a16);
+  a01=(a00+a01);
+  a10=(a10-a01);
+  a16=A3[S*2];
+  a07=(a07*a16);
+  a10=(a10+a07);
+  a07=casadi_sq(a01);
+  a16=(a01*a07);
+  a16=(a08*a16);
+  a10=(a10+a16);
+  a06=(a06+a10);
+  a02=(a02*a06);
+  a03=(a03+a02);
+  R0[S*1]=a03;
+  a02=A1[0];
+  a06=(a11<a02);
+  a10=(a06?a11:0);
+  a06=(!a06);
+  a06=(a06?a02:0);
+  a10=(a10+a06);
+  R1[0]=a10;
+  a10=A1[S*1];
+  a06=(a03<a10);
+  a02=(a06?a03:0);
+  a06=(!a06);
+  a06=(a06?a10:0);
+  a02=(a02+a06);
+  R1[S*1]=a02;
+  a02=A2[0];
+  a06=(a02<a11);
+  a11=(a06?a11:0);
+  a06=(!a06);
+  a06=(a06?a02:0);
+  a11=(a11+a06);
+  R2[0]=a11;
+  a11=A2[S*1];
+  a06=(a11<a03);
+  a03=(a06?a03:0);
+  a06=(!a06);
+  a06=(a06?a11:0);
+  a03=(a03+a06);
+  R2[S*1]=a03;
+  a03=-1.;
+  a06=(2.*a00);
+  a00=(a00*a06);
+  a09=(a09+a00);
+  a09=(a08*a09);
+  a09=(a03+a09);
+  R3[0]=a09;
+  R3[S*1]=a05;
+  a05=(2.*a13);
+  a13=(a13*a05);
+  a15=(a15+a13);
+  a15=(a08*a15);
+  a15=(a03+a15);
+  R3[S*2]=a15;
+  a15=(2.*a04);
+  a04=(a04*a15);
+  a14=(a14+a04);
+  a14=(a08*a14);
+  a14=(a03+a14);
+  R3[S*3]=a14;
+  a14=(2.*a01);
+  a01=(a01*a14);
+  a07=(a07+a01);
+  a08=(a08*a07);
+  a03=(a03+a08);
+  R3[S*4]=a03;
+}
+static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3) { gs_tangent_state_strided(A0, A1, A2, A3, A4, R0, R1, R2, R3, 1); }
+
+/* tangent_vector, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_vector_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_int S) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  a00=A0[0];
+  a01=A2[S*3];
+  a02=6.;
+  a02=(a01/a02);
+  a03=A0[S*2];
+  a04=2.;
+  a04=(a01/a04);
+  a05=A1[0];
+  a05=(a05*a00);
+  a06=A1[S*1];
+  a07=(a06*a03);
+  a05=(a05+a07);
+  a07=(a04*a05);
+  a07=(a03+a07);
+  a08=(2.*a07);
+  a08=(a03+a08);
+  a09=A1[S*2];
+  a10=(a04*a03);
+  a10=(a00+a10);
+  a09=(a09*a10);
+  a10=(a06*a07);
+  a09=(a09+a10);
+  a10=(a04*a09);
+  a10=(a03+a10);
+  a11=(2.*a10);
+  a08=(a08+a11);
+  a11=A1[S*3];
+  a04=(a04*a07);
+  a04=(a00+a04);
+  a11=(a11*a04);
+  a04=(a06*a10);
+  a11=(a11+a04);
+  a04=(a01*a11);
+  a04=(a03+a04);
+  a08=(a08+a04);
+  a08=(a02*a08);
+  a08=(a00+a08);
+  R0[0]=a08;
+  a09=(2.*a09);
+  a05=(a05+a09);
+  a11=(2.*a11);
+  a05=(a05+a11);
+  a11=A1[S*4];
+  a01=(a01*a10);
+  a00=(a00+a01);
+  a11=(a11*a00);
+  a06=(a06*a04);
+  a11=(a11+a06);
+  a05=(a05+a11);
+  a02=(a02*a05);
+  a03=(a03+a02);
+  R0[S*2]=a03;
+}
+static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) { gs_tangent_vector_strided(A0, A1, A2, R0, 1); }
+
+/* state_block, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_block_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14;
+  a00=A0[0];
+  a01=A4[S*3];
+  a02=6.;
+  a02=(a01/a02);
+  a03=A0[S*1];
+  a04=2.;
+  a04=(a01/a04);
+  a05=A4[S*1];
+  a06=(a03*a05);
+  a06=(a06-a00);
+  a07=A4[S*2];
+  a08=A3[0];
+  a08=(a07*a08);
+  a06=(a06+a08);
+  a08=A4[0];
+  a09=casadi_sq(a00);
+  a09=(a00*a09);
+  a09=(a08*a09);
+  a06=(a06+a09);
+  a09=(a04*a06);
+  a09=(a03+a09);
+  a10=(2.*a09);
+  a10=(a03+a10);
+  a11=(a09*a05);
+  a12=(a04*a03);
+  a12=(a00+a12);
+  a11=(a11-a12);
+  a13=A3[S*1];
+  a13=(a07*a13);
+  a11=(a11+a13);
+  a14=casadi_sq(a12);
+  a12=(a12*a14);
+  a12=(a08*a12);
+  a11=(a11+a12);
+  a12=(a04*a11);
+  a12=(a03+a12);
+  a14=(2.*a12);
+  a10=(a10+a14);
+  a14=(a12*a05);
+  a04=(a04*a09);
+  a04=(a00+a04);
+  a14=(a14-a04);
+  a14=(a14+a13);
+  a13=casadi_sq(a04);
+  a04=(a04*a13);
+  a04=(a08*a04);
+  a14=(a14+a04);
+  a04=(a01*a14);
+  a04=(a03+a04);
+  a10=(a10+a04);
+  a10=(a02*a10);
+  a10=(a00+a10);
+  R0[0]=a10;
+  a11=(2.*a11);
+  a06=(a06+a11);
+  a14=(2.*a14);
+  a06=(a06+a14);
+  a04=(a04*a05);
+  a01=(a01*a12);
+  a00=(a00+a01);
+  a04=(a04-a00);
+  a01=A3[S*2];
+  a07=(a07*a01);
+  a04=(a04+a07);
+  a07=casadi_sq(a00);
+  a00=(a00*a07);
+  a08=(a08*a00);
+  a04=(a04+a08);
+  a06=(a06+a04);
+  a02=(a02*a06);
+  a03=(a03+a02);
+  R0[S*1]=a03;
+  a02=A1[0];
+  a06=(a10<a02);
+  a04=(a06?a10:0);
+  a06=(!a06);
+  a06=(a06?a02:0);
+  a04=(a04+a06);
+  R1[0]=a04;
+  a04=A1[S*1];
+  a06=(a03<a04);
+  a02=(a06?a03:0);
+  a06=(!a06);
+  a06=(a06?a04:0);
+  a02=(a02+a06);
+  R1[S*1]=a02;
+  a02=A2[0];
+  a06=(a02<a10);
+  a10=(a06?a10:0);
+  a06=(!a06);
+  a06=(a06?a02:0);
+  a10=(a10+a06);
+  R2[0]=a10;
+  a10=A2[S*1];
+  a06=(a10<a03);
+  a03=(a06?a03:0);
+  a06=(!a06);
+  a06=(a06?a10:0);
+  a03=(a03+a06);
+  R2[S*1]=a03;
+}
+static GEARSYM_INLINE void gs_state_block(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_state_block_strided(A0, A1, A2, A3, A4, R0, R1, R2, 1); }
+
+/* gram_schmidt, from CasADi's C of it */
+static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
+  casadi_real a0, a1, a2, a3, a4, a5, a6;
+  a0=A0[0];
+  a1=casadi_sq(a0);
+  a2=A0[1];
+  a3=casadi_sq(a2);
+  a1=(a1+a3);
+  a1=sqrt(a1);
+  a0=(a0/a1);
+  R0[0]=a0;
+  a2=(a2/a1);
+  R0[1]=a2;
+  a3=A0[2];
+  a4=(a0*a3);
+  a5=A0[3];
+  a6=(a2*a5);
+  a4=(a4+a6);
+  a0=(a4*a0);
+  a3=(a3-a0);
+  a0=casadi_sq(a3);
+  a4=(a4*a2);
+  a5=(a5-a4);
+  a4=casadi_sq(a5);
+  a0=(a0+a4);
+  a0=sqrt(a0);
+  a3=(a3/a0);
+  R0[2]=a3;
+  a5=(a5/a0);
+  R0[3]=a5;
+  a1=log(a1);
+  R1[0]=a1;
+  a0=log(a0);
+  R1[1]=a0;
+}
+
+/* constants, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_constants_strided(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
+  casadi_real a0, a1;
+  a0=A0[S*1];
+  a0=(-a0);
+  R0[0]=a0;
+  a0=-2.;
+  a1=A0[0];
+  a0=(a0*a1);
+  R0[S*1]=a0;
+  a0=A0[S*2];
+  R0[S*2]=a0;
+  a0=3.1415926535897934e-02;
+  a1=A0[S*3];
+  a0=(a0/a1);
+  R0[S*3]=a0;
+  a0=6.2831853071795862e+00;
+  a0=(a0/a1);
+  R1[0]=a0;
+}
+static GEARSYM_INLINE void gs_constants(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) { gs_constants_strided(A0, R0, R1, 1); }
+
+#ifndef GEARSYM_STEP_PIECES_ONLY  /* (the lanes' C includes the pieces above) */
+
 /* rhs:(t,y[2],p[4])->(dy[2]) */
 static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a0, a1, a2, a3;
@@ -628,376 +1025,6 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
   return 0;
 }
 
-/* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
-#if defined(__GNUC__)
-#define GEARSYM_INLINE inline __attribute__((always_inline))
-#define GEARSYM_NOINLINE __attribute__((noinline))
-#define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
-/* a loop left to the vectoriser (gcc unrolls a loop of 2 iterations before it, which then stays scalar) */
-#define GEARSYM_NOT_UNROLLED _Pragma("GCC unroll 1")
-#else
-#define GEARSYM_INLINE inline
-#define GEARSYM_NOINLINE
-#define GEARSYM_UNLIKELY(x) (x)
-#define GEARSYM_NOT_UNROLLED
-#endif
-
-static const casadi_real gs_zeros[600] = {0.};
-
-/* an input as CasADi passes it (a null pointer: zeros) into a local array */
-static inline void gs_load(const casadi_real* x, casadi_int n, casadi_real* y) {
-  casadi_int i;
-  for (i = 0; i < n; ++i) y[i] = x ? x[i] : 0;
-}
-
-static inline void gs_copy(const casadi_real* restrict x, casadi_int n, casadi_real* restrict y) {
-  casadi_int i;
-  for (i = 0; i < n; ++i) y[i] = x[i];
-}
-
-/* the n x n matrix x transposed into y (tangent vectors: from columns to side by side and back) */
-static inline void gs_transpose(const casadi_real* restrict x, casadi_int n, casadi_real* restrict y) {
-  casadi_int i, j;
-  for (i = 0; i < n; ++i) for (j = 0; j < n; ++j) y[j * n + i] = x[i * n + j];
-}
-
-/* an output column (none if the caller passes a null pointer) */
-static inline void gs_store(const casadi_real* x, casadi_int n, casadi_real* y, casadi_int at) {
-  casadi_int i;
-  if (y) for (i = 0; i < n; ++i) y[at + i] = x[i];
-}
-
-/* tangent_state, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17;
-  a00=A0[0];
-  a01=A4[3];
-  a02=6.;
-  a02=(a01/a02);
-  a03=A0[1];
-  a04=2.;
-  a04=(a01/a04);
-  a05=A4[1];
-  a06=(a03*a05);
-  a06=(a06-a00);
-  a07=A4[2];
-  a08=A3[0];
-  a08=(a07*a08);
-  a06=(a06+a08);
-  a08=A4[0];
-  a09=casadi_sq(a00);
-  a10=(a00*a09);
-  a10=(a08*a10);
-  a06=(a06+a10);
-  a10=(a04*a06);
-  a10=(a03+a10);
-  a11=(2.*a10);
-  a11=(a03+a11);
-  a12=(a10*a05);
-  a13=(a04*a03);
-  a13=(a00+a13);
-  a12=(a12-a13);
-  a14=A3[1];
-  a14=(a07*a14);
-  a12=(a12+a14);
-  a15=casadi_sq(a13);
-  a16=(a13*a15);
-  a16=(a08*a16);
-  a12=(a12+a16);
-  a16=(a04*a12);
-  a16=(a03+a16);
-  a17=(2.*a16);
-  a11=(a11+a17);
-  a17=(a16*a05);
-  a04=(a04*a10);
-  a04=(a00+a04);
-  a17=(a17-a04);
-  a17=(a17+a14);
-  a14=casadi_sq(a04);
-  a10=(a04*a14);
-  a10=(a08*a10);
-  a17=(a17+a10);
-  a10=(a01*a17);
-  a10=(a03+a10);
-  a11=(a11+a10);
-  a11=(a02*a11);
-  a11=(a00+a11);
-  R0[0]=a11;
-  a12=(2.*a12);
-  a06=(a06+a12);
-  a17=(2.*a17);
-  a06=(a06+a17);
-  a10=(a10*a05);
-  a01=(a01*a16);
-  a01=(a00+a01);
-  a10=(a10-a01);
-  a16=A3[2];
-  a07=(a07*a16);
-  a10=(a10+a07);
-  a07=casadi_sq(a01);
-  a16=(a01*a07);
-  a16=(a08*a16);
-  a10=(a10+a16);
-  a06=(a06+a10);
-  a02=(a02*a06);
-  a03=(a03+a02);
-  R0[1]=a03;
-  a02=A1[0];
-  a06=(a11<a02);
-  a10=(a06?a11:0);
-  a06=(!a06);
-  a06=(a06?a02:0);
-  a10=(a10+a06);
-  R1[0]=a10;
-  a10=A1[1];
-  a06=(a03<a10);
-  a02=(a06?a03:0);
-  a06=(!a06);
-  a06=(a06?a10:0);
-  a02=(a02+a06);
-  R1[1]=a02;
-  a02=A2[0];
-  a06=(a02<a11);
-  a11=(a06?a11:0);
-  a06=(!a06);
-  a06=(a06?a02:0);
-  a11=(a11+a06);
-  R2[0]=a11;
-  a11=A2[1];
-  a06=(a11<a03);
-  a03=(a06?a03:0);
-  a06=(!a06);
-  a06=(a06?a11:0);
-  a03=(a03+a06);
-  R2[1]=a03;
-  a03=-1.;
-  a06=(2.*a00);
-  a00=(a00*a06);
-  a09=(a09+a00);
-  a09=(a08*a09);
-  a09=(a03+a09);
-  R3[0]=a09;
-  R3[1]=a05;
-  a05=(2.*a13);
-  a13=(a13*a05);
-  a15=(a15+a13);
-  a15=(a08*a15);
-  a15=(a03+a15);
-  R3[2]=a15;
-  a15=(2.*a04);
-  a04=(a04*a15);
-  a14=(a14+a04);
-  a14=(a08*a14);
-  a14=(a03+a14);
-  R3[3]=a14;
-  a14=(2.*a01);
-  a01=(a01*a14);
-  a07=(a07+a01);
-  a08=(a08*a07);
-  a03=(a03+a08);
-  R3[4]=a03;
-}
-
-/* tangent_vector, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  a00=A0[0];
-  a01=A2[3];
-  a02=6.;
-  a02=(a01/a02);
-  a03=A0[2];
-  a04=2.;
-  a04=(a01/a04);
-  a05=A1[0];
-  a05=(a05*a00);
-  a06=A1[1];
-  a07=(a06*a03);
-  a05=(a05+a07);
-  a07=(a04*a05);
-  a07=(a03+a07);
-  a08=(2.*a07);
-  a08=(a03+a08);
-  a09=A1[2];
-  a10=(a04*a03);
-  a10=(a00+a10);
-  a09=(a09*a10);
-  a10=(a06*a07);
-  a09=(a09+a10);
-  a10=(a04*a09);
-  a10=(a03+a10);
-  a11=(2.*a10);
-  a08=(a08+a11);
-  a11=A1[3];
-  a04=(a04*a07);
-  a04=(a00+a04);
-  a11=(a11*a04);
-  a04=(a06*a10);
-  a11=(a11+a04);
-  a04=(a01*a11);
-  a04=(a03+a04);
-  a08=(a08+a04);
-  a08=(a02*a08);
-  a08=(a00+a08);
-  R0[0]=a08;
-  a09=(2.*a09);
-  a05=(a05+a09);
-  a11=(2.*a11);
-  a05=(a05+a11);
-  a11=A1[4];
-  a01=(a01*a10);
-  a00=(a00+a01);
-  a11=(a11*a00);
-  a06=(a06*a04);
-  a11=(a11+a06);
-  a05=(a05+a11);
-  a02=(a02*a05);
-  a03=(a03+a02);
-  R0[2]=a03;
-}
-
-/* state_block, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_block(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14;
-  a00=A0[0];
-  a01=A4[3];
-  a02=6.;
-  a02=(a01/a02);
-  a03=A0[1];
-  a04=2.;
-  a04=(a01/a04);
-  a05=A4[1];
-  a06=(a03*a05);
-  a06=(a06-a00);
-  a07=A4[2];
-  a08=A3[0];
-  a08=(a07*a08);
-  a06=(a06+a08);
-  a08=A4[0];
-  a09=casadi_sq(a00);
-  a09=(a00*a09);
-  a09=(a08*a09);
-  a06=(a06+a09);
-  a09=(a04*a06);
-  a09=(a03+a09);
-  a10=(2.*a09);
-  a10=(a03+a10);
-  a11=(a09*a05);
-  a12=(a04*a03);
-  a12=(a00+a12);
-  a11=(a11-a12);
-  a13=A3[1];
-  a13=(a07*a13);
-  a11=(a11+a13);
-  a14=casadi_sq(a12);
-  a12=(a12*a14);
-  a12=(a08*a12);
-  a11=(a11+a12);
-  a12=(a04*a11);
-  a12=(a03+a12);
-  a14=(2.*a12);
-  a10=(a10+a14);
-  a14=(a12*a05);
-  a04=(a04*a09);
-  a04=(a00+a04);
-  a14=(a14-a04);
-  a14=(a14+a13);
-  a13=casadi_sq(a04);
-  a04=(a04*a13);
-  a04=(a08*a04);
-  a14=(a14+a04);
-  a04=(a01*a14);
-  a04=(a03+a04);
-  a10=(a10+a04);
-  a10=(a02*a10);
-  a10=(a00+a10);
-  R0[0]=a10;
-  a11=(2.*a11);
-  a06=(a06+a11);
-  a14=(2.*a14);
-  a06=(a06+a14);
-  a04=(a04*a05);
-  a01=(a01*a12);
-  a00=(a00+a01);
-  a04=(a04-a00);
-  a01=A3[2];
-  a07=(a07*a01);
-  a04=(a04+a07);
-  a07=casadi_sq(a00);
-  a00=(a00*a07);
-  a08=(a08*a00);
-  a04=(a04+a08);
-  a06=(a06+a04);
-  a02=(a02*a06);
-  a03=(a03+a02);
-  R0[1]=a03;
-  a02=A1[0];
-  a06=(a10<a02);
-  a04=(a06?a10:0);
-  a06=(!a06);
-  a06=(a06?a02:0);
-  a04=(a04+a06);
-  R1[0]=a04;
-  a04=A1[1];
-  a06=(a03<a04);
-  a02=(a06?a03:0);
-  a06=(!a06);
-  a06=(a06?a04:0);
-  a02=(a02+a06);
-  R1[1]=a02;
-  a02=A2[0];
-  a06=(a02<a10);
-  a10=(a06?a10:0);
-  a06=(!a06);
-  a06=(a06?a02:0);
-  a10=(a10+a06);
-  R2[0]=a10;
-  a10=A2[1];
-  a06=(a10<a03);
-  a03=(a06?a03:0);
-  a06=(!a06);
-  a06=(a06?a10:0);
-  a03=(a03+a06);
-  R2[1]=a03;
-}
-
-/* gram_schmidt, from CasADi's C of it */
-static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
-  casadi_real a0, a1, a2, a3, a4, a5, a6;
-  a0=A0[0];
-  a1=casadi_sq(a0);
-  a2=A0[1];
-  a3=casadi_sq(a2);
-  a1=(a1+a3);
-  a1=sqrt(a1);
-  a0=(a0/a1);
-  R0[0]=a0;
-  a2=(a2/a1);
-  R0[1]=a2;
-  a3=A0[2];
-  a4=(a0*a3);
-  a5=A0[3];
-  a6=(a2*a5);
-  a4=(a4+a6);
-  a0=(a4*a0);
-  a3=(a3-a0);
-  a0=casadi_sq(a3);
-  a4=(a4*a2);
-  a5=(a5-a4);
-  a4=casadi_sq(a5);
-  a0=(a0+a4);
-  a0=sqrt(a0);
-  a3=(a3/a0);
-  R0[2]=a3;
-  a5=(a5/a0);
-  R0[3]=a5;
-  a1=log(a1);
-  R1[0]=a1;
-  a0=log(a0);
-  R1[1]=a0;
-}
-
 /* one block of tangent steps (the SX functions' step, as CasADi's Switch runs it) */
 static GEARSYM_INLINE void gs_tangent_step(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real J[5]; casadi_int j;
@@ -1042,12 +1069,11 @@ static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 2, y); gs_load(arg[1], 4, Q); gs_load(arg[3], 4, c);
-  casadi_real Qn[4], logs[2];
+  casadi_real Qn[4], logs[2]; casadi_real piece[2]; casadi_int g, i;
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[1]; hi[1] = y[1];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 4, Q);
+    for (i = 0; i < 2; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T + 3*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 4, Q); for (i = 0; i < 2; ++i) logs[i] += piece[i]; }
     gs_store(y, 2, res[0], 2*p); gs_store(logs, 2, res[2], 2*p);
     gs_store(lo, 2, res[3], 2*p); gs_store(hi, 2, res[4], 2*p);
   }
@@ -1146,12 +1172,11 @@ static int casadi_f10(const casadi_real** arg, casadi_real** res, casadi_int* iw
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 2, y); gs_load(arg[1], 4, Q); gs_load(arg[3], 4, c);
-  casadi_real Qn[4], logs[2];
+  casadi_real Qn[4], logs[2]; casadi_real piece[2]; casadi_int g, i;
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[1]; hi[1] = y[1];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 4, Q);
+    for (i = 0; i < 2; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T + 3*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 4, Q); for (i = 0; i < 2; ++i) logs[i] += piece[i]; }
     gs_store(y, 2, res[0], 2*p); gs_store(logs, 2, res[2], 2*p);
     gs_store(lo, 2, res[3], 2*p); gs_store(hi, 2, res[4], 2*p);
   }
@@ -1721,6 +1746,8 @@ CASADI_SYMBOL_EXPORT int monodromy_period_work_bytes(casadi_int *sz_arg, casadi_
   return 0;
 }
 
+
+#endif  /* GEARSYM_STEP_PIECES_ONLY */
 
 #ifdef __cplusplus
 } /* extern "C" */

@@ -221,700 +221,6 @@ static const casadi_real casadi_c0[401] =
 static const casadi_real casadi_zeros[13] = 
   {0.};
 
-/* rhs:(t,y[4],p[13])->(dy[4]) */
-static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13;
-  a00=arg[1]? arg[1][1] : 0;
-  if (res[0]!=0) res[0][0]=a00;
-  a01=-2.;
-  a01=(a01*a00);
-  a00=arg[2]? arg[2][1] : 0;
-  a01=(a01*a00);
-  a00=arg[2]? arg[2][0] : 0;
-  a02=(a01/a00);
-  a03=arg[2]? arg[2][9] : 0;
-  a04=arg[1]? arg[1][2] : 0;
-  a03=(a03*a04);
-  a04=arg[2]? arg[2][5] : 0;
-  a05=(a03/a04);
-  a06=casadi_sq(a00);
-  a05=(a05/a06);
-  a02=(a02-a05);
-  a05=arg[2]? arg[2][2] : 0;
-  a07=arg[2]? arg[2][3] : 0;
-  a08=arg[2]? arg[2][7] : 0;
-  a09=arg[0]? arg[0][0] : 0;
-  a08=(a08+a09);
-  a08=cos(a08);
-  a07=(a07*a08);
-  a05=(a05+a07);
-  a05=(a05/a06);
-  a02=(a02+a05);
-  a05=0.;
-  a07=arg[1]? arg[1][0] : 0;
-  a05=(a05<=a07);
-  a05=(a05?a07:0);
-  a08=arg[2]? arg[2][8] : 0;
-  a10=(-a08);
-  a10=(a07<=a10);
-  a07=(a07+a08);
-  a10=(a10?a07:0);
-  a05=(a05+a10);
-  a10=(a05/a06);
-  a07=1.;
-  a08=arg[2]? arg[2][10] : 0;
-  a11=1.1800386146799999e+00;
-  a12=cos(a09);
-  a11=(a11*a12);
-  a12=1.9272434388400000e-01;
-  a13=4.;
-  a13=(a13*a09);
-  a13=cos(a13);
-  a12=(a12*a13);
-  a11=(a11+a12);
-  a12=1.4883754528799999e-02;
-  a13=7.;
-  a13=(a13*a09);
-  a13=cos(a13);
-  a12=(a12*a13);
-  a11=(a11+a12);
-  a12=-6.0567417982099997e-02;
-  a13=6.;
-  a13=(a13*a09);
-  a13=cos(a13);
-  a12=(a12*a13);
-  a11=(a11+a12);
-  a12=-3.3689450631399998e-01;
-  a13=(2.*a09);
-  a13=cos(a13);
-  a12=(a12*a13);
-  a11=(a11+a12);
-  a12=-1.9563283778700000e-01;
-  a13=3.;
-  a13=(a13*a09);
-  a13=cos(a13);
-  a12=(a12*a13);
-  a11=(a11+a12);
-  a08=(a08*a11);
-  a07=(a07+a08);
-  a10=(a10*a07);
-  a02=(a02-a10);
-  if (res[0]!=0) res[0][1]=a02;
-  a02=arg[1]? arg[1][3] : 0;
-  if (res[0]!=0) res[0][2]=a02;
-  a01=(a01/a04);
-  a02=arg[2]? arg[2][12] : 0;
-  a02=casadi_sq(a02);
-  a01=(a01*a02);
-  a01=(a01/a00);
-  a00=arg[2]? arg[2][11] : 0;
-  a00=casadi_sq(a00);
-  a10=arg[2]? arg[2][4] : 0;
-  a00=(a00/a10);
-  a02=(a02/a04);
-  a00=(a00+a02);
-  a01=(a01/a00);
-  a03=(a03/a06);
-  a04=(1./a04);
-  a10=arg[2]? arg[2][6] : 0;
-  a10=(1./a10);
-  a04=(a04+a10);
-  a03=(a03*a04);
-  a01=(a01-a03);
-  a02=(a02/a06);
-  a02=(a02*a05);
-  a02=(a02/a00);
-  a02=(a02*a07);
-  a01=(a01-a02);
-  if (res[0]!=0) res[0][3]=a01;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int rhs(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f0(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int rhs_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void rhs_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void rhs_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void rhs_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int rhs_n_in(void) { return 3;}
-
-CASADI_SYMBOL_EXPORT casadi_int rhs_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real rhs_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* rhs_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "y";
-    case 2: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* rhs_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "dy";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s1;
-    case 2: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s1;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int rhs_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int rhs_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* jacobian:(t,y[4],p[13])->(J[4x4]) */
-static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10;
-  a00=0.;
-  if (res[0]!=0) res[0][0]=a00;
-  a01=1.;
-  a02=arg[2]? arg[2][10] : 0;
-  a03=1.1800386146799999e+00;
-  a04=arg[0]? arg[0][0] : 0;
-  a05=cos(a04);
-  a03=(a03*a05);
-  a05=1.9272434388400000e-01;
-  a06=4.;
-  a06=(a06*a04);
-  a06=cos(a06);
-  a05=(a05*a06);
-  a03=(a03+a05);
-  a05=1.4883754528799999e-02;
-  a06=7.;
-  a06=(a06*a04);
-  a06=cos(a06);
-  a05=(a05*a06);
-  a03=(a03+a05);
-  a05=-6.0567417982099997e-02;
-  a06=6.;
-  a06=(a06*a04);
-  a06=cos(a06);
-  a05=(a05*a06);
-  a03=(a03+a05);
-  a05=-3.3689450631399998e-01;
-  a06=(2.*a04);
-  a06=cos(a06);
-  a05=(a05*a06);
-  a03=(a03+a05);
-  a05=-1.9563283778700000e-01;
-  a06=3.;
-  a06=(a06*a04);
-  a06=cos(a06);
-  a05=(a05*a06);
-  a03=(a03+a05);
-  a02=(a02*a03);
-  a02=(a01+a02);
-  a03=arg[1]? arg[1][0] : 0;
-  a05=(a00<=a03);
-  a05=(a05?a01:0);
-  a06=arg[2]? arg[2][8] : 0;
-  a06=(-a06);
-  a03=(a03<=a06);
-  a03=(a03?a01:0);
-  a05=(a05+a03);
-  a03=arg[2]? arg[2][0] : 0;
-  a06=casadi_sq(a03);
-  a04=(a05/a06);
-  a04=(a02*a04);
-  a04=(-a04);
-  if (res[0]!=0) res[0][1]=a04;
-  if (res[0]!=0) res[0][2]=a00;
-  a04=arg[2]? arg[2][12] : 0;
-  a04=casadi_sq(a04);
-  a07=arg[2]? arg[2][5] : 0;
-  a08=(a04/a07);
-  a09=(a08/a06);
-  a09=(a09*a05);
-  a05=arg[2]? arg[2][11] : 0;
-  a05=casadi_sq(a05);
-  a10=arg[2]? arg[2][4] : 0;
-  a05=(a05/a10);
-  a05=(a05+a08);
-  a09=(a09/a05);
-  a02=(a02*a09);
-  a02=(-a02);
-  if (res[0]!=0) res[0][3]=a02;
-  if (res[0]!=0) res[0][4]=a01;
-  a02=-2.;
-  a09=arg[2]? arg[2][1] : 0;
-  a02=(a02*a09);
-  a09=(a02/a03);
-  if (res[0]!=0) res[0][5]=a09;
-  if (res[0]!=0) res[0][6]=a00;
-  a02=(a02/a07);
-  a04=(a04*a02);
-  a04=(a04/a03);
-  a04=(a04/a05);
-  if (res[0]!=0) res[0][7]=a04;
-  if (res[0]!=0) res[0][8]=a00;
-  a04=arg[2]? arg[2][9] : 0;
-  a05=(a04/a07);
-  a05=(a05/a06);
-  a05=(-a05);
-  if (res[0]!=0) res[0][9]=a05;
-  if (res[0]!=0) res[0][10]=a00;
-  a07=(1./a07);
-  a05=arg[2]? arg[2][6] : 0;
-  a05=(1./a05);
-  a07=(a07+a05);
-  a04=(a04/a06);
-  a07=(a07*a04);
-  a07=(-a07);
-  if (res[0]!=0) res[0][11]=a07;
-  if (res[0]!=0) res[0][12]=a00;
-  if (res[0]!=0) res[0][13]=a00;
-  if (res[0]!=0) res[0][14]=a01;
-  if (res[0]!=0) res[0][15]=a00;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int jacobian(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f1(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int jacobian_n_in(void) { return 3;}
-
-CASADI_SYMBOL_EXPORT casadi_int jacobian_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real jacobian_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* jacobian_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "y";
-    case 2: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* jacobian_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "J";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s1;
-    case 2: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s3;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* constants:(p[13])->(c[9],period) */
-static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a0, a1, a2, a3, a4, a5, a6, a7;
-  a0=arg[0]? arg[0][8] : 0;
-  if (res[0]!=0) res[0][0]=a0;
-  a0=arg[0]? arg[0][0] : 0;
-  a1=casadi_sq(a0);
-  a2=(1./a1);
-  a3=(-a2);
-  if (res[0]!=0) res[0][1]=a3;
-  a3=-2.;
-  a4=arg[0]? arg[0][1] : 0;
-  a3=(a3*a4);
-  a4=(a3/a0);
-  if (res[0]!=0) res[0][2]=a4;
-  a4=arg[0]? arg[0][9] : 0;
-  a5=arg[0]? arg[0][5] : 0;
-  a6=(a4/a5);
-  a6=(a6/a1);
-  a6=(-a6);
-  if (res[0]!=0) res[0][3]=a6;
-  if (res[0]!=0) res[0][4]=a2;
-  a4=(a4/a1);
-  a2=(1./a5);
-  a6=arg[0]? arg[0][6] : 0;
-  a6=(1./a6);
-  a2=(a2+a6);
-  a4=(a4*a2);
-  a4=(-a4);
-  if (res[0]!=0) res[0][5]=a4;
-  a4=arg[0]? arg[0][12] : 0;
-  a4=casadi_sq(a4);
-  a2=(a4/a5);
-  a1=(a2/a1);
-  a6=arg[0]? arg[0][11] : 0;
-  a6=casadi_sq(a6);
-  a7=arg[0]? arg[0][4] : 0;
-  a6=(a6/a7);
-  a6=(a6+a2);
-  a1=(a1/a6);
-  a1=(-a1);
-  if (res[0]!=0) res[0][6]=a1;
-  a3=(a3/a5);
-  a3=(a3*a4);
-  a3=(a3/a0);
-  a3=(a3/a6);
-  if (res[0]!=0) res[0][7]=a3;
-  a3=3.1415926535897934e-02;
-  if (res[0]!=0) res[0][8]=a3;
-  a3=6.2831853071795862e+00;
-  if (res[1]!=0) res[1][0]=a3;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int constants(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f2(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int constants_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void constants_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void constants_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void constants_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int constants_n_in(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_int constants_n_out(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_real constants_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* constants_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* constants_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "c";
-    case 1: return "period";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s4;
-    case 1: return casadi_s0;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int constants_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 1;
-  if (sz_res) *sz_res = 2;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 1*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 2*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* table_point:(t,p[13])->(values[2]) */
-static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a0, a1, a2, a3, a4, a5;
-  a0=1.;
-  a1=arg[1]? arg[1][10] : 0;
-  a2=1.1800386146799999e+00;
-  a3=arg[0]? arg[0][0] : 0;
-  a4=cos(a3);
-  a2=(a2*a4);
-  a4=1.9272434388400000e-01;
-  a5=4.;
-  a5=(a5*a3);
-  a5=cos(a5);
-  a4=(a4*a5);
-  a2=(a2+a4);
-  a4=1.4883754528799999e-02;
-  a5=7.;
-  a5=(a5*a3);
-  a5=cos(a5);
-  a4=(a4*a5);
-  a2=(a2+a4);
-  a4=-6.0567417982099997e-02;
-  a5=6.;
-  a5=(a5*a3);
-  a5=cos(a5);
-  a4=(a4*a5);
-  a2=(a2+a4);
-  a4=-3.3689450631399998e-01;
-  a5=(2.*a3);
-  a5=cos(a5);
-  a4=(a4*a5);
-  a2=(a2+a4);
-  a4=-1.9563283778700000e-01;
-  a5=3.;
-  a5=(a5*a3);
-  a5=cos(a5);
-  a4=(a4*a5);
-  a2=(a2+a4);
-  a1=(a1*a2);
-  a0=(a0+a1);
-  if (res[0]!=0) res[0][0]=a0;
-  a0=arg[1]? arg[1][2] : 0;
-  a1=arg[1]? arg[1][3] : 0;
-  a2=arg[1]? arg[1][7] : 0;
-  a2=(a2+a3);
-  a2=cos(a2);
-  a1=(a1*a2);
-  a0=(a0+a1);
-  if (res[0]!=0) res[0][1]=a0;
-  return 0;
-}
-
-/* map401_table_point:(t[1x401],p[13x401])->(values[2x401]) */
-static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i;
-  casadi_real* *res1;
-  const casadi_real* *arg1;
-  arg1 = arg+2;
-  for (i=0; i<2; ++i) arg1[i]=arg[i];
-  res1 = res+1;
-  for (i=0; i<1; ++i) res1[i]=res[i];
-  for (i=0; i<401; ++i) {
-    if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-    if (arg1[0]) arg1[0]+=1;
-    if (arg1[1]) arg1[1]+=13;
-    if (res1[0]) res1[0]+=2;
-  }
-  return 0;
-}
-
-/* table:(t0,p[13])->(table[6x200],probe[2x2]) */
-static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i, j;
-  casadi_real **res1=res+2, *rr, w00, *w01=w+8, *w03=w+409, w04, w05, w06, *w07=w+418, *w08=w+5631, *w09=w+6433, *w10=w+6833;
-  casadi_real *w11=w+7233, *w12=w+7633, *w13=w+8033, *w14=w+9233, *w15=w+10433;
-  const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
-  w00 = arg[0] ? arg[0][0] : 0;
-  wr01 = casadi_c0;
-  wr02 = arg[1] ? arg[1] : casadi_zeros;
-  arg1[0]=wr02;
-  res1[0]=w03;
-  res1[1]=(&w04);
-  if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
-  for (rr=(&w05), cs=w03+8; cs!=w03+9; cs+=1) *rr++ = *cs;
-  w06 = 2.;
-  w05 /= w06;
-  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w05);
-  for (i=0, rr=w01, cs=w01; i<401; ++i) (*rr++)  = (w00+(*cs++));
-  for (i=0;i<401;++i) {
-    casadi_copy(wr02, 13, w07+ i*13);
-  }
-  arg1[0]=w01;
-  arg1[1]=w07;
-  res1[0]=w08;
-  if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
-  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+0; ct!=cs+2; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w10, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+2; ct!=cs+4; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w11, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+4; ct!=cs+6; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w12, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
-  rr=w13;
-  for (i=0, cs=w10; i<400; ++i) *rr++ = *cs++;
-  for (i=0, cs=w11; i<400; ++i) *rr++ = *cs++;
-  for (i=0, cs=w12; i<400; ++i) *rr++ = *cs++;
-  for (i=0, rr=w14, cs=w13; i<6; ++i) for (j=0; j<200; ++j) rr[i+j*6] = *cs++;
-  casadi_copy(w14, 1200, res[0]);
-  w05 = 3.7000000000000000e-01;
-  w05 *= w04;
-  w05  = (w00+w05);
-  arg1[0]=(&w05);
-  arg1[1]=wr02;
-  res1[0]=w15;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-  casadi_copy(w15, 2, res[1]);
-  w05 = 1.3700000000000001e+00;
-  w05 *= w04;
-  w00 += w05;
-  arg1[0]=(&w00);
-  arg1[1]=wr02;
-  res1[0]=w15;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-  if (res[1]) casadi_copy(w15, 2, res[1]+2);
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f3(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int table_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void table_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void table_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void table_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t0";
-    case 1: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "table";
-    case 1: return "probe";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s5;
-    case 1: return casadi_s6;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 6;
-  if (sz_res) *sz_res = 4;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 10435;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 10435*sizeof(casadi_real);
-  return 0;
-}
-
 /* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
 #if defined(__GNUC__)
 #define GEARSYM_INLINE inline __attribute__((always_inline))
@@ -1027,29 +333,29 @@ static GEARSYM_INLINE void gs_tangent_keep(const casadi_real* restrict A0, const
   R3[1]=a1;
 }
 
-/* state_try, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1) {
+/* state_try, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_try_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
   a00=A0[0];
-  a01=A2[8];
+  a01=A2[S*8];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[1];
+  a03=A0[S*1];
   a04=2.;
   a04=(a01/a04);
-  a05=A2[2];
+  a05=A2[S*2];
   a06=(a03*a05);
-  a07=A0[2];
-  a08=A2[3];
+  a07=A0[S*2];
+  a08=A2[S*3];
   a09=(a07*a08);
   a06=(a06+a09);
-  a09=A2[4];
-  a10=A1[1];
+  a09=A2[S*4];
+  a10=A1[S*1];
   a10=(a09*a10);
   a06=(a06+a10);
-  a10=A2[1];
+  a10=A2[S*1];
   a11=A1[0];
   a12=(a10*a11);
   a13=A2[0];
@@ -1069,15 +375,15 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a21=(2.*a12);
   a21=(a03+a21);
   a22=(a12*a05);
-  a23=A0[3];
+  a23=A0[S*3];
   a24=(a04*a23);
   a24=(a07+a24);
   a25=(a24*a08);
   a22=(a22+a25);
-  a25=A1[3];
+  a25=A1[S*3];
   a25=(a09*a25);
   a22=(a22+a25);
-  a26=A1[2];
+  a26=A1[S*2];
   a27=(a10*a26);
   a28=(a04*a03);
   a28=(a00+a28);
@@ -1090,12 +396,12 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a30=(2.*a29);
   a21=(a21+a30);
   a30=(a29*a05);
-  a31=A2[7];
+  a31=A2[S*7];
   a32=(a03*a31);
-  a33=A2[5];
+  a33=A2[S*5];
   a34=(a07*a33);
   a32=(a32+a34);
-  a34=A2[6];
+  a34=A2[S*6];
   a11=(a34*a11);
   a11=(a11*a20);
   a32=(a32+a11);
@@ -1135,10 +441,10 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a28=(a07+a28);
   a08=(a28*a08);
   a05=(a05+a08);
-  a08=A1[5];
+  a08=A1[S*5];
   a09=(a09*a08);
   a05=(a05+a09);
-  a09=A1[4];
+  a09=A1[S*4];
   a10=(a10*a09);
   a08=(a01*a29);
   a08=(a00+a08);
@@ -1149,7 +455,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a06=(a06+a05);
   a06=(a02*a06);
   a06=(a03+a06);
-  R0[1]=a06;
+  R0[S*1]=a06;
   a11=(2.*a11);
   a11=(a23+a11);
   a04=(2.*a04);
@@ -1164,7 +470,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a11=(a11+a26);
   a11=(a02*a11);
   a07=(a07+a11);
-  R0[2]=a07;
+  R0[S*2]=a07;
   a12=(2.*a12);
   a32=(a32+a12);
   a29=(2.*a29);
@@ -1178,7 +484,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a32=(a32+a27);
   a02=(a02*a32);
   a23=(a23+a02);
-  R0[3]=a23;
+  R0[S*3]=a23;
   a18=(2.*a18);
   a23=1.;
   a18=(a18-a23);
@@ -1218,18 +524,19 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a14=(a14<a02);
   R1[0]=a14;
 }
+static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1) { gs_state_try_strided(A0, A1, A2, R0, R1, 1); }
 
-/* state_keep, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+/* state_keep, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_keep_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
   casadi_real a0, a1, a2, a3, a4;
   a0=A3[0];
   R0[0]=a0;
-  a1=A3[1];
-  R0[1]=a1;
-  a1=A3[2];
-  R0[2]=a1;
-  a2=A3[3];
-  R0[3]=a2;
+  a1=A3[S*1];
+  R0[S*1]=a1;
+  a1=A3[S*2];
+  R0[S*2]=a1;
+  a2=A3[S*3];
+  R0[S*3]=a2;
   a2=A1[0];
   a3=(a0<a2);
   a4=(a3?a0:0);
@@ -1237,13 +544,13 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
   a3=(a3?a2:0);
   a4=(a4+a3);
   R1[0]=a4;
-  a4=A1[1];
+  a4=A1[S*1];
   a3=(a1<a4);
   a2=(a3?a1:0);
   a3=(!a3);
   a3=(a3?a4:0);
   a2=(a2+a3);
-  R1[1]=a2;
+  R1[S*1]=a2;
   a2=A2[0];
   a3=(a2<a0);
   a0=(a3?a0:0);
@@ -1251,14 +558,15 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
   a3=(a3?a2:0);
   a0=(a0+a3);
   R2[0]=a0;
-  a0=A2[1];
+  a0=A2[S*1];
   a3=(a0<a1);
   a1=(a3?a1:0);
   a3=(!a3);
   a3=(a3?a0:0);
   a1=(a1+a3);
-  R2[1]=a1;
+  R2[S*1]=a1;
 }
+static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_state_keep_strided(A0, A1, A2, A3, A4, A5, R0, R1, R2, 1); }
 
 /* split_start, from CasADi's C of it */
 static GEARSYM_NOINLINE void gs_split_start(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
@@ -2782,30 +2090,30 @@ static GEARSYM_NOINLINE void gs_state_mode_step(const casadi_real* restrict A0, 
   R0[3]=a18;
 }
 
-/* tangent_state, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+/* tangent_state, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_state_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
   casadi_real a36, a37;
   a00=A0[0];
-  a01=A2[8];
+  a01=A2[S*8];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[1];
+  a03=A0[S*1];
   a04=2.;
   a04=(a01/a04);
-  a05=A2[2];
+  a05=A2[S*2];
   a06=(a03*a05);
-  a07=A0[2];
-  a08=A2[3];
+  a07=A0[S*2];
+  a08=A2[S*3];
   a09=(a07*a08);
   a06=(a06+a09);
-  a09=A2[4];
-  a10=A1[1];
+  a09=A2[S*4];
+  a10=A1[S*1];
   a10=(a09*a10);
   a06=(a06+a10);
-  a10=A2[1];
+  a10=A2[S*1];
   a11=A1[0];
   a12=(a10*a11);
   a13=A2[0];
@@ -2825,15 +2133,15 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a22=(2.*a21);
   a22=(a03+a22);
   a23=(a21*a05);
-  a24=A0[3];
+  a24=A0[S*3];
   a25=(a04*a24);
   a25=(a07+a25);
   a26=(a25*a08);
   a23=(a23+a26);
-  a26=A1[3];
+  a26=A1[S*3];
   a26=(a09*a26);
   a23=(a23+a26);
-  a27=A1[2];
+  a27=A1[S*2];
   a28=(a10*a27);
   a29=(a04*a03);
   a29=(a00+a29);
@@ -2846,12 +2154,12 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a31=(2.*a30);
   a22=(a22+a31);
   a31=(a30*a05);
-  a32=A2[7];
+  a32=A2[S*7];
   a33=(a03*a32);
-  a34=A2[5];
+  a34=A2[S*5];
   a35=(a07*a34);
   a33=(a33+a35);
-  a35=A2[6];
+  a35=A2[S*6];
   a11=(a35*a11);
   a20=(a11*a20);
   a33=(a33+a20);
@@ -2891,10 +2199,10 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a29=(a07+a29);
   a25=(a29*a08);
   a31=(a31+a25);
-  a25=A1[5];
+  a25=A1[S*5];
   a09=(a09*a25);
   a31=(a31+a09);
-  a09=A1[4];
+  a09=A1[S*4];
   a10=(a10*a09);
   a25=(a01*a30);
   a25=(a00+a25);
@@ -2905,7 +2213,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a06=(a06+a31);
   a06=(a02*a06);
   a06=(a03+a06);
-  R0[1]=a06;
+  R0[S*1]=a06;
   a20=(2.*a20);
   a20=(a24+a20);
   a04=(2.*a04);
@@ -2920,7 +2228,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a20=(a20+a26);
   a20=(a02*a20);
   a07=(a07+a20);
-  R0[2]=a07;
+  R0[S*2]=a07;
   a21=(2.*a21);
   a33=(a33+a21);
   a30=(2.*a30);
@@ -2934,7 +2242,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a33=(a33+a37);
   a02=(a02*a33);
   a24=(a24+a02);
-  R0[3]=a24;
+  R0[S*3]=a24;
   a18=(2.*a18);
   a24=1.;
   a18=(a18-a24);
@@ -2976,54 +2284,55 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a12=(a12*a19);
   R2[0]=a12;
   a11=(a11*a19);
-  R2[1]=a11;
-  R2[2]=a05;
-  R2[3]=a32;
-  R2[4]=a08;
-  R2[5]=a34;
+  R2[S*1]=a11;
+  R2[S*2]=a05;
+  R2[S*3]=a32;
+  R2[S*4]=a08;
+  R2[S*5]=a34;
   a28=(a28*a19);
-  R2[6]=a28;
+  R2[S*6]=a28;
   a27=(a27*a19);
-  R2[7]=a27;
-  R2[8]=a28;
-  R2[9]=a27;
+  R2[S*7]=a27;
+  R2[S*8]=a28;
+  R2[S*9]=a27;
   a10=(a10*a19);
-  R2[10]=a10;
+  R2[S*10]=a10;
   a35=(a35*a19);
-  R2[11]=a35;
+  R2[S*11]=a35;
 }
+static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_tangent_state_strided(A0, A1, A2, R0, R1, R2, 1); }
 
-/* tangent_vector, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) {
+/* tangent_vector, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_vector_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   a00=A0[0];
-  a01=A2[8];
+  a01=A2[S*8];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[4];
+  a03=A0[S*4];
   a04=2.;
   a04=(a01/a04);
   a05=A1[0];
   a05=(a05*a00);
-  a06=A1[2];
+  a06=A1[S*2];
   a07=(a06*a03);
   a05=(a05+a07);
-  a07=A1[4];
-  a08=A0[8];
+  a07=A1[S*4];
+  a08=A0[S*8];
   a09=(a07*a08);
   a05=(a05+a09);
   a09=(a04*a05);
   a09=(a03+a09);
   a10=(2.*a09);
   a10=(a03+a10);
-  a11=A1[6];
+  a11=A1[S*6];
   a12=(a04*a03);
   a12=(a00+a12);
   a11=(a11*a12);
   a13=(a06*a09);
   a11=(a11+a13);
-  a13=A0[12];
+  a13=A0[S*12];
   a14=(a04*a13);
   a14=(a08+a14);
   a15=(a07*a14);
@@ -3032,18 +2341,18 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a15=(a03+a15);
   a16=(2.*a15);
   a10=(a10+a16);
-  a16=A1[8];
+  a16=A1[S*8];
   a17=(a04*a09);
   a17=(a00+a17);
   a16=(a16*a17);
   a18=(a06*a15);
   a16=(a16+a18);
-  a18=A1[1];
+  a18=A1[S*1];
   a18=(a18*a00);
-  a19=A1[3];
+  a19=A1[S*3];
   a20=(a19*a03);
   a18=(a18+a20);
-  a20=A1[5];
+  a20=A1[S*5];
   a21=(a20*a08);
   a18=(a18+a21);
   a21=(a04*a18);
@@ -3062,13 +2371,13 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a05=(a05+a11);
   a16=(2.*a16);
   a05=(a05+a16);
-  a16=A1[10];
+  a16=A1[S*10];
   a11=(a01*a15);
   a00=(a00+a11);
   a16=(a16*a00);
   a06=(a06*a23);
   a16=(a16+a06);
-  a06=A1[7];
+  a06=A1[S*7];
   a06=(a06*a12);
   a09=(a19*a09);
   a06=(a06+a09);
@@ -3083,12 +2392,12 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a05=(a05+a16);
   a05=(a02*a05);
   a03=(a03+a05);
-  R0[4]=a03;
+  R0[S*4]=a03;
   a21=(2.*a21);
   a21=(a13+a21);
   a04=(2.*a04);
   a21=(a21+a04);
-  a04=A1[9];
+  a04=A1[S*9];
   a04=(a04*a17);
   a15=(a19*a15);
   a04=(a04+a15);
@@ -3099,12 +2408,12 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a21=(a21+a01);
   a21=(a02*a21);
   a08=(a08+a21);
-  R0[8]=a08;
+  R0[S*8]=a08;
   a06=(2.*a06);
   a18=(a18+a06);
   a04=(2.*a04);
   a18=(a18+a04);
-  a04=A1[11];
+  a04=A1[S*11];
   a04=(a04*a00);
   a19=(a19*a23);
   a04=(a04+a19);
@@ -3113,8 +2422,9 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a18=(a18+a04);
   a02=(a02*a18);
   a13=(a13+a02);
-  R0[12]=a13;
+  R0[S*12]=a13;
 }
+static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) { gs_tangent_vector_strided(A0, A1, A2, R0, 1); }
 
 /* gram_schmidt, from CasADi's C of it */
 static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
@@ -3300,6 +2610,60 @@ static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casad
   R1[3]=a06;
 }
 
+/* constants, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_constants_strided(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
+  casadi_real a0, a1, a2, a3, a4, a5, a6, a7;
+  a0=A0[S*8];
+  R0[0]=a0;
+  a0=A0[0];
+  a1=casadi_sq(a0);
+  a2=(1./a1);
+  a3=(-a2);
+  R0[S*1]=a3;
+  a3=-2.;
+  a4=A0[S*1];
+  a3=(a3*a4);
+  a4=(a3/a0);
+  R0[S*2]=a4;
+  a4=A0[S*9];
+  a5=A0[S*5];
+  a6=(a4/a5);
+  a6=(a6/a1);
+  a6=(-a6);
+  R0[S*3]=a6;
+  R0[S*4]=a2;
+  a4=(a4/a1);
+  a2=(1./a5);
+  a6=A0[S*6];
+  a6=(1./a6);
+  a2=(a2+a6);
+  a4=(a4*a2);
+  a4=(-a4);
+  R0[S*5]=a4;
+  a4=A0[S*12];
+  a4=casadi_sq(a4);
+  a2=(a4/a5);
+  a1=(a2/a1);
+  a6=A0[S*11];
+  a6=casadi_sq(a6);
+  a7=A0[S*4];
+  a6=(a6/a7);
+  a6=(a6+a2);
+  a1=(a1/a6);
+  a1=(-a1);
+  R0[S*6]=a1;
+  a3=(a3/a5);
+  a3=(a3*a4);
+  a3=(a3/a0);
+  a3=(a3/a6);
+  R0[S*7]=a3;
+  a3=3.1415926535897934e-02;
+  R0[S*8]=a3;
+  a3=6.2831853071795862e+00;
+  R1[0]=a3;
+}
+static GEARSYM_INLINE void gs_constants(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) { gs_constants_strided(A0, R0, R1, 1); }
+
 /* the located step that crosses: its legs, RK4 of the sides held fixed on each (calls of one
    mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/crossing.py) */
 static GEARSYM_NOINLINE void gs_tangent_split(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict yt, const casadi_real* restrict Qt, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
@@ -3340,6 +2704,702 @@ static GEARSYM_NOINLINE void gs_state_split(const casadi_real* restrict y, const
   gs_state_mode_step(yb, leg_b, c, yc);
   gs_state_mode_step(yc, leg_c, c, yn);
   gs_state_keep(y, lo, hi, yn, T, c, y1, lo1, hi1);
+}
+
+#ifndef GEARSYM_STEP_PIECES_ONLY  /* (the lanes' C includes the pieces above) */
+
+/* rhs:(t,y[4],p[13])->(dy[4]) */
+static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13;
+  a00=arg[1]? arg[1][1] : 0;
+  if (res[0]!=0) res[0][0]=a00;
+  a01=-2.;
+  a01=(a01*a00);
+  a00=arg[2]? arg[2][1] : 0;
+  a01=(a01*a00);
+  a00=arg[2]? arg[2][0] : 0;
+  a02=(a01/a00);
+  a03=arg[2]? arg[2][9] : 0;
+  a04=arg[1]? arg[1][2] : 0;
+  a03=(a03*a04);
+  a04=arg[2]? arg[2][5] : 0;
+  a05=(a03/a04);
+  a06=casadi_sq(a00);
+  a05=(a05/a06);
+  a02=(a02-a05);
+  a05=arg[2]? arg[2][2] : 0;
+  a07=arg[2]? arg[2][3] : 0;
+  a08=arg[2]? arg[2][7] : 0;
+  a09=arg[0]? arg[0][0] : 0;
+  a08=(a08+a09);
+  a08=cos(a08);
+  a07=(a07*a08);
+  a05=(a05+a07);
+  a05=(a05/a06);
+  a02=(a02+a05);
+  a05=0.;
+  a07=arg[1]? arg[1][0] : 0;
+  a05=(a05<=a07);
+  a05=(a05?a07:0);
+  a08=arg[2]? arg[2][8] : 0;
+  a10=(-a08);
+  a10=(a07<=a10);
+  a07=(a07+a08);
+  a10=(a10?a07:0);
+  a05=(a05+a10);
+  a10=(a05/a06);
+  a07=1.;
+  a08=arg[2]? arg[2][10] : 0;
+  a11=1.1800386146799999e+00;
+  a12=cos(a09);
+  a11=(a11*a12);
+  a12=1.9272434388400000e-01;
+  a13=4.;
+  a13=(a13*a09);
+  a13=cos(a13);
+  a12=(a12*a13);
+  a11=(a11+a12);
+  a12=1.4883754528799999e-02;
+  a13=7.;
+  a13=(a13*a09);
+  a13=cos(a13);
+  a12=(a12*a13);
+  a11=(a11+a12);
+  a12=-6.0567417982099997e-02;
+  a13=6.;
+  a13=(a13*a09);
+  a13=cos(a13);
+  a12=(a12*a13);
+  a11=(a11+a12);
+  a12=-3.3689450631399998e-01;
+  a13=(2.*a09);
+  a13=cos(a13);
+  a12=(a12*a13);
+  a11=(a11+a12);
+  a12=-1.9563283778700000e-01;
+  a13=3.;
+  a13=(a13*a09);
+  a13=cos(a13);
+  a12=(a12*a13);
+  a11=(a11+a12);
+  a08=(a08*a11);
+  a07=(a07+a08);
+  a10=(a10*a07);
+  a02=(a02-a10);
+  if (res[0]!=0) res[0][1]=a02;
+  a02=arg[1]? arg[1][3] : 0;
+  if (res[0]!=0) res[0][2]=a02;
+  a01=(a01/a04);
+  a02=arg[2]? arg[2][12] : 0;
+  a02=casadi_sq(a02);
+  a01=(a01*a02);
+  a01=(a01/a00);
+  a00=arg[2]? arg[2][11] : 0;
+  a00=casadi_sq(a00);
+  a10=arg[2]? arg[2][4] : 0;
+  a00=(a00/a10);
+  a02=(a02/a04);
+  a00=(a00+a02);
+  a01=(a01/a00);
+  a03=(a03/a06);
+  a04=(1./a04);
+  a10=arg[2]? arg[2][6] : 0;
+  a10=(1./a10);
+  a04=(a04+a10);
+  a03=(a03*a04);
+  a01=(a01-a03);
+  a02=(a02/a06);
+  a02=(a02*a05);
+  a02=(a02/a00);
+  a02=(a02*a07);
+  a01=(a01-a02);
+  if (res[0]!=0) res[0][3]=a01;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int rhs(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f0(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int rhs_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void rhs_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void rhs_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void rhs_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int rhs_n_in(void) { return 3;}
+
+CASADI_SYMBOL_EXPORT casadi_int rhs_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real rhs_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* rhs_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "y";
+    case 2: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* rhs_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "dy";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s1;
+    case 2: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s1;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int rhs_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int rhs_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* jacobian:(t,y[4],p[13])->(J[4x4]) */
+static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10;
+  a00=0.;
+  if (res[0]!=0) res[0][0]=a00;
+  a01=1.;
+  a02=arg[2]? arg[2][10] : 0;
+  a03=1.1800386146799999e+00;
+  a04=arg[0]? arg[0][0] : 0;
+  a05=cos(a04);
+  a03=(a03*a05);
+  a05=1.9272434388400000e-01;
+  a06=4.;
+  a06=(a06*a04);
+  a06=cos(a06);
+  a05=(a05*a06);
+  a03=(a03+a05);
+  a05=1.4883754528799999e-02;
+  a06=7.;
+  a06=(a06*a04);
+  a06=cos(a06);
+  a05=(a05*a06);
+  a03=(a03+a05);
+  a05=-6.0567417982099997e-02;
+  a06=6.;
+  a06=(a06*a04);
+  a06=cos(a06);
+  a05=(a05*a06);
+  a03=(a03+a05);
+  a05=-3.3689450631399998e-01;
+  a06=(2.*a04);
+  a06=cos(a06);
+  a05=(a05*a06);
+  a03=(a03+a05);
+  a05=-1.9563283778700000e-01;
+  a06=3.;
+  a06=(a06*a04);
+  a06=cos(a06);
+  a05=(a05*a06);
+  a03=(a03+a05);
+  a02=(a02*a03);
+  a02=(a01+a02);
+  a03=arg[1]? arg[1][0] : 0;
+  a05=(a00<=a03);
+  a05=(a05?a01:0);
+  a06=arg[2]? arg[2][8] : 0;
+  a06=(-a06);
+  a03=(a03<=a06);
+  a03=(a03?a01:0);
+  a05=(a05+a03);
+  a03=arg[2]? arg[2][0] : 0;
+  a06=casadi_sq(a03);
+  a04=(a05/a06);
+  a04=(a02*a04);
+  a04=(-a04);
+  if (res[0]!=0) res[0][1]=a04;
+  if (res[0]!=0) res[0][2]=a00;
+  a04=arg[2]? arg[2][12] : 0;
+  a04=casadi_sq(a04);
+  a07=arg[2]? arg[2][5] : 0;
+  a08=(a04/a07);
+  a09=(a08/a06);
+  a09=(a09*a05);
+  a05=arg[2]? arg[2][11] : 0;
+  a05=casadi_sq(a05);
+  a10=arg[2]? arg[2][4] : 0;
+  a05=(a05/a10);
+  a05=(a05+a08);
+  a09=(a09/a05);
+  a02=(a02*a09);
+  a02=(-a02);
+  if (res[0]!=0) res[0][3]=a02;
+  if (res[0]!=0) res[0][4]=a01;
+  a02=-2.;
+  a09=arg[2]? arg[2][1] : 0;
+  a02=(a02*a09);
+  a09=(a02/a03);
+  if (res[0]!=0) res[0][5]=a09;
+  if (res[0]!=0) res[0][6]=a00;
+  a02=(a02/a07);
+  a04=(a04*a02);
+  a04=(a04/a03);
+  a04=(a04/a05);
+  if (res[0]!=0) res[0][7]=a04;
+  if (res[0]!=0) res[0][8]=a00;
+  a04=arg[2]? arg[2][9] : 0;
+  a05=(a04/a07);
+  a05=(a05/a06);
+  a05=(-a05);
+  if (res[0]!=0) res[0][9]=a05;
+  if (res[0]!=0) res[0][10]=a00;
+  a07=(1./a07);
+  a05=arg[2]? arg[2][6] : 0;
+  a05=(1./a05);
+  a07=(a07+a05);
+  a04=(a04/a06);
+  a07=(a07*a04);
+  a07=(-a07);
+  if (res[0]!=0) res[0][11]=a07;
+  if (res[0]!=0) res[0][12]=a00;
+  if (res[0]!=0) res[0][13]=a00;
+  if (res[0]!=0) res[0][14]=a01;
+  if (res[0]!=0) res[0][15]=a00;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int jacobian(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f1(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int jacobian_n_in(void) { return 3;}
+
+CASADI_SYMBOL_EXPORT casadi_int jacobian_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real jacobian_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* jacobian_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "y";
+    case 2: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* jacobian_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "J";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s1;
+    case 2: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s3;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* constants:(p[13])->(c[9],period) */
+static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a0, a1, a2, a3, a4, a5, a6, a7;
+  a0=arg[0]? arg[0][8] : 0;
+  if (res[0]!=0) res[0][0]=a0;
+  a0=arg[0]? arg[0][0] : 0;
+  a1=casadi_sq(a0);
+  a2=(1./a1);
+  a3=(-a2);
+  if (res[0]!=0) res[0][1]=a3;
+  a3=-2.;
+  a4=arg[0]? arg[0][1] : 0;
+  a3=(a3*a4);
+  a4=(a3/a0);
+  if (res[0]!=0) res[0][2]=a4;
+  a4=arg[0]? arg[0][9] : 0;
+  a5=arg[0]? arg[0][5] : 0;
+  a6=(a4/a5);
+  a6=(a6/a1);
+  a6=(-a6);
+  if (res[0]!=0) res[0][3]=a6;
+  if (res[0]!=0) res[0][4]=a2;
+  a4=(a4/a1);
+  a2=(1./a5);
+  a6=arg[0]? arg[0][6] : 0;
+  a6=(1./a6);
+  a2=(a2+a6);
+  a4=(a4*a2);
+  a4=(-a4);
+  if (res[0]!=0) res[0][5]=a4;
+  a4=arg[0]? arg[0][12] : 0;
+  a4=casadi_sq(a4);
+  a2=(a4/a5);
+  a1=(a2/a1);
+  a6=arg[0]? arg[0][11] : 0;
+  a6=casadi_sq(a6);
+  a7=arg[0]? arg[0][4] : 0;
+  a6=(a6/a7);
+  a6=(a6+a2);
+  a1=(a1/a6);
+  a1=(-a1);
+  if (res[0]!=0) res[0][6]=a1;
+  a3=(a3/a5);
+  a3=(a3*a4);
+  a3=(a3/a0);
+  a3=(a3/a6);
+  if (res[0]!=0) res[0][7]=a3;
+  a3=3.1415926535897934e-02;
+  if (res[0]!=0) res[0][8]=a3;
+  a3=6.2831853071795862e+00;
+  if (res[1]!=0) res[1][0]=a3;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int constants(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f2(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int constants_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void constants_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void constants_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void constants_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int constants_n_in(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_int constants_n_out(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_real constants_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* constants_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* constants_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "c";
+    case 1: return "period";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s4;
+    case 1: return casadi_s0;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int constants_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 1;
+  if (sz_res) *sz_res = 2;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 1*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 2*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* table_point:(t,p[13])->(values[2]) */
+static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a0, a1, a2, a3, a4, a5;
+  a0=1.;
+  a1=arg[1]? arg[1][10] : 0;
+  a2=1.1800386146799999e+00;
+  a3=arg[0]? arg[0][0] : 0;
+  a4=cos(a3);
+  a2=(a2*a4);
+  a4=1.9272434388400000e-01;
+  a5=4.;
+  a5=(a5*a3);
+  a5=cos(a5);
+  a4=(a4*a5);
+  a2=(a2+a4);
+  a4=1.4883754528799999e-02;
+  a5=7.;
+  a5=(a5*a3);
+  a5=cos(a5);
+  a4=(a4*a5);
+  a2=(a2+a4);
+  a4=-6.0567417982099997e-02;
+  a5=6.;
+  a5=(a5*a3);
+  a5=cos(a5);
+  a4=(a4*a5);
+  a2=(a2+a4);
+  a4=-3.3689450631399998e-01;
+  a5=(2.*a3);
+  a5=cos(a5);
+  a4=(a4*a5);
+  a2=(a2+a4);
+  a4=-1.9563283778700000e-01;
+  a5=3.;
+  a5=(a5*a3);
+  a5=cos(a5);
+  a4=(a4*a5);
+  a2=(a2+a4);
+  a1=(a1*a2);
+  a0=(a0+a1);
+  if (res[0]!=0) res[0][0]=a0;
+  a0=arg[1]? arg[1][2] : 0;
+  a1=arg[1]? arg[1][3] : 0;
+  a2=arg[1]? arg[1][7] : 0;
+  a2=(a2+a3);
+  a2=cos(a2);
+  a1=(a1*a2);
+  a0=(a0+a1);
+  if (res[0]!=0) res[0][1]=a0;
+  return 0;
+}
+
+/* map401_table_point:(t[1x401],p[13x401])->(values[2x401]) */
+static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_int i;
+  casadi_real* *res1;
+  const casadi_real* *arg1;
+  arg1 = arg+2;
+  for (i=0; i<2; ++i) arg1[i]=arg[i];
+  res1 = res+1;
+  for (i=0; i<1; ++i) res1[i]=res[i];
+  for (i=0; i<401; ++i) {
+    if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+    if (arg1[0]) arg1[0]+=1;
+    if (arg1[1]) arg1[1]+=13;
+    if (res1[0]) res1[0]+=2;
+  }
+  return 0;
+}
+
+/* table:(t0,p[13])->(table[6x200],probe[2x2]) */
+static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_int i, j;
+  casadi_real **res1=res+2, *rr, w00, *w01=w+8, *w03=w+409, w04, w05, w06, *w07=w+418, *w08=w+5631, *w09=w+6433, *w10=w+6833;
+  casadi_real *w11=w+7233, *w12=w+7633, *w13=w+8033, *w14=w+9233, *w15=w+10433;
+  const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
+  w00 = arg[0] ? arg[0][0] : 0;
+  wr01 = casadi_c0;
+  wr02 = arg[1] ? arg[1] : casadi_zeros;
+  arg1[0]=wr02;
+  res1[0]=w03;
+  res1[1]=(&w04);
+  if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
+  for (rr=(&w05), cs=w03+8; cs!=w03+9; cs+=1) *rr++ = *cs;
+  w06 = 2.;
+  w05 /= w06;
+  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w05);
+  for (i=0, rr=w01, cs=w01; i<401; ++i) (*rr++)  = (w00+(*cs++));
+  for (i=0;i<401;++i) {
+    casadi_copy(wr02, 13, w07+ i*13);
+  }
+  arg1[0]=w01;
+  arg1[1]=w07;
+  res1[0]=w08;
+  if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
+  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+0; ct!=cs+2; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w10, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+2; ct!=cs+4; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w11, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+4; ct!=cs+6; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w12, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
+  rr=w13;
+  for (i=0, cs=w10; i<400; ++i) *rr++ = *cs++;
+  for (i=0, cs=w11; i<400; ++i) *rr++ = *cs++;
+  for (i=0, cs=w12; i<400; ++i) *rr++ = *cs++;
+  for (i=0, rr=w14, cs=w13; i<6; ++i) for (j=0; j<200; ++j) rr[i+j*6] = *cs++;
+  casadi_copy(w14, 1200, res[0]);
+  w05 = 3.7000000000000000e-01;
+  w05 *= w04;
+  w05  = (w00+w05);
+  arg1[0]=(&w05);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  casadi_copy(w15, 2, res[1]);
+  w05 = 1.3700000000000001e+00;
+  w05 *= w04;
+  w00 += w05;
+  arg1[0]=(&w00);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (res[1]) casadi_copy(w15, 2, res[1]+2);
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f3(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int table_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void table_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void table_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void table_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t0";
+    case 1: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "table";
+    case 1: return "probe";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s5;
+    case 1: return casadi_s6;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 6;
+  if (sz_res) *sz_res = 4;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 10435;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 10435*sizeof(casadi_real);
+  return 0;
 }
 
 /* one block of tangent steps (the SX functions' step, as CasADi's Switch runs it) */
@@ -3397,12 +3457,11 @@ static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 4, y); gs_load(arg[1], 16, Q); gs_load(arg[3], 9, c);
-  casadi_real Qn[16], logs[4];
+  casadi_real Qn[16], logs[4]; casadi_real piece[4]; casadi_int g, i;
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 16, Q);
+    for (i = 0; i < 4; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T + 6*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 16, Q); for (i = 0; i < 4; ++i) logs[i] += piece[i]; }
     gs_store(y, 4, res[0], 4*p); gs_store(logs, 4, res[2], 4*p);
     gs_store(lo, 2, res[3], 2*p); gs_store(hi, 2, res[4], 2*p);
   }
@@ -3501,12 +3560,11 @@ static int casadi_f19(const casadi_real** arg, casadi_real** res, casadi_int* iw
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 4, y); gs_load(arg[1], 16, Q); gs_load(arg[3], 9, c);
-  casadi_real Qn[16], logs[4];
+  casadi_real Qn[16], logs[4]; casadi_real piece[4]; casadi_int g, i;
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 16, Q);
+    for (i = 0; i < 4; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T + 6*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 16, Q); for (i = 0; i < 4; ++i) logs[i] += piece[i]; }
     gs_store(y, 4, res[0], 4*p); gs_store(logs, 4, res[2], 4*p);
     gs_store(lo, 2, res[3], 2*p); gs_store(hi, 2, res[4], 2*p);
   }
@@ -4076,6 +4134,8 @@ CASADI_SYMBOL_EXPORT int monodromy_period_work_bytes(casadi_int *sz_arg, casadi_
   return 0;
 }
 
+
+#endif  /* GEARSYM_STEP_PIECES_ONLY */
 
 #ifdef __cplusplus
 } /* extern "C" */

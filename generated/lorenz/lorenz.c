@@ -121,6 +121,571 @@ static const casadi_int casadi_s10[3] = {3, 50, 1};
 static const casadi_int casadi_s11[3] = {3, 200, 1};
 static const casadi_int casadi_s12[3] = {0, 50, 1};
 
+/* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
+#if defined(__GNUC__)
+#define GEARSYM_INLINE inline __attribute__((always_inline))
+#define GEARSYM_NOINLINE __attribute__((noinline))
+#define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
+/* a loop left to the vectoriser (gcc unrolls a loop of 2 iterations before it, which then stays scalar) */
+#define GEARSYM_NOT_UNROLLED _Pragma("GCC unroll 1")
+#else
+#define GEARSYM_INLINE inline
+#define GEARSYM_NOINLINE
+#define GEARSYM_UNLIKELY(x) (x)
+#define GEARSYM_NOT_UNROLLED
+#endif
+
+static const casadi_real gs_zeros[1] = {0.};
+
+/* an input as CasADi passes it (a null pointer: zeros) into a local array */
+static inline void gs_load(const casadi_real* x, casadi_int n, casadi_real* y) {
+  casadi_int i;
+  for (i = 0; i < n; ++i) y[i] = x ? x[i] : 0;
+}
+
+static inline void gs_copy(const casadi_real* restrict x, casadi_int n, casadi_real* restrict y) {
+  casadi_int i;
+  for (i = 0; i < n; ++i) y[i] = x[i];
+}
+
+/* the n x n matrix x transposed into y (tangent vectors: from columns to side by side and back) */
+static inline void gs_transpose(const casadi_real* restrict x, casadi_int n, casadi_real* restrict y) {
+  casadi_int i, j;
+  for (i = 0; i < n; ++i) for (j = 0; j < n; ++j) y[j * n + i] = x[i * n + j];
+}
+
+/* an output column (none if the caller passes a null pointer) */
+static inline void gs_store(const casadi_real* x, casadi_int n, casadi_real* y, casadi_int at) {
+  casadi_int i;
+  if (y) for (i = 0; i < n; ++i) y[at + i] = x[i];
+}
+
+/* tangent_state, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_state_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3, casadi_int S) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+  casadi_real a24;
+  a00=A0[0];
+  a01=A4[S*3];
+  a02=6.;
+  a02=(a01/a02);
+  a03=A4[0];
+  a04=A0[S*1];
+  a05=(a04-a00);
+  a05=(a03*a05);
+  a06=2.;
+  a06=(a01/a06);
+  a07=A4[S*1];
+  a08=A0[S*2];
+  a09=(a07-a08);
+  a10=(a00*a09);
+  a10=(a10-a04);
+  a11=(a06*a10);
+  a11=(a04+a11);
+  a12=(a06*a05);
+  a12=(a00+a12);
+  a13=(a11-a12);
+  a13=(a03*a13);
+  a14=(2.*a13);
+  a05=(a05+a14);
+  a14=(a00*a04);
+  a15=A4[S*2];
+  a16=(a08*a15);
+  a14=(a14+a16);
+  a16=(a06*a14);
+  a16=(a08+a16);
+  a17=(a07-a16);
+  a18=(a12*a17);
+  a18=(a18-a11);
+  a19=(a06*a18);
+  a19=(a04+a19);
+  a13=(a06*a13);
+  a13=(a00+a13);
+  a20=(a19-a13);
+  a20=(a03*a20);
+  a21=(2.*a20);
+  a05=(a05+a21);
+  a21=(a12*a11);
+  a16=(a16*a15);
+  a21=(a21+a16);
+  a06=(a06*a21);
+  a06=(a08+a06);
+  a16=(a07-a06);
+  a22=(a13*a16);
+  a22=(a22-a19);
+  a23=(a01*a22);
+  a23=(a04+a23);
+  a20=(a01*a20);
+  a20=(a00+a20);
+  a24=(a23-a20);
+  a24=(a03*a24);
+  a05=(a05+a24);
+  a05=(a02*a05);
+  a05=(a00+a05);
+  R0[0]=a05;
+  a18=(2.*a18);
+  a10=(a10+a18);
+  a22=(2.*a22);
+  a10=(a10+a22);
+  a22=(a13*a19);
+  a06=(a06*a15);
+  a22=(a22+a06);
+  a01=(a01*a22);
+  a01=(a08+a01);
+  a07=(a07-a01);
+  a06=(a20*a07);
+  a06=(a06-a23);
+  a10=(a10+a06);
+  a10=(a02*a10);
+  a10=(a04+a10);
+  R0[S*1]=a10;
+  a21=(2.*a21);
+  a14=(a14+a21);
+  a22=(2.*a22);
+  a14=(a14+a22);
+  a22=(a20*a23);
+  a01=(a01*a15);
+  a22=(a22+a01);
+  a14=(a14+a22);
+  a02=(a02*a14);
+  a08=(a08+a02);
+  R0[S*2]=a08;
+  a02=A1[0];
+  a14=(a05<a02);
+  a22=(a14?a05:0);
+  a14=(!a14);
+  a14=(a14?a02:0);
+  a22=(a22+a14);
+  R1[0]=a22;
+  a22=A1[S*1];
+  a14=(a10<a22);
+  a02=(a14?a10:0);
+  a14=(!a14);
+  a14=(a14?a22:0);
+  a02=(a02+a14);
+  R1[S*1]=a02;
+  a02=A1[S*2];
+  a14=(a08<a02);
+  a22=(a14?a08:0);
+  a14=(!a14);
+  a14=(a14?a02:0);
+  a22=(a22+a14);
+  R1[S*2]=a22;
+  a22=A2[0];
+  a14=(a22<a05);
+  a05=(a14?a05:0);
+  a14=(!a14);
+  a14=(a14?a22:0);
+  a05=(a05+a14);
+  R2[0]=a05;
+  a05=A2[S*1];
+  a14=(a05<a10);
+  a10=(a14?a10:0);
+  a14=(!a14);
+  a14=(a14?a05:0);
+  a10=(a10+a14);
+  R2[S*1]=a10;
+  a10=A2[S*2];
+  a14=(a10<a08);
+  a08=(a14?a08:0);
+  a14=(!a14);
+  a14=(a14?a10:0);
+  a08=(a08+a14);
+  R2[S*2]=a08;
+  a08=(-a03);
+  R3[0]=a08;
+  R3[S*1]=a09;
+  R3[S*2]=a04;
+  R3[S*3]=a03;
+  R3[S*4]=a00;
+  a00=(-a00);
+  R3[S*5]=a00;
+  R3[S*6]=a15;
+  R3[S*7]=a17;
+  R3[S*8]=a11;
+  R3[S*9]=a12;
+  a12=(-a12);
+  R3[S*10]=a12;
+  R3[S*11]=a16;
+  R3[S*12]=a19;
+  R3[S*13]=a13;
+  a13=(-a13);
+  R3[S*14]=a13;
+  R3[S*15]=a07;
+  R3[S*16]=a23;
+  R3[S*17]=a20;
+  a20=(-a20);
+  R3[S*18]=a20;
+}
+static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3) { gs_tangent_state_strided(A0, A1, A2, A3, A4, R0, R1, R2, R3, 1); }
+
+/* tangent_vector, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_vector_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_int S) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21;
+  a00=A0[0];
+  a01=A2[S*3];
+  a02=6.;
+  a02=(a01/a02);
+  a03=A1[0];
+  a04=(a03*a00);
+  a05=A1[S*3];
+  a06=A0[S*3];
+  a07=(a05*a06);
+  a04=(a04+a07);
+  a07=2.;
+  a07=(a01/a07);
+  a08=(a07*a04);
+  a08=(a00+a08);
+  a09=(a03*a08);
+  a10=A1[S*1];
+  a10=(a10*a00);
+  a10=(a10-a06);
+  a11=A1[S*5];
+  a12=A0[S*6];
+  a11=(a11*a12);
+  a10=(a10+a11);
+  a11=(a07*a10);
+  a11=(a06+a11);
+  a13=(a05*a11);
+  a09=(a09+a13);
+  a13=(2.*a09);
+  a04=(a04+a13);
+  a09=(a07*a09);
+  a09=(a00+a09);
+  a13=(a03*a09);
+  a14=A1[S*7];
+  a14=(a14*a08);
+  a14=(a14-a11);
+  a15=A1[S*10];
+  a16=A1[S*2];
+  a16=(a16*a00);
+  a17=A1[S*4];
+  a17=(a17*a06);
+  a16=(a16+a17);
+  a17=A1[S*6];
+  a18=(a17*a12);
+  a16=(a16+a18);
+  a18=(a07*a16);
+  a18=(a12+a18);
+  a15=(a15*a18);
+  a14=(a14+a15);
+  a15=(a07*a14);
+  a15=(a06+a15);
+  a19=(a05*a15);
+  a13=(a13+a19);
+  a19=(2.*a13);
+  a04=(a04+a19);
+  a13=(a01*a13);
+  a13=(a00+a13);
+  a03=(a03*a13);
+  a19=A1[S*11];
+  a19=(a19*a09);
+  a19=(a19-a15);
+  a20=A1[S*14];
+  a21=A1[S*8];
+  a21=(a21*a08);
+  a08=A1[S*9];
+  a08=(a08*a11);
+  a21=(a21+a08);
+  a18=(a17*a18);
+  a21=(a21+a18);
+  a07=(a07*a21);
+  a07=(a12+a07);
+  a20=(a20*a07);
+  a19=(a19+a20);
+  a20=(a01*a19);
+  a20=(a06+a20);
+  a05=(a05*a20);
+  a03=(a03+a05);
+  a04=(a04+a03);
+  a04=(a02*a04);
+  a00=(a00+a04);
+  R0[0]=a00;
+  a14=(2.*a14);
+  a10=(a10+a14);
+  a19=(2.*a19);
+  a10=(a10+a19);
+  a19=A1[S*15];
+  a19=(a19*a13);
+  a19=(a19-a20);
+  a14=A1[S*18];
+  a00=A1[S*12];
+  a00=(a00*a09);
+  a09=A1[S*13];
+  a09=(a09*a15);
+  a00=(a00+a09);
+  a07=(a17*a07);
+  a00=(a00+a07);
+  a01=(a01*a00);
+  a01=(a12+a01);
+  a14=(a14*a01);
+  a19=(a19+a14);
+  a10=(a10+a19);
+  a10=(a02*a10);
+  a06=(a06+a10);
+  R0[S*3]=a06;
+  a21=(2.*a21);
+  a16=(a16+a21);
+  a00=(2.*a00);
+  a16=(a16+a00);
+  a00=A1[S*16];
+  a00=(a00*a13);
+  a13=A1[S*17];
+  a13=(a13*a20);
+  a00=(a00+a13);
+  a17=(a17*a01);
+  a00=(a00+a17);
+  a16=(a16+a00);
+  a02=(a02*a16);
+  a12=(a12+a02);
+  R0[S*6]=a12;
+}
+static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) { gs_tangent_vector_strided(A0, A1, A2, R0, 1); }
+
+/* state_block, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_block_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19;
+  a00=A0[0];
+  a01=A4[S*3];
+  a02=6.;
+  a02=(a01/a02);
+  a03=A4[0];
+  a04=A0[S*1];
+  a05=(a04-a00);
+  a05=(a03*a05);
+  a06=2.;
+  a06=(a01/a06);
+  a07=A4[S*1];
+  a08=A0[S*2];
+  a09=(a07-a08);
+  a09=(a00*a09);
+  a09=(a09-a04);
+  a10=(a06*a09);
+  a10=(a04+a10);
+  a11=(a06*a05);
+  a11=(a00+a11);
+  a12=(a10-a11);
+  a12=(a03*a12);
+  a13=(2.*a12);
+  a05=(a05+a13);
+  a13=(a00*a04);
+  a14=A4[S*2];
+  a15=(a08*a14);
+  a13=(a13+a15);
+  a15=(a06*a13);
+  a15=(a08+a15);
+  a16=(a07-a15);
+  a16=(a11*a16);
+  a16=(a16-a10);
+  a17=(a06*a16);
+  a17=(a04+a17);
+  a12=(a06*a12);
+  a12=(a00+a12);
+  a18=(a17-a12);
+  a18=(a03*a18);
+  a19=(2.*a18);
+  a05=(a05+a19);
+  a11=(a11*a10);
+  a15=(a15*a14);
+  a11=(a11+a15);
+  a06=(a06*a11);
+  a06=(a08+a06);
+  a15=(a07-a06);
+  a15=(a12*a15);
+  a15=(a15-a17);
+  a10=(a01*a15);
+  a10=(a04+a10);
+  a18=(a01*a18);
+  a18=(a00+a18);
+  a19=(a10-a18);
+  a03=(a03*a19);
+  a05=(a05+a03);
+  a05=(a02*a05);
+  a00=(a00+a05);
+  R0[0]=a00;
+  a16=(2.*a16);
+  a09=(a09+a16);
+  a15=(2.*a15);
+  a09=(a09+a15);
+  a12=(a12*a17);
+  a06=(a06*a14);
+  a12=(a12+a06);
+  a01=(a01*a12);
+  a01=(a08+a01);
+  a07=(a07-a01);
+  a07=(a18*a07);
+  a07=(a07-a10);
+  a09=(a09+a07);
+  a09=(a02*a09);
+  a04=(a04+a09);
+  R0[S*1]=a04;
+  a11=(2.*a11);
+  a13=(a13+a11);
+  a12=(2.*a12);
+  a13=(a13+a12);
+  a18=(a18*a10);
+  a01=(a01*a14);
+  a18=(a18+a01);
+  a13=(a13+a18);
+  a02=(a02*a13);
+  a08=(a08+a02);
+  R0[S*2]=a08;
+  a02=A1[0];
+  a13=(a00<a02);
+  a18=(a13?a00:0);
+  a13=(!a13);
+  a13=(a13?a02:0);
+  a18=(a18+a13);
+  R1[0]=a18;
+  a18=A1[S*1];
+  a13=(a04<a18);
+  a02=(a13?a04:0);
+  a13=(!a13);
+  a13=(a13?a18:0);
+  a02=(a02+a13);
+  R1[S*1]=a02;
+  a02=A1[S*2];
+  a13=(a08<a02);
+  a18=(a13?a08:0);
+  a13=(!a13);
+  a13=(a13?a02:0);
+  a18=(a18+a13);
+  R1[S*2]=a18;
+  a18=A2[0];
+  a13=(a18<a00);
+  a00=(a13?a00:0);
+  a13=(!a13);
+  a13=(a13?a18:0);
+  a00=(a00+a13);
+  R2[0]=a00;
+  a00=A2[S*1];
+  a13=(a00<a04);
+  a04=(a13?a04:0);
+  a13=(!a13);
+  a13=(a13?a00:0);
+  a04=(a04+a13);
+  R2[S*1]=a04;
+  a04=A2[S*2];
+  a13=(a04<a08);
+  a08=(a13?a08:0);
+  a13=(!a13);
+  a13=(a13?a04:0);
+  a08=(a08+a13);
+  R2[S*2]=a08;
+}
+static GEARSYM_INLINE void gs_state_block(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_state_block_strided(A0, A1, A2, A3, A4, R0, R1, R2, 1); }
+
+/* gram_schmidt, from CasADi's C of it */
+static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12;
+  a00=A0[0];
+  a01=casadi_sq(a00);
+  a02=A0[1];
+  a03=casadi_sq(a02);
+  a01=(a01+a03);
+  a03=A0[2];
+  a04=casadi_sq(a03);
+  a01=(a01+a04);
+  a01=sqrt(a01);
+  a00=(a00/a01);
+  R0[0]=a00;
+  a02=(a02/a01);
+  R0[1]=a02;
+  a03=(a03/a01);
+  R0[2]=a03;
+  a04=A0[3];
+  a05=(a00*a04);
+  a06=A0[4];
+  a07=(a02*a06);
+  a05=(a05+a07);
+  a07=A0[5];
+  a08=(a03*a07);
+  a05=(a05+a08);
+  a08=(a05*a00);
+  a04=(a04-a08);
+  a08=casadi_sq(a04);
+  a09=(a05*a02);
+  a06=(a06-a09);
+  a09=casadi_sq(a06);
+  a08=(a08+a09);
+  a05=(a05*a03);
+  a07=(a07-a05);
+  a05=casadi_sq(a07);
+  a08=(a08+a05);
+  a08=sqrt(a08);
+  a04=(a04/a08);
+  R0[3]=a04;
+  a06=(a06/a08);
+  R0[4]=a06;
+  a07=(a07/a08);
+  R0[5]=a07;
+  a05=A0[6];
+  a09=(a00*a05);
+  a10=A0[7];
+  a11=(a02*a10);
+  a09=(a09+a11);
+  a11=A0[8];
+  a12=(a03*a11);
+  a09=(a09+a12);
+  a00=(a09*a00);
+  a05=(a05-a00);
+  a00=(a04*a05);
+  a02=(a09*a02);
+  a10=(a10-a02);
+  a02=(a06*a10);
+  a00=(a00+a02);
+  a09=(a09*a03);
+  a11=(a11-a09);
+  a09=(a07*a11);
+  a00=(a00+a09);
+  a04=(a00*a04);
+  a05=(a05-a04);
+  a04=casadi_sq(a05);
+  a06=(a00*a06);
+  a10=(a10-a06);
+  a06=casadi_sq(a10);
+  a04=(a04+a06);
+  a00=(a00*a07);
+  a11=(a11-a00);
+  a00=casadi_sq(a11);
+  a04=(a04+a00);
+  a04=sqrt(a04);
+  a05=(a05/a04);
+  R0[6]=a05;
+  a10=(a10/a04);
+  R0[7]=a10;
+  a11=(a11/a04);
+  R0[8]=a11;
+  a01=log(a01);
+  R1[0]=a01;
+  a08=log(a08);
+  R1[1]=a08;
+  a04=log(a04);
+  R1[2]=a04;
+}
+
+/* constants, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_constants_strided(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
+  casadi_real a0;
+  a0=A0[0];
+  R0[0]=a0;
+  a0=A0[S*1];
+  R0[S*1]=a0;
+  a0=A0[S*2];
+  a0=(-a0);
+  R0[S*2]=a0;
+  a0=5.0000000000000001e-03;
+  R0[S*3]=a0;
+  a0=1.;
+  R1[0]=a0;
+}
+static GEARSYM_INLINE void gs_constants(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) { gs_constants_strided(A0, R0, R1, 1); }
+
+#ifndef GEARSYM_STEP_PIECES_ONLY  /* (the lanes' C includes the pieces above) */
+
 /* rhs:(t,y[3],p[3])->(dy[3]) */
 static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real a0, a1, a2, a3;
@@ -491,549 +1056,6 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
   return 0;
 }
 
-/* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
-#if defined(__GNUC__)
-#define GEARSYM_INLINE inline __attribute__((always_inline))
-#define GEARSYM_NOINLINE __attribute__((noinline))
-#define GEARSYM_UNLIKELY(x) __builtin_expect(!!(x), 0)
-/* a loop left to the vectoriser (gcc unrolls a loop of 2 iterations before it, which then stays scalar) */
-#define GEARSYM_NOT_UNROLLED _Pragma("GCC unroll 1")
-#else
-#define GEARSYM_INLINE inline
-#define GEARSYM_NOINLINE
-#define GEARSYM_UNLIKELY(x) (x)
-#define GEARSYM_NOT_UNROLLED
-#endif
-
-static const casadi_real gs_zeros[1] = {0.};
-
-/* an input as CasADi passes it (a null pointer: zeros) into a local array */
-static inline void gs_load(const casadi_real* x, casadi_int n, casadi_real* y) {
-  casadi_int i;
-  for (i = 0; i < n; ++i) y[i] = x ? x[i] : 0;
-}
-
-static inline void gs_copy(const casadi_real* restrict x, casadi_int n, casadi_real* restrict y) {
-  casadi_int i;
-  for (i = 0; i < n; ++i) y[i] = x[i];
-}
-
-/* the n x n matrix x transposed into y (tangent vectors: from columns to side by side and back) */
-static inline void gs_transpose(const casadi_real* restrict x, casadi_int n, casadi_real* restrict y) {
-  casadi_int i, j;
-  for (i = 0; i < n; ++i) for (j = 0; j < n; ++j) y[j * n + i] = x[i * n + j];
-}
-
-/* an output column (none if the caller passes a null pointer) */
-static inline void gs_store(const casadi_real* x, casadi_int n, casadi_real* y, casadi_int at) {
-  casadi_int i;
-  if (y) for (i = 0; i < n; ++i) y[at + i] = x[i];
-}
-
-/* tangent_state, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_real* restrict R3) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
-  casadi_real a24;
-  a00=A0[0];
-  a01=A4[3];
-  a02=6.;
-  a02=(a01/a02);
-  a03=A4[0];
-  a04=A0[1];
-  a05=(a04-a00);
-  a05=(a03*a05);
-  a06=2.;
-  a06=(a01/a06);
-  a07=A4[1];
-  a08=A0[2];
-  a09=(a07-a08);
-  a10=(a00*a09);
-  a10=(a10-a04);
-  a11=(a06*a10);
-  a11=(a04+a11);
-  a12=(a06*a05);
-  a12=(a00+a12);
-  a13=(a11-a12);
-  a13=(a03*a13);
-  a14=(2.*a13);
-  a05=(a05+a14);
-  a14=(a00*a04);
-  a15=A4[2];
-  a16=(a08*a15);
-  a14=(a14+a16);
-  a16=(a06*a14);
-  a16=(a08+a16);
-  a17=(a07-a16);
-  a18=(a12*a17);
-  a18=(a18-a11);
-  a19=(a06*a18);
-  a19=(a04+a19);
-  a13=(a06*a13);
-  a13=(a00+a13);
-  a20=(a19-a13);
-  a20=(a03*a20);
-  a21=(2.*a20);
-  a05=(a05+a21);
-  a21=(a12*a11);
-  a16=(a16*a15);
-  a21=(a21+a16);
-  a06=(a06*a21);
-  a06=(a08+a06);
-  a16=(a07-a06);
-  a22=(a13*a16);
-  a22=(a22-a19);
-  a23=(a01*a22);
-  a23=(a04+a23);
-  a20=(a01*a20);
-  a20=(a00+a20);
-  a24=(a23-a20);
-  a24=(a03*a24);
-  a05=(a05+a24);
-  a05=(a02*a05);
-  a05=(a00+a05);
-  R0[0]=a05;
-  a18=(2.*a18);
-  a10=(a10+a18);
-  a22=(2.*a22);
-  a10=(a10+a22);
-  a22=(a13*a19);
-  a06=(a06*a15);
-  a22=(a22+a06);
-  a01=(a01*a22);
-  a01=(a08+a01);
-  a07=(a07-a01);
-  a06=(a20*a07);
-  a06=(a06-a23);
-  a10=(a10+a06);
-  a10=(a02*a10);
-  a10=(a04+a10);
-  R0[1]=a10;
-  a21=(2.*a21);
-  a14=(a14+a21);
-  a22=(2.*a22);
-  a14=(a14+a22);
-  a22=(a20*a23);
-  a01=(a01*a15);
-  a22=(a22+a01);
-  a14=(a14+a22);
-  a02=(a02*a14);
-  a08=(a08+a02);
-  R0[2]=a08;
-  a02=A1[0];
-  a14=(a05<a02);
-  a22=(a14?a05:0);
-  a14=(!a14);
-  a14=(a14?a02:0);
-  a22=(a22+a14);
-  R1[0]=a22;
-  a22=A1[1];
-  a14=(a10<a22);
-  a02=(a14?a10:0);
-  a14=(!a14);
-  a14=(a14?a22:0);
-  a02=(a02+a14);
-  R1[1]=a02;
-  a02=A1[2];
-  a14=(a08<a02);
-  a22=(a14?a08:0);
-  a14=(!a14);
-  a14=(a14?a02:0);
-  a22=(a22+a14);
-  R1[2]=a22;
-  a22=A2[0];
-  a14=(a22<a05);
-  a05=(a14?a05:0);
-  a14=(!a14);
-  a14=(a14?a22:0);
-  a05=(a05+a14);
-  R2[0]=a05;
-  a05=A2[1];
-  a14=(a05<a10);
-  a10=(a14?a10:0);
-  a14=(!a14);
-  a14=(a14?a05:0);
-  a10=(a10+a14);
-  R2[1]=a10;
-  a10=A2[2];
-  a14=(a10<a08);
-  a08=(a14?a08:0);
-  a14=(!a14);
-  a14=(a14?a10:0);
-  a08=(a08+a14);
-  R2[2]=a08;
-  a08=(-a03);
-  R3[0]=a08;
-  R3[1]=a09;
-  R3[2]=a04;
-  R3[3]=a03;
-  R3[4]=a00;
-  a00=(-a00);
-  R3[5]=a00;
-  R3[6]=a15;
-  R3[7]=a17;
-  R3[8]=a11;
-  R3[9]=a12;
-  a12=(-a12);
-  R3[10]=a12;
-  R3[11]=a16;
-  R3[12]=a19;
-  R3[13]=a13;
-  a13=(-a13);
-  R3[14]=a13;
-  R3[15]=a07;
-  R3[16]=a23;
-  R3[17]=a20;
-  a20=(-a20);
-  R3[18]=a20;
-}
-
-/* tangent_vector, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21;
-  a00=A0[0];
-  a01=A2[3];
-  a02=6.;
-  a02=(a01/a02);
-  a03=A1[0];
-  a04=(a03*a00);
-  a05=A1[3];
-  a06=A0[3];
-  a07=(a05*a06);
-  a04=(a04+a07);
-  a07=2.;
-  a07=(a01/a07);
-  a08=(a07*a04);
-  a08=(a00+a08);
-  a09=(a03*a08);
-  a10=A1[1];
-  a10=(a10*a00);
-  a10=(a10-a06);
-  a11=A1[5];
-  a12=A0[6];
-  a11=(a11*a12);
-  a10=(a10+a11);
-  a11=(a07*a10);
-  a11=(a06+a11);
-  a13=(a05*a11);
-  a09=(a09+a13);
-  a13=(2.*a09);
-  a04=(a04+a13);
-  a09=(a07*a09);
-  a09=(a00+a09);
-  a13=(a03*a09);
-  a14=A1[7];
-  a14=(a14*a08);
-  a14=(a14-a11);
-  a15=A1[10];
-  a16=A1[2];
-  a16=(a16*a00);
-  a17=A1[4];
-  a17=(a17*a06);
-  a16=(a16+a17);
-  a17=A1[6];
-  a18=(a17*a12);
-  a16=(a16+a18);
-  a18=(a07*a16);
-  a18=(a12+a18);
-  a15=(a15*a18);
-  a14=(a14+a15);
-  a15=(a07*a14);
-  a15=(a06+a15);
-  a19=(a05*a15);
-  a13=(a13+a19);
-  a19=(2.*a13);
-  a04=(a04+a19);
-  a13=(a01*a13);
-  a13=(a00+a13);
-  a03=(a03*a13);
-  a19=A1[11];
-  a19=(a19*a09);
-  a19=(a19-a15);
-  a20=A1[14];
-  a21=A1[8];
-  a21=(a21*a08);
-  a08=A1[9];
-  a08=(a08*a11);
-  a21=(a21+a08);
-  a18=(a17*a18);
-  a21=(a21+a18);
-  a07=(a07*a21);
-  a07=(a12+a07);
-  a20=(a20*a07);
-  a19=(a19+a20);
-  a20=(a01*a19);
-  a20=(a06+a20);
-  a05=(a05*a20);
-  a03=(a03+a05);
-  a04=(a04+a03);
-  a04=(a02*a04);
-  a00=(a00+a04);
-  R0[0]=a00;
-  a14=(2.*a14);
-  a10=(a10+a14);
-  a19=(2.*a19);
-  a10=(a10+a19);
-  a19=A1[15];
-  a19=(a19*a13);
-  a19=(a19-a20);
-  a14=A1[18];
-  a00=A1[12];
-  a00=(a00*a09);
-  a09=A1[13];
-  a09=(a09*a15);
-  a00=(a00+a09);
-  a07=(a17*a07);
-  a00=(a00+a07);
-  a01=(a01*a00);
-  a01=(a12+a01);
-  a14=(a14*a01);
-  a19=(a19+a14);
-  a10=(a10+a19);
-  a10=(a02*a10);
-  a06=(a06+a10);
-  R0[3]=a06;
-  a21=(2.*a21);
-  a16=(a16+a21);
-  a00=(2.*a00);
-  a16=(a16+a00);
-  a00=A1[16];
-  a00=(a00*a13);
-  a13=A1[17];
-  a13=(a13*a20);
-  a00=(a00+a13);
-  a17=(a17*a01);
-  a00=(a00+a17);
-  a16=(a16+a00);
-  a02=(a02*a16);
-  a12=(a12+a02);
-  R0[6]=a12;
-}
-
-/* state_block, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_block(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19;
-  a00=A0[0];
-  a01=A4[3];
-  a02=6.;
-  a02=(a01/a02);
-  a03=A4[0];
-  a04=A0[1];
-  a05=(a04-a00);
-  a05=(a03*a05);
-  a06=2.;
-  a06=(a01/a06);
-  a07=A4[1];
-  a08=A0[2];
-  a09=(a07-a08);
-  a09=(a00*a09);
-  a09=(a09-a04);
-  a10=(a06*a09);
-  a10=(a04+a10);
-  a11=(a06*a05);
-  a11=(a00+a11);
-  a12=(a10-a11);
-  a12=(a03*a12);
-  a13=(2.*a12);
-  a05=(a05+a13);
-  a13=(a00*a04);
-  a14=A4[2];
-  a15=(a08*a14);
-  a13=(a13+a15);
-  a15=(a06*a13);
-  a15=(a08+a15);
-  a16=(a07-a15);
-  a16=(a11*a16);
-  a16=(a16-a10);
-  a17=(a06*a16);
-  a17=(a04+a17);
-  a12=(a06*a12);
-  a12=(a00+a12);
-  a18=(a17-a12);
-  a18=(a03*a18);
-  a19=(2.*a18);
-  a05=(a05+a19);
-  a11=(a11*a10);
-  a15=(a15*a14);
-  a11=(a11+a15);
-  a06=(a06*a11);
-  a06=(a08+a06);
-  a15=(a07-a06);
-  a15=(a12*a15);
-  a15=(a15-a17);
-  a10=(a01*a15);
-  a10=(a04+a10);
-  a18=(a01*a18);
-  a18=(a00+a18);
-  a19=(a10-a18);
-  a03=(a03*a19);
-  a05=(a05+a03);
-  a05=(a02*a05);
-  a00=(a00+a05);
-  R0[0]=a00;
-  a16=(2.*a16);
-  a09=(a09+a16);
-  a15=(2.*a15);
-  a09=(a09+a15);
-  a12=(a12*a17);
-  a06=(a06*a14);
-  a12=(a12+a06);
-  a01=(a01*a12);
-  a01=(a08+a01);
-  a07=(a07-a01);
-  a07=(a18*a07);
-  a07=(a07-a10);
-  a09=(a09+a07);
-  a09=(a02*a09);
-  a04=(a04+a09);
-  R0[1]=a04;
-  a11=(2.*a11);
-  a13=(a13+a11);
-  a12=(2.*a12);
-  a13=(a13+a12);
-  a18=(a18*a10);
-  a01=(a01*a14);
-  a18=(a18+a01);
-  a13=(a13+a18);
-  a02=(a02*a13);
-  a08=(a08+a02);
-  R0[2]=a08;
-  a02=A1[0];
-  a13=(a00<a02);
-  a18=(a13?a00:0);
-  a13=(!a13);
-  a13=(a13?a02:0);
-  a18=(a18+a13);
-  R1[0]=a18;
-  a18=A1[1];
-  a13=(a04<a18);
-  a02=(a13?a04:0);
-  a13=(!a13);
-  a13=(a13?a18:0);
-  a02=(a02+a13);
-  R1[1]=a02;
-  a02=A1[2];
-  a13=(a08<a02);
-  a18=(a13?a08:0);
-  a13=(!a13);
-  a13=(a13?a02:0);
-  a18=(a18+a13);
-  R1[2]=a18;
-  a18=A2[0];
-  a13=(a18<a00);
-  a00=(a13?a00:0);
-  a13=(!a13);
-  a13=(a13?a18:0);
-  a00=(a00+a13);
-  R2[0]=a00;
-  a00=A2[1];
-  a13=(a00<a04);
-  a04=(a13?a04:0);
-  a13=(!a13);
-  a13=(a13?a00:0);
-  a04=(a04+a13);
-  R2[1]=a04;
-  a04=A2[2];
-  a13=(a04<a08);
-  a08=(a13?a08:0);
-  a13=(!a13);
-  a13=(a13?a04:0);
-  a08=(a08+a13);
-  R2[2]=a08;
-}
-
-/* gram_schmidt, from CasADi's C of it */
-static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12;
-  a00=A0[0];
-  a01=casadi_sq(a00);
-  a02=A0[1];
-  a03=casadi_sq(a02);
-  a01=(a01+a03);
-  a03=A0[2];
-  a04=casadi_sq(a03);
-  a01=(a01+a04);
-  a01=sqrt(a01);
-  a00=(a00/a01);
-  R0[0]=a00;
-  a02=(a02/a01);
-  R0[1]=a02;
-  a03=(a03/a01);
-  R0[2]=a03;
-  a04=A0[3];
-  a05=(a00*a04);
-  a06=A0[4];
-  a07=(a02*a06);
-  a05=(a05+a07);
-  a07=A0[5];
-  a08=(a03*a07);
-  a05=(a05+a08);
-  a08=(a05*a00);
-  a04=(a04-a08);
-  a08=casadi_sq(a04);
-  a09=(a05*a02);
-  a06=(a06-a09);
-  a09=casadi_sq(a06);
-  a08=(a08+a09);
-  a05=(a05*a03);
-  a07=(a07-a05);
-  a05=casadi_sq(a07);
-  a08=(a08+a05);
-  a08=sqrt(a08);
-  a04=(a04/a08);
-  R0[3]=a04;
-  a06=(a06/a08);
-  R0[4]=a06;
-  a07=(a07/a08);
-  R0[5]=a07;
-  a05=A0[6];
-  a09=(a00*a05);
-  a10=A0[7];
-  a11=(a02*a10);
-  a09=(a09+a11);
-  a11=A0[8];
-  a12=(a03*a11);
-  a09=(a09+a12);
-  a00=(a09*a00);
-  a05=(a05-a00);
-  a00=(a04*a05);
-  a02=(a09*a02);
-  a10=(a10-a02);
-  a02=(a06*a10);
-  a00=(a00+a02);
-  a09=(a09*a03);
-  a11=(a11-a09);
-  a09=(a07*a11);
-  a00=(a00+a09);
-  a04=(a00*a04);
-  a05=(a05-a04);
-  a04=casadi_sq(a05);
-  a06=(a00*a06);
-  a10=(a10-a06);
-  a06=casadi_sq(a10);
-  a04=(a04+a06);
-  a00=(a00*a07);
-  a11=(a11-a00);
-  a00=casadi_sq(a11);
-  a04=(a04+a00);
-  a04=sqrt(a04);
-  a05=(a05/a04);
-  R0[6]=a05;
-  a10=(a10/a04);
-  R0[7]=a10;
-  a11=(a11/a04);
-  R0[8]=a11;
-  a01=log(a01);
-  R1[0]=a01;
-  a08=log(a08);
-  R1[1]=a08;
-  a04=log(a04);
-  R1[2]=a04;
-}
-
 /* one block of tangent steps (the SX functions' step, as CasADi's Switch runs it) */
 static GEARSYM_INLINE void gs_tangent_step(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
   casadi_real J[19]; casadi_int j;
@@ -1078,12 +1100,11 @@ static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 3, y); gs_load(arg[1], 9, Q); gs_load(arg[3], 4, c);
-  casadi_real Qn[9], logs[3];
+  casadi_real Qn[9], logs[3]; casadi_real piece[3]; casadi_int g, i;
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[1]; hi[1] = y[1]; lo[2] = y[2]; hi[2] = y[2];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 9, Q);
+    for (i = 0; i < 3; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T, c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 9, Q); for (i = 0; i < 3; ++i) logs[i] += piece[i]; }
     gs_store(y, 3, res[0], 3*p); gs_store(logs, 3, res[2], 3*p);
     gs_store(lo, 3, res[3], 3*p); gs_store(hi, 3, res[4], 3*p);
   }
@@ -1182,12 +1203,11 @@ static int casadi_f8(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 3, y); gs_load(arg[1], 9, Q); gs_load(arg[3], 4, c);
-  casadi_real Qn[9], logs[3];
+  casadi_real Qn[9], logs[3]; casadi_real piece[3]; casadi_int g, i;
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[1]; hi[1] = y[1]; lo[2] = y[2]; hi[2] = y[2];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 9, Q);
+    for (i = 0; i < 3; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T, c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 9, Q); for (i = 0; i < 3; ++i) logs[i] += piece[i]; }
     gs_store(y, 3, res[0], 3*p); gs_store(logs, 3, res[2], 3*p);
     gs_store(lo, 3, res[3], 3*p); gs_store(hi, 3, res[4], 3*p);
   }
@@ -1759,6 +1779,8 @@ CASADI_SYMBOL_EXPORT int monodromy_period_work_bytes(casadi_int *sz_arg, casadi_
   return 0;
 }
 
+
+#endif  /* GEARSYM_STEP_PIECES_ONLY */
 
 #ifdef __cplusplus
 } /* extern "C" */

@@ -227,1392 +227,6 @@ static const casadi_real casadi_c0[401] =
 static const casadi_real casadi_zeros[16] = 
   {0.};
 
-/* rhs:(t,y[8],p[16])->(dy[8]) */
-static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
-  casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
-  casadi_real a36, a37, a38, a39, a40, a41, a42, a43, a44, a45, a46, a47;
-  casadi_real a48, a49, a50, a51, a52, a53, a54, a55, a56, a57, a58, a59;
-  a00=arg[1]? arg[1][1] : 0;
-  if (res[0]!=0) res[0][0]=a00;
-  a01=-2.;
-  a02=(a01*a00);
-  a03=arg[2]? arg[2][1] : 0;
-  a04=(a02*a03);
-  a05=arg[2]? arg[2][0] : 0;
-  a04=(a04/a05);
-  a06=arg[2]? arg[2][4] : 0;
-  a07=arg[2]? arg[2][5] : 0;
-  a08=arg[2]? arg[2][10] : 0;
-  a09=arg[0]? arg[0][0] : 0;
-  a08=(a08+a09);
-  a08=cos(a08);
-  a07=(a07*a08);
-  a06=(a06+a07);
-  a07=casadi_sq(a05);
-  a06=(a06/a07);
-  a08=(a04+a06);
-  a10=-4.;
-  a11=arg[1]? arg[1][7] : 0;
-  a12=(a10*a11);
-  a13=arg[2]? arg[2][3] : 0;
-  a12=(a12*a13);
-  a12=(a12/a05);
-  a14=arg[2]? arg[2][13] : 0;
-  a15=arg[2]? arg[2][14] : 0;
-  a16=(a14*a15);
-  a17=arg[2]? arg[2][7] : 0;
-  a16=(a16/a17);
-  a18=casadi_sq(a14);
-  a19=(a18/a17);
-  a20=(a16-a19);
-  a21=arg[2]? arg[2][15] : 0;
-  a22=(a15*a21);
-  a22=(a22/a17);
-  a20=(a20+a22);
-  a23=(a14*a21);
-  a23=(a23/a17);
-  a20=(a20-a23);
-  a24=(a12*a20);
-  a25=casadi_sq(a15);
-  a25=(a25/a17);
-  a25=(a19+a25);
-  a26=arg[2]? arg[2][8] : 0;
-  a18=(a18/a26);
-  a26=(a25+a18);
-  a27=(a01*a14);
-  a27=(a27*a15);
-  a27=(a27/a17);
-  a26=(a26+a27);
-  a24=(a24/a26);
-  a08=(a08+a24);
-  a10=(a10*a00);
-  a10=(a10*a13);
-  a10=(a10/a05);
-  a00=(a10*a20);
-  a00=(a00/a26);
-  a08=(a08+a00);
-  a00=(a01*a11);
-  a00=(a00*a13);
-  a00=(a00/a05);
-  a15=(a19+a18);
-  a16=(a16-a15);
-  a16=(a16+a22);
-  a16=(a16-a23);
-  a23=(a00*a16);
-  a23=(a23/a26);
-  a08=(a08+a23);
-  a22=arg[1]? arg[1][3] : 0;
-  a15=(a01*a22);
-  a15=(a15*a03);
-  a15=(a15/a05);
-  a28=casadi_sq(a21);
-  a29=(a28/a17);
-  a19=(a19+a29);
-  a29=arg[2]? arg[2][9] : 0;
-  a28=(a28/a29);
-  a29=(a19+a28);
-  a14=(2.*a14);
-  a14=(a14*a21);
-  a14=(a14/a17);
-  a29=(a29+a14);
-  a17=(a15*a29);
-  a19=(a19+a18);
-  a19=(a19+a28);
-  a19=(a19+a14);
-  a17=(a17/a19);
-  a08=(a08+a17);
-  a14=arg[1]? arg[1][5] : 0;
-  a01=(a01*a14);
-  a01=(a01*a03);
-  a01=(a01/a05);
-  a03=(a01*a29);
-  a03=(a03/a19);
-  a08=(a08+a03);
-  a28=(2.*a22);
-  a28=(a28*a13);
-  a28=(a28/a05);
-  a18=(a28*a20);
-  a18=(a18/a26);
-  a08=(a08+a18);
-  a21=(2.*a14);
-  a21=(a21*a13);
-  a21=(a21/a05);
-  a30=(a21*a20);
-  a30=(a30/a26);
-  a08=(a08+a30);
-  a31=0.;
-  a32=arg[1]? arg[1][0] : 0;
-  a33=(a31<=a32);
-  a33=(a33?a32:0);
-  a34=arg[2]? arg[2][11] : 0;
-  a35=(-a34);
-  a36=(a32<=a35);
-  a37=(a32+a34);
-  a36=(a36?a37:0);
-  a33=(a33+a36);
-  a33=(a33/a07);
-  a36=1.;
-  a37=arg[2]? arg[2][12] : 0;
-  a38=1.1800386146799999e+00;
-  a39=cos(a09);
-  a38=(a38*a39);
-  a39=1.9272434388400000e-01;
-  a40=4.;
-  a40=(a40*a09);
-  a41=cos(a40);
-  a39=(a39*a41);
-  a38=(a38+a39);
-  a39=1.4883754528799999e-02;
-  a41=7.;
-  a41=(a41*a09);
-  a42=cos(a41);
-  a39=(a39*a42);
-  a38=(a38+a39);
-  a39=-6.0567417982099997e-02;
-  a42=6.;
-  a42=(a42*a09);
-  a42=cos(a42);
-  a39=(a39*a42);
-  a38=(a38+a39);
-  a42=-3.3689450631399998e-01;
-  a43=(2.*a09);
-  a44=cos(a43);
-  a42=(a42*a44);
-  a38=(a38+a42);
-  a42=-1.9563283778700000e-01;
-  a44=3.;
-  a44=(a44*a09);
-  a44=cos(a44);
-  a42=(a42*a44);
-  a38=(a38+a42);
-  a38=(a37*a38);
-  a38=(a36+a38);
-  a44=(a33*a38);
-  a08=(a08-a44);
-  a44=arg[2]? arg[2][2] : 0;
-  a44=(a44/a07);
-  a45=arg[1]? arg[1][6] : 0;
-  a46=(a31<=a45);
-  a46=(a46?a45:0);
-  a47=(a45<=a35);
-  a48=(a45+a34);
-  a47=(a47?a48:0);
-  a46=(a46+a47);
-  a46=(a44*a46);
-  a47=(a46*a16);
-  a47=(a47/a26);
-  a47=(a47*a38);
-  a08=(a08-a47);
-  a47=arg[1]? arg[1][2] : 0;
-  a48=(a31<=a47);
-  a48=(a48?a47:0);
-  a49=(a47<=a35);
-  a50=(a47+a34);
-  a49=(a49?a50:0);
-  a48=(a48+a49);
-  a48=(a48/a07);
-  a49=(a48*a29);
-  a49=(a49/a19);
-  a39=(a39+a42);
-  a42=3.3689450631399998e-01;
-  a50=1.0471975511965976e+00;
-  a51=(a43+a50);
-  a51=cos(a51);
-  a51=(a42*a51);
-  a51=(a39+a51);
-  a52=-1.1800386146799999e+00;
-  a53=5.2359877559829882e-01;
-  a54=(a09+a53);
-  a54=sin(a54);
-  a54=(a52*a54);
-  a51=(a51+a54);
-  a54=-1.9272434388400000e-01;
-  a55=(a40+a53);
-  a55=sin(a55);
-  a55=(a54*a55);
-  a51=(a51+a55);
-  a55=-1.4883754528799999e-02;
-  a56=(a41+a53);
-  a56=sin(a56);
-  a56=(a55*a56);
-  a51=(a51+a56);
-  a51=(a37*a51);
-  a51=(a36+a51);
-  a49=(a49*a51);
-  a08=(a08-a49);
-  a56=arg[1]? arg[1][4] : 0;
-  a57=(a31<=a56);
-  a57=(a57?a56:0);
-  a58=(a56<=a35);
-  a59=(a56+a34);
-  a58=(a58?a59:0);
-  a57=(a57+a58);
-  a57=(a57/a07);
-  a58=(a57*a29);
-  a58=(a58/a19);
-  a43=(a43+a53);
-  a43=sin(a43);
-  a42=(a42*a43);
-  a39=(a39+a42);
-  a09=(a09+a50);
-  a09=cos(a09);
-  a52=(a52*a09);
-  a39=(a39+a52);
-  a40=(a40+a50);
-  a40=cos(a40);
-  a54=(a54*a40);
-  a39=(a39+a54);
-  a41=(a41+a50);
-  a41=cos(a41);
-  a55=(a55*a41);
-  a39=(a39+a55);
-  a37=(a37*a39);
-  a36=(a36+a37);
-  a58=(a58*a36);
-  a08=(a08-a58);
-  a37=(a44*a20);
-  a32=(a32+a45);
-  a47=(a32-a47);
-  a45=(a31<=a47);
-  a45=(a45?a47:0);
-  a39=(a47<=a35);
-  a47=(a47+a34);
-  a39=(a39?a47:0);
-  a45=(a45+a39);
-  a39=(a37*a45);
-  a39=(a39/a26);
-  a39=(a39*a51);
-  a08=(a08-a39);
-  a32=(a32-a56);
-  a31=(a31<=a32);
-  a31=(a31?a32:0);
-  a35=(a32<=a35);
-  a32=(a32+a34);
-  a35=(a35?a32:0);
-  a31=(a31+a35);
-  a37=(a37*a31);
-  a37=(a37/a26);
-  a37=(a37*a36);
-  a08=(a08-a37);
-  if (res[0]!=0) res[0][1]=a08;
-  if (res[0]!=0) res[0][2]=a22;
-  a22=(a15+a06);
-  a22=(a22+a24);
-  a22=(a22+a23);
-  a08=(a04*a29);
-  a08=(a08/a19);
-  a22=(a22+a08);
-  a02=(a02*a13);
-  a02=(a02/a05);
-  a05=(a02*a20);
-  a05=(a05/a26);
-  a22=(a22+a05);
-  a02=(a02*a16);
-  a02=(a02/a26);
-  a22=(a22+a02);
-  a22=(a22+a03);
-  a03=(a28*a16);
-  a03=(a03/a26);
-  a22=(a22+a03);
-  a22=(a22+a30);
-  a29=(a33*a29);
-  a29=(a29/a19);
-  a29=(a29*a38);
-  a22=(a22-a29);
-  a30=(a46*a20);
-  a30=(a30/a26);
-  a30=(a30*a38);
-  a22=(a22-a30);
-  a03=(a48*a51);
-  a22=(a22-a03);
-  a22=(a22-a58);
-  a58=(a44*a16);
-  a03=(a58*a45);
-  a03=(a03/a26);
-  a03=(a03*a51);
-  a22=(a22-a03);
-  a22=(a22-a37);
-  if (res[0]!=0) res[0][3]=a22;
-  if (res[0]!=0) res[0][4]=a14;
-  a06=(a01+a06);
-  a06=(a06+a24);
-  a06=(a06+a23);
-  a06=(a06+a08);
-  a06=(a06+a05);
-  a06=(a06+a02);
-  a06=(a06+a17);
-  a06=(a06+a18);
-  a18=(a21*a16);
-  a18=(a18/a26);
-  a06=(a06+a18);
-  a06=(a06-a29);
-  a06=(a06-a30);
-  a30=(a57*a36);
-  a06=(a06-a30);
-  a06=(a06-a49);
-  a06=(a06-a39);
-  a58=(a58*a31);
-  a58=(a58/a26);
-  a58=(a58*a36);
-  a06=(a06-a58);
-  if (res[0]!=0) res[0][5]=a06;
-  if (res[0]!=0) res[0][6]=a11;
-  a11=arg[2]? arg[2][6] : 0;
-  a11=(a11/a07);
-  a11=(a11+a00);
-  a25=(a25+a27);
-  a12=(a12*a25);
-  a12=(a12/a26);
-  a11=(a11+a12);
-  a10=(a10*a25);
-  a10=(a10/a26);
-  a11=(a11+a10);
-  a04=(a04*a16);
-  a04=(a04/a19);
-  a11=(a11+a04);
-  a15=(a15*a20);
-  a15=(a15/a19);
-  a11=(a11+a15);
-  a01=(a01*a20);
-  a01=(a01/a19);
-  a11=(a11+a01);
-  a28=(a28*a25);
-  a28=(a28/a26);
-  a11=(a11+a28);
-  a21=(a21*a25);
-  a21=(a21/a26);
-  a11=(a11+a21);
-  a46=(a46*a38);
-  a11=(a11-a46);
-  a33=(a33*a16);
-  a33=(a33/a19);
-  a33=(a33*a38);
-  a11=(a11-a33);
-  a48=(a48*a20);
-  a48=(a48/a19);
-  a48=(a48*a51);
-  a11=(a11-a48);
-  a57=(a57*a20);
-  a57=(a57/a19);
-  a57=(a57*a36);
-  a11=(a11-a57);
-  a44=(a44*a25);
-  a45=(a44*a45);
-  a45=(a45/a26);
-  a45=(a45*a51);
-  a11=(a11-a45);
-  a44=(a44*a31);
-  a44=(a44/a26);
-  a44=(a44*a36);
-  a11=(a11-a44);
-  if (res[0]!=0) res[0][7]=a11;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int rhs(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f0(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int rhs_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void rhs_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void rhs_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void rhs_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int rhs_n_in(void) { return 3;}
-
-CASADI_SYMBOL_EXPORT casadi_int rhs_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real rhs_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* rhs_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "y";
-    case 2: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* rhs_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "dy";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s1;
-    case 2: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s1;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int rhs_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int rhs_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* jacobian:(t,y[8],p[16])->(J[8x8]) */
-static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
-  casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
-  casadi_real a36, a37, a38, a39, a40, a41, a42, a43;
-  a00=0.;
-  if (res[0]!=0) res[0][0]=a00;
-  a01=1.;
-  a02=arg[2]? arg[2][12] : 0;
-  a03=1.1800386146799999e+00;
-  a04=arg[0]? arg[0][0] : 0;
-  a05=cos(a04);
-  a03=(a03*a05);
-  a05=1.9272434388400000e-01;
-  a06=4.;
-  a06=(a06*a04);
-  a07=cos(a06);
-  a05=(a05*a07);
-  a03=(a03+a05);
-  a05=1.4883754528799999e-02;
-  a07=7.;
-  a07=(a07*a04);
-  a08=cos(a07);
-  a05=(a05*a08);
-  a03=(a03+a05);
-  a05=-6.0567417982099997e-02;
-  a08=6.;
-  a08=(a08*a04);
-  a08=cos(a08);
-  a05=(a05*a08);
-  a03=(a03+a05);
-  a08=-3.3689450631399998e-01;
-  a09=(2.*a04);
-  a10=cos(a09);
-  a08=(a08*a10);
-  a03=(a03+a08);
-  a08=-1.9563283778700000e-01;
-  a10=3.;
-  a10=(a10*a04);
-  a10=cos(a10);
-  a08=(a08*a10);
-  a03=(a03+a08);
-  a03=(a02*a03);
-  a03=(a01+a03);
-  a10=arg[1]? arg[1][0] : 0;
-  a11=(a00<=a10);
-  a11=(a11?a01:0);
-  a12=arg[2]? arg[2][11] : 0;
-  a12=(-a12);
-  a13=(a10<=a12);
-  a13=(a13?a01:0);
-  a11=(a11+a13);
-  a13=arg[2]? arg[2][0] : 0;
-  a14=casadi_sq(a13);
-  a11=(a11/a14);
-  a15=(a03*a11);
-  a05=(a05+a08);
-  a08=3.3689450631399998e-01;
-  a16=1.0471975511965976e+00;
-  a17=(a09+a16);
-  a17=cos(a17);
-  a17=(a08*a17);
-  a17=(a05+a17);
-  a18=-1.1800386146799999e+00;
-  a19=5.2359877559829882e-01;
-  a20=(a04+a19);
-  a20=sin(a20);
-  a20=(a18*a20);
-  a17=(a17+a20);
-  a20=-1.9272434388400000e-01;
-  a21=(a06+a19);
-  a21=sin(a21);
-  a21=(a20*a21);
-  a17=(a17+a21);
-  a21=-1.4883754528799999e-02;
-  a22=(a07+a19);
-  a22=sin(a22);
-  a22=(a21*a22);
-  a17=(a17+a22);
-  a17=(a02*a17);
-  a17=(a01+a17);
-  a22=arg[2]? arg[2][2] : 0;
-  a22=(a22/a14);
-  a23=arg[2]? arg[2][13] : 0;
-  a24=arg[2]? arg[2][14] : 0;
-  a25=(a23*a24);
-  a26=arg[2]? arg[2][7] : 0;
-  a25=(a25/a26);
-  a27=casadi_sq(a23);
-  a28=(a27/a26);
-  a29=(a25-a28);
-  a30=arg[2]? arg[2][15] : 0;
-  a31=(a24*a30);
-  a31=(a31/a26);
-  a29=(a29+a31);
-  a32=(a23*a30);
-  a32=(a32/a26);
-  a29=(a29-a32);
-  a33=(a22*a29);
-  a34=arg[1]? arg[1][6] : 0;
-  a10=(a10+a34);
-  a35=arg[1]? arg[1][2] : 0;
-  a36=(a10-a35);
-  a37=(a00<=a36);
-  a38=(a37?a01:0);
-  a36=(a36<=a12);
-  a39=(a36?a01:0);
-  a38=(a38+a39);
-  a39=(a33*a38);
-  a40=casadi_sq(a24);
-  a40=(a40/a26);
-  a40=(a28+a40);
-  a41=arg[2]? arg[2][8] : 0;
-  a27=(a27/a41);
-  a41=(a40+a27);
-  a42=-2.;
-  a43=(a42*a23);
-  a43=(a43*a24);
-  a43=(a43/a26);
-  a41=(a41+a43);
-  a39=(a39/a41);
-  a39=(a17*a39);
-  a15=(a15+a39);
-  a09=(a09+a19);
-  a09=sin(a09);
-  a08=(a08*a09);
-  a05=(a05+a08);
-  a04=(a04+a16);
-  a04=cos(a04);
-  a18=(a18*a04);
-  a05=(a05+a18);
-  a06=(a06+a16);
-  a06=cos(a06);
-  a20=(a20*a06);
-  a05=(a05+a20);
-  a07=(a07+a16);
-  a07=cos(a07);
-  a21=(a21*a07);
-  a05=(a05+a21);
-  a02=(a02*a05);
-  a02=(a01+a02);
-  a05=arg[1]? arg[1][4] : 0;
-  a10=(a10-a05);
-  a21=(a00<=a10);
-  a07=(a21?a01:0);
-  a10=(a10<=a12);
-  a16=(a10?a01:0);
-  a07=(a07+a16);
-  a16=(a33*a07);
-  a16=(a16/a41);
-  a16=(a02*a16);
-  a15=(a15+a16);
-  a15=(-a15);
-  if (res[0]!=0) res[0][1]=a15;
-  if (res[0]!=0) res[0][2]=a00;
-  a15=casadi_sq(a30);
-  a20=(a15/a26);
-  a20=(a28+a20);
-  a06=arg[2]? arg[2][9] : 0;
-  a15=(a15/a06);
-  a06=(a20+a15);
-  a23=(2.*a23);
-  a23=(a23*a30);
-  a23=(a23/a26);
-  a06=(a06+a23);
-  a26=(a06*a11);
-  a20=(a20+a27);
-  a20=(a20+a15);
-  a20=(a20+a23);
-  a26=(a26/a20);
-  a26=(a03*a26);
-  a28=(a28+a27);
-  a25=(a25-a28);
-  a25=(a25+a31);
-  a25=(a25-a32);
-  a32=(a22*a25);
-  a31=(a32*a38);
-  a31=(a31/a41);
-  a31=(a17*a31);
-  a28=(a26+a31);
-  a28=(a28+a16);
-  a28=(-a28);
-  if (res[0]!=0) res[0][3]=a28;
-  if (res[0]!=0) res[0][4]=a00;
-  a26=(a26+a39);
-  a28=(a32*a07);
-  a28=(a28/a41);
-  a28=(a02*a28);
-  a26=(a26+a28);
-  a26=(-a26);
-  if (res[0]!=0) res[0][5]=a26;
-  if (res[0]!=0) res[0][6]=a00;
-  a11=(a25*a11);
-  a11=(a11/a20);
-  a11=(a03*a11);
-  a40=(a40+a43);
-  a43=(a22*a40);
-  a38=(a43*a38);
-  a38=(a38/a41);
-  a38=(a17*a38);
-  a11=(a11+a38);
-  a07=(a43*a07);
-  a07=(a07/a41);
-  a07=(a02*a07);
-  a11=(a11+a07);
-  a11=(-a11);
-  if (res[0]!=0) res[0][7]=a11;
-  if (res[0]!=0) res[0][8]=a01;
-  a11=arg[2]? arg[2][1] : 0;
-  a11=(a42*a11);
-  a11=(a11/a13);
-  a26=-4.;
-  a27=arg[2]? arg[2][3] : 0;
-  a26=(a26*a27);
-  a26=(a26/a13);
-  a23=(a29*a26);
-  a23=(a23/a41);
-  a15=(a11+a23);
-  if (res[0]!=0) res[0][9]=a15;
-  if (res[0]!=0) res[0][10]=a00;
-  a15=(a06*a11);
-  a15=(a15/a20);
-  a42=(a42*a27);
-  a42=(a42/a13);
-  a30=(a29*a42);
-  a30=(a30/a41);
-  a30=(a15+a30);
-  a18=(a25*a42);
-  a18=(a18/a41);
-  a30=(a30+a18);
-  if (res[0]!=0) res[0][11]=a30;
-  if (res[0]!=0) res[0][12]=a00;
-  if (res[0]!=0) res[0][13]=a30;
-  if (res[0]!=0) res[0][14]=a00;
-  a26=(a40*a26);
-  a26=(a26/a41);
-  a30=(a25*a11);
-  a30=(a30/a20);
-  a30=(a26+a30);
-  if (res[0]!=0) res[0][15]=a30;
-  if (res[0]!=0) res[0][16]=a00;
-  a30=(a00<=a35);
-  a30=(a30?a01:0);
-  a35=(a35<=a12);
-  a35=(a35?a01:0);
-  a30=(a30+a35);
-  a30=(a30/a14);
-  a35=(a06*a30);
-  a35=(a35/a20);
-  a35=(a17*a35);
-  a04=-1.;
-  a37=(a37?a04:0);
-  a36=(a36?a04:0);
-  a37=(a37+a36);
-  a36=(a33*a37);
-  a36=(a36/a41);
-  a36=(a17*a36);
-  a35=(a35+a36);
-  a35=(-a35);
-  if (res[0]!=0) res[0][17]=a35;
-  if (res[0]!=0) res[0][18]=a00;
-  a36=(a17*a30);
-  a08=(a32*a37);
-  a08=(a08/a41);
-  a08=(a17*a08);
-  a36=(a36+a08);
-  a36=(-a36);
-  if (res[0]!=0) res[0][19]=a36;
-  if (res[0]!=0) res[0][20]=a00;
-  if (res[0]!=0) res[0][21]=a35;
-  if (res[0]!=0) res[0][22]=a00;
-  a30=(a29*a30);
-  a30=(a30/a20);
-  a30=(a17*a30);
-  a37=(a43*a37);
-  a37=(a37/a41);
-  a17=(a17*a37);
-  a30=(a30+a17);
-  a30=(-a30);
-  if (res[0]!=0) res[0][23]=a30;
-  if (res[0]!=0) res[0][24]=a00;
-  a27=(2.*a27);
-  a27=(a27/a13);
-  a13=(a29*a27);
-  a13=(a13/a41);
-  a15=(a15+a13);
-  if (res[0]!=0) res[0][25]=a15;
-  if (res[0]!=0) res[0][26]=a01;
-  a13=(a25*a27);
-  a13=(a13/a41);
-  a13=(a11+a13);
-  if (res[0]!=0) res[0][27]=a13;
-  if (res[0]!=0) res[0][28]=a00;
-  if (res[0]!=0) res[0][29]=a15;
-  if (res[0]!=0) res[0][30]=a00;
-  a11=(a29*a11);
-  a11=(a11/a20);
-  a40=(a40*a27);
-  a40=(a40/a41);
-  a11=(a11+a40);
-  if (res[0]!=0) res[0][31]=a11;
-  if (res[0]!=0) res[0][32]=a00;
-  a40=(a00<=a05);
-  a40=(a40?a01:0);
-  a05=(a05<=a12);
-  a05=(a05?a01:0);
-  a40=(a40+a05);
-  a40=(a40/a14);
-  a06=(a06*a40);
-  a06=(a06/a20);
-  a06=(a02*a06);
-  a21=(a21?a04:0);
-  a10=(a10?a04:0);
-  a21=(a21+a10);
-  a33=(a33*a21);
-  a33=(a33/a41);
-  a33=(a02*a33);
-  a06=(a06+a33);
-  a06=(-a06);
-  if (res[0]!=0) res[0][33]=a06;
-  if (res[0]!=0) res[0][34]=a00;
-  if (res[0]!=0) res[0][35]=a06;
-  if (res[0]!=0) res[0][36]=a00;
-  a06=(a02*a40);
-  a32=(a32*a21);
-  a32=(a32/a41);
-  a32=(a02*a32);
-  a06=(a06+a32);
-  a06=(-a06);
-  if (res[0]!=0) res[0][37]=a06;
-  if (res[0]!=0) res[0][38]=a00;
-  a40=(a29*a40);
-  a40=(a40/a20);
-  a40=(a02*a40);
-  a43=(a43*a21);
-  a43=(a43/a41);
-  a02=(a02*a43);
-  a40=(a40+a02);
-  a40=(-a40);
-  if (res[0]!=0) res[0][39]=a40;
-  if (res[0]!=0) res[0][40]=a00;
-  if (res[0]!=0) res[0][41]=a15;
-  if (res[0]!=0) res[0][42]=a00;
-  if (res[0]!=0) res[0][43]=a15;
-  if (res[0]!=0) res[0][44]=a01;
-  if (res[0]!=0) res[0][45]=a13;
-  if (res[0]!=0) res[0][46]=a00;
-  if (res[0]!=0) res[0][47]=a11;
-  if (res[0]!=0) res[0][48]=a00;
-  a11=(a00<=a34);
-  a11=(a11?a01:0);
-  a34=(a34<=a12);
-  a34=(a34?a01:0);
-  a11=(a11+a34);
-  a22=(a22*a11);
-  a25=(a25*a22);
-  a25=(a25/a41);
-  a25=(a03*a25);
-  a25=(a25+a39);
-  a25=(a25+a16);
-  a25=(-a25);
-  if (res[0]!=0) res[0][49]=a25;
-  if (res[0]!=0) res[0][50]=a00;
-  a29=(a29*a22);
-  a29=(a29/a41);
-  a29=(a03*a29);
-  a31=(a29+a31);
-  a31=(a31+a16);
-  a31=(-a31);
-  if (res[0]!=0) res[0][51]=a31;
-  if (res[0]!=0) res[0][52]=a00;
-  a29=(a29+a39);
-  a29=(a29+a28);
-  a29=(-a29);
-  if (res[0]!=0) res[0][53]=a29;
-  if (res[0]!=0) res[0][54]=a00;
-  a03=(a03*a22);
-  a03=(a03+a38);
-  a03=(a03+a07);
-  a03=(-a03);
-  if (res[0]!=0) res[0][55]=a03;
-  if (res[0]!=0) res[0][56]=a00;
-  a23=(a23+a18);
-  if (res[0]!=0) res[0][57]=a23;
-  if (res[0]!=0) res[0][58]=a00;
-  if (res[0]!=0) res[0][59]=a23;
-  if (res[0]!=0) res[0][60]=a00;
-  if (res[0]!=0) res[0][61]=a23;
-  if (res[0]!=0) res[0][62]=a01;
-  a42=(a42+a26);
-  if (res[0]!=0) res[0][63]=a42;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int jacobian(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f1(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int jacobian_n_in(void) { return 3;}
-
-CASADI_SYMBOL_EXPORT casadi_int jacobian_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real jacobian_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* jacobian_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "y";
-    case 2: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* jacobian_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "J";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s1;
-    case 2: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s3;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* constants:(p[16])->(c[24],period) */
-static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20;
-  a00=arg[0]? arg[0][11] : 0;
-  if (res[0]!=0) res[0][0]=a00;
-  a00=arg[0]? arg[0][0] : 0;
-  a01=casadi_sq(a00);
-  a02=(1./a01);
-  a03=(-a02);
-  if (res[0]!=0) res[0][1]=a03;
-  a03=-2.;
-  a04=arg[0]? arg[0][1] : 0;
-  a04=(a03*a04);
-  a04=(a04/a00);
-  if (res[0]!=0) res[0][2]=a04;
-  a05=arg[0]? arg[0][13] : 0;
-  a06=casadi_sq(a05);
-  a07=arg[0]? arg[0][7] : 0;
-  a08=(a06/a07);
-  a09=arg[0]? arg[0][15] : 0;
-  a10=casadi_sq(a09);
-  a11=(a10/a07);
-  a11=(a08+a11);
-  a12=arg[0]? arg[0][9] : 0;
-  a10=(a10/a12);
-  a12=(a11+a10);
-  a13=(2.*a05);
-  a13=(a13*a09);
-  a13=(a13/a07);
-  a12=(a12+a13);
-  a14=(a12/a01);
-  a15=arg[0]? arg[0][8] : 0;
-  a06=(a06/a15);
-  a11=(a11+a06);
-  a11=(a11+a10);
-  a11=(a11+a13);
-  a14=(a14/a11);
-  a14=(-a14);
-  if (res[0]!=0) res[0][3]=a14;
-  a14=-4.;
-  a13=arg[0]? arg[0][3] : 0;
-  a14=(a14*a13);
-  a14=(a14/a00);
-  a10=arg[0]? arg[0][14] : 0;
-  a15=(a05*a10);
-  a15=(a15/a07);
-  a16=(a15-a08);
-  a17=(a10*a09);
-  a17=(a17/a07);
-  a16=(a16+a17);
-  a09=(a05*a09);
-  a09=(a09/a07);
-  a16=(a16-a09);
-  a18=(a14*a16);
-  a19=casadi_sq(a10);
-  a19=(a19/a07);
-  a19=(a08+a19);
-  a20=(a19+a06);
-  a05=(a03*a05);
-  a05=(a05*a10);
-  a05=(a05/a07);
-  a20=(a20+a05);
-  a18=(a18/a20);
-  if (res[0]!=0) res[0][4]=a18;
-  a03=(a03*a13);
-  a03=(a03/a00);
-  a08=(a08+a06);
-  a15=(a15-a08);
-  a15=(a15+a17);
-  a15=(a15-a09);
-  a09=(a03*a15);
-  a09=(a09/a20);
-  if (res[0]!=0) res[0][5]=a09;
-  a12=(a04*a12);
-  a12=(a12/a11);
-  if (res[0]!=0) res[0][6]=a12;
-  a13=(2.*a13);
-  a13=(a13/a00);
-  a00=(a13*a16);
-  a00=(a00/a20);
-  if (res[0]!=0) res[0][7]=a00;
-  a00=arg[0]? arg[0][2] : 0;
-  a00=(a00/a01);
-  a12=(a00*a15);
-  a12=(a12/a20);
-  a12=(-a12);
-  if (res[0]!=0) res[0][8]=a12;
-  a12=(a00*a16);
-  a12=(a12/a20);
-  a12=(-a12);
-  if (res[0]!=0) res[0][9]=a12;
-  if (res[0]!=0) res[0][10]=a02;
-  a02=(a03*a16);
-  a02=(a02/a20);
-  if (res[0]!=0) res[0][11]=a02;
-  a02=(a13*a15);
-  a02=(a02/a20);
-  if (res[0]!=0) res[0][12]=a02;
-  if (res[0]!=0) res[0][13]=a03;
-  a03=(-a00);
-  if (res[0]!=0) res[0][14]=a03;
-  a03=(a15/a01);
-  a03=(a03/a11);
-  a03=(-a03);
-  if (res[0]!=0) res[0][15]=a03;
-  a03=(a16/a01);
-  a03=(a03/a11);
-  a03=(-a03);
-  if (res[0]!=0) res[0][16]=a03;
-  a19=(a19+a05);
-  a14=(a14*a19);
-  a14=(a14/a20);
-  if (res[0]!=0) res[0][17]=a14;
-  a15=(a04*a15);
-  a15=(a15/a11);
-  if (res[0]!=0) res[0][18]=a15;
-  a04=(a04*a16);
-  a04=(a04/a11);
-  if (res[0]!=0) res[0][19]=a04;
-  a13=(a13*a19);
-  a13=(a13/a20);
-  if (res[0]!=0) res[0][20]=a13;
-  a00=(a00*a19);
-  a00=(a00/a20);
-  a00=(-a00);
-  if (res[0]!=0) res[0][21]=a00;
-  a00=arg[0]? arg[0][6] : 0;
-  a00=(a00/a01);
-  if (res[0]!=0) res[0][22]=a00;
-  a00=3.1415926535897934e-02;
-  if (res[0]!=0) res[0][23]=a00;
-  a00=6.2831853071795862e+00;
-  if (res[1]!=0) res[1][0]=a00;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int constants(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f2(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int constants_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void constants_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void constants_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void constants_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int constants_n_in(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_int constants_n_out(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_real constants_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* constants_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* constants_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "c";
-    case 1: return "period";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s4;
-    case 1: return casadi_s0;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int constants_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 1;
-  if (sz_res) *sz_res = 2;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 1*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 2*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* table_point:(t,p[16])->(values[4]) */
-static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14;
-  a00=1.;
-  a01=arg[1]? arg[1][12] : 0;
-  a02=1.1800386146799999e+00;
-  a03=arg[0]? arg[0][0] : 0;
-  a04=cos(a03);
-  a02=(a02*a04);
-  a04=1.9272434388400000e-01;
-  a05=4.;
-  a05=(a05*a03);
-  a06=cos(a05);
-  a04=(a04*a06);
-  a02=(a02+a04);
-  a04=1.4883754528799999e-02;
-  a06=7.;
-  a06=(a06*a03);
-  a07=cos(a06);
-  a04=(a04*a07);
-  a02=(a02+a04);
-  a04=-6.0567417982099997e-02;
-  a07=6.;
-  a07=(a07*a03);
-  a07=cos(a07);
-  a04=(a04*a07);
-  a02=(a02+a04);
-  a07=-3.3689450631399998e-01;
-  a08=(2.*a03);
-  a09=cos(a08);
-  a07=(a07*a09);
-  a02=(a02+a07);
-  a07=-1.9563283778700000e-01;
-  a09=3.;
-  a09=(a09*a03);
-  a09=cos(a09);
-  a07=(a07*a09);
-  a02=(a02+a07);
-  a02=(a01*a02);
-  a02=(a00+a02);
-  if (res[0]!=0) res[0][0]=a02;
-  a04=(a04+a07);
-  a07=3.3689450631399998e-01;
-  a02=1.0471975511965976e+00;
-  a09=(a08+a02);
-  a09=cos(a09);
-  a09=(a07*a09);
-  a09=(a04+a09);
-  a10=-1.1800386146799999e+00;
-  a11=5.2359877559829882e-01;
-  a12=(a03+a11);
-  a12=sin(a12);
-  a12=(a10*a12);
-  a09=(a09+a12);
-  a12=-1.9272434388400000e-01;
-  a13=(a05+a11);
-  a13=sin(a13);
-  a13=(a12*a13);
-  a09=(a09+a13);
-  a13=-1.4883754528799999e-02;
-  a14=(a06+a11);
-  a14=sin(a14);
-  a14=(a13*a14);
-  a09=(a09+a14);
-  a09=(a01*a09);
-  a09=(a00+a09);
-  if (res[0]!=0) res[0][1]=a09;
-  a08=(a08+a11);
-  a08=sin(a08);
-  a07=(a07*a08);
-  a04=(a04+a07);
-  a07=(a03+a02);
-  a07=cos(a07);
-  a10=(a10*a07);
-  a04=(a04+a10);
-  a05=(a05+a02);
-  a05=cos(a05);
-  a12=(a12*a05);
-  a04=(a04+a12);
-  a06=(a06+a02);
-  a06=cos(a06);
-  a13=(a13*a06);
-  a04=(a04+a13);
-  a01=(a01*a04);
-  a00=(a00+a01);
-  if (res[0]!=0) res[0][2]=a00;
-  a00=arg[1]? arg[1][4] : 0;
-  a01=arg[1]? arg[1][5] : 0;
-  a04=arg[1]? arg[1][10] : 0;
-  a04=(a04+a03);
-  a04=cos(a04);
-  a01=(a01*a04);
-  a00=(a00+a01);
-  if (res[0]!=0) res[0][3]=a00;
-  return 0;
-}
-
-/* map401_table_point:(t[1x401],p[16x401])->(values[4x401]) */
-static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i;
-  casadi_real* *res1;
-  const casadi_real* *arg1;
-  arg1 = arg+2;
-  for (i=0; i<2; ++i) arg1[i]=arg[i];
-  res1 = res+1;
-  for (i=0; i<1; ++i) res1[i]=res[i];
-  for (i=0; i<401; ++i) {
-    if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-    if (arg1[0]) arg1[0]+=1;
-    if (arg1[1]) arg1[1]+=16;
-    if (res1[0]) res1[0]+=4;
-  }
-  return 0;
-}
-
-/* table:(t0,p[16])->(table[12x200],probe[4x2]) */
-static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i, j;
-  casadi_real **res1=res+2, *rr, w00, *w01=w+21, *w03=w+422, w04, w05, w06, *w07=w+446, *w08=w+6862, *w09=w+8466, *w10=w+9266;
-  casadi_real *w11=w+10066, *w12=w+10866, *w13=w+11666, *w14=w+14066, *w15=w+16466;
-  const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
-  w00 = arg[0] ? arg[0][0] : 0;
-  wr01 = casadi_c0;
-  wr02 = arg[1] ? arg[1] : casadi_zeros;
-  arg1[0]=wr02;
-  res1[0]=w03;
-  res1[1]=(&w04);
-  if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
-  for (rr=(&w05), cs=w03+23; cs!=w03+24; cs+=1) *rr++ = *cs;
-  w06 = 2.;
-  w05 /= w06;
-  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w05);
-  for (i=0, rr=w01, cs=w01; i<401; ++i) (*rr++)  = (w00+(*cs++));
-  for (i=0;i<401;++i) {
-    casadi_copy(wr02, 16, w07+ i*16);
-  }
-  arg1[0]=w01;
-  arg1[1]=w07;
-  res1[0]=w08;
-  if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
-  for (rr=w09, cs=w08+0; cs!=w08+1600; cs+=8) for (ct=cs+0; ct!=cs+4; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w10, cs=w09; i<200; ++i) for (j=0; j<4; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+1600; cs+=8) for (ct=cs+4; ct!=cs+8; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w11, cs=w09; i<200; ++i) for (j=0; j<4; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+1600; cs+=8) for (ct=cs+8; ct!=cs+12; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w12, cs=w09; i<200; ++i) for (j=0; j<4; ++j) rr[i+j*200] = *cs++;
-  rr=w13;
-  for (i=0, cs=w10; i<800; ++i) *rr++ = *cs++;
-  for (i=0, cs=w11; i<800; ++i) *rr++ = *cs++;
-  for (i=0, cs=w12; i<800; ++i) *rr++ = *cs++;
-  for (i=0, rr=w14, cs=w13; i<12; ++i) for (j=0; j<200; ++j) rr[i+j*12] = *cs++;
-  casadi_copy(w14, 2400, res[0]);
-  w05 = 3.7000000000000000e-01;
-  w05 *= w04;
-  w05  = (w00+w05);
-  arg1[0]=(&w05);
-  arg1[1]=wr02;
-  res1[0]=w15;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-  casadi_copy(w15, 4, res[1]);
-  w05 = 1.3700000000000001e+00;
-  w05 *= w04;
-  w00 += w05;
-  arg1[0]=(&w00);
-  arg1[1]=wr02;
-  res1[0]=w15;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-  if (res[1]) casadi_copy(w15, 4, res[1]+4);
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f3(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int table_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void table_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void table_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void table_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t0";
-    case 1: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "table";
-    case 1: return "probe";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s5;
-    case 1: return casadi_s6;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 6;
-  if (sz_res) *sz_res = 4;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 16470;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 16470*sizeof(casadi_real);
-  return 0;
-}
-
 /* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
 #if defined(__GNUC__)
 #define GEARSYM_INLINE inline __attribute__((always_inline))
@@ -1857,8 +471,8 @@ static GEARSYM_INLINE void gs_tangent_keep(const casadi_real* restrict A0, const
   R3[3]=a3;
 }
 
-/* state_try, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1) {
+/* state_try, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_try_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
   casadi_real a000, a001, a002, a003, a004, a005, a006, a007, a008, a009, a010, a011;
   casadi_real a012, a013, a014, a015, a016, a017, a018, a019, a020, a021, a022, a023;
   casadi_real a024, a025, a026, a027, a028, a029, a030, a031, a032, a033, a034, a035;
@@ -1870,40 +484,40 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   casadi_real a096, a097, a098, a099, a100, a101, a102, a103, a104, a105, a106, a107;
   casadi_real a108, a109, a110, a111, a112, a113, a114;
   a000=A0[0];
-  a001=A2[23];
+  a001=A2[S*23];
   a002=6.;
   a002=(a001/a002);
-  a003=A0[1];
+  a003=A0[S*1];
   a004=2.;
   a004=(a001/a004);
-  a005=A0[7];
-  a006=A2[4];
+  a005=A0[S*7];
+  a006=A2[S*4];
   a007=(a005*a006);
-  a008=A2[5];
+  a008=A2[S*5];
   a009=(a005*a008);
   a007=(a007+a009);
-  a009=A2[2];
+  a009=A2[S*2];
   a010=(a003*a009);
   a010=(a007+a010);
   a011=(a003*a006);
   a010=(a010+a011);
-  a011=A0[3];
-  a012=A2[6];
+  a011=A0[S*3];
+  a012=A2[S*6];
   a013=(a011*a012);
   a010=(a010+a013);
-  a014=A2[7];
+  a014=A2[S*7];
   a015=(a011*a014);
   a010=(a010+a015);
-  a016=A0[5];
+  a016=A0[S*5];
   a017=(a016*a012);
   a010=(a010+a017);
   a018=(a016*a014);
   a010=(a010+a018);
-  a019=A2[10];
-  a020=A1[3];
+  a019=A2[S*10];
+  a020=A1[S*3];
   a020=(a019*a020);
   a010=(a010+a020);
-  a021=A2[1];
+  a021=A2[S*1];
   a022=A1[0];
   a023=(a021*a022);
   a024=A2[0];
@@ -1918,10 +532,10 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a031=(a028+a031);
   a023=(a023*a031);
   a010=(a010+a023);
-  a023=A2[3];
-  a032=A1[1];
+  a023=A2[S*3];
+  a032=A1[S*1];
   a033=(a023*a032);
-  a034=A0[2];
+  a034=A0[S*2];
   a035=(a034+a024);
   a036=(-a035);
   a036=(a025<=a036);
@@ -1932,9 +546,9 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a040=(a037+a040);
   a033=(a033*a040);
   a010=(a010+a033);
-  a041=A1[2];
+  a041=A1[S*2];
   a042=(a023*a041);
-  a043=A0[4];
+  a043=A0[S*4];
   a044=(a043+a024);
   a045=(-a044);
   a045=(a025<=a045);
@@ -1945,9 +559,9 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a049=(a046+a049);
   a042=(a042*a049);
   a010=(a010+a042);
-  a050=A2[8];
+  a050=A2[S*8];
   a051=(a050*a022);
-  a052=A0[6];
+  a052=A0[S*6];
   a053=(a052+a024);
   a054=(-a053);
   a054=(a025<=a054);
@@ -1958,7 +572,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a058=(a055+a058);
   a051=(a051*a058);
   a010=(a010+a051);
-  a051=A2[9];
+  a051=A2[S*9];
   a059=(a051*a041);
   a060=(a043-a000);
   a060=(a060-a052);
@@ -1990,44 +604,44 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a075=(a003+a075);
   a076=(2.*a075);
   a076=(a003+a076);
-  a077=A2[22];
-  a078=A2[13];
+  a077=A2[S*22];
+  a078=A2[S*13];
   a079=(a005*a078);
   a079=(a077+a079);
-  a080=A2[17];
+  a080=A2[S*17];
   a081=(a005*a080);
   a079=(a079+a081);
   a081=(a003*a080);
   a079=(a079+a081);
-  a081=A2[18];
+  a081=A2[S*18];
   a082=(a003*a081);
   a079=(a079+a082);
-  a082=A2[19];
+  a082=A2[S*19];
   a083=(a011*a082);
   a079=(a079+a083);
-  a083=A2[20];
+  a083=A2[S*20];
   a084=(a011*a083);
   a079=(a079+a084);
   a084=(a016*a082);
   a079=(a079+a084);
   a084=(a016*a083);
   a079=(a079+a084);
-  a084=A2[15];
+  a084=A2[S*15];
   a085=(a084*a022);
   a085=(a085*a031);
   a079=(a079+a085);
-  a085=A2[16];
+  a085=A2[S*16];
   a086=(a085*a032);
   a086=(a086*a040);
   a079=(a079+a086);
   a086=(a085*a041);
   a086=(a086*a049);
   a079=(a079+a086);
-  a086=A2[14];
+  a086=A2[S*14];
   a087=(a086*a022);
   a087=(a087*a058);
   a079=(a079+a087);
-  a087=A2[21];
+  a087=A2[S*21];
   a088=(a087*a041);
   a088=(a088*a067);
   a079=(a079+a088);
@@ -2043,14 +657,14 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a090=(a089+a090);
   a091=(a075*a006);
   a090=(a090+a091);
-  a091=A2[11];
+  a091=A2[S*11];
   a092=(a003*a091);
   a007=(a007+a092);
   a092=(a003*a008);
   a007=(a007+a092);
   a092=(a003*a012);
   a007=(a007+a092);
-  a092=A2[12];
+  a092=A2[S*12];
   a093=(a011*a092);
   a093=(a007+a093);
   a094=(a011*a009);
@@ -2101,10 +715,10 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a090=(a090+a041);
   a067=(a068*a014);
   a090=(a090+a067);
-  a022=A1[7];
+  a022=A1[S*7];
   a022=(a019*a022);
   a090=(a090+a022);
-  a033=A1[4];
+  a033=A1[S*4];
   a049=(a021*a033);
   a018=(a004*a003);
   a018=(a000+a018);
@@ -2112,7 +726,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a020=(a028+a020);
   a015=(a049*a020);
   a090=(a090+a015);
-  a015=A1[5];
+  a015=A1[S*5];
   a013=(a023*a015);
   a058=(a004*a011);
   a058=(a034+a058);
@@ -2120,7 +734,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a042=(a037+a042);
   a031=(a013*a042);
   a090=(a090+a031);
-  a040=A1[6];
+  a040=A1[S*6];
   a017=(a023*a040);
   a094=(a004*a016);
   a094=(a043+a094);
@@ -2384,10 +998,10 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a107=(a107+a040);
   a014=(a101*a014);
   a107=(a107+a014);
-  a059=A1[11];
+  a059=A1[S*11];
   a019=(a019*a059);
   a107=(a107+a019);
-  a059=A1[8];
+  a059=A1[S*8];
   a033=(a021*a059);
   a102=(a001*a102);
   a102=(a000+a102);
@@ -2395,7 +1009,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a028=(a028+a030);
   a033=(a033*a028);
   a107=(a107+a033);
-  a033=A1[9];
+  a033=A1[S*9];
   a030=(a023*a033);
   a031=(a001*a018);
   a031=(a034+a031);
@@ -2403,7 +1017,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a037=(a037+a039);
   a030=(a030*a037);
   a107=(a107+a030);
-  a039=A1[10];
+  a039=A1[S*10];
   a074=(a023*a039);
   a013=(a001*a058);
   a013=(a043+a013);
@@ -2434,7 +1048,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a010=(a010+a107);
   a010=(a002*a010);
   a010=(a003+a010);
-  R0[1]=a010;
+  R0[S*1]=a010;
   a032=(2.*a032);
   a032=(a011+a032);
   a018=(2.*a018);
@@ -2442,7 +1056,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a032=(a032+a015);
   a032=(a002*a032);
   a032=(a034+a032);
-  R0[2]=a032;
+  R0[S*2]=a032;
   a113=(2.*a113);
   a093=(a093+a113);
   a006=(2.*a006);
@@ -2477,7 +1091,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a093=(a093+a012);
   a093=(a002*a093);
   a093=(a011+a093);
-  R0[3]=a093;
+  R0[S*3]=a093;
   a068=(2.*a068);
   a068=(a016+a068);
   a058=(2.*a058);
@@ -2485,7 +1099,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a068=(a068+a101);
   a068=(a002*a068);
   a068=(a043+a068);
-  R0[4]=a068;
+  R0[S*4]=a068;
   a089=(2.*a089);
   a007=(a007+a089);
   a111=(2.*a111);
@@ -2510,7 +1124,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a007=(a007+a108);
   a007=(a002*a007);
   a007=(a016+a007);
-  R0[5]=a007;
+  R0[S*5]=a007;
   a088=(2.*a088);
   a088=(a005+a088);
   a110=(2.*a110);
@@ -2518,7 +1132,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a088=(a088+a109);
   a088=(a002*a088);
   a088=(a052+a088);
-  R0[6]=a088;
+  R0[S*6]=a088;
   a103=(2.*a103);
   a079=(a079+a103);
   a112=(2.*a112);
@@ -2560,7 +1174,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a079=(a079+a077);
   a002=(a002*a079);
   a002=(a005+a002);
-  R0[7]=a002;
+  R0[S*7]=a002;
   a029=(2.*a029);
   a079=1.;
   a029=(a029-a079);
@@ -2792,26 +1406,27 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a025=(a025<a077);
   R1[0]=a025;
 }
+static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1) { gs_state_try_strided(A0, A1, A2, R0, R1, 1); }
 
-/* state_keep, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+/* state_keep, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_keep_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
   casadi_real a0, a1, a2, a3, a4, a5, a6;
   a0=A3[0];
   R0[0]=a0;
-  a1=A3[1];
-  R0[1]=a1;
-  a1=A3[2];
-  R0[2]=a1;
-  a2=A3[3];
-  R0[3]=a2;
-  a2=A3[4];
-  R0[4]=a2;
-  a3=A3[5];
-  R0[5]=a3;
-  a3=A3[6];
-  R0[6]=a3;
-  a4=A3[7];
-  R0[7]=a4;
+  a1=A3[S*1];
+  R0[S*1]=a1;
+  a1=A3[S*2];
+  R0[S*2]=a1;
+  a2=A3[S*3];
+  R0[S*3]=a2;
+  a2=A3[S*4];
+  R0[S*4]=a2;
+  a3=A3[S*5];
+  R0[S*5]=a3;
+  a3=A3[S*6];
+  R0[S*6]=a3;
+  a4=A3[S*7];
+  R0[S*7]=a4;
   a4=A1[0];
   a5=(a0<a4);
   a6=(a5?a0:0);
@@ -2819,27 +1434,27 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
   a5=(a5?a4:0);
   a6=(a6+a5);
   R1[0]=a6;
-  a6=A1[1];
+  a6=A1[S*1];
   a5=(a1<a6);
   a4=(a5?a1:0);
   a5=(!a5);
   a5=(a5?a6:0);
   a4=(a4+a5);
-  R1[1]=a4;
-  a4=A1[2];
+  R1[S*1]=a4;
+  a4=A1[S*2];
   a5=(a2<a4);
   a6=(a5?a2:0);
   a5=(!a5);
   a5=(a5?a4:0);
   a6=(a6+a5);
-  R1[2]=a6;
-  a6=A1[3];
+  R1[S*2]=a6;
+  a6=A1[S*3];
   a5=(a3<a6);
   a4=(a5?a3:0);
   a5=(!a5);
   a5=(a5?a6:0);
   a4=(a4+a5);
-  R1[3]=a4;
+  R1[S*3]=a4;
   a4=A2[0];
   a5=(a4<a0);
   a0=(a5?a0:0);
@@ -2847,28 +1462,29 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
   a5=(a5?a4:0);
   a0=(a0+a5);
   R2[0]=a0;
-  a0=A2[1];
+  a0=A2[S*1];
   a5=(a0<a1);
   a1=(a5?a1:0);
   a5=(!a5);
   a5=(a5?a0:0);
   a1=(a1+a5);
-  R2[1]=a1;
-  a1=A2[2];
+  R2[S*1]=a1;
+  a1=A2[S*2];
   a5=(a1<a2);
   a2=(a5?a2:0);
   a5=(!a5);
   a5=(a5?a1:0);
   a2=(a2+a5);
-  R2[2]=a2;
-  a2=A2[3];
+  R2[S*2]=a2;
+  a2=A2[S*3];
   a5=(a2<a3);
   a3=(a5?a3:0);
   a5=(!a5);
   a5=(a5?a2:0);
   a3=(a3+a5);
-  R2[3]=a3;
+  R2[S*3]=a3;
 }
+static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_state_keep_strided(A0, A1, A2, A3, A4, A5, R0, R1, R2, 1); }
 
 /* split_start, from CasADi's C of it */
 static GEARSYM_NOINLINE void gs_split_start(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
@@ -8372,8 +6988,8 @@ static GEARSYM_NOINLINE void gs_state_mode_step(const casadi_real* restrict A0, 
   R0[7]=a05;
 }
 
-/* tangent_state, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+/* tangent_state, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_state_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
   casadi_real a000, a001, a002, a003, a004, a005, a006, a007, a008, a009, a010, a011;
   casadi_real a012, a013, a014, a015, a016, a017, a018, a019, a020, a021, a022, a023;
   casadi_real a024, a025, a026, a027, a028, a029, a030, a031, a032, a033, a034, a035;
@@ -8387,40 +7003,40 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   casadi_real a120, a121, a122, a123, a124, a125, a126, a127, a128, a129, a130, a131;
   casadi_real a132, a133, a134, a135, a136, a137, a138, a139, a140, a141, a142;
   a000=A0[0];
-  a001=A2[23];
+  a001=A2[S*23];
   a002=6.;
   a002=(a001/a002);
-  a003=A0[1];
+  a003=A0[S*1];
   a004=2.;
   a004=(a001/a004);
-  a005=A0[7];
-  a006=A2[4];
+  a005=A0[S*7];
+  a006=A2[S*4];
   a007=(a005*a006);
-  a008=A2[5];
+  a008=A2[S*5];
   a009=(a005*a008);
   a007=(a007+a009);
-  a009=A2[2];
+  a009=A2[S*2];
   a010=(a003*a009);
   a010=(a007+a010);
   a011=(a003*a006);
   a010=(a010+a011);
-  a011=A0[3];
-  a012=A2[6];
+  a011=A0[S*3];
+  a012=A2[S*6];
   a013=(a011*a012);
   a010=(a010+a013);
-  a014=A2[7];
+  a014=A2[S*7];
   a015=(a011*a014);
   a010=(a010+a015);
-  a016=A0[5];
+  a016=A0[S*5];
   a017=(a016*a012);
   a010=(a010+a017);
   a018=(a016*a014);
   a010=(a010+a018);
-  a019=A2[10];
-  a020=A1[3];
+  a019=A2[S*10];
+  a020=A1[S*3];
   a020=(a019*a020);
   a010=(a010+a020);
-  a021=A2[1];
+  a021=A2[S*1];
   a022=A1[0];
   a023=(a021*a022);
   a024=A2[0];
@@ -8435,10 +7051,10 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a031=(a028+a031);
   a032=(a023*a031);
   a010=(a010+a032);
-  a032=A2[3];
-  a033=A1[1];
+  a032=A2[S*3];
+  a033=A1[S*1];
   a034=(a032*a033);
-  a035=A0[2];
+  a035=A0[S*2];
   a036=(a035+a024);
   a037=(-a036);
   a037=(a025<=a037);
@@ -8449,9 +7065,9 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a041=(a038+a041);
   a042=(a034*a041);
   a010=(a010+a042);
-  a043=A1[2];
+  a043=A1[S*2];
   a044=(a032*a043);
-  a045=A0[4];
+  a045=A0[S*4];
   a046=(a045+a024);
   a047=(-a046);
   a047=(a025<=a047);
@@ -8462,9 +7078,9 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a051=(a048+a051);
   a052=(a044*a051);
   a010=(a010+a052);
-  a053=A2[8];
+  a053=A2[S*8];
   a054=(a053*a022);
-  a055=A0[6];
+  a055=A0[S*6];
   a056=(a055+a024);
   a057=(-a056);
   a057=(a025<=a057);
@@ -8475,7 +7091,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a061=(a058+a061);
   a062=(a054*a061);
   a010=(a010+a062);
-  a062=A2[9];
+  a062=A2[S*9];
   a063=(a062*a043);
   a064=(a045-a000);
   a064=(a064-a055);
@@ -8507,44 +7123,44 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a081=(a003+a081);
   a082=(2.*a081);
   a082=(a003+a082);
-  a083=A2[22];
-  a084=A2[13];
+  a083=A2[S*22];
+  a084=A2[S*13];
   a085=(a005*a084);
   a085=(a083+a085);
-  a086=A2[17];
+  a086=A2[S*17];
   a087=(a005*a086);
   a085=(a085+a087);
   a087=(a003*a086);
   a085=(a085+a087);
-  a087=A2[18];
+  a087=A2[S*18];
   a088=(a003*a087);
   a085=(a085+a088);
-  a088=A2[19];
+  a088=A2[S*19];
   a089=(a011*a088);
   a085=(a085+a089);
-  a089=A2[20];
+  a089=A2[S*20];
   a090=(a011*a089);
   a085=(a085+a090);
   a090=(a016*a088);
   a085=(a085+a090);
   a090=(a016*a089);
   a085=(a085+a090);
-  a090=A2[15];
+  a090=A2[S*15];
   a091=(a090*a022);
   a092=(a091*a031);
   a085=(a085+a092);
-  a092=A2[16];
+  a092=A2[S*16];
   a093=(a092*a033);
   a094=(a093*a041);
   a085=(a085+a094);
   a094=(a092*a043);
   a095=(a094*a051);
   a085=(a085+a095);
-  a095=A2[14];
+  a095=A2[S*14];
   a096=(a095*a022);
   a097=(a096*a061);
   a085=(a085+a097);
-  a097=A2[21];
+  a097=A2[S*21];
   a098=(a097*a043);
   a099=(a098*a071);
   a085=(a085+a099);
@@ -8560,14 +7176,14 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a102=(a101+a102);
   a103=(a081*a006);
   a102=(a102+a103);
-  a103=A2[11];
+  a103=A2[S*11];
   a104=(a003*a103);
   a007=(a007+a104);
   a104=(a003*a008);
   a007=(a007+a104);
   a104=(a003*a012);
   a007=(a007+a104);
-  a104=A2[12];
+  a104=A2[S*12];
   a105=(a011*a104);
   a105=(a007+a105);
   a106=(a011*a009);
@@ -8618,10 +7234,10 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a102=(a102+a071);
   a061=(a080*a014);
   a102=(a102+a061);
-  a051=A1[7];
+  a051=A1[S*7];
   a051=(a019*a051);
   a102=(a102+a051);
-  a031=A1[4];
+  a031=A1[S*4];
   a020=(a021*a031);
   a015=(a004*a003);
   a015=(a000+a015);
@@ -8629,7 +7245,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a013=(a028+a013);
   a041=(a020*a013);
   a102=(a102+a041);
-  a041=A1[5];
+  a041=A1[S*5];
   a106=(a032*a041);
   a107=(a004*a011);
   a107=(a035+a107);
@@ -8637,7 +7253,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a108=(a038+a108);
   a109=(a106*a108);
   a102=(a102+a109);
-  a110=A1[6];
+  a110=A1[S*6];
   a111=(a032*a110);
   a112=(a004*a016);
   a112=(a045+a112);
@@ -8901,10 +7517,10 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a137=(a137+a108);
   a134=(a013*a014);
   a137=(a137+a134);
-  a132=A1[11];
+  a132=A1[S*11];
   a019=(a019*a132);
   a137=(a137+a019);
-  a132=A1[8];
+  a132=A1[S*8];
   a072=(a021*a132);
   a120=(a001*a120);
   a120=(a000+a120);
@@ -8912,7 +7528,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a028=(a028+a113);
   a113=(a072*a028);
   a137=(a137+a113);
-  a113=A1[9];
+  a113=A1[S*9];
   a051=(a032*a113);
   a114=(a001*a015);
   a114=(a035+a114);
@@ -8920,7 +7536,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a038=(a038+a116);
   a116=(a051*a038);
   a137=(a137+a116);
-  a052=A1[10];
+  a052=A1[S*10];
   a117=(a032*a052);
   a112=(a001*a107);
   a112=(a045+a112);
@@ -8951,7 +7567,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a010=(a010+a137);
   a010=(a002*a010);
   a010=(a003+a010);
-  R0[1]=a010;
+  R0[S*1]=a010;
   a079=(2.*a079);
   a079=(a011+a079);
   a015=(2.*a015);
@@ -8959,7 +7575,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a079=(a079+a081);
   a079=(a002*a079);
   a079=(a035+a079);
-  R0[2]=a079;
+  R0[S*2]=a079;
   a131=(2.*a131);
   a105=(a105+a131);
   a138=(2.*a138);
@@ -8994,7 +7610,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a105=(a105+a138);
   a105=(a002*a105);
   a105=(a011+a105);
-  R0[3]=a105;
+  R0[S*3]=a105;
   a080=(2.*a080);
   a080=(a016+a080);
   a107=(2.*a107);
@@ -9002,7 +7618,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a080=(a080+a013);
   a080=(a002*a080);
   a080=(a045+a080);
-  R0[4]=a080;
+  R0[S*4]=a080;
   a101=(2.*a101);
   a007=(a007+a101);
   a129=(2.*a129);
@@ -9027,7 +7643,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a007=(a007+a136);
   a007=(a002*a007);
   a007=(a016+a007);
-  R0[5]=a007;
+  R0[S*5]=a007;
   a100=(2.*a100);
   a100=(a005+a100);
   a128=(2.*a128);
@@ -9035,7 +7651,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a100=(a100+a102);
   a100=(a002*a100);
   a100=(a055+a100);
-  R0[6]=a100;
+  R0[S*6]=a100;
   a121=(2.*a121);
   a085=(a085+a121);
   a130=(2.*a130);
@@ -9077,7 +7693,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a085=(a085+a083);
   a002=(a002*a085);
   a002=(a005+a002);
-  R0[7]=a002;
+  R0[S*7]=a002;
   a029=(2.*a029);
   a085=1.;
   a029=(a029-a085);
@@ -9318,350 +7934,351 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a023=(a018+a063);
   a033=(a033*a078);
   a023=(a023+a033);
-  R2[1]=a023;
+  R2[S*1]=a023;
   a043=(a043*a070);
   a018=(a018+a043);
   a018=(a018+a073);
-  R2[2]=a018;
+  R2[S*2]=a018;
   a091=(a091*a030);
   a098=(a098*a070);
   a091=(a091+a098);
   a099=(a099*a078);
   a091=(a091+a099);
-  R2[3]=a091;
+  R2[S*3]=a091;
   a091=(a009+a006);
-  R2[4]=a091;
+  R2[S*4]=a091;
   a103=(a103+a008);
   a103=(a103+a012);
-  R2[5]=a103;
-  R2[6]=a103;
+  R2[S*5]=a103;
+  R2[S*6]=a103;
   a087=(a086+a087);
-  R2[7]=a087;
+  R2[S*7]=a087;
   a034=(a034*a040);
   a034=(a034-a073);
-  R2[8]=a034;
+  R2[S*8]=a034;
   a017=(a017*a040);
   a017=(a017-a033);
-  R2[9]=a017;
-  R2[10]=a034;
+  R2[S*9]=a017;
+  R2[S*10]=a034;
   a093=(a093*a040);
   a093=(a093-a099);
-  R2[11]=a093;
+  R2[S*11]=a093;
   a012=(a012+a014);
-  R2[12]=a012;
+  R2[S*12]=a012;
   a104=(a104+a009);
-  R2[13]=a104;
-  R2[14]=a012;
+  R2[S*13]=a104;
+  R2[S*14]=a012;
   a088=(a088+a089);
-  R2[15]=a088;
+  R2[S*15]=a088;
   a044=(a044*a050);
   a044=(a044-a063);
-  R2[16]=a044;
-  R2[17]=a044;
+  R2[S*16]=a044;
+  R2[S*17]=a044;
   a042=(a042*a050);
   a042=(a042-a043);
-  R2[18]=a042;
+  R2[S*18]=a042;
   a094=(a094*a050);
   a094=(a094-a098);
-  R2[19]=a094;
-  R2[20]=a012;
-  R2[21]=a012;
-  R2[22]=a104;
-  R2[23]=a088;
+  R2[S*19]=a094;
+  R2[S*20]=a012;
+  R2[S*21]=a012;
+  R2[S*22]=a104;
+  R2[S*23]=a088;
   a054=(a054*a060);
   a054=(a054+a063);
   a054=(a054+a073);
-  R2[24]=a054;
+  R2[S*24]=a054;
   a022=(a022*a060);
   a063=(a022+a063);
   a063=(a063+a033);
-  R2[25]=a063;
+  R2[S*25]=a063;
   a022=(a022+a043);
   a022=(a022+a073);
-  R2[26]=a022;
+  R2[S*26]=a022;
   a096=(a096*a060);
   a096=(a096+a098);
   a096=(a096+a099);
-  R2[27]=a096;
+  R2[S*27]=a096;
   a006=(a006+a008);
-  R2[28]=a006;
-  R2[29]=a006;
-  R2[30]=a006;
+  R2[S*28]=a006;
+  R2[S*29]=a006;
+  R2[S*30]=a006;
   a084=(a084+a086);
-  R2[31]=a084;
+  R2[S*31]=a084;
   a020=(a020*a030);
   a118=(a118*a070);
   a020=(a020+a118);
   a119=(a119*a078);
   a020=(a020+a119);
-  R2[32]=a020;
+  R2[S*32]=a020;
   a061=(a061*a030);
   a084=(a061+a118);
   a041=(a041*a078);
   a084=(a084+a041);
-  R2[33]=a084;
+  R2[S*33]=a084;
   a110=(a110*a070);
   a061=(a061+a110);
   a061=(a061+a119);
-  R2[34]=a061;
+  R2[S*34]=a061;
   a122=(a122*a030);
   a126=(a126*a070);
   a122=(a122+a126);
   a127=(a127*a078);
   a122=(a122+a127);
-  R2[35]=a122;
+  R2[S*35]=a122;
   a106=(a106*a040);
   a106=(a106-a119);
-  R2[36]=a106;
+  R2[S*36]=a106;
   a071=(a071*a040);
   a071=(a071-a041);
-  R2[37]=a071;
-  R2[38]=a106;
+  R2[S*37]=a071;
+  R2[S*38]=a106;
   a123=(a123*a040);
   a123=(a123-a127);
-  R2[39]=a123;
+  R2[S*39]=a123;
   a111=(a111*a050);
   a111=(a111-a118);
-  R2[40]=a111;
-  R2[41]=a111;
+  R2[S*40]=a111;
+  R2[S*41]=a111;
   a109=(a109*a050);
   a109=(a109-a110);
-  R2[42]=a109;
+  R2[S*42]=a109;
   a124=(a124*a050);
   a124=(a124-a126);
-  R2[43]=a124;
+  R2[S*43]=a124;
   a115=(a115*a060);
   a115=(a115+a118);
   a115=(a115+a119);
-  R2[44]=a115;
+  R2[S*44]=a115;
   a031=(a031*a060);
   a118=(a031+a118);
   a118=(a118+a041);
-  R2[45]=a118;
+  R2[S*45]=a118;
   a031=(a031+a110);
   a031=(a031+a119);
-  R2[46]=a031;
+  R2[S*46]=a031;
   a125=(a125*a060);
   a125=(a125+a126);
   a125=(a125+a127);
-  R2[47]=a125;
-  R2[48]=a020;
-  R2[49]=a084;
-  R2[50]=a061;
-  R2[51]=a122;
-  R2[52]=a106;
-  R2[53]=a071;
-  R2[54]=a106;
-  R2[55]=a123;
-  R2[56]=a111;
-  R2[57]=a111;
-  R2[58]=a109;
-  R2[59]=a124;
-  R2[60]=a115;
-  R2[61]=a118;
-  R2[62]=a031;
-  R2[63]=a125;
+  R2[S*47]=a125;
+  R2[S*48]=a020;
+  R2[S*49]=a084;
+  R2[S*50]=a061;
+  R2[S*51]=a122;
+  R2[S*52]=a106;
+  R2[S*53]=a071;
+  R2[S*54]=a106;
+  R2[S*55]=a123;
+  R2[S*56]=a111;
+  R2[S*57]=a111;
+  R2[S*58]=a109;
+  R2[S*59]=a124;
+  R2[S*60]=a115;
+  R2[S*61]=a118;
+  R2[S*62]=a031;
+  R2[S*63]=a125;
   a072=(a072*a030);
   a142=(a142*a070);
   a072=(a072+a142);
   a141=(a141*a078);
   a072=(a072+a141);
-  R2[64]=a072;
+  R2[S*64]=a072;
   a032=(a032*a030);
   a072=(a032+a142);
   a112=(a112*a078);
   a072=(a072+a112);
-  R2[65]=a072;
+  R2[S*65]=a072;
   a053=(a053*a070);
   a032=(a032+a053);
   a032=(a032+a141);
-  R2[66]=a032;
+  R2[S*66]=a032;
   a090=(a090*a030);
   a052=(a052*a070);
   a090=(a090+a052);
   a097=(a097*a078);
   a090=(a090+a097);
-  R2[67]=a090;
+  R2[S*67]=a090;
   a051=(a051*a040);
   a051=(a051-a141);
-  R2[68]=a051;
+  R2[S*68]=a051;
   a108=(a108*a040);
   a108=(a108-a112);
-  R2[69]=a108;
-  R2[70]=a051;
+  R2[S*69]=a108;
+  R2[S*70]=a051;
   a028=(a028*a040);
   a028=(a028-a097);
-  R2[71]=a028;
+  R2[S*71]=a028;
   a117=(a117*a050);
   a117=(a117-a142);
-  R2[72]=a117;
-  R2[73]=a117;
+  R2[S*72]=a117;
+  R2[S*73]=a117;
   a021=(a021*a050);
   a021=(a021-a053);
-  R2[74]=a021;
+  R2[S*74]=a021;
   a092=(a092*a050);
   a092=(a092-a052);
-  R2[75]=a092;
+  R2[S*75]=a092;
   a140=(a140*a060);
   a140=(a140+a142);
   a140=(a140+a141);
-  R2[76]=a140;
+  R2[S*76]=a140;
   a062=(a062*a060);
   a142=(a062+a142);
   a142=(a142+a112);
-  R2[77]=a142;
+  R2[S*77]=a142;
   a062=(a062+a053);
   a062=(a062+a141);
-  R2[78]=a062;
+  R2[S*78]=a062;
   a095=(a095*a060);
   a095=(a095+a052);
   a095=(a095+a097);
-  R2[79]=a095;
+  R2[S*79]=a095;
 }
+static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_tangent_state_strided(A0, A1, A2, R0, R1, R2, 1); }
 
-/* tangent_vector, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) {
+/* tangent_vector, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_vector_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
   casadi_real a36, a37, a38, a39, a40, a41, a42, a43, a44, a45, a46, a47;
   casadi_real a48, a49, a50, a51;
   a00=A0[0];
-  a01=A2[23];
+  a01=A2[S*23];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[8];
+  a03=A0[S*8];
   a04=2.;
   a04=(a01/a04);
   a05=A1[0];
   a05=(a05*a00);
-  a06=A1[4];
+  a06=A1[S*4];
   a07=(a06*a03);
   a05=(a05+a07);
-  a07=A1[8];
-  a08=A0[16];
+  a07=A1[S*8];
+  a08=A0[S*16];
   a07=(a07*a08);
   a05=(a05+a07);
-  a07=A1[12];
-  a09=A0[24];
+  a07=A1[S*12];
+  a09=A0[S*24];
   a10=(a07*a09);
   a05=(a05+a10);
-  a10=A1[16];
-  a11=A0[32];
+  a10=A1[S*16];
+  a11=A0[S*32];
   a10=(a10*a11);
   a05=(a05+a10);
-  a10=A1[20];
-  a12=A0[40];
+  a10=A1[S*20];
+  a12=A0[S*40];
   a13=(a10*a12);
   a05=(a05+a13);
-  a13=A1[24];
-  a14=A0[48];
+  a13=A1[S*24];
+  a14=A0[S*48];
   a13=(a13*a14);
   a05=(a05+a13);
-  a13=A1[28];
-  a15=A0[56];
+  a13=A1[S*28];
+  a15=A0[S*56];
   a16=(a13*a15);
   a05=(a05+a16);
   a16=(a04*a05);
   a16=(a03+a16);
   a17=(2.*a16);
   a17=(a03+a17);
-  a18=A1[32];
+  a18=A1[S*32];
   a19=(a04*a03);
   a19=(a00+a19);
   a18=(a18*a19);
   a20=(a06*a16);
   a18=(a18+a20);
-  a20=A1[36];
+  a20=A1[S*36];
   a21=(a04*a09);
   a21=(a08+a21);
   a20=(a20*a21);
   a18=(a18+a20);
-  a20=A1[1];
+  a20=A1[S*1];
   a20=(a20*a00);
-  a22=A1[5];
+  a22=A1[S*5];
   a23=(a22*a03);
   a20=(a20+a23);
-  a23=A1[9];
+  a23=A1[S*9];
   a23=(a23*a08);
   a20=(a20+a23);
-  a23=A1[13];
+  a23=A1[S*13];
   a24=(a23*a09);
   a20=(a20+a24);
-  a24=A1[17];
+  a24=A1[S*17];
   a24=(a24*a11);
   a20=(a20+a24);
-  a24=A1[21];
+  a24=A1[S*21];
   a25=(a24*a12);
   a20=(a20+a25);
-  a25=A1[25];
+  a25=A1[S*25];
   a25=(a25*a14);
   a20=(a20+a25);
-  a25=A1[29];
+  a25=A1[S*29];
   a26=(a25*a15);
   a20=(a20+a26);
   a26=(a04*a20);
   a26=(a09+a26);
   a27=(a07*a26);
   a18=(a18+a27);
-  a27=A1[40];
+  a27=A1[S*40];
   a28=(a04*a12);
   a28=(a11+a28);
   a27=(a27*a28);
   a18=(a18+a27);
-  a27=A1[2];
+  a27=A1[S*2];
   a27=(a27*a00);
-  a29=A1[6];
+  a29=A1[S*6];
   a30=(a29*a03);
   a27=(a27+a30);
-  a30=A1[10];
+  a30=A1[S*10];
   a30=(a30*a08);
   a27=(a27+a30);
-  a30=A1[14];
+  a30=A1[S*14];
   a31=(a30*a09);
   a27=(a27+a31);
-  a31=A1[18];
+  a31=A1[S*18];
   a31=(a31*a11);
   a27=(a27+a31);
-  a31=A1[22];
+  a31=A1[S*22];
   a32=(a31*a12);
   a27=(a27+a32);
-  a32=A1[26];
+  a32=A1[S*26];
   a32=(a32*a14);
   a27=(a27+a32);
-  a32=A1[30];
+  a32=A1[S*30];
   a33=(a32*a15);
   a27=(a27+a33);
   a33=(a04*a27);
   a33=(a12+a33);
   a34=(a10*a33);
   a18=(a18+a34);
-  a34=A1[44];
+  a34=A1[S*44];
   a35=(a04*a15);
   a35=(a14+a35);
   a34=(a34*a35);
   a18=(a18+a34);
-  a34=A1[3];
+  a34=A1[S*3];
   a34=(a34*a00);
-  a36=A1[7];
+  a36=A1[S*7];
   a37=(a36*a03);
   a34=(a34+a37);
-  a37=A1[11];
+  a37=A1[S*11];
   a37=(a37*a08);
   a34=(a34+a37);
-  a37=A1[15];
+  a37=A1[S*15];
   a38=(a37*a09);
   a34=(a34+a38);
-  a38=A1[19];
+  a38=A1[S*19];
   a38=(a38*a11);
   a34=(a34+a38);
-  a38=A1[23];
+  a38=A1[S*23];
   a39=(a38*a12);
   a34=(a34+a39);
-  a39=A1[27];
+  a39=A1[S*27];
   a39=(a39*a14);
   a34=(a34+a39);
-  a39=A1[31];
+  a39=A1[S*31];
   a40=(a39*a15);
   a34=(a34+a40);
   a40=(a04*a34);
@@ -9672,32 +8289,32 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a41=(a03+a41);
   a42=(2.*a41);
   a17=(a17+a42);
-  a42=A1[48];
+  a42=A1[S*48];
   a43=(a04*a16);
   a43=(a00+a43);
   a42=(a42*a43);
   a44=(a06*a41);
   a42=(a42+a44);
-  a44=A1[52];
+  a44=A1[S*52];
   a45=(a04*a26);
   a45=(a08+a45);
   a44=(a44*a45);
   a42=(a42+a44);
-  a44=A1[33];
+  a44=A1[S*33];
   a44=(a44*a19);
   a46=(a22*a16);
   a44=(a44+a46);
-  a46=A1[37];
+  a46=A1[S*37];
   a46=(a46*a21);
   a44=(a44+a46);
   a46=(a23*a26);
   a44=(a44+a46);
-  a46=A1[41];
+  a46=A1[S*41];
   a46=(a46*a28);
   a44=(a44+a46);
   a46=(a24*a33);
   a44=(a44+a46);
-  a46=A1[45];
+  a46=A1[S*45];
   a46=(a46*a35);
   a44=(a44+a46);
   a46=(a25*a40);
@@ -9706,26 +8323,26 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a46=(a09+a46);
   a47=(a07*a46);
   a42=(a42+a47);
-  a47=A1[56];
+  a47=A1[S*56];
   a48=(a04*a33);
   a48=(a11+a48);
   a47=(a47*a48);
   a42=(a42+a47);
-  a47=A1[34];
+  a47=A1[S*34];
   a47=(a47*a19);
   a49=(a29*a16);
   a47=(a47+a49);
-  a49=A1[38];
+  a49=A1[S*38];
   a49=(a49*a21);
   a47=(a47+a49);
   a49=(a30*a26);
   a47=(a47+a49);
-  a49=A1[42];
+  a49=A1[S*42];
   a49=(a49*a28);
   a47=(a47+a49);
   a49=(a31*a33);
   a47=(a47+a49);
-  a49=A1[46];
+  a49=A1[S*46];
   a49=(a49*a35);
   a47=(a47+a49);
   a49=(a32*a40);
@@ -9734,26 +8351,26 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a49=(a12+a49);
   a50=(a10*a49);
   a42=(a42+a50);
-  a50=A1[60];
+  a50=A1[S*60];
   a51=(a04*a40);
   a51=(a14+a51);
   a50=(a50*a51);
   a42=(a42+a50);
-  a50=A1[35];
+  a50=A1[S*35];
   a50=(a50*a19);
   a16=(a36*a16);
   a50=(a50+a16);
-  a16=A1[39];
+  a16=A1[S*39];
   a16=(a16*a21);
   a50=(a50+a16);
   a16=(a37*a26);
   a50=(a50+a16);
-  a16=A1[43];
+  a16=A1[S*43];
   a16=(a16*a28);
   a50=(a50+a16);
   a16=(a38*a33);
   a50=(a50+a16);
-  a16=A1[47];
+  a16=A1[S*47];
   a16=(a16*a35);
   a50=(a50+a16);
   a16=(a39*a40);
@@ -9772,32 +8389,32 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a05=(a05+a18);
   a42=(2.*a42);
   a05=(a05+a42);
-  a42=A1[64];
+  a42=A1[S*64];
   a18=(a01*a41);
   a00=(a00+a18);
   a42=(a42*a00);
   a06=(a06*a16);
   a42=(a42+a06);
-  a06=A1[68];
+  a06=A1[S*68];
   a18=(a01*a46);
   a18=(a08+a18);
   a06=(a06*a18);
   a42=(a42+a06);
-  a06=A1[49];
+  a06=A1[S*49];
   a06=(a06*a43);
   a17=(a22*a41);
   a06=(a06+a17);
-  a17=A1[53];
+  a17=A1[S*53];
   a17=(a17*a45);
   a06=(a06+a17);
   a17=(a23*a46);
   a06=(a06+a17);
-  a17=A1[57];
+  a17=A1[S*57];
   a17=(a17*a48);
   a06=(a06+a17);
   a17=(a24*a49);
   a06=(a06+a17);
-  a17=A1[61];
+  a17=A1[S*61];
   a17=(a17*a51);
   a06=(a06+a17);
   a17=(a25*a04);
@@ -9806,26 +8423,26 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a17=(a09+a17);
   a07=(a07*a17);
   a42=(a42+a07);
-  a07=A1[72];
+  a07=A1[S*72];
   a35=(a01*a49);
   a35=(a11+a35);
   a07=(a07*a35);
   a42=(a42+a07);
-  a07=A1[50];
+  a07=A1[S*50];
   a07=(a07*a43);
   a28=(a29*a41);
   a07=(a07+a28);
-  a28=A1[54];
+  a28=A1[S*54];
   a28=(a28*a45);
   a07=(a07+a28);
   a28=(a30*a46);
   a07=(a07+a28);
-  a28=A1[58];
+  a28=A1[S*58];
   a28=(a28*a48);
   a07=(a07+a28);
   a28=(a31*a49);
   a07=(a07+a28);
-  a28=A1[62];
+  a28=A1[S*62];
   a28=(a28*a51);
   a07=(a07+a28);
   a28=(a32*a04);
@@ -9834,26 +8451,26 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a28=(a12+a28);
   a10=(a10*a28);
   a42=(a42+a10);
-  a10=A1[76];
+  a10=A1[S*76];
   a21=(a01*a04);
   a21=(a14+a21);
   a10=(a10*a21);
   a42=(a42+a10);
-  a10=A1[51];
+  a10=A1[S*51];
   a10=(a10*a43);
   a41=(a36*a41);
   a10=(a10+a41);
-  a41=A1[55];
+  a41=A1[S*55];
   a41=(a41*a45);
   a10=(a10+a41);
   a41=(a37*a46);
   a10=(a10+a41);
-  a41=A1[59];
+  a41=A1[S*59];
   a41=(a41*a48);
   a10=(a10+a41);
   a41=(a38*a49);
   a10=(a10+a41);
-  a41=A1[63];
+  a41=A1[S*63];
   a41=(a41*a51);
   a10=(a10+a41);
   a41=(a39*a04);
@@ -9865,7 +8482,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a05=(a05+a42);
   a05=(a02*a05);
   a03=(a03+a05);
-  R0[8]=a03;
+  R0[S*8]=a03;
   a26=(2.*a26);
   a26=(a09+a26);
   a46=(2.*a46);
@@ -9873,26 +8490,26 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a26=(a26+a17);
   a26=(a02*a26);
   a08=(a08+a26);
-  R0[16]=a08;
+  R0[S*16]=a08;
   a44=(2.*a44);
   a20=(a20+a44);
   a06=(2.*a06);
   a20=(a20+a06);
-  a06=A1[65];
+  a06=A1[S*65];
   a06=(a06*a00);
   a22=(a22*a16);
   a06=(a06+a22);
-  a22=A1[69];
+  a22=A1[S*69];
   a22=(a22*a18);
   a06=(a06+a22);
   a23=(a23*a17);
   a06=(a06+a23);
-  a23=A1[73];
+  a23=A1[S*73];
   a23=(a23*a35);
   a06=(a06+a23);
   a24=(a24*a28);
   a06=(a06+a24);
-  a24=A1[77];
+  a24=A1[S*77];
   a24=(a24*a21);
   a06=(a06+a24);
   a25=(a25*a01);
@@ -9900,7 +8517,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a20=(a20+a06);
   a20=(a02*a20);
   a09=(a09+a20);
-  R0[24]=a09;
+  R0[S*24]=a09;
   a33=(2.*a33);
   a33=(a12+a33);
   a49=(2.*a49);
@@ -9908,26 +8525,26 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a33=(a33+a28);
   a33=(a02*a33);
   a11=(a11+a33);
-  R0[32]=a11;
+  R0[S*32]=a11;
   a47=(2.*a47);
   a27=(a27+a47);
   a07=(2.*a07);
   a27=(a27+a07);
-  a07=A1[66];
+  a07=A1[S*66];
   a07=(a07*a00);
   a29=(a29*a16);
   a07=(a07+a29);
-  a29=A1[70];
+  a29=A1[S*70];
   a29=(a29*a18);
   a07=(a07+a29);
   a30=(a30*a17);
   a07=(a07+a30);
-  a30=A1[74];
+  a30=A1[S*74];
   a30=(a30*a35);
   a07=(a07+a30);
   a31=(a31*a28);
   a07=(a07+a31);
-  a31=A1[78];
+  a31=A1[S*78];
   a31=(a31*a21);
   a07=(a07+a31);
   a32=(a32*a01);
@@ -9935,7 +8552,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a27=(a27+a07);
   a27=(a02*a27);
   a12=(a12+a27);
-  R0[40]=a12;
+  R0[S*40]=a12;
   a40=(2.*a40);
   a40=(a15+a40);
   a04=(2.*a04);
@@ -9943,26 +8560,26 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a40=(a40+a01);
   a40=(a02*a40);
   a14=(a14+a40);
-  R0[48]=a14;
+  R0[S*48]=a14;
   a50=(2.*a50);
   a34=(a34+a50);
   a10=(2.*a10);
   a34=(a34+a10);
-  a10=A1[67];
+  a10=A1[S*67];
   a10=(a10*a00);
   a36=(a36*a16);
   a10=(a10+a36);
-  a36=A1[71];
+  a36=A1[S*71];
   a36=(a36*a18);
   a10=(a10+a36);
   a37=(a37*a17);
   a10=(a10+a37);
-  a37=A1[75];
+  a37=A1[S*75];
   a37=(a37*a35);
   a10=(a10+a37);
   a38=(a38*a28);
   a10=(a10+a38);
-  a38=A1[79];
+  a38=A1[S*79];
   a38=(a38*a21);
   a10=(a10+a38);
   a39=(a39*a01);
@@ -9970,8 +8587,9 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a34=(a34+a10);
   a02=(a02*a34);
   a15=(a15+a02);
-  R0[56]=a15;
+  R0[S*56]=a15;
 }
+static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) { gs_tangent_vector_strided(A0, A1, A2, R0, 1); }
 
 /* gram_schmidt, from CasADi's C of it */
 static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
@@ -11188,6 +9806,143 @@ static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casad
   R1[7]=a46;
 }
 
+/* constants, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_constants_strided(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20;
+  a00=A0[S*11];
+  R0[0]=a00;
+  a00=A0[0];
+  a01=casadi_sq(a00);
+  a02=(1./a01);
+  a03=(-a02);
+  R0[S*1]=a03;
+  a03=-2.;
+  a04=A0[S*1];
+  a04=(a03*a04);
+  a04=(a04/a00);
+  R0[S*2]=a04;
+  a05=A0[S*13];
+  a06=casadi_sq(a05);
+  a07=A0[S*7];
+  a08=(a06/a07);
+  a09=A0[S*15];
+  a10=casadi_sq(a09);
+  a11=(a10/a07);
+  a11=(a08+a11);
+  a12=A0[S*9];
+  a10=(a10/a12);
+  a12=(a11+a10);
+  a13=(2.*a05);
+  a13=(a13*a09);
+  a13=(a13/a07);
+  a12=(a12+a13);
+  a14=(a12/a01);
+  a15=A0[S*8];
+  a06=(a06/a15);
+  a11=(a11+a06);
+  a11=(a11+a10);
+  a11=(a11+a13);
+  a14=(a14/a11);
+  a14=(-a14);
+  R0[S*3]=a14;
+  a14=-4.;
+  a13=A0[S*3];
+  a14=(a14*a13);
+  a14=(a14/a00);
+  a10=A0[S*14];
+  a15=(a05*a10);
+  a15=(a15/a07);
+  a16=(a15-a08);
+  a17=(a10*a09);
+  a17=(a17/a07);
+  a16=(a16+a17);
+  a09=(a05*a09);
+  a09=(a09/a07);
+  a16=(a16-a09);
+  a18=(a14*a16);
+  a19=casadi_sq(a10);
+  a19=(a19/a07);
+  a19=(a08+a19);
+  a20=(a19+a06);
+  a05=(a03*a05);
+  a05=(a05*a10);
+  a05=(a05/a07);
+  a20=(a20+a05);
+  a18=(a18/a20);
+  R0[S*4]=a18;
+  a03=(a03*a13);
+  a03=(a03/a00);
+  a08=(a08+a06);
+  a15=(a15-a08);
+  a15=(a15+a17);
+  a15=(a15-a09);
+  a09=(a03*a15);
+  a09=(a09/a20);
+  R0[S*5]=a09;
+  a12=(a04*a12);
+  a12=(a12/a11);
+  R0[S*6]=a12;
+  a13=(2.*a13);
+  a13=(a13/a00);
+  a00=(a13*a16);
+  a00=(a00/a20);
+  R0[S*7]=a00;
+  a00=A0[S*2];
+  a00=(a00/a01);
+  a12=(a00*a15);
+  a12=(a12/a20);
+  a12=(-a12);
+  R0[S*8]=a12;
+  a12=(a00*a16);
+  a12=(a12/a20);
+  a12=(-a12);
+  R0[S*9]=a12;
+  R0[S*10]=a02;
+  a02=(a03*a16);
+  a02=(a02/a20);
+  R0[S*11]=a02;
+  a02=(a13*a15);
+  a02=(a02/a20);
+  R0[S*12]=a02;
+  R0[S*13]=a03;
+  a03=(-a00);
+  R0[S*14]=a03;
+  a03=(a15/a01);
+  a03=(a03/a11);
+  a03=(-a03);
+  R0[S*15]=a03;
+  a03=(a16/a01);
+  a03=(a03/a11);
+  a03=(-a03);
+  R0[S*16]=a03;
+  a19=(a19+a05);
+  a14=(a14*a19);
+  a14=(a14/a20);
+  R0[S*17]=a14;
+  a15=(a04*a15);
+  a15=(a15/a11);
+  R0[S*18]=a15;
+  a04=(a04*a16);
+  a04=(a04/a11);
+  R0[S*19]=a04;
+  a13=(a13*a19);
+  a13=(a13/a20);
+  R0[S*20]=a13;
+  a00=(a00*a19);
+  a00=(a00/a20);
+  a00=(-a00);
+  R0[S*21]=a00;
+  a00=A0[S*6];
+  a00=(a00/a01);
+  R0[S*22]=a00;
+  a00=3.1415926535897934e-02;
+  R0[S*23]=a00;
+  a00=6.2831853071795862e+00;
+  R1[0]=a00;
+}
+static GEARSYM_INLINE void gs_constants(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) { gs_constants_strided(A0, R0, R1, 1); }
+
 /* the located step that crosses: its legs, RK4 of the sides held fixed on each (calls of one
    mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/crossing.py) */
 static GEARSYM_NOINLINE void gs_tangent_split(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict yt, const casadi_real* restrict Qt, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
@@ -11228,6 +9983,1394 @@ static GEARSYM_NOINLINE void gs_state_split(const casadi_real* restrict y, const
   gs_state_mode_step(yb, leg_b, c, yc);
   gs_state_mode_step(yc, leg_c, c, yn);
   gs_state_keep(y, lo, hi, yn, T, c, y1, lo1, hi1);
+}
+
+#ifndef GEARSYM_STEP_PIECES_ONLY  /* (the lanes' C includes the pieces above) */
+
+/* rhs:(t,y[8],p[16])->(dy[8]) */
+static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+  casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
+  casadi_real a36, a37, a38, a39, a40, a41, a42, a43, a44, a45, a46, a47;
+  casadi_real a48, a49, a50, a51, a52, a53, a54, a55, a56, a57, a58, a59;
+  a00=arg[1]? arg[1][1] : 0;
+  if (res[0]!=0) res[0][0]=a00;
+  a01=-2.;
+  a02=(a01*a00);
+  a03=arg[2]? arg[2][1] : 0;
+  a04=(a02*a03);
+  a05=arg[2]? arg[2][0] : 0;
+  a04=(a04/a05);
+  a06=arg[2]? arg[2][4] : 0;
+  a07=arg[2]? arg[2][5] : 0;
+  a08=arg[2]? arg[2][10] : 0;
+  a09=arg[0]? arg[0][0] : 0;
+  a08=(a08+a09);
+  a08=cos(a08);
+  a07=(a07*a08);
+  a06=(a06+a07);
+  a07=casadi_sq(a05);
+  a06=(a06/a07);
+  a08=(a04+a06);
+  a10=-4.;
+  a11=arg[1]? arg[1][7] : 0;
+  a12=(a10*a11);
+  a13=arg[2]? arg[2][3] : 0;
+  a12=(a12*a13);
+  a12=(a12/a05);
+  a14=arg[2]? arg[2][13] : 0;
+  a15=arg[2]? arg[2][14] : 0;
+  a16=(a14*a15);
+  a17=arg[2]? arg[2][7] : 0;
+  a16=(a16/a17);
+  a18=casadi_sq(a14);
+  a19=(a18/a17);
+  a20=(a16-a19);
+  a21=arg[2]? arg[2][15] : 0;
+  a22=(a15*a21);
+  a22=(a22/a17);
+  a20=(a20+a22);
+  a23=(a14*a21);
+  a23=(a23/a17);
+  a20=(a20-a23);
+  a24=(a12*a20);
+  a25=casadi_sq(a15);
+  a25=(a25/a17);
+  a25=(a19+a25);
+  a26=arg[2]? arg[2][8] : 0;
+  a18=(a18/a26);
+  a26=(a25+a18);
+  a27=(a01*a14);
+  a27=(a27*a15);
+  a27=(a27/a17);
+  a26=(a26+a27);
+  a24=(a24/a26);
+  a08=(a08+a24);
+  a10=(a10*a00);
+  a10=(a10*a13);
+  a10=(a10/a05);
+  a00=(a10*a20);
+  a00=(a00/a26);
+  a08=(a08+a00);
+  a00=(a01*a11);
+  a00=(a00*a13);
+  a00=(a00/a05);
+  a15=(a19+a18);
+  a16=(a16-a15);
+  a16=(a16+a22);
+  a16=(a16-a23);
+  a23=(a00*a16);
+  a23=(a23/a26);
+  a08=(a08+a23);
+  a22=arg[1]? arg[1][3] : 0;
+  a15=(a01*a22);
+  a15=(a15*a03);
+  a15=(a15/a05);
+  a28=casadi_sq(a21);
+  a29=(a28/a17);
+  a19=(a19+a29);
+  a29=arg[2]? arg[2][9] : 0;
+  a28=(a28/a29);
+  a29=(a19+a28);
+  a14=(2.*a14);
+  a14=(a14*a21);
+  a14=(a14/a17);
+  a29=(a29+a14);
+  a17=(a15*a29);
+  a19=(a19+a18);
+  a19=(a19+a28);
+  a19=(a19+a14);
+  a17=(a17/a19);
+  a08=(a08+a17);
+  a14=arg[1]? arg[1][5] : 0;
+  a01=(a01*a14);
+  a01=(a01*a03);
+  a01=(a01/a05);
+  a03=(a01*a29);
+  a03=(a03/a19);
+  a08=(a08+a03);
+  a28=(2.*a22);
+  a28=(a28*a13);
+  a28=(a28/a05);
+  a18=(a28*a20);
+  a18=(a18/a26);
+  a08=(a08+a18);
+  a21=(2.*a14);
+  a21=(a21*a13);
+  a21=(a21/a05);
+  a30=(a21*a20);
+  a30=(a30/a26);
+  a08=(a08+a30);
+  a31=0.;
+  a32=arg[1]? arg[1][0] : 0;
+  a33=(a31<=a32);
+  a33=(a33?a32:0);
+  a34=arg[2]? arg[2][11] : 0;
+  a35=(-a34);
+  a36=(a32<=a35);
+  a37=(a32+a34);
+  a36=(a36?a37:0);
+  a33=(a33+a36);
+  a33=(a33/a07);
+  a36=1.;
+  a37=arg[2]? arg[2][12] : 0;
+  a38=1.1800386146799999e+00;
+  a39=cos(a09);
+  a38=(a38*a39);
+  a39=1.9272434388400000e-01;
+  a40=4.;
+  a40=(a40*a09);
+  a41=cos(a40);
+  a39=(a39*a41);
+  a38=(a38+a39);
+  a39=1.4883754528799999e-02;
+  a41=7.;
+  a41=(a41*a09);
+  a42=cos(a41);
+  a39=(a39*a42);
+  a38=(a38+a39);
+  a39=-6.0567417982099997e-02;
+  a42=6.;
+  a42=(a42*a09);
+  a42=cos(a42);
+  a39=(a39*a42);
+  a38=(a38+a39);
+  a42=-3.3689450631399998e-01;
+  a43=(2.*a09);
+  a44=cos(a43);
+  a42=(a42*a44);
+  a38=(a38+a42);
+  a42=-1.9563283778700000e-01;
+  a44=3.;
+  a44=(a44*a09);
+  a44=cos(a44);
+  a42=(a42*a44);
+  a38=(a38+a42);
+  a38=(a37*a38);
+  a38=(a36+a38);
+  a44=(a33*a38);
+  a08=(a08-a44);
+  a44=arg[2]? arg[2][2] : 0;
+  a44=(a44/a07);
+  a45=arg[1]? arg[1][6] : 0;
+  a46=(a31<=a45);
+  a46=(a46?a45:0);
+  a47=(a45<=a35);
+  a48=(a45+a34);
+  a47=(a47?a48:0);
+  a46=(a46+a47);
+  a46=(a44*a46);
+  a47=(a46*a16);
+  a47=(a47/a26);
+  a47=(a47*a38);
+  a08=(a08-a47);
+  a47=arg[1]? arg[1][2] : 0;
+  a48=(a31<=a47);
+  a48=(a48?a47:0);
+  a49=(a47<=a35);
+  a50=(a47+a34);
+  a49=(a49?a50:0);
+  a48=(a48+a49);
+  a48=(a48/a07);
+  a49=(a48*a29);
+  a49=(a49/a19);
+  a39=(a39+a42);
+  a42=3.3689450631399998e-01;
+  a50=1.0471975511965976e+00;
+  a51=(a43+a50);
+  a51=cos(a51);
+  a51=(a42*a51);
+  a51=(a39+a51);
+  a52=-1.1800386146799999e+00;
+  a53=5.2359877559829882e-01;
+  a54=(a09+a53);
+  a54=sin(a54);
+  a54=(a52*a54);
+  a51=(a51+a54);
+  a54=-1.9272434388400000e-01;
+  a55=(a40+a53);
+  a55=sin(a55);
+  a55=(a54*a55);
+  a51=(a51+a55);
+  a55=-1.4883754528799999e-02;
+  a56=(a41+a53);
+  a56=sin(a56);
+  a56=(a55*a56);
+  a51=(a51+a56);
+  a51=(a37*a51);
+  a51=(a36+a51);
+  a49=(a49*a51);
+  a08=(a08-a49);
+  a56=arg[1]? arg[1][4] : 0;
+  a57=(a31<=a56);
+  a57=(a57?a56:0);
+  a58=(a56<=a35);
+  a59=(a56+a34);
+  a58=(a58?a59:0);
+  a57=(a57+a58);
+  a57=(a57/a07);
+  a58=(a57*a29);
+  a58=(a58/a19);
+  a43=(a43+a53);
+  a43=sin(a43);
+  a42=(a42*a43);
+  a39=(a39+a42);
+  a09=(a09+a50);
+  a09=cos(a09);
+  a52=(a52*a09);
+  a39=(a39+a52);
+  a40=(a40+a50);
+  a40=cos(a40);
+  a54=(a54*a40);
+  a39=(a39+a54);
+  a41=(a41+a50);
+  a41=cos(a41);
+  a55=(a55*a41);
+  a39=(a39+a55);
+  a37=(a37*a39);
+  a36=(a36+a37);
+  a58=(a58*a36);
+  a08=(a08-a58);
+  a37=(a44*a20);
+  a32=(a32+a45);
+  a47=(a32-a47);
+  a45=(a31<=a47);
+  a45=(a45?a47:0);
+  a39=(a47<=a35);
+  a47=(a47+a34);
+  a39=(a39?a47:0);
+  a45=(a45+a39);
+  a39=(a37*a45);
+  a39=(a39/a26);
+  a39=(a39*a51);
+  a08=(a08-a39);
+  a32=(a32-a56);
+  a31=(a31<=a32);
+  a31=(a31?a32:0);
+  a35=(a32<=a35);
+  a32=(a32+a34);
+  a35=(a35?a32:0);
+  a31=(a31+a35);
+  a37=(a37*a31);
+  a37=(a37/a26);
+  a37=(a37*a36);
+  a08=(a08-a37);
+  if (res[0]!=0) res[0][1]=a08;
+  if (res[0]!=0) res[0][2]=a22;
+  a22=(a15+a06);
+  a22=(a22+a24);
+  a22=(a22+a23);
+  a08=(a04*a29);
+  a08=(a08/a19);
+  a22=(a22+a08);
+  a02=(a02*a13);
+  a02=(a02/a05);
+  a05=(a02*a20);
+  a05=(a05/a26);
+  a22=(a22+a05);
+  a02=(a02*a16);
+  a02=(a02/a26);
+  a22=(a22+a02);
+  a22=(a22+a03);
+  a03=(a28*a16);
+  a03=(a03/a26);
+  a22=(a22+a03);
+  a22=(a22+a30);
+  a29=(a33*a29);
+  a29=(a29/a19);
+  a29=(a29*a38);
+  a22=(a22-a29);
+  a30=(a46*a20);
+  a30=(a30/a26);
+  a30=(a30*a38);
+  a22=(a22-a30);
+  a03=(a48*a51);
+  a22=(a22-a03);
+  a22=(a22-a58);
+  a58=(a44*a16);
+  a03=(a58*a45);
+  a03=(a03/a26);
+  a03=(a03*a51);
+  a22=(a22-a03);
+  a22=(a22-a37);
+  if (res[0]!=0) res[0][3]=a22;
+  if (res[0]!=0) res[0][4]=a14;
+  a06=(a01+a06);
+  a06=(a06+a24);
+  a06=(a06+a23);
+  a06=(a06+a08);
+  a06=(a06+a05);
+  a06=(a06+a02);
+  a06=(a06+a17);
+  a06=(a06+a18);
+  a18=(a21*a16);
+  a18=(a18/a26);
+  a06=(a06+a18);
+  a06=(a06-a29);
+  a06=(a06-a30);
+  a30=(a57*a36);
+  a06=(a06-a30);
+  a06=(a06-a49);
+  a06=(a06-a39);
+  a58=(a58*a31);
+  a58=(a58/a26);
+  a58=(a58*a36);
+  a06=(a06-a58);
+  if (res[0]!=0) res[0][5]=a06;
+  if (res[0]!=0) res[0][6]=a11;
+  a11=arg[2]? arg[2][6] : 0;
+  a11=(a11/a07);
+  a11=(a11+a00);
+  a25=(a25+a27);
+  a12=(a12*a25);
+  a12=(a12/a26);
+  a11=(a11+a12);
+  a10=(a10*a25);
+  a10=(a10/a26);
+  a11=(a11+a10);
+  a04=(a04*a16);
+  a04=(a04/a19);
+  a11=(a11+a04);
+  a15=(a15*a20);
+  a15=(a15/a19);
+  a11=(a11+a15);
+  a01=(a01*a20);
+  a01=(a01/a19);
+  a11=(a11+a01);
+  a28=(a28*a25);
+  a28=(a28/a26);
+  a11=(a11+a28);
+  a21=(a21*a25);
+  a21=(a21/a26);
+  a11=(a11+a21);
+  a46=(a46*a38);
+  a11=(a11-a46);
+  a33=(a33*a16);
+  a33=(a33/a19);
+  a33=(a33*a38);
+  a11=(a11-a33);
+  a48=(a48*a20);
+  a48=(a48/a19);
+  a48=(a48*a51);
+  a11=(a11-a48);
+  a57=(a57*a20);
+  a57=(a57/a19);
+  a57=(a57*a36);
+  a11=(a11-a57);
+  a44=(a44*a25);
+  a45=(a44*a45);
+  a45=(a45/a26);
+  a45=(a45*a51);
+  a11=(a11-a45);
+  a44=(a44*a31);
+  a44=(a44/a26);
+  a44=(a44*a36);
+  a11=(a11-a44);
+  if (res[0]!=0) res[0][7]=a11;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int rhs(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f0(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int rhs_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void rhs_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void rhs_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void rhs_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int rhs_n_in(void) { return 3;}
+
+CASADI_SYMBOL_EXPORT casadi_int rhs_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real rhs_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* rhs_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "y";
+    case 2: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* rhs_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "dy";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s1;
+    case 2: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s1;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int rhs_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int rhs_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* jacobian:(t,y[8],p[16])->(J[8x8]) */
+static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+  casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
+  casadi_real a36, a37, a38, a39, a40, a41, a42, a43;
+  a00=0.;
+  if (res[0]!=0) res[0][0]=a00;
+  a01=1.;
+  a02=arg[2]? arg[2][12] : 0;
+  a03=1.1800386146799999e+00;
+  a04=arg[0]? arg[0][0] : 0;
+  a05=cos(a04);
+  a03=(a03*a05);
+  a05=1.9272434388400000e-01;
+  a06=4.;
+  a06=(a06*a04);
+  a07=cos(a06);
+  a05=(a05*a07);
+  a03=(a03+a05);
+  a05=1.4883754528799999e-02;
+  a07=7.;
+  a07=(a07*a04);
+  a08=cos(a07);
+  a05=(a05*a08);
+  a03=(a03+a05);
+  a05=-6.0567417982099997e-02;
+  a08=6.;
+  a08=(a08*a04);
+  a08=cos(a08);
+  a05=(a05*a08);
+  a03=(a03+a05);
+  a08=-3.3689450631399998e-01;
+  a09=(2.*a04);
+  a10=cos(a09);
+  a08=(a08*a10);
+  a03=(a03+a08);
+  a08=-1.9563283778700000e-01;
+  a10=3.;
+  a10=(a10*a04);
+  a10=cos(a10);
+  a08=(a08*a10);
+  a03=(a03+a08);
+  a03=(a02*a03);
+  a03=(a01+a03);
+  a10=arg[1]? arg[1][0] : 0;
+  a11=(a00<=a10);
+  a11=(a11?a01:0);
+  a12=arg[2]? arg[2][11] : 0;
+  a12=(-a12);
+  a13=(a10<=a12);
+  a13=(a13?a01:0);
+  a11=(a11+a13);
+  a13=arg[2]? arg[2][0] : 0;
+  a14=casadi_sq(a13);
+  a11=(a11/a14);
+  a15=(a03*a11);
+  a05=(a05+a08);
+  a08=3.3689450631399998e-01;
+  a16=1.0471975511965976e+00;
+  a17=(a09+a16);
+  a17=cos(a17);
+  a17=(a08*a17);
+  a17=(a05+a17);
+  a18=-1.1800386146799999e+00;
+  a19=5.2359877559829882e-01;
+  a20=(a04+a19);
+  a20=sin(a20);
+  a20=(a18*a20);
+  a17=(a17+a20);
+  a20=-1.9272434388400000e-01;
+  a21=(a06+a19);
+  a21=sin(a21);
+  a21=(a20*a21);
+  a17=(a17+a21);
+  a21=-1.4883754528799999e-02;
+  a22=(a07+a19);
+  a22=sin(a22);
+  a22=(a21*a22);
+  a17=(a17+a22);
+  a17=(a02*a17);
+  a17=(a01+a17);
+  a22=arg[2]? arg[2][2] : 0;
+  a22=(a22/a14);
+  a23=arg[2]? arg[2][13] : 0;
+  a24=arg[2]? arg[2][14] : 0;
+  a25=(a23*a24);
+  a26=arg[2]? arg[2][7] : 0;
+  a25=(a25/a26);
+  a27=casadi_sq(a23);
+  a28=(a27/a26);
+  a29=(a25-a28);
+  a30=arg[2]? arg[2][15] : 0;
+  a31=(a24*a30);
+  a31=(a31/a26);
+  a29=(a29+a31);
+  a32=(a23*a30);
+  a32=(a32/a26);
+  a29=(a29-a32);
+  a33=(a22*a29);
+  a34=arg[1]? arg[1][6] : 0;
+  a10=(a10+a34);
+  a35=arg[1]? arg[1][2] : 0;
+  a36=(a10-a35);
+  a37=(a00<=a36);
+  a38=(a37?a01:0);
+  a36=(a36<=a12);
+  a39=(a36?a01:0);
+  a38=(a38+a39);
+  a39=(a33*a38);
+  a40=casadi_sq(a24);
+  a40=(a40/a26);
+  a40=(a28+a40);
+  a41=arg[2]? arg[2][8] : 0;
+  a27=(a27/a41);
+  a41=(a40+a27);
+  a42=-2.;
+  a43=(a42*a23);
+  a43=(a43*a24);
+  a43=(a43/a26);
+  a41=(a41+a43);
+  a39=(a39/a41);
+  a39=(a17*a39);
+  a15=(a15+a39);
+  a09=(a09+a19);
+  a09=sin(a09);
+  a08=(a08*a09);
+  a05=(a05+a08);
+  a04=(a04+a16);
+  a04=cos(a04);
+  a18=(a18*a04);
+  a05=(a05+a18);
+  a06=(a06+a16);
+  a06=cos(a06);
+  a20=(a20*a06);
+  a05=(a05+a20);
+  a07=(a07+a16);
+  a07=cos(a07);
+  a21=(a21*a07);
+  a05=(a05+a21);
+  a02=(a02*a05);
+  a02=(a01+a02);
+  a05=arg[1]? arg[1][4] : 0;
+  a10=(a10-a05);
+  a21=(a00<=a10);
+  a07=(a21?a01:0);
+  a10=(a10<=a12);
+  a16=(a10?a01:0);
+  a07=(a07+a16);
+  a16=(a33*a07);
+  a16=(a16/a41);
+  a16=(a02*a16);
+  a15=(a15+a16);
+  a15=(-a15);
+  if (res[0]!=0) res[0][1]=a15;
+  if (res[0]!=0) res[0][2]=a00;
+  a15=casadi_sq(a30);
+  a20=(a15/a26);
+  a20=(a28+a20);
+  a06=arg[2]? arg[2][9] : 0;
+  a15=(a15/a06);
+  a06=(a20+a15);
+  a23=(2.*a23);
+  a23=(a23*a30);
+  a23=(a23/a26);
+  a06=(a06+a23);
+  a26=(a06*a11);
+  a20=(a20+a27);
+  a20=(a20+a15);
+  a20=(a20+a23);
+  a26=(a26/a20);
+  a26=(a03*a26);
+  a28=(a28+a27);
+  a25=(a25-a28);
+  a25=(a25+a31);
+  a25=(a25-a32);
+  a32=(a22*a25);
+  a31=(a32*a38);
+  a31=(a31/a41);
+  a31=(a17*a31);
+  a28=(a26+a31);
+  a28=(a28+a16);
+  a28=(-a28);
+  if (res[0]!=0) res[0][3]=a28;
+  if (res[0]!=0) res[0][4]=a00;
+  a26=(a26+a39);
+  a28=(a32*a07);
+  a28=(a28/a41);
+  a28=(a02*a28);
+  a26=(a26+a28);
+  a26=(-a26);
+  if (res[0]!=0) res[0][5]=a26;
+  if (res[0]!=0) res[0][6]=a00;
+  a11=(a25*a11);
+  a11=(a11/a20);
+  a11=(a03*a11);
+  a40=(a40+a43);
+  a43=(a22*a40);
+  a38=(a43*a38);
+  a38=(a38/a41);
+  a38=(a17*a38);
+  a11=(a11+a38);
+  a07=(a43*a07);
+  a07=(a07/a41);
+  a07=(a02*a07);
+  a11=(a11+a07);
+  a11=(-a11);
+  if (res[0]!=0) res[0][7]=a11;
+  if (res[0]!=0) res[0][8]=a01;
+  a11=arg[2]? arg[2][1] : 0;
+  a11=(a42*a11);
+  a11=(a11/a13);
+  a26=-4.;
+  a27=arg[2]? arg[2][3] : 0;
+  a26=(a26*a27);
+  a26=(a26/a13);
+  a23=(a29*a26);
+  a23=(a23/a41);
+  a15=(a11+a23);
+  if (res[0]!=0) res[0][9]=a15;
+  if (res[0]!=0) res[0][10]=a00;
+  a15=(a06*a11);
+  a15=(a15/a20);
+  a42=(a42*a27);
+  a42=(a42/a13);
+  a30=(a29*a42);
+  a30=(a30/a41);
+  a30=(a15+a30);
+  a18=(a25*a42);
+  a18=(a18/a41);
+  a30=(a30+a18);
+  if (res[0]!=0) res[0][11]=a30;
+  if (res[0]!=0) res[0][12]=a00;
+  if (res[0]!=0) res[0][13]=a30;
+  if (res[0]!=0) res[0][14]=a00;
+  a26=(a40*a26);
+  a26=(a26/a41);
+  a30=(a25*a11);
+  a30=(a30/a20);
+  a30=(a26+a30);
+  if (res[0]!=0) res[0][15]=a30;
+  if (res[0]!=0) res[0][16]=a00;
+  a30=(a00<=a35);
+  a30=(a30?a01:0);
+  a35=(a35<=a12);
+  a35=(a35?a01:0);
+  a30=(a30+a35);
+  a30=(a30/a14);
+  a35=(a06*a30);
+  a35=(a35/a20);
+  a35=(a17*a35);
+  a04=-1.;
+  a37=(a37?a04:0);
+  a36=(a36?a04:0);
+  a37=(a37+a36);
+  a36=(a33*a37);
+  a36=(a36/a41);
+  a36=(a17*a36);
+  a35=(a35+a36);
+  a35=(-a35);
+  if (res[0]!=0) res[0][17]=a35;
+  if (res[0]!=0) res[0][18]=a00;
+  a36=(a17*a30);
+  a08=(a32*a37);
+  a08=(a08/a41);
+  a08=(a17*a08);
+  a36=(a36+a08);
+  a36=(-a36);
+  if (res[0]!=0) res[0][19]=a36;
+  if (res[0]!=0) res[0][20]=a00;
+  if (res[0]!=0) res[0][21]=a35;
+  if (res[0]!=0) res[0][22]=a00;
+  a30=(a29*a30);
+  a30=(a30/a20);
+  a30=(a17*a30);
+  a37=(a43*a37);
+  a37=(a37/a41);
+  a17=(a17*a37);
+  a30=(a30+a17);
+  a30=(-a30);
+  if (res[0]!=0) res[0][23]=a30;
+  if (res[0]!=0) res[0][24]=a00;
+  a27=(2.*a27);
+  a27=(a27/a13);
+  a13=(a29*a27);
+  a13=(a13/a41);
+  a15=(a15+a13);
+  if (res[0]!=0) res[0][25]=a15;
+  if (res[0]!=0) res[0][26]=a01;
+  a13=(a25*a27);
+  a13=(a13/a41);
+  a13=(a11+a13);
+  if (res[0]!=0) res[0][27]=a13;
+  if (res[0]!=0) res[0][28]=a00;
+  if (res[0]!=0) res[0][29]=a15;
+  if (res[0]!=0) res[0][30]=a00;
+  a11=(a29*a11);
+  a11=(a11/a20);
+  a40=(a40*a27);
+  a40=(a40/a41);
+  a11=(a11+a40);
+  if (res[0]!=0) res[0][31]=a11;
+  if (res[0]!=0) res[0][32]=a00;
+  a40=(a00<=a05);
+  a40=(a40?a01:0);
+  a05=(a05<=a12);
+  a05=(a05?a01:0);
+  a40=(a40+a05);
+  a40=(a40/a14);
+  a06=(a06*a40);
+  a06=(a06/a20);
+  a06=(a02*a06);
+  a21=(a21?a04:0);
+  a10=(a10?a04:0);
+  a21=(a21+a10);
+  a33=(a33*a21);
+  a33=(a33/a41);
+  a33=(a02*a33);
+  a06=(a06+a33);
+  a06=(-a06);
+  if (res[0]!=0) res[0][33]=a06;
+  if (res[0]!=0) res[0][34]=a00;
+  if (res[0]!=0) res[0][35]=a06;
+  if (res[0]!=0) res[0][36]=a00;
+  a06=(a02*a40);
+  a32=(a32*a21);
+  a32=(a32/a41);
+  a32=(a02*a32);
+  a06=(a06+a32);
+  a06=(-a06);
+  if (res[0]!=0) res[0][37]=a06;
+  if (res[0]!=0) res[0][38]=a00;
+  a40=(a29*a40);
+  a40=(a40/a20);
+  a40=(a02*a40);
+  a43=(a43*a21);
+  a43=(a43/a41);
+  a02=(a02*a43);
+  a40=(a40+a02);
+  a40=(-a40);
+  if (res[0]!=0) res[0][39]=a40;
+  if (res[0]!=0) res[0][40]=a00;
+  if (res[0]!=0) res[0][41]=a15;
+  if (res[0]!=0) res[0][42]=a00;
+  if (res[0]!=0) res[0][43]=a15;
+  if (res[0]!=0) res[0][44]=a01;
+  if (res[0]!=0) res[0][45]=a13;
+  if (res[0]!=0) res[0][46]=a00;
+  if (res[0]!=0) res[0][47]=a11;
+  if (res[0]!=0) res[0][48]=a00;
+  a11=(a00<=a34);
+  a11=(a11?a01:0);
+  a34=(a34<=a12);
+  a34=(a34?a01:0);
+  a11=(a11+a34);
+  a22=(a22*a11);
+  a25=(a25*a22);
+  a25=(a25/a41);
+  a25=(a03*a25);
+  a25=(a25+a39);
+  a25=(a25+a16);
+  a25=(-a25);
+  if (res[0]!=0) res[0][49]=a25;
+  if (res[0]!=0) res[0][50]=a00;
+  a29=(a29*a22);
+  a29=(a29/a41);
+  a29=(a03*a29);
+  a31=(a29+a31);
+  a31=(a31+a16);
+  a31=(-a31);
+  if (res[0]!=0) res[0][51]=a31;
+  if (res[0]!=0) res[0][52]=a00;
+  a29=(a29+a39);
+  a29=(a29+a28);
+  a29=(-a29);
+  if (res[0]!=0) res[0][53]=a29;
+  if (res[0]!=0) res[0][54]=a00;
+  a03=(a03*a22);
+  a03=(a03+a38);
+  a03=(a03+a07);
+  a03=(-a03);
+  if (res[0]!=0) res[0][55]=a03;
+  if (res[0]!=0) res[0][56]=a00;
+  a23=(a23+a18);
+  if (res[0]!=0) res[0][57]=a23;
+  if (res[0]!=0) res[0][58]=a00;
+  if (res[0]!=0) res[0][59]=a23;
+  if (res[0]!=0) res[0][60]=a00;
+  if (res[0]!=0) res[0][61]=a23;
+  if (res[0]!=0) res[0][62]=a01;
+  a42=(a42+a26);
+  if (res[0]!=0) res[0][63]=a42;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int jacobian(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f1(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int jacobian_n_in(void) { return 3;}
+
+CASADI_SYMBOL_EXPORT casadi_int jacobian_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real jacobian_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* jacobian_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "y";
+    case 2: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* jacobian_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "J";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s1;
+    case 2: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s3;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* constants:(p[16])->(c[24],period) */
+static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20;
+  a00=arg[0]? arg[0][11] : 0;
+  if (res[0]!=0) res[0][0]=a00;
+  a00=arg[0]? arg[0][0] : 0;
+  a01=casadi_sq(a00);
+  a02=(1./a01);
+  a03=(-a02);
+  if (res[0]!=0) res[0][1]=a03;
+  a03=-2.;
+  a04=arg[0]? arg[0][1] : 0;
+  a04=(a03*a04);
+  a04=(a04/a00);
+  if (res[0]!=0) res[0][2]=a04;
+  a05=arg[0]? arg[0][13] : 0;
+  a06=casadi_sq(a05);
+  a07=arg[0]? arg[0][7] : 0;
+  a08=(a06/a07);
+  a09=arg[0]? arg[0][15] : 0;
+  a10=casadi_sq(a09);
+  a11=(a10/a07);
+  a11=(a08+a11);
+  a12=arg[0]? arg[0][9] : 0;
+  a10=(a10/a12);
+  a12=(a11+a10);
+  a13=(2.*a05);
+  a13=(a13*a09);
+  a13=(a13/a07);
+  a12=(a12+a13);
+  a14=(a12/a01);
+  a15=arg[0]? arg[0][8] : 0;
+  a06=(a06/a15);
+  a11=(a11+a06);
+  a11=(a11+a10);
+  a11=(a11+a13);
+  a14=(a14/a11);
+  a14=(-a14);
+  if (res[0]!=0) res[0][3]=a14;
+  a14=-4.;
+  a13=arg[0]? arg[0][3] : 0;
+  a14=(a14*a13);
+  a14=(a14/a00);
+  a10=arg[0]? arg[0][14] : 0;
+  a15=(a05*a10);
+  a15=(a15/a07);
+  a16=(a15-a08);
+  a17=(a10*a09);
+  a17=(a17/a07);
+  a16=(a16+a17);
+  a09=(a05*a09);
+  a09=(a09/a07);
+  a16=(a16-a09);
+  a18=(a14*a16);
+  a19=casadi_sq(a10);
+  a19=(a19/a07);
+  a19=(a08+a19);
+  a20=(a19+a06);
+  a05=(a03*a05);
+  a05=(a05*a10);
+  a05=(a05/a07);
+  a20=(a20+a05);
+  a18=(a18/a20);
+  if (res[0]!=0) res[0][4]=a18;
+  a03=(a03*a13);
+  a03=(a03/a00);
+  a08=(a08+a06);
+  a15=(a15-a08);
+  a15=(a15+a17);
+  a15=(a15-a09);
+  a09=(a03*a15);
+  a09=(a09/a20);
+  if (res[0]!=0) res[0][5]=a09;
+  a12=(a04*a12);
+  a12=(a12/a11);
+  if (res[0]!=0) res[0][6]=a12;
+  a13=(2.*a13);
+  a13=(a13/a00);
+  a00=(a13*a16);
+  a00=(a00/a20);
+  if (res[0]!=0) res[0][7]=a00;
+  a00=arg[0]? arg[0][2] : 0;
+  a00=(a00/a01);
+  a12=(a00*a15);
+  a12=(a12/a20);
+  a12=(-a12);
+  if (res[0]!=0) res[0][8]=a12;
+  a12=(a00*a16);
+  a12=(a12/a20);
+  a12=(-a12);
+  if (res[0]!=0) res[0][9]=a12;
+  if (res[0]!=0) res[0][10]=a02;
+  a02=(a03*a16);
+  a02=(a02/a20);
+  if (res[0]!=0) res[0][11]=a02;
+  a02=(a13*a15);
+  a02=(a02/a20);
+  if (res[0]!=0) res[0][12]=a02;
+  if (res[0]!=0) res[0][13]=a03;
+  a03=(-a00);
+  if (res[0]!=0) res[0][14]=a03;
+  a03=(a15/a01);
+  a03=(a03/a11);
+  a03=(-a03);
+  if (res[0]!=0) res[0][15]=a03;
+  a03=(a16/a01);
+  a03=(a03/a11);
+  a03=(-a03);
+  if (res[0]!=0) res[0][16]=a03;
+  a19=(a19+a05);
+  a14=(a14*a19);
+  a14=(a14/a20);
+  if (res[0]!=0) res[0][17]=a14;
+  a15=(a04*a15);
+  a15=(a15/a11);
+  if (res[0]!=0) res[0][18]=a15;
+  a04=(a04*a16);
+  a04=(a04/a11);
+  if (res[0]!=0) res[0][19]=a04;
+  a13=(a13*a19);
+  a13=(a13/a20);
+  if (res[0]!=0) res[0][20]=a13;
+  a00=(a00*a19);
+  a00=(a00/a20);
+  a00=(-a00);
+  if (res[0]!=0) res[0][21]=a00;
+  a00=arg[0]? arg[0][6] : 0;
+  a00=(a00/a01);
+  if (res[0]!=0) res[0][22]=a00;
+  a00=3.1415926535897934e-02;
+  if (res[0]!=0) res[0][23]=a00;
+  a00=6.2831853071795862e+00;
+  if (res[1]!=0) res[1][0]=a00;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int constants(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f2(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int constants_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void constants_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void constants_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void constants_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int constants_n_in(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_int constants_n_out(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_real constants_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* constants_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* constants_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "c";
+    case 1: return "period";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s4;
+    case 1: return casadi_s0;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int constants_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 1;
+  if (sz_res) *sz_res = 2;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 1*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 2*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* table_point:(t,p[16])->(values[4]) */
+static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14;
+  a00=1.;
+  a01=arg[1]? arg[1][12] : 0;
+  a02=1.1800386146799999e+00;
+  a03=arg[0]? arg[0][0] : 0;
+  a04=cos(a03);
+  a02=(a02*a04);
+  a04=1.9272434388400000e-01;
+  a05=4.;
+  a05=(a05*a03);
+  a06=cos(a05);
+  a04=(a04*a06);
+  a02=(a02+a04);
+  a04=1.4883754528799999e-02;
+  a06=7.;
+  a06=(a06*a03);
+  a07=cos(a06);
+  a04=(a04*a07);
+  a02=(a02+a04);
+  a04=-6.0567417982099997e-02;
+  a07=6.;
+  a07=(a07*a03);
+  a07=cos(a07);
+  a04=(a04*a07);
+  a02=(a02+a04);
+  a07=-3.3689450631399998e-01;
+  a08=(2.*a03);
+  a09=cos(a08);
+  a07=(a07*a09);
+  a02=(a02+a07);
+  a07=-1.9563283778700000e-01;
+  a09=3.;
+  a09=(a09*a03);
+  a09=cos(a09);
+  a07=(a07*a09);
+  a02=(a02+a07);
+  a02=(a01*a02);
+  a02=(a00+a02);
+  if (res[0]!=0) res[0][0]=a02;
+  a04=(a04+a07);
+  a07=3.3689450631399998e-01;
+  a02=1.0471975511965976e+00;
+  a09=(a08+a02);
+  a09=cos(a09);
+  a09=(a07*a09);
+  a09=(a04+a09);
+  a10=-1.1800386146799999e+00;
+  a11=5.2359877559829882e-01;
+  a12=(a03+a11);
+  a12=sin(a12);
+  a12=(a10*a12);
+  a09=(a09+a12);
+  a12=-1.9272434388400000e-01;
+  a13=(a05+a11);
+  a13=sin(a13);
+  a13=(a12*a13);
+  a09=(a09+a13);
+  a13=-1.4883754528799999e-02;
+  a14=(a06+a11);
+  a14=sin(a14);
+  a14=(a13*a14);
+  a09=(a09+a14);
+  a09=(a01*a09);
+  a09=(a00+a09);
+  if (res[0]!=0) res[0][1]=a09;
+  a08=(a08+a11);
+  a08=sin(a08);
+  a07=(a07*a08);
+  a04=(a04+a07);
+  a07=(a03+a02);
+  a07=cos(a07);
+  a10=(a10*a07);
+  a04=(a04+a10);
+  a05=(a05+a02);
+  a05=cos(a05);
+  a12=(a12*a05);
+  a04=(a04+a12);
+  a06=(a06+a02);
+  a06=cos(a06);
+  a13=(a13*a06);
+  a04=(a04+a13);
+  a01=(a01*a04);
+  a00=(a00+a01);
+  if (res[0]!=0) res[0][2]=a00;
+  a00=arg[1]? arg[1][4] : 0;
+  a01=arg[1]? arg[1][5] : 0;
+  a04=arg[1]? arg[1][10] : 0;
+  a04=(a04+a03);
+  a04=cos(a04);
+  a01=(a01*a04);
+  a00=(a00+a01);
+  if (res[0]!=0) res[0][3]=a00;
+  return 0;
+}
+
+/* map401_table_point:(t[1x401],p[16x401])->(values[4x401]) */
+static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_int i;
+  casadi_real* *res1;
+  const casadi_real* *arg1;
+  arg1 = arg+2;
+  for (i=0; i<2; ++i) arg1[i]=arg[i];
+  res1 = res+1;
+  for (i=0; i<1; ++i) res1[i]=res[i];
+  for (i=0; i<401; ++i) {
+    if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+    if (arg1[0]) arg1[0]+=1;
+    if (arg1[1]) arg1[1]+=16;
+    if (res1[0]) res1[0]+=4;
+  }
+  return 0;
+}
+
+/* table:(t0,p[16])->(table[12x200],probe[4x2]) */
+static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_int i, j;
+  casadi_real **res1=res+2, *rr, w00, *w01=w+21, *w03=w+422, w04, w05, w06, *w07=w+446, *w08=w+6862, *w09=w+8466, *w10=w+9266;
+  casadi_real *w11=w+10066, *w12=w+10866, *w13=w+11666, *w14=w+14066, *w15=w+16466;
+  const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
+  w00 = arg[0] ? arg[0][0] : 0;
+  wr01 = casadi_c0;
+  wr02 = arg[1] ? arg[1] : casadi_zeros;
+  arg1[0]=wr02;
+  res1[0]=w03;
+  res1[1]=(&w04);
+  if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
+  for (rr=(&w05), cs=w03+23; cs!=w03+24; cs+=1) *rr++ = *cs;
+  w06 = 2.;
+  w05 /= w06;
+  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w05);
+  for (i=0, rr=w01, cs=w01; i<401; ++i) (*rr++)  = (w00+(*cs++));
+  for (i=0;i<401;++i) {
+    casadi_copy(wr02, 16, w07+ i*16);
+  }
+  arg1[0]=w01;
+  arg1[1]=w07;
+  res1[0]=w08;
+  if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
+  for (rr=w09, cs=w08+0; cs!=w08+1600; cs+=8) for (ct=cs+0; ct!=cs+4; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w10, cs=w09; i<200; ++i) for (j=0; j<4; ++j) rr[i+j*200] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+1600; cs+=8) for (ct=cs+4; ct!=cs+8; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w11, cs=w09; i<200; ++i) for (j=0; j<4; ++j) rr[i+j*200] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+1600; cs+=8) for (ct=cs+8; ct!=cs+12; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w12, cs=w09; i<200; ++i) for (j=0; j<4; ++j) rr[i+j*200] = *cs++;
+  rr=w13;
+  for (i=0, cs=w10; i<800; ++i) *rr++ = *cs++;
+  for (i=0, cs=w11; i<800; ++i) *rr++ = *cs++;
+  for (i=0, cs=w12; i<800; ++i) *rr++ = *cs++;
+  for (i=0, rr=w14, cs=w13; i<12; ++i) for (j=0; j<200; ++j) rr[i+j*12] = *cs++;
+  casadi_copy(w14, 2400, res[0]);
+  w05 = 3.7000000000000000e-01;
+  w05 *= w04;
+  w05  = (w00+w05);
+  arg1[0]=(&w05);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  casadi_copy(w15, 4, res[1]);
+  w05 = 1.3700000000000001e+00;
+  w05 *= w04;
+  w00 += w05;
+  arg1[0]=(&w00);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (res[1]) casadi_copy(w15, 4, res[1]+4);
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f3(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int table_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void table_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void table_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void table_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t0";
+    case 1: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "table";
+    case 1: return "probe";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s5;
+    case 1: return casadi_s6;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 6;
+  if (sz_res) *sz_res = 4;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 16470;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 16470*sizeof(casadi_real);
+  return 0;
 }
 
 /* one block of tangent steps (the SX functions' step, as CasADi's Switch runs it) */
@@ -11285,12 +11428,11 @@ static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 8, y); gs_load(arg[1], 64, Q); gs_load(arg[3], 24, c);
-  casadi_real Qn[64], logs[8];
+  casadi_real Qn[64], logs[8]; casadi_real piece[8]; casadi_int g, i;
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 64, Q);
+    for (i = 0; i < 8; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T + 12*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 64, Q); for (i = 0; i < 8; ++i) logs[i] += piece[i]; }
     gs_store(y, 8, res[0], 8*p); gs_store(logs, 8, res[2], 8*p);
     gs_store(lo, 4, res[3], 4*p); gs_store(hi, 4, res[4], 4*p);
   }
@@ -11389,12 +11531,11 @@ static int casadi_f19(const casadi_real** arg, casadi_real** res, casadi_int* iw
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 8, y); gs_load(arg[1], 64, Q); gs_load(arg[3], 24, c);
-  casadi_real Qn[64], logs[8];
+  casadi_real Qn[64], logs[8]; casadi_real piece[8]; casadi_int g, i;
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 64, Q);
+    for (i = 0; i < 8; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T + 12*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 64, Q); for (i = 0; i < 8; ++i) logs[i] += piece[i]; }
     gs_store(y, 8, res[0], 8*p); gs_store(logs, 8, res[2], 8*p);
     gs_store(lo, 4, res[3], 4*p); gs_store(hi, 4, res[4], 4*p);
   }
@@ -11968,6 +12109,8 @@ CASADI_SYMBOL_EXPORT int monodromy_period_work_bytes(casadi_int *sz_arg, casadi_
   return 0;
 }
 
+
+#endif  /* GEARSYM_STEP_PIECES_ONLY */
 
 #ifdef __cplusplus
 } /* extern "C" */

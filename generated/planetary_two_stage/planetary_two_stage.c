@@ -151,7 +151,7 @@ static const casadi_int casadi_s1[3] = {12, 1, 1};
 static const casadi_int casadi_s2[3] = {24, 1, 1};
 static const casadi_int casadi_s3[3] = {12, 12, 1};
 static const casadi_int casadi_s4[3] = {39, 1, 1};
-static const casadi_int casadi_s5[3] = {15, 200, 1};
+static const casadi_int casadi_s5[3] = {15, 400, 1};
 static const casadi_int casadi_s6[3] = {5, 2, 1};
 static const casadi_int casadi_s7[12] = 
   {0};
@@ -173,10 +173,10 @@ static const casadi_int casadi_s15[144] =
 static const casadi_int casadi_s16[3] = {12, 50, 1};
 static const casadi_int casadi_s17[3] = {6, 50, 1};
 static const casadi_int casadi_s18[3] = {6, 1, 1};
-static const casadi_int casadi_s19[3] = {12, 200, 1};
+static const casadi_int casadi_s19[3] = {12, 400, 1};
 static const casadi_int casadi_s20[3] = {15, 50, 1};
 
-static const casadi_real casadi_c0[401] = 
+static const casadi_real casadi_c0[801] = 
   {0., 1., 2., 3., 4., 5., 6., 7.,
   8., 9., 10., 11., 12., 13., 14., 15.,
   16., 17., 18., 19., 20., 21., 22., 23.,
@@ -227,1877 +227,60 @@ static const casadi_real casadi_c0[401] =
   376., 377., 378., 379., 380., 381., 382., 383.,
   384., 385., 386., 387., 388., 389., 390., 391.,
   392., 393., 394., 395., 396., 397., 398., 399.,
-  400.};
+  400., 401., 402., 403., 404., 405., 406., 407.,
+  408., 409., 410., 411., 412., 413., 414., 415.,
+  416., 417., 418., 419., 420., 421., 422., 423.,
+  424., 425., 426., 427., 428., 429., 430., 431.,
+  432., 433., 434., 435., 436., 437., 438., 439.,
+  440., 441., 442., 443., 444., 445., 446., 447.,
+  448., 449., 450., 451., 452., 453., 454., 455.,
+  456., 457., 458., 459., 460., 461., 462., 463.,
+  464., 465., 466., 467., 468., 469., 470., 471.,
+  472., 473., 474., 475., 476., 477., 478., 479.,
+  480., 481., 482., 483., 484., 485., 486., 487.,
+  488., 489., 490., 491., 492., 493., 494., 495.,
+  496., 497., 498., 499., 500., 501., 502., 503.,
+  504., 505., 506., 507., 508., 509., 510., 511.,
+  512., 513., 514., 515., 516., 517., 518., 519.,
+  520., 521., 522., 523., 524., 525., 526., 527.,
+  528., 529., 530., 531., 532., 533., 534., 535.,
+  536., 537., 538., 539., 540., 541., 542., 543.,
+  544., 545., 546., 547., 548., 549., 550., 551.,
+  552., 553., 554., 555., 556., 557., 558., 559.,
+  560., 561., 562., 563., 564., 565., 566., 567.,
+  568., 569., 570., 571., 572., 573., 574., 575.,
+  576., 577., 578., 579., 580., 581., 582., 583.,
+  584., 585., 586., 587., 588., 589., 590., 591.,
+  592., 593., 594., 595., 596., 597., 598., 599.,
+  600., 601., 602., 603., 604., 605., 606., 607.,
+  608., 609., 610., 611., 612., 613., 614., 615.,
+  616., 617., 618., 619., 620., 621., 622., 623.,
+  624., 625., 626., 627., 628., 629., 630., 631.,
+  632., 633., 634., 635., 636., 637., 638., 639.,
+  640., 641., 642., 643., 644., 645., 646., 647.,
+  648., 649., 650., 651., 652., 653., 654., 655.,
+  656., 657., 658., 659., 660., 661., 662., 663.,
+  664., 665., 666., 667., 668., 669., 670., 671.,
+  672., 673., 674., 675., 676., 677., 678., 679.,
+  680., 681., 682., 683., 684., 685., 686., 687.,
+  688., 689., 690., 691., 692., 693., 694., 695.,
+  696., 697., 698., 699., 700., 701., 702., 703.,
+  704., 705., 706., 707., 708., 709., 710., 711.,
+  712., 713., 714., 715., 716., 717., 718., 719.,
+  720., 721., 722., 723., 724., 725., 726., 727.,
+  728., 729., 730., 731., 732., 733., 734., 735.,
+  736., 737., 738., 739., 740., 741., 742., 743.,
+  744., 745., 746., 747., 748., 749., 750., 751.,
+  752., 753., 754., 755., 756., 757., 758., 759.,
+  760., 761., 762., 763., 764., 765., 766., 767.,
+  768., 769., 770., 771., 772., 773., 774., 775.,
+  776., 777., 778., 779., 780., 781., 782., 783.,
+  784., 785., 786., 787., 788., 789., 790., 791.,
+  792., 793., 794., 795., 796., 797., 798., 799.,
+  800.};
 
 static const casadi_real casadi_zeros[24] = 
   {0.};
-
-/* rhs:(t,y[12],p[24])->(dy[12]) */
-static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
-  casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
-  casadi_real a36, a37, a38, a39, a40, a41, a42, a43, a44, a45, a46, a47;
-  casadi_real a48, a49, a50, a51, a52, a53, a54, a55, a56, a57, a58, a59;
-  casadi_real a60, a61, a62, a63, a64, a65, a66, a67, a68, a69, a70, a71;
-  casadi_real a72, a73, a74, a75, a76, a77, a78;
-  a00=arg[1]? arg[1][1] : 0;
-  if (res[0]!=0) res[0][0]=a00;
-  a01=-2.;
-  a02=(a01*a00);
-  a03=arg[2]? arg[2][1] : 0;
-  a04=(a02*a03);
-  a05=arg[2]? arg[2][0] : 0;
-  a04=(a04/a05);
-  a06=arg[2]? arg[2][17] : 0;
-  a07=arg[1]? arg[1][8] : 0;
-  a06=(a06*a07);
-  a07=casadi_sq(a05);
-  a08=(a06/a07);
-  a09=arg[2]? arg[2][21] : 0;
-  a10=arg[2]? arg[2][11] : 0;
-  a11=(a09/a10);
-  a12=arg[2]? arg[2][19] : 0;
-  a11=(a11/a12);
-  a13=arg[2]? arg[2][23] : 0;
-  a14=(a13/a10);
-  a14=(a14/a12);
-  a14=(a11+a14);
-  a14=(a08*a14);
-  a15=(a04-a14);
-  a16=arg[2]? arg[2][6] : 0;
-  a17=arg[2]? arg[2][7] : 0;
-  a18=arg[2]? arg[2][14] : 0;
-  a19=arg[0]? arg[0][0] : 0;
-  a18=(a18+a19);
-  a18=cos(a18);
-  a17=(a17*a18);
-  a16=(a16+a17);
-  a16=(a16/a07);
-  a15=(a15+a16);
-  a17=-4.;
-  a18=arg[1]? arg[1][7] : 0;
-  a20=(a17*a18);
-  a21=arg[2]? arg[2][3] : 0;
-  a20=(a20*a21);
-  a20=(a20/a05);
-  a22=arg[2]? arg[2][22] : 0;
-  a23=(a09*a22);
-  a23=(a23/a10);
-  a24=casadi_sq(a09);
-  a25=(a24/a10);
-  a26=(a23-a25);
-  a27=(a22*a13);
-  a27=(a27/a10);
-  a26=(a26+a27);
-  a28=(a09*a13);
-  a28=(a28/a10);
-  a26=(a26-a28);
-  a29=(a20*a26);
-  a30=casadi_sq(a22);
-  a30=(a30/a10);
-  a30=(a25+a30);
-  a31=arg[2]? arg[2][12] : 0;
-  a24=(a24/a31);
-  a31=(a30+a24);
-  a32=(a01*a09);
-  a32=(a32*a22);
-  a32=(a32/a10);
-  a31=(a31+a32);
-  a29=(a29/a31);
-  a15=(a15+a29);
-  a17=(a17*a00);
-  a17=(a17*a21);
-  a17=(a17/a05);
-  a00=(a17*a26);
-  a00=(a00/a31);
-  a15=(a15+a00);
-  a00=(a01*a18);
-  a00=(a00*a21);
-  a00=(a00/a05);
-  a33=(a25+a24);
-  a23=(a23-a33);
-  a23=(a23+a27);
-  a23=(a23-a28);
-  a28=(a00*a23);
-  a28=(a28/a31);
-  a15=(a15+a28);
-  a27=arg[1]? arg[1][3] : 0;
-  a33=(a01*a27);
-  a33=(a33*a03);
-  a33=(a33/a05);
-  a34=casadi_sq(a13);
-  a35=(a34/a10);
-  a25=(a25+a35);
-  a35=arg[2]? arg[2][13] : 0;
-  a34=(a34/a35);
-  a35=(a25+a34);
-  a36=(2.*a09);
-  a36=(a36*a13);
-  a36=(a36/a10);
-  a35=(a35+a36);
-  a37=(a33*a35);
-  a25=(a25+a24);
-  a25=(a25+a34);
-  a25=(a25+a36);
-  a37=(a37/a25);
-  a15=(a15+a37);
-  a36=arg[1]? arg[1][5] : 0;
-  a34=(a01*a36);
-  a34=(a34*a03);
-  a34=(a34/a05);
-  a03=(a34*a35);
-  a03=(a03/a25);
-  a15=(a15+a03);
-  a24=(2.*a27);
-  a24=(a24*a21);
-  a24=(a24/a05);
-  a38=(a24*a26);
-  a38=(a38/a31);
-  a15=(a15+a38);
-  a39=(2.*a36);
-  a39=(a39*a21);
-  a39=(a39/a05);
-  a40=(a39*a26);
-  a40=(a40/a31);
-  a15=(a15+a40);
-  a41=0.;
-  a42=arg[1]? arg[1][0] : 0;
-  a43=(a41<=a42);
-  a43=(a43?a42:0);
-  a44=arg[2]? arg[2][15] : 0;
-  a45=(-a44);
-  a46=(a42<=a45);
-  a47=(a42+a44);
-  a46=(a46?a47:0);
-  a43=(a43+a46);
-  a43=(a43/a07);
-  a46=1.;
-  a47=arg[2]? arg[2][18] : 0;
-  a48=1.1800386146799999e+00;
-  a49=cos(a19);
-  a50=(a48*a49);
-  a51=1.9272434388400000e-01;
-  a52=4.;
-  a52=(a52*a19);
-  a53=cos(a52);
-  a53=(a51*a53);
-  a50=(a50+a53);
-  a53=1.4883754528799999e-02;
-  a54=7.;
-  a54=(a54*a19);
-  a55=cos(a54);
-  a55=(a53*a55);
-  a50=(a50+a55);
-  a55=-6.0567417982099997e-02;
-  a56=6.;
-  a56=(a56*a19);
-  a56=cos(a56);
-  a56=(a55*a56);
-  a50=(a50+a56);
-  a57=-3.3689450631399998e-01;
-  a58=(2.*a19);
-  a59=cos(a58);
-  a60=(a57*a59);
-  a50=(a50+a60);
-  a60=-1.9563283778700000e-01;
-  a61=3.;
-  a61=(a61*a19);
-  a61=cos(a61);
-  a62=(a60*a61);
-  a50=(a50+a62);
-  a50=(a47*a50);
-  a50=(a46+a50);
-  a63=(a43*a50);
-  a15=(a15-a63);
-  a63=arg[2]? arg[2][2] : 0;
-  a63=(a63/a07);
-  a64=arg[1]? arg[1][6] : 0;
-  a65=(a41<=a64);
-  a65=(a65?a64:0);
-  a66=(a64<=a45);
-  a67=(a64+a44);
-  a66=(a66?a67:0);
-  a65=(a65+a66);
-  a65=(a63*a65);
-  a66=(a65*a23);
-  a66=(a66/a31);
-  a66=(a66*a50);
-  a15=(a15-a66);
-  a66=arg[1]? arg[1][2] : 0;
-  a67=(a41<=a66);
-  a67=(a67?a66:0);
-  a68=(a66<=a45);
-  a69=(a66+a44);
-  a68=(a68?a69:0);
-  a67=(a67+a68);
-  a67=(a67/a07);
-  a68=(a67*a35);
-  a68=(a68/a25);
-  a56=(a56+a62);
-  a62=3.3689450631399998e-01;
-  a69=1.0471975511965976e+00;
-  a70=(a58+a69);
-  a70=cos(a70);
-  a70=(a62*a70);
-  a70=(a56+a70);
-  a71=-1.1800386146799999e+00;
-  a72=5.2359877559829882e-01;
-  a73=(a19+a72);
-  a73=sin(a73);
-  a73=(a71*a73);
-  a70=(a70+a73);
-  a73=-1.9272434388400000e-01;
-  a74=(a52+a72);
-  a74=sin(a74);
-  a74=(a73*a74);
-  a70=(a70+a74);
-  a74=-1.4883754528799999e-02;
-  a75=(a54+a72);
-  a75=sin(a75);
-  a75=(a74*a75);
-  a70=(a70+a75);
-  a70=(a47*a70);
-  a70=(a46+a70);
-  a68=(a68*a70);
-  a15=(a15-a68);
-  a75=arg[1]? arg[1][4] : 0;
-  a76=(a41<=a75);
-  a76=(a76?a75:0);
-  a77=(a75<=a45);
-  a78=(a75+a44);
-  a77=(a77?a78:0);
-  a76=(a76+a77);
-  a76=(a76/a07);
-  a77=(a76*a35);
-  a77=(a77/a25);
-  a58=(a58+a72);
-  a58=sin(a58);
-  a62=(a62*a58);
-  a56=(a56+a62);
-  a62=(a19+a69);
-  a62=cos(a62);
-  a71=(a71*a62);
-  a56=(a56+a71);
-  a52=(a52+a69);
-  a52=cos(a52);
-  a73=(a73*a52);
-  a56=(a56+a73);
-  a54=(a54+a69);
-  a54=cos(a54);
-  a74=(a74*a54);
-  a56=(a56+a74);
-  a56=(a47*a56);
-  a56=(a46+a56);
-  a77=(a77*a56);
-  a15=(a15-a77);
-  a74=(a63*a26);
-  a42=(a42+a64);
-  a66=(a42-a66);
-  a64=(a41<=a66);
-  a64=(a64?a66:0);
-  a54=(a66<=a45);
-  a66=(a66+a44);
-  a54=(a54?a66:0);
-  a64=(a64+a54);
-  a54=(a74*a64);
-  a54=(a54/a31);
-  a54=(a54*a70);
-  a15=(a15-a54);
-  a42=(a42-a75);
-  a75=(a41<=a42);
-  a75=(a75?a42:0);
-  a45=(a42<=a45);
-  a42=(a42+a44);
-  a45=(a45?a42:0);
-  a75=(a75+a45);
-  a74=(a74*a75);
-  a74=(a74/a31);
-  a74=(a74*a56);
-  a15=(a15-a74);
-  if (res[0]!=0) res[0][1]=a15;
-  if (res[0]!=0) res[0][2]=a27;
-  a27=(a33-a14);
-  a27=(a27+a16);
-  a27=(a27+a29);
-  a27=(a27+a28);
-  a15=(a04*a35);
-  a15=(a15/a25);
-  a27=(a27+a15);
-  a02=(a02*a21);
-  a02=(a02/a05);
-  a45=(a02*a26);
-  a45=(a45/a31);
-  a27=(a27+a45);
-  a02=(a02*a23);
-  a02=(a02/a31);
-  a27=(a27+a02);
-  a27=(a27+a03);
-  a03=(a24*a23);
-  a03=(a03/a31);
-  a27=(a27+a03);
-  a27=(a27+a40);
-  a35=(a43*a35);
-  a35=(a35/a25);
-  a35=(a35*a50);
-  a27=(a27-a35);
-  a40=(a65*a26);
-  a40=(a40/a31);
-  a40=(a40*a50);
-  a27=(a27-a40);
-  a03=(a67*a70);
-  a27=(a27-a03);
-  a27=(a27-a77);
-  a77=(a63*a23);
-  a03=(a77*a64);
-  a03=(a03/a31);
-  a03=(a03*a70);
-  a27=(a27-a03);
-  a27=(a27-a74);
-  if (res[0]!=0) res[0][3]=a27;
-  if (res[0]!=0) res[0][4]=a36;
-  a14=(a34-a14);
-  a14=(a14+a16);
-  a14=(a14+a29);
-  a14=(a14+a28);
-  a14=(a14+a15);
-  a14=(a14+a45);
-  a14=(a14+a02);
-  a14=(a14+a37);
-  a14=(a14+a38);
-  a38=(a39*a23);
-  a38=(a38/a31);
-  a14=(a14+a38);
-  a14=(a14-a35);
-  a14=(a14-a40);
-  a40=(a76*a56);
-  a14=(a14-a40);
-  a14=(a14-a68);
-  a14=(a14-a54);
-  a77=(a77*a75);
-  a77=(a77/a31);
-  a77=(a77*a56);
-  a14=(a14-a77);
-  if (res[0]!=0) res[0][5]=a14;
-  if (res[0]!=0) res[0][6]=a18;
-  a14=(a22/a10);
-  a14=(a14/a12);
-  a14=(a14-a11);
-  a14=(a08*a14);
-  a00=(a00-a14);
-  a30=(a30+a32);
-  a20=(a20*a30);
-  a20=(a20/a31);
-  a00=(a00+a20);
-  a20=(a17*a30);
-  a20=(a20/a31);
-  a00=(a00+a20);
-  a20=(a04*a23);
-  a20=(a20/a25);
-  a00=(a00+a20);
-  a20=(a33*a26);
-  a20=(a20/a25);
-  a00=(a00+a20);
-  a20=(a34*a26);
-  a20=(a20/a25);
-  a00=(a00+a20);
-  a20=(a24*a30);
-  a20=(a20/a31);
-  a00=(a00+a20);
-  a20=(a39*a30);
-  a20=(a20/a31);
-  a00=(a00+a20);
-  a20=(a65*a50);
-  a00=(a00-a20);
-  a23=(a43*a23);
-  a23=(a23/a25);
-  a23=(a23*a50);
-  a00=(a00-a23);
-  a23=(a67*a26);
-  a23=(a23/a25);
-  a23=(a23*a70);
-  a00=(a00-a23);
-  a26=(a76*a26);
-  a26=(a26/a25);
-  a26=(a26*a56);
-  a00=(a00-a26);
-  a30=(a63*a30);
-  a26=(a30*a64);
-  a26=(a26/a31);
-  a26=(a26*a70);
-  a00=(a00-a26);
-  a30=(a30*a75);
-  a30=(a30/a31);
-  a30=(a30*a56);
-  a00=(a00-a30);
-  if (res[0]!=0) res[0][7]=a00;
-  a00=arg[1]? arg[1][9] : 0;
-  if (res[0]!=0) res[0][8]=a00;
-  a00=-6.;
-  a00=(a00*a18);
-  a00=(a00*a21);
-  a00=(a00/a05);
-  a22=(a12*a22);
-  a22=(a22/a10);
-  a09=(a12*a09);
-  a09=(a09/a10);
-  a22=(a22-a09);
-  a00=(a00*a22);
-  a00=(a00/a31);
-  a21=arg[2]? arg[2][9] : 0;
-  a18=(1./a21);
-  a30=(1./a10);
-  a18=(a18+a30);
-  a08=(a08*a18);
-  a00=(a00-a08);
-  a17=(a17*a22);
-  a17=(a17/a31);
-  a00=(a00+a17);
-  a13=(a12*a13);
-  a13=(a13/a10);
-  a09=(a09+a13);
-  a04=(a04*a09);
-  a04=(a04/a25);
-  a00=(a00+a04);
-  a33=(a33*a09);
-  a33=(a33/a25);
-  a00=(a00+a33);
-  a34=(a34*a09);
-  a34=(a34/a25);
-  a00=(a00+a34);
-  a24=(a24*a22);
-  a24=(a24/a31);
-  a00=(a00+a24);
-  a39=(a39*a22);
-  a39=(a39/a31);
-  a00=(a00+a39);
-  a39=arg[1]? arg[1][11] : 0;
-  a01=(a01*a39);
-  a24=arg[2]? arg[2][5] : 0;
-  a01=(a01*a24);
-  a24=(a01/a21);
-  a12=casadi_sq(a12);
-  a24=(a24*a12);
-  a24=(a24/a05);
-  a34=(a12/a21);
-  a33=arg[2]? arg[2][20] : 0;
-  a33=casadi_sq(a33);
-  a04=arg[2]? arg[2][10] : 0;
-  a33=(a33/a04);
-  a34=(a34+a33);
-  a24=(a24/a34);
-  a00=(a00+a24);
-  a43=(a43*a09);
-  a43=(a43/a25);
-  a43=(a43*a50);
-  a00=(a00-a43);
-  a65=(a65*a22);
-  a65=(a65/a31);
-  a65=(a65*a50);
-  a00=(a00-a65);
-  a65=arg[2]? arg[2][4] : 0;
-  a50=(a65/a21);
-  a50=(a50*a12);
-  a50=(a50/a07);
-  a12=arg[1]? arg[1][10] : 0;
-  a41=(a41<=a12);
-  a41=(a41?a12:0);
-  a43=arg[2]? arg[2][16] : 0;
-  a24=(-a43);
-  a24=(a12<=a24);
-  a12=(a12+a43);
-  a24=(a24?a12:0);
-  a41=(a41+a24);
-  a50=(a50*a41);
-  a50=(a50/a34);
-  a57=(a57*a49);
-  a49=5.0000000000000000e-01;
-  a49=(a49*a19);
-  a49=cos(a49);
-  a48=(a48*a49);
-  a57=(a57+a48);
-  a51=(a51*a59);
-  a57=(a57+a51);
-  a51=3.5000000000000000e+00;
-  a51=(a51*a19);
-  a51=cos(a51);
-  a53=(a53*a51);
-  a57=(a57+a53);
-  a55=(a55*a61);
-  a57=(a57+a55);
-  a55=1.5000000000000000e+00;
-  a55=(a55*a19);
-  a55=cos(a55);
-  a60=(a60*a55);
-  a57=(a57+a60);
-  a47=(a47*a57);
-  a46=(a46+a47);
-  a50=(a50*a46);
-  a00=(a00-a50);
-  a67=(a67*a09);
-  a67=(a67/a25);
-  a67=(a67*a70);
-  a00=(a00-a67);
-  a76=(a76*a09);
-  a76=(a76/a25);
-  a76=(a76*a56);
-  a00=(a00-a76);
-  a63=(a63*a22);
-  a64=(a63*a64);
-  a64=(a64/a31);
-  a64=(a64*a70);
-  a00=(a00-a64);
-  a63=(a63*a75);
-  a63=(a63/a31);
-  a63=(a63*a56);
-  a00=(a00-a63);
-  if (res[0]!=0) res[0][9]=a00;
-  if (res[0]!=0) res[0][10]=a39;
-  a39=arg[2]? arg[2][8] : 0;
-  a39=(a39/a07);
-  a01=(a01/a05);
-  a39=(a39+a01);
-  a06=(a06/a21);
-  a06=(a06/a07);
-  a39=(a39-a06);
-  a65=(a65/a07);
-  a65=(a65*a41);
-  a65=(a65*a46);
-  a39=(a39-a65);
-  if (res[0]!=0) res[0][11]=a39;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int rhs(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f0(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int rhs_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void rhs_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void rhs_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void rhs_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int rhs_n_in(void) { return 3;}
-
-CASADI_SYMBOL_EXPORT casadi_int rhs_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real rhs_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* rhs_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "y";
-    case 2: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* rhs_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "dy";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s1;
-    case 2: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s1;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int rhs_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int rhs_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* jacobian:(t,y[12],p[24])->(J[12x12]) */
-static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
-  casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
-  casadi_real a36, a37, a38, a39, a40, a41, a42, a43, a44, a45, a46, a47;
-  casadi_real a48, a49, a50, a51, a52, a53, a54, a55, a56, a57, a58, a59;
-  casadi_real a60, a61, a62, a63;
-  a00=0.;
-  if (res[0]!=0) res[0][0]=a00;
-  a01=1.;
-  a02=arg[2]? arg[2][18] : 0;
-  a03=1.1800386146799999e+00;
-  a04=arg[0]? arg[0][0] : 0;
-  a05=cos(a04);
-  a06=(a03*a05);
-  a07=1.9272434388400000e-01;
-  a08=4.;
-  a08=(a08*a04);
-  a09=cos(a08);
-  a09=(a07*a09);
-  a06=(a06+a09);
-  a09=1.4883754528799999e-02;
-  a10=7.;
-  a10=(a10*a04);
-  a11=cos(a10);
-  a11=(a09*a11);
-  a06=(a06+a11);
-  a11=-6.0567417982099997e-02;
-  a12=6.;
-  a12=(a12*a04);
-  a12=cos(a12);
-  a12=(a11*a12);
-  a06=(a06+a12);
-  a13=-3.3689450631399998e-01;
-  a14=(2.*a04);
-  a15=cos(a14);
-  a16=(a13*a15);
-  a06=(a06+a16);
-  a16=-1.9563283778700000e-01;
-  a17=3.;
-  a17=(a17*a04);
-  a17=cos(a17);
-  a18=(a16*a17);
-  a06=(a06+a18);
-  a06=(a02*a06);
-  a06=(a01+a06);
-  a19=arg[1]? arg[1][0] : 0;
-  a20=(a00<=a19);
-  a20=(a20?a01:0);
-  a21=arg[2]? arg[2][15] : 0;
-  a21=(-a21);
-  a22=(a19<=a21);
-  a22=(a22?a01:0);
-  a20=(a20+a22);
-  a22=arg[2]? arg[2][0] : 0;
-  a23=casadi_sq(a22);
-  a20=(a20/a23);
-  a24=(a06*a20);
-  a12=(a12+a18);
-  a18=3.3689450631399998e-01;
-  a25=1.0471975511965976e+00;
-  a26=(a14+a25);
-  a26=cos(a26);
-  a26=(a18*a26);
-  a26=(a12+a26);
-  a27=-1.1800386146799999e+00;
-  a28=5.2359877559829882e-01;
-  a29=(a04+a28);
-  a29=sin(a29);
-  a29=(a27*a29);
-  a26=(a26+a29);
-  a29=-1.9272434388400000e-01;
-  a30=(a08+a28);
-  a30=sin(a30);
-  a30=(a29*a30);
-  a26=(a26+a30);
-  a30=-1.4883754528799999e-02;
-  a31=(a10+a28);
-  a31=sin(a31);
-  a31=(a30*a31);
-  a26=(a26+a31);
-  a26=(a02*a26);
-  a26=(a01+a26);
-  a31=arg[2]? arg[2][2] : 0;
-  a31=(a31/a23);
-  a32=arg[2]? arg[2][21] : 0;
-  a33=arg[2]? arg[2][22] : 0;
-  a34=(a32*a33);
-  a35=arg[2]? arg[2][11] : 0;
-  a34=(a34/a35);
-  a36=casadi_sq(a32);
-  a37=(a36/a35);
-  a38=(a34-a37);
-  a39=arg[2]? arg[2][23] : 0;
-  a40=(a33*a39);
-  a40=(a40/a35);
-  a38=(a38+a40);
-  a41=(a32*a39);
-  a41=(a41/a35);
-  a38=(a38-a41);
-  a42=(a31*a38);
-  a43=arg[1]? arg[1][6] : 0;
-  a19=(a19+a43);
-  a44=arg[1]? arg[1][2] : 0;
-  a45=(a19-a44);
-  a46=(a00<=a45);
-  a47=(a46?a01:0);
-  a45=(a45<=a21);
-  a48=(a45?a01:0);
-  a47=(a47+a48);
-  a48=(a42*a47);
-  a49=casadi_sq(a33);
-  a49=(a49/a35);
-  a49=(a37+a49);
-  a50=arg[2]? arg[2][12] : 0;
-  a36=(a36/a50);
-  a50=(a49+a36);
-  a51=-2.;
-  a52=(a51*a32);
-  a52=(a52*a33);
-  a52=(a52/a35);
-  a50=(a50+a52);
-  a48=(a48/a50);
-  a48=(a26*a48);
-  a24=(a24+a48);
-  a14=(a14+a28);
-  a14=sin(a14);
-  a18=(a18*a14);
-  a12=(a12+a18);
-  a18=(a04+a25);
-  a18=cos(a18);
-  a27=(a27*a18);
-  a12=(a12+a27);
-  a08=(a08+a25);
-  a08=cos(a08);
-  a29=(a29*a08);
-  a12=(a12+a29);
-  a10=(a10+a25);
-  a10=cos(a10);
-  a30=(a30*a10);
-  a12=(a12+a30);
-  a12=(a02*a12);
-  a12=(a01+a12);
-  a30=arg[1]? arg[1][4] : 0;
-  a19=(a19-a30);
-  a10=(a00<=a19);
-  a25=(a10?a01:0);
-  a19=(a19<=a21);
-  a29=(a19?a01:0);
-  a25=(a25+a29);
-  a29=(a42*a25);
-  a29=(a29/a50);
-  a29=(a12*a29);
-  a24=(a24+a29);
-  a24=(-a24);
-  if (res[0]!=0) res[0][1]=a24;
-  if (res[0]!=0) res[0][2]=a00;
-  a24=casadi_sq(a39);
-  a08=(a24/a35);
-  a08=(a37+a08);
-  a27=arg[2]? arg[2][13] : 0;
-  a24=(a24/a27);
-  a27=(a08+a24);
-  a18=(2.*a32);
-  a18=(a18*a39);
-  a18=(a18/a35);
-  a27=(a27+a18);
-  a14=(a27*a20);
-  a08=(a08+a36);
-  a08=(a08+a24);
-  a08=(a08+a18);
-  a14=(a14/a08);
-  a14=(a06*a14);
-  a37=(a37+a36);
-  a34=(a34-a37);
-  a34=(a34+a40);
-  a34=(a34-a41);
-  a41=(a31*a34);
-  a40=(a41*a47);
-  a40=(a40/a50);
-  a40=(a26*a40);
-  a37=(a14+a40);
-  a37=(a37+a29);
-  a37=(-a37);
-  if (res[0]!=0) res[0][3]=a37;
-  if (res[0]!=0) res[0][4]=a00;
-  a14=(a14+a48);
-  a37=(a41*a25);
-  a37=(a37/a50);
-  a37=(a12*a37);
-  a14=(a14+a37);
-  a14=(-a14);
-  if (res[0]!=0) res[0][5]=a14;
-  if (res[0]!=0) res[0][6]=a00;
-  a14=(a34*a20);
-  a14=(a14/a08);
-  a14=(a06*a14);
-  a49=(a49+a52);
-  a52=(a31*a49);
-  a36=(a52*a47);
-  a36=(a36/a50);
-  a36=(a26*a36);
-  a14=(a14+a36);
-  a18=(a52*a25);
-  a18=(a18/a50);
-  a18=(a12*a18);
-  a14=(a14+a18);
-  a14=(-a14);
-  if (res[0]!=0) res[0][7]=a14;
-  if (res[0]!=0) res[0][8]=a00;
-  a14=arg[2]? arg[2][19] : 0;
-  a24=(a14*a32);
-  a24=(a24/a35);
-  a28=(a14*a39);
-  a28=(a28/a35);
-  a28=(a24+a28);
-  a20=(a28*a20);
-  a20=(a20/a08);
-  a20=(a06*a20);
-  a53=(a14*a33);
-  a53=(a53/a35);
-  a53=(a53-a24);
-  a24=(a31*a53);
-  a47=(a24*a47);
-  a47=(a47/a50);
-  a47=(a26*a47);
-  a20=(a20+a47);
-  a25=(a24*a25);
-  a25=(a25/a50);
-  a25=(a12*a25);
-  a20=(a20+a25);
-  a20=(-a20);
-  if (res[0]!=0) res[0][9]=a20;
-  if (res[0]!=0) res[0][10]=a00;
-  if (res[0]!=0) res[0][11]=a00;
-  if (res[0]!=0) res[0][12]=a01;
-  a20=arg[2]? arg[2][1] : 0;
-  a20=(a51*a20);
-  a20=(a20/a22);
-  a54=-4.;
-  a55=arg[2]? arg[2][3] : 0;
-  a54=(a54*a55);
-  a54=(a54/a22);
-  a56=(a38*a54);
-  a56=(a56/a50);
-  a57=(a20+a56);
-  if (res[0]!=0) res[0][13]=a57;
-  if (res[0]!=0) res[0][14]=a00;
-  a57=(a27*a20);
-  a57=(a57/a08);
-  a58=(a51*a55);
-  a58=(a58/a22);
-  a59=(a38*a58);
-  a59=(a59/a50);
-  a59=(a57+a59);
-  a60=(a34*a58);
-  a60=(a60/a50);
-  a59=(a59+a60);
-  if (res[0]!=0) res[0][15]=a59;
-  if (res[0]!=0) res[0][16]=a00;
-  if (res[0]!=0) res[0][17]=a59;
-  if (res[0]!=0) res[0][18]=a00;
-  a59=(a49*a54);
-  a59=(a59/a50);
-  a61=(a34*a20);
-  a61=(a61/a08);
-  a61=(a59+a61);
-  if (res[0]!=0) res[0][19]=a61;
-  if (res[0]!=0) res[0][20]=a00;
-  a54=(a53*a54);
-  a54=(a54/a50);
-  a61=(a28*a20);
-  a61=(a61/a08);
-  a54=(a54+a61);
-  if (res[0]!=0) res[0][21]=a54;
-  if (res[0]!=0) res[0][22]=a00;
-  if (res[0]!=0) res[0][23]=a00;
-  if (res[0]!=0) res[0][24]=a00;
-  a54=(a00<=a44);
-  a54=(a54?a01:0);
-  a44=(a44<=a21);
-  a44=(a44?a01:0);
-  a54=(a54+a44);
-  a54=(a54/a23);
-  a44=(a27*a54);
-  a44=(a44/a08);
-  a44=(a26*a44);
-  a62=-1.;
-  a46=(a46?a62:0);
-  a45=(a45?a62:0);
-  a46=(a46+a45);
-  a45=(a42*a46);
-  a45=(a45/a50);
-  a45=(a26*a45);
-  a44=(a44+a45);
-  a44=(-a44);
-  if (res[0]!=0) res[0][25]=a44;
-  if (res[0]!=0) res[0][26]=a00;
-  a45=(a26*a54);
-  a63=(a41*a46);
-  a63=(a63/a50);
-  a63=(a26*a63);
-  a45=(a45+a63);
-  a45=(-a45);
-  if (res[0]!=0) res[0][27]=a45;
-  if (res[0]!=0) res[0][28]=a00;
-  if (res[0]!=0) res[0][29]=a44;
-  if (res[0]!=0) res[0][30]=a00;
-  a44=(a38*a54);
-  a44=(a44/a08);
-  a44=(a26*a44);
-  a45=(a52*a46);
-  a45=(a45/a50);
-  a45=(a26*a45);
-  a44=(a44+a45);
-  a44=(-a44);
-  if (res[0]!=0) res[0][31]=a44;
-  if (res[0]!=0) res[0][32]=a00;
-  a54=(a28*a54);
-  a54=(a54/a08);
-  a54=(a26*a54);
-  a46=(a24*a46);
-  a46=(a46/a50);
-  a26=(a26*a46);
-  a54=(a54+a26);
-  a54=(-a54);
-  if (res[0]!=0) res[0][33]=a54;
-  if (res[0]!=0) res[0][34]=a00;
-  if (res[0]!=0) res[0][35]=a00;
-  if (res[0]!=0) res[0][36]=a00;
-  a54=(2.*a55);
-  a54=(a54/a22);
-  a26=(a38*a54);
-  a26=(a26/a50);
-  a57=(a57+a26);
-  if (res[0]!=0) res[0][37]=a57;
-  if (res[0]!=0) res[0][38]=a01;
-  a26=(a34*a54);
-  a26=(a26/a50);
-  a26=(a20+a26);
-  if (res[0]!=0) res[0][39]=a26;
-  if (res[0]!=0) res[0][40]=a00;
-  if (res[0]!=0) res[0][41]=a57;
-  if (res[0]!=0) res[0][42]=a00;
-  a20=(a38*a20);
-  a20=(a20/a08);
-  a49=(a49*a54);
-  a49=(a49/a50);
-  a20=(a20+a49);
-  if (res[0]!=0) res[0][43]=a20;
-  if (res[0]!=0) res[0][44]=a00;
-  a54=(a53*a54);
-  a54=(a54/a50);
-  a61=(a61+a54);
-  if (res[0]!=0) res[0][45]=a61;
-  if (res[0]!=0) res[0][46]=a00;
-  if (res[0]!=0) res[0][47]=a00;
-  if (res[0]!=0) res[0][48]=a00;
-  a54=(a00<=a30);
-  a54=(a54?a01:0);
-  a30=(a30<=a21);
-  a30=(a30?a01:0);
-  a54=(a54+a30);
-  a54=(a54/a23);
-  a27=(a27*a54);
-  a27=(a27/a08);
-  a27=(a12*a27);
-  a10=(a10?a62:0);
-  a19=(a19?a62:0);
-  a10=(a10+a19);
-  a42=(a42*a10);
-  a42=(a42/a50);
-  a42=(a12*a42);
-  a27=(a27+a42);
-  a27=(-a27);
-  if (res[0]!=0) res[0][49]=a27;
-  if (res[0]!=0) res[0][50]=a00;
-  if (res[0]!=0) res[0][51]=a27;
-  if (res[0]!=0) res[0][52]=a00;
-  a27=(a12*a54);
-  a41=(a41*a10);
-  a41=(a41/a50);
-  a41=(a12*a41);
-  a27=(a27+a41);
-  a27=(-a27);
-  if (res[0]!=0) res[0][53]=a27;
-  if (res[0]!=0) res[0][54]=a00;
-  a27=(a38*a54);
-  a27=(a27/a08);
-  a27=(a12*a27);
-  a52=(a52*a10);
-  a52=(a52/a50);
-  a52=(a12*a52);
-  a27=(a27+a52);
-  a27=(-a27);
-  if (res[0]!=0) res[0][55]=a27;
-  if (res[0]!=0) res[0][56]=a00;
-  a28=(a28*a54);
-  a28=(a28/a08);
-  a28=(a12*a28);
-  a24=(a24*a10);
-  a24=(a24/a50);
-  a12=(a12*a24);
-  a28=(a28+a12);
-  a28=(-a28);
-  if (res[0]!=0) res[0][57]=a28;
-  if (res[0]!=0) res[0][58]=a00;
-  if (res[0]!=0) res[0][59]=a00;
-  if (res[0]!=0) res[0][60]=a00;
-  if (res[0]!=0) res[0][61]=a57;
-  if (res[0]!=0) res[0][62]=a00;
-  if (res[0]!=0) res[0][63]=a57;
-  if (res[0]!=0) res[0][64]=a01;
-  if (res[0]!=0) res[0][65]=a26;
-  if (res[0]!=0) res[0][66]=a00;
-  if (res[0]!=0) res[0][67]=a20;
-  if (res[0]!=0) res[0][68]=a00;
-  if (res[0]!=0) res[0][69]=a61;
-  if (res[0]!=0) res[0][70]=a00;
-  if (res[0]!=0) res[0][71]=a00;
-  if (res[0]!=0) res[0][72]=a00;
-  a61=(a00<=a43);
-  a61=(a61?a01:0);
-  a43=(a43<=a21);
-  a43=(a43?a01:0);
-  a61=(a61+a43);
-  a31=(a31*a61);
-  a34=(a34*a31);
-  a34=(a34/a50);
-  a34=(a06*a34);
-  a34=(a34+a48);
-  a34=(a34+a29);
-  a34=(-a34);
-  if (res[0]!=0) res[0][73]=a34;
-  if (res[0]!=0) res[0][74]=a00;
-  a38=(a38*a31);
-  a38=(a38/a50);
-  a38=(a06*a38);
-  a40=(a38+a40);
-  a40=(a40+a29);
-  a40=(-a40);
-  if (res[0]!=0) res[0][75]=a40;
-  if (res[0]!=0) res[0][76]=a00;
-  a38=(a38+a48);
-  a38=(a38+a37);
-  a38=(-a38);
-  if (res[0]!=0) res[0][77]=a38;
-  if (res[0]!=0) res[0][78]=a00;
-  a38=(a06*a31);
-  a38=(a38+a36);
-  a38=(a38+a18);
-  a38=(-a38);
-  if (res[0]!=0) res[0][79]=a38;
-  if (res[0]!=0) res[0][80]=a00;
-  a31=(a53*a31);
-  a31=(a31/a50);
-  a06=(a06*a31);
-  a06=(a06+a47);
-  a06=(a06+a25);
-  a06=(-a06);
-  if (res[0]!=0) res[0][81]=a06;
-  if (res[0]!=0) res[0][82]=a00;
-  if (res[0]!=0) res[0][83]=a00;
-  if (res[0]!=0) res[0][84]=a00;
-  a56=(a56+a60);
-  if (res[0]!=0) res[0][85]=a56;
-  if (res[0]!=0) res[0][86]=a00;
-  if (res[0]!=0) res[0][87]=a56;
-  if (res[0]!=0) res[0][88]=a00;
-  if (res[0]!=0) res[0][89]=a56;
-  if (res[0]!=0) res[0][90]=a01;
-  a58=(a58+a59);
-  if (res[0]!=0) res[0][91]=a58;
-  if (res[0]!=0) res[0][92]=a00;
-  a58=-6.;
-  a58=(a58*a55);
-  a58=(a58/a22);
-  a53=(a53*a58);
-  a53=(a53/a50);
-  if (res[0]!=0) res[0][93]=a53;
-  if (res[0]!=0) res[0][94]=a00;
-  if (res[0]!=0) res[0][95]=a00;
-  if (res[0]!=0) res[0][96]=a00;
-  a32=(a32/a35);
-  a32=(a32/a14);
-  a39=(a39/a35);
-  a39=(a39/a14);
-  a39=(a32+a39);
-  a53=arg[2]? arg[2][17] : 0;
-  a50=(a53/a23);
-  a39=(a39*a50);
-  a39=(-a39);
-  if (res[0]!=0) res[0][97]=a39;
-  if (res[0]!=0) res[0][98]=a00;
-  if (res[0]!=0) res[0][99]=a39;
-  if (res[0]!=0) res[0][100]=a00;
-  if (res[0]!=0) res[0][101]=a39;
-  if (res[0]!=0) res[0][102]=a00;
-  a33=(a33/a35);
-  a33=(a33/a14);
-  a33=(a33-a32);
-  a33=(a33*a50);
-  a33=(-a33);
-  if (res[0]!=0) res[0][103]=a33;
-  if (res[0]!=0) res[0][104]=a00;
-  a33=arg[2]? arg[2][9] : 0;
-  a32=(1./a33);
-  a35=(1./a35);
-  a32=(a32+a35);
-  a32=(a32*a50);
-  a32=(-a32);
-  if (res[0]!=0) res[0][105]=a32;
-  if (res[0]!=0) res[0][106]=a00;
-  a53=(a53/a33);
-  a53=(a53/a23);
-  a53=(-a53);
-  if (res[0]!=0) res[0][107]=a53;
-  if (res[0]!=0) res[0][108]=a00;
-  if (res[0]!=0) res[0][109]=a00;
-  if (res[0]!=0) res[0][110]=a00;
-  if (res[0]!=0) res[0][111]=a00;
-  if (res[0]!=0) res[0][112]=a00;
-  if (res[0]!=0) res[0][113]=a00;
-  if (res[0]!=0) res[0][114]=a00;
-  if (res[0]!=0) res[0][115]=a00;
-  if (res[0]!=0) res[0][116]=a01;
-  if (res[0]!=0) res[0][117]=a00;
-  if (res[0]!=0) res[0][118]=a00;
-  if (res[0]!=0) res[0][119]=a00;
-  if (res[0]!=0) res[0][120]=a00;
-  if (res[0]!=0) res[0][121]=a00;
-  if (res[0]!=0) res[0][122]=a00;
-  if (res[0]!=0) res[0][123]=a00;
-  if (res[0]!=0) res[0][124]=a00;
-  if (res[0]!=0) res[0][125]=a00;
-  if (res[0]!=0) res[0][126]=a00;
-  if (res[0]!=0) res[0][127]=a00;
-  if (res[0]!=0) res[0][128]=a00;
-  a13=(a13*a05);
-  a05=5.0000000000000000e-01;
-  a05=(a05*a04);
-  a05=cos(a05);
-  a03=(a03*a05);
-  a13=(a13+a03);
-  a07=(a07*a15);
-  a13=(a13+a07);
-  a07=3.5000000000000000e+00;
-  a07=(a07*a04);
-  a07=cos(a07);
-  a09=(a09*a07);
-  a13=(a13+a09);
-  a11=(a11*a17);
-  a13=(a13+a11);
-  a11=1.5000000000000000e+00;
-  a11=(a11*a04);
-  a11=cos(a11);
-  a16=(a16*a11);
-  a13=(a13+a16);
-  a02=(a02*a13);
-  a02=(a01+a02);
-  a13=arg[2]? arg[2][4] : 0;
-  a16=(a13/a33);
-  a14=casadi_sq(a14);
-  a16=(a16*a14);
-  a16=(a16/a23);
-  a11=arg[1]? arg[1][10] : 0;
-  a04=(a00<=a11);
-  a04=(a04?a01:0);
-  a17=arg[2]? arg[2][16] : 0;
-  a17=(-a17);
-  a11=(a11<=a17);
-  a11=(a11?a01:0);
-  a04=(a04+a11);
-  a16=(a16*a04);
-  a11=(a14/a33);
-  a17=arg[2]? arg[2][20] : 0;
-  a17=casadi_sq(a17);
-  a09=arg[2]? arg[2][10] : 0;
-  a17=(a17/a09);
-  a11=(a11+a17);
-  a16=(a16/a11);
-  a16=(a02*a16);
-  a16=(-a16);
-  if (res[0]!=0) res[0][129]=a16;
-  if (res[0]!=0) res[0][130]=a00;
-  a13=(a13/a23);
-  a13=(a13*a04);
-  a02=(a02*a13);
-  a02=(-a02);
-  if (res[0]!=0) res[0][131]=a02;
-  if (res[0]!=0) res[0][132]=a00;
-  if (res[0]!=0) res[0][133]=a00;
-  if (res[0]!=0) res[0][134]=a00;
-  if (res[0]!=0) res[0][135]=a00;
-  if (res[0]!=0) res[0][136]=a00;
-  if (res[0]!=0) res[0][137]=a00;
-  if (res[0]!=0) res[0][138]=a00;
-  if (res[0]!=0) res[0][139]=a00;
-  if (res[0]!=0) res[0][140]=a00;
-  a00=arg[2]? arg[2][5] : 0;
-  a51=(a51*a00);
-  a33=(a51/a33);
-  a14=(a14*a33);
-  a14=(a14/a22);
-  a14=(a14/a11);
-  if (res[0]!=0) res[0][141]=a14;
-  if (res[0]!=0) res[0][142]=a01;
-  a51=(a51/a22);
-  if (res[0]!=0) res[0][143]=a51;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int jacobian(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f1(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int jacobian_n_in(void) { return 3;}
-
-CASADI_SYMBOL_EXPORT casadi_int jacobian_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real jacobian_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* jacobian_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "y";
-    case 2: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* jacobian_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "J";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s1;
-    case 2: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s3;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* constants:(p[24])->(c[39],period) */
-static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
-  casadi_real a24, a25, a26;
-  a00=arg[0]? arg[0][15] : 0;
-  if (res[0]!=0) res[0][0]=a00;
-  a00=arg[0]? arg[0][0] : 0;
-  a01=casadi_sq(a00);
-  a02=(1./a01);
-  a03=(-a02);
-  if (res[0]!=0) res[0][1]=a03;
-  a03=-2.;
-  a04=arg[0]? arg[0][1] : 0;
-  a04=(a03*a04);
-  a04=(a04/a00);
-  if (res[0]!=0) res[0][2]=a04;
-  a05=arg[0]? arg[0][17] : 0;
-  a06=(a05/a01);
-  a07=arg[0]? arg[0][21] : 0;
-  a08=arg[0]? arg[0][11] : 0;
-  a09=(a07/a08);
-  a10=arg[0]? arg[0][19] : 0;
-  a09=(a09/a10);
-  a11=arg[0]? arg[0][23] : 0;
-  a12=(a11/a08);
-  a12=(a12/a10);
-  a12=(a09+a12);
-  a12=(a06*a12);
-  a12=(-a12);
-  if (res[0]!=0) res[0][3]=a12;
-  a12=casadi_sq(a07);
-  a13=(a12/a08);
-  a14=casadi_sq(a11);
-  a15=(a14/a08);
-  a15=(a13+a15);
-  a16=arg[0]? arg[0][13] : 0;
-  a14=(a14/a16);
-  a16=(a15+a14);
-  a17=(2.*a07);
-  a17=(a17*a11);
-  a17=(a17/a08);
-  a16=(a16+a17);
-  a18=(a16/a01);
-  a19=arg[0]? arg[0][12] : 0;
-  a12=(a12/a19);
-  a15=(a15+a12);
-  a15=(a15+a14);
-  a15=(a15+a17);
-  a18=(a18/a15);
-  a18=(-a18);
-  if (res[0]!=0) res[0][4]=a18;
-  a18=-4.;
-  a17=arg[0]? arg[0][3] : 0;
-  a18=(a18*a17);
-  a18=(a18/a00);
-  a14=arg[0]? arg[0][22] : 0;
-  a19=(a07*a14);
-  a19=(a19/a08);
-  a20=(a19-a13);
-  a21=(a14*a11);
-  a21=(a21/a08);
-  a20=(a20+a21);
-  a22=(a07*a11);
-  a22=(a22/a08);
-  a20=(a20-a22);
-  a23=(a18*a20);
-  a24=casadi_sq(a14);
-  a24=(a24/a08);
-  a24=(a13+a24);
-  a25=(a24+a12);
-  a26=(a03*a07);
-  a26=(a26*a14);
-  a26=(a26/a08);
-  a25=(a25+a26);
-  a23=(a23/a25);
-  if (res[0]!=0) res[0][5]=a23;
-  a23=(a03*a17);
-  a23=(a23/a00);
-  a13=(a13+a12);
-  a19=(a19-a13);
-  a19=(a19+a21);
-  a19=(a19-a22);
-  a22=(a23*a19);
-  a22=(a22/a25);
-  if (res[0]!=0) res[0][6]=a22;
-  a16=(a04*a16);
-  a16=(a16/a15);
-  if (res[0]!=0) res[0][7]=a16;
-  a16=(2.*a17);
-  a16=(a16/a00);
-  a22=(a16*a20);
-  a22=(a22/a25);
-  if (res[0]!=0) res[0][8]=a22;
-  a22=arg[0]? arg[0][2] : 0;
-  a22=(a22/a01);
-  a21=(a22*a19);
-  a21=(a21/a25);
-  a21=(-a21);
-  if (res[0]!=0) res[0][9]=a21;
-  a21=(a22*a20);
-  a21=(a21/a25);
-  a21=(-a21);
-  if (res[0]!=0) res[0][10]=a21;
-  if (res[0]!=0) res[0][11]=a02;
-  a02=(a23*a20);
-  a02=(a02/a25);
-  if (res[0]!=0) res[0][12]=a02;
-  a02=(a16*a19);
-  a02=(a02/a25);
-  if (res[0]!=0) res[0][13]=a02;
-  if (res[0]!=0) res[0][14]=a23;
-  a23=(-a22);
-  if (res[0]!=0) res[0][15]=a23;
-  a23=(a14/a08);
-  a23=(a23/a10);
-  a23=(a23-a09);
-  a23=(a06*a23);
-  a23=(-a23);
-  if (res[0]!=0) res[0][16]=a23;
-  a23=(a19/a01);
-  a23=(a23/a15);
-  a23=(-a23);
-  if (res[0]!=0) res[0][17]=a23;
-  a23=(a20/a01);
-  a23=(a23/a15);
-  a23=(-a23);
-  if (res[0]!=0) res[0][18]=a23;
-  a24=(a24+a26);
-  a26=(a18*a24);
-  a26=(a26/a25);
-  if (res[0]!=0) res[0][19]=a26;
-  a19=(a04*a19);
-  a19=(a19/a15);
-  if (res[0]!=0) res[0][20]=a19;
-  a20=(a04*a20);
-  a20=(a20/a15);
-  if (res[0]!=0) res[0][21]=a20;
-  a20=(a16*a24);
-  a20=(a20/a25);
-  if (res[0]!=0) res[0][22]=a20;
-  a24=(a22*a24);
-  a24=(a24/a25);
-  a24=(-a24);
-  if (res[0]!=0) res[0][23]=a24;
-  a24=arg[0]? arg[0][9] : 0;
-  a20=(1./a24);
-  a19=(1./a08);
-  a20=(a20+a19);
-  a06=(a06*a20);
-  a06=(-a06);
-  if (res[0]!=0) res[0][24]=a06;
-  a07=(a10*a07);
-  a07=(a07/a08);
-  a11=(a10*a11);
-  a11=(a11/a08);
-  a11=(a07+a11);
-  a06=(a11/a01);
-  a06=(a06/a15);
-  a06=(-a06);
-  if (res[0]!=0) res[0][25]=a06;
-  a06=-6.;
-  a06=(a06*a17);
-  a06=(a06/a00);
-  a14=(a10*a14);
-  a14=(a14/a08);
-  a14=(a14-a07);
-  a06=(a06*a14);
-  a06=(a06/a25);
-  if (res[0]!=0) res[0][26]=a06;
-  a18=(a18*a14);
-  a18=(a18/a25);
-  if (res[0]!=0) res[0][27]=a18;
-  a04=(a04*a11);
-  a04=(a04/a15);
-  if (res[0]!=0) res[0][28]=a04;
-  a16=(a16*a14);
-  a16=(a16/a25);
-  if (res[0]!=0) res[0][29]=a16;
-  a22=(a22*a14);
-  a22=(a22/a25);
-  a22=(-a22);
-  if (res[0]!=0) res[0][30]=a22;
-  a22=arg[0]? arg[0][5] : 0;
-  a03=(a03*a22);
-  a22=(a03/a24);
-  a10=casadi_sq(a10);
-  a22=(a22*a10);
-  a22=(a22/a00);
-  a25=(a10/a24);
-  a14=arg[0]? arg[0][20] : 0;
-  a14=casadi_sq(a14);
-  a16=arg[0]? arg[0][10] : 0;
-  a14=(a14/a16);
-  a25=(a25+a14);
-  a22=(a22/a25);
-  if (res[0]!=0) res[0][31]=a22;
-  a22=arg[0]? arg[0][16] : 0;
-  if (res[0]!=0) res[0][32]=a22;
-  a22=arg[0]? arg[0][4] : 0;
-  a14=(a22/a24);
-  a14=(a14*a10);
-  a14=(a14/a01);
-  a14=(a14/a25);
-  a14=(-a14);
-  if (res[0]!=0) res[0][33]=a14;
-  a03=(a03/a00);
-  if (res[0]!=0) res[0][34]=a03;
-  a22=(a22/a01);
-  a22=(-a22);
-  if (res[0]!=0) res[0][35]=a22;
-  a05=(a05/a24);
-  a05=(a05/a01);
-  a05=(-a05);
-  if (res[0]!=0) res[0][36]=a05;
-  a05=arg[0]? arg[0][8] : 0;
-  a05=(a05/a01);
-  if (res[0]!=0) res[0][37]=a05;
-  a05=6.2831853071795868e-02;
-  if (res[0]!=0) res[0][38]=a05;
-  a05=1.2566370614359172e+01;
-  if (res[1]!=0) res[1][0]=a05;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int constants(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f2(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int constants_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void constants_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void constants_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void constants_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int constants_n_in(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_int constants_n_out(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_real constants_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* constants_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* constants_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "c";
-    case 1: return "period";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s4;
-    case 1: return casadi_s0;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int constants_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 1;
-  if (sz_res) *sz_res = 2;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 1*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 2*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* table_point:(t,p[24])->(values[5]) */
-static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
-  a00=1.;
-  a01=arg[1]? arg[1][18] : 0;
-  a02=1.1800386146799999e+00;
-  a03=arg[0]? arg[0][0] : 0;
-  a04=cos(a03);
-  a05=(a02*a04);
-  a06=1.9272434388400000e-01;
-  a07=4.;
-  a07=(a07*a03);
-  a08=cos(a07);
-  a08=(a06*a08);
-  a05=(a05+a08);
-  a08=1.4883754528799999e-02;
-  a09=7.;
-  a09=(a09*a03);
-  a10=cos(a09);
-  a10=(a08*a10);
-  a05=(a05+a10);
-  a10=-6.0567417982099997e-02;
-  a11=6.;
-  a11=(a11*a03);
-  a11=cos(a11);
-  a11=(a10*a11);
-  a05=(a05+a11);
-  a12=-3.3689450631399998e-01;
-  a13=(2.*a03);
-  a14=cos(a13);
-  a15=(a12*a14);
-  a05=(a05+a15);
-  a15=-1.9563283778700000e-01;
-  a16=3.;
-  a16=(a16*a03);
-  a16=cos(a16);
-  a17=(a15*a16);
-  a05=(a05+a17);
-  a05=(a01*a05);
-  a05=(a00+a05);
-  if (res[0]!=0) res[0][0]=a05;
-  a11=(a11+a17);
-  a17=3.3689450631399998e-01;
-  a05=1.0471975511965976e+00;
-  a18=(a13+a05);
-  a18=cos(a18);
-  a18=(a17*a18);
-  a18=(a11+a18);
-  a19=-1.1800386146799999e+00;
-  a20=5.2359877559829882e-01;
-  a21=(a03+a20);
-  a21=sin(a21);
-  a21=(a19*a21);
-  a18=(a18+a21);
-  a21=-1.9272434388400000e-01;
-  a22=(a07+a20);
-  a22=sin(a22);
-  a22=(a21*a22);
-  a18=(a18+a22);
-  a22=-1.4883754528799999e-02;
-  a23=(a09+a20);
-  a23=sin(a23);
-  a23=(a22*a23);
-  a18=(a18+a23);
-  a18=(a01*a18);
-  a18=(a00+a18);
-  if (res[0]!=0) res[0][1]=a18;
-  a13=(a13+a20);
-  a13=sin(a13);
-  a17=(a17*a13);
-  a11=(a11+a17);
-  a17=(a03+a05);
-  a17=cos(a17);
-  a19=(a19*a17);
-  a11=(a11+a19);
-  a07=(a07+a05);
-  a07=cos(a07);
-  a21=(a21*a07);
-  a11=(a11+a21);
-  a09=(a09+a05);
-  a09=cos(a09);
-  a22=(a22*a09);
-  a11=(a11+a22);
-  a11=(a01*a11);
-  a11=(a00+a11);
-  if (res[0]!=0) res[0][2]=a11;
-  a11=arg[1]? arg[1][6] : 0;
-  a22=arg[1]? arg[1][7] : 0;
-  a09=arg[1]? arg[1][14] : 0;
-  a09=(a09+a03);
-  a09=cos(a09);
-  a22=(a22*a09);
-  a11=(a11+a22);
-  if (res[0]!=0) res[0][3]=a11;
-  a12=(a12*a04);
-  a04=5.0000000000000000e-01;
-  a04=(a04*a03);
-  a04=cos(a04);
-  a02=(a02*a04);
-  a12=(a12+a02);
-  a06=(a06*a14);
-  a12=(a12+a06);
-  a06=3.5000000000000000e+00;
-  a06=(a06*a03);
-  a06=cos(a06);
-  a08=(a08*a06);
-  a12=(a12+a08);
-  a10=(a10*a16);
-  a12=(a12+a10);
-  a10=1.5000000000000000e+00;
-  a10=(a10*a03);
-  a10=cos(a10);
-  a15=(a15*a10);
-  a12=(a12+a15);
-  a01=(a01*a12);
-  a00=(a00+a01);
-  if (res[0]!=0) res[0][4]=a00;
-  return 0;
-}
-
-/* map401_table_point:(t[1x401],p[24x401])->(values[5x401]) */
-static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i;
-  casadi_real* *res1;
-  const casadi_real* *arg1;
-  arg1 = arg+2;
-  for (i=0; i<2; ++i) arg1[i]=arg[i];
-  res1 = res+1;
-  for (i=0; i<1; ++i) res1[i]=res[i];
-  for (i=0; i<401; ++i) {
-    if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-    if (arg1[0]) arg1[0]+=1;
-    if (arg1[1]) arg1[1]+=24;
-    if (res1[0]) res1[0]+=5;
-  }
-  return 0;
-}
-
-/* table:(t0,p[24])->(table[15x200],probe[5x2]) */
-static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i, j;
-  casadi_real **res1=res+2, *rr, w00, *w01=w+27, *w03=w+428, w04, w05, w06, *w07=w+467, *w08=w+10091, *w09=w+12096, *w10=w+13096;
-  casadi_real *w11=w+14096, *w12=w+15096, *w13=w+16096, *w14=w+19096, *w15=w+22096;
-  const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
-  w00 = arg[0] ? arg[0][0] : 0;
-  wr01 = casadi_c0;
-  wr02 = arg[1] ? arg[1] : casadi_zeros;
-  arg1[0]=wr02;
-  res1[0]=w03;
-  res1[1]=(&w04);
-  if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
-  for (rr=(&w05), cs=w03+38; cs!=w03+39; cs+=1) *rr++ = *cs;
-  w06 = 2.;
-  w05 /= w06;
-  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w05);
-  for (i=0, rr=w01, cs=w01; i<401; ++i) (*rr++)  = (w00+(*cs++));
-  for (i=0;i<401;++i) {
-    casadi_copy(wr02, 24, w07+ i*24);
-  }
-  arg1[0]=w01;
-  arg1[1]=w07;
-  res1[0]=w08;
-  if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
-  for (rr=w09, cs=w08+0; cs!=w08+2000; cs+=10) for (ct=cs+0; ct!=cs+5; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w10, cs=w09; i<200; ++i) for (j=0; j<5; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+2000; cs+=10) for (ct=cs+5; ct!=cs+10; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w11, cs=w09; i<200; ++i) for (j=0; j<5; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+2000; cs+=10) for (ct=cs+10; ct!=cs+15; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w12, cs=w09; i<200; ++i) for (j=0; j<5; ++j) rr[i+j*200] = *cs++;
-  rr=w13;
-  for (i=0, cs=w10; i<1000; ++i) *rr++ = *cs++;
-  for (i=0, cs=w11; i<1000; ++i) *rr++ = *cs++;
-  for (i=0, cs=w12; i<1000; ++i) *rr++ = *cs++;
-  for (i=0, rr=w14, cs=w13; i<15; ++i) for (j=0; j<200; ++j) rr[i+j*15] = *cs++;
-  casadi_copy(w14, 3000, res[0]);
-  w05 = 3.7000000000000000e-01;
-  w05 *= w04;
-  w05  = (w00+w05);
-  arg1[0]=(&w05);
-  arg1[1]=wr02;
-  res1[0]=w15;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-  casadi_copy(w15, 5, res[1]);
-  w05 = 1.3700000000000001e+00;
-  w05 *= w04;
-  w00 += w05;
-  arg1[0]=(&w00);
-  arg1[1]=wr02;
-  res1[0]=w15;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-  if (res[1]) casadi_copy(w15, 5, res[1]+5);
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f3(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int table_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void table_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void table_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void table_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t0";
-    case 1: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "table";
-    case 1: return "probe";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s5;
-    case 1: return casadi_s6;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 6;
-  if (sz_res) *sz_res = 4;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 22101;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 22101*sizeof(casadi_real);
-  return 0;
-}
 
 /* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
 #if defined(__GNUC__)
@@ -2113,7 +296,7 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
 #define GEARSYM_NOT_UNROLLED
 #endif
 
-static const casadi_real gs_zeros[3000] = {0.};
+static const casadi_real gs_zeros[6000] = {0.};
 
 /* an input as CasADi passes it (a null pointer: zeros) into a local array */
 static inline void gs_load(const casadi_real* x, casadi_int n, casadi_real* y) {
@@ -2539,8 +722,8 @@ static GEARSYM_INLINE void gs_tangent_keep(const casadi_real* restrict A0, const
   R3[5]=a5;
 }
 
-/* state_try, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1) {
+/* state_try, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_try_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
   casadi_real a000, a001, a002, a003, a004, a005, a006, a007, a008, a009, a010, a011;
   casadi_real a012, a013, a014, a015, a016, a017, a018, a019, a020, a021, a022, a023;
   casadi_real a024, a025, a026, a027, a028, a029, a030, a031, a032, a033, a034, a035;
@@ -2555,44 +738,44 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   casadi_real a132, a133, a134, a135, a136, a137, a138, a139, a140, a141, a142, a143;
   casadi_real a144, a145, a146, a147, a148, a149, a150, a151;
   a000=A0[0];
-  a001=A2[38];
+  a001=A2[S*38];
   a002=6.;
   a002=(a001/a002);
-  a003=A0[1];
+  a003=A0[S*1];
   a004=2.;
   a004=(a001/a004);
-  a005=A0[7];
-  a006=A2[5];
+  a005=A0[S*7];
+  a006=A2[S*5];
   a007=(a005*a006);
-  a008=A2[6];
+  a008=A2[S*6];
   a009=(a005*a008);
   a007=(a007+a009);
-  a009=A2[2];
+  a009=A2[S*2];
   a010=(a003*a009);
   a010=(a007+a010);
   a011=(a003*a006);
   a010=(a010+a011);
-  a011=A0[3];
-  a012=A2[7];
+  a011=A0[S*3];
+  a012=A2[S*7];
   a013=(a011*a012);
   a010=(a010+a013);
-  a014=A2[8];
+  a014=A2[S*8];
   a015=(a011*a014);
   a010=(a010+a015);
-  a016=A0[5];
+  a016=A0[S*5];
   a017=(a016*a012);
   a010=(a010+a017);
   a018=(a016*a014);
   a010=(a010+a018);
-  a019=A0[8];
-  a020=A2[3];
+  a019=A0[S*8];
+  a020=A2[S*3];
   a021=(a019*a020);
   a010=(a010+a021);
-  a022=A2[11];
-  a023=A1[3];
+  a022=A2[S*11];
+  a023=A1[S*3];
   a023=(a022*a023);
   a010=(a010+a023);
-  a024=A2[1];
+  a024=A2[S*1];
   a025=A1[0];
   a026=(a024*a025);
   a027=A2[0];
@@ -2607,10 +790,10 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a034=(a031+a034);
   a026=(a026*a034);
   a010=(a010+a026);
-  a026=A2[4];
-  a035=A1[1];
+  a026=A2[S*4];
+  a035=A1[S*1];
   a036=(a026*a035);
-  a037=A0[2];
+  a037=A0[S*2];
   a038=(a037+a027);
   a039=(-a038);
   a039=(a028<=a039);
@@ -2621,9 +804,9 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a043=(a040+a043);
   a036=(a036*a043);
   a010=(a010+a036);
-  a044=A1[2];
+  a044=A1[S*2];
   a045=(a026*a044);
-  a046=A0[4];
+  a046=A0[S*4];
   a047=(a046+a027);
   a048=(-a047);
   a048=(a028<=a048);
@@ -2634,9 +817,9 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a052=(a049+a052);
   a045=(a045*a052);
   a010=(a010+a045);
-  a053=A2[9];
+  a053=A2[S*9];
   a054=(a053*a025);
-  a055=A0[6];
+  a055=A0[S*6];
   a056=(a055+a027);
   a057=(-a056);
   a057=(a028<=a057);
@@ -2647,7 +830,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a061=(a058+a061);
   a054=(a054*a061);
   a010=(a010+a054);
-  a054=A2[10];
+  a054=A2[S*10];
   a062=(a054*a035);
   a063=(a037-a000);
   a063=(a063-a055);
@@ -2679,45 +862,45 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a078=(a003+a078);
   a079=(2.*a078);
   a079=(a003+a079);
-  a080=A2[14];
+  a080=A2[S*14];
   a081=(a005*a080);
-  a082=A2[19];
+  a082=A2[S*19];
   a083=(a005*a082);
   a081=(a081+a083);
   a083=(a003*a082);
   a081=(a081+a083);
-  a083=A2[20];
+  a083=A2[S*20];
   a084=(a003*a083);
   a081=(a081+a084);
-  a084=A2[21];
+  a084=A2[S*21];
   a085=(a011*a084);
   a081=(a081+a085);
-  a085=A2[22];
+  a085=A2[S*22];
   a086=(a011*a085);
   a081=(a081+a086);
   a086=(a016*a084);
   a081=(a081+a086);
   a086=(a016*a085);
   a081=(a081+a086);
-  a086=A2[16];
+  a086=A2[S*16];
   a087=(a019*a086);
   a081=(a081+a087);
-  a087=A2[17];
+  a087=A2[S*17];
   a088=(a087*a025);
   a088=(a088*a034);
   a081=(a081+a088);
-  a088=A2[18];
+  a088=A2[S*18];
   a089=(a088*a035);
   a089=(a089*a043);
   a081=(a081+a089);
   a089=(a088*a044);
   a089=(a089*a052);
   a081=(a081+a089);
-  a089=A2[15];
+  a089=A2[S*15];
   a090=(a089*a025);
   a090=(a090*a061);
   a081=(a081+a090);
-  a090=A2[23];
+  a090=A2[S*23];
   a091=(a090*a035);
   a091=(a091*a070);
   a081=(a081+a091);
@@ -2733,14 +916,14 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a093=(a092+a093);
   a094=(a078*a006);
   a093=(a093+a094);
-  a094=A2[12];
+  a094=A2[S*12];
   a095=(a003*a094);
   a007=(a007+a095);
   a095=(a003*a008);
   a007=(a007+a095);
   a095=(a003*a012);
   a007=(a007+a095);
-  a095=A2[13];
+  a095=A2[S*13];
   a096=(a011*a095);
   a096=(a007+a096);
   a097=(a011*a009);
@@ -2793,15 +976,15 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a093=(a093+a045);
   a036=(a062*a014);
   a093=(a093+a036);
-  a018=A0[9];
+  a018=A0[S*9];
   a023=(a004*a018);
   a023=(a019+a023);
   a021=(a023*a020);
   a093=(a093+a021);
-  a015=A1[8];
+  a015=A1[S*8];
   a015=(a022*a015);
   a093=(a093+a015);
-  a013=A1[5];
+  a013=A1[S*5];
   a098=(a024*a013);
   a099=(a004*a003);
   a099=(a000+a099);
@@ -2809,7 +992,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a100=(a031+a100);
   a101=(a098*a100);
   a093=(a093+a101);
-  a101=A1[6];
+  a101=A1[S*6];
   a102=(a026*a101);
   a103=(a004*a011);
   a103=(a037+a103);
@@ -2817,7 +1000,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a104=(a040+a104);
   a105=(a102*a104);
   a093=(a093+a105);
-  a106=A1[7];
+  a106=A1[S*7];
   a107=(a026*a106);
   a108=(a004*a016);
   a108=(a046+a108);
@@ -2951,31 +1134,31 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a126=(a126+a045);
   a021=(a129*a014);
   a126=(a126+a021);
-  a097=A2[26];
+  a097=A2[S*26];
   a017=(a005*a097);
-  a133=A0[11];
-  a134=A2[31];
+  a133=A0[S*11];
+  a134=A2[S*31];
   a135=(a133*a134);
   a017=(a017+a135);
-  a135=A2[27];
+  a135=A2[S*27];
   a136=(a003*a135);
   a017=(a017+a136);
-  a136=A2[28];
+  a136=A2[S*28];
   a137=(a003*a136);
   a017=(a017+a137);
   a137=(a011*a136);
   a017=(a017+a137);
-  a137=A2[29];
+  a137=A2[S*29];
   a138=(a011*a137);
   a017=(a017+a138);
   a138=(a016*a136);
   a017=(a017+a138);
   a138=(a016*a137);
   a017=(a017+a138);
-  a138=A2[24];
+  a138=A2[S*24];
   a139=(a019*a138);
   a017=(a017+a139);
-  a139=A2[25];
+  a139=A2[S*25];
   a140=(a139*a025);
   a140=(a140*a034);
   a017=(a017+a140);
@@ -2985,15 +1168,15 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a140=(a139*a044);
   a140=(a140*a052);
   a017=(a017+a140);
-  a140=A2[30];
+  a140=A2[S*30];
   a025=(a140*a025);
   a025=(a025*a061);
   a017=(a017+a025);
-  a025=A2[33];
-  a061=A1[4];
+  a025=A2[S*33];
+  a061=A1[S*4];
   a052=(a025*a061);
-  a043=A2[32];
-  a034=A0[10];
+  a043=A2[S*32];
+  a034=A0[S*10];
   a141=(a034+a043);
   a142=(-a141);
   a142=(a028<=a142);
@@ -3153,14 +1336,14 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a014=(a112*a014);
   a121=(a121+a014);
   a110=(a091*a097);
-  a105=A2[37];
-  a102=A2[34];
+  a105=A2[S*37];
+  a102=A2[S*34];
   a036=(a133*a102);
   a036=(a105+a036);
-  a015=A2[36];
+  a015=A2[S*36];
   a035=(a019*a015);
   a036=(a036+a035);
-  a035=A2[35];
+  a035=A2[S*35];
   a061=(a035*a061);
   a061=(a061*a146);
   a036=(a036+a061);
@@ -3194,7 +1377,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a013=(a140*a013);
   a113=(a013*a113);
   a110=(a110+a113);
-  a113=A1[9];
+  a113=A1[S*9];
   a109=(a025*a113);
   a146=(a004*a133);
   a146=(a034+a146);
@@ -3214,10 +1397,10 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a103=(a019+a103);
   a020=(a103*a020);
   a121=(a121+a020);
-  a132=A1[13];
+  a132=A1[S*13];
   a022=(a022*a132);
   a121=(a121+a022);
-  a132=A1[10];
+  a132=A1[S*10];
   a131=(a024*a132);
   a128=(a001*a116);
   a128=(a000+a128);
@@ -3225,7 +1408,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a031=(a031+a033);
   a131=(a131*a031);
   a121=(a121+a131);
-  a131=A1[11];
+  a131=A1[S*11];
   a033=(a026*a131);
   a021=(a001*a108);
   a021=(a037+a021);
@@ -3233,7 +1416,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a040=(a040+a042);
   a033=(a033*a040);
   a121=(a121+a033);
-  a042=A1[12];
+  a042=A1[S*12];
   a045=(a026*a042);
   a120=(a001*a129);
   a120=(a046+a120);
@@ -3264,7 +1447,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a010=(a010+a121);
   a010=(a002*a010);
   a010=(a003+a010);
-  R0[1]=a010;
+  R0[S*1]=a010;
   a071=(2.*a071);
   a071=(a011+a071);
   a121=(2.*a108);
@@ -3272,7 +1455,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a071=(a071+a115);
   a071=(a002*a071);
   a071=(a037+a071);
-  R0[2]=a071;
+  R0[S*2]=a071;
   a127=(2.*a127);
   a096=(a096+a127);
   a006=(2.*a006);
@@ -3308,7 +1491,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a096=(a096+a012);
   a096=(a002*a096);
   a096=(a011+a096);
-  R0[3]=a096;
+  R0[S*3]=a096;
   a062=(2.*a062);
   a062=(a016+a062);
   a012=(2.*a129);
@@ -3316,7 +1499,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a062=(a062+a112);
   a062=(a002*a062);
   a062=(a046+a062);
-  R0[4]=a062;
+  R0[S*4]=a062;
   a092=(2.*a092);
   a007=(a007+a092);
   a125=(2.*a125);
@@ -3342,7 +1525,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a007=(a007+a122);
   a007=(a002*a007);
   a007=(a016+a007);
-  R0[5]=a007;
+  R0[S*5]=a007;
   a091=(2.*a091);
   a091=(a005+a091);
   a122=(2.*a124);
@@ -3350,7 +1533,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a091=(a091+a123);
   a091=(a002*a091);
   a091=(a055+a091);
-  R0[6]=a091;
+  R0[S*6]=a091;
   a117=(2.*a117);
   a081=(a081+a117);
   a126=(2.*a126);
@@ -3393,7 +1576,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a081=(a081+a080);
   a081=(a002*a081);
   a081=(a005+a081);
-  R0[7]=a081;
+  R0[S*7]=a081;
   a044=(2.*a044);
   a044=(a018+a044);
   a099=(2.*a099);
@@ -3447,7 +1630,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a044=(a044+a106);
   a044=(a002*a044);
   a019=(a019+a044);
-  R0[8]=a019;
+  R0[S*8]=a019;
   a110=(2.*a110);
   a017=(a017+a110);
   a124=(2.*a124);
@@ -3489,7 +1672,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a132=(a140*a132);
   a132=(a132*a058);
   a123=(a123+a132);
-  a132=A1[14];
+  a132=A1[S*14];
   a025=(a025*a132);
   a058=(a001*a146);
   a058=(a034+a058);
@@ -3506,7 +1689,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a017=(a017+a123);
   a017=(a002*a017);
   a018=(a018+a017);
-  R0[9]=a018;
+  R0[S*9]=a018;
   a061=(2.*a061);
   a061=(a133+a061);
   a146=(2.*a146);
@@ -3514,7 +1697,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a061=(a061+a113);
   a061=(a002*a061);
   a061=(a034+a061);
-  R0[10]=a061;
+  R0[S*10]=a061;
   a099=(2.*a099);
   a036=(a036+a099);
   a097=(2.*a097);
@@ -3529,7 +1712,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a036=(a036+a105);
   a002=(a002*a036);
   a002=(a133+a002);
-  R0[11]=a002;
+  R0[S*11]=a002;
   a032=(2.*a032);
   a036=1.;
   a032=(a032-a036);
@@ -3796,34 +1979,35 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a028=(a028<a105);
   R1[0]=a028;
 }
+static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1) { gs_state_try_strided(A0, A1, A2, R0, R1, 1); }
 
-/* state_keep, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+/* state_keep, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_keep_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
   casadi_real a0, a1, a2, a3, a4, a5, a6, a7, a8;
   a0=A3[0];
   R0[0]=a0;
-  a1=A3[1];
-  R0[1]=a1;
-  a1=A3[2];
-  R0[2]=a1;
-  a2=A3[3];
-  R0[3]=a2;
-  a2=A3[4];
-  R0[4]=a2;
-  a3=A3[5];
-  R0[5]=a3;
-  a3=A3[6];
-  R0[6]=a3;
-  a4=A3[7];
-  R0[7]=a4;
-  a4=A3[8];
-  R0[8]=a4;
-  a5=A3[9];
-  R0[9]=a5;
-  a5=A3[10];
-  R0[10]=a5;
-  a6=A3[11];
-  R0[11]=a6;
+  a1=A3[S*1];
+  R0[S*1]=a1;
+  a1=A3[S*2];
+  R0[S*2]=a1;
+  a2=A3[S*3];
+  R0[S*3]=a2;
+  a2=A3[S*4];
+  R0[S*4]=a2;
+  a3=A3[S*5];
+  R0[S*5]=a3;
+  a3=A3[S*6];
+  R0[S*6]=a3;
+  a4=A3[S*7];
+  R0[S*7]=a4;
+  a4=A3[S*8];
+  R0[S*8]=a4;
+  a5=A3[S*9];
+  R0[S*9]=a5;
+  a5=A3[S*10];
+  R0[S*10]=a5;
+  a6=A3[S*11];
+  R0[S*11]=a6;
   a6=A1[0];
   a7=(a0<a6);
   a8=(a7?a0:0);
@@ -3831,41 +2015,41 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
   a7=(a7?a6:0);
   a8=(a8+a7);
   R1[0]=a8;
-  a8=A1[1];
+  a8=A1[S*1];
   a7=(a1<a8);
   a6=(a7?a1:0);
   a7=(!a7);
   a7=(a7?a8:0);
   a6=(a6+a7);
-  R1[1]=a6;
-  a6=A1[2];
+  R1[S*1]=a6;
+  a6=A1[S*2];
   a7=(a2<a6);
   a8=(a7?a2:0);
   a7=(!a7);
   a7=(a7?a6:0);
   a8=(a8+a7);
-  R1[2]=a8;
-  a8=A1[3];
+  R1[S*2]=a8;
+  a8=A1[S*3];
   a7=(a3<a8);
   a6=(a7?a3:0);
   a7=(!a7);
   a7=(a7?a8:0);
   a6=(a6+a7);
-  R1[3]=a6;
-  a6=A1[4];
+  R1[S*3]=a6;
+  a6=A1[S*4];
   a7=(a4<a6);
   a8=(a7?a4:0);
   a7=(!a7);
   a7=(a7?a6:0);
   a8=(a8+a7);
-  R1[4]=a8;
-  a8=A1[5];
+  R1[S*4]=a8;
+  a8=A1[S*5];
   a7=(a5<a8);
   a6=(a7?a5:0);
   a7=(!a7);
   a7=(a7?a8:0);
   a6=(a6+a7);
-  R1[5]=a6;
+  R1[S*5]=a6;
   a6=A2[0];
   a7=(a6<a0);
   a0=(a7?a0:0);
@@ -3873,42 +2057,43 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
   a7=(a7?a6:0);
   a0=(a0+a7);
   R2[0]=a0;
-  a0=A2[1];
+  a0=A2[S*1];
   a7=(a0<a1);
   a1=(a7?a1:0);
   a7=(!a7);
   a7=(a7?a0:0);
   a1=(a1+a7);
-  R2[1]=a1;
-  a1=A2[2];
+  R2[S*1]=a1;
+  a1=A2[S*2];
   a7=(a1<a2);
   a2=(a7?a2:0);
   a7=(!a7);
   a7=(a7?a1:0);
   a2=(a2+a7);
-  R2[2]=a2;
-  a2=A2[3];
+  R2[S*2]=a2;
+  a2=A2[S*3];
   a7=(a2<a3);
   a3=(a7?a3:0);
   a7=(!a7);
   a7=(a7?a2:0);
   a3=(a3+a7);
-  R2[3]=a3;
-  a3=A2[4];
+  R2[S*3]=a3;
+  a3=A2[S*4];
   a7=(a3<a4);
   a4=(a7?a4:0);
   a7=(!a7);
   a7=(a7?a3:0);
   a4=(a4+a7);
-  R2[4]=a4;
-  a4=A2[5];
+  R2[S*4]=a4;
+  a4=A2[S*5];
   a7=(a4<a5);
   a5=(a7?a5:0);
   a7=(!a7);
   a7=(a7?a4:0);
   a5=(a5+a7);
-  R2[5]=a5;
+  R2[S*5]=a5;
 }
+static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_state_keep_strided(A0, A1, A2, A3, A4, A5, R0, R1, R2, 1); }
 
 /* split_start, from CasADi's C of it */
 static GEARSYM_NOINLINE void gs_split_start(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
@@ -13737,8 +11922,8 @@ static GEARSYM_NOINLINE void gs_state_mode_step(const casadi_real* restrict A0, 
   R0[11]=a111;
 }
 
-/* tangent_state, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+/* tangent_state, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_state_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
   casadi_real a000, a001, a002, a003, a004, a005, a006, a007, a008, a009, a010, a011;
   casadi_real a012, a013, a014, a015, a016, a017, a018, a019, a020, a021, a022, a023;
   casadi_real a024, a025, a026, a027, a028, a029, a030, a031, a032, a033, a034, a035;
@@ -13757,44 +11942,44 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   casadi_real a180, a181, a182, a183, a184, a185, a186, a187, a188, a189, a190, a191;
   casadi_real a192, a193, a194, a195, a196, a197, a198, a199, a200, a201;
   a000=A0[0];
-  a001=A2[38];
+  a001=A2[S*38];
   a002=6.;
   a002=(a001/a002);
-  a003=A0[1];
+  a003=A0[S*1];
   a004=2.;
   a004=(a001/a004);
-  a005=A0[7];
-  a006=A2[5];
+  a005=A0[S*7];
+  a006=A2[S*5];
   a007=(a005*a006);
-  a008=A2[6];
+  a008=A2[S*6];
   a009=(a005*a008);
   a007=(a007+a009);
-  a009=A2[2];
+  a009=A2[S*2];
   a010=(a003*a009);
   a010=(a007+a010);
   a011=(a003*a006);
   a010=(a010+a011);
-  a011=A0[3];
-  a012=A2[7];
+  a011=A0[S*3];
+  a012=A2[S*7];
   a013=(a011*a012);
   a010=(a010+a013);
-  a014=A2[8];
+  a014=A2[S*8];
   a015=(a011*a014);
   a010=(a010+a015);
-  a016=A0[5];
+  a016=A0[S*5];
   a017=(a016*a012);
   a010=(a010+a017);
   a018=(a016*a014);
   a010=(a010+a018);
-  a019=A0[8];
-  a020=A2[3];
+  a019=A0[S*8];
+  a020=A2[S*3];
   a021=(a019*a020);
   a010=(a010+a021);
-  a022=A2[11];
-  a023=A1[3];
+  a022=A2[S*11];
+  a023=A1[S*3];
   a023=(a022*a023);
   a010=(a010+a023);
-  a024=A2[1];
+  a024=A2[S*1];
   a025=A1[0];
   a026=(a024*a025);
   a027=A2[0];
@@ -13809,10 +11994,10 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a034=(a031+a034);
   a035=(a026*a034);
   a010=(a010+a035);
-  a035=A2[4];
-  a036=A1[1];
+  a035=A2[S*4];
+  a036=A1[S*1];
   a037=(a035*a036);
-  a038=A0[2];
+  a038=A0[S*2];
   a039=(a038+a027);
   a040=(-a039);
   a040=(a028<=a040);
@@ -13823,9 +12008,9 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a044=(a041+a044);
   a045=(a037*a044);
   a010=(a010+a045);
-  a046=A1[2];
+  a046=A1[S*2];
   a047=(a035*a046);
-  a048=A0[4];
+  a048=A0[S*4];
   a049=(a048+a027);
   a050=(-a049);
   a050=(a028<=a050);
@@ -13836,9 +12021,9 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a054=(a051+a054);
   a055=(a047*a054);
   a010=(a010+a055);
-  a056=A2[9];
+  a056=A2[S*9];
   a057=(a056*a025);
-  a058=A0[6];
+  a058=A0[S*6];
   a059=(a058+a027);
   a060=(-a059);
   a060=(a028<=a060);
@@ -13849,7 +12034,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a064=(a061+a064);
   a065=(a057*a064);
   a010=(a010+a065);
-  a065=A2[10];
+  a065=A2[S*10];
   a066=(a065*a036);
   a067=(a038-a000);
   a067=(a067-a058);
@@ -13881,45 +12066,45 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a084=(a003+a084);
   a085=(2.*a084);
   a085=(a003+a085);
-  a086=A2[14];
+  a086=A2[S*14];
   a087=(a005*a086);
-  a088=A2[19];
+  a088=A2[S*19];
   a089=(a005*a088);
   a087=(a087+a089);
   a089=(a003*a088);
   a087=(a087+a089);
-  a089=A2[20];
+  a089=A2[S*20];
   a090=(a003*a089);
   a087=(a087+a090);
-  a090=A2[21];
+  a090=A2[S*21];
   a091=(a011*a090);
   a087=(a087+a091);
-  a091=A2[22];
+  a091=A2[S*22];
   a092=(a011*a091);
   a087=(a087+a092);
   a092=(a016*a090);
   a087=(a087+a092);
   a092=(a016*a091);
   a087=(a087+a092);
-  a092=A2[16];
+  a092=A2[S*16];
   a093=(a019*a092);
   a087=(a087+a093);
-  a093=A2[17];
+  a093=A2[S*17];
   a094=(a093*a025);
   a095=(a094*a034);
   a087=(a087+a095);
-  a095=A2[18];
+  a095=A2[S*18];
   a096=(a095*a036);
   a097=(a096*a044);
   a087=(a087+a097);
   a097=(a095*a046);
   a098=(a097*a054);
   a087=(a087+a098);
-  a098=A2[15];
+  a098=A2[S*15];
   a099=(a098*a025);
   a100=(a099*a064);
   a087=(a087+a100);
-  a100=A2[23];
+  a100=A2[S*23];
   a101=(a100*a036);
   a102=(a101*a074);
   a087=(a087+a102);
@@ -13935,14 +12120,14 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a105=(a104+a105);
   a106=(a084*a006);
   a105=(a105+a106);
-  a106=A2[12];
+  a106=A2[S*12];
   a107=(a003*a106);
   a007=(a007+a107);
   a107=(a003*a008);
   a007=(a007+a107);
   a107=(a003*a012);
   a007=(a007+a107);
-  a107=A2[13];
+  a107=A2[S*13];
   a108=(a011*a107);
   a108=(a007+a108);
   a109=(a011*a009);
@@ -13995,15 +12180,15 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a105=(a105+a017);
   a023=(a110*a014);
   a105=(a105+a023);
-  a021=A0[9];
+  a021=A0[S*9];
   a015=(a004*a021);
   a015=(a019+a015);
   a013=(a015*a020);
   a105=(a105+a013);
-  a114=A1[8];
+  a114=A1[S*8];
   a114=(a022*a114);
   a105=(a105+a114);
-  a115=A1[5];
+  a115=A1[S*5];
   a116=(a024*a115);
   a117=(a004*a003);
   a117=(a000+a117);
@@ -14011,7 +12196,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a118=(a031+a118);
   a119=(a116*a118);
   a105=(a105+a119);
-  a119=A1[6];
+  a119=A1[S*6];
   a120=(a035*a119);
   a121=(a004*a011);
   a121=(a038+a121);
@@ -14019,7 +12204,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a122=(a041+a122);
   a123=(a120*a122);
   a105=(a105+a123);
-  a124=A1[7];
+  a124=A1[S*7];
   a125=(a035*a124);
   a126=(a004*a016);
   a126=(a048+a126);
@@ -14153,31 +12338,31 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a144=(a144+a017);
   a013=(a147*a014);
   a144=(a144+a013);
-  a113=A2[26];
+  a113=A2[S*26];
   a112=(a005*a113);
-  a151=A0[11];
-  a152=A2[31];
+  a151=A0[S*11];
+  a152=A2[S*31];
   a153=(a151*a152);
   a112=(a112+a153);
-  a153=A2[27];
+  a153=A2[S*27];
   a154=(a003*a153);
   a112=(a112+a154);
-  a154=A2[28];
+  a154=A2[S*28];
   a155=(a003*a154);
   a112=(a112+a155);
   a155=(a011*a154);
   a112=(a112+a155);
-  a155=A2[29];
+  a155=A2[S*29];
   a156=(a011*a155);
   a112=(a112+a156);
   a156=(a016*a154);
   a112=(a112+a156);
   a156=(a016*a155);
   a112=(a112+a156);
-  a156=A2[24];
+  a156=A2[S*24];
   a157=(a019*a156);
   a112=(a112+a157);
-  a157=A2[25];
+  a157=A2[S*25];
   a158=(a157*a025);
   a034=(a158*a034);
   a112=(a112+a034);
@@ -14187,15 +12372,15 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a044=(a157*a046);
   a054=(a044*a054);
   a112=(a112+a054);
-  a054=A2[30];
+  a054=A2[S*30];
   a025=(a054*a025);
   a064=(a025*a064);
   a112=(a112+a064);
-  a064=A2[33];
-  a159=A1[4];
+  a064=A2[S*33];
+  a159=A1[S*4];
   a160=(a064*a159);
-  a161=A2[32];
-  a162=A0[10];
+  a161=A2[S*32];
+  a162=A0[S*10];
   a163=(a162+a161);
   a164=(-a163);
   a164=(a028<=a164);
@@ -14355,14 +12540,14 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a174=(a178*a014);
   a182=(a182+a174);
   a013=(a103*a113);
-  a114=A2[37];
-  a169=A2[34];
+  a114=A2[S*37];
+  a169=A2[S*34];
   a150=(a151*a169);
   a150=(a114+a150);
-  a149=A2[36];
+  a149=A2[S*36];
   a185=(a019*a149);
   a150=(a150+a185);
-  a185=A2[35];
+  a185=A2[S*35];
   a159=(a185*a159);
   a168=(a159*a168);
   a150=(a150+a168);
@@ -14396,7 +12581,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a115=(a054*a115);
   a131=(a115*a131);
   a013=(a013+a131);
-  a131=A1[9];
+  a131=A1[S*9];
   a127=(a064*a131);
   a186=(a004*a151);
   a186=(a162+a186);
@@ -14416,10 +12601,10 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a121=(a019+a121);
   a187=(a121*a020);
   a182=(a182+a187);
-  a188=A1[13];
+  a188=A1[S*13];
   a022=(a022*a188);
   a182=(a182+a022);
-  a188=A1[10];
+  a188=A1[S*10];
   a189=(a024*a188);
   a190=(a001*a134);
   a190=(a000+a190);
@@ -14427,7 +12612,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a031=(a031+a191);
   a191=(a189*a031);
   a182=(a182+a191);
-  a191=A1[11];
+  a191=A1[S*11];
   a192=(a035*a191);
   a193=(a001*a126);
   a193=(a038+a193);
@@ -14435,7 +12620,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a041=(a041+a194);
   a194=(a192*a041);
   a182=(a182+a194);
-  a195=A1[12];
+  a195=A1[S*12];
   a196=(a035*a195);
   a197=(a001*a147);
   a197=(a048+a197);
@@ -14466,7 +12651,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a010=(a010+a182);
   a010=(a002*a010);
   a010=(a003+a010);
-  R0[1]=a010;
+  R0[S*1]=a010;
   a083=(2.*a083);
   a083=(a011+a083);
   a182=(2.*a126);
@@ -14474,7 +12659,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a083=(a083+a175);
   a083=(a002*a083);
   a083=(a038+a083);
-  R0[2]=a083;
+  R0[S*2]=a083;
   a145=(2.*a145);
   a108=(a108+a145);
   a183=(2.*a183);
@@ -14510,7 +12695,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a108=(a108+a183);
   a108=(a002*a108);
   a108=(a011+a108);
-  R0[3]=a108;
+  R0[S*3]=a108;
   a110=(2.*a110);
   a110=(a016+a110);
   a183=(2.*a147);
@@ -14518,7 +12703,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a110=(a110+a178);
   a110=(a002*a110);
   a110=(a048+a110);
-  R0[4]=a110;
+  R0[S*4]=a110;
   a104=(2.*a104);
   a007=(a007+a104);
   a143=(2.*a143);
@@ -14544,7 +12729,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a007=(a007+a181);
   a007=(a002*a007);
   a007=(a016+a007);
-  R0[5]=a007;
+  R0[S*5]=a007;
   a103=(2.*a103);
   a103=(a005+a103);
   a181=(2.*a142);
@@ -14552,7 +12737,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a103=(a103+a105);
   a103=(a002*a103);
   a103=(a058+a103);
-  R0[6]=a103;
+  R0[S*6]=a103;
   a135=(2.*a135);
   a087=(a087+a135);
   a144=(2.*a144);
@@ -14595,7 +12780,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a087=(a087+a144);
   a087=(a002*a087);
   a087=(a005+a087);
-  R0[7]=a087;
+  R0[S*7]=a087;
   a082=(2.*a082);
   a082=(a021+a082);
   a117=(2.*a117);
@@ -14649,7 +12834,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a082=(a082+a170);
   a082=(a002*a082);
   a019=(a019+a082);
-  R0[8]=a019;
+  R0[S*8]=a019;
   a013=(2.*a013);
   a112=(a112+a013);
   a142=(2.*a142);
@@ -14691,7 +12876,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a188=(a054*a188);
   a061=(a188*a061);
   a105=(a105+a061);
-  a061=A1[14];
+  a061=A1[S*14];
   a064=(a064*a061);
   a051=(a001*a186);
   a051=(a162+a051);
@@ -14708,7 +12893,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a112=(a112+a105);
   a112=(a002*a112);
   a021=(a021+a112);
-  R0[9]=a021;
+  R0[S*9]=a021;
   a168=(2.*a168);
   a168=(a151+a168);
   a186=(2.*a186);
@@ -14716,7 +12901,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a168=(a168+a004);
   a168=(a002*a168);
   a168=(a162+a168);
-  R0[10]=a168;
+  R0[S*10]=a168;
   a117=(2.*a117);
   a150=(a150+a117);
   a142=(2.*a142);
@@ -14731,7 +12916,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a150=(a150+a114);
   a002=(a002*a150);
   a002=(a151+a002);
-  R0[11]=a002;
+  R0[S*11]=a002;
   a032=(2.*a032);
   a150=1.;
   a032=(a032-a150);
@@ -15007,287 +13192,288 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a111=(a111*a073);
   a026=(a018+a111);
   a026=(a026+a076);
-  R2[1]=a026;
+  R2[S*1]=a026;
   a018=(a018+a066);
   a075=(a075*a081);
   a018=(a018+a075);
-  R2[2]=a018;
+  R2[S*2]=a018;
   a094=(a094*a033);
   a101=(a101*a073);
   a094=(a094+a101);
   a102=(a102*a081);
   a094=(a094+a102);
-  R2[3]=a094;
+  R2[S*3]=a094;
   a158=(a158*a033);
   a036=(a036*a073);
   a158=(a158+a036);
   a046=(a046*a081);
   a158=(a158+a046);
-  R2[4]=a158;
+  R2[S*4]=a158;
   a158=(a009+a006);
-  R2[5]=a158;
+  R2[S*5]=a158;
   a106=(a106+a008);
   a106=(a106+a012);
-  R2[6]=a106;
-  R2[7]=a106;
+  R2[S*6]=a106;
+  R2[S*7]=a106;
   a089=(a088+a089);
-  R2[8]=a089;
+  R2[S*8]=a089;
   a153=(a153+a154);
-  R2[9]=a153;
+  R2[S*9]=a153;
   a037=(a037*a043);
   a037=(a037-a066);
-  R2[10]=a037;
+  R2[S*10]=a037;
   a109=(a109*a043);
   a109=(a109-a111);
-  R2[11]=a109;
-  R2[12]=a037;
+  R2[S*11]=a109;
+  R2[S*12]=a037;
   a096=(a096*a043);
   a096=(a096-a101);
-  R2[13]=a096;
+  R2[S*13]=a096;
   a034=(a034*a043);
   a034=(a034-a036);
-  R2[14]=a034;
+  R2[S*14]=a034;
   a012=(a012+a014);
-  R2[15]=a012;
+  R2[S*15]=a012;
   a107=(a107+a009);
-  R2[16]=a107;
-  R2[17]=a012;
+  R2[S*16]=a107;
+  R2[S*17]=a012;
   a090=(a090+a091);
-  R2[18]=a090;
+  R2[S*18]=a090;
   a154=(a154+a155);
-  R2[19]=a154;
+  R2[S*19]=a154;
   a047=(a047*a053);
   a047=(a047-a076);
-  R2[20]=a047;
-  R2[21]=a047;
+  R2[S*20]=a047;
+  R2[S*21]=a047;
   a045=(a045*a053);
   a045=(a045-a075);
-  R2[22]=a045;
+  R2[S*22]=a045;
   a097=(a097*a053);
   a097=(a097-a102);
-  R2[23]=a097;
+  R2[S*23]=a097;
   a044=(a044*a053);
   a044=(a044-a046);
-  R2[24]=a044;
-  R2[25]=a012;
-  R2[26]=a012;
-  R2[27]=a107;
-  R2[28]=a090;
-  R2[29]=a154;
+  R2[S*24]=a044;
+  R2[S*25]=a012;
+  R2[S*26]=a012;
+  R2[S*27]=a107;
+  R2[S*28]=a090;
+  R2[S*29]=a154;
   a057=(a057*a063);
   a057=(a057+a066);
   a057=(a057+a076);
-  R2[30]=a057;
+  R2[S*30]=a057;
   a055=(a055*a063);
   a111=(a055+a111);
   a111=(a111+a076);
-  R2[31]=a111;
+  R2[S*31]=a111;
   a055=(a055+a066);
   a055=(a055+a075);
-  R2[32]=a055;
+  R2[S*32]=a055;
   a099=(a099*a063);
   a099=(a099+a101);
   a099=(a099+a102);
-  R2[33]=a099;
+  R2[S*33]=a099;
   a025=(a025*a063);
   a025=(a025+a036);
   a025=(a025+a046);
-  R2[34]=a025;
+  R2[S*34]=a025;
   a006=(a006+a008);
-  R2[35]=a006;
-  R2[36]=a006;
-  R2[37]=a006;
+  R2[S*35]=a006;
+  R2[S*36]=a006;
+  R2[S*37]=a006;
   a086=(a086+a088);
-  R2[38]=a086;
-  R2[39]=a113;
-  R2[40]=a020;
-  R2[41]=a092;
-  R2[42]=a156;
-  R2[43]=a149;
+  R2[S*38]=a086;
+  R2[S*39]=a113;
+  R2[S*40]=a020;
+  R2[S*41]=a092;
+  R2[S*42]=a156;
+  R2[S*43]=a149;
   a160=(a160*a167);
-  R2[44]=a160;
+  R2[S*44]=a160;
   a159=(a159*a167);
-  R2[45]=a159;
-  R2[46]=a152;
-  R2[47]=a169;
+  R2[S*45]=a159;
+  R2[S*46]=a152;
+  R2[S*47]=a169;
   a116=(a116*a033);
   a132=(a132*a073);
   a116=(a116+a132);
   a133=(a133*a081);
   a116=(a116+a133);
-  R2[48]=a116;
+  R2[S*48]=a116;
   a023=(a023*a033);
   a148=(a148*a073);
   a169=(a023+a148);
   a169=(a169+a133);
-  R2[49]=a169;
+  R2[S*49]=a169;
   a023=(a023+a132);
   a130=(a130*a081);
   a023=(a023+a130);
-  R2[50]=a023;
+  R2[S*50]=a023;
   a136=(a136*a033);
   a140=(a140*a073);
   a136=(a136+a140);
   a141=(a141*a081);
   a136=(a136+a141);
-  R2[51]=a136;
+  R2[S*51]=a136;
   a084=(a084*a033);
   a119=(a119*a073);
   a084=(a084+a119);
   a124=(a124*a081);
   a084=(a084+a124);
-  R2[52]=a084;
+  R2[S*52]=a084;
   a120=(a120*a043);
   a120=(a120-a132);
-  R2[53]=a120;
+  R2[S*53]=a120;
   a146=(a146*a043);
   a146=(a146-a148);
-  R2[54]=a146;
-  R2[55]=a120;
+  R2[S*54]=a146;
+  R2[S*55]=a120;
   a137=(a137*a043);
   a137=(a137-a140);
-  R2[56]=a137;
+  R2[S*56]=a137;
   a118=(a118*a043);
   a118=(a118-a119);
-  R2[57]=a118;
+  R2[S*57]=a118;
   a125=(a125*a053);
   a125=(a125-a133);
-  R2[58]=a125;
-  R2[59]=a125;
+  R2[S*58]=a125;
+  R2[S*59]=a125;
   a123=(a123*a053);
   a123=(a123-a130);
-  R2[60]=a123;
+  R2[S*60]=a123;
   a138=(a138*a053);
   a138=(a138-a141);
-  R2[61]=a138;
+  R2[S*61]=a138;
   a122=(a122*a053);
   a122=(a122-a124);
-  R2[62]=a122;
+  R2[S*62]=a122;
   a129=(a129*a063);
   a129=(a129+a132);
   a129=(a129+a133);
-  R2[63]=a129;
+  R2[S*63]=a129;
   a128=(a128*a063);
   a148=(a128+a148);
   a148=(a148+a133);
-  R2[64]=a148;
+  R2[S*64]=a148;
   a128=(a128+a132);
   a128=(a128+a130);
-  R2[65]=a128;
+  R2[S*65]=a128;
   a139=(a139*a063);
   a139=(a139+a140);
   a139=(a139+a141);
-  R2[66]=a139;
+  R2[S*66]=a139;
   a115=(a115*a063);
   a115=(a115+a119);
   a115=(a115+a124);
-  R2[67]=a115;
+  R2[S*67]=a115;
   a127=(a127*a167);
-  R2[68]=a127;
+  R2[S*68]=a127;
   a131=(a131*a167);
-  R2[69]=a131;
-  R2[70]=a116;
-  R2[71]=a169;
-  R2[72]=a023;
-  R2[73]=a136;
-  R2[74]=a084;
-  R2[75]=a120;
-  R2[76]=a146;
-  R2[77]=a120;
-  R2[78]=a137;
-  R2[79]=a118;
-  R2[80]=a125;
-  R2[81]=a125;
-  R2[82]=a123;
-  R2[83]=a138;
-  R2[84]=a122;
-  R2[85]=a129;
-  R2[86]=a148;
-  R2[87]=a128;
-  R2[88]=a139;
-  R2[89]=a115;
-  R2[90]=a127;
-  R2[91]=a131;
+  R2[S*69]=a131;
+  R2[S*70]=a116;
+  R2[S*71]=a169;
+  R2[S*72]=a023;
+  R2[S*73]=a136;
+  R2[S*74]=a084;
+  R2[S*75]=a120;
+  R2[S*76]=a146;
+  R2[S*77]=a120;
+  R2[S*78]=a137;
+  R2[S*79]=a118;
+  R2[S*80]=a125;
+  R2[S*81]=a125;
+  R2[S*82]=a123;
+  R2[S*83]=a138;
+  R2[S*84]=a122;
+  R2[S*85]=a129;
+  R2[S*86]=a148;
+  R2[S*87]=a128;
+  R2[S*88]=a139;
+  R2[S*89]=a115;
+  R2[S*90]=a127;
+  R2[S*91]=a131;
   a189=(a189*a033);
   a201=(a201*a073);
   a189=(a189+a201);
   a200=(a200*a081);
   a189=(a189+a200);
-  R2[92]=a189;
+  R2[S*92]=a189;
   a035=(a035*a033);
   a145=(a145*a073);
   a189=(a035+a145);
   a189=(a189+a200);
-  R2[93]=a189;
+  R2[S*93]=a189;
   a035=(a035+a201);
   a056=(a056*a081);
   a035=(a035+a056);
-  R2[94]=a035;
+  R2[S*94]=a035;
   a093=(a093*a033);
   a181=(a181*a073);
   a093=(a093+a181);
   a100=(a100*a081);
   a093=(a093+a100);
-  R2[95]=a093;
+  R2[S*95]=a093;
   a178=(a178*a033);
   a191=(a191*a073);
   a178=(a178+a191);
   a054=(a054*a081);
   a178=(a178+a054);
-  R2[96]=a178;
+  R2[S*96]=a178;
   a192=(a192*a043);
   a192=(a192-a201);
-  R2[97]=a192;
+  R2[S*97]=a192;
   a177=(a177*a043);
   a177=(a177-a145);
-  R2[98]=a177;
-  R2[99]=a192;
+  R2[S*98]=a177;
+  R2[S*99]=a192;
   a135=(a135*a043);
   a135=(a135-a181);
-  R2[100]=a135;
+  R2[S*100]=a135;
   a031=(a031*a043);
   a031=(a031-a191);
-  R2[101]=a031;
+  R2[S*101]=a031;
   a196=(a196*a053);
   a196=(a196-a200);
-  R2[102]=a196;
-  R2[103]=a196;
+  R2[S*102]=a196;
+  R2[S*103]=a196;
   a024=(a024*a053);
   a024=(a024-a056);
-  R2[104]=a024;
+  R2[S*104]=a024;
   a095=(a095*a053);
   a095=(a095-a100);
-  R2[105]=a095;
+  R2[S*105]=a095;
   a157=(a157*a053);
   a157=(a157-a054);
-  R2[106]=a157;
+  R2[S*106]=a157;
   a199=(a199*a063);
   a199=(a199+a201);
   a199=(a199+a200);
-  R2[107]=a199;
+  R2[S*107]=a199;
   a065=(a065*a063);
   a145=(a065+a145);
   a145=(a145+a200);
-  R2[108]=a145;
+  R2[S*108]=a145;
   a065=(a065+a201);
   a065=(a065+a056);
-  R2[109]=a065;
+  R2[S*109]=a065;
   a098=(a098*a063);
   a098=(a098+a181);
   a098=(a098+a100);
-  R2[110]=a098;
+  R2[S*110]=a098;
   a188=(a188*a063);
   a188=(a188+a191);
   a188=(a188+a054);
-  R2[111]=a188;
+  R2[S*111]=a188;
   a064=(a064*a167);
-  R2[112]=a064;
+  R2[S*112]=a064;
   a185=(a185*a167);
-  R2[113]=a185;
+  R2[S*113]=a185;
 }
+static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_tangent_state_strided(A0, A1, A2, R0, R1, R2, 1); }
 
-/* tangent_vector, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) {
+/* tangent_vector, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_vector_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
@@ -15296,81 +13482,81 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   casadi_real a60, a61, a62, a63, a64, a65, a66, a67, a68, a69, a70, a71;
   casadi_real a72, a73, a74, a75;
   a00=A0[0];
-  a01=A2[38];
+  a01=A2[S*38];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[12];
+  a03=A0[S*12];
   a04=2.;
   a04=(a01/a04);
   a05=A1[0];
   a05=(a05*a00);
-  a06=A1[5];
+  a06=A1[S*5];
   a07=(a06*a03);
   a05=(a05+a07);
-  a07=A1[10];
-  a08=A0[24];
+  a07=A1[S*10];
+  a08=A0[S*24];
   a07=(a07*a08);
   a05=(a05+a07);
-  a07=A1[15];
-  a09=A0[36];
+  a07=A1[S*15];
+  a09=A0[S*36];
   a10=(a07*a09);
   a05=(a05+a10);
-  a10=A1[20];
-  a11=A0[48];
+  a10=A1[S*20];
+  a11=A0[S*48];
   a10=(a10*a11);
   a05=(a05+a10);
-  a10=A1[25];
-  a12=A0[60];
+  a10=A1[S*25];
+  a12=A0[S*60];
   a13=(a10*a12);
   a05=(a05+a13);
-  a13=A1[30];
-  a14=A0[72];
+  a13=A1[S*30];
+  a14=A0[S*72];
   a13=(a13*a14);
   a05=(a05+a13);
-  a13=A1[35];
-  a15=A0[84];
+  a13=A1[S*35];
+  a15=A0[S*84];
   a16=(a13*a15);
   a05=(a05+a16);
-  a16=A1[40];
-  a17=A0[96];
+  a16=A1[S*40];
+  a17=A0[S*96];
   a18=(a16*a17);
   a05=(a05+a18);
   a19=(a04*a05);
   a19=(a03+a19);
   a20=(2.*a19);
   a20=(a03+a20);
-  a21=A1[48];
+  a21=A1[S*48];
   a22=(a04*a03);
   a22=(a00+a22);
   a21=(a21*a22);
   a23=(a06*a19);
   a21=(a21+a23);
-  a23=A1[53];
+  a23=A1[S*53];
   a24=(a04*a09);
   a24=(a08+a24);
   a23=(a23*a24);
   a21=(a21+a23);
-  a23=A1[1];
+  a23=A1[S*1];
   a23=(a23*a00);
-  a25=A1[6];
+  a25=A1[S*6];
   a26=(a25*a03);
   a23=(a23+a26);
-  a26=A1[11];
+  a26=A1[S*11];
   a26=(a26*a08);
   a23=(a23+a26);
-  a26=A1[16];
+  a26=A1[S*16];
   a27=(a26*a09);
   a23=(a23+a27);
-  a27=A1[21];
+  a27=A1[S*21];
   a27=(a27*a11);
   a23=(a23+a27);
-  a27=A1[26];
+  a27=A1[S*26];
   a28=(a27*a12);
   a23=(a23+a28);
-  a28=A1[31];
+  a28=A1[S*31];
   a28=(a28*a14);
   a23=(a23+a28);
-  a28=A1[36];
+  a28=A1[S*36];
   a29=(a28*a15);
   a23=(a23+a29);
   a23=(a23+a18);
@@ -15378,32 +13564,32 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a29=(a09+a29);
   a30=(a07*a29);
   a21=(a21+a30);
-  a30=A1[58];
+  a30=A1[S*58];
   a31=(a04*a12);
   a31=(a11+a31);
   a30=(a30*a31);
   a21=(a21+a30);
-  a30=A1[2];
+  a30=A1[S*2];
   a30=(a30*a00);
-  a32=A1[7];
+  a32=A1[S*7];
   a33=(a32*a03);
   a30=(a30+a33);
-  a33=A1[12];
+  a33=A1[S*12];
   a33=(a33*a08);
   a30=(a30+a33);
-  a33=A1[17];
+  a33=A1[S*17];
   a34=(a33*a09);
   a30=(a30+a34);
-  a34=A1[22];
+  a34=A1[S*22];
   a34=(a34*a11);
   a30=(a30+a34);
-  a34=A1[27];
+  a34=A1[S*27];
   a35=(a34*a12);
   a30=(a30+a35);
-  a35=A1[32];
+  a35=A1[S*32];
   a35=(a35*a14);
   a30=(a30+a35);
-  a35=A1[37];
+  a35=A1[S*37];
   a36=(a35*a15);
   a30=(a30+a36);
   a30=(a30+a18);
@@ -15411,42 +13597,42 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a18=(a12+a18);
   a36=(a10*a18);
   a21=(a21+a36);
-  a36=A1[63];
+  a36=A1[S*63];
   a37=(a04*a15);
   a37=(a14+a37);
   a36=(a36*a37);
   a21=(a21+a36);
-  a36=A1[3];
+  a36=A1[S*3];
   a36=(a36*a00);
-  a38=A1[8];
+  a38=A1[S*8];
   a39=(a38*a03);
   a36=(a36+a39);
-  a39=A1[13];
+  a39=A1[S*13];
   a39=(a39*a08);
   a36=(a36+a39);
-  a39=A1[18];
+  a39=A1[S*18];
   a40=(a39*a09);
   a36=(a36+a40);
-  a40=A1[23];
+  a40=A1[S*23];
   a40=(a40*a11);
   a36=(a36+a40);
-  a40=A1[28];
+  a40=A1[S*28];
   a41=(a40*a12);
   a36=(a36+a41);
-  a41=A1[33];
+  a41=A1[S*33];
   a41=(a41*a14);
   a36=(a36+a41);
-  a41=A1[38];
+  a41=A1[S*38];
   a42=(a41*a15);
   a36=(a36+a42);
-  a42=A1[41];
+  a42=A1[S*41];
   a43=(a42*a17);
   a36=(a36+a43);
   a43=(a04*a36);
   a43=(a15+a43);
   a44=(a13*a43);
   a21=(a21+a44);
-  a44=A0[108];
+  a44=A0[S*108];
   a45=(a04*a44);
   a45=(a17+a45);
   a46=(a16*a45);
@@ -15455,32 +13641,32 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a47=(a03+a47);
   a48=(2.*a47);
   a20=(a20+a48);
-  a48=A1[70];
+  a48=A1[S*70];
   a49=(a04*a19);
   a49=(a00+a49);
   a48=(a48*a49);
   a50=(a06*a47);
   a48=(a48+a50);
-  a50=A1[75];
+  a50=A1[S*75];
   a51=(a04*a29);
   a51=(a08+a51);
   a50=(a50*a51);
   a48=(a48+a50);
-  a50=A1[49];
+  a50=A1[S*49];
   a50=(a50*a22);
   a52=(a25*a19);
   a50=(a50+a52);
-  a52=A1[54];
+  a52=A1[S*54];
   a52=(a52*a24);
   a50=(a50+a52);
   a52=(a26*a29);
   a50=(a50+a52);
-  a52=A1[59];
+  a52=A1[S*59];
   a52=(a52*a31);
   a50=(a50+a52);
   a52=(a27*a18);
   a50=(a50+a52);
-  a52=A1[64];
+  a52=A1[S*64];
   a52=(a52*a37);
   a50=(a50+a52);
   a52=(a28*a43);
@@ -15490,26 +13676,26 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a52=(a09+a52);
   a53=(a07*a52);
   a48=(a48+a53);
-  a53=A1[80];
+  a53=A1[S*80];
   a54=(a04*a18);
   a54=(a11+a54);
   a53=(a53*a54);
   a48=(a48+a53);
-  a53=A1[50];
+  a53=A1[S*50];
   a53=(a53*a22);
   a55=(a32*a19);
   a53=(a53+a55);
-  a55=A1[55];
+  a55=A1[S*55];
   a55=(a55*a24);
   a53=(a53+a55);
   a55=(a33*a29);
   a53=(a53+a55);
-  a55=A1[60];
+  a55=A1[S*60];
   a55=(a55*a31);
   a53=(a53+a55);
   a55=(a34*a18);
   a53=(a53+a55);
-  a55=A1[65];
+  a55=A1[S*65];
   a55=(a55*a37);
   a53=(a53+a55);
   a55=(a35*a43);
@@ -15519,26 +13705,26 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a46=(a12+a46);
   a55=(a10*a46);
   a48=(a48+a55);
-  a55=A1[85];
+  a55=A1[S*85];
   a56=(a04*a43);
   a56=(a14+a56);
   a55=(a55*a56);
   a48=(a48+a55);
-  a55=A1[51];
+  a55=A1[S*51];
   a55=(a55*a22);
   a57=(a38*a19);
   a55=(a55+a57);
-  a57=A1[56];
+  a57=A1[S*56];
   a57=(a57*a24);
   a55=(a55+a57);
   a57=(a39*a29);
   a55=(a55+a57);
-  a57=A1[61];
+  a57=A1[S*61];
   a57=(a57*a31);
   a55=(a55+a57);
   a57=(a40*a18);
   a55=(a55+a57);
-  a57=A1[66];
+  a57=A1[S*66];
   a57=(a57*a37);
   a55=(a55+a57);
   a57=(a41*a43);
@@ -15549,38 +13735,38 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a57=(a15+a57);
   a58=(a13*a57);
   a48=(a48+a58);
-  a58=A1[4];
+  a58=A1[S*4];
   a58=(a58*a00);
-  a59=A1[9];
+  a59=A1[S*9];
   a60=(a59*a03);
   a58=(a58+a60);
-  a60=A1[14];
+  a60=A1[S*14];
   a60=(a60*a08);
   a58=(a58+a60);
-  a60=A1[19];
+  a60=A1[S*19];
   a61=(a60*a09);
   a58=(a58+a61);
-  a61=A1[24];
+  a61=A1[S*24];
   a61=(a61*a11);
   a58=(a58+a61);
-  a61=A1[29];
+  a61=A1[S*29];
   a62=(a61*a12);
   a58=(a58+a62);
-  a62=A1[34];
+  a62=A1[S*34];
   a62=(a62*a14);
   a58=(a58+a62);
-  a62=A1[39];
+  a62=A1[S*39];
   a63=(a62*a15);
   a58=(a58+a63);
-  a63=A1[42];
+  a63=A1[S*42];
   a64=(a63*a17);
   a58=(a58+a64);
-  a64=A1[44];
-  a65=A0[120];
+  a64=A1[S*44];
+  a65=A0[S*120];
   a64=(a64*a65);
   a58=(a58+a64);
-  a64=A1[46];
-  a66=A0[132];
+  a64=A1[S*46];
+  a66=A0[S*132];
   a67=(a64*a66);
   a58=(a58+a67);
   a67=(a04*a58);
@@ -15599,32 +13785,32 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a05=(a05+a21);
   a48=(2.*a48);
   a05=(a05+a48);
-  a48=A1[92];
+  a48=A1[S*92];
   a21=(a01*a47);
   a00=(a00+a21);
   a48=(a48*a00);
   a06=(a06*a70);
   a48=(a48+a06);
-  a06=A1[97];
+  a06=A1[S*97];
   a21=(a01*a52);
   a21=(a08+a21);
   a06=(a06*a21);
   a48=(a48+a06);
-  a06=A1[71];
+  a06=A1[S*71];
   a06=(a06*a49);
   a20=(a25*a47);
   a06=(a06+a20);
-  a20=A1[76];
+  a20=A1[S*76];
   a20=(a20*a51);
   a06=(a06+a20);
   a20=(a26*a52);
   a06=(a06+a20);
-  a20=A1[81];
+  a20=A1[S*81];
   a20=(a20*a54);
   a06=(a06+a20);
   a20=(a27*a46);
   a06=(a06+a20);
-  a20=A1[86];
+  a20=A1[S*86];
   a20=(a20*a56);
   a06=(a06+a20);
   a20=(a28*a57);
@@ -15634,26 +13820,26 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a20=(a09+a20);
   a07=(a07*a20);
   a48=(a48+a07);
-  a07=A1[102];
+  a07=A1[S*102];
   a71=(a01*a46);
   a71=(a11+a71);
   a07=(a07*a71);
   a48=(a48+a07);
-  a07=A1[72];
+  a07=A1[S*72];
   a07=(a07*a49);
   a72=(a32*a47);
   a07=(a07+a72);
-  a72=A1[77];
+  a72=A1[S*77];
   a72=(a72*a51);
   a07=(a07+a72);
   a72=(a33*a52);
   a07=(a07+a72);
-  a72=A1[82];
+  a72=A1[S*82];
   a72=(a72*a54);
   a07=(a07+a72);
   a72=(a34*a46);
   a07=(a07+a72);
-  a72=A1[87];
+  a72=A1[S*87];
   a72=(a72*a56);
   a07=(a07+a72);
   a72=(a35*a57);
@@ -15663,26 +13849,26 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a69=(a12+a69);
   a10=(a10*a69);
   a48=(a48+a10);
-  a10=A1[107];
+  a10=A1[S*107];
   a72=(a01*a57);
   a72=(a14+a72);
   a10=(a10*a72);
   a48=(a48+a10);
-  a10=A1[73];
+  a10=A1[S*73];
   a10=(a10*a49);
   a73=(a38*a47);
   a10=(a10+a73);
-  a73=A1[78];
+  a73=A1[S*78];
   a73=(a73*a51);
   a10=(a10+a73);
   a73=(a39*a52);
   a10=(a10+a73);
-  a73=A1[83];
+  a73=A1[S*83];
   a73=(a73*a54);
   a10=(a10+a73);
   a73=(a40*a46);
   a10=(a10+a73);
-  a73=A1[88];
+  a73=A1[S*88];
   a73=(a73*a56);
   a10=(a10+a73);
   a73=(a41*a57);
@@ -15693,38 +13879,38 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a73=(a15+a73);
   a13=(a13*a73);
   a48=(a48+a13);
-  a13=A1[52];
+  a13=A1[S*52];
   a13=(a13*a22);
   a19=(a59*a19);
   a13=(a13+a19);
-  a19=A1[57];
+  a19=A1[S*57];
   a19=(a19*a24);
   a13=(a13+a19);
   a19=(a60*a29);
   a13=(a13+a19);
-  a19=A1[62];
+  a19=A1[S*62];
   a19=(a19*a31);
   a13=(a13+a19);
   a19=(a61*a18);
   a13=(a13+a19);
-  a19=A1[67];
+  a19=A1[S*67];
   a19=(a19*a37);
   a13=(a13+a19);
   a19=(a62*a43);
   a13=(a13+a19);
   a19=(a63*a45);
   a13=(a13+a19);
-  a19=A1[68];
+  a19=A1[S*68];
   a37=(a04*a66);
   a37=(a65+a37);
   a19=(a19*a37);
   a13=(a13+a19);
-  a19=A1[43];
+  a19=A1[S*43];
   a31=(a19*a17);
-  a24=A1[45];
+  a24=A1[S*45];
   a24=(a24*a65);
   a31=(a31+a24);
-  a24=A1[47];
+  a24=A1[S*47];
   a22=(a24*a66);
   a31=(a31+a22);
   a22=(a04*a31);
@@ -15740,7 +13926,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a05=(a05+a48);
   a05=(a02*a05);
   a03=(a03+a05);
-  R0[12]=a03;
+  R0[S*12]=a03;
   a29=(2.*a29);
   a29=(a09+a29);
   a03=(2.*a52);
@@ -15748,26 +13934,26 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a29=(a29+a20);
   a29=(a02*a29);
   a08=(a08+a29);
-  R0[24]=a08;
+  R0[S*24]=a08;
   a50=(2.*a50);
   a23=(a23+a50);
   a06=(2.*a06);
   a23=(a23+a06);
-  a06=A1[93];
+  a06=A1[S*93];
   a06=(a06*a00);
   a25=(a25*a70);
   a06=(a06+a25);
-  a25=A1[98];
+  a25=A1[S*98];
   a25=(a25*a21);
   a06=(a06+a25);
   a26=(a26*a20);
   a06=(a06+a26);
-  a26=A1[103];
+  a26=A1[S*103];
   a26=(a26*a71);
   a06=(a06+a26);
   a27=(a27*a69);
   a06=(a06+a27);
-  a27=A1[108];
+  a27=A1[S*108];
   a27=(a27*a72);
   a06=(a06+a27);
   a28=(a28*a73);
@@ -15776,7 +13962,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a23=(a23+a06);
   a23=(a02*a23);
   a09=(a09+a23);
-  R0[36]=a09;
+  R0[S*36]=a09;
   a18=(2.*a18);
   a18=(a12+a18);
   a09=(2.*a46);
@@ -15784,26 +13970,26 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a18=(a18+a69);
   a18=(a02*a18);
   a11=(a11+a18);
-  R0[48]=a11;
+  R0[S*48]=a11;
   a53=(2.*a53);
   a30=(a30+a53);
   a07=(2.*a07);
   a30=(a30+a07);
-  a07=A1[94];
+  a07=A1[S*94];
   a07=(a07*a00);
   a32=(a32*a70);
   a07=(a07+a32);
-  a32=A1[99];
+  a32=A1[S*99];
   a32=(a32*a21);
   a07=(a07+a32);
   a33=(a33*a20);
   a07=(a07+a33);
-  a33=A1[104];
+  a33=A1[S*104];
   a33=(a33*a71);
   a07=(a07+a33);
   a34=(a34*a69);
   a07=(a07+a34);
-  a34=A1[109];
+  a34=A1[S*109];
   a34=(a34*a72);
   a07=(a07+a34);
   a35=(a35*a73);
@@ -15812,7 +13998,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a30=(a30+a07);
   a30=(a02*a30);
   a12=(a12+a30);
-  R0[60]=a12;
+  R0[S*60]=a12;
   a43=(2.*a43);
   a43=(a15+a43);
   a12=(2.*a57);
@@ -15820,26 +14006,26 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a43=(a43+a73);
   a43=(a02*a43);
   a14=(a14+a43);
-  R0[72]=a14;
+  R0[S*72]=a14;
   a55=(2.*a55);
   a36=(a36+a55);
   a10=(2.*a10);
   a36=(a36+a10);
-  a10=A1[95];
+  a10=A1[S*95];
   a10=(a10*a00);
   a38=(a38*a70);
   a10=(a10+a38);
-  a38=A1[100];
+  a38=A1[S*100];
   a38=(a38*a21);
   a10=(a10+a38);
   a39=(a39*a20);
   a10=(a10+a39);
-  a39=A1[105];
+  a39=A1[S*105];
   a39=(a39*a71);
   a10=(a10+a39);
   a40=(a40*a69);
   a10=(a10+a40);
-  a40=A1[110];
+  a40=A1[S*110];
   a40=(a40*a72);
   a10=(a10+a40);
   a41=(a41*a73);
@@ -15849,39 +14035,39 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a36=(a36+a10);
   a36=(a02*a36);
   a15=(a15+a36);
-  R0[84]=a15;
+  R0[S*84]=a15;
   a67=(2.*a67);
   a67=(a44+a67);
   a74=(2.*a74);
   a67=(a67+a74);
-  a74=A1[74];
+  a74=A1[S*74];
   a74=(a74*a49);
   a47=(a59*a47);
   a74=(a74+a47);
-  a47=A1[79];
+  a47=A1[S*79];
   a47=(a47*a51);
   a74=(a74+a47);
   a52=(a60*a52);
   a74=(a74+a52);
-  a52=A1[84];
+  a52=A1[S*84];
   a52=(a52*a54);
   a74=(a74+a52);
   a46=(a61*a46);
   a74=(a74+a46);
-  a46=A1[89];
+  a46=A1[S*89];
   a46=(a46*a56);
   a74=(a74+a46);
   a57=(a62*a57);
   a74=(a74+a57);
   a57=(a63*a68);
   a74=(a74+a57);
-  a57=A1[90];
+  a57=A1[S*90];
   a46=(a04*a22);
   a46=(a65+a46);
   a57=(a57*a46);
   a74=(a74+a57);
   a45=(a19*a45);
-  a57=A1[69];
+  a57=A1[S*69];
   a57=(a57*a37);
   a45=(a45+a57);
   a57=(a24*a22);
@@ -15895,39 +14081,39 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a67=(a67+a57);
   a67=(a02*a67);
   a17=(a17+a67);
-  R0[96]=a17;
+  R0[S*96]=a17;
   a13=(2.*a13);
   a58=(a58+a13);
   a74=(2.*a74);
   a58=(a58+a74);
-  a74=A1[96];
+  a74=A1[S*96];
   a74=(a74*a00);
   a59=(a59*a70);
   a74=(a74+a59);
-  a59=A1[101];
+  a59=A1[S*101];
   a59=(a59*a21);
   a74=(a74+a59);
   a60=(a60*a20);
   a74=(a74+a60);
-  a60=A1[106];
+  a60=A1[S*106];
   a60=(a60*a71);
   a74=(a74+a60);
   a61=(a61*a69);
   a74=(a74+a61);
-  a61=A1[111];
+  a61=A1[S*111];
   a61=(a61*a72);
   a74=(a74+a61);
   a62=(a62*a73);
   a74=(a74+a62);
   a63=(a63*a75);
   a74=(a74+a63);
-  a63=A1[112];
+  a63=A1[S*112];
   a62=(a01*a04);
   a62=(a65+a62);
   a63=(a63*a62);
   a74=(a74+a63);
   a68=(a19*a68);
-  a63=A1[91];
+  a63=A1[S*91];
   a63=(a63*a46);
   a68=(a68+a63);
   a63=(a24*a04);
@@ -15939,7 +14125,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a58=(a58+a74);
   a58=(a02*a58);
   a44=(a44+a58);
-  R0[108]=a44;
+  R0[S*108]=a44;
   a22=(2.*a22);
   a22=(a66+a22);
   a04=(2.*a04);
@@ -15947,13 +14133,13 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a22=(a22+a01);
   a22=(a02*a22);
   a65=(a65+a22);
-  R0[120]=a65;
+  R0[S*120]=a65;
   a45=(2.*a45);
   a31=(a31+a45);
   a68=(2.*a68);
   a31=(a31+a68);
   a19=(a19*a75);
-  a75=A1[113];
+  a75=A1[S*113];
   a75=(a75*a62);
   a19=(a19+a75);
   a24=(a24*a01);
@@ -15961,8 +14147,9 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a31=(a31+a19);
   a02=(a02*a31);
   a66=(a66+a02);
-  R0[132]=a66;
+  R0[S*132]=a66;
 }
+static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) { gs_tangent_vector_strided(A0, A1, A2, R0, 1); }
 
 /* gram_schmidt, from CasADi's C of it */
 static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
@@ -19828,6 +18015,231 @@ static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casad
   R1[11]=a118;
 }
 
+/* constants, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_constants_strided(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+  casadi_real a24, a25, a26;
+  a00=A0[S*15];
+  R0[0]=a00;
+  a00=A0[0];
+  a01=casadi_sq(a00);
+  a02=(1./a01);
+  a03=(-a02);
+  R0[S*1]=a03;
+  a03=-2.;
+  a04=A0[S*1];
+  a04=(a03*a04);
+  a04=(a04/a00);
+  R0[S*2]=a04;
+  a05=A0[S*17];
+  a06=(a05/a01);
+  a07=A0[S*21];
+  a08=A0[S*11];
+  a09=(a07/a08);
+  a10=A0[S*19];
+  a09=(a09/a10);
+  a11=A0[S*23];
+  a12=(a11/a08);
+  a12=(a12/a10);
+  a12=(a09+a12);
+  a12=(a06*a12);
+  a12=(-a12);
+  R0[S*3]=a12;
+  a12=casadi_sq(a07);
+  a13=(a12/a08);
+  a14=casadi_sq(a11);
+  a15=(a14/a08);
+  a15=(a13+a15);
+  a16=A0[S*13];
+  a14=(a14/a16);
+  a16=(a15+a14);
+  a17=(2.*a07);
+  a17=(a17*a11);
+  a17=(a17/a08);
+  a16=(a16+a17);
+  a18=(a16/a01);
+  a19=A0[S*12];
+  a12=(a12/a19);
+  a15=(a15+a12);
+  a15=(a15+a14);
+  a15=(a15+a17);
+  a18=(a18/a15);
+  a18=(-a18);
+  R0[S*4]=a18;
+  a18=-4.;
+  a17=A0[S*3];
+  a18=(a18*a17);
+  a18=(a18/a00);
+  a14=A0[S*22];
+  a19=(a07*a14);
+  a19=(a19/a08);
+  a20=(a19-a13);
+  a21=(a14*a11);
+  a21=(a21/a08);
+  a20=(a20+a21);
+  a22=(a07*a11);
+  a22=(a22/a08);
+  a20=(a20-a22);
+  a23=(a18*a20);
+  a24=casadi_sq(a14);
+  a24=(a24/a08);
+  a24=(a13+a24);
+  a25=(a24+a12);
+  a26=(a03*a07);
+  a26=(a26*a14);
+  a26=(a26/a08);
+  a25=(a25+a26);
+  a23=(a23/a25);
+  R0[S*5]=a23;
+  a23=(a03*a17);
+  a23=(a23/a00);
+  a13=(a13+a12);
+  a19=(a19-a13);
+  a19=(a19+a21);
+  a19=(a19-a22);
+  a22=(a23*a19);
+  a22=(a22/a25);
+  R0[S*6]=a22;
+  a16=(a04*a16);
+  a16=(a16/a15);
+  R0[S*7]=a16;
+  a16=(2.*a17);
+  a16=(a16/a00);
+  a22=(a16*a20);
+  a22=(a22/a25);
+  R0[S*8]=a22;
+  a22=A0[S*2];
+  a22=(a22/a01);
+  a21=(a22*a19);
+  a21=(a21/a25);
+  a21=(-a21);
+  R0[S*9]=a21;
+  a21=(a22*a20);
+  a21=(a21/a25);
+  a21=(-a21);
+  R0[S*10]=a21;
+  R0[S*11]=a02;
+  a02=(a23*a20);
+  a02=(a02/a25);
+  R0[S*12]=a02;
+  a02=(a16*a19);
+  a02=(a02/a25);
+  R0[S*13]=a02;
+  R0[S*14]=a23;
+  a23=(-a22);
+  R0[S*15]=a23;
+  a23=(a14/a08);
+  a23=(a23/a10);
+  a23=(a23-a09);
+  a23=(a06*a23);
+  a23=(-a23);
+  R0[S*16]=a23;
+  a23=(a19/a01);
+  a23=(a23/a15);
+  a23=(-a23);
+  R0[S*17]=a23;
+  a23=(a20/a01);
+  a23=(a23/a15);
+  a23=(-a23);
+  R0[S*18]=a23;
+  a24=(a24+a26);
+  a26=(a18*a24);
+  a26=(a26/a25);
+  R0[S*19]=a26;
+  a19=(a04*a19);
+  a19=(a19/a15);
+  R0[S*20]=a19;
+  a20=(a04*a20);
+  a20=(a20/a15);
+  R0[S*21]=a20;
+  a20=(a16*a24);
+  a20=(a20/a25);
+  R0[S*22]=a20;
+  a24=(a22*a24);
+  a24=(a24/a25);
+  a24=(-a24);
+  R0[S*23]=a24;
+  a24=A0[S*9];
+  a20=(1./a24);
+  a19=(1./a08);
+  a20=(a20+a19);
+  a06=(a06*a20);
+  a06=(-a06);
+  R0[S*24]=a06;
+  a07=(a10*a07);
+  a07=(a07/a08);
+  a11=(a10*a11);
+  a11=(a11/a08);
+  a11=(a07+a11);
+  a06=(a11/a01);
+  a06=(a06/a15);
+  a06=(-a06);
+  R0[S*25]=a06;
+  a06=-6.;
+  a06=(a06*a17);
+  a06=(a06/a00);
+  a14=(a10*a14);
+  a14=(a14/a08);
+  a14=(a14-a07);
+  a06=(a06*a14);
+  a06=(a06/a25);
+  R0[S*26]=a06;
+  a18=(a18*a14);
+  a18=(a18/a25);
+  R0[S*27]=a18;
+  a04=(a04*a11);
+  a04=(a04/a15);
+  R0[S*28]=a04;
+  a16=(a16*a14);
+  a16=(a16/a25);
+  R0[S*29]=a16;
+  a22=(a22*a14);
+  a22=(a22/a25);
+  a22=(-a22);
+  R0[S*30]=a22;
+  a22=A0[S*5];
+  a03=(a03*a22);
+  a22=(a03/a24);
+  a10=casadi_sq(a10);
+  a22=(a22*a10);
+  a22=(a22/a00);
+  a25=(a10/a24);
+  a14=A0[S*20];
+  a14=casadi_sq(a14);
+  a16=A0[S*10];
+  a14=(a14/a16);
+  a25=(a25+a14);
+  a22=(a22/a25);
+  R0[S*31]=a22;
+  a22=A0[S*16];
+  R0[S*32]=a22;
+  a22=A0[S*4];
+  a14=(a22/a24);
+  a14=(a14*a10);
+  a14=(a14/a01);
+  a14=(a14/a25);
+  a14=(-a14);
+  R0[S*33]=a14;
+  a03=(a03/a00);
+  R0[S*34]=a03;
+  a22=(a22/a01);
+  a22=(-a22);
+  R0[S*35]=a22;
+  a05=(a05/a24);
+  a05=(a05/a01);
+  a05=(-a05);
+  R0[S*36]=a05;
+  a05=A0[S*8];
+  a05=(a05/a01);
+  R0[S*37]=a05;
+  a05=3.1415926535897934e-02;
+  R0[S*38]=a05;
+  a05=1.2566370614359172e+01;
+  R1[0]=a05;
+}
+static GEARSYM_INLINE void gs_constants(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) { gs_constants_strided(A0, R0, R1, 1); }
+
 /* the located step that crosses: its legs, RK4 of the sides held fixed on each (calls of one
    mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/crossing.py) */
 static GEARSYM_NOINLINE void gs_tangent_split(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict yt, const casadi_real* restrict Qt, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
@@ -19868,6 +18280,1875 @@ static GEARSYM_NOINLINE void gs_state_split(const casadi_real* restrict y, const
   gs_state_mode_step(yb, leg_b, c, yc);
   gs_state_mode_step(yc, leg_c, c, yn);
   gs_state_keep(y, lo, hi, yn, T, c, y1, lo1, hi1);
+}
+
+#ifndef GEARSYM_STEP_PIECES_ONLY  /* (the lanes' C includes the pieces above) */
+
+/* rhs:(t,y[12],p[24])->(dy[12]) */
+static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+  casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
+  casadi_real a36, a37, a38, a39, a40, a41, a42, a43, a44, a45, a46, a47;
+  casadi_real a48, a49, a50, a51, a52, a53, a54, a55, a56, a57, a58, a59;
+  casadi_real a60, a61, a62, a63, a64, a65, a66, a67, a68, a69, a70, a71;
+  casadi_real a72, a73, a74, a75, a76, a77, a78;
+  a00=arg[1]? arg[1][1] : 0;
+  if (res[0]!=0) res[0][0]=a00;
+  a01=-2.;
+  a02=(a01*a00);
+  a03=arg[2]? arg[2][1] : 0;
+  a04=(a02*a03);
+  a05=arg[2]? arg[2][0] : 0;
+  a04=(a04/a05);
+  a06=arg[2]? arg[2][17] : 0;
+  a07=arg[1]? arg[1][8] : 0;
+  a06=(a06*a07);
+  a07=casadi_sq(a05);
+  a08=(a06/a07);
+  a09=arg[2]? arg[2][21] : 0;
+  a10=arg[2]? arg[2][11] : 0;
+  a11=(a09/a10);
+  a12=arg[2]? arg[2][19] : 0;
+  a11=(a11/a12);
+  a13=arg[2]? arg[2][23] : 0;
+  a14=(a13/a10);
+  a14=(a14/a12);
+  a14=(a11+a14);
+  a14=(a08*a14);
+  a15=(a04-a14);
+  a16=arg[2]? arg[2][6] : 0;
+  a17=arg[2]? arg[2][7] : 0;
+  a18=arg[2]? arg[2][14] : 0;
+  a19=arg[0]? arg[0][0] : 0;
+  a18=(a18+a19);
+  a18=cos(a18);
+  a17=(a17*a18);
+  a16=(a16+a17);
+  a16=(a16/a07);
+  a15=(a15+a16);
+  a17=-4.;
+  a18=arg[1]? arg[1][7] : 0;
+  a20=(a17*a18);
+  a21=arg[2]? arg[2][3] : 0;
+  a20=(a20*a21);
+  a20=(a20/a05);
+  a22=arg[2]? arg[2][22] : 0;
+  a23=(a09*a22);
+  a23=(a23/a10);
+  a24=casadi_sq(a09);
+  a25=(a24/a10);
+  a26=(a23-a25);
+  a27=(a22*a13);
+  a27=(a27/a10);
+  a26=(a26+a27);
+  a28=(a09*a13);
+  a28=(a28/a10);
+  a26=(a26-a28);
+  a29=(a20*a26);
+  a30=casadi_sq(a22);
+  a30=(a30/a10);
+  a30=(a25+a30);
+  a31=arg[2]? arg[2][12] : 0;
+  a24=(a24/a31);
+  a31=(a30+a24);
+  a32=(a01*a09);
+  a32=(a32*a22);
+  a32=(a32/a10);
+  a31=(a31+a32);
+  a29=(a29/a31);
+  a15=(a15+a29);
+  a17=(a17*a00);
+  a17=(a17*a21);
+  a17=(a17/a05);
+  a00=(a17*a26);
+  a00=(a00/a31);
+  a15=(a15+a00);
+  a00=(a01*a18);
+  a00=(a00*a21);
+  a00=(a00/a05);
+  a33=(a25+a24);
+  a23=(a23-a33);
+  a23=(a23+a27);
+  a23=(a23-a28);
+  a28=(a00*a23);
+  a28=(a28/a31);
+  a15=(a15+a28);
+  a27=arg[1]? arg[1][3] : 0;
+  a33=(a01*a27);
+  a33=(a33*a03);
+  a33=(a33/a05);
+  a34=casadi_sq(a13);
+  a35=(a34/a10);
+  a25=(a25+a35);
+  a35=arg[2]? arg[2][13] : 0;
+  a34=(a34/a35);
+  a35=(a25+a34);
+  a36=(2.*a09);
+  a36=(a36*a13);
+  a36=(a36/a10);
+  a35=(a35+a36);
+  a37=(a33*a35);
+  a25=(a25+a24);
+  a25=(a25+a34);
+  a25=(a25+a36);
+  a37=(a37/a25);
+  a15=(a15+a37);
+  a36=arg[1]? arg[1][5] : 0;
+  a34=(a01*a36);
+  a34=(a34*a03);
+  a34=(a34/a05);
+  a03=(a34*a35);
+  a03=(a03/a25);
+  a15=(a15+a03);
+  a24=(2.*a27);
+  a24=(a24*a21);
+  a24=(a24/a05);
+  a38=(a24*a26);
+  a38=(a38/a31);
+  a15=(a15+a38);
+  a39=(2.*a36);
+  a39=(a39*a21);
+  a39=(a39/a05);
+  a40=(a39*a26);
+  a40=(a40/a31);
+  a15=(a15+a40);
+  a41=0.;
+  a42=arg[1]? arg[1][0] : 0;
+  a43=(a41<=a42);
+  a43=(a43?a42:0);
+  a44=arg[2]? arg[2][15] : 0;
+  a45=(-a44);
+  a46=(a42<=a45);
+  a47=(a42+a44);
+  a46=(a46?a47:0);
+  a43=(a43+a46);
+  a43=(a43/a07);
+  a46=1.;
+  a47=arg[2]? arg[2][18] : 0;
+  a48=1.1800386146799999e+00;
+  a49=cos(a19);
+  a50=(a48*a49);
+  a51=1.9272434388400000e-01;
+  a52=4.;
+  a52=(a52*a19);
+  a53=cos(a52);
+  a53=(a51*a53);
+  a50=(a50+a53);
+  a53=1.4883754528799999e-02;
+  a54=7.;
+  a54=(a54*a19);
+  a55=cos(a54);
+  a55=(a53*a55);
+  a50=(a50+a55);
+  a55=-6.0567417982099997e-02;
+  a56=6.;
+  a56=(a56*a19);
+  a56=cos(a56);
+  a56=(a55*a56);
+  a50=(a50+a56);
+  a57=-3.3689450631399998e-01;
+  a58=(2.*a19);
+  a59=cos(a58);
+  a60=(a57*a59);
+  a50=(a50+a60);
+  a60=-1.9563283778700000e-01;
+  a61=3.;
+  a61=(a61*a19);
+  a61=cos(a61);
+  a62=(a60*a61);
+  a50=(a50+a62);
+  a50=(a47*a50);
+  a50=(a46+a50);
+  a63=(a43*a50);
+  a15=(a15-a63);
+  a63=arg[2]? arg[2][2] : 0;
+  a63=(a63/a07);
+  a64=arg[1]? arg[1][6] : 0;
+  a65=(a41<=a64);
+  a65=(a65?a64:0);
+  a66=(a64<=a45);
+  a67=(a64+a44);
+  a66=(a66?a67:0);
+  a65=(a65+a66);
+  a65=(a63*a65);
+  a66=(a65*a23);
+  a66=(a66/a31);
+  a66=(a66*a50);
+  a15=(a15-a66);
+  a66=arg[1]? arg[1][2] : 0;
+  a67=(a41<=a66);
+  a67=(a67?a66:0);
+  a68=(a66<=a45);
+  a69=(a66+a44);
+  a68=(a68?a69:0);
+  a67=(a67+a68);
+  a67=(a67/a07);
+  a68=(a67*a35);
+  a68=(a68/a25);
+  a56=(a56+a62);
+  a62=3.3689450631399998e-01;
+  a69=1.0471975511965976e+00;
+  a70=(a58+a69);
+  a70=cos(a70);
+  a70=(a62*a70);
+  a70=(a56+a70);
+  a71=-1.1800386146799999e+00;
+  a72=5.2359877559829882e-01;
+  a73=(a19+a72);
+  a73=sin(a73);
+  a73=(a71*a73);
+  a70=(a70+a73);
+  a73=-1.9272434388400000e-01;
+  a74=(a52+a72);
+  a74=sin(a74);
+  a74=(a73*a74);
+  a70=(a70+a74);
+  a74=-1.4883754528799999e-02;
+  a75=(a54+a72);
+  a75=sin(a75);
+  a75=(a74*a75);
+  a70=(a70+a75);
+  a70=(a47*a70);
+  a70=(a46+a70);
+  a68=(a68*a70);
+  a15=(a15-a68);
+  a75=arg[1]? arg[1][4] : 0;
+  a76=(a41<=a75);
+  a76=(a76?a75:0);
+  a77=(a75<=a45);
+  a78=(a75+a44);
+  a77=(a77?a78:0);
+  a76=(a76+a77);
+  a76=(a76/a07);
+  a77=(a76*a35);
+  a77=(a77/a25);
+  a58=(a58+a72);
+  a58=sin(a58);
+  a62=(a62*a58);
+  a56=(a56+a62);
+  a62=(a19+a69);
+  a62=cos(a62);
+  a71=(a71*a62);
+  a56=(a56+a71);
+  a52=(a52+a69);
+  a52=cos(a52);
+  a73=(a73*a52);
+  a56=(a56+a73);
+  a54=(a54+a69);
+  a54=cos(a54);
+  a74=(a74*a54);
+  a56=(a56+a74);
+  a56=(a47*a56);
+  a56=(a46+a56);
+  a77=(a77*a56);
+  a15=(a15-a77);
+  a74=(a63*a26);
+  a42=(a42+a64);
+  a66=(a42-a66);
+  a64=(a41<=a66);
+  a64=(a64?a66:0);
+  a54=(a66<=a45);
+  a66=(a66+a44);
+  a54=(a54?a66:0);
+  a64=(a64+a54);
+  a54=(a74*a64);
+  a54=(a54/a31);
+  a54=(a54*a70);
+  a15=(a15-a54);
+  a42=(a42-a75);
+  a75=(a41<=a42);
+  a75=(a75?a42:0);
+  a45=(a42<=a45);
+  a42=(a42+a44);
+  a45=(a45?a42:0);
+  a75=(a75+a45);
+  a74=(a74*a75);
+  a74=(a74/a31);
+  a74=(a74*a56);
+  a15=(a15-a74);
+  if (res[0]!=0) res[0][1]=a15;
+  if (res[0]!=0) res[0][2]=a27;
+  a27=(a33-a14);
+  a27=(a27+a16);
+  a27=(a27+a29);
+  a27=(a27+a28);
+  a15=(a04*a35);
+  a15=(a15/a25);
+  a27=(a27+a15);
+  a02=(a02*a21);
+  a02=(a02/a05);
+  a45=(a02*a26);
+  a45=(a45/a31);
+  a27=(a27+a45);
+  a02=(a02*a23);
+  a02=(a02/a31);
+  a27=(a27+a02);
+  a27=(a27+a03);
+  a03=(a24*a23);
+  a03=(a03/a31);
+  a27=(a27+a03);
+  a27=(a27+a40);
+  a35=(a43*a35);
+  a35=(a35/a25);
+  a35=(a35*a50);
+  a27=(a27-a35);
+  a40=(a65*a26);
+  a40=(a40/a31);
+  a40=(a40*a50);
+  a27=(a27-a40);
+  a03=(a67*a70);
+  a27=(a27-a03);
+  a27=(a27-a77);
+  a77=(a63*a23);
+  a03=(a77*a64);
+  a03=(a03/a31);
+  a03=(a03*a70);
+  a27=(a27-a03);
+  a27=(a27-a74);
+  if (res[0]!=0) res[0][3]=a27;
+  if (res[0]!=0) res[0][4]=a36;
+  a14=(a34-a14);
+  a14=(a14+a16);
+  a14=(a14+a29);
+  a14=(a14+a28);
+  a14=(a14+a15);
+  a14=(a14+a45);
+  a14=(a14+a02);
+  a14=(a14+a37);
+  a14=(a14+a38);
+  a38=(a39*a23);
+  a38=(a38/a31);
+  a14=(a14+a38);
+  a14=(a14-a35);
+  a14=(a14-a40);
+  a40=(a76*a56);
+  a14=(a14-a40);
+  a14=(a14-a68);
+  a14=(a14-a54);
+  a77=(a77*a75);
+  a77=(a77/a31);
+  a77=(a77*a56);
+  a14=(a14-a77);
+  if (res[0]!=0) res[0][5]=a14;
+  if (res[0]!=0) res[0][6]=a18;
+  a14=(a22/a10);
+  a14=(a14/a12);
+  a14=(a14-a11);
+  a14=(a08*a14);
+  a00=(a00-a14);
+  a30=(a30+a32);
+  a20=(a20*a30);
+  a20=(a20/a31);
+  a00=(a00+a20);
+  a20=(a17*a30);
+  a20=(a20/a31);
+  a00=(a00+a20);
+  a20=(a04*a23);
+  a20=(a20/a25);
+  a00=(a00+a20);
+  a20=(a33*a26);
+  a20=(a20/a25);
+  a00=(a00+a20);
+  a20=(a34*a26);
+  a20=(a20/a25);
+  a00=(a00+a20);
+  a20=(a24*a30);
+  a20=(a20/a31);
+  a00=(a00+a20);
+  a20=(a39*a30);
+  a20=(a20/a31);
+  a00=(a00+a20);
+  a20=(a65*a50);
+  a00=(a00-a20);
+  a23=(a43*a23);
+  a23=(a23/a25);
+  a23=(a23*a50);
+  a00=(a00-a23);
+  a23=(a67*a26);
+  a23=(a23/a25);
+  a23=(a23*a70);
+  a00=(a00-a23);
+  a26=(a76*a26);
+  a26=(a26/a25);
+  a26=(a26*a56);
+  a00=(a00-a26);
+  a30=(a63*a30);
+  a26=(a30*a64);
+  a26=(a26/a31);
+  a26=(a26*a70);
+  a00=(a00-a26);
+  a30=(a30*a75);
+  a30=(a30/a31);
+  a30=(a30*a56);
+  a00=(a00-a30);
+  if (res[0]!=0) res[0][7]=a00;
+  a00=arg[1]? arg[1][9] : 0;
+  if (res[0]!=0) res[0][8]=a00;
+  a00=-6.;
+  a00=(a00*a18);
+  a00=(a00*a21);
+  a00=(a00/a05);
+  a22=(a12*a22);
+  a22=(a22/a10);
+  a09=(a12*a09);
+  a09=(a09/a10);
+  a22=(a22-a09);
+  a00=(a00*a22);
+  a00=(a00/a31);
+  a21=arg[2]? arg[2][9] : 0;
+  a18=(1./a21);
+  a30=(1./a10);
+  a18=(a18+a30);
+  a08=(a08*a18);
+  a00=(a00-a08);
+  a17=(a17*a22);
+  a17=(a17/a31);
+  a00=(a00+a17);
+  a13=(a12*a13);
+  a13=(a13/a10);
+  a09=(a09+a13);
+  a04=(a04*a09);
+  a04=(a04/a25);
+  a00=(a00+a04);
+  a33=(a33*a09);
+  a33=(a33/a25);
+  a00=(a00+a33);
+  a34=(a34*a09);
+  a34=(a34/a25);
+  a00=(a00+a34);
+  a24=(a24*a22);
+  a24=(a24/a31);
+  a00=(a00+a24);
+  a39=(a39*a22);
+  a39=(a39/a31);
+  a00=(a00+a39);
+  a39=arg[1]? arg[1][11] : 0;
+  a01=(a01*a39);
+  a24=arg[2]? arg[2][5] : 0;
+  a01=(a01*a24);
+  a24=(a01/a21);
+  a12=casadi_sq(a12);
+  a24=(a24*a12);
+  a24=(a24/a05);
+  a34=(a12/a21);
+  a33=arg[2]? arg[2][20] : 0;
+  a33=casadi_sq(a33);
+  a04=arg[2]? arg[2][10] : 0;
+  a33=(a33/a04);
+  a34=(a34+a33);
+  a24=(a24/a34);
+  a00=(a00+a24);
+  a43=(a43*a09);
+  a43=(a43/a25);
+  a43=(a43*a50);
+  a00=(a00-a43);
+  a65=(a65*a22);
+  a65=(a65/a31);
+  a65=(a65*a50);
+  a00=(a00-a65);
+  a65=arg[2]? arg[2][4] : 0;
+  a50=(a65/a21);
+  a50=(a50*a12);
+  a50=(a50/a07);
+  a12=arg[1]? arg[1][10] : 0;
+  a41=(a41<=a12);
+  a41=(a41?a12:0);
+  a43=arg[2]? arg[2][16] : 0;
+  a24=(-a43);
+  a24=(a12<=a24);
+  a12=(a12+a43);
+  a24=(a24?a12:0);
+  a41=(a41+a24);
+  a50=(a50*a41);
+  a50=(a50/a34);
+  a57=(a57*a49);
+  a49=5.0000000000000000e-01;
+  a49=(a49*a19);
+  a49=cos(a49);
+  a48=(a48*a49);
+  a57=(a57+a48);
+  a51=(a51*a59);
+  a57=(a57+a51);
+  a51=3.5000000000000000e+00;
+  a51=(a51*a19);
+  a51=cos(a51);
+  a53=(a53*a51);
+  a57=(a57+a53);
+  a55=(a55*a61);
+  a57=(a57+a55);
+  a55=1.5000000000000000e+00;
+  a55=(a55*a19);
+  a55=cos(a55);
+  a60=(a60*a55);
+  a57=(a57+a60);
+  a47=(a47*a57);
+  a46=(a46+a47);
+  a50=(a50*a46);
+  a00=(a00-a50);
+  a67=(a67*a09);
+  a67=(a67/a25);
+  a67=(a67*a70);
+  a00=(a00-a67);
+  a76=(a76*a09);
+  a76=(a76/a25);
+  a76=(a76*a56);
+  a00=(a00-a76);
+  a63=(a63*a22);
+  a64=(a63*a64);
+  a64=(a64/a31);
+  a64=(a64*a70);
+  a00=(a00-a64);
+  a63=(a63*a75);
+  a63=(a63/a31);
+  a63=(a63*a56);
+  a00=(a00-a63);
+  if (res[0]!=0) res[0][9]=a00;
+  if (res[0]!=0) res[0][10]=a39;
+  a39=arg[2]? arg[2][8] : 0;
+  a39=(a39/a07);
+  a01=(a01/a05);
+  a39=(a39+a01);
+  a06=(a06/a21);
+  a06=(a06/a07);
+  a39=(a39-a06);
+  a65=(a65/a07);
+  a65=(a65*a41);
+  a65=(a65*a46);
+  a39=(a39-a65);
+  if (res[0]!=0) res[0][11]=a39;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int rhs(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f0(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int rhs_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void rhs_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void rhs_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void rhs_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int rhs_n_in(void) { return 3;}
+
+CASADI_SYMBOL_EXPORT casadi_int rhs_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real rhs_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* rhs_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "y";
+    case 2: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* rhs_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "dy";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s1;
+    case 2: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s1;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int rhs_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int rhs_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* jacobian:(t,y[12],p[24])->(J[12x12]) */
+static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+  casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
+  casadi_real a36, a37, a38, a39, a40, a41, a42, a43, a44, a45, a46, a47;
+  casadi_real a48, a49, a50, a51, a52, a53, a54, a55, a56, a57, a58, a59;
+  casadi_real a60, a61, a62, a63;
+  a00=0.;
+  if (res[0]!=0) res[0][0]=a00;
+  a01=1.;
+  a02=arg[2]? arg[2][18] : 0;
+  a03=1.1800386146799999e+00;
+  a04=arg[0]? arg[0][0] : 0;
+  a05=cos(a04);
+  a06=(a03*a05);
+  a07=1.9272434388400000e-01;
+  a08=4.;
+  a08=(a08*a04);
+  a09=cos(a08);
+  a09=(a07*a09);
+  a06=(a06+a09);
+  a09=1.4883754528799999e-02;
+  a10=7.;
+  a10=(a10*a04);
+  a11=cos(a10);
+  a11=(a09*a11);
+  a06=(a06+a11);
+  a11=-6.0567417982099997e-02;
+  a12=6.;
+  a12=(a12*a04);
+  a12=cos(a12);
+  a12=(a11*a12);
+  a06=(a06+a12);
+  a13=-3.3689450631399998e-01;
+  a14=(2.*a04);
+  a15=cos(a14);
+  a16=(a13*a15);
+  a06=(a06+a16);
+  a16=-1.9563283778700000e-01;
+  a17=3.;
+  a17=(a17*a04);
+  a17=cos(a17);
+  a18=(a16*a17);
+  a06=(a06+a18);
+  a06=(a02*a06);
+  a06=(a01+a06);
+  a19=arg[1]? arg[1][0] : 0;
+  a20=(a00<=a19);
+  a20=(a20?a01:0);
+  a21=arg[2]? arg[2][15] : 0;
+  a21=(-a21);
+  a22=(a19<=a21);
+  a22=(a22?a01:0);
+  a20=(a20+a22);
+  a22=arg[2]? arg[2][0] : 0;
+  a23=casadi_sq(a22);
+  a20=(a20/a23);
+  a24=(a06*a20);
+  a12=(a12+a18);
+  a18=3.3689450631399998e-01;
+  a25=1.0471975511965976e+00;
+  a26=(a14+a25);
+  a26=cos(a26);
+  a26=(a18*a26);
+  a26=(a12+a26);
+  a27=-1.1800386146799999e+00;
+  a28=5.2359877559829882e-01;
+  a29=(a04+a28);
+  a29=sin(a29);
+  a29=(a27*a29);
+  a26=(a26+a29);
+  a29=-1.9272434388400000e-01;
+  a30=(a08+a28);
+  a30=sin(a30);
+  a30=(a29*a30);
+  a26=(a26+a30);
+  a30=-1.4883754528799999e-02;
+  a31=(a10+a28);
+  a31=sin(a31);
+  a31=(a30*a31);
+  a26=(a26+a31);
+  a26=(a02*a26);
+  a26=(a01+a26);
+  a31=arg[2]? arg[2][2] : 0;
+  a31=(a31/a23);
+  a32=arg[2]? arg[2][21] : 0;
+  a33=arg[2]? arg[2][22] : 0;
+  a34=(a32*a33);
+  a35=arg[2]? arg[2][11] : 0;
+  a34=(a34/a35);
+  a36=casadi_sq(a32);
+  a37=(a36/a35);
+  a38=(a34-a37);
+  a39=arg[2]? arg[2][23] : 0;
+  a40=(a33*a39);
+  a40=(a40/a35);
+  a38=(a38+a40);
+  a41=(a32*a39);
+  a41=(a41/a35);
+  a38=(a38-a41);
+  a42=(a31*a38);
+  a43=arg[1]? arg[1][6] : 0;
+  a19=(a19+a43);
+  a44=arg[1]? arg[1][2] : 0;
+  a45=(a19-a44);
+  a46=(a00<=a45);
+  a47=(a46?a01:0);
+  a45=(a45<=a21);
+  a48=(a45?a01:0);
+  a47=(a47+a48);
+  a48=(a42*a47);
+  a49=casadi_sq(a33);
+  a49=(a49/a35);
+  a49=(a37+a49);
+  a50=arg[2]? arg[2][12] : 0;
+  a36=(a36/a50);
+  a50=(a49+a36);
+  a51=-2.;
+  a52=(a51*a32);
+  a52=(a52*a33);
+  a52=(a52/a35);
+  a50=(a50+a52);
+  a48=(a48/a50);
+  a48=(a26*a48);
+  a24=(a24+a48);
+  a14=(a14+a28);
+  a14=sin(a14);
+  a18=(a18*a14);
+  a12=(a12+a18);
+  a18=(a04+a25);
+  a18=cos(a18);
+  a27=(a27*a18);
+  a12=(a12+a27);
+  a08=(a08+a25);
+  a08=cos(a08);
+  a29=(a29*a08);
+  a12=(a12+a29);
+  a10=(a10+a25);
+  a10=cos(a10);
+  a30=(a30*a10);
+  a12=(a12+a30);
+  a12=(a02*a12);
+  a12=(a01+a12);
+  a30=arg[1]? arg[1][4] : 0;
+  a19=(a19-a30);
+  a10=(a00<=a19);
+  a25=(a10?a01:0);
+  a19=(a19<=a21);
+  a29=(a19?a01:0);
+  a25=(a25+a29);
+  a29=(a42*a25);
+  a29=(a29/a50);
+  a29=(a12*a29);
+  a24=(a24+a29);
+  a24=(-a24);
+  if (res[0]!=0) res[0][1]=a24;
+  if (res[0]!=0) res[0][2]=a00;
+  a24=casadi_sq(a39);
+  a08=(a24/a35);
+  a08=(a37+a08);
+  a27=arg[2]? arg[2][13] : 0;
+  a24=(a24/a27);
+  a27=(a08+a24);
+  a18=(2.*a32);
+  a18=(a18*a39);
+  a18=(a18/a35);
+  a27=(a27+a18);
+  a14=(a27*a20);
+  a08=(a08+a36);
+  a08=(a08+a24);
+  a08=(a08+a18);
+  a14=(a14/a08);
+  a14=(a06*a14);
+  a37=(a37+a36);
+  a34=(a34-a37);
+  a34=(a34+a40);
+  a34=(a34-a41);
+  a41=(a31*a34);
+  a40=(a41*a47);
+  a40=(a40/a50);
+  a40=(a26*a40);
+  a37=(a14+a40);
+  a37=(a37+a29);
+  a37=(-a37);
+  if (res[0]!=0) res[0][3]=a37;
+  if (res[0]!=0) res[0][4]=a00;
+  a14=(a14+a48);
+  a37=(a41*a25);
+  a37=(a37/a50);
+  a37=(a12*a37);
+  a14=(a14+a37);
+  a14=(-a14);
+  if (res[0]!=0) res[0][5]=a14;
+  if (res[0]!=0) res[0][6]=a00;
+  a14=(a34*a20);
+  a14=(a14/a08);
+  a14=(a06*a14);
+  a49=(a49+a52);
+  a52=(a31*a49);
+  a36=(a52*a47);
+  a36=(a36/a50);
+  a36=(a26*a36);
+  a14=(a14+a36);
+  a18=(a52*a25);
+  a18=(a18/a50);
+  a18=(a12*a18);
+  a14=(a14+a18);
+  a14=(-a14);
+  if (res[0]!=0) res[0][7]=a14;
+  if (res[0]!=0) res[0][8]=a00;
+  a14=arg[2]? arg[2][19] : 0;
+  a24=(a14*a32);
+  a24=(a24/a35);
+  a28=(a14*a39);
+  a28=(a28/a35);
+  a28=(a24+a28);
+  a20=(a28*a20);
+  a20=(a20/a08);
+  a20=(a06*a20);
+  a53=(a14*a33);
+  a53=(a53/a35);
+  a53=(a53-a24);
+  a24=(a31*a53);
+  a47=(a24*a47);
+  a47=(a47/a50);
+  a47=(a26*a47);
+  a20=(a20+a47);
+  a25=(a24*a25);
+  a25=(a25/a50);
+  a25=(a12*a25);
+  a20=(a20+a25);
+  a20=(-a20);
+  if (res[0]!=0) res[0][9]=a20;
+  if (res[0]!=0) res[0][10]=a00;
+  if (res[0]!=0) res[0][11]=a00;
+  if (res[0]!=0) res[0][12]=a01;
+  a20=arg[2]? arg[2][1] : 0;
+  a20=(a51*a20);
+  a20=(a20/a22);
+  a54=-4.;
+  a55=arg[2]? arg[2][3] : 0;
+  a54=(a54*a55);
+  a54=(a54/a22);
+  a56=(a38*a54);
+  a56=(a56/a50);
+  a57=(a20+a56);
+  if (res[0]!=0) res[0][13]=a57;
+  if (res[0]!=0) res[0][14]=a00;
+  a57=(a27*a20);
+  a57=(a57/a08);
+  a58=(a51*a55);
+  a58=(a58/a22);
+  a59=(a38*a58);
+  a59=(a59/a50);
+  a59=(a57+a59);
+  a60=(a34*a58);
+  a60=(a60/a50);
+  a59=(a59+a60);
+  if (res[0]!=0) res[0][15]=a59;
+  if (res[0]!=0) res[0][16]=a00;
+  if (res[0]!=0) res[0][17]=a59;
+  if (res[0]!=0) res[0][18]=a00;
+  a59=(a49*a54);
+  a59=(a59/a50);
+  a61=(a34*a20);
+  a61=(a61/a08);
+  a61=(a59+a61);
+  if (res[0]!=0) res[0][19]=a61;
+  if (res[0]!=0) res[0][20]=a00;
+  a54=(a53*a54);
+  a54=(a54/a50);
+  a61=(a28*a20);
+  a61=(a61/a08);
+  a54=(a54+a61);
+  if (res[0]!=0) res[0][21]=a54;
+  if (res[0]!=0) res[0][22]=a00;
+  if (res[0]!=0) res[0][23]=a00;
+  if (res[0]!=0) res[0][24]=a00;
+  a54=(a00<=a44);
+  a54=(a54?a01:0);
+  a44=(a44<=a21);
+  a44=(a44?a01:0);
+  a54=(a54+a44);
+  a54=(a54/a23);
+  a44=(a27*a54);
+  a44=(a44/a08);
+  a44=(a26*a44);
+  a62=-1.;
+  a46=(a46?a62:0);
+  a45=(a45?a62:0);
+  a46=(a46+a45);
+  a45=(a42*a46);
+  a45=(a45/a50);
+  a45=(a26*a45);
+  a44=(a44+a45);
+  a44=(-a44);
+  if (res[0]!=0) res[0][25]=a44;
+  if (res[0]!=0) res[0][26]=a00;
+  a45=(a26*a54);
+  a63=(a41*a46);
+  a63=(a63/a50);
+  a63=(a26*a63);
+  a45=(a45+a63);
+  a45=(-a45);
+  if (res[0]!=0) res[0][27]=a45;
+  if (res[0]!=0) res[0][28]=a00;
+  if (res[0]!=0) res[0][29]=a44;
+  if (res[0]!=0) res[0][30]=a00;
+  a44=(a38*a54);
+  a44=(a44/a08);
+  a44=(a26*a44);
+  a45=(a52*a46);
+  a45=(a45/a50);
+  a45=(a26*a45);
+  a44=(a44+a45);
+  a44=(-a44);
+  if (res[0]!=0) res[0][31]=a44;
+  if (res[0]!=0) res[0][32]=a00;
+  a54=(a28*a54);
+  a54=(a54/a08);
+  a54=(a26*a54);
+  a46=(a24*a46);
+  a46=(a46/a50);
+  a26=(a26*a46);
+  a54=(a54+a26);
+  a54=(-a54);
+  if (res[0]!=0) res[0][33]=a54;
+  if (res[0]!=0) res[0][34]=a00;
+  if (res[0]!=0) res[0][35]=a00;
+  if (res[0]!=0) res[0][36]=a00;
+  a54=(2.*a55);
+  a54=(a54/a22);
+  a26=(a38*a54);
+  a26=(a26/a50);
+  a57=(a57+a26);
+  if (res[0]!=0) res[0][37]=a57;
+  if (res[0]!=0) res[0][38]=a01;
+  a26=(a34*a54);
+  a26=(a26/a50);
+  a26=(a20+a26);
+  if (res[0]!=0) res[0][39]=a26;
+  if (res[0]!=0) res[0][40]=a00;
+  if (res[0]!=0) res[0][41]=a57;
+  if (res[0]!=0) res[0][42]=a00;
+  a20=(a38*a20);
+  a20=(a20/a08);
+  a49=(a49*a54);
+  a49=(a49/a50);
+  a20=(a20+a49);
+  if (res[0]!=0) res[0][43]=a20;
+  if (res[0]!=0) res[0][44]=a00;
+  a54=(a53*a54);
+  a54=(a54/a50);
+  a61=(a61+a54);
+  if (res[0]!=0) res[0][45]=a61;
+  if (res[0]!=0) res[0][46]=a00;
+  if (res[0]!=0) res[0][47]=a00;
+  if (res[0]!=0) res[0][48]=a00;
+  a54=(a00<=a30);
+  a54=(a54?a01:0);
+  a30=(a30<=a21);
+  a30=(a30?a01:0);
+  a54=(a54+a30);
+  a54=(a54/a23);
+  a27=(a27*a54);
+  a27=(a27/a08);
+  a27=(a12*a27);
+  a10=(a10?a62:0);
+  a19=(a19?a62:0);
+  a10=(a10+a19);
+  a42=(a42*a10);
+  a42=(a42/a50);
+  a42=(a12*a42);
+  a27=(a27+a42);
+  a27=(-a27);
+  if (res[0]!=0) res[0][49]=a27;
+  if (res[0]!=0) res[0][50]=a00;
+  if (res[0]!=0) res[0][51]=a27;
+  if (res[0]!=0) res[0][52]=a00;
+  a27=(a12*a54);
+  a41=(a41*a10);
+  a41=(a41/a50);
+  a41=(a12*a41);
+  a27=(a27+a41);
+  a27=(-a27);
+  if (res[0]!=0) res[0][53]=a27;
+  if (res[0]!=0) res[0][54]=a00;
+  a27=(a38*a54);
+  a27=(a27/a08);
+  a27=(a12*a27);
+  a52=(a52*a10);
+  a52=(a52/a50);
+  a52=(a12*a52);
+  a27=(a27+a52);
+  a27=(-a27);
+  if (res[0]!=0) res[0][55]=a27;
+  if (res[0]!=0) res[0][56]=a00;
+  a28=(a28*a54);
+  a28=(a28/a08);
+  a28=(a12*a28);
+  a24=(a24*a10);
+  a24=(a24/a50);
+  a12=(a12*a24);
+  a28=(a28+a12);
+  a28=(-a28);
+  if (res[0]!=0) res[0][57]=a28;
+  if (res[0]!=0) res[0][58]=a00;
+  if (res[0]!=0) res[0][59]=a00;
+  if (res[0]!=0) res[0][60]=a00;
+  if (res[0]!=0) res[0][61]=a57;
+  if (res[0]!=0) res[0][62]=a00;
+  if (res[0]!=0) res[0][63]=a57;
+  if (res[0]!=0) res[0][64]=a01;
+  if (res[0]!=0) res[0][65]=a26;
+  if (res[0]!=0) res[0][66]=a00;
+  if (res[0]!=0) res[0][67]=a20;
+  if (res[0]!=0) res[0][68]=a00;
+  if (res[0]!=0) res[0][69]=a61;
+  if (res[0]!=0) res[0][70]=a00;
+  if (res[0]!=0) res[0][71]=a00;
+  if (res[0]!=0) res[0][72]=a00;
+  a61=(a00<=a43);
+  a61=(a61?a01:0);
+  a43=(a43<=a21);
+  a43=(a43?a01:0);
+  a61=(a61+a43);
+  a31=(a31*a61);
+  a34=(a34*a31);
+  a34=(a34/a50);
+  a34=(a06*a34);
+  a34=(a34+a48);
+  a34=(a34+a29);
+  a34=(-a34);
+  if (res[0]!=0) res[0][73]=a34;
+  if (res[0]!=0) res[0][74]=a00;
+  a38=(a38*a31);
+  a38=(a38/a50);
+  a38=(a06*a38);
+  a40=(a38+a40);
+  a40=(a40+a29);
+  a40=(-a40);
+  if (res[0]!=0) res[0][75]=a40;
+  if (res[0]!=0) res[0][76]=a00;
+  a38=(a38+a48);
+  a38=(a38+a37);
+  a38=(-a38);
+  if (res[0]!=0) res[0][77]=a38;
+  if (res[0]!=0) res[0][78]=a00;
+  a38=(a06*a31);
+  a38=(a38+a36);
+  a38=(a38+a18);
+  a38=(-a38);
+  if (res[0]!=0) res[0][79]=a38;
+  if (res[0]!=0) res[0][80]=a00;
+  a31=(a53*a31);
+  a31=(a31/a50);
+  a06=(a06*a31);
+  a06=(a06+a47);
+  a06=(a06+a25);
+  a06=(-a06);
+  if (res[0]!=0) res[0][81]=a06;
+  if (res[0]!=0) res[0][82]=a00;
+  if (res[0]!=0) res[0][83]=a00;
+  if (res[0]!=0) res[0][84]=a00;
+  a56=(a56+a60);
+  if (res[0]!=0) res[0][85]=a56;
+  if (res[0]!=0) res[0][86]=a00;
+  if (res[0]!=0) res[0][87]=a56;
+  if (res[0]!=0) res[0][88]=a00;
+  if (res[0]!=0) res[0][89]=a56;
+  if (res[0]!=0) res[0][90]=a01;
+  a58=(a58+a59);
+  if (res[0]!=0) res[0][91]=a58;
+  if (res[0]!=0) res[0][92]=a00;
+  a58=-6.;
+  a58=(a58*a55);
+  a58=(a58/a22);
+  a53=(a53*a58);
+  a53=(a53/a50);
+  if (res[0]!=0) res[0][93]=a53;
+  if (res[0]!=0) res[0][94]=a00;
+  if (res[0]!=0) res[0][95]=a00;
+  if (res[0]!=0) res[0][96]=a00;
+  a32=(a32/a35);
+  a32=(a32/a14);
+  a39=(a39/a35);
+  a39=(a39/a14);
+  a39=(a32+a39);
+  a53=arg[2]? arg[2][17] : 0;
+  a50=(a53/a23);
+  a39=(a39*a50);
+  a39=(-a39);
+  if (res[0]!=0) res[0][97]=a39;
+  if (res[0]!=0) res[0][98]=a00;
+  if (res[0]!=0) res[0][99]=a39;
+  if (res[0]!=0) res[0][100]=a00;
+  if (res[0]!=0) res[0][101]=a39;
+  if (res[0]!=0) res[0][102]=a00;
+  a33=(a33/a35);
+  a33=(a33/a14);
+  a33=(a33-a32);
+  a33=(a33*a50);
+  a33=(-a33);
+  if (res[0]!=0) res[0][103]=a33;
+  if (res[0]!=0) res[0][104]=a00;
+  a33=arg[2]? arg[2][9] : 0;
+  a32=(1./a33);
+  a35=(1./a35);
+  a32=(a32+a35);
+  a32=(a32*a50);
+  a32=(-a32);
+  if (res[0]!=0) res[0][105]=a32;
+  if (res[0]!=0) res[0][106]=a00;
+  a53=(a53/a33);
+  a53=(a53/a23);
+  a53=(-a53);
+  if (res[0]!=0) res[0][107]=a53;
+  if (res[0]!=0) res[0][108]=a00;
+  if (res[0]!=0) res[0][109]=a00;
+  if (res[0]!=0) res[0][110]=a00;
+  if (res[0]!=0) res[0][111]=a00;
+  if (res[0]!=0) res[0][112]=a00;
+  if (res[0]!=0) res[0][113]=a00;
+  if (res[0]!=0) res[0][114]=a00;
+  if (res[0]!=0) res[0][115]=a00;
+  if (res[0]!=0) res[0][116]=a01;
+  if (res[0]!=0) res[0][117]=a00;
+  if (res[0]!=0) res[0][118]=a00;
+  if (res[0]!=0) res[0][119]=a00;
+  if (res[0]!=0) res[0][120]=a00;
+  if (res[0]!=0) res[0][121]=a00;
+  if (res[0]!=0) res[0][122]=a00;
+  if (res[0]!=0) res[0][123]=a00;
+  if (res[0]!=0) res[0][124]=a00;
+  if (res[0]!=0) res[0][125]=a00;
+  if (res[0]!=0) res[0][126]=a00;
+  if (res[0]!=0) res[0][127]=a00;
+  if (res[0]!=0) res[0][128]=a00;
+  a13=(a13*a05);
+  a05=5.0000000000000000e-01;
+  a05=(a05*a04);
+  a05=cos(a05);
+  a03=(a03*a05);
+  a13=(a13+a03);
+  a07=(a07*a15);
+  a13=(a13+a07);
+  a07=3.5000000000000000e+00;
+  a07=(a07*a04);
+  a07=cos(a07);
+  a09=(a09*a07);
+  a13=(a13+a09);
+  a11=(a11*a17);
+  a13=(a13+a11);
+  a11=1.5000000000000000e+00;
+  a11=(a11*a04);
+  a11=cos(a11);
+  a16=(a16*a11);
+  a13=(a13+a16);
+  a02=(a02*a13);
+  a02=(a01+a02);
+  a13=arg[2]? arg[2][4] : 0;
+  a16=(a13/a33);
+  a14=casadi_sq(a14);
+  a16=(a16*a14);
+  a16=(a16/a23);
+  a11=arg[1]? arg[1][10] : 0;
+  a04=(a00<=a11);
+  a04=(a04?a01:0);
+  a17=arg[2]? arg[2][16] : 0;
+  a17=(-a17);
+  a11=(a11<=a17);
+  a11=(a11?a01:0);
+  a04=(a04+a11);
+  a16=(a16*a04);
+  a11=(a14/a33);
+  a17=arg[2]? arg[2][20] : 0;
+  a17=casadi_sq(a17);
+  a09=arg[2]? arg[2][10] : 0;
+  a17=(a17/a09);
+  a11=(a11+a17);
+  a16=(a16/a11);
+  a16=(a02*a16);
+  a16=(-a16);
+  if (res[0]!=0) res[0][129]=a16;
+  if (res[0]!=0) res[0][130]=a00;
+  a13=(a13/a23);
+  a13=(a13*a04);
+  a02=(a02*a13);
+  a02=(-a02);
+  if (res[0]!=0) res[0][131]=a02;
+  if (res[0]!=0) res[0][132]=a00;
+  if (res[0]!=0) res[0][133]=a00;
+  if (res[0]!=0) res[0][134]=a00;
+  if (res[0]!=0) res[0][135]=a00;
+  if (res[0]!=0) res[0][136]=a00;
+  if (res[0]!=0) res[0][137]=a00;
+  if (res[0]!=0) res[0][138]=a00;
+  if (res[0]!=0) res[0][139]=a00;
+  if (res[0]!=0) res[0][140]=a00;
+  a00=arg[2]? arg[2][5] : 0;
+  a51=(a51*a00);
+  a33=(a51/a33);
+  a14=(a14*a33);
+  a14=(a14/a22);
+  a14=(a14/a11);
+  if (res[0]!=0) res[0][141]=a14;
+  if (res[0]!=0) res[0][142]=a01;
+  a51=(a51/a22);
+  if (res[0]!=0) res[0][143]=a51;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int jacobian(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f1(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int jacobian_n_in(void) { return 3;}
+
+CASADI_SYMBOL_EXPORT casadi_int jacobian_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real jacobian_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* jacobian_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "y";
+    case 2: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* jacobian_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "J";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s1;
+    case 2: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s3;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* constants:(p[24])->(c[39],period) */
+static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+  casadi_real a24, a25, a26;
+  a00=arg[0]? arg[0][15] : 0;
+  if (res[0]!=0) res[0][0]=a00;
+  a00=arg[0]? arg[0][0] : 0;
+  a01=casadi_sq(a00);
+  a02=(1./a01);
+  a03=(-a02);
+  if (res[0]!=0) res[0][1]=a03;
+  a03=-2.;
+  a04=arg[0]? arg[0][1] : 0;
+  a04=(a03*a04);
+  a04=(a04/a00);
+  if (res[0]!=0) res[0][2]=a04;
+  a05=arg[0]? arg[0][17] : 0;
+  a06=(a05/a01);
+  a07=arg[0]? arg[0][21] : 0;
+  a08=arg[0]? arg[0][11] : 0;
+  a09=(a07/a08);
+  a10=arg[0]? arg[0][19] : 0;
+  a09=(a09/a10);
+  a11=arg[0]? arg[0][23] : 0;
+  a12=(a11/a08);
+  a12=(a12/a10);
+  a12=(a09+a12);
+  a12=(a06*a12);
+  a12=(-a12);
+  if (res[0]!=0) res[0][3]=a12;
+  a12=casadi_sq(a07);
+  a13=(a12/a08);
+  a14=casadi_sq(a11);
+  a15=(a14/a08);
+  a15=(a13+a15);
+  a16=arg[0]? arg[0][13] : 0;
+  a14=(a14/a16);
+  a16=(a15+a14);
+  a17=(2.*a07);
+  a17=(a17*a11);
+  a17=(a17/a08);
+  a16=(a16+a17);
+  a18=(a16/a01);
+  a19=arg[0]? arg[0][12] : 0;
+  a12=(a12/a19);
+  a15=(a15+a12);
+  a15=(a15+a14);
+  a15=(a15+a17);
+  a18=(a18/a15);
+  a18=(-a18);
+  if (res[0]!=0) res[0][4]=a18;
+  a18=-4.;
+  a17=arg[0]? arg[0][3] : 0;
+  a18=(a18*a17);
+  a18=(a18/a00);
+  a14=arg[0]? arg[0][22] : 0;
+  a19=(a07*a14);
+  a19=(a19/a08);
+  a20=(a19-a13);
+  a21=(a14*a11);
+  a21=(a21/a08);
+  a20=(a20+a21);
+  a22=(a07*a11);
+  a22=(a22/a08);
+  a20=(a20-a22);
+  a23=(a18*a20);
+  a24=casadi_sq(a14);
+  a24=(a24/a08);
+  a24=(a13+a24);
+  a25=(a24+a12);
+  a26=(a03*a07);
+  a26=(a26*a14);
+  a26=(a26/a08);
+  a25=(a25+a26);
+  a23=(a23/a25);
+  if (res[0]!=0) res[0][5]=a23;
+  a23=(a03*a17);
+  a23=(a23/a00);
+  a13=(a13+a12);
+  a19=(a19-a13);
+  a19=(a19+a21);
+  a19=(a19-a22);
+  a22=(a23*a19);
+  a22=(a22/a25);
+  if (res[0]!=0) res[0][6]=a22;
+  a16=(a04*a16);
+  a16=(a16/a15);
+  if (res[0]!=0) res[0][7]=a16;
+  a16=(2.*a17);
+  a16=(a16/a00);
+  a22=(a16*a20);
+  a22=(a22/a25);
+  if (res[0]!=0) res[0][8]=a22;
+  a22=arg[0]? arg[0][2] : 0;
+  a22=(a22/a01);
+  a21=(a22*a19);
+  a21=(a21/a25);
+  a21=(-a21);
+  if (res[0]!=0) res[0][9]=a21;
+  a21=(a22*a20);
+  a21=(a21/a25);
+  a21=(-a21);
+  if (res[0]!=0) res[0][10]=a21;
+  if (res[0]!=0) res[0][11]=a02;
+  a02=(a23*a20);
+  a02=(a02/a25);
+  if (res[0]!=0) res[0][12]=a02;
+  a02=(a16*a19);
+  a02=(a02/a25);
+  if (res[0]!=0) res[0][13]=a02;
+  if (res[0]!=0) res[0][14]=a23;
+  a23=(-a22);
+  if (res[0]!=0) res[0][15]=a23;
+  a23=(a14/a08);
+  a23=(a23/a10);
+  a23=(a23-a09);
+  a23=(a06*a23);
+  a23=(-a23);
+  if (res[0]!=0) res[0][16]=a23;
+  a23=(a19/a01);
+  a23=(a23/a15);
+  a23=(-a23);
+  if (res[0]!=0) res[0][17]=a23;
+  a23=(a20/a01);
+  a23=(a23/a15);
+  a23=(-a23);
+  if (res[0]!=0) res[0][18]=a23;
+  a24=(a24+a26);
+  a26=(a18*a24);
+  a26=(a26/a25);
+  if (res[0]!=0) res[0][19]=a26;
+  a19=(a04*a19);
+  a19=(a19/a15);
+  if (res[0]!=0) res[0][20]=a19;
+  a20=(a04*a20);
+  a20=(a20/a15);
+  if (res[0]!=0) res[0][21]=a20;
+  a20=(a16*a24);
+  a20=(a20/a25);
+  if (res[0]!=0) res[0][22]=a20;
+  a24=(a22*a24);
+  a24=(a24/a25);
+  a24=(-a24);
+  if (res[0]!=0) res[0][23]=a24;
+  a24=arg[0]? arg[0][9] : 0;
+  a20=(1./a24);
+  a19=(1./a08);
+  a20=(a20+a19);
+  a06=(a06*a20);
+  a06=(-a06);
+  if (res[0]!=0) res[0][24]=a06;
+  a07=(a10*a07);
+  a07=(a07/a08);
+  a11=(a10*a11);
+  a11=(a11/a08);
+  a11=(a07+a11);
+  a06=(a11/a01);
+  a06=(a06/a15);
+  a06=(-a06);
+  if (res[0]!=0) res[0][25]=a06;
+  a06=-6.;
+  a06=(a06*a17);
+  a06=(a06/a00);
+  a14=(a10*a14);
+  a14=(a14/a08);
+  a14=(a14-a07);
+  a06=(a06*a14);
+  a06=(a06/a25);
+  if (res[0]!=0) res[0][26]=a06;
+  a18=(a18*a14);
+  a18=(a18/a25);
+  if (res[0]!=0) res[0][27]=a18;
+  a04=(a04*a11);
+  a04=(a04/a15);
+  if (res[0]!=0) res[0][28]=a04;
+  a16=(a16*a14);
+  a16=(a16/a25);
+  if (res[0]!=0) res[0][29]=a16;
+  a22=(a22*a14);
+  a22=(a22/a25);
+  a22=(-a22);
+  if (res[0]!=0) res[0][30]=a22;
+  a22=arg[0]? arg[0][5] : 0;
+  a03=(a03*a22);
+  a22=(a03/a24);
+  a10=casadi_sq(a10);
+  a22=(a22*a10);
+  a22=(a22/a00);
+  a25=(a10/a24);
+  a14=arg[0]? arg[0][20] : 0;
+  a14=casadi_sq(a14);
+  a16=arg[0]? arg[0][10] : 0;
+  a14=(a14/a16);
+  a25=(a25+a14);
+  a22=(a22/a25);
+  if (res[0]!=0) res[0][31]=a22;
+  a22=arg[0]? arg[0][16] : 0;
+  if (res[0]!=0) res[0][32]=a22;
+  a22=arg[0]? arg[0][4] : 0;
+  a14=(a22/a24);
+  a14=(a14*a10);
+  a14=(a14/a01);
+  a14=(a14/a25);
+  a14=(-a14);
+  if (res[0]!=0) res[0][33]=a14;
+  a03=(a03/a00);
+  if (res[0]!=0) res[0][34]=a03;
+  a22=(a22/a01);
+  a22=(-a22);
+  if (res[0]!=0) res[0][35]=a22;
+  a05=(a05/a24);
+  a05=(a05/a01);
+  a05=(-a05);
+  if (res[0]!=0) res[0][36]=a05;
+  a05=arg[0]? arg[0][8] : 0;
+  a05=(a05/a01);
+  if (res[0]!=0) res[0][37]=a05;
+  a05=3.1415926535897934e-02;
+  if (res[0]!=0) res[0][38]=a05;
+  a05=1.2566370614359172e+01;
+  if (res[1]!=0) res[1][0]=a05;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int constants(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f2(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int constants_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void constants_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void constants_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void constants_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int constants_n_in(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_int constants_n_out(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_real constants_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* constants_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* constants_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "c";
+    case 1: return "period";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s4;
+    case 1: return casadi_s0;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int constants_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 1;
+  if (sz_res) *sz_res = 2;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 1*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 2*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* table_point:(t,p[24])->(values[5]) */
+static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+  a00=1.;
+  a01=arg[1]? arg[1][18] : 0;
+  a02=1.1800386146799999e+00;
+  a03=arg[0]? arg[0][0] : 0;
+  a04=cos(a03);
+  a05=(a02*a04);
+  a06=1.9272434388400000e-01;
+  a07=4.;
+  a07=(a07*a03);
+  a08=cos(a07);
+  a08=(a06*a08);
+  a05=(a05+a08);
+  a08=1.4883754528799999e-02;
+  a09=7.;
+  a09=(a09*a03);
+  a10=cos(a09);
+  a10=(a08*a10);
+  a05=(a05+a10);
+  a10=-6.0567417982099997e-02;
+  a11=6.;
+  a11=(a11*a03);
+  a11=cos(a11);
+  a11=(a10*a11);
+  a05=(a05+a11);
+  a12=-3.3689450631399998e-01;
+  a13=(2.*a03);
+  a14=cos(a13);
+  a15=(a12*a14);
+  a05=(a05+a15);
+  a15=-1.9563283778700000e-01;
+  a16=3.;
+  a16=(a16*a03);
+  a16=cos(a16);
+  a17=(a15*a16);
+  a05=(a05+a17);
+  a05=(a01*a05);
+  a05=(a00+a05);
+  if (res[0]!=0) res[0][0]=a05;
+  a11=(a11+a17);
+  a17=3.3689450631399998e-01;
+  a05=1.0471975511965976e+00;
+  a18=(a13+a05);
+  a18=cos(a18);
+  a18=(a17*a18);
+  a18=(a11+a18);
+  a19=-1.1800386146799999e+00;
+  a20=5.2359877559829882e-01;
+  a21=(a03+a20);
+  a21=sin(a21);
+  a21=(a19*a21);
+  a18=(a18+a21);
+  a21=-1.9272434388400000e-01;
+  a22=(a07+a20);
+  a22=sin(a22);
+  a22=(a21*a22);
+  a18=(a18+a22);
+  a22=-1.4883754528799999e-02;
+  a23=(a09+a20);
+  a23=sin(a23);
+  a23=(a22*a23);
+  a18=(a18+a23);
+  a18=(a01*a18);
+  a18=(a00+a18);
+  if (res[0]!=0) res[0][1]=a18;
+  a13=(a13+a20);
+  a13=sin(a13);
+  a17=(a17*a13);
+  a11=(a11+a17);
+  a17=(a03+a05);
+  a17=cos(a17);
+  a19=(a19*a17);
+  a11=(a11+a19);
+  a07=(a07+a05);
+  a07=cos(a07);
+  a21=(a21*a07);
+  a11=(a11+a21);
+  a09=(a09+a05);
+  a09=cos(a09);
+  a22=(a22*a09);
+  a11=(a11+a22);
+  a11=(a01*a11);
+  a11=(a00+a11);
+  if (res[0]!=0) res[0][2]=a11;
+  a11=arg[1]? arg[1][6] : 0;
+  a22=arg[1]? arg[1][7] : 0;
+  a09=arg[1]? arg[1][14] : 0;
+  a09=(a09+a03);
+  a09=cos(a09);
+  a22=(a22*a09);
+  a11=(a11+a22);
+  if (res[0]!=0) res[0][3]=a11;
+  a12=(a12*a04);
+  a04=5.0000000000000000e-01;
+  a04=(a04*a03);
+  a04=cos(a04);
+  a02=(a02*a04);
+  a12=(a12+a02);
+  a06=(a06*a14);
+  a12=(a12+a06);
+  a06=3.5000000000000000e+00;
+  a06=(a06*a03);
+  a06=cos(a06);
+  a08=(a08*a06);
+  a12=(a12+a08);
+  a10=(a10*a16);
+  a12=(a12+a10);
+  a10=1.5000000000000000e+00;
+  a10=(a10*a03);
+  a10=cos(a10);
+  a15=(a15*a10);
+  a12=(a12+a15);
+  a01=(a01*a12);
+  a00=(a00+a01);
+  if (res[0]!=0) res[0][4]=a00;
+  return 0;
+}
+
+/* map801_table_point:(t[1x801],p[24x801])->(values[5x801]) */
+static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_int i;
+  casadi_real* *res1;
+  const casadi_real* *arg1;
+  arg1 = arg+2;
+  for (i=0; i<2; ++i) arg1[i]=arg[i];
+  res1 = res+1;
+  for (i=0; i<1; ++i) res1[i]=res[i];
+  for (i=0; i<801; ++i) {
+    if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+    if (arg1[0]) arg1[0]+=1;
+    if (arg1[1]) arg1[1]+=24;
+    if (res1[0]) res1[0]+=5;
+  }
+  return 0;
+}
+
+/* table:(t0,p[24])->(table[15x400],probe[5x2]) */
+static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_int i, j;
+  casadi_real **res1=res+2, *rr, w00, *w01=w+27, *w03=w+828, w04, w05, w06, *w07=w+867, *w08=w+20091, *w09=w+24096, *w10=w+26096;
+  casadi_real *w11=w+28096, *w12=w+30096, *w13=w+32096, *w14=w+38096, *w15=w+44096;
+  const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
+  w00 = arg[0] ? arg[0][0] : 0;
+  wr01 = casadi_c0;
+  wr02 = arg[1] ? arg[1] : casadi_zeros;
+  arg1[0]=wr02;
+  res1[0]=w03;
+  res1[1]=(&w04);
+  if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
+  for (rr=(&w05), cs=w03+38; cs!=w03+39; cs+=1) *rr++ = *cs;
+  w06 = 2.;
+  w05 /= w06;
+  for (i=0, rr=w01, cr=wr01; i<801; ++i) (*rr++)  = ((*cr++)*w05);
+  for (i=0, rr=w01, cs=w01; i<801; ++i) (*rr++)  = (w00+(*cs++));
+  for (i=0;i<801;++i) {
+    casadi_copy(wr02, 24, w07+ i*24);
+  }
+  arg1[0]=w01;
+  arg1[1]=w07;
+  res1[0]=w08;
+  if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
+  for (rr=w09, cs=w08+0; cs!=w08+4000; cs+=10) for (ct=cs+0; ct!=cs+5; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w10, cs=w09; i<400; ++i) for (j=0; j<5; ++j) rr[i+j*400] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+4000; cs+=10) for (ct=cs+5; ct!=cs+10; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w11, cs=w09; i<400; ++i) for (j=0; j<5; ++j) rr[i+j*400] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+4000; cs+=10) for (ct=cs+10; ct!=cs+15; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w12, cs=w09; i<400; ++i) for (j=0; j<5; ++j) rr[i+j*400] = *cs++;
+  rr=w13;
+  for (i=0, cs=w10; i<2000; ++i) *rr++ = *cs++;
+  for (i=0, cs=w11; i<2000; ++i) *rr++ = *cs++;
+  for (i=0, cs=w12; i<2000; ++i) *rr++ = *cs++;
+  for (i=0, rr=w14, cs=w13; i<15; ++i) for (j=0; j<400; ++j) rr[i+j*15] = *cs++;
+  casadi_copy(w14, 6000, res[0]);
+  w05 = 3.7000000000000000e-01;
+  w05 *= w04;
+  w05  = (w00+w05);
+  arg1[0]=(&w05);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  casadi_copy(w15, 5, res[1]);
+  w05 = 1.3700000000000001e+00;
+  w05 *= w04;
+  w00 += w05;
+  arg1[0]=(&w00);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (res[1]) casadi_copy(w15, 5, res[1]+5);
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f3(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int table_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void table_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void table_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void table_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t0";
+    case 1: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "table";
+    case 1: return "probe";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s5;
+    case 1: return casadi_s6;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 6;
+  if (sz_res) *sz_res = 4;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 44101;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 44101*sizeof(casadi_real);
+  return 0;
 }
 
 /* one block of tangent steps (the SX functions' step, as CasADi's Switch runs it) */
@@ -19919,18 +20200,17 @@ static GEARSYM_NOINLINE void gs_state_span(casadi_real* restrict y, casadi_real*
   gs_copy(ya, 12, y); gs_copy(loa, 6, lo); gs_copy(hia, 6, hi);
 }
 
-/* lyapunov_chunk:(y0[12],Q0[12x12],table[15x200],c[39])->(strobe[12x50],Q[12x12],log_stretch[12x50],low[6x50],high[6x50]) */
+/* lyapunov_chunk:(y0[12],Q0[12x12],table[15x400],c[39])->(strobe[12x50],Q[12x12],log_stretch[12x50],low[6x50],high[6x50]) */
 static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[12], lo[6], hi[6], c[39]; casadi_real Q[144];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 12, y); gs_load(arg[1], 144, Q); gs_load(arg[3], 39, c);
-  casadi_real Qn[144], logs[12];
+  casadi_real Qn[144], logs[12]; casadi_real piece[12]; casadi_int g, i;
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6]; lo[4] = y[8]; hi[4] = y[8]; lo[5] = y[10]; hi[5] = y[10];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 144, Q);
+    for (i = 0; i < 12; ++i) logs[i] = 0;
+    for (g = 0; g < 16; ++g) { gs_tangent_span(y, Q, lo, hi, T + 15*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 144, Q); for (i = 0; i < 12; ++i) logs[i] += piece[i]; }
     gs_store(y, 12, res[0], 12*p); gs_store(logs, 12, res[2], 12*p);
     gs_store(lo, 6, res[3], 6*p); gs_store(hi, 6, res[4], 6*p);
   }
@@ -20023,18 +20303,17 @@ CASADI_SYMBOL_EXPORT int lyapunov_chunk_work_bytes(casadi_int *sz_arg, casadi_in
   return 0;
 }
 
-/* lyapunov_period:(y0[12],Q0[12x12],table[15x200],c[39])->(strobe[12],Q[12x12],log_stretch[12],low[6],high[6]) */
+/* lyapunov_period:(y0[12],Q0[12x12],table[15x400],c[39])->(strobe[12],Q[12x12],log_stretch[12],low[6],high[6]) */
 static int casadi_f19(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[12], lo[6], hi[6], c[39]; casadi_real Q[144];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 12, y); gs_load(arg[1], 144, Q); gs_load(arg[3], 39, c);
-  casadi_real Qn[144], logs[12];
+  casadi_real Qn[144], logs[12]; casadi_real piece[12]; casadi_int g, i;
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6]; lo[4] = y[8]; hi[4] = y[8]; lo[5] = y[10]; hi[5] = y[10];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 144, Q);
+    for (i = 0; i < 12; ++i) logs[i] = 0;
+    for (g = 0; g < 16; ++g) { gs_tangent_span(y, Q, lo, hi, T + 15*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 144, Q); for (i = 0; i < 12; ++i) logs[i] += piece[i]; }
     gs_store(y, 12, res[0], 12*p); gs_store(logs, 12, res[2], 12*p);
     gs_store(lo, 6, res[3], 6*p); gs_store(hi, 6, res[4], 6*p);
   }
@@ -20127,7 +20406,7 @@ CASADI_SYMBOL_EXPORT int lyapunov_period_work_bytes(casadi_int *sz_arg, casadi_i
   return 0;
 }
 
-/* orbit_chunk:(y0[12],table[15x200],c[39])->(strobe[12x50],low[6x50],high[6x50]) */
+/* orbit_chunk:(y0[12],table[15x400],c[39])->(strobe[12x50],low[6x50],high[6x50]) */
 static int casadi_f20(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[12], lo[6], hi[6], c[39];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
@@ -20135,7 +20414,7 @@ static int casadi_f20(const casadi_real** arg, casadi_real** res, casadi_int* iw
   gs_load(arg[0], 12, y); gs_load(arg[2], 39, c);
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6]; lo[4] = y[8]; hi[4] = y[8]; lo[5] = y[10]; hi[5] = y[10];
-    gs_state_span(y, lo, hi, T, c, 200);
+    gs_state_span(y, lo, hi, T, c, 400);
     gs_store(y, 12, res[0], 12*p); gs_store(lo, 6, res[1], 6*p); gs_store(hi, 6, res[2], 6*p);
   }
   return 0;
@@ -20220,7 +20499,7 @@ CASADI_SYMBOL_EXPORT int orbit_chunk_work_bytes(casadi_int *sz_arg, casadi_int* 
   return 0;
 }
 
-/* orbit_period:(y0[12],table[15x200],c[39])->(strobe[12],low[6],high[6]) */
+/* orbit_period:(y0[12],table[15x400],c[39])->(strobe[12],low[6],high[6]) */
 static int casadi_f22(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[12], lo[6], hi[6], c[39];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
@@ -20228,7 +20507,7 @@ static int casadi_f22(const casadi_real** arg, casadi_real** res, casadi_int* iw
   gs_load(arg[0], 12, y); gs_load(arg[2], 39, c);
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6]; lo[4] = y[8]; hi[4] = y[8]; lo[5] = y[10]; hi[5] = y[10];
-    gs_state_span(y, lo, hi, T, c, 200);
+    gs_state_span(y, lo, hi, T, c, 400);
     gs_store(y, 12, res[0], 12*p); gs_store(lo, 6, res[1], 6*p); gs_store(hi, 6, res[2], 6*p);
   }
   return 0;
@@ -20313,14 +20592,14 @@ CASADI_SYMBOL_EXPORT int orbit_period_work_bytes(casadi_int *sz_arg, casadi_int*
   return 0;
 }
 
-/* trajectory:(y0[12],table[15x200],c[39])->(states[12x200]) */
+/* trajectory:(y0[12],table[15x400],c[39])->(states[12x400]) */
 static int casadi_f23(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[12], lo[6], hi[6], c[39];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 12, y); gs_load(arg[2], 39, c);
   lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6]; lo[4] = y[8]; hi[4] = y[8]; lo[5] = y[10]; hi[5] = y[10];
-  for (p = 0; p < 200; ++p) {
+  for (p = 0; p < 400; ++p) {
     gs_state_span(y, lo, hi, T + 15*p, c, 1);
     gs_store(y, 12, res[0], 12*p);
   }
@@ -20390,7 +20669,7 @@ CASADI_SYMBOL_EXPORT int trajectory_work(casadi_int *sz_arg, casadi_int* sz_res,
   if (sz_arg) *sz_arg = 9;
   if (sz_res) *sz_res = 4;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 2841;
+  if (sz_w) *sz_w = 5241;
   return 0;
 }
 
@@ -20398,7 +20677,7 @@ CASADI_SYMBOL_EXPORT int trajectory_work_bytes(casadi_int *sz_arg, casadi_int* s
   if (sz_arg) *sz_arg = 9*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 4*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 2841*sizeof(casadi_real);
+  if (sz_w) *sz_w = 5241*sizeof(casadi_real);
   return 0;
 }
 
@@ -20499,7 +20778,7 @@ CASADI_SYMBOL_EXPORT int monodromy_segment_work_bytes(casadi_int *sz_arg, casadi
   return 0;
 }
 
-/* monodromy_period:(y0[12],Q0[12x12],table[15x200],c[39])->(strobe[12],M[12x12],low[6],high[6]) */
+/* monodromy_period:(y0[12],Q0[12x12],table[15x400],c[39])->(strobe[12],M[12x12],low[6],high[6]) */
 static int casadi_f25(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[12], lo[6], hi[6], c[39]; casadi_real Q[144];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
@@ -20507,7 +20786,7 @@ static int casadi_f25(const casadi_real** arg, casadi_real** res, casadi_int* iw
   gs_load(arg[0], 12, y); gs_load(arg[1], 144, Q); gs_load(arg[3], 39, c);
   casadi_real lk[6], hk[6];
   lk[0] = y[0]; hk[0] = y[0]; lk[1] = y[2]; hk[1] = y[2]; lk[2] = y[4]; hk[2] = y[4]; lk[3] = y[6]; hk[3] = y[6]; lk[4] = y[8]; hk[4] = y[8]; lk[5] = y[10]; hk[5] = y[10];
-  for (p = 0; p < 4; ++p) {
+  for (p = 0; p < 8; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4]; lo[3] = y[6]; hi[3] = y[6]; lo[4] = y[8]; hi[4] = y[8]; lo[5] = y[10]; hi[5] = y[10];
     gs_tangent_span(y, Q, lo, hi, T + 750*p, c, 50);
     lk[0] = (lo[0] < lk[0] ? lo[0] : 0) + (lo[0] < lk[0] ? 0 : lk[0]);
@@ -20612,6 +20891,8 @@ CASADI_SYMBOL_EXPORT int monodromy_period_work_bytes(casadi_int *sz_arg, casadi_
   return 0;
 }
 
+
+#endif  /* GEARSYM_STEP_PIECES_ONLY */
 
 #ifdef __cplusplus
 } /* extern "C" */

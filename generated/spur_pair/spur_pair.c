@@ -209,689 +209,6 @@ static const casadi_real casadi_c0[401] =
   392., 393., 394., 395., 396., 397., 398., 399.,
   400.};
 
-/* rhs:(t,y[2],p[6])->(dy[2]) */
-static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a0, a1, a2, a3, a4, a5, a6, a7, a8, a9;
-  a0=arg[1]? arg[1][1] : 0;
-  if (res[0]!=0) res[0][0]=a0;
-  a1=-2.;
-  a1=(a1*a0);
-  a0=arg[2]? arg[2][1] : 0;
-  a1=(a1*a0);
-  a0=arg[2]? arg[2][0] : 0;
-  a1=(a1/a0);
-  a2=arg[2]? arg[2][2] : 0;
-  a3=arg[2]? arg[2][3] : 0;
-  a4=arg[2]? arg[2][4] : 0;
-  a5=arg[0]? arg[0][0] : 0;
-  a4=(a4+a5);
-  a4=cos(a4);
-  a3=(a3*a4);
-  a2=(a2+a3);
-  a0=casadi_sq(a0);
-  a2=(a2/a0);
-  a1=(a1+a2);
-  a2=0.;
-  a3=arg[1]? arg[1][0] : 0;
-  a2=(a2<=a3);
-  a2=(a2?a3:0);
-  a4=arg[2]? arg[2][5] : 0;
-  a6=(-a4);
-  a6=(a3<=a6);
-  a3=(a3+a4);
-  a6=(a6?a3:0);
-  a2=(a2+a6);
-  a2=(a2/a0);
-  a0=1.;
-  a6=2.7661221359999999e-01;
-  a3=sin(a5);
-  a6=(a6*a3);
-  a0=(a0+a6);
-  a6=-1.2805164159999999e-01;
-  a3=cos(a5);
-  a6=(a6*a3);
-  a0=(a0+a6);
-  a6=6.2617029230000003e-03;
-  a3=7.;
-  a3=(a3*a5);
-  a4=sin(a3);
-  a6=(a6*a4);
-  a0=(a0+a6);
-  a6=1.3450290380000000e-02;
-  a4=5.;
-  a4=(a4*a5);
-  a7=cos(a4);
-  a6=(a6*a7);
-  a0=(a0+a6);
-  a6=6.7468832359999995e-02;
-  a7=(2.*a5);
-  a8=cos(a7);
-  a6=(a6*a8);
-  a0=(a0+a6);
-  a6=4.3708772070000000e-03;
-  a8=6.;
-  a8=(a8*a5);
-  a9=sin(a8);
-  a6=(a6*a9);
-  a0=(a0+a6);
-  a6=9.1421067960000008e-03;
-  a4=sin(a4);
-  a6=(a6*a4);
-  a0=(a0+a6);
-  a6=7.9504500709999995e-02;
-  a7=sin(a7);
-  a6=(a6*a7);
-  a0=(a0+a6);
-  a6=6.7080805820000000e-04;
-  a3=cos(a3);
-  a6=(a6*a3);
-  a0=(a0+a6);
-  a6=4.9745246999999999e-02;
-  a3=4.;
-  a3=(a3*a5);
-  a7=sin(a3);
-  a6=(a6*a7);
-  a0=(a0+a6);
-  a6=6.8506266280000004e-03;
-  a7=3.;
-  a7=(a7*a5);
-  a5=sin(a7);
-  a6=(a6*a5);
-  a0=(a0+a6);
-  a6=-2.4739900039999999e-02;
-  a7=cos(a7);
-  a6=(a6*a7);
-  a0=(a0+a6);
-  a6=-8.2022960919999992e-03;
-  a3=cos(a3);
-  a6=(a6*a3);
-  a0=(a0+a6);
-  a6=-7.2871874210000001e-03;
-  a8=cos(a8);
-  a6=(a6*a8);
-  a0=(a0+a6);
-  a2=(a2*a0);
-  a1=(a1-a2);
-  if (res[0]!=0) res[0][1]=a1;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int rhs(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f0(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int rhs_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void rhs_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void rhs_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void rhs_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int rhs_n_in(void) { return 3;}
-
-CASADI_SYMBOL_EXPORT casadi_int rhs_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real rhs_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* rhs_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "y";
-    case 2: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* rhs_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "dy";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s1;
-    case 2: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s1;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int rhs_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int rhs_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* jacobian:(t,y[2],p[6])->(J[2x2]) */
-static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a0, a1, a2, a3, a4, a5, a6, a7, a8, a9;
-  a0=0.;
-  if (res[0]!=0) res[0][0]=a0;
-  a1=1.;
-  a2=2.7661221359999999e-01;
-  a3=arg[0]? arg[0][0] : 0;
-  a4=sin(a3);
-  a2=(a2*a4);
-  a2=(a1+a2);
-  a4=-1.2805164159999999e-01;
-  a5=cos(a3);
-  a4=(a4*a5);
-  a2=(a2+a4);
-  a4=6.2617029230000003e-03;
-  a5=7.;
-  a5=(a5*a3);
-  a6=sin(a5);
-  a4=(a4*a6);
-  a2=(a2+a4);
-  a4=1.3450290380000000e-02;
-  a6=5.;
-  a6=(a6*a3);
-  a7=cos(a6);
-  a4=(a4*a7);
-  a2=(a2+a4);
-  a4=6.7468832359999995e-02;
-  a7=(2.*a3);
-  a8=cos(a7);
-  a4=(a4*a8);
-  a2=(a2+a4);
-  a4=4.3708772070000000e-03;
-  a8=6.;
-  a8=(a8*a3);
-  a9=sin(a8);
-  a4=(a4*a9);
-  a2=(a2+a4);
-  a4=9.1421067960000008e-03;
-  a6=sin(a6);
-  a4=(a4*a6);
-  a2=(a2+a4);
-  a4=7.9504500709999995e-02;
-  a7=sin(a7);
-  a4=(a4*a7);
-  a2=(a2+a4);
-  a4=6.7080805820000000e-04;
-  a5=cos(a5);
-  a4=(a4*a5);
-  a2=(a2+a4);
-  a4=4.9745246999999999e-02;
-  a5=4.;
-  a5=(a5*a3);
-  a7=sin(a5);
-  a4=(a4*a7);
-  a2=(a2+a4);
-  a4=6.8506266280000004e-03;
-  a7=3.;
-  a7=(a7*a3);
-  a3=sin(a7);
-  a4=(a4*a3);
-  a2=(a2+a4);
-  a4=-2.4739900039999999e-02;
-  a7=cos(a7);
-  a4=(a4*a7);
-  a2=(a2+a4);
-  a4=-8.2022960919999992e-03;
-  a5=cos(a5);
-  a4=(a4*a5);
-  a2=(a2+a4);
-  a4=-7.2871874210000001e-03;
-  a8=cos(a8);
-  a4=(a4*a8);
-  a2=(a2+a4);
-  a4=arg[1]? arg[1][0] : 0;
-  a0=(a0<=a4);
-  a0=(a0?a1:0);
-  a8=arg[2]? arg[2][5] : 0;
-  a8=(-a8);
-  a4=(a4<=a8);
-  a4=(a4?a1:0);
-  a0=(a0+a4);
-  a4=arg[2]? arg[2][0] : 0;
-  a8=casadi_sq(a4);
-  a0=(a0/a8);
-  a2=(a2*a0);
-  a2=(-a2);
-  if (res[0]!=0) res[0][1]=a2;
-  if (res[0]!=0) res[0][2]=a1;
-  a1=-2.;
-  a2=arg[2]? arg[2][1] : 0;
-  a1=(a1*a2);
-  a1=(a1/a4);
-  if (res[0]!=0) res[0][3]=a1;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int jacobian(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f1(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int jacobian_n_in(void) { return 3;}
-
-CASADI_SYMBOL_EXPORT casadi_int jacobian_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real jacobian_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* jacobian_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "y";
-    case 2: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* jacobian_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "J";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s1;
-    case 2: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s3;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* constants:(p[6])->(c[5],period) */
-static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a0, a1, a2, a3;
-  a0=arg[0]? arg[0][5] : 0;
-  if (res[0]!=0) res[0][0]=a0;
-  a0=arg[0]? arg[0][0] : 0;
-  a1=casadi_sq(a0);
-  a1=(1./a1);
-  a2=(-a1);
-  if (res[0]!=0) res[0][1]=a2;
-  a2=-2.;
-  a3=arg[0]? arg[0][1] : 0;
-  a2=(a2*a3);
-  a2=(a2/a0);
-  if (res[0]!=0) res[0][2]=a2;
-  if (res[0]!=0) res[0][3]=a1;
-  a1=3.1415926535897934e-02;
-  if (res[0]!=0) res[0][4]=a1;
-  a1=6.2831853071795862e+00;
-  if (res[1]!=0) res[1][0]=a1;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int constants(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f2(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int constants_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void constants_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void constants_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void constants_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int constants_n_in(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_int constants_n_out(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_real constants_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* constants_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* constants_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "c";
-    case 1: return "period";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s4;
-    case 1: return casadi_s0;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int constants_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 1;
-  if (sz_res) *sz_res = 2;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 1*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 2*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* table_point:(t,p[6])->(values[2]) */
-static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a0, a1, a2, a3, a4, a5, a6, a7;
-  a0=1.;
-  a1=2.7661221359999999e-01;
-  a2=arg[0]? arg[0][0] : 0;
-  a3=sin(a2);
-  a1=(a1*a3);
-  a0=(a0+a1);
-  a1=-1.2805164159999999e-01;
-  a3=cos(a2);
-  a1=(a1*a3);
-  a0=(a0+a1);
-  a1=6.2617029230000003e-03;
-  a3=7.;
-  a3=(a3*a2);
-  a4=sin(a3);
-  a1=(a1*a4);
-  a0=(a0+a1);
-  a1=1.3450290380000000e-02;
-  a4=5.;
-  a4=(a4*a2);
-  a5=cos(a4);
-  a1=(a1*a5);
-  a0=(a0+a1);
-  a1=6.7468832359999995e-02;
-  a5=(2.*a2);
-  a6=cos(a5);
-  a1=(a1*a6);
-  a0=(a0+a1);
-  a1=4.3708772070000000e-03;
-  a6=6.;
-  a6=(a6*a2);
-  a7=sin(a6);
-  a1=(a1*a7);
-  a0=(a0+a1);
-  a1=9.1421067960000008e-03;
-  a4=sin(a4);
-  a1=(a1*a4);
-  a0=(a0+a1);
-  a1=7.9504500709999995e-02;
-  a5=sin(a5);
-  a1=(a1*a5);
-  a0=(a0+a1);
-  a1=6.7080805820000000e-04;
-  a3=cos(a3);
-  a1=(a1*a3);
-  a0=(a0+a1);
-  a1=4.9745246999999999e-02;
-  a3=4.;
-  a3=(a3*a2);
-  a5=sin(a3);
-  a1=(a1*a5);
-  a0=(a0+a1);
-  a1=6.8506266280000004e-03;
-  a5=3.;
-  a5=(a5*a2);
-  a4=sin(a5);
-  a1=(a1*a4);
-  a0=(a0+a1);
-  a1=-2.4739900039999999e-02;
-  a5=cos(a5);
-  a1=(a1*a5);
-  a0=(a0+a1);
-  a1=-8.2022960919999992e-03;
-  a3=cos(a3);
-  a1=(a1*a3);
-  a0=(a0+a1);
-  a1=-7.2871874210000001e-03;
-  a6=cos(a6);
-  a1=(a1*a6);
-  a0=(a0+a1);
-  if (res[0]!=0) res[0][0]=a0;
-  a0=arg[1]? arg[1][2] : 0;
-  a1=arg[1]? arg[1][3] : 0;
-  a6=arg[1]? arg[1][4] : 0;
-  a6=(a6+a2);
-  a6=cos(a6);
-  a1=(a1*a6);
-  a0=(a0+a1);
-  if (res[0]!=0) res[0][1]=a0;
-  return 0;
-}
-
-/* map401_table_point:(t[1x401],p[6x401])->(values[2x401]) */
-static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i;
-  casadi_real* *res1;
-  const casadi_real* *arg1;
-  arg1 = arg+2;
-  for (i=0; i<2; ++i) arg1[i]=arg[i];
-  res1 = res+1;
-  for (i=0; i<1; ++i) res1[i]=res[i];
-  for (i=0; i<401; ++i) {
-    if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-    if (arg1[0]) arg1[0]+=1;
-    if (arg1[1]) arg1[1]+=6;
-    if (res1[0]) res1[0]+=2;
-  }
-  return 0;
-}
-
-/* table:(t0,p[6])->(table[6x200],probe[2x2]) */
-static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i, j;
-  casadi_real **res1=res+2, *rr, w00, *w01=w+8, *w02=w+409, *w03=w+415, w04, w05, w06, *w07=w+420, *w08=w+2826, *w09=w+3628;
-  casadi_real *w10=w+4028, *w11=w+4428, *w12=w+4828, *w13=w+5228, *w14=w+6428, *w15=w+7628;
-  const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01;
-  w00 = arg[0] ? arg[0][0] : 0;
-  wr01 = casadi_c0;
-  casadi_copy(arg[1], 6, w02);
-  arg1[0]=w02;
-  res1[0]=w03;
-  res1[1]=(&w04);
-  if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
-  for (rr=(&w05), cs=w03+4; cs!=w03+5; cs+=1) *rr++ = *cs;
-  w06 = 2.;
-  w05 /= w06;
-  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w05);
-  for (i=0, rr=w01, cs=w01; i<401; ++i) (*rr++)  = (w00+(*cs++));
-  for (i=0;i<401;++i) {
-    casadi_copy(w02, 6, w07+ i*6);
-  }
-  arg1[0]=w01;
-  arg1[1]=w07;
-  res1[0]=w08;
-  if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
-  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+0; ct!=cs+2; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w10, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+2; ct!=cs+4; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w11, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+4; ct!=cs+6; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w12, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
-  rr=w13;
-  for (i=0, cs=w10; i<400; ++i) *rr++ = *cs++;
-  for (i=0, cs=w11; i<400; ++i) *rr++ = *cs++;
-  for (i=0, cs=w12; i<400; ++i) *rr++ = *cs++;
-  for (i=0, rr=w14, cs=w13; i<6; ++i) for (j=0; j<200; ++j) rr[i+j*6] = *cs++;
-  casadi_copy(w14, 1200, res[0]);
-  w05 = 3.7000000000000000e-01;
-  w05 *= w04;
-  w05  = (w00+w05);
-  arg1[0]=(&w05);
-  arg1[1]=w02;
-  res1[0]=w15;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-  casadi_copy(w15, 2, res[1]);
-  w05 = 1.3700000000000001e+00;
-  w05 *= w04;
-  w00 += w05;
-  arg1[0]=(&w00);
-  arg1[1]=w02;
-  res1[0]=w15;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-  if (res[1]) casadi_copy(w15, 2, res[1]+2);
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f3(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int table_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void table_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void table_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void table_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t0";
-    case 1: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "table";
-    case 1: return "probe";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s5;
-    case 1: return casadi_s3;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 6;
-  if (sz_res) *sz_res = 4;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 7630;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 7630*sizeof(casadi_real);
-  return 0;
-}
-
 /* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
 #if defined(__GNUC__)
 #define GEARSYM_INLINE inline __attribute__((always_inline))
@@ -962,24 +279,24 @@ static GEARSYM_INLINE void gs_tangent_keep(const casadi_real* restrict A0, const
   R3[0]=a0;
 }
 
-/* state_try, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1) {
+/* state_try, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_try_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22;
   a00=A0[0];
-  a01=A2[4];
+  a01=A2[S*4];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[1];
+  a03=A0[S*1];
   a04=2.;
   a04=(a01/a04);
-  a05=A2[2];
+  a05=A2[S*2];
   a06=(a03*a05);
-  a07=A2[3];
-  a08=A1[1];
+  a07=A2[S*3];
+  a08=A1[S*1];
   a08=(a07*a08);
   a06=(a06+a08);
-  a08=A2[1];
+  a08=A2[S*1];
   a09=A1[0];
   a09=(a08*a09);
   a10=A2[0];
@@ -999,10 +316,10 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a17=(2.*a09);
   a17=(a03+a17);
   a18=(a09*a05);
-  a19=A1[3];
+  a19=A1[S*3];
   a19=(a07*a19);
   a18=(a18+a19);
-  a20=A1[2];
+  a20=A1[S*2];
   a20=(a08*a20);
   a21=(a04*a03);
   a21=(a00+a21);
@@ -1033,10 +350,10 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a22=(2.*a22);
   a06=(a06+a22);
   a20=(a20*a05);
-  a05=A1[5];
+  a05=A1[S*5];
   a07=(a07*a05);
   a20=(a20+a07);
-  a07=A1[4];
+  a07=A1[S*4];
   a08=(a08*a07);
   a21=(a01*a21);
   a21=(a00+a21);
@@ -1047,7 +364,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a06=(a06+a20);
   a02=(a02*a06);
   a02=(a03+a02);
-  R0[1]=a02;
+  R0[S*1]=a02;
   a15=(2.*a15);
   a06=1.;
   a15=(a15-a06);
@@ -1087,14 +404,15 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a11=(a11<a20);
   R1[0]=a11;
 }
+static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1) { gs_state_try_strided(A0, A1, A2, R0, R1, 1); }
 
-/* state_keep, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+/* state_keep, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_keep_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
   casadi_real a0, a1, a2, a3;
   a0=A3[0];
   R0[0]=a0;
-  a1=A3[1];
-  R0[1]=a1;
+  a1=A3[S*1];
+  R0[S*1]=a1;
   a1=A1[0];
   a2=(a0<a1);
   a3=(a2?a0:0);
@@ -1110,6 +428,7 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
   a0=(a0+a2);
   R2[0]=a0;
 }
+static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_state_keep_strided(A0, A1, A2, A3, A4, A5, R0, R1, R2, 1); }
 
 /* split_start, from CasADi's C of it */
 static GEARSYM_NOINLINE void gs_split_start(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
@@ -2182,24 +1501,24 @@ static GEARSYM_NOINLINE void gs_state_mode_step(const casadi_real* restrict A0, 
   R0[1]=a03;
 }
 
-/* tangent_state, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+/* tangent_state, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_state_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   a00=A0[0];
-  a01=A2[4];
+  a01=A2[S*4];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[1];
+  a03=A0[S*1];
   a04=2.;
   a04=(a01/a04);
-  a05=A2[2];
+  a05=A2[S*2];
   a06=(a03*a05);
-  a07=A2[3];
-  a08=A1[1];
+  a07=A2[S*3];
+  a08=A1[S*1];
   a08=(a07*a08);
   a06=(a06+a08);
-  a08=A2[1];
+  a08=A2[S*1];
   a09=A1[0];
   a09=(a08*a09);
   a10=A2[0];
@@ -2219,10 +1538,10 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a18=(2.*a17);
   a18=(a03+a18);
   a19=(a17*a05);
-  a20=A1[3];
+  a20=A1[S*3];
   a20=(a07*a20);
   a19=(a19+a20);
-  a21=A1[2];
+  a21=A1[S*2];
   a21=(a08*a21);
   a22=(a04*a03);
   a22=(a00+a22);
@@ -2253,10 +1572,10 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a23=(2.*a23);
   a06=(a06+a23);
   a04=(a04*a05);
-  a23=A1[5];
+  a23=A1[S*5];
   a07=(a07*a23);
   a04=(a04+a07);
-  a07=A1[4];
+  a07=A1[S*4];
   a08=(a08*a07);
   a22=(a01*a22);
   a22=(a00+a22);
@@ -2267,7 +1586,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a06=(a06+a04);
   a02=(a02*a06);
   a02=(a03+a02);
-  R0[1]=a02;
+  R0[S*1]=a02;
   a15=(2.*a15);
   a06=1.;
   a15=(a15-a06);
@@ -2308,34 +1627,35 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   R1[0]=a11;
   a09=(a09*a16);
   R2[0]=a09;
-  R2[1]=a05;
+  R2[S*1]=a05;
   a21=(a21*a16);
-  R2[2]=a21;
-  R2[3]=a21;
+  R2[S*2]=a21;
+  R2[S*3]=a21;
   a08=(a08*a16);
-  R2[4]=a08;
+  R2[S*4]=a08;
 }
+static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_tangent_state_strided(A0, A1, A2, R0, R1, R2, 1); }
 
-/* tangent_vector, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) {
+/* tangent_vector, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_vector_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   a00=A0[0];
-  a01=A2[4];
+  a01=A2[S*4];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[2];
+  a03=A0[S*2];
   a04=2.;
   a04=(a01/a04);
   a05=A1[0];
   a05=(a05*a00);
-  a06=A1[1];
+  a06=A1[S*1];
   a07=(a06*a03);
   a05=(a05+a07);
   a07=(a04*a05);
   a07=(a03+a07);
   a08=(2.*a07);
   a08=(a03+a08);
-  a09=A1[2];
+  a09=A1[S*2];
   a10=(a04*a03);
   a10=(a00+a10);
   a09=(a09*a10);
@@ -2345,7 +1665,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a10=(a03+a10);
   a11=(2.*a10);
   a08=(a08+a11);
-  a11=A1[3];
+  a11=A1[S*3];
   a04=(a04*a07);
   a04=(a00+a04);
   a11=(a11*a04);
@@ -2361,7 +1681,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a05=(a05+a09);
   a11=(2.*a11);
   a05=(a05+a11);
-  a11=A1[4];
+  a11=A1[S*4];
   a01=(a01*a10);
   a00=(a00+a01);
   a11=(a11*a00);
@@ -2370,8 +1690,9 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a05=(a05+a11);
   a02=(a02*a05);
   a03=(a03+a02);
-  R0[2]=a03;
+  R0[S*2]=a03;
 }
+static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) { gs_tangent_vector_strided(A0, A1, A2, R0, 1); }
 
 /* gram_schmidt, from CasADi's C of it */
 static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
@@ -2408,6 +1729,29 @@ static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casad
   a0=log(a0);
   R1[1]=a0;
 }
+
+/* constants, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_constants_strided(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
+  casadi_real a0, a1, a2, a3;
+  a0=A0[S*5];
+  R0[0]=a0;
+  a0=A0[0];
+  a1=casadi_sq(a0);
+  a1=(1./a1);
+  a2=(-a1);
+  R0[S*1]=a2;
+  a2=-2.;
+  a3=A0[S*1];
+  a2=(a2*a3);
+  a2=(a2/a0);
+  R0[S*2]=a2;
+  R0[S*3]=a1;
+  a1=3.1415926535897934e-02;
+  R0[S*4]=a1;
+  a1=6.2831853071795862e+00;
+  R1[0]=a1;
+}
+static GEARSYM_INLINE void gs_constants(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) { gs_constants_strided(A0, R0, R1, 1); }
 
 /* the located step that crosses: its legs, RK4 of the sides held fixed on each (calls of one
    mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/crossing.py) */
@@ -2449,6 +1793,691 @@ static GEARSYM_NOINLINE void gs_state_split(const casadi_real* restrict y, const
   gs_state_mode_step(yb, leg_b, c, yc);
   gs_state_mode_step(yc, leg_c, c, yn);
   gs_state_keep(y, lo, hi, yn, T, c, y1, lo1, hi1);
+}
+
+#ifndef GEARSYM_STEP_PIECES_ONLY  /* (the lanes' C includes the pieces above) */
+
+/* rhs:(t,y[2],p[6])->(dy[2]) */
+static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a0, a1, a2, a3, a4, a5, a6, a7, a8, a9;
+  a0=arg[1]? arg[1][1] : 0;
+  if (res[0]!=0) res[0][0]=a0;
+  a1=-2.;
+  a1=(a1*a0);
+  a0=arg[2]? arg[2][1] : 0;
+  a1=(a1*a0);
+  a0=arg[2]? arg[2][0] : 0;
+  a1=(a1/a0);
+  a2=arg[2]? arg[2][2] : 0;
+  a3=arg[2]? arg[2][3] : 0;
+  a4=arg[2]? arg[2][4] : 0;
+  a5=arg[0]? arg[0][0] : 0;
+  a4=(a4+a5);
+  a4=cos(a4);
+  a3=(a3*a4);
+  a2=(a2+a3);
+  a0=casadi_sq(a0);
+  a2=(a2/a0);
+  a1=(a1+a2);
+  a2=0.;
+  a3=arg[1]? arg[1][0] : 0;
+  a2=(a2<=a3);
+  a2=(a2?a3:0);
+  a4=arg[2]? arg[2][5] : 0;
+  a6=(-a4);
+  a6=(a3<=a6);
+  a3=(a3+a4);
+  a6=(a6?a3:0);
+  a2=(a2+a6);
+  a2=(a2/a0);
+  a0=1.;
+  a6=2.7661221359999999e-01;
+  a3=sin(a5);
+  a6=(a6*a3);
+  a0=(a0+a6);
+  a6=-1.2805164159999999e-01;
+  a3=cos(a5);
+  a6=(a6*a3);
+  a0=(a0+a6);
+  a6=6.2617029230000003e-03;
+  a3=7.;
+  a3=(a3*a5);
+  a4=sin(a3);
+  a6=(a6*a4);
+  a0=(a0+a6);
+  a6=1.3450290380000000e-02;
+  a4=5.;
+  a4=(a4*a5);
+  a7=cos(a4);
+  a6=(a6*a7);
+  a0=(a0+a6);
+  a6=6.7468832359999995e-02;
+  a7=(2.*a5);
+  a8=cos(a7);
+  a6=(a6*a8);
+  a0=(a0+a6);
+  a6=4.3708772070000000e-03;
+  a8=6.;
+  a8=(a8*a5);
+  a9=sin(a8);
+  a6=(a6*a9);
+  a0=(a0+a6);
+  a6=9.1421067960000008e-03;
+  a4=sin(a4);
+  a6=(a6*a4);
+  a0=(a0+a6);
+  a6=7.9504500709999995e-02;
+  a7=sin(a7);
+  a6=(a6*a7);
+  a0=(a0+a6);
+  a6=6.7080805820000000e-04;
+  a3=cos(a3);
+  a6=(a6*a3);
+  a0=(a0+a6);
+  a6=4.9745246999999999e-02;
+  a3=4.;
+  a3=(a3*a5);
+  a7=sin(a3);
+  a6=(a6*a7);
+  a0=(a0+a6);
+  a6=6.8506266280000004e-03;
+  a7=3.;
+  a7=(a7*a5);
+  a5=sin(a7);
+  a6=(a6*a5);
+  a0=(a0+a6);
+  a6=-2.4739900039999999e-02;
+  a7=cos(a7);
+  a6=(a6*a7);
+  a0=(a0+a6);
+  a6=-8.2022960919999992e-03;
+  a3=cos(a3);
+  a6=(a6*a3);
+  a0=(a0+a6);
+  a6=-7.2871874210000001e-03;
+  a8=cos(a8);
+  a6=(a6*a8);
+  a0=(a0+a6);
+  a2=(a2*a0);
+  a1=(a1-a2);
+  if (res[0]!=0) res[0][1]=a1;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int rhs(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f0(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int rhs_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void rhs_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void rhs_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void rhs_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int rhs_n_in(void) { return 3;}
+
+CASADI_SYMBOL_EXPORT casadi_int rhs_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real rhs_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* rhs_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "y";
+    case 2: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* rhs_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "dy";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s1;
+    case 2: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s1;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int rhs_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int rhs_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* jacobian:(t,y[2],p[6])->(J[2x2]) */
+static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a0, a1, a2, a3, a4, a5, a6, a7, a8, a9;
+  a0=0.;
+  if (res[0]!=0) res[0][0]=a0;
+  a1=1.;
+  a2=2.7661221359999999e-01;
+  a3=arg[0]? arg[0][0] : 0;
+  a4=sin(a3);
+  a2=(a2*a4);
+  a2=(a1+a2);
+  a4=-1.2805164159999999e-01;
+  a5=cos(a3);
+  a4=(a4*a5);
+  a2=(a2+a4);
+  a4=6.2617029230000003e-03;
+  a5=7.;
+  a5=(a5*a3);
+  a6=sin(a5);
+  a4=(a4*a6);
+  a2=(a2+a4);
+  a4=1.3450290380000000e-02;
+  a6=5.;
+  a6=(a6*a3);
+  a7=cos(a6);
+  a4=(a4*a7);
+  a2=(a2+a4);
+  a4=6.7468832359999995e-02;
+  a7=(2.*a3);
+  a8=cos(a7);
+  a4=(a4*a8);
+  a2=(a2+a4);
+  a4=4.3708772070000000e-03;
+  a8=6.;
+  a8=(a8*a3);
+  a9=sin(a8);
+  a4=(a4*a9);
+  a2=(a2+a4);
+  a4=9.1421067960000008e-03;
+  a6=sin(a6);
+  a4=(a4*a6);
+  a2=(a2+a4);
+  a4=7.9504500709999995e-02;
+  a7=sin(a7);
+  a4=(a4*a7);
+  a2=(a2+a4);
+  a4=6.7080805820000000e-04;
+  a5=cos(a5);
+  a4=(a4*a5);
+  a2=(a2+a4);
+  a4=4.9745246999999999e-02;
+  a5=4.;
+  a5=(a5*a3);
+  a7=sin(a5);
+  a4=(a4*a7);
+  a2=(a2+a4);
+  a4=6.8506266280000004e-03;
+  a7=3.;
+  a7=(a7*a3);
+  a3=sin(a7);
+  a4=(a4*a3);
+  a2=(a2+a4);
+  a4=-2.4739900039999999e-02;
+  a7=cos(a7);
+  a4=(a4*a7);
+  a2=(a2+a4);
+  a4=-8.2022960919999992e-03;
+  a5=cos(a5);
+  a4=(a4*a5);
+  a2=(a2+a4);
+  a4=-7.2871874210000001e-03;
+  a8=cos(a8);
+  a4=(a4*a8);
+  a2=(a2+a4);
+  a4=arg[1]? arg[1][0] : 0;
+  a0=(a0<=a4);
+  a0=(a0?a1:0);
+  a8=arg[2]? arg[2][5] : 0;
+  a8=(-a8);
+  a4=(a4<=a8);
+  a4=(a4?a1:0);
+  a0=(a0+a4);
+  a4=arg[2]? arg[2][0] : 0;
+  a8=casadi_sq(a4);
+  a0=(a0/a8);
+  a2=(a2*a0);
+  a2=(-a2);
+  if (res[0]!=0) res[0][1]=a2;
+  if (res[0]!=0) res[0][2]=a1;
+  a1=-2.;
+  a2=arg[2]? arg[2][1] : 0;
+  a1=(a1*a2);
+  a1=(a1/a4);
+  if (res[0]!=0) res[0][3]=a1;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int jacobian(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f1(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int jacobian_n_in(void) { return 3;}
+
+CASADI_SYMBOL_EXPORT casadi_int jacobian_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real jacobian_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* jacobian_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "y";
+    case 2: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* jacobian_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "J";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s1;
+    case 2: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s3;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* constants:(p[6])->(c[5],period) */
+static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a0, a1, a2, a3;
+  a0=arg[0]? arg[0][5] : 0;
+  if (res[0]!=0) res[0][0]=a0;
+  a0=arg[0]? arg[0][0] : 0;
+  a1=casadi_sq(a0);
+  a1=(1./a1);
+  a2=(-a1);
+  if (res[0]!=0) res[0][1]=a2;
+  a2=-2.;
+  a3=arg[0]? arg[0][1] : 0;
+  a2=(a2*a3);
+  a2=(a2/a0);
+  if (res[0]!=0) res[0][2]=a2;
+  if (res[0]!=0) res[0][3]=a1;
+  a1=3.1415926535897934e-02;
+  if (res[0]!=0) res[0][4]=a1;
+  a1=6.2831853071795862e+00;
+  if (res[1]!=0) res[1][0]=a1;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int constants(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f2(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int constants_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void constants_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void constants_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void constants_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int constants_n_in(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_int constants_n_out(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_real constants_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* constants_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* constants_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "c";
+    case 1: return "period";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s4;
+    case 1: return casadi_s0;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int constants_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 1;
+  if (sz_res) *sz_res = 2;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 1*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 2*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* table_point:(t,p[6])->(values[2]) */
+static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a0, a1, a2, a3, a4, a5, a6, a7;
+  a0=1.;
+  a1=2.7661221359999999e-01;
+  a2=arg[0]? arg[0][0] : 0;
+  a3=sin(a2);
+  a1=(a1*a3);
+  a0=(a0+a1);
+  a1=-1.2805164159999999e-01;
+  a3=cos(a2);
+  a1=(a1*a3);
+  a0=(a0+a1);
+  a1=6.2617029230000003e-03;
+  a3=7.;
+  a3=(a3*a2);
+  a4=sin(a3);
+  a1=(a1*a4);
+  a0=(a0+a1);
+  a1=1.3450290380000000e-02;
+  a4=5.;
+  a4=(a4*a2);
+  a5=cos(a4);
+  a1=(a1*a5);
+  a0=(a0+a1);
+  a1=6.7468832359999995e-02;
+  a5=(2.*a2);
+  a6=cos(a5);
+  a1=(a1*a6);
+  a0=(a0+a1);
+  a1=4.3708772070000000e-03;
+  a6=6.;
+  a6=(a6*a2);
+  a7=sin(a6);
+  a1=(a1*a7);
+  a0=(a0+a1);
+  a1=9.1421067960000008e-03;
+  a4=sin(a4);
+  a1=(a1*a4);
+  a0=(a0+a1);
+  a1=7.9504500709999995e-02;
+  a5=sin(a5);
+  a1=(a1*a5);
+  a0=(a0+a1);
+  a1=6.7080805820000000e-04;
+  a3=cos(a3);
+  a1=(a1*a3);
+  a0=(a0+a1);
+  a1=4.9745246999999999e-02;
+  a3=4.;
+  a3=(a3*a2);
+  a5=sin(a3);
+  a1=(a1*a5);
+  a0=(a0+a1);
+  a1=6.8506266280000004e-03;
+  a5=3.;
+  a5=(a5*a2);
+  a4=sin(a5);
+  a1=(a1*a4);
+  a0=(a0+a1);
+  a1=-2.4739900039999999e-02;
+  a5=cos(a5);
+  a1=(a1*a5);
+  a0=(a0+a1);
+  a1=-8.2022960919999992e-03;
+  a3=cos(a3);
+  a1=(a1*a3);
+  a0=(a0+a1);
+  a1=-7.2871874210000001e-03;
+  a6=cos(a6);
+  a1=(a1*a6);
+  a0=(a0+a1);
+  if (res[0]!=0) res[0][0]=a0;
+  a0=arg[1]? arg[1][2] : 0;
+  a1=arg[1]? arg[1][3] : 0;
+  a6=arg[1]? arg[1][4] : 0;
+  a6=(a6+a2);
+  a6=cos(a6);
+  a1=(a1*a6);
+  a0=(a0+a1);
+  if (res[0]!=0) res[0][1]=a0;
+  return 0;
+}
+
+/* map401_table_point:(t[1x401],p[6x401])->(values[2x401]) */
+static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_int i;
+  casadi_real* *res1;
+  const casadi_real* *arg1;
+  arg1 = arg+2;
+  for (i=0; i<2; ++i) arg1[i]=arg[i];
+  res1 = res+1;
+  for (i=0; i<1; ++i) res1[i]=res[i];
+  for (i=0; i<401; ++i) {
+    if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+    if (arg1[0]) arg1[0]+=1;
+    if (arg1[1]) arg1[1]+=6;
+    if (res1[0]) res1[0]+=2;
+  }
+  return 0;
+}
+
+/* table:(t0,p[6])->(table[6x200],probe[2x2]) */
+static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_int i, j;
+  casadi_real **res1=res+2, *rr, w00, *w01=w+8, *w02=w+409, *w03=w+415, w04, w05, w06, *w07=w+420, *w08=w+2826, *w09=w+3628;
+  casadi_real *w10=w+4028, *w11=w+4428, *w12=w+4828, *w13=w+5228, *w14=w+6428, *w15=w+7628;
+  const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01;
+  w00 = arg[0] ? arg[0][0] : 0;
+  wr01 = casadi_c0;
+  casadi_copy(arg[1], 6, w02);
+  arg1[0]=w02;
+  res1[0]=w03;
+  res1[1]=(&w04);
+  if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
+  for (rr=(&w05), cs=w03+4; cs!=w03+5; cs+=1) *rr++ = *cs;
+  w06 = 2.;
+  w05 /= w06;
+  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w05);
+  for (i=0, rr=w01, cs=w01; i<401; ++i) (*rr++)  = (w00+(*cs++));
+  for (i=0;i<401;++i) {
+    casadi_copy(w02, 6, w07+ i*6);
+  }
+  arg1[0]=w01;
+  arg1[1]=w07;
+  res1[0]=w08;
+  if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
+  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+0; ct!=cs+2; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w10, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+2; ct!=cs+4; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w11, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+800; cs+=4) for (ct=cs+4; ct!=cs+6; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w12, cs=w09; i<200; ++i) for (j=0; j<2; ++j) rr[i+j*200] = *cs++;
+  rr=w13;
+  for (i=0, cs=w10; i<400; ++i) *rr++ = *cs++;
+  for (i=0, cs=w11; i<400; ++i) *rr++ = *cs++;
+  for (i=0, cs=w12; i<400; ++i) *rr++ = *cs++;
+  for (i=0, rr=w14, cs=w13; i<6; ++i) for (j=0; j<200; ++j) rr[i+j*6] = *cs++;
+  casadi_copy(w14, 1200, res[0]);
+  w05 = 3.7000000000000000e-01;
+  w05 *= w04;
+  w05  = (w00+w05);
+  arg1[0]=(&w05);
+  arg1[1]=w02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  casadi_copy(w15, 2, res[1]);
+  w05 = 1.3700000000000001e+00;
+  w05 *= w04;
+  w00 += w05;
+  arg1[0]=(&w00);
+  arg1[1]=w02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (res[1]) casadi_copy(w15, 2, res[1]+2);
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f3(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int table_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void table_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void table_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void table_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t0";
+    case 1: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "table";
+    case 1: return "probe";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s5;
+    case 1: return casadi_s3;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 6;
+  if (sz_res) *sz_res = 4;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 7630;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 7630*sizeof(casadi_real);
+  return 0;
 }
 
 /* one block of tangent steps (the SX functions' step, as CasADi's Switch runs it) */
@@ -2506,12 +2535,11 @@ static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw,
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 2, y); gs_load(arg[1], 4, Q); gs_load(arg[3], 5, c);
-  casadi_real Qn[4], logs[2];
+  casadi_real Qn[4], logs[2]; casadi_real piece[2]; casadi_int g, i;
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 4, Q);
+    for (i = 0; i < 2; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T + 6*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 4, Q); for (i = 0; i < 2; ++i) logs[i] += piece[i]; }
     gs_store(y, 2, res[0], 2*p); gs_store(logs, 2, res[2], 2*p);
     gs_store(lo, 1, res[3], 1*p); gs_store(hi, 1, res[4], 1*p);
   }
@@ -2610,12 +2638,11 @@ static int casadi_f19(const casadi_real** arg, casadi_real** res, casadi_int* iw
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 2, y); gs_load(arg[1], 4, Q); gs_load(arg[3], 5, c);
-  casadi_real Qn[4], logs[2];
+  casadi_real Qn[4], logs[2]; casadi_real piece[2]; casadi_int g, i;
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 4, Q);
+    for (i = 0; i < 2; ++i) logs[i] = 0;
+    for (g = 0; g < 8; ++g) { gs_tangent_span(y, Q, lo, hi, T + 6*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 4, Q); for (i = 0; i < 2; ++i) logs[i] += piece[i]; }
     gs_store(y, 2, res[0], 2*p); gs_store(logs, 2, res[2], 2*p);
     gs_store(lo, 1, res[3], 1*p); gs_store(hi, 1, res[4], 1*p);
   }
@@ -3183,6 +3210,8 @@ CASADI_SYMBOL_EXPORT int monodromy_period_work_bytes(casadi_int *sz_arg, casadi_
   return 0;
 }
 
+
+#endif  /* GEARSYM_STEP_PIECES_ONLY */
 
 #ifdef __cplusplus
 } /* extern "C" */

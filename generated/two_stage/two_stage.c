@@ -151,7 +151,7 @@ static const casadi_int casadi_s1[3] = {6, 1, 1};
 static const casadi_int casadi_s2[3] = {21, 1, 1};
 static const casadi_int casadi_s3[3] = {6, 6, 1};
 static const casadi_int casadi_s4[3] = {16, 1, 1};
-static const casadi_int casadi_s5[3] = {9, 200, 1};
+static const casadi_int casadi_s5[3] = {9, 400, 1};
 static const casadi_int casadi_s6[3] = {3, 2, 1};
 static const casadi_int casadi_s7[6] = {0};
 static const casadi_int casadi_s8[9] = 
@@ -170,10 +170,10 @@ static const casadi_int casadi_s15[36] =
 static const casadi_int casadi_s16[3] = {6, 50, 1};
 static const casadi_int casadi_s17[3] = {3, 50, 1};
 static const casadi_int casadi_s18[3] = {3, 1, 1};
-static const casadi_int casadi_s19[3] = {6, 200, 1};
+static const casadi_int casadi_s19[3] = {6, 400, 1};
 static const casadi_int casadi_s20[3] = {9, 50, 1};
 
-static const casadi_real casadi_c0[401] = 
+static const casadi_real casadi_c0[801] = 
   {0., 1., 2., 3., 4., 5., 6., 7.,
   8., 9., 10., 11., 12., 13., 14., 15.,
   16., 17., 18., 19., 20., 21., 22., 23.,
@@ -224,936 +224,60 @@ static const casadi_real casadi_c0[401] =
   376., 377., 378., 379., 380., 381., 382., 383.,
   384., 385., 386., 387., 388., 389., 390., 391.,
   392., 393., 394., 395., 396., 397., 398., 399.,
-  400.};
+  400., 401., 402., 403., 404., 405., 406., 407.,
+  408., 409., 410., 411., 412., 413., 414., 415.,
+  416., 417., 418., 419., 420., 421., 422., 423.,
+  424., 425., 426., 427., 428., 429., 430., 431.,
+  432., 433., 434., 435., 436., 437., 438., 439.,
+  440., 441., 442., 443., 444., 445., 446., 447.,
+  448., 449., 450., 451., 452., 453., 454., 455.,
+  456., 457., 458., 459., 460., 461., 462., 463.,
+  464., 465., 466., 467., 468., 469., 470., 471.,
+  472., 473., 474., 475., 476., 477., 478., 479.,
+  480., 481., 482., 483., 484., 485., 486., 487.,
+  488., 489., 490., 491., 492., 493., 494., 495.,
+  496., 497., 498., 499., 500., 501., 502., 503.,
+  504., 505., 506., 507., 508., 509., 510., 511.,
+  512., 513., 514., 515., 516., 517., 518., 519.,
+  520., 521., 522., 523., 524., 525., 526., 527.,
+  528., 529., 530., 531., 532., 533., 534., 535.,
+  536., 537., 538., 539., 540., 541., 542., 543.,
+  544., 545., 546., 547., 548., 549., 550., 551.,
+  552., 553., 554., 555., 556., 557., 558., 559.,
+  560., 561., 562., 563., 564., 565., 566., 567.,
+  568., 569., 570., 571., 572., 573., 574., 575.,
+  576., 577., 578., 579., 580., 581., 582., 583.,
+  584., 585., 586., 587., 588., 589., 590., 591.,
+  592., 593., 594., 595., 596., 597., 598., 599.,
+  600., 601., 602., 603., 604., 605., 606., 607.,
+  608., 609., 610., 611., 612., 613., 614., 615.,
+  616., 617., 618., 619., 620., 621., 622., 623.,
+  624., 625., 626., 627., 628., 629., 630., 631.,
+  632., 633., 634., 635., 636., 637., 638., 639.,
+  640., 641., 642., 643., 644., 645., 646., 647.,
+  648., 649., 650., 651., 652., 653., 654., 655.,
+  656., 657., 658., 659., 660., 661., 662., 663.,
+  664., 665., 666., 667., 668., 669., 670., 671.,
+  672., 673., 674., 675., 676., 677., 678., 679.,
+  680., 681., 682., 683., 684., 685., 686., 687.,
+  688., 689., 690., 691., 692., 693., 694., 695.,
+  696., 697., 698., 699., 700., 701., 702., 703.,
+  704., 705., 706., 707., 708., 709., 710., 711.,
+  712., 713., 714., 715., 716., 717., 718., 719.,
+  720., 721., 722., 723., 724., 725., 726., 727.,
+  728., 729., 730., 731., 732., 733., 734., 735.,
+  736., 737., 738., 739., 740., 741., 742., 743.,
+  744., 745., 746., 747., 748., 749., 750., 751.,
+  752., 753., 754., 755., 756., 757., 758., 759.,
+  760., 761., 762., 763., 764., 765., 766., 767.,
+  768., 769., 770., 771., 772., 773., 774., 775.,
+  776., 777., 778., 779., 780., 781., 782., 783.,
+  784., 785., 786., 787., 788., 789., 790., 791.,
+  792., 793., 794., 795., 796., 797., 798., 799.,
+  800.};
 
 static const casadi_real casadi_zeros[21] = 
   {0.};
-
-/* rhs:(t,y[6],p[21])->(dy[6]) */
-static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
-  casadi_real a24, a25, a26, a27, a28, a29, a30;
-  a00=arg[1]? arg[1][1] : 0;
-  if (res[0]!=0) res[0][0]=a00;
-  a01=-2.;
-  a00=(a01*a00);
-  a02=arg[2]? arg[2][1] : 0;
-  a00=(a00*a02);
-  a02=arg[2]? arg[2][0] : 0;
-  a03=(a00/a02);
-  a04=arg[2]? arg[2][14] : 0;
-  a05=arg[1]? arg[1][2] : 0;
-  a06=(a04*a05);
-  a07=arg[2]? arg[2][8] : 0;
-  a08=(a06/a07);
-  a09=casadi_sq(a02);
-  a08=(a08/a09);
-  a03=(a03-a08);
-  a08=arg[2]? arg[2][4] : 0;
-  a10=arg[2]? arg[2][5] : 0;
-  a11=arg[2]? arg[2][11] : 0;
-  a12=arg[0]? arg[0][0] : 0;
-  a11=(a11+a12);
-  a11=cos(a11);
-  a10=(a10*a11);
-  a08=(a08+a10);
-  a08=(a08/a09);
-  a03=(a03+a08);
-  a08=0.;
-  a10=arg[1]? arg[1][0] : 0;
-  a11=(a08<=a10);
-  a11=(a11?a10:0);
-  a13=arg[2]? arg[2][12] : 0;
-  a14=(-a13);
-  a14=(a10<=a14);
-  a10=(a10+a13);
-  a14=(a14?a10:0);
-  a11=(a11+a14);
-  a14=(a11/a09);
-  a10=1.;
-  a13=arg[2]? arg[2][15] : 0;
-  a15=1.1800386146799999e+00;
-  a16=cos(a12);
-  a17=(a15*a16);
-  a18=1.9272434388400000e-01;
-  a19=4.;
-  a19=(a19*a12);
-  a19=cos(a19);
-  a19=(a18*a19);
-  a17=(a17+a19);
-  a19=1.4883754528799999e-02;
-  a20=7.;
-  a20=(a20*a12);
-  a20=cos(a20);
-  a20=(a19*a20);
-  a17=(a17+a20);
-  a20=-6.0567417982099997e-02;
-  a21=6.;
-  a21=(a21*a12);
-  a21=cos(a21);
-  a21=(a20*a21);
-  a17=(a17+a21);
-  a21=-3.3689450631399998e-01;
-  a22=(2.*a12);
-  a22=cos(a22);
-  a23=(a21*a22);
-  a17=(a17+a23);
-  a23=-1.9563283778700000e-01;
-  a24=3.;
-  a24=(a24*a12);
-  a24=cos(a24);
-  a25=(a23*a24);
-  a17=(a17+a25);
-  a13=(a13*a17);
-  a13=(a10+a13);
-  a14=(a14*a13);
-  a03=(a03-a14);
-  if (res[0]!=0) res[0][1]=a03;
-  a03=arg[1]? arg[1][3] : 0;
-  if (res[0]!=0) res[0][2]=a03;
-  a00=(a00/a07);
-  a03=arg[2]? arg[2][18] : 0;
-  a14=casadi_sq(a03);
-  a00=(a00*a14);
-  a00=(a00/a02);
-  a17=arg[2]? arg[2][17] : 0;
-  a17=casadi_sq(a17);
-  a25=arg[2]? arg[2][7] : 0;
-  a17=(a17/a25);
-  a14=(a14/a07);
-  a17=(a17+a14);
-  a00=(a00/a17);
-  a06=(a06/a09);
-  a07=(1./a07);
-  a25=arg[2]? arg[2][9] : 0;
-  a26=(1./a25);
-  a07=(a07+a26);
-  a06=(a06*a07);
-  a00=(a00-a06);
-  a06=(a01*a03);
-  a07=arg[2]? arg[2][19] : 0;
-  a06=(a06*a07);
-  a26=arg[1]? arg[1][5] : 0;
-  a06=(a06*a26);
-  a27=arg[2]? arg[2][3] : 0;
-  a06=(a06*a27);
-  a06=(a06/a25);
-  a06=(a06/a02);
-  a28=casadi_sq(a07);
-  a28=(a28/a25);
-  a29=arg[2]? arg[2][20] : 0;
-  a29=casadi_sq(a29);
-  a30=arg[2]? arg[2][10] : 0;
-  a29=(a29/a30);
-  a28=(a28+a29);
-  a06=(a06/a28);
-  a00=(a00+a06);
-  a14=(a14/a09);
-  a14=(a14*a11);
-  a14=(a14/a17);
-  a14=(a14*a13);
-  a00=(a00-a14);
-  a14=arg[2]? arg[2][2] : 0;
-  a13=(a14*a03);
-  a13=(a13*a07);
-  a13=(a13/a25);
-  a13=(a13/a09);
-  a17=arg[1]? arg[1][4] : 0;
-  a08=(a08<=a17);
-  a08=(a08?a17:0);
-  a11=arg[2]? arg[2][13] : 0;
-  a06=(-a11);
-  a06=(a17<=a06);
-  a17=(a17+a11);
-  a06=(a06?a17:0);
-  a08=(a08+a06);
-  a13=(a13*a08);
-  a13=(a13/a28);
-  a28=arg[2]? arg[2][16] : 0;
-  a21=(a21*a16);
-  a16=5.0000000000000000e-01;
-  a16=(a16*a12);
-  a16=cos(a16);
-  a15=(a15*a16);
-  a21=(a21+a15);
-  a18=(a18*a22);
-  a21=(a21+a18);
-  a18=3.5000000000000000e+00;
-  a18=(a18*a12);
-  a18=cos(a18);
-  a19=(a19*a18);
-  a21=(a21+a19);
-  a20=(a20*a24);
-  a21=(a21+a20);
-  a20=1.5000000000000000e+00;
-  a20=(a20*a12);
-  a20=cos(a20);
-  a23=(a23*a20);
-  a21=(a21+a23);
-  a28=(a28*a21);
-  a10=(a10+a28);
-  a13=(a13*a10);
-  a00=(a00-a13);
-  if (res[0]!=0) res[0][3]=a00;
-  if (res[0]!=0) res[0][4]=a26;
-  a00=arg[2]? arg[2][6] : 0;
-  a00=(a00/a09);
-  a01=(a01*a26);
-  a01=(a01*a27);
-  a01=(a01/a02);
-  a00=(a00+a01);
-  a04=(a04*a07);
-  a04=(a04*a05);
-  a04=(a04/a25);
-  a04=(a04/a03);
-  a04=(a04/a09);
-  a00=(a00-a04);
-  a14=(a14/a09);
-  a14=(a14*a08);
-  a14=(a14*a10);
-  a00=(a00-a14);
-  if (res[0]!=0) res[0][5]=a00;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int rhs(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f0(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int rhs_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void rhs_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void rhs_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void rhs_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int rhs_n_in(void) { return 3;}
-
-CASADI_SYMBOL_EXPORT casadi_int rhs_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real rhs_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* rhs_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "y";
-    case 2: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* rhs_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "dy";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s1;
-    case 2: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s1;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int rhs_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int rhs_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* jacobian:(t,y[6],p[21])->(J[6x6]) */
-static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21;
-  a00=0.;
-  if (res[0]!=0) res[0][0]=a00;
-  a01=1.;
-  a02=arg[2]? arg[2][15] : 0;
-  a03=1.1800386146799999e+00;
-  a04=arg[0]? arg[0][0] : 0;
-  a05=cos(a04);
-  a06=(a03*a05);
-  a07=1.9272434388400000e-01;
-  a08=4.;
-  a08=(a08*a04);
-  a08=cos(a08);
-  a08=(a07*a08);
-  a06=(a06+a08);
-  a08=1.4883754528799999e-02;
-  a09=7.;
-  a09=(a09*a04);
-  a09=cos(a09);
-  a09=(a08*a09);
-  a06=(a06+a09);
-  a09=-6.0567417982099997e-02;
-  a10=6.;
-  a10=(a10*a04);
-  a10=cos(a10);
-  a10=(a09*a10);
-  a06=(a06+a10);
-  a10=-3.3689450631399998e-01;
-  a11=(2.*a04);
-  a11=cos(a11);
-  a12=(a10*a11);
-  a06=(a06+a12);
-  a12=-1.9563283778700000e-01;
-  a13=3.;
-  a13=(a13*a04);
-  a13=cos(a13);
-  a14=(a12*a13);
-  a06=(a06+a14);
-  a02=(a02*a06);
-  a02=(a01+a02);
-  a06=arg[1]? arg[1][0] : 0;
-  a14=(a00<=a06);
-  a14=(a14?a01:0);
-  a15=arg[2]? arg[2][12] : 0;
-  a15=(-a15);
-  a06=(a06<=a15);
-  a06=(a06?a01:0);
-  a14=(a14+a06);
-  a06=arg[2]? arg[2][0] : 0;
-  a15=casadi_sq(a06);
-  a16=(a14/a15);
-  a16=(a02*a16);
-  a16=(-a16);
-  if (res[0]!=0) res[0][1]=a16;
-  if (res[0]!=0) res[0][2]=a00;
-  a16=arg[2]? arg[2][18] : 0;
-  a17=casadi_sq(a16);
-  a18=arg[2]? arg[2][8] : 0;
-  a19=(a17/a18);
-  a20=(a19/a15);
-  a20=(a20*a14);
-  a14=arg[2]? arg[2][17] : 0;
-  a14=casadi_sq(a14);
-  a21=arg[2]? arg[2][7] : 0;
-  a14=(a14/a21);
-  a14=(a14+a19);
-  a20=(a20/a14);
-  a02=(a02*a20);
-  a02=(-a02);
-  if (res[0]!=0) res[0][3]=a02;
-  if (res[0]!=0) res[0][4]=a00;
-  if (res[0]!=0) res[0][5]=a00;
-  if (res[0]!=0) res[0][6]=a01;
-  a02=-2.;
-  a20=arg[2]? arg[2][1] : 0;
-  a20=(a02*a20);
-  a19=(a20/a06);
-  if (res[0]!=0) res[0][7]=a19;
-  if (res[0]!=0) res[0][8]=a00;
-  a20=(a20/a18);
-  a17=(a17*a20);
-  a17=(a17/a06);
-  a17=(a17/a14);
-  if (res[0]!=0) res[0][9]=a17;
-  if (res[0]!=0) res[0][10]=a00;
-  if (res[0]!=0) res[0][11]=a00;
-  if (res[0]!=0) res[0][12]=a00;
-  a17=arg[2]? arg[2][14] : 0;
-  a14=(a17/a18);
-  a14=(a14/a15);
-  a14=(-a14);
-  if (res[0]!=0) res[0][13]=a14;
-  if (res[0]!=0) res[0][14]=a00;
-  a18=(1./a18);
-  a14=arg[2]? arg[2][9] : 0;
-  a20=(1./a14);
-  a18=(a18+a20);
-  a20=(a17/a15);
-  a18=(a18*a20);
-  a18=(-a18);
-  if (res[0]!=0) res[0][15]=a18;
-  if (res[0]!=0) res[0][16]=a00;
-  a18=arg[2]? arg[2][19] : 0;
-  a17=(a17*a18);
-  a17=(a17/a14);
-  a17=(a17/a16);
-  a17=(a17/a15);
-  a17=(-a17);
-  if (res[0]!=0) res[0][17]=a17;
-  if (res[0]!=0) res[0][18]=a00;
-  if (res[0]!=0) res[0][19]=a00;
-  if (res[0]!=0) res[0][20]=a01;
-  if (res[0]!=0) res[0][21]=a00;
-  if (res[0]!=0) res[0][22]=a00;
-  if (res[0]!=0) res[0][23]=a00;
-  if (res[0]!=0) res[0][24]=a00;
-  if (res[0]!=0) res[0][25]=a00;
-  if (res[0]!=0) res[0][26]=a00;
-  a17=arg[2]? arg[2][16] : 0;
-  a10=(a10*a05);
-  a05=5.0000000000000000e-01;
-  a05=(a05*a04);
-  a05=cos(a05);
-  a03=(a03*a05);
-  a10=(a10+a03);
-  a07=(a07*a11);
-  a10=(a10+a07);
-  a07=3.5000000000000000e+00;
-  a07=(a07*a04);
-  a07=cos(a07);
-  a08=(a08*a07);
-  a10=(a10+a08);
-  a09=(a09*a13);
-  a10=(a10+a09);
-  a09=1.5000000000000000e+00;
-  a09=(a09*a04);
-  a09=cos(a09);
-  a12=(a12*a09);
-  a10=(a10+a12);
-  a17=(a17*a10);
-  a17=(a01+a17);
-  a10=arg[2]? arg[2][2] : 0;
-  a12=(a10*a16);
-  a12=(a12*a18);
-  a12=(a12/a14);
-  a12=(a12/a15);
-  a09=arg[1]? arg[1][4] : 0;
-  a04=(a00<=a09);
-  a04=(a04?a01:0);
-  a13=arg[2]? arg[2][13] : 0;
-  a13=(-a13);
-  a09=(a09<=a13);
-  a09=(a09?a01:0);
-  a04=(a04+a09);
-  a12=(a12*a04);
-  a09=casadi_sq(a18);
-  a09=(a09/a14);
-  a13=arg[2]? arg[2][20] : 0;
-  a13=casadi_sq(a13);
-  a08=arg[2]? arg[2][10] : 0;
-  a13=(a13/a08);
-  a09=(a09+a13);
-  a12=(a12/a09);
-  a12=(a17*a12);
-  a12=(-a12);
-  if (res[0]!=0) res[0][27]=a12;
-  if (res[0]!=0) res[0][28]=a00;
-  a10=(a10/a15);
-  a10=(a10*a04);
-  a17=(a17*a10);
-  a17=(-a17);
-  if (res[0]!=0) res[0][29]=a17;
-  if (res[0]!=0) res[0][30]=a00;
-  if (res[0]!=0) res[0][31]=a00;
-  if (res[0]!=0) res[0][32]=a00;
-  a00=arg[2]? arg[2][3] : 0;
-  a16=(a02*a16);
-  a16=(a16*a18);
-  a16=(a00*a16);
-  a16=(a16/a14);
-  a16=(a16/a06);
-  a16=(a16/a09);
-  if (res[0]!=0) res[0][33]=a16;
-  if (res[0]!=0) res[0][34]=a01;
-  a02=(a02*a00);
-  a02=(a02/a06);
-  if (res[0]!=0) res[0][35]=a02;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int jacobian(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f1(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void jacobian_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int jacobian_n_in(void) { return 3;}
-
-CASADI_SYMBOL_EXPORT casadi_int jacobian_n_out(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_real jacobian_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* jacobian_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t";
-    case 1: return "y";
-    case 2: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* jacobian_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "J";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s1;
-    case 2: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s3;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3;
-  if (sz_res) *sz_res = 1;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int jacobian_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* constants:(p[21])->(c[16],period) */
-static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12;
-  a00=arg[0]? arg[0][12] : 0;
-  if (res[0]!=0) res[0][0]=a00;
-  a00=arg[0]? arg[0][0] : 0;
-  a01=casadi_sq(a00);
-  a02=(1./a01);
-  a03=(-a02);
-  if (res[0]!=0) res[0][1]=a03;
-  a03=-2.;
-  a04=arg[0]? arg[0][1] : 0;
-  a04=(a03*a04);
-  a05=(a04/a00);
-  if (res[0]!=0) res[0][2]=a05;
-  a05=arg[0]? arg[0][14] : 0;
-  a06=arg[0]? arg[0][8] : 0;
-  a07=(a05/a06);
-  a07=(a07/a01);
-  a07=(-a07);
-  if (res[0]!=0) res[0][3]=a07;
-  if (res[0]!=0) res[0][4]=a02;
-  a02=(a05/a01);
-  a07=(1./a06);
-  a08=arg[0]? arg[0][9] : 0;
-  a09=(1./a08);
-  a07=(a07+a09);
-  a02=(a02*a07);
-  a02=(-a02);
-  if (res[0]!=0) res[0][5]=a02;
-  a02=arg[0]? arg[0][18] : 0;
-  a07=casadi_sq(a02);
-  a09=(a07/a06);
-  a10=(a09/a01);
-  a11=arg[0]? arg[0][17] : 0;
-  a11=casadi_sq(a11);
-  a12=arg[0]? arg[0][7] : 0;
-  a11=(a11/a12);
-  a11=(a11+a09);
-  a10=(a10/a11);
-  a10=(-a10);
-  if (res[0]!=0) res[0][6]=a10;
-  a04=(a04/a06);
-  a04=(a04*a07);
-  a04=(a04/a00);
-  a04=(a04/a11);
-  if (res[0]!=0) res[0][7]=a04;
-  a04=(a03*a02);
-  a11=arg[0]? arg[0][19] : 0;
-  a04=(a04*a11);
-  a07=arg[0]? arg[0][3] : 0;
-  a04=(a04*a07);
-  a04=(a04/a08);
-  a04=(a04/a00);
-  a06=casadi_sq(a11);
-  a06=(a06/a08);
-  a10=arg[0]? arg[0][20] : 0;
-  a10=casadi_sq(a10);
-  a09=arg[0]? arg[0][10] : 0;
-  a10=(a10/a09);
-  a06=(a06+a10);
-  a04=(a04/a06);
-  if (res[0]!=0) res[0][8]=a04;
-  a04=arg[0]? arg[0][13] : 0;
-  if (res[0]!=0) res[0][9]=a04;
-  a04=arg[0]? arg[0][2] : 0;
-  a10=(a04*a02);
-  a10=(a10*a11);
-  a10=(a10/a08);
-  a10=(a10/a01);
-  a10=(a10/a06);
-  a10=(-a10);
-  if (res[0]!=0) res[0][10]=a10;
-  a03=(a03*a07);
-  a03=(a03/a00);
-  if (res[0]!=0) res[0][11]=a03;
-  a04=(a04/a01);
-  a04=(-a04);
-  if (res[0]!=0) res[0][12]=a04;
-  a05=(a05*a11);
-  a05=(a05/a08);
-  a05=(a05/a02);
-  a05=(a05/a01);
-  a05=(-a05);
-  if (res[0]!=0) res[0][13]=a05;
-  a05=arg[0]? arg[0][6] : 0;
-  a05=(a05/a01);
-  if (res[0]!=0) res[0][14]=a05;
-  a05=6.2831853071795868e-02;
-  if (res[0]!=0) res[0][15]=a05;
-  a05=1.2566370614359172e+01;
-  if (res[1]!=0) res[1][0]=a05;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int constants(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f2(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int constants_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void constants_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void constants_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void constants_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int constants_n_in(void) { return 1;}
-
-CASADI_SYMBOL_EXPORT casadi_int constants_n_out(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_real constants_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* constants_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* constants_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "c";
-    case 1: return "period";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s4;
-    case 1: return casadi_s0;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int constants_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 1;
-  if (sz_res) *sz_res = 2;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 0;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 1*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 2*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 0*sizeof(casadi_real);
-  return 0;
-}
-
-/* table_point:(t,p[21])->(values[3]) */
-static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13;
-  a00=1.;
-  a01=arg[1]? arg[1][15] : 0;
-  a02=1.1800386146799999e+00;
-  a03=arg[0]? arg[0][0] : 0;
-  a04=cos(a03);
-  a05=(a02*a04);
-  a06=1.9272434388400000e-01;
-  a07=4.;
-  a07=(a07*a03);
-  a07=cos(a07);
-  a07=(a06*a07);
-  a05=(a05+a07);
-  a07=1.4883754528799999e-02;
-  a08=7.;
-  a08=(a08*a03);
-  a08=cos(a08);
-  a08=(a07*a08);
-  a05=(a05+a08);
-  a08=-6.0567417982099997e-02;
-  a09=6.;
-  a09=(a09*a03);
-  a09=cos(a09);
-  a09=(a08*a09);
-  a05=(a05+a09);
-  a09=-3.3689450631399998e-01;
-  a10=(2.*a03);
-  a10=cos(a10);
-  a11=(a09*a10);
-  a05=(a05+a11);
-  a11=-1.9563283778700000e-01;
-  a12=3.;
-  a12=(a12*a03);
-  a12=cos(a12);
-  a13=(a11*a12);
-  a05=(a05+a13);
-  a01=(a01*a05);
-  a01=(a00+a01);
-  if (res[0]!=0) res[0][0]=a01;
-  a01=arg[1]? arg[1][4] : 0;
-  a05=arg[1]? arg[1][5] : 0;
-  a13=arg[1]? arg[1][11] : 0;
-  a13=(a13+a03);
-  a13=cos(a13);
-  a05=(a05*a13);
-  a01=(a01+a05);
-  if (res[0]!=0) res[0][1]=a01;
-  a01=arg[1]? arg[1][16] : 0;
-  a09=(a09*a04);
-  a04=5.0000000000000000e-01;
-  a04=(a04*a03);
-  a04=cos(a04);
-  a02=(a02*a04);
-  a09=(a09+a02);
-  a06=(a06*a10);
-  a09=(a09+a06);
-  a06=3.5000000000000000e+00;
-  a06=(a06*a03);
-  a06=cos(a06);
-  a07=(a07*a06);
-  a09=(a09+a07);
-  a08=(a08*a12);
-  a09=(a09+a08);
-  a08=1.5000000000000000e+00;
-  a08=(a08*a03);
-  a08=cos(a08);
-  a11=(a11*a08);
-  a09=(a09+a11);
-  a01=(a01*a09);
-  a00=(a00+a01);
-  if (res[0]!=0) res[0][2]=a00;
-  return 0;
-}
-
-/* map401_table_point:(t[1x401],p[21x401])->(values[3x401]) */
-static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i;
-  casadi_real* *res1;
-  const casadi_real* *arg1;
-  arg1 = arg+2;
-  for (i=0; i<2; ++i) arg1[i]=arg[i];
-  res1 = res+1;
-  for (i=0; i<1; ++i) res1[i]=res[i];
-  for (i=0; i<401; ++i) {
-    if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-    if (arg1[0]) arg1[0]+=1;
-    if (arg1[1]) arg1[1]+=21;
-    if (res1[0]) res1[0]+=3;
-  }
-  return 0;
-}
-
-/* table:(t0,p[21])->(table[9x200],probe[3x2]) */
-static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  casadi_int i, j;
-  casadi_real **res1=res+2, *rr, w00, *w01=w+14, *w03=w+415, w04, w05, w06, *w07=w+431, *w08=w+8852, *w09=w+10055, *w10=w+10655;
-  casadi_real *w11=w+11255, *w12=w+11855, *w13=w+12455, *w14=w+14255, *w15=w+16055;
-  const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
-  w00 = arg[0] ? arg[0][0] : 0;
-  wr01 = casadi_c0;
-  wr02 = arg[1] ? arg[1] : casadi_zeros;
-  arg1[0]=wr02;
-  res1[0]=w03;
-  res1[1]=(&w04);
-  if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
-  for (rr=(&w05), cs=w03+15; cs!=w03+16; cs+=1) *rr++ = *cs;
-  w06 = 2.;
-  w05 /= w06;
-  for (i=0, rr=w01, cr=wr01; i<401; ++i) (*rr++)  = ((*cr++)*w05);
-  for (i=0, rr=w01, cs=w01; i<401; ++i) (*rr++)  = (w00+(*cs++));
-  for (i=0;i<401;++i) {
-    casadi_copy(wr02, 21, w07+ i*21);
-  }
-  arg1[0]=w01;
-  arg1[1]=w07;
-  res1[0]=w08;
-  if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
-  for (rr=w09, cs=w08+0; cs!=w08+1200; cs+=6) for (ct=cs+0; ct!=cs+3; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w10, cs=w09; i<200; ++i) for (j=0; j<3; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+1200; cs+=6) for (ct=cs+3; ct!=cs+6; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w11, cs=w09; i<200; ++i) for (j=0; j<3; ++j) rr[i+j*200] = *cs++;
-  for (rr=w09, cs=w08+0; cs!=w08+1200; cs+=6) for (ct=cs+6; ct!=cs+9; ct+=1) *rr++ = *ct;
-  for (i=0, rr=w12, cs=w09; i<200; ++i) for (j=0; j<3; ++j) rr[i+j*200] = *cs++;
-  rr=w13;
-  for (i=0, cs=w10; i<600; ++i) *rr++ = *cs++;
-  for (i=0, cs=w11; i<600; ++i) *rr++ = *cs++;
-  for (i=0, cs=w12; i<600; ++i) *rr++ = *cs++;
-  for (i=0, rr=w14, cs=w13; i<9; ++i) for (j=0; j<200; ++j) rr[i+j*9] = *cs++;
-  casadi_copy(w14, 1800, res[0]);
-  w05 = 3.7000000000000000e-01;
-  w05 *= w04;
-  w05  = (w00+w05);
-  arg1[0]=(&w05);
-  arg1[1]=wr02;
-  res1[0]=w15;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-  casadi_copy(w15, 3, res[1]);
-  w05 = 1.3700000000000001e+00;
-  w05 *= w04;
-  w00 += w05;
-  arg1[0]=(&w00);
-  arg1[1]=wr02;
-  res1[0]=w15;
-  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
-  if (res[1]) casadi_copy(w15, 3, res[1]+3);
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
-  return casadi_f3(arg, res, iw, w, mem);
-}
-
-CASADI_SYMBOL_EXPORT int table_checkout(void) {
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT void table_release(int mem) {
-}
-
-CASADI_SYMBOL_EXPORT void table_incref(void) {
-}
-
-CASADI_SYMBOL_EXPORT void table_decref(void) {
-}
-
-CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
-
-CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
-  switch (i) {
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
-  switch (i) {
-    case 0: return "t0";
-    case 1: return "p";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
-  switch (i) {
-    case 0: return "table";
-    case 1: return "probe";
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s0;
-    case 1: return casadi_s2;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
-  switch (i) {
-    case 0: return casadi_s5;
-    case 1: return casadi_s6;
-    default: return 0;
-  }
-}
-
-CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 6;
-  if (sz_res) *sz_res = 4;
-  if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 16058;
-  return 0;
-}
-
-CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
-  if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
-  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
-  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 16058*sizeof(casadi_real);
-  return 0;
-}
 
 /* gearsym: the integration loops, printed around CasADi's C of one step (see gearsym/codegen/printed.py) */
 #if defined(__GNUC__)
@@ -1169,7 +293,7 @@ CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res
 #define GEARSYM_NOT_UNROLLED
 #endif
 
-static const casadi_real gs_zeros[1800] = {0.};
+static const casadi_real gs_zeros[3600] = {0.};
 
 /* an input as CasADi passes it (a null pointer: zeros) into a local array */
 static inline void gs_load(const casadi_real* x, casadi_int n, casadi_real* y) {
@@ -1325,31 +449,31 @@ static GEARSYM_INLINE void gs_tangent_keep(const casadi_real* restrict A0, const
   R3[2]=a2;
 }
 
-/* state_try, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1) {
+/* state_try, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_try_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
   casadi_real a36, a37, a38, a39, a40, a41, a42, a43, a44, a45, a46, a47;
   casadi_real a48, a49, a50, a51, a52;
   a00=A0[0];
-  a01=A2[15];
+  a01=A2[S*15];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[1];
+  a03=A0[S*1];
   a04=2.;
   a04=(a01/a04);
-  a05=A2[2];
+  a05=A2[S*2];
   a06=(a03*a05);
-  a07=A0[2];
-  a08=A2[3];
+  a07=A0[S*2];
+  a08=A2[S*3];
   a09=(a07*a08);
   a06=(a06+a09);
-  a09=A2[4];
-  a10=A1[1];
+  a09=A2[S*4];
+  a10=A1[S*1];
   a10=(a09*a10);
   a06=(a06+a10);
-  a10=A2[1];
+  a10=A2[S*1];
   a11=A1[0];
   a12=(a10*a11);
   a13=A2[0];
@@ -1369,15 +493,15 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a21=(2.*a12);
   a21=(a03+a21);
   a22=(a12*a05);
-  a23=A0[3];
+  a23=A0[S*3];
   a24=(a04*a23);
   a24=(a07+a24);
   a25=(a24*a08);
   a22=(a22+a25);
-  a25=A1[4];
+  a25=A1[S*4];
   a25=(a09*a25);
   a22=(a22+a25);
-  a26=A1[3];
+  a26=A1[S*3];
   a27=(a10*a26);
   a28=(a04*a03);
   a28=(a00+a28);
@@ -1390,24 +514,24 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a30=(2.*a29);
   a21=(a21+a30);
   a30=(a29*a05);
-  a31=A2[7];
+  a31=A2[S*7];
   a32=(a03*a31);
-  a33=A0[5];
-  a34=A2[8];
+  a33=A0[S*5];
+  a34=A2[S*8];
   a35=(a33*a34);
   a32=(a32+a35);
-  a35=A2[5];
+  a35=A2[S*5];
   a36=(a07*a35);
   a32=(a32+a36);
-  a36=A2[6];
+  a36=A2[S*6];
   a11=(a36*a11);
   a11=(a11*a20);
   a32=(a32+a11);
-  a11=A2[10];
-  a20=A1[2];
+  a11=A2[S*10];
+  a20=A1[S*2];
   a37=(a11*a20);
-  a38=A2[9];
-  a39=A0[4];
+  a38=A2[S*9];
+  a39=A0[S*4];
   a40=(a39+a38);
   a41=(-a40);
   a41=(a14<=a41);
@@ -1443,14 +567,14 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a06=(a06+a30);
   a05=(a27*a05);
   a12=(a12*a31);
-  a30=A2[14];
-  a22=A2[11];
+  a30=A2[S*14];
+  a22=A2[S*11];
   a47=(a33*a22);
   a47=(a30+a47);
-  a48=A2[13];
+  a48=A2[S*13];
   a49=(a07*a48);
   a47=(a47+a49);
-  a49=A2[12];
+  a49=A2[S*12];
   a20=(a49*a20);
   a20=(a20*a45);
   a47=(a47+a20);
@@ -1463,7 +587,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a26=(a36*a26);
   a28=(a26*a28);
   a12=(a12+a28);
-  a28=A1[5];
+  a28=A1[S*5];
   a45=(a11*a28);
   a50=(a04*a33);
   a50=(a39+a50);
@@ -1477,10 +601,10 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a52=(a07+a52);
   a08=(a52*a08);
   a05=(a05+a08);
-  a08=A1[7];
+  a08=A1[S*7];
   a09=(a09*a08);
   a05=(a05+a09);
-  a09=A1[6];
+  a09=A1[S*6];
   a10=(a10*a09);
   a08=(a01*a29);
   a08=(a00+a08);
@@ -1491,7 +615,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a06=(a06+a05);
   a06=(a02*a06);
   a06=(a03+a06);
-  R0[1]=a06;
+  R0[S*1]=a06;
   a37=(2.*a37);
   a37=(a23+a37);
   a51=(2.*a51);
@@ -1523,7 +647,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a37=(a37+a45);
   a37=(a02*a37);
   a07=(a07+a37);
-  R0[2]=a07;
+  R0[S*2]=a07;
   a12=(2.*a12);
   a32=(a32+a12);
   a29=(2.*a29);
@@ -1544,7 +668,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a36=(a36*a09);
   a36=(a36*a17);
   a27=(a27+a36);
-  a36=A1[8];
+  a36=A1[S*8];
   a11=(a11*a36);
   a17=(a01*a50);
   a17=(a39+a17);
@@ -1555,7 +679,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a32=(a32+a27);
   a32=(a02*a32);
   a23=(a23+a32);
-  R0[3]=a23;
+  R0[S*3]=a23;
   a20=(2.*a20);
   a20=(a33+a20);
   a50=(2.*a50);
@@ -1563,7 +687,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a20=(a20+a28);
   a20=(a02*a20);
   a20=(a39+a20);
-  R0[4]=a20;
+  R0[S*4]=a20;
   a51=(2.*a51);
   a47=(a47+a51);
   a31=(2.*a31);
@@ -1578,7 +702,7 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a47=(a47+a30);
   a02=(a02*a47);
   a02=(a33+a02);
-  R0[5]=a02;
+  R0[S*5]=a02;
   a18=(2.*a18);
   a47=1.;
   a18=(a18-a47);
@@ -1653,22 +777,23 @@ static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const ca
   a14=(a14<a30);
   R1[0]=a14;
 }
+static GEARSYM_INLINE void gs_state_try(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1) { gs_state_try_strided(A0, A1, A2, R0, R1, 1); }
 
-/* state_keep, from CasADi's C of it */
-static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+/* state_keep, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_state_keep_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
   casadi_real a0, a1, a2, a3, a4, a5;
   a0=A3[0];
   R0[0]=a0;
-  a1=A3[1];
-  R0[1]=a1;
-  a1=A3[2];
-  R0[2]=a1;
-  a2=A3[3];
-  R0[3]=a2;
-  a2=A3[4];
-  R0[4]=a2;
-  a3=A3[5];
-  R0[5]=a3;
+  a1=A3[S*1];
+  R0[S*1]=a1;
+  a1=A3[S*2];
+  R0[S*2]=a1;
+  a2=A3[S*3];
+  R0[S*3]=a2;
+  a2=A3[S*4];
+  R0[S*4]=a2;
+  a3=A3[S*5];
+  R0[S*5]=a3;
   a3=A1[0];
   a4=(a0<a3);
   a5=(a4?a0:0);
@@ -1676,20 +801,20 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
   a4=(a4?a3:0);
   a5=(a5+a4);
   R1[0]=a5;
-  a5=A1[1];
+  a5=A1[S*1];
   a4=(a1<a5);
   a3=(a4?a1:0);
   a4=(!a4);
   a4=(a4?a5:0);
   a3=(a3+a4);
-  R1[1]=a3;
-  a3=A1[2];
+  R1[S*1]=a3;
+  a3=A1[S*2];
   a4=(a2<a3);
   a5=(a4?a2:0);
   a4=(!a4);
   a4=(a4?a3:0);
   a5=(a5+a4);
-  R1[2]=a5;
+  R1[S*2]=a5;
   a5=A2[0];
   a4=(a5<a0);
   a0=(a4?a0:0);
@@ -1697,21 +822,22 @@ static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const c
   a4=(a4?a5:0);
   a0=(a0+a4);
   R2[0]=a0;
-  a0=A2[1];
+  a0=A2[S*1];
   a4=(a0<a1);
   a1=(a4?a1:0);
   a4=(!a4);
   a4=(a4?a0:0);
   a1=(a1+a4);
-  R2[1]=a1;
-  a1=A2[2];
+  R2[S*1]=a1;
+  a1=A2[S*2];
   a4=(a1<a2);
   a2=(a4?a2:0);
   a4=(!a4);
   a4=(a4?a1:0);
   a2=(a2+a4);
-  R2[2]=a2;
+  R2[S*2]=a2;
 }
+static GEARSYM_INLINE void gs_state_keep(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, const casadi_real* restrict A3, const casadi_real* restrict A4, const casadi_real* restrict A5, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_state_keep_strided(A0, A1, A2, A3, A4, A5, R0, R1, R2, 1); }
 
 /* split_start, from CasADi's C of it */
 static GEARSYM_NOINLINE void gs_split_start(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
@@ -4161,31 +3287,31 @@ static GEARSYM_NOINLINE void gs_state_mode_step(const casadi_real* restrict A0, 
   R0[5]=a28;
 }
 
-/* tangent_state, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) {
+/* tangent_state, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_state_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
   casadi_real a36, a37, a38, a39, a40, a41, a42, a43, a44, a45, a46, a47;
   casadi_real a48, a49, a50, a51, a52, a53, a54, a55, a56, a57, a58, a59;
   a00=A0[0];
-  a01=A2[15];
+  a01=A2[S*15];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[1];
+  a03=A0[S*1];
   a04=2.;
   a04=(a01/a04);
-  a05=A2[2];
+  a05=A2[S*2];
   a06=(a03*a05);
-  a07=A0[2];
-  a08=A2[3];
+  a07=A0[S*2];
+  a08=A2[S*3];
   a09=(a07*a08);
   a06=(a06+a09);
-  a09=A2[4];
-  a10=A1[1];
+  a09=A2[S*4];
+  a10=A1[S*1];
   a10=(a09*a10);
   a06=(a06+a10);
-  a10=A2[1];
+  a10=A2[S*1];
   a11=A1[0];
   a12=(a10*a11);
   a13=A2[0];
@@ -4205,15 +3331,15 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a22=(2.*a21);
   a22=(a03+a22);
   a23=(a21*a05);
-  a24=A0[3];
+  a24=A0[S*3];
   a25=(a04*a24);
   a25=(a07+a25);
   a26=(a25*a08);
   a23=(a23+a26);
-  a26=A1[4];
+  a26=A1[S*4];
   a26=(a09*a26);
   a23=(a23+a26);
-  a27=A1[3];
+  a27=A1[S*3];
   a28=(a10*a27);
   a29=(a04*a03);
   a29=(a00+a29);
@@ -4226,24 +3352,24 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a31=(2.*a30);
   a22=(a22+a31);
   a31=(a30*a05);
-  a32=A2[7];
+  a32=A2[S*7];
   a33=(a03*a32);
-  a34=A0[5];
-  a35=A2[8];
+  a34=A0[S*5];
+  a35=A2[S*8];
   a36=(a34*a35);
   a33=(a33+a36);
-  a36=A2[5];
+  a36=A2[S*5];
   a37=(a07*a36);
   a33=(a33+a37);
-  a37=A2[6];
+  a37=A2[S*6];
   a11=(a37*a11);
   a20=(a11*a20);
   a33=(a33+a20);
-  a20=A2[10];
-  a38=A1[2];
+  a20=A2[S*10];
+  a38=A1[S*2];
   a39=(a20*a38);
-  a40=A2[9];
-  a41=A0[4];
+  a40=A2[S*9];
+  a41=A0[S*4];
   a42=(a41+a40);
   a43=(-a42);
   a43=(a14<=a43);
@@ -4279,14 +3405,14 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a06=(a06+a31);
   a31=(a50*a05);
   a21=(a21*a32);
-  a23=A2[14];
-  a51=A2[11];
+  a23=A2[S*14];
+  a51=A2[S*11];
   a52=(a34*a51);
   a52=(a23+a52);
-  a53=A2[13];
+  a53=A2[S*13];
   a54=(a07*a53);
   a52=(a52+a54);
-  a54=A2[12];
+  a54=A2[S*12];
   a38=(a54*a38);
   a47=(a38*a47);
   a52=(a52+a47);
@@ -4299,7 +3425,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a27=(a37*a27);
   a29=(a27*a29);
   a21=(a21+a29);
-  a29=A1[5];
+  a29=A1[S*5];
   a55=(a20*a29);
   a56=(a04*a34);
   a56=(a41+a56);
@@ -4313,10 +3439,10 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a58=(a07+a58);
   a59=(a58*a08);
   a31=(a31+a59);
-  a59=A1[7];
+  a59=A1[S*7];
   a09=(a09*a59);
   a31=(a31+a09);
-  a09=A1[6];
+  a09=A1[S*6];
   a10=(a10*a09);
   a59=(a01*a30);
   a59=(a00+a59);
@@ -4327,7 +3453,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a06=(a06+a31);
   a06=(a02*a06);
   a06=(a03+a06);
-  R0[1]=a06;
+  R0[S*1]=a06;
   a48=(2.*a48);
   a48=(a24+a48);
   a57=(2.*a57);
@@ -4359,7 +3485,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a48=(a48+a26);
   a48=(a02*a48);
   a07=(a07+a48);
-  R0[2]=a07;
+  R0[S*2]=a07;
   a21=(2.*a21);
   a33=(a33+a21);
   a30=(2.*a30);
@@ -4380,7 +3506,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a37=(a37*a09);
   a17=(a37*a17);
   a50=(a50+a17);
-  a17=A1[8];
+  a17=A1[S*8];
   a20=(a20*a17);
   a09=(a01*a56);
   a09=(a41+a09);
@@ -4391,7 +3517,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a33=(a33+a50);
   a33=(a02*a33);
   a24=(a24+a33);
-  R0[3]=a24;
+  R0[S*3]=a24;
   a47=(2.*a47);
   a47=(a34+a47);
   a56=(2.*a56);
@@ -4399,7 +3525,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a47=(a47+a04);
   a47=(a02*a47);
   a47=(a41+a47);
-  R0[4]=a47;
+  R0[S*4]=a47;
   a57=(2.*a57);
   a52=(a52+a57);
   a30=(2.*a30);
@@ -4414,7 +3540,7 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a52=(a52+a23);
   a02=(a02*a52);
   a02=(a34+a02);
-  R0[5]=a02;
+  R0[S*5]=a02;
   a18=(2.*a18);
   a52=1.;
   a18=(a18-a52);
@@ -4491,72 +3617,73 @@ static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, cons
   a12=(a12*a19);
   R2[0]=a12;
   a11=(a11*a19);
-  R2[1]=a11;
-  R2[2]=a05;
-  R2[3]=a32;
-  R2[4]=a08;
-  R2[5]=a36;
-  R2[6]=a53;
+  R2[S*1]=a11;
+  R2[S*2]=a05;
+  R2[S*3]=a32;
+  R2[S*4]=a08;
+  R2[S*5]=a36;
+  R2[S*6]=a53;
   a39=(a39*a46);
-  R2[7]=a39;
+  R2[S*7]=a39;
   a38=(a38*a46);
-  R2[8]=a38;
-  R2[9]=a35;
-  R2[10]=a51;
+  R2[S*8]=a38;
+  R2[S*9]=a35;
+  R2[S*10]=a51;
   a28=(a28*a19);
-  R2[11]=a28;
+  R2[S*11]=a28;
   a27=(a27*a19);
-  R2[12]=a27;
+  R2[S*12]=a27;
   a55=(a55*a46);
-  R2[13]=a55;
+  R2[S*13]=a55;
   a29=(a29*a46);
-  R2[14]=a29;
-  R2[15]=a28;
-  R2[16]=a27;
-  R2[17]=a55;
-  R2[18]=a29;
+  R2[S*14]=a29;
+  R2[S*15]=a28;
+  R2[S*16]=a27;
+  R2[S*17]=a55;
+  R2[S*18]=a29;
   a10=(a10*a19);
-  R2[19]=a10;
+  R2[S*19]=a10;
   a37=(a37*a19);
-  R2[20]=a37;
+  R2[S*20]=a37;
   a20=(a20*a46);
-  R2[21]=a20;
+  R2[S*21]=a20;
   a54=(a54*a46);
-  R2[22]=a54;
+  R2[S*22]=a54;
 }
+static GEARSYM_INLINE void gs_tangent_state(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_real* restrict R1, casadi_real* restrict R2) { gs_tangent_state_strided(A0, A1, A2, R0, R1, R2, 1); }
 
-/* tangent_vector, from CasADi's C of it */
-static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) {
+/* tangent_vector, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_tangent_vector_strided(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0, casadi_int S) {
   casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
   casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
   casadi_real a24, a25, a26, a27, a28, a29;
   a00=A0[0];
-  a01=A2[15];
+  a01=A2[S*15];
   a02=6.;
   a02=(a01/a02);
-  a03=A0[6];
+  a03=A0[S*6];
   a04=2.;
   a04=(a01/a04);
   a05=A1[0];
   a05=(a05*a00);
-  a06=A1[2];
+  a06=A1[S*2];
   a07=(a06*a03);
   a05=(a05+a07);
-  a07=A1[4];
-  a08=A0[12];
+  a07=A1[S*4];
+  a08=A0[S*12];
   a09=(a07*a08);
   a05=(a05+a09);
   a09=(a04*a05);
   a09=(a03+a09);
   a10=(2.*a09);
   a10=(a03+a10);
-  a11=A1[11];
+  a11=A1[S*11];
   a12=(a04*a03);
   a12=(a00+a12);
   a11=(a11*a12);
   a13=(a06*a09);
   a11=(a11+a13);
-  a13=A0[18];
+  a13=A0[S*18];
   a14=(a04*a13);
   a14=(a08+a14);
   a15=(a07*a14);
@@ -4565,26 +3692,26 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a15=(a03+a15);
   a16=(2.*a15);
   a10=(a10+a16);
-  a16=A1[15];
+  a16=A1[S*15];
   a17=(a04*a09);
   a17=(a00+a17);
   a16=(a16*a17);
   a18=(a06*a15);
   a16=(a16+a18);
-  a18=A1[1];
+  a18=A1[S*1];
   a18=(a18*a00);
-  a19=A1[3];
+  a19=A1[S*3];
   a20=(a19*a03);
   a18=(a18+a20);
-  a20=A1[5];
+  a20=A1[S*5];
   a21=(a20*a08);
   a18=(a18+a21);
-  a21=A1[7];
-  a22=A0[24];
+  a21=A1[S*7];
+  a22=A0[S*24];
   a21=(a21*a22);
   a18=(a18+a21);
-  a21=A1[9];
-  a23=A0[30];
+  a21=A1[S*9];
+  a23=A0[S*30];
   a24=(a21*a23);
   a18=(a18+a24);
   a24=(a04*a18);
@@ -4603,29 +3730,29 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a05=(a05+a11);
   a16=(2.*a16);
   a05=(a05+a16);
-  a16=A1[19];
+  a16=A1[S*19];
   a11=(a01*a15);
   a00=(a00+a11);
   a16=(a16*a00);
   a06=(a06*a26);
   a16=(a16+a06);
-  a06=A1[12];
+  a06=A1[S*12];
   a06=(a06*a12);
   a09=(a19*a09);
   a06=(a06+a09);
   a09=(a20*a14);
   a06=(a06+a09);
-  a09=A1[13];
+  a09=A1[S*13];
   a12=(a04*a23);
   a12=(a22+a12);
   a09=(a09*a12);
   a06=(a06+a09);
-  a09=A1[6];
+  a09=A1[S*6];
   a11=(a09*a08);
-  a10=A1[8];
+  a10=A1[S*8];
   a10=(a10*a22);
   a11=(a11+a10);
-  a10=A1[10];
+  a10=A1[S*10];
   a27=(a10*a23);
   a11=(a11+a27);
   a27=(a04*a11);
@@ -4641,24 +3768,24 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a05=(a05+a16);
   a05=(a02*a05);
   a03=(a03+a05);
-  R0[6]=a03;
+  R0[S*6]=a03;
   a24=(2.*a24);
   a24=(a13+a24);
   a28=(2.*a28);
   a24=(a24+a28);
-  a28=A1[16];
+  a28=A1[S*16];
   a28=(a28*a17);
   a15=(a19*a15);
   a28=(a28+a15);
   a15=(a20*a25);
   a28=(a28+a15);
-  a15=A1[17];
+  a15=A1[S*17];
   a17=(a04*a27);
   a17=(a22+a17);
   a15=(a15*a17);
   a28=(a28+a15);
   a14=(a09*a14);
-  a15=A1[14];
+  a15=A1[S*14];
   a15=(a15*a12);
   a14=(a14+a15);
   a15=(a10*a27);
@@ -4672,24 +3799,24 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a24=(a24+a15);
   a24=(a02*a24);
   a08=(a08+a24);
-  R0[12]=a08;
+  R0[S*12]=a08;
   a06=(2.*a06);
   a18=(a18+a06);
   a28=(2.*a28);
   a18=(a18+a28);
-  a28=A1[20];
+  a28=A1[S*20];
   a28=(a28*a00);
   a19=(a19*a26);
   a28=(a28+a19);
   a20=(a20*a29);
   a28=(a28+a20);
-  a20=A1[21];
+  a20=A1[S*21];
   a19=(a01*a04);
   a19=(a22+a19);
   a20=(a20*a19);
   a28=(a28+a20);
   a25=(a09*a25);
-  a20=A1[18];
+  a20=A1[S*18];
   a20=(a20*a17);
   a25=(a25+a20);
   a20=(a10*a04);
@@ -4701,7 +3828,7 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a18=(a18+a28);
   a18=(a02*a18);
   a13=(a13+a18);
-  R0[18]=a13;
+  R0[S*18]=a13;
   a27=(2.*a27);
   a27=(a23+a27);
   a04=(2.*a04);
@@ -4709,13 +3836,13 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a27=(a27+a01);
   a27=(a02*a27);
   a22=(a22+a27);
-  R0[24]=a22;
+  R0[S*24]=a22;
   a14=(2.*a14);
   a11=(a11+a14);
   a25=(2.*a25);
   a11=(a11+a25);
   a09=(a09*a29);
-  a29=A1[22];
+  a29=A1[S*22];
   a29=(a29*a19);
   a09=(a09+a29);
   a10=(a10*a01);
@@ -4723,8 +3850,9 @@ static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, con
   a11=(a11+a09);
   a02=(a02*a11);
   a23=(a23+a02);
-  R0[30]=a23;
+  R0[S*30]=a23;
 }
+static GEARSYM_INLINE void gs_tangent_vector(const casadi_real* restrict A0, const casadi_real* restrict A1, const casadi_real* restrict A2, casadi_real* restrict R0) { gs_tangent_vector_strided(A0, A1, A2, R0, 1); }
 
 /* gram_schmidt, from CasADi's C of it */
 static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) {
@@ -5271,6 +4399,102 @@ static GEARSYM_INLINE void gs_gram_schmidt(const casadi_real* restrict A0, casad
   R1[5]=a22;
 }
 
+/* constants, from CasADi's C of it: every entry S apart (the lanes call it on each lane) */
+static GEARSYM_INLINE void gs_constants_strided(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1, casadi_int S) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12;
+  a00=A0[S*12];
+  R0[0]=a00;
+  a00=A0[0];
+  a01=casadi_sq(a00);
+  a02=(1./a01);
+  a03=(-a02);
+  R0[S*1]=a03;
+  a03=-2.;
+  a04=A0[S*1];
+  a04=(a03*a04);
+  a05=(a04/a00);
+  R0[S*2]=a05;
+  a05=A0[S*14];
+  a06=A0[S*8];
+  a07=(a05/a06);
+  a07=(a07/a01);
+  a07=(-a07);
+  R0[S*3]=a07;
+  R0[S*4]=a02;
+  a02=(a05/a01);
+  a07=(1./a06);
+  a08=A0[S*9];
+  a09=(1./a08);
+  a07=(a07+a09);
+  a02=(a02*a07);
+  a02=(-a02);
+  R0[S*5]=a02;
+  a02=A0[S*18];
+  a07=casadi_sq(a02);
+  a09=(a07/a06);
+  a10=(a09/a01);
+  a11=A0[S*17];
+  a11=casadi_sq(a11);
+  a12=A0[S*7];
+  a11=(a11/a12);
+  a11=(a11+a09);
+  a10=(a10/a11);
+  a10=(-a10);
+  R0[S*6]=a10;
+  a04=(a04/a06);
+  a04=(a04*a07);
+  a04=(a04/a00);
+  a04=(a04/a11);
+  R0[S*7]=a04;
+  a04=(a03*a02);
+  a11=A0[S*19];
+  a04=(a04*a11);
+  a07=A0[S*3];
+  a04=(a04*a07);
+  a04=(a04/a08);
+  a04=(a04/a00);
+  a06=casadi_sq(a11);
+  a06=(a06/a08);
+  a10=A0[S*20];
+  a10=casadi_sq(a10);
+  a09=A0[S*10];
+  a10=(a10/a09);
+  a06=(a06+a10);
+  a04=(a04/a06);
+  R0[S*8]=a04;
+  a04=A0[S*13];
+  R0[S*9]=a04;
+  a04=A0[S*2];
+  a10=(a04*a02);
+  a10=(a10*a11);
+  a10=(a10/a08);
+  a10=(a10/a01);
+  a10=(a10/a06);
+  a10=(-a10);
+  R0[S*10]=a10;
+  a03=(a03*a07);
+  a03=(a03/a00);
+  R0[S*11]=a03;
+  a04=(a04/a01);
+  a04=(-a04);
+  R0[S*12]=a04;
+  a05=(a05*a11);
+  a05=(a05/a08);
+  a05=(a05/a02);
+  a05=(a05/a01);
+  a05=(-a05);
+  R0[S*13]=a05;
+  a05=A0[S*6];
+  a05=(a05/a01);
+  R0[S*14]=a05;
+  a05=3.1415926535897934e-02;
+  R0[S*15]=a05;
+  a05=1.2566370614359172e+01;
+  R1[0]=a05;
+}
+static GEARSYM_INLINE void gs_constants(const casadi_real* restrict A0, casadi_real* restrict R0, casadi_real* restrict R1) { gs_constants_strided(A0, R0, R1, 1); }
+
 /* the located step that crosses: its legs, RK4 of the sides held fixed on each (calls of one
    mode-RK4 step), as the MX function of the split (SPLIT_CALLS in gearsym/codegen/crossing.py) */
 static GEARSYM_NOINLINE void gs_tangent_split(const casadi_real* restrict y, const casadi_real* restrict Q, const casadi_real* restrict lo, const casadi_real* restrict hi, const casadi_real* restrict yt, const casadi_real* restrict Qt, const casadi_real* restrict T, const casadi_real* restrict c, casadi_real* restrict y1, casadi_real* restrict Q1, casadi_real* restrict lo1, casadi_real* restrict hi1) {
@@ -5311,6 +4535,934 @@ static GEARSYM_NOINLINE void gs_state_split(const casadi_real* restrict y, const
   gs_state_mode_step(yb, leg_b, c, yc);
   gs_state_mode_step(yc, leg_c, c, yn);
   gs_state_keep(y, lo, hi, yn, T, c, y1, lo1, hi1);
+}
+
+#ifndef GEARSYM_STEP_PIECES_ONLY  /* (the lanes' C includes the pieces above) */
+
+/* rhs:(t,y[6],p[21])->(dy[6]) */
+static int casadi_f0(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
+  casadi_real a24, a25, a26, a27, a28, a29, a30;
+  a00=arg[1]? arg[1][1] : 0;
+  if (res[0]!=0) res[0][0]=a00;
+  a01=-2.;
+  a00=(a01*a00);
+  a02=arg[2]? arg[2][1] : 0;
+  a00=(a00*a02);
+  a02=arg[2]? arg[2][0] : 0;
+  a03=(a00/a02);
+  a04=arg[2]? arg[2][14] : 0;
+  a05=arg[1]? arg[1][2] : 0;
+  a06=(a04*a05);
+  a07=arg[2]? arg[2][8] : 0;
+  a08=(a06/a07);
+  a09=casadi_sq(a02);
+  a08=(a08/a09);
+  a03=(a03-a08);
+  a08=arg[2]? arg[2][4] : 0;
+  a10=arg[2]? arg[2][5] : 0;
+  a11=arg[2]? arg[2][11] : 0;
+  a12=arg[0]? arg[0][0] : 0;
+  a11=(a11+a12);
+  a11=cos(a11);
+  a10=(a10*a11);
+  a08=(a08+a10);
+  a08=(a08/a09);
+  a03=(a03+a08);
+  a08=0.;
+  a10=arg[1]? arg[1][0] : 0;
+  a11=(a08<=a10);
+  a11=(a11?a10:0);
+  a13=arg[2]? arg[2][12] : 0;
+  a14=(-a13);
+  a14=(a10<=a14);
+  a10=(a10+a13);
+  a14=(a14?a10:0);
+  a11=(a11+a14);
+  a14=(a11/a09);
+  a10=1.;
+  a13=arg[2]? arg[2][15] : 0;
+  a15=1.1800386146799999e+00;
+  a16=cos(a12);
+  a17=(a15*a16);
+  a18=1.9272434388400000e-01;
+  a19=4.;
+  a19=(a19*a12);
+  a19=cos(a19);
+  a19=(a18*a19);
+  a17=(a17+a19);
+  a19=1.4883754528799999e-02;
+  a20=7.;
+  a20=(a20*a12);
+  a20=cos(a20);
+  a20=(a19*a20);
+  a17=(a17+a20);
+  a20=-6.0567417982099997e-02;
+  a21=6.;
+  a21=(a21*a12);
+  a21=cos(a21);
+  a21=(a20*a21);
+  a17=(a17+a21);
+  a21=-3.3689450631399998e-01;
+  a22=(2.*a12);
+  a22=cos(a22);
+  a23=(a21*a22);
+  a17=(a17+a23);
+  a23=-1.9563283778700000e-01;
+  a24=3.;
+  a24=(a24*a12);
+  a24=cos(a24);
+  a25=(a23*a24);
+  a17=(a17+a25);
+  a13=(a13*a17);
+  a13=(a10+a13);
+  a14=(a14*a13);
+  a03=(a03-a14);
+  if (res[0]!=0) res[0][1]=a03;
+  a03=arg[1]? arg[1][3] : 0;
+  if (res[0]!=0) res[0][2]=a03;
+  a00=(a00/a07);
+  a03=arg[2]? arg[2][18] : 0;
+  a14=casadi_sq(a03);
+  a00=(a00*a14);
+  a00=(a00/a02);
+  a17=arg[2]? arg[2][17] : 0;
+  a17=casadi_sq(a17);
+  a25=arg[2]? arg[2][7] : 0;
+  a17=(a17/a25);
+  a14=(a14/a07);
+  a17=(a17+a14);
+  a00=(a00/a17);
+  a06=(a06/a09);
+  a07=(1./a07);
+  a25=arg[2]? arg[2][9] : 0;
+  a26=(1./a25);
+  a07=(a07+a26);
+  a06=(a06*a07);
+  a00=(a00-a06);
+  a06=(a01*a03);
+  a07=arg[2]? arg[2][19] : 0;
+  a06=(a06*a07);
+  a26=arg[1]? arg[1][5] : 0;
+  a06=(a06*a26);
+  a27=arg[2]? arg[2][3] : 0;
+  a06=(a06*a27);
+  a06=(a06/a25);
+  a06=(a06/a02);
+  a28=casadi_sq(a07);
+  a28=(a28/a25);
+  a29=arg[2]? arg[2][20] : 0;
+  a29=casadi_sq(a29);
+  a30=arg[2]? arg[2][10] : 0;
+  a29=(a29/a30);
+  a28=(a28+a29);
+  a06=(a06/a28);
+  a00=(a00+a06);
+  a14=(a14/a09);
+  a14=(a14*a11);
+  a14=(a14/a17);
+  a14=(a14*a13);
+  a00=(a00-a14);
+  a14=arg[2]? arg[2][2] : 0;
+  a13=(a14*a03);
+  a13=(a13*a07);
+  a13=(a13/a25);
+  a13=(a13/a09);
+  a17=arg[1]? arg[1][4] : 0;
+  a08=(a08<=a17);
+  a08=(a08?a17:0);
+  a11=arg[2]? arg[2][13] : 0;
+  a06=(-a11);
+  a06=(a17<=a06);
+  a17=(a17+a11);
+  a06=(a06?a17:0);
+  a08=(a08+a06);
+  a13=(a13*a08);
+  a13=(a13/a28);
+  a28=arg[2]? arg[2][16] : 0;
+  a21=(a21*a16);
+  a16=5.0000000000000000e-01;
+  a16=(a16*a12);
+  a16=cos(a16);
+  a15=(a15*a16);
+  a21=(a21+a15);
+  a18=(a18*a22);
+  a21=(a21+a18);
+  a18=3.5000000000000000e+00;
+  a18=(a18*a12);
+  a18=cos(a18);
+  a19=(a19*a18);
+  a21=(a21+a19);
+  a20=(a20*a24);
+  a21=(a21+a20);
+  a20=1.5000000000000000e+00;
+  a20=(a20*a12);
+  a20=cos(a20);
+  a23=(a23*a20);
+  a21=(a21+a23);
+  a28=(a28*a21);
+  a10=(a10+a28);
+  a13=(a13*a10);
+  a00=(a00-a13);
+  if (res[0]!=0) res[0][3]=a00;
+  if (res[0]!=0) res[0][4]=a26;
+  a00=arg[2]? arg[2][6] : 0;
+  a00=(a00/a09);
+  a01=(a01*a26);
+  a01=(a01*a27);
+  a01=(a01/a02);
+  a00=(a00+a01);
+  a04=(a04*a07);
+  a04=(a04*a05);
+  a04=(a04/a25);
+  a04=(a04/a03);
+  a04=(a04/a09);
+  a00=(a00-a04);
+  a14=(a14/a09);
+  a14=(a14*a08);
+  a14=(a14*a10);
+  a00=(a00-a14);
+  if (res[0]!=0) res[0][5]=a00;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int rhs(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f0(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int rhs_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void rhs_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void rhs_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void rhs_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int rhs_n_in(void) { return 3;}
+
+CASADI_SYMBOL_EXPORT casadi_int rhs_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real rhs_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* rhs_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "y";
+    case 2: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* rhs_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "dy";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s1;
+    case 2: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* rhs_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s1;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int rhs_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int rhs_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* jacobian:(t,y[6],p[21])->(J[6x6]) */
+static int casadi_f1(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21;
+  a00=0.;
+  if (res[0]!=0) res[0][0]=a00;
+  a01=1.;
+  a02=arg[2]? arg[2][15] : 0;
+  a03=1.1800386146799999e+00;
+  a04=arg[0]? arg[0][0] : 0;
+  a05=cos(a04);
+  a06=(a03*a05);
+  a07=1.9272434388400000e-01;
+  a08=4.;
+  a08=(a08*a04);
+  a08=cos(a08);
+  a08=(a07*a08);
+  a06=(a06+a08);
+  a08=1.4883754528799999e-02;
+  a09=7.;
+  a09=(a09*a04);
+  a09=cos(a09);
+  a09=(a08*a09);
+  a06=(a06+a09);
+  a09=-6.0567417982099997e-02;
+  a10=6.;
+  a10=(a10*a04);
+  a10=cos(a10);
+  a10=(a09*a10);
+  a06=(a06+a10);
+  a10=-3.3689450631399998e-01;
+  a11=(2.*a04);
+  a11=cos(a11);
+  a12=(a10*a11);
+  a06=(a06+a12);
+  a12=-1.9563283778700000e-01;
+  a13=3.;
+  a13=(a13*a04);
+  a13=cos(a13);
+  a14=(a12*a13);
+  a06=(a06+a14);
+  a02=(a02*a06);
+  a02=(a01+a02);
+  a06=arg[1]? arg[1][0] : 0;
+  a14=(a00<=a06);
+  a14=(a14?a01:0);
+  a15=arg[2]? arg[2][12] : 0;
+  a15=(-a15);
+  a06=(a06<=a15);
+  a06=(a06?a01:0);
+  a14=(a14+a06);
+  a06=arg[2]? arg[2][0] : 0;
+  a15=casadi_sq(a06);
+  a16=(a14/a15);
+  a16=(a02*a16);
+  a16=(-a16);
+  if (res[0]!=0) res[0][1]=a16;
+  if (res[0]!=0) res[0][2]=a00;
+  a16=arg[2]? arg[2][18] : 0;
+  a17=casadi_sq(a16);
+  a18=arg[2]? arg[2][8] : 0;
+  a19=(a17/a18);
+  a20=(a19/a15);
+  a20=(a20*a14);
+  a14=arg[2]? arg[2][17] : 0;
+  a14=casadi_sq(a14);
+  a21=arg[2]? arg[2][7] : 0;
+  a14=(a14/a21);
+  a14=(a14+a19);
+  a20=(a20/a14);
+  a02=(a02*a20);
+  a02=(-a02);
+  if (res[0]!=0) res[0][3]=a02;
+  if (res[0]!=0) res[0][4]=a00;
+  if (res[0]!=0) res[0][5]=a00;
+  if (res[0]!=0) res[0][6]=a01;
+  a02=-2.;
+  a20=arg[2]? arg[2][1] : 0;
+  a20=(a02*a20);
+  a19=(a20/a06);
+  if (res[0]!=0) res[0][7]=a19;
+  if (res[0]!=0) res[0][8]=a00;
+  a20=(a20/a18);
+  a17=(a17*a20);
+  a17=(a17/a06);
+  a17=(a17/a14);
+  if (res[0]!=0) res[0][9]=a17;
+  if (res[0]!=0) res[0][10]=a00;
+  if (res[0]!=0) res[0][11]=a00;
+  if (res[0]!=0) res[0][12]=a00;
+  a17=arg[2]? arg[2][14] : 0;
+  a14=(a17/a18);
+  a14=(a14/a15);
+  a14=(-a14);
+  if (res[0]!=0) res[0][13]=a14;
+  if (res[0]!=0) res[0][14]=a00;
+  a18=(1./a18);
+  a14=arg[2]? arg[2][9] : 0;
+  a20=(1./a14);
+  a18=(a18+a20);
+  a20=(a17/a15);
+  a18=(a18*a20);
+  a18=(-a18);
+  if (res[0]!=0) res[0][15]=a18;
+  if (res[0]!=0) res[0][16]=a00;
+  a18=arg[2]? arg[2][19] : 0;
+  a17=(a17*a18);
+  a17=(a17/a14);
+  a17=(a17/a16);
+  a17=(a17/a15);
+  a17=(-a17);
+  if (res[0]!=0) res[0][17]=a17;
+  if (res[0]!=0) res[0][18]=a00;
+  if (res[0]!=0) res[0][19]=a00;
+  if (res[0]!=0) res[0][20]=a01;
+  if (res[0]!=0) res[0][21]=a00;
+  if (res[0]!=0) res[0][22]=a00;
+  if (res[0]!=0) res[0][23]=a00;
+  if (res[0]!=0) res[0][24]=a00;
+  if (res[0]!=0) res[0][25]=a00;
+  if (res[0]!=0) res[0][26]=a00;
+  a17=arg[2]? arg[2][16] : 0;
+  a10=(a10*a05);
+  a05=5.0000000000000000e-01;
+  a05=(a05*a04);
+  a05=cos(a05);
+  a03=(a03*a05);
+  a10=(a10+a03);
+  a07=(a07*a11);
+  a10=(a10+a07);
+  a07=3.5000000000000000e+00;
+  a07=(a07*a04);
+  a07=cos(a07);
+  a08=(a08*a07);
+  a10=(a10+a08);
+  a09=(a09*a13);
+  a10=(a10+a09);
+  a09=1.5000000000000000e+00;
+  a09=(a09*a04);
+  a09=cos(a09);
+  a12=(a12*a09);
+  a10=(a10+a12);
+  a17=(a17*a10);
+  a17=(a01+a17);
+  a10=arg[2]? arg[2][2] : 0;
+  a12=(a10*a16);
+  a12=(a12*a18);
+  a12=(a12/a14);
+  a12=(a12/a15);
+  a09=arg[1]? arg[1][4] : 0;
+  a04=(a00<=a09);
+  a04=(a04?a01:0);
+  a13=arg[2]? arg[2][13] : 0;
+  a13=(-a13);
+  a09=(a09<=a13);
+  a09=(a09?a01:0);
+  a04=(a04+a09);
+  a12=(a12*a04);
+  a09=casadi_sq(a18);
+  a09=(a09/a14);
+  a13=arg[2]? arg[2][20] : 0;
+  a13=casadi_sq(a13);
+  a08=arg[2]? arg[2][10] : 0;
+  a13=(a13/a08);
+  a09=(a09+a13);
+  a12=(a12/a09);
+  a12=(a17*a12);
+  a12=(-a12);
+  if (res[0]!=0) res[0][27]=a12;
+  if (res[0]!=0) res[0][28]=a00;
+  a10=(a10/a15);
+  a10=(a10*a04);
+  a17=(a17*a10);
+  a17=(-a17);
+  if (res[0]!=0) res[0][29]=a17;
+  if (res[0]!=0) res[0][30]=a00;
+  if (res[0]!=0) res[0][31]=a00;
+  if (res[0]!=0) res[0][32]=a00;
+  a00=arg[2]? arg[2][3] : 0;
+  a16=(a02*a16);
+  a16=(a16*a18);
+  a16=(a00*a16);
+  a16=(a16/a14);
+  a16=(a16/a06);
+  a16=(a16/a09);
+  if (res[0]!=0) res[0][33]=a16;
+  if (res[0]!=0) res[0][34]=a01;
+  a02=(a02*a00);
+  a02=(a02/a06);
+  if (res[0]!=0) res[0][35]=a02;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int jacobian(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f1(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void jacobian_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int jacobian_n_in(void) { return 3;}
+
+CASADI_SYMBOL_EXPORT casadi_int jacobian_n_out(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_real jacobian_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* jacobian_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t";
+    case 1: return "y";
+    case 2: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* jacobian_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "J";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s1;
+    case 2: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* jacobian_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s3;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3;
+  if (sz_res) *sz_res = 1;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int jacobian_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 3*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 1*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* constants:(p[21])->(c[16],period) */
+static int casadi_f2(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12;
+  a00=arg[0]? arg[0][12] : 0;
+  if (res[0]!=0) res[0][0]=a00;
+  a00=arg[0]? arg[0][0] : 0;
+  a01=casadi_sq(a00);
+  a02=(1./a01);
+  a03=(-a02);
+  if (res[0]!=0) res[0][1]=a03;
+  a03=-2.;
+  a04=arg[0]? arg[0][1] : 0;
+  a04=(a03*a04);
+  a05=(a04/a00);
+  if (res[0]!=0) res[0][2]=a05;
+  a05=arg[0]? arg[0][14] : 0;
+  a06=arg[0]? arg[0][8] : 0;
+  a07=(a05/a06);
+  a07=(a07/a01);
+  a07=(-a07);
+  if (res[0]!=0) res[0][3]=a07;
+  if (res[0]!=0) res[0][4]=a02;
+  a02=(a05/a01);
+  a07=(1./a06);
+  a08=arg[0]? arg[0][9] : 0;
+  a09=(1./a08);
+  a07=(a07+a09);
+  a02=(a02*a07);
+  a02=(-a02);
+  if (res[0]!=0) res[0][5]=a02;
+  a02=arg[0]? arg[0][18] : 0;
+  a07=casadi_sq(a02);
+  a09=(a07/a06);
+  a10=(a09/a01);
+  a11=arg[0]? arg[0][17] : 0;
+  a11=casadi_sq(a11);
+  a12=arg[0]? arg[0][7] : 0;
+  a11=(a11/a12);
+  a11=(a11+a09);
+  a10=(a10/a11);
+  a10=(-a10);
+  if (res[0]!=0) res[0][6]=a10;
+  a04=(a04/a06);
+  a04=(a04*a07);
+  a04=(a04/a00);
+  a04=(a04/a11);
+  if (res[0]!=0) res[0][7]=a04;
+  a04=(a03*a02);
+  a11=arg[0]? arg[0][19] : 0;
+  a04=(a04*a11);
+  a07=arg[0]? arg[0][3] : 0;
+  a04=(a04*a07);
+  a04=(a04/a08);
+  a04=(a04/a00);
+  a06=casadi_sq(a11);
+  a06=(a06/a08);
+  a10=arg[0]? arg[0][20] : 0;
+  a10=casadi_sq(a10);
+  a09=arg[0]? arg[0][10] : 0;
+  a10=(a10/a09);
+  a06=(a06+a10);
+  a04=(a04/a06);
+  if (res[0]!=0) res[0][8]=a04;
+  a04=arg[0]? arg[0][13] : 0;
+  if (res[0]!=0) res[0][9]=a04;
+  a04=arg[0]? arg[0][2] : 0;
+  a10=(a04*a02);
+  a10=(a10*a11);
+  a10=(a10/a08);
+  a10=(a10/a01);
+  a10=(a10/a06);
+  a10=(-a10);
+  if (res[0]!=0) res[0][10]=a10;
+  a03=(a03*a07);
+  a03=(a03/a00);
+  if (res[0]!=0) res[0][11]=a03;
+  a04=(a04/a01);
+  a04=(-a04);
+  if (res[0]!=0) res[0][12]=a04;
+  a05=(a05*a11);
+  a05=(a05/a08);
+  a05=(a05/a02);
+  a05=(a05/a01);
+  a05=(-a05);
+  if (res[0]!=0) res[0][13]=a05;
+  a05=arg[0]? arg[0][6] : 0;
+  a05=(a05/a01);
+  if (res[0]!=0) res[0][14]=a05;
+  a05=3.1415926535897934e-02;
+  if (res[0]!=0) res[0][15]=a05;
+  a05=1.2566370614359172e+01;
+  if (res[1]!=0) res[1][0]=a05;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int constants(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f2(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int constants_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void constants_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void constants_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void constants_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int constants_n_in(void) { return 1;}
+
+CASADI_SYMBOL_EXPORT casadi_int constants_n_out(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_real constants_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* constants_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* constants_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "c";
+    case 1: return "period";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* constants_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s4;
+    case 1: return casadi_s0;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int constants_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 1;
+  if (sz_res) *sz_res = 2;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 0;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int constants_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 1*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 2*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 0*sizeof(casadi_real);
+  return 0;
+}
+
+/* table_point:(t,p[21])->(values[3]) */
+static int casadi_f5(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
+  casadi_real a12, a13;
+  a00=1.;
+  a01=arg[1]? arg[1][15] : 0;
+  a02=1.1800386146799999e+00;
+  a03=arg[0]? arg[0][0] : 0;
+  a04=cos(a03);
+  a05=(a02*a04);
+  a06=1.9272434388400000e-01;
+  a07=4.;
+  a07=(a07*a03);
+  a07=cos(a07);
+  a07=(a06*a07);
+  a05=(a05+a07);
+  a07=1.4883754528799999e-02;
+  a08=7.;
+  a08=(a08*a03);
+  a08=cos(a08);
+  a08=(a07*a08);
+  a05=(a05+a08);
+  a08=-6.0567417982099997e-02;
+  a09=6.;
+  a09=(a09*a03);
+  a09=cos(a09);
+  a09=(a08*a09);
+  a05=(a05+a09);
+  a09=-3.3689450631399998e-01;
+  a10=(2.*a03);
+  a10=cos(a10);
+  a11=(a09*a10);
+  a05=(a05+a11);
+  a11=-1.9563283778700000e-01;
+  a12=3.;
+  a12=(a12*a03);
+  a12=cos(a12);
+  a13=(a11*a12);
+  a05=(a05+a13);
+  a01=(a01*a05);
+  a01=(a00+a01);
+  if (res[0]!=0) res[0][0]=a01;
+  a01=arg[1]? arg[1][4] : 0;
+  a05=arg[1]? arg[1][5] : 0;
+  a13=arg[1]? arg[1][11] : 0;
+  a13=(a13+a03);
+  a13=cos(a13);
+  a05=(a05*a13);
+  a01=(a01+a05);
+  if (res[0]!=0) res[0][1]=a01;
+  a01=arg[1]? arg[1][16] : 0;
+  a09=(a09*a04);
+  a04=5.0000000000000000e-01;
+  a04=(a04*a03);
+  a04=cos(a04);
+  a02=(a02*a04);
+  a09=(a09+a02);
+  a06=(a06*a10);
+  a09=(a09+a06);
+  a06=3.5000000000000000e+00;
+  a06=(a06*a03);
+  a06=cos(a06);
+  a07=(a07*a06);
+  a09=(a09+a07);
+  a08=(a08*a12);
+  a09=(a09+a08);
+  a08=1.5000000000000000e+00;
+  a08=(a08*a03);
+  a08=cos(a08);
+  a11=(a11*a08);
+  a09=(a09+a11);
+  a01=(a01*a09);
+  a00=(a00+a01);
+  if (res[0]!=0) res[0][2]=a00;
+  return 0;
+}
+
+/* map801_table_point:(t[1x801],p[21x801])->(values[3x801]) */
+static int casadi_f4(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_int i;
+  casadi_real* *res1;
+  const casadi_real* *arg1;
+  arg1 = arg+2;
+  for (i=0; i<2; ++i) arg1[i]=arg[i];
+  res1 = res+1;
+  for (i=0; i<1; ++i) res1[i]=res[i];
+  for (i=0; i<801; ++i) {
+    if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+    if (arg1[0]) arg1[0]+=1;
+    if (arg1[1]) arg1[1]+=21;
+    if (res1[0]) res1[0]+=3;
+  }
+  return 0;
+}
+
+/* table:(t0,p[21])->(table[9x400],probe[3x2]) */
+static int casadi_f3(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
+  casadi_int i, j;
+  casadi_real **res1=res+2, *rr, w00, *w01=w+14, *w03=w+815, w04, w05, w06, *w07=w+831, *w08=w+17652, *w09=w+20055, *w10=w+21255;
+  casadi_real *w11=w+22455, *w12=w+23655, *w13=w+24855, *w14=w+28455, *w15=w+32055;
+  const casadi_real **arg1=arg+2, *cr, *cs, *ct, *wr01, *wr02;
+  w00 = arg[0] ? arg[0][0] : 0;
+  wr01 = casadi_c0;
+  wr02 = arg[1] ? arg[1] : casadi_zeros;
+  arg1[0]=wr02;
+  res1[0]=w03;
+  res1[1]=(&w04);
+  if (casadi_f2(arg1, res1, iw, w, 0)) return 1;
+  for (rr=(&w05), cs=w03+15; cs!=w03+16; cs+=1) *rr++ = *cs;
+  w06 = 2.;
+  w05 /= w06;
+  for (i=0, rr=w01, cr=wr01; i<801; ++i) (*rr++)  = ((*cr++)*w05);
+  for (i=0, rr=w01, cs=w01; i<801; ++i) (*rr++)  = (w00+(*cs++));
+  for (i=0;i<801;++i) {
+    casadi_copy(wr02, 21, w07+ i*21);
+  }
+  arg1[0]=w01;
+  arg1[1]=w07;
+  res1[0]=w08;
+  if (casadi_f4(arg1, res1, iw, w, 0)) return 1;
+  for (rr=w09, cs=w08+0; cs!=w08+2400; cs+=6) for (ct=cs+0; ct!=cs+3; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w10, cs=w09; i<400; ++i) for (j=0; j<3; ++j) rr[i+j*400] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+2400; cs+=6) for (ct=cs+3; ct!=cs+6; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w11, cs=w09; i<400; ++i) for (j=0; j<3; ++j) rr[i+j*400] = *cs++;
+  for (rr=w09, cs=w08+0; cs!=w08+2400; cs+=6) for (ct=cs+6; ct!=cs+9; ct+=1) *rr++ = *ct;
+  for (i=0, rr=w12, cs=w09; i<400; ++i) for (j=0; j<3; ++j) rr[i+j*400] = *cs++;
+  rr=w13;
+  for (i=0, cs=w10; i<1200; ++i) *rr++ = *cs++;
+  for (i=0, cs=w11; i<1200; ++i) *rr++ = *cs++;
+  for (i=0, cs=w12; i<1200; ++i) *rr++ = *cs++;
+  for (i=0, rr=w14, cs=w13; i<9; ++i) for (j=0; j<400; ++j) rr[i+j*9] = *cs++;
+  casadi_copy(w14, 3600, res[0]);
+  w05 = 3.7000000000000000e-01;
+  w05 *= w04;
+  w05  = (w00+w05);
+  arg1[0]=(&w05);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  casadi_copy(w15, 3, res[1]);
+  w05 = 1.3700000000000001e+00;
+  w05 *= w04;
+  w00 += w05;
+  arg1[0]=(&w00);
+  arg1[1]=wr02;
+  res1[0]=w15;
+  if (casadi_f5(arg1, res1, iw, w, 0)) return 1;
+  if (res[1]) casadi_copy(w15, 3, res[1]+3);
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem){
+  return casadi_f3(arg, res, iw, w, mem);
+}
+
+CASADI_SYMBOL_EXPORT int table_checkout(void) {
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT void table_release(int mem) {
+}
+
+CASADI_SYMBOL_EXPORT void table_incref(void) {
+}
+
+CASADI_SYMBOL_EXPORT void table_decref(void) {
+}
+
+CASADI_SYMBOL_EXPORT casadi_int table_n_in(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_int table_n_out(void) { return 2;}
+
+CASADI_SYMBOL_EXPORT casadi_real table_default_in(casadi_int i) {
+  switch (i) {
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_name_in(casadi_int i) {
+  switch (i) {
+    case 0: return "t0";
+    case 1: return "p";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const char* table_name_out(casadi_int i) {
+  switch (i) {
+    case 0: return "table";
+    case 1: return "probe";
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_in(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s0;
+    case 1: return casadi_s2;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT const casadi_int* table_sparsity_out(casadi_int i) {
+  switch (i) {
+    case 0: return casadi_s5;
+    case 1: return casadi_s6;
+    default: return 0;
+  }
+}
+
+CASADI_SYMBOL_EXPORT int table_work(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 6;
+  if (sz_res) *sz_res = 4;
+  if (sz_iw) *sz_iw = 0;
+  if (sz_w) *sz_w = 32058;
+  return 0;
+}
+
+CASADI_SYMBOL_EXPORT int table_work_bytes(casadi_int *sz_arg, casadi_int* sz_res, casadi_int *sz_iw, casadi_int *sz_w) {
+  if (sz_arg) *sz_arg = 6*sizeof(const casadi_real*);
+  if (sz_res) *sz_res = 4*sizeof(casadi_real*);
+  if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
+  if (sz_w) *sz_w = 32058*sizeof(casadi_real);
+  return 0;
 }
 
 /* one block of tangent steps (the SX functions' step, as CasADi's Switch runs it) */
@@ -5362,18 +5514,17 @@ static GEARSYM_NOINLINE void gs_state_span(casadi_real* restrict y, casadi_real*
   gs_copy(ya, 6, y); gs_copy(loa, 3, lo); gs_copy(hia, 3, hi);
 }
 
-/* lyapunov_chunk:(y0[6],Q0[6x6],table[9x200],c[16])->(strobe[6x50],Q[6x6],log_stretch[6x50],low[3x50],high[3x50]) */
+/* lyapunov_chunk:(y0[6],Q0[6x6],table[9x400],c[16])->(strobe[6x50],Q[6x6],log_stretch[6x50],low[3x50],high[3x50]) */
 static int casadi_f6(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[6], lo[3], hi[3], c[16]; casadi_real Q[36];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 6, y); gs_load(arg[1], 36, Q); gs_load(arg[3], 16, c);
-  casadi_real Qn[36], logs[6];
+  casadi_real Qn[36], logs[6]; casadi_real piece[6]; casadi_int g, i;
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 36, Q);
+    for (i = 0; i < 6; ++i) logs[i] = 0;
+    for (g = 0; g < 16; ++g) { gs_tangent_span(y, Q, lo, hi, T + 9*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 36, Q); for (i = 0; i < 6; ++i) logs[i] += piece[i]; }
     gs_store(y, 6, res[0], 6*p); gs_store(logs, 6, res[2], 6*p);
     gs_store(lo, 3, res[3], 3*p); gs_store(hi, 3, res[4], 3*p);
   }
@@ -5466,18 +5617,17 @@ CASADI_SYMBOL_EXPORT int lyapunov_chunk_work_bytes(casadi_int *sz_arg, casadi_in
   return 0;
 }
 
-/* lyapunov_period:(y0[6],Q0[6x6],table[9x200],c[16])->(strobe[6],Q[6x6],log_stretch[6],low[3],high[3]) */
+/* lyapunov_period:(y0[6],Q0[6x6],table[9x400],c[16])->(strobe[6],Q[6x6],log_stretch[6],low[3],high[3]) */
 static int casadi_f19(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[6], lo[3], hi[3], c[16]; casadi_real Q[36];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 6, y); gs_load(arg[1], 36, Q); gs_load(arg[3], 16, c);
-  casadi_real Qn[36], logs[6];
+  casadi_real Qn[36], logs[6]; casadi_real piece[6]; casadi_int g, i;
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4];
-    gs_tangent_span(y, Q, lo, hi, T, c, 200);
-    gs_gram_schmidt(Q, Qn, logs);
-    gs_copy(Qn, 36, Q);
+    for (i = 0; i < 6; ++i) logs[i] = 0;
+    for (g = 0; g < 16; ++g) { gs_tangent_span(y, Q, lo, hi, T + 9*(25*g), c, 25); gs_gram_schmidt(Q, Qn, piece); gs_copy(Qn, 36, Q); for (i = 0; i < 6; ++i) logs[i] += piece[i]; }
     gs_store(y, 6, res[0], 6*p); gs_store(logs, 6, res[2], 6*p);
     gs_store(lo, 3, res[3], 3*p); gs_store(hi, 3, res[4], 3*p);
   }
@@ -5570,7 +5720,7 @@ CASADI_SYMBOL_EXPORT int lyapunov_period_work_bytes(casadi_int *sz_arg, casadi_i
   return 0;
 }
 
-/* orbit_chunk:(y0[6],table[9x200],c[16])->(strobe[6x50],low[3x50],high[3x50]) */
+/* orbit_chunk:(y0[6],table[9x400],c[16])->(strobe[6x50],low[3x50],high[3x50]) */
 static int casadi_f20(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[6], lo[3], hi[3], c[16];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
@@ -5578,7 +5728,7 @@ static int casadi_f20(const casadi_real** arg, casadi_real** res, casadi_int* iw
   gs_load(arg[0], 6, y); gs_load(arg[2], 16, c);
   for (p = 0; p < 50; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4];
-    gs_state_span(y, lo, hi, T, c, 200);
+    gs_state_span(y, lo, hi, T, c, 400);
     gs_store(y, 6, res[0], 6*p); gs_store(lo, 3, res[1], 3*p); gs_store(hi, 3, res[2], 3*p);
   }
   return 0;
@@ -5663,7 +5813,7 @@ CASADI_SYMBOL_EXPORT int orbit_chunk_work_bytes(casadi_int *sz_arg, casadi_int* 
   return 0;
 }
 
-/* orbit_period:(y0[6],table[9x200],c[16])->(strobe[6],low[3],high[3]) */
+/* orbit_period:(y0[6],table[9x400],c[16])->(strobe[6],low[3],high[3]) */
 static int casadi_f22(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[6], lo[3], hi[3], c[16];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
@@ -5671,7 +5821,7 @@ static int casadi_f22(const casadi_real** arg, casadi_real** res, casadi_int* iw
   gs_load(arg[0], 6, y); gs_load(arg[2], 16, c);
   for (p = 0; p < 1; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4];
-    gs_state_span(y, lo, hi, T, c, 200);
+    gs_state_span(y, lo, hi, T, c, 400);
     gs_store(y, 6, res[0], 6*p); gs_store(lo, 3, res[1], 3*p); gs_store(hi, 3, res[2], 3*p);
   }
   return 0;
@@ -5756,14 +5906,14 @@ CASADI_SYMBOL_EXPORT int orbit_period_work_bytes(casadi_int *sz_arg, casadi_int*
   return 0;
 }
 
-/* trajectory:(y0[6],table[9x200],c[16])->(states[6x200]) */
+/* trajectory:(y0[6],table[9x400],c[16])->(states[6x400]) */
 static int casadi_f23(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[6], lo[3], hi[3], c[16];
   const casadi_real* T = arg[1] ? arg[1] : gs_zeros;
   casadi_int p;
   gs_load(arg[0], 6, y); gs_load(arg[2], 16, c);
   lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4];
-  for (p = 0; p < 200; ++p) {
+  for (p = 0; p < 400; ++p) {
     gs_state_span(y, lo, hi, T + 9*p, c, 1);
     gs_store(y, 6, res[0], 6*p);
   }
@@ -5833,7 +5983,7 @@ CASADI_SYMBOL_EXPORT int trajectory_work(casadi_int *sz_arg, casadi_int* sz_res,
   if (sz_arg) *sz_arg = 9;
   if (sz_res) *sz_res = 4;
   if (sz_iw) *sz_iw = 0;
-  if (sz_w) *sz_w = 1367;
+  if (sz_w) *sz_w = 2567;
   return 0;
 }
 
@@ -5841,7 +5991,7 @@ CASADI_SYMBOL_EXPORT int trajectory_work_bytes(casadi_int *sz_arg, casadi_int* s
   if (sz_arg) *sz_arg = 9*sizeof(const casadi_real*);
   if (sz_res) *sz_res = 4*sizeof(casadi_real*);
   if (sz_iw) *sz_iw = 0*sizeof(casadi_int);
-  if (sz_w) *sz_w = 1367*sizeof(casadi_real);
+  if (sz_w) *sz_w = 2567*sizeof(casadi_real);
   return 0;
 }
 
@@ -5942,7 +6092,7 @@ CASADI_SYMBOL_EXPORT int monodromy_segment_work_bytes(casadi_int *sz_arg, casadi
   return 0;
 }
 
-/* monodromy_period:(y0[6],Q0[6x6],table[9x200],c[16])->(strobe[6],M[6x6],low[3],high[3]) */
+/* monodromy_period:(y0[6],Q0[6x6],table[9x400],c[16])->(strobe[6],M[6x6],low[3],high[3]) */
 static int casadi_f25(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
   casadi_real y[6], lo[3], hi[3], c[16]; casadi_real Q[36];
   const casadi_real* T = arg[2] ? arg[2] : gs_zeros;
@@ -5950,7 +6100,7 @@ static int casadi_f25(const casadi_real** arg, casadi_real** res, casadi_int* iw
   gs_load(arg[0], 6, y); gs_load(arg[1], 36, Q); gs_load(arg[3], 16, c);
   casadi_real lk[3], hk[3];
   lk[0] = y[0]; hk[0] = y[0]; lk[1] = y[2]; hk[1] = y[2]; lk[2] = y[4]; hk[2] = y[4];
-  for (p = 0; p < 4; ++p) {
+  for (p = 0; p < 8; ++p) {
     lo[0] = y[0]; hi[0] = y[0]; lo[1] = y[2]; hi[1] = y[2]; lo[2] = y[4]; hi[2] = y[4];
     gs_tangent_span(y, Q, lo, hi, T + 450*p, c, 50);
     lk[0] = (lo[0] < lk[0] ? lo[0] : 0) + (lo[0] < lk[0] ? 0 : lk[0]);
@@ -6049,6 +6199,8 @@ CASADI_SYMBOL_EXPORT int monodromy_period_work_bytes(casadi_int *sz_arg, casadi_
   return 0;
 }
 
+
+#endif  /* GEARSYM_STEP_PIECES_ONLY */
 
 #ifdef __cplusplus
 } /* extern "C" */

@@ -140,7 +140,8 @@ static double gs_tau(const Instance* m) { return m->tau_ref + m->rate * (m->time
 
 /* a state's unit in the FMU: its value there is scale x the engine's */
 static double gs_scale(const Instance* m, int i) {
-  return gs_state_kind[i] == 1 ? GS_LENGTH_UNIT : gs_state_kind[i] == 2 ? GS_LENGTH_UNIT * m->rate : 1.0;
+  return gs_state_scale[i] * (gs_state_kind[i] == 1 ? GS_LENGTH_UNIT : gs_state_kind[i] == 2 ? GS_LENGTH_UNIT * m->rate
+                               : 1.0);  /* (scale: 1, or 1/radius for a shaft's twist in rad) */
 }
 
 static void gs_engine_state(const Instance* m, double* y) {
@@ -205,12 +206,12 @@ static fmi2Status gs_real(Instance* m, fmi2ValueReference vr, fmi2Real* value) {
     if (k < 2 * GS_NM) {
       int mesh = k / 2;
       if (k % 2 == 0) { *value = GS_LENGTH_UNIT * out[mesh]; return fmi2OK; }
-      *value = GS_FORCE_UNIT * out[GS_NM + mesh];
+      *value = gs_mesh_force_unit[mesh] * out[GS_NM + mesh];  /* (from the mesh's own stiffness) */
       if (gs_mesh_damping[mesh] >= 0)  /* (a physical model: its damping in N s/m times the rate in m/s) */
         *value += m->P[gs_mesh_damping[mesh]] * GS_LENGTH_UNIT * m->rate * out[2 * GS_NM + mesh];
       return fmi2OK;
     }
-    *value = GS_LENGTH_UNIT * out[4 * GS_NM + (k - 2 * GS_NM)];
+    *value = GS_LENGTH_UNIT * gs_shaft_scale[k - 2 * GS_NM] * out[4 * GS_NM + (k - 2 * GS_NM)];  /* rad */
   }
   return fmi2OK;
 }

@@ -1,4 +1,8 @@
-"""Parsing ``--set NAME=VALUE`` and ``--y0 x=-2,v=-0.5`` (shared by the subcommands)."""
+"""Parsing ``--set NAME=VALUE``, ``--teeth Z1,Z2`` and ``--y0 x=-2,v=-0.5`` (shared by the subcommands).
+
+``--set`` and ``--teeth`` are read as they are given, once, into typed values (a quantity into a
+:class:`~gearsym.units.Measure` in SI, a number into a float, tooth counts into
+:class:`~gearsym.model.tooth_counts.ToothCounts`): ``args.set`` is a dict of them, ``args.teeth`` counts or None."""
 from __future__ import annotations
 
 import argparse
@@ -7,16 +11,16 @@ import sys
 
 import gearsym  # the face: SymPy is loaded only when a formula is built
 
-from ..errors import GearsymError
-from ..model.grammar import canonical_formula
-from ..model.length_scale import check_length_scale
-from ..model.tooth_counts import parse_teeth
-from ..units import looks_like_quantity, parse_quantity
+from ...errors import GearsymError
+from ...model.grammar import canonical_formula
+from ...model.length_scale import check_length_scale
+from ...model.tooth_counts import ToothCounts
+from ...units import looks_like_quantity, measure
 
 
 def add_set_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
-        "--set", action="append", default=[], metavar="NAME=VALUE",
+        "--set", action=_Setting, default={}, metavar="NAME=VALUE",
         help="a parameter value (omega=1.5), a physical value with its unit (kZ=\"2e8 N/m\", speed=\"3000 rpm\"; "
              "length_scale=static|backlash|\"1 um\") or a new mesh stiffness formula in tau "
              "(\"k=1+0.2*cos(tau)\"); repeat for several",
@@ -26,20 +30,32 @@ def add_set_argument(parser: argparse.ArgumentParser) -> None:
 
 def add_teeth_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
-        "--teeth", default=None, metavar="Z1,Z2",
+        "--teeth", action=_Teeth, default=None, metavar="Z1,Z2",
         help="tooth counts of the first mesh's pinion (its driving gear) and wheel, for a model that declares none: "
              "shaft orders, tooth faults and eccentricity need them (one pinion revolution is Z1 mesh periods)",
     )
+
+
+class _Setting(argparse.Action):
+    """One ``--set NAME=VALUE``, read into its typed value as it is given, kept in the dict ``args.set``."""
+
+    def __call__(self, parser, namespace, pair, option_string=None):
+        setattr(namespace, self.dest, parse_settings([pair], getattr(namespace, self.dest) or {}))
+
+
+class _Teeth(argparse.Action):
+    """``--teeth Z1,Z2``, read into :class:`~gearsym.model.tooth_counts.ToothCounts` as it is given."""
+
+    def __call__(self, parser, namespace, value, option_string=None):
+        setattr(namespace, self.dest, ToothCounts.of(value))
 
 
 def model_settings(args: argparse.Namespace, *, cached: bool = False) -> dict:
     """--set's values and, with --teeth, ``teeth`` = (Z1, Z2): what the face's ``gearsym.load`` takes. A formula's
     numbers are checked here too (:func:`checked_formulas`), unless the caller may find the model in the start-up
     cache (``cached``): it checks them when it builds the model, and a cached model's run never loads SymPy."""
-    settings: dict = parse_settings(args.set)
-    teeth = parse_teeth(getattr(args, "teeth", None))
-    if teeth is not None:
-        settings["teeth"] = teeth
+    teeth = getattr(args, "teeth", None)
+    settings = {**args.set, **({"teeth": teeth} if teeth is not None else {})}
     return settings if cached else checked_formulas(settings)
 
 
@@ -53,12 +69,13 @@ def checked_formulas(settings: dict) -> dict:
     return settings
 
 
-def parse_settings(pairs: list[str]) -> dict[str, str]:
-    """``NAME=VALUE`` pairs; every value reads as a quantity (a number and a unit) or a safe formula (checked here,
-    before any work starts; neither is ever run as Python). A formula's grammar is checked here without SymPy, and
-    it is kept in one spelling (:func:`~gearsym.model.grammar.canonical_formula`: the start-up cache's key); its
-    numbers are checked when it is built (:func:`checked_formulas`)."""
-    settings = {}
+def parse_settings(pairs: list[str], settings: dict | None = None) -> dict[str, object]:
+    """``NAME=VALUE`` pairs added to ``settings`` (a new dict), each value read once into what it is (before any
+    work starts; nothing is ever run as Python): a quantity (a number and a unit) becomes a
+    :class:`~gearsym.units.Measure` in SI, a number a float, a length scale's name stays text, and a formula's
+    grammar is checked without SymPy and kept in one spelling (:func:`~gearsym.model.grammar.canonical_formula`:
+    the start-up cache's key); its numbers are checked when it is built (:func:`checked_formulas`)."""
+    settings = dict(settings or {})
     for pair in pairs:
         name, sep, value = pair.partition("=")
         name, value = name.strip(), value.strip()
@@ -68,25 +85,24 @@ def parse_settings(pairs: list[str]) -> dict[str, str]:
             raise GearsymError(f"--set gives {name} twice")
         if name == "teeth":
             raise GearsymError("--set teeth=...: tooth counts are given with --teeth Z1,Z2")
-        if looks_like_quantity(value):
-            parse_quantity(value, f"--set {name}")
-        elif name == "length_scale":
-            check_length_scale(value, "--set length_scale")
+        if name == "length_scale":
+            settings[name] = check_length_scale(value, "--set length_scale")
+        elif looks_like_quantity(value):
+            settings[name] = measure(value, f"--set {name}")
         elif _is_number(value):  # (a number needs no parser, and so no SymPy)
             if not math.isfinite(float(value)):
                 raise GearsymError(f"--set {name}={value}: not a finite number (a double holds at most "
                                    f"{sys.float_info.max:.3g}); give a finite value")
+            settings[name] = float(value)
         else:  # (its grammar, on Python's syntax tree alone; its numbers when it is built: checked_formulas)
-            value = canonical_formula(value, f"--set {name}")
-        settings[name] = value
+            settings[name] = canonical_formula(value, f"--set {name}")
     return settings
 
 
 def _is_formula(name: str, value) -> bool:
-    """Whether a --set value is a formula (what :func:`parse_settings` neither reads as a quantity, a length scale
-    nor a number)."""
-    return (isinstance(value, str) and name != "length_scale" and not looks_like_quantity(value)
-            and not _is_number(value))
+    """Whether a --set value is a formula (text :func:`parse_settings` kept: not a quantity, not a number, not a
+    length scale's name)."""
+    return isinstance(value, str) and name != "length_scale"
 
 
 def refuse_swept_and_set(swept: list[tuple[str, str]], settings: dict[str, str]) -> None:
