@@ -56,6 +56,7 @@ VERBS = {
 #: public name -> the module that defines it (imported when the name is first used: the declaring and
 #: reducing stages import SymPy, which a command on a cached model never needs)
 _LAZY = {
+    "Bearing": "gearsym.model.components",
     "Disk": "gearsym.model.components",
     "Drivetrain": "gearsym.model.drivetrain",
     "Gear": "gearsym.model.components",
@@ -68,6 +69,7 @@ _LAZY = {
     "Spall": "gearsym.model.faults",
     "Eccentricity": "gearsym.model.faults",
     "SpacingErrors": "gearsym.model.faults",
+    "cracked_tooth": "gearsym.model.faults",
     "rectangular_mesh_stiffness": "gearsym.model.stiffness",
     "parse_formula": "gearsym.model.formula",
     "NondimensionalModel": "gearsym.reduction",
@@ -105,6 +107,7 @@ _LAZY = {
     "gear_geometry": "gearsym.geometry",
     "Crack": "gearsym.geometry",
     "crack_stiffness_loss": "gearsym.geometry",
+    "crack_loss_along_path": "gearsym.geometry",
     "gear_pair": "gearsym.geometry",
     "mesh_stiffness": "gearsym.geometry",
     "iso6336_stiffness": "gearsym.geometry",
@@ -136,9 +139,9 @@ if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .fit import EFFECTS, explain
     from .fmu.export import export_fmu
     from .loading import is_physical, load, natural_modes, scaling
-    from .model.components import Disk, Gear, Harmonic, Mesh, Planet, Shaft, Torque
+    from .model.components import Bearing, Disk, Gear, Harmonic, Mesh, Planet, Shaft, Torque
     from .model.drivetrain import Drivetrain
-    from .model.faults import Eccentricity, Spall, SpacingErrors, ToothFault
+    from .model.faults import Eccentricity, Spall, SpacingErrors, ToothFault, cracked_tooth
     from .model.stiffness import rectangular_mesh_stiffness
     from .physical.campbell import campbell
     from .reduction import NondimensionalModel, reduce

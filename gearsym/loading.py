@@ -7,7 +7,9 @@ takes the typed object these make; nothing below resolves a name.
 """
 from __future__ import annotations
 
-from .analysis.modes import Modes, nondimensional_modes, physical_modes
+import os
+
+from .analysis.modes import Modes, drivetrain_modes, nondimensional_modes, physical_modes
 from .codegen.build import compile_model
 from .errors import GearsymError
 from .options import Integration
@@ -15,25 +17,35 @@ from .model.teeth import with_teeth
 from .model.tooth_counts import ToothCounts
 from .physical.answers import PhysicalScaling
 from .reduction import NondimensionalModel, reduce
-from .registry import load_model
+from .registry import load_model, model_options
 from .scales.settings import maybe_number, physical_settings
+from .scales.si_values import si_values
 from .system import FirstOrderSystem
 from .units import is_quantity
 
 
-def declared(ref, teeth=None):
+def declared(ref, teeth=None, options=None):
     """The declared model of a name, a file or a model, with ``teeth`` = (pinion, wheel) tooth counts given to a
-    drivetrain that declares none (:func:`gearsym.model.teeth.with_teeth`; read here, where they enter)."""
-    return with_teeth(load_model(ref), ToothCounts.of(teeth))
+    drivetrain that declares none (:func:`gearsym.model.teeth.with_teeth`; read here, where they enter) and
+    ``options`` given to its file's ``build`` (model options such as ``planets=4``)."""
+    return with_teeth(load_model(ref, options), ToothCounts.of(teeth))
 
 
-def reduced(ref, teeth=None) -> NondimensionalModel:
+def split_options(ref, values: dict) -> tuple[dict, dict]:
+    """``values`` split into the model options its file declares (``planets=4``) and the rest."""
+    if not isinstance(ref, (str, os.PathLike)) or not values:
+        return {}, dict(values)
+    names = model_options(ref)
+    return ({k: v for k, v in values.items() if k in names}, {k: v for k, v in values.items() if k not in names})
+
+
+def reduced(ref, teeth=None, options=None) -> NondimensionalModel:
     """The reduction of a model (a name, a file, a Drivetrain or its reduction)."""
     if isinstance(ref, NondimensionalModel):
         if teeth is not None:
             return reduced(ref.drivetrain, teeth)
         return ref
-    model = declared(ref, teeth)
+    model = declared(ref, teeth, options)
     if not model.is_drivetrain:
         raise GearsymError(f"{model.name}: a first-order system has no components to reduce (it is one already)")
     return reduce(model)
@@ -55,7 +67,8 @@ def scaling(model, length_scale=None, *, teeth=None, **physical) -> PhysicalScal
     by a formula in tau or phi (``k="1+0.2*cos(tau)"``, with the values of its new parameters); ``teeth``: tooth
     counts for a model that declares none."""
     if not isinstance(model, NondimensionalModel):
-        model, teeth = declared(model, teeth), None
+        options, physical = split_options(model, physical)
+        model, teeth = declared(model, teeth, options), None
         if not model.is_drivetrain:
             raise GearsymError(f"{model.name}: physical values need a drivetrain model (a FirstOrderSystem has no "
                                "components to give them units)")
@@ -73,7 +86,8 @@ def load(ref, *, teeth=None, **values) -> FirstOrderSystem:
     nondimensional values by :class:`gearsym.scales.map.Scaling`. ``teeth`` = (Z1, Z2): the tooth counts of the
     first mesh's pinion (its driving gear) and wheel, for a model that declares none (``--teeth Z1,Z2``).
     """
-    model = reduced(ref, teeth) if isinstance(ref, NondimensionalModel) else declared(ref, teeth)
+    options, values = split_options(ref, values)
+    model = reduced(ref, teeth) if isinstance(ref, NondimensionalModel) else declared(ref, teeth, options)
     values = {k: maybe_number(v) for k, v in values.items()}
     if isinstance(model, FirstOrderSystem):
         for key, value in values.items():
@@ -96,7 +110,14 @@ def natural_modes(model, *, teeth=None, **settings) -> Modes:
     values (``kZ="2e8 N/m"``: frequencies in Hz; also for a model that declares physical values) or, for a
     model without, nondimensional parameter values (``kS=0.5``); a stiffness formula (``k="1+0.2*cos(tau)"``)
     enters through its mean."""
-    nd = reduced(model, teeth)
+    options, settings = split_options(model, settings)
+    found = declared(model, teeth, options) if not isinstance(model, NondimensionalModel) else model.drivetrain
+    plain = all(is_quantity(v) or isinstance(maybe_number(v), (int, float)) for v in settings.values())
+    if getattr(found, "is_drivetrain", False) and getattr(found, "bearings", None) and found.physical \
+            and "length_scale" not in settings and plain:
+        # (a drivetrain on bearings: its modes from its kinematics, without the long reduction)
+        return drivetrain_modes(found, si_values(found, settings))
+    nd = reduced(model, teeth, options)
     split = physical_settings(nd, dict(settings))
     if split is not None:
         length_scale, physical, formulas = split
@@ -107,7 +128,8 @@ def natural_modes(model, *, teeth=None, **settings) -> Modes:
 def is_physical(model, *, teeth=None, **values) -> bool:
     """Whether ``model`` (a name, a file or a model) with ``values`` runs in physical units (it declares
     physical values, or ``values`` give one or a length scale). Nothing is reduced to tell."""
-    found = model if isinstance(model, NondimensionalModel) else load_model(model)
+    options, values = split_options(model, values)
+    found = model if isinstance(model, NondimensionalModel) else load_model(model, options)
     drivetrain = found.drivetrain if isinstance(found, NondimensionalModel) else found
     if not drivetrain.is_drivetrain:
         return False

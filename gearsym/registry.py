@@ -33,6 +33,14 @@ def available_models() -> list[str]:
     return sorted(p.stem for p in d.glob("*.py") if not p.stem.startswith("_") and p.is_file())
 
 
+def pregenerated_models() -> list[str]:
+    """The models whose C and derivation page are committed (``generated/``, ``docs/derivations/``): what
+    ``gearsym compile --all``, ``gearsym docs --all`` and ``gearsym fmu --all`` make. A model file that sets
+    ``PREGENERATED = False`` is shipped and runs by name, but is derived and compiled on its first use only (one
+    too large to compile within a test run: Lin & Parker's translational set)."""
+    return [name for name in available_models() if getattr(_module(name), "PREGENERATED", True) is not False]
+
+
 def model_path(ref: str) -> Path | None:
     """The file (resolved) of a model name or path; None if there is none (:func:`load_model` says why). A name
     that the working directory's ``models/`` gives another file than the shipped model of that name is said
@@ -70,10 +78,59 @@ def _shown(ref: str, quote=str) -> str:
     return quote(ref) if len(ref) <= 80 else f"{quote(ref[:60])}... ({len(ref)} characters)"
 
 
-def load_model(ref: Union[str, Path, Model]) -> Model:
-    """A model object from a name in ``models/``, a path to a ``.py`` file, or a model itself."""
+def load_model(ref: Union[str, Path, Model], options: dict | None = None) -> Model:
+    """A model object from a name in ``models/``, a path to a ``.py`` file, or a model itself; ``options`` are
+    model options its file declares (``OPTIONS = {"planets": 3}``), given to its ``build`` (``--set planets=4``)."""
     if isinstance(ref, Model):
+        if options:
+            raise GearsymError(f"{ref.name}: model options ({', '.join(options)}) need a model file's build, not a "
+                               "model object")
         return ref
+    module = _module(ref)
+    if not options:
+        return _model_of(module, ref)
+    declared = model_options(ref)
+    options = dict(options)
+    for name, value in list(options.items()):
+        if name not in declared:
+            raise GearsymError(f"{_model_of(module, ref).name} has no model option {name!r} (its options: "
+                               f"{', '.join(declared) or 'none'})")
+        if isinstance(value, str):
+            try:
+                value = float(value)
+            except ValueError:
+                raise GearsymError(f"--set {name}={value}: the model option {name} is a number") from None
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value or abs(value) == float("inf"):
+            raise GearsymError(f"the model option {name} is a finite number, got {value!r}")
+        options[name] = int(value) if float(value).is_integer() else float(value)
+    key = (id(module), tuple(sorted(options.items())))
+    if key not in _BUILT:  # (one model per options and module: its reduction is cached on it)
+        _BUILT[key] = (module, _with_models_importable(lambda: module.build(**options), Path(module.__file__)))
+    return _BUILT[key][1]
+
+
+def model_options(ref) -> dict:
+    """The model options a model's file declares (``OPTIONS``: name -> default), none for a model object."""
+    if isinstance(ref, Model):
+        return {}
+    options = getattr(_module(ref), "OPTIONS", None)
+    return dict(options) if isinstance(options, dict) else {}
+
+
+_BUILT: dict[tuple, tuple] = {}  # (module, options) -> (the module, kept alive; its model with those options)
+
+
+def _model_of(module, ref) -> Model:
+    model = getattr(module, "model", None)
+    if not isinstance(model, Model):
+        raise ModelError(
+            "a model file must define `model`, a Drivetrain or a FirstOrderSystem", getattr(module, "__file__", ref)
+        )
+    return model
+
+
+def _module(ref):
+    """The module of a model name or file (run once)."""
     ref = str(ref)
     path = model_path(ref)
     if _is_path(ref):
@@ -93,12 +150,7 @@ def load_model(ref: Union[str, Path, Model]) -> Model:
                 f"{models_dir()}: {', '.join(names)}; or give the path of a model file."
             )
         module = _with_models_importable(lambda: importlib.import_module(f"models.{ref}"))
-    model = getattr(module, "model", None)
-    if not isinstance(model, Model):
-        raise ModelError(
-            "a model file must define `model`, a Drivetrain or a FirstOrderSystem", getattr(module, "__file__", ref)
-        )
-    return model
+    return module
 
 
 def model_module(name: str):

@@ -103,6 +103,9 @@ class FirstOrderSystem(ParameterChecks, Model):
     couplings: tuple[Coupling, ...] = ()
     constraints: Mapping[str, Constraint] = field(default_factory=dict)
     cycles: int = 1
+    #: a drivetrain on bearings: each body centre's translation in the states ("pinion_y" -> y_pinion), the
+    #: engine's length unit; a measured acceleration of it is the channel a_<name> (a_pinion_y)
+    translations: Mapping[str, sp.Expr] = field(default_factory=dict)
 
     def __post_init__(self):
         if isinstance(self.cycles, bool) or not isinstance(self.cycles, int) or self.cycles < 1:
@@ -132,7 +135,8 @@ class FirstOrderSystem(ParameterChecks, Model):
             raise ModelError(f"names used both as state and parameter: {sorted(clash)}", self.name)
         names = {s.name for s in self.states}
         for c in self.couplings:
-            used = {c.coordinate, c.velocity} if not c.closes_loop else {s.name for s in c.rate.free_symbols}
+            used = {c.coordinate, c.velocity} if not c.closes_loop else \
+                {s.name for s in c.rate.free_symbols} - set(self.parameters)  # (its coefficients: parameters)
             if not used <= names:
                 raise ModelError(f"coupling {c.name!r} acts on {', '.join(sorted(used - names))}, which are not states",
                                  self.name)

@@ -17,6 +17,16 @@ import gearsym
 from gearsym.model.symbols import parameter_symbol, t
 
 GEAR_MODELS = ("one_stage", "one_stage_resonant", "flexible_shaft", "two_stage")
+#: pre-generated models whose byte-for-byte checks of generated/ and docs/derivations/ take many seconds (run with
+#: -m slow); none now: a model too large to compile in a test run is not pre-generated (PREGENERATED = False)
+SLOW_MODELS: tuple[str, ...] = ()
+
+
+def model_params(names):
+    """Model names as test parameters, the slow ones marked slow."""
+    import pytest
+
+    return [pytest.param(n, marks=pytest.mark.slow) if n in SLOW_MODELS else n for n in names]
 
 
 @functools.cache

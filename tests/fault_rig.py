@@ -10,6 +10,8 @@ period n (counted from 1) and in mesh from u = n - 1 - (e - 1)/2 to n + (e - 1)/
 
 * a tooth fault: s(tau) the faulty pair's share of the mesh stiffness, 1/2 in double contact and 1 in single
   contact, each edge a smoothstep over 0.1 mesh periods (gearsym uses tanh windows: the shapes differ slightly);
+* a crack that lowers the *whole* mesh stiffness by q while its tooth is in mesh (not the pair's share: the shape of
+  no named fault of the library), edges smoothsteps over 0.15 mesh periods;
 * an eccentric gear: e(tau) = A cos(u 2 pi / Z + psi);
 * spacing errors: e(tau) = e_n while tooth n carries the load, blended by smoothsteps over the double contact.
 """
@@ -47,6 +49,13 @@ def tooth_share(u: float, teeth: int, tooth: int) -> float:
     return 0.5 * whole + 0.5 * single
 
 
+def in_mesh(u: float, teeth: int, tooth: int, edge: float = 0.15) -> float:
+    """About 1 while the pair of ``tooth`` is in mesh (from u = tooth - 1 - (e - 1)/2 to tooth + (e - 1)/2)."""
+    w = _around(u, tooth - 1, teeth)
+    d = CONTACT - 1
+    return smoothstep(w + d / 2, edge) - smoothstep(w - 1 - d / 2, edge)
+
+
 def spacing_error(u: float, teeth: int, errors) -> float:
     """errors[n - 1] while tooth n carries the load, blended over the double contact."""
     n = int(math.floor(u)) % teeth  # the tooth (0-based) of this mesh period
@@ -60,11 +69,12 @@ def spacing_error(u: float, teeth: int, errors) -> float:
 
 
 class Pair:
-    """The typed equations of one pair: ``fault`` (gear 1 or 2, tooth, q), ``eccentric`` (gear, A, psi),
-    ``spacing`` (gear, errors); ``teeth`` = (Z1, Z2)."""
+    """The typed equations of one pair: ``fault`` (gear 1 or 2, tooth, q), ``whole`` (gear, tooth, q: the whole mesh
+    stiffness lowered while the tooth is in mesh), ``eccentric`` (gear, A, psi), ``spacing`` (gear, errors); ``teeth``
+    = (Z1, Z2)."""
 
-    def __init__(self, teeth=(11, 17), fault=None, eccentric=None, spacing=None, **values):
-        self.teeth, self.fault, self.eccentric, self.spacing = teeth, fault, eccentric, spacing
+    def __init__(self, teeth=(11, 17), fault=None, eccentric=None, spacing=None, whole=None, **values):
+        self.teeth, self.fault, self.eccentric, self.spacing, self.whole = teeth, fault, eccentric, spacing, whole
         self.p = {**rig.DEFAULTS, **values}
 
     def stiffness(self, tau: float) -> float:
@@ -72,6 +82,9 @@ class Pair:
         if self.fault:
             gear, tooth, q = self.fault
             k *= 1 - q * tooth_share(tau / T, self.teeth[gear - 1], tooth)
+        if self.whole:
+            gear, tooth, q = self.whole
+            k *= 1 - q * in_mesh(tau / T, self.teeth[gear - 1], tooth)
         return k
 
     def error(self, tau: float) -> float:

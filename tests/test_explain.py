@@ -88,7 +88,11 @@ TRUTHS = {
     # a profile error e = 0.5 cos(tau) + 0.3 sin(tau): the mesh force k(tau) g(x - e) instead of k(tau) g(x)
     "transmission_error": lambda t, x, v, w: -stiffness(t) * (rig.backlash(x - 0.5 * math.cos(t) - 0.3 * math.sin(t),
                                                                             10.0) - rig.backlash(x, 10.0)) / w**2,
+    # issue 41's accelerometer case: a profile error of amplitude 0.25, e = 0.25 cos(tau)
+    "small_transmission_error": lambda t, x, v, w: -stiffness(t) * (rig.backlash(x - 0.25 * math.cos(t), 10.0)
+                                                                    - rig.backlash(x, 10.0)) / w**2,
     "clean": None,
+    "clean_default": None,  # (the rig's own values: the accelerometer's clean floor)
 }
 RIG_VALUES = {"clean": {"Theta": 2.0, "B1": 3.5}}
 
@@ -148,6 +152,31 @@ def test_an_accelerometers_offset_is_fitted_by_default_and_the_report_says_so(on
     page = report_page(ex, one_stage, augment(one_stage, ex.effects), data, ())
     assert ("and the offsets of x_ddot, fitted by default: an acceleration's steady mean is zero for bounded "
             "motion, so a constant offset is the sensor's bias") in page
+
+
+@pytest.mark.slow
+def test_an_accelerometer_with_an_offset_measures_a_small_transmission_error_to_its_amplitude(one_stage, rig_runs,
+                                                                                             tmp_path):
+    """Issue 41: acceleration-only records (omega 1.2 and 1.6) with a 5 % offset and a profile error of amplitude
+    0.25 were reported to stop at a held-out error of 0.037 with amplitude 0.22. Here the profile error is named with
+    its amplitude within 10 % (0.250), the offset is the one written, and the held-out error falls to the clean
+    records' (the same accelerometer, no profile error) within 1.5x. The offset is estimated with B0 held at its
+    value, as explain does: with B0 fitted as well, the two trade a constant acceleration (1/omega^2 against 1) and
+    both come out off by several per cent."""
+    runs = rig_runs("small_transmission_error")
+    offset = 0.05 * float(np.std(np.concatenate([run["x_ddot"] for _, run in runs])))
+    data = load_measurements([rig.write(tmp_path / "acc.csv", runs, ("x_ddot",), bias={"x_ddot": offset})],
+                             conftest.system("one_stage"))
+    clean = load_measurements([rig.write(tmp_path / "clean.csv", rig_runs("clean_default"), ("x_ddot",),
+                                         bias={"x_ddot": offset})], conftest.system("one_stage"))
+    candidates = ["transmission_error", "hertzian_contact", "coast_side_stiffness"]
+    ex = explain(one_stage, data, ["zeta", "B1"], candidates=candidates, propose=False)
+    floor = explain(one_stage, clean, ["zeta", "B1"], candidates=[], propose=False).base.error
+    assert ex.verdict == "explained" and ex.effects == ["transmission_error_1"]
+    (te,) = ex.harmonics().values()
+    assert te["amplitude"] == pytest.approx(0.25, rel=0.1) and abs(te["phase"]) < 0.1
+    assert ex.final.error <= 1.5 * floor, (ex.final.error, floor)
+    assert ex.final.fit.bias["x_ddot"] == pytest.approx(offset, abs=3 * ex.final.fit.bias_stderr["x_ddot"])
 
 
 def test_only_channels_of_accelerations_get_an_offset_by_default(tmp_path):

@@ -536,10 +536,10 @@ def _layout_of(name: str):
 
 
 def test_every_variable_of_every_shipped_models_fmu_has_a_description():
-    from gearsym.registry import available_models
+    from gearsym.registry import pregenerated_models
 
     missing = {name: [v.name for v in _layout_of(name).variables if not v.description.strip()]
-               for name in available_models()}
+               for name in pregenerated_models()}
     assert {name: names for name, names in missing.items() if names} == {}
     planetary = {v.name: v.description for v in _layout_of("planetary").variables}
     assert planetary["r_r"] == "base radius of 'ring' (held)" and planetary["I_p"] == "moment of inertia of 'planet1'"

@@ -140,6 +140,36 @@ def committed_numbers_are_the_formulas(data: dict) -> None:
     assert data["min"] == pytest.approx(k.min(), rel=1e-3) and data["max"] == pytest.approx(k.max(), rel=1e-9)
 
 
+CRACKED = REPO / "docs" / "figures" / "stiffness-cracked-tian"
+TIAN = ("stiffness", "--teeth", "19,48", "--module", "3.2 mm", "--face-width", "16 mm", "--pressure-angle", "20 deg", "--material",
+        "206.8 GPa,0.3")
+
+
+def test_the_committed_crack_figure_and_data_regenerate(capsys, tmp_path):
+    """docs/figures/stiffness-cracked-tian.{json,png}, the command docs/geometry.md gives: Tian's 19/48 pair with a 3 mm
+    crack at 70 deg on a pinion tooth, the mesh stiffness while it passes and the loss against depth."""
+    code, out, _ = run(capsys, *TIAN, "--crack", "3 mm,70 deg", "--cracked-gear", "1", "--format", "json", "--plot",
+                       str(tmp_path / "k.png"))
+    assert code == 0
+    made, committed = json.loads(out), json.loads(CRACKED.with_suffix(".json").read_text())
+    _numbers_close(made, committed)
+    crack = made["crack"]
+    assert 0.10 < crack["mean_loss"] < 0.25 and crack["mean_losses"] == sorted(crack["mean_losses"])
+    assert min(np.subtract(crack["healthy"], crack["cracked"])) > -1e-6  # the crack only softens the mesh
+    from matplotlib.image import imread
+
+    new, old = imread(tmp_path / "k.png"), imread(CRACKED.with_suffix(".png"))
+    assert new.shape == old.shape, "docs/figures/stiffness-cracked-tian.png differs in size"
+    moved = (np.abs(new - old).max(axis=-1) > 0.25).mean()
+    assert np.abs(new - old).mean() < 2e-3 and moved < 2e-4, \
+        f"docs/figures/stiffness-cracked-tian.png differs ({moved:.2%} of its pixels): rerun docs/geometry.md's command"
+
+
+def test_a_crack_through_the_tooth_is_refused_before_any_work(capsys):
+    code, _, err = run(capsys, *TIAN, "--crack", "9 mm,80 deg", "--cracked-gear", "1")
+    assert code == 2 and "reaches the other flank of the tooth" in err and "Traceback" not in err
+
+
 # --------------------------------------------------------------------------- the basic rack
 HIGH = NASA[:-1] + ["25 deg"]
 

@@ -238,7 +238,7 @@ def test_gearsym_modes_prints_json_by_coordinate(capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["unit"] == "omega_n" and out["frequencies"] == sorted(out["frequencies"])
     assert [m["kind"] for m in out["modes"]] == ["rigid", "elastic", "elastic"]
-    assert set(out["modes"][1]["angles"]) == {"gear1", "gear2", "disk3"}
+    assert set(out["modes"][1]["shape"]) == {"gear1", "gear2", "disk3"}
     assert set(out["modes"][1]["coordinates"]) == {"x1", "x2"}
 
 

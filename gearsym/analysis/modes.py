@@ -26,6 +26,8 @@ import numpy as np
 import sympy as sp
 
 from ..errors import GearsymError
+from ..model.components import Planet
+from ..reduction.coordinates import coupling_deflections, rigid_body_modes
 from ..reduction.statics import mean_over, mean_stiffness, number as _number
 from ..model.symbols import parameter_symbol, tau
 
@@ -35,18 +37,30 @@ DEGENERATE = 1e-8
 
 @dataclass(frozen=True)
 class Mode:
-    """One natural mode: its frequency, whether it is a rigid-body mode, how many modes share its frequency,
-    and its shape by body angle and by relative coordinate (largest angle component 1)."""
+    """One natural mode: its frequency, its kind, how many modes share its frequency, and its shape by degree of
+    freedom (body angles by the body's name, a centre's translations as ``sun.x``, ``planet1.radial``; largest
+    component 1) and by relative coordinate.
+
+    The kind: "rigid" for a rigid-body mode; for a drivetrain whose bodies all turn only, "elastic"; for a planetary
+    set whose members translate, Lin & Parker's classes: "rotational" (the central members only turn, every
+    planet moves alike), "translational" (the central members only translate, a pair of equal frequency) and
+    "planet" (the central members still); for other drivetrains on bearings, the degrees of freedom that hold
+    most of the mode's kinetic energy ("pinion.y+wheel.y")."""
 
     frequency: float
-    kind: str  # "rigid" | "elastic"
+    kind: str
     multiplicity: int
-    angles: dict[str, float]
+    angles: dict[str, float]  # every degree of freedom's component (rotations by the body's name)
     coordinates: dict[str, float]
+    unit: str = "Hz"
+
+    @property
+    def shape(self) -> dict[str, float]:
+        return self.angles
 
     def as_dict(self) -> dict:
-        return {"frequency": self.frequency, "kind": self.kind, "multiplicity": self.multiplicity,
-                "angles": self.angles, "coordinates": self.coordinates}
+        return {"frequency": {"value": self.frequency, "unit": self.unit}, "kind": self.kind,
+                "multiplicity": self.multiplicity, "shape": self.angles, "coordinates": self.coordinates}
 
 
 @dataclass(frozen=True)
@@ -58,8 +72,9 @@ class Modes:
     modes: tuple[Mode, ...]
     values: dict[str, float]  # the component values used (SI with physical values)
     assumed: tuple[str, ...] = ()  # parameters without a value, taken as 1
-    shapes: str = field(default="angles: body angles psi_i; coordinates: relative coordinates x = T psi "
-                                  "(mesh deflections and shaft twists as lengths)")
+    shapes: str = field(default="shape: body angles psi_i (and a centre's translations on its bearing); "
+                                  "coordinates: relative coordinates x = T psi (mesh deflections, shaft twists and "
+                                  "bearing deflections as lengths)")
 
     @property
     def frequencies(self) -> tuple[float, ...]:
@@ -67,10 +82,10 @@ class Modes:
 
     @property
     def elastic(self) -> tuple[Mode, ...]:
-        return tuple(m for m in self.modes if m.kind == "elastic")
+        return tuple(m for m in self.modes if m.kind != "rigid")
 
     def as_dict(self) -> dict:
-        """JSON-ready: the keys of ``gearsym modes --format json``."""
+        """JSON-ready: the keys of ``gearsym modes --format json`` (each mode's frequency as value and unit)."""
         return {"model": self.model, "unit": self.unit, "frequencies": list(self.frequencies),
                 "modes": [m.as_dict() for m in self.modes], "shapes": self.shapes, "values": self.values,
                 "assumed": list(self.assumed)}
@@ -84,6 +99,32 @@ def physical_modes(scaling, formulas: Mapping[str, object] | None = None) -> Mod
     formulas = scaling.functions if formulas is None else formulas
     values = {**scaling.values, **scaling.formula_values}
     return _solve(nd, dict(scaling.si_values), "Hz", (), _formula_means(nd, formulas, values))
+
+
+@dataclass(frozen=True)
+class _Kinematics:
+    """What the modes need of a reduction: the resolved drivetrain, its coordinates, T and rigid-body modes."""
+
+    resolved: object
+    coordinates: tuple
+    transform: sp.Matrix
+    rigid_modes: tuple
+    name: str
+
+    @property
+    def reduction(self):
+        return self
+
+
+def drivetrain_modes(drivetrain, values: Mapping[str, float], unit: str = "Hz") -> Modes:
+    """The natural modes of a declared drivetrain at ``values`` (every parameter of its masses, inertias, rows and
+    couplings, in SI for Hz), from its kinematics alone: the coordinates and rigid-body modes, not the whole
+    reduction (a drivetrain on bearings has many degrees of freedom, and its modes need no Lagrange equations)."""
+    rd = drivetrain.resolved
+    coordinates, transform, _ = coupling_deflections(rd)
+    rigid = [u.applyfunc(rd.with_geometry) for u in rigid_body_modes(rd)]
+    light = _Kinematics(rd, tuple(coordinates), transform.applyfunc(rd.with_geometry), tuple(rigid), drivetrain.name)
+    return _solve(light, dict(values), unit, ())
 
 
 def nondimensional_modes(nd, settings: Mapping[str, object]) -> Modes:
@@ -146,11 +187,12 @@ def _nondimensional_values(nd, settings) -> tuple[dict[str, float], tuple[str, .
 def _solve(nd, values: dict[str, float], unit: str, assumed: tuple[str, ...],
            factors: Mapping[str, float] | None = None) -> Modes:
     rd = nd.reduction.resolved
-    names = [rb.body.name for rb in rd.bodies]
-    inertia = np.array([_number(rb.inertia, values, f"the inertia of {rb.body.name!r}") for rb in rd.bodies])
+    names = [d.label for d in rd.dofs]
+    inertia = np.array([_number(d.inertia, values, f"the {'inertia' if d.motion == 'rotation' else 'mass'} of "
+                                                   f"{d.body.name!r}") for d in rd.dofs])
     stiffness = np.zeros((len(names), len(names)))
     for rc in rd.couplings:
-        row = np.array([_number(e, values, f"the deflection of {rc.name!r}") for e in rc.row])
+        row = np.array([_number(rd.with_geometry(e), values, f"the deflection of {rc.name!r}") for e in rc.row])
         stiffness += mean_stiffness(rc, values) * (factors or {}).get(rc.name, 1.0) * np.outer(row, row)
     transform = np.array([[_number(e, values, "the coordinate change") for e in r]
                           for r in nd.reduction.transform.tolist()])
@@ -166,18 +208,61 @@ def _solve(nd, values: dict[str, float], unit: str, assumed: tuple[str, ...],
     elastic = [int(i) for i in order[len(rigid):]]
     to_unit = (lambda w: w / (2 * math.pi)) if unit == "Hz" else (lambda w: w)
     coordinates = [c.name for c in nd.coordinates]
-    modes = [_mode(0.0, "rigid", len(rigid), u, names, transform, coordinates) for u in rigid]
+    classify = _kinds(rd, inertia)
+    modes = [_mode(0.0, "rigid", len(rigid), u, names, transform, coordinates, unit) for u in rigid]
     for group in _repeated(elastic, eigenvalues, DEGENERATE * top):
         w = to_unit(math.sqrt(max(float(np.mean(eigenvalues[group])), 0.0)))
+        kind = classify(shapes[:, group]) if classify else "elastic"
         for shape in canonical_basis(shapes[:, group].T):
-            modes.append(_mode(w, "elastic", len(group), shape, names, transform, coordinates))
+            modes.append(_mode(w, kind, len(group), shape, names, transform, coordinates, unit))
     used = set()
-    for rb in rd.bodies:
+    for rb in rd.dofs:
         used |= rb.inertia.free_symbols | (rb.radius.free_symbols if rb.radius is not None else set())
     for rc in rd.couplings:
-        used |= rc.stiffness.free_symbols | rc.variation.free_symbols | sp.Matrix(rc.row).free_symbols
+        used |= rc.stiffness.free_symbols | rc.variation.free_symbols
+        used |= sp.Matrix([rd.with_geometry(e) for e in rc.row]).free_symbols
     shown = {n: v for n, v in values.items() if parameter_symbol(n) in used}
     return Modes(nd.name, unit, tuple(modes), shown, assumed)
+
+
+#: a central member's share of a mode's kinetic energy below this counts as none (Lin & Parker's classes)
+STILL = 1e-9
+
+
+def _kinds(rd, inertia: np.ndarray):
+    """The classifier of a drivetrain with translations (None for one whose bodies only turn): Lin & Parker's
+    classes for a planetary set whose planets translate, else the degrees of freedom that hold most of the
+    kinetic energy."""
+    if not rd.translations:
+        return None
+    planets = {d.body.name for d in rd.dofs if isinstance(d.body, Planet)}
+    if planets and any(isinstance(d.body, Planet) for d in rd.translations):
+        central_turn = [i for i, d in enumerate(rd.dofs) if d.body.name not in planets and d.motion == "rotation"]
+        central_move = [i for i, d in enumerate(rd.dofs) if d.body.name not in planets and d.motion != "rotation"]
+
+        def lin_parker(space: np.ndarray) -> str:
+            energy = inertia[:, None] * space**2
+            total = float(np.sum(energy))
+            turn = float(np.sum(energy[central_turn])) / total
+            move = float(np.sum(energy[central_move])) / total
+            if turn < STILL and move < STILL:
+                return "planet"
+            if move < STILL:
+                return "rotational"
+            if turn < STILL:
+                return "translational"
+            return "mixed"
+
+        return lin_parker
+    labels = [d.label for d in rd.dofs]
+
+    def dominant(space: np.ndarray) -> str:
+        energy = np.sum(inertia[:, None] * space**2, axis=1)
+        share = energy / float(np.sum(energy))
+        top = [labels[i] for i in np.argsort(-share) if share[i] >= 0.2][:3]
+        return "+".join(top) if top else labels[int(np.argmax(share))]
+
+    return dominant
 
 
 def _repeated(order: list[int], eigenvalues: np.ndarray, within: float) -> list[list[int]]:
@@ -225,10 +310,10 @@ def canonical_basis(rows: np.ndarray) -> list[np.ndarray]:
 
 
 def _mode(frequency: float, kind: str, multiplicity: int, shape: np.ndarray, names: list[str],
-          transform: np.ndarray, coordinates: list[str]) -> Mode:
-    """A mode with its shape scaled so that its largest angle component (the first of equal ones) is +1."""
+          transform: np.ndarray, coordinates: list[str], unit: str = "Hz") -> Mode:
+    """A mode with its shape scaled so that its largest component (the first of equal ones) is +1."""
     size = np.abs(shape)
     big = int(np.flatnonzero(size >= size.max() * (1 - 1e-9))[0])
     shape = shape / shape[big]
     return Mode(frequency, kind, multiplicity, {n: float(v) for n, v in zip(names, shape)},
-                {c: float(v) for c, v in zip(coordinates, transform @ shape)})
+                {c: float(v) for c, v in zip(coordinates, transform @ shape)}, unit)

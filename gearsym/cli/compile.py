@@ -8,7 +8,7 @@ from pathlib import Path
 from ..codegen.generated import generate_model
 from ..files.outputs import check_folder
 from ..loading import load
-from ..registry import available_models, output_root
+from ..registry import pregenerated_models, output_root
 from .arguments.integration import add_integration_arguments, integration_from
 from .arguments.settings import add_set_argument, model_settings
 
@@ -18,7 +18,9 @@ HELP = "generate the model's C code into generated/<model>/ and compile it (cach
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("models", nargs="*", metavar="MODEL", help="model names or model file paths")
-    parser.add_argument("--all", action="store_true", help="every model of `gearsym list`")
+    parser.add_argument("--all", action="store_true",
+                        help="every model of `gearsym list` whose C and page are committed (not one whose file "
+                             "says PREGENERATED = False)")
     add_set_argument(parser)
     add_integration_arguments(parser, periods=None)
     parser.add_argument("--out", type=Path, default=None, metavar="DIR",
@@ -32,7 +34,7 @@ def run(args: argparse.Namespace) -> int:
     if bool(args.all) == bool(args.models):
         print("gearsym compile: error: give model names or --all (not both)", file=sys.stderr)
         return 2
-    refs = available_models() if args.all else args.models
+    refs = pregenerated_models() if args.all else args.models
     settings = model_settings(args)
     options = integration_from(args)
     outs = [args.out or output_root(ref) / "generated" for ref in refs]

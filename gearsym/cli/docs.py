@@ -13,7 +13,7 @@ from ..derivation import derive, render
 from ..files.atomic import write_atomically
 from ..files.outputs import check_folder
 from ..loading import declared
-from ..registry import available_models, output_root
+from ..registry import pregenerated_models, output_root
 from .arguments.settings import add_teeth_argument
 
 NAME = "docs"
@@ -22,7 +22,9 @@ HELP = "write the Markdown derivation of models to DIR/<model>.md"
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("models", nargs="*", metavar="MODEL", help="model names or model file paths")
-    parser.add_argument("--all", action="store_true", help="every model of `gearsym list`")
+    parser.add_argument("--all", action="store_true",
+                        help="every model of `gearsym list` whose C and page are committed (not one whose file "
+                             "says PREGENERATED = False)")
     parser.add_argument("--out", type=Path, default=None, metavar="DIR",
                         help="output folder (default: docs/derivations/ of the current directory)")
     parser.add_argument("--check", action="store_true",
@@ -48,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
     if bool(args.all) == bool(args.models):
         print("gearsym docs: error: give model names or --all (not both)", file=sys.stderr)
         return 2
-    refs = available_models() if args.all else args.models
+    refs = pregenerated_models() if args.all else args.models
     outs = [args.out or output_root(ref) / "docs" / "derivations" for ref in refs]
     for out in set(outs) if not args.check else ():
         check_folder(out)

@@ -31,7 +31,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="fraction of each record (its last whole periods) held out for judging (default 0.25)")
     parser.add_argument("--effects", default=None, metavar="NAME,NAME",
                         help="candidate effects (default: the whole library); a harmonic family's bare name "
-                             "(torque_harmonic) stands for its orders 1 ... --harmonics, or name one (torque_harmonic_2)")
+                             "(torque_harmonic) stands for its orders 1 ... --harmonics, or name one (torque_harmonic_2); "
+                             "with --teeth a shaft-order kind (tooth_fault, spall, eccentricity, spacing_errors) for "
+                             "every gear's, and tooth_stiffness, tooth_profile for the tooth-by-tooth forms")
     parser.add_argument("--harmonics", type=int, default=None, metavar="N",
                         help="highest order of the harmonic families and of the proposals' harmonics (default 4)")
     parser.add_argument("--channel", action="append", default=[], metavar="NAME=FORMULA",

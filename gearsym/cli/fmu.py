@@ -8,7 +8,7 @@ from pathlib import Path
 from ..errors import GearsymError
 from ..fmu.export import export_fmu
 from ..files.outputs import check_folder
-from ..registry import available_models, load_model
+from ..registry import pregenerated_models, load_model
 from .arguments.integration import add_integration_arguments, integration_from
 from .arguments.settings import add_set_argument, model_settings
 
@@ -18,7 +18,8 @@ HELP = "export the model as an FMI 2.0 FMU (co-simulation and model exchange) fo
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("model", nargs="?", help="a model name (see `gearsym list`) or the path of a model file")
-    parser.add_argument("--all", action="store_true", help="every model of `gearsym list`, as DIR/<model>.fmu")
+    parser.add_argument("--all", action="store_true",
+                        help="every model of `gearsym list` whose C is committed, as DIR/<model>.fmu")
     add_set_argument(parser)
     add_integration_arguments(parser, periods=None, steps_help="RK4 steps per forcing period of the default "
                               "experiment's communication step (default 200)")
@@ -34,7 +35,7 @@ def run(args: argparse.Namespace) -> int:
     options = integration_from(args)
     if args.all:
         folder = check_folder(args.out)
-        refs = available_models()
+        refs = pregenerated_models()
         targets = [folder / f"{ref}.fmu" for ref in refs]
     else:
         load_model(args.model)  # an unknown model or a broken file: one line, before anything else

@@ -8,9 +8,12 @@ import math
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import GearsymError
-from ..figures.stiffness import plot_mesh_stiffness
-from ..geometry import GearGeometry, GearPair, Material, mesh_stiffness, STEEL
+from ..figures.stiffness import plot_cracked_mesh, plot_mesh_stiffness
+from ..geometry import (ORIGINS, GearGeometry, GearPair, Material, crack_loss_along_path, cracked_mesh_stiffness,
+                        loss_against_depth, mesh_stiffness, root_crack, STEEL)
 from ..files.outputs import check_figure
 from ..geometry.gear import ISO53_FILLET
 from ..units import parse_quantity, Quantity, shown
@@ -44,7 +47,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--slices", type=int, default=None, help="slices of a helical pair's face width (default 20)")
     parser.add_argument("--format", choices=("text", "json"), default="text")
     parser.add_argument("--plot", type=Path, default=None, metavar="FILE.png",
-                        help="the curve, its contact zones, its mean and ISO's")
+                        help="the curve, its contact zones, its mean and ISO's (with --crack: the mesh stiffness while "
+                             "the cracked tooth passes, beside the healthy curve, and the loss against crack depth)")
+    parser.add_argument("--crack", default=None, metavar="DEPTH,ANGLE",
+                        help='a root crack on one tooth of --cracked-gear, e.g. "3 mm,70 deg": its depth and its angle '
+                             "to the tooth's centre line, from ISO 6336-3's critical section (--crack-origin)")
+    parser.add_argument("--cracked-gear", type=int, choices=(1, 2), default=2,
+                        help="the gear whose tooth is cracked (1: driving, 2: driven; default 2)")
+    parser.add_argument("--crack-origin", choices=ORIGINS, default="critical_section",
+                        help="where the crack starts: ISO 6336-3's critical section (the 30 deg tangent, default) or "
+                             "the base circle (Tian 2004)")
 
 
 def _split(text: str, option: str, count: int | None = 2) -> list[str]:
@@ -137,7 +149,9 @@ def run(args: argparse.Namespace) -> int:
     if args.plot is not None:
         check_figure(args.plot)
     pair, title, length_unit = _geometry(args)
+    crack = _crack(args, pair)
     result = mesh_stiffness(pair, slices=args.slices)
+    cracked = _cracked(pair, args.cracked_gear, crack) if crack is not None else None
     if args.format == "json":
         data = result.as_dict()
         data["pair"] = title
@@ -145,13 +159,64 @@ def run(args: argparse.Namespace) -> int:
         data["gears"] = [_gear_dict(g) for g in (pair.gear1, pair.gear2)]
         data["units"]["gears"] = "m, kg, kg m^2"
         data["units"]["rack"] = "modules"
+        if cracked is not None:
+            data["crack"] = cracked
+            data["units"]["crack"] = "m, rad, fractions of the pair's stiffness; phase in rad"
         print(json.dumps(data, indent=1))
     else:
         _print_text(result, pair, title, length_unit)
+        if cracked is not None:
+            _print_crack(cracked, args.crack, length_unit)
     if args.plot is not None:
-        plot_mesh_stiffness(result, args.plot, title)
+        if crack is None:
+            plot_mesh_stiffness(result, args.plot, title)
+        else:
+            plot_cracked_mesh(pair, args.cracked_gear, crack, cracked, args.plot, f"{title}; crack {args.crack} on "
+                              f"a tooth of gear {args.cracked_gear}, from {crack.origin.replace('_', ' ')}")
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     return 0
+
+
+#: samples of the mesh stiffness while the cracked tooth passes, and of the loss against depth
+_PASSAGE_POINTS = 481
+_DEPTHS = 25
+
+
+def _crack(args, pair):
+    """The crack of ``--crack``, checked against the pair before any work (None without one)."""
+    if args.crack is None:
+        return None
+    depth_text, angle_text = _split(args.crack, "--crack")
+    depth = _quantity(depth_text, "--crack (its depth)", "m", '"3 mm,70 deg"').to("m").magnitude
+    angle = _quantity(angle_text, "--crack (its angle)", "rad", '"3 mm,70 deg"').to("rad").magnitude
+    crack = root_crack(depth, angle, origin=args.crack_origin)
+    if pair.gear1.helix_angle:
+        raise GearsymError("--crack: the root crack model is for spur pairs (Tian; Chen & Shao); drop --helix-angle")
+    gear = pair.gear1 if args.cracked_gear == 1 else pair.gear2
+    crack.path(gear.profile)  # (a crack through the tooth is refused here)
+    return crack
+
+
+def _cracked(pair, gear: int, crack) -> dict:
+    """The crack's loss along the path, the mesh stiffness while its tooth passes, and its mean loss against depth
+    (from 0 to just short of the unloaded flank, at its angle), JSON-ready."""
+    loss = crack_loss_along_path(pair, gear, crack.depth, crack.angle, origin=crack.origin,
+                                 limit_line=crack.limit_line)
+    e = pair.contact_ratio
+    phase = 2 * math.pi * np.linspace(-0.5, e + 0.5, _PASSAGE_POINTS)
+    healthy, cracked = cracked_mesh_stiffness(pair, gear, crack, phase)
+    depths, means, crossing = loss_against_depth(pair, gear, crack, _DEPTHS)
+    return {"depth": crack.depth, "angle": crack.angle, "origin": crack.origin, "limit_line": crack.limit_line,
+            "gear": gear, "mean_loss": loss.mean, "path_fraction": loss.fraction.tolist(), "loss": loss.loss.tolist(),
+            "phase": phase.tolist(), "healthy": healthy.tolist(), "cracked": cracked.tolist(),
+            "depths": depths.tolist(), "mean_losses": means.tolist(), "centre_line_depth": crossing}
+
+
+def _print_crack(cracked: dict, text: str, length_unit) -> None:
+    loss = np.array(cracked["loss"])
+    print(f"crack {text} on a tooth of gear {cracked['gear']} from {cracked['origin'].replace('_', ' ')}: its pair "
+          f"loses {100 * cracked['mean_loss']:.4g} % of its stiffness averaged over the path of contact "
+          f"({100 * loss.min():.3g} % to {100 * loss.max():.3g} % along it)")
 
 
 def _rack_dict(gear) -> dict:

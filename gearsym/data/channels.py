@@ -14,8 +14,11 @@ from .columns import PHYSICAL_TIME, RECORD
 
 #: the suffixes of a state's time derivatives as channel names, and their order
 DERIVATIVES = {"_dot": 1, "_ddot": 2}
-CHANNELS_HELP = ("a state (x), its time derivative (x_dot) or second derivative (x_ddot, an accelerometer), or a "
-                 "combination declared with channels={name: formula} (--channel NAME=FORMULA)")
+CHANNELS_HELP = ("a state (x), its time derivative (x_dot) or second derivative (x_ddot, an accelerometer), a body "
+                 "centre's acceleration on its bearing (a_pinion_y, a_sun_x, a_planet1_radial), or a combination "
+                 "declared with channels={name: formula} (--channel NAME=FORMULA)")
+#: the prefix of a body centre's acceleration as a channel name (a drivetrain on bearings)
+ACCELERATION = "a_"
 
 
 def channel_symbols(system: FirstOrderSystem) -> dict[str, sp.Symbol]:
@@ -24,6 +27,8 @@ def channel_symbols(system: FirstOrderSystem) -> dict[str, sp.Symbol]:
     out = {s.name: s for s in system.states}
     for s in system.states:
         out.update({s.name + suffix: sp.Symbol(s.name + suffix, real=True) for suffix in DERIVATIVES})
+    for name, expr in getattr(system, "translations", {}).items():  # (linear in the positions: their x_ddot)
+        out[ACCELERATION + name] = expr.xreplace({s: out[s.name + "_ddot"] for s in system.states})
     return out
 
 

@@ -78,7 +78,8 @@ def _components(
     """The component tables; ``coordinates`` maps a coupling's name to its coordinate's."""
     bodies = tuple(
         BodyRecord(rb.body.name, type(rb.body).__name__, rb.inertia, rb.radius, rb.angle) for rb in rd.bodies
-    )
+    ) + tuple(BodyRecord(rb.label, f"{type(rb.body).__name__} centre ({rb.motion})", rb.inertia, None, rb.angle)
+              for rb in rd.translations)
     couplings = []
     for rc in rd.couplings:
         in_time = sp.Eq(rd.stiffness_at(rc), rd.stiffness_definition(rc)) if rc.kind == "mesh" else None
@@ -128,6 +129,7 @@ def _derive_reduced(nd: NondimensionalModel) -> Derivation:
         engine_rhs=engine_rhs,
         closing=tuple(ClosingRecord(c.name, c.coupling.name, c.definition, c.in_states()[0]) for c in red.dependent),
         fixed=tuple(rb.body.name for rb in rd.fixed),
+        geometry=tuple(sorted(rd.geometry.items(), key=lambda kv: kv[0].name)),
     )
     return Derivation(
         model=model.name, title=model.title, description=model.description, time=tau,

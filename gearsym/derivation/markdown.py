@@ -56,7 +56,10 @@ def _section(title: str) -> list[str]:
 def _components(d: Derivation, m: Mechanics) -> list[str]:
     bare = d.bare_functions
     out = _section("Components")
-    out += ["Bodies (the angle is what remains after the steady rotation is removed):"]
+    out += ["Bodies (the angle is what remains after the steady rotation is removed; a body on a bearing also "
+            "translates: its centre's coordinate, with its mass):" if m.geometry or any("centre" in b.kind
+                                                                                      for b in m.bodies)
+            else "Bodies (the angle is what remains after the steady rotation is removed):"]
     out += table(["Body", "Type", "Inertia", "Base radius", "Angle"], [
         [f"`{b.name}`", b.kind, inline(to_latex(b.inertia, bare)),
          inline(to_latex(b.radius, bare)) if b.radius is not None else "—", inline(to_latex(b.angle, bare))]
@@ -64,6 +67,17 @@ def _components(d: Derivation, m: Mechanics) -> list[str]:
     ])
     if m.fixed:
         out += ["Fixed (held) bodies, which have no angle: " + ", ".join(f"`{name}`" for name in m.fixed) + "."]
+        out += [""]
+    if any("centre" in b.kind for b in m.bodies):
+        out += ["A mesh between gears whose centres move adds the projection of both centres' displacements on its "
+                "line of action (the line gear a's contact point moves along when its angle increases, on the flank "
+                "that closes); a bearing's coupling deflects by its body's centre displacement (a planet's relative "
+                "to its pin on the carrier: the carrier's translation and its rotation times the orbit radius)."]
+        out += [""]
+    if m.geometry:
+        out += ["The lines of action's numbers are carried as symbols through the derivation and put back in the "
+                "reduced equations: " + ", ".join(f"${to_latex(sym, bare)} = {to_latex(value, bare)}$"
+                                                   for sym, value in m.geometry) + "."]
         out += [""]
     if m.closing:
         out += ["Couplings (a mesh deflects by $r_a \\psi_a - r_b \\psi_b$ along the line of action, by "

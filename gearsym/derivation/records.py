@@ -144,6 +144,7 @@ class Mechanics:
     engine_rhs: tuple[sp.Expr, ...]  # the right-hand side as the engine receives it
     closing: tuple["ClosingRecord", ...] = ()  # deflections of couplings that close a kinematic loop
     fixed: tuple[str, ...] = ()  # bodies declared fixed (held): no angle
+    geometry: tuple = ()  # (symbol, what it stands for): the numbers of the lines of action of gears on bearings
 
     @property
     def angles(self) -> tuple[sp.Expr, ...]:

@@ -1,4 +1,5 @@
-"""The data loop's report: its figures (where the held-out residual lives, the one-period-ahead prediction), and
+"""The data loop's report: its figures (where the held-out residual lives, the one-period-ahead prediction, a
+tooth-by-tooth form's values tooth by tooth), and
 the folder of page, data and figures written together (:func:`write_report`, the pages from
 :mod:`gearsym.fit.report`); :func:`explain_files`, the whole loop from measurement files to that folder."""
 from __future__ import annotations
@@ -14,8 +15,10 @@ from ..files.atomic import write_atomically
 from ..files.outputs import check_folder
 from ..files.sets import written_together
 from ..fit.effects import augment
-from ..fit.report import PARTIAL_MARKER, REPORT_FILES, derived_model_page, report_page
-from ..fit.selection import Candidate, Explanation, explain
+from ..fit.report import PARTIAL_MARKER, REPORT_FILES, TEETH_FIGURE, derived_model_page, report_page
+from ..fit.selection import Candidate, Explanation, explain, record_label
+from ..fit.tooth_forms import standing_out, tooth_values
+from ..fit.tooth_scan import from_record_start
 from ..system import FirstOrderSystem
 from .layout import fit_texts
 from .save import pyplot, save_figure
@@ -43,18 +46,25 @@ def explain_files(paths, system, fit, *, out=None, time_scale=None, held_out: fl
 
 
 def write_report(ex: Explanation, system: FirstOrderSystem, out: str | Path, sources=()) -> dict:
-    """Write DIR/report.md, DIR/report.json, DIR/residuals.png, DIR/prediction.png and DIR/derived_model.md, all
-    or none: a failure or a kill while they are made leaves the previous report as it was (never a new
-    report.json beside an old report.md)."""
-    with written_together(out, REPORT_FILES, PARTIAL_MARKER, "the report") as stage:
+    """Write DIR/report.md, DIR/report.json, DIR/residuals.png, DIR/prediction.png and DIR/derived_model.md (and
+    DIR/teeth.png when a tooth-by-tooth form was tried), all or none: a failure or a kill while they are made
+    leaves the previous report as it was (never a new report.json beside an old report.md)."""
+    teeth = _tooth_candidate(ex)
+    names = REPORT_FILES + ((TEETH_FIGURE,) if teeth is not None else ())
+    with written_together(out, names, PARTIAL_MARKER, "the report") as stage:
         data = json_safe(ex.as_dict())
         write_atomically(stage / "report.json", json.dumps(data, indent=1, allow_nan=False) + "\n")
         save_figure(residual_figure(ex, system), stage / "residuals.png", dpi=100)
         save_figure(prediction_figure(ex, system.name), stage / "prediction.png", dpi=100)
+        if teeth is not None:
+            save_figure(tooth_figure(ex, teeth, system.name, sources), stage / TEETH_FIGURE, dpi=100)
         effects = [ex.library[e] for e in ex.effects]
         derived = augment(system, effects) if effects else system
         write_atomically(stage / "derived_model.md", derived_model_page(system, derived, effects))
         write_atomically(stage / "report.md", report_page(ex, system, derived, data, sources))
+    stale = Path(out) / TEETH_FIGURE
+    if teeth is None and stale.is_file() and not stale.is_symlink():  # (a previous run's, not this report's)
+        stale.unlink()
     return data
 
 
@@ -67,6 +77,57 @@ def _views(c: Candidate, system: FirstOrderSystem):
     v = names.index(mesh.velocity) if mesh else min(1, len(names) - 1)
     channel = next(iter(p.residual))
     return np.mod(p.tau, 2 * np.pi), p.states[x], p.states[v], p.residual[channel], channel, names[x], names[v]
+
+
+def _tooth_candidate(ex: Explanation) -> Candidate | None:
+    """The tooth-by-tooth candidate a report draws: the chosen one, else the best tried."""
+    tried = [c for c in ex.tried if c.regularised is not None or any(ex.library[e].gears for e in c.effects)]
+    chosen = [c for c in tried if c is ex.final]
+    return (chosen or sorted(tried, key=lambda c: c.error))[0] if tried else None
+
+
+def tooth_figure(ex: Explanation, c: Candidate, system_name: str = "", sources=()):
+    """Every tooth's value of a tooth-by-tooth form (its regularised fit, ± one standard error), gear by gear,
+    counted from the first record's start; the teeth that stand out in red, each gear's median dashed (a level
+    shared by every tooth of one gear and taken back by every tooth of the other is one no record can tell from
+    nothing: compare a tooth with its gear's median)."""
+    plt = pyplot()
+    e = next(ex.library[name] for name in c.effects if ex.library[name].gears)
+    every = c.regularised or c.fit
+    values = tooth_values(e, every.estimates, every.stderr)
+    out = standing_out(values)
+    stiffness = e.name.startswith("tooth_stiffness")
+    starts = ex.info.get("records", {})
+    first_key = next(iter(starts), None)
+    start = starts.get(first_key, 0.0)
+    order = next((float(cp.order or 1) for cp in (ex.system.couplings if ex.system else ())
+                  if cp.coordinate == e.coordinate), 1.0)
+    fig, axs = plt.subplots(1, len(values), figsize=(5 + 0.12 * sum(len(v) for v in values.values()), 4.0),
+                            constrained_layout=True, squeeze=False, sharey=True,
+                            gridspec_kw={"width_ratios": [len(v) for v in values.values()]})
+    scale = 100 if stiffness else 1
+    for ax, (gear, vs) in zip(axs[0], values.items()):
+        Z = len(vs)
+        counted = np.array([from_record_start(n, Z, start, order) for n in range(1, Z + 1)])
+        shown = np.array([-v * scale if stiffness else v for v, _ in vs])
+        errs = np.array([(err or 0.0) * scale for _, err in vs])
+        colours = ["C3" if n in out[gear] else "0.55" for n in range(1, Z + 1)]
+        ax.bar(counted, shown, color=colours, yerr=errs, capsize=2, error_kw={"lw": 0.8})
+        ax.axhline(0, color="k", lw=0.6)
+        ax.axhline(np.median(shown), color="0.3", lw=0.8, ls="--")
+        ax.set_xticks(np.arange(1, Z + 1)[:: max(1, Z // 20)])
+        ax.set_xlabel(f"tooth of {gear} ({Z} teeth)")
+        named = sorted(from_record_start(n, Z, start, order) for n in out[gear])
+        ax.set_title(f"{gear}: standing out (red): {', '.join(map(str, named)) or 'none'}", fontsize=9)
+    axs[0][0].set_ylabel("mesh stiffness change while in mesh [%]" if stiffness else
+                         "profile error while carrying the load\n[length unit of the mesh coordinate]")
+    state = "chosen" if c is ex.final else f"tried, not chosen (held-out error {c.error:.3g})"
+    data = f"; data {', '.join(Path(str(s)).name for s in sources)}" if sources else ""
+    record = f" ({record_label(first_key)})" if first_key is not None else ""
+    fig.suptitle(f"{system_name}: {e.name}, every tooth of both gears fitted together (regularised; bars ± one "
+                 f"standard error, dashed: the gear's median) — {state}{data}; teeth counted from the first "
+                 f"record's start{record}", fontsize=8.5)
+    return fig
 
 
 def residual_figure(ex: Explanation, system: FirstOrderSystem):
@@ -140,4 +201,4 @@ def prediction_figure(ex: Explanation, system_name: str = ""):
     return fig
 
 
-__all__ = ["explain_files", "prediction_figure", "residual_figure", "write_report"]
+__all__ = ["explain_files", "prediction_figure", "residual_figure", "tooth_figure", "write_report"]

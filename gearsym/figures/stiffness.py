@@ -61,3 +61,49 @@ def _bodies(pair) -> str:
                 f"E {m1.E / 1e9:.4g}/{m2.E / 1e9:.4g} GPa, ν {m1.nu:.3g}/{m2.nu:.3g}")
     bodies = " / ".join("solid" if g.bore_diameter == 0 else "bored" for g in (pair.gear1, pair.gear2))
     return f"{material}; gear bodies {bodies} (Sainsot et al. 2004)"
+
+
+def plot_cracked_mesh(pair, gear: int, crack, cracked: dict, path: str | Path | None = None, title: str | None = None):
+    """A root crack's cost: left, the mesh stiffness while the cracked tooth passes (its pair in contact from phase 0
+    to 2 pi eps), healthy (black) and cracked (red), the zones shaded; right, the crack's mean loss over the path of
+    contact against its depth at its angle, the depth drawn marked and where the crack reaches the centre line.
+    ``cracked``: what ``gearsym stiffness --crack`` computes (the CLI's ``_cracked``)."""
+    plt = pyplot()
+    fig, (ax, right) = plt.subplots(1, 2, figsize=(11.0, 4.6), constrained_layout=True,
+                                    gridspec_kw={"width_ratios": [1.6, 1.0]})
+    e = pair.contact_ratio
+    periods = np.asarray(cracked["phase"]) / (2 * math.pi)
+    for start in range(-1, math.ceil(e) + 1):  # double contact: where a pair enters, for eps - 1 mesh periods
+        ax.axvspan(start, start + e - 1, color=_ZONE_COLOURS[2], zorder=0,
+                   label="2 pairs of teeth in contact" if start == -1 else None)
+    ax.axvspan(0, e, ymax=0.04, color="C3", alpha=0.5, zorder=1, label="the cracked tooth's pair in contact")
+    healthy, broken = np.asarray(cracked["healthy"]), np.asarray(cracked["cracked"])
+    ax.plot(periods, healthy, color="k", lw=1.4, label="healthy")
+    ax.plot(periods, broken, color="C3", lw=1.4,
+            label=f"cracked: {cracked['depth'] * 1e3:.3g} mm at {math.degrees(cracked['angle']):.3g}° "
+                  f"(mean loss of its pair {100 * cracked['mean_loss']:.3g} %)")
+    ax.set_xlim(periods[0], periods[-1])
+    ax.set_ylim(0.0, 1.3 * healthy.max())
+    ax.set_xlabel("mesh periods since the cracked tooth's pair came into contact (φ / 2π)")
+    ax.set_ylabel("mesh stiffness k [N/m]")
+    ax.legend(fontsize=7.5, loc="upper right", ncol=2)
+    ax.set_title(f"mesh stiffness while the cracked tooth (gear {gear}, {(pair.gear1, pair.gear2)[gear - 1].teeth} "
+                 f"teeth) passes (ε_α = {e:.4g})", fontsize=9)
+    depths = np.asarray(cracked["depths"]) * 1e3
+    right.plot(depths, 100 * np.asarray(cracked["mean_losses"]), color="C3", lw=1.4,
+               label="mean over the path of contact")
+    right.axvline(cracked["depth"] * 1e3, color="C3", ls=":", lw=1.0, label="the crack drawn left")
+    crossing = cracked["centre_line_depth"] * 1e3
+    if crossing < depths[-1]:
+        right.axvline(crossing, color="0.4", ls="--", lw=1.0, label="reaches the tooth's centre line")
+    right.set_xlabel(f"crack depth [mm] at {math.degrees(cracked['angle']):.3g}° to the centre line")
+    right.set_ylabel("stiffness of the cracked pair lost [%]")
+    right.set_xlim(0, depths[-1])
+    right.set_ylim(0, None)
+    right.legend(fontsize=7.5, loc="upper left")
+    right.set_title(f"loss against depth (from the {cracked['origin'].replace('_', ' ')})", fontsize=9)
+    heading = "\n".join(textwrap.wrap(title or pair.describe(), 130))
+    fig.suptitle(f"{heading}\n{_bodies(pair)}", fontsize=9)
+    if path is not None:
+        save_figure(fig, path, dpi=110)
+    return fig

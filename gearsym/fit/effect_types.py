@@ -95,6 +95,9 @@ class Effect:
     gear: str = ""  # a shaft-order effect's gear (:mod:`.shaft_effects`) and its tooth count
     teeth: int = 0
     scan: str = ""  # a fixed parameter found by a scan over the gear's teeth (the faulty tooth)
+    gears: tuple[tuple[str, int], ...] = ()  # a tooth-by-tooth form's gears and tooth counts (both gears of a mesh)
+    prior: float = 0.0  # a tooth-by-tooth form's prior spread of each parameter (regularised: 0 for none) ...
+    prior_unit: str = ""  # ... in the parameter's units ("") or times the mesh coordinate's spread ("displacement")
     constraints: Mapping[str, Constraint] = field(default_factory=dict)  # what its parameters may be, physically
 
     @property
@@ -103,8 +106,14 @@ class Effect:
 
     @property
     def shaft_order(self) -> bool:
-        """An effect that repeats once per revolution of its gear (a tooth fault, an eccentricity)."""
-        return bool(self.teeth)
+        """An effect that repeats once per revolution of its gear (a tooth fault, an eccentricity) or of each of its
+        gears (a tooth-by-tooth form)."""
+        return bool(self.teeth or self.gears)
+
+    @property
+    def revolutions(self) -> tuple[tuple[str, int], ...]:
+        """(gear, teeth) of every gear whose revolution the effect repeats on."""
+        return self.gears or (((self.gear, self.teeth),) if self.teeth else ())
 
     @property
     def family(self) -> str:

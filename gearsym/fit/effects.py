@@ -55,6 +55,7 @@ from ..model.symbols import parameter_symbol
 from ..system import FirstOrderSystem
 from .effect_types import Change, Effect, Site, site
 from .shaft_effects import KINDS as SHAFT_KINDS, shaft_effect, with_revolution
+from .tooth_forms import GENERAL_KINDS
 
 INF = math.inf
 
@@ -174,7 +175,7 @@ def effect(name: str | Effect, system: FirstOrderSystem | None = None) -> Effect
 
 def library_names() -> list[str]:
     """Every effect's name as the user writes it (families with _N, shaft-order effects with _GEAR)."""
-    return [*EFFECTS, *(f"{f}_N" for f in FAMILIES), *(f"{k}_GEAR" for k in SHAFT_KINDS)]
+    return [*EFFECTS, *(f"{f}_N" for f in FAMILIES), *(f"{k}_GEAR" for k in SHAFT_KINDS), *GENERAL_KINDS]
 
 
 def applies_to(system: FirstOrderSystem, e: Effect, coordinate: str | None = None) -> bool:

@@ -7,17 +7,24 @@ import numpy as np
 from .problem import Problem
 
 
-def levenberg_marquardt(problem: Problem, u, low, high, max_iterations: int):
+def levenberg_marquardt(problem: Problem, u, low, high, max_iterations: int, ridge=None):
     """Gauss-Newton steps with Marquardt's damping, projected onto the bounds: robust where the backlash makes
-    the exact Hessian jump, and it needs only the Jacobian."""
+    the exact Hessian jump, and it needs only the Jacobian. ``ridge``: per parameter and offset a weight w, the
+    cost r.r + sum w u^2 (a regularised fit; None: none)."""
     r, J = problem(u)
-    cost, mu = float(r @ r), 1e-3
+    p = J.P.shape[1]
+    ridge = np.zeros(p) if ridge is None else np.asarray(ridge, dtype=float)
+
+    def total(r, u):
+        return float(r @ r) + float(ridge @ (u[:p] * u[:p]))
+
+    cost, mu = total(r, u), 1e-3
     converged, iteration = False, 0
     if not (np.isfinite(cost) and J.finite):  # the model does not even run from the first guess
         return u, J, r, iteration, converged
-    p = J.P.shape[1]
     for iteration in range(1, max_iterations + 1):
         U, W, V, gP, gS = J.normal(r)
+        U, gP = U + np.diag(ridge), gP + ridge * u[:p]
         held = ((u[:p] <= low[:p]) & (gP > 0)) | ((u[:p] >= high[:p]) & (gP < 0))  # the descent would leave the box
         while True:
             try:
@@ -31,7 +38,7 @@ def levenberg_marquardt(problem: Problem, u, low, high, max_iterations: int):
                 continue
             u_new = np.clip(u + step, low, high)
             r_new, J_new = problem(u_new)
-            new_cost = float(r_new @ r_new) if np.all(np.isfinite(r_new)) and J_new.finite else np.inf
+            new_cost = total(r_new, u_new) if np.all(np.isfinite(r_new)) and J_new.finite else np.inf
             if new_cost < cost:
                 break
             mu *= 10

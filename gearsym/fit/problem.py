@@ -18,14 +18,23 @@ from .segment import Segment, substeps_for
 
 
 class Problem:
-    """Scaled residuals of every window and their exact Jacobian, by u = [theta, bias, S[:, 0], S[:, 1], ...]."""
+    """Scaled residuals of every window and their exact Jacobian, by u = [theta, bias, S[:, 0], S[:, 1], ...].
+
+    ``slots``: tooth-by-tooth forms as the compiled model has them (:class:`gearsym.fit.tooth_forms.Slots`): the
+    per-tooth parameters among ``fit`` reach each window through its slots (its first tooth set from its start time,
+    each slot the parameter of its tooth), and each slot's derivative column adds to its tooth's."""
 
     def __init__(self, system: FirstOrderSystem, segments: Sequence[Segment], fit: list[str], bias: list[str],
-                 period: float, options: Integration):
+                 period: float, options: Integration, slots: Sequence = ()):
         self.system, self.segments, self.fit, self.period = system, list(segments), fit, period
         self._integrated = None
         self.names = tuple(system.parameters)
-        self.index = np.array([self.names.index(p) for p in fit], dtype=int)
+        per_tooth = {name: (sl, k) for sl in slots for k, name in enumerate(sl.teeth_names)}
+        unknown = [p for p in fit if p not in self.names and p not in per_tooth]
+        if unknown:
+            raise GearsymError(f"cannot fit {', '.join(unknown)}: not parameters of {system.name}")
+        self.direct = np.array([i for i, p in enumerate(fit) if p in self.names], dtype=int)  # positions in theta
+        self.index = np.array([self.names.index(fit[i]) for i in self.direct], dtype=int)
         self.n, self.m = system.dimension, len(fit)
         keys = list(dict.fromkeys((name, seg.channel(name)) for seg in segments for name in seg.observed))
         self.channel_names = [k[0] for k in keys]
@@ -50,6 +59,18 @@ class Problem:
         self.dt = np.array([float(np.median(np.diff(s.tau))) for s in segments])
         self.substeps = np.array([substeps_for(dt, period, options) for dt in self.dt], dtype=np.int64)
         self.base = np.array([[s.parameters[n] for n in self.names] for s in segments], dtype=float).T
+        # per slot (across the forms' gears): its parameter's row, and per window the position in theta of its tooth's
+        self.slot_rows, slot_positions = [], []
+        for sl in slots:
+            firsts = np.array([sl.first_tooth(t) for t in self.t0])
+            self.base[self.names.index(sl.first), :] = firsts
+            for j, name in enumerate(sl.slots):
+                self.slot_rows.append(self.names.index(name))
+                position = [fit.index(sl.teeth_names[k]) if sl.teeth_names[k] in fit else -1
+                            for k in (firsts + j - 1) % sl.teeth]
+                slot_positions.append(position)
+        self.slot_rows = np.array(self.slot_rows, dtype=int)
+        self.slot_positions = np.array(slot_positions, dtype=int).reshape(len(self.slot_rows), len(segments))
         offsets = np.concatenate([[0], np.cumsum(self.samples)])
         channel, column, window, data, weight, bias_of = [], [], [], [], [], []
         for k, seg in enumerate(segments):
@@ -96,12 +117,32 @@ class Problem:
 
     def parameters(self, theta: np.ndarray) -> np.ndarray:
         P = self.base.copy()
-        P[self.index, :] = theta[:, None]
+        P[self.index, :] = theta[self.direct, None]
+        if self.slot_rows.size:
+            padded = np.append(theta, 0.0)  # (position -1: a tooth not fitted, its slot at 0)
+            P[self.slot_rows, :] = padded[self.slot_positions]
         return P
+
+    @property
+    def columns(self) -> np.ndarray:
+        """The parameters whose derivative columns a run computes: the fitted ones, then the slots."""
+        return np.concatenate([self.index, self.slot_rows]).astype(int)
 
     def run(self, theta: np.ndarray, S: np.ndarray, tangent: bool):
         return self.engine.run(S, self.t0, self.dt, self.samples, self.substeps, self.parameters(theta), tangent,
-                               columns=self.index)
+                               columns=self.columns)
+
+    def _parameter_columns(self, D: np.ndarray) -> np.ndarray:
+        """The residuals' derivatives by theta from the run's columns (fitted parameters, then slots)."""
+        direct = len(self.index)
+        out = np.zeros((D.shape[0], self.m))
+        out[:, self.direct] = D[:, :direct]
+        rows = np.arange(D.shape[0])
+        for j in range(len(self.slot_rows)):
+            position = self.slot_positions[j][self.window]
+            fitted = position >= 0
+            np.add.at(out, (rows[fitted], position[fitted]), D[fitted, direct + j])
+        return out
 
     def __call__(self, u: np.ndarray, jacobian: bool = True):
         theta, b, S = self.split(u)
@@ -113,5 +154,5 @@ class Problem:
         D = run.derivatives[self.rows[0], :, self.rows[1]] * self.weight[:, None]  # (residuals, n + fitted)
         offsets = np.stack([np.where(self.bias_of == j, self.weight, 0.0) for j in range(len(self.bias))], axis=1) \
             if self.bias else np.zeros((r.size, 0))
-        return r, Jacobian(np.hstack([D[:, self.n:], offsets]), D[:, :self.n], self.window,
+        return r, Jacobian(np.hstack([self._parameter_columns(D[:, self.n:]), offsets]), D[:, :self.n], self.window,
                            self.row_offsets)

@@ -26,6 +26,8 @@ VERDICTS = {
 
 #: the files of a report, replaced together (:func:`~gearsym.files.sets.written_together`)
 REPORT_FILES = ("report.json", "residuals.png", "prediction.png", "derived_model.md", "report.md")
+#: the figure of a tooth-by-tooth form's values, tooth by tooth, written beside them when one was tried
+TEETH_FIGURE = "teeth.png"
 #: the file that says a report folder is partial (a run killed while it replaced the files)
 PARTIAL_MARKER = "REPORT-INCOMPLETE.txt"
 
@@ -76,7 +78,9 @@ def report_page(ex: Explanation, system: FirstOrderSystem, derived: FirstOrderSy
     lines += _candidates(ex) + _spectrum(ex) + _sidebands(data) + _proposals(ex) + _estimates(ex, data)
     lines += ["## The derived model", ""]
     if ex.effects:
-        for name, rows in effect_terms(system, [ex.library[e] for e in ex.effects]).items():
+        for name in (e for e in ex.effects if ex.library[e].gears):
+            lines += [f"- **{name}**: {ex.library[name].description}; the teeth that do not stand out at 0.", ""]
+        for name, rows in effect_terms(system, [ex.library[e] for e in ex.effects if not ex.library[e].gears]).items():
             lines += [f"- **{name}** ({ex.library[name].description}) adds:", ""]
             for state, term in rows.items():
                 lines += [f"$$ \\frac{{d{sp.latex(sp.Symbol(state))}}}{{d\\tau}} \\mathrel{{+}}= {sp.latex(term)} $$", ""]
@@ -96,7 +100,16 @@ def fault_lines(faults: list[dict]) -> list[str]:
     """The verdict's lines of the shaft-order effects found: which gear, which tooth, how much."""
     out = []
     for f in faults:
-        if f["kind"] == "tooth fault":
+        if f["kind"] in ("tooth stiffness", "tooth profile"):
+            out += _tooth_lines(f)
+        elif f["kind"] == "spall":
+            change = _pm_percent(f["stiffness_change_percent"], f["stiffness_change_stderr_percent"])
+            where = f"tooth {f['tooth']} of {f['gear']}" if f["tooth"] is not None else \
+                f"{f['gear']}, " + ", ".join(f"tooth {n} in {r}" for r, n in f["tooth_by_record"].items())
+            out.append(f"- **{where}: a spall, face width {change}** (`{f['effect']}`: the pair of that tooth, counted "
+                       f"from the record's start, loses this fraction of its width over the middle of its path of "
+                       f"contact; {f['teeth']} teeth).")
+        elif f["kind"] == "tooth fault":
             change = _pm_percent(f["stiffness_change_percent"], f["stiffness_change_stderr_percent"])
             if f["tooth"] is not None:
                 where = f"tooth {f['tooth']} of {f['gear']}"
@@ -112,6 +125,32 @@ def fault_lines(faults: list[dict]) -> list[str]:
             shown = ", ".join(f"{e:.3g}" for e in f["errors"])
             out.append(f"- **spacing errors of {f['gear']}** (`{f['effect']}`, tooth 1 ... {f['teeth']} from "
                        f"tau = 0): {shown}.")
+    return out
+
+
+def _tooth_lines(f: dict) -> list[str]:
+    """A tooth-by-tooth form's verdict lines: the teeth that stand out, gear by gear, counted from each record's
+    start, with their refitted values; or that none does."""
+    stiffness = f["kind"] == "tooth stiffness"
+    out = []
+    for gear, teeth in f["standing_out"].items():
+        if not teeth:
+            continue
+        by_record = {r: g[gear] for r, g in f["standing_out_by_record"].items()}
+        counted = set(map(tuple, by_record.values()))
+        numbers = (", ".join(map(str, counted.pop())) if len(counted) == 1 else
+                   "; ".join(f"{', '.join(map(str, n))} in {r}" for r, n in by_record.items()))
+        values = []
+        for n in teeth:
+            value, err = f["refitted"][gear][n] if n in f["refitted"][gear] else f["refitted"][gear][str(n)]
+            values.append(_pm_percent(-100 * value, None if err is None else 100 * err) if stiffness
+                          else _pm(value, err))
+        what = "mesh stiffness while in mesh" if stiffness else "profile error"
+        out.append(f"- **{gear}, tooth {numbers}: {what} {', '.join(values)}** (`{f['effect']}`: every tooth of "
+                   f"both gears fitted, {sum(f['gears'].values())} parameters; the teeth that stand out, counted from "
+                   "the record's start, refitted; see teeth.png).")
+    if not out:
+        out.append(f"- `{f['effect']}`: no tooth stands out (every tooth of both gears fitted; see teeth.png).")
     return out
 
 
@@ -150,8 +189,10 @@ def _candidates(ex: Explanation) -> list[str]:
     lines = ["## Candidates (held-out error, lower is better)", "",
              "| model | held-out error | training σ | its estimates | note |", "|---|---|---|---|---|"]
     for c in ex.tried:
-        own = [p for e in c.effects for p in ex.library[e].fitted] or list(ex.fitted)
+        own = [p for e in c.effects for p in ex.library[e].fitted if p in c.fit.estimates] or list(ex.fitted)
         shown = ", ".join(f"{p} = {_estimate(c, p)}" for p in own)
+        if any(ex.library[e].gears for e in c.effects) and not shown:
+            shown = "no tooth stands out"
         note = f"rejected: {c.rejected}" if c.rejected else ("**chosen**" if c is ex.final and c.effects else "")
         lines.append(f"| {'+'.join(c.effects) or 'as declared'} | {c.error:.4g} | {c.fit.sigma:.4g} | {shown} | {note} |")
     lines.append("")
@@ -243,4 +284,5 @@ def _estimate(c: Candidate, name: str) -> str:
     return _pm(f.estimates[name], f.stderr[name])
 
 
-__all__ = ["REPORT_FILES", "PARTIAL_MARKER", "VERDICTS", "derived_model_page", "report_page"]
+__all__ = ["REPORT_FILES", "PARTIAL_MARKER", "TEETH_FIGURE", "VERDICTS",
+           "derived_model_page", "report_page"]

@@ -54,6 +54,7 @@ from .segment import Segment
 from .shaft_effects import BUILDERS as SHAFT_BUILDERS, DEFAULT_KINDS as SHAFT_DEFAULTS, revolution_length, \
     shaft_effects
 from .shooting import fit_windows
+from .tooth_forms import GENERAL_KINDS, general_forms, local_effect, place_slots, standing_out, tooth_values
 from .tooth_scan import from_record_start, Placement, scan_teeth
 
 MIN_GAIN = 0.2
@@ -88,6 +89,9 @@ class Candidate:
     prediction: Prediction
     rejected: str = ""
     placements: dict = field(default_factory=dict)  # a tooth fault's effect -> record key -> its tooth (from tau 0)
+    system: FirstOrderSystem | None = None  # the compiled model it was fitted on, where not the search's (a
+    slots: tuple = ()  # tooth-by-tooth form's, with its slots: :mod:`.tooth_forms`) ...
+    regularised: Fit | None = None  # ... and its regularised fit of every tooth (``fit``: the teeth that stand out)
 
     @property
     def error(self) -> float:
@@ -165,14 +169,35 @@ class Explanation:
             if not e.shaft_order:
                 continue
             item = {"effect": name, "gear": e.gear, "teeth": e.teeth}
-            if e.scan:
+            order = _order_of(self.system, e)
+            if e.gears:
+                item = {"effect": name, "gears": {g: z for g, z in e.gears}}
+                every = c.regularised or fit  # every tooth (regularised); the ones that stand out refitted in fit
+                values = tooth_values(e, every.estimates, every.stderr)
+                out_ = standing_out(values)
+                refit = {g: {n: [fit.estimates.get(p), fit.stderr.get(p)] for n, p in zip(out_[g], _tooth_names(e, g, out_[g]))}
+                         for g in out_}
+                stiffness = name.startswith("tooth_stiffness")
+                item.update(kind="tooth stiffness" if stiffness else "tooth profile",
+                            quantity="loss of mesh stiffness while the tooth is in mesh (fraction)" if stiffness
+                            else "transmission error while the tooth carries the load (length unit of the mesh "
+                                 "coordinate)",
+                            values={g: [v for v, _ in vs] for g, vs in values.items()},
+                            stderr={g: [err for _, err in vs] for g, vs in values.items()},
+                            median={g: float(np.median([v for v, _ in vs])) for g, vs in values.items()},
+                            standing_out=out_, refitted=refit,
+                            standing_out_by_record={
+                                record_label(key): {g: [from_record_start(n, z, start, order) for n in out_[g]]
+                                                     for g, z in e.gears}
+                                for key, start in starts.items()})
+            elif e.scan:
                 q = fit.estimates[e.fitted[0]]
                 sq = fit.stderr.get(e.fitted[0])
-                order = _order_of(self.system, e)
-                by_record = {_record_label(key): from_record_start(int(n), e.teeth, starts.get(key, 0.0), order)
+                by_record = {record_label(key): from_record_start(int(n), e.teeth, starts.get(key, 0.0), order)
                              for key, n in c.placements.get(name, {}).items()}
                 common = set(by_record.values())
-                item.update(kind="tooth fault", tooth=common.pop() if len(common) == 1 else None,
+                item.update(kind="spall" if name.startswith("spall_") else "tooth fault",
+                            tooth=common.pop() if len(common) == 1 else None,
                             tooth_by_record=by_record, severity=q, severity_stderr=sq,
                             stiffness_change_percent=-100 * q, stiffness_change_stderr_percent=None if sq is None
                             else 100 * sq)
@@ -296,9 +321,19 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
     for name in bias:
         if name not in measurements.observed:
             raise GearsymError(f"bias of {name}: no such channel in the data ({', '.join(measurements.observed)})")
-    library = candidate_library(system, candidates, harmonics, terms)
-    too_short = _too_short(system, measurements, library, named={c for c in candidates or () if isinstance(c, str)})
+    forms = general_forms(system)
+    named_forms = [c for c in candidates or () if isinstance(c, str) and (c in GENERAL_KINDS or c in forms)]
+    library = candidate_library(system, None if candidates is None else
+                                [c for c in candidates if c not in named_forms], harmonics, terms)
+    general = {name: e for name, e in forms.items()
+               if candidates is None or name in named_forms or any(name.startswith(k + "_") for k in named_forms)}
+    if named_forms and not general:
+        raise GearsymError(f"{named_forms[0]}: no mesh of {system.name} has two gears with tooth counts; give a model "
+                           "that declares Gear(..., teeth=Z), or --teeth Z1,Z2 (teeth=(Z1, Z2) in Python)")
+    named = {c for c in candidates or () if isinstance(c, str)}
+    too_short = _too_short(system, measurements, {**library, **general}, named=named)
     library = {name: e for name, e in library.items() if name not in too_short}
+    general = {name: e for name, e in general.items() if name not in too_short}
     superset = augment(system, list(library.values()), name=f"{system.name}_candidates") if library else system
     train, test = measurements.split(held_out)
     seg_train, keys_train = segments_of(superset, train)
@@ -357,6 +392,28 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
             break
         current = best
         current_spectrum = spectrum_of(current)
+    if general and (named_forms or _lag1(current.prediction) > max_correlation):
+        # the named faults leave something systematic (or the general forms were asked for): every tooth's own
+        # parameter, in place of the named tooth faults (the other effects kept); chosen only where it predicts
+        # clearly better than the named faults do
+        others = tuple(e for e in current.effects if not library[e].scan)
+        start = next((c for c in tried if c.effects == others), base)
+        round_ = []
+        clock.plan(len(general))
+        for e in general.values():
+            round_.append(_general_candidate(system, library, e, others, start, list(fit), train, test, bounds,
+                                             options, bias, say, clock))
+            library[e.name] = e
+            if not round_[-1].rejected and _lag1(round_[-1].prediction) <= max_correlation:
+                break  # (explained: the next form would only cost its compilation)
+        tried.extend(round_)
+        eligible = [c for c in round_ if not c.rejected and np.isfinite(c.error)]
+        if eligible:
+            best = min(eligible, key=lambda c: c.error)
+            if best.error <= (1 - min_gain) * current.error:
+                say(f"{'+'.join(best.effects)} predicts better than the named faults ({best.error:.4g} against "
+                    f"{current.error:.4g}): chosen")
+                current, current_spectrum = best, spectrum_of(best)
     correlation = _lag1(current.prediction)
     unexplained = bool(correlation > max_correlation)
     evidence = None
@@ -369,7 +426,7 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
     ex = Explanation(base, current, tried, unexplained, correlation, tuple(fit), held_out, info,
                      spectrum=spectrum, final_spectrum=current_spectrum, library=library, system=system,
                      bias=tuple(bias), bias_by_default=tuple(by_default))
-    if unexplained and propose:
+    if unexplained and propose and current.system is None:  # (not on a tooth-by-tooth form's own model)
         final_train, final_test = (placed(segs, current.placements, library) for segs in (seg_train, seg_test))
         ex = replace(ex, proposed=propose_terms(ex, superset, final_train, final_test, keys, options, harmonics,
                                                 say))
@@ -384,6 +441,55 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
                 ex = replace(alone, correlation=_lag1(base.prediction), final_spectrum=spectrum,
                              info={**ex.info, "displaced": displaced})
     return ex
+
+
+def _general_candidate(system: FirstOrderSystem, library: dict[str, Effect], e: Effect, others: tuple[str, ...],
+                       start: Candidate, fit: list[str], train, test, bounds: dict, options: Integration,
+                       bias: Sequence[str], say, clock: Clock) -> Candidate:
+    """The tooth-by-tooth form ``e`` beside the effects ``others``, fitted (regularised, from the fit ``start``) and
+    its held-out prediction, on a compiled model of its own: the declared one with ``others`` and ``e``'s slots
+    (:func:`.tooth_forms.local_effect`)."""
+    coupling = next(c for c in system.couplings if c.coordinate == e.coordinate)
+    local, slots = local_effect(e, float(coupling.order or 1), 2 * np.pi)
+    model = augment(system, [*(library[o] for o in others), local], name=f"{system.name}_{e.name}_fit")
+    seg_train, keys_train = segments_of(model, train)
+    seg_test, keys = segments_of(model, test)
+    seg_train = place_slots(seg_train, slots)
+    names = fit + [p for o in others for p in library[o].fitted]
+    scale = 1.0
+    if e.prior_unit == "displacement":  # the prior's spread: a fraction of the mesh coordinate's
+        row = system.state_names.index(e.coordinate)
+        scale = float(np.std(np.concatenate([states[row] for states in start.fit.states]))) or 1.0
+    ridge = {p: (start.fit.sigma / (e.prior * scale)) ** 2 for p in e.fitted}
+    regularised = fit_windows(model, seg_train, names + list(e.fitted), guess=start.fit.estimates, options=options,
+                              bias=bias, bounds={**bounds, **e.bounds}, starts=start.fit.starts,
+                              guess_bias=start.fit.bias, slots=slots, ridge=ridge)
+    # the teeth that stand out, refitted without the prior (which shrinks them), the others at 0: the prior picks the
+    # teeth, the data alone say how much (a regularised estimate's shrinkage and its noise on every other tooth both
+    # cost the one-period-ahead prediction more than its training fit shows)
+    chosen = [name for gear, teeth in standing_out(tooth_values(e, regularised.estimates, regularised.stderr)).items()
+              for name in _tooth_names(e, gear, teeth)]
+    result = regularised
+    if chosen:
+        result = fit_windows(model, seg_train, names + chosen, guess=regularised.estimates, options=options, bias=bias,
+                             bounds={**bounds, **e.bounds}, starts=regularised.starts, guess_bias=regularised.bias,
+                             slots=slots)
+    direct = canonical(model, {k: v for k, v in result.estimates.items() if k in model.parameters})
+    result = replace(result, estimates={**result.estimates, **direct})
+    anchors = {key[0]: (seg.tau[0], s0) for key, seg, s0 in zip(keys_train, seg_train, result.starts.T)}
+    prediction = predict_ahead(model, place_slots(seg_test, slots, result.estimates), keys, direct, options=options,
+                               bias=result.bias, anchors=anchors)
+    rejected = _rejection(result, [*(library[o] for o in others)]) or _rejection(regularised, [e])
+    effects = others + (e.name,)
+    say(f"{'+'.join(effects)}: held-out error {prediction.error:.4g}" + (f" (rejected: {rejected})" if rejected else "")
+        + f"; {clock.tick()}")
+    return Candidate(effects, result, prediction, rejected, {}, model, slots, regularised)
+
+
+def _tooth_names(e: Effect, gear: str, teeth: Sequence[int]) -> list[str]:
+    """The parameter names of ``teeth`` (1 ... Z) of ``gear`` in the tooth-by-tooth form ``e``."""
+    prefix = "kt" if e.name.startswith("tooth_stiffness") else "te"
+    return [f"{prefix}{n}_{gear}" for n in teeth]
 
 
 class Clock:
@@ -417,7 +523,7 @@ def _record_starts(keys: Sequence[tuple], segments: Sequence[Segment]) -> dict:
     return out
 
 
-def _record_label(key) -> str:
+def record_label(key) -> str:
     """A record's key (its file and id) as the report names it."""
     if isinstance(key, tuple) and len(key) == 2:
         return f"{Path(str(key[0])).name} record {key[1]}"
@@ -453,8 +559,9 @@ def _too_short(system: FirstOrderSystem, measurements: Measurements, library: di
         short = [r for r in measurements if r.samples * r.step < need * (1 - 1e-9)]
         if short:
             r = short[0]
+            gear, teeth = max(e.revolutions, key=lambda item: item[1])
             out[name] = (f"{r.label} covers {r.samples * r.step / (2 * np.pi):.4g} mesh periods (tau "
-                         f"{r.samples * r.step:.4g}), shorter than one revolution of {e.gear}: {e.teeth} mesh periods "
+                         f"{r.samples * r.step:.4g}), shorter than one revolution of {gear}: {teeth} mesh periods "
                          f"(tau {need:.4g}); record at least that long to look for {name}")
             if name in named:
                 raise GearsymError(f"cannot look for {name}: {out[name]}")

@@ -9,6 +9,10 @@ system's couplings, ``Coupling.gears``), with parameters whose value 0 switches 
                                         fraction q_<gear> of its stiffness while in mesh (0 <= q < 1); the tooth
                                         ``tooth_<gear>`` (counted from tau = 0) is not fitted but found by a scan
                                         over the gear's teeth (:mod:`.tooth_scan`)
+``spall_<gear>``                        k(tau) -> k(tau) (1 - w_<gear> s_n(phi) P_n(phi)): pitting or a spall takes the
+                                        fraction w_<gear> of the face width of tooth n's pair over the middle of its
+                                        path of contact (P_n: from 30 % to 70 % of it, around the pitch point, where
+                                        pitting starts), the tooth ``spall_tooth_<gear>`` found by the same scan
 ``eccentricity_<gear>``                 g(x - e) with e = e_c_<gear> cos(phi/Z) + e_s_<gear> sin(phi/Z): a
                                         transmission error at the gear's shaft order (eccentricity, run-out),
                                         reported as amplitude and phase
@@ -29,7 +33,7 @@ import re
 import sympy as sp
 
 from ..errors import GearsymError
-from ..model.shaft_orders import DEFAULT_EDGE, tooth_by_tooth, tooth_share, window
+from ..model.shaft_orders import DEFAULT_EDGE, path_window, tooth_by_tooth, tooth_share, window
 from ..model.stiffness import DEFAULT_CONTACT_RATIO
 from ..model.symbols import parameter_symbol
 from ..parameters import Constraint
@@ -37,11 +41,14 @@ from ..system import FirstOrderSystem
 from .effect_types import Change, Effect, Site
 
 #: the shaft-order families, by the prefix of their names
-KINDS = ("tooth_fault", "eccentricity", "spacing_errors")
+KINDS = ("tooth_fault", "spall", "eccentricity", "spacing_errors")
 #: the kinds in the default library (spacing errors have a parameter per tooth: only when named)
-DEFAULT_KINDS = ("tooth_fault", "eccentricity")
-_NAME = re.compile(r"^(?P<kind>tooth_fault|eccentricity|spacing_errors)_(?P<gear>.+)$")
+DEFAULT_KINDS = ("tooth_fault", "spall", "eccentricity")
+_NAME = re.compile(r"^(?P<kind>tooth_fault|spall|eccentricity|spacing_errors)_(?P<gear>.+)$")
 _TAKES = "a tooth fault takes stiffness away from its pair: 0 <= q < 1"
+_LOSES = "a spall takes contact width away: 0 <= w < 1"
+#: the part of a pair's path of contact a spall of the library covers (fractions of the path, 0 where it enters)
+SPALL_PATH = (0.3, 0.7)
 
 
 def _p(name: str) -> sp.Symbol:
@@ -61,6 +68,20 @@ def tooth_fault(gear: str, teeth: int, coordinate: str) -> Effect:
                   constraints={q: Constraint(f"the fraction of stiffness a fault of a tooth of {gear} takes from its "
                                              "pair", True, below=1.0),
                                n: Constraint(f"the faulty tooth of {gear} (counted from tau = 0)", whole=(1, teeth))})
+
+
+def spall(gear: str, teeth: int, coordinate: str) -> Effect:
+    w, n = f"ws_{gear}", f"spall_tooth_{gear}"
+
+    def build(s: Site) -> Change:
+        share = tooth_share(s.phase, teeth, _p(n), DEFAULT_CONTACT_RATIO, DEFAULT_EDGE)
+        part = path_window(s.phase, teeth, _p(n), DEFAULT_CONTACT_RATIO, *SPALL_PATH, DEFAULT_EDGE)
+        return Change(law=-_p(w) * share * part * s.stiffness * s.backlash / s.omega**2)
+
+    return Effect(f"spall_{gear}", f"pitting or a spall on one tooth of {gear} ({teeth} teeth): its pair loses the "
+                  f"fraction {w} of its face width over {SPALL_PATH[0]:.0%}-{SPALL_PATH[1]:.0%} of its path of contact",
+                  (w,), {n: 1.0}, build, bounds={w: (0.0, 0.95, _LOSES)}, coordinate=coordinate, gear=gear,
+                  teeth=teeth, scan=n)
 
 
 def eccentricity(gear: str, teeth: int, coordinate: str) -> Effect:
@@ -89,7 +110,7 @@ def spacing_errors(gear: str, teeth: int, coordinate: str) -> Effect:
                   {}, build, coordinate=coordinate, gear=gear, teeth=teeth)
 
 
-BUILDERS = {"tooth_fault": tooth_fault, "eccentricity": eccentricity, "spacing_errors": spacing_errors}
+BUILDERS = {"tooth_fault": tooth_fault, "spall": spall, "eccentricity": eccentricity, "spacing_errors": spacing_errors}
 
 
 def geared(system: FirstOrderSystem) -> list[tuple[str, int, str]]:
@@ -134,22 +155,24 @@ def shaft_effect(name: str, system: FirstOrderSystem | None) -> Effect | None:
 
 
 def revolution_length(e: Effect, system: FirstOrderSystem) -> float:
-    """One revolution of the effect's gear in the system's time: Z mesh periods."""
+    """One revolution of the effect's gear (of the larger of its gears) in the system's time: Z mesh periods."""
     c = next(c for c in system.couplings if c.coordinate == e.coordinate)
-    return 2 * math.pi * e.teeth / float(c.order or 1)
+    return 2 * math.pi * max(teeth for _, teeth in e.revolutions) / float(c.order or 1)
 
 
 def with_revolution(system: FirstOrderSystem, e: Effect) -> tuple[sp.Expr, int]:
-    """The period and cycles of ``system`` once ``e``'s gear revolution is added: the least common multiple of the
-    system's period and the revolution, in forcing periods."""
+    """The period and cycles of ``system`` once ``e``'s gears' revolutions are added: the least common multiple of
+    the system's period and the revolutions, in forcing periods."""
     forcing = system.period / system.cycles
     c = next(c for c in system.couplings if c.coordinate == e.coordinate)
-    revolution = 2 * sp.pi * e.teeth / (c.order or sp.S.One)
-    ratio = sp.nsimplify(revolution / forcing)
-    if not ratio.is_Rational:
-        raise GearsymError(f"{e.name}: the gear's revolution {revolution} is no rational multiple of the forcing "
-                           f"period {forcing}")
-    cycles = int(sp.ilcm(system.cycles, sp.Rational(ratio).p))
+    cycles = system.cycles
+    for _, teeth in e.revolutions:
+        revolution = 2 * sp.pi * teeth / (c.order or sp.S.One)
+        ratio = sp.nsimplify(revolution / forcing)
+        if not ratio.is_Rational:
+            raise GearsymError(f"{e.name}: the gear's revolution {revolution} is no rational multiple of the forcing "
+                               f"period {forcing}")
+        cycles = int(sp.ilcm(cycles, sp.Rational(ratio).p))
     return forcing * cycles, cycles
 
 

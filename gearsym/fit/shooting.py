@@ -48,7 +48,8 @@ def fit_windows(system: FirstOrderSystem, segments: Sequence[Segment], fit: Sequ
                 guess: Mapping[str, float] | None = None, starts: np.ndarray | None = None,
                 period: float = 2 * np.pi, max_iterations: int = 200, options: Integration = Integration(),
                 bias: Sequence[str] = (), bounds: Mapping[str, tuple] | None = None,
-                guess_bias: Mapping[str, float] | None = None) -> Fit:
+                guess_bias: Mapping[str, float] | None = None, slots: Sequence = (),
+                ridge: Mapping[str, float] | None = None) -> Fit:
     """Estimate the parameters ``fit`` (every window's start state, and the offsets of the channels named in
     ``bias``) from ``segments``.
 
@@ -58,7 +59,9 @@ def fit_windows(system: FirstOrderSystem, segments: Sequence[Segment], fit: Sequ
     ``fit`` may be empty: then only the start states (and biases) are fitted.
     ``bounds``: (low, high[, why]) per fitted parameter, beside the model's own constraints (a damping
     ratio >= 0 ...). ``options``: its steps per period set the RK4 steps between samples, its backend
-    where they run.
+    where they run. ``slots``: tooth-by-tooth forms (:class:`gearsym.fit.tooth_forms.Slots`), whose per-tooth
+    parameters ``fit`` may name. ``ridge``: per fitted parameter, a weight w: the cost gains w theta^2 (a Gaussian
+    prior of spread sigma / sqrt(w) around 0, sigma the residuals' noise), and the uncertainties are the posterior's.
     """
     if not segments:
         raise GearsymError("nothing to fit: no whole forcing period in the data")
@@ -66,23 +69,25 @@ def fit_windows(system: FirstOrderSystem, segments: Sequence[Segment], fit: Sequ
     twice = [p for i, p in enumerate(fit) if p in fit[:i]]
     if twice:
         raise GearsymError(f"{twice[0]} is named twice among the parameters to fit; name each once")
-    unknown = [p for p in fit if p not in names]
+    per_tooth = {name for sl in slots for name in sl.teeth_names}
+    unknown = [p for p in fit if p not in names and p not in per_tooth]
     if unknown:
         raise GearsymError(f"cannot fit {', '.join(unknown)}: not parameters of {system.name} ({', '.join(names)})")
-    problem = Problem(system, segments, list(fit), list(bias), period, options)
-    theta = np.array([(guess or {}).get(p, segments[0].parameters[p]) for p in fit], dtype=float)
+    problem = Problem(system, segments, list(fit), list(bias), period, options, slots)
+    theta = np.array([(guess or {}).get(p, segments[0].parameters.get(p, 0.0)) for p in fit], dtype=float)
     b0 = np.array([(guess_bias or {}).get(c, 0.0) for c in problem.bias], dtype=float)
     S = np.array(starts if starts is not None else data_starts(problem, theta), dtype=float)
     low, high, why = _bounds(system, fit, bounds or {}, problem.unknowns(S.shape[1]))
     u0 = np.clip(np.concatenate([theta, b0, S.reshape(-1, order="F")]), low, high)
-    u, J, r, iterations, converged = levenberg_marquardt(problem, u0, low, high, max_iterations)
+    weights = np.array([float((ridge or {}).get(p, 0.0)) for p in fit] + [0.0] * len(problem.bias))
+    u, J, r, iterations, converged = levenberg_marquardt(problem, u0, low, high, max_iterations, weights)
     for _ in range(POLISH_ROUNDS if problem.unmeasured else 0):
         better = carried_over(problem, u)
         if better is None:
             break
-        u, J, r, more, converged = levenberg_marquardt(problem, better, low, high, max_iterations)
+        u, J, r, more, converged = levenberg_marquardt(problem, better, low, high, max_iterations, weights)
         iterations += more
-    return _result(problem, u, J, r, iterations, converged, low, high, why)
+    return _result(problem, u, J, r, iterations, converged, low, high, why, weights)
 
 
 def _bounds(system: FirstOrderSystem, fit: Sequence[str], given: Mapping[str, tuple], count: int):
@@ -102,7 +107,7 @@ def _bounds(system: FirstOrderSystem, fit: Sequence[str], given: Mapping[str, tu
     return low, high, why
 
 
-def _result(problem: Problem, u, J, r, iterations, converged, low, high, why) -> Fit:
+def _result(problem: Problem, u, J, r, iterations, converged, low, high, why, ridge) -> Fit:
     theta, b, S = problem.split(u)
     nb = len(problem.bias)
     names = [*problem.fit, *(f"bias:{c}" for c in problem.bias)]
@@ -115,7 +120,7 @@ def _result(problem: Problem, u, J, r, iterations, converged, low, high, why) ->
     held = np.array([n in at for n in problem.fit] + [False] * nb, dtype=bool)
     dof = max(1, r.size - int((~held).sum()) - S.size)
     sigma2 = float(r @ r) / dof
-    stderr, identifiable, correlations, covariance = uncertainty(J, r, sigma2, names, held)
+    stderr, identifiable, correlations, covariance = uncertainty(J, r, sigma2, names, held, ridge)
     estimates = dict(zip(problem.fit, map(float, theta)))
     for name in at:
         stderr[name] = None

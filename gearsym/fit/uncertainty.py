@@ -16,10 +16,11 @@ TIE = 1e-6
 STRONG_CORRELATION = 0.95
 
 
-def uncertainty(J: Jacobian, r: np.ndarray, sigma2: float, names: list[str], held: np.ndarray):
+def uncertainty(J: Jacobian, r: np.ndarray, sigma2: float, names: list[str], held: np.ndarray, prior=None):
     """Standard errors (None: not identifiable), identifiability, strong correlations and the covariance of the
     parameters and offsets ``names`` (those ``held`` at a bound left out), with the start states profiled out:
-    the information matrix on them is the Schur complement U - sum_k W_k V_k^+ W_k^T."""
+    the information matrix on them is the Schur complement U - sum_k W_k V_k^+ W_k^T. ``prior``: per name, the
+    information a regularised fit's prior adds (w / sigma^2 for a ridge weight w): the posterior's."""
     free_names = [n for n, h in zip(names, held) if not h]
     p = len(free_names)
     if not J.finite or not np.isfinite(sigma2):  # a fit that went nowhere: nothing is determined
@@ -27,6 +28,8 @@ def uncertainty(J: Jacobian, r: np.ndarray, sigma2: float, names: list[str], hel
     U, W, V, _, _ = J.normal(r)
     free = ~np.asarray(held, dtype=bool)
     U, W = U[np.ix_(free, free)], W[:, free, :]
+    if prior is not None:
+        U = U + np.diag(np.asarray(prior, dtype=float)[free])
     info = U - np.einsum("kpn,knm,kqm->pq", W, np.linalg.pinv(V), W)
     norms = np.sqrt(np.maximum(np.diag(U), 0.0))
     scale = np.where(norms > 0, norms, 1.0)

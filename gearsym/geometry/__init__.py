@@ -14,8 +14,10 @@ The method, its validity and the comparison with ISO 6336: docs/geometry.md.
 from __future__ import annotations
 
 from ..errors import GearsymError
-from .crack import Crack
-from .crack import crack_stiffness_loss as _crack_stiffness_loss
+from .crack import LIMIT_LINES, ORIGINS, Crack
+from .crack_loss import CrackLoss, cracked_mesh_stiffness, loss_against_depth
+from .crack_loss import crack_loss_along_path as _crack_loss_along_path
+from .crack_loss import crack_stiffness_loss as _crack_stiffness_loss
 from .foundation import BODY_RATIO_RANGE, ROOT_ANGLE_RANGE
 from .gear import GearGeometry
 from .iso6336 import Iso6336Stiffness, iso6336_stiffness
@@ -25,7 +27,8 @@ from .meshing import mesh_stiffness as _mesh_stiffness
 from .pair import GearPair
 from .tooth_pair import TERMS, pair_compliances, pair_stiffness
 
-__all__ = ["BODY_RATIO_RANGE", "Crack", "crack_stiffness_loss", "Fourier", "GearGeometry", "GearPair", "Iso6336Stiffness", "Material",
+__all__ = ["BODY_RATIO_RANGE", "Crack", "CrackLoss", "LIMIT_LINES", "ORIGINS", "crack_loss_along_path",
+           "crack_stiffness_loss", "cracked_mesh_stiffness", "loss_against_depth", "root_crack", "Fourier", "GearGeometry", "GearPair", "Iso6336Stiffness", "Material",
            "MeshStiffness", "ROOT_ANGLE_RANGE", "STEEL", "StiffnessOptions", "TERMS", "Zone", "gear_geometry",
            "gear_pair", "iso6336_stiffness", "mesh_stiffness", "pair_compliances", "pair_stiffness"]
 
@@ -81,8 +84,25 @@ def mesh_stiffness(pair: GearPair, options: StiffnessOptions | None = None, *, l
     return _mesh_stiffness(pair, options, line_load=line_load)
 
 
-def crack_stiffness_loss(pair: GearPair, gear: int, depth, angle) -> float:
+def root_crack(depth, angle, *, origin: str = "critical_section", limit_line: str = "parallel") -> Crack:
+    """A root :class:`Crack` (:mod:`.crack`): ``depth`` in m and ``angle`` (from the tooth's centre line) in rad, or
+    pint Quantities; ``origin`` where it starts (ISO 6336-3's critical section, or Tian's base circle)."""
+    return Crack(_si(depth, "m", "crack depth"), _si(angle, "rad", "crack angle"), origin, limit_line)
+
+
+def crack_stiffness_loss(pair: GearPair, gear: int, depth, angle, *, origin: str = "critical_section",
+                         limit_line: str = "parallel") -> float:
     """The fraction of its pair's stiffness a root crack on a tooth of gear ``gear`` (1: the pair's driving gear, 2)
     takes away, averaged over the path of contact (:mod:`.crack`): ``depth`` in m and ``angle`` (from the tooth's
-    centre line) in rad, or pint Quantities. It is the depth of a :class:`gearsym.ToothFault` on that tooth."""
-    return _crack_stiffness_loss(pair, gear, _si(depth, "m", "crack depth"), _si(angle, "rad", "crack angle"))
+    centre line) in rad, or pint Quantities. It is the depth of a constant :class:`gearsym.ToothFault` on that tooth;
+    :func:`crack_loss_along_path` gives the loss along the path, which :func:`gearsym.cracked_tooth` puts in a model."""
+    return _crack_stiffness_loss(pair, gear, _si(depth, "m", "crack depth"), _si(angle, "rad", "crack angle"),
+                                 origin=origin, limit_line=limit_line)
+
+
+def crack_loss_along_path(pair: GearPair, gear: int, depth, angle, *, origin: str = "critical_section",
+                          limit_line: str = "parallel") -> CrackLoss:
+    """The :class:`CrackLoss` of a root crack on a tooth of gear ``gear`` of ``pair``: its loss of the pair's
+    stiffness along the path of contact, its mean, and the shape a model carries it with (lengths in m or
+    Quantities, as :func:`crack_stiffness_loss`)."""
+    return _crack_loss_along_path(pair, gear, root_crack(depth, angle, origin=origin, limit_line=limit_line))

@@ -47,11 +47,13 @@ class Body:
     """A rotating inertia (base class of :class:`Gear` and :class:`Disk`).
 
     ``fixed=True`` grounds it (a held ring gear or carrier): it has no angle and needs no inertia.
+    ``mass``: the body's mass, which a body on a :class:`Bearing` needs (its centre translates).
     """
 
     name: str
     inertia: Optional[ExprLike] = None
     fixed: bool = field(default=False, kw_only=True)
+    mass: Optional[ExprLike] = field(default=None, kw_only=True)
 
     @property
     def radius(self) -> Optional[ExprLike]:
@@ -70,7 +72,10 @@ class Body:
         """The physical values this body gives the model when it is added (a gear from its geometry: its
         inertia and base radius); none for a body declared with parameters."""
         geometry = getattr(self, "geometry", None)
-        return {} if geometry is None else body_values(geometry, str(self.inertia), str(self.radius))
+        if geometry is None:
+            return {}
+        mass = str(self.mass) if isinstance(self.mass, str) and self.mass.isidentifier() else None
+        return body_values(geometry, str(self.inertia), str(self.radius), mass)
 
 
 @dataclass(eq=False, frozen=True)
@@ -96,19 +101,21 @@ class Gear(Body):
 
     @classmethod
     def from_geometry(cls, name: str, geometry: Optional[GearGeometry] = None, *, inertia: Optional[str] = None,
-                      base_radius: Optional[str] = None, speed: Optional[str] = None, **dimensions) -> "Gear":
+                      base_radius: Optional[str] = None, speed: Optional[str] = None, mass: Optional[str] = None,
+                      **dimensions) -> "Gear":
         """A gear declared from its geometry: a :class:`~gearsym.geometry.GearGeometry` (SI), or its dimensions
         as quantities with units (``teeth=28, module="3.175 mm", pressure_angle="20 deg", face_width="6.35 mm"``,
         and ``profile_shift``, ``helix_angle``, ``bore_diameter``, the rack's coefficients, ``material``).
 
         Its inertia is the disk with its bore (:attr:`GearGeometry.polar_inertia`), its base radius and tooth count
         the geometry's: the parameters ``inertia`` and ``base_radius`` (default ``I_<name>``, ``r_<name>``) get them
-        as physical values when the gear is added to a drivetrain. A :meth:`Mesh.from_gears` between two such gears
-        computes its stiffness from them.
+        as physical values when the gear is added to a drivetrain, and ``mass`` (a parameter name, for a gear on a
+        :class:`Bearing`) the body's mass. A :meth:`Mesh.from_gears` between two such gears computes its stiffness
+        from them.
         """
         geometry = geometry_from(f"Gear {name!r}", geometry, dimensions)
         return cls(name, inertia=inertia or f"I_{name}", base_radius=base_radius or f"r_{name}",
-                   teeth=geometry.teeth, speed=speed, geometry=geometry)
+                   teeth=geometry.teeth, speed=speed, geometry=geometry, mass=mass)
 
     @property
     def radius(self) -> ExprLike:
@@ -126,10 +133,14 @@ class Planet(Gear):
     ``position`` (Parker & Lin 2004: ``-Z position`` in the mesh phase, with the sign of the central gear's
     rotation relative to the carrier), and a sun and a ring with teeth must let the planet be assembled
     there (``(Z_sun + Z_ring) position / 2 pi`` a whole number).
+
+    A planet on a :class:`Bearing` (its pin) translates in the carrier's frame, radially and tangentially;
+    ``orbit`` is then the radius of the circle its centre turns on (Lin & Parker's carrier radius r_c).
     """
 
     carrier: Optional[BodyRef] = field(default=None, kw_only=True)
     position: ExprLike = field(default=0, kw_only=True)
+    orbit: Optional[ExprLike] = field(default=None, kw_only=True)
 
 
 @dataclass(eq=False, frozen=True)
@@ -163,6 +174,11 @@ class Mesh:
     * ``backlash``: the clearance eta; 0 gives a linear mesh.
     * ``phase``: added to the mesh phase; a planet's position adds its own (see :class:`Planet`).
     * ``computed``: the stiffness of a mesh declared from its gears' geometry (:meth:`from_gears`).
+    * ``pressure_angle``, ``centres``: where the mesh's line of action lies, for gears that translate (on a
+      :class:`Bearing`): the pressure angle and the direction of the line of centres from gear a's centre to
+      gear b's (radians from the x axis; derived from the planet's position for a planet's mesh). The
+      deflection is then the projection of both centres' motions and both rotations on the line of action of
+      the flank that gear a's positive rotation closes (see :mod:`gearsym.model.geometry_rows`).
     """
 
     name: str
@@ -179,6 +195,8 @@ class Mesh:
     damping_group: Optional[str] = None
     stiffness_group: Optional[str] = None
     computed: Optional[ComputedStiffness] = field(default=None, kw_only=True, repr=False)
+    pressure_angle: ExprLike = field(default=0, kw_only=True)
+    centres: Optional[ExprLike] = field(default=None, kw_only=True)
 
     @property
     def ends(self) -> tuple[BodyRef, BodyRef]:
@@ -262,5 +280,37 @@ class Torque:
     load: bool = False
 
 
+@dataclass(eq=False, frozen=True)
+class Bearing:
+    """The bearing of a body's centre: translational stiffness and damping, and a torsional support.
+
+    The body ``on`` gets its centre's translations (it must declare a ``mass``): ``directions`` "xy" (both),
+    "x" or "y" (the other held rigidly), in the fixed frame, or in the carrier's frame for the members of a
+    planetary set whose planets translate (Lin & Parker: x, y of the sun, ring and carrier turn with the
+    carrier). On a :class:`Planet` it is the planet's pin on its carrier: x is radial, y tangential, and
+    the deflection is the planet's centre relative to the pin (the carrier's translation and rotation
+    carried to it). ``stiffness`` (N/m) and ``damping`` act in both directions unless ``stiffness_y`` and
+    ``damping_y`` give the y direction its own (isotropic bearings only in a rotating frame).
+    ``torsional``: the stiffness (N m/rad) of a torsional support holding the body's rotation (Lin & Parker's
+    k_u, which acts on u = r theta, is k_u r^2 here), with ``torsional_damping``; None: the body turns freely.
+    A torsional support's coordinate is the support's twist times the body's base radius (a length).
+    """
+
+    name: str
+    on: BodyRef
+    stiffness: ExprLike = "k_b"
+    damping: ExprLike = 0
+    stiffness_y: Optional[ExprLike] = None
+    damping_y: Optional[ExprLike] = None
+    directions: str = "xy"
+    torsional: Optional[ExprLike] = None
+    torsional_damping: ExprLike = 0
+    coordinates: Optional[tuple[str, ...]] = field(default=None, kw_only=True)
+
+    @property
+    def ends(self) -> tuple[BodyRef]:
+        return (self.on,)
+
+
 Coupling = Union[Mesh, Shaft]
-Component = Union[Body, Mesh, Shaft, Torque]
+Component = Union[Body, Mesh, Shaft, Torque, Bearing]

@@ -16,7 +16,7 @@ import sympy as sp
 from .declared import Model
 from ..errors import ModelError
 from ..units import Measure, measure
-from .components import Body, Coupling, Mesh, Shaft, Torque
+from .components import Bearing, Body, Coupling, Mesh, Shaft, Torque
 from .expressions import ExprLike
 from .faults import ShaftOrderTerm
 from .length_scale import check_length_scale
@@ -40,6 +40,9 @@ class Drivetrain(Model):
         self.couplings: list[Coupling] = []
         self.torques: list[Torque] = []
         self.shaft_terms: list[ShaftOrderTerm] = []  # eccentricity, tooth faults, ... (:mod:`.faults`)
+        self.bearings: list[Bearing] = []  # bodies whose centres translate (:class:`Bearing`)
+        self.joints: list = []  # meshes, shafts and bearings in the order declared (their coordinates' order)
+        self._frame_terms = True  # the rotating frame's Coriolis and centripetal terms (planets that translate)
         self._defaults: dict[str, ExprLike] = {}
         self._descriptions: dict[str, str] = {}
         self._initial: dict[str, float | Measure] = {}
@@ -56,7 +59,7 @@ class Drivetrain(Model):
     def add(self, component):
         """Add a component; returns it, so ``g1 = model.add(Gear(...))`` reads naturally."""
         self._changed()
-        names = {c.name for c in (*self.bodies, *self.couplings, *self.torques, *self.shaft_terms)}
+        names = {c.name for c in (*self.bodies, *self.couplings, *self.torques, *self.shaft_terms, *self.bearings)}
         if not getattr(component, "name", None) or not isinstance(component.name, str):
             raise ModelError("every component needs a name (a non-empty string)", repr(component))
         if component.name in names:
@@ -66,13 +69,17 @@ class Drivetrain(Model):
             self.bodies.append(component)
         elif isinstance(component, (Mesh, Shaft)):
             self.couplings.append(component)
+            self.joints.append(component)
         elif isinstance(component, Torque):
             self.torques.append(component)
         elif isinstance(component, ShaftOrderTerm):
             self.shaft_terms.append(component)
+        elif isinstance(component, Bearing):
+            self.bearings.append(component)
+            self.joints.append(component)
         else:
             raise ModelError(
-                f"cannot add a {type(component).__name__}; add Gear, Disk, Mesh, Shaft, Torque or a shaft-order term "
+                f"cannot add a {type(component).__name__}; add Gear, Disk, Mesh, Shaft, Bearing, Torque or a shaft-order term "
                 "(ToothFault, Spall, Eccentricity, SpacingErrors)",
                 getattr(component, "name", None),
             )
@@ -106,6 +113,21 @@ class Drivetrain(Model):
         for name, value in values.items():
             self._physical[name] = measure(value, f"{self.name}: set_physical {name}")
         return self
+
+    def set_frame_terms(self, included: bool) -> "Drivetrain":
+        """Whether the equations of bodies that translate in a turning carrier's frame (the planets and, with them,
+        the central members, as Lin & Parker write them) keep the frame's Coriolis and centripetal terms,
+        ``2 m Omega_c (-y', x')`` and ``-m Omega_c^2 (x, y)``, with the carrier's speed Omega_c from the
+        forcing frequency and the tooth counts (default True). ``False`` is Lin & Parker's stationary model."""
+        if not isinstance(included, bool):
+            raise ModelError(f"set_frame_terms takes True or False, got {included!r}", self.name)
+        self._changed()
+        self._frame_terms = included
+        return self
+
+    @property
+    def frame_terms(self) -> bool:
+        return self._frame_terms
 
     def set_length_scale(self, scale) -> "Drivetrain":
         """The length unit of the nondimensional model: ``"static"`` (the static deflection of the first mesh
@@ -176,8 +198,9 @@ class Drivetrain(Model):
 
         for body in self.bodies:
             out.add(rewired(new[body.name]))
-        for component in (*self.couplings, *self.torques, *self.shaft_terms):
+        for component in (*self.joints, *self.torques, *self.shaft_terms):  # (joints: meshes, shafts, bearings)
             out.add(rewired(component))
+        out._frame_terms = self._frame_terms
         out._defaults.update(self._defaults)
         out._descriptions.update(self._descriptions)
         out._physical.update(self._physical)  # (SI values already read and checked)
@@ -202,6 +225,7 @@ class Drivetrain(Model):
 
     def __repr__(self) -> str:
         faults = f", {len(self.shaft_terms)} shaft-order terms" if self.shaft_terms else ""
+        faults += f", {len(self.bearings)} bearings" if self.bearings else ""
         return (
             f"Drivetrain({self.name!r}: {len(self.bodies)} bodies, "
             f"{len(self.couplings)} couplings, {len(self.torques)} torques{faults})"

@@ -21,10 +21,11 @@ from typing import Optional
 import sympy as sp
 
 from ..errors import ModelError
+from ..geometry import GearPair, crack_loss_along_path
 from ..parameters import Constraint
 from .components import BodyRef
 from .expressions import ExprLike, to_expr
-from .shaft_orders import DEFAULT_EDGE, path_window, shaft_harmonic, tooth_by_tooth, tooth_share
+from .shaft_orders import DEFAULT_EDGE, path_coordinate, path_window, shaft_harmonic, tooth_by_tooth, tooth_share
 from .stiffness import DEFAULT_CONTACT_RATIO
 
 
@@ -65,16 +66,21 @@ class ShaftOrderTerm:
 @dataclass(eq=False, frozen=True)
 class ToothFault(ShaftOrderTerm):
     """A local fault of tooth ``tooth`` (a crack, a broken corner): the pair it forms loses the fraction
-    ``depth`` of its stiffness while it is in mesh, so the mesh stiffness is ``k(phi) (1 - depth s_n(phi))`` with
+    ``depth`` of its stiffness while it is in mesh, so the mesh stiffness is ``k(phi) (1 - depth p(w) s_n(phi))`` with
     ``s_n`` the pair's share (:func:`~.shaft_orders.tooth_share`: over ``contact_ratio`` mesh periods, each
-    edge rising over ``edge`` of them). ``depth`` is a fraction (0: healthy), a number or a parameter; for a root
-    crack of a given depth and angle, the fraction its pair loses by the gear geometry's potential-energy method
-    (:func:`gearsym.geometry.crack_stiffness_loss`)."""
+    edge rising over ``edge`` of them). ``depth`` is a fraction (0: healthy), a number or a parameter.
+
+    ``along_path``: how the loss runs along the pair's path of contact, p(w) = sum_k c_k w^k with ``along_path`` =
+    (c_0, c_1, ...) and w from -1 (the pair comes into mesh) to +1 (it leaves)
+    (:func:`~.shaft_orders.path_coordinate`); empty (the default): the same loss all along, p = 1. A root crack's
+    loss runs from a few per cent to tens of per cent along the path: :func:`cracked_tooth` declares one from the gear
+    geometry (its depth the mean loss, its ``along_path`` the shape, its contact ratio the pair's)."""
 
     tooth: int = 1
     depth: ExprLike = "q"
     contact_ratio: float = DEFAULT_CONTACT_RATIO
     edge: float = DEFAULT_EDGE
+    along_path: tuple = ()
 
     def __post_init__(self):
         _check_fraction(self.depth, "depth", f"ToothFault {self.name!r}")
@@ -85,8 +91,44 @@ class ToothFault(ShaftOrderTerm):
 
     def terms(self, phi: sp.Expr, teeth: int, where: str) -> MeshTerms:
         tooth = self._tooth(self.tooth, teeth, where)
-        return MeshTerms(loss=to_expr(self.depth, where) * tooth_share(phi, teeth, tooth, self.contact_ratio,
-                                                                       self.edge))
+        loss = to_expr(self.depth, where) * tooth_share(phi, teeth, tooth, self.contact_ratio, self.edge)
+        if self.along_path:
+            w = path_coordinate(phi, teeth, tooth, self.contact_ratio)
+            shape = sp.Add(*(_coefficient(c, where) * w**k for k, c in enumerate(self.along_path)))
+            loss = loss * shape
+        return MeshTerms(loss=loss)
+
+
+def _coefficient(value, where: str) -> sp.Expr:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or value != value or abs(value) == float("inf"):
+        raise ModelError(f"along_path holds polynomial coefficients (finite numbers), got {value!r}", where)
+    return sp.Float(f"{float(value):.12g}")
+
+
+def cracked_tooth(name: str, gear: BodyRef, pair, *, tooth: int, depth, angle, on: int | None = None,
+                  origin: str = "critical_section", limit_line: str = "parallel",
+                  mesh: Optional[str] = None) -> ToothFault:
+    """A :class:`ToothFault` for a root crack from the gear geometry: tooth ``tooth`` of ``gear`` (the model's) is
+    tooth of gear ``on`` (1 or 2; default: the one of ``pair`` with the gear's tooth count) of the geometry's
+    ``pair`` (:class:`gearsym.GearPair`), cracked ``depth`` deep at ``angle`` to its centre line (m and rad,
+    or Quantities; ``origin``, ``limit_line``: :class:`gearsym.geometry.Crack`'s). The fault's depth is the crack's
+    mean loss over the path of contact, its ``along_path`` the loss along the path over that mean, its contact ratio
+    the pair's: the model's mesh stiffness takes the cracked pair's stiffness phase by phase
+    (:class:`gearsym.geometry.CrackLoss`)."""
+    where = f"cracked_tooth {name!r}"
+    if not isinstance(pair, GearPair):
+        raise ModelError(f"needs the gear pair's geometry (gearsym.geometry.gear_pair(...)), got {type(pair).__name__}",
+                         where)
+    if on is None:
+        teeth = getattr(gear, "tooth_count", None)
+        matches = [i for i, g in ((1, pair.gear1), (2, pair.gear2)) if g.teeth == teeth]
+        if len(matches) != 1:
+            raise ModelError(f"say which gear of the pair ({pair.gear1.teeth}/{pair.gear2.teeth} teeth) the tooth is "
+                             "on: on=1 or on=2", where)
+        on = matches[0]
+    loss = crack_loss_along_path(pair, on, depth, angle, origin=origin, limit_line=limit_line)
+    return ToothFault(name, gear, tooth=tooth, depth=float(f"{loss.mean:.12g}"), along_path=loss.shape(),
+                      contact_ratio=float(f"{pair.contact_ratio:.6f}"), mesh=mesh)
 
 
 @dataclass(eq=False, frozen=True)

@@ -94,10 +94,14 @@ def geometry_from(where: str, geometry: GearGeometry | None, dimensions: dict) -
         raise ModelError(str(exc), where) from None
 
 
-def body_values(geometry: GearGeometry, inertia: str, base_radius: str) -> dict[str, Measure]:
-    """The physical values a gear from its geometry gives: its inertia (kg m^2) and base radius (mm)."""
-    return {inertia: measure(f"{geometry.polar_inertia:.{DIGITS}g} kg*m^2", inertia),
-            base_radius: measure(f"{geometry.base_radius * 1e3:.{DIGITS}g} mm", base_radius)}
+def body_values(geometry: GearGeometry, inertia: str, base_radius: str, mass: str | None = None) -> dict[str, Measure]:
+    """The physical values a gear from its geometry gives: its inertia (kg m^2) and base radius (mm), and its mass
+    (kg) when it has a mass parameter (a gear on a bearing)."""
+    out = {inertia: measure(f"{geometry.polar_inertia:.{DIGITS}g} kg*m^2", inertia),
+           base_radius: measure(f"{geometry.base_radius * 1e3:.{DIGITS}g} mm", base_radius)}
+    if mass is not None:
+        out[mass] = measure(f"{geometry.mass:.{DIGITS}g} kg", mass)
+    return out
 
 
 def check_harmonics(harmonics, where: str | None) -> None:

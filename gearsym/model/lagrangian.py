@@ -22,7 +22,8 @@ class LagrangianForms:
 
     @property
     def angles(self) -> list[sp.Expr]:
-        return [rb.angle for rb in self.bodies]
+        """Every degree of freedom as a function of t: the bodies' angles, then their centres' translations."""
+        return [rb.angle for rb in self.dofs]
 
     def deflection(self, rc: ResolvedCoupling) -> sp.Expr:
         """Mesh deflection r_a psi_a - r_b psi_b, or shaft twist psi_b - psi_a."""
@@ -60,7 +61,8 @@ class LagrangianForms:
 
     @cached_property
     def kinetic_energy(self) -> sp.Expr:
-        return sum((rb.inertia * sp.diff(rb.angle, t) ** 2 / 2 for rb in self.bodies), sp.S.Zero)
+        own = sum((rb.inertia * sp.diff(rb.angle, t) ** 2 / 2 for rb in self.dofs), sp.S.Zero)
+        return own + self.frame_energy()
 
     @cached_property
     def potential_energy(self) -> sp.Expr:
@@ -73,7 +75,7 @@ class LagrangianForms:
     @cached_property
     def generalized_forces(self) -> list[sp.Expr]:
         """Q_i from the virtual work of the external torques, delta W = sum M_j delta psi_j."""
-        q = [sp.S.Zero] * len(self.bodies)
+        q = [sp.S.Zero] * len(self.dofs)
         for f in self.forcing:
             q[f.body.index] += f.amplitude * f.time_function
         return q
@@ -81,9 +83,13 @@ class LagrangianForms:
     def lagrange_lhs(self, lagrangian: sp.Expr, dissipation: sp.Expr) -> list[sp.Expr]:
         """d/dt dL/dpsi' - dL/dpsi + dR/dpsi' for each body."""
         out = []
+        terms_l, terms_r = sp.Add.make_args(sp.expand(lagrangian, deep=False, mul=False)), sp.Add.make_args(dissipation)
         for q in self.angles:
             qd = sp.diff(q, t)
-            lhs = sp.diff(sp.diff(lagrangian, qd), t) - sp.diff(lagrangian, q) + sp.diff(dissipation, qd)
+            # (only the terms that hold q: the others differentiate to zero, and a drivetrain on bearings has many)
+            lag = sp.Add(*(e for e in terms_l if e.has(q)))
+            dis = sp.Add(*(e for e in terms_r if e.has(q)))
+            lhs = sp.diff(sp.diff(lag, qd), t) - sp.diff(lag, q) + sp.diff(dis, qd)
             out.append(sp.Add(*(sp.factor_terms(term) for term in sp.Add.make_args(lhs))))
         return out
 
@@ -92,6 +98,14 @@ class LagrangianForms:
         lagrangian = self.kinetic_energy - self.potential_energy
         lhs = self.lagrange_lhs(lagrangian, self.dissipation)
         return [sp.Eq(l, r) for l, r in zip(lhs, self.generalized_forces)]
+
+    @cached_property
+    def frame_forces(self) -> list[sp.Expr]:
+        """Generalized forces of the turning frame (Coriolis and centripetal): -(d/dt dT_f/dq' - dT_f/dq)."""
+        energy = self.frame_energy()
+        if energy == 0:
+            return [sp.S.Zero] * len(self.dofs)
+        return [-sp.expand(e) for e in self.lagrange_lhs(energy, sp.S.Zero)]
 
     def coupling_forces(self, rc: ResolvedCoupling) -> list[sp.Expr]:
         """Generalized forces of one coupling alone: -(dV_c/dpsi + dR_c/dpsi')."""

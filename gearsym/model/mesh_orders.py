@@ -34,7 +34,7 @@ class MeshOrders:
         without both tooth counts, or not one rigid-body mode (a differential's speeds are not fixed by teeth)."""
         rows = []
         for rc in self.couplings:
-            if rc.kind == "shaft":
+            if rc.kind in ("shaft", "bearing"):  # (a bearing holds its centre still in the steady rotation)
                 rows.append(list(rc.row))
                 continue
             teeth = [end.body.tooth_count for end in (rc.a, rc.b)]

@@ -16,6 +16,7 @@ import sympy as sp
 from ..errors import ModelError
 from .components import Planet
 from .expressions import to_expr
+from .linear_algebra import numeric_nullspace
 from .resolved_components import ResolvedBody, ResolvedCoupling
 
 
@@ -63,7 +64,7 @@ class PlanetaryPhasing:
         """The steady rotation of a train with one rigid-body mode, oriented so that its input (the body that
         declares the speed, else the first driven body, else the first body) turns forward; None otherwise."""
         rows = sp.Matrix([list(rc.row) for rc in self.couplings])
-        modes = rows.xreplace(self._numeric_values()).nullspace()
+        modes = numeric_nullspace(rows.xreplace(self._numeric_values()))
         if len(modes) != 1:
             return None
         u = [float(e) for e in modes[0]]
@@ -85,6 +86,41 @@ class PlanetaryPhasing:
             raise ModelError(f"{central.body.name!r} does not turn relative to the carrier in the steady motion, so "
                              "the mesh has no frequency", f"Mesh {rc.name!r}")
         return 1 if rate > 0 else -1
+
+    def carrier_speed_ratio(self) -> sp.Expr:
+        """The carrier's nominal speed (counterclockwise in the frame) over the forcing frequency, exact, from the
+        tooth counts: the steady rotation of the gears rolling with pitch radii in the ratio of their teeth, the
+        first mesh's frequency its central gear's teeth times its speed relative to the carrier, over its order."""
+        meshes = [rc for rc in self.couplings if rc.kind == "mesh"]
+        where = f"{self.model.name}: the turning frame (set_frame_terms)"
+        rows = [list(rc.row[:len(self.bodies)]) for rc in self.couplings if rc.kind == "shaft"]  # (held: supports)
+        for rc in meshes:
+            teeth = [end.body.tooth_count for end in (rc.a, rc.b)]
+            if None in teeth:
+                raise ModelError("the carrier's speed in the frame's Coriolis and centripetal terms follows from the "
+                                 f"tooth counts, and mesh {rc.name!r} has a gear without teeth=: declare them, or "
+                                 "model.set_frame_terms(False) (Lin & Parker's stationary model)", where)
+            sign = 1 if any(getattr(end.body, "internal", False) for end in (rc.a, rc.b)) else -1
+            turn_a, turn_b = (row[:len(self.bodies)] for row in rc.turning) if rc.turning[0] else (
+                self._unit_row(rc.a)[:len(self.bodies)], self._unit_row(rc.b)[:len(self.bodies)])
+            rows.append([teeth[0] * x + sign * teeth[1] * y for x, y in zip(turn_a, turn_b)])
+        modes = sp.Matrix(rows).nullspace()
+        if len(modes) != 1:
+            raise ModelError(f"the gears' kinematics leave {len(modes)} rotations free, so the carrier's speed is not "
+                             "set by the forcing frequency; model.set_frame_terms(False) leaves the frame's terms out",
+                             where)
+        u = modes[0]
+        driven = [f.body for f in self.forcing if f.amplitude.could_extract_minus_sign() is False and f.order == 0]
+        inputs = [rb for rb in self.bodies if rb.body.speed_parameter] + driven + self.bodies
+        reference = next(rb for rb in inputs if u[rb.index] != 0)
+        u = u if u[reference.index] > 0 else -u
+        first = meshes[0]
+        central = next((e for e in (first.a, first.b) if not isinstance(e.body, Planet)), first.a)
+        turning = first.turning[0] if central is first.a else first.turning[1]
+        rate = abs(sum(e * x for e, x in zip(turning[:len(self.bodies)], u))) if turning else abs(u[central.index])
+        carrier = self.frame_carrier
+        return sp.nsimplify(self._senses.get(carrier.body.name, 1) * u[carrier.index] * first.order
+                            / (central.body.tooth_count * rate))
 
     def _numeric_values(self) -> dict[sp.Symbol, sp.Expr]:
         """Numbers for the radii in the deflection rows: declared defaults and physical values, else generic

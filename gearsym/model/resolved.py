@@ -15,7 +15,7 @@ from ..checks import sign_violation
 from .declared import Model
 from ..errors import ModelError, suggest
 from .symbols import omega, parameter_symbol, phi, t
-from .components import Body, BodyRef, Coupling, Gear, Harmonic, Mesh, Planet, Torque
+from .components import Bearing, Body, BodyRef, Coupling, Gear, Harmonic, Mesh, Planet, Torque
 from .expressions import ExprLike, parameter_names, to_expr
 from .lagrangian import LagrangianForms
 from .mesh_orders import MeshOrders
@@ -23,9 +23,11 @@ from .planetary import PlanetaryPhasing
 from .resolved_faults import ShaftOrderResolution
 from .resolved_components import ResolvedBody, ResolvedCoupling, ResolvedForcing
 from .stiffness import check_periodic
+from .translations import TranslationResolution
 
 
-class ResolvedDrivetrain(MeshOrders, PlanetaryPhasing, ShaftOrderResolution, LagrangianForms):
+class ResolvedDrivetrain(MeshOrders, PlanetaryPhasing, ShaftOrderResolution, TranslationResolution,
+                         LagrangianForms):
     """The checked, symbolic view of a :class:`Drivetrain`."""
 
     def __init__(self, model: Model):  # (a Drivetrain, which resolves itself here)
@@ -40,13 +42,19 @@ class ResolvedDrivetrain(MeshOrders, PlanetaryPhasing, ShaftOrderResolution, Lag
         self.bodies = [self._resolve_body(i, b) for i, b in enumerate(moving)]
         self.fixed = [self._resolve_body(None, b) for b in model.bodies if b.fixed]
         self._by_name = {rb.body.name: rb for rb in (*self.bodies, *self.fixed)}
-        self.couplings = [self._resolve_coupling(c) for c in model.couplings]
+        self.dofs = list(self.bodies)  # the rotations, then the translations of bodies on bearings
+        self.translations = self._resolve_bearings(len(self.bodies))
+        self.dofs = self.bodies + self.translations
+        self.couplings = []
+        for c in model.joints:
+            self.couplings += self._bearing_couplings(c) if isinstance(c, Bearing) else [self._resolve_coupling(c)]
         self.forcing = [f for tq in model.torques for f in self._resolve_torque(tq)]
         self._check_connected()
         self.couplings = self._with_orders(self.couplings)
         self.couplings = [self._with_planet_phase(rc) for rc in self.couplings]
         self._check_assembly()
         self.couplings = self._with_shaft_terms(self.couplings)
+        self.couplings = self._with_geometry_symbols(self.couplings)
 
     # ---- helpers
     def _default_value(self, expr: sp.Expr) -> Optional[float]:
@@ -103,8 +111,8 @@ class ResolvedDrivetrain(MeshOrders, PlanetaryPhasing, ShaftOrderResolution, Lag
         return ResolvedBody(body, index, angle, inertia, radius)
 
     def _unit_row(self, rb: ResolvedBody) -> list[sp.Expr]:
-        """The row of psi that is this body's angle (zeros for a fixed body)."""
-        row = [sp.S.Zero] * len(self.bodies)
+        """The row over the degrees of freedom that is this body's angle (zeros for a fixed body)."""
+        row = [sp.S.Zero] * len(self.dofs)
         if rb.index is not None:
             row[rb.index] = sp.S.One
         return row
@@ -138,7 +146,7 @@ class ResolvedDrivetrain(MeshOrders, PlanetaryPhasing, ShaftOrderResolution, Lag
             row = [e + sign * c for e, c in zip(row, self._unit_row(carrier))]
         return row
 
-    def _mesh_rows(self, a: ResolvedBody, b: ResolvedBody, where: str):
+    def _mesh_rows(self, mesh: Mesh, a: ResolvedBody, b: ResolvedBody, where: str):
         """The deflection row ``r_a phi_a -+ r_b phi_b`` (minus for an external, plus for an internal mesh) in
         the angles phi relative to the carrier, the carrier, and the two relative-angle rows."""
         for end in (a, b):
@@ -148,7 +156,7 @@ class ResolvedDrivetrain(MeshOrders, PlanetaryPhasing, ShaftOrderResolution, Lag
                     "a mesh needs two Gear bodies",
                     where,
                 )
-        if a.fixed and b.fixed:
+        if a.fixed and b.fixed and not (self.translates(a) or self.translates(b)):
             raise ModelError(f"joins two fixed bodies ({a.body.name!r}, {b.body.name!r}); it could never deflect", where)
         internal = [end.body.name for end in (a, b) if getattr(end.body, "internal", False)]
         if len(internal) == 2:
@@ -156,7 +164,12 @@ class ResolvedDrivetrain(MeshOrders, PlanetaryPhasing, ShaftOrderResolution, Lag
         carrier = self._carrier_of(a, b, where)
         turn_a, turn_b = self._turning(a, carrier), self._turning(b, carrier)
         sign = 1 if internal else -1
-        row = tuple(a.radius * x + sign * b.radius * y for x, y in zip(turn_a, turn_b))
+        # a planet on its pin: its centre's motion (the carrier's rotation too) is in the projection, so the
+        # rotations are the gears' own
+        own = carrier is not None and any(isinstance(e.body, Planet) and self.translates(e) for e in (a, b))
+        rot_a, rot_b = (self._unit_row(a), self._unit_row(b)) if own else (turn_a, turn_b)
+        projection = self._projection(mesh, a, b, carrier, where)
+        row = tuple(a.radius * x + sign * b.radius * y + p for x, y, p in zip(rot_a, rot_b, projection))
         return row, carrier, (tuple(turn_a), tuple(turn_b))
 
     def _resolve_coupling(self, c: Coupling) -> ResolvedCoupling:
@@ -166,7 +179,7 @@ class ResolvedDrivetrain(MeshOrders, PlanetaryPhasing, ShaftOrderResolution, Lag
         if a is b:
             raise ModelError(f"joins body {a.body.name!r} to itself; a {kind} must join two different bodies", where)
         if isinstance(c, Mesh):
-            row, carrier, turning = self._mesh_rows(a, b, where)
+            row, carrier, turning = self._mesh_rows(c, a, b, where)
             order = None if c.order is None else to_expr(c.order, where)  # None: from the teeth (mesh_orders.py)
             if order is not None and not (order.is_number and order.is_positive and order.is_rational):
                 raise ModelError(f"the mesh order must be a positive rational number (e.g. order=sp.Rational(19, 61)), "
@@ -231,7 +244,7 @@ class ResolvedDrivetrain(MeshOrders, PlanetaryPhasing, ShaftOrderResolution, Lag
     def _check_connected(self) -> None:
         """Every body must be loaded by some coupling (a carrier is, through its planets' meshes)."""
         used = {i for rc in self.couplings for i, e in enumerate(rc.row) if e != 0}
-        ends = {end.body.name for rc in self.couplings for end in (rc.a, rc.b)}
+        ends = {end.body.name for rc in self.couplings if rc.kind != "bearing" for end in (rc.a, rc.b)}
         for rb in (*self.bodies, *self.fixed):
             if (rb.index not in used) if rb.index is not None else (rb.body.name not in ends):
                 raise ModelError(

@@ -12,23 +12,32 @@ from .components import Body, Coupling, Torque
 
 @dataclass(frozen=True)
 class ResolvedBody:
+    """One degree of freedom of a body: its rotation (``motion`` "rotation": the paper's psi_i), or a translation
+    of its centre on its bearing ("x", "y"; a planet's "radial", "tangential" in the carrier's frame)."""
+
     body: Body
-    index: Optional[int]  # 0-based position among the moving bodies (the paper's psi_{index+1}); None if fixed
-    angle: sp.Expr  # psi_i(t); 0 for a fixed body
-    inertia: Optional[sp.Expr]  # None for a fixed body
+    index: Optional[int]  # 0-based position among the degrees of freedom (rotations first); None if fixed
+    angle: sp.Expr  # the coordinate as a function of t: psi_i(t), X_body(t) ...; 0 for a fixed body
+    inertia: Optional[sp.Expr]  # moment of inertia (a mass for a translation); None for a fixed body
     radius: Optional[sp.Expr]
+    motion: str = "rotation"  # "rotation" | "x" | "y" | "radial" | "tangential"
 
     @property
     def fixed(self) -> bool:
         return self.index is None
+
+    @property
+    def label(self) -> str:
+        """The body's name, with the direction for a translation (``sun.x``, ``planet1.radial``)."""
+        return self.body.name if self.motion == "rotation" else f"{self.body.name}.{self.motion}"
 
 
 @dataclass(frozen=True)
 class ResolvedCoupling:
     """A mesh or shaft with its expressions parsed and its kinematics set up."""
 
-    component: Coupling
-    kind: str  # "mesh" | "shaft"
+    component: Coupling  # (a Bearing for "bearing" couplings and torsional supports)
+    kind: str  # "mesh" | "shaft" | "bearing" (a torsional support is a "shaft" to the ground)
     a: ResolvedBody
     b: ResolvedBody
     row: tuple[sp.Expr, ...]  # J: deflection = sum(row[i] * psi_i)
@@ -47,10 +56,12 @@ class ResolvedCoupling:
     loss: sp.Expr = sp.S.Zero
     error: sp.Expr = sp.S.Zero
     revolutions: tuple[int, ...] = ()
+    label: Optional[str] = None  # a bearing's direction: its own name ("b1_x"), not the component's
+    coordinate_name: Optional[str] = None  # the default name of its coordinate, where the component gives none
 
     @property
     def name(self) -> str:
-        return self.component.name
+        return self.label or self.component.name
 
     @property
     def shaft_frequencies(self) -> tuple[sp.Expr, ...]:

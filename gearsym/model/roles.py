@@ -32,9 +32,13 @@ def parameter_roles(rd: ResolvedDrivetrain) -> dict[str, str]:
             put(rb.inertia, f"moment of inertia of {rb.body.name!r}")
         if rb.radius is not None:
             put(rb.radius, f"base radius of {rb.body.name!r}" + (" (held)" if rb.body.fixed else ""))
+    for rb in rd.translations:  # (a body on bearings: its centre's mass)
+        put(rb.inertia, f"mass of {rb.body.name!r}")
     for rc in rd.couplings:
-        put(rc.stiffness, f"{'mean mesh' if rc.kind == 'mesh' else 'torsional'} stiffness of {rc.kind} {rc.name!r}")
-        put(rc.damping, f"damping of {rc.kind} {rc.name!r}")
+        kind = {"mesh": "mean mesh", "bearing": "translational"}.get(rc.kind, "torsional")
+        name = rc.component.name if rc.kind == "bearing" else rc.name  # (a bearing's x and y share its name)
+        put(rc.stiffness, f"{kind} stiffness of {rc.kind} {name!r}")
+        put(rc.damping, f"damping of {rc.kind} {name!r}")
         if rc.kind == "mesh":
             put(rc.backlash, f"backlash (clearance) of mesh {rc.name!r}")
             amplitude = default_wave_amplitude(rc.variation)

@@ -93,6 +93,17 @@ def tooth_share(phi: sp.Expr, teeth, tooth, contact_ratio, edge=DEFAULT_EDGE) ->
     return whole[1] / 2 + whole[1] * (1 - whole[0]) * (1 - whole[2]) / 2
 
 
+def path_coordinate(phi: sp.Expr, teeth, tooth, contact_ratio) -> sp.Expr:
+    """w = sin(a) / sin(h): -1 where the pair of ``tooth`` comes into mesh, +1 where it leaves, a the gear's angle from
+    the middle of its time in mesh and h half that time's angle (pi e / Z); along its path of contact, a smooth
+    coordinate of the contact's position that repeats once per revolution (a loss along the path is a polynomial in
+    it: :class:`~gearsym.model.faults.ToothFault`'s ``along_path``)."""
+    e = sp.nsimplify(contact_ratio)
+    Z = sp.Integer(teeth)
+    half = sp.pi * e / Z
+    return sp.sin((phi - 2 * sp.pi * (tooth - sp.Rational(1, 2))) / Z) / sp.sin(half)
+
+
 def path_window(phi: sp.Expr, teeth, tooth, contact_ratio, start, end, edge=DEFAULT_EDGE) -> sp.Expr:
     """About 1 while the pair of tooth ``tooth`` is between the fractions ``start`` and ``end`` of its path of
     contact (0: where it comes into mesh, 1: where it leaves)."""

@@ -75,6 +75,7 @@ class PhysicalPoint:
     shaft_torque: dict = field(default_factory=dict)  # shaft -> {"mean", "min", "max", "dynamic"} in N·m
     #: per exponent: "" (resolved) or what is known of one the run did not resolve (never its value)
     unresolved: tuple[str, ...] = ()
+    bearing_force: dict = field(default_factory=dict)  # bearing direction -> {"mean", ...} in N
 
     def exponent_texts(self) -> list[str]:
         """Each exponent as text: its value, or what is known of it where the run did not resolve it."""
@@ -98,6 +99,8 @@ class PhysicalPoint:
             out["mesh_force"] = {m: {k: q(v) for k, v in f.items()} for m, f in self.mesh_force.items()}
         if self.shaft_torque:
             out["shaft_torque"] = {m: {k: q(v) for k, v in f.items()} for m, f in self.shaft_torque.items()}
+        if self.bearing_force:
+            out["bearing_force"] = {m: {k: q(v) for k, v in f.items()} for m, f in self.bearing_force.items()}
         return out
 
     def lines(self) -> list[str]:
@@ -107,7 +110,8 @@ class PhysicalPoint:
                f"omega_n = {shown(self.natural_frequency)} (omega = {self.omega:.6g})",
                "Lyapunov exponents per second: " + ", ".join(self.exponent_texts())]
         out += [f"amplitude A_{k} = {shown(v)}" for k, v in self.amplitude.items()]
-        for what, table in (("mesh force", self.mesh_force), ("shaft torque", self.shaft_torque)):
+        for what, table in (("mesh force", self.mesh_force), ("shaft torque", self.shaft_torque),
+                            ("bearing force", self.bearing_force)):
             for name, f in table.items():
                 out.append(f"{what} {name}: mean {shown(f['mean'])}, {shown(f['min'])} to {shown(f['max'])} "
                            f"(dynamic amplitude {shown(f['dynamic'])})")
@@ -170,13 +174,15 @@ class MeshUnits:
 
 @dataclass(frozen=True)
 class ShaftUnits:
-    """A shaft's law in SI: torque = stiffness twist + damping d(twist)/dt."""
+    """A shaft's law in SI: torque = stiffness twist + damping d(twist)/dt; a bearing's (``kind`` "bearing"): its
+    force = stiffness deflection + damping d(deflection)/dt (N/m and N s/m, a deflection in m)."""
 
     name: str
     coordinate: str
     velocity: str
-    stiffness: float  # N m/rad
-    damping: float  # N m s/rad
+    stiffness: float  # N m/rad (a bearing's N/m)
+    damping: float  # N m s/rad (a bearing's N s/m)
+    kind: str = "shaft"
 
     def torque(self, twist, rate) -> np.ndarray:
         """The torque in N·m along a trajectory (twist in rad, its rate in rad/s)."""
@@ -290,8 +296,13 @@ class PointUnits:
             {k: self.state(k, v, w) for k, v in result.final_state.items()},
             Measured(self.length_shown, self.length_text),
             {m: self._summary(time, f, period, self.newton) for m, f in forces.items()},
-            {s: self._summary(time, f, period, self.newton_metre) for s, f in torques.items()},
-            self._unresolved(result, per_second))
+            {s: self._summary(time, f, period, self.newton_metre) for s, f in torques.items() if s in self._shafts},
+            self._unresolved(result, per_second),
+            {s: self._summary(time, f, period, self.newton) for s, f in torques.items() if s not in self._shafts})
+
+    @property
+    def _shafts(self) -> set[str]:
+        return {s.name for s in self.shafts if s.kind == "shaft"}
 
     def _unresolved(self, result, per_second: float) -> tuple[str, ...]:
         known = getattr(result, "resolution", None)

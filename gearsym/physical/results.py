@@ -33,10 +33,11 @@ def rate(scaling: Scaling, omega: float) -> float:
 
 
 def kinds(scaling: Scaling) -> dict[str, str]:
-    """state name -> what it is: a mesh's deflection (LENGTH), a shaft's twist (ANGLE), or their rates."""
+    """state name -> what it is: a mesh's or a bearing's deflection (LENGTH), a shaft's twist (ANGLE), or their
+    rates."""
     out = {}
     for c in scaling.model.coordinates:
-        shaft = c.coupling.kind != "mesh"
+        shaft = c.coupling.kind == "shaft"
         out[c.name], out[c.velocity_name] = (ANGLE, ANGULAR_VELOCITY) if shaft else (LENGTH, VELOCITY)
     return out
 
@@ -47,7 +48,7 @@ def _per_unit(scaling: Scaling) -> dict[str, float]:
     out = {}
     for c in scaling.model.coordinates:
         rc = c.coupling
-        radius = 1.0 if rc.kind == "mesh" else evaluate(rc.scale, scaling.inputs,
+        radius = 1.0 if rc.kind != "shaft" else evaluate(rc.scale, scaling.inputs,
                                                         f"{scaling.name}: shaft {rc.name!r} coordinate radius").si
         out[c.name] = out[c.velocity_name] = scaling.length_si / radius
     return out
@@ -147,9 +148,9 @@ def _shaft_units(scaling: Scaling):
         rc = c.coupling
         if rc.kind == "mesh":
             continue
-        where = f"{scaling.name}: shaft {rc.name!r}"
+        where = f"{scaling.name}: {rc.kind} {rc.name!r}"
         yield ShaftUnits(rc.name, c.name, c.velocity_name, evaluate(rc.stiffness, si, where).si,
-                         evaluate(rc.damping, si, where).si)
+                         evaluate(rc.damping, si, where).si, rc.kind)
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..errors import ModelError
+from ..model.linear_algebra import is_zero, nullspace, numeric_rank, pivot_columns, solve_rows
 from ..model.resolved import ResolvedDrivetrain
 from ..model.resolved_components import ResolvedCoupling
 from ..model.symbols import t
@@ -69,7 +70,7 @@ class Coordinate:
 
 def generic_rank(m: sp.Matrix, seed: int = 7) -> int:
     """Rank at random positive values of the symbols (the rank for almost all parameter values)."""
-    return m.xreplace(generic_values(m, seed)).rank()
+    return numeric_rank(m, seed)
 
 
 def deflection_matrix(rd: ResolvedDrivetrain) -> sp.Matrix:
@@ -78,12 +79,7 @@ def deflection_matrix(rd: ResolvedDrivetrain) -> sp.Matrix:
 
 def rigid_body_modes(rd: ResolvedDrivetrain) -> list[sp.Matrix]:
     """Basis of the motions that load no coupling (one per separately rotating sub-train)."""
-    modes = []
-    for v in deflection_matrix(rd).nullspace(simplify=True):
-        denominators = [sp.fraction(sp.together(e))[1] for e in v]
-        scale = sp.lcm_list(denominators) if denominators else 1
-        modes.append(sp.simplify(v * scale))
-    return modes
+    return nullspace(deflection_matrix(rd), f"{rd.model.name}: the rigid-body modes")
 
 
 def relative_coordinates(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.Matrix]:
@@ -96,7 +92,7 @@ def coupling_deflections(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.M
     """The relative coordinates, the transform T and every coupling's deflection (the coordinates themselves and
     the combinations of those that close a loop), in declaration order."""
     jac = deflection_matrix(rd)
-    n_bodies, n_couplings = len(rd.bodies), len(rd.couplings)
+    n_bodies, n_couplings = len(rd.dofs), len(rd.couplings)
     kept: list[int] = []
     for i in range(n_couplings):  # a spanning tree of the couplings, in declaration order
         if generic_rank(jac.extract(kept + [i], list(range(n_bodies)))) > len(kept):
@@ -104,7 +100,8 @@ def coupling_deflections(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.M
     single = n_couplings == 1
     names, seen = [], {}
     for i, rc in enumerate(rd.couplings):
-        name = rc.component.coordinate or ("x" if single else f"x{i + 1}")
+        name = rc.coordinate_name if rc.kind == "bearing" or rc.coordinate_name else None
+        name = name or rc.component.coordinate or ("x" if single else f"x{i + 1}")
         if not name.isidentifier() or name in ("t", "tau", "phi"):
             raise ModelError(f"coordinate name {name!r} is not a usable identifier", rc.name)
         if name in seen:
@@ -121,7 +118,7 @@ def coupling_deflections(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.M
         if i in kept:
             deflections.append(coords[kept.index(i)])
             continue
-        solve = solve or _combination_solver(transform)
+        solve = solve or combination_solver(transform)
         coefficients = solve(sp.Matrix([scaled[i]]))
         combination = tuple((c, a) for c, a in zip(coords, coefficients) if a != 0)
         deflections.append(Coordinate(names[i], rc, _definition(rd, i), combination))
@@ -133,18 +130,17 @@ def _definition(rd: ResolvedDrivetrain, i: int) -> sp.Expr:
     return sp.Add(*(rc.scale * c * a for c, a in zip(rc.row, rd.angles)))
 
 
-def _combination_solver(transform: sp.Matrix):
+def combination_solver(transform: sp.Matrix):
     """A function giving the coefficients J with ``row = J T`` exactly, for a row in the span of T: solved on
     columns where T is invertible (found at generic values), then checked on every column."""
     k = transform.rows
-    numeric = transform.xreplace(generic_values(transform))
-    _, pivots = numeric.rref()
-    inverse = transform.extract(list(range(k)), list(pivots)).inv(method="LU").applyfunc(sp.cancel)
+    pivots = pivot_columns(transform)
+    square = transform.extract(list(range(k)), list(pivots))
 
     def solve(row: sp.Matrix) -> list[sp.Expr]:
-        coefficients = (row.extract([0], list(pivots)) * inverse).applyfunc(sp.factor)
-        residual = (coefficients * transform - row).applyfunc(sp.cancel)
-        if residual != sp.zeros(1, transform.cols):
+        coefficients = solve_rows(square, row.extract([0], list(pivots))).applyfunc(sp.factor)
+        residual = coefficients * transform - row
+        if not all(is_zero(e) for e in residual):
             raise ModelError(f"the deflection {list(row)} is not a combination of the coordinates' (a bug)", "reduction")
         return list(coefficients)
 
@@ -152,14 +148,23 @@ def _combination_solver(transform: sp.Matrix):
 
 
 def generic_values(m: sp.Matrix, seed: int = 7) -> dict:
+    """Random positive rationals for the symbols of ``m``; a symbol inside a sine or cosine (a pressure angle)
+    gets a rational cosine and sine of one angle (from a Pythagorean triple), so that the values stay rational
+    and cos^2 + sin^2 = 1 still holds."""
     rng = random.Random(seed)
-    return {s: sp.Rational(rng.randint(11, 97), rng.randint(11, 97)) for s in sorted(m.free_symbols, key=str)}
+    out = {s: sp.Rational(rng.randint(11, 97), rng.randint(11, 97)) for s in sorted(m.free_symbols, key=str)}
+    angles = sorted({f.args[0] for f in m.atoms(sp.sin, sp.cos) if isinstance(f.args[0], sp.Symbol)}, key=str)
+    for angle in angles:
+        k = sp.Integer(rng.randint(2, 9))
+        out[sp.cos(angle)] = (k**2 - 1) / (k**2 + 1)
+        out[sp.sin(angle)] = 2 * k / (k**2 + 1)
+    return out
 
 
 def angle_symbols(rd: ResolvedDrivetrain) -> tuple[list[sp.Symbol], list[sp.Symbol]]:
     """Plain symbols standing for psi_i(t) and psi_i'(t) during the algebra."""
-    p = [sp.Symbol(f"_p{i}", real=True) for i in range(len(rd.bodies))]
-    pd = [sp.Symbol(f"_pd{i}", real=True) for i in range(len(rd.bodies))]
+    p = [sp.Symbol(f"_p{i}", real=True) for i in range(len(rd.dofs))]
+    pd = [sp.Symbol(f"_pd{i}", real=True) for i in range(len(rd.dofs))]
     return p, pd
 
 

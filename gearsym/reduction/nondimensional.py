@@ -20,8 +20,9 @@ Groups are numbered shafts first, then meshes, as in the paper's Eq. 10.
 from __future__ import annotations
 
 import functools
+import zlib
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Optional
 
@@ -35,10 +36,12 @@ from ..model.resolved_components import ResolvedCoupling
 from ..model.roles import parameter_roles
 from ..model.expressions import ExprLike, parameter_names, to_expr
 from ..model.stiffness import check_periodic
+from ..model.linear_algebra import numeric_rank, simplified
+from ..model.translations import CARRIER_SPEED
 from ..model.symbols import omega, parameter_symbol, phi, t, tau
 from ..system import Constraint, Coupling, FirstOrderSystem, Gearing
-from .coordinates import generic_values
-from .reduction import Reduction, reduce_drivetrain
+from .coordinates import combination_solver
+from .reduction import Reduction, reduce_drivetrain, sub_frame, with_geometry
 
 
 @dataclass(frozen=True)
@@ -249,6 +252,9 @@ class NondimensionalModel:
             for value, what in ((rb.inertia, "an inertia"), (rb.radius, "a radius")):
                 if isinstance(value, sp.Symbol):
                     out[value.name] = Constraint(what, False)
+        for rb in rd.translations:
+            if isinstance(rb.inertia, sp.Symbol):
+                out[rb.inertia.name] = Constraint("a mass", False)
         for rc in rd.couplings:
             for value, what in ((rc.backlash, "a backlash"), (rc.damping, "a damping"), (rc.stiffness, "a stiffness")):
                 if isinstance(value, sp.Symbol):
@@ -339,7 +345,37 @@ class NondimensionalModel:
         return FirstOrderSystem(self.name, tau, self.states, rhs, params, self.period, descriptions,
                                 self.drivetrain.title, tuple(c.name for c in self.coordinates),
                                 self._initial(initial), self._system_couplings(functions), constraints,
-                                cycles=self.cycles)
+                                cycles=self.cycles, translations=self.translations)
+
+    @cached_property
+    def translations(self) -> dict[str, sp.Expr]:
+        """Each translation of a body centre on a bearing in the states (``pinion_y`` -> y_pinion), where the
+        coordinates determine it (a planet's tangential translation moves with the rigid-body rotation: none)."""
+        red = self.reduction
+        rd = red.resolved
+        out = {}
+        if not rd.translations:
+            return out
+        by_row = {}
+        for c in red.coordinates:
+            row = [e for e in red.transform.row(red.coordinates.index(c))]
+            nonzero = [i for i, e in enumerate(row) if e != 0]
+            if len(nonzero) == 1 and row[nonzero[0]] == 1:
+                by_row[nonzero[0]] = sp.Symbol(c.name, real=True)
+        solve = None
+        for d in rd.translations:
+            name = d.label.replace(".", "_")
+            if d.index in by_row:
+                out[name] = by_row[d.index]
+                continue
+            target = sp.zeros(1, red.transform.cols)
+            target[d.index] = 1
+            if numeric_rank(sp.Matrix.vstack(red.transform, target)) > red.transform.rows:
+                continue  # (not determined by the coordinates)
+            solve = solve or combination_solver(red.transform)
+            weights = solve(target)
+            out[name] = sp.Add(*(w * sp.Symbol(c.name, real=True) for w, c in zip(weights, red.coordinates)))
+        return out
 
     def _initial(self, initial: Optional[Mapping[str, float]]) -> dict[str, float]:
         """The initial state in the engine's units: ``initial``, or the declared numbers (a physical value needs
@@ -410,16 +446,38 @@ def gears_of(rc: ResolvedCoupling) -> tuple[Gearing, ...]:
 
 
 # ============================================================================ construction
+#: the geometry's symbols of the drivetrain being assembled (symbol -> what it stands for), for _equal
+_GEOMETRY: dict = {}
+
+
+def _generic_number(name: str) -> sp.Rational:
+    """A fixed generic value for the parameter ``name`` (the same in every process)."""
+    code = zlib.crc32(name.encode())
+    return sp.Rational(11 + code % 89, 11 + (code // 89) % 83)
+
+
+def fingerprint(expr: sp.Expr) -> sp.Float:
+    """``expr`` at generic values of its parameters, with the geometry's numbers: two definitions that differ
+    differ here (for almost all values)."""
+    expr = expr.xreplace(_GEOMETRY) if _GEOMETRY else expr
+    values = {s: _generic_number(s.name) for s in expr.free_symbols}
+    return sp.N(expr.xreplace(values), 30)
+
+
 def _equal(a: sp.Expr, b: sp.Expr) -> bool:
     """Whether two group definitions (rational functions of the parameters) are the same: different at generic
-    values is enough to tell them apart, and equal ones are confirmed exactly."""
+    values is enough to tell them apart, and equal ones are confirmed exactly (with the geometry's numbers, whose
+    relations may make two different-looking definitions equal)."""
     difference = a - b
-    values = generic_values(difference)
     try:
-        if difference.xreplace(values) != 0:
-            return False
+        number = fingerprint(difference)
     except ZeroDivisionError:
-        pass
+        number = None
+    if number is not None and number.is_number and abs(number) > sp.Float(10) ** -20 * (
+            1 + abs(fingerprint(a))):
+        return False
+    if _GEOMETRY and difference.free_symbols & set(_GEOMETRY):
+        return simplified(difference.xreplace(_GEOMETRY)) == 0
     return sp.cancel(difference) == 0
 
 
@@ -441,6 +499,7 @@ class _Assembly:
         self.rhs = [sp.S.Zero] * n  # forcing numerators (over omega^2)
         self.coupling_rows: dict[str, list[tuple[int, sp.Expr]]] = {}  # coupling -> (row, factor of its law)
         self._betas: dict[sp.Expr, sp.Expr] = {}
+        self._beta_keys: dict = {}  # generic value (15 digits) -> [(definition, group symbol)]
         self._forcing: list[tuple[tuple, Group]] = []  # ((order, phase), group) of the forcing groups named
 
     def add_group(self, gr: Group) -> Group:
@@ -460,12 +519,15 @@ class _Assembly:
         """The group standing for ``definition`` (one per distinct value), or the number itself."""
         if definition.is_number:
             return definition
-        for known, sym in self._betas.items():
+        key = fingerprint(definition)
+        key = sp.Float(key, 15) if key.is_number else definition  # (candidates: the same value at generic values)
+        for known, sym in self._beta_keys.get(key, ()):
             if _equal(known, definition):
                 return sym
         gr = Group(f"beta_{len(self._betas) + 1}", definition, "derived", description, "coupling")
         self.groups.append(gr)
         self._betas[definition] = gr.symbol
+        self._beta_keys.setdefault(key, []).append((definition, gr.symbol))
         return gr.symbol
 
     def own_factor(self, rc: ResolvedCoupling) -> sp.Expr:
@@ -476,15 +538,15 @@ class _Assembly:
         if own.independent:
             row = red.coordinates.index(own)
             return next(ct.factor for ct in red.row_terms(row) if ct.coupling is rc)
-        inertias = [rb.inertia for rb in red.resolved.bodies]
+        inertias = [rb.inertia for rb in red.resolved.dofs]
         return sp.factor(sp.Add(*(e**2 / i for e, i in zip(rc.row, inertias))))
 
     def add_shaft(self, rc: ResolvedCoupling) -> None:
-        """beta * (kS x + cS x') in every row the shaft reaches."""
+        """beta * (kS x + cS x') in every row the shaft (or bearing: a linear spring too) reaches."""
         red = self.red
         x = red.deflection_of(rc).contact(tau)
         for ct in (ct for ct in red.coupling_terms if ct.coupling is rc):
-            b = self.beta(sp.expand(ct.factor), f"coupling of shaft {rc.name!r} into {red.coordinates[ct.row].name}")
+            b = self.beta(sp.expand(ct.factor), f"coupling of {rc.kind} {rc.name!r} into {red.coordinates[ct.row].name}")
             self.lhs[ct.row] += b * rc.stiffness * x / omega**2 + b * rc.damping * sp.diff(x, tau) / omega
             self.coupling_rows.setdefault(rc.name, []).append((ct.row, b))
 
@@ -540,6 +602,19 @@ class _Assembly:
                 self.lhs[ct.row] += sp.expand(b * law)
                 self.coupling_rows.setdefault(rc.name, []).append((ct.row, b))
 
+    def add_frame(self, ratio: sp.Expr) -> None:
+        """The turning frame's forces of each row in tau: with Omega_c = ratio * omega (the carrier's speed over
+        the forcing frequency, from the tooth counts), ``2 Omega_c x'`` becomes ``2 ratio x'(tau)`` and
+        ``Omega_c^2 x`` becomes ``ratio^2 x``: the frame's terms do not depend on omega in tau."""
+        red = self.red
+        speed = sp.Symbol(CARRIER_SPEED, real=True)
+        # every term is Omega_c x' or Omega_c^2 x: omega^2 in tau, which the division by omega^2 takes out; so
+        # omega is left out of the substitution instead (the rows stay unexpanded: see _frame_rows)
+        rates = {sp.Derivative(c.of(t), t): sp.diff(c.of(tau), tau) for c in red.coordinates}
+        values = {c.of(t): c.of(tau) for c in red.coordinates}
+        for row, force in enumerate(red.frame_rows):
+            self.lhs[row] -= force.xreplace(rates).xreplace(values).xreplace({speed: ratio})
+
     def add_forcing(self, row: int) -> None:
         """The forcing of one row, grouped by harmonic into B0, B1, D, ...; an unforced shaft's constant
         forcing becomes the torque-balance condition (Eq. 10)."""
@@ -553,7 +628,7 @@ class _Assembly:
             definition = sp.expand(sp.Add(*(ft.coefficient for ft in terms)))
             if definition == 0:
                 continue
-            if order == 0 and cx.kind == "shaft" and not cx.coupling.component.forced:
+            if order == 0 and cx.kind == "shaft" and not getattr(cx.coupling.component, "forced", True):
                 self.conditions.append(Condition(
                     sp.Eq(0, definition),
                     f"torque balance: no constant torque may load the twist {cx.name} of shaft "
@@ -600,20 +675,54 @@ class _Assembly:
 
 
 def nondimensionalize(red: Reduction) -> NondimensionalModel:
-    """Name the coefficient groups of ``red`` and write its equations in tau."""
+    """Name the coefficient groups of ``red`` and write its equations in tau (the geometry's symbols of gears on
+    bearings put back at the end: :func:`with_geometry`)."""
+    global _GEOMETRY
+    _GEOMETRY = dict(red.resolved.geometry)
+    try:
+        return _nondimensionalize(red)
+    finally:
+        _GEOMETRY = {}
+
+
+def _nondimensionalize(red: Reduction) -> NondimensionalModel:
     build = _Assembly(red)
     meshes = [rc for rc in red.resolved.couplings if rc.kind == "mesh"]
     for rc in red.resolved.couplings:
-        if rc.kind == "shaft":
+        if rc.kind != "mesh":
             build.add_shaft(rc)
     laws = {rc.name: build.mesh_law(rc, meshes[0]) for rc in meshes}
+    taken = set()
+    for rc in red.resolved.couplings:
+        taken |= parameter_names(rc.stiffness) | parameter_names(rc.damping) | parameter_names(rc.backlash)
+    for rb in red.resolved.dofs:
+        taken |= parameter_names(rb.inertia)
+    for f in build.functions:
+        if f.name in taken:
+            raise ModelError(f"the stiffness function of mesh {f.mesh!r} would be named {f.name!r}, which is a "
+                             "parameter of the model too; name it otherwise: Mesh(..., function='k_...')",
+                             red.drivetrain.name)
     for rc in meshes:
         build.add_mesh_rows(rc, laws[rc.name])
     for row in range(len(red.coordinates)):
         build.add_forcing(row)
+    if red.frame_rows:
+        build.add_frame(red.resolved.carrier_speed_ratio())
     groups = sorted(build.groups, key=lambda gr: gr.kind == "derived")  # stable: free groups first, betas in order
-    return NondimensionalModel(red, groups, build.conditions, build.functions, build.lhs, build.rhs,
-                               {name: tuple(rows) for name, rows in build.coupling_rows.items()})
+    rows = {name: tuple(rows) for name, rows in build.coupling_rows.items()}
+    geometry = red.resolved.geometry
+    if not geometry:
+        return NondimensionalModel(red, groups, build.conditions, build.functions, build.lhs, build.rhs, rows)
+
+    def sub(e):
+        return e.xreplace(geometry)
+
+    return NondimensionalModel(
+        with_geometry(red), [replace(gr, definition=sub(gr.definition)) for gr in groups],
+        [replace(c, equation=sp.Eq(simplified(sub(c.equation.lhs)), sub(c.equation.rhs))) for c in build.conditions],
+        [replace(f, definition=f.definition.xreplace(geometry)) for f in build.functions],
+        [sub(e) for e in build.lhs], [sub(e) for e in build.rhs],
+        {name: tuple((r, sub(f)) for r, f in pairs) for name, pairs in rows.items()})
 
 
 def reduce(model: Drivetrain) -> NondimensionalModel:
@@ -624,7 +733,7 @@ def reduce(model: Drivetrain) -> NondimensionalModel:
     cached = model.__dict__.get("_reduced")
     if cached is not None and cached[0] == model.version:
         return cached[1]
-    nd = nondimensionalize(reduce_drivetrain(model))
+    nd = nondimensionalize(reduce_drivetrain(model, numbers=False))
     model.__dict__["_reduced"] = (model.version, nd)
     return nd
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 import random
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 import sympy as sp
@@ -21,10 +21,11 @@ import sympy as sp
 from ..model.backlash import g
 from ..errors import GearsymError
 from ..model.drivetrain import Drivetrain
+from ..model.linear_algebra import numeric_rank, pivot_columns, simplified, solve_rows
 from ..model.resolved import ResolvedDrivetrain
 from ..model.resolved_components import ResolvedCoupling, ResolvedForcing
 from ..model.symbols import t
-from .coordinates import Coordinate, coupling_deflections, rigid_body_modes
+from .coordinates import Coordinate, combination_solver, coupling_deflections, generic_rank, rigid_body_modes
 
 
 class ReductionError(GearsymError):
@@ -88,6 +89,10 @@ class Reduction:
         """The deflections of the couplings that close a kinematic loop (combinations of the coordinates)."""
         return [d for d in self.deflections if not d.independent]
 
+    #: per row, the turning frame's forces (Coriolis, centripetal) in the coordinates x_k(t), with the carrier's
+    #: speed Omega_c: sum_k (a_k Omega_c x_k' + b_k Omega_c^2 x_k); empty without a turning frame
+    frame_rows: list[sp.Expr] = field(default_factory=list)
+
     def row_terms(self, row: int) -> list[CouplingTerm]:
         return [ct for ct in self.coupling_terms if ct.row == row]
 
@@ -101,6 +106,8 @@ class Reduction:
         for i, c in enumerate(self.coordinates):
             rhs = -sp.Add(*(ct.factor * self.law(ct.coupling) for ct in self.row_terms(i)))
             rhs += sp.Add(*(ft.coefficient * ft.source.time_function for ft in self.row_forcing(i)))
+            if self.frame_rows:
+                rhs += self.frame_rows[i]
             out.append(sp.Eq(sp.diff(c.of(t), t, 2), rhs))
         return out
 
@@ -110,7 +117,7 @@ class Reduction:
         rd = self.resolved
         out = []
         for u in self.rigid_modes:
-            lhs = sp.Add(*(u[i] * rb.inertia * sp.diff(rb.angle, t, 2) for i, rb in enumerate(rd.bodies)))
+            lhs = sp.Add(*(u[i] * rb.inertia * sp.diff(rb.angle, t, 2) for i, rb in enumerate(rd.dofs)))
             rhs = sp.Add(*(u[i] * q for i, q in enumerate(rd.generalized_forces)))
             out.append(sp.Eq(lhs, rhs))
         return out
@@ -120,15 +127,16 @@ def _is_zero(expr: sp.Expr) -> bool:
     return sp.expand(expr) == 0 or sp.simplify(expr) == 0
 
 
-def reduce_drivetrain(model: Drivetrain) -> Reduction:
-    """Derive the reduced equations of ``model`` in relative coordinates."""
+def reduce_drivetrain(model: Drivetrain, numbers: bool = True) -> Reduction:
+    """Derive the reduced equations of ``model`` in relative coordinates; ``numbers=False`` leaves the geometry's
+    symbols in (the nondimensional form puts them back at its end, :func:`with_geometry`)."""
     rd = model.resolved
     coords, T, deflections = coupling_deflections(rd)
     modes = rigid_body_modes(rd)
     red = Reduction(model, rd, coords, T, modes, deflections)
-    n = len(rd.bodies)
+    n = len(rd.dofs)
     M = rd.mass_matrix
-    if M != sp.diag(*[rb.inertia for rb in rd.bodies]):
+    if M != sp.diag(*[rb.inertia for rb in rd.dofs]):
         raise ReductionError(f"unexpected inertia matrix {M}; bodies must be uncoupled rotors")
     if T.rows + len(modes) != n:
         raise ReductionError(f"{len(coords)} coordinates and {len(modes)} rigid modes do not span {n} angles")
@@ -150,10 +158,13 @@ def reduce_drivetrain(model: Drivetrain) -> Reduction:
             factor = sp.factor(sp.Add(*(TMinv[i, j] * rc.row[j] for j in range(n))) / rc.scale)
             if factor != 0:
                 red.coupling_terms.append(CouplingTerm(i, rc, factor))
+    frame = sp.Matrix(rd.frame_forces)
+    if frame != sp.zeros(n, 1):
+        red.frame_rows = _frame_rows(red, TMinv, frame)
     eom_forces = [sp.expand(eq.rhs - (eq.lhs - sum(M[i, j] * sp.diff(rd.angles[j], t, 2) for j in range(n))))
                   for i, eq in enumerate(rd.equations_of_motion)]
     for i in range(n):
-        if not _is_zero(eom_forces[i] - sp.expand(total[i] + rd.generalized_forces[i])):
+        if not _is_zero(eom_forces[i] - sp.expand(total[i] + frame[i] + rd.generalized_forces[i])):
             raise ReductionError(f"coupling forces do not add up to the equation of motion of psi_{i + 1}")
 
     # external torques: row i gets (T M^-1)_{i, body} * torque
@@ -165,7 +176,131 @@ def reduce_drivetrain(model: Drivetrain) -> Reduction:
 
     # final check: the assembled equations give the accelerations of Lagrange's equations, at random states
     _check_against_lagrange(red, eom_forces)
-    return red
+    return with_geometry(red) if numbers and rd.geometry else red
+
+
+def with_geometry(red: Reduction) -> Reduction:
+    """The reduction with the geometry's symbols (sines and cosines of pressure angles, radicals of planet
+    positions: :meth:`ResolvedDrivetrain._with_geometry_symbols`) replaced by what they stand for, in normal form
+    modulo their relations; a rank the numbers lower is an error (the generic algebra would not hold)."""
+    rd = red.resolved
+    geometry = rd.geometry
+    generic = generic_rank(red.transform)
+    if numeric_rank(red.transform.xreplace(geometry)) != generic:
+        raise ReductionError(f"{red.drivetrain.name}: the geometry's numbers make the coordinates dependent")
+
+    def sub(e):  # (numbers in: evaluated as they are used; the coefficients' normal form is for display only)
+        return e.xreplace(geometry)
+
+    coordinates, old_to_new = [], {}
+    for c in red.coordinates:
+        new = replace(c, definition=sub(c.definition))
+        old_to_new[id(c)] = new
+        coordinates.append(new)
+    deflections = []
+    for d in red.deflections:
+        if d.independent:
+            deflections.append(old_to_new[id(d)])
+        else:
+            deflections.append(replace(d, definition=sub(d.definition),
+                                       combination=tuple((old_to_new[id(c)], sub(a)) for c, a in d.combination)))
+    return Reduction(
+        red.drivetrain, rd, coordinates, red.transform.applyfunc(sub), [u.applyfunc(sub) for u in red.rigid_modes],
+        deflections,
+        [CouplingTerm(ct.row, ct.coupling, sub(ct.factor)) for ct in red.coupling_terms],
+        [ForcingTerm(ft.row, ft.source, sub(ft.coefficient)) for ft in red.forcing_terms],
+        [sub(f) for f in red.frame_rows])
+
+
+def sub_frame(expr: sp.Expr, geometry) -> sp.Expr:
+    """``expr`` with the geometry's numbers, term by term: the coefficient of each function, derivative or backlash
+    law in normal form."""
+    if not expr.free_symbols & set(geometry):
+        return expr
+    from sympy.core.function import AppliedUndef
+
+    collected: dict[sp.Expr, sp.Expr] = {}
+    for term in sp.Add.make_args(sp.expand(expr)):
+        dependent = [f for f in sp.Mul.make_args(term) if f.has(AppliedUndef) or f.has(sp.Derivative)]
+        key = sp.Mul(*dependent)
+        collected[key] = collected.get(key, sp.S.Zero) + term / key
+    return sp.Add(*(simplified(c.xreplace(geometry)) * k for k, c in collected.items()))
+
+
+def _frame_rows(red: Reduction, weights_rows: sp.Matrix, forces: sp.Matrix) -> list[sp.Expr]:
+    """The frame's forces of each row, T M^-1 Q_f (``weights_rows`` T M^-1, ``forces`` Q_f), with every translation
+    written in the coordinates (its combination of them; for a translation a rigid-body mode moves too, a planet's
+    tangential one, the motion M-orthogonal to the rigid-body modes: the rigid coordinates are the nominal rotation
+    the frame turns with)."""
+    rd = red.resolved
+    moving = sorted({i for f in forces for i, d in enumerate(rd.dofs) if d.motion != "rotation"
+                     and f.has(d.angle)})
+    weights_rows = [list(weights_rows.row(k)) for k in range(weights_rows.rows)]
+    weights_of: dict[int, list[sp.Expr]] = {}
+    held = [i for i in moving if any(u[i] != 0 for u in red.rigid_modes)]  # (a rigid-body mode moves it too)
+    solve = None
+    itself = {}  # dof -> the coordinate that is it (a bearing to the ground: x_sun = X_sun)
+    for k in range(red.transform.rows):
+        nonzero = [j for j, e in enumerate(red.transform.row(k)) if e != 0]
+        if len(nonzero) == 1 and red.transform[k, nonzero[0]] == 1:
+            itself[nonzero[0]] = k
+    for i in moving:
+        if i in held:
+            continue
+        if i in itself:
+            weights_of[i] = [sp.S.One if k == itself[i] else sp.S.Zero for k in range(len(red.coordinates))]
+            continue
+        solve = solve or combination_solver(red.transform)
+        target = sp.zeros(1, red.transform.cols)
+        target[i] = 1
+        weights_of[i] = list(solve(target))
+    if held:
+        weights_of.update(zip(held, translations_in_coordinates(red, held)))
+    rates, positions = {}, {}
+    for i in moving:
+        q = sp.Add(*(w * c.of(t) for w, c in zip(weights_of[i], red.coordinates)))
+        rates[sp.Derivative(rd.dofs[i].angle, t)] = sp.diff(q, t)
+        positions[rd.dofs[i].angle] = q
+    # Each row is kept as T M^-1 times the frame's force on each body, the body's translation a combination of the
+    # coordinates (its weights factored, over the rigid-body modes' Gram determinant): expanded, the combinations'
+    # rational weights multiply out into every row (Lin & Parker's set: 10^5 characters a row, a C file of megabytes
+    # gcc does not finish); kept, each combination is one subexpression the generated code computes once.
+    return [sp.Add(*(weight * sp.factor_terms(force).xreplace(rates).xreplace(positions)
+                     for weight, force in zip(weights, forces) if weight != 0 and force != 0))
+            for weights in weights_rows]
+
+
+def translations_in_coordinates(red: Reduction, indices: list[int]) -> list[list[sp.Expr]]:
+    """For each degree of freedom of ``indices``, the weights w with dof = w . q for the motion M-orthogonal to the
+    rigid-body modes (T psi = q, U^T M psi = 0): with R a right inverse of T (the inverse of T's pivot columns, in
+    their rows), W = (I - U (U^T M U)^-1 U^T M) R; only the rows of R the result needs are solved for, without the
+    masses (they enter at the end)."""
+    rd = red.resolved
+    transform = red.transform
+    pivots = pivot_columns(transform)
+    square = transform.extract(list(range(transform.rows)), pivots)
+    modes = sp.Matrix.hstack(*red.rigid_modes)
+    masses = [d.inertia for d in rd.dofs]
+    needed = sorted(set(indices) | {j for j in range(len(masses)) if any(modes[j, m] != 0 for m in range(modes.cols))})
+    needed = [j for j in needed if j in pivots]
+    targets = sp.zeros(len(needed), transform.rows)
+    for k, j in enumerate(needed):
+        targets[k, pivots.index(j)] = 1
+    solved = solve_rows(square, targets) if needed else sp.zeros(0, transform.rows)
+    right = {j: solved.row(k) for k, j in enumerate(needed)}
+    zero = sp.zeros(1, transform.rows)
+    gram = (modes.T * sp.diag(*masses) * modes).inv()
+    weighted = [sum((modes[j, m] * masses[j] * right.get(j, zero) for j in range(len(masses))), zero)
+                for m in range(modes.cols)]
+    out = []
+    for i in indices:
+        w = right.get(i, zero)
+        for a in range(modes.cols):
+            for b in range(modes.cols):
+                if modes[i, a] != 0:
+                    w = w - modes[i, a] * gram[a, b] * weighted[b]
+        out.append([sp.factor(e) for e in w])
+    return out
 
 
 def _law_in_angles(rd: ResolvedDrivetrain, rc: ResolvedCoupling) -> sp.Expr:
@@ -174,6 +309,15 @@ def _law_in_angles(rd: ResolvedDrivetrain, rc: ResolvedCoupling) -> sp.Expr:
     if rc.kind == "mesh":
         return rd.stiffness_at(rc) * g(rd.contact_of(rc), rc.backlash) + rc.damping * sp.diff(d, t)
     return rc.stiffness * d + rc.damping * sp.diff(d, t)
+
+
+def _without_rigid_motion(red: Reduction, vector: list, values: dict) -> list:
+    """``vector`` less its M-orthogonal projection on the rigid-body modes (exact, at ``values``)."""
+    rd = red.resolved
+    m = sp.diag(*[d.inertia.xreplace(values) for d in rd.dofs])
+    v = sp.Matrix(vector)
+    u = sp.Matrix.hstack(*red.rigid_modes).xreplace(values).evalf(CHECK_DIGITS)
+    return list(v - u * (u.T * m * u).inv() * (u.T * m * v))
 
 
 #: random states at which the reduced equations are checked against Lagrange's, and the agreement asked
@@ -207,7 +351,7 @@ def _check_against_lagrange(red: Reduction, eom_forces: list[sp.Expr]) -> None:
     every coordinate, every loop-closing combination and every rigid coordinate eliminated."""
     rd = red.resolved
     rng = random.Random(11)
-    n = len(rd.bodies)
+    n = len(rd.dofs)
     symbols = set()
     for expr in (*eom_forces, *(eq.rhs for eq in red.equations)):
         symbols |= expr.free_symbols
@@ -218,18 +362,23 @@ def _check_against_lagrange(red: Reduction, eom_forces: list[sp.Expr]) -> None:
     tolerance = _check_tolerance((*eom_forces, *(eq.rhs for eq in red.equations)))
     for _ in range(CHECK_POINTS):
         values = {s: sp.Rational(rng.randint(5, 40), rng.randint(5, 20)) for s in sorted(symbols - {t}, key=str)}
+        if rd.translations:  # (numbers of 30 digits: exact rationals swell in the many terms of gears on bearings)
+            values = {s: sp.Float(v, CHECK_DIGITS + 5) for s, v in values.items()}
         values[t] = sp.Rational(rng.randint(0, 100), 7)
         values |= {f: sp.Rational(rng.randint(5, 40), 10) for f in sorted(functions, key=str)}
         psi = [sp.Rational(rng.randint(-60, 60), 20) for _ in range(n)]
         rate = [sp.Rational(rng.randint(-60, 60), 20) for _ in range(n)]
+        if red.frame_rows and red.rigid_modes:  # the frame turns with the rigid coordinates: none of their motion
+            psi, rate = (_without_rigid_motion(red, v, values) for v in (psi, rate))
         state = {sp.Derivative(a, t): r for a, r in zip(rd.angles, rate)}
         forces = [_numeric(e.xreplace(state).xreplace(dict(zip(rd.angles, psi))).xreplace(values)) for e in eom_forces]
-        accel = [f / rb.inertia.xreplace(values) for f, rb in zip(forces, rd.bodies)]
-        q = red.transform.xreplace(values) * sp.Matrix(psi)
-        qd = red.transform.xreplace(values) * sp.Matrix(rate)
+        accel = [f / rb.inertia.xreplace(values) for f, rb in zip(forces, rd.dofs)]
+        transform = red.transform.xreplace(values).evalf(CHECK_DIGITS)  # (numbers: radicals and sines as floats)
+        q = transform * sp.Matrix(psi)
+        qd = transform * sp.Matrix(rate)
         reduced_state = {sp.Derivative(c.of(t), t): qd[k] for k, c in enumerate(red.coordinates)}
         for k, (c, eq) in enumerate(zip(red.coordinates, red.equations)):
-            expected = sum(red.transform[k, j].xreplace(values) * accel[j] for j in range(n))
+            expected = sum(transform[k, j] * accel[j] for j in range(n))
             got = eq.rhs.xreplace(reduced_state).xreplace({x.of(t): q[i] for i, x in enumerate(red.coordinates)})
             got = _numeric(got.xreplace(values))
             if not (got.is_number and abs(got - expected) <= tolerance * (1 + abs(expected))):

@@ -77,6 +77,7 @@ class StaticState:
     deflections: dict[str, float]  # each coupling's deflection, by coupling name (loop-closing ones too)
     mesh_forces: dict[str, float]  # each mesh's static force k g(d, eta), by mesh name
     contact: dict[str, str]  # each mesh's flank: "drive" (d >= 0), "gap" or "back" (d <= -eta)
+    bearing_forces: dict[str, float] = None  # each bearing direction's static force k d (gears on bearings)
 
 
 @dataclass(frozen=True)
@@ -136,6 +137,8 @@ def static_state(red: Reduction, values: Mapping[str, float]) -> StaticState:
         deflections=deflections,
         mesh_forces={name: by_name[name].force(d) for name, d in deflections.items() if by_name[name].kind == "mesh"},
         contact={name: by_name[name].flank(d) for name, d in deflections.items() if by_name[name].kind == "mesh"},
+        bearing_forces={name: by_name[name].force(d) for name, d in deflections.items()
+                        if by_name[name].kind == "bearing"},
     )
 
 

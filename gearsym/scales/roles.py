@@ -46,6 +46,11 @@ TORQUE = Role("a torque", "N*m")
 PHASE = Role("a phase angle", "")
 RATIO = Role("a dimensionless ratio", "")
 SPEED = Role("a rotational speed", "rpm")
+MASS = Role("a mass", "kg")
+BEARING_STIFFNESS = Role("a bearing stiffness", "N/m")
+BEARING_DAMPING = Role("a bearing damping", "N*s/m")
+ANGLE = Role("an angle", "")
+ORBIT = Role("a carrier radius", "mm")
 TRANSMISSION_ERROR = Role("a transmission error", "um")
 
 
@@ -66,8 +71,22 @@ def fields(rd: ResolvedDrivetrain) -> list[Field]:
         out.append(Field(rb.inertia, INERTIA, f"{where} inertia"))
         if rb.radius is not None:
             out.append(Field(rb.radius, LENGTH, f"{where} base radius"))
+    for rb in rd.translations:
+        where = f"{type(rb.body).__name__} {rb.body.name!r}"
+        out.append(Field(rb.inertia, MASS, f"{where} mass"))
+        orbit = getattr(rb.body, "orbit", None)
+        if orbit is not None and rb.motion == "tangential":
+            out.append(Field(sp.sympify(orbit), ORBIT, f"{where} orbit radius"))
     for rc in rd.couplings:
         where = f"{type(rc.component).__name__} {rc.name!r}"
+        if rc.kind == "bearing":
+            out += [Field(rc.stiffness, BEARING_STIFFNESS, f"{where} stiffness"),
+                    Field(rc.damping, BEARING_DAMPING, f"{where} damping")]
+            continue
+        if rc.kind == "mesh" and rd.translations:
+            out += [Field(sp.sympify(rc.component.pressure_angle), ANGLE, f"{where} pressure angle")]
+            if rc.component.centres is not None:
+                out += [Field(sp.sympify(rc.component.centres), ANGLE, f"{where} line of centres")]
         if rc.kind == "mesh":
             out += [Field(rc.stiffness, MESH_STIFFNESS, f"{where} stiffness"),
                     Field(rc.damping, MESH_DAMPING, f"{where} damping"),

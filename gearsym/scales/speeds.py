@@ -64,8 +64,24 @@ class SpeedRatios:
         raise GearsymError(f"{self.model.name}: {body!r} does not turn with {self.speed.body!r} (no rigid-body mode "
                            "joins them), so its speed is not set by the declared speed")
 
+    def relative(self, rc: ResolvedCoupling, end) -> float:
+        """The speed of a gear of a mesh relative to the planets' carrier (its own speed without one), per unit
+        operating speed."""
+        turning = rc.turning[0] if end is rc.a else rc.turning[1]
+        if rc.carrier is None or not turning:
+            return self.body(end.body.name)
+        rd = self.model.reduction.resolved
+        index = {rb.body.name: rb.index for rb in rd.bodies}
+        ref = index[self.speed.body]
+        for mode in self.model.reduction.rigid_modes:
+            u = [float(e.xreplace(self.values)) for e in mode]
+            if u[ref] != 0:
+                return abs(sum(float(c) * x for c, x in zip(turning, u)) / u[ref])
+        return self.body(end.body.name)
+
     def mesh(self, rc: ResolvedCoupling) -> float:
-        """A mesh's tooth-passing frequency per unit operating speed (radians per radian of the driving body)."""
+        """A mesh's tooth-passing frequency per unit operating speed (radians per radian of the driving body); a
+        planet's mesh turns with the speeds relative to the carrier."""
         rates = []
         for end in (rc.a, rc.b):
             teeth = end.body.tooth_count
@@ -73,7 +89,7 @@ class SpeedRatios:
                 if not (isinstance(teeth, int) and not isinstance(teeth, bool) and teeth > 0):
                     raise ModelError(f"teeth must be a positive whole number, got {teeth!r}",
                                      f"{type(end.body).__name__} {end.body.name!r}")
-                rates.append((end.body.name, teeth * self.body(end.body.name)))
+                rates.append((end.body.name, teeth * self.relative(rc, end)))
         if not rates:
             raise GearsymError(f"{self.model.name}: mesh {rc.name!r} needs tooth counts to turn the speed into a mesh "
                                f"frequency: declare Gear(..., teeth=N) on {rc.a.body.name!r} and {rc.b.body.name!r}")
