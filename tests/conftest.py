@@ -210,6 +210,7 @@ def interrupt_after(count):
     return on_point
 
 
+@pytest.hookimpl(tryfirst=True)  # (before xdist's own, which suffixes each node id with the groups it sees)
 def pytest_collection_modifyitems(config, items):
     """For a parallel run (pytest -n auto --dist loadgroup): every test file is a group that runs on one worker, so
     that its module fixtures (a compiled model, simulated data) are made once, as in a serial run; the docs' pages
