@@ -90,7 +90,9 @@ class TranslationResolution:
         if carriers:
             carrier_ref = carriers.pop()
             self.frame, self.frame_carrier = "carrier", self.body(carrier_ref, "the planets' carrier")
-        self._senses = self._rotation_senses()
+        # (the senses of rotation place the lines of action of gears on bearings; a drivetrain without bearings
+        # needs none, and its closed loops of meshes are checked where its couplings are resolved)
+        self._senses = self._rotation_senses() if bearings else {}
         out: list[ResolvedBody] = []
         for bearing in bearings:
             rb = self.body(bearing.on, f"Bearing {bearing.name!r}")
