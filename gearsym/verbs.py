@@ -16,7 +16,7 @@ from . import VERBS
 from .codegen.build import compile_model
 from .codegen.compiled import CompiledModel
 from .errors import GearsymError
-from .options import Integration
+from .options import Execution, Integration
 from .physical.answers import PhysicalScaling
 from .physical.stability import chart_in_units
 from .physical.sweeps import axes_with_units, nondimensional_axes
@@ -98,12 +98,14 @@ stability_chart = _made["stability_chart"]
 
 @stability_chart.register
 def _system_chart(model: FirstOrderSystem, grid, *, about: str = "static", options: Integration | None = None,
-                  verbose: bool = False, **kwargs):
+                  execution: Execution | None = None, **kwargs):
     """About the static state only the linearisation is compiled (the model's own loops are not needed)."""
+    verbose = bool(execution and execution.progress)
     if about == "static":
-        return static_chart(compile_linearisation(model, options, verbose=verbose), grid, verbose=verbose, **kwargs)
-    return _stability_chart(compile_model(model, options or Integration()), grid, about=about, verbose=verbose,
+        return static_chart(compile_linearisation(model, options, verbose=verbose), grid, execution=execution,
                             **kwargs)
+    return _stability_chart(compile_model(model, options or Integration(), verbose=verbose), grid, about=about,
+                            execution=execution, **kwargs)
 
 
 @stability_chart.register

@@ -23,6 +23,7 @@ from scipy.special import mathieu_a, mathieu_b
 import conftest
 import gearsym
 import gearsym.stability
+from gearsym import Execution
 from gearsym.cli import main
 from gearsym.stability import (ABOUT, FOLD, NEIMARK_SACKER, NO_ORBIT, PERIOD_DOUBLING, compile_linearisation,
                                static_chart)
@@ -145,7 +146,7 @@ def test_every_lane_has_its_own_tables_the_chart_equals_the_scalar_loops(mathieu
     side in the lanes; each must run on its own (the scalar loops run point by point)."""
     grid = {"k_a": np.round(np.linspace(0.0, 0.7, 16), 10), "omega": [0.9, 1.1, 1.9]}
     lanes = static_chart(mathieu, grid, refine=False, zeta=0.01)
-    scalar = static_chart(mathieu, grid, refine=False, zeta=0.01, lanes=False)
+    scalar = static_chart(mathieu, grid, refine=False, zeta=0.01, execution=Execution(lanes=False))
     assert all(same(m, s, 1e-12) for m, s in zip(lanes.multipliers.reshape(-1, 2), scalar.multipliers.reshape(-1, 2)))
     assert (lanes.kind == scalar.kind).all()
 
@@ -256,7 +257,7 @@ def test_the_phasing_panel_draws_each_kept_tongue_as_its_wedge_and_each_suppress
     from matplotlib.colors import to_rgb
 
     chart = static_chart(shaft, {"omega": np.round(np.arange(1.3, 2.6, 0.05), 10), "k_a": [0.2, 0.5]}, refine=False,
-                         lanes=False)  # (the scalar loops: no lanes to compile for a few points)
+                         execution=Execution(lanes=False))  # (the scalar loops: no lanes to compile for a few points)
     prediction = gearsym.stability.phasing_prediction(chart, shaft)
     tongues = list(prediction.tongues)
     combination = next(k for k, t in enumerate(tongues) if t.label == "(ω1+ω2)/1")
@@ -298,7 +299,7 @@ def test_a_point_without_a_periodic_orbit_is_marked_not_guessed():
     system = conftest.system("one_stage", **values)
     model = gearsym.compile_model(system, gearsym.Integration())
     chart = orbit_chart(model, static_recipe(system), {"omega": [0.8, 1.3], "k_m": [0.0, 0.5, 1.0]}, refine=False,
-                        lanes=False)
+                        execution=Execution(lanes=False))
     assert (chart.stable[0] == None).all() and (chart.kind[0] == NO_ORBIT).all()  # noqa: E711
     assert np.isnan(chart.multipliers[0]).all() and np.isnan(chart.max_modulus[0]).all()
     assert (chart.stable[1:] != None).all() and chart.counts()[NO_ORBIT] == 2  # noqa: E711

@@ -108,7 +108,7 @@ def measure(repeats: int, log) -> dict:
             results["C"] = r
         for name, jobs in (("1 thread", 1), ("every core", 0)):
             t, cpu = time.perf_counter(), time.process_time()
-            chart = static_chart(lin, grid, refine=False, jobs=jobs)
+            chart = static_chart(lin, grid, refine=False, execution=gearsym.Execution(jobs=jobs))
             gearsym_runs[name].append(time.perf_counter() - t)
             gearsym_cpu[name].append(time.process_time() - cpu)
             results["gearsym"] = {"unstable": int(np.sum(chart.stable == False)),  # noqa: E712
@@ -121,7 +121,7 @@ def measure(repeats: int, log) -> dict:
             + " s CPU; gearsym " + ", ".join(f"{k}: {gearsym_cpu[k][-1]:.3f} s CPU ({gearsym_runs[k][-1]:.3f} s)"
                                                for k in gearsym_runs) + f"; load {os.getloadavg()[0]:.1f}")
     t, cpu = time.perf_counter(), time.process_time()
-    refined = static_chart(lin, grid, jobs=0)
+    refined = static_chart(lin, grid, execution=gearsym.Execution(jobs=0))
     refine_wall, refine_cpu = time.perf_counter() - t, time.process_time() - cpu
     commands = {}
     for refine in (True, False):

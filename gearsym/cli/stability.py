@@ -20,6 +20,7 @@ import gearsym  # the face: its verbs load on first use, so a cached model's cha
 from .. import stability  # (lazy: the linearisation, SymPy and the generator load only on a cache miss)
 from ..cached import load_linearisation, load_static_recipe
 from ..errors import GearsymError
+from ..options import Execution
 from ..files.atomic import write_atomically
 from ..figures.basins import axis_label
 from ..figures.stability import plot_stability
@@ -83,10 +84,10 @@ def run(args: argparse.Namespace) -> int:
     tolerance_of = lambda axes: tuple(args.tolerance * (max(a.values) - min(a.values) or max(1.0, abs(a.values[0])))
                                       for a in axes)
     progress = None if args.quiet else _Progress()
+    execution = Execution(args.jobs, lanes=not args.no_lanes, progress=progress or False)
     settings = model_settings(args, cached=True)  # (a formula's numbers are checked if the model is built)
     start = time.perf_counter()
-    common = dict(refine=not args.no_refine, lanes=not args.no_lanes, jobs=args.jobs, progress=progress,
-                  verbose=not args.quiet)
+    common = dict(refine=not args.no_refine, execution=execution)
     if args.about == "static":  # (the linearisation's cache says whether the model is physical: no SymPy then)
         lin = load_linearisation(args.model, settings, options, verbose=not args.quiet,
                                  derive=lambda: _linearisation(args, settings, options, given, user))
@@ -224,15 +225,11 @@ class _Progress:
     """One line on stderr, rewritten at most a few times a second."""
 
     def __init__(self):
-        self.last, self.shown = 0.0, False
+        self.shown = False
 
-    def __call__(self, stage: str, done: int, total: int) -> None:
-        now = time.perf_counter()
-        if now - self.last < 0.5 and done < total:
-            return
-        self.last = now
+    def __call__(self, line: str) -> None:  # (the chart says a stage's count at most every PROGRESS_EVERY s)
         end = "\r" if sys.stderr.isatty() else "\n"
-        print(f"gearsym: {stage}: {done}/{total}", end=end, file=sys.stderr, flush=True)
+        print(f"gearsym: {line}", end=end, file=sys.stderr, flush=True)
         self.shown = True
 
     def done(self) -> None:

@@ -16,6 +16,7 @@ import numpy as np
 from ..checks import json_safe
 from ..codegen.compiled import CompiledModel
 from ..errors import GearsymError
+from ..options import Execution
 from ..sweep.grid import Axis, axes_from
 from .boundaries import Boundary, Crossing, curves, grid_crossings, midpoints, refine
 from .kinds import MARGIN, NO_ORBIT, NO_STATIC_STATE, classify, multipliers
@@ -331,31 +332,53 @@ def chart_axes(model_parameters: Sequence[str], grid) -> tuple[Axis, ...]:
     return axes
 
 
-def static_chart(lin: CompiledLinearisation, grid, *, refine: bool = True, tolerance=None, lanes: bool = True,
-                 jobs: int = 0, progress=None, verbose: bool = False, **values: float) -> StabilityChart:
+def static_chart(lin: CompiledLinearisation, grid, *, refine: bool = True, tolerance=None,
+                 execution: Execution | None = None, **values: float) -> StabilityChart:
     """The chart of a compiled linearisation (:func:`compile_linearisation`) over ``grid`` (two axes of the
-    model's parameters), the other parameters at ``values`` or the model's."""
+    model's parameters), the other parameters at ``values`` or the model's. ``execution``: threads, the lanes (on
+    by default) and progress (each stage's points done)."""
+    execution = execution or Execution()
     names = tuple(lin.base_parameters)
     axes = chart_axes(names, grid)
     merged = _values(lin.base_parameters, values, lin.base)
     base = np.array([merged[n] for n in names], dtype=float)
     g = _Grid(names, base, axes)
-    problem = _Static(lin, g, lanes, jobs, verbose)
+    problem = _Static(lin, g, execution.with_lanes(True), execution.jobs, bool(execution.progress))
     return chart_of(problem, g, model=lin.base, steps=lin.model.steps_per_cycle, parameters=merged,
-                    refine_boundaries=refine, tolerance=tolerance, progress=progress)
+                    refine_boundaries=refine, tolerance=tolerance, progress=stage_progress(execution))
 
 
 def orbit_chart(model: CompiledModel, recipe: StaticRecipe, grid, *, refine: bool = True, tolerance=None,
-                lanes: bool = True, jobs: int = 0, progress=None, verbose: bool = False,
-                **values: float) -> StabilityChart:
+                execution: Execution | None = None, **values: float) -> StabilityChart:
     """The chart of ``model``'s period-1 orbits over ``grid`` (see :func:`static_chart`)."""
+    execution = execution or Execution()
     names = tuple(model.parameter_names)
     axes = chart_axes(names, grid)
     merged = dict(zip(names, model.parameter_vector(values).tolist()))
     g = _Grid(names, np.array([merged[n] for n in names]), axes)
-    problem = _Orbit(model, recipe, g, lanes, jobs, verbose)
+    problem = _Orbit(model, recipe, g, execution.with_lanes(True), execution.jobs, bool(execution.progress))
     return chart_of(problem, g, model=model.name, steps=model.steps_per_cycle, parameters=merged,
-                    refine_boundaries=refine, tolerance=tolerance, progress=progress)
+                    refine_boundaries=refine, tolerance=tolerance, progress=stage_progress(execution))
+
+
+#: at most one progress line this often (seconds), and the last of each stage
+PROGRESS_EVERY = 0.5
+
+
+def stage_progress(execution: Execution) -> Callable[[str, int, int], None] | None:
+    """``progress(stage, done, total)`` for :func:`chart_of`: a line ``'<stage>: <done>/<total>'`` said through
+    ``execution`` at most every PROGRESS_EVERY seconds (and when a stage ends); None without progress."""
+    if not execution.progress:
+        return None
+    say, last = execution.say, [-PROGRESS_EVERY]
+
+    def progress(stage: str, done: int, total: int) -> None:
+        now = time.perf_counter()
+        if now - last[0] >= PROGRESS_EVERY or done >= total:
+            last[0] = now
+            say(f"{stage}: {done}/{total}")
+
+    return progress
 
 
 def _values(parameters: Mapping[str, float], values: Mapping[str, float], model: str) -> dict[str, float]:
