@@ -56,6 +56,11 @@ class Execution:
         if not (isinstance(self.progress, bool) or callable(self.progress)):
             raise GearsymError(f"progress must be True, False or a function of one line, got {self.progress!r}")
 
+    @property
+    def verbose(self) -> bool:
+        """Whether the run says what it does (its progress, and the compiling it does first)."""
+        return bool(self.progress)
+
     def with_lanes(self, default: bool) -> bool:
         """Whether to run in the lanes: as asked, else the verb's ``default``."""
         return default if self.lanes is None else self.lanes

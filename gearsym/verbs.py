@@ -100,7 +100,7 @@ stability_chart = _made["stability_chart"]
 def _system_chart(model: FirstOrderSystem, grid, *, about: str = "static", options: Integration | None = None,
                   execution: Execution | None = None, **kwargs):
     """About the static state only the linearisation is compiled (the model's own loops are not needed)."""
-    verbose = bool(execution and execution.progress)
+    verbose = (execution or Execution()).verbose
     if about == "static":
         return static_chart(compile_linearisation(model, options, verbose=verbose), grid, execution=execution,
                             **kwargs)

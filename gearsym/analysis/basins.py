@@ -217,7 +217,7 @@ def basin_map(model: CompiledModel, grid: Mapping[str, Sequence[float]], *, opti
     axes, held, starts = grid_starts(model, grid, y0)
     inputs = model.prepare(p)
     runner = LaneRunner(model, options.discard, options.measured, lanes=execution.with_lanes(True),
-                        verbose=bool(execution.progress))
+                        verbose=execution.verbose)
     chunks = chunked(len(starts), CHUNK * runner.width)
     summary = Summary.join(list(threaded(lambda rows: Summary.of(runner.orbits(starts[rows], inputs)), chunks,
                                          execution.jobs)))

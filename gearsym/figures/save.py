@@ -41,7 +41,8 @@ def save_figure(fig, path: str | Path, dpi: int, keep_same: bool = False) -> Pat
         fig.savefig(image, format=path.suffix.lstrip(".").lower() or None, dpi=dpi, metadata={"Software": None})
     finally:
         pyplot().close(fig)
-    if keep_same and path.is_file() and same_picture(io.BytesIO(image.getvalue()), path):
+    image.seek(0)  # (the picture is read back from its start, without a copy of its bytes)
+    if keep_same and path.is_file() and same_picture(image, path):
         return path
     return write_atomically(path, image.getvalue())
 

@@ -343,7 +343,7 @@ def static_chart(lin: CompiledLinearisation, grid, *, refine: bool = True, toler
     merged = _values(lin.base_parameters, values, lin.base)
     base = np.array([merged[n] for n in names], dtype=float)
     g = _Grid(names, base, axes)
-    problem = _Static(lin, g, execution.with_lanes(True), execution.jobs, bool(execution.progress))
+    problem = _Static(lin, g, execution.with_lanes(True), execution.jobs, execution.verbose)
     return chart_of(problem, g, model=lin.base, steps=lin.model.steps_per_cycle, parameters=merged,
                     refine_boundaries=refine, tolerance=tolerance, progress=stage_progress(execution))
 
@@ -356,7 +356,7 @@ def orbit_chart(model: CompiledModel, recipe: StaticRecipe, grid, *, refine: boo
     axes = chart_axes(names, grid)
     merged = dict(zip(names, model.parameter_vector(values).tolist()))
     g = _Grid(names, np.array([merged[n] for n in names]), axes)
-    problem = _Orbit(model, recipe, g, execution.with_lanes(True), execution.jobs, bool(execution.progress))
+    problem = _Orbit(model, recipe, g, execution.with_lanes(True), execution.jobs, execution.verbose)
     return chart_of(problem, g, model=model.name, steps=model.steps_per_cycle, parameters=merged,
                     refine_boundaries=refine, tolerance=tolerance, progress=stage_progress(execution))
 

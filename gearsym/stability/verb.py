@@ -27,7 +27,7 @@ def stability_chart(model: CompiledModel, grid, *, about: str = "static", option
     system = getattr(model.system, "full", model.system)
     if about == "static":
         lin = compile_linearisation(system, options or model.integration,
-                                    verbose=bool(execution and execution.progress))
+                                    verbose=(execution or Execution()).verbose)
         defaults = dict(zip(model.parameter_names, model.parameter_vector(values).tolist()))
         lin = replace(lin, base_parameters=defaults)
         return static_chart(lin, grid, refine=refine, tolerance=tolerance, execution=execution)

@@ -78,7 +78,7 @@ def run_sweep(
     """
     options = model.run_options(options)
     execution = execution or Execution()
-    workers, lanes, progress = Workers.of(execution), execution.with_lanes(False), bool(execution.progress)
+    workers, lanes, progress = Workers.of(execution), execution.with_lanes(False), execution.verbose
     plan = _SweepPlan.make(model, axes, options, mode, direction, y0, poincare, values)
     at_once = 1 if workers.scheduler is not None else min(workers.count, len(plan.points))
     if at_once > 1:  # each worker holds the records of a point
