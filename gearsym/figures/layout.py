@@ -65,7 +65,9 @@ def fit_texts(fig):
     """Wrap every title of ``fig`` that is wider than what holds it, laying the figure out again until
     nothing changes; returns ``fig``."""
     for _ in range(4):
-        fig.canvas.draw()
+        # the layout and every text's size, without rasterising a pixel: a figure of many points costs its
+        # rendering once, when it is saved, not at each pass here
+        fig.draw_without_rendering()
         renderer = fig.canvas.get_renderer()
         if not any([_rewrap(text, room, renderer) for text, room in _titles(fig)]):
             break
