@@ -19,7 +19,7 @@ BENCH = ROOT.parent / "bench"
 
 #: the stages from the bottom up (docs/architecture.md): a module may import its own stage and those below
 LAYERS = [
-    {"errors", "version", "files", "units", "checks", "options", "parameters", "caller", "memory", "rounding"},
+    {"errors", "version", "files", "units", "checks", "options", "parameters", "caller", "memory"},
     {"geometry"},
     {"model"},
     {"system", "registry"},
