@@ -83,8 +83,9 @@ INTEGRATORS = ("auto", *METHODS)
 class Integration:
     """Fixed-step RK4 over whole forcing periods.
 
-    * ``periods``: forcing periods in all, the transient included; ``discard``: the transient periods
-      left out of every average, amplitude and sample.
+    * ``periods``: periods in all, the transient included; ``discard``: the transient periods
+      left out of every average, amplitude and sample. A period is the system's: one forcing period, or for
+      a system whose period holds several (``FirstOrderSystem.cycles``: 61 for a 23/61, 19/47 box) all of them.
     * ``steps_per_period``: RK4 steps per forcing period.
     * ``locate_crossings``: split every step that crosses a backlash switching surface at the crossing,
       so that RK4 stays 4th order across the kink of g (exponents on periodic orbits ~1e-8 accurate at 200
@@ -115,7 +116,8 @@ class Integration:
         discard = whole_number(self.discard, "discard")
         if discard >= periods:
             raise GearsymError(f"the transient (discard={discard}) must be shorter than the run (periods={periods}): "
-                               "periods counts every forcing period, the discarded ones included")
+                               "periods counts every forcing period, the discarded ones included; give "
+                               f"{option('discard', 0)} or more periods")
         steps = whole_number(self.steps_per_period, "steps per period", 1)
         if steps > MAX_STEPS_PER_PERIOD:
             raise GearsymError(f"{option('steps_per_period', steps)}: at most {MAX_STEPS_PER_PERIOD} RK4 steps per "

@@ -13,6 +13,7 @@ import gearsym
 from gearsym import Execution, FirstOrderSystem, Integration
 from gearsym.analysis.basins import DIVERGED, UNDETERMINED, basin_map
 from gearsym.cli import main
+from gearsym.figures.basins import plot_basin_map
 from gearsym.sweep.basin_continuation import APPEARS, VANISHES, continue_basins
 
 import conftest
@@ -242,3 +243,22 @@ def test_a_model_with_physical_values_is_mapped_and_answered_in_its_units(capsys
         assert a["amplitude"]["x"]["unit"] == "µm" and a["points"]["v"]["unit"] == "mm/s"
     code, _, err = run_cli(capsys, "basins", "spur_pair", "--grid", "x=-1:1:1", "--grid", "v=0,1")
     assert code == 2 and "give the grid with its unit" in err
+
+
+def test_a_physical_maps_title_gives_the_users_values_and_its_exponents_are_per_second(capsys, tmp_path,
+                                                                                          monkeypatch):
+    import gearsym.cli.basins as command
+
+    drawn = []
+    monkeypatch.setattr(command, "plot_basin_map", lambda shown, path: drawn.append(plot_basin_map(shown, path)))
+    code, out, _ = run_cli(capsys, "basins", "spur_pair", "--set", "speed=5000 rpm", "--grid", "x=-20um:20um:20um",
+                           "--grid", "v=-300mm/s:300mm/s:300mm/s", "--periods", "60", "--discard", "20",
+                           "--plot", str(tmp_path / "map.png"))
+    assert code == 0
+    fig = drawn[0]
+    title = fig.axes[0].get_title().replace("\n", " ")
+    assert "speed=5000 rpm" in title and "the rest as the model declares them" in title
+    assert "ζ" not in title and "B0" not in title  # (the engine's groups: in the files, not the title)
+    legend = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert any("λ₁ = " in t and t.endswith("1/s") for t in legend)
+    assert "the rest as the model declares them" in out

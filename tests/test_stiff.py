@@ -174,3 +174,32 @@ def test_a_stiff_damped_shaft_integrated_by_the_stiff_step_agrees_with_scipys_ra
     ours = np.array([trajectory[name][-1] for name in s.state_names])
     scale = np.max(np.abs(radau.y), axis=1)
     assert np.max(np.abs(ours - radau.y[:, -1]) / scale) < 1e-6
+
+
+def test_a_ranges_step_is_said_in_seconds_and_hz_at_the_speed_whose_fastest_mode_chose_it():
+    from types import SimpleNamespace
+
+    from gearsym.cli.arguments.integration import step_line
+    from gearsym.codegen.fastest_mode import chosen_integration
+
+    scaling = gearsym.scaling("spur_pair")  # declared at 6000 rpm
+    s = scaling.system()
+    low = scaling.omega("1000 rpm")  # per unit tau, its modes are 6 times faster there: it chooses the step
+
+    def said(points):
+        options = chosen_integration(Integration(), s, points)
+        steps = options.steps_per_period
+        return options, step_line(SimpleNamespace(integration=options, system=s, steps_per_cycle=steps,
+                                                  steps_per_period=steps, cycles=1), scaling)
+
+    own, line_own = said([])
+    ranged, line = said([{"omega": low}, {"omega": s.parameters["omega"]}])
+    hz = fastest_rate(s, {"omega": low}) * low * scaling.omega_n_si / (2 * math.pi)
+    assert ranged.steps_per_period > own.steps_per_period
+    def hz_said(text):  # (from the rate as printed, 4 digits)
+        return float(text.split("per unit time = ")[1].split(" Hz")[0])
+
+    assert " Hz at 1000 rpm" in line and hz_said(line) == pytest.approx(hz, rel=1e-3)  # (not 6 times it)
+    assert hz_said(line_own) == pytest.approx(hz, rel=2e-3)  # the same mode at 6000 rpm
+    h = 2 * math.pi / ranged.steps_per_period / (low * scaling.omega_n_si)
+    assert f"h = {h * 1e6:.4g} µs at 1000 rpm" in line

@@ -18,7 +18,7 @@ from ..sweep.basin_continuation import MATCH_DISTANCE, StartGrid, continue_basin
 from ..sweep.grid import Axis, parse_axis
 from ..sweep.store import sidecar
 from .arguments.integration import add_integration_arguments, compiled_from, scaling_from
-from .arguments.settings import add_set_argument, parse_state
+from .arguments.settings import add_set_argument, model_settings, parse_state
 
 NAME = "basins"
 HELP = "basins of attraction on a grid of starts (attractors by their Poincare sets), and their fractions along a parameter"
@@ -87,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
         if "omega" in compiled.parameter_names else 1.0
     grid = engine_grid(units, grid_axes, omega) if units is not None else {a.name: a.values for a in grid_axes}
     result = basin_map(compiled, grid, y0=y0, execution=_execution(args))
-    shown = ShownBasinMap(result, shown_in(units), tuple(grid_axes))
+    shown = ShownBasinMap(result, shown_in(units, model_settings(args, cached=True)), tuple(grid_axes))
     if args.out:
         written = write_basin_map(shown, args.out)
         print(f"gearsym: wrote {' and '.join(map(str, written))}", file=sys.stderr)

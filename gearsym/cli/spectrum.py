@@ -78,8 +78,9 @@ def run(args: argparse.Namespace) -> int:
         strongest = sorted((ln for ln in s.lines if ln.gear and math.isfinite(ln.amplitude)),
                            key=lambda ln: -ln.amplitude)[:3]
         energy = ", ".join(f"{g} {s.sideband_energy(g):.3g}" for g in s.gears)
-        print(f"{s.title}: {s.length:.4g} mesh periods; sideband energy {energy}; strongest "
-              + ", ".join(f"{ln.label} ({ln.order:.4g}) {ln.amplitude:.3g}" for ln in strongest))
+        unit = f" {s.unit}" if s.unit else ""  # (a physical model: its label in the user's values, not the engine's)
+        print(f"{s.info.get('label') or s.title}: {s.length:.4g} mesh periods; sideband energy {energy}; strongest "
+              + ", ".join(f"{ln.label} ({ln.order:.4g}) {ln.amplitude:.3g}{unit}" for ln in strongest))
     if args.out:
         write_atomically(args.out, json.dumps(json_safe({"model": args.model, "source": what,
                                                           "spectra": [s.as_dict() for s in spectra]}), indent=1) + "\n")

@@ -41,5 +41,11 @@ def chosen_integration(options: Integration, system: FirstOrderSystem, points=()
     every point at a step that resolves its fastest mode."""
     if options.integrator != "auto":
         return options
-    rho = max([fastest_rate(system)] + [fastest_rate(system, values) for values in points])
-    return chosen(options, rho, system.cycle_at())
+    own = system.parameters.get("omega")
+    rates = [(fastest_rate(system), own)] + [(fastest_rate(system, values), values.get("omega", own))
+                                             for values in points]
+    rho, omega = max(rates, key=lambda r: r[0])
+    # (a rate per unit time is per unit of tau: where omega differs from the model's, the note says at which, so
+    # that its frequency is converted there)
+    where = f" at omega={omega!r}" if omega is not None and omega != own else ""
+    return chosen(options, rho, system.cycle_at(), where)

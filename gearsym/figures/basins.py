@@ -74,7 +74,7 @@ def _shown_number(shown: ShownBasinMap, name: str, value: float) -> str:
 
 def attractor_label(a, shown: ShownBasinMap) -> str:
     amplitude = ", ".join(f"A_{k} = {_shown_number(shown, k, v)}" for k, v in a.amplitude.items())
-    lam = f", λ₁ = {a.exponents[0]:+.4f}" if len(a.exponents) and np.isfinite(a.exponents[0]) else ""
+    lam = f", λ₁ = {shown.exponent(a.exponents[0])}" if len(a.exponents) and np.isfinite(a.exponents[0]) else ""
     return (f"{a.number}: {a.description}, {100 * a.fraction:.1f} ± {100 * a.stderr:.1f} % of starts; "
             f"{amplitude}{lam}")
 

@@ -39,12 +39,23 @@ class OwnNumbers:
         """The parameter values of a run, as a title shows them."""
         return ", ".join(parameter_text(k, v) for k, v in values.items())
 
+    def run_parameters(self, values: dict) -> str:
+        """The parameter values of one run, as its title shows them."""
+        return self.parameters(values)
+
+    def exponent(self, value: float, omega: float | None) -> str:
+        """An exponent (per unit of the model's time) as shown."""
+        return f"{value:+.4f}"
+
 
 class PhysicalUnits(OwnNumbers):
-    """States in the length unit and mm/s, omega as the speed (in its unit), other parameters as they are."""
+    """States in the length unit and mm/s, omega as the speed (in its unit); of the other parameters (the engine's
+    groups, numbers nobody gave) a title shows only the values the user gave (``given``: --set's, as given), the
+    rest being the model's declared physical values (every engine number is in the files)."""
 
-    def __init__(self, units: PointUnits):
+    def __init__(self, units: PointUnits, given: dict | None = None):
         self.units = units
+        self.given = {k: v for k, v in (given or {}).items() if k != "teeth"}
 
     def state(self, name: str, values, omega: float | None = None) -> tuple[np.ndarray, str]:
         if name not in self.units.kinds:
@@ -74,6 +85,20 @@ class PhysicalUnits(OwnNumbers):
                 parts.append(parameter_text(k, v))
         return ", ".join(parts)
 
+    def run_parameters(self, values: dict) -> str:
+        """The speed and the values the user gave, in their units (not the engine's groups, which nobody gave:
+        the files hold them)."""
+        speed = self.units.speed.parameter if self.units.speed is not None else None
+        parts = [self.parameters({"omega": values["omega"]})] if "omega" in values and speed else []
+        parts += [f"{k}={v}" for k, v in self.given.items() if k != speed]
+        return ", ".join(parts + ["the rest as the model declares them"])
+
+    def exponent(self, value: float, omega: float | None) -> str:
+        """An exponent (per unit tau at ``omega``) as shown: per second."""
+        if omega is None:
+            return super().exponent(value, omega)
+        return f"{value * omega * self.units.omega_n:+.4g} 1/s"
+
 
 #: the dimension (exponents of mass, length, time) of each kind of state, and a grid of it in its unit
 _DIMENSIONS = {LENGTH: ((0.0, 1.0, 0.0), "-20um:20um:1um"), VELOCITY: ((0.0, 1.0, -1.0), "-500mm/s:500mm/s:25mm/s"),
@@ -99,9 +124,10 @@ def check_grid_units(units: PointUnits, axes: Sequence[Axis]) -> None:
                                f"a unit of a {kind}, e.g. {example}")
 
 
-def shown_in(units: PointUnits | None) -> OwnNumbers:
-    """How results are shown for a model with these ``units`` (None: a model without physical values)."""
-    return OwnNumbers() if units is None else PhysicalUnits(units)
+def shown_in(units: PointUnits | None, given: dict | None = None) -> OwnNumbers:
+    """How results are shown for a model with these ``units`` (None: a model without physical values), the values
+    the user gave being ``given``."""
+    return OwnNumbers() if units is None else PhysicalUnits(units, given)
 
 
 @dataclass(frozen=True)
@@ -130,7 +156,11 @@ class ShownBasinMap:
         return float(values[0]), unit
 
     def parameters_text(self) -> str:
-        return self.units.parameters(self.result.parameters)
+        return self.units.run_parameters(self.result.parameters)
+
+    def exponent(self, value: float) -> str:
+        """An exponent of the map's run as shown (per second for a model with physical values)."""
+        return self.units.exponent(value, self.omega)
 
     def as_dict(self) -> dict:
         """The map's record: in the model's units when it has physical values (the grid as given, amplitudes,

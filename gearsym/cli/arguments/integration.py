@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import itertools
+import re
 from collections.abc import Callable
 
 import gearsym  # the face: its verbs load on first use, so a cached model's run never loads the generator
@@ -22,7 +23,9 @@ def add_integration_arguments(parser: argparse.ArgumentParser, *, periods: int |
     group = parser.add_argument_group("integration (the same for every command that integrates)")
     if periods is not None:
         group.add_argument("--periods", type=int, default=periods,
-                           help=f"forcing periods in all, the discarded ones included (default {periods})")
+                           help=f"periods in all, the discarded ones included (default {periods}): forcing "
+                                "periods, or for a model whose meshes repeat only together its common period (61 "
+                                "mesh periods for a 23/61, 19/47 box: the run says which)")
         group.add_argument("--discard", type=int, default=discard,
                            help=f"transient periods left out of every result (default {discard})")
     group.add_argument("--steps-per-period", type=int, default=None, help=steps_help)
@@ -114,14 +117,22 @@ def step_line(compiled, scaling=None) -> str:
     first = scaling.point_units().meshes[0].name if scaling is not None and scaling.point_units().meshes else None
     per = f"mesh period of {first!r}" if first else "forcing period"
     span = (f", {compiled.steps_per_period} per period of {compiled.cycles} of them" if compiled.cycles > 1 else "")
+    why = integration.choice or "as asked"
+    # the point of a sweep's range whose fastest mode chose the step (fastest_mode.chosen_integration), if not the
+    # model's own: its step in seconds and its mode in Hz are at that point's speed
+    at = re.search(r" at omega=(\S+?)(?=[:;)\s]|$)", why)
     if scaling is not None:
         units = scaling.point_units()
-        omega = compiled.system.parameters.get("omega", 1.0)
+        omega = float(at[1]) if at else compiled.system.parameters.get("omega", 1.0)
         to_s = 1.0 / (omega * units.omega_n)  # seconds per unit of tau
-        h = f"h = {cycle / steps * to_s * 1e6:.4g} µs"
+        where = ""
+        if at:
+            speed = scaling.speed_at(omega)
+            where = f" at {speed.magnitude:.4g} {speed.units:~P}"
+            why = why.replace(at[0], where)
+        h = f"h = {cycle / steps * to_s * 1e6:.4g} µs{where}"
     else:
         h = f"h = {cycle / steps:.4g}"
-    why = integration.choice or "as asked"
     if scaling is not None and "fastest linearised mode" in why:  # its rate in Hz too
         rate = float(why.split("fastest linearised mode ")[1].split(":")[0].split()[0])
         why = why.replace(f"fastest linearised mode {rate:.4g}",
