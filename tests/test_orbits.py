@@ -4,6 +4,7 @@ SciPy shooting of the Duffing oscillator's folds and its harmonic balance, and a
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -323,3 +324,23 @@ def test_the_count_of_each_bifurcation_is_the_same_when_the_linear_algebra_round
         assert again[kind] == pytest.approx(found[kind], abs=1e-6), kind
     for a, b in zip(plain.branches[1:], perturbed.branches[1:]):
         assert b.states[0] == pytest.approx(a.states[0], abs=1e-6)
+
+
+def test_a_continuation_says_its_progress_as_it_goes_and_quiet_silences_it(monkeypatch, capsys):
+    """Long work shows progress: each branch's points and its share of the range, a line every few seconds (here
+    every point), to the caller's function in Python, on stderr from the command line unless --quiet."""
+    import gearsym.periodic.continuation as continuation
+
+    monkeypatch.setattr(continuation, "PROGRESS_SECONDS", 0.0)
+    lines = []
+    result = continue_orbits(compile_model(system("one_stage")), "omega", 1.6, 2.0, max_points=30,
+                             execution=gearsym.Execution(progress=lines.append))
+    said = [re.fullmatch(r"orbits: period-(\d+) branch: (\d+) points \(at most 30\), (-?\d+)% of the range from "
+                         r"its start", line) for line in lines]
+    assert said and all(said) and said[0].group(1) == "1", lines
+    first = [(int(m.group(2)), int(m.group(3))) for m in said if m.group(1) == "1"]
+    assert first == sorted(first) and 0 < first[-1][1] <= 100 and len(result.branches[0]) >= first[-1][0]
+    assert continue_orbits(compile_model(system("one_stage")), "omega", 1.6, 2.0, max_points=30).branches
+    argv = ["orbits", "one_stage", "--param", "omega=1.6:2.0", "--max-points", "30"]
+    assert main(argv) == 0 and "orbits: period-1 branch: " in capsys.readouterr().err
+    assert main([*argv, "--quiet"]) == 0 and "orbits: " not in capsys.readouterr().err

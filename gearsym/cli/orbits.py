@@ -14,6 +14,7 @@ from ..errors import GearsymError, UnknownParameterError
 from ..figures.orbits import plot_orbits
 from ..files.atomic import write_atomically
 from ..files.outputs import check_figure, check_file
+from ..options import Execution
 from ..periodic import ContinuationInterrupted, continue_orbits, periodic_orbit
 from ..periodic.files import write_orbits
 from ..periodic.orbit import sweep_start
@@ -62,6 +63,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="follow the period-2n branch born at each period doubling, D doublings deep "
                              "(default 1; 0: none)")
     parser.add_argument("--max-points", type=int, default=2000, help="points per branch at most (default 2000)")
+    parser.add_argument("--quiet", action="store_true", help="no progress lines while a branch is followed")
     add_integration_arguments(parser, periods=None)
     parser.add_argument("--out", type=Path, metavar="F.csv",
                         help="one row per branch point (parameter, amplitudes, |multipliers|, stable, contact "
@@ -195,7 +197,8 @@ def _json(value: Measured) -> dict:
 def _continuation(compiled, args, name, start, stop, y0, sweep, physical) -> int:
     try:
         result = continue_orbits(compiled, name, start, stop, y0=y0, period_multiple=args.period_multiple,
-                                 segments=args.segments, switch_depth=args.switch_depth, max_points=args.max_points)
+                                 segments=args.segments, switch_depth=args.switch_depth, max_points=args.max_points,
+                                 execution=Execution(progress=not args.quiet))
     except ContinuationInterrupted as exc:  # keep what was traced: the files say it was interrupted
         if args.out:
             _write(exc.result, args.out, physical)

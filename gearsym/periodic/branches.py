@@ -8,7 +8,7 @@ import numpy as np
 from ..checks import json_safe, whole_number
 from ..codegen import CompiledModel, engine_verb
 from ..errors import GearsymError, UnknownParameterError
-from ..options import Integration
+from ..options import Execution, Integration
 from .continuation import Solution, Steps, Traced, Tracer
 from .floquet import contact_regime, mesh_watches, PERIOD_DOUBLING
 from .orbit import find_orbit, starting_states
@@ -129,7 +129,7 @@ class Continuation:
 def continue_orbits(model: CompiledModel, parameter: str, start: float, stop: float, *, y0=None,
                     period_multiple: int = 1, segments: int | None = None, options: Integration | None = None,
                     step: float | None = None, max_step: float | None = None, max_points: int = 2000,
-                    switch_depth: int = 1, **values: float) -> Continuation:
+                    switch_depth: int = 1, execution: Execution | None = None, **values: float) -> Continuation:
     """Periodic orbits of ``period_multiple`` forcing periods from ``parameter`` = ``start`` to ``stop``, by
     pseudo-arclength continuation through folds, with their Floquet multipliers, stability, contact
     regimes and the bifurcations between them located (folds, period doublings, Neimark-Sacker, grazings).
@@ -139,6 +139,7 @@ def continue_orbits(model: CompiledModel, parameter: str, start: float, stop: fl
     followed too, down to ``switch_depth`` doublings (0: none). ``step``, ``max_step``: in the norm of
     :mod:`gearsym.periodic.continuation` (default: 1/50 of the range, and the smaller of half the range and
     ``MAX_STEP_OF_SIZE`` times 1 + the root-mean-square state of the orbit a step starts from).
+    ``execution``: its ``progress`` says each branch's points as they come (a line every few seconds).
     """
     options = model.run_options(options)
     segments = model.cycles if segments is None else segments  # (one per mesh period of a revolution)
@@ -156,14 +157,15 @@ def continue_orbits(model: CompiledModel, parameter: str, start: float, stop: fl
     watches = mesh_watches(model)
     started: list[Traced] = []
     ev, _ = find_orbit(problem, starting_states(model, y0, options, period_multiple, problem.inputs(start)), start)
-    tracer = Tracer(problem, start, stop, steps, watches, started)
+    say = execution.say if execution is not None and execution.verbose else None
+    tracer = Tracer(problem, start, stop, steps, watches, started, say)
     settings = {"integration": options.describe(), "steps_per_period": model.steps_per_period,
                 "locate_crossings": model.options.locate_crossings, "period_multiple": period_multiple,
                 "segments": segments, "transient_periods": None if y0 is not None else options.periods,
                 "switch_depth": switch_depth, "steps": vars(tracer.steps)}
     try:
         traced = [tracer.trace(tracer.first(ev.z, start))]
-        _switch_branches(model, parameter, traced, start, stop, steps, watches, switch_depth, started)
+        _switch_branches(model, parameter, traced, start, stop, steps, watches, switch_depth, started, say)
     except KeyboardInterrupt as exc:
         if not started:
             raise
@@ -195,7 +197,7 @@ def _continuation(model, problem, parameter, start, stop, traced, watches, setti
 
 
 def _switch_branches(model, parameter: str, traced: list[Traced], start, stop, steps, watches, depth: int,
-                     started: list) -> None:
+                     started: list, say=None) -> None:
     """Branch switching at every period doubling (breadth first, ``depth`` doublings deep): a period-2n
     branch that rejoins its parent at another period doubling takes that one off the list."""
     queue = [(0, s) for s in traced[0].solutions if s.event and s.event[0] == PERIOD_DOUBLING] if depth else []
@@ -205,7 +207,7 @@ def _switch_branches(model, parameter: str, traced: list[Traced], start, stop, s
         if id(pd) in done:
             continue
         done.add(id(pd))
-        child = _doubled_branch(model, parameter, traced[parent], pd, start, stop, steps, watches, started)
+        child = _doubled_branch(model, parameter, traced[parent], pd, start, stop, steps, watches, started, say)
         if child is None:
             continue
         child.parent = parent
@@ -227,13 +229,13 @@ def _switch_branches(model, parameter: str, traced: list[Traced], start, stop, s
 
 
 def _doubled_branch(model, parameter: str, parent: Traced, pd: Solution, start, stop, steps, watches,
-                    started: list) -> Traced | None:
+                    started: list, say=None) -> Traced | None:
     """The period-2n branch born at the period doubling ``pd``: its start is ``pd``'s orbit taken twice
     plus a step along the eigenvector of the multiplier nearest -1, carried around the doubled orbit."""
     base = pd.ev.z
     shooting = Shooting(parent.period_multiple * 2, len(base) // parent.period_multiple)
     problem = OrbitMap(model, shooting, parameter, dict(zip(model.parameter_names, pd.ev.inputs.p)))
-    tracer = Tracer(problem, start, stop, steps, watches, started)
+    tracer = Tracer(problem, start, stop, steps, watches, started, say)
     mu, vectors = np.linalg.eig(pd.ev.monodromy)
     k = int(np.argmin(np.abs(mu + 1)))
     direction = np.real(vectors[:, k])

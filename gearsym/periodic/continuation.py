@@ -34,6 +34,8 @@ never a fold: the branch turns there onto its own other half).
 """
 from __future__ import annotations
 
+import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -64,6 +66,8 @@ MAX_STEP_OF_SIZE = 0.02
 GROW, EASY, HARD = 1.5, 3, 5
 #: Newton iterations of a corrector before the step is halved
 MAX_CORRECTIONS = 8
+#: seconds between two lines of a continuation's progress
+PROGRESS_SECONDS = 2.0
 #: regula falsi iterations to locate a test function's zero, and when it is located: the bracket below this
 #: fraction of the step, or the test function below this fraction of its change over the step
 MAX_LOCATE, LOCATED = 30, 1e-10
@@ -136,8 +140,10 @@ class Traced:
 class Tracer:
     """Follows branches of one shooting problem over [lo, hi] of its parameter."""
 
-    def __init__(self, problem: OrbitMap, start: float, stop: float, steps: Steps, watches=(), started=None):
+    def __init__(self, problem: OrbitMap, start: float, stop: float, steps: Steps, watches=(), started=None,
+                 say: Callable[[str], None] | None = None):
         self.problem, self.steps = problem, steps.resolved(stop - start)
+        self.start, self.say = start, say  # say: a line of progress every PROGRESS_SECONDS (None: silent)
         self.sized = steps.max_step is None  # the largest step follows the orbits' size
         self.started = started if started is not None else []  # every branch traced, finished or not, in order
         self.lo, self.hi, self.direction = min(start, stop), max(start, stop), (1.0 if stop >= start else -1.0)
@@ -286,11 +292,23 @@ class Tracer:
                 traced.end = f"reached {self.problem.parameter}={b.value:g}"
                 break
             a = b
+            self.report(traced, b)
             if doubled:
                 self.reference = self.halves(b)
             ds = min(ds * GROW, self.largest_step(b)) if b.iterations <= EASY else ds / 2 if b.iterations >= HARD \
                 else ds
         return traced
+
+    def report(self, traced: Traced, b: Solution) -> None:
+        """A line of progress, at most every ``PROGRESS_SECONDS``: the branch, its points, where it is in the range
+        (as a share of it from the start: the parameter's own unit is the caller's)."""
+        now = time.monotonic()
+        if self.say is None or now - getattr(self, "_said", now - PROGRESS_SECONDS) < PROGRESS_SECONDS:
+            return
+        self._said = now
+        share = (b.value - self.start) / (self.hi - self.lo) * self.direction
+        self.say(f"orbits: period-{self.problem.shooting.period_multiple} branch: {len(traced.solutions)} points "
+                 f"(at most {self.steps.max_points}), {share:.0%} of the range from its start")
 
     def rejoin(self, located: list, b: Solution) -> Solution | None:
         """Where a period-2n branch comes back to the period-n branch in this step: the located zero of its
