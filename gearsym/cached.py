@@ -18,7 +18,7 @@ it does not keep (a SymPy expression). A summary that is missing, unreadable, no
 library that is gone is ignored and rewritten; files are written atomically. Only JSON is read.
 
 A summary is trusted no more than the library: it is read as a private file
-(:func:`~gearsym.files.private.read_private`), its content must match the seal written with it (a hash of the
+(:func:`~gearsym.files.sealed.read_sealed`), its content must match the seal written with it (a hash of the
 content and the file's name, which hashes the model and values it is for), and what it says must match what
 it describes: the library's record (:mod:`gearsym.codegen.trust`) must name the same model, code hash, states
 and parameters. A summary that does not (edited: states swapped, values changed, another model's library) is
@@ -43,11 +43,10 @@ from .codegen.loops import LoopOptions
 from .codegen.step_choice import chosen
 from .codegen.native import load_native
 from .codegen.trust import check, differences
-from .errors import warn
 from .options import Integration
 from .parameters import Constraint, ParameterChecks
 from .physical.point import CachedScaling, PointUnits
-from .files.private import NotPrivate, read_private, write_private
+from .files.sealed import distrust, read_sealed, write_sealed
 from .registry import model_file, models_dir
 from .stability.recipe import CompiledLinearisation
 from .stability.recipe import StaticRecipe
@@ -200,41 +199,16 @@ def summary_path(name: str, key: str) -> Path:
 
 
 def read_json(path: Path) -> dict | None:
-    """A summary this module wrote, or None (missing, partial, corrupt, of another format; or not private, or
-    changed since it was written: said in a warning)."""
-    try:
-        data = json.loads(read_private(path))
-    except NotPrivate as exc:
-        _distrust(path, str(exc))
-        return None
-    except (OSError, ValueError):
-        return None
-    if not (isinstance(data, dict) and data.get("format") == SUMMARY_FORMAT):
-        return None
-    if data.pop("seal", None) != _seal(path, data):
-        _distrust(path, "its content is not what gearsym wrote (edited?)")
-        return None
-    return data
+    """A summary this module wrote, or None (:func:`~gearsym.files.sealed.read_sealed`)."""
+    return read_sealed(path, SUMMARY_FORMAT, _WHAT)
 
 
 def write_json(path: Path, data: dict) -> None:
-    # (keys in their order: the parameters' order is that of the parameter vector)
-    data = {"format": SUMMARY_FORMAT, **data}
-    write_private(path, (json.dumps({**data, "seal": _seal(path, data)}, indent=1) + "\n").encode())
+    write_sealed(path, data, SUMMARY_FORMAT)
 
 
-def _seal(path: Path, data: dict) -> str:
-    """The hash of a summary's content and file name (which hashes the model and values it is for)."""
-    return hashlib.sha256(f"{path.name}\0{json.dumps(data, sort_keys=True)}".encode()).hexdigest()
-
-
-def _distrust(path: Path, why: str) -> None:
-    if path not in _DISTRUSTED:  # (a summary is read more than once in a run: said once)
-        _DISTRUSTED.add(path)
-        warn(f"the cached summary {path} is not used: {why}; gearsym writes it again")
-
-
-_DISTRUSTED: set[Path] = set()
+#: how a warning names a summary not used
+_WHAT = "cached summary"
 
 
 def load_compiled(ref: str, values: Mapping[str, object], options: Integration, *,
@@ -296,7 +270,10 @@ def cached_scaling(ref: str, values: Mapping[str, object], scaling: Callable[[],
 
 def _system_data(ref, values) -> dict | None:
     path = model_file(ref) if isinstance(ref, str) else None
-    return read_json(summary_path(path.stem, system_key(path, values))) if path else None
+    if path is None:
+        return None
+    key = system_key(path, values)
+    return read_json(summary_path(path.stem, key))
 
 
 def _from_cache(system_file: Path, build_file: Path, options: Integration, loops: LoopOptions,
@@ -311,14 +288,14 @@ def _from_cache(system_file: Path, build_file: Path, options: Integration, loops
     if library.parent != cache_dir("lib") or library.name.startswith("."):
         return None  # (only a library of our own cache is loaded)
     if not set(timed) <= set(summary.parameters):
-        _distrust(build_file, "it names parameters its model does not have")
+        distrust(build_file, "it names parameters its model does not have", _WHAT)
         return None
     verdict = check(library)  # (a library not as compiled is said and made again by compile_model)
     if verdict.data is None:
         return None
     why = differences(verdict.describes, library_describes(summary, digest))
     if why is not None:  # (the summaries do not describe the library they point at: edited)
-        _distrust(build_file, f"{library.name}, the library it points at, does not match it: {why}")
+        distrust(build_file, f"{library.name}, the library it points at, does not match it: {why}", _WHAT)
         return None
     key = model_key(digest, "compiled")
     found = loaded(key)

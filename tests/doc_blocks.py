@@ -11,6 +11,12 @@ command prints when it runs after the page's blocks before it:
 
     <!-- output of: gearsym modes planetary -->
 
+A ``bash`` block that shows again commands a page of the docs runs (the README's overview of a verb whose page
+explains it) names that page, and is not run a second time: each of its commands must be, word for word, a
+command of a block that runs on one of the pages named (``tests/test_doc_examples.py`` checks it):
+
+    <!-- runs in: docs/orbits.md -->
+
 A ``mermaid`` diagram needs no marker; any other fence (untagged, ``text``, ...) needs one of the two, so that
 no command hides in a block nobody runs. Each page's blocks run in order in one folder of their own (a
 command may use the file an earlier block wrote, as a reader following the page would).
@@ -34,7 +40,7 @@ RUN = ("bash", "python")
 DIAGRAMS = ("mermaid",)
 _FENCE = re.compile(r"^(?P<indent>[ \t]*)```(?P<language>[\w-]*)[ \t]*\n(?P<body>.*?)^(?P=indent)```[ \t]*$",
                     re.S | re.M)
-_MARKER = re.compile(r"<!--\s*(not run|output of):\s*(.*?)\s*-->")
+_MARKER = re.compile(r"<!--\s*(not run|output of|runs in):\s*(.*?)\s*-->")
 
 
 @dataclass
@@ -45,6 +51,7 @@ class Block:
     code: str
     not_run: str | None = None  # the reason given
     output_of: str | None = None  # the command whose output the block lists
+    runs_in: str | None = None  # the pages whose blocks run its commands (comma-separated)
 
     @property
     def name(self) -> str:
@@ -52,7 +59,12 @@ class Block:
 
     @property
     def runs(self) -> bool:
-        return self.language in RUN and self.not_run is None and self.output_of is None
+        return self.language in RUN and self.not_run is None and self.output_of is None and self.runs_in is None
+
+    @property
+    def commands(self) -> list[str]:
+        """The block's commands as one line each: continuation lines joined, comments and spacing dropped."""
+        return commands(self.code)
 
 
 def pages() -> list[Path]:
@@ -74,14 +86,27 @@ def blocks(page: Path) -> list[Block]:
         code = "\n".join(line[len(indent):] if line.startswith(indent) else line
                          for line in m.group("body").split("\n"))
         out.append(Block(name, text[:m.start()].count("\n") + 1, m.group("language"), code,
-                         markers.get("not run"), markers.get("output of")))
+                         markers.get("not run"), markers.get("output of"), markers.get("runs in")))
     return out
+
+
+def commands(code: str) -> list[str]:
+    """The shell commands of ``code``, each as one line (see ``Block.commands``)."""
+    joined = re.sub(r"\\\n\s*", " ", code)
+    found = []
+    for line in joined.split("\n"):
+        words = shlex.split(line, comments=True)
+        if words:
+            found.append(shlex.join(words))
+    return found
 
 
 def unmarked(block: Block) -> str | None:
     """Why a block breaks the rules above (None if it keeps them)."""
     if block.not_run is not None and not block.not_run.strip():
         return "a 'not run' marker without its reason"
+    if block.runs_in is not None and block.language != "bash":
+        return "a 'runs in' marker on a block that is not ```bash (only shell commands are looked up on a page)"
     if block.language in RUN or block.language in DIAGRAMS:
         return None
     if block.not_run is None and block.output_of is None:

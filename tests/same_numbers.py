@@ -1,11 +1,11 @@
-"""Committed outputs compared as numbers, not bytes (``gearsym.rounding`` says how): texts, listings, JSON
+"""Committed outputs compared as numbers, not bytes (``gearsym.reproduce.rounding`` says how): texts, listings, JSON
 records, and CSV files cell by cell."""
 from __future__ import annotations
 
 import csv
 import io
 
-from gearsym.rounding import NUMBER, differences, numbers_agree, record_differences
+from gearsym.reproduce.rounding import NUMBER, differences, numbers_agree, record_differences
 
 __all__ = ["NUMBER", "csv_differences", "differences", "json_differences", "numbers_agree"]
 json_differences = record_differences

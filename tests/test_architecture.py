@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import ast
 import collections
+import functools
 from pathlib import Path
 
 import pytest
@@ -19,7 +20,7 @@ BENCH = ROOT.parent / "bench"
 
 #: the stages from the bottom up (docs/architecture.md): a module may import its own stage and those below
 LAYERS = [
-    {"errors", "version", "files", "units", "checks", "options", "parameters", "caller", "memory", "rounding"},
+    {"errors", "version", "files", "units", "checks", "options", "parameters", "caller", "memory"},
     {"geometry"},
     {"model"},
     {"system", "registry"},
@@ -48,26 +49,39 @@ def modules(root: Path) -> dict[str, Path]:
     return out
 
 
-def _type_checking_nodes(tree: ast.AST) -> set[int]:
-    skip = set()
-    for node in ast.walk(tree):
+def _import_nodes(tree: ast.AST, inside: bool = False):
+    """Every import statement of ``tree`` with whether it is inside a function, those under ``if TYPE_CHECKING``
+    left out (one pass over the tree)."""
+    for node in ast.iter_child_nodes(tree):
         if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
-            skip |= {id(sub) for sub in ast.walk(node)}
-    return skip
+            continue
+        if isinstance(node, (ast.Import, ast.ImportFrom)):
+            yield node, inside
+        yield from _import_nodes(node, inside or isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)))
 
 
-def imports(root: Path):
-    """(importer, imported module, inside a function?) for every import of the package's own modules."""
+def imports(root: Path) -> tuple[tuple[str, str, bool], ...]:
+    """(importer, imported module, inside a function?) for every import of the package's own modules (the files
+    read and parsed once for all the tests of this file)."""
+    return _imports(root)
+
+
+@functools.cache
+def _imports(root: Path) -> tuple[tuple[str, str, bool], ...]:
+    return tuple(_each_import(root))
+
+
+@functools.cache
+def _parsed(path: Path) -> ast.AST:
+    return ast.parse(path.read_text())
+
+
+def _each_import(root: Path):
     mods = modules(root)
     for name, path in mods.items():
-        tree = ast.parse(path.read_text())
-        skip = _type_checking_nodes(tree)
-        inside = {id(sub) for f in ast.walk(tree) if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef))
-                  for sub in ast.walk(f)}
+        tree = _parsed(path)
         package = name.split(".") if path.name == "__init__.py" else name.split(".")[:-1]
-        for node in ast.walk(tree):
-            if id(node) in skip or not isinstance(node, (ast.Import, ast.ImportFrom)):
-                continue
+        for node, inside in _import_nodes(tree):
             if isinstance(node, ast.ImportFrom):
                 base = ".".join((package[: len(package) - node.level + 1] if node.level else [])
                                 + ([node.module] if node.module else []))
@@ -78,7 +92,7 @@ def imports(root: Path):
                 while target and target not in mods:
                     target = target.rpartition(".")[0]
                 if target and target != name:
-                    yield name, target, id(node) in inside
+                    yield name, target, inside
                     break
 
 
@@ -147,7 +161,7 @@ def test_imports_run_down_the_pipeline():
 def test_functions_import_only_heavy_libraries():
     light = []
     for name, path in modules(ROOT).items():
-        tree = ast.parse(path.read_text())
+        tree = _parsed(path)
         for f in ast.walk(tree):
             if isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 for node in ast.walk(f):

@@ -56,6 +56,17 @@ def test_a_block_runs_as_printed(block, user_folders):
                                      f"listing: {r.listing_missing}")
 
 
+@pytest.mark.parametrize("block", [b for b in BLOCKS if b.runs_in is not None], ids=lambda b: b.name)
+def test_a_block_shown_again_is_run_on_the_page_it_names(block):
+    """The README's overview of a verb shows the commands its docs page runs: each is run once, there, word for word."""
+    named = [REPO / p.strip() for p in block.runs_in.split(",")]
+    assert all(p.is_file() for p in named), f"{block.name}: 'runs in' names no page: {block.runs_in}"
+    run_there = {c for p in named for b in doc_blocks.blocks(p) if b.runs and b.language == "bash" for c in b.commands}
+    assert block.commands, f"{block.name}: no command to look up"
+    missing = [c for c in block.commands if c not in run_there]
+    assert not missing, f"{block.name}: not run on {block.runs_in}: {missing}"
+
+
 def test_the_test_command_and_the_main_command_are_marked_as_the_clones_own():
     readme = {b.line: b for b in doc_blocks.blocks(REPO / "README.md")}
     text = (REPO / "README.md").read_text().split("\n")

@@ -580,3 +580,17 @@ def test_a_fault_depth_outside_0_to_1_is_refused_by_the_fmu(cracked, q):
     assert "failed with status 3 (error)" in error
     assert (f"the parameter values make the engine's q {q:g}, but it must be at least 0 and less than 1 (the fraction "
             "of the stiffness of the pair of tooth 7 of 'gear1' that its fault takes away)") in log
+
+
+def test_all_writes_one_fmu_per_model_into_the_folder(tmp_path, monkeypatch, capsys):
+    """`gearsym fmu --all --out DIR` (docs/fmu.md): an FMU for each model of `gearsym list`, named after it, into
+    DIR, each said in a line. Two models stand for the list here: every shipped model's FMU costs a minute."""
+    import gearsym.cli.fmu as command
+
+    monkeypatch.setattr(command, "pregenerated_models", lambda: ["one_stage", "spur_pair"])
+    assert main(["fmu", "--all", "--out", str(tmp_path)]) == 0
+    said = capsys.readouterr().out.splitlines()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["one_stage.fmu", "spur_pair.fmu"]
+    for name in ("one_stage", "spur_pair"):
+        assert read_model_description(str(tmp_path / f"{name}.fmu")).modelName == name
+        assert any(line.startswith(f"{name}: {tmp_path / name}.fmu") for line in said), said

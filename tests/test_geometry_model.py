@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 import sympy as sp
-from scipy.integrate import quad
+from scipy.integrate import quad, quad_vec
 
 import gearsym
 from conftest import reduced
@@ -57,19 +57,20 @@ def mesh_of(model: Drivetrain) -> Mesh:
 
 def independent_coefficients(curve, order: int):
     """k / mean's mean square and its cosine and sine coefficients, n = 1 ... order, by SciPy's adaptive quadrature
-    of the sampled curve between its jumps (single <-> double contact), and the mean."""
+    of the sampled curve between its jumps (single <-> double contact), and the mean: every integrand at once
+    (quad_vec, one adaptive subdivision for all of them, to the same tolerance)."""
     split = 2 * math.pi * (curve.contact_ratio - math.floor(curve.contact_ratio))
-    pieces = [(0.0, split), (split, 2 * math.pi)]
+    n = np.arange(1, order + 1)
 
-    def integral(f):
-        return sum(quad(lambda p: float(f(p)), a, b, epsabs=0, epsrel=1e-10, limit=200)[0] for a, b in pieces)
+    def integrands(p):
+        k = float(curve.at(np.array([p]))[0])
+        return np.concatenate([[k, k * k], k * np.cos(n * p), k * np.sin(n * p)])
 
-    k = lambda p: float(curve.at(np.array([p]))[0])  # noqa: E731
-    mean = integral(k) / (2 * math.pi)
-    square = integral(lambda p: (k(p) / mean) ** 2) / (2 * math.pi)
-    cos = [integral(lambda p, n=n: k(p) * math.cos(n * p)) / (math.pi * mean) for n in range(1, order + 1)]
-    sin = [integral(lambda p, n=n: k(p) * math.sin(n * p)) / (math.pi * mean) for n in range(1, order + 1)]
-    return mean, square, np.array(cos), np.array(sin)
+    total = sum(quad_vec(integrands, a, b, epsabs=0, epsrel=1e-10, limit=2000)[0]
+                for a, b in ((0.0, split), (split, 2 * math.pi)))
+    mean = total[0] / (2 * math.pi)
+    square = total[1] / (2 * math.pi) / mean**2
+    return mean, square, total[2:2 + order] / (math.pi * mean), total[2 + order:] / (math.pi * mean)
 
 
 @pytest.fixture(scope="module")

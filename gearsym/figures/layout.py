@@ -61,14 +61,28 @@ def _rewrap(text, room: float, renderer) -> bool:
     return True
 
 
+def _fitted_as(fig) -> tuple:
+    """What the fit of ``fig``'s titles depends on, short of laying it out: its size, its axes and every title's
+    text (a builder fits its figure before it returns it, and saving it fits it again: the second fit is
+    needed only where something was added or retitled in between)."""
+    texts = [t.get_text() for t in (getattr(fig, "_suptitle", None), getattr(fig, "_supxlabel", None)) if t]
+    texts += [t.get_text() for ax in fig.axes for t in (ax.title, ax._left_title, ax._right_title)]
+    return (tuple(fig.get_size_inches()), fig.dpi, tuple(id(ax) for ax in fig.axes), tuple(texts))
+
+
 def fit_texts(fig):
     """Wrap every title of ``fig`` that is wider than what holds it, laying the figure out again until
     nothing changes; returns ``fig``."""
+    if getattr(fig, "_gearsym_fitted", None) == _fitted_as(fig):
+        return fig
     for _ in range(4):
-        fig.canvas.draw()
+        # the layout and every text's size, without rasterising a pixel: a figure of many points costs its
+        # rendering once, when it is saved, not at each pass here
+        fig.draw_without_rendering()
         renderer = fig.canvas.get_renderer()
         if not any([_rewrap(text, room, renderer) for text, room in _titles(fig)]):
             break
+    fig._gearsym_fitted = _fitted_as(fig)
     return fig
 
 

@@ -108,7 +108,7 @@ def place_labels(ax, labels) -> list:
     if not labels:
         return []
     fig = ax.figure
-    fig.canvas.draw()
+    fig.draw_without_rendering()  # (the layout, where the labels are placed; no pixel is needed for it)
     renderer = fig.canvas.get_renderer()
     frame = ax.get_window_extent(renderer)
     points = ax.transData.transform(np.array([(x, y) for x, y, _ in labels], dtype=float))

@@ -38,7 +38,7 @@ def nondimensional_axis(scaling: Scaling, axis: Axis, where: str | None = None) 
     unit = axis.unit
     base = scaling.values
     columns = [scaling.values_at(**{name: Quantity(v, unit)}) for v in axis.values]
-    moved = sorted({k for row in columns for k in row if row[k] != base[k]} or {_first_moved(scaling, name)})
+    moved = sorted({k for row in columns for k in row if row[k] != base[k]} or {scaling.parameter_moved_by(name)})
     if len(moved) != 1:
         raise GearsymError(f"{where}: {name} moves {', '.join(moved)} of the nondimensional model "
                            "together (it changes the units themselves); sweep a value that moves one of them, or "
@@ -63,15 +63,6 @@ def _spelled(axis: Axis, unit: str, where: str) -> str:
     if _PLAIN_UNIT.fullmatch(shown):
         return f"{axis.name}=" + separator.join(f"{p}{shown}" for p in parts)
     return f"\"{axis.name}={separator.join(parts)} {shown}\""
-
-
-def _first_moved(scaling: Scaling, name: str) -> str:
-    """The parameter a one-point axis moves: found by a small step away from it."""
-    q = scaling.inputs.get(name)
-    shifted = scaling.values_at(**{name: q.with_si(q.si * 1.01) if q is not None
-                                   else Quantity(scaling.speed_si() * 1.01, "rad/s")})
-    moved = [k for k, v in shifted.items() if v != scaling.values[k]]
-    return moved[0] if len(moved) == 1 else ",".join(moved)
 
 
 def nondimensional_axes(scaling: Scaling, axes: Sequence[Axis], where: str | None = None) -> tuple[Axis, ...]:

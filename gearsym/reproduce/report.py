@@ -14,7 +14,7 @@ from pathlib import Path
 
 from ..files.atomic import write_atomically
 from ..periodic import FOLD, GRAZING, NEIMARK_SACKER, PERIOD_DOUBLING
-from ..rounding import record_differences
+from .rounding import record_differences
 from .claims import MIN_CHAOTIC
 from .stability import report_lines as stability_lines
 
@@ -338,7 +338,7 @@ SAME_RECORD = 1e-5
 
 def write(record: dict, json_path: Path, doc_path: Path) -> dict:
     """``json_path`` and ``doc_path`` from ``record``; an existing record that ``record`` equals to within rounding
-    (:data:`SAME_RECORD`, texts to the last printed digit: ``gearsym.rounding``) is kept as it is, with its report,
+    (:data:`SAME_RECORD`, texts to the last printed digit: ``gearsym.reproduce.rounding``) is kept as it is, with its report,
     so that another machine's run leaves committed files unchanged. Returns the record written or kept."""
     try:
         old = json.loads(Path(json_path).read_text())

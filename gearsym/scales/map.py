@@ -444,6 +444,15 @@ class Scaling:
         """The nondimensional values with some physical values changed (``speed="3000 rpm"``)."""
         return self.with_values(**physical).values if physical else dict(self.values)
 
+    def parameter_moved_by(self, name: str) -> str:
+        """The nondimensional parameter that the physical value ``name`` moves, found by a small step away from it
+        (the one a one-point axis of ``name`` sweeps; several, comma-separated, where it moves more than one)."""
+        q = self.inputs.get(name)
+        shifted = self.values_at(**{name: q.with_si(q.si * 1.01) if q is not None
+                                    else Quantity(self.speed_si() * 1.01, "rad/s")})
+        moved = [k for k, v in shifted.items() if v != self.values[k]]
+        return moved[0] if len(moved) == 1 else ",".join(moved)
+
     @cached_property
     def initial(self) -> dict[str, float]:
         """The declared initial state in the engine's units: plain numbers are in the model's declared length unit

@@ -89,6 +89,7 @@ def compiled_from(args: argparse.Namespace, options: Integration | None = None, 
                   before: Callable[[object], object] | None = None):
     """The compiled model of the command's MODEL with its --set values (or of ``system``); ``before(system)``:
     the command's checks of its request against the loaded system, made before it is compiled (seconds)."""
+    settings = model_settings(args, cached=True)  # (a formula's numbers are checked if the model is built)
     options = options or integration_from(args)  # checked before the model is reduced (seconds)
     verbose = not getattr(args, "quiet", False)
 
@@ -99,7 +100,6 @@ def compiled_from(args: argparse.Namespace, options: Integration | None = None, 
 
     if system is not None:
         return checked_and_compiled(system)
-    settings = model_settings(args, cached=True)  # (a formula's numbers are checked if the model is built)
     return load_compiled(args.model, settings, options, verbose=verbose,
                          compile=lambda: checked_and_compiled(gearsym.load(args.model, **checked_formulas(settings))),
                          scaling=lambda: scaling_of(args.model, settings))
