@@ -33,12 +33,16 @@ def available_models() -> list[str]:
     return sorted(p.stem for p in d.glob("*.py") if not p.stem.startswith("_") and p.is_file())
 
 
-def pregenerated_models() -> list[str]:
-    """The models whose C and derivation page are committed (``generated/``, ``docs/derivations/``): what
-    ``gearsym compile --all``, ``gearsym docs --all`` and ``gearsym fmu --all`` make. A model file that sets
-    ``PREGENERATED = False`` is shipped and runs by name, but is derived and compiled on its first use only (one
-    too large to compile within a test run: Lin & Parker's translational set)."""
-    return [name for name in available_models() if getattr(_module(name), "PREGENERATED", True) is not False]
+def pregenerated_models(what: str = "code") -> list[str]:
+    """The models whose C (``what="code"``: ``generated/``) or derivation page (``"page"``: ``docs/derivations/``)
+    is committed: what ``gearsym compile --all`` and ``gearsym fmu --all``, or ``gearsym docs --all``, make. A model
+    file that sets ``PREGENERATED = False`` is shipped and runs by name, but is derived and compiled on its first
+    use only; ``PREGENERATED = "code"``: its C is committed, its page not (Lin & Parker's translational set, whose
+    page of formulas would be a megabyte)."""
+    if what not in ("code", "page"):
+        raise ValueError(f"what is 'code' or 'page', not {what!r}")
+    flags = {name: getattr(_module(name), "PREGENERATED", True) for name in available_models()}
+    return [name for name, flag in flags.items() if flag is True or flag == what]
 
 
 def model_path(ref: str) -> Path | None:

@@ -18,8 +18,8 @@ from gearsym.model.symbols import parameter_symbol, t
 
 GEAR_MODELS = ("one_stage", "one_stage_resonant", "flexible_shaft", "two_stage")
 #: pre-generated models whose byte-for-byte checks of generated/ and docs/derivations/ take many seconds (run with
-#: -m slow); none now: a model too large to compile in a test run is not pre-generated (PREGENERATED = False)
-SLOW_MODELS: tuple[str, ...] = ()
+#: -m slow): Lin & Parker's translational set (its reduction 40 s of SymPy, then 8 s to generate its C)
+SLOW_MODELS: tuple[str, ...] = ("planetary_translational",)
 
 
 def model_params(names):

@@ -25,7 +25,7 @@ from gearsym.files.paths import REPO_ROOT
 from gearsym.model.symbols import parameter_symbol
 
 DOCS = REPO_ROOT / "docs" / "derivations"
-MODELS = pregenerated_models()  # (the models whose pages are committed)
+MODELS = pregenerated_models("page")  # (the models whose pages are committed)
 GEAR_MODELS = [m for m in MODELS if isinstance(conftest.load(m), Drivetrain)]
 
 

@@ -181,6 +181,18 @@ def test_the_command_writes_the_chart_as_json_and_says_what_it_linearised(tmp_pa
     assert json.loads(out.with_suffix(".json").read_text())["boundaries"] == data["boundaries"]
 
 
+def test_a_physical_axis_is_charted_when_the_start_up_cache_already_holds_the_models_numbers(capsys):
+    """After another command on the model (here lyap), its scaling comes from the start-up cache (a stand-in that
+    converts no axis): the chart converts the speed in rpm with the full scaling all the same."""
+    assert main(["lyap", "spur_pair", "--periods", "10", "--discard", "0"]) == 0
+    capsys.readouterr()
+    args = ["stability", "spur_pair", "--param", "speed=4000rpm,6000rpm", "--param", "zeta=0.05,0.1", "--no-refine",
+            "--quiet", "--format", "json"]
+    assert main(args) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["grid"]["speed"] == [4000.0, 6000.0] and len(data["points"]) == 4
+
+
 @pytest.mark.parametrize("args, message", [
     (["--param", "omega=1:2:0.5"], "give two --param axes"),
     (["--param", "omega=1:2:0.5", "--param", "nope=1,2"], "nope is not a parameter"),

@@ -9,7 +9,14 @@ measured in one run:
   tangent product using the Jacobian's block structure), same steps per period, same periods, one after the
   other in this process; both give the exponents per unit tau, compared as a check that they integrate the same
   equations (the C has one more zero exponent pair: the rigid rotation it integrates);
-* a periodic orbit with its Floquet multipliers (``gearsym.periodic_orbit``: transient, Newton, monodromy).
+* a periodic orbit with its Floquet multipliers (``gearsym.periodic_orbit``: transient, Newton, monodromy);
+* for both models on bearings (``spur_pair_bearings`` and the planetary set), with the default integration (the
+  step chosen from the fastest mode, crossings located): the library from an empty cache in a fresh process (the
+  committed C compiled: load + gcc), and the Lyapunov spectrum's time per mesh period against SciPy's
+  ``solve_ivp`` (DOP853, rtol = atol = 1e-8) of the same equations: the model's right-hand side and exact Jacobian
+  (its CasADi functions, in-process) with the variational equations, re-orthonormalised each period; both from
+  the same state on the attractor; the check that they integrate the same: the state after SciPy's periods and
+  the largest exponents over them, gearsym run over the same periods from the same state.
 
     python -m bench.bearings            # writes bench/results/bearings.json
     python -m bench.bearings --quick    # fewer periods and repeats; writes nothing unless --out
@@ -32,6 +39,9 @@ import numpy as np
 from bench.machine import REPO
 
 MODEL = "planetary_translational"
+MODELS = ("spur_pair_bearings", "planetary_translational")
+#: mesh periods of the spectrum timed in gearsym, and in SciPy (far slower: a few)
+SPECTRUM_PERIODS, SCIPY_PERIODS = 40, 10
 HERE = Path(__file__).parent
 STEPS, PERIODS, REPEATS = 256, 20, 5
 VARIATION = 0.2  # every mesh's stiffness: its mean times 1 + VARIATION cos(phi), phi its mesh phase
@@ -117,18 +127,23 @@ def c_input(scaling, steps: int, periods: int) -> str:
             f1[f.body.index] += value
             theta = num(f.phase)
     ka = VARIATION
-    lines = [f"{n} {len(meshes)} {steps} {periods} {si['eta']!r} {ka!r} {theta!r}"]
-    lines.append(" ".join(repr(x) for x in minv))
+    lines = [f"{n} {len(meshes)} {steps} {periods} {number(si['eta'])} {number(ka)} {number(theta)}"]
+    lines.append(" ".join(number(x) for x in minv))
     for m in (kb / w**2, cb / w, g / w, ko / w**2):
-        lines.append(" ".join(repr(float(x)) for x in m.ravel()))
-    lines.append(" ".join(repr(float(x)) for row, *_ in meshes for x in row))
-    lines.append(" ".join(repr(k / w**2) for _, k, _, _ in meshes))
-    lines.append(" ".join(repr(c / w) for _, _, c, _ in meshes))
-    lines.append(" ".join(repr(p) for *_, p in meshes))
-    lines.append(" ".join(repr(x / w**2) for x in f0))
-    lines.append(" ".join(repr(x / w**2) for x in f1))
+        lines.append(" ".join(number(float(x)) for x in m.ravel()))
+    lines.append(" ".join(number(float(x)) for row, *_ in meshes for x in row))
+    lines.append(" ".join(number(k / w**2) for _, k, _, _ in meshes))
+    lines.append(" ".join(number(c / w) for _, _, c, _ in meshes))
+    lines.append(" ".join(number(p) for *_, p in meshes))
+    lines.append(" ".join(number(x / w**2) for x in f0))
+    lines.append(" ".join(number(x / w**2) for x in f1))
     lines.append(" ".join("0.0" for _ in range(2 * n)))
     return "\n".join(lines) + "\n"
+
+
+def number(x) -> str:
+    """A number as the C reads it (NumPy 2's repr of its floats is np.float64(...), which it does not)."""
+    return repr(float(x))
 
 
 def per_step(cache: str, steps: int, periods: int) -> dict:
@@ -151,7 +166,7 @@ def per_step(cache: str, steps: int, periods: int) -> dict:
     gearsym_step = (time.perf_counter() - t) / (steps * periods)
     binary = Path(tempfile.mkdtemp()) / "planetary_translational"
     subprocess.run([shutil.which("gcc") or "cc", "-O3", "-std=gnu99", "-o", str(binary), str(HERE / f"{MODEL}.c"),
-                    "-lm"], check=True)
+                    "-lm"], check=True, capture_output=True, text=True)
     data = binary.with_suffix(".txt")
     data.write_text(c_input(scaling, steps, periods))
     proc = subprocess.run([str(binary), str(data)], capture_output=True, text=True, check=True)
@@ -171,6 +186,80 @@ def per_step(cache: str, steps: int, periods: int) -> dict:
                       "largest_multiplier": float(np.max(np.abs(orbit.multipliers)))}}
 
 
+_DEFAULT_COMPILE = """
+import json, sys, time
+t = time.perf_counter()
+import gearsym
+system = gearsym.load(sys.argv[1])
+loaded = time.perf_counter() - t
+cm = gearsym.compile_model(system, gearsym.Integration(backend="compiled"))
+print(json.dumps({"load_seconds": loaded, "timings": cm.timings, "total_seconds": time.perf_counter() - t,
+                  "integration": cm.integration.choice, "states": cm.dimension}))
+"""
+
+
+def default_compile(model: str, cache: str) -> dict:
+    """The model with the default integration, from an empty cache in a fresh process: its committed C compiled."""
+    env = {**os.environ, "GEARSYM_CACHE": cache}
+    t = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-c", _DEFAULT_COMPILE, model], capture_output=True, text=True, env=env,
+                          cwd=REPO)
+    if proc.returncode:
+        raise RuntimeError(proc.stderr[-2000:])
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    out["process_seconds"] = time.perf_counter() - t
+    c = REPO / "generated" / model / f"{model}.c"
+    out["c_kib"] = round(c.stat().st_size / 1024) if c.is_file() else None
+    return out
+
+
+def spectrum_against_scipy(model: str, cache: str, periods: int, scipy_periods: int) -> dict:
+    """gearsym's spectrum per mesh period (compiled, default integration) against SciPy's solve_ivp of the same
+    equations with their variational equations, from the same state on the attractor."""
+    from scipy.integrate import solve_ivp
+
+    os.environ["GEARSYM_CACHE"] = cache
+    import gearsym
+
+    cm = gearsym.compile_model(gearsym.load(model), gearsym.Integration(backend="compiled"))
+    settle = gearsym.lyapunov_spectrum(cm, options=cm.integration.run(periods=20, discard=0))  # (warm; a start)
+    y0 = np.array(list(settle.final_state.values()))
+    options = cm.integration.run(periods=periods, discard=0)
+    t = time.perf_counter()
+    spectrum = gearsym.lyapunov_spectrum(cm, options=options, y0=dict(settle.final_state))
+    gearsym_period = (time.perf_counter() - t) / periods
+    p, n, T = cm.parameter_vector(), cm.dimension, cm.prepare().period
+
+    def variational(time_, z):
+        y, Q = z[:n], z[n:].reshape(n, n)
+        return np.concatenate([cm.rhs(time_, y, p), (cm.jacobian(time_, y, p) @ Q).ravel()])
+
+    y, Q, logs, evaluations = y0, np.eye(n), np.zeros(n), 0
+    t = time.perf_counter()
+    for k in range(scipy_periods):  # (the spectrum's start is at t = 0 of the forcing: whole periods on)
+        sol = solve_ivp(variational, (k * T, (k + 1) * T), np.concatenate([y, Q.ravel()]), method="DOP853",
+                        rtol=1e-8, atol=1e-8)
+        evaluations += sol.nfev
+        y, Q = sol.y[:n, -1], sol.y[n:, -1].reshape(n, n)
+        Q, R = np.linalg.qr(Q)
+        signs = np.sign(np.diag(R))
+        Q, logs = Q * signs, logs + np.log(np.abs(np.diag(R)))
+    scipy_period = (time.perf_counter() - t) / scipy_periods
+    # the check: gearsym over the same periods from the same state (its exponents from the same Gram-Schmidt)
+    same = gearsym.lyapunov_spectrum(cm, options=cm.integration.run(periods=scipy_periods, discard=0),
+                                     y0=dict(settle.final_state))
+    y_gearsym = np.array(list(same.final_state.values()))
+    return {"states": n, "integration": cm.integration.choice, "gearsym_periods": periods,
+            "scipy_periods": scipy_periods, "gearsym_seconds_per_period": gearsym_period,
+            "scipy_seconds_per_period": scipy_period, "scipy_over_gearsym": scipy_period / gearsym_period,
+            "scipy_rhs_evaluations_per_period": evaluations / scipy_periods,
+            "gearsym_largest_exponents": [float(x) for x in spectrum.exponents[:3]],
+            "check_over_the_scipy_periods": {
+                "state_difference_relative": float(np.max(np.abs(y_gearsym - y)) / np.max(np.abs(y))),
+                "gearsym_largest_exponents": [float(x) for x in same.exponents[:3]],
+                "scipy_largest_exponents": sorted((float(x) for x in logs / (scipy_periods * T)), reverse=True)[:3]}}
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m bench.bearings", description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true")
@@ -183,10 +272,28 @@ def main(argv=None) -> int:
         print(f"declaration -> compiled library: {out['compile']['process_seconds']:.1f} s", file=sys.stderr)
         out["startup"] = startup(cache, repeats)
         print(f"cached start-up: {out['startup']['median']:.3f} s", file=sys.stderr)
-        out["step"] = per_step(cache, STEPS, periods)
-        print(f"per RK4 step with the tangent map: gearsym {out['step']['gearsym_seconds_per_step'] * 1e6:.2f} us, "
-              f"hand-written C {out['step']['c_seconds_per_step'] * 1e6:.2f} us (x{out['step']['ratio']:.2f}); "
-              f"periodic orbit {out['step']['orbit']['seconds']:.2f} s", file=sys.stderr)
+        try:
+            out["step"] = per_step(cache, STEPS, periods)
+        except subprocess.CalledProcessError as exc:  # (recorded as failed; the other stages still run)
+            out["step"] = {"error": f"{' '.join(map(str, exc.cmd))}: exit {exc.returncode}: {exc.stderr}"}
+            print(f"per RK4 step: failed: {out['step']['error']}", file=sys.stderr)
+        else:
+            print(f"per RK4 step with the tangent map: gearsym {out['step']['gearsym_seconds_per_step'] * 1e6:.2f} "
+                  f"us, hand-written C {out['step']['c_seconds_per_step'] * 1e6:.2f} us (x{out['step']['ratio']:.2f}); "
+                  f"periodic orbit {out['step']['orbit']['seconds']:.2f} s", file=sys.stderr)
+    spectrum_periods, scipy_periods = (8, 1) if args.quick else (SPECTRUM_PERIODS, SCIPY_PERIODS)
+    out["models"] = {}
+    for model in MODELS:
+        with tempfile.TemporaryDirectory() as cache:
+            row = {"compile": default_compile(model, cache)}
+            print(f"{model}: library from an empty cache {row['compile']['process_seconds']:.1f} s "
+                  f"(gcc {row['compile']['timings'].get('compile', 0):.1f} s)", file=sys.stderr)
+            row["spectrum"] = spectrum_against_scipy(model, cache, spectrum_periods, scipy_periods)
+            s = row["spectrum"]
+            print(f"{model}: spectrum per mesh period gearsym {s['gearsym_seconds_per_period'] * 1e3:.3f} ms, SciPy "
+                  f"DOP853 {s['scipy_seconds_per_period'] * 1e3:.1f} ms (x{s['scipy_over_gearsym']:.0f})",
+                  file=sys.stderr)
+            out["models"][model] = row
     out["load_at_end"] = os.getloadavg()[0]
     target = args.out or (None if args.quick else REPO / "bench" / "results" / "bearings.json")
     if target:

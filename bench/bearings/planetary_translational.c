@@ -28,6 +28,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#ifndef M_PI  /* (POSIX, not ISO C: _POSIX_C_SOURCE above hides it in glibc) */
+#define M_PI 3.14159265358979323846
+#endif
 #include <time.h>
 
 static int n, nm, steps, periods;

@@ -50,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
     if bool(args.all) == bool(args.models):
         print("gearsym docs: error: give model names or --all (not both)", file=sys.stderr)
         return 2
-    refs = pregenerated_models() if args.all else args.models
+    refs = pregenerated_models("page") if args.all else args.models
     outs = [args.out or output_root(ref) / "docs" / "derivations" for ref in refs]
     for out in set(outs) if not args.check else ():
         check_folder(out)

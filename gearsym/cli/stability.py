@@ -171,7 +171,7 @@ def _engine_axes(given, scaling):
             raise GearsymError(f"--param {unit.spec!r} has a unit, but the model has no physical values; declare "
                                "them (model.set_physical) or give them with --set NAME='VALUE UNIT'")
         return tuple(given)
-    return tuple(nondimensional_axes(scaling, given))
+    return tuple(nondimensional_axes(scaling.full, given))  # (the start-up cache's stand-in converts no axis)
 
 
 def write_table(path: Path, chart: StabilityChart) -> None:

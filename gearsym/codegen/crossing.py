@@ -10,13 +10,15 @@ from __future__ import annotations
 import casadi as ca
 
 from .casadi_symbols import SX_OPTIONS, LoopSymbols
+from .columns import mode_step_by_column
 from .rk4 import by_vector, rk4_step, tabulated_rhs
 from .switching import Switching
 from .time_tables import SplitRHS
 from .translate import select_max, select_min, to_casadi
 
 
-def crossing_steps(sym: LoopSymbols, split: SplitRHS, switching: Switching, where: str, kind: type | None = None):
+def crossing_steps(sym: LoopSymbols, split: SplitRHS, switching: Switching, where: str, kind: type | None = None,
+                   by_column: bool = False):
     """``tangent_block``, ``state_block`` and ``state_step`` (one step each) that split a step at a crossing,
     and the SX pieces they call, by name (the printed loops call them directly, :mod:`.printed`).
 
@@ -49,8 +51,12 @@ def crossing_steps(sym: LoopSymbols, split: SplitRHS, switching: Switching, wher
     there; only J jumps, and each substep integrates J of its own mode. A third zero in one step is
     integrated on the extension of the mode before it (first order there). The min/max of the observed
     states are taken after the step, as in the plain loops.
+
+    ``by_column``: the substep with the tangent matrix (``tangent_mode_step``) is made of pieces by column
+    (:mod:`.columns`: a large model's C stays small).
     """
-    step = (kind or CrossingStep)(sym, split, switching, where)  # (kind: the stiff step's, stiff_crossing.py)
+    # (kind: the stiff step's, stiff_crossing.py)
+    step = (kind or CrossingStep)(sym, split, switching, where, by_column)
     pieces = {f.name(): f for f in step.pieces()}
     # try, then Switch(keep | split), emitted straight into the caller's MX graph (a Function around the two
     # calls would copy its inputs once more at every step)
@@ -127,8 +133,9 @@ class CrossingStep:
     """The pieces of a crossing-located RK4 step (see :func:`crossing_steps`): the frozen-mode right-hand
     side and Jacobian, the surfaces and their rates, in the loop's symbols."""
 
-    def __init__(self, sym: LoopSymbols, split: SplitRHS, switching: Switching, where: str):
+    def __init__(self, sym: LoopSymbols, split: SplitRHS, switching: Switching, where: str, by_column: bool = False):
         n, m, nc = sym.y.numel(), len(split.tables), sym.ch.numel() - 1
+        self.by_column = by_column  # the substep with the tangent matrix made of pieces by column (columns.py)
         self.sym, self.n, self.m, self.nc = sym, n, m, nc
         y, T, ch = sym.y, sym.T, sym.ch
         self.h = ch[nc]
@@ -241,6 +248,25 @@ class CrossingStep:
             return ca.Function("tangent_mode_step", [y, Q, leg, ch], [yn, Qn], SX_OPTIONS)
         return ca.Function("state_mode_step", [y, leg, ch], [yn], SX_OPTIONS)
 
+    def mode_step_by_column(self) -> list[ca.Function]:
+        """``tangent_mode_step`` made of pieces by column (:func:`.columns.mode_step_by_column`), then the pieces:
+        ``tangent_mode_state`` (the state's substep along a leg and its stages' Jacobians, as :func:`by_vector`
+        splits the plain step) and ``tangent_mode_vector`` (one column's substep given them)."""
+        y, ch = self.sym.y, self.sym.ch
+        leg = ca.SX.sym("leg", self.surfaces + 1 + 3 * self.m)
+        mode, length, T0, Tm, T1 = self.unpack(leg)
+        yn, jacobians, q, qn, symbols = self.mode_by_vector(mode, length, T0, Tm, T1)
+        state = ca.Function("tangent_mode_state", [y, leg, ch], [yn, jacobians], SX_OPTIONS)
+        vector = ca.Function("tangent_mode_vector", [q, symbols, leg, ch], [qn], SX_OPTIONS)
+        return [mode_step_by_column(state, vector), state, vector]
+
+    def mode_by_vector(self, mode, length, T0, Tm, T1):
+        """(the state after a substep of the sides ``mode`` from y, its stages' Jacobians' nonzeros, a tangent
+        vector q, q after the substep given them, the symbols that stand for them in it)."""
+        states, jacobians, q, qn, symbols = by_vector(self.f_mode(mode), self.J_mode(mode), self.sym.y, length,
+                                                      [(T0, Tm, T1)])
+        return states[0], jacobians, q, qn, symbols
+
     def split_start(self) -> ca.Function:
         """``split_start``: the try's leg (mode A, the sides at the step's start, over the whole step), the
         step's start (0) and mode A. The located step (:data:`SPLIT_CALLS`): up to two crossings in the step (a
@@ -300,9 +326,9 @@ class CrossingStep:
 
     def pieces(self) -> list[ca.Function]:
         """The SX pieces of the located steps (:data:`SPLIT_CALLS`), in a fixed order."""
+        tangent = self.mode_step_by_column() if self.by_column else [self.mode_step(True)]
         return [*self.switched("tangent", True), *self.switched("state", False), self.split_start(),
-                *self.crossing(), self.split_legs(), self.mode_step(True), self.mode_step(False),
-                *self.tried_by_vector()]
+                *self.crossing(), self.split_legs(), *tangent, self.mode_step(False), *self.tried_by_vector()]
 
     def single(self, state_try: ca.Function, state_switch: ca.Function) -> ca.Function:
         """One located step of the state (phase portraits), as an MX function (the extremes unused)."""

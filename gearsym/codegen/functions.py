@@ -6,7 +6,9 @@ and 80 000 inlined RK4 steps crash the C compiler):
 
 * SX, straight-line code with common subexpressions removed: ``rhs``,
   ``jacobian``, one RK4 step of the state and its tangent matrix (a *block*),
-  the Gram-Schmidt re-orthonormalisation;
+  the Gram-Schmidt re-orthonormalisation (from ``BY_COLUMN_FROM`` states on, the two functions that carry the
+  whole tangent matrix, Gram-Schmidt and the located step's substep, are SX pieces of one column each composed
+  in MX, :mod:`.columns`: their unrolled C grows with n^3 and n^2);
 * MX, which calls those functions instead of inlining them: one forcing
   period calls the block N times and then Gram-Schmidt; a *chunk* calls the
   period 50 times. Shared inputs (tables, constants) reach every call by
@@ -39,6 +41,7 @@ import casadi as ca
 from ..errors import ModelError
 from ..system import FirstOrderSystem
 from .casadi_symbols import SX_OPTIONS, LoopSymbols
+from .columns import gram_schmidt_by_column
 from .crossing import crossing_steps
 from .loops import LoopOptions
 from .period_loops import gram_schmidt_function, monodromy, orthonormalised_period, over_period
@@ -61,7 +64,8 @@ class ModelFunctions:
     #: the SX pieces the printed loops call (:mod:`.printed`): ``tangent_state``, ``tangent_vector`` (the tangent
     #: step, or with crossings located its try, by vector), ``state_block`` (plain; and ``trajectory_step`` for
     #: blocks of several steps) or ``state_try``, ``{tangent,state}_keep`` and the split's pieces (located,
-    #: :data:`SPLIT_CALLS`), and ``gram_schmidt``
+    #: :data:`SPLIT_CALLS`), and ``gram_schmidt``; for a large model, functions of pieces by column (MX) and their
+    #: pieces (:data:`.columns.PARTS`)
     steps: dict[str, ca.Function]
 
     @property
@@ -98,20 +102,26 @@ def build_functions(system: FirstOrderSystem, options: LoopOptions = LoopOptions
                               ["t", "p"], ["values"], SX_OPTIONS)
 
     switching = find_switching(system, split) if options.locate_crossings else None
+    by_column = options.by_column(n)  # a large model's tangent matrix by column (columns.py): its C stays small
     if stiff and (switching is None or not switching.surfaces):
         tangent_block, state_block, state_step, steps = rosenbrock_functions(sym, split, where)
         steps["state_block"] = state_block
     elif stiff:
         tangent_block, state_block, state_step, steps = crossing_steps(sym, split, switching, where,
-                                                                       RosenbrockCrossingStep)
+                                                                       RosenbrockCrossingStep, by_column)
     elif switching is None or not switching.surfaces:  # nothing switches (Lorenz): the plain loops
         tangent_block, state_block, state_step = rk4_functions(sym, split, K, where)
         steps = {**tangent_by_vector(sym, split, K, where), "state_block": state_block}
         if K > 1:  # the trajectory's steps one at a time
             steps["trajectory_step"] = state_step
     else:
-        tangent_block, state_block, state_step, steps = crossing_steps(sym, split, switching, where)
-    gram_schmidt = gram_schmidt_function(n)
+        tangent_block, state_block, state_step, steps = crossing_steps(sym, split, switching, where,
+                                                                       by_column=by_column)
+    if by_column:
+        gram_schmidt, *parts = gram_schmidt_by_column(n)
+        steps.update({f.name(): f for f in parts})
+    else:
+        gram_schmidt = gram_schmidt_function(n)
     steps["gram_schmidt"] = gram_schmidt
 
     # MX loops over the SX functions

@@ -51,6 +51,11 @@ class LoopOptions:
             return 0, 0
         return every, blocks % every
 
+    def by_column(self, dimension: int) -> bool:
+        """Whether the functions that carry the whole tangent matrix (the located step's substep, Gram-Schmidt)
+        are made of pieces by column (:mod:`.columns`): from :data:`BY_COLUMN_FROM` states on."""
+        return dimension >= BY_COLUMN_FROM
+
     def block(self, dimension: int) -> int:
         """RK4 steps per SX function call.
 
@@ -62,6 +67,11 @@ class LoopOptions:
         target = self.block_steps or 1
         return max(d for d in range(1, target + 1) if self.steps_per_period % d == 0)
 
+
+#: states from which the tangent matrix's functions are made of pieces by column (:mod:`.columns`): their C grows
+#: with n^2 then, not n^3 (Lin & Parker's planetary set, 34 states: 4.8 MB of C unrolled); below it (every shipped
+#: model up to planetary_two_stage's 12 states) the unrolled functions, whose C the tests compare byte for byte
+BY_COLUMN_FROM = 16
 
 #: steps between the Gram-Schmidt re-orthonormalisations within a period (LoopOptions.reorthonormalise), but for
 #: the paper's plain scheme

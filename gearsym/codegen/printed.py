@@ -36,6 +36,8 @@ import re
 
 import casadi as ca
 
+from .columns import PARTS
+from .columns import printed as by_column
 from .crossing import SPLIT_INPUTS, SPLIT_OUTPUTS, SPLIT_PER_SURFACE, split_calls, split_names
 from .functions import ModelFunctions
 from .loops import shooting_segments
@@ -71,10 +73,18 @@ def pieces(mf: ModelFunctions, loop: str) -> list[ca.Function]:
                                    else [])]
     else:
         names = [f"{kind}_try", *(piece for piece, _, _ in split_calls(kind))]
-    names = list(dict.fromkeys(names))
     if loop.startswith("lyapunov"):
         names.append("gram_schmidt")
-    return [mf.steps[name] for name in names]
+    # a function made of pieces by column (a large model's, columns.py) is printed from its pieces' C
+    names = [part for name in names for part in (_parts(mf, name) or (name,))]
+    return [mf.steps[name] for name in dict.fromkeys(names)]
+
+
+def _parts(mf: ModelFunctions, name: str) -> tuple[str, ...]:
+    """The pieces by column of the step ``name`` (:data:`.columns.PARTS`) if the model's steps are made of them,
+    else ()."""
+    parts = PARTS.get(name, ())
+    return parts if parts and all(part in mf.steps for part in parts) else ()
 
 
 def stand_in(f: ca.Function, calls: list[ca.Function]) -> ca.Function:
@@ -97,13 +107,16 @@ def stand_in(f: ca.Function, calls: list[ca.Function]) -> ca.Function:
 def print_loops(text: str, mf: ModelFunctions) -> str:
     """CasADi's C ``text`` (written with :func:`stand_in` for the :data:`LOOP_NAMES`) with the loops printed."""
     definitions = {m.group("name"): m for m in _DEFINITION.finditer(text)}
-    missing = [name for name in (*LOOP_NAMES, *mf.steps, *LANE_FUNCTIONS) if name not in definitions]
+    composed = [name for name in mf.steps if _parts(mf, name)]  # (printed from their pieces by column)
+    missing = [name for name in (*LOOP_NAMES, *mf.steps, *LANE_FUNCTIONS)
+               if name not in definitions and name not in composed]
     if missing:
         raise AssertionError(f"no C definition of {', '.join(missing)} in the generated code")
     shape = _Shape(mf)
     steps = [_PREAMBLE.format(zeros=max(1, shape.rows * shape.N))]
     steps += [_inline(name, definitions[name].group("body"), mf.steps[name],
-                      shape.n if name == "tangent_vector" else 1) for name in mf.steps]
+                      shape.n if name == "tangent_vector" else 1) for name in mf.steps if name not in composed]
+    steps += [by_column(name, shape.n, mf.steps) for name in composed]
     steps += [_inline(name, definitions[name].group("body"), mf.functions[name]) for name in LANE_FUNCTIONS]
     steps += [_split(mf, kind) for kind in ("tangent", "state") if shape.located]
     # the spans go before the first stand-in; each stand-in's body becomes its loop
@@ -209,6 +222,9 @@ class _Shape:
         #: blocks between two Gram-Schmidt steps and in the last piece of a period ((0, 0): once per period)
         self.every, self.rest = mf.options.orthonormalised(self.n)
         self.located = "state_try" in mf.steps
+        #: a large model (columns.py): its step is compiled once and called from both halves of the span, not
+        #: inlined in each (gcc's time halves; a call costs nothing next to a step of that size)
+        self.by_column = mf.options.by_column(self.n)
         self.stepwise = "trajectory_step" in mf.steps  # (blocks of several steps: the trajectory steps alone)
         #: the tangent step (or try): the state's step, then each tangent vector's (:func:`_by_vector`)
         self.by_vector = "tangent_vector" in mf.steps
@@ -288,8 +304,9 @@ def _spans(mf: ModelFunctions, s: _Shape) -> list[str]:
             body = _by_vector(s)
         else:
             body = f"  gs_{kind}_block({args});\n"
+        where = "GEARSYM_NOINLINE" if s.by_column else "GEARSYM_INLINE"
         out.append(f"/* one block of {kind} steps (the SX functions' step, as CasADi's Switch runs it) */\n"
-                   f"static GEARSYM_INLINE void gs_{kind}_step({', '.join(ins + outs)}) {{\n{body}}}\n")
+                   f"static {where} void gs_{kind}_step({', '.join(ins + outs)}) {{\n{body}}}\n")
         sizes = {"y": s.size("y"), "Q": s.size("Q"), "lo": s.size("o"), "hi": s.size("o")}
         a = [f"{v}a" for v in state]
         b = [f"{v}b" for v in state]

@@ -84,24 +84,26 @@ def by_vector(f, J, y, h, columns: list) -> tuple:
     tangent matrix computes each of its columns with these operations (``mtimes`` works column by column, and
     the constant entries, which it simplifies, stay constants here), so the pieces give its bits."""
     n = y.numel()
-    stages, entries = [], []  # each stage's Jacobian; its distinct non-constant nonzeros
+    stages, entries = [], {}  # each stage's Jacobian; its distinct non-constant nonzeros, by node, in order
 
     def recorded(x, T):
         Jx = J(x, T)
         stages.append(Jx)
-        entries.extend(e for e in Jx.nonzeros() if not e.is_constant() and _position(entries, e) is None)
+        for e in Jx.nonzeros():
+            if not e.is_constant():
+                entries.setdefault(e.element_hash(), (len(entries), e))
         return Jx
 
     yk, qk, states = y, ca.SX.sym("q0", n), []  # (a stand-in vector: only the Jacobians are kept)
     for Ta, Tb, Tc in columns:
         yk, qk = rk4_step(f, recorded, yk, qk, h, Ta, Tb, Tc)
         states.append(yk)
-    J_all = ca.vertcat(*entries) if entries else ca.SX(0, 1)
+    J_all = ca.vertcat(*(e for _, e in entries.values())) if entries else ca.SX(0, 1)
 
     symbols = ca.SX.sym("J", max(1, len(entries)))
     given = []  # the same matrices with the symbols in place of the computed entries
     for Jx in stages:
-        values = [e if e.is_constant() else symbols[_position(entries, e)] for e in Jx.nonzeros()]
+        values = [e if e.is_constant() else symbols[entries[e.element_hash()][0]] for e in Jx.nonzeros()]
         given.append(ca.SX(Jx.sparsity(), ca.vertcat(*values) if values else ca.SX(0, 1)))
     replay = iter(given)
     q = ca.SX.sym("q", n)
@@ -109,11 +111,6 @@ def by_vector(f, J, y, h, columns: list) -> tuple:
     for Ta, Tb, Tc in columns:
         _, qk = rk4_step(f, lambda x, T: next(replay), y, qk, h, Ta, Tb, Tc)
     return states, J_all, q, qk, symbols
-
-
-def _position(entries: list, e) -> int | None:
-    """Where the SX node ``e`` itself (not an equal expression) is in ``entries``."""
-    return next((i for i, x in enumerate(entries) if ca.is_equal(x, e, 0)), None)
 
 
 def rk4_step(f, J, yk, Qk, h, Ta, Tb, Tc):

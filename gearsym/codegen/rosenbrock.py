@@ -174,6 +174,12 @@ def by_vector(M: ca.SX, ch: ca.SX) -> tuple[ca.SX, ca.Function]:
     """The step map M in the two pieces of the printed loops' tangent step (as :func:`.rk4.by_vector`): its
     non-constant nonzeros, which the state's piece outputs, and ``tangent_vector``, one tangent vector through
     the map given them (the loop applies it to each vector in turn)."""
+    entries, q, Mq, symbols = matrix_by_vector(M)
+    return entries, ca.Function("tangent_vector", [q, symbols, ch], [Mq], SX_OPTIONS)
+
+
+def matrix_by_vector(M: ca.SX) -> tuple[ca.SX, ca.SX, ca.SX, ca.SX]:
+    """(M's non-constant nonzeros, a vector q, M q with symbols in place of those nonzeros, the symbols)."""
     entries = [e for e in M.nonzeros() if not e.is_constant()]
     symbols = ca.SX.sym("J", max(1, len(entries)))
     given, k = [], 0
@@ -185,5 +191,4 @@ def by_vector(M: ca.SX, ch: ca.SX) -> tuple[ca.SX, ca.Function]:
             k += 1
     Mg = ca.SX(M.sparsity(), ca.vertcat(*given) if given else ca.SX(0, 1))
     q = ca.SX.sym("q", M.size2())
-    vector = ca.Function("tangent_vector", [q, symbols, ch], [ca.mtimes(Mg, q)], SX_OPTIONS)
-    return (ca.vertcat(*entries) if entries else ca.SX(0, 1)), vector
+    return (ca.vertcat(*entries) if entries else ca.SX(0, 1)), q, ca.mtimes(Mg, q), symbols

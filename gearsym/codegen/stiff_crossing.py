@@ -11,7 +11,7 @@ import casadi as ca
 
 from .casadi_symbols import SX_OPTIONS
 from .crossing import CrossingStep
-from .rosenbrock import by_vector, rosenbrock_step
+from .rosenbrock import by_vector, matrix_by_vector, rosenbrock_step
 
 
 class RosenbrockCrossingStep(CrossingStep):
@@ -33,6 +33,11 @@ class RosenbrockCrossingStep(CrossingStep):
         entries, vector = by_vector(ca.jacobian(yn, y), ch)
         return [ca.Function("tangent_state", [y, self.col, ch], [yn, self.crossed(yn, mode), entries], SX_OPTIONS),
                 vector]
+
+    def mode_by_vector(self, mode, length, T0, Tm, T1):
+        yn, _ = self.step(mode, self.sym.y, None, length, T0, Tm, T1)
+        jacobians, q, qn, symbols = matrix_by_vector(ca.jacobian(yn, self.sym.y))
+        return yn, jacobians, q, qn, symbols
 
     def mode_step(self, with_tangent: bool) -> ca.Function:
         y, ch = self.sym.y, self.sym.ch
