@@ -126,9 +126,8 @@ def step_line(compiled, scaling=None) -> str:
         omega = float(at[1]) if at else compiled.system.parameters.get("omega", 1.0)
         to_s = 1.0 / (omega * units.omega_n)  # seconds per unit of tau
         where = ""
-        if at:
-            speed = scaling.speed_at(omega)
-            where = f" at {speed.magnitude:.4g} {speed.units:~P}"
+        if at:  # (from the point units, which a cached model's stand-in scaling has too)
+            where = f" at {float(units.speed_of(omega)):.4g} {units.speed_unit}"
             why = why.replace(at[0], where)
         h = f"h = {cycle / steps * to_s * 1e6:.4g} µs{where}"
     else:
