@@ -144,6 +144,7 @@ class Tracer:
                  say: Callable[[str], None] | None = None):
         self.problem, self.steps = problem, steps.resolved(stop - start)
         self.start, self.say = start, say  # say: a line of progress every PROGRESS_SECONDS (None: silent)
+        self.said = time.monotonic()  # (the first line after PROGRESS_SECONDS of work: a short run says none)
         self.sized = steps.max_step is None  # the largest step follows the orbits' size
         self.started = started if started is not None else []  # every branch traced, finished or not, in order
         self.lo, self.hi, self.direction = min(start, stop), max(start, stop), (1.0 if stop >= start else -1.0)
@@ -303,9 +304,9 @@ class Tracer:
         """A line of progress, at most every ``PROGRESS_SECONDS``: the branch, its points, where it is in the range
         (as a share of it from the start: the parameter's own unit is the caller's)."""
         now = time.monotonic()
-        if self.say is None or now - getattr(self, "_said", now - PROGRESS_SECONDS) < PROGRESS_SECONDS:
+        if self.say is None or now - self.said < PROGRESS_SECONDS:
             return
-        self._said = now
+        self.said = now
         share = (b.value - self.start) / (self.hi - self.lo) * self.direction
         self.say(f"orbits: period-{self.problem.shooting.period_multiple} branch: {len(traced.solutions)} points "
                  f"(at most {self.steps.max_points}), {share:.0%} of the range from its start")
