@@ -37,8 +37,10 @@ def stability_record(lin: CompiledLinearisation, out: str | Path, quick: bool = 
     g = grid(quick)
     span = (g["omega"][-1] - g["omega"][0], g["k_a"][-1] - g["k_a"][0])
     chart = static_chart(lin, g, tolerance=(TOLERANCE * span[0], TOLERANCE * span[1]))
+    # kept if the picture is the same (keep_same), as the paper's figures are: another CPU's or matplotlib's rounding
+    # moves a pixel or two, and the main job must leave the committed figure as it is
     save_figure(plot_stability(chart, title=f"{MODEL} at the paper's values (Eq. 2)"), Path(out) / "stability.png",
-                dpi=110)
+                dpi=110, keep_same=True)
     tongues = []
     for b in chart.boundaries:
         if len(b.points) < 2:
