@@ -97,7 +97,7 @@ class PhysicalUnits(OwnNumbers):
         """An exponent (per unit tau at ``omega``) as shown: per second."""
         if omega is None:
             return super().exponent(value, omega)
-        return f"{value * omega * self.units.omega_n:+.4g} 1/s"
+        return f"{value * omega * self.units.omega_n:+.4g} {self.units.per_second}"
 
 
 #: the dimension (exponents of mass, length, time) of each kind of state, and a grid of it in its unit
