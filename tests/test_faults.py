@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import math
 import re
+from pathlib import Path
 import shlex
 from dataclasses import replace
 
@@ -20,7 +21,7 @@ import pytest
 from matplotlib.colors import to_rgb
 
 import fault_rig
-from same_numbers import csv_differences, differences
+from same_numbers import differences, measured_differences, wrong_models_held
 import gearsym
 from gearsym import explain, load_measurements
 from gearsym.cli import main
@@ -243,14 +244,25 @@ def example_commands() -> dict[str, list[str]]:
 @pytest.mark.slow
 def test_the_cracked_tooth_example_is_what_its_commands_write(tmp_path, monkeypatch):
     commands = example_commands()
-    monkeypatch.chdir(tmp_path)
-    for verb in ("simulate", "explain", "spectrum"):
-        assert main([*commands[verb], *(["--quiet"] if verb == "explain" else [])]) == 0
-    assert not csv_differences((tmp_path / "measured.csv").read_text(), (EXAMPLE / "measured.csv").read_text()), (
+    (tmp_path / "simulated").mkdir()
+    monkeypatch.chdir(tmp_path / "simulated")
+    assert main(commands["simulate"]) == 0
+    # The record at omega = 1.2 is chaotic (largest exponent 0.075): without FMA contraction it leaves the committed
+    # trajectory within its 160 mesh periods, so it is compared as the attractor it is on, and the committed record
+    # is what explain and spectrum read here, as they read it in the example's folder.
+    assert not measured_differences(Path("measured.csv").read_text(), (EXAMPLE / "measured.csv").read_text(),
+                                    ("x",), attractor=True), (
         "docs/examples/explain-cracked-tooth/measured.csv is not what docs/data-loop.md's command writes: rerun it")
-    for name in ("report.md", "derived_model.md"):
-        assert not differences((tmp_path / name).read_text(), (EXAMPLE / name).read_text()), (
-            f"docs/examples/explain-cracked-tooth/{name} is out of date: rerun the commands in docs/data-loop.md")
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "measured.csv").write_bytes((EXAMPLE / "measured.csv").read_bytes())
+    assert main([*commands["explain"], "--quiet"]) == 0 and main(commands["spectrum"]) == 0
+    (made, held), (committed, kept) = (wrong_models_held(p.read_text()) for p in (tmp_path / "report.md",
+                                                                                   EXAMPLE / "report.md"))
+    assert not differences(made, committed), (
+        "docs/examples/explain-cracked-tooth/report.md is out of date: rerun the commands in docs/data-loop.md")
+    assert held["errors"].keys() == kept["errors"].keys() and min(held["errors"].values()) > held["chosen"]
+    assert not differences((tmp_path / "derived_model.md").read_text(), (EXAMPLE / "derived_model.md").read_text()), (
+        "docs/examples/explain-cracked-tooth/derived_model.md is out of date: rerun the commands in docs/data-loop.md")
     report = json.loads((tmp_path / "report.json").read_text())
     (fault,) = report["faults"]
     assert report["effects"] == ["tooth_fault_gear1"] and fault["tooth"] == 7 and fault["gear"] == "gear1"
