@@ -27,8 +27,6 @@ import rig
 CONTACT = 1.6
 EDGE = 0.1
 T = 2 * math.pi
-#: (n, c_n) of the mesh stiffness variation's cos(n tau) terms
-HARMONICS = tuple((n + 1, c) for n, c in enumerate(rig.STIFFNESS))
 
 
 def smoothstep(z: float, width: float) -> float:
@@ -84,7 +82,7 @@ class Pair:
         self.p = {**rig.DEFAULTS, **values}
 
     def stiffness(self, tau: float) -> float:
-        k = 1 + self.p["k_a"] * sum([c * math.cos(n * tau) for n, c in HARMONICS])
+        k = 1 + self.p["k_a"] * rig.variation(tau)
         if self.fault:
             gear, tooth, q = self.fault
             k *= 1 - q * tooth_share(tau / T, self.teeth[gear - 1], tooth)
