@@ -135,7 +135,7 @@ def _simulated(args, settings: dict):
     options = Integration(periods=periods, discard=discard, steps_per_period=steps, locate_crossings=not args.plain,
                           backend=args.backend)
     compiled = compiled_from(args, options, system)
-    scale, unit = _unit(args, name)
+    scale, unit, values = _unit(args, name)
     s = simulated_order_spectrum(compiled, coordinate=name, mesh_harmonics=args.mesh_harmonics,
                                  sidebands=args.sidebands, scale=scale, unit=unit)
     if unit:  # a physical model: its title in the user's values (the engine's numbers stay in the JSON's title)
@@ -143,19 +143,20 @@ def _simulated(args, settings: dict):
         span = s.title.split(";")[0].split(": ", 1)[1]
         s.info["label"] = (f"{system.name} at {given}: {span}, {compiled.steps_per_cycle} "
                            f"{compiled.integration.method_name} steps per mesh period")
+        s.info["parameters"] = values  # (every physical value as given: the title's are the engine's numbers)
     return [s], f"a run of {system.name}" + (f" ({', '.join(args.effect)})" if args.effect else "")
 
 
-def _unit(args, name: str) -> tuple[float, str]:
+def _unit(args, name: str) -> tuple[float, str, dict]:
     """The factor and unit of a run's coordinate in the model's physical units (µm for a mesh's deflection, rad
-    for a shaft's twist), or (1, "") for a model without physical values."""
+    for a shaft's twist) and its physical values as given, or (1, "", {}) for a model without physical values."""
     scaling = scaling_from(args)
     if scaling is None:
-        return 1.0, ""
+        return 1.0, "", {}
     units = scaling.point_units()
     if units.kinds.get(name) == LENGTH:
-        return units.per_unit[name] * units.m_to_length, units.length_text.text
-    return units.per_unit.get(name, 1.0), units.radian.text
+        return units.per_unit[name] * units.m_to_length, units.length_text.text, dict(units.values)
+    return units.per_unit.get(name, 1.0), units.radian.text, dict(units.values)
 
 
 def _measured(args, settings: dict):
