@@ -21,6 +21,7 @@ from .. import stability  # (lazy: the linearisation, SymPy and the generator lo
 from ..cached import load_linearisation, load_static_recipe
 from ..errors import GearsymError
 from ..options import Execution
+from ..registry import model_options
 from ..files.atomic import write_atomically
 from ..figures.basins import axis_label
 from ..figures.stability import plot_stability
@@ -79,6 +80,7 @@ def run(args: argparse.Namespace) -> int:
     if len(given) != 2:
         raise GearsymError(f"give two --param axes (got {len(given)}); for a line give the second one value, e.g. "
                            "--param k_a=0.2")
+    _refuse_model_options(args.model, given)
     options = integration_from(args)
     user = _formula_axes(args, given)
     tolerance_of = lambda axes: tuple(args.tolerance * (max(a.values) - min(a.values) or max(1.0, abs(a.values[0])))
@@ -129,6 +131,17 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(report(chart, shown, seconds, fixed))
     return 0
+
+
+def _refuse_model_options(model: str, given) -> None:
+    """An axis that names a model option (planets, dof: another model built, another set of equations) cannot be
+    charted: refused from the model file's options (a second), before the model is reduced and compiled."""
+    options = model_options(model)
+    for a in given:
+        if a.name in options:
+            raise GearsymError(f"--param {a.spec!r}: {a.name} is a model option of {model} (it builds another model, "
+                               f"with other equations), not a parameter a chart can move: give it one value with "
+                               f"--set {a.name}={options[a.name]}, one chart per value")
 
 
 def _formula_axes(args, given) -> dict:
