@@ -142,6 +142,26 @@ def test_the_code_generator_takes_no_strings(sandbox):
     assert str(to_casadi([x + 1, 2, 0.5], {x: ca.SX.sym("x")})) == "[SX((1+x)), SX(2), SX(0.5)]"
 
 
+
+def test_no_module_hands_sympify_what_it_could_run():
+    """Every sympify in the package is strict (numbers and SymPy objects only: a string is refused, never parsed as
+    Python), so a value that comes from a model file, the cache or a record can reach none as code."""
+    import ast
+
+    from gearsym.files.paths import PACKAGE_DIR as PACKAGE_ROOT
+
+    loose = []
+    for path in sorted(PACKAGE_ROOT.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Call) and getattr(node.func, "attr", getattr(node.func, "id", "")) == "sympify" \
+                    and not any(k.arg == "strict" and getattr(k.value, "value", False) is True for k in node.keywords):
+                loose.append(f"{path.relative_to(PACKAGE_ROOT)}:{node.lineno}")
+    assert loose == []
+    from gearsym.reduction.statics import number  # (one of them, handed a string as a record could)
+    with pytest.raises(sp.SympifyError):
+        number(TOUCH, {}, "a stiffness")
+
+
 def _p(*names):
     return [parameter_symbol(n) for n in names]
 

@@ -218,9 +218,9 @@ def stiffness_notes(system, values: Mapping[str, float], defaults: Mapping[str, 
 
     notes = []
     time = system.time
-    period = float(sp.sympify(system.period).subs({sp.Symbol(k, real=True): v for k, v in values.items()}))
+    period = float(sp.sympify(system.period, strict=True).subs({sp.Symbol(k, real=True): v for k, v in values.items()}))
     for c in getattr(system, "couplings", ()):
-        expr = sp.sympify(c.stiffness)
+        expr = sp.sympify(c.stiffness, strict=True)
         names = sorted(s.name for s in expr.free_symbols if s != time and s.name in values)
         if {s for s in expr.free_symbols if s != time and s.name not in values}:
             continue

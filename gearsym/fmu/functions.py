@@ -74,7 +74,7 @@ def _mapping(system: FirstOrderSystem, sym: SystemSymbols, exprs) -> dict:
     states = {s.name: sym.y[i] for i, s in enumerate(system.states)}
     params = {name: sym.p[j] for j, name in enumerate(system.parameters)}
     for e in exprs:
-        for s in sp.sympify(e).free_symbols:
+        for s in sp.sympify(e, strict=True).free_symbols:
             if s in mapping:
                 continue
             if s.name in states:

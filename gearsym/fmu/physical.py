@@ -108,8 +108,8 @@ def engine_mean_stiffness(system, mesh: str, values: Mapping[str, float]) -> flo
     import sympy as sp
 
     coupling = next(c for c in system.couplings if c.name == mesh)
-    numbers = {s: values[s.name] for s in sp.sympify(coupling.stiffness).free_symbols if s.name in values}
-    k = sp.lambdify(system.time, sp.sympify(coupling.stiffness).xreplace(numbers), "numpy")
+    numbers = {s: values[s.name] for s in sp.sympify(coupling.stiffness, strict=True).free_symbols if s.name in values}
+    k = sp.lambdify(system.time, sp.sympify(coupling.stiffness, strict=True).xreplace(numbers), "numpy")
     tau = np.linspace(0.0, float(system.period_at(values)), 4096, endpoint=False)
     return float(np.mean(np.broadcast_to(np.asarray(k(tau), dtype=float), tau.shape)))
 

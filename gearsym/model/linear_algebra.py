@@ -33,7 +33,7 @@ class Generators:
     def __init__(self, exprs):
         self.of: dict[sp.Expr, sp.Dummy] = {}
         for e in exprs:
-            self._walk(sp.sympify(e))
+            self._walk(sp.sympify(e, strict=True))
         self.back = {d: e for e, d in self.of.items()}
 
     def _walk(self, e: sp.Expr) -> None:
@@ -79,7 +79,7 @@ class Generators:
 
     def normal(self, expr: sp.Expr) -> sp.Expr:
         """``expr`` with its generators' relations applied: numerator and denominator reduced."""
-        expr = self.to(sp.sympify(expr))
+        expr = self.to(sp.sympify(expr, strict=True))
         if not self.relations or not (expr.free_symbols & set(self.back)):
             return self.from_(sp.cancel(expr))
         num, den = sp.fraction(sp.cancel(sp.together(expr)))

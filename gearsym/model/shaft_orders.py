@@ -38,7 +38,7 @@ DEFAULT_EDGE = sp.Rational(1, 10)
 
 
 def _rational(value, what: str, where: str) -> sp.Expr:
-    expr = sp.nsimplify(value) if isinstance(value, (int, float)) else sp.sympify(value)
+    expr = sp.nsimplify(value) if isinstance(value, (int, float)) else sp.sympify(value, strict=True)
     if not expr.is_number:
         raise ModelError(f"{what} must be a number, got {value!r}", where)
     return sp.Rational(expr) if expr.is_Rational else expr

@@ -35,7 +35,7 @@ MAX_STEPS = 60
 
 def number(expr: sp.Expr, values: Mapping[str, float], what: str) -> float:
     """``expr`` at ``values``, or a one-line error naming what has no value."""
-    value = sp.sympify(expr).xreplace({parameter_symbol(k): sp.Float(v) for k, v in values.items()})
+    value = sp.sympify(expr, strict=True).xreplace({parameter_symbol(k): sp.Float(v) for k, v in values.items()})
     if not value.is_number:
         missing = ", ".join(sorted(s.name for s in value.free_symbols))
         raise GearsymError(f"{what} needs a value for {missing}")

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import sympy as sp
 
 from ..model.resolved import ResolvedDrivetrain
-from ..model.expressions import parameter_names
+from ..model.expressions import parameter_names, to_expr
 from ..model.symbols import omega, phi, t
 from ..units import dimension_text, unit_dims
 
@@ -76,7 +76,7 @@ def fields(rd: ResolvedDrivetrain) -> list[Field]:
         out.append(Field(rb.inertia, MASS, f"{where} mass"))
         orbit = getattr(rb.body, "orbit", None)
         if orbit is not None and rb.motion == "tangential":
-            out.append(Field(sp.sympify(orbit), ORBIT, f"{where} orbit radius"))
+            out.append(Field(to_expr(orbit, where), ORBIT, f"{where} orbit radius"))
     for rc in rd.couplings:
         where = f"{type(rc.component).__name__} {rc.name!r}"
         if rc.kind == "bearing":
@@ -84,9 +84,9 @@ def fields(rd: ResolvedDrivetrain) -> list[Field]:
                     Field(rc.damping, BEARING_DAMPING, f"{where} damping")]
             continue
         if rc.kind == "mesh" and rd.translations:
-            out += [Field(sp.sympify(rc.component.pressure_angle), ANGLE, f"{where} pressure angle")]
+            out += [Field(to_expr(rc.component.pressure_angle, where), ANGLE, f"{where} pressure angle")]
             if rc.component.centres is not None:
-                out += [Field(sp.sympify(rc.component.centres), ANGLE, f"{where} line of centres")]
+                out += [Field(to_expr(rc.component.centres, where), ANGLE, f"{where} line of centres")]
         if rc.kind == "mesh":
             out += [Field(rc.stiffness, MESH_STIFFNESS, f"{where} stiffness"),
                     Field(rc.damping, MESH_DAMPING, f"{where} damping"),

@@ -107,7 +107,7 @@ def static_recipe(system: FirstOrderSystem) -> StaticRecipe:
                          f"{len(unknowns)} states ({', '.join(s.name for s in unknowns)})", system.name)
     meshes = [c for c in system.meshes if c.backlash != 0]
     contacts = [c.contact.xreplace(resting) for c in meshes]
-    backlashes = [sp.sympify(c.backlash) for c in meshes]
+    backlashes = [sp.sympify(c.backlash, strict=True) for c in meshes]
     used_parameters = set()
     for e in (*remaining, *contacts, *backlashes):
         used_parameters |= {s.name for s in e.free_symbols if s.name in system.parameters}
