@@ -5,11 +5,24 @@ import os
 import platform
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
+
+
+def user_environment(name: str) -> dict[str, str]:
+    """The environment of a timed command: Python keeps its bytecode as for any user (an installed package has
+    it), in a temporary PYTHONPYCACHEPREFIX (not in the repository) that lives as long as this process, even where
+    PYTHONDONTWRITEBYTECODE is set, which would add compiling gearsym's sources (about 0.3 s) to every start-up."""
+    folder = tempfile.TemporaryDirectory(prefix=f"bench-{name}-pycache-")
+    _KEPT.append(folder)
+    return {**{k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}, "PYTHONPYCACHEPREFIX": folder.name}
+
+
+_KEPT: list[tempfile.TemporaryDirectory] = []  # (the folders, removed when the benchmark's process ends)
 
 
 def _run_text(cmd: list[str]) -> str:

@@ -44,6 +44,8 @@ def tooth_share(u: float, teeth: int, tooth: int) -> float:
     """The share of the mesh stiffness the pair of ``tooth`` carries at u mesh periods."""
     w = _around(u, tooth - 1, teeth)  # mesh periods since the start of its single-contact period's mesh period
     d = CONTACT - 1
+    if not -d / 2 - EDGE < w < 1 + d / 2 + EDGE:  # out of mesh, every edge flat: exactly 0 (most of a revolution)
+        return 0.0
     whole = smoothstep(w + d / 2, EDGE) - smoothstep(w - 1 - d / 2, EDGE)
     single = smoothstep(w - d / 2, EDGE) - smoothstep(w - 1 + d / 2, EDGE)
     return 0.5 * whole + 0.5 * single
@@ -53,6 +55,8 @@ def in_mesh(u: float, teeth: int, tooth: int, edge: float = 0.15) -> float:
     """About 1 while the pair of ``tooth`` is in mesh (from u = tooth - 1 - (e - 1)/2 to tooth + (e - 1)/2)."""
     w = _around(u, tooth - 1, teeth)
     d = CONTACT - 1
+    if not -d / 2 - edge < w < 1 + d / 2 + edge:  # out of mesh, both edges flat: exactly 0
+        return 0.0
     return smoothstep(w + d / 2, edge) - smoothstep(w - 1 - d / 2, edge)
 
 
@@ -78,7 +82,7 @@ class Pair:
         self.p = {**rig.DEFAULTS, **values}
 
     def stiffness(self, tau: float) -> float:
-        k = 1 + self.p["k_a"] * sum(c * math.cos((n + 1) * tau) for n, c in enumerate(rig.STIFFNESS))
+        k = 1 + self.p["k_a"] * rig.variation(tau)
         if self.fault:
             gear, tooth, q = self.fault
             k *= 1 - q * tooth_share(tau / T, self.teeth[gear - 1], tooth)

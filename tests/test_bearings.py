@@ -278,3 +278,46 @@ def test_gearsym_lyap_answers_bearing_deflections_in_um_and_bearing_forces_in_ne
     assert "amplitude A_y_pinion" in out and "rad" not in out.split("amplitude A_y_pinion")[1].splitlines()[0]
     forces = [line for line in out.splitlines() if line.startswith("bearing force bearing1_y")]
     assert forces and forces[0].split("mean ")[1].split()[1] == "N,"
+
+
+# ------------------------------------------------------------------ the values a run was made at, in the user's units
+#: the pinion bearing's stiffness as the model declares it, and as the engine's number it becomes (k_b1 / kZ)
+K_B1 = "k_b1=1e+08 N/m"
+
+
+def test_gearsym_lyap_says_the_values_it_ran_at_in_the_users_units_not_the_engines_numbers(capsys):
+    """The engine's numbers carry the physical values' names (k_b1 = 0.996842 is k_b1 / kZ): printed as
+    'parameters:' they would read as those values in other units."""
+    assert main(["lyap", "spur_pair_bearings", "--periods", "16", "--discard", "6"]) == 0
+    line = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("parameters: "))
+    assert K_B1 in line and "speed=6000 rpm" in line and "eta=100 µm" in line and "omega=" not in line
+    assert main(["lyap", "spur_pair_bearings", "--periods", "16", "--discard", "6", "--format", "json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["physical"]["parameters"]["k_b1"] == "1e+08 N/m" and "omega" in data["parameters"]
+
+
+def test_gearsym_orbits_says_the_orbits_values_in_the_users_units_and_writes_them_to_its_record(capsys, tmp_path):
+    out = tmp_path / "orbit.json"
+    assert main(["orbits", "spur_pair_bearings", "--transient", "50", "--out", str(out)]) == 0
+    line = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("parameters: "))
+    assert K_B1 in line and "omega=" not in line
+    assert json.loads(out.read_text())["physical"]["parameters"]["k_b1"] == "1e+08 N/m"
+
+
+def test_a_spectrums_record_carries_the_values_it_ran_at_in_the_users_units(capsys, tmp_path):
+    out = tmp_path / "spectrum.json"
+    assert main(["spectrum", "spur_pair_bearings", "--periods", "160", "--discard", "100", "--out", str(out)]) == 0
+    spectrum = json.loads(out.read_text())["spectra"][0]
+    assert spectrum["parameters"]["k_b1"] == "1e+08 N/m" and spectrum["parameters"]["speed"] == "6000 rpm"
+
+
+def test_a_charts_held_values_are_the_users_but_its_axes_and_what_an_engine_axis_stands_for():
+    """'fixed:' of `gearsym stability` on a physical model: every physical value but the axes (the speed, here
+    charted as given), and an axis in the engine's numbers (zeta) with the values it is made of."""
+    from gearsym.cli.stability import held_values
+    from gearsym.sweep.grid import axes_from
+
+    held = held_values(gearsym.scaling("spur_pair_bearings"), axes_from(["speed=4000rpm,6000rpm", "zeta=0.05,0.1"]))
+    values, engine = held.split("; ")
+    assert K_B1 in values and "eta=100 µm" in values and "speed=" not in values and "zeta" not in values
+    assert engine.startswith("zeta charted in the engine's numbers") and "cZ" in engine

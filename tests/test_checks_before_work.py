@@ -213,3 +213,32 @@ def test_a_closed_stdout_ends_the_command_quietly():
     proc.stdout.close()  # as `gearsym list | head -0`: the reader is gone before anything is written
     err = proc.stderr.read().decode()
     assert proc.wait() == 141 and err == ""
+
+
+# --------------------------------------------------------------------------- checks from the declaration alone
+@pytest.fixture
+def no_reduction(no_work, monkeypatch):
+    """Any reduction of a model (the SymPy derivation: half a minute for a planetary set on bearings) or
+    linearisation fails the test too: the check must come from the model's declaration."""
+    import gearsym.cli.spectrum
+    import gearsym.stability
+
+    def work(*args, **kwargs):
+        raise AssertionError("the model was reduced before the input was checked")
+
+    for module, name in ((gearsym.loading, "reduce"), (gearsym.cli.spectrum, "load"),
+                         (gearsym.stability, "compile_linearisation")):
+        monkeypatch.setattr(module, name, work)
+
+
+def test_a_spectrum_run_too_short_for_the_sidebands_is_refused_from_the_declaration(capsys, no_reduction):
+    err = error_line(capsys, "spectrum", "spur_pair_bearings", "--periods", "140")
+    assert "holds 40 mesh periods, less than the 2 revolutions of pinion (28 teeth" in err
+    assert "give at least --periods 156" in err
+
+
+@pytest.mark.parametrize("about", ["static", "orbit"])
+def test_a_chart_along_a_model_option_is_refused_before_the_model_is_reduced(capsys, no_reduction, about):
+    err = error_line(capsys, "stability", "spur_pair_bearings", "--param", "speed=4000rpm,6000rpm", "--param",
+                     "dof=4,6", "--about", about, "--quiet")
+    assert "dof is a model option of spur_pair_bearings" in err and "--set dof=4" in err

@@ -75,7 +75,7 @@ def test_a_missing_effect_is_named_and_the_error_falls_fivefold(one_stage, tmp_p
 
 # --------------------------------------------------------------------------- rig-shaped data
 def stiffness(tau):
-    return 1 + 0.2 * sum(c * math.cos((n + 1) * tau) for n, c in enumerate(rig.STIFFNESS))
+    return 1 + 0.2 * rig.variation(tau)
 
 
 #: what the declared model lacks, typed here: (the extra acceleration, its parameters as the library names them)

@@ -166,10 +166,14 @@ def test_a_stiff_damped_shaft_integrated_by_the_stiff_step_agrees_with_scipys_ra
     trajectory = phase_trajectory(model)
     numbers = {sp.Symbol(k, real=True): v for k, v in s.parameters.items()}
     numbers[sp.Symbol("omega", positive=True)] = s.parameters["omega"]
-    f = sp.lambdify([s.time, sp.Matrix(s.states)], sp.Matrix(s.rhs).subs(numbers),
-                    modules=[{"g": lambda x, eta: np.where(x >= 0, x, np.where(x <= -eta, x + eta, 0.0))}, "numpy"])
+    rhs = sp.Matrix(s.rhs).subs(numbers)
+    numpy_g = {"g": lambda x, eta: np.where(x >= 0, x, np.where(x <= -eta, x + eta, 0.0)),
+               "g_slope": lambda x, eta: np.where((x >= 0) | (x <= -eta), 1.0, 0.0)}  # (in contact 1, in the gap 0)
+    f = sp.lambdify([s.time, sp.Matrix(s.states)], rhs, modules=[numpy_g, "numpy"])
+    J = sp.lambdify([s.time, sp.Matrix(s.states)], rhs.jacobian(s.states), modules=[numpy_g, "numpy"])
     radau = solve_ivp(lambda t, y: np.asarray(f(t, y), dtype=float).ravel(), (0.0, trajectory.time[-1]),
-                      s.initial_vector, method="Radau", rtol=1e-11, atol=1e-12)
+                      s.initial_vector, method="Radau", rtol=1e-9, atol=1e-11,
+                      jac=lambda t, y: np.asarray(J(t, y), dtype=float))
     assert radau.success
     ours = np.array([trajectory[name][-1] for name in s.state_names])
     scale = np.max(np.abs(radau.y), axis=1)

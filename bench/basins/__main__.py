@@ -26,7 +26,6 @@ import resource
 import shlex
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -37,7 +36,7 @@ from gearsym import Integration
 from gearsym.codegen.lane_runs import LaneRunner
 
 from bench.basins.report import summary
-from bench.machine import REPO, machine_info
+from bench.machine import REPO, machine_info, user_environment
 from bench.yardstick import runner
 
 DEFAULT_OUT = REPO / "bench" / "results" / "basins.json"
@@ -66,11 +65,7 @@ def _children_cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-#: the commands' environment: Python keeps its bytecode as for any user (in a temporary PYTHONPYCACHEPREFIX, not in
-#: the repository), even where PYTHONDONTWRITEBYTECODE is set, which would add compiling gearsym's sources to every
-#: start-up (as in bench/speed/startup.py)
-_PYCACHE = tempfile.TemporaryDirectory(prefix="bench-basins-pycache-")
-_ENV = {**{k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}, "PYTHONPYCACHEPREFIX": _PYCACHE.name}
+_ENV = user_environment("basins")  # (bytecode kept, as for any user)
 
 
 def _timed_command(cmd: list[str]) -> tuple[float, float, dict]:

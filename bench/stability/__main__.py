@@ -35,7 +35,7 @@ import gearsym
 from gearsym.stability import compile_linearisation, static_chart
 from gearsym.stability.monodromies import MonodromyRunner
 
-from bench.machine import REPO, machine_info
+from bench.machine import REPO, machine_info, user_environment
 
 DEFAULT_OUT = REPO / "bench" / "results" / "stability.json"
 YARDSTICK = REPO / "bench" / "yardstick" / "monodromy.c"
@@ -47,8 +47,7 @@ COMMAND_AXES = ("omega=0.3:2.4945:0.0055", "k_a=0:0.798:0.002")  # 400 x 400 as 
 #: the targets of issue 40
 TARGET_WALL, TARGET_RATIO = 3.0, 0.3
 
-_PYCACHE = tempfile.TemporaryDirectory(prefix="bench-stability-pycache-")
-_ENV = {**{k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}, "PYTHONPYCACHEPREFIX": _PYCACHE.name}
+_ENV = user_environment("stability")  # (bytecode kept, as for any user)
 
 
 def _children_cpu() -> float:

@@ -14,6 +14,7 @@ from ..errors import GearsymError
 from ..files.atomic import write_atomically
 from ..figures import plot_point
 from ..files.outputs import check_figure
+from ..physical.text import parameters_line
 from .arguments.integration import add_integration_arguments, compiled_from, scaling_from, step_line
 from .arguments.settings import add_set_argument, model_settings, parse_state
 
@@ -59,13 +60,15 @@ def run(args: argparse.Namespace) -> int:
             plot_point(result, trajectory, args.plot, x=coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     if args.format == "json":
-        print(json.dumps({**result.as_dict(), **({"physical": physical.as_dict()} if physical else {})}, indent=2))
+        values = {"parameters": scaling.point_units().values} if physical else {}  # (as given, with their units)
+        print(json.dumps({**result.as_dict(), **({"physical": {**physical.as_dict(), **values}} if physical else {})},
+                         indent=2))
         return 0
     print(f"{result.model}: {result.periods} periods ({result.discard} discarded), "
           f"{result.steps_per_period} {compiled.integration.method_name} steps/period, "
           f"{'plain' if args.plain else 'crossings located'}, {result.backend}")
     print(step_line(compiled, scaling))
-    print("parameters: " + ", ".join(f"{k}={v:g}" for k, v in result.parameters.items()))
+    print("parameters: " + parameters_line(result.parameters, scaling and scaling.point_units()))
     print("Lyapunov exponents (per unit time, +- standard error):")
     paired = {j: i for i, j in result.pairs}
     known = result.resolution

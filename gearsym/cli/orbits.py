@@ -22,6 +22,7 @@ from ..periodic.shooting import check_segments, pieces_per_period
 from ..physical.files import write_physical_rows
 from ..physical.point import Measured
 from ..physical.sweeps import nondimensional_axis
+from ..physical.text import parameters_line
 from ..sweep import read_sweep
 from ..sweep.grid import _numbers_and_unit, Axis
 from ..sweep.store import sidecar
@@ -157,7 +158,7 @@ def _one_orbit(compiled, args, y0, physical) -> int:
     orbit = periodic_orbit(compiled, y0=y0, period_multiple=args.period_multiple, segments=args.segments)
     print(f"{orbit.model}: period-{orbit.period_multiple} orbit, Newton residual {orbit.residual:.2g} after "
           f"{orbit.iterations} iterations, {'stable' if orbit.stable else 'unstable'}")
-    print("parameters: " + ", ".join(f"{k}={v:g}" for k, v in orbit.parameters.items()))
+    print("parameters: " + parameters_line(orbit.parameters, physical and physical.point_units()))
     print("state at the section: " + ", ".join(f"{k}={v:.10g}" for k, v in zip(orbit.state_names, orbit.state)))
     largest = float(np.max(np.abs(orbit.multipliers)))
     held = [m for m in orbit.multipliers if abs(m) > ROUNDED * largest]  # (the rest is the product's rounding)
@@ -183,7 +184,7 @@ def _one_orbit(compiled, args, y0, physical) -> int:
               + ", ".join(f"A_{k} = {shown(v)}" for k, v in amplitude.items())
               + "; state at the section: " + ", ".join(f"{k}={shown(v, 10)}" for k, v in state.items()))
         record["physical"] = {**({"speed": _json(speed)} if speed else {}), "amplitude": {k: _json(v) for k, v in amplitude.items()},
-                              "state": {k: _json(v) for k, v in state.items()}}
+                              "state": {k: _json(v) for k, v in state.items()}, "parameters": dict(units.values)}
     if args.out:
         write_atomically(args.out, json.dumps(record, indent=1) + "\n")
         print(f"gearsym: wrote {args.out}", file=sys.stderr)

@@ -19,7 +19,7 @@ from ..data.measurements import load_measurements
 from ..errors import GearsymError
 from ..files.atomic import write_atomically
 from ..figures.orders import plot_order_spectra
-from ..loading import load
+from ..loading import declared, load, split_options
 from ..memory import check_fits
 from ..options import STEPS_PER_PERIOD, Integration
 from ..files.outputs import check_figure, check_file
@@ -109,11 +109,12 @@ def _spectrum_bytes(lines: int) -> int:
 
 
 def _simulated(args, settings: dict):
+    _check_periods_declared(args, settings)
     system = with_effects(args.model, args.effect, settings) if args.effect else load(args.model, **settings)
     name, gears, _ = mesh_gears(system, args.coordinate)
     _check_sidebands(args, gears)
     cycles = system.cycles
-    discard = args.discard if args.discard is not None else max(1, math.ceil(100 / cycles))
+    discard = _discard(args, cycles)
     measured = max(1, math.ceil(max(4 * max(gears.values()), MIN_MESH_PERIODS) / cycles))
     periods = args.periods if args.periods is not None else discard + measured
     steps = args.steps_per_period or STEPS_PER_PERIOD
@@ -123,9 +124,7 @@ def _simulated(args, settings: dict):
                  "after the transient)")
     else:
         asked = f"--periods {args.periods}"
-        check_length((periods - discard) * cycles, gears, f"the run of --periods {args.periods} minus --discard "
-                     f"{discard} ({cycles} mesh period{'s' if cycles > 1 else ''} each)",
-                     f"give at least --periods {discard + math.ceil(MIN_REVOLUTIONS * max(gears.values()) / cycles)}")
+        _check_periods(args, gears, cycles)
     lines = args.mesh_harmonics * (1 + 2 * len(gears) * args.sidebands) + len(gears) * args.sidebands
     samples = SAMPLES_PER_CYCLE * cycles
     check_fits(periods, 16 * steps * cycles * (len(system.states) + 1) + (periods - discard) / periods * samples
@@ -135,7 +134,7 @@ def _simulated(args, settings: dict):
     options = Integration(periods=periods, discard=discard, steps_per_period=steps, locate_crossings=not args.plain,
                           backend=args.backend)
     compiled = compiled_from(args, options, system)
-    scale, unit = _unit(args, name)
+    scale, unit, values = _unit(args, name)
     s = simulated_order_spectrum(compiled, coordinate=name, mesh_harmonics=args.mesh_harmonics,
                                  sidebands=args.sidebands, scale=scale, unit=unit)
     if unit:  # a physical model: its title in the user's values (the engine's numbers stay in the JSON's title)
@@ -143,19 +142,53 @@ def _simulated(args, settings: dict):
         span = s.title.split(";")[0].split(": ", 1)[1]
         s.info["label"] = (f"{system.name} at {given}: {span}, {compiled.steps_per_cycle} "
                            f"{compiled.integration.method_name} steps per mesh period")
+        s.info["parameters"] = values  # (every physical value as given: the title's are the engine's numbers)
     return [s], f"a run of {system.name}" + (f" ({', '.join(args.effect)})" if args.effect else "")
 
 
-def _unit(args, name: str) -> tuple[float, str]:
+def _discard(args, cycles: int) -> int:
+    """--discard, or by default 100 mesh periods."""
+    return args.discard if args.discard is not None else max(1, math.ceil(100 / cycles))
+
+
+def _check_periods(args, gears: dict, cycles: int) -> None:
+    """--periods (minus --discard) holds MIN_REVOLUTIONS revolutions of every gear of ``gears`` (periods of
+    ``cycles`` mesh periods each)."""
+    discard = _discard(args, cycles)
+    check_length((args.periods - discard) * cycles, gears, f"the run of --periods {args.periods} minus --discard "
+                 f"{discard} ({cycles} mesh period{'s' if cycles > 1 else ''} each)",
+                 f"give at least --periods {discard + math.ceil(MIN_REVOLUTIONS * max(gears.values()) / cycles)}")
+
+
+def _check_periods_declared(args, settings: dict) -> None:
+    """--periods too short for any mesh's sidebands, refused from the model's declaration (its tooth counts and
+    period: a second) before it is reduced and compiled (minutes for a large model). The mesh the run will show
+    is known only after the reduction (a planet's second mesh closes a loop): the run is refused here when it is
+    too short for every mesh with tooth counts, and checked again against its own mesh once it is known. A run
+    with --effect is checked then only (a tooth fault lengthens the period)."""
+    if args.periods is None or args.effect:
+        return
+    options, _ = split_options(args.model, {k: v for k, v in settings.items() if k != "teeth"})
+    model = declared(args.model, settings.get("teeth"), options)
+    if not model.is_drivetrain:
+        return
+    resolved = model.resolved
+    meshes = [{end.body.name: end.body.tooth_count for end in (rc.a, rc.b)} for rc in resolved.couplings
+              if rc.kind == "mesh" and rc.a.body.tooth_count and rc.b.body.tooth_count]
+    if meshes:  # (the mesh whose sidebands need the shortest run)
+        _check_periods(args, min(meshes, key=lambda gears: max(gears.values())), resolved.cycles)
+
+
+def _unit(args, name: str) -> tuple[float, str, dict]:
     """The factor and unit of a run's coordinate in the model's physical units (µm for a mesh's deflection, rad
-    for a shaft's twist), or (1, "") for a model without physical values."""
+    for a shaft's twist) and its physical values as given, or (1, "", {}) for a model without physical values."""
     scaling = scaling_from(args)
     if scaling is None:
-        return 1.0, ""
+        return 1.0, "", {}
     units = scaling.point_units()
     if units.kinds.get(name) == LENGTH:
-        return units.per_unit[name] * units.m_to_length, units.length_text.text
-    return units.per_unit.get(name, 1.0), units.radian.text
+        return units.per_unit[name] * units.m_to_length, units.length_text.text, dict(units.values)
+    return units.per_unit.get(name, 1.0), units.radian.text, dict(units.values)
 
 
 def _measured(args, settings: dict):

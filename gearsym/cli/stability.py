@@ -21,6 +21,7 @@ from .. import stability  # (lazy: the linearisation, SymPy and the generator lo
 from ..cached import load_linearisation, load_static_recipe
 from ..errors import GearsymError
 from ..options import Execution
+from ..registry import model_options
 from ..files.atomic import write_atomically
 from ..figures.basins import axis_label
 from ..figures.stability import plot_stability
@@ -79,6 +80,7 @@ def run(args: argparse.Namespace) -> int:
     if len(given) != 2:
         raise GearsymError(f"give two --param axes (got {len(given)}); for a line give the second one value, e.g. "
                            "--param k_a=0.2")
+    _refuse_model_options(args.model, given)
     options = integration_from(args)
     user = _formula_axes(args, given)
     tolerance_of = lambda axes: tuple(args.tolerance * (max(a.values) - min(a.values) or max(1.0, abs(a.values[0])))
@@ -109,10 +111,11 @@ def run(args: argparse.Namespace) -> int:
     if args.plot and args.about == "static" and len(lin.recipe.meshes) > 1:  # (the phasing rule's panel)
         factor = given[0].values[0] / axes[0].values[0] if axes[0].values[0] else 1.0
         prediction = stability.phasing_prediction(chart, lin, factor=factor)
-    shown = OwnNumbers()
+    shown, fixed = OwnNumbers(), None
     if scaling is not None:
         chart = chart_in_units(chart, tuple(given), tuple(axes))
         shown = shown_in(scaling.point_units())
+        fixed = held_values(scaling, given)
     seconds = time.perf_counter() - start
     if args.out:
         write_table(args.out, chart)
@@ -126,8 +129,19 @@ def run(args: argparse.Namespace) -> int:
     if args.format == "json":
         print(json.dumps(chart.as_dict(), indent=1))
     else:
-        print(report(chart, shown, seconds))
+        print(report(chart, shown, seconds, fixed))
     return 0
+
+
+def _refuse_model_options(model: str, given) -> None:
+    """An axis that names a model option (planets, dof: another model built, another set of equations) cannot be
+    charted: refused from the model file's options (a second), before the model is reduced and compiled."""
+    options = model_options(model)
+    for a in given:
+        if a.name in options:
+            raise GearsymError(f"--param {a.spec!r}: {a.name} is a model option of {model} (it builds another model, "
+                               f"with other equations), not a parameter a chart can move: give it one value with "
+                               f"--set {a.name}={options[a.name]}, one chart per value")
 
 
 def _formula_axes(args, given) -> dict:
@@ -198,13 +212,29 @@ def _number(x: float) -> str:
     return repr(float(x)) if np.isfinite(x) else ""
 
 
-def report(chart: StabilityChart, shown: OwnNumbers, seconds: float) -> str:
+def held_values(scaling, given) -> str:
+    """The physical values held over a chart, as the user gave them: all but its axes' own (and the speed, for an
+    axis of omega); an axis in the engine's numbers (zeta) is said with the physical values it is made of, which
+    it overrides."""
+    units = scaling.point_units()
+    names = {a.name for a in given} | ({scaling.speed.parameter} if scaling.speed and "omega" in
+                                       {a.name for a in given} else set())
+    groups = {g.name: g for g in scaling.full.model.groups}
+    overridden = [f"{a.name} charted in the engine's numbers over the values it is made of ("
+                  + ", ".join(sorted(str(x) for x in groups[a.name].definition.free_symbols)) + ")"
+                  for a in given if a.name in groups]
+    return "; ".join([units.parameters_text(leave_out=names), *overridden])
+
+
+def report(chart: StabilityChart, shown: OwnNumbers, seconds: float, fixed: str | None = None) -> str:
+    """The chart's text; ``fixed``: the values held over it as the user gave them (a model with physical values),
+    else the chart's own numbers."""
     (na, nb), (ua, ub) = chart.names, chart.units
     a, b = chart.values
     lines = [f"{chart.model}: stability of its {'static state' if chart.about == 'static' else 'period-1 orbit'} "
              f"on {len(a)} x {len(b)} points, {axis_label(na, ua)} in [{a.min():g}, {a.max():g}] x "
              f"{axis_label(nb, ub)} in [{b.min():g}, {b.max():g}] ({seconds:.2f} s)",
-             f"fixed: {shown.parameters(chart.fixed).replace('$', '')}",
+             f"fixed: {(fixed if fixed is not None else shown.parameters(chart.fixed)).replace('$', '')}",
              "points: " + ", ".join(f"{k} {v}" for k, v in chart.counts().items())]
     t = chart.timings
     if chart.crossings:

@@ -340,6 +340,11 @@ class PointUnits:
                  + f"\n{result.regime}, λ₁ = {spectrum.exponents[0]:+.5g} {self.per_second.text}")
         return spectrum, shown_trajectory, units, title
 
+    def parameters_text(self, leave_out=()) -> str:
+        """Every physical value as the model or the user gave it, in one line ('speed=6000 rpm, kZ=1.27e+08 N/m'),
+        but those named in ``leave_out`` (a chart's axes): how a command's text says where it ran."""
+        return ", ".join(f"{k}={v}" for k, v in self.values.items() if k not in leave_out)
+
     def caption(self) -> str:
         """Every physical value of the point as the model or the user gave it, one a line: what a figure's title
         leaves to its caption file."""

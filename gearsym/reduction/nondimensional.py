@@ -155,25 +155,20 @@ class NondimensionalModel:
         """The forcing period in tau: one mesh period of the first mesh (2 pi / its order; 2 pi without a mesh).
         Steps are counted per forcing period, so that a mesh of another order (a second stage) costs periods,
         not accuracy."""
-        meshes = [rc.order for rc in self.reduction.resolved.couplings if rc.kind == "mesh"]
-        return 2 * sp.pi / meshes[0] if meshes else 2 * sp.pi
+        return self.reduction.resolved.forcing_period
 
     @cached_property
     def period(self) -> sp.Expr:
-        """The period the model repeats on, in tau: 2 pi / the greatest common divisor of every frequency in it
-        (every mesh's order, the torques' harmonics, and with shaft-order terms, a tooth fault or an eccentric
-        gear, theirs): the forcing period for a single pair, the common period of the meshes of a multi-stage
-        box (61 mesh periods of a 23/61 first stage), a gear's revolution or the hunting period. Every analysis
-        runs on it."""
-        freqs = [rc.order for rc in self.reduction.resolved.couplings if rc.kind == "mesh"]
-        freqs += [sp.Integer(f.order) for f in self.reduction.resolved.forcing if f.order]
-        freqs += [f for rc in self.reduction.resolved.couplings for f in rc.shaft_frequencies]
-        return 2 * sp.pi / functools.reduce(sp.gcd, freqs, sp.S.Zero) if freqs else 2 * sp.pi
+        """The period the model repeats on, in tau (the resolved drivetrain's: every mesh's order, the torques'
+        harmonics and with shaft-order terms, a tooth fault or an eccentric gear, theirs): the forcing period for
+        a single pair, the common period of the meshes of a multi-stage box (61 mesh periods of a 23/61 first
+        stage), a gear's revolution or the hunting period. Every analysis runs on it."""
+        return self.reduction.resolved.period
 
     @property
     def cycles(self) -> int:
         """Forcing periods (mesh periods of the first mesh) in one :attr:`period`: 1 for a single pair."""
-        return int(sp.nsimplify(self.period / self.forcing_period))
+        return self.reduction.resolved.cycles
 
     # ------------------------------------------------------------- parameters
     @cached_property
