@@ -20,13 +20,23 @@ GEAR_MODELS = ("one_stage", "one_stage_resonant", "flexible_shaft", "two_stage")
 #: pre-generated models whose byte-for-byte checks of generated/ and docs/derivations/ take many seconds (run with
 #: -m slow): Lin & Parker's translational set (its reduction 40 s of SymPy, then 8 s to generate its C)
 SLOW_MODELS: tuple[str, ...] = ("planetary_translational",)
+#: the xdist group of the tests that reduce a slow model (`slow_models_group`): in a parallel run (pytest -n auto
+#: --dist loadgroup) they run on one worker, so that the model's reduction, cached on the model, is made once
+SLOW_MODELS_GROUP = "reductions of the slow models"
+
+
+def slow_models_group():
+    """The mark of a test that reduces a slow model (see SLOW_MODELS_GROUP)."""
+    import pytest
+
+    return pytest.mark.xdist_group(SLOW_MODELS_GROUP)
 
 
 def model_params(names):
-    """Model names as test parameters, the slow ones marked slow."""
+    """Model names as test parameters, the slow ones marked slow and put in the slow models' group."""
     import pytest
 
-    return [pytest.param(n, marks=pytest.mark.slow) if n in SLOW_MODELS else n for n in names]
+    return [pytest.param(n, marks=(pytest.mark.slow, slow_models_group())) if n in SLOW_MODELS else n for n in names]
 
 
 @functools.cache

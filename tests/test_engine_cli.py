@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from conftest import SLOW_MODELS, compiled, paper_rk4_spectrum
+from conftest import SLOW_MODELS, compiled, paper_rk4_spectrum, slow_models_group
 from gearsym import Integration, available_models, lyapunov_spectrum
 from gearsym.registry import pregenerated_models
 from gearsym.cli import main
@@ -150,6 +150,7 @@ def test_compile_check_reports_up_to_date(capsys, monkeypatch):
 
 
 @pytest.mark.slow
+@slow_models_group()  # (it reduces every model: with the other tests that reduce the slow ones)
 def test_compile_check_all_reports_up_to_date(capsys, monkeypatch):
     monkeypatch.chdir(REPO_ROOT)
     code, out, _ = run(capsys, "compile", "--all", "--check")

@@ -32,7 +32,7 @@ from gearsym.codegen.loops import LoopOptions  # noqa: E402
 from gearsym.codegen.surfaces import switching_surfaces  # noqa: E402
 from gearsym.fmu.functions import indicators  # noqa: E402
 from gearsym.files.paths import REPO_ROOT  # noqa: E402
-from conftest import system  # noqa: E402
+from conftest import slow_models_group, system  # noqa: E402
 
 K = "1+0.2*cos(tau)"  # the stiffness formula
 PERIODS, STEPS = 40, 200
@@ -535,6 +535,8 @@ def _layout_of(name: str):
     return layout(sys_, frame or Frame(), ())
 
 
+@pytest.mark.slow
+@slow_models_group()  # (it reduces every model: with the other tests that reduce the slow ones)
 def test_every_variable_of_every_shipped_models_fmu_has_a_description():
     from gearsym.registry import pregenerated_models
 

@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 import sympy as sp
@@ -35,7 +36,11 @@ MAX_STEPS = 60
 
 def number(expr: sp.Expr, values: Mapping[str, float], what: str) -> float:
     """``expr`` at ``values``, or a one-line error naming what has no value."""
-    value = sp.sympify(expr, strict=True).xreplace({parameter_symbol(k): sp.Float(v) for k, v in values.items()})
+    expr = sp.sympify(expr, strict=True)
+    # only the parameters ``expr`` has (a planetary set's scaling evaluates thousands of small expressions, each
+    # against every value of the model: a Float made for each value was most of the time)
+    value = expr.xreplace({s: sp.Float(values[s.name]) for s in expr.free_symbols
+                           if s.name in values and s == parameter_symbol(s.name)})
     if not value.is_number:
         missing = ", ".join(sorted(s.name for s in value.free_symbols))
         raise GearsymError(f"{what} needs a value for {missing}")
@@ -52,13 +57,18 @@ def mean_over(expr: sp.Expr, variable: sp.Symbol, period: float, values: Mapping
     if shape.free_symbols - {variable}:
         missing = ", ".join(sorted(s.name for s in shape.free_symbols - {variable}))
         raise GearsymError(f"{what} needs a value for {missing}")
-    samples = np.linspace(0.0, period, MEAN_SAMPLES, endpoint=False)
-    with np.errstate(all="ignore"):
-        sampled = np.asarray(sp.lambdify(variable, shape, "numpy")(samples), dtype=float) * np.ones(MEAN_SAMPLES)
-    mean = float(np.mean(sampled))
+    mean = _sampled_mean(shape, variable, float(period))
     if not math.isfinite(mean):
         raise GearsymError(f"{what} is not finite over its period")
     return mean
+
+
+@lru_cache(maxsize=256)  # (a scaling probes many values: the meshes of a planetary set share their shape)
+def _sampled_mean(shape: sp.Expr, variable: sp.Symbol, period: float) -> float:
+    samples = np.linspace(0.0, period, MEAN_SAMPLES, endpoint=False)
+    with np.errstate(all="ignore"):
+        sampled = np.asarray(sp.lambdify(variable, shape, "numpy")(samples), dtype=float) * np.ones(MEAN_SAMPLES)
+    return float(np.mean(sampled))
 
 
 def mean_stiffness(rc: ResolvedCoupling, values: Mapping[str, float]) -> float:
