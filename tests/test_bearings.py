@@ -321,3 +321,13 @@ def test_a_charts_held_values_are_the_users_but_its_axes_and_what_an_engine_axis
     values, engine = held.split("; ")
     assert K_B1 in values and "eta=100 µm" in values and "speed=" not in values and "zeta" not in values
     assert engine.startswith("zeta charted in the engine's numbers") and "cZ" in engine
+    from types import SimpleNamespace
+
+    from gearsym.figures.stability import chart_title
+    from gearsym.physical.basins import shown_in
+
+    units = gearsym.scaling("spur_pair_bearings").point_units()  # the chart's title holds the same values
+    engine_values = {"k_b1": 0.996842, "eta": 1.0}
+    chart = SimpleNamespace(about="static", steps_per_period=200, model="spur_pair_bearings", fixed=engine_values)
+    title = chart_title(chart, shown_in(units), fixed=held)
+    assert held in title and "k_b1=0.996842" not in title

@@ -123,7 +123,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"gearsym: wrote {args.out} and {sidecar(args.out, '.json')}", file=sys.stderr)
     if args.plot:
         formula = settings.get("k")
-        plot_stability(chart, args.plot, shown=shown, prediction=prediction,
+        plot_stability(chart, args.plot, shown=shown, prediction=prediction, fixed=fixed,
                        title=f"{chart.model} with k(τ) = {formula}" if isinstance(formula, str) else None)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     if args.format == "json":

@@ -56,19 +56,23 @@ def draw_chart(ax, chart: StabilityChart, *, boundaries: bool = True) -> list:
     return handles
 
 
-def chart_title(chart: StabilityChart, shown: OwnNumbers | None = None, title: str | None = None) -> str:
+def chart_title(chart: StabilityChart, shown: OwnNumbers | None = None, title: str | None = None,
+                fixed: str | None = None) -> str:
+    """The chart's title: the model, what is charted, and the values held over it (``fixed``: as the user gave
+    them, for a model with physical values; else the chart's own numbers)."""
     shown = shown or OwnNumbers()
     about = "its static state" if chart.about == "static" else "its period-1 orbit"
-    fixed = shown.parameters(chart.fixed)
+    fixed = fixed if fixed is not None else shown.parameters(chart.fixed)
     return (f"{title or chart.model}: Floquet stability of {about}, {chart.steps_per_period} RK4 steps/period\n"
             f"{fixed}")
 
 
 def plot_stability(chart: StabilityChart, path: str | Path | None = None, *, shown: OwnNumbers | None = None,
-                   prediction=None, exact: Sequence[tuple[str, np.ndarray]] = (), title: str | None = None):
+                   prediction=None, exact: Sequence[tuple[str, np.ndarray]] = (), title: str | None = None,
+                   fixed: str | None = None):
     """The chart (and, with ``prediction``, the phasing rule's panel beside it); ``exact``: curves (label,
-    points k x 2) drawn dashed over the chart (a check against known transition curves). Written to ``path`` if
-    given; returns the Figure."""
+    points k x 2) drawn dashed over the chart (a check against known transition curves); ``fixed``: the values held
+    over it as the user gave them (:func:`chart_title`). Written to ``path`` if given; returns the Figure."""
     plt = pyplot()
     panels = 2 if prediction is not None else 1
     fig, axes = plt.subplots(1, panels, figsize=(7.2 * panels, 6.4), squeeze=False, constrained_layout=True)
@@ -84,7 +88,7 @@ def plot_stability(chart: StabilityChart, path: str | Path | None = None, *, sho
     ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.11), fontsize=8, frameon=False, ncol=1)
     if prediction is not None:
         draw_prediction(axes[0, 1], prediction, chart)
-    fig.suptitle(chart_title(chart, shown, title), fontsize=10)
+    fig.suptitle(chart_title(chart, shown, title, fixed), fontsize=10)
     fit_texts(fig)
     if path is not None:
         save_figure(fig, path, dpi=130)
