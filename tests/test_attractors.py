@@ -263,6 +263,7 @@ def test_cli_text_lists_attractors_and_runs_and_plots(capsys, tmp_path):
     assert out.count("-> attractor") == 3
 
 
+@pytest.mark.slow
 def test_cli_plot_shows_the_coordinate_asked_for(capsys, tmp_path, monkeypatch):
     import gearsym.cli.poincare as command
 

@@ -121,6 +121,7 @@ def scipy_escapes(xs, vs, periods: int) -> np.ndarray:
     return out
 
 
+@pytest.mark.slow
 def test_a_start_that_diverges_is_a_class_of_its_own_and_the_fractions_sum_to_one():
     model = gearsym.compile_model(escape_oscillator(), Integration(periods=80, discard=40))
     xs, vs = np.linspace(-1.2, 1.8, 7), np.linspace(-1.0, 1.0, 5)

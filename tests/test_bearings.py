@@ -42,6 +42,7 @@ def planetary(request):
     return planets, drivetrain_modes(model, values), frequencies
 
 
+@pytest.mark.slow
 def test_the_translational_planetary_set_has_the_frequencies_of_lin_and_parkers_matrices(planetary):
     planets, modes, expected = planetary
     got = np.array(modes.frequencies)
@@ -175,6 +176,7 @@ def test_the_pair_on_stiff_bearings_has_the_torsional_pairs_frequency():
     assert min(abs(m.frequency - torsional) for m in soft.elastic) > 1e-3 * torsional
 
 
+@pytest.mark.slow
 def test_the_pair_on_stiff_bearings_responds_as_the_torsional_pair(pair):
     """With bearings 1e4 times stiffer than the mesh the periodic orbit's mesh deflection is spur_pair's."""
     run = Integration(steps_per_period=2048, periods=300, discard=250)
@@ -190,6 +192,7 @@ def test_the_pair_on_stiff_bearings_responds_as_the_torsional_pair(pair):
 # ----------------------------------------------------------------------------- a bearing's accelerometer
 
 
+@pytest.mark.slow
 def test_a_bearing_accelerometer_is_a_channel_and_its_record_gives_the_mesh_damping_back(pair, tmp_path):
     """A record of the pinion centre's acceleration (the channel a_pinion_y, what an accelerometer on its
     bearing housing reads) is a channel of the pair on bearings, and fitting the mesh's damping ratio to it
@@ -272,6 +275,7 @@ def test_the_translational_sets_mesh_phases_are_the_rotational_sets():
     assert len(set(translational.values())) == 3  # 26/94 teeth, three planets: 0, 2 pi/3, 4 pi/3
 
 
+@pytest.mark.slow
 def test_gearsym_lyap_answers_bearing_deflections_in_um_and_bearing_forces_in_newtons(capsys):
     assert main(["lyap", "spur_pair_bearings", "--periods", "16", "--discard", "6"]) == 0
     out = capsys.readouterr().out

@@ -117,6 +117,7 @@ def one_line_warning(stderr: str, text: str) -> str:
 
 
 # ------------------------------------------------------------------ made private
+@pytest.mark.slow
 def test_a_new_cache_is_private_at_every_level_gearsym_makes_even_under_umask_000(seeded):
     _, _, modes = seeded
     assert len(modes) > 12  # (the levels, lib/, models/, code/, libraries, records, summaries, C)
@@ -207,6 +208,7 @@ def test_a_symlink_in_place_of_a_library_is_never_followed(cache, clean, planted
 
 
 @pytest.mark.skipif(os.geteuid() != 0, reason="giving a file to another user needs root")
+@pytest.mark.slow
 def test_a_library_that_belongs_to_someone_else_is_not_loaded(cache, clean, planted):
     data, marker = planted
     lib = library(cache)
@@ -236,6 +238,7 @@ def one_constant(data: bytes) -> bytes:
 
 
 @pytest.mark.parametrize("damage", [truncate, garbage, one_constant])
+@pytest.mark.slow
 def test_a_damaged_library_is_found_compiled_again_and_gives_the_same_results(cache, clean, damage):
     lib = library(cache)
     lib.write_bytes(damage(lib.read_bytes()))  # (in place: its record stays as it was)
@@ -299,6 +302,7 @@ def change_default(data: dict) -> dict:
 
 
 @pytest.mark.parametrize("edit", [swap_states, change_default])
+@pytest.mark.slow
 def test_an_edited_summary_is_found_and_written_again(cache, clean, edit):
     system, _ = summaries(cache)
     system.write_text(json.dumps(edit(json.loads(system.read_text())), indent=1))
@@ -363,6 +367,7 @@ def test_a_cache_path_that_is_no_folder_is_a_one_line_error_before_any_work(tmp_
     assert len(run.stderr.splitlines()) == 1 and "Traceback" not in run.stderr
 
 
+@pytest.mark.slow
 def test_the_library_gearsym_compile_makes_is_the_one_a_run_loads(tmp_path):
     cache = tmp_path / "cache"
     made = gearsym(cache, "compile", "duffing", "--out", str(tmp_path / "generated"))

@@ -76,6 +76,7 @@ def test_time_dependence_that_is_not_periodic_is_rejected():
 
 # ------------------------------------------------------------------ generated/ is what the models give
 @pytest.mark.parametrize("name", model_params(pregenerated_models()))
+@pytest.mark.slow
 def test_committed_generated_code_is_regenerated_byte_for_byte(name):
     import json
     made_with = json.loads((REPO_ROOT / "generated" / name / "manifest.json").read_text())["casadi_version"]
@@ -85,6 +86,7 @@ def test_committed_generated_code_is_regenerated_byte_for_byte(name):
     assert report.stale == [], f"stale: {report.stale}; run `gearsym compile --all` and commit generated/"
 
 
+@pytest.mark.slow
 def test_generated_code_does_not_depend_on_the_hash_seed(tmp_path):
     script = ("import sys, gearsym; from gearsym.codegen.generated import generate_model; "
               "generate_model(gearsym.load('one_stage'), sys.argv[1], compile=False)")

@@ -45,6 +45,7 @@ def errors(model, locate: bool, **values) -> list[float]:
 
 
 @pytest.mark.parametrize("model, omega", [("one_stage", 1.5), ("one_stage", 1.8), ("flexible_shaft", 1.8)])
+@pytest.mark.slow
 def test_exponents_converge_at_fourth_order_with_crossings_located(model, omega):
     located = errors(model, True, omega=omega)
     ratios = [a / b for a, b in zip(located, located[1:])]

@@ -46,6 +46,7 @@ def test_the_models_are_the_expected_ones():
 
 
 @pytest.mark.parametrize("model", conftest.model_params(MODELS))
+@pytest.mark.slow
 def test_committed_page_is_regenerated_byte_for_byte(model):
     path = DOCS / f"{model}.md"
     assert path.is_file(), f"{path} is missing: run `gearsym docs --all`"

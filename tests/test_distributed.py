@@ -99,6 +99,7 @@ def test_interrupted_on_the_cluster_cancels_its_tasks_and_resumes_to_the_same_fi
     _same_files(tmp_path / "whole.csv", part)
 
 
+@pytest.mark.slow
 def test_sweep_command_with_a_local_cluster(tmp_path, capsys):
     args = ["sweep", "one_stage", "--param", "omega=1:1.3:0.1", "--mode", "independent", "--periods", "40",
             "--discard", "10", "--quiet"]

@@ -142,6 +142,7 @@ def test_lyap_errors_are_one_line_messages(capsys, argv, message):
     assert message in err and "Traceback" not in err
 
 
+@pytest.mark.slow
 def test_compile_check_reports_up_to_date(capsys, monkeypatch):
     monkeypatch.chdir(REPO_ROOT)  # (the C is checked where it would be written: the current folder's)
     fast = [m for m in pregenerated_models() if m not in SLOW_MODELS]

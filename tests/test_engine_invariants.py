@@ -31,6 +31,7 @@ def test_trace_of_jacobian_is_minus_two_zeta_over_omega(name):
     ("flexible_shaft", {"omega": 0.9, "kS": 1.0}, 8e-7),     # [7.4e-8]
     ("two_stage", {"omega": 1.2}, 5e-6),  # period 4 pi: the second mesh turns at half the speed [4.1e-7]
 ])
+@pytest.mark.slow
 def test_exponents_sum_to_mean_trace(name, settings, rel):
     result = lyapunov_spectrum(compiled(name), options=Integration(periods=300, discard=100), **settings)
     trace = system(name).jacobian().trace()  # constant for these models: the mean trace is its value
@@ -59,6 +60,7 @@ def test_a_plain_ode_with_a_parameter_dependent_period():
 
 
 @pytest.mark.parametrize("scheme", [Integration.paper, Integration])
+@pytest.mark.slow
 def test_trace_error_shrinks_with_more_steps(scheme):
     """RK4's tangent map has det = exp(trace * h) + O(h^5): the error of the sum falls ~ h^4 (measured ratios
     5.5 and 11 for the plain scheme, 8.7 and 13 with the crossings located)."""

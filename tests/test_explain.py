@@ -62,6 +62,7 @@ def measure(system, tmp_path, name, records=RECORDS, noise=0.01, options=RECORD)
 
 
 @pytest.mark.parametrize("name", list(CASES))
+@pytest.mark.slow
 def test_a_missing_effect_is_named_and_the_error_falls_fivefold(one_stage, tmp_path, name):
     values, records = CASES[name]
     data = measure(augment(one_stage, [name], values=values), tmp_path, name, records,
@@ -114,6 +115,7 @@ def rig_data(rig_runs, tmp_path, case, channels=("x",), bias=None, omegas=(1.2, 
     return load_measurements([path], conftest.system("one_stage"))
 
 
+@pytest.mark.slow
 def test_an_accelerometer_record_with_an_offset_is_explained_as_well_as_a_displacement_record(
         one_stage, rig_runs, tmp_path):
     """At omega = 1.0 and 1.8, where the motion with the cubic stiffness is periodic (at 1.2 and 1.6 it is
@@ -131,6 +133,7 @@ def test_an_accelerometer_record_with_an_offset_is_explained_as_well_as_a_displa
     assert felt.final.fit.bias["x_ddot"] == pytest.approx(0.3, abs=3 * felt.final.fit.bias_stderr["x_ddot"] + 0.01)
 
 
+@pytest.mark.slow
 def test_an_accelerometers_offset_is_fitted_by_default_and_the_report_says_so(one_stage, rig_runs, tmp_path):
     """Issue 25: with a 5 % offset in an accelerometer's channel every candidate made the held-out error worse and
     the verdict was 'unexplained', unless --bias was given. Bounded motion has zero mean acceleration, so the
@@ -235,6 +238,7 @@ def test_clean_rig_data_get_no_effect_and_canonical_parameters(rig_runs, tmp_pat
     assert ex.final.error < 0.02  # the noise floor (1 % noise)
 
 
+@pytest.mark.slow
 def test_a_term_beyond_the_library_is_proposed_and_adding_it_by_hand_closes_the_loop(rig_runs, tmp_path, capsys):
     path = rig.write(tmp_path / "ripple.csv", rig_runs("damping_ripple"))
     out = tmp_path / "first"
@@ -300,6 +304,7 @@ def clean_explained(rig_runs, tmp_path_factory):
     return declared, explain(declared, data, ["zeta"], candidates=["cubic_stiffness"])
 
 
+@pytest.mark.slow
 def test_the_as_declared_residual_figure_is_drawn_when_no_effect_is_added(clean_explained):
     declared, ex = clean_explained
     assert ex.effects == []
@@ -423,6 +428,7 @@ def test_the_worked_example_data_are_what_the_documented_command_writes(tmp_path
         "docs/examples/explain-cubic-stiffness/measured.csv is not what docs/data-loop.md's command writes: rerun it")
 
 
+@pytest.mark.slow
 def test_the_committed_worked_example_is_what_explain_writes(tmp_path):
     from gearsym.figures.fit_report import explain_files
 
@@ -450,6 +456,7 @@ def test_the_rig_example_data_are_what_the_documented_command_writes(tmp_path):
         "docs/examples/explain-rig-accelerometer/measured.csv is not what `python tests/rig.py` writes: rerun it")
 
 
+@pytest.mark.slow
 def test_the_committed_rig_example_is_what_explain_writes(tmp_path, monkeypatch, capsys):
     page = (REPO_ROOT / "docs" / "data-loop.md").read_text()
     command = re.search(r"^\s*gearsym explain measured.csv .*--time-scale.*$", page, re.M).group(0).strip()

@@ -71,6 +71,7 @@ def computed(tmp_path_factory):
 
 
 @pytest.mark.parametrize("name", ["fig3", "fig4", "fig6", "fig7", "hysteresis"])
+@pytest.mark.slow
 def test_every_paper_figure_states_its_parameter_set(computed, name):
     fig = paper_figures.FIGURES[name][0](computed)
     top = fig._suptitle.get_text()
@@ -421,6 +422,7 @@ def test_the_prediction_figure_says_which_record_and_periods_it_shows():
 
 # ------------------------------------------------------------------ the paper's figures, as they are written
 @pytest.mark.parametrize("name", [n for n in paper_figures.FIGURES if n != "study"])
+@pytest.mark.slow
 def test_no_paper_figure_clips_a_text_or_covers_a_curve_with_a_legend(computed, name):
     if name == "fig3-orbits" and not computed.orbits:
         pytest.skip("the quick plan has no continuation")

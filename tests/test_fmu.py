@@ -410,6 +410,7 @@ def planetary_reference(s, periods=PERIODS):
     return tau, sol.y
 
 
+@pytest.mark.slow
 def test_a_planetary_fmu_runs_both_ways_and_agrees_with_its_equations(planetary):
     assert validate_fmu(str(planetary)) == []
     s = system("planetary")

@@ -85,6 +85,7 @@ def per_second(scaling, linear, exponents):
     return np.asarray(exponents) * rate(scaling, linear.parameters["omega"])
 
 
+@pytest.mark.slow
 def test_every_exponent_of_the_linear_gearbox_is_the_real_part_of_an_eigenvalue_of_its_lagrange_equations(
         scaling, linear, exact, spectrum):
     model, result = spectrum
@@ -100,6 +101,7 @@ def test_every_exponent_of_the_linear_gearbox_is_the_real_part_of_an_eigenvalue_
     assert per_second(scaling, linear, result.sum) == pytest.approx(trace, rel=1e-4)
 
 
+@pytest.mark.slow
 def test_exponents_the_step_cannot_resolve_are_said_as_such_and_the_resolved_ones_are_exact(
         scaling, linear, exact):
     # RK4 at 100 steps per mesh period, a quarter of what the default chooses: h |mu| = 0.9 and 1.1 on the two

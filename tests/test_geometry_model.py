@@ -232,6 +232,7 @@ def test_two_gears_giving_one_parameter_two_values_are_refused():
         model.add(Gear.from_geometry("b", inertia="I", base_radius="r2", **WHEEL))
 
 
+@pytest.mark.slow
 def test_the_located_crossings_converge_at_fourth_order_with_the_computed_stiffness():
     """At 12 000 rpm spur_pair's teeth separate; with the series smooth in time, the located crossings keep RK4's
     fourth order (step halving divides the error by about 16) and beat the unlocated steps by orders of magnitude."""

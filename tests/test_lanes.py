@@ -67,6 +67,7 @@ def _records_equal(a, b) -> list[str]:
 @needs_cc
 @pytest.mark.parametrize("name, located, omega", [("one_stage", True, 1.5), ("one_stage", False, 1.0),
                                                   ("lorenz", False, None)])
+@pytest.mark.slow
 def test_every_lane_gives_the_bits_of_the_scalar_loop_from_its_start(name, located, omega, tmp_path):
     # the plain scheme in blocks of 3 steps and 45 steps a period: blocks of several steps, an odd number of them
     options = LoopOptions(steps_per_period=45 if not located else 90, block_steps=3, locate_crossings=located)

@@ -178,6 +178,7 @@ def test_a_user_model_writes_docs_and_c_beside_the_user_not_into_the_installed_t
         shutil.rmtree(REPO_ROOT / "generated" / "my_oscillator", ignore_errors=True)
 
 
+@pytest.mark.slow
 def test_shipped_models_run_from_a_scratch_folder_write_into_it_not_into_the_installed_tree(tmp_path):
     before = repository_state()
     for command in (["docs", "flexible_shaft"], ["compile", "one_stage", "lorenz", "--no-compile"]):

@@ -259,6 +259,7 @@ def test_a_linear_regimes_period_doubling_has_a_vertical_period_two_branch_and_n
 
 
 # ------------------------------------------------------------------ (g) into the interval from either end
+@pytest.mark.slow
 def test_the_continuation_goes_through_the_interval_from_either_end_and_finds_the_same_curve():
     """k = 1 + 0.2 cos(tau): from omega = 0.1 the branch went back out through 0.1 after 8 points (the corrector
     had converged behind the start), from 2.0 it came back to 2.0. Each way, the first branch must reach the
@@ -292,6 +293,7 @@ def test_folds_narrower_than_the_continuations_resolution_are_dropped_in_pairs_o
     assert [p.value for p in wiggles(branch((0.5, False), (0.4999, True), (0.7, False)), 1e-3)] == [0.4999]
 
 
+@pytest.mark.slow
 def test_the_count_of_each_bifurcation_is_the_same_when_the_linear_algebra_rounds_otherwise(monkeypatch):
     """On an AMD EPYC (another BLAS kernel) the D = 2 branches of the reproduction had 16 folds where the committed
     run had 17: the fold test (the tangent's parameter component) vanishes at a pitchfork's tip too, where a

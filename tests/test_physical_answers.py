@@ -53,6 +53,7 @@ def motor_coupling_gear() -> Drivetrain:
     return m
 
 
+@pytest.mark.slow
 def test_shaft_twists_come_back_in_radians_and_their_torques_in_newton_metres():
     from scipy.integrate import solve_ivp
 
@@ -97,6 +98,7 @@ def test_shaft_twists_come_back_in_radians_and_their_torques_in_newton_metres():
     assert np.max(np.abs(ours.mesh_force["mesh"].to("N").magnitude - theirs)) < 1e-5 * np.max(np.abs(theirs))
 
 
+@pytest.mark.slow
 def test_a_spectrum_of_a_train_with_shafts_gives_twists_in_rad_and_shaft_torques_in_newton_metres():
     s = gearsym.scaling(motor_coupling_gear())
     result = gearsym.lyapunov_spectrum(s.system(), options=Integration(periods=120, discard=60))
@@ -139,6 +141,7 @@ def test_the_mean_mesh_force_of_a_point_is_the_mean_over_whole_periods():
     assert abs(np.mean(samples) - exact) > 1e-5 * exact
 
 
+@pytest.mark.slow
 def test_python_and_the_command_line_give_the_mean_mesh_force_of_a_periodic_orbit_exactly(spur, capsys):
     """On a periodic orbit the pinion does not accelerate on average, so the mean mesh force is M1 / r1 (the
     torque harmonic and the damping average out); ``to_physical`` runs the trajectory itself when not given

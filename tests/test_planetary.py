@@ -204,6 +204,7 @@ def planets_of(count: int, ring_fixed: bool = True) -> gearsym.NondimensionalMod
 
 
 @pytest.mark.parametrize("planets", [3, 4, 5])
+@pytest.mark.slow
 def test_equally_spaced_planets_give_rotational_modes_and_planet_modes_of_multiplicity_n_minus_1(planets):
     modes = natural_modes(planets_of(planets)).elastic
     planet_modes = [m for m in modes if m.multiplicity == planets - 1]

@@ -34,6 +34,7 @@ def _library(name: str, options: LoopOptions, tmp_path):
 @needs_cc
 @pytest.mark.parametrize("name, located", [("one_stage", False), ("one_stage", True), ("flexible_shaft", False),
                                            ("flexible_shaft", True), ("lorenz", True)])
+@pytest.mark.slow
 def test_the_printed_loops_give_the_bits_of_casadis_loops_evaluated_in_process(name, located, tmp_path):
     # 45 steps in blocks of 3 (plain): odd numbers of blocks per period and per shooting piece (3 of 15 steps)
     options = LoopOptions(steps_per_period=45, chunk_periods=3, block_steps=3, locate_crossings=located)

@@ -116,6 +116,7 @@ def whole(tmp_path_factory) -> Path:
 
 # ------------------------------------------------------------------ processes
 @needs_fork
+@pytest.mark.slow
 def test_sweep_workers_die_with_a_killed_parent_and_the_sweep_resumes(tmp_path, sweep_process, whole):
     out = tmp_path / "part.csv"
     proc, workers, _ = sweep_process(out)

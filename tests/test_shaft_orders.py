@@ -198,6 +198,7 @@ def eccentric(name: str, amplitude: float, phase: float, teeth=TEETH, both: bool
     return pair(name, *terms, teeth=teeth, A=amplitude, psi=phase, **extra)
 
 
+@pytest.mark.slow
 def test_a_periodic_orbit_of_a_revolution_agrees_with_brute_force_integration():
     """An eccentric pinion (9 teeth) at omega = 1.8: Newton on the revolution's map, shot once per mesh period, from
     the model's start; the orbit against SciPy's DOP853 of the equations typed in tests/fault_rig.py: it returns to
@@ -229,6 +230,7 @@ def test_a_periodic_orbit_of_a_revolution_agrees_with_brute_force_integration():
     np.testing.assert_allclose(y, orbit.state, atol=1e-5)
 
 
+@pytest.mark.slow
 def test_an_orbit_of_the_hunting_period_is_found_by_shooting_once_per_mesh_period():
     """Both gears eccentric (13 and 17 teeth): the period is the hunting period, 221 mesh periods, shot in 221
     segments (442 unknowns, a sparse Newton system); the orbit is where a long run of the engine ends, at every

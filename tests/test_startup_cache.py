@@ -131,6 +131,7 @@ FORMULA = ("--set", "k=1+0.2*cos(tau)")
 
 @pytest.mark.parametrize("name, settings", [("one_stage", ()), ("spur_pair", ()), ("one_stage", FORMULA)],
                          ids=["one_stage", "spur_pair", "a stiffness formula"])
+@pytest.mark.slow
 def test_a_command_on_a_cached_model_imports_neither_sympy_nor_pint(model_copy, name, settings, capsys):
     model_file = model_copy(name)
     argv = [str(model_file), *settings, *ARGS]

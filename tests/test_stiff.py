@@ -154,6 +154,7 @@ def test_the_floquet_multipliers_of_a_stiff_orbit_multiply_to_the_exponential_of
     assert abs(np.prod(orbit.multipliers)) == pytest.approx(expected, rel=1e-6)
 
 
+@pytest.mark.slow
 def test_a_stiff_damped_shaft_integrated_by_the_stiff_step_agrees_with_scipys_radau():
     from scipy.integrate import solve_ivp
 

@@ -150,6 +150,7 @@ def test_a_point_whose_poincare_samples_were_cut_off_is_computed_again_on_resume
 
 
 @pytest.mark.skipif(os.geteuid() != 0 or not sys.platform.startswith("linux"), reason="mounting a tmpfs needs root")
+@pytest.mark.slow
 def test_a_real_full_disk(tmp_path):
     """The same on a 200 KiB tmpfs, from the command line: the disk really full."""
     disk = tmp_path / "disk"
