@@ -29,15 +29,16 @@ def order_text(order: sp.Expr) -> str:
 
 class MeshOrders:
     """The orders of a resolved drivetrain's meshes, from their tooth counts (a base of ResolvedDrivetrain), and
-    the periods they make (known from the declaration, before the equations are derived)."""
+    the periods they make (known from the declaration, before the equations are derived; found once: the
+    reduced model's periods and every run's count of cycles read them)."""
 
-    @property
+    @functools.cached_property
     def forcing_period(self) -> sp.Expr:
         """The forcing period in tau: one mesh period of the first mesh (2 pi / its order; 2 pi without a mesh)."""
         meshes = [rc.order for rc in self.couplings if rc.kind == "mesh"]
         return 2 * sp.pi / meshes[0] if meshes else 2 * sp.pi
 
-    @property
+    @functools.cached_property
     def period(self) -> sp.Expr:
         """The period the drivetrain repeats on, in tau: 2 pi / the greatest common divisor of every frequency in
         it (every mesh's order, the torques' harmonics and the shaft-order terms' frequencies)."""
@@ -46,7 +47,7 @@ class MeshOrders:
         freqs += [f for rc in self.couplings for f in rc.shaft_frequencies]
         return 2 * sp.pi / functools.reduce(sp.gcd, freqs, sp.S.Zero) if freqs else 2 * sp.pi
 
-    @property
+    @functools.cached_property
     def cycles(self) -> int:
         """Forcing periods in one :attr:`period`: 1 for a single pair."""
         return int(sp.nsimplify(self.period / self.forcing_period))
