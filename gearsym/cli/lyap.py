@@ -45,22 +45,21 @@ def run(args: argparse.Namespace) -> int:
         raise GearsymError(diverged_message(compiled, result))
     # (the mesh forces and shaft torques from a trajectory at the point, as in Python: physical/point.py)
     physical = scaling.to_physical(result, model=compiled) if scaling is not None else None
+    units = scaling.point_units() if scaling is not None else None  # (the figure's, the JSON's and the text's)
     if args.plot:
         shown = min(30, result.periods - result.discard)
         trajectory = phase_trajectory(compiled, options=compiled.integration.run(discard=result.periods - shown),
                                       y0=parse_state(args.y0))
         if physical is not None:  # in the model's units: exponents per second, um, mm/s, rad
-            point_units = scaling.point_units()
-            spectrum, shown_trajectory, units, title = point_units.figure(result, trajectory, model_settings(args))
-            plot_point(spectrum, shown_trajectory, args.plot, x=coordinate, units=units, title=title)
+            spectrum, shown_trajectory, shown_units, title = units.figure(result, trajectory, model_settings(args))
+            plot_point(spectrum, shown_trajectory, args.plot, x=coordinate, units=shown_units, title=title)
             caption = args.plot.with_suffix(".caption.txt")  # (the values the title leaves out)
-            write_atomically(caption, f"{scaling.name}: the figure {args.plot.name}'s values\n"
-                             + point_units.caption())
+            write_atomically(caption, f"{scaling.name}: the figure {args.plot.name}'s values\n" + units.caption())
         else:
             plot_point(result, trajectory, args.plot, x=coordinate)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
     if args.format == "json":
-        values = {"parameters": scaling.point_units().values} if physical else {}  # (as given, with their units)
+        values = {"parameters": units.values} if physical else {}  # (as given, with their units)
         print(json.dumps({**result.as_dict(), **({"physical": {**physical.as_dict(), **values}} if physical else {})},
                          indent=2))
         return 0
@@ -68,7 +67,7 @@ def run(args: argparse.Namespace) -> int:
           f"{result.steps_per_period} {compiled.integration.method_name} steps/period, "
           f"{'plain' if args.plain else 'crossings located'}, {result.backend}")
     print(step_line(compiled, scaling))
-    print("parameters: " + parameters_line(result.parameters, scaling and scaling.point_units()))
+    print("parameters: " + parameters_line(result.parameters, units))
     print("Lyapunov exponents (per unit time, +- standard error):")
     paired = {j: i for i, j in result.pairs}
     known = result.resolution

@@ -158,7 +158,8 @@ def _one_orbit(compiled, args, y0, physical) -> int:
     orbit = periodic_orbit(compiled, y0=y0, period_multiple=args.period_multiple, segments=args.segments)
     print(f"{orbit.model}: period-{orbit.period_multiple} orbit, Newton residual {orbit.residual:.2g} after "
           f"{orbit.iterations} iterations, {'stable' if orbit.stable else 'unstable'}")
-    print("parameters: " + parameters_line(orbit.parameters, physical and physical.point_units()))
+    units = physical.point_units() if physical is not None else None  # (the text's and the record's)
+    print("parameters: " + parameters_line(orbit.parameters, units))
     print("state at the section: " + ", ".join(f"{k}={v:.10g}" for k, v in zip(orbit.state_names, orbit.state)))
     largest = float(np.max(np.abs(orbit.multipliers)))
     held = [m for m in orbit.multipliers if abs(m) > ROUNDED * largest]  # (the rest is the product's rounding)
@@ -176,7 +177,7 @@ def _one_orbit(compiled, args, y0, physical) -> int:
         print(f"contact of {mesh}: {regime}")
     record = orbit.as_dict()
     if physical is not None:  # the same in the model's units
-        units, w = physical.point_units(), orbit.parameters["omega"]
+        w = orbit.parameters["omega"]
         amplitude = {k: units.state(k, v, w) for k, v in orbit.amplitude.items()}
         state = {k: units.state(k, v, w) for k, v in zip(orbit.state_names, orbit.state)}
         speed = Measured(float(units.speed_of(w)), units.speed_unit) if units.speed else None

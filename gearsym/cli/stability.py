@@ -217,8 +217,8 @@ def held_values(scaling, given) -> str:
     axis of omega); an axis in the engine's numbers (zeta) is said with the physical values it is made of, which
     it overrides."""
     units = scaling.point_units()
-    names = {a.name for a in given} | ({scaling.speed.parameter} if scaling.speed and "omega" in
-                                       {a.name for a in given} else set())
+    axes = {a.name for a in given}
+    names = axes | ({scaling.speed.parameter} if scaling.speed and "omega" in axes else set())
     groups = {g.name: g for g in scaling.full.model.groups}
     overridden = [f"{a.name} charted in the engine's numbers over the values it is made of ("
                   + ", ".join(sorted(str(x) for x in groups[a.name].definition.free_symbols)) + ")"
