@@ -14,13 +14,13 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import casadi as ca
-import sympy as sp
 
 from ..files.atomic import write_atomically
 from ..system import FirstOrderSystem
 from .functions import ModelFunctions
 from .loops import LoopOptions
 from .code_files import lanes_file, source_file
+from .expression_text import ExpressionText
 from .lanes import lanes_source
 from .printed import LOOP_NAMES, pieces, print_loops, stand_in
 
@@ -31,7 +31,7 @@ CODEGEN_VERSION = 2
 #: can never leave a stale library or committed C in use (the tests then ask to regenerate)
 _GENERATOR_SOURCES = ("translate.py", "time_tables.py", "casadi_symbols.py", "rk4.py", "switching.py", "crossing.py",
                       "period_loops.py", "tables.py", "functions.py", "loops.py", "generate.py", "printed.py",
-                      "lanes.py", "rosenbrock.py", "stiff_crossing.py", "columns.py")
+                      "lanes.py", "rosenbrock.py", "stiff_crossing.py", "columns.py", "expression_text.py")
 
 
 def generator_digest() -> str:
@@ -45,6 +45,7 @@ def generator_digest() -> str:
 
 def code_hash(system: FirstOrderSystem, options: LoopOptions) -> str:
     """SHA-256 of everything that determines the C: model equations, names, loop options, versions."""
+    text = ExpressionText()
     description = {
         "codegen": CODEGEN_VERSION,
         "generator": generator_digest(),
@@ -52,9 +53,9 @@ def code_hash(system: FirstOrderSystem, options: LoopOptions) -> str:
         "name": system.name,
         "time": system.time.name,
         "states": [s.name for s in system.states],
-        "rhs": [sp.srepr(f) for f in system.rhs],
+        "rhs": [text.srepr(f) for f in system.rhs],
         "parameters": list(system.parameters),
-        "period": sp.srepr(system.period),
+        "period": text.srepr(system.period),
         "observed": list(system.observed),
         "options": asdict(options),
     }
@@ -63,6 +64,7 @@ def code_hash(system: FirstOrderSystem, options: LoopOptions) -> str:
 
 def manifest(mf: ModelFunctions, digest: str) -> dict:
     s = mf.system
+    text = ExpressionText().str
     return {
         "model": s.name,
         "hash": digest,
@@ -70,13 +72,13 @@ def manifest(mf: ModelFunctions, digest: str) -> dict:
         "codegen_version": CODEGEN_VERSION,
         "options": asdict(mf.options),
         "time": s.time.name,
-        "period": str(s.period),
+        "period": text(s.period),
         "states": [x.name for x in s.states],
         "observed": list(s.observed),
         "parameters": list(s.parameters),
-        "equations": {f"d{x.name}/d{s.time.name}": str(f) for x, f in zip(s.states, s.rhs)},
-        "tables": {str(k): str(v) for k, v in mf.split.tables},
-        "constants": {str(k): str(v) for k, v in mf.split.constants},
+        "equations": {f"d{x.name}/d{s.time.name}": text(f) for x, f in zip(s.states, s.rhs)},
+        "tables": {str(k): text(v) for k, v in mf.split.tables},
+        "constants": {str(k): text(v) for k, v in mf.split.constants},
         "functions": {name: str(f) for name, f in mf.functions.items()},
     }
 

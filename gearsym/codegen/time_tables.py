@@ -47,20 +47,33 @@ def split_rhs(system: FirstOrderSystem, factored: bool = False) -> SplitRHS:
     tables: dict[sp.Expr, sp.Symbol] = {}
     constants: dict[sp.Expr, sp.Symbol] = {}
 
+    def holds(symbols: set, memo: dict):
+        """Whether an expression holds one of ``symbols``, each node asked once (its free symbols, gathered at
+        every node of a large model's rows, were most of the time)."""
+        def test(e: sp.Basic) -> bool:
+            hit = memo.get(e)
+            if hit is None:
+                hit = memo[e] = e in symbols if e.is_Symbol else any(test(a) for a in e.args)
+            return hit
+        return test
+
+    timed = holds({time}, {})
+    stateful = holds(states, {})
+
     def entry(e: sp.Expr) -> sp.Expr:
         if e.is_Number:
             return e
-        if factored and e.is_Mul and time in e.free_symbols:
-            fixed = [a for a in e.args if time not in a.free_symbols]
+        if factored and e.is_Mul and timed(e):
+            fixed = [a for a in e.args if not timed(a)]
             if fixed:  # k(tau)/omega^2 as const * table: a table then depends on fewer parameters
-                return entry(sp.Mul(*fixed)) * entry(sp.Mul(*(a for a in e.args if time in a.free_symbols)))
-        book, prefix = (tables, "table") if time in e.free_symbols else (constants, "const")
+                return entry(sp.Mul(*fixed)) * entry(sp.Mul(*(a for a in e.args if timed(a))))
+        book, prefix = (tables, "table") if timed(e) else (constants, "const")
         if e not in book:  # a Dummy: never equal to a user's symbol of the same name
             book[e] = sp.Dummy(f"{prefix}_{len(book)}", real=True)
         return book[e]
 
     def state_free(e: sp.Expr) -> bool:
-        return not (e.free_symbols & states)
+        return not stateful(e)
 
     def condition(c):
         """A Piecewise condition: state-free ones become a 0/1 table entry or constant compared with 1/2."""
@@ -72,7 +85,15 @@ def split_rhs(system: FirstOrderSystem, factored: bool = False) -> SplitRHS:
             return c.func(visit(c.lhs), visit(c.rhs))
         return c.func(*(condition(a) for a in c.args))  # And, Or, Not
 
-    def visit(e: sp.Expr) -> sp.Expr:
+    visited: dict[sp.Expr, sp.Expr] = {}
+
+    def visit(e: sp.Expr) -> sp.Expr:  # (each node once: a node met again gives the same, and names nothing new)
+        hit = visited.get(e)
+        if hit is None:
+            hit = visited[e] = split_node(e)
+        return hit
+
+    def split_node(e: sp.Expr) -> sp.Expr:
         if e in states:
             return e
         if state_free(e):

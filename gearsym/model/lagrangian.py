@@ -80,24 +80,53 @@ class LagrangianForms:
             q[f.body.index] += f.amplitude * f.time_function
         return q
 
+    @cached_property
+    def _symbols(self) -> tuple[dict, dict]:
+        """Plain symbols for every psi_i(t), psi_i'(t) and psi_i''(t) (keys in that order), and the way back.
+        Lagrange's derivatives are taken with respect to them: SymPy differentiates by a function of t through a
+        dummy it substitutes into the whole expression at every call (seconds for a drivetrain on bearings)."""
+        to, back = {}, {}
+        for i, q in enumerate(self.angles):
+            p, pd, pdd = (sp.Dummy(f"{kind}{i}", real=True) for kind in ("q", "qd", "qdd"))
+            to[sp.Derivative(q, (t, 2))], to[sp.Derivative(q, t)], to[q] = pdd, pd, p
+            back.update({p: q, pd: sp.Derivative(q, t), pdd: sp.Derivative(q, (t, 2))})
+        return to, back
+
+    def _in_symbols(self, expr: sp.Expr) -> sp.Expr:
+        to, _ = self._symbols  # (derivatives first: psi'(t) holds psi(t))
+        return expr.xreplace({k: v for k, v in to.items() if isinstance(k, sp.Derivative)}).xreplace(
+            {q: to[q] for q in self.angles})
+
     def lagrange_lhs(self, lagrangian: sp.Expr, dissipation: sp.Expr) -> list[sp.Expr]:
-        """d/dt dL/dpsi' - dL/dpsi + dR/dpsi' for each body."""
+        """d/dt dL/dpsi' - dL/dpsi + dR/dpsi' for each body; d/dt by the chain rule over the positions, the rates
+        and t itself."""
+        to, back = self._symbols
+        positions = [to[q] for q in self.angles]
+        rates = [to[sp.Derivative(q, t)] for q in self.angles]
+        accelerations = [to[sp.Derivative(q, (t, 2))] for q in self.angles]
+        terms_l = sp.Add.make_args(self._in_symbols(sp.expand(lagrangian, deep=False, mul=False)))
+        terms_r = sp.Add.make_args(self._in_symbols(dissipation))
         out = []
-        terms_l, terms_r = sp.Add.make_args(sp.expand(lagrangian, deep=False, mul=False)), sp.Add.make_args(dissipation)
-        for q in self.angles:
-            qd = sp.diff(q, t)
+        for q, qd in zip(positions, rates):
             # (only the terms that hold q: the others differentiate to zero, and a drivetrain on bearings has many)
-            lag = sp.Add(*(e for e in terms_l if e.has(q)))
-            dis = sp.Add(*(e for e in terms_r if e.has(q)))
-            lhs = sp.diff(sp.diff(lag, qd), t) - sp.diff(lag, q) + sp.diff(dis, qd)
-            out.append(sp.Add(*(sp.factor_terms(term) for term in sp.Add.make_args(lhs))))
+            lag = sp.Add(*(e for e in terms_l if e.has(q) or e.has(qd)))
+            dis = sp.Add(*(e for e in terms_r if e.has(q) or e.has(qd)))
+            momentum = sp.diff(lag, qd)
+            rate_of_momentum = sp.diff(momentum, t) + sp.Add(*(
+                sp.diff(momentum, x) * xd for x, xd in zip(positions + rates, rates + accelerations) if momentum.has(x)))
+            out.append((rate_of_momentum - sp.diff(lag, q) + sp.diff(dis, qd)).xreplace(back))
         return out
 
     @cached_property
+    def lagrange_rows(self) -> list[sp.Expr]:
+        """The left-hand sides of Lagrange's equations as the derivatives give them (what a check evaluates)."""
+        return self.lagrange_lhs(self.kinetic_energy - self.potential_energy, self.dissipation)
+
+    @cached_property
     def equations_of_motion(self) -> list[sp.Eq]:
-        lagrangian = self.kinetic_energy - self.potential_energy
-        lhs = self.lagrange_lhs(lagrangian, self.dissipation)
-        return [sp.Eq(l, r) for l, r in zip(lhs, self.generalized_forces)]
+        """Lagrange's equations, each term's common factors taken out (for reading)."""
+        lhs = [sp.Add(*(sp.factor_terms(term) for term in sp.Add.make_args(row))) for row in self.lagrange_rows]
+        return [sp.Eq(l, r, evaluate=False) for l, r in zip(lhs, self.generalized_forces)]
 
     @cached_property
     def frame_forces(self) -> list[sp.Expr]:
@@ -113,5 +142,8 @@ class LagrangianForms:
 
     @cached_property
     def mass_matrix(self) -> sp.Matrix:
-        acc = [sp.diff(q, t, 2) for q in self.angles]
-        return sp.Matrix([[sp.expand(eq.lhs).coeff(a) for a in acc] for eq in self.equations_of_motion])
+        """d^2 T / dpsi_i' dpsi_j': the coefficients of the accelerations in Lagrange's equations (neither the
+        potential nor the dissipation holds one)."""
+        to, back = self._symbols
+        rates = [to[sp.Derivative(q, t)] for q in self.angles]
+        return sp.hessian(self._in_symbols(self.kinetic_energy), rates).applyfunc(lambda e: e.xreplace(back))

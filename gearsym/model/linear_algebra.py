@@ -89,42 +89,54 @@ class Generators:
         return self.from_(sp.cancel(num / den))
 
 
-def numeric_rank(m: sp.Matrix, seed: int = 7) -> int:
-    """The rank of ``m`` at random rational values of its parameters and the actual values of its numbers
-    (Gaussian elimination with partial pivoting, 40 digits)."""
+def _at_generic_values(m: sp.Matrix, seed: int) -> list[list[mpmath.mpf]]:
+    """``m`` at random rational values of its parameters and the actual values of its numbers (DIGITS digits)."""
     rng = random.Random(seed)
     values = {s: sp.Rational(rng.randint(11, 97), rng.randint(11, 97)) for s in sorted(m.free_symbols, key=str)}
     with mpmath.workdps(DIGITS):
-        rows = [[mpmath.mpf(sp.N(e.xreplace(values), DIGITS)) if e != 0 else mpmath.mpf(0) for e in m.row(i)]
+        return [[mpmath.mpf(sp.N(e.xreplace(values), DIGITS)) if e != 0 else mpmath.mpf(0) for e in m.row(i)]
                 for i in range(m.rows)]
+
+
+def numeric_rank(m: sp.Matrix, seed: int = 7) -> int:
+    """The rank of ``m`` at random rational values of its parameters and the actual values of its numbers
+    (Gaussian elimination with partial pivoting, 40 digits)."""
+    return len(independent_rows(m, seed))
+
+
+def independent_rows(m: sp.Matrix, seed: int = 7, base: int | None = None) -> list[int]:
+    """The rows of ``m``, in order, that are independent of the rows before them, at random rational values of its
+    parameters and the actual values of its numbers (40 digits; each row reduced by those kept, pivoting on its
+    largest entry). ``m`` is evaluated once: a rank asked row by row of the same matrix costs one elimination.
+    With ``base``, the rows from ``base`` on are each reduced by the first ``base`` rows' only (not by each other)."""
+    rows = _at_generic_values(m, seed)
+    with mpmath.workdps(DIGITS):
         scale = max((abs(x) for r in rows for x in r), default=mpmath.mpf(0))
-        if scale == 0:
-            return 0
-        rank, col = 0, 0
-        while rank < len(rows) and col < m.cols:
-            pivot = max(range(rank, len(rows)), key=lambda i: abs(rows[i][col]))
-            if abs(rows[pivot][col]) <= TINY * scale:
-                col += 1
-                continue
-            rows[rank], rows[pivot] = rows[pivot], rows[rank]
-            for i in range(rank + 1, len(rows)):
-                f = rows[i][col] / rows[rank][col]
+        kept: list[int] = []
+        basis: list[tuple[int, list]] = []
+        for i, row in enumerate(rows):
+            for pivot, b in basis:
+                f = row[pivot] / b[pivot]
                 if f != 0:
-                    rows[i] = [a - f * b for a, b in zip(rows[i], rows[rank])]
-            rank += 1
-            col += 1
-        return rank
+                    row = [a - f * c for a, c in zip(row, b)]
+            pivot = max(range(len(row)), key=lambda k: abs(row[k]), default=None)
+            if pivot is not None and abs(row[pivot]) > TINY * scale:
+                if base is None or i < base:
+                    basis.append((pivot, row))
+                kept.append(i)
+        return kept
+
+
+def outside_span(m: sp.Matrix, rows: list[sp.Matrix], seed: int = 7) -> list[bool]:
+    """For each of ``rows``, whether it is independent of the rows of ``m`` at generic values (as
+    :func:`independent_rows`; ``m`` evaluated once for all of them)."""
+    both = independent_rows(sp.Matrix.vstack(m, *rows), seed, base=m.rows)
+    return [m.rows + k in both for k in range(len(rows))]
 
 
 def pivot_columns(m: sp.Matrix) -> list[int]:
     """The pivot columns of ``m``'s row echelon form at generic values (the first independent columns)."""
-    chosen: list[int] = []
-    for j in range(m.cols):
-        if len(chosen) == m.rows:
-            break
-        if numeric_rank(m.extract(list(range(m.rows)), chosen + [j])) > len(chosen):
-            chosen.append(j)
-    return chosen
+    return independent_rows(m.T)[:m.rows]
 
 
 def nullspace(m: sp.Matrix, what: str) -> list[sp.Matrix]:
@@ -160,10 +172,60 @@ def solve_rows(matrix: sp.Matrix, rows: sp.Matrix) -> sp.Matrix:
     a = dm[:n, :].transpose()
     b = dm[n:, :].transpose()
     numerator, denominator = a.solve_den(b)
-    x = numerator.to_Matrix().T / dm.domain.to_sympy(denominator)
     if gens.of:
+        x = numerator.to_Matrix().T / dm.domain.to_sympy(denominator)
         return x.applyfunc(lambda e: gens.normal(gens.from_(e)))
-    return x.applyfunc(sp.cancel)
+    # (each entry cancelled in the field of fractions of the domain: SymPy's cancel on expressions converts every
+    # entry to polynomials and back, several times slower)
+    field = dm.domain.get_field()
+    return (numerator.convert_to(field) / field.convert_from(denominator, dm.domain)).to_Matrix().T
+
+
+def fraction_forms(elements, domain, known=()) -> list[sp.Expr]:
+    """Elements of ``domain`` (rational numbers, or a field of rational functions: exact arithmetic without
+    expression trees) as compact expressions: each numerator its rational and monomial content times a primitive
+    polynomial, each denominator the product of the irreducible factors of the ``known`` polynomials it holds (the
+    few pieces a linear solve builds its denominators from: factoring each entry's denominator whole costs seconds),
+    anything left factored."""
+    if not domain.is_FractionField:
+        return [sp.factor(domain.to_sympy(e)) for e in elements]
+    ring = domain.get_ring().ring
+    pieces = []
+    for p in known:
+        pieces += [f for f, _ in p.factor_list()[1] if f.degree() > 0 and f not in pieces]
+    written: dict = {}
+
+    def denominator(p) -> sp.Expr:
+        if p not in written:
+            content, rest = p.primitive()
+            factors = []
+            for f in pieces:
+                power = 0
+                while rest.degree() > 0:
+                    quotient, remainder = rest.div(f)
+                    if remainder:
+                        break
+                    rest, power = quotient, power + 1
+                if power:
+                    factors.append(f.as_expr() ** power)
+            left = sp.factor(rest.as_expr()) if rest.degree() > 0 else rest.as_expr()
+            written[p] = sp.Mul(ring.domain.to_sympy(content), left, *factors)
+        return written[p]
+
+    out = []
+    for e in elements:
+        if not e:
+            out.append(sp.S.Zero)
+            continue
+        content, numerator = e.numer.primitive()
+        if numerator.LC < 0:
+            content, numerator = -content, -numerator
+        terms = numerator.terms()
+        monomial = tuple(min(m[i] for m, _ in terms) for i in range(ring.ngens))
+        numerator = ring({tuple(a - b for a, b in zip(m, monomial)): c for m, c in terms})
+        out.append(sp.Mul(ring.domain.to_sympy(content), *(x**k for x, k in zip(ring.symbols, monomial)),
+                          numerator.as_expr()) / denominator(e.denom))
+    return out
 
 
 def is_zero(expr: sp.Expr) -> bool:

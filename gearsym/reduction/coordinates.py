@@ -18,9 +18,10 @@ import random
 from dataclasses import dataclass
 
 import sympy as sp
+from sympy.polys.constructor import construct_domain
 
 from ..errors import ModelError
-from ..model.linear_algebra import is_zero, nullspace, numeric_rank, pivot_columns, solve_rows
+from ..model.linear_algebra import independent_rows, is_zero, nullspace, numeric_rank, pivot_columns, solve_rows
 from ..model.resolved import ResolvedDrivetrain
 from ..model.resolved_components import ResolvedCoupling
 from ..model.symbols import t
@@ -93,10 +94,7 @@ def coupling_deflections(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.M
     the combinations of those that close a loop), in declaration order."""
     jac = deflection_matrix(rd)
     n_bodies, n_couplings = len(rd.dofs), len(rd.couplings)
-    kept: list[int] = []
-    for i in range(n_couplings):  # a spanning tree of the couplings, in declaration order
-        if generic_rank(jac.extract(kept + [i], list(range(n_bodies)))) > len(kept):
-            kept.append(i)
+    kept = independent_rows(jac)  # a spanning tree of the couplings, in declaration order
     single = n_couplings == 1
     names, seen = [], {}
     for i, rc in enumerate(rd.couplings):
@@ -139,12 +137,23 @@ def combination_solver(transform: sp.Matrix):
 
     def solve(row: sp.Matrix) -> list[sp.Expr]:
         coefficients = solve_rows(square, row.extract([0], list(pivots))).applyfunc(sp.factor)
-        residual = coefficients * transform - row
-        if not all(is_zero(e) for e in residual):
+        if not all(is_zero(e) for e in combination_residual(coefficients, transform, row)):
             raise ModelError(f"the deflection {list(row)} is not a combination of the coordinates' (a bug)", "reduction")
         return list(coefficients)
 
     return solve
+
+
+def combination_residual(coefficients: sp.Matrix, transform: sp.Matrix, row: sp.Matrix) -> list[sp.Expr]:
+    """``coefficients * transform - row``, computed in the field of rational functions of its symbols when they are
+    plain symbols (exact, each entry cancelled: zero reads as zero), else as expressions (sines, cosines and radicals
+    left for :func:`~gearsym.model.linear_algebra.is_zero`)."""
+    domain, elements = construct_domain([*coefficients, *transform, *row], field=True)
+    if domain.is_EX:
+        return list(coefficients * transform - row)
+    k, n = coefficients.cols, transform.cols
+    c, m, r = elements[:k], elements[k:k + k * n], elements[k + k * n:]
+    return [domain.to_sympy(sum((c[i] * m[i * n + j] for i in range(k)), domain.zero) - r[j]) for j in range(n)]
 
 
 def generic_values(m: sp.Matrix, seed: int = 7) -> dict:

@@ -36,9 +36,9 @@ from ..model.resolved_components import ResolvedCoupling
 from ..model.roles import parameter_roles
 from ..model.expressions import ExprLike, parameter_names, to_expr
 from ..model.stiffness import check_periodic
-from ..model.linear_algebra import numeric_rank, simplified
+from ..model.linear_algebra import outside_span, simplified
 from ..model.translations import CARRIER_SPEED
-from ..model.symbols import omega, parameter_symbol, phi, t, tau
+from ..model.symbols import RESERVED, omega, parameter_symbol, phi, t, tau
 from ..system import Constraint, Coupling, FirstOrderSystem, Gearing
 from .coordinates import combination_solver
 from .reduction import Reduction, reduce_drivetrain, sub_frame, with_geometry
@@ -124,7 +124,8 @@ class NondimensionalModel:
         """Second-order equations in tau, in the paper's layout (x'' + ... = (...)/omega^2)."""
         out = []
         for c, lhs, rhs in zip(self.coordinates, self.row_lhs, self.row_rhs):
-            out.append(sp.Eq(sp.diff(c.of(tau), tau, 2) + lhs, rhs / omega**2 if rhs != 0 else sp.S.Zero))
+            out.append(sp.Eq(sp.diff(c.of(tau), tau, 2) + lhs, rhs / omega**2 if rhs != 0 else sp.S.Zero,
+                             evaluate=False))
         return out
 
     @cached_property
@@ -145,9 +146,9 @@ class NondimensionalModel:
     def rhs(self) -> tuple[sp.Expr, ...]:
         """First-order right-hand side d(x, v)/dtau, with groups and k(tau) as symbols."""
         out = []
-        for c, eq in zip(self.coordinates, self.equations):
+        for c, lhs, rhs in zip(self.coordinates, self.row_lhs, self.row_rhs):  # (the equations' x'' = rhs - lhs)
             out.append(sp.Symbol(c.velocity_name, real=True))
-            out.append(self._to_state_symbols(eq.rhs - (eq.lhs - sp.diff(c.of(tau), tau, 2))))
+            out.append(self._to_state_symbols((rhs / omega**2 if rhs != 0 else sp.S.Zero) - lhs))
         return tuple(out)
 
     @cached_property
@@ -174,9 +175,16 @@ class NondimensionalModel:
     @cached_property
     def parameter_names(self) -> list[str]:
         """Parameters of the nondimensional model: omega, free groups, then the rest by name."""
-        expr_syms = set()
-        for f in self._substituted_rhs(None):
-            expr_syms |= parameter_names(f)
+        # (the names of the right-hand side with its stiffness functions and derived groups written out, without
+        # writing them out: substituting into a large model's rows costs seconds)
+        symbols = set().union(*(f.free_symbols for f in self.rhs))
+        applied = set().union(*(f.atoms(AppliedUndef) for f in self.rhs))
+        for sf in self.functions:
+            if sf.applied in applied:
+                symbols |= sf.expression.free_symbols
+        derived = {gr.symbol: gr.definition for gr in self.groups if gr.kind == "derived" and gr.symbol in symbols}
+        symbols = (symbols - set(derived)).union(*(d.free_symbols for d in derived.values()))
+        expr_syms = {s.name for s in symbols if s.name not in RESERVED}
         expr_syms -= {s.name for s in self.states}
         free = [gr.name for gr in self.groups if gr.kind == "free" and gr.name in expr_syms]
         rest = sorted(expr_syms - set(free) - {"omega"})
@@ -357,18 +365,25 @@ class NondimensionalModel:
             nonzero = [i for i, e in enumerate(row) if e != 0]
             if len(nonzero) == 1 and row[nonzero[0]] == 1:
                 by_row[nonzero[0]] = sp.Symbol(c.name, real=True)
+        # (in the geometry's symbols, where the algebra is rational, when the transform is theirs with the numbers in:
+        # then the weights' numbers go in at the end)
+        geometry = rd.geometry
+        transform = red.transform.xreplace({v: k for k, v in geometry.items()}) if geometry else red.transform
+        if geometry and transform.xreplace(geometry) != red.transform:
+            transform, geometry = red.transform, {}
+        pending = [d for d in rd.translations if d.index not in by_row]
+        targets = [sp.Matrix([[1 if j == d.index else 0 for j in range(transform.cols)]]) for d in pending]
+        free = dict(zip((d.index for d in pending), outside_span(transform, targets))) if pending else {}
         solve = None
         for d in rd.translations:
             name = d.label.replace(".", "_")
             if d.index in by_row:
                 out[name] = by_row[d.index]
                 continue
-            target = sp.zeros(1, red.transform.cols)
-            target[d.index] = 1
-            if numeric_rank(sp.Matrix.vstack(red.transform, target)) > red.transform.rows:
+            if free[d.index]:
                 continue  # (not determined by the coordinates)
-            solve = solve or combination_solver(red.transform)
-            weights = solve(target)
+            solve = solve or combination_solver(transform)
+            weights = [w.xreplace(geometry) if geometry else w for w in solve(sp.Matrix(targets[pending.index(d)]))]
             out[name] = sp.Add(*(w * sp.Symbol(c.name, real=True) for w, c in zip(weights, red.coordinates)))
         return out
 

@@ -16,12 +16,16 @@ import random
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 
+import mpmath
 import sympy as sp
+from sympy.polys.constructor import construct_domain
+from sympy.polys.matrices import DomainMatrix
 
 from ..model.backlash import g
+from ..model.evaluation import PointValues
 from ..errors import GearsymError
 from ..model.drivetrain import Drivetrain
-from ..model.linear_algebra import numeric_rank, pivot_columns, simplified, solve_rows
+from ..model.linear_algebra import fraction_forms, numeric_rank, pivot_columns, simplified, solve_rows
 from ..model.resolved import ResolvedDrivetrain
 from ..model.resolved_components import ResolvedCoupling, ResolvedForcing
 from ..model.symbols import t
@@ -108,7 +112,7 @@ class Reduction:
             rhs += sp.Add(*(ft.coefficient * ft.source.time_function for ft in self.row_forcing(i)))
             if self.frame_rows:
                 rhs += self.frame_rows[i]
-            out.append(sp.Eq(sp.diff(c.of(t), t, 2), rhs))
+            out.append(sp.Eq(sp.diff(c.of(t), t, 2), rhs, evaluate=False))
         return out
 
     @cached_property
@@ -119,7 +123,7 @@ class Reduction:
         for u in self.rigid_modes:
             lhs = sp.Add(*(u[i] * rb.inertia * sp.diff(rb.angle, t, 2) for i, rb in enumerate(rd.dofs)))
             rhs = sp.Add(*(u[i] * q for i, q in enumerate(rd.generalized_forces)))
-            out.append(sp.Eq(lhs, rhs))
+            out.append(sp.Eq(lhs, rhs, evaluate=False))
         return out
 
 
@@ -142,18 +146,12 @@ def reduce_drivetrain(model: Drivetrain, numbers: bool = True) -> Reduction:
         raise ReductionError(f"{len(coords)} coordinates and {len(modes)} rigid modes do not span {n} angles")
     TMinv = T * M.inv()
 
-    # each coupling's generalized forces from Lagrange are -C_c^T law_c(C_c psi): its law, along its row
-    total = sp.zeros(n, 1)
     for rc in rd.couplings:
-        Qc = sp.Matrix(rd.coupling_forces(rc))
-        total += Qc
-        law = _law_in_angles(rd, rc)
-        if not all(_is_zero(Qc[i] + rc.row[i] * law) for i in range(n)):
-            raise ReductionError(f"{rc.name}: its generalized forces are not its law along its deflection row")
         for u in modes:
             if not _is_zero(sum(c * x for c, x in zip(rc.row, u))):
                 raise ReductionError(f"{rc.name}: its forces do work in a rigid-body rotation")
-        # row i of T M^-1 Q_c = -(T M^-1 C_c^T)_i law_c, and the law is in the coordinates since C_c = J_c T
+        # Lagrange gives each coupling the generalized forces -C_c^T law_c(C_c psi) (checked below at random states),
+        # so row i of T M^-1 Q_c = -(T M^-1 C_c^T)_i law_c, and the law is in the coordinates since C_c = J_c T
         for i in range(len(coords)):
             factor = sp.factor(sp.Add(*(TMinv[i, j] * rc.row[j] for j in range(n))) / rc.scale)
             if factor != 0:
@@ -161,11 +159,6 @@ def reduce_drivetrain(model: Drivetrain, numbers: bool = True) -> Reduction:
     frame = sp.Matrix(rd.frame_forces)
     if frame != sp.zeros(n, 1):
         red.frame_rows = _frame_rows(red, TMinv, frame)
-    eom_forces = [sp.expand(eq.rhs - (eq.lhs - sum(M[i, j] * sp.diff(rd.angles[j], t, 2) for j in range(n))))
-                  for i, eq in enumerate(rd.equations_of_motion)]
-    for i in range(n):
-        if not _is_zero(eom_forces[i] - sp.expand(total[i] + frame[i] + rd.generalized_forces[i])):
-            raise ReductionError(f"coupling forces do not add up to the equation of motion of psi_{i + 1}")
 
     # external torques: row i gets (T M^-1)_{i, body} * torque
     for f in rd.forcing:
@@ -174,8 +167,9 @@ def reduce_drivetrain(model: Drivetrain, numbers: bool = True) -> Reduction:
             if coefficient != 0:
                 red.forcing_terms.append(ForcingTerm(i, f, coefficient))
 
-    # final check: the assembled equations give the accelerations of Lagrange's equations, at random states
-    _check_against_lagrange(red, eom_forces)
+    # final check: Lagrange's equations are the couplings' laws along their rows, and the assembled equations give
+    # their accelerations, at random states
+    check_against_lagrange(red)
     return with_geometry(red) if numbers and rd.geometry else red
 
 
@@ -257,10 +251,10 @@ def _frame_rows(red: Reduction, weights_rows: sp.Matrix, forces: sp.Matrix) -> l
     if held:
         weights_of.update(zip(held, translations_in_coordinates(red, held)))
     rates, positions = {}, {}
-    for i in moving:
-        q = sp.Add(*(w * c.of(t) for w, c in zip(weights_of[i], red.coordinates)))
-        rates[sp.Derivative(rd.dofs[i].angle, t)] = sp.diff(q, t)
-        positions[rd.dofs[i].angle] = q
+    for i in moving:  # (the weights are constants: the rate is the same combination of the coordinates' rates)
+        pairs = [(w, c) for w, c in zip(weights_of[i], red.coordinates) if w != 0]
+        rates[sp.Derivative(rd.dofs[i].angle, t)] = sp.Add(*(w * sp.Derivative(c.of(t), t) for w, c in pairs))
+        positions[rd.dofs[i].angle] = sp.Add(*(w * c.of(t) for w, c in pairs))
     # Each row is kept as T M^-1 times the frame's force on each body, the body's translation a combination of the
     # coordinates (its weights factored, over the rigid-body modes' Gram determinant): expanded, the combinations'
     # rational weights multiply out into every row (Lin & Parker's set: 10^5 characters a row, a C file of megabytes
@@ -273,8 +267,12 @@ def _frame_rows(red: Reduction, weights_rows: sp.Matrix, forces: sp.Matrix) -> l
 def translations_in_coordinates(red: Reduction, indices: list[int]) -> list[list[sp.Expr]]:
     """For each degree of freedom of ``indices``, the weights w with dof = w . q for the motion M-orthogonal to the
     rigid-body modes (T psi = q, U^T M psi = 0): with R a right inverse of T (the inverse of T's pivot columns, in
-    their rows), W = (I - U (U^T M U)^-1 U^T M) R; only the rows of R the result needs are solved for, without the
-    masses (they enter at the end)."""
+    their rows), W = (I - U (U^T M U)^-1 U^T M) R; only the rows of R the result needs are solved for.
+
+    Exact and without expression trees: the solve is fraction-free in the polynomial ring of the symbols (R = N / d,
+    one denominator), the Gram matrix's inverse its adjugate over its determinant, so every weight is a polynomial
+    over d det(U^T M U) until one cancellation at the end; the weights are written with those two as their
+    denominators' pieces (:func:`~gearsym.model.linear_algebra.fraction_forms`)."""
     rd = red.resolved
     transform = red.transform
     pivots = pivot_columns(transform)
@@ -286,20 +284,38 @@ def translations_in_coordinates(red: Reduction, indices: list[int]) -> list[list
     targets = sp.zeros(len(needed), transform.rows)
     for k, j in enumerate(needed):
         targets[k, pivots.index(j)] = 1
-    solved = solve_rows(square, targets) if needed else sp.zeros(0, transform.rows)
-    right = {j: solved.row(k) for k, j in enumerate(needed)}
-    zero = sp.zeros(1, transform.rows)
-    gram = (modes.T * sp.diag(*masses) * modes).inv()
-    weighted = [sum((modes[j, m] * masses[j] * right.get(j, zero) for j in range(len(masses))), zero)
-                for m in range(modes.cols)]
+    groups = [list(square), list(targets), list(modes), masses]
+    ring, elements = construct_domain([e for group in groups for e in group])
+    parts, at = [], 0
+    for group in groups:
+        parts.append(elements[at:at + len(group)])
+        at += len(group)
+    square_elements, target_elements, mode_elements, mass = parts
+    width, cols = transform.rows, modes.cols
+    square_dm = DomainMatrix([square_elements[r * width:(r + 1) * width] for r in range(width)], (width, width), ring)
+    targets_dm = DomainMatrix([target_elements[r * width:(r + 1) * width] for r in range(len(needed))],
+                              (len(needed), width), ring)
+    numerator, denominator = square_dm.transpose().solve_den(targets_dm.transpose()) if needed else (None, ring.one)
+    right = {j: row for j, row in zip(needed, numerator.transpose().to_list())} if needed else {}
+    u = [mode_elements[j * cols:(j + 1) * cols] for j in range(modes.rows)]  # (row j: degree of freedom j in each mode)
+    zero = [ring.zero] * width
+    gram = DomainMatrix([[sum((uj[a] * mj * uj[b] for uj, mj in zip(u, mass)), ring.zero) for b in range(cols)]
+                         for a in range(cols)], (cols, cols), ring)
+    adjugate, determinant = gram.adj_det()
+    adjugate = adjugate.to_list()
+    weighted = [[sum((uj[m] * mj * right.get(j, zero)[e] for j, (uj, mj) in enumerate(zip(u, mass)) if uj[m]),
+                     ring.zero) for e in range(width)] for m in range(cols)]
+    field = ring.get_field()
+    over = field.convert_from(denominator * determinant, ring)
     out = []
     for i in indices:
-        w = right.get(i, zero)
-        for a in range(modes.cols):
-            for b in range(modes.cols):
-                if modes[i, a] != 0:
-                    w = w - modes[i, a] * gram[a, b] * weighted[b]
-        out.append([sp.factor(e) for e in w])
+        w = [x * determinant for x in right.get(i, zero)]
+        for a in range(cols):
+            for b in range(cols):
+                if u[i][a] and adjugate[a][b]:
+                    w = [x - u[i][a] * adjugate[a][b] * y for x, y in zip(w, weighted[b])]
+        out.append(fraction_forms([field.convert_from(x, ring) / over for x in w], field,
+                                  [denominator, determinant] if field.is_FractionField else []))
     return out
 
 
@@ -311,13 +327,14 @@ def _law_in_angles(rd: ResolvedDrivetrain, rc: ResolvedCoupling) -> sp.Expr:
     return rc.stiffness * d + rc.damping * sp.diff(d, t)
 
 
-def _without_rigid_motion(red: Reduction, vector: list, values: dict) -> list:
-    """``vector`` less its M-orthogonal projection on the rigid-body modes (exact, at ``values``)."""
+def _without_rigid_motion(red: Reduction, vector: list, at: PointValues) -> list:
+    """``vector`` less its M-orthogonal projection on the rigid-body modes (numbers, at the point ``at``)."""
     rd = red.resolved
-    m = sp.diag(*[d.inertia.xreplace(values) for d in rd.dofs])
-    v = sp.Matrix(vector)
-    u = sp.Matrix.hstack(*red.rigid_modes).xreplace(values).evalf(CHECK_DIGITS)
-    return list(v - u * (u.T * m * u).inv() * (u.T * m * v))
+    with mpmath.workdps(at.digits):
+        m = mpmath.diag([at(d.inertia) for d in rd.dofs])
+        v = mpmath.matrix(vector)
+        u = mpmath.matrix([[at(e) for e in mode] for mode in red.rigid_modes]).T
+        return list(v - u * mpmath.inverse(u.T * m * u) * (u.T * m * v))
 
 
 #: random states at which the reduced equations are checked against Lagrange's, and the agreement asked
@@ -326,61 +343,89 @@ CHECK_POINTS, CHECK_DIGITS = 3, 30
 #: the two sides round such numbers' products in different orders (a transmission error 0.1 cos(...) / 4 is
 #: 0.025 cos(...) on one side and 0.1/4 on the other), so they agree to the double's digits, not to 30
 FLOAT_SLACK = 4
+#: digits the check computes with beyond CHECK_DIGITS (sums of many terms cancel some)
+GUARD_DIGITS = 20
 
 
-def _check_tolerance(exprs) -> sp.Float:
+def _check_tolerance(exprs) -> mpmath.mpf:
     """The relative disagreement the check allows: 10^(8 - CHECK_DIGITS) between exact numbers; with floating-point
     numbers in the equations (a number a model file gives as a float), what their precision holds less FLOAT_SLACK
     digits (1e-11 for doubles: still far below any term that is wrong)."""
     bits = min((f._prec for e in exprs for f in e.atoms(sp.Float)), default=None)
     digits = CHECK_DIGITS - 8 if bits is None else min(CHECK_DIGITS - 8, int(bits * math.log10(2)) - FLOAT_SLACK)
-    return sp.Float(10) ** -digits
+    return mpmath.mpf(10) ** -digits
 
 
-def _numeric(expr: sp.Expr) -> sp.Expr:
-    """``expr`` (numbers only) to CHECK_DIGITS digits; a backlash g of a transmission error (cos of a number) is
-    evaluated at its arguments' values, which g itself does only for plain numbers."""
-    if expr.has(g):
-        expr = expr.replace(lambda e: isinstance(e, g), lambda e: g(*(sp.N(a, CHECK_DIGITS) for a in e.args)))
-    return sp.N(expr, CHECK_DIGITS)
+def _agree(got, expected, tolerance) -> bool:
+    return abs(got - expected) <= tolerance * (1 + abs(expected))
 
 
-def _check_against_lagrange(red: Reduction, eom_forces: list[sp.Expr]) -> None:
-    """At random angles, rates, times and parameter values (exact rationals; backlash contacts on both flanks
-    and in the gap), the reduced right-hand sides equal T psi'' with psi'' = M^-1 Q from Lagrange's equations,
-    every coordinate, every loop-closing combination and every rigid coordinate eliminated."""
+def check_against_lagrange(red: Reduction) -> None:
+    """At random angles, rates, times and parameter values (backlash contacts on both flanks and in the gap), two
+    checks against Lagrange's equations of the unreduced drivetrain (its Lagrangian differentiated, nothing of the
+    reduction used): their forces are the couplings' laws along their deflection rows, the frame's forces and the
+    external torques, every degree of freedom; and the reduced right-hand sides are T psi'' with psi'' = M^-1 Q,
+    every coordinate, every loop-closing combination and every rigid coordinate eliminated. Numbers to
+    CHECK_DIGITS digits, each subexpression computed once (:class:`~gearsym.model.evaluation.PointValues`); a
+    disagreement is a :class:`ReductionError` that names the row, and the coupling when one is to blame."""
     rd = red.resolved
     rng = random.Random(11)
     n = len(rd.dofs)
-    symbols = set()
-    for expr in (*eom_forces, *(eq.rhs for eq in red.equations)):
-        symbols |= expr.free_symbols
-    functions = set()
-    for expr in (*eom_forces, *(eq.rhs for eq in red.equations)):
-        functions |= {f for f in expr.atoms(sp.Function) if f.args == (t,)}
+    lagrange = rd.lagrange_rows
+    external = list(rd.generalized_forces)
+    frame = list(rd.frame_forces)
+    laws = [_law_in_angles(rd, rc) for rc in rd.couplings]
+    reduced = [eq.rhs for eq in red.equations]
+    everything = (*lagrange, *external, *frame, *laws, *reduced)
+    symbols = set().union(*(e.free_symbols for e in everything)) - {t} - set(rd.geometry)
+    symbols |= set().union(*(e.free_symbols for e in rd.geometry.values()))
+    functions = set().union(*({f for f in e.atoms(sp.Function) if f.args == (t,)} for e in everything))
     functions -= set(rd.angles) | {c.of(t) for c in red.coordinates}
-    tolerance = _check_tolerance((*eom_forces, *(eq.rhs for eq in red.equations)))
+    tolerance = _check_tolerance(everything)
+    digits = CHECK_DIGITS + GUARD_DIGITS
     for _ in range(CHECK_POINTS):
-        values = {s: sp.Rational(rng.randint(5, 40), rng.randint(5, 20)) for s in sorted(symbols - {t}, key=str)}
-        if rd.translations:  # (numbers of 30 digits: exact rationals swell in the many terms of gears on bearings)
-            values = {s: sp.Float(v, CHECK_DIGITS + 5) for s, v in values.items()}
-        values[t] = sp.Rational(rng.randint(0, 100), 7)
+        values = {s: sp.Rational(rng.randint(5, 40), rng.randint(5, 20)) for s in sorted(symbols, key=str)}
         values |= {f: sp.Rational(rng.randint(5, 40), 10) for f in sorted(functions, key=str)}
+        values[t] = sp.Rational(rng.randint(0, 100), 7)
+        values |= {s: e.xreplace(values) for s, e in rd.geometry.items()}  # (the geometry at its numbers)
         psi = [sp.Rational(rng.randint(-60, 60), 20) for _ in range(n)]
         rate = [sp.Rational(rng.randint(-60, 60), 20) for _ in range(n)]
+        at = PointValues(values, digits)
         if red.frame_rows and red.rigid_modes:  # the frame turns with the rigid coordinates: none of their motion
-            psi, rate = (_without_rigid_motion(red, v, values) for v in (psi, rate))
-        state = {sp.Derivative(a, t): r for a, r in zip(rd.angles, rate)}
-        forces = [_numeric(e.xreplace(state).xreplace(dict(zip(rd.angles, psi))).xreplace(values)) for e in eom_forces]
-        accel = [f / rb.inertia.xreplace(values) for f, rb in zip(forces, rd.dofs)]
-        transform = red.transform.xreplace(values).evalf(CHECK_DIGITS)  # (numbers: radicals and sines as floats)
-        q = transform * sp.Matrix(psi)
-        qd = transform * sp.Matrix(rate)
-        reduced_state = {sp.Derivative(c.of(t), t): qd[k] for k, c in enumerate(red.coordinates)}
-        for k, (c, eq) in enumerate(zip(red.coordinates, red.equations)):
-            expected = sum(transform[k, j] * accel[j] for j in range(n))
-            got = eq.rhs.xreplace(reduced_state).xreplace({x.of(t): q[i] for i, x in enumerate(red.coordinates)})
-            got = _numeric(got.xreplace(values))
-            if not (got.is_number and abs(got - expected) <= tolerance * (1 + abs(expected))):
-                raise ReductionError(f"reduced equation of {c.name} does not give Lagrange's acceleration "
-                                     f"({got} instead of {expected})")
+            psi, rate = (_without_rigid_motion(red, v, at) for v in (psi, rate))
+        state = {**dict(zip(rd.angles, psi)), **{sp.Derivative(a, t): r for a, r in zip(rd.angles, rate)},
+                 **{sp.Derivative(a, (t, 2)): 0 for a in rd.angles}}
+        at = PointValues({**values, **state}, digits)
+        with mpmath.workdps(digits):
+            forces = [at(q) - at(lhs) for q, lhs in zip(external, lagrange)]  # (Lagrange's, accelerations at 0)
+            law = [at(e) for e in laws]
+            for i in range(n):
+                assembled = at(external[i]) + at(frame[i]) - mpmath.fsum(
+                    at(rc.row[i]) * law[c] for c, rc in enumerate(rd.couplings) if rc.row[i] != 0)
+                if not _agree(assembled, forces[i], tolerance):
+                    raise ReductionError(_which_coupling(rd, i, at, law, tolerance)
+                                         or f"coupling forces do not add up to the equation of motion of "
+                                            f"{rd.dofs[i].label} ({assembled} instead of {forces[i]})")
+            accel = [f / at(rb.inertia) for f, rb in zip(forces, rd.dofs)]
+            transform = [[at(e) for e in red.transform.row(k)] for k in range(red.transform.rows)]
+            q = [mpmath.fsum(a * p for a, p in zip(row, psi)) for row in transform]
+            qd = [mpmath.fsum(a * r for a, r in zip(row, rate)) for row in transform]
+            coordinates = {**{c.of(t): q[k] for k, c in enumerate(red.coordinates)},
+                           **{sp.Derivative(c.of(t), t): qd[k] for k, c in enumerate(red.coordinates)}}
+            at = PointValues({**values, **coordinates}, digits)
+            for k, (c, rhs) in enumerate(zip(red.coordinates, reduced)):
+                expected = mpmath.fsum(a * x for a, x in zip(transform[k], accel))
+                got = at(rhs)
+                if not _agree(got, expected, tolerance):
+                    raise ReductionError(f"reduced equation of {c.name} does not give Lagrange's acceleration "
+                                         f"({mpmath.nstr(got, 15)} instead of {mpmath.nstr(expected, 15)})")
+
+
+def _which_coupling(rd: ResolvedDrivetrain, i: int, at: PointValues, law: list, tolerance) -> str | None:
+    """The first coupling whose own generalized force on degree of freedom ``i`` (Lagrange's, of its potential and
+    dissipation alone) is not its law along its row, named; None if each is (derived only when the sum disagrees)."""
+    for c, rc in enumerate(rd.couplings):
+        lagrange = at(rd.coupling_forces(rc)[i])
+        if not _agree(lagrange, -at(rc.row[i]) * law[c], tolerance):
+            return f"{rc.name}: its generalized forces are not its law along its deflection row ({rd.dofs[i].label})"
+    return None
