@@ -27,7 +27,8 @@ import sympy as sp
 
 from ..errors import GearsymError
 from ..model.components import Planet
-from ..reduction.coordinates import coupling_deflections, rigid_body_modes
+from ..model.linear_algebra import pivot_columns
+from ..reduction.coordinates import deflection_matrix, relative_coordinates
 from ..reduction.statics import mean_over, mean_stiffness, number as _number
 from ..model.symbols import parameter_symbol, tau
 
@@ -121,10 +122,30 @@ def drivetrain_modes(drivetrain, values: Mapping[str, float], unit: str = "Hz") 
     couplings, in SI for Hz), from its kinematics alone: the coordinates and rigid-body modes, not the whole
     reduction (a drivetrain on bearings has many degrees of freedom, and its modes need no Lagrange equations)."""
     rd = drivetrain.resolved
-    coordinates, transform, _ = coupling_deflections(rd)
-    rigid = [u.applyfunc(rd.with_geometry) for u in rigid_body_modes(rd)]
+    coordinates, transform = relative_coordinates(rd)
+    rigid = _rigid_modes_at(rd, values)
     light = _Kinematics(rd, tuple(coordinates), transform.applyfunc(rd.with_geometry), tuple(rigid), drivetrain.name)
     return _solve(light, dict(values), unit, ())
+
+
+def _rigid_modes_at(rd, values: Mapping[str, float]) -> list[np.ndarray]:
+    """The rigid-body modes at ``values``, the basis the exact null space has (each free column of the deflection
+    rows' echelon form at generic values 1 in its own mode, 0 in the others'), solved in numbers: the modes need
+    their values only, and the exact null space of a planetary set on bearings takes SymPy seconds."""
+    rows = deflection_matrix(rd)
+    pivots = pivot_columns(rows)
+    free = [j for j in range(rows.cols) if j not in pivots]
+    if not free:
+        return []
+    a = np.array([[_number(rd.with_geometry(e), values, "a deflection row") for e in r] for r in rows.tolist()])
+    modes = []
+    for f in free:
+        u = np.zeros(rows.cols)
+        u[f] = 1.0
+        u[pivots] = np.linalg.lstsq(a[:, pivots], -a[:, f], rcond=None)[0]
+        u[np.abs(u) <= AT_REST * np.max(np.abs(u))] = 0.0  # (a body at rest in the mode, but for rounding)
+        modes.append(u)
+    return modes
 
 
 def nondimensional_modes(nd, settings: Mapping[str, object]) -> Modes:

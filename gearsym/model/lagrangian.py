@@ -146,4 +146,12 @@ class LagrangianForms:
         potential nor the dissipation holds one)."""
         to, back = self._symbols
         rates = [to[sp.Derivative(q, t)] for q in self.angles]
-        return sp.hessian(self._in_symbols(self.kinetic_energy), rates).applyfunc(lambda e: e.xreplace(back))
+        energy = self._in_symbols(self.kinetic_energy)
+        n = len(rates)
+        out = sp.zeros(n, n)
+        for i, a in enumerate(rates):
+            first = sp.diff(energy, a)
+            for j, b in enumerate(rates):
+                if first.has(b):  # (most pairs of a drivetrain's rates share no term)
+                    out[i, j] = sp.diff(first, b).xreplace(back)
+        return out

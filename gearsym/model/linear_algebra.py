@@ -146,7 +146,10 @@ def nullspace(m: sp.Matrix, what: str) -> list[sp.Matrix]:
         return [sp.eye(m.cols)[:, j] for j in range(m.cols)]
     gens = Generators(m)
     dm = DomainMatrix.from_Matrix(gens.to(m))
-    basis = dm.nullspace().to_Matrix()
+    basis = dm.nullspace()
+    if not gens.of and basis.domain.is_PolynomialRing:
+        return _checked_nullspace(m, what, [_without_common_factor(row, basis.domain) for row in basis.to_list()])
+    basis = basis.to_Matrix()
     vectors = []
     for i in range(basis.rows):
         entries = [sp.cancel(gens.normal(gens.from_(e))) if gens.of else sp.cancel(e) for e in basis.row(i)]
@@ -155,6 +158,20 @@ def nullspace(m: sp.Matrix, what: str) -> list[sp.Matrix]:
         entries = [sp.expand(e * scale) for e in entries]
         common = sp.gcd_list([e for e in entries if e != 0])
         vectors.append(sp.Matrix([sp.factor(sp.cancel(e / common)) for e in entries]))
+    return _checked_nullspace(m, what, vectors)
+
+
+def _without_common_factor(row: list, ring) -> sp.Matrix:
+    """A null vector of polynomials (``ring``'s elements) divided by their gcd (SymPy's, as for expressions), each
+    entry factored: the division exact in the ring (expressions' cancel takes their gcd again, term by term)."""
+    scale = sp.lcm_list([sp.Integer(int(e.clear_denoms()[0])) for e in row if e] or [1])  # (rational coefficients)
+    row = [e * ring.convert(scale) for e in row]
+    common = sp.gcd_list([ring.to_sympy(e) for e in row if e])
+    divisor = ring.from_sympy(common)
+    return sp.Matrix([sp.factor(ring.to_sympy(ring.exquo(e, divisor))) if e else sp.S.Zero for e in row])
+
+
+def _checked_nullspace(m: sp.Matrix, what: str, vectors: list[sp.Matrix]) -> list[sp.Matrix]:
     expected = m.cols - numeric_rank(m)
     if expected != len(vectors):
         raise GearsymError(f"{what}: the exact null space ({len(vectors)}) and the numeric one ({expected}) disagree "

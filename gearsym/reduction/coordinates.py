@@ -84,14 +84,14 @@ def rigid_body_modes(rd: ResolvedDrivetrain) -> list[sp.Matrix]:
 
 
 def relative_coordinates(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.Matrix]:
-    """The relative coordinates (one per independent coupling) and the transform T (q = T psi)."""
-    coords, transform, _ = coupling_deflections(rd)
+    """The relative coordinates (one per independent coupling) and the transform T (q = T psi), without the
+    combinations of the couplings that close a loop (:func:`coupling_deflections` solves for those)."""
+    coords, transform, _, _ = _coordinates(rd)
     return coords, transform
 
 
-def coupling_deflections(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.Matrix, list[Coordinate]]:
-    """The relative coordinates, the transform T and every coupling's deflection (the coordinates themselves and
-    the combinations of those that close a loop), in declaration order."""
+def _coordinates(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.Matrix, list[str], list[int]]:
+    """The relative coordinates, T, every coupling's coordinate name and the indices of the couplings kept."""
     jac = deflection_matrix(rd)
     n_bodies, n_couplings = len(rd.dofs), len(rd.couplings)
     kept = independent_rows(jac)  # a spanning tree of the couplings, in declaration order
@@ -106,10 +106,19 @@ def coupling_deflections(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.M
             raise ModelError(f"coordinate name {name!r} is used by {seen[name]!r} too; give each a distinct name", rc.name)
         seen[name] = rc.name
         names.append(name)
-    scaled = [[rc.scale * c for c in rc.row] for rc in rd.couplings]
-    transform = sp.Matrix([scaled[i] for i in kept])
+    transform = sp.Matrix([_scaled(rd.couplings[i]) for i in kept])
     assert transform.shape == (len(kept), n_bodies)
-    coords = [Coordinate(names[i], rd.couplings[i], _definition(rd, i)) for i in kept]
+    return [Coordinate(names[i], rd.couplings[i], _definition(rd, i)) for i in kept], transform, names, kept
+
+
+def _scaled(rc: ResolvedCoupling) -> list[sp.Expr]:
+    return [rc.scale * c for c in rc.row]
+
+
+def coupling_deflections(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.Matrix, list[Coordinate]]:
+    """The relative coordinates, the transform T and every coupling's deflection (the coordinates themselves and
+    the combinations of those that close a loop), in declaration order."""
+    coords, transform, names, kept = _coordinates(rd)
     solve = None
     deflections = []
     for i, rc in enumerate(rd.couplings):
@@ -117,7 +126,7 @@ def coupling_deflections(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.M
             deflections.append(coords[kept.index(i)])
             continue
         solve = solve or combination_solver(transform)
-        coefficients = solve(sp.Matrix([scaled[i]]))
+        coefficients = solve(sp.Matrix([_scaled(rc)]))
         combination = tuple((c, a) for c, a in zip(coords, coefficients) if a != 0)
         deflections.append(Coordinate(names[i], rc, _definition(rd, i), combination))
     return coords, transform, deflections

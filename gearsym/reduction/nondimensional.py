@@ -37,6 +37,7 @@ from ..model.roles import parameter_roles
 from ..model.expressions import ExprLike, parameter_names, to_expr
 from ..model.stiffness import check_periodic
 from ..model.linear_algebra import outside_span, simplified
+from ..model.replacing import Replacer
 from ..model.translations import CARRIER_SPEED
 from ..model.symbols import RESERVED, omega, parameter_symbol, phi, t, tau
 from ..system import Constraint, Coupling, FirstOrderSystem, Gearing
@@ -135,12 +136,12 @@ class NondimensionalModel:
             out += [sp.Symbol(c.name, real=True), sp.Symbol(c.velocity_name, real=True)]
         return tuple(out)
 
-    def _to_state_symbols(self, expr: sp.Expr) -> sp.Expr:
-        sub = {}
-        for c in self.coordinates:
-            sub[sp.Derivative(c.of(tau), tau)] = sp.Symbol(c.velocity_name, real=True)
-        expr = expr.xreplace(sub)
-        return expr.xreplace({c.of(tau): sp.Symbol(c.name, real=True) for c in self.coordinates})
+    @cached_property
+    def _to_state_symbols(self) -> Replacer:
+        """x'(tau) -> v and x(tau) -> x (a rate first: the whole derivative, not its function)."""
+        return Replacer({**{sp.Derivative(c.of(tau), tau): sp.Symbol(c.velocity_name, real=True)
+                            for c in self.coordinates},
+                         **{c.of(tau): sp.Symbol(c.name, real=True) for c in self.coordinates}})
 
     @cached_property
     def rhs(self) -> tuple[sp.Expr, ...]:
@@ -318,7 +319,10 @@ class NondimensionalModel:
             expr = sf.expression if functions is None or sf.name not in functions else functions[sf.name]
             fsub[sf.applied] = expr
         gsub = {gr.symbol: gr.definition for gr in self.groups if gr.kind == "derived"}
-        return [f.xreplace(fsub).xreplace(gsub) for f in self.rhs]
+        # (one pass: the functions' expressions with the groups already written out)
+        groups = Replacer(gsub)
+        both = Replacer({**{k: groups(v) for k, v in fsub.items()}, **gsub})
+        return [both(f) for f in self.rhs]
 
     def system(self, *, initial: Optional[Mapping[str, float]] = None, **settings: ExprLike) -> FirstOrderSystem:
         """The first-order system for the engine.
@@ -620,10 +624,10 @@ class _Assembly:
         speed = sp.Symbol(CARRIER_SPEED, real=True)
         # every term is Omega_c x' or Omega_c^2 x: omega^2 in tau, which the division by omega^2 takes out; so
         # omega is left out of the substitution instead (the rows stay unexpanded: see _frame_rows)
-        rates = {sp.Derivative(c.of(t), t): sp.diff(c.of(tau), tau) for c in red.coordinates}
-        values = {c.of(t): c.of(tau) for c in red.coordinates}
+        in_tau = Replacer({**{sp.Derivative(c.of(t), t): sp.diff(c.of(tau), tau) for c in red.coordinates},
+                           **{c.of(t): c.of(tau) for c in red.coordinates}, speed: ratio})
         for row, force in enumerate(red.frame_rows):
-            self.lhs[row] -= force.xreplace(rates).xreplace(values).xreplace({speed: ratio})
+            self.lhs[row] -= in_tau(force)
 
     def add_forcing(self, row: int) -> None:
         """The forcing of one row, grouped by harmonic into B0, B1, D, ...; an unforced shaft's constant
@@ -724,9 +728,7 @@ def _nondimensionalize(red: Reduction) -> NondimensionalModel:
     if not geometry:
         return NondimensionalModel(red, groups, build.conditions, build.functions, build.lhs, build.rhs, rows)
 
-    def sub(e):
-        return e.xreplace(geometry)
-
+    sub = Replacer(geometry)
     return NondimensionalModel(
         with_geometry(red), [replace(gr, definition=sub(gr.definition)) for gr in groups],
         [replace(c, equation=sp.Eq(simplified(sub(c.equation.lhs)), sub(c.equation.rhs))) for c in build.conditions],

@@ -23,6 +23,7 @@ from sympy.polys.matrices import DomainMatrix
 
 from ..model.backlash import g
 from ..model.evaluation import PointValues
+from ..model.replacing import Replacer
 from ..errors import GearsymError
 from ..model.drivetrain import Drivetrain
 from ..model.linear_algebra import fraction_forms, numeric_rank, pivot_columns, simplified, solve_rows
@@ -183,8 +184,7 @@ def with_geometry(red: Reduction) -> Reduction:
     if numeric_rank(red.transform.xreplace(geometry)) != generic:
         raise ReductionError(f"{red.drivetrain.name}: the geometry's numbers make the coordinates dependent")
 
-    def sub(e):  # (numbers in: evaluated as they are used; the coefficients' normal form is for display only)
-        return e.xreplace(geometry)
+    sub = Replacer(geometry)  # (numbers in: evaluated as they are used; the coefficients' normal form is for display only)
 
     coordinates, old_to_new = [], {}
     for c in red.coordinates:
@@ -259,8 +259,9 @@ def _frame_rows(red: Reduction, weights_rows: sp.Matrix, forces: sp.Matrix) -> l
     # coordinates (its weights factored, over the rigid-body modes' Gram determinant): expanded, the combinations'
     # rational weights multiply out into every row (Lin & Parker's set: 10^5 characters a row, a C file of megabytes
     # gcc does not finish); kept, each combination is one subexpression the generated code computes once.
-    return [sp.Add(*(weight * sp.factor_terms(force).xreplace(rates).xreplace(positions)
-                     for weight, force in zip(weights, forces) if weight != 0 and force != 0))
+    in_coordinates = Replacer({**rates, **positions})  # (a rate first: the whole derivative, not its function)
+    forces = [in_coordinates(sp.factor_terms(force)) if force != 0 else force for force in forces]
+    return [sp.Add(*(weight * force for weight, force in zip(weights, forces) if weight != 0 and force != 0))
             for weights in weights_rows]
 
 
