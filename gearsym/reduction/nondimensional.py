@@ -37,6 +37,7 @@ from ..model.roles import parameter_roles
 from ..model.expressions import ExprLike, parameter_names, to_expr
 from ..model.stiffness import check_periodic
 from ..model.linear_algebra import outside_span, simplified
+from ..model.evaluation import PointValues
 from ..model.replacing import Replacer
 from ..model.translations import CARRIER_SPEED
 from ..model.symbols import RESERVED, omega, parameter_symbol, phi, t, tau
@@ -473,9 +474,15 @@ def _generic_number(name: str) -> sp.Rational:
 def fingerprint(expr: sp.Expr) -> sp.Float:
     """``expr`` at generic values of its parameters, with the geometry's numbers: two definitions that differ
     differ here (for almost all values)."""
-    expr = expr.xreplace(_GEOMETRY) if _GEOMETRY else expr
-    values = {s: _generic_number(s.name) for s in expr.free_symbols}
-    return sp.N(expr.xreplace(values), 30)
+    leaves = {}
+    for s in expr.free_symbols:
+        atom = _GEOMETRY.get(s)
+        leaves[s] = _generic_number(s.name) if atom is None else \
+            atom.xreplace({a: _generic_number(a.name) for a in atom.free_symbols})
+    try:  # (evaluated as it stands, each subexpression once: rebuilding it with the numbers in cost seconds)
+        return sp.Float(PointValues(leaves, 40)(expr), 30)
+    except KeyError:  # (a function of time, say: SymPy's evaluation says what it can)
+        return sp.N(expr.xreplace(_GEOMETRY).xreplace(leaves), 30)
 
 
 def _equal(a: sp.Expr, b: sp.Expr) -> bool:
