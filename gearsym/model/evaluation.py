@@ -79,3 +79,26 @@ def _leaves(expr: sp.Basic) -> set:
             out.add(node)
             walk.skip()
     return out
+
+
+def inventory(exprs) -> tuple[set, set, int | None]:
+    """The symbols, the applied functions of ``exprs`` (their undefined ones: k(t), psi(t)) and the least precision
+    in bits of their Floats (None without one), each distinct node visited once (``atoms`` visits a subexpression
+    as often as it recurs)."""
+    symbols, functions, bits = set(), set(), None
+    seen: set = set()
+    stack = [e for e in exprs if isinstance(e, sp.Basic)]
+    while stack:
+        node = stack.pop()
+        if node in seen:
+            continue
+        seen.add(node)
+        if node.is_Symbol:
+            symbols.add(node)
+            continue
+        if node.is_Float:
+            bits = node._prec if bits is None else min(bits, node._prec)
+        elif isinstance(node, sp.core.function.AppliedUndef):
+            functions.add(node)
+        stack.extend(a for a in node.args if isinstance(a, sp.Basic))
+    return symbols, functions, bits

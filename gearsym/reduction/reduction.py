@@ -22,7 +22,7 @@ from sympy.polys.constructor import construct_domain
 from sympy.polys.matrices import DomainMatrix
 
 from ..model.backlash import g
-from ..model.evaluation import PointValues
+from ..model.evaluation import PointValues, inventory
 from ..model.replacing import Replacer
 from ..errors import GearsymError
 from ..model.drivetrain import Drivetrain
@@ -348,11 +348,10 @@ FLOAT_SLACK = 4
 GUARD_DIGITS = 20
 
 
-def _check_tolerance(exprs) -> mpmath.mpf:
+def _check_tolerance(bits: int | None) -> mpmath.mpf:
     """The relative disagreement the check allows: 10^(8 - CHECK_DIGITS) between exact numbers; with floating-point
-    numbers in the equations (a number a model file gives as a float), what their precision holds less FLOAT_SLACK
-    digits (1e-11 for doubles: still far below any term that is wrong)."""
-    bits = min((f._prec for e in exprs for f in e.atoms(sp.Float)), default=None)
+    numbers in the equations (a number a model file gives as a float: ``bits``, their least precision), what their
+    precision holds less FLOAT_SLACK digits (1e-11 for doubles: still far below any term that is wrong)."""
     digits = CHECK_DIGITS - 8 if bits is None else min(CHECK_DIGITS - 8, int(bits * math.log10(2)) - FLOAT_SLACK)
     return mpmath.mpf(10) ** -digits
 
@@ -377,12 +376,10 @@ def check_against_lagrange(red: Reduction) -> None:
     frame = list(rd.frame_forces)
     laws = [_law_in_angles(rd, rc) for rc in rd.couplings]
     reduced = [eq.rhs for eq in red.equations]
-    everything = (*lagrange, *external, *frame, *laws, *reduced)
-    symbols = set().union(*(e.free_symbols for e in everything)) - {t} - set(rd.geometry)
-    symbols |= set().union(*(e.free_symbols for e in rd.geometry.values()))
-    functions = set().union(*({f for f in e.atoms(sp.Function) if f.args == (t,)} for e in everything))
-    functions -= set(rd.angles) | {c.of(t) for c in red.coordinates}
-    tolerance = _check_tolerance(everything)
+    symbols, functions, bits = inventory((*lagrange, *external, *frame, *laws, *reduced))
+    symbols = (symbols - {t} - set(rd.geometry)).union(*(e.free_symbols for e in rd.geometry.values()))
+    functions = {f for f in functions if f.args == (t,)} - set(rd.angles) - {c.of(t) for c in red.coordinates}
+    tolerance = _check_tolerance(bits)
     digits = CHECK_DIGITS + GUARD_DIGITS
     for _ in range(CHECK_POINTS):
         values = {s: sp.Rational(rng.randint(5, 40), rng.randint(5, 20)) for s in sorted(symbols, key=str)}
