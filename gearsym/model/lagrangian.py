@@ -11,6 +11,7 @@ from functools import cached_property
 import sympy as sp
 
 from .backlash import G
+from .partial import partial
 from .symbols import t
 from .resolved_components import ResolvedCoupling
 
@@ -111,10 +112,10 @@ class LagrangianForms:
             # (only the terms that hold q: the others differentiate to zero, and a drivetrain on bearings has many)
             lag = sp.Add(*(e for e in terms_l if e.has(q) or e.has(qd)))
             dis = sp.Add(*(e for e in terms_r if e.has(q) or e.has(qd)))
-            momentum = sp.diff(lag, qd)
-            rate_of_momentum = sp.diff(momentum, t) + sp.Add(*(
-                sp.diff(momentum, x) * xd for x, xd in zip(positions + rates, rates + accelerations) if momentum.has(x)))
-            out.append((rate_of_momentum - sp.diff(lag, q) + sp.diff(dis, qd)).xreplace(back))
+            momentum = partial(lag, qd)
+            rate_of_momentum = partial(momentum, t) + sp.Add(*(
+                partial(momentum, x) * xd for x, xd in zip(positions + rates, rates + accelerations) if momentum.has(x)))
+            out.append((rate_of_momentum - partial(lag, q) + partial(dis, qd)).xreplace(back))
         return out
 
     @cached_property
@@ -150,8 +151,8 @@ class LagrangianForms:
         n = len(rates)
         out = sp.zeros(n, n)
         for i, a in enumerate(rates):
-            first = sp.diff(energy, a)
+            first = partial(energy, a)
             for j, b in enumerate(rates):
                 if first.has(b):  # (most pairs of a drivetrain's rates share no term)
-                    out[i, j] = sp.diff(first, b).xreplace(back)
+                    out[i, j] = partial(first, b).xreplace(back)
         return out
