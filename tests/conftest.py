@@ -18,7 +18,8 @@ from gearsym.model.symbols import parameter_symbol, t
 
 GEAR_MODELS = ("one_stage", "one_stage_resonant", "flexible_shaft", "two_stage")
 #: pre-generated models whose byte-for-byte checks of generated/ and docs/derivations/ take many seconds (run with
-#: -m slow): Lin & Parker's translational set (its reduction 40 s of SymPy, then 8 s to generate its C)
+#: -m slow): Lin & Parker's translational set (its reduction about 5 s of CPU, then 4 s to generate its C:
+#: python -m bench.reduction)
 SLOW_MODELS: tuple[str, ...] = ("planetary_translational",)
 #: the xdist group of the tests that reduce a slow model (`slow_models_group`): in a parallel run (pytest -n auto
 #: --dist loadgroup) they run on one worker, so that the model's reduction, cached on the model, is made once
