@@ -119,15 +119,15 @@ def coupling_deflections(rd: ResolvedDrivetrain) -> tuple[list[Coordinate], sp.M
     """The relative coordinates, the transform T and every coupling's deflection (the coordinates themselves and
     the combinations of those that close a loop), in declaration order."""
     coords, transform, names, kept = _coordinates(rd)
-    solve = None
+    closing = [i for i in range(len(rd.couplings)) if i not in kept]
+    solved = dict(zip(closing, combination_solver(transform).many(
+        [sp.Matrix([_scaled(rd.couplings[i])]) for i in closing]))) if closing else {}
     deflections = []
     for i, rc in enumerate(rd.couplings):
         if i in kept:
             deflections.append(coords[kept.index(i)])
             continue
-        solve = solve or combination_solver(transform)
-        coefficients = solve(sp.Matrix([_scaled(rc)]))
-        combination = tuple((c, a) for c, a in zip(coords, coefficients) if a != 0)
+        combination = tuple((c, a) for c, a in zip(coords, solved[i]) if a != 0)
         deflections.append(Coordinate(names[i], rc, _definition(rd, i), combination))
     return coords, transform, deflections
 
@@ -137,20 +137,35 @@ def _definition(rd: ResolvedDrivetrain, i: int) -> sp.Expr:
     return sp.Add(*(rc.scale * c * a for c, a in zip(rc.row, rd.angles)))
 
 
-def combination_solver(transform: sp.Matrix):
-    """A function giving the coefficients J with ``row = J T`` exactly, for a row in the span of T: solved on
-    columns where T is invertible (found at generic values), then checked on every column."""
-    k = transform.rows
-    pivots = pivot_columns(transform)
-    square = transform.extract(list(range(k)), list(pivots))
+def combination_solver(transform: sp.Matrix) -> "CombinationSolver":
+    """The coefficients J with ``row = J T`` exactly, for rows in the span of T (:class:`CombinationSolver`)."""
+    return CombinationSolver(transform)
 
-    def solve(row: sp.Matrix) -> list[sp.Expr]:
-        coefficients = solve_rows(square, row.extract([0], list(pivots))).applyfunc(sp.factor)
-        if not all(is_zero(e) for e in combination_residual(coefficients, transform, row)):
-            raise ModelError(f"the deflection {list(row)} is not a combination of the coordinates' (a bug)", "reduction")
-        return list(coefficients)
 
-    return solve
+class CombinationSolver:
+    """``solver(row)``, or ``solver.many(rows)`` at the price of one (a fraction-free solve costs its elimination of
+    T's pivot columns, whatever the number of rows): the coefficients J with ``row = J T``, solved on columns where T
+    is invertible (found at generic values), then checked on every column."""
+
+    def __init__(self, transform: sp.Matrix):
+        self.transform = transform
+        self.pivots = pivot_columns(transform)
+        self.square = transform.extract(list(range(transform.rows)), list(self.pivots))
+
+    def __call__(self, row: sp.Matrix) -> list[sp.Expr]:
+        return self.many([row])[0]
+
+    def many(self, rows: list[sp.Matrix]) -> list[list[sp.Expr]]:
+        stacked = sp.Matrix.vstack(*rows)
+        coefficients = solve_rows(self.square, stacked.extract(list(range(stacked.rows)), list(self.pivots)))
+        out = []
+        for k, row in enumerate(rows):
+            found = coefficients.row(k).applyfunc(sp.factor)
+            if not all(is_zero(e) for e in combination_residual(found, self.transform, row)):
+                raise ModelError(f"the deflection {list(row)} is not a combination of the coordinates' (a bug)",
+                                 "reduction")
+            out.append(list(found))
+        return out
 
 
 def combination_residual(coefficients: sp.Matrix, transform: sp.Matrix, row: sp.Matrix) -> list[sp.Expr]:

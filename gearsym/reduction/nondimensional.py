@@ -379,17 +379,16 @@ class NondimensionalModel:
         pending = [d for d in rd.translations if d.index not in by_row]
         targets = [sp.Matrix([[1 if j == d.index else 0 for j in range(transform.cols)]]) for d in pending]
         free = dict(zip((d.index for d in pending), outside_span(transform, targets))) if pending else {}
-        solve = None
+        determined = [d for d in pending if not free[d.index]]  # (the others: not determined by the coordinates)
+        solved = dict(zip((d.index for d in determined), combination_solver(transform).many(
+            [targets[pending.index(d)] for d in determined]))) if determined else {}
         for d in rd.translations:
             name = d.label.replace(".", "_")
             if d.index in by_row:
                 out[name] = by_row[d.index]
-                continue
-            if free[d.index]:
-                continue  # (not determined by the coordinates)
-            solve = solve or combination_solver(transform)
-            weights = [w.xreplace(geometry) if geometry else w for w in solve(sp.Matrix(targets[pending.index(d)]))]
-            out[name] = sp.Add(*(w * sp.Symbol(c.name, real=True) for w, c in zip(weights, red.coordinates)))
+            elif d.index in solved:
+                weights = [w.xreplace(geometry) if geometry else w for w in solved[d.index]]
+                out[name] = sp.Add(*(w * sp.Symbol(c.name, real=True) for w, c in zip(weights, red.coordinates)))
         return out
 
     def _initial(self, initial: Optional[Mapping[str, float]]) -> dict[str, float]:

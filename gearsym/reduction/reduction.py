@@ -232,22 +232,18 @@ def _frame_rows(red: Reduction, weights_rows: sp.Matrix, forces: sp.Matrix) -> l
     weights_rows = [list(weights_rows.row(k)) for k in range(weights_rows.rows)]
     weights_of: dict[int, list[sp.Expr]] = {}
     held = [i for i in moving if any(u[i] != 0 for u in red.rigid_modes)]  # (a rigid-body mode moves it too)
-    solve = None
     itself = {}  # dof -> the coordinate that is it (a bearing to the ground: x_sun = X_sun)
     for k in range(red.transform.rows):
         nonzero = [j for j, e in enumerate(red.transform.row(k)) if e != 0]
         if len(nonzero) == 1 and red.transform[k, nonzero[0]] == 1:
             itself[nonzero[0]] = k
+    solved = [i for i in moving if i not in held and i not in itself]
     for i in moving:
-        if i in held:
-            continue
-        if i in itself:
+        if i in itself and i not in held:
             weights_of[i] = [sp.S.One if k == itself[i] else sp.S.Zero for k in range(len(red.coordinates))]
-            continue
-        solve = solve or combination_solver(red.transform)
-        target = sp.zeros(1, red.transform.cols)
-        target[i] = 1
-        weights_of[i] = list(solve(target))
+    if solved:  # (one solve for all of them)
+        targets = [sp.Matrix([[1 if j == i else 0 for j in range(red.transform.cols)]]) for i in solved]
+        weights_of.update(zip(solved, combination_solver(red.transform).many(targets)))
     if held:
         weights_of.update(zip(held, translations_in_coordinates(red, held)))
     rates, positions = {}, {}
