@@ -232,10 +232,13 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))
     # the heaviest groups first (a slow test counts as SLOW_WEIGHT quick ones), so that no worker is left with a
     # long group at the end while the other has finished: xdist takes the groups in this order (pytest_configure)
-    weight = collections.Counter()
-    for item in items:
+    if not hasattr(config, "workerinput"):  # (a serial run keeps the files' order)
+        return
+    weight, first = collections.Counter(), {}
+    for n, item in enumerate(items):
         weight[_group(item)] += SLOW_WEIGHT if item.get_closest_marker("slow") else 1
-    items.sort(key=lambda item: -weight[_group(item)])  # (stable: a group's tests keep their order)
+        first.setdefault(_group(item), n)
+    items.sort(key=lambda item: (-weight[_group(item)], first[_group(item)]))  # (stable: a group's tests in order)
 
 
 #: about how many quick tests' time a test marked slow takes (~10 s against ~0.3 s)
