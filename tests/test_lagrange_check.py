@@ -10,7 +10,7 @@ from dataclasses import replace
 import pytest
 import sympy as sp
 
-from conftest import load, reduced, slow_models_group
+from conftest import reduced, slow_models_group
 from gearsym.reduction import ReductionError
 from gearsym.reduction import reduction as reduction_module
 from gearsym.reduction.reduction import Reduction, check_against_lagrange

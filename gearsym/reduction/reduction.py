@@ -26,7 +26,7 @@ from ..model.evaluation import PointValues, inventory
 from ..model.replacing import Replacer
 from ..errors import GearsymError
 from ..model.drivetrain import Drivetrain
-from ..model.linear_algebra import fraction_forms, numeric_rank, pivot_columns, simplified, solve_rows
+from ..model.linear_algebra import fraction_forms, numeric_rank, pivot_columns, simplified
 from ..model.resolved import ResolvedDrivetrain
 from ..model.resolved_components import ResolvedCoupling, ResolvedForcing
 from ..model.symbols import t
@@ -252,9 +252,10 @@ def _frame_rows(red: Reduction, weights_rows: sp.Matrix, forces: sp.Matrix) -> l
         rates[sp.Derivative(rd.dofs[i].angle, t)] = sp.Add(*(w * sp.Derivative(c.of(t), t) for w, c in pairs))
         positions[rd.dofs[i].angle] = sp.Add(*(w * c.of(t) for w, c in pairs))
     # Each row is kept as T M^-1 times the frame's force on each body, the body's translation a combination of the
-    # coordinates (its weights factored, over the rigid-body modes' Gram determinant): expanded, the combinations'
-    # rational weights multiply out into every row (Lin & Parker's set: 10^5 characters a row, a C file of megabytes
-    # gcc does not finish); kept, each combination is one subexpression the generated code computes once.
+    # coordinates (its weights over the rigid-body modes' Gram determinant, each denominator in its pieces): expanded,
+    # the combinations' rational weights multiply out into every row (Lin & Parker's set: 10^5 characters a row, a C
+    # file of megabytes gcc does not finish); kept, each combination is one subexpression the generated code computes
+    # once.
     in_coordinates = Replacer({**rates, **positions})  # (a rate first: the whole derivative, not its function)
     forces = [in_coordinates(sp.factor_terms(force)) if force != 0 else force for force in forces]
     return [sp.Add(*(weight * force for weight, force in zip(weights, forces) if weight != 0 and force != 0))
