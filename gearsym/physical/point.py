@@ -1,7 +1,7 @@
 """One operating point of a spectrum run in physical units, from numbers alone (no pint, no SymPy).
 
 :func:`gearsym.physical.results.point_units` reads once, with pint, what carrying a
-:class:`~gearsym.analysis.LyapunovSpectrum` back to physical units takes (the time unit, the length unit,
+:class:`~gearsym.analysis.lyapunov.LyapunovSpectrum` back to physical units takes (the time unit, the length unit,
 the unit conversions, each mesh's stiffness, damping, backlash and its variation k(tau) as a CasADi
 function, each shaft's stiffness and damping); :class:`PointUnits` keeps those numbers and does the carrying.
 The mesh forces and shaft torques of a point come from a trajectory at that point (:func:`loads_trajectory`:
@@ -20,6 +20,7 @@ import numpy as np
 
 from ..analysis.lyapunov import LyapunovSpectrum
 from ..analysis.poincare import phase_trajectory
+from ..codegen.on_arrays import evaluate_on_samples
 from ..errors import GearsymError
 from ..scales.speeds import Speed
 from ..units import shown
@@ -167,8 +168,7 @@ class MeshUnits:
         import casadi as ca
 
         taus = np.atleast_1d(np.asarray(tau, dtype=float))
-        k_of_tau = ca.Function.deserialize(self.variation).map(taus.size)
-        k = np.asarray(k_of_tau(taus.reshape(1, -1)), dtype=float).reshape(taus.shape)
+        k = evaluate_on_samples(ca.Function.deserialize(self.variation), taus)  # (all samples at once)
         return self.stiffness * k * contact(x, self.eta) + self.damping * v
 
 
@@ -278,7 +278,7 @@ class PointUnits:
         return _significant(np.asarray(omega, dtype=float) * self.omega_n / self.forcing_ratio * self.rad_s_to_speed)
 
     def point(self, result, trajectory=None) -> PhysicalPoint:
-        """A :class:`~gearsym.analysis.LyapunovSpectrum` in physical units (with the mesh forces and shaft
+        """A :class:`~gearsym.analysis.lyapunov.LyapunovSpectrum` in physical units (with the mesh forces and shaft
         torques of ``trajectory``, a :class:`~gearsym.analysis.poincare.Trajectory` at the same point, if given)."""
         w = float(result.parameters["omega"])
         per_second = w * self.omega_n
