@@ -38,7 +38,7 @@ def evaluate_on_samples(function: ca.Function, samples: np.ndarray) -> np.ndarra
     """``function`` (SX, one scalar input, one scalar output) at every value of ``samples``, an array of that
     shape."""
     samples = np.asarray(samples, dtype=float)
-    program = _program(function)
+    program = numpy_program(function)
     if program is None:  # (an instruction NumPy does not have: CasADi's map, sample after sample)
         mapped = function.map(samples.size)(samples.reshape(1, -1))
         return np.asarray(mapped, dtype=float).reshape(samples.shape)
@@ -59,7 +59,7 @@ def evaluate_on_samples(function: ca.Function, samples: np.ndarray) -> np.ndarra
     return np.broadcast_to(np.asarray(result, dtype=float), samples.shape).copy()
 
 
-def _program(function: ca.Function) -> list[tuple] | None:
+def numpy_program(function: ca.Function) -> list[tuple] | None:
     """The function's instructions as (operation, inputs, output, constant), or None if one has no NumPy twin
     (or the function is not of one scalar to one scalar)."""
     if not function.is_a("SXFunction") or (function.n_in(), function.n_out()) != (1, 1) \

@@ -163,12 +163,15 @@ class MeshUnits:
     eta: float  # m
     variation: str  # k(tau), a serialized CasADi function
 
-    def force(self, tau, x, v) -> np.ndarray:
-        """The force in N along a trajectory (x in m, v in m/s)."""
+    def variation_at(self, tau) -> np.ndarray:
+        """k(tau) at every sample of ``tau`` (all at once: :mod:`gearsym.codegen.on_arrays`)."""
         import casadi as ca
 
-        taus = np.atleast_1d(np.asarray(tau, dtype=float))
-        k = evaluate_on_samples(ca.Function.deserialize(self.variation), taus)  # (all samples at once)
+        return evaluate_on_samples(ca.Function.deserialize(self.variation), np.atleast_1d(np.asarray(tau, dtype=float)))
+
+    def force(self, tau, x, v, k=None) -> np.ndarray:
+        """The force in N along a trajectory (x in m, v in m/s; ``k``: :meth:`variation_at` ``tau``, if known)."""
+        k = self.variation_at(tau) if k is None else k
         return self.stiffness * k * contact(x, self.eta) + self.damping * v
 
 
@@ -357,7 +360,10 @@ class PointUnits:
         def si(name):
             return self.state(name, trajectory[name], omega, si=True)
 
-        forces = {m.name: m.force(tau, si(m.coordinate), si(m.velocity)) for m in self.meshes}
+        k = {}  # k(tau) once per variation (a planetary set's sun and ring meshes of one planet share theirs)
+        for m in self.meshes:
+            k[m.variation] = k[m.variation] if m.variation in k else m.variation_at(tau)
+        forces = {m.name: m.force(tau, si(m.coordinate), si(m.velocity), k[m.variation]) for m in self.meshes}
         torques = {s.name: s.torque(si(s.coordinate), si(s.velocity)) for s in self.shafts}
         return forces, torques
 
