@@ -82,12 +82,12 @@ _LAZY = {
     "CompiledModel": "gearsym.codegen",
     "compile_model": "gearsym.codegen.build",
     "chosen_integration": "gearsym.codegen.fastest_mode",
-    "LyapunovSpectrum": "gearsym.analysis",
-    "classify_regime": "gearsym.analysis",
+    "LyapunovSpectrum": "gearsym.analysis.lyapunov",
+    "classify_regime": "gearsym.analysis.regime",
     "StabilityChart": "gearsym.stability",
     "read_sweep": "gearsym.sweep",
     "SweepInterrupted": "gearsym.sweep",
-    "order_spectrum": "gearsym.analysis",
+    "order_spectrum": "gearsym.analysis.orders",
     "load_measurements": "gearsym.data",
     "explain": "gearsym.fit",
     "EFFECTS": "gearsym.fit",
@@ -131,7 +131,9 @@ def __dir__() -> list[str]:
 
 
 if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
-    from .analysis import LyapunovSpectrum, classify_regime, order_spectrum
+    from .analysis.lyapunov import LyapunovSpectrum
+    from .analysis.orders import order_spectrum
+    from .analysis.regime import classify_regime
     from .codegen import CompiledModel
     from .codegen.build import compile_model
     from .data import load_measurements

@@ -152,10 +152,21 @@ def _source_digest(folder: Path) -> str:
     """Every Python file below ``folder`` (gearsym's own code: whatever derives a system) by its size and time of
     change, as Python's own bytecode cache tells an edited module (reading them all would cost start-up time)."""
     digest = hashlib.sha256()
-    for path in sorted(folder.rglob("*.py")):
-        stat = path.stat()
-        digest.update(f"{path.relative_to(folder)}\0{stat.st_size}\0{stat.st_mtime_ns}\n".encode())
+    for parts, size, changed in sorted(_python_files(folder)):  # (in the order of the paths' parts, as Paths sort)
+        digest.update(f"{'/'.join(parts)}\0{size}\0{changed}\n".encode())
     return digest.hexdigest()
+
+
+def _python_files(folder, parts: tuple[str, ...] = ()):
+    """(path parts below ``folder``, size, time of change) of every ``*.py`` file there, as ``Path.rglob`` finds
+    them, read with ``os.scandir`` (half the time of making a Path of each)."""
+    with os.scandir(folder) as entries:
+        for entry in entries:
+            if entry.is_dir():
+                yield from _python_files(entry.path, (*parts, entry.name))
+            elif entry.name.endswith(".py"):
+                stat = entry.stat()
+                yield (*parts, entry.name), stat.st_size, stat.st_mtime_ns
 
 
 def _model_files(folders: tuple[Path, ...]) -> dict[str, str]:

@@ -22,6 +22,7 @@ from gearsym import FirstOrderSystem, GearsymError, Integration, ModelError, Unk
 from gearsym.model.backlash import G, g, g_slope
 from gearsym.codegen import CompilerError
 from gearsym.codegen.generated import generate_model
+from gearsym.codegen.on_arrays import evaluate_on_samples, numpy_program
 from gearsym.codegen.time_tables import split_rhs
 from gearsym.codegen.translate import to_casadi
 from gearsym.files.paths import REPO_ROOT
@@ -396,3 +397,20 @@ def test_the_backlash_term_of_a_sum_is_added_last_so_each_stage_waits_for_one_op
         out = to_casadi([expr], symbols)[0]
         last, rest = out.dep(1), out.dep(0)
         assert ca.depends_on(last, symbols[x]) and not ca.depends_on(rest, symbols[x]), expr
+
+
+def test_a_function_of_tau_on_arrays_gives_casadis_numbers():
+    """A mesh's k(tau) over a trajectory's samples all at once, one NumPy operation per instruction: CasADi's numbers
+    (within an ulp: NumPy's own sin and cos on some CPUs); an instruction NumPy lacks (erf) goes to CasADi's map."""
+    tau = ca.SX.sym("tau")
+    forms = [1 + 0.2 * ca.cos(tau) - 0.05 * ca.sin(3 * tau + 0.5),  # a planet mesh's variation
+             ca.if_else(ca.fmod(tau, 1.0) < 0.3, 1 - 0.2 * ca.sin(tau) ** 2, 1 / (1 + tau)),  # a fault's window
+             ca.fmin(ca.fabs(ca.sin(3 * tau)), 0.5) + ca.floor(tau / 7) * ca.sign(ca.cos(tau)) - ca.sqrt(tau),
+             ca.logic_and(tau > 1, tau < 5) + ca.logic_or(tau <= 2, tau >= 100) + ca.logic_not(tau == 3),
+             ca.erf(tau / 100), ca.SX(1.5)]
+    samples = np.linspace(0.0, 120.0, 1201)
+    for form in forms:
+        f = ca.Function("k", [tau], [form])
+        expected = np.asarray(f.map(samples.size)(samples.reshape(1, -1))).reshape(-1)
+        assert evaluate_on_samples(f, samples) == pytest.approx(expected, rel=1e-14, abs=1e-15)
+    assert [numpy_program(ca.Function("k", [tau], [form])) is None for form in forms] == [False] * 4 + [True, False]

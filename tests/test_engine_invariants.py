@@ -1,6 +1,8 @@
 """The compiled engine against invariants, published values and an independent implementation."""
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 import sympy as sp
@@ -115,6 +117,23 @@ def test_strobe_samples_agree_between_tangent_orbit_and_trajectory_runs():
     assert orbit.amplitude["x"] == pytest.approx(lyap.amplitude["x"], abs=1e-12)
     x = traj["x"]
     assert (x.max() - x.min()) / 2 == pytest.approx(orbit.amplitude["x"], abs=1e-12)
+
+
+def test_the_librarys_own_calls_give_casadis_numbers():
+    """trajectory, rhs and jacobian call the compiled library directly (no CasADi call, no copies of its results):
+    the same C, so the numbers of CasADi's call of it to the bit; a state of the wrong size is CasADi's to refuse."""
+    cm = compiled("one_stage")
+    through_casadi = dataclasses.replace(cm, native=None)
+    inputs = cm.prepare(cm.parameter_vector(omega=0.8))
+    y = cm.initial_state(None) + 0.3
+    (time, states), (time_casadi, states_casadi) = (m.trajectory(y, 3, inputs) for m in (cm, through_casadi))
+    assert states.shape == (2, 3 * cm.steps_per_period + 1)
+    assert np.array_equal(states, states_casadi) and np.array_equal(time, time_casadi)
+    for t in (0.0, 1.3):
+        assert np.array_equal(cm.rhs(t, y, inputs.p), through_casadi.rhs(t, y, inputs.p))
+        assert np.array_equal(cm.jacobian(t, y, inputs.p), through_casadi.jacobian(t, y, inputs.p))
+    with pytest.raises(RuntimeError):
+        cm.jacobian(0.0, np.append(y, 0.0), inputs.p)
 
 
 def test_history_and_initial_state():

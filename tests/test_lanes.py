@@ -16,7 +16,7 @@ import pytest
 
 import gearsym
 from gearsym import FirstOrderSystem, GearsymError, Integration, find_attractors, lyapunov_spectrum
-from gearsym.analysis.lyapunov import lyapunov_spectra
+from gearsym.analysis.lane_spectra import lyapunov_spectra
 from gearsym.analysis.regime import DIVERGED
 from gearsym.codegen.compiled import CompiledModel
 from gearsym.codegen.compiler import compile_library, find_compiler

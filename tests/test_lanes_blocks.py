@@ -16,7 +16,7 @@ from scipy.integrate import solve_ivp
 
 import gearsym
 from gearsym import Integration, lyapunov_spectrum
-from gearsym.analysis.lyapunov import lyapunov_spectra
+from gearsym.analysis.lane_spectra import lyapunov_spectra
 from gearsym.codegen.compiler import find_compiler
 from gearsym.codegen.lane_runs import LaneRunner
 

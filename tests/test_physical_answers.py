@@ -133,8 +133,8 @@ def test_the_mean_mesh_force_of_a_point_is_the_mean_over_whole_periods():
     x = (2.0 + np.cos(tau)) * 1e-6 / s.length_si  # in contact throughout: force = kZ k(tau) x + cZ x'
     trajectory = Trajectory("spur_pair", ("x", "v"), tau, np.vstack([x, np.zeros_like(x)]), np.zeros((2, 21)))
     samples = units.mesh_forces(trajectory, 1.0)["mesh"]
-    spectrum = gearsym.analysis.LyapunovSpectrum("spur_pair", {"omega": 1.0}, np.zeros(2), np.zeros(2),
-                                                 np.zeros((1, 2)), {}, {}, np.zeros((2, 1)), 21, 1, per, period, "")
+    spectrum = gearsym.LyapunovSpectrum("spur_pair", {"omega": 1.0}, np.zeros(2), np.zeros(2),
+                                        np.zeros((1, 2)), {}, {}, np.zeros((2, 1)), 21, 1, per, period, "")
     mean = units.point(spectrum, trajectory).mesh_force["mesh"]["mean"].magnitude
     exact = np.mean(samples[:-1])  # one sample per phase (the last repeats the first)
     assert mean == pytest.approx(exact, rel=1e-13)

@@ -151,6 +151,20 @@ def test_a_command_on_a_cached_model_imports_neither_sympy_nor_pint(model_copy, 
     assert json.loads(run.stdout) == json.loads(first.stdout) == lyap(capsys, *argv[:-len(ARGS)])
 
 
+def test_a_single_spectrum_loads_no_other_analysis():
+    """What `gearsym lyap` imports (its command and the start-up cache) leaves out the runs from many starts, the
+    lanes, the orders and their figures: each module is start-up time of every cached run (issue 39)."""
+    script = "import sys, gearsym.cli.lyap, gearsym.cached; print(' '.join(sorted(sys.modules)))"
+    loaded = set(subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO_ROOT,
+                                env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120, check=True).stdout.split())
+    assert "gearsym.analysis.lyapunov" in loaded and "gearsym.physical.point" in loaded
+    unused = {"gearsym.analysis.attractors", "gearsym.analysis.basins", "gearsym.analysis.jumps",
+              "gearsym.analysis.orders", "gearsym.analysis.order_run", "gearsym.analysis.lane_spectra",
+              "gearsym.codegen.lane_runs", "gearsym.figures.poincare", "concurrent.futures", "sympy", "pint",
+              "matplotlib"}
+    assert unused.isdisjoint(loaded), sorted(unused & loaded)
+
+
 @pytest.mark.slow
 def test_a_formula_spelt_another_way_is_the_same_cached_model(model_file, reductions, capsys):
     first = lyap(capsys, str(model_file), *FORMULA)

@@ -19,7 +19,7 @@ import sympy as sp
 import conftest
 import gearsym
 from gearsym import Integration, lyapunov_spectrum, periodic_orbit, run_sweep
-from gearsym.analysis import batch_means_stderr
+from gearsym.analysis.statistics import batch_means_stderr
 from gearsym.analysis.divergence import GROWING, PAST_BOUND
 from gearsym.analysis.pairs import finite_time_bias
 from gearsym.cli import main

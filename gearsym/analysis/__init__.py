@@ -1,16 +1,12 @@
-"""Analyses on one parameter point: a high-level call on a model, or a low-level
-call on a prebuilt :class:`~gearsym.codegen.CompiledModel` reused across a sweep."""
-from .attractors import Attractor, AttractorSet, find_attractors
-from .basins import BasinAttractor, BasinMap, basin_map
-from .jumps import Jump, find_jumps, hysteresis_intervals
-from .lyapunov import LyapunovSpectrum, lyapunov_spectrum
-from .poincare import Orbit, Trajectory, phase_trajectory, poincare_samples
-from .order_run import simulated_order_spectrum
-from .orders import OrderSpectrum, order_spectrum
-from .regime import REGIMES, classify_regime
-from .statistics import batch_means_stderr
+"""Analyses on one parameter point: a high-level call on a model, or a low-level call on a prebuilt
+:class:`~gearsym.codegen.CompiledModel` reused across a sweep. Each is imported from its module (the face,
+:mod:`gearsym`, names the public ones), so that a command imports the analyses it runs and no others:
+``gearsym lyap`` on a cached model starts without the attractors', basins' and orders' modules.
 
-__all__ = ["Attractor", "AttractorSet", "BasinAttractor", "BasinMap", "Jump", "LyapunovSpectrum", "Orbit",
-           "OrderSpectrum", "REGIMES", "Trajectory", "basin_map", "batch_means_stderr", "classify_regime",
-           "find_attractors", "find_jumps", "hysteresis_intervals", "lyapunov_spectrum", "order_spectrum",
-           "phase_trajectory", "poincare_samples", "simulated_order_spectrum"]
+:mod:`.lyapunov` (:func:`~.lyapunov.lyapunov_spectrum`, with :mod:`.divergence`, :mod:`.pairs`,
+:mod:`.resolution`, :mod:`.regime`, :mod:`.settling` and :mod:`.statistics`); :mod:`.poincare` (stroboscopic
+samples and trajectories); :mod:`.attractors` (coexisting attractors from many starts, their spectra at once in
+the lanes: :mod:`.lane_spectra`) and :mod:`.basins` (basins of attraction); :mod:`.jumps` (jumps and hysteresis
+along a continuation); :mod:`.orders` and :mod:`.order_run` (order spectra); :mod:`.modes` (natural frequencies
+and mode shapes).
+"""

@@ -37,7 +37,8 @@ from ..codegen import CompiledModel, engine_verb
 from ..options import Integration
 from ..errors import GearsymError, suggest
 from ..memory import check_fits
-from .lyapunov import LyapunovSpectrum, lyapunov_spectra
+from .lane_spectra import lyapunov_spectra
+from .lyapunov import LyapunovSpectrum
 from .regime import classify_regime
 
 #: the box initial states are drawn from, for every state the caller does not name
@@ -221,7 +222,7 @@ def find_attractors(
     """Run from many initial states and group the runs into distinct attractors.
 
     ``model`` is a :class:`CompiledModel` (``values`` are parameter values) or a system, as for
-    :func:`~gearsym.analysis.lyapunov_spectrum`. The ``ics`` initial states are
+    :func:`~gearsym.analysis.lyapunov.lyapunov_spectrum`. The ``ics`` initial states are
     drawn uniformly from ``box`` (state name -> (low, high); every state not named
     spans ``DEFAULT_BOX`` = [-5, 5]) with ``numpy.random.default_rng(seed)``, so a
     seed gives the same states every time; or ``initial_states`` (a sequence of

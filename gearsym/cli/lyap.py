@@ -6,7 +6,8 @@ import json
 import sys
 from pathlib import Path
 
-from ..analysis import lyapunov_spectrum, phase_trajectory
+from ..analysis.lyapunov import lyapunov_spectrum
+from ..analysis.poincare import phase_trajectory
 from ..analysis.divergence import stiffness_notes
 from ..analysis.regime import describe_regime, zero_band
 from ..checks import chosen_coordinate

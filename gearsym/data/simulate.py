@@ -4,7 +4,7 @@ Each record is one run at its operating conditions: ``discard`` forcing periods 
 from ``y0`` (the model's start by default), then the other ``periods - discard`` periods
 sampled ``samples_per_period`` times per period (the end point included, so a record has
 ``(periods - discard) * samples_per_period + 1`` rows). The samples are RK4 steps of the engine itself
-(:func:`~gearsym.analysis.phase_trajectory`), so the engine's steps per period is a multiple
+(:func:`~gearsym.analysis.poincare.phase_trajectory`), so the engine's steps per period is a multiple
 of ``samples_per_period``: by default the smallest multiple of at least 200.
 
 ``tau`` starts at 0 in every record. The transient is a whole number of forcing periods, so
@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis import phase_trajectory
+from ..analysis.poincare import phase_trajectory
 from ..caller import name as caller_name, option
 from ..checks import MAX_STEPS_PER_PERIOD, whole_number
 from ..codegen import CompiledModel, engine_verb

@@ -24,6 +24,7 @@ from ..analysis.poincare import Trajectory, phase_trajectory
 from ..errors import GearsymError
 from ..physical.text import parameter_text
 from .layout import fit_texts
+from .phase_plane import phase_axes
 from .save import pyplot, save_figure
 
 #: overlaid layers: gray first, then black, as the paper's Fig. 4; then colours
@@ -133,16 +134,6 @@ def _panels(sets) -> list[list[AttractorSet]]:
         raise GearsymError("plot_attractors needs AttractorSets: one, a list of them (one panel each), "
                            "or a list of lists (sets overlaid in one panel)")
     return panels
-
-
-def phase_axes(names: Sequence[str], x: str | None = None, y: str | None = None) -> tuple[str, str]:
-    """The phase plane: ``x`` (default the first state) against ``y`` (default the state after ``x``,
-    its velocity in the gear models: x1 -> v1, x2 -> v2)."""
-    names = list(names)
-    x = x or names[0]
-    if y is None and x in names:
-        y = names[(names.index(x) + 1) % len(names)]
-    return x, y or names[min(1, len(names) - 1)]
 
 
 def attractor_kind(a: Attractor) -> str:

@@ -15,7 +15,7 @@ import numpy as np
 from ..analysis.lyapunov import LyapunovSpectrum
 from ..analysis.poincare import Trajectory
 from .layout import fit_texts, line_style, outside_below
-from .poincare import phase_axes
+from .phase_plane import phase_axes
 from .save import pyplot, save_figure
 
 

@@ -1,7 +1,7 @@
 """One operating point of a spectrum run in physical units, from numbers alone (no pint, no SymPy).
 
 :func:`gearsym.physical.results.point_units` reads once, with pint, what carrying a
-:class:`~gearsym.analysis.LyapunovSpectrum` back to physical units takes (the time unit, the length unit,
+:class:`~gearsym.analysis.lyapunov.LyapunovSpectrum` back to physical units takes (the time unit, the length unit,
 the unit conversions, each mesh's stiffness, damping, backlash and its variation k(tau) as a CasADi
 function, each shaft's stiffness and damping); :class:`PointUnits` keeps those numbers and does the carrying.
 The mesh forces and shaft torques of a point come from a trajectory at that point (:func:`loads_trajectory`:
@@ -20,6 +20,7 @@ import numpy as np
 
 from ..analysis.lyapunov import LyapunovSpectrum
 from ..analysis.poincare import phase_trajectory
+from ..codegen.on_arrays import evaluate_on_samples
 from ..errors import GearsymError
 from ..scales.speeds import Speed
 from ..units import shown
@@ -162,13 +163,15 @@ class MeshUnits:
     eta: float  # m
     variation: str  # k(tau), a serialized CasADi function
 
-    def force(self, tau, x, v) -> np.ndarray:
-        """The force in N along a trajectory (x in m, v in m/s)."""
+    def variation_at(self, tau) -> np.ndarray:
+        """k(tau) at every sample of ``tau`` (all at once: :mod:`gearsym.codegen.on_arrays`)."""
         import casadi as ca
 
-        taus = np.atleast_1d(np.asarray(tau, dtype=float))
-        k_of_tau = ca.Function.deserialize(self.variation).map(taus.size)
-        k = np.asarray(k_of_tau(taus.reshape(1, -1)), dtype=float).reshape(taus.shape)
+        return evaluate_on_samples(ca.Function.deserialize(self.variation), np.atleast_1d(np.asarray(tau, dtype=float)))
+
+    def force(self, tau, x, v, k=None) -> np.ndarray:
+        """The force in N along a trajectory (x in m, v in m/s; ``k``: :meth:`variation_at` ``tau``, if known)."""
+        k = self.variation_at(tau) if k is None else k
         return self.stiffness * k * contact(x, self.eta) + self.damping * v
 
 
@@ -278,7 +281,7 @@ class PointUnits:
         return _significant(np.asarray(omega, dtype=float) * self.omega_n / self.forcing_ratio * self.rad_s_to_speed)
 
     def point(self, result, trajectory=None) -> PhysicalPoint:
-        """A :class:`~gearsym.analysis.LyapunovSpectrum` in physical units (with the mesh forces and shaft
+        """A :class:`~gearsym.analysis.lyapunov.LyapunovSpectrum` in physical units (with the mesh forces and shaft
         torques of ``trajectory``, a :class:`~gearsym.analysis.poincare.Trajectory` at the same point, if given)."""
         w = float(result.parameters["omega"])
         per_second = w * self.omega_n
@@ -357,7 +360,10 @@ class PointUnits:
         def si(name):
             return self.state(name, trajectory[name], omega, si=True)
 
-        forces = {m.name: m.force(tau, si(m.coordinate), si(m.velocity)) for m in self.meshes}
+        k = {}  # k(tau) once per variation (a planetary set's sun and ring meshes of one planet share theirs)
+        for m in self.meshes:
+            k[m.variation] = k[m.variation] if m.variation in k else m.variation_at(tau)
+        forces = {m.name: m.force(tau, si(m.coordinate), si(m.velocity), k[m.variation]) for m in self.meshes}
         torques = {s.name: s.torque(si(s.coordinate), si(s.velocity)) for s in self.shafts}
         return forces, torques
 

@@ -64,7 +64,7 @@ def state_to_physical(scaling: Scaling, name: str, values, omega, length_unit: s
 
 def point_to_physical(scaling: Scaling, result, length_unit: str = LENGTH_UNIT, trajectory=None,
                       model=None) -> PhysicalPoint:
-    """A :class:`~gearsym.analysis.LyapunovSpectrum` in physical units, with the mesh forces and shaft torques
+    """A :class:`~gearsym.analysis.lyapunov.LyapunovSpectrum` in physical units, with the mesh forces and shaft torques
     of a trajectory at the same point: ``trajectory`` if given, else one run from the spectrum's final state on
     ``model`` (the compiled model the spectrum ran on; by default the scaling's :meth:`compiled_for` it)."""
     if trajectory is None:

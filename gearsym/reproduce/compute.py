@@ -12,7 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..analysis import LyapunovSpectrum, Trajectory, lyapunov_spectrum, phase_trajectory
+from ..analysis.lyapunov import LyapunovSpectrum, lyapunov_spectrum
+from ..analysis.poincare import Trajectory, phase_trajectory
 from ..analysis.attractors import DEFAULT_BOX, AttractorSet, find_attractors
 from ..analysis.basins import BasinMap, basin_map, method
 from ..codegen.build import compile_model

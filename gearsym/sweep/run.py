@@ -1,7 +1,7 @@
 """Running a sweep: the Lyapunov spectrum and amplitudes at every point of a grid.
 
 The model is compiled once; every point only changes the parameter vector (:mod:`.point_runs`: the
-low-level loops of :func:`~gearsym.analysis.lyapunov_spectrum`, summarised in batches). Tasks (single points,
+low-level loops of :func:`~gearsym.analysis.lyapunov.lyapunov_spectrum`, summarised in batches). Tasks (single points,
 or whole continuation lines) run where :class:`~.workers.Workers` says: this process and processes forked
 from it (:mod:`.processes`), threads (:mod:`.threads`), or a Dask cluster (:mod:`.distributed`). Workers hand
 finished points to the main process, which alone writes the files (:mod:`.store`) and moves the progress bar.
