@@ -85,6 +85,12 @@ def test_a_figure_matplotlib_cannot_write_is_refused_before_computing(capsys, no
     assert "--plot" in err and ".png" in err and ".pdf" in err and ".svg" in err
 
 
+@pytest.mark.parametrize("command", [["lyap", "one_stage"], ["simulate", "one_stage", "--out", "m.csv"]])
+def test_a_bad_start_is_refused_before_the_model_is_compiled(capsys, no_work, tmp_path, monkeypatch, command):
+    monkeypatch.chdir(tmp_path)
+    assert "--y0 'x=fast'" in error_line(capsys, *command, "--y0", "x=fast")
+
+
 def unwritable_places(tmp_path: Path) -> list[Path]:
     blocker = tmp_path / "a-file"
     blocker.write_text("")
