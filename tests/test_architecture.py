@@ -133,6 +133,7 @@ def unit(module: str) -> str:
     return parts[1] if len(parts) > 1 else "__init__"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("root", [ROOT, BENCH], ids=["gearsym", "bench"])
 def test_no_file_and_no_folder_imports_itself_round_a_circle(root):
     files, folders = collections.defaultdict(set), collections.defaultdict(set)

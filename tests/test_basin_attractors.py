@@ -66,6 +66,7 @@ def period_16(clocked):
     return xs, ys, basin_map(clocked, {"x": xs, "y": ys}, options=RUN, K=16.0)
 
 
+@pytest.mark.slow
 def test_an_orbit_of_period_16_is_found_with_its_16_points(period_16):
     """16 is the longest period told from the Poincare points: each attractor is period 16, its points those of
     the closed form."""

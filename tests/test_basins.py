@@ -62,6 +62,7 @@ def clusters(points: np.ndarray, tolerance: float = 1e-4) -> tuple[np.ndarray, n
     return np.array(centres), index.reshape(points.shape[:-1])
 
 
+@pytest.mark.slow
 def test_duffing_basins_in_its_hysteresis_window_agree_with_scipy(duffing):
     xs, vs = np.linspace(-4, 4, 11), np.linspace(-4, 4, 11)
     found = basin_map(duffing, {"x": xs, "v": vs}, options=RUN, omega=WINDOW_OMEGA)

@@ -51,6 +51,7 @@ def test_the_translational_planetary_set_has_the_frequencies_of_lin_and_parkers_
     assert np.max(np.abs(got[1:] - expected[1:]) / expected[1:]) < 1e-9
 
 
+@pytest.mark.slow
 def test_its_modes_fall_into_lin_and_parkers_three_classes_with_their_multiplicities(planetary):
     planets, modes, _ = planetary
     elastic = [m for m in modes.modes if m.kind != "rigid"]
@@ -141,6 +142,7 @@ def kahraman_singh(p: dict, forcing: float):
     return rhs
 
 
+@pytest.mark.slow
 def test_the_pair_on_bearings_follows_its_typed_equations_at_a_periodic_point_with_tooth_separations(pair):
     from scipy.integrate import solve_ivp
 
@@ -289,6 +291,7 @@ def test_gearsym_lyap_answers_bearing_deflections_in_um_and_bearing_forces_in_ne
 K_B1 = "k_b1=1e+08 N/m"
 
 
+@pytest.mark.slow
 def test_gearsym_lyap_says_the_values_it_ran_at_in_the_users_units_not_the_engines_numbers(capsys):
     """The engine's numbers carry the physical values' names (k_b1 = 0.996842 is k_b1 / kZ): printed as
     'parameters:' they would read as those values in other units."""

@@ -127,6 +127,7 @@ def test_a_new_cache_is_private_at_every_level_gearsym_makes_even_under_umask_00
 
 
 # ------------------------------------------------------------------ planted code never runs
+@pytest.mark.slow
 def test_a_library_planted_in_a_cache_others_can_write_never_runs(cache, clean, planted):
     data, marker = planted
     plant(library(cache), data)  # (with a record of its bytes, and the summaries pointing at it)
@@ -191,6 +192,7 @@ def test_a_folder_above_the_cache_that_others_can_write_is_not_trusted_unless_st
         assert compiler.cache_dir() != cache
 
 
+@pytest.mark.slow
 def test_a_symlink_in_place_of_a_library_is_never_followed(cache, clean, planted, tmp_path):
     data, marker = planted
     lib = library(cache)
@@ -250,6 +252,7 @@ def test_a_damaged_library_is_found_compiled_again_and_gives_the_same_results(ca
     assert again.returncode == 0 and "warning" not in again.stderr and again.stdout == clean["one_stage"]
 
 
+@pytest.mark.slow
 def test_a_changed_constant_in_the_cached_c_is_found_and_the_c_generated_again(cache, clean):
     (source,) = (cache / "code").glob("duffing-*/duffing.c")
     text = source.read_text()

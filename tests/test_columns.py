@@ -60,6 +60,7 @@ def test_the_tangent_matrix_by_column_gives_the_unrolled_exponents_and_monodromy
             assert b == pytest.approx(a, rel=1e-12, abs=1e-12 * max(1.0, np.max(np.abs(a)))), (loop, name)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(find_compiler() is None, reason="needs a C compiler")
 def test_the_printed_loops_over_the_columns_give_the_bits_of_casadis_loops(monkeypatch, tmp_path):
     options = LoopOptions(steps_per_period=45, chunk_periods=3, locate_crossings=True)

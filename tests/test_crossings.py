@@ -142,6 +142,7 @@ def at_200_steps():
             for locate in (False, True)}
 
 
+@pytest.mark.slow
 def test_agrees_with_dop853_where_plain_rk4_does_not(at_200_steps):
     reference = dop853_exponents(1.5, 60, 20)
     located = np.abs(at_200_steps[True] - reference).max()
@@ -154,6 +155,7 @@ def test_sum_rule_holds_with_crossings_located(at_200_steps):
     assert abs(at_200_steps[True].sum() + 2 * ZETA / 1.5) < 1e-9  # trace of J = -2 zeta / omega
 
 
+@pytest.mark.slow
 def test_the_default_integration_locates_the_crossings(at_200_steps):
     """gearsym.lyapunov_spectrum with no scheme asked for: DOP853's exponents, not the paper's plain RK4's."""
     default = gearsym.lyapunov_spectrum(system("one_stage"), options=Integration(periods=60, discard=20),

@@ -76,6 +76,7 @@ def test_page_does_not_depend_on_the_hash_seed():
 
 
 # ------------------------------------------------------------------ page content
+@pytest.mark.slow
 @pytest.mark.parametrize("model", conftest.model_params(MODELS))
 def test_page_header_and_no_run_dependent_text(model):
     text = page(model)

@@ -59,6 +59,7 @@ def _same_files(a, b):
     ("flexible_shaft", ["omega=1.2:1.6:0.1", "kS=0.1,0.5"], "independent", "up"),
     ("one_stage", ["omega=0.9:1.3:0.1", "B1=3.5,4"], "continuation", "both"),  # 2 lines, up and back down
 ])
+@pytest.mark.slow
 def test_a_cluster_sweep_equals_the_single_process_sweep_bit_for_bit(tmp_path, cluster, worker_cache, monkeypatch,
                                                                      model, axes, mode, direction):
     monkeypatch.setattr(dsweep, "POINTS_PER_TASK", 3)  # several chunks, and lines handed from task to task
@@ -137,6 +138,7 @@ def test_a_worker_like_the_client_writes_the_shipped_bytes_and_needs_no_compiler
     assert np.array_equal(a.exponents, b.exponents) and a.final_state == b.final_state
 
 
+@pytest.mark.slow
 def test_a_worker_on_another_kind_of_machine_compiles_the_shipped_source(tmp_path, monkeypatch, one_stage):
     elsewhere = replace(ship(one_stage), binary_key="0ther0machine", library=b"not for this machine")
     monkeypatch.setenv("GEARSYM_CACHE", str(tmp_path))

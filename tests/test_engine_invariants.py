@@ -84,6 +84,7 @@ def test_lorenz_published_exponents():
 
 
 # ------------------------------------------------------------------ an independent implementation (in conftest)
+@pytest.mark.slow
 @pytest.mark.parametrize("omega", [0.5, 1.6])
 def test_one_stage_agrees_with_independent_numpy_rk4(omega):
     periods, discard, steps = 60, 20, 200

@@ -196,6 +196,7 @@ def test_only_channels_of_accelerations_get_an_offset_by_default(tmp_path):
     assert acceleration_channels(data, flexible) == ("x1_ddot", "acc")
 
 
+@pytest.mark.slow
 def test_an_additive_third_stiffness_harmonic_is_named_with_its_order_amplitude_and_phase(one_stage, rig_runs, tmp_path):
     ex = explain(one_stage, rig_data(rig_runs, tmp_path, "stiffness_3"), ["zeta", "B1"])
     assert ex.effects == ["mesh_stiffness_harmonic_3"]
@@ -313,6 +314,7 @@ def test_the_as_declared_residual_figure_is_drawn_when_no_effect_is_added(clean_
     assert fig.axes[0].get_title() and len(fig.axes[3].patches) == len(ex.spectrum.orders)
 
 
+@pytest.mark.slow
 def test_a_partly_explained_report_leads_with_its_verdict_and_never_says_zero_plus_minus_zero(clean_explained):
     """A cubic stiffness made final, its k3 undetermined (a fit leaves its estimate at 0 with no error) and the
     residual still structured."""
@@ -391,6 +393,7 @@ def test_bad_requests_say_what_is_wrong(one_stage, tmp_path, capsys):
     assert not (tmp_path / "pwned").exists() and not (tmp_path / "out" / "report.md").exists()
 
 
+@pytest.mark.slow
 def test_explain_command_writes_the_report(one_stage, tmp_path, capsys):
     data = tmp_path / "cubic.csv"
     simulate_measurements(augment(one_stage, ["cubic_stiffness"], values={"k3": 0.02}), options=RECORD,

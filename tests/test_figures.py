@@ -79,6 +79,7 @@ def test_every_paper_figure_states_its_parameter_set(computed, name):
     assert "the paper's values: " in top and "B1=4" in top
 
 
+@pytest.mark.slow
 def test_figure_4_marks_each_attractor_by_its_regime_in_both_panels(computed):
     fig = paper_figures.figure4(computed)
     for ax, omega in zip(fig.axes, (1.5, 1.6)):

@@ -75,6 +75,7 @@ def fmu(tmp_path_factory):
     return path
 
 
+@pytest.mark.slow
 def test_each_meshs_force_comes_from_its_own_stiffness_and_the_twist_is_in_radians(fmu):
     md = read_model_description(str(fmu))
     units = {v.name: v.unit for v in md.modelVariables}
@@ -116,6 +117,7 @@ def gearbox_run(path, per_mesh_period: int):
                         output=["stage1.force", "stage2.force"])
 
 
+@pytest.mark.slow
 def test_the_gearboxs_meshes_carry_their_static_forces_on_average_whatever_the_importers_step(gearbox):
     si = {k: v.si for k, v in gearsym.model_module("two_stage_gearbox").model.physical.items()}
     # torque balance, typed here: the first pinion carries the motor's torque, the second pinion the

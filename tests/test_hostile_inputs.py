@@ -140,6 +140,7 @@ STIFFNESS = ["stiffness", "--teeth", "28,28", "--module", "3.175 mm", "--face-wi
              "20 deg", "--bore", "20 mm"]  # (a bore in Sainsot's range: no warning)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("argv", [["list"], [*STIFFNESS, "--format", "json"]])
 def test_a_full_or_closed_stdout_is_one_line_not_a_traceback(argv):
     command = " ".join(f"'{a}'" for a in [sys.executable, "-m", "gearsym.cli", *argv])

@@ -89,6 +89,7 @@ def test_every_lane_gives_the_bits_of_the_scalar_loop_from_its_start(name, locat
         assert ((x.min(axis=1) < 0) & (x.max(axis=1) > 0)).any()
 
 
+@pytest.mark.slow
 @needs_cc
 def test_constants_may_differ_from_lane_to_lane(tmp_path):
     """Points of a sweep that share their tables (omega in tau) run in one call, each lane with its constants."""
@@ -165,6 +166,7 @@ def test_every_per_step_piece_is_the_models_own_called_in_a_loop_over_the_lanes(
 @needs_cc
 @pytest.mark.parametrize("name, axes", [("one_stage", ["omega=1.5,1.6,1.7,1.8,1.9"]),
                                         ("flexible_shaft", ["omega=1.5,1.8", "kS=0.5,1.0,2.0"])])
+@pytest.mark.slow
 def test_an_independent_sweep_in_the_lanes_gives_the_scalar_sweeps_rows(name, axes):
     """Points that only move constants share a lanes call, each lane with its constants: the rows are those of
     the scalar sweep (periodic points, where a rounding difference would not grow: the lanes may fuse other

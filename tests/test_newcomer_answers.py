@@ -159,6 +159,7 @@ def repository_state() -> str:
                           cwd=REPO_ROOT, capture_output=True, text=True, check=True).stdout
 
 
+@pytest.mark.slow
 def test_a_user_model_writes_docs_and_c_beside_the_user_not_into_the_installed_tree(tmp_path):
     models, work = tmp_path / "mymodels", tmp_path / "work"
     models.mkdir()

@@ -28,6 +28,7 @@ def raw():
     return json.loads(RECORD.read_text())
 
 
+@pytest.mark.slow
 def test_page_and_figure_regenerate_from_the_record(raw, tmp_path):
     page, fig = report.write_report(RECORD, tmp_path / "performance.md", tmp_path / "performance.png")[:2]
     assert page.read_text() == report.PAGE.read_text(), "docs/performance.md differs: run python -m bench.speed.report"

@@ -217,6 +217,7 @@ def test_equally_spaced_planets_give_rotational_modes_and_planet_modes_of_multip
         assert np.ptp([mode.angles[f"planet{n + 1}"] for n in range(planets)]) < 1e-9
 
 
+@pytest.mark.slow
 def test_a_repeated_frequencys_modes_are_the_same_whatever_basis_lapack_returns(monkeypatch):
     """Any basis of the planet modes' plane is right, and another BLAS kernel (another CPU) returns another:
     docs/planetary.md's listing changed on an AMD EPYC. The modes shown are the plane's reduced row echelon
@@ -246,6 +247,7 @@ def test_a_repeated_frequencys_modes_are_the_same_whatever_basis_lapack_returns(
     ("differential with 4 planets", 4, 2, ("sun", "ring", "carrier")),
     ("planetary_two_stage", 3, 1, ("sun", "carrier", "pinion", "wheel")),
 ])
+@pytest.mark.slow
 def test_a_free_ring_or_a_driven_parallel_stage_keeps_the_planet_modes_with_every_other_body_at_rest(
         model, planets, rigid, central):
     modes = natural_modes(planets_of(planets, ring_fixed=False) if model.startswith("differential") else reduced(model))

@@ -50,6 +50,7 @@ def previous(explanations, tmp_path_factory):
 
 @pytest.mark.parametrize("failure", [GearsymError("a figure failed"), KeyboardInterrupt(),  # (SIGTERM: as Ctrl-C)
                                      OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))])
+@pytest.mark.slow
 def test_a_report_that_fails_while_it_is_written_leaves_the_previous_one_as_it_was(explanations, previous, tmp_path,
                                                                                    monkeypatch, failure):
     system, _, unexplained = explanations
@@ -69,6 +70,7 @@ def test_a_report_that_fails_while_it_is_written_leaves_the_previous_one_as_it_w
                                      "there before is unchanged")
 
 
+@pytest.mark.slow
 def test_a_run_killed_while_the_files_are_renamed_leaves_a_marker_that_says_the_report_is_partial(
         explanations, previous, tmp_path, monkeypatch):
     system, _, unexplained = explanations

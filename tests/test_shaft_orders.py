@@ -133,6 +133,7 @@ def test_a_pairs_share_of_the_mesh_stiffness_over_the_teeth_adds_up_to_one():
     assert tooth(2 * math.pi * 3.0) == pytest.approx(0, abs=1e-9) == tooth(2 * math.pi * 9.0)
 
 
+@pytest.mark.slow
 def test_a_spall_and_spacing_errors_are_declared_like_a_tooth_fault():
     m = pair("spalled", lambda g1, g2: Spall("pit", g1, tooth=2, width="w", start=0.25, end=1.0),
              lambda g1, g2: SpacingErrors("pitch", g2, errors=tuple(f"s{n}" for n in range(1, 14))),
@@ -175,6 +176,7 @@ def test_tooth_counts_go_to_the_pinion_and_the_wheel_of_a_model_that_declares_no
         gearsym.reduce(pair("wrong", lambda g1, g2: ToothFault("crack", g2, tooth=14)))
 
 
+@pytest.mark.slow
 def test_the_revolution_period_spectrum_is_the_mesh_period_spectrum_without_a_shaft_order_term():
     """A tooth fault of depth 0 makes the period a revolution of the pinion (9 mesh periods) and changes no
     equation's value: the same RK4 steps (steps per mesh period kept), Gram-Schmidt every 9 mesh periods instead of
@@ -279,6 +281,7 @@ def test_the_spectrum_command_writes_the_lines_and_the_figure(tmp_path, capsys):
     assert "tooth counts" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_a_sweep_and_a_continuation_of_an_eccentric_pinion_run_on_its_revolution():
     """The period the model implies, not the user's: a sweep's Poincaré samples of an eccentric pinion (9 teeth) are
     one revolution apart (SciPy's DOP853 of the equations typed in tests/fault_rig.py carries each sample to the

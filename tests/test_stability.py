@@ -122,6 +122,7 @@ def shaft_J(omega, ka, zeta=0.01, kS=0.5, I1=1.0, I2=1.0, I3=1.0, r1=1.0, r2=1.0
     return J
 
 
+@pytest.mark.slow
 def test_the_flexible_shaft_chart_matches_an_independent_floquet_computation_with_a_combination_tongue(shaft):
     # modes of the mean stiffness: omega_i^2 = 0.5 and 1.5; tongues at 2 omega_1 = 1.41, omega_1 + omega_2 = 1.93
     # (the combination: a complex pair leaves the circle), 2 omega_2 = 2.45
@@ -151,6 +152,7 @@ def test_every_lane_has_its_own_tables_the_chart_equals_the_scalar_loops(mathieu
     assert (lanes.kind == scalar.kind).all()
 
 
+@pytest.mark.slow
 def test_about_the_orbit_a_linear_models_multipliers_are_its_static_states(mathieu):
     """Without backlash the model is linear: the variational equation about its forced orbit is the one about
     its static state, so the two charts' multipliers agree; Newton finds every orbit off the tongues' edges."""

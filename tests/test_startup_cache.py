@@ -152,6 +152,7 @@ def test_a_command_on_a_cached_model_imports_neither_sympy_nor_pint(model_copy, 
     assert json.loads(run.stdout) == json.loads(first.stdout) == lyap(capsys, *argv[:-len(ARGS)])
 
 
+@pytest.mark.slow
 def test_a_formula_spelt_another_way_is_the_same_cached_model(model_file, reductions, capsys):
     first = lyap(capsys, str(model_file), *FORMULA)
     assert len(reductions) == 1
@@ -161,6 +162,7 @@ def test_a_formula_spelt_another_way_is_the_same_cached_model(model_file, reduct
     assert len(reductions) == 2 and other["exponents"] != first["exponents"]
 
 
+@pytest.mark.slow
 def test_a_sweep_of_a_cached_physical_model_is_carried_to_physical_units(model_copy, tmp_path, capsys):
     spur = str(model_copy("spur_pair"))
     lyap(capsys, spur, "--set", "speed=3000 rpm")

@@ -131,6 +131,7 @@ def _unreduced_deflections(model: Drivetrain, values: dict[str, float]) -> dict[
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", DRIVETRAINS)
 def test_the_static_solution_of_the_reduced_equations_is_that_of_lagranges(name):
     model = load(name)

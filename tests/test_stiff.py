@@ -73,6 +73,7 @@ def test_exponents_lost_in_round_off_are_not_reported_as_values():
     assert "round-off" in lost.resolution.note(3)
 
 
+@pytest.mark.slow
 def test_the_stiff_step_is_chosen_where_rk4_would_need_many_more_steps_and_resolves_the_slow_modes():
     model, result = run(100.0)
     assert model.integration.integrator == "stiff" and model.integration.steps_per_period == 200
@@ -138,6 +139,7 @@ def stiff_shaft():
     return compile_model(system("flexible_shaft"), Integration(periods=160, discard=60, integrator="stiff"))
 
 
+@pytest.mark.slow
 def test_the_stiff_step_gives_the_explicit_steps_exponents_and_their_sum_is_the_mean_trace():
     values = {"omega": 1.8, "kS": 0.1}
     stiff = lyapunov_spectrum(stiff_shaft(), **values)
