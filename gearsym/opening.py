@@ -64,7 +64,7 @@ class OpenModel:
         self.slot = cache_slot(request.model, request.settings)
 
     @cached_property
-    def settings(self) -> dict:
+    def checked_settings(self) -> dict:
         """The request's settings, each formula's numbers checked (SymPy): what loading the model takes."""
         return checked_formulas(self.request.settings, self.request.given_as)
 
@@ -82,16 +82,16 @@ class OpenModel:
     @cached_property
     def full_scaling(self):
         """The model's :class:`~gearsym.scales.map.Scaling` (the model loaded and reduced), or None."""
-        if not gearsym.is_physical(self.request.model, **self.settings):
+        if not gearsym.is_physical(self.request.model, **self.checked_settings):
             return None
-        physical = dict(self.settings)
+        physical = dict(self.checked_settings)
         length_scale = physical.pop("length_scale", None)
         return gearsym.scaling(self.request.model, length_scale, **physical)  # (a stiffness formula too)
 
     @cached_property
     def system(self):
         """The model's first-order system (loaded and reduced: seconds)."""
-        return gearsym.load(self.request.model, **self.settings)
+        return gearsym.load(self.request.model, **self.checked_settings)
 
     def compiled(self, options: Integration | None = None, *, over: Mapping | None = None,
                  before: Callable[[object], object] | None = None):
@@ -130,7 +130,7 @@ class OpenModel:
 
     def _linearised(self, before: Callable[[object], object] | None):
         system = self.system
-        physical = gearsym.is_physical(self.request.model, **self.settings)
+        physical = gearsym.is_physical(self.request.model, **self.checked_settings)
         if before is not None:
             before(system)
         lin = stability.compile_linearisation(system, self.request.options, verbose=self.request.verbose)

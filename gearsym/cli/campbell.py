@@ -59,7 +59,7 @@ def run(args: argparse.Namespace) -> int:
                            f"({scaling.speed.parameter}=...), not {axis.name}")
     refuse_swept_and_set([(axis.name, args.param)], args.set)
     engine_axis = nondimensional_axis(scaling.full, axis)  # (a speed without its unit is refused here)
-    modes = natural_modes(scaling.full.model, **model.settings)
+    modes = natural_modes(scaling.full.model, **model.checked_settings)
     diagram = campbell(scaling.full, axis.values, axis.unit, modes, args.orders)
     write_atomically(sidecar(args.out, ".campbell.json"), json.dumps(diagram.as_dict(), indent=2) + "\n")
     print(f"{diagram.model}: natural frequencies " + ", ".join(f"{f:.6g} Hz" for f in diagram.natural_frequencies))
