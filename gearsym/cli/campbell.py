@@ -48,7 +48,8 @@ def run(args: argparse.Namespace) -> int:
     check_figure(args.plot)
     if args.orders < 1:
         raise GearsymError(f"--orders must be at least 1, got {args.orders}")
-    model = open_model(model_request(args, integration_from(args)))
+    request = model_request(args, integration_from(args))
+    model = open_model(request)
     scaling = model.scaling
     if scaling is None or not scaling.speed:
         raise GearsymError(f"{args.model}: a Campbell diagram needs physical values and a declared speed "

@@ -59,12 +59,12 @@ def run(args: argparse.Namespace) -> int:
     candidates = [e.strip() for e in args.effects.split(",")] if args.effects else None
     bias = None if args.bias is None else [c.strip() for c in args.bias.split(",") if c.strip() not in ("", "none")]
     channels = dict(_channel(text) for text in args.channel)
-    options = integration_from(args)
+    request = model_request(args, integration_from(args))
     check_folder(args.out)  # before the model is reduced (seconds)
-    model = open_model(model_request(args, options))
+    model = open_model(request)
     report = explain_files(args.data, model.system, fit, out=args.out, time_scale=_time_scale(args, model),
                            held_out=args.held_out, candidates=candidates, execution=Execution(progress=not args.quiet),
-                           options=options,
+                           options=request.options,
                            channels=channels, bias=bias, terms=args.add_term, harmonics=args.harmonics)
     added = ", ".join(report["effects"]) or "none"
     print(f"{report['verdict']}: effects added: {added}; held-out error {report['error_before']:.4g} -> "

@@ -129,7 +129,8 @@ def run(args: argparse.Namespace) -> int:
         sweep = read_sweep(args.sweep)
 
     options = integration_from(args).run(periods=args.transient, discard=0)
-    model = open_model(model_request(args, options))
+    request = model_request(args, options)
+    model = open_model(request)
     scaling = model.scaling
     physical = scaling  # (None without physical values; else the answers are also in its units)
     if parameter:

@@ -61,7 +61,8 @@ def run(args: argparse.Namespace) -> int:
     box = parse_box(args.box)
     options = integration_from(args)
     check_ics(args.ics, 1, options.periods)  # at least one state each: before the model is compiled
-    compiled = open_model(model_request(args, options)).compiled()
+    request = model_request(args, options)
+    compiled = open_model(request).compiled()
     coordinate = chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     found = find_attractors(compiled, ics=args.ics, seed=args.seed, box=box)
     if args.plot:

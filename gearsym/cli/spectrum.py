@@ -73,7 +73,8 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         check_figure(args.plot)
     settings = model_settings(args)
-    model = open_model(model_request(args, settings=settings))  # (the run's options: from the model's tooth counts)
+    request = model_request(args, settings=settings)  # (the run's options: from the model's tooth counts)
+    model = open_model(request)
     if args.data:
         spectra, what = _measured(args, model)
     else:

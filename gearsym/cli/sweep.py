@@ -81,8 +81,9 @@ def run(args: argparse.Namespace) -> int:
     y0 = parse_state(args.y0)  # before the model is compiled
     options = integration_from(args)  # (sizes too) before the model is loaded
     poincare_samples_of(args.poincare, options)
+    request = model_request(args, options)
     given = axes_from(args.param)
-    model = open_model(model_request(args, options))
+    model = open_model(request)
     scaling = model.scaling
     axes = _engine_axes(given, scaling)
     refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], args.set)
