@@ -45,7 +45,7 @@ from .codegen.native import load_native
 from .codegen.trust import check, differences
 from .options import Integration
 from .parameters import Constraint, ParameterChecks
-from .physical.point import CachedScaling, PointUnits
+from .physical.point import PointUnits
 from .files.sealed import distrust, read_sealed, write_sealed
 from .registry import model_file, models_dir
 from .stability.recipe import CompiledLinearisation
@@ -222,76 +222,76 @@ def write_json(path: Path, data: dict) -> None:
 _WHAT = "cached summary"
 
 
-def load_compiled(ref: str, values: Mapping[str, object], options: Integration, *,
-                  compile: Callable[[], object], scaling: Callable[[], object], verbose: bool = False):
-    """The compiled model of the model ``ref`` (a name or a file) with ``values``: from its summaries in the
-    cache when they and its library are there, else ``compile()`` (the model loaded, reduced and compiled) and
-    the summaries written; ``scaling()`` gives its scaling (None without physical values) for them. The two
-    callables are the caller's (the command line's face), so that this module never loads the generator."""
+@dataclass(frozen=True)
+class CacheSlot:
+    """Where the start-up cache keeps the model ``ref`` with given values (its file's name and the key that hashes
+    what its reduction depends on; ``name`` None for a model that is no file, which the cache does not keep), and
+    what the slot holds: the system's summary as read (``system``: None when there is none, or none to trust) and,
+    for a model with physical values, its :class:`~gearsym.physical.point.PointUnits`. Read once per run."""
+
+    name: str | None = None
+    key: str = ""
+    system: Mapping | None = None
+    units: PointUnits | None = None
+
+    @property
+    def physical(self) -> bool | None:
+        """Whether the model has physical values, as its summary says (None: no summary)."""
+        return None if self.system is None else bool(self.system["physical"])
+
+    def keeps(self, options: Integration) -> bool:
+        """Whether a model compiled with ``options`` is kept here (a model in a file, compiled to a library)."""
+        return self.name is not None and resolve_backend(options.backend) == "compiled"
+
+
+def cache_slot(ref, values: Mapping[str, object]) -> CacheSlot:
+    """The slot of the model ``ref`` (a name or a file) with ``values``, and the summary it holds, read once."""
     path = model_file(ref) if isinstance(ref, str) else None
-    if path is None or resolve_backend(options.backend) != "compiled":
-        return compile()
+    if path is None:
+        return CacheSlot()
     key = system_key(path, values)
-    system_file = summary_path(path.stem, key)
+    data = read_json(summary_path(path.stem, key))
+    try:
+        system = data["system"]
+        physical = data["physical"] if system["physical"] else None
+        return CacheSlot(path.stem, key, system, PointUnits.from_dict(physical) if physical else None)
+    except (KeyError, TypeError, ValueError, AttributeError):
+        return CacheSlot(path.stem, key)
+
+
+def cached_compiled(slot: CacheSlot, options: Integration, full: Callable[[], object]):
+    """The compiled model the slot's summaries and library give for ``options`` (``full``: the full system, loaded
+    only if a caller asks for its symbolic part), or None: no summary, no library for these loops, a backend other
+    than the compiled one, or summaries not to trust."""
+    if not slot.keeps(options):
+        return None
     if options.integrator == "auto":  # (chosen from the model's fastest mode, which its summary keeps)
         try:
-            known = read_json(system_file)["system"]
-            options = chosen(options, float(known["fastest"]), float(known["cycle"]))
+            options = chosen(options, float(slot.system["fastest"]), float(slot.system["cycle"]))
         except (KeyError, TypeError, ValueError):
-            options = None
-    if options is not None:
-        loops = LoopOptions.of(options)
-        build_file = summary_path(path.stem, f"{key}-{loops_key(loops)}")
-        compiled = _from_cache(system_file, build_file, options, loops, lambda: compile().system)
-        if compiled is not None:
-            return compiled
-    return _compiled_and_kept(path.stem, key, compile, scaling)
+            return None
+    build_file = summary_path(slot.name, f"{slot.key}-{loops_key(LoopOptions.of(options))}")
+    return _from_cache(slot.system, build_file, options, full)
 
 
-def _compiled_and_kept(name: str, key: str, compile: Callable[[], object], scaling: Callable[[], object]):
-    """``compile()``, and its summaries written (the build's under the loops it was compiled with)."""
-    compiled = compile()
-    system_file = summary_path(name, key)
-    build_file = summary_path(name, f"{key}-{loops_key(LoopOptions.of(compiled.integration))}")
-    physical = scaling()
-    units = None if physical is None else physical.point_units()
-    summary = SystemSummary.of(compiled.system, physical is not None, compiled.fastest)
-    write_json(system_file, {"system": summary.as_dict(),
-                             "physical": units and units.as_dict()})
+def keep_compiled(slot: CacheSlot, compiled, units: PointUnits | None) -> None:
+    """``compiled``'s summaries written into its slot (the build's under the loops it was compiled with), with
+    the ``units`` of a model with physical values."""
+    system_file = summary_path(slot.name, slot.key)
+    build_file = summary_path(slot.name, f"{slot.key}-{loops_key(LoopOptions.of(compiled.integration))}")
+    summary = SystemSummary.of(compiled.system, units is not None, compiled.fastest)
+    write_json(system_file, {"system": summary.as_dict(), "physical": units and units.as_dict()})
     write_json(build_file, {"hash": compiled.hash, "library": str(compiled.library),
                             "timed_parameters": sorted(compiled.timed_parameters),
                             "table_texts": list(compiled.table_texts)})
-    return compiled
 
 
-def cached_scaling(ref: str, values: Mapping[str, object], scaling: Callable[[], object]):
-    """The scaling of ``ref`` with ``values`` (None for a model without physical values): a
-    :class:`~gearsym.physical.point.CachedScaling` when the cache has its numbers (a spectrum run then needs
-    neither pint nor the reduction), else ``scaling()`` (the model loaded and reduced)."""
-    data = _system_data(ref, values)
+def _from_cache(system: Mapping | None, build_file: Path, options: Integration, full: Callable[[], object]):
+    """The compiled model of a system's summary as read (``system``) and the build summary in ``build_file``, or
+    None."""
+    build = read_json(build_file)
     try:
-        if data is not None and not data["system"]["physical"]:
-            return None
-        if data is not None and data["physical"]:
-            return CachedScaling(PointUnits.from_dict(data["physical"]), scaling)
-    except (KeyError, TypeError, ValueError, AttributeError):
-        pass
-    return scaling()
-
-
-def _system_data(ref, values) -> dict | None:
-    path = model_file(ref) if isinstance(ref, str) else None
-    if path is None:
-        return None
-    key = system_key(path, values)
-    return read_json(summary_path(path.stem, key))
-
-
-def _from_cache(system_file: Path, build_file: Path, options: Integration, loops: LoopOptions,
-                full: Callable[[], object]):
-    data, build = read_json(system_file), read_json(build_file)
-    try:
-        summary = SystemSummary.from_dict(data["system"], full)
+        summary = SystemSummary.from_dict(system, full)
         digest, library, timed = str(build["hash"]), Path(build["library"]), frozenset(build["timed_parameters"])
         texts = tuple(str(t) for t in build["table_texts"])
     except (KeyError, TypeError, ValueError, AttributeError):
@@ -323,7 +323,7 @@ def _from_cache(system_file: Path, build_file: Path, options: Integration, loops
 def load_linearisation(ref: str, values: Mapping[str, object], options: Integration, *,
                        derive: Callable[[], CompiledLinearisation], verbose: bool = False) -> CompiledLinearisation:
     """The compiled linearisation about its static state of the model ``ref`` with ``values`` (a stability
-    chart's): from the cache as :func:`load_compiled` keeps a model (its summaries beside the linear system's
+    chart's): from the cache as :func:`keep_compiled` keeps a model (its summaries beside the linear system's
     library, with the static recipe and the model's own parameters), else ``derive()`` (the model loaded,
     linearised and compiled) and the summaries written."""
     path = model_file(ref) if isinstance(ref, str) else None
@@ -334,9 +334,10 @@ def load_linearisation(ref: str, values: Mapping[str, object], options: Integrat
     name = f"{path.stem}_linearised"
     system_file = summary_path(name, key)
     build_file = summary_path(name, f"{key}-{loops_key(loops)}")
-    compiled = _from_cache(system_file, build_file, options, loops, lambda: derive().model.system)
-    data = read_json(system_file) if compiled is not None else None
-    if data is not None:
+    data = read_json(system_file)
+    compiled = _from_cache(data.get("system") if data is not None else None, build_file, options,
+                           lambda: derive().model.system)
+    if compiled is not None:
         try:
             about = data["linearisation"]
             return CompiledLinearisation(compiled, StaticRecipe.from_dict(about["static"]),

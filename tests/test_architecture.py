@@ -31,7 +31,7 @@ LAYERS = [
     {"sweep", "periodic", "stability"},
     {"fit", "physical"},
     {"figures"},
-    {"verbs", "loading", "cached", "fmu"},
+    {"verbs", "loading", "cached", "opening", "fmu"},
     {"reproduce"},
     {"cli", "__init__"},
 ]

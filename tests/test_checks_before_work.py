@@ -20,8 +20,6 @@ import gearsym.loading
 import gearsym.registry
 import gearsym.reproduce.compute  # likewise
 import gearsym.cli.docs
-import gearsym.cli.explain
-import gearsym.cli.arguments.integration
 import gearsym.cli.lyap
 import gearsym.cli.poincare
 import gearsym.cli.simulate
@@ -46,8 +44,7 @@ def no_work(monkeypatch):
     def work(*args, **kwargs):
         raise AssertionError("the work started before the input was checked")
 
-    for module, name in ((gearsym.cli.arguments.integration, "system_from"), (gearsym.cli.explain, "system_from"),
-                         (gearsym, "compile_model"), (gearsym.codegen.build, "compile_model"),
+    for module, name in ((gearsym, "compile_model"), (gearsym.codegen.build, "compile_model"),
                          (gearsym.cli.sweep, "run_sweep"),
                          (gearsym.cli.simulate, "with_effects"),
                          (gearsym, "load"), (gearsym.loading, "load"), (gearsym.codegen.generated, "generate_model"),
@@ -86,6 +83,12 @@ def test_a_figure_matplotlib_cannot_write_is_refused_before_computing(capsys, no
     monkeypatch.chdir(tmp_path)
     err = error_line(capsys, *argv)
     assert "--plot" in err and ".png" in err and ".pdf" in err and ".svg" in err
+
+
+@pytest.mark.parametrize("command", [["lyap", "one_stage"], ["simulate", "one_stage", "--out", "m.csv"]])
+def test_a_bad_start_is_refused_before_the_model_is_compiled(capsys, no_work, tmp_path, monkeypatch, command):
+    monkeypatch.chdir(tmp_path)
+    assert "--y0 'x=fast'" in error_line(capsys, *command, "--y0", "x=fast")
 
 
 def unwritable_places(tmp_path: Path) -> list[Path]:
@@ -220,14 +223,12 @@ def test_a_closed_stdout_ends_the_command_quietly():
 def no_reduction(no_work, monkeypatch):
     """Any reduction of a model (the SymPy derivation: half a minute for a planetary set on bearings) or
     linearisation fails the test too: the check must come from the model's declaration."""
-    import gearsym.cli.spectrum
     import gearsym.stability
 
     def work(*args, **kwargs):
         raise AssertionError("the model was reduced before the input was checked")
 
-    for module, name in ((gearsym.loading, "reduce"), (gearsym.cli.spectrum, "load"),
-                         (gearsym.stability, "compile_linearisation")):
+    for module, name in ((gearsym.loading, "reduce"), (gearsym.stability, "compile_linearisation")):
         monkeypatch.setattr(module, name, work)
 
 

@@ -10,6 +10,7 @@ from ..analysis.basins import RUN, basin_map
 from ..errors import GearsymError
 from ..figures.basins import plot_basin_fractions, plot_basin_map
 from ..files.outputs import check_figure, check_file
+from ..opening import open_model
 from ..options import Execution
 from ..physical.basins import PhysicalGrid, ShownBasinMap, ShownFractions, check_grid_units, engine_grid, shown_in
 from ..physical.files import write_basin_fractions, write_basin_map
@@ -17,8 +18,8 @@ from ..physical.sweeps import nondimensional_axes
 from ..sweep.basin_continuation import MATCH_DISTANCE, StartGrid, continue_basins
 from ..sweep.grid import Axis, parse_axis
 from ..sweep.store import sidecar
-from .arguments.integration import add_integration_arguments, compiled_from, scaling_from
-from .arguments.settings import add_set_argument, model_settings, parse_state
+from .arguments.integration import add_integration_arguments, integration_from, model_request
+from .arguments.settings import add_set_argument, parse_state
 
 NAME = "basins"
 HELP = "basins of attraction on a grid of starts (attractors by their Poincare sets), and their fractions along a parameter"
@@ -69,7 +70,9 @@ def run(args: argparse.Namespace) -> int:
     if len(grid_axes) != 2 or grid_axes[0].name == grid_axes[1].name:
         raise GearsymError(f"--grid: give two different states (e.g. --grid x=-5:5:0.1 --grid v=-5:5:0.1), got "
                            f"{', '.join(a.name for a in grid_axes) or 'none'}")
-    scaling = scaling_from(args)
+    request = model_request(args, integration_from(args))
+    model = open_model(request)
+    scaling = model.scaling
     units = scaling.point_units() if scaling is not None else None
     if units is None:
         unit = next((a for a in [*grid_axes, *([axis] if axis else [])] if a.unit), None)
@@ -80,14 +83,14 @@ def run(args: argparse.Namespace) -> int:
         check_grid_units(units, grid_axes)  # (before the model is compiled)
     if axis is not None and units is not None:
         axis = nondimensional_axes(scaling.full, [axis])[0]
-    compiled = compiled_from(args)
+    compiled = model.compiled()
     if axis is not None:
         return _continuation(args, compiled, grid_axes, axis, units, y0)
     omega = compiled.parameter_vector()[compiled.parameter_names.index("omega")] \
         if "omega" in compiled.parameter_names else 1.0
     grid = engine_grid(units, grid_axes, omega) if units is not None else {a.name: a.values for a in grid_axes}
     result = basin_map(compiled, grid, y0=y0, execution=_execution(args))
-    shown = ShownBasinMap(result, shown_in(units, model_settings(args, cached=True)), tuple(grid_axes))
+    shown = ShownBasinMap(result, shown_in(units, request.settings), tuple(grid_axes))
     if args.out:
         written = write_basin_map(shown, args.out)
         print(f"gearsym: wrote {' and '.join(map(str, written))}", file=sys.stderr)

@@ -15,12 +15,13 @@ from ..files.outputs import check_figure, check_file
 from ..physical.campbell import campbell
 from ..physical.files import write_physical_table
 from ..physical.sweeps import nondimensional_axis
+from ..opening import open_model
 from ..options import Execution
 from ..sweep import run_sweep
 from ..sweep.grid import parse_axis
 from ..sweep.store import sidecar
-from .arguments.integration import add_integration_arguments, compiled_from, scaling_from
-from .arguments.settings import add_set_argument, model_settings, refuse_swept_and_set
+from .arguments.integration import add_integration_arguments, integration_from, model_request
+from .arguments.settings import add_set_argument, refuse_swept_and_set
 
 NAME = "campbell"
 HELP = "Campbell diagram (natural frequencies, mesh and torque orders, crossings) beside the amplitude over speed"
@@ -47,7 +48,9 @@ def run(args: argparse.Namespace) -> int:
     check_figure(args.plot)
     if args.orders < 1:
         raise GearsymError(f"--orders must be at least 1, got {args.orders}")
-    scaling = scaling_from(args)
+    request = model_request(args, integration_from(args))
+    model = open_model(request)
+    scaling = model.scaling
     if scaling is None or not scaling.speed:
         raise GearsymError(f"{args.model}: a Campbell diagram needs physical values and a declared speed "
                            "(model.set_physical, Gear(..., teeth=N, speed='speed')); see docs/units.md")
@@ -57,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
                            f"({scaling.speed.parameter}=...), not {axis.name}")
     refuse_swept_and_set([(axis.name, args.param)], args.set)
     engine_axis = nondimensional_axis(scaling.full, axis)  # (a speed without its unit is refused here)
-    modes = natural_modes(scaling.full.model, **model_settings(args))
+    modes = natural_modes(scaling.full.model, **model.checked_settings)
     diagram = campbell(scaling.full, axis.values, axis.unit, modes, args.orders)
     write_atomically(sidecar(args.out, ".campbell.json"), json.dumps(diagram.as_dict(), indent=2) + "\n")
     print(f"{diagram.model}: natural frequencies " + ", ".join(f"{f:.6g} Hz" for f in diagram.natural_frequencies))
@@ -65,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"crossing: {c.order} meets {c.natural_frequency:.6g} Hz at {c.speed:.6g} {axis.unit}")
     sweep = None
     if not args.no_sweep:
-        compiled = compiled_from(args)
+        compiled = model.compiled()
         result = run_sweep(compiled, [engine_axis], options=compiled.integration,
                            out=args.out, execution=Execution(args.jobs, progress=not args.quiet))
         sweep = scaling.to_physical(result, given=[axis])

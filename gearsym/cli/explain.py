@@ -9,7 +9,8 @@ from ..figures.fit_report import explain_files
 from ..fit.selection import check_fit_names, check_harmonics
 from ..files.outputs import check_folder
 from ..options import Execution
-from .arguments.integration import add_integration_arguments, integration_from, scaling_from, system_from
+from ..opening import OpenModel, open_model
+from .arguments.integration import add_integration_arguments, integration_from, model_request
 from .arguments.settings import add_set_argument
 
 NAME = "explain"
@@ -58,11 +59,12 @@ def run(args: argparse.Namespace) -> int:
     candidates = [e.strip() for e in args.effects.split(",")] if args.effects else None
     bias = None if args.bias is None else [c.strip() for c in args.bias.split(",") if c.strip() not in ("", "none")]
     channels = dict(_channel(text) for text in args.channel)
-    options = integration_from(args)
+    request = model_request(args, integration_from(args))
     check_folder(args.out)  # before the model is reduced (seconds)
-    report = explain_files(args.data, system_from(args), fit, out=args.out, time_scale=_time_scale(args),
+    model = open_model(request)
+    report = explain_files(args.data, model.system, fit, out=args.out, time_scale=_time_scale(args, model),
                            held_out=args.held_out, candidates=candidates, execution=Execution(progress=not args.quiet),
-                           options=options,
+                           options=request.options,
                            channels=channels, bias=bias, terms=args.add_term, harmonics=args.harmonics)
     added = ", ".join(report["effects"]) or "none"
     print(f"{report['verdict']}: effects added: {added}; held-out error {report['error_before']:.4g} -> "
@@ -78,11 +80,11 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _time_scale(args: argparse.Namespace) -> float | None:
+def _time_scale(args: argparse.Namespace, model: OpenModel) -> float | None:
     """--time-scale, or for a model with physical values its time unit: tau = omega_n t with t in seconds."""
     if args.time_scale is not None:
         return args.time_scale
-    scaling = scaling_from(args)
+    scaling = model.scaling
     return None if scaling is None else float(scaling.full.omega_n.to("rad/s").magnitude)
 
 

@@ -15,9 +15,10 @@ from ..errors import GearsymError
 from ..files.atomic import write_atomically
 from ..figures import plot_point
 from ..files.outputs import check_figure
+from ..opening import open_model
 from ..physical.text import parameters_line
-from .arguments.integration import add_integration_arguments, compiled_from, scaling_from, step_line
-from .arguments.settings import add_set_argument, model_settings, parse_state
+from .arguments.integration import add_integration_arguments, integration_from, model_request, step_line
+from .arguments.settings import add_set_argument, parse_state
 
 NAME = "lyap"
 HELP = "Lyapunov spectrum (all exponents, per unit time) at one parameter point"
@@ -38,10 +39,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     if args.plot:
         check_figure(args.plot)
-    scaling = scaling_from(args)
-    compiled = compiled_from(args)
+    y0 = parse_state(args.y0)  # (before the model is compiled)
+    request = model_request(args, integration_from(args))
+    model = open_model(request)
+    scaling = model.scaling
+    compiled = model.compiled()
     coordinate = chosen_coordinate(args.coordinate, compiled.observed, args.plot)
-    result = lyapunov_spectrum(compiled, y0=parse_state(args.y0))
+    result = lyapunov_spectrum(compiled, y0=y0)
     if result.divergence is not None:
         raise GearsymError(diverged_message(compiled, result))
     # (the mesh forces and shaft torques from a trajectory at the point, as in Python: physical/point.py)
@@ -50,9 +54,9 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         shown = min(30, result.periods - result.discard)
         trajectory = phase_trajectory(compiled, options=compiled.integration.run(discard=result.periods - shown),
-                                      y0=parse_state(args.y0))
+                                      y0=y0)
         if physical is not None:  # in the model's units: exponents per second, um, mm/s, rad
-            spectrum, shown_trajectory, shown_units, title = units.figure(result, trajectory, model_settings(args))
+            spectrum, shown_trajectory, shown_units, title = units.figure(result, trajectory, request.settings)
             plot_point(spectrum, shown_trajectory, args.plot, x=coordinate, units=shown_units, title=title)
             caption = args.plot.with_suffix(".caption.txt")  # (the values the title leaves out)
             write_atomically(caption, f"{scaling.name}: the figure {args.plot.name}'s values\n" + units.caption())

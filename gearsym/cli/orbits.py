@@ -14,6 +14,7 @@ from ..errors import GearsymError, UnknownParameterError
 from ..figures.orbits import plot_orbits
 from ..files.atomic import write_atomically
 from ..files.outputs import check_figure, check_file
+from ..opening import open_model
 from ..options import Execution
 from ..periodic import ContinuationInterrupted, continue_orbits, periodic_orbit
 from ..periodic.files import write_orbits
@@ -27,8 +28,7 @@ from ..sweep import read_sweep
 from ..sweep.grid import _numbers_and_unit, Axis
 from ..sweep.store import sidecar
 from ..units import shown
-from .arguments.integration import (add_integration_arguments, chosen_over, compiled_from, integration_from, scaling_from,
-                          step_line, system_from)
+from .arguments.integration import add_integration_arguments, integration_from, model_request, step_line
 from .arguments.settings import add_set_argument, parse_state, refuse_swept_and_set
 
 NAME = "orbits"
@@ -129,21 +129,21 @@ def run(args: argparse.Namespace) -> int:
         sweep = read_sweep(args.sweep)
 
     options = integration_from(args).run(periods=args.transient, discard=0)
-    scaling = scaling_from(args)
+    request = model_request(args, options)
+    model = open_model(request)
+    scaling = model.scaling
     physical = scaling  # (None without physical values; else the answers are also in its units)
     if parameter:
         given = parameter[0]
         parameter = engine_range(args, parameter, scaling)
         refuse_swept_and_set([(given, args.param), (parameter[0], args.param)], args.set)
-    system = system_from(args)
+    system = model.system
     if args.segments is not None:  # (before the code is compiled: a period of cycles forcing periods has
         pieces = system.cycles * pieces_per_period(options.steps_per_period)  # pieces in each)
         check_segments(args.segments, pieces, f"--segments {args.segments}: ", options.steps_per_period * system.cycles)
     if parameter and parameter[0] not in system.parameters:
         raise UnknownParameterError(parameter[0], system.parameters, f"--param {args.param}")
-    if parameter:  # (the step the range's fastest point needs)
-        options = chosen_over(args, options, {parameter[0]: (parameter[1], parameter[2])})
-    compiled = compiled_from(args, options, system)
+    compiled = model.compiled(over={parameter[0]: (parameter[1], parameter[2])} if parameter else None)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     print(f"gearsym: {step_line(compiled, scaling)}", file=sys.stderr)
     if parameter is None:

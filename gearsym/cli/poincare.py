@@ -11,7 +11,8 @@ from ..checks import chosen_coordinate
 from ..errors import GearsymError
 from ..figures.poincare import plot_attractors
 from ..files.outputs import check_figure
-from .arguments.integration import add_integration_arguments, compiled_from, integration_from
+from ..opening import open_model
+from .arguments.integration import add_integration_arguments, integration_from, model_request
 from .arguments.settings import add_set_argument
 
 NAME = "poincare"
@@ -60,7 +61,8 @@ def run(args: argparse.Namespace) -> int:
     box = parse_box(args.box)
     options = integration_from(args)
     check_ics(args.ics, 1, options.periods)  # at least one state each: before the model is compiled
-    compiled = compiled_from(args, options)
+    request = model_request(args, options)
+    compiled = open_model(request).compiled()
     coordinate = chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     found = find_attractors(compiled, ics=args.ics, seed=args.seed, box=box)
     if args.plot:

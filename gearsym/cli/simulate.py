@@ -4,13 +4,16 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+import gearsym  # the face: the code generator loads on first use
+
 from ..data.simulate import RUN, simulate_measurements, steps_for
 from ..errors import GearsymError
 from ..fit.effects import augment, effect
 from ..fit.shaft_effects import is_shaft_effect
 from ..files.outputs import check_file
 from ..loading import load
-from .arguments.integration import add_integration_arguments, compiled_from, integration_from
+from ..opening import open_model
+from .arguments.integration import add_integration_arguments, integration_from, model_request
 from .arguments.settings import add_set_argument, model_settings, parse_numbers, parse_state
 
 NAME = "simulate"
@@ -47,15 +50,20 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     records = [parse_conditions(text) for text in args.record]
+    y0 = parse_state(args.y0)  # (before the model is compiled)
     settings = model_settings(args)
     options = integration_from(args, steps_for(args.samples_per_period, args.steps_per_period), exponents=False)
+    request = model_request(args, options, settings=settings)
     check_file(args.out, (".csv",))
     check_strengths([e for e in args.effect if not is_shaft_effect(e)], settings)  # (shaft-order ones: on the model)
-    system = with_effects(args.model, args.effect, settings) if args.effect else None
-    compiled = compiled_from(args, options, system)
+    if args.effect:  # (the model with the effects added: a system of this run's own, compiled as it is)
+        compiled = gearsym.compile_model(with_effects(request.model, args.effect, settings), options,
+                                         verbose=request.verbose)
+    else:
+        compiled = open_model(request).compiled()
     table = simulate_measurements(compiled, samples_per_period=args.samples_per_period,
                                   noise=args.noise, seed=args.seed, records=records or None,
-                                  y0=parse_state(args.y0), velocities=args.velocities, out=args.out)
+                                  y0=y0, velocities=args.velocities, out=args.out)
     per_record = table.rows // table.records
     conditions = f"; conditions {', '.join(table.conditions)}" if table.conditions else ""
     cycles = compiled.cycles  # (a period of several forcing periods: a gear's revolution)

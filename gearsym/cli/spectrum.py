@@ -12,6 +12,8 @@ import json
 import math
 from pathlib import Path
 
+import gearsym  # the face: the code generator loads on first use
+
 from ..analysis.order_run import SAMPLES_PER_CYCLE, mesh_gears, simulated_order_spectrum
 from ..analysis.orders import MESH_HARMONICS, MIN_REVOLUTIONS, SIDEBANDS, check_length, most_sidebands, order_spectrum
 from ..checks import check_run, json_safe
@@ -19,12 +21,13 @@ from ..data.measurements import load_measurements
 from ..errors import GearsymError
 from ..files.atomic import write_atomically
 from ..figures.orders import plot_order_spectra
-from ..loading import declared, load, split_options
+from ..loading import declared, split_options
 from ..memory import check_fits
+from ..opening import OpenModel, open_model
 from ..options import STEPS_PER_PERIOD, Integration
 from ..files.outputs import check_figure, check_file
 from ..physical.point import LENGTH
-from .arguments.integration import add_integration_arguments, compiled_from, scaling_from
+from .arguments.integration import add_integration_arguments, model_request
 from .arguments.settings import add_set_argument, model_settings
 from .simulate import with_effects
 
@@ -70,10 +73,12 @@ def run(args: argparse.Namespace) -> int:
     if args.plot:
         check_figure(args.plot)
     settings = model_settings(args)
+    request = model_request(args, settings=settings)  # (the run's options: from the model's tooth counts)
+    model = open_model(request)
     if args.data:
-        spectra, what = _measured(args, settings)
+        spectra, what = _measured(args, model)
     else:
-        spectra, what = _simulated(args, settings)
+        spectra, what = _simulated(args, model)
     for s in spectra:
         strongest = sorted((ln for ln in s.lines if ln.gear and math.isfinite(ln.amplitude)),
                            key=lambda ln: -ln.amplitude)[:3]
@@ -108,9 +113,10 @@ def _spectrum_bytes(lines: int) -> int:
     return 8 * (2 + 2 * (1 + 2 * lines))
 
 
-def _simulated(args, settings: dict):
+def _simulated(args, model: OpenModel):
+    settings = model.request.settings
     _check_periods_declared(args, settings)
-    system = with_effects(args.model, args.effect, settings) if args.effect else load(args.model, **settings)
+    system = with_effects(args.model, args.effect, settings) if args.effect else model.system
     name, gears, _ = mesh_gears(system, args.coordinate)
     _check_sidebands(args, gears)
     cycles = system.cycles
@@ -133,8 +139,11 @@ def _simulated(args, settings: dict):
     check_run(steps_per_period=steps)
     options = Integration(periods=periods, discard=discard, steps_per_period=steps, locate_crossings=not args.plain,
                           backend=args.backend)
-    compiled = compiled_from(args, options, system)
-    scale, unit, values = _unit(args, name)
+    if args.effect:  # (the model with the effects added: a system of this run's own, compiled as it is)
+        compiled = gearsym.compile_model(system, options, verbose=model.request.verbose)
+    else:
+        compiled = model.compiled(options)
+    scale, unit, values = _unit(model, name)
     s = simulated_order_spectrum(compiled, coordinate=name, mesh_harmonics=args.mesh_harmonics,
                                  sidebands=args.sidebands, scale=scale, unit=unit)
     if unit:  # a physical model: its title in the user's values (the engine's numbers stay in the JSON's title)
@@ -179,10 +188,10 @@ def _check_periods_declared(args, settings: dict) -> None:
         _check_periods(args, min(meshes, key=lambda gears: max(gears.values())), resolved.cycles)
 
 
-def _unit(args, name: str) -> tuple[float, str, dict]:
+def _unit(model: OpenModel, name: str) -> tuple[float, str, dict]:
     """The factor and unit of a run's coordinate in the model's physical units (µm for a mesh's deflection, rad
     for a shaft's twist) and its physical values as given, or (1, "", {}) for a model without physical values."""
-    scaling = scaling_from(args)
+    scaling = model.scaling
     if scaling is None:
         return 1.0, "", {}
     units = scaling.point_units()
@@ -191,10 +200,10 @@ def _unit(args, name: str) -> tuple[float, str, dict]:
     return units.per_unit.get(name, 1.0), units.radian.text, dict(units.values)
 
 
-def _measured(args, settings: dict):
+def _measured(args, model: OpenModel):
     if args.effect:
         raise GearsymError("--effect simulates a run; --data analyses measured records: give one of them")
-    system = load(args.model, **settings)
+    system = model.system
     _, gears, mesh_order = mesh_gears(system)
     _check_sidebands(args, gears)
     data = load_measurements(args.data, system, time_scale=args.time_scale)

@@ -10,16 +10,13 @@ import io
 import json
 import sys
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-import gearsym  # the face: its verbs load on first use, so a cached model's chart never loads the generator
-
 from .. import stability  # (lazy: the linearisation, SymPy and the generator load only on a cache miss)
-from ..cached import load_linearisation, load_static_recipe
 from ..errors import GearsymError
+from ..opening import open_model
 from ..options import Execution
 from ..registry import model_options
 from ..files.atomic import write_atomically
@@ -33,8 +30,8 @@ from ..physical.sweeps import nondimensional_axes
 from ..stability.chart import ABOUT, RELATIVE_TOLERANCE, StabilityChart, chart_axes, orbit_chart, static_chart
 from ..sweep.grid import axes_from
 from ..sweep.store import sidecar
-from .arguments.integration import add_integration_arguments, compiled_from, integration_from, scaling_from
-from .arguments.settings import add_set_argument, checked_formulas, model_settings, refuse_swept_and_set
+from .arguments.integration import add_integration_arguments, integration_from, model_request
+from .arguments.settings import add_set_argument, refuse_swept_and_set
 
 NAME = "stability"
 HELP = ("stability chart: Floquet multipliers of the static state (or the periodic orbit) over a grid of two "
@@ -87,24 +84,24 @@ def run(args: argparse.Namespace) -> int:
                                       for a in axes)
     progress = None if args.quiet else _Progress()
     execution = Execution(args.jobs, lanes=not args.no_lanes, progress=progress or False)
-    settings = model_settings(args, cached=True)  # (a formula's numbers are checked if the model is built)
+    request = model_request(args, options)  # (after the formula's placeholders: the model is loaded with them)
+    model = open_model(request)
     start = time.perf_counter()
     common = dict(refine=not args.no_refine, execution=execution)
+
+    def checked(system):  # (the axes against the loaded model, before the compiler's seconds)
+        return _checked_axes(user, given, tuple(system.parameters), model.scaling)
+
     if args.about == "static":  # (the linearisation's cache says whether the model is physical: no SymPy then)
-        lin = load_linearisation(args.model, settings, options, verbose=not args.quiet,
-                                 derive=lambda: _linearisation(args, settings, options, given, user))
-        scaling = scaling_from(args) if lin.physical else None
+        lin = model.linearised(before=checked)
+        scaling = model.scaling if lin.physical else None
         axes = _checked_axes(user, given, tuple(lin.base_parameters), scaling)
         chart = static_chart(lin, axes, tolerance=tolerance_of(axes), **common)
     else:
-        compiled = compiled_from(args, options, before=lambda system: _checked_axes(
-            user, given, tuple(system.parameters), scaling_from(args)))
-        scaling = scaling_from(args)
+        compiled = model.compiled(before=checked)
+        scaling = model.scaling
         axes = _checked_axes(user, given, compiled.parameter_names, scaling)
-        recipe = load_static_recipe(args.model, settings,
-                                    derive=lambda: stability.static_recipe(getattr(compiled.system, "full",
-                                                                                   compiled.system)))
-        chart = orbit_chart(compiled, recipe, axes, tolerance=tolerance_of(axes), **common)
+        chart = orbit_chart(compiled, model.static_recipe(), axes, tolerance=tolerance_of(axes), **common)
     if progress:
         progress.done()
     prediction = None
@@ -122,7 +119,7 @@ def run(args: argparse.Namespace) -> int:
         write_atomically(sidecar(args.out, ".json"), json.dumps(chart.as_dict(), indent=1) + "\n")
         print(f"gearsym: wrote {args.out} and {sidecar(args.out, '.json')}", file=sys.stderr)
     if args.plot:
-        formula = settings.get("k")
+        formula = request.settings.get("k")
         plot_stability(chart, args.plot, shown=shown, prediction=prediction, fixed=fixed,
                        title=f"{chart.model} with k(τ) = {formula}" if isinstance(formula, str) else None)
         print(f"gearsym: wrote {args.plot}", file=sys.stderr)
@@ -156,17 +153,6 @@ def _formula_axes(args, given) -> dict:
     args.set = {**user, **{a.name: float(a.values[0]) for a in given
                            if a.name in introduced and a.name not in user and not a.unit}}
     return user
-
-
-def _linearisation(args, settings, options, given, user):
-    """The model loaded, the axes checked against it, then linearised and compiled (a wrong --param is said before
-    the compiler's seconds)."""
-    checked = checked_formulas(settings)
-    system = gearsym.load(args.model, **checked)
-    physical = gearsym.is_physical(args.model, **checked)
-    _checked_axes(user, given, tuple(system.parameters), scaling_from(args) if physical else None)
-    lin = stability.compile_linearisation(system, options, verbose=not args.quiet)
-    return replace(lin, physical=physical)
 
 
 def _checked_axes(user: dict, given, parameters: tuple[str, ...], scaling) -> tuple:

@@ -14,14 +14,14 @@ from ..figures.sweep import plot_sweep
 from ..files.outputs import check_figure, check_file
 from ..physical.files import write_physical_record, write_physical_table
 from ..physical.sweeps import nondimensional_axes
+from ..opening import open_model
 from ..options import PARALLEL, Execution
 from ..sweep import DIRECTIONS, MODES, POINCARE_SAMPLES, Workers, run_sweep
 from ..sweep.grid import axes_from
 from ..sweep.run import poincare_samples_of
 from ..sweep.report import findings_lines
 from ..sweep.store import sidecar
-from .arguments.integration import (add_integration_arguments, chosen_over, compiled_from, integration_from, scaling_from,
-                          step_line)
+from .arguments.integration import add_integration_arguments, integration_from, model_request, step_line
 from .arguments.settings import add_set_argument, parse_state, refuse_swept_and_set
 
 NAME = "sweep"
@@ -81,12 +81,13 @@ def run(args: argparse.Namespace) -> int:
     y0 = parse_state(args.y0)  # before the model is compiled
     options = integration_from(args)  # (sizes too) before the model is loaded
     poincare_samples_of(args.poincare, options)
+    request = model_request(args, options)
     given = axes_from(args.param)
-    scaling = scaling_from(args)
+    model = open_model(request)
+    scaling = model.scaling
     axes = _engine_axes(given, scaling)
     refuse_swept_and_set([(a.name, g.spec) for g, e in zip(given, axes) for a in (g, e)], args.set)
-    options = chosen_over(args, options, {a.name: a.values for a in axes})  # (the step its fastest point needs)
-    compiled = compiled_from(args, options)
+    compiled = model.compiled(over={a.name: a.values for a in axes})  # (the step its fastest point needs)
     chosen_coordinate(args.coordinate, compiled.observed, args.plot)
     if not args.quiet:
         print(f"gearsym: {step_line(compiled, scaling)}", file=sys.stderr)

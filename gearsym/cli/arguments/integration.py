@@ -1,18 +1,15 @@
 """The options every integrating command shares, declared once: the command-line face of
-:class:`~gearsym.options.Integration`, and the one way a command turns MODEL and --set into a compiled model."""
+:class:`~gearsym.options.Integration`, and what a command asks of its MODEL (:func:`model_request`), read once
+into a :class:`~gearsym.opening.ModelRequest` that :func:`~gearsym.opening.open_model` opens."""
 from __future__ import annotations
 
 import argparse
-import itertools
 import re
-from collections.abc import Callable
 
-import gearsym  # the face: its verbs load on first use, so a cached model's run never loads the generator
-
-from ...cached import cached_scaling, load_compiled
 from ...checks import check_run
+from ...opening import ModelRequest
 from ...options import BACKENDS, INTEGRATORS, STEPS_PER_PERIOD, Integration
-from .settings import checked_formulas, model_settings
+from .settings import model_settings
 
 
 def add_integration_arguments(parser: argparse.ArgumentParser, *, periods: int | None = 400, discard: int = 100,
@@ -56,56 +53,13 @@ def integration_from(args: argparse.Namespace, steps_per_period: int | None = No
                        integrator=getattr(args, "integrator", "auto"))
 
 
-def chosen_over(args: argparse.Namespace, options: Integration, axes) -> Integration:
-    """``options`` with the step chosen for every point of the engine's ``axes`` (name -> values: their ends
-    decide; an integrator asked is kept): a sweep or a continuation compiles once, at the step its fastest point
-    needs."""
-    if options.integrator != "auto" or not axes:
-        return options
-    ends = [{name: float(v) for name, v in zip(axes, point)}
-            for point in itertools.product(*[(min(v), max(v)) for v in axes.values()])]
-    return gearsym.chosen_integration(options, system_from(args), ends)
-
-
-def system_from(args: argparse.Namespace):
-    """The system of the command's MODEL with its --set values (names and files are resolved here, at the edge)."""
-    return gearsym.load(args.model, **model_settings(args))
-
-
-def scaling_of(model, settings: dict):
-    """The scaling of ``model`` with ``settings`` (--set values), or None for a model without physical values."""
-    if not gearsym.is_physical(model, **settings):
-        return None
-    physical = dict(settings)
-    length_scale = physical.pop("length_scale", None)
-    return gearsym.scaling(model, length_scale, **physical)  # (a stiffness formula too: the mesh forces use it)
-
-
-def scaling_from(args: argparse.Namespace):
-    """The scaling of the command's MODEL and --set values (a cached one when the start-up cache has its numbers),
-    or None for a model without physical values."""
-    settings = model_settings(args, cached=True)
-    return cached_scaling(args.model, settings, lambda: scaling_of(args.model, checked_formulas(settings)))
-
-
-def compiled_from(args: argparse.Namespace, options: Integration | None = None, system=None,
-                  before: Callable[[object], object] | None = None):
-    """The compiled model of the command's MODEL with its --set values (or of ``system``); ``before(system)``:
-    the command's checks of its request against the loaded system, made before it is compiled (seconds)."""
-    settings = model_settings(args, cached=True)  # (a formula's numbers are checked if the model is built)
-    options = options or integration_from(args)  # checked before the model is reduced (seconds)
-    verbose = not getattr(args, "quiet", False)
-
-    def checked_and_compiled(system):
-        if before is not None:
-            before(system)
-        return gearsym.compile_model(system, options, verbose=verbose)
-
-    if system is not None:
-        return checked_and_compiled(system)
-    return load_compiled(args.model, settings, options, verbose=verbose,
-                         compile=lambda: checked_and_compiled(gearsym.load(args.model, **checked_formulas(settings))),
-                         scaling=lambda: scaling_of(args.model, settings))
+def model_request(args: argparse.Namespace, options: Integration | None = None, *,
+                  settings: dict | None = None) -> ModelRequest:
+    """What the command asks of its MODEL, read once: the name or file, its --set and --teeth values (``settings``
+    if the command read them already; a formula's numbers are checked when the model is built), the run's
+    ``options`` (from :func:`integration_from`, or the command's own) and --quiet."""
+    return ModelRequest(args.model, model_settings(args, cached=True) if settings is None else settings,
+                        options or Integration(), verbose=not getattr(args, "quiet", False), given_as="--set")
 
 
 def step_line(compiled, scaling=None) -> str:

@@ -9,12 +9,11 @@ import argparse
 import math
 import sys
 
-import gearsym  # the face: SymPy is loaded only when a formula is built
-
 from ...errors import GearsymError
 from ...model.grammar import canonical_formula
 from ...model.length_scale import check_length_scale
 from ...model.tooth_counts import ToothCounts
+from ...opening import checked_formulas as formulas_checked
 from ...units import looks_like_quantity, measure
 
 
@@ -63,10 +62,7 @@ def checked_formulas(settings: dict) -> dict:
     """``settings``, after each formula among them is built (SymPy) to check its numbers: 1/0, log(0) or
     exp(1000) are refused with the option that gave them, before the model is loaded. (A model in the start-up
     cache was built with its formula once: the cache has it only if the formula passed.)"""
-    for name, value in settings.items():
-        if _is_formula(name, value):
-            gearsym.parse_formula(value, f"--set {name}")
-    return settings
+    return formulas_checked(settings, "--set")
 
 
 def parse_settings(pairs: list[str], settings: dict | None = None) -> dict[str, object]:
@@ -97,12 +93,6 @@ def parse_settings(pairs: list[str], settings: dict | None = None) -> dict[str, 
         else:  # (its grammar, on Python's syntax tree alone; its numbers when it is built: checked_formulas)
             settings[name] = canonical_formula(value, f"--set {name}")
     return settings
-
-
-def _is_formula(name: str, value) -> bool:
-    """Whether a --set value is a formula (text :func:`parse_settings` kept: not a quantity, not a number, not a
-    length scale's name)."""
-    return isinstance(value, str) and name != "length_scale"
 
 
 def refuse_swept_and_set(swept: list[tuple[str, str]], settings: dict[str, str]) -> None:
