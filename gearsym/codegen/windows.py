@@ -72,8 +72,10 @@ def _harmonics_of_time(exprs: Sequence[sp.Expr], time: sp.Symbol, t: ca.SX) -> t
     found: dict[tuple[str, int], sp.Symbol] = {}
 
     def order(arg: sp.Expr) -> int | None:
-        n = sp.simplify(arg / time)
-        return int(n) if n.is_Integer and n > 0 else None
+        # arg = n time exactly: its derivative by time is the whole number n and nothing is left beside n time (an
+        # expansion, not simplify(), which took seconds on each of a shaft-order window's phases)
+        n = sp.diff(arg, time)
+        return int(n) if n.is_Integer and n > 0 and sp.expand(arg - n * time) == 0 else None
 
     def replace_in(e: sp.Expr) -> sp.Expr:
         mapping = {}
