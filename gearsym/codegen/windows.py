@@ -41,7 +41,7 @@ import sympy as sp
 from ..errors import GearsymError
 from ..files.private import write_private
 from ..system import FirstOrderSystem
-from .compiler import cache_dir, compile_library, find_compiler
+from .compiler import WINDOW_FLAGS, cache_dir, compile_flags, compile_library, find_compiler
 from .loaded import load_once, open_library
 from .casadi_symbols import SystemSymbols
 from .rk4 import rk4_step
@@ -197,7 +197,8 @@ class Windows:
             text = self._source().encode()
             record(source, text, describes)
             write_private(source, text)
-        library = compile_library(source, f"{self.system.name}_windows", describes=describes)
+        library = compile_library(source, f"{self.system.name}_windows", flags=compile_flags(WINDOW_FLAGS),
+                                  describes=describes)
         lib = open_library(library.path)
         call = lib.gearsym_fit_windows
         call.restype = ctypes.c_int
