@@ -240,6 +240,7 @@ def test_clean_rig_data_get_no_effect_and_canonical_parameters(rig_runs, tmp_pat
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("report_without_its_two_plots")  # (it never looks at the residual and prediction plots)
 def test_a_term_beyond_the_library_is_proposed_and_adding_it_by_hand_closes_the_loop(rig_runs, tmp_path, capsys):
     path = rig.write(tmp_path / "ripple.csv", rig_runs("damping_ripple"))
     out = tmp_path / "first"
@@ -455,6 +456,7 @@ def test_the_worked_example_data_are_what_the_documented_command_writes(tmp_path
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("report_without_its_two_plots")  # (it never looks at the residual and prediction plots)
 def test_the_committed_worked_example_is_what_explain_writes(tmp_path):
     from gearsym.figures.fit_report import explain_files
 
@@ -483,6 +485,7 @@ def test_the_rig_example_data_are_what_the_documented_command_writes(tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("report_without_its_two_plots")  # (it never looks at the residual and prediction plots)
 def test_the_committed_rig_example_is_what_explain_writes(tmp_path, monkeypatch, capsys):
     page = (REPO_ROOT / "docs" / "data-loop.md").read_text()
     command = re.search(r"^\s*gearsym explain measured.csv .*--time-scale.*$", page, re.M).group(0).strip()
