@@ -211,6 +211,21 @@ def _cores_for_two_workers():
         yield
 
 
+@pytest.fixture
+def report_without_its_two_plots(monkeypatch):
+    """For a test that reads a report's pages and data but never looks at its residual and prediction figures: the
+    report writes those two files empty instead of drawing them (about 3 s of matplotlib's layout a report; the teeth
+    figure is still drawn). The figures are drawn and checked where a test looks at them:
+    test_explain.py's residual figure and report command."""
+    import gearsym.figures.fit_report as fit_report
+
+    drawn = fit_report.save_figure
+    monkeypatch.setattr(fit_report, "residual_figure", lambda *args, **kwargs: None)
+    monkeypatch.setattr(fit_report, "prediction_figure", lambda *args, **kwargs: None)
+    monkeypatch.setattr(fit_report, "save_figure", lambda fig, path, **kwargs: (
+        drawn(fig, path, **kwargs) if fig is not None else path.write_bytes(b"")))
+
+
 def interrupt_after(count):
     """An ``on_point`` for sweeps that presses Ctrl-C once ``count`` points are stored."""
     seen = []

@@ -24,6 +24,7 @@ from gearsym import EFFECTS, Integration, explain, load_measurements, simulate_m
 from gearsym.model.backlash import g
 from gearsym.cli import main
 from gearsym.errors import GearsymError, ModelError
+import gearsym.fit.levenberg_marquardt as marquardt
 from gearsym.fit import Effect, augment, effect_terms, fit_windows, term_effect
 from gearsym.fit.canonical import amplitude_phase, canonical, wrap_phase
 from gearsym.fit.effects import Change
@@ -240,6 +241,7 @@ def test_clean_rig_data_get_no_effect_and_canonical_parameters(rig_runs, tmp_pat
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("report_without_its_two_plots")  # (it never looks at the residual and prediction plots)
 def test_a_term_beyond_the_library_is_proposed_and_adding_it_by_hand_closes_the_loop(rig_runs, tmp_path, capsys):
     path = rig.write(tmp_path / "ripple.csv", rig_runs("damping_ripple"))
     out = tmp_path / "first"
@@ -353,6 +355,31 @@ def test_the_fit_recovers_known_parameters_within_their_errors(one_stage, tmp_pa
         assert abs(result.estimates[p] - true) < 4 * result.stderr[p] + 1e-4
 
 
+def test_the_fit_stops_where_a_further_step_changes_nothing_the_noise_lets_one_see(one_stage, rig_runs, tmp_path,
+                                                                                    monkeypatch):
+    """Levenberg-Marquardt stops once a step would move every unknown by less than STEP_IN_SIGMAS (1e-3) of its
+    standard error: its estimates, offset and noise level are those of the same fit run on until a step gains less
+    than 1e-12 of the cost (the stop before), within 1 % of their standard errors, in fewer steps. An accelerometer
+    with an offset and the start far off: its start states are unmeasured, the slowest fit the loop makes."""
+    path = rig.write(tmp_path / "acc.csv", rig_runs("cubic", (1.0, 1.8))[:1], ("x_ddot",), bias={"x_ddot": 0.3})
+    model = augment(one_stage, ["cubic_stiffness"])
+    segments, _ = segments_of(model, load_measurements([path], one_stage))
+
+    def fitted():
+        return fit_windows(model, segments, ["zeta", "B1", "k3"], guess={"zeta": 0.12, "B1": 3.3, "k3": 0.0},
+                           bias=["x_ddot"])
+
+    stopped = fitted()
+    monkeypatch.setattr(marquardt, "STEP_IN_SIGMAS", 0.0)  # the relative gain alone stops it
+    tight = fitted()
+    assert stopped.success and tight.success and stopped.iterations < tight.iterations, (stopped.iterations,
+                                                                                         tight.iterations)
+    for p, value in tight.estimates.items():
+        assert abs(stopped.estimates[p] - value) <= 0.01 * tight.stderr[p], (p, stopped.estimates[p], value)
+    assert abs(stopped.bias["x_ddot"] - tight.bias["x_ddot"]) <= 0.01 * tight.bias_stderr["x_ddot"]
+    assert stopped.sigma == pytest.approx(tight.sigma, rel=1e-4)
+
+
 def test_effects_extend_the_symbolic_model(one_stage):
     model = augment(one_stage, ["cubic_stiffness", "coulomb_friction"], values={"k3": 0.1})
     assert model.name == "one_stage_with_cubic_stiffness_and_coulomb_friction"
@@ -432,6 +459,7 @@ def test_the_worked_example_data_are_what_the_documented_command_writes(tmp_path
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("report_without_its_two_plots")  # (it never looks at the residual and prediction plots)
 def test_the_committed_worked_example_is_what_explain_writes(tmp_path):
     from gearsym.figures.fit_report import explain_files
 
@@ -460,6 +488,7 @@ def test_the_rig_example_data_are_what_the_documented_command_writes(tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("report_without_its_two_plots")  # (it never looks at the residual and prediction plots)
 def test_the_committed_rig_example_is_what_explain_writes(tmp_path, monkeypatch, capsys):
     page = (REPO_ROOT / "docs" / "data-loop.md").read_text()
     command = re.search(r"^\s*gearsym explain measured.csv .*--time-scale.*$", page, re.M).group(0).strip()

@@ -85,6 +85,7 @@ def geared():
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("report_without_its_two_plots")  # (it never looks at the residual and prediction plots)
 def test_a_cracked_tooth_on_the_wheel_is_named_with_its_tooth_and_severity(data, tmp_path, capsys, monkeypatch):
     """The documented command: the fault found on the wheel (not on the pinion), on its tooth counted from each
     record's start, with its severity and standard error (the screen's three of largest gain refitted, see REFITS)."""
@@ -182,6 +183,7 @@ def test_a_crack_that_softens_the_whole_mesh_is_found_tooth_by_tooth(whole, clea
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("report_without_its_two_plots")  # (it never looks at the residual and prediction plots)
 def test_the_report_names_and_draws_the_teeth_that_stand_out(whole, geared, tmp_path):
     """The report of a tooth-by-tooth form says which tooth of which gear stands out (counted from the record's start)
     with its refitted change, and teeth.png draws every tooth's value: the one that stands out in red, where the rig
@@ -250,6 +252,7 @@ def example_commands() -> dict[str, list[str]]:
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("report_without_its_two_plots")  # (it never looks at the residual and prediction plots)
 def test_the_cracked_tooth_example_is_what_its_commands_write(tmp_path, monkeypatch):
     commands = example_commands()
     (tmp_path / "simulated").mkdir()

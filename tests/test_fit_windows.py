@@ -66,6 +66,25 @@ def test_harmonics_of_time_are_evaluated_exactly(case):
     np.testing.assert_allclose(run.outputs[2], np.cos(7 * tau) * run.states[0], rtol=0, atol=1e-12 * 20)
 
 
+def test_every_column_at_once_is_each_column_asked_for_alone(case):
+    """A call asking for every parameter's column takes them from every parameter's forcing at once (fewer operations
+    than the columns one by one, which is what the driver compares: so here); a call asking for one parameter alone
+    takes its own column function. They are the same derivatives."""
+    system, channels, args = case
+    windows = Windows(system, channels, "compiled")
+    f = windows.functions
+    one_by_one = sum(f[f"fit_param_{j}"].n_instructions() for j in range(windows.parameters))
+    assert f["fit_forcing"].n_instructions() + windows.parameters * f["fit_column_forced"].n_instructions() < one_by_one
+    every = windows.run(*args).derivatives
+    n = system.dimension
+    for j in range(windows.parameters):
+        alone = windows.run(*args, columns=[j]).derivatives
+        np.testing.assert_allclose(every[:, :n], alone[:, :n], rtol=0, atol=1e-13 * np.abs(alone[:, :n]).max())
+        scale = np.abs(alone[:, n]).max()
+        np.testing.assert_allclose(every[:, n + j], alone[:, n], rtol=0, atol=1e-12 * max(scale, 1e-300),
+                                   err_msg=list(system.parameters)[j])
+
+
 @pytest.mark.parametrize("tangent,columns", [(True, None), (True, [1, 4]), (False, None)])
 def test_windows_shared_between_threads_give_the_bits_of_one_call(case, monkeypatch, tangent, columns):
     """A large call is split over the cores, each thread writing its windows' columns: the same numbers, bit for

@@ -52,6 +52,12 @@ from ..files.private import CACHE_ADVICE, NotPrivate, private_folder
 from .trust import record, trusted
 
 DEFAULT_FLAGS = ("-O3", "-march=native", "-mtune=generic", "-fno-tree-partial-pre")
+#: the fit's window libraries (:mod:`.windows`): a function of straight-line code per parameter column, up to 800 kB of
+#: C for a shaft-order library, where -O3's passes and the points-to analysis cost 3x the compile time and gain nothing
+#: (the 20/53 pair's library of docs/examples/explain-cracked-tooth: gcc 12, 15.8 s of CPU at DEFAULT_FLAGS, 5.3 s at
+#: these; one evaluation of its 78 windows with the tangent 0.141 and 0.147 s, of a 9/13 pair's 0.063 and 0.063 s,
+#: min of 12 each); FMA contraction stays (-march=native)
+WINDOW_FLAGS = ("-O1", "-fno-tree-pta", "-march=native", "-mtune=generic")
 
 #: compiled into every library beside the generated code: the entry points are called through it, with the
 #: stack moved to a fixed place modulo 4 KiB relative to the caller's work arrays (see :mod:`.native`)
@@ -117,9 +123,10 @@ def _named(configured: Path) -> str:
     return f"GEARSYM_CACHE={configured}" if os.environ.get("GEARSYM_CACHE") else str(configured)
 
 
-def compile_flags() -> tuple[str, ...]:
+def compile_flags(default: tuple[str, ...] = DEFAULT_FLAGS) -> tuple[str, ...]:
+    """``$GEARSYM_CFLAGS`` if set, else ``default``."""
     flags = os.environ.get("GEARSYM_CFLAGS")
-    return tuple(shlex.split(flags)) if flags is not None else DEFAULT_FLAGS
+    return tuple(shlex.split(flags)) if flags is not None else default
 
 
 @lru_cache(maxsize=None)

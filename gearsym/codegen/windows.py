@@ -12,6 +12,8 @@ state and by the parameters. Here that is one C call for all windows:
   combination) and dh/d(y0, p) = dh/dy Q + [0 | dh/dp];
 * the same step by columns (:func:`column_functions`): ``fit_stages`` (the state's step, its stage states
   and Jacobians), ``fit_column`` (a start state's column), ``fit_param_<j>`` (parameter j's), ``fit_channels``;
+  and for many columns at once ``fit_forcing`` (df/dp of every parameter at the four stages, its common
+  subexpressions computed once) with ``fit_column_forced`` (a column from its forcing);
 * ``gearsym_fit_windows`` (hand-written C around the column functions): every window from its start
   state, its samples ``substeps`` RK4 steps apart, the outputs and the derivatives by the start state and
   the parameters asked for written into the caller's arrays.
@@ -19,7 +21,12 @@ state and by the parameters. Here that is one C call for all windows:
 Every parameter has its column function, and a fit asks for the columns it estimates, so the library of
 candidate effects (all parameters at 0 but the tried ones) is compiled once for all candidates, and a fit
 of three parameters in a library of forty pays for three (the whole tangent step is what the in-process
-backend evaluates, mapped over the windows, and what the column functions are tested against).
+backend evaluates, mapped over the windows, and what the column functions are tested against). A call that
+asks for many columns, or for columns that share most of their work (a transmission error's or spacing errors'
+parameters each need the whole mesh force's derivative), takes them all from ``fit_forcing`` instead: the driver
+compares the operations of the two ways (each function's count, written into the C) and takes the cheaper
+(a 9/13 pair's library: its eight spacing errors 8064 operations a step one by one, 2065 all at once; the
+screen's forty columns 21600 against 2065).
 The C is cached like the engine's (:mod:`.compiler`); without a compiler the same functions run in
 CasADi's virtual machine, mapped over the windows.
 """
@@ -41,7 +48,7 @@ import sympy as sp
 from ..errors import GearsymError
 from ..files.private import write_private
 from ..system import FirstOrderSystem
-from .compiler import cache_dir, compile_library, find_compiler
+from .compiler import WINDOW_FLAGS, cache_dir, compile_flags, compile_library, find_compiler
 from .loaded import load_once, open_library
 from .casadi_symbols import SystemSymbols
 from .rk4 import rk4_step
@@ -50,7 +57,7 @@ from .translate import to_casadi
 from .trust import record, trusted
 
 #: bump when the generated window code changes for the same system and channels
-WINDOWS_VERSION = 2
+WINDOWS_VERSION = 3
 _OPTS = {"cse": True}
 #: RK4 steps in a call below which its windows run in one thread
 MIN_SHARED_STEPS = 20_000
@@ -72,8 +79,10 @@ def _harmonics_of_time(exprs: Sequence[sp.Expr], time: sp.Symbol, t: ca.SX) -> t
     found: dict[tuple[str, int], sp.Symbol] = {}
 
     def order(arg: sp.Expr) -> int | None:
-        n = sp.simplify(arg / time)
-        return int(n) if n.is_Integer and n > 0 else None
+        # arg = n time exactly: its derivative by time is the whole number n and nothing is left beside n time (an
+        # expansion, not simplify(), which took seconds on each of a shaft-order window's phases)
+        n = sp.diff(arg, time)
+        return int(n) if n.is_Integer and n > 0 and sp.expand(arg - n * time) == 0 else None
 
     def replace_in(e: sp.Expr) -> sp.Expr:
         mapping = {}
@@ -165,6 +174,12 @@ def column_functions(system: FirstOrderSystem, rhs: ca.Function, out: ca.SX, sym
         forcing = [dfdp(Y[:, i], time, p)[:, j] for i, time in enumerate(times)]
         out_fns[f"fit_param_{j}"] = ca.Function(f"fit_param_{j}", [q, J, Y, t, h, p], [ca.densify(column(forcing))],
                                                 _OPTS)
+    # every parameter's forcing at the four stages at once, (n, 4 m): stage i's df/dp in columns i m ... i m + m - 1
+    out_fns["fit_forcing"] = ca.Function("fit_forcing", [Y, t, h, p], [ca.densify(ca.horzcat(
+        *(dfdp(Y[:, i], time, p) for i, time in enumerate(times))))], _OPTS)
+    F = ca.SX.sym("F", n, 4)
+    out_fns["fit_column_forced"] = ca.Function("fit_column_forced", [q, J, F, h],
+                                               [ca.densify(column([F[:, i] for i in range(4)]))], _OPTS)
     out_fns["fit_channels"] = ca.Function("fit_channels", [y, t, p], [ca.densify(out), ca.densify(ca.jacobian(out, y)),
                                                                       ca.densify(ca.jacobian(out, p))], _OPTS)
     return out_fns
@@ -195,7 +210,8 @@ class Windows:
             text = self._source().encode()
             record(source, text, describes)
             write_private(source, text)
-        library = compile_library(source, f"{self.system.name}_windows", describes=describes)
+        library = compile_library(source, f"{self.system.name}_windows", flags=compile_flags(WINDOW_FLAGS),
+                                  describes=describes)
         lib = open_library(library.path)
         call = lib.gearsym_fit_windows
         call.restype = ctypes.c_int
@@ -210,8 +226,12 @@ class Windows:
                 gen.add(f)
         table = ", ".join(f"fit_param_{j}" for j in range(self.parameters)) or "0"
         works = ", ".join(f"fit_param_{j}_work" for j in range(self.parameters)) or "0"
+        functions = self.functions
+        costs = ", ".join(str(functions[f"fit_param_{j}"].n_instructions()) for j in range(self.parameters)) or "0"
         return gen.dump() + _DRIVER.format(n=self.n, p=self.parameters, c=len(self.channels), table=table,
-                                           works=works, p1=max(1, self.parameters))
+                                           works=works, p1=max(1, self.parameters), costs=costs,
+                                           forcing=functions["fit_forcing"].n_instructions(),
+                                           forced=functions["fit_column_forced"].n_instructions())
 
     def run(self, starts: np.ndarray, t0: Sequence[float], dt: Sequence[float], samples: Sequence[int],
             substeps: Sequence[int], parameters: np.ndarray, tangent: bool = True,
@@ -349,6 +369,10 @@ typedef int (*gs_fn)(const casadi_real**, casadi_real**, casadi_int*, casadi_rea
 typedef int (*gs_work_fn)(casadi_int*, casadi_int*, casadi_int*, casadi_int*);
 static const gs_fn gs_param[{p1}] = {{{table}}};
 static const gs_work_fn gs_param_work[{p1}] = {{{works}}};
+/* operations a step: each parameter's column function's, and every forcing at once with a column from its forcing */
+static const casadi_int gs_param_cost[{p1}] = {{{costs}}};
+#define GS_FORCING_COST {forcing}
+#define GS_FORCED_COST {forced}
 
 static casadi_int gs_max(casadi_int a, casadi_int b) {{ return a > b ? a : b; }}
 
@@ -363,8 +387,9 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
     const casadi_int* substeps, const casadi_real* t0, const casadi_real* dt, const casadi_real* start,
     const casadi_real* p, casadi_int tangent, casadi_int ncols, const casadi_int* cols, casadi_real* states,
     casadi_real* outputs, casadi_real* derivatives) {{
-  casadi_int sz[4] = {{0, 0, 0, 0}}, i, k, s, j, l, col = 0, width = GS_N + ncols;
-  casadi_real y[GS_N], y1[GS_N], Y[4 * GS_N], J[4 * GS_N * GS_N], q1[GS_N], t, h;
+  casadi_int sz[4] = {{0, 0, 0, 0}}, i, k, s, j, l, col = 0, width = GS_N + ncols, all = 0, one_by_one = 0;
+  casadi_real y[GS_N], y1[GS_N], Y[4 * GS_N], J[4 * GS_N * GS_N], q1[GS_N], Fj[4 * GS_N], t, h;
+  casadi_real* F = 0;
   casadi_real out[GS_C > 0 ? GS_C : 1], Hy[GS_C * GS_N > 0 ? GS_C * GS_N : 1], Hp[GS_C * GS_P > 0 ? GS_C * GS_P : 1];
   casadi_real* Q = 0;
   const casadi_real** arg;
@@ -375,7 +400,16 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
   gs_grow(fit_channels_work, sz);
   for (j = 0; j < ncols; ++j) {{
     if (cols[j] < 0 || cols[j] >= GS_P) return 1;
-    gs_grow(gs_param_work[cols[j]], sz);
+    one_by_one += gs_param_cost[cols[j]];
+  }}
+  /* the parameters' columns from every forcing at once where that is fewer operations than one by one */
+  all = tangent && ncols > 0 && GS_FORCING_COST + ncols * GS_FORCED_COST < one_by_one;
+  if (all) {{
+    gs_grow(fit_forcing_work, sz); gs_grow(fit_column_forced_work, sz);
+    F = (casadi_real*)malloc(sizeof(casadi_real) * (size_t)(4 * GS_N * GS_P));
+    if (!F) return 1;
+  }} else {{
+    for (j = 0; j < ncols; ++j) gs_grow(gs_param_work[cols[j]], sz);
   }}
   arg = (const casadi_real**)malloc(sizeof(casadi_real*) * (size_t)gs_max(sz[0], 1));
   res = (casadi_real**)malloc(sizeof(casadi_real*) * (size_t)gs_max(sz[1], 1));
@@ -396,11 +430,21 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
           if (tangent) {{
             arg[0] = y; arg[1] = &t; arg[2] = &h; arg[3] = pk; res[0] = y1; res[1] = Y; res[2] = J;
             if (fit_stages(arg, res, iw, work, 0)) goto fail;
+            if (all) {{
+              arg[0] = Y; arg[1] = &t; arg[2] = &h; arg[3] = pk; res[0] = F;
+              if (fit_forcing(arg, res, iw, work, 0)) goto fail;
+            }}
             for (j = 0; j < width; ++j) {{
               casadi_real* qj = Q + j * GS_N;
               if (j < GS_N) {{
                 arg[0] = qj; arg[1] = J; arg[2] = &h; res[0] = q1;
                 if (fit_column(arg, res, iw, work, 0)) goto fail;
+              }} else if (all) {{
+                casadi_int stage, r;
+                for (stage = 0; stage < 4; ++stage)  /* (F: n x 4 P, stage i's df/dp in its columns i P ...) */
+                  for (r = 0; r < GS_N; ++r) Fj[stage * GS_N + r] = F[(stage * GS_P + cols[j - GS_N]) * GS_N + r];
+                arg[0] = qj; arg[1] = J; arg[2] = Fj; arg[3] = &h; res[0] = q1;
+                if (fit_column_forced(arg, res, iw, work, 0)) goto fail;
               }} else {{
                 arg[0] = qj; arg[1] = J; arg[2] = Y; arg[3] = &t; arg[4] = &h; arg[5] = pk; res[0] = q1;
                 if (gs_param[cols[j - GS_N]](arg, res, iw, work, 0)) goto fail;
@@ -432,10 +476,10 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
       }}
     }}
   }}
-  free(arg); free(res); free(iw); free(work); free(Q);
+  free(arg); free(res); free(iw); free(work); free(Q); free(F);
   return 0;
 fail:
-  free(arg); free(res); free(iw); free(work); free(Q);
+  free(arg); free(res); free(iw); free(work); free(Q); free(F);
   return 1;
 }}
 """

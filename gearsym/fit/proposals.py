@@ -131,11 +131,17 @@ def sparse_regression(D: np.ndarray, y: np.ndarray, sweep: int = 40) -> tuple[np
 
 def propose_terms(ex, superset: FirstOrderSystem, train: Sequence[Segment], test: Sequence[Segment], keys,
                   options: Integration, harmonics: int, say=None) -> list[Proposal]:
-    """The terms of the dictionary that the final model's residual asks for, each refitted (module docstring)."""
+    """The terms of the dictionary that the final model's residual asks for, each refitted (module docstring). The
+    terms are added to the final model (the declared one with the effects chosen), not to the search's ``superset``:
+    its other candidates are 0 there, and each would cost the dictionary's compiled code and every step of its
+    runs for nothing."""
     say = say or (lambda message: None)
-    terms = dictionary(superset, harmonics)
-    effects = [own_term(f"d{i}", f"d_{i}", t, f"dictionary term {term_text(t, superset)}") for i, t in enumerate(terms)]
-    model = augment(superset, effects, name=f"{ex.system.name}_dictionary")
+    chosen = [ex.library[e] for e in ex.final.effects]
+    final_model = augment(ex.system, chosen, name=f"{ex.system.name}_final") if chosen else ex.system
+    terms = dictionary(final_model, harmonics)
+    effects = [own_term(f"d{i}", f"d_{i}", t, f"dictionary term {term_text(t, final_model)}")
+               for i, t in enumerate(terms)]
+    model = augment(final_model, effects, name=f"{ex.system.name}_dictionary")
     zeros = {e.fitted[0]: 0.0 for e in effects}
     train = [replace(s, parameters={**s.parameters, **zeros}) for s in train]
     test = [replace(s, parameters={**s.parameters, **zeros}) for s in test]
@@ -150,7 +156,7 @@ def propose_terms(ex, superset: FirstOrderSystem, train: Sequence[Segment], test
     bounds = bounds_of([ex.library[e] for e in ex.final.effects])
     out = []
     for i in chosen:
-        text = term_text(terms[i], superset)
+        text = term_text(terms[i], final_model)
         result = fit_windows(model, train, names + [coefficients[i]], guess={**final.estimates, coefficients[i]: coef[i]},
                              starts=final.starts, options=options, bias=ex.bias, bounds=bounds, guess_bias=final.bias)
         prediction = predict_ahead(model, test, keys, result.estimates, options=options, bias=result.bias)
