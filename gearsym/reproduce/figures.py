@@ -324,4 +324,5 @@ def draw_all(c: Computed, out: str | Path, suffix: str = "") -> list[Path]:
     out = Path(out)
     names = [n for n in FIGURES if (n != "study" or "study_ka" in c.sweeps) and (n != "fig3-orbits" or c.orbits)
              and (n != "basins" or c.basins) and (n != "basin-fractions" or c.fractions)]
-    return [save_figure(build(n, c), out / f"{n}{suffix}.png", FIGURES[n][1], keep_same=True) for n in names]
+    # (fitted as they are written, at their resolution: build's fit at the screen's would be laid out again)
+    return [save_figure(FIGURES[n][0](c), out / f"{n}{suffix}.png", FIGURES[n][1], keep_same=True) for n in names]
