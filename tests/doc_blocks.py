@@ -125,10 +125,16 @@ class Ran:
     cpu: float = 0.0
 
 
+#: what the user's environment does not have: nothing of the clone importable but the installed package, no
+#: test of pytest's running, and Python's bytecode cache as a user's Python keeps it (a machine that turns it off
+#: has every command compile the hundred-odd modules of gearsym it imports from source again: 0.3 s each)
+NOT_THE_USERS = ("PYTHONPATH", "PYTEST_CURRENT_TEST", "PYTHONDONTWRITEBYTECODE")
+
+
 def environment() -> dict:
-    """The user's environment: gearsym's command on the PATH, the session's library cache, no PYTHONPATH
-    (nothing of the clone is importable but the installed package), matplotlib without a display."""
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTEST_CURRENT_TEST")}
+    """The user's environment: gearsym's command on the PATH, the session's library cache, none of
+    :data:`NOT_THE_USERS`, matplotlib without a display."""
+    env = {k: v for k, v in os.environ.items() if k not in NOT_THE_USERS}
     env["PATH"] = f"{Path(sys.executable).parent}{os.pathsep}{env.get('PATH', '')}"
     env["MPLBACKEND"] = "Agg"
     return env

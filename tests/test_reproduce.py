@@ -22,6 +22,7 @@ from gearsym.reproduce import claims as claim_checks
 from gearsym.reproduce import SCENARIOS, compute, paper_plan, render, reproduce
 from gearsym.reproduce.compute import box_grid
 from gearsym.reproduce.report import VERDICT_MARK
+from gearsym.reproduce.stability import grid as stability_grid
 from same_numbers import differences, json_differences
 
 DOCS = REPO_ROOT / "docs"
@@ -127,11 +128,14 @@ def test_a_quick_reproduction_writes_every_output_and_reuses_its_data(tmp_path, 
     maps = sorted((tmp_path / "figures" / "data").glob("*/basins/map-*.json"))
     assert len(maps) == 2 * len(paper_plan(True).basins)
     stamps = {p: p.stat().st_mtime_ns for p in (*maps, *(tmp_path / "figures" / "data").glob("*/basins/*.csv"))}
-    drawn = []  # what the second run would draw: each scenario's computed plan, reused
+    drawn = []  # what the second run would draw: each scenario's computed plan, reused, and the stability chart
     monkeypatch.setattr(sys.modules["gearsym.reproduce"], "draw_all",
                         lambda computed, out, suffix="": drawn.append((computed.plan.scenario.name, suffix)) or [])
+    monkeypatch.setattr(sys.modules["gearsym.reproduce"], "draw_stability",
+                        lambda chart, out: drawn.append(("stability", chart.shape)))
     again = reproduce(tmp_path / "figures", tmp_path / "reproduction.md", quick=True)
-    assert drawn == [(s.name, "" if i == 0 else f"-{s.name}") for i, s in enumerate(SCENARIOS)]
+    assert drawn == [(s.name, "" if i == 0 else f"-{s.name}") for i, s in enumerate(SCENARIOS)] + [
+        ("stability", (len(stability_grid(True)["k_a"]), len(stability_grid(True)["omega"])))]
     assert all(json.loads(p.read_text())["points"]["computed"] == 0 for p in records)  # the data were reused
     assert {p: p.stat().st_mtime_ns for p in stamps} == stamps  # the basins' too: read, not written again
     assert again == record

@@ -225,10 +225,10 @@ def test_the_phasing_prediction_places_the_shafts_tongues_where_its_modes_put_th
 def test_the_reproductions_stability_chart_recomputed_matches_the_committed_record(tmp_path):
     """docs/reproduction.md's chart of the paper's model, again: the same tongues, opening at the committed k_a to
     1e-5 (located to 6e-7; another CPU rounds differently), the same verdicts for the two parameter sets."""
-    from gearsym.reproduce.stability import MODEL, stability_record
+    from gearsym.reproduce.stability import MODEL, chart, stability_record
 
     committed = json.loads((ROOT / "docs" / "figures" / "claims.json").read_text())["stability"]
-    again = stability_record(compile_linearisation(conftest.system(MODEL)), tmp_path)
+    again = stability_record(chart(compile_linearisation(conftest.system(MODEL))))
     assert [t["kind"] for t in again["tongues"]] == [t["kind"] for t in committed["tongues"]]
     for t, c in zip(again["tongues"], committed["tongues"]):
         assert abs(t["opens_at_k_a"] - c["opens_at_k_a"]) < 1e-5 and abs(t["omega"] - c["omega"]) < 1e-9

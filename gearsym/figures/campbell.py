@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .layout import fit_texts, LINE_COLORS
-from .save import pyplot, save_figure
+from .layout import LINE_COLORS
+from .save import finish, pyplot
 from .sweep import plot_amplitude
 
 #: a crossing (an order meets a natural frequency): the same mark in both panels
@@ -113,7 +113,4 @@ def plot_campbell(diagram, path: str | Path | None = None, sweep=None, coordinat
     fig.suptitle(f"{diagram.model}: Campbell diagram over {low:g}..{high:g} {unit}"
                  + (f" ({given})" if given else " (the model's values)") + "; natural frequencies "
                  + ", ".join(f"{f:.6g} Hz" for f in diagram.natural_frequencies), fontsize=9)
-    fit_texts(fig)
-    if path is not None:
-        save_figure(fig, path, dpi=120)
-    return fig
+    return finish(fig, path, dpi=120)

@@ -3,7 +3,9 @@
 
 :func:`fit_texts` is called by every figure builder before it returns (and by :func:`~.save.save_figure`):
 it lays the figure out, then re-wraps each title that is wider than what holds it (the figure for a
-suptitle, the axes for an axes title) and lays out again.
+suptitle, the axes for an axes title) and lays out again. Laying out is the layout engine's work alone
+(:func:`lay_out`): where every axes goes follows from the sizes of the texts around it, which need no artist
+drawn; the figure is drawn once, when it is saved.
 """
 from __future__ import annotations
 
@@ -70,18 +72,32 @@ def _fitted_as(fig) -> tuple:
     return (tuple(fig.get_size_inches()), fig.dpi, tuple(id(ax) for ax in fig.axes), tuple(texts))
 
 
-def fit_texts(fig):
+def lay_out(fig) -> None:
+    """Place ``fig``'s axes where its layout engine puts them when it is drawn (constrained layout: from the
+    sizes of the texts around each axes), without drawing an artist: drawing a figure of many points costs its
+    rendering, once, when it is saved. A figure without a layout engine keeps the positions it was given."""
+    engine = fig.get_layout_engine()
+    if fig.axes and engine is not None:
+        try:
+            engine.execute(fig)
+        except ValueError:  # (as matplotlib's own draw: a layout that cannot be made leaves the positions)
+            pass
+
+
+def fit_texts(fig, *, again: bool = False):
     """Wrap every title of ``fig`` that is wider than what holds it, laying the figure out again until
-    nothing changes; returns ``fig``."""
-    if getattr(fig, "_gearsym_fitted", None) == _fitted_as(fig):
+    nothing changes; returns ``fig``, laid out with its final titles. ``again``: lay it out even if it was
+    fitted as it is (what changed since may not show in its titles: :func:`~.save.save_figure` draws the
+    layout made here)."""
+    if not again and getattr(fig, "_gearsym_fitted", None) == _fitted_as(fig):
         return fig
     for _ in range(4):
-        # the layout and every text's size, without rasterising a pixel: a figure of many points costs its
-        # rendering once, when it is saved, not at each pass here
-        fig.draw_without_rendering()
+        lay_out(fig)
         renderer = fig.canvas.get_renderer()
         if not any([_rewrap(text, room, renderer) for text, room in _titles(fig)]):
             break
+    else:
+        lay_out(fig)  # (the layout of the titles as they were last wrapped)
     fig._gearsym_fitted = _fitted_as(fig)
     return fig
 

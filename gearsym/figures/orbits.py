@@ -103,12 +103,13 @@ def place_labels(ax, labels) -> list:
     and not the legend, inside the axes, crossing as few curves as it can, joined to its point by a thin
     line when it had to move away. Returns the labels' Annotations.
 
-    The figure is laid out first; the labels are placed in pixels (written as offsets in points, so that
-    they stay put at any resolution) and kept out of the layout, so that they stay where they were put."""
+    The figure is laid out first (fitted: :func:`~.layout.fit_texts`); the labels are placed in pixels (written
+    as offsets in points, so that they stay put at any resolution) and kept out of the layout, so that they stay
+    where they were put."""
     if not labels:
         return []
     fig = ax.figure
-    fig.draw_without_rendering()  # (the layout, where the labels are placed; no pixel is needed for it)
+    fit_texts(fig)  # (the layout, where the labels are placed: made already if the figure was fitted)
     renderer = fig.canvas.get_renderer()
     frame = ax.get_window_extent(renderer)
     points = ax.transData.transform(np.array([(x, y) for x, y, _ in labels], dtype=float))

@@ -23,9 +23,8 @@ from ..analysis.attractors import Attractor, AttractorSet
 from ..analysis.poincare import Trajectory, phase_trajectory
 from ..errors import GearsymError
 from ..physical.text import parameter_text
-from .layout import fit_texts
 from .phase_plane import phase_axes
-from .save import pyplot, save_figure
+from .save import finish, pyplot
 
 #: overlaid layers: gray first, then black, as the paper's Fig. 4; then colours
 LAYER_COLORS = ("0.55", "k", "C3", "C0", "C2", "C1")
@@ -99,10 +98,7 @@ def plot_attractors(sets: AttractorSet | Sequence[AttractorSet | Sequence[Attrac
                       fontsize=7.5, markerscale=1.0)
         fig.supxlabel(_caption(panels), fontsize=7, color="0.35")
         fig.suptitle(attractors_title(panels, labels), fontsize=9)
-        fit_texts(fig)
-        if path is not None:
-            save_figure(fig, path, dpi=150)
-        return fig
+        return finish(fig, path, dpi=150)
 
 
 def attractors_title(panels: Sequence[Sequence[AttractorSet]], labels: Sequence[str] | None = None) -> str:
@@ -299,10 +295,7 @@ def plot_phase_portraits(panels: Sequence[PhasePanel], path: str | Path | None =
             ax.text(0.02, 0.97, f"({chr(ord('a') + k)})", transform=ax.transAxes, ha="left", va="top",
                     fontsize=11, fontweight="bold")
         fig.supxlabel(_window_caption(panels), fontsize=7, color="0.35")
-        fit_texts(fig)
-        if path is not None:
-            save_figure(fig, path, dpi=150)
-        return fig
+        return finish(fig, path, dpi=150)
 
 
 def _window_caption(panels: Sequence[PhasePanel]) -> str:

@@ -14,9 +14,9 @@ import numpy as np
 
 from ..analysis.lyapunov import LyapunovSpectrum
 from ..analysis.poincare import Trajectory
-from .layout import fit_texts, line_style, outside_below
+from .layout import line_style, outside_below
 from .phase_plane import phase_axes
-from .save import pyplot, save_figure
+from .save import finish, pyplot
 
 
 def plot_point(spectrum: LyapunovSpectrum, trajectory: Trajectory, path: str | Path | None = None,
@@ -65,7 +65,4 @@ def plot_point(spectrum: LyapunovSpectrum, trajectory: Trajectory, path: str | P
         values = ", ".join(f"{k}={v:g}" for k, v in spectrum.parameters.items())
         title = f"{spectrum.model}: {values}\n{spectrum.regime}, λ₁ = {spectrum.exponents[0]:+.4f}"
     fig.suptitle(title, fontsize=9)
-    fit_texts(fig)
-    if path is not None:
-        save_figure(fig, path, dpi=120)
-    return fig
+    return finish(fig, path, dpi=120)

@@ -29,22 +29,39 @@ SAME_MEAN, SAME_MOVED = 2e-3, 2e-4
 
 def save_figure(fig, path: str | Path, dpi: int, keep_same: bool = False) -> Path:
     """Write ``fig`` to ``path`` (folders made as needed) and close it, its titles wrapped to fit
-    (:func:`~.layout.fit_texts`). No 'Software' entry, so the bytes do not depend on the matplotlib version:
-    committed figures are compared as files. Written whole or not at all (:func:`~gearsym.files.atomic.write_atomically`:
+    (:func:`~.layout.fit_texts`): laid out at ``dpi``, then drawn once, as laid out. No 'Software' entry, so the
+    bytes do not depend on the matplotlib version: committed figures are compared as files. Written whole or not at all (:func:`~gearsym.files.atomic.write_atomically`:
     a full disk leaves no half a figure). ``keep_same``: a file already there that shows the same picture
     (:func:`same_picture`) is left as it is (a committed figure redrawn on another machine, whose rounding moved
     a line by a fraction of a pixel)."""
     path = Path(path)
-    fit_texts(fig)
+    fig.set_dpi(dpi)  # (laid out at the resolution it is written at: the layout made here is the one drawn)
+    fit_texts(fig, again=True)
+    engine = fig.get_layout_engine()
     image = io.BytesIO()
     try:
+        if engine is not None:  # drawn as laid out above, not laid out once more
+            fig.set_layout_engine("none")
         fig.savefig(image, format=path.suffix.lstrip(".").lower() or None, dpi=dpi, metadata={"Software": None})
     finally:
+        if engine is not None:
+            fig.set_layout_engine(engine)
         pyplot().close(fig)
     image.seek(0)  # (the picture is read back from its start, without a copy of its bytes)
     if keep_same and path.is_file() and same_picture(image, path):
         return path
     return write_atomically(path, image.getvalue())
+
+
+def finish(fig, path: str | Path | None, dpi: int):
+    """A figure builder's last step: ``fig`` written to ``path`` at ``dpi`` (:func:`save_figure`: its titles are
+    fitted there, at the resolution it is written at) if a path is given, else its titles fitted for the caller
+    (:func:`~.layout.fit_texts`); returns ``fig``."""
+    if path is not None:
+        save_figure(fig, path, dpi)
+    else:
+        fit_texts(fig)
+    return fig
 
 
 def same_picture(a, b: str | Path) -> bool:

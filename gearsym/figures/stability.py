@@ -13,8 +13,7 @@ from ..stability.chart import StabilityChart
 from ..stability.kinds import FOLD, NEIMARK_SACKER, PERIOD_DOUBLING
 from ..physical.basins import OwnNumbers
 from .basins import axis_label, cell_edges
-from .layout import fit_texts
-from .save import pyplot, save_figure
+from .save import finish, pyplot
 
 #: the colour of each kind (stable: white), and of the points without a result
 KIND_COLORS = {FOLD: "#f4a261", PERIOD_DOUBLING: "#4c8bd6", NEIMARK_SACKER: "#8fbf6a"}
@@ -89,10 +88,7 @@ def plot_stability(chart: StabilityChart, path: str | Path | None = None, *, sho
     if prediction is not None:
         draw_prediction(axes[0, 1], prediction, chart)
     fig.suptitle(chart_title(chart, shown, title, fixed), fontsize=10)
-    fit_texts(fig)
-    if path is not None:
-        save_figure(fig, path, dpi=130)
-    return fig
+    return finish(fig, path, dpi=130)
 
 
 def draw_prediction(ax, prediction, chart: StabilityChart) -> None:

@@ -15,8 +15,8 @@ import numpy as np
 from ..analysis.regime import DIVERGED, REGIMES, UNDETERMINED
 from ..errors import GearsymError
 from ..sweep.result import SweepResult
-from .layout import fit_texts, line_style
-from .save import pyplot, save_figure
+from .layout import line_style
+from .save import finish, pyplot
 
 REGIME_COLORS = {"periodic": "#4c72b0", "quasi-periodic": "#55a868", "chaotic": "#dd8452",
                  "hyperchaotic": "#c44e52", "equilibrium": "#8172b3", UNDETERMINED: "#b0b0b0", DIVERGED: "#222222"}
@@ -316,7 +316,4 @@ def plot_sweep(result: SweepResult, path: str | Path | None = None, coordinate: 
                          + (f", the {direction} run" if direction else ", independent points"), fontsize=9)
         axs[3].set_xlabel(_axis_label(result.axes[0].name, result.units))
         fig.suptitle(sweep_title(result, 100), fontsize=8)
-    fit_texts(fig)
-    if path is not None:
-        save_figure(fig, path, dpi=120)
-    return fig
+    return finish(fig, path, dpi=120)

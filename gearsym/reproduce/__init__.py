@@ -17,10 +17,10 @@ from ..options import Execution
 from .basins import basins_record
 from .claims import evaluate
 from .compute import Computed, compute
-from .figures import draw_all
+from .figures import draw_all, draw_stability
 from .plan import NOT_IN_PAPER, SCENARIOS, Plan, Scenario, paper_plan
 from .report import render, write
-from .stability import MODEL as STABILITY_MODEL, stability_record
+from .stability import MODEL as STABILITY_MODEL, chart as stability_chart, stability_record
 
 __all__ = ["SCENARIOS", "Computed", "Plan", "Scenario", "compute", "evaluate", "paper_plan", "record_of", "render",
            "reproduce"]
@@ -70,7 +70,9 @@ def reproduce(out: str | Path = "docs/figures", doc: str | Path | None = None, *
         computed.append(compute(plan, data / scenario.name, execution=execution))
         draw_all(computed[-1], out, "" if i == 0 else f"-{scenario.name}")
     record = record_of(computed)
-    record["stability"] = stability_record(compile_linearisation(load(STABILITY_MODEL)), out, quick)
+    chart = stability_chart(compile_linearisation(load(STABILITY_MODEL)), quick)
+    draw_stability(chart, out)
+    record["stability"] = stability_record(chart)
     record = write(record, out / "claims.json", Path(doc) if doc else out.parent / "reproduction.md")
     for s in record["scenarios"]:
         verdicts = [c["verdict"] for c in s["claims"]]

@@ -7,7 +7,8 @@ says at its top which parameter set it shows (:data:`~gearsym.reproduce.plan.SCE
 calibrated to the paper, or the models' defaults) with the values the paper leaves
 open, and the values it does give.
 
-Each ``figureN(c)`` returns a matplotlib Figure (tests read it); :func:`draw_all` writes them.
+Each ``figureN(c)`` returns a matplotlib Figure (tests read it); :func:`draw_all` writes them, and
+:func:`draw_stability` the stability chart's.
 """
 from __future__ import annotations
 
@@ -23,10 +24,13 @@ from ..figures.orbits import legend_handles, plot_branches, plot_sweep_points
 from ..figures.poincare import PhasePanel, plot_attractors, plot_phase_portraits
 from ..physical.text import parameter_text
 from ..figures.save import pyplot, save_figure
+from ..figures.stability import plot_stability
 from ..figures.sweep import (add_colorbar, plot_amplitude, plot_bifurcation, plot_exponents, plot_map,
                              plot_regime_strip, ZERO_CONTOUR)
+from ..stability.chart import StabilityChart
 from .compute import Computed
 from .plan import CHAOS_BAND, NEAR_ONE, NOT_IN_PAPER, PAPER_JUMPS
+from .stability import MODEL as STABILITY_MODEL
 
 CURVE_COLORS = ("C0", "C3", "C2")
 DPI = 110
@@ -324,4 +328,13 @@ def draw_all(c: Computed, out: str | Path, suffix: str = "") -> list[Path]:
     out = Path(out)
     names = [n for n in FIGURES if (n != "study" or "study_ka" in c.sweeps) and (n != "fig3-orbits" or c.orbits)
              and (n != "basins" or c.basins) and (n != "basin-fractions" or c.fractions)]
-    return [save_figure(build(n, c), out / f"{n}{suffix}.png", FIGURES[n][1], keep_same=True) for n in names]
+    # (fitted as they are written, at their resolution: build's fit at the screen's would be laid out again)
+    return [save_figure(FIGURES[n][0](c), out / f"{n}{suffix}.png", FIGURES[n][1], keep_same=True) for n in names]
+
+
+def draw_stability(chart: StabilityChart, out: str | Path) -> Path:
+    """The stability chart of the paper's model (:mod:`.stability`), kept if the picture is the same (keep_same),
+    as the paper's figures are: another CPU's or matplotlib's rounding moves a pixel or two, and the main job must
+    leave the committed figure as it is."""
+    return save_figure(plot_stability(chart, title=f"{STABILITY_MODEL} at the paper's values (Eq. 2)"),
+                       Path(out) / "stability.png", dpi=110, keep_same=True)

@@ -5,14 +5,11 @@ model's default) lie. Cheap (a few thousand monodromy matrices, one period each)
 keeps numbers that another CPU reproduces to rounding, and the tests compare them with tolerances."""
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 
 from ..checks import json_safe
-from ..figures.save import save_figure
-from ..figures.stability import plot_stability
-from ..stability.chart import static_chart
+from ..stability.chart import StabilityChart, static_chart
 from ..stability.kinds import PERIOD_DOUBLING
 from ..stability.recipe import CompiledLinearisation
 from .plan import SCENARIOS
@@ -30,17 +27,18 @@ def grid(quick: bool) -> dict[str, np.ndarray]:
     return {"omega": np.round(np.arange(w0, w1 + dw / 2, dw), 10), "k_a": np.round(np.arange(k0, k1 + dk / 2, dk), 10)}
 
 
-def stability_record(lin: CompiledLinearisation, out: str | Path, quick: bool = False) -> dict:
-    """The chart of ``lin`` (the paper's model linearised about its static state), its figure written into
-    ``out``, and what the report quotes: the points' verdicts, each tongue's lowest located k_a (where it opens)
-    and its omega, and the scenarios' k_a lines, stable or not along omega."""
+def chart(lin: CompiledLinearisation, quick: bool = False) -> StabilityChart:
+    """The chart of ``lin`` (the paper's model linearised about its static state) on the reproduction's grid,
+    its boundaries located to :data:`TOLERANCE` of each axis's range."""
     g = grid(quick)
     span = (g["omega"][-1] - g["omega"][0], g["k_a"][-1] - g["k_a"][0])
-    chart = static_chart(lin, g, tolerance=(TOLERANCE * span[0], TOLERANCE * span[1]))
-    # kept if the picture is the same (keep_same), as the paper's figures are: another CPU's or matplotlib's rounding
-    # moves a pixel or two, and the main job must leave the committed figure as it is
-    save_figure(plot_stability(chart, title=f"{MODEL} at the paper's values (Eq. 2)"), Path(out) / "stability.png",
-                dpi=110, keep_same=True)
+    return static_chart(lin, g, tolerance=(TOLERANCE * span[0], TOLERANCE * span[1]))
+
+
+def stability_record(chart: StabilityChart) -> dict:
+    """What the report quotes of the chart (its figure is drawn with the others, :mod:`.figures`): the points'
+    verdicts, each tongue's lowest located k_a (where it opens) and its omega, and the scenarios' k_a lines,
+    stable or not along omega."""
     tongues = []
     for b in chart.boundaries:
         if len(b.points) < 2:
@@ -52,10 +50,11 @@ def stability_record(lin: CompiledLinearisation, out: str | Path, quick: bool = 
     lowest = min((t["opens_at_k_a"] for t in tongues), default=None)
     lines = []
     for s in SCENARIOS:
-        ka = s.settings(MODEL).get("k_a", lin.base_parameters["k_a"])
+        ka = s.settings(MODEL).get("k_a", chart.parameters["k_a"])  # (the model's own, where a scenario has none)
         lines.append({"scenario": s.name, "label": s.label, "k_a": ka,
                       "unstable_somewhere": lowest is not None and ka >= lowest})
     principal = next((t for t in tongues if t["kind"] == PERIOD_DOUBLING and 1.5 < t["omega"] < 2.5), None)
+    g = dict(zip(chart.names, chart.values))
     return json_safe({"model": MODEL, "parameters": chart.fixed, "grid": {k: [float(v[0]), float(v[-1]),
                       int(len(v))] for k, v in g.items()}, "steps_per_period": chart.steps_per_period,
                       "counts": chart.counts(), "tongues": tongues, "principal": principal, "scenarios": lines,
