@@ -18,9 +18,9 @@ def model_description(lay: Layout, guid: str, sources: tuple[str, ...], experime
     system = lay.system
     title = system.title or system.name
     files = "".join(f'      <File name={quoteattr(name)}/>\n' for name in sources)
-    common = (f'needsExecutionTool="false" canBeInstantiatedOnlyOncePerProcess="false" '
-              f'canNotUseMemoryManagementFunctions="false" canGetAndSetFMUstate="false" '
-              f'canSerializeFMUstate="false" providesDirectionalDerivative="false"')
+    common = ('needsExecutionTool="false" canBeInstantiatedOnlyOncePerProcess="false" '
+              'canNotUseMemoryManagementFunctions="false" canGetAndSetFMUstate="false" '
+              'canSerializeFMUstate="false" providesDirectionalDerivative="false"')
     out = ['<?xml version="1.0" encoding="UTF-8"?>',
            f'<fmiModelDescription fmiVersion="2.0" modelName={quoteattr(system.name)} guid={quoteattr(guid)}',
            f'  description={quoteattr(_description(lay, title))}',

@@ -31,7 +31,7 @@ import sympy as sp
 
 from ..errors import ModelError
 from .symbols import t
-from .components import Bearing, Body, Gear, Mesh, Planet, Shaft
+from .components import Bearing, Body, Mesh, Planet, Shaft
 from .expressions import to_expr
 from .linear_algebra import named_generators
 from .resolved_components import ResolvedBody, ResolvedCoupling
@@ -101,7 +101,6 @@ class TranslationResolution:
 
     def _translations_of(self, bearing: Bearing, rb: ResolvedBody, index: int) -> list[ResolvedBody]:
         body = rb.body
-        where = f"Bearing {bearing.name!r}"
         if body.mass is None:
             raise ModelError(f"sits on a bearing, so its centre translates: give it a mass ({type(body).__name__}"
                              f"(..., mass='m_{body.name}'))", f"{type(body).__name__} {body.name!r}")

@@ -43,7 +43,7 @@ from ..model.translations import CARRIER_SPEED
 from ..model.symbols import RESERVED, omega, parameter_symbol, phi, t, tau
 from ..system import Constraint, Coupling, FirstOrderSystem, Gearing
 from .coordinates import combination_solver
-from .reduction import Reduction, reduce_drivetrain, sub_frame, with_geometry
+from .reduction import Reduction, reduce_drivetrain, with_geometry
 
 
 @dataclass(frozen=True)
