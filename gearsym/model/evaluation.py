@@ -38,7 +38,7 @@ class PointValues:
 
     def __call__(self, expr) -> mpmath.mpf:
         with mpmath.workdps(self.digits):
-            return self._value(sp.sympify(expr))
+            return self._value(sp.sympify(expr, strict=True))
 
     def _value(self, expr: sp.Expr) -> mpmath.mpf:
         known = self._known.get(expr)

@@ -56,4 +56,4 @@ def partial(expr: sp.Expr, x: sp.Symbol) -> sp.Expr:
         done[e] = out
         return out
 
-    return d(sp.sympify(expr))
+    return d(sp.sympify(expr, strict=True))
