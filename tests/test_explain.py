@@ -28,6 +28,7 @@ import gearsym.fit.levenberg_marquardt as marquardt
 from gearsym.fit import Effect, augment, effect_terms, fit_windows, term_effect
 from gearsym.fit.canonical import amplitude_phase, canonical, wrap_phase
 from gearsym.fit.effects import Change
+from gearsym.fit.problem import Problem
 from gearsym.fit.selection import segments_of
 from gearsym.checks import json_safe
 from gearsym.figures.fit_report import residual_figure
@@ -353,6 +354,20 @@ def test_the_fit_recovers_known_parameters_within_their_errors(one_stage, tmp_pa
     assert result.success
     for p, true in (("zeta", 0.08), ("B1", 4.0)):
         assert abs(result.estimates[p] - true) < 4 * result.stderr[p] + 1e-4
+    # the fit's outputs come from the run that ended it, kept by its problem (not run again): the same bits as a new run
+    # at its estimates, which a problem gives only for unknowns it has not run at lately
+    problem = Problem(one_stage, segments, ["zeta", "B1"], [], 2 * np.pi, Integration())
+    at = np.concatenate([[result.estimates["zeta"], result.estimates["B1"]], result.starts.reshape(-1, order="F")])
+    fresh = problem.run_at(at)
+    assert problem.run_at(at) is not fresh  # (a run of run_at's own is not kept: only those of the fit's calls)
+    problem(at)
+    kept = problem.run_at(at)
+    problem(at + 1e-3)  # a later trial elsewhere
+    assert problem.run_at(at) is kept and problem.run_at(at + 2e-3) is not kept
+    for a, b in ((fresh.states, kept.states), (fresh.outputs, kept.outputs)):
+        assert np.array_equal(a, b)
+    np.testing.assert_array_equal(np.concatenate([res["x"] for res in result.residuals]),
+                                  np.concatenate([seg.observed["x"] for seg in segments]) - fresh.outputs[0])
 
 
 def test_the_fit_stops_where_a_further_step_changes_nothing_the_noise_lets_one_see(one_stage, rig_runs, tmp_path,
