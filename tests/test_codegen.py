@@ -17,7 +17,7 @@ import gearsym.codegen.loaded as loaded_module
 import gearsym.codegen.library as library_module
 import gearsym.codegen.compiler as compiler
 import gearsym.codegen.functions
-from conftest import model_params, system
+from conftest import model_params, slow_models_group, system
 from gearsym import FirstOrderSystem, GearsymError, Integration, ModelError, UnknownParameterError, compile_model
 from gearsym.model.backlash import G, g, g_slope
 from gearsym.codegen import CompilerError
@@ -78,6 +78,7 @@ def test_time_dependence_that_is_not_periodic_is_rejected():
 # ------------------------------------------------------------------ generated/ is what the models give
 @pytest.mark.parametrize("name", model_params(pregenerated_models()))
 @pytest.mark.slow
+@slow_models_group()  # (with `gearsym compile --all --check`, which then compares with the C made here: made once)
 def test_committed_generated_code_is_regenerated_byte_for_byte(name):
     import json
     made_with = json.loads((REPO_ROOT / "generated" / name / "manifest.json").read_text())["casadi_version"]

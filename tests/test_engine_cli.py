@@ -144,6 +144,7 @@ def test_lyap_errors_are_one_line_messages(capsys, argv, message):
 
 
 @pytest.mark.slow
+@slow_models_group()  # (with the other checks of the committed C: each model's C is made once in a worker)
 def test_compile_check_reports_up_to_date(capsys, monkeypatch):
     monkeypatch.chdir(REPO_ROOT)  # (the C is checked where it would be written: the current folder's)
     fast = [m for m in pregenerated_models() if m not in SLOW_MODELS]

@@ -2,7 +2,7 @@
 
 Without fused multiply-adds every lane does the scalar loop's operations in its order, so the records must be the
 same bits; a chaotic model (Lorenz) turns any difference into an O(1) one within a few periods, so it is the
-sharpest check. The libraries are built with -O3 alone: no -march, so the lanes' entry points are the portable
+sharpest check. The libraries are built with -O3 -ffp-contract=off: no -march, so the lanes' entry points are the portable
 build's (cloned for AVX2 and the baseline, the CPU choosing at load time), which is also what must run on a CPU
 without AVX2.
 """
@@ -30,8 +30,15 @@ import conftest
 
 needs_cc = pytest.mark.skipif(find_compiler() is None, reason="needs a C compiler")
 
-#: no fused multiply-adds, no -march: the portable build
-PORTABLE = ("-O3",)
+#: no fused multiply-adds, no -march: the portable build (with no contraction at all: also where the baseline has
+#: FMA); test_printed_loops.py's flags, so that the scalar loops' libraries it compiles are the session cache's
+PORTABLE = ("-O3", "-ffp-contract=off")
+
+
+def loop_options(located: bool) -> LoopOptions:
+    """45 steps a period in blocks of 3 (plain: blocks of several steps, an odd number of them), chunks of 3
+    periods: test_printed_loops.py's options, whose C (and library) it makes too."""
+    return LoopOptions(steps_per_period=45, chunk_periods=3, block_steps=3, locate_crossings=located)
 
 
 _BUILT: dict = {}
@@ -69,9 +76,7 @@ def _records_equal(a, b) -> list[str]:
                                                   ("lorenz", False, None)])
 @pytest.mark.slow
 def test_every_lane_gives_the_bits_of_the_scalar_loop_from_its_start(name, located, omega, tmp_path):
-    # the plain scheme in blocks of 3 steps and 45 steps a period: blocks of several steps, an odd number of them
-    options = LoopOptions(steps_per_period=45 if not located else 90, block_steps=3, locate_crossings=located)
-    model, lanes = _built(name, options, tmp_path)
+    model, lanes = _built(name, loop_options(located), tmp_path)
     assert lanes.width >= 2, "the portable build has lanes (cloned for AVX2 and the baseline on x86-64)"
     values = {"omega": omega} if omega else {}
     inputs = model.prepare(model.parameter_vector(values))
@@ -93,7 +98,7 @@ def test_every_lane_gives_the_bits_of_the_scalar_loop_from_its_start(name, locat
 @needs_cc
 def test_constants_may_differ_from_lane_to_lane(tmp_path):
     """Points of a sweep that share their tables (omega in tau) run in one call, each lane with its constants."""
-    model, lanes = _built("one_stage", LoopOptions(steps_per_period=90, block_steps=3, locate_crossings=True), tmp_path)
+    model, lanes = _built("one_stage", loop_options(True), tmp_path)
     omegas = np.linspace(0.9, 1.6, lanes.width + 2)
     inputs = [model.prepare(model.parameter_vector(omega=w)) for w in omegas]
     constants = np.array([i.constants for i in inputs])
@@ -145,7 +150,7 @@ def test_every_per_step_piece_is_the_models_own_called_in_a_loop_over_the_lanes(
     """The lanes' C (as the generator writes it) includes the model's up to its step pieces and holds no copy
     of them: each per-step piece is the model's, its entries a stride apart, called in a loop over the lanes on
     lane l's entries (the tables of time too); the split and Gram-Schmidt are the scalar loops' own functions."""
-    options = LoopOptions(steps_per_period=90, block_steps=3, locate_crossings=True)
+    options = loop_options(True)
     _built("one_stage", options, tmp_path)
     lanes = _BUILT[("one_stage", options, PORTABLE)][2]
     source, model = lanes.read_text(), (lanes.parent / "one_stage.c").read_text()

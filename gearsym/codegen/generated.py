@@ -8,6 +8,7 @@ from pathlib import Path
 from ..files.atomic import writing
 from ..options import Integration
 from ..system import FirstOrderSystem
+from .code_files import source_file
 from .library import library_describes
 from .compiler import compile_library
 from .functions import build_functions
@@ -35,14 +36,13 @@ def generate_model(system: FirstOrderSystem, out: Path, options: Integration = I
     loops = LoopOptions.of(options, system.cycles)
     digest = code_hash(system, loops)
     target = Path(out) / system.name
-    mf = build_functions(system, loops)
     if check:
-        with tempfile.TemporaryDirectory() as tmp:
-            fresh = write_code(mf, Path(tmp) / system.name, digest)
-            stale = [target / p.name for p in (fresh.source, fresh.lanes, fresh.manifest)
-                     if not (target / p.name).is_file() or (target / p.name).read_bytes() != p.read_bytes()]
-            return GenerateReport(system.name, target / fresh.source.name, digest, fresh.source.stat().st_size,
-                                  stale=stale)
+        fresh = _fresh_code(system, loops, digest)
+        stale = [target / name for name in fresh
+                 if not (target / name).is_file() or (target / name).read_bytes() != fresh[name]]
+        source = source_file(system.name)
+        return GenerateReport(system.name, target / source, digest, len(fresh[source]), stale=stale)
+    mf = build_functions(system, loops)
     with writing(target):
         code = write_code(mf, target, digest)
     report = GenerateReport(system.name, code.source, digest, code.source.stat().st_size)
@@ -51,3 +51,18 @@ def generate_model(system: FirstOrderSystem, out: Path, options: Integration = I
         lib = compile_library(code.source, system.name, describes=library_describes(system, digest))
         report.library, report.compile_seconds = lib.path, lib.seconds if lib.compiled else 0.0
     return report
+
+
+#: the files of a code hash as this process generated them (file name -> bytes): the same hash is the same C (what the
+#: hash is for), so a check of a model checked before in the process (`gearsym compile --check` after the tests' own
+#: checks, a notebook checking twice) compares with these instead of building and printing the model's C again
+_FRESH: dict[str, dict[str, bytes]] = {}
+
+
+def _fresh_code(system: FirstOrderSystem, loops: LoopOptions, digest: str) -> dict[str, bytes]:
+    """The C, lanes' C and manifest of ``system`` with ``loops`` (hash ``digest``), by file name."""
+    if digest not in _FRESH:
+        with tempfile.TemporaryDirectory() as tmp:
+            fresh = write_code(build_functions(system, loops), Path(tmp) / system.name, digest)
+            _FRESH[digest] = {p.name: p.read_bytes() for p in (fresh.source, fresh.lanes, fresh.manifest)}
+    return _FRESH[digest]
