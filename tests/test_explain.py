@@ -216,6 +216,7 @@ def test_a_second_torque_harmonic_is_named_and_the_held_out_error_falls_fivefold
     assert h["phase"] == pytest.approx(math.atan2(-0.5, 1.2), abs=0.1)
 
 
+@pytest.mark.slow
 def test_quadratic_damping_is_named_nonlinear_damping_never_negative_friction(one_stage, rig_runs, tmp_path):
     ex = explain(one_stage, rig_data(rig_runs, tmp_path, "quadratic_damping"), ["zeta", "B1"])
     assert ex.effects == ["nonlinear_damping"] and ex.verdict == "explained"
