@@ -52,7 +52,7 @@ from .stability.recipe import CompiledLinearisation
 from .stability.recipe import StaticRecipe
 
 #: bump when what a summary holds changes
-SUMMARY_FORMAT = 4
+SUMMARY_FORMAT = 5
 
 
 @dataclass(frozen=True, eq=False)
@@ -76,6 +76,9 @@ class SystemSummary(ParameterChecks):
     cycles: int = 1  # forcing periods in one period (a gear's revolution with shaft-order terms)
     fastest: float = 0.0  # the fastest linearised mode's rate and the forcing period at these values: the step's
     cycle: float = 0.0  # choice (codegen/step_choice.py) without the model
+    #: the full system's contact_watches when each is numbers and parameters' names (what an orbit's contact is
+    #: read from, without the reduction); None: from the full system
+    watches: tuple[tuple[str, str, float | str, float | str], ...] | None = None
 
     @property
     def dimension(self) -> int:
@@ -115,6 +118,11 @@ class SystemSummary(ParameterChecks):
         return self.full.period
 
     @property
+    def contact_watches(self) -> tuple:
+        """The meshes an orbit's contact regime is read on (see the full system's ``contact_watches``)."""
+        return self.full.contact_watches if self.watches is None else self.watches
+
+    @property
     def couplings(self):
         """The meshes and shafts the reduction handed on (from the full system)."""
         return self.full.couplings
@@ -126,7 +134,8 @@ class SystemSummary(ParameterChecks):
                 "descriptions": dict(self.descriptions),
                 "constraints": {k: c.as_list() for k, c in self.constraints.items()},
                 "autonomous": self.autonomous, "physical": self.physical, "cycles": self.cycles,
-                "fastest": self.fastest, "cycle": self.cycle}
+                "fastest": self.fastest, "cycle": self.cycle,
+                "watches": None if self.watches is None else [list(w) for w in self.watches]}
 
     @classmethod
     def from_dict(cls, d: dict, load: Callable[[], object]) -> "SystemSummary":
@@ -136,7 +145,7 @@ class SystemSummary(ParameterChecks):
                    {str(k): str(v) for k, v in d["descriptions"].items()},
                    {str(k): Constraint.from_list(c) for k, c in d["constraints"].items()},
                    bool(d["autonomous"]), bool(d["physical"]), load, int(d["cycles"]), float(d["fastest"]),
-                   float(d["cycle"]))
+                   float(d["cycle"]), _watches(d["watches"]))
 
     @classmethod
     def of(cls, system, physical: bool, fastest: float = 0.0) -> "SystemSummary":
@@ -144,7 +153,21 @@ class SystemSummary(ParameterChecks):
         return cls(system.name, system.title, system.time.name, system.state_names, dict(system.parameters),
                    dict(system.initial), tuple(system.coordinates), dict(system.descriptions),
                    dict(system.constraints), system.autonomous, physical, lambda: system, system.cycles,
-                   fastest, system.cycle_at())
+                   fastest, system.cycle_at(),
+                   system.watches if isinstance(system, SystemSummary) else _plain_watches(system.contact_watches))
+
+
+def _plain_watches(watches) -> tuple | None:
+    """``watches`` if each backlash and offset is a number or a parameter's name (what a summary can hold), else
+    None."""
+    plain = all(isinstance(v, (float, str)) for w in watches for v in w[2:])
+    return tuple(tuple(w) for w in watches) if plain else None
+
+
+def _watches(stored) -> tuple | None:
+    if stored is None:
+        return None
+    return tuple((str(n), str(c), *(v if isinstance(v, str) else float(v) for v in (b, o))) for n, c, b, o in stored)
 
 
 @lru_cache(maxsize=None)

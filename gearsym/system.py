@@ -199,6 +199,22 @@ class FirstOrderSystem(ParameterChecks, Model):
     def state_names(self) -> tuple[str, ...]:
         return tuple(s.name for s in self.states)
 
+    @cached_property
+    def contact_watches(self) -> tuple[tuple[str, str, object, object], ...]:
+        """(name, coordinate, backlash, offset) of each mesh with backlash whose contact coordinate is observed and
+        shifted by parameters only (contact = coordinate + offset; every mesh of the shipped drivetrains), what an
+        orbit's extremes are read on: backlash and offset as a number, a parameter's name, or an expression."""
+        out = []
+        params = set(self.parameters)
+        for c in self.couplings:
+            if c.kind != "mesh" or c.backlash == 0 or c.coordinate not in self.observed:
+                continue
+            offset = sp.simplify(c.contact - sp.Symbol(c.coordinate, real=True))
+            if {s.name for s in offset.free_symbols} - params:
+                continue  # shifted by time or states: no extreme of the coordinate says where it is
+            out.append((c.name, c.coordinate, _plain(c.backlash), _plain(offset)))
+        return tuple(out)
+
     @property
     def full(self) -> "FirstOrderSystem":
         """The system itself (the start-up cache's summary of one, :class:`~gearsym.cached.SystemSummary`, loads
@@ -239,3 +255,10 @@ class FirstOrderSystem(ParameterChecks, Model):
     def jacobian(self) -> sp.Matrix:
         """Exact Jacobian d rhs / d y."""
         return sp.Matrix(self.rhs).jacobian(sp.Matrix(self.states))
+
+
+def _plain(expr: sp.Expr) -> float | str | sp.Expr:
+    """A number as a float, a parameter as its name, anything else as the expression."""
+    if expr.is_Number:
+        return float(expr)
+    return expr.name if isinstance(expr, sp.Symbol) else expr

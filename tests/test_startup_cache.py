@@ -155,6 +155,26 @@ def test_a_command_on_a_cached_model_imports_neither_sympy_nor_pint(model_copy, 
     assert json.loads(run.stdout) == json.loads(first.stdout) == lyap(capsys, *unplotted[:-len(ARGS)])
 
 
+@pytest.mark.slow
+def test_an_orbit_of_a_cached_model_imports_neither_sympy_nor_pint(model_copy):
+    """Its contact regime is read on the meshes the summary names (the reduction's couplings are not loaded)."""
+    script = ("import sys; from gearsym.cli import main; "
+              f"main(['orbits', {str(model_copy('one_stage'))!r}, '--set', 'omega=1.2']); "
+              "print(sorted(m for m in ('sympy', 'pint') if m in sys.modules), file=sys.stderr)")
+
+    def command():
+        return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO_ROOT,
+                              env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120)
+
+    first = command()
+    assert first.returncode == 0, first.stderr
+    run = command()
+    assert run.returncode == 0, run.stderr
+    assert run.stderr.strip().splitlines()[-1] == "[]", run.stderr[-3000:]
+    assert run.stdout == first.stdout
+    assert "contact of mesh: single-sided impact" in run.stdout
+
+
 def test_a_single_spectrum_loads_no_other_analysis():
     """What `gearsym lyap` imports (its command and the start-up cache) leaves out the runs from many starts, the
     lanes, the orders and their figures: each module is start-up time of every cached run (issue 39)."""

@@ -137,7 +137,7 @@ def run(args: argparse.Namespace) -> int:
         given = parameter[0]
         parameter = engine_range(args, parameter, scaling)
         refuse_swept_and_set([(given, args.param), (parameter[0], args.param)], args.set)
-    system = model.system
+    system = model.summary  # (a cached model's: no reduction for these checks)
     if args.segments is not None:  # (before the code is compiled: a period of cycles forcing periods has
         pieces = system.cycles * pieces_per_period(options.steps_per_period)  # pieces in each)
         check_segments(args.segments, pieces, f"--segments {args.segments}: ", options.steps_per_period * system.cycles)

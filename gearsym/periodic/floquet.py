@@ -26,7 +26,6 @@ from dataclasses import dataclass
 from itertools import combinations
 
 import numpy as np
-import sympy as sp
 
 from ..codegen import CompiledModel
 
@@ -68,14 +67,14 @@ class MeshWatch:
     name: str
     coordinate: str
     column: int  # in the model's observed states
-    backlash: sp.Expr
-    offset: sp.Expr  # contact = coordinate + offset (an effect may shift it by parameters)
+    backlash: float | str | object  # a number, a parameter's name or a SymPy expression in parameters
+    offset: float | str | object  # contact = coordinate + offset (an effect may shift it by parameters)
 
-    def value(self, expr: sp.Expr, names: tuple[str, ...], p: np.ndarray) -> float:
-        if expr.is_Number:
+    def value(self, expr, names: tuple[str, ...], p: np.ndarray) -> float:
+        if isinstance(expr, (int, float)):
             return float(expr)
-        if isinstance(expr, sp.Symbol):
-            return float(p[names.index(expr.name)])
+        if isinstance(expr, str):
+            return float(p[names.index(expr)])
         return float(expr.xreplace({s: float(p[names.index(s.name)]) for s in expr.free_symbols}))
 
     def extremes(self, low: np.ndarray, high: np.ndarray, names, p) -> tuple[float, float, float]:
@@ -86,17 +85,10 @@ class MeshWatch:
 
 def mesh_watches(model: CompiledModel) -> tuple[MeshWatch, ...]:
     """The meshes with backlash of ``model`` whose contact coordinate is observed and shifted by parameters
-    only (every mesh of the shipped drivetrains); none for a plain ODE."""
-    out = []
-    params = set(model.parameter_names)
-    for c in model.system.couplings:
-        if c.kind != "mesh" or c.backlash == 0 or c.coordinate not in model.observed:
-            continue
-        offset = sp.simplify(c.contact - sp.Symbol(c.coordinate, real=True))
-        if {s.name for s in offset.free_symbols} - params:
-            continue  # shifted by time or states: no extreme of the coordinate says where it is
-        out.append(MeshWatch(c.name, c.coordinate, model.observed.index(c.coordinate), c.backlash, offset))
-    return tuple(out)
+    only (every mesh of the shipped drivetrains); none for a plain ODE. A model from the start-up cache reads
+    them from its summary (no SymPy, no reduction)."""
+    return tuple(MeshWatch(name, coordinate, model.observed.index(coordinate), backlash, offset)
+                 for name, coordinate, backlash, offset in model.system.contact_watches)
 
 
 def contact_regime(low: float, high: float, eta: float) -> str:
