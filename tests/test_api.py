@@ -99,6 +99,7 @@ def test_a_verb_on_a_system_is_the_verb_on_the_system_compiled_with_the_same_opt
     assert np.array_equal(orbit.strobe, low.strobe)
 
 
+@pytest.mark.slow
 def test_a_system_is_compiled_for_each_verbs_own_run_when_no_options_are_given():
     duffing = FirstOrderSystem.from_equations(
         "weak_duffing", ["x", "v"], ["v", "-d*v + x - x**3 + F*cos(w*t)"], {"d": 0.3, "F": 0.1, "w": 1.2},

@@ -48,6 +48,7 @@ def side_of_each_run(found) -> list[int]:
 
 
 # ------------------------------------------------------------------------------------------ grouping
+@pytest.mark.slow
 def test_weak_forcing_gives_one_period_one_orbit_per_well(duffing):
     found = find_attractors(duffing, ics=12, seed=3, box=WELLS, options=run(duffing, 210, 150))
     assert len(found) == 2
@@ -151,6 +152,7 @@ def test_bad_input_is_a_clear_error(duffing, kwargs, message):
 
 
 # ------------------------------------------------------------------------------------------ figures
+@pytest.mark.slow
 def test_figures_are_written(duffing, tmp_path):
     from gearsym.figures.poincare import PhasePanel, phase_panel, plot_attractors, plot_phase_portraits
 

@@ -185,6 +185,7 @@ def stable_points(p: float) -> list[float]:
     return [float(real[0]), float(real[-1])] if len(real) == 3 else [float(real[0])]
 
 
+@pytest.mark.slow
 def test_a_continuation_tracks_attractors_that_split_merge_and_vanish(fork):
     """0 splits into -0.2 and 0.1: the nearer (0.1, attractor 2 of the map by its points) keeps the id, -0.2 is new;
     they merge back into 0 (the farther one merges into the nearer's id); then two far apart points appear and

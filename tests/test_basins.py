@@ -234,6 +234,7 @@ def test_cli_errors_are_one_line_messages(capsys, argv, message):
     assert all(line.startswith("gearsym: compiling") for line in before)  # (at most the note of a first compile)
 
 
+@pytest.mark.slow
 def test_a_model_with_physical_values_is_mapped_and_answered_in_its_units(capsys):
     code, out, _ = run_cli(capsys, "basins", "spur_pair", "--grid", "x=-20um:20um:20um", "--grid",
                            "v=-300mm/s:300mm/s:300mm/s", "--periods", "60", "--discard", "20", "--format", "json")

@@ -325,6 +325,7 @@ def test_summaries_edited_with_their_seal_made_again_are_checked_against_the_lib
     assert run.stdout == clean["one_stage"]
 
 
+@pytest.mark.slow
 def test_a_summary_pointing_at_another_models_library_is_not_trusted(cache, clean):
     _, build = summaries(cache)
     _, lorenz = summaries(cache, "lorenz")
@@ -337,6 +338,7 @@ def test_a_summary_pointing_at_another_models_library_is_not_trusted(cache, clea
     assert run.stdout == clean["one_stage"]
 
 
+@pytest.mark.slow
 def test_a_summary_pointing_at_a_library_outside_the_caches_lib_folder_never_loads_it(cache, clean, planted,
                                                                                        tmp_path):
     """A library beside a record that vouches for it, in a folder of the user's own, but not the cache's lib/: a

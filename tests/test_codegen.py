@@ -116,6 +116,7 @@ def test_manifest_records_hash_options_and_casadi_version():
     # in the log stretches after 60 periods; the periodic point keeps the 1e-12
     (Integration, ({"omega": 1.7, "kS": 1.0},)),
 ])
+@pytest.mark.slow
 def test_compiled_and_in_process_agree(scheme, points):
     compiled = compile_model(system("flexible_shaft"), scheme(backend="compiled"))
     inproc = compile_model(system("flexible_shaft"), scheme(backend="in-process"))
@@ -156,6 +157,7 @@ def test_changing_parameters_never_rebuilds(monkeypatch):
     assert again.parameter_vector()[list(again.parameter_names).index("omega")] == 0.7
 
 
+@pytest.mark.slow
 def test_library_cache_survives_a_new_process_and_misses_on_a_new_model(monkeypatch):
     compile_model(system("lorenz"))
     monkeypatch.setattr(loaded_module, "LOADED", {})  # as in a fresh process

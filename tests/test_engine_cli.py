@@ -52,6 +52,7 @@ def test_lyap_locates_the_crossings_unless_told_plain_as_the_python_api_does(cap
     assert "200 RK4 steps/period, crossings located" in out
 
 
+@pytest.mark.slow
 def test_lyap_accepts_a_new_stiffness_formula(capsys):
     """The exponents with k = 1 + 0.3 cos(tau) are those of Eq. 2 with that k typed in NumPy (the paper's plain
     RK4, as --plain runs it), not those of the model's own k(tau)."""

@@ -28,6 +28,7 @@ import gearsym.fit.levenberg_marquardt as marquardt
 from gearsym.fit import Effect, augment, effect_terms, fit_windows, term_effect
 from gearsym.fit.canonical import amplitude_phase, canonical, wrap_phase
 from gearsym.fit.effects import Change
+from gearsym.fit.problem import Problem
 from gearsym.fit.selection import segments_of
 from gearsym.checks import json_safe
 from gearsym.figures.fit_report import residual_figure
@@ -216,6 +217,7 @@ def test_a_second_torque_harmonic_is_named_and_the_held_out_error_falls_fivefold
     assert h["phase"] == pytest.approx(math.atan2(-0.5, 1.2), abs=0.1)
 
 
+@pytest.mark.slow
 def test_quadratic_damping_is_named_nonlinear_damping_never_negative_friction(one_stage, rig_runs, tmp_path):
     ex = explain(one_stage, rig_data(rig_runs, tmp_path, "quadratic_damping"), ["zeta", "B1"])
     assert ex.effects == ["nonlinear_damping"] and ex.verdict == "explained"
@@ -353,6 +355,20 @@ def test_the_fit_recovers_known_parameters_within_their_errors(one_stage, tmp_pa
     assert result.success
     for p, true in (("zeta", 0.08), ("B1", 4.0)):
         assert abs(result.estimates[p] - true) < 4 * result.stderr[p] + 1e-4
+    # the fit's outputs come from the run that ended it, kept by its problem (not run again): the same bits as a new run
+    # at its estimates, which a problem gives only for unknowns it has not run at lately
+    problem = Problem(one_stage, segments, ["zeta", "B1"], [], 2 * np.pi, Integration())
+    at = np.concatenate([[result.estimates["zeta"], result.estimates["B1"]], result.starts.reshape(-1, order="F")])
+    fresh = problem.run_at(at)
+    assert problem.run_at(at) is not fresh  # (a run of run_at's own is not kept: only those of the fit's calls)
+    problem(at)
+    kept = problem.run_at(at)
+    problem(at + 1e-3)  # a later trial elsewhere
+    assert problem.run_at(at) is kept and problem.run_at(at + 2e-3) is not kept
+    for a, b in ((fresh.states, kept.states), (fresh.outputs, kept.outputs)):
+        assert np.array_equal(a, b)
+    np.testing.assert_array_equal(np.concatenate([res["x"] for res in result.residuals]),
+                                  np.concatenate([seg.observed["x"] for seg in segments]) - fresh.outputs[0])
 
 
 def test_the_fit_stops_where_a_further_step_changes_nothing_the_noise_lets_one_see(one_stage, rig_runs, tmp_path,

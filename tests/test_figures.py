@@ -30,6 +30,7 @@ def up_and_down():
                      **SHORT)
 
 
+@pytest.mark.slow
 def test_sweep_plot_legends_say_which_line_style_is_which_direction(up_and_down):
     amplitude, exponents, bifurcation, _ = plot_sweep(up_and_down).axes[:4]
     labels = [t.get_text() for t in amplitude.get_legend().get_texts()]
@@ -56,6 +57,7 @@ def test_sweep_plot_titles_carry_the_fixed_parameter_values(up_and_down):
         assert f"{name}={up_and_down.record['parameters'][name]:g}" in title
 
 
+@pytest.mark.slow
 def test_2d_sweep_maps_name_their_axes_direction_and_fixed_values():
     result = run_sweep(system("one_stage"), ["omega=1.2,1.3", "B1=3.5,4"], **SHORT)
     fig = plot_sweep(result)
@@ -319,6 +321,7 @@ def test_a_long_title_is_wrapped_inside_the_figure(point):
     assert "a_user_model_with_a_long_name" in title and all(f"{k}=" in title for k in many)
 
 
+@pytest.mark.slow
 def test_the_legends_of_lyap_plot_cover_no_poincare_point(point):
     """Even where the Poincare points fill the phase plane (a chaotic attractor), no legend covers one."""
     spectrum, trajectory = point
@@ -332,6 +335,7 @@ def test_the_legends_of_lyap_plot_cover_no_poincare_point(point):
 
 
 # ------------------------------------------------------------------ attractors: poincare --plot
+@pytest.mark.slow
 def test_the_poincare_figure_names_the_model_and_every_parameter():
     """It was titled 'ω=1.6' only."""
     found = find_attractors(compiled("one_stage", Integration(periods=60, discard=40)), ics=3, seed=0, omega=1.6)
@@ -394,6 +398,7 @@ def eight_exponents():
     return synthetic_sweep({"omega": x}, columns, strobe, model="planetary")
 
 
+@pytest.mark.slow
 def test_eight_exponent_lines_are_told_apart_even_where_they_coincide():
     """The planetary sweep's 8 exponent lines were indistinguishable."""
     fig = plot_sweep(eight_exponents())

@@ -169,6 +169,7 @@ def test_model_exchange_agrees_with_an_independent_solution_to_its_tolerance(one
     assert error_tight < error_loose / 20  # the error follows CVode's tolerance
 
 
+@pytest.mark.slow
 def test_model_exchange_stops_at_every_kink_of_the_backlash(one_stage):
     """The event indicators are x and -(x + eta): CVode stops where either changes sign, as many times as the
     independent solution crosses x = 0 and x = -eta (eta = 3 here, set through FMI, so that both flanks are
@@ -439,6 +440,7 @@ def test_the_archive_is_the_same_bytes_when_built_again_and_names_nothing_of_thi
         assert where.encode() not in data, where
 
 
+@pytest.mark.slow
 def test_the_fmu_carries_the_engines_c_and_fmpy_builds_it_from_its_sources(one_stage, built):
     """sources/ is enough: FMPy compiles it (CMake) into a binary that gives the same run."""
     from fmpy.build import build_platform_binary
@@ -585,6 +587,7 @@ def test_a_fault_depth_outside_0_to_1_is_refused_by_the_fmu(cracked, q):
             "of the stiffness of the pair of tooth 7 of 'gear1' that its fault takes away)") in log
 
 
+@pytest.mark.slow
 def test_all_writes_one_fmu_per_model_into_the_folder(tmp_path, monkeypatch, capsys):
     """`gearsym fmu --all --out DIR` (docs/fmu.md): an FMU for each model of `gearsym list`, named after it, into
     DIR, each said in a line. Two models stand for the list here: every shipped model's FMU costs a minute."""

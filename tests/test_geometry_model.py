@@ -179,6 +179,7 @@ def test_the_default_series_stays_within_the_curves_extremes(spur_mesh):
 
 
 # ------------------------------------------------------------------ derive -> compile -> lyap / sweep / orbits
+@pytest.mark.slow
 def test_a_pair_declared_from_geometry_derives_compiles_and_runs_in_physical_units():
     model = geared_pair()
     nd = gearsym.reduce(model)  # derive: the series is a term of the reduced equations' k(tau)

@@ -87,6 +87,7 @@ def shadowing(tmp_path):
     return tmp_path
 
 
+@pytest.mark.slow
 def test_a_models_package_in_the_working_directory_that_replaces_a_shipped_model_is_named(shadowing):
     shadow = shadowing / "models" / "one_stage.py"
     for _ in range(2):  # (the second run from the cache, without loading the model: said all the same)

@@ -185,6 +185,7 @@ def test_an_independent_sweep_in_the_lanes_gives_the_scalar_sweeps_rows(name, ax
     assert list(wide.record.items()) == list(one.record.items())
 
 
+@pytest.mark.slow
 def test_the_lanes_spectra_carry_each_start_s_verdict_as_lyapunov_spectrum_gives_it():
     """lyapunov_spectra (find_attractors' runs, in the lanes) gives each start what lyapunov_spectrum gives it from
     there: the regime (where the exponents cannot decide, decided by the Poincare points: periodic, or
@@ -207,6 +208,7 @@ def escape_oscillator() -> FirstOrderSystem:
                                            {"d": 0.1, "F": 0.02, "w": 0.8}, time="t", period="2*pi/w")
 
 
+@pytest.mark.slow
 def test_a_start_that_diverges_in_the_lanes_is_diverged_and_find_attractors_names_it():
     """A run that grows without bound is 'diverged' in the lanes as in lyapunov_spectrum (not an error, not a
     regime); find_attractors, which has no attractor to group it with, says which start and what to do."""

@@ -129,6 +129,7 @@ def harmonic_balance_folds(zeta: float, beta: float, force: float) -> np.ndarray
     return np.sort(w[turns])
 
 
+@pytest.mark.slow
 def test_the_duffing_folds_agree_with_scipy_shooting_and_weakly_nonlinear_with_harmonic_balance():
     folds = continue_orbits(duffing(), "omega", 0.6, 2.0).of_kind(FOLD)
     assert len(folds) == 2
@@ -162,6 +163,7 @@ def test_folds_bracket_the_hysteresis_of_a_sweep_up_and_down_within_a_grid_step(
 
 
 # ------------------------------------------------------------------ the command
+@pytest.mark.slow
 def test_gearsym_orbits_writes_a_plain_odes_branches_bifurcations_and_curve(tmp_path, capsys):
     out = tmp_path / "frc.csv"
     assert main(["orbits", "duffing", "--param", "omega=0.8:1.6", "--out", str(out), "--plot",
@@ -229,6 +231,7 @@ def test_an_interrupted_continuation_keeps_and_writes_what_it_traced(tmp_path, c
     assert len(out.read_text().splitlines()) == 1 + 12
 
 
+@pytest.mark.slow
 def test_a_physical_models_orbits_continue_over_a_speed_range_in_rpm(tmp_path, capsys):
     """speed=1000rpm:3000rpm is the omega range it moves: the mesh frequency is proportional to the speed."""
     from conftest import reduced

@@ -98,6 +98,7 @@ def pair_model() -> Drivetrain:
     return m
 
 
+@pytest.mark.slow
 def test_a_simulation_of_the_physical_lagrange_equations_agrees_with_gearsym_carried_back():
     from scipy.integrate import solve_ivp
 

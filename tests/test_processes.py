@@ -143,6 +143,7 @@ def test_without_the_kernels_help_workers_still_die_with_their_parent(tmp_path, 
     assert len(workers) == 2 and left_alive(workers) == []
 
 
+@pytest.mark.slow
 @needs_fork
 def test_sigterm_stops_a_sweep_like_ctrl_c(tmp_path, sweep_process):
     out = tmp_path / "part.csv"

@@ -209,6 +209,7 @@ CASES = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name,targets", CASES)
 def test_reduced_equations_match_lagrange_numerically(name, targets):
     rng = random.Random(zlib.crc32(f"{name}{sorted(targets.items())}".encode()))
@@ -272,6 +273,7 @@ def test_first_order_system_flexible_shaft_matches_eq9():
         assert got == pytest.approx([v1, a1, v2, a2], rel=1e-10, abs=1e-10)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["one_stage_resonant", "two_stage", "rich"])
 def test_first_order_system_matches_second_order_equations(name):
     """Generic: x_i'' from nd.equations with groups and k(tau) substituted, vs system().rhs."""

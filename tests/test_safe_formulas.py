@@ -143,6 +143,7 @@ def test_the_code_generator_takes_no_strings(sandbox):
 
 
 
+@pytest.mark.slow
 def test_no_module_hands_sympify_what_it_could_run():
     """Every sympify in the package is strict (numbers and SymPy objects only: a string is refused, never parsed as
     Python), so a value that comes from a model file, the cache or a record can reach none as code."""

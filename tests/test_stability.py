@@ -183,6 +183,7 @@ def test_the_command_writes_the_chart_as_json_and_says_what_it_linearised(tmp_pa
     assert json.loads(out.with_suffix(".json").read_text())["boundaries"] == data["boundaries"]
 
 
+@pytest.mark.slow
 def test_a_physical_axis_is_charted_when_the_start_up_cache_already_holds_the_models_numbers(capsys):
     """After another command on the model (here lyap), its scaling comes from the start-up cache (a stand-in that
     converts no axis): the chart converts the speed in rpm with the full scaling all the same."""
@@ -222,6 +223,7 @@ def test_the_phasing_prediction_places_the_shafts_tongues_where_its_modes_put_th
         assert chart.stable[0, j] == False, t.label  # noqa: E712 (an object array: True, False or None)
 
 
+@pytest.mark.slow
 def test_the_reproductions_stability_chart_recomputed_matches_the_committed_record(tmp_path):
     """docs/reproduction.md's chart of the paper's model, again: the same tongues, opening at the committed k_a to
     1e-5 (located to 6e-7; another CPU rounds differently), the same verdicts for the two parameter sets."""

@@ -39,6 +39,7 @@ def _numeric(expr, system, values: dict):
     return sp.lambdify((system.time, x), expr.xreplace(subs), "numpy")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["tooth_stiffness", "tooth_profile"])
 def test_the_fits_slots_are_the_written_out_form_in_every_window(geared, kind):
     """Per-tooth values at random: within two forcing periods from any start, the mesh law of the form the fit

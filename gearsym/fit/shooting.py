@@ -124,7 +124,7 @@ def _result(problem: Problem, u, J, r, iterations, converged, low, high, why, ri
     estimates = dict(zip(problem.fit, map(float, theta)))
     for name in at:
         stderr[name] = None
-    run = problem.run(theta, S, False)
+    run = problem.run_at(u)  # (the run that ended the fit, kept by the problem)
     predicted, residuals, states = [], [], []
     for k, seg in enumerate(problem.segments):
         cols = slice(problem.offsets[k], problem.offsets[k + 1])
