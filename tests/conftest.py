@@ -8,6 +8,8 @@ module-level singletons shared by all tests: tests must never mutate them
 from __future__ import annotations
 
 import collections
+from pathlib import Path
+from types import SimpleNamespace
 
 import functools
 import sys
@@ -33,6 +35,18 @@ def slow_models_group():
     import pytest
 
     return pytest.mark.xdist_group(SLOW_MODELS_GROUP)
+
+
+#: the xdist group of the tests that read the one quick reproduction of the session (`quick_reproduction`): its
+#: figures checked in test_figures.py, its files in test_reproduce.py, made once on one worker
+QUICK_REPRODUCTION_GROUP = "the quick reproduction"
+
+
+def quick_reproduction_group():
+    """The mark of a test that reads the session's quick reproduction (see QUICK_REPRODUCTION_GROUP)."""
+    import pytest
+
+    return pytest.mark.xdist_group(QUICK_REPRODUCTION_GROUP)
 
 
 def model_params(names):
@@ -209,6 +223,38 @@ def _cores_for_two_workers():
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(workers, "cores", lambda: max(2, cores()))
         yield
+
+
+@pytest.fixture(scope="session")
+def quick_reproduction(tmp_path_factory):
+    """``gearsym reproduce --quick`` run once for the session, as the user runs it (into a folder of its own):
+    its folder, its record, each scenario's computed plan (by scenario name) and every figure it wrote (by file
+    name), as written: laid out at the resolution it was written at, on an Agg canvas that draws that layout
+    (the layout engine set aside, as when it was saved), so that a check reads what the PNG shows."""
+    import gearsym.figures.save as save
+    import gearsym.reproduce as reproduction
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    computed, figures = {}, {}
+    written, drawn = save.save_figure, reproduction.draw_all
+
+    def kept(fig, path, *args, **kwargs):
+        figures[Path(path).name] = fig
+        return written(fig, path, *args, **kwargs)
+
+    def recorded(c, out, suffix=""):
+        computed[c.plan.scenario.name] = c
+        return drawn(c, out, suffix)
+
+    out = tmp_path_factory.mktemp("quick-reproduction")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(reproduction, "draw_all", recorded)
+        patch.setattr(sys.modules["gearsym.reproduce.figures"], "save_figure", kept)
+        record = reproduction.reproduce(out / "figures", out / "reproduction.md", quick=True)
+    for fig in figures.values():
+        FigureCanvasAgg(fig)  # (the closed figure's canvas: drawn as saved, not laid out again)
+        fig.set_layout_engine("none")
+    return SimpleNamespace(out=out, record=record, computed=computed, figures=figures)
 
 
 @pytest.fixture

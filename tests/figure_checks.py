@@ -8,19 +8,25 @@ from matplotlib.text import Text
 
 
 def laid_out(fig):
-    fig.canvas.draw()
+    """``fig`` drawn (laid out by its engine, as when it is saved) and the renderer it was drawn with: drawn
+    again only if something changed since it was last drawn (the checks of one figure read one layout)."""
+    if fig.stale or getattr(fig, "_checks_drawn", None) is not fig.canvas:
+        fig.canvas.draw()
+        fig._checks_drawn = fig.canvas
     return fig.canvas.get_renderer()
 
 
 def _undrawn_tick_labels(fig) -> set[int]:
-    """Tick labels matplotlib keeps but does not draw (their ticks lie outside the axis' view)."""
-    out = set()
+    """Tick labels matplotlib keeps but does not draw (their ticks lie outside the axis' view). Read only: the
+    ticks it asks for are those the draw made (a figure drawn before is left as not changed since)."""
+    out, stale = set(), fig.stale
     for ax in fig.findobj(lambda a: hasattr(a, "xaxis") and hasattr(a, "yaxis")):
         for axis in (ax.xaxis, ax.yaxis):
             drawn = {id(t) for t in axis._update_ticks()}
             for tick in [*axis.get_major_ticks(), *axis.get_minor_ticks()]:
                 if id(tick) not in drawn:
                     out |= {id(tick.label1), id(tick.label2)}
+    fig.stale = stale
     return out
 
 

@@ -9,9 +9,9 @@ import pytest
 
 from gearsym.figures.poincare import REGIME_MARKERS
 from gearsym.figures.sweep import plot_sweep
-from gearsym.reproduce import compute, paper_plan
+from gearsym.reproduce import SCENARIOS
 from gearsym.reproduce import figures as paper_figures
-from conftest import system
+from conftest import quick_reproduction_group, system
 from gearsym import Integration, run_sweep
 
 SHORT = dict(options=Integration(periods=60, discard=20))
@@ -67,23 +67,35 @@ def test_2d_sweep_maps_name_their_axes_direction_and_fixed_values():
 
 
 # ------------------------------------------------------------------ the paper's figures
+# (as `gearsym reproduce --quick` writes them: the session's one quick reproduction, whose files test_reproduce.py
+# checks; its first scenario, the one calibrated to the paper)
 @pytest.fixture(scope="module")
-def computed(tmp_path_factory):
-    return compute(paper_plan(quick=True, study=False), tmp_path_factory.mktemp("data"))
+def computed(quick_reproduction):
+    return quick_reproduction.computed[SCENARIOS[0].name]
+
+
+def written(quick_reproduction, name):
+    """The figure ``name`` of the first scenario as the quick reproduction wrote it (laid out, titles fitted)."""
+    return quick_reproduction.figures[f"{name}.png"]
+
+
+def suptitle(fig) -> str:
+    return fig._suptitle.get_text().replace("\n", " ")  # (as wrapped to fit: a line break for a space)
 
 
 @pytest.mark.parametrize("name", ["fig3", "fig4", "fig6", "fig7", "hysteresis"])
 @pytest.mark.slow
-def test_every_paper_figure_states_its_parameter_set(computed, name):
-    fig = paper_figures.FIGURES[name][0](computed)
-    top = fig._suptitle.get_text()
+@quick_reproduction_group()
+def test_every_paper_figure_states_its_parameter_set(quick_reproduction, computed, name):
+    top = suptitle(written(quick_reproduction, name))
     assert f"parameter set: {computed.plan.scenario.label} ($k_a$=0.05" in top
     assert "the paper's values: " in top and "B1=4" in top
 
 
 @pytest.mark.slow
-def test_figure_4_marks_each_attractor_by_its_regime_in_both_panels(computed):
-    fig = paper_figures.figure4(computed)
+@quick_reproduction_group()
+def test_figure_4_marks_each_attractor_by_its_regime_in_both_panels(quick_reproduction, computed):
+    fig = written(quick_reproduction, "fig4")
     for ax, omega in zip(fig.axes, (1.5, 1.6)):
         legend = ax.get_legend()
         entries = [(t.get_text(), h.get_marker()) for t, h in zip(legend.get_texts(), legend.legend_handles)]
@@ -93,8 +105,10 @@ def test_figure_4_marks_each_attractor_by_its_regime_in_both_panels(computed):
                 assert marker == REGIME_MARKERS[a.regime] and f"'{a.paper_label}'" in text and "#" not in text
 
 
-def test_figure_6c_has_an_inset_on_lambda_1_and_2_near_zero(computed):
-    fig = paper_figures.figure6(computed)
+@pytest.mark.slow  # (it reads a reproduction)
+@quick_reproduction_group()
+def test_figure_6c_has_an_inset_on_lambda_1_and_2_near_zero(quick_reproduction, computed):
+    fig = written(quick_reproduction, "fig6")
     panel = next(ax for ax in fig.axes if ax.get_title().startswith("kS = 0.1"))
     (inset,) = panel.child_axes
     r = computed.sweeps["fig6"]
@@ -105,13 +119,16 @@ def test_figure_6c_has_an_inset_on_lambda_1_and_2_near_zero(computed):
     assert low < 0 < high and (high - low) < 0.25 * np.diff(panel.get_ylim())[0]
 
 
-def test_figure_7_panels_show_their_runs_regime_and_poincare_points_in_the_drawn_window(computed):
-    fig = paper_figures.figure7(computed)
+@pytest.mark.slow  # (it reads a reproduction)
+@quick_reproduction_group()
+def test_figure_7_panels_show_their_runs_regime_and_poincare_points_in_the_drawn_window(quick_reproduction, computed):
+    fig = written(quick_reproduction, "fig7")
     steps = computed.portraits[0].spectrum.steps_per_period
     panels = [ax for ax in fig.axes if ax.get_visible()]
     assert len(panels) == len(computed.portraits)
     for ax, p in zip(panels, computed.portraits):
-        assert p.spectrum.regime in ax.get_title() and f"λ₁ = {p.spectrum.exponents[0]:+.4f}" in ax.get_title()
+        title = ax.get_title().replace("\n", " ")
+        assert p.spectrum.regime in title and f"λ₁ = {p.spectrum.exponents[0]:+.4f}" in title
         trajectory, points = ax.lines[:2]
         window = np.column_stack([trajectory.get_xdata(), trajectory.get_ydata()])
         at_periods = window[::steps]  # the states of the drawn window at t = kT
@@ -429,10 +446,11 @@ def test_the_prediction_figure_says_which_record_and_periods_it_shows():
 # ------------------------------------------------------------------ the paper's figures, as they are written
 @pytest.mark.parametrize("name", [n for n in paper_figures.FIGURES if n != "study"])
 @pytest.mark.slow
-def test_no_paper_figure_clips_a_text_or_covers_a_curve_with_a_legend(computed, name):
+@quick_reproduction_group()
+def test_no_paper_figure_clips_a_text_or_covers_a_curve_with_a_legend(quick_reproduction, computed, name):
     if name == "fig3-orbits" and not computed.orbits:
         pytest.skip("the quick plan has no continuation")
-    fig = paper_figures.build(name, computed)
+    fig = written(quick_reproduction, name)
     assert fc.clipped_texts(fig) == []
     for ax in fig.axes:
         assert fc.points_under_legend(ax) == 0, f"a legend covers data in {ax.get_title()!r}"

@@ -23,6 +23,7 @@ from gearsym.reproduce import SCENARIOS, compute, paper_plan, render, reproduce
 from gearsym.reproduce.compute import box_grid
 from gearsym.reproduce.report import VERDICT_MARK
 from gearsym.reproduce.stability import grid as stability_grid
+from conftest import quick_reproduction_group
 from same_numbers import differences, json_differences
 
 DOCS = REPO_ROOT / "docs"
@@ -69,7 +70,7 @@ def test_figure_3_claims_recomputed_match_the_committed_record(tmp_path, committ
     committed run's did (the sweeps' amplitudes at the periodic points are the test of that)."""
     full = paper_plan(scenario=SCENARIOS[0])
     plan = dataclasses.replace(full, sweeps=tuple(s for s in full.sweeps if s.name.startswith("fig3")),
-                               attractors=(), portraits=())
+                               attractors=(), portraits=(), basins=(), fractions=())  # (the basins: their own test)
     computed = compute(plan, tmp_path)
     recorded = {c["id"]: c for c in committed["scenarios"][0]["claims"]}
     for check in (claim_checks.chaos_d0, claim_checks.regular_d2, claim_checks.amplitude_d2, claim_checks.jumps_d2):
@@ -108,32 +109,34 @@ def test_every_paper_jump_and_hysteresis_end_is_a_located_bifurcation_a_crisis_o
 
 
 @pytest.mark.slow
-def test_a_quick_reproduction_writes_every_output_and_reuses_its_data(tmp_path, monkeypatch):
-    """A quick run writes every figure, the record and the report; a second run reuses the first run's data (no
-    point computed again, the basins' files read, not written) and makes the same record. The second run's figures
-    are not drawn again: the first run's are checked above, and drawing them is most of a run that reuses its data
-    (each is drawn from what the run computed, which the record compared equal shows is the same)."""
-    record = reproduce(tmp_path / "figures", tmp_path / "reproduction.md", quick=True)
+@quick_reproduction_group()
+def test_a_quick_reproduction_writes_every_output_and_reuses_its_data(quick_reproduction, monkeypatch):
+    """A quick run (the session's, whose figures test_figures.py checks) writes every figure, the record and the
+    report; a second run reuses the first run's data (no point computed again, the basins' files read, not
+    written) and makes the same record. The second run's figures are not drawn again: the first run's are checked
+    above, and drawing them is most of a run that reuses its data (each is drawn from what the run computed, which
+    the record compared equal shows is the same)."""
+    out, record = quick_reproduction.out, quick_reproduction.record
     for name in ("fig3.png", "fig3-orbits.png", "fig4.png", "fig6.png", "fig7.png", "hysteresis.png", "study.png",
                  "basins.png", "basin-fractions.png", "basins-defaults.png", "basin-fractions-defaults.png",
                  "stability.png", "claims.json"):
-        assert (tmp_path / "figures" / name).stat().st_size > 1000, name
-    page = (tmp_path / "reproduction.md").read_text()
+        assert (out / "figures" / name).stat().st_size > 1000, name
+    page = (out / "reproduction.md").read_text()
     for scenario in record["scenarios"]:
         assert len(scenario["claims"]) == len(claim_checks.CHECKS)
         assert all(c["measured"] in page for c in scenario["claims"])
-    records = sorted((tmp_path / "figures" / "data").glob("*/*.json"))
+    records = sorted((out / "figures" / "data").glob("*/*.json"))
     assert len(records) == sum(len(paper_plan(True, s, study=i == 0).sweeps) for i, s in enumerate(SCENARIOS))
     assert all(json.loads(p.read_text())["points"]["computed"] > 0 for p in records)
-    maps = sorted((tmp_path / "figures" / "data").glob("*/basins/map-*.json"))
+    maps = sorted((out / "figures" / "data").glob("*/basins/map-*.json"))
     assert len(maps) == 2 * len(paper_plan(True).basins)
-    stamps = {p: p.stat().st_mtime_ns for p in (*maps, *(tmp_path / "figures" / "data").glob("*/basins/*.csv"))}
+    stamps = {p: p.stat().st_mtime_ns for p in (*maps, *(out / "figures" / "data").glob("*/basins/*.csv"))}
     drawn = []  # what the second run would draw: each scenario's computed plan, reused, and the stability chart
     monkeypatch.setattr(sys.modules["gearsym.reproduce"], "draw_all",
-                        lambda computed, out, suffix="": drawn.append((computed.plan.scenario.name, suffix)) or [])
+                        lambda computed, folder, suffix="": drawn.append((computed.plan.scenario.name, suffix)) or [])
     monkeypatch.setattr(sys.modules["gearsym.reproduce"], "draw_stability",
-                        lambda chart, out: drawn.append(("stability", chart.shape)))
-    again = reproduce(tmp_path / "figures", tmp_path / "reproduction.md", quick=True)
+                        lambda chart, folder: drawn.append(("stability", chart.shape)))
+    again = reproduce(out / "figures", out / "reproduction.md", quick=True)
     assert drawn == [(s.name, "" if i == 0 else f"-{s.name}") for i, s in enumerate(SCENARIOS)] + [
         ("stability", (len(stability_grid(True)["k_a"]), len(stability_grid(True)["omega"])))]
     assert all(json.loads(p.read_text())["points"]["computed"] == 0 for p in records)  # the data were reused

@@ -115,8 +115,9 @@ def plot_regime_strip(ax, result: SweepResult, *, direction: str | None = None, 
     for row, (d, values, idx) in enumerate(runs):
         xs = result[x][idx]
         width = np.min(np.diff(np.sort(xs))) if len(xs) > 1 else 1.0
-        for xv, reg in zip(xs, result["regime"][idx]):
-            ax.broken_barh([(xv - width / 2, width)], (row, 0.8), color=regime_color(reg), lw=0)
+        if len(xs):  # (one collection a row, its bars drawn in the order of its points, as one bar each would be)
+            ax.broken_barh([(xv - width / 2, width) for xv in xs], (row, 0.8),
+                           color=[regime_color(reg) for reg in result["regime"][idx]], lw=0)
     ax.set_yticks([r + 0.4 for r in range(len(runs))], [_run_label(d, v, style=False) for d, v, _ in runs], fontsize=7)
     ax.set_ylim(0, max(len(runs), 1))
     shown = regimes_shown(r for _, _, idx in runs for r in result["regime"][idx])
