@@ -318,6 +318,7 @@ def test_an_edited_summary_is_found_and_written_again(cache, clean, edit):
     assert json.loads(system.read_text()) != edit(json.loads(system.read_text()))  # (written again)
 
 
+@pytest.mark.slow
 def test_summaries_edited_with_their_seal_made_again_are_checked_against_the_library(cache, clean):
     system, _ = summaries(cache)
     reseal(system, swap_states(json.loads(system.read_text())))
@@ -364,6 +365,7 @@ def test_a_summary_pointing_at_a_library_outside_the_caches_lib_folder_never_loa
 
 
 # ------------------------------------------------------------------ a cache path that cannot be one
+@pytest.mark.slow
 @pytest.mark.parametrize("where", ["/dev/null", "a file", "below a file"])
 def test_a_cache_path_that_is_no_folder_is_a_one_line_error_before_any_work(tmp_path, where):
     (tmp_path / "f").write_text("")

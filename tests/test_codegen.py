@@ -227,6 +227,7 @@ def _numpy_orbit(system, p, y0, t0, periods, steps):
     return np.array(out).T
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("backend", ["compiled", "in-process"])
 def test_piecewise_min_max_powers_and_time_conditions_survive_the_split(backend):
     odd = FirstOrderSystem.from_equations(

@@ -66,6 +66,7 @@ def test_rendering_twice_is_identical(model, fmt):
     assert first == render(derive(load_model(model)), fmt, full=True)  # a fresh derivation of the declared model
 
 
+@pytest.mark.slow
 def test_page_does_not_depend_on_the_hash_seed():
     """Set iteration order changes with PYTHONHASHSEED; the page must not."""
     code = ("import sys, gearsym; from gearsym.derivation import derive, render; "

@@ -462,6 +462,7 @@ def test_explain_command_writes_the_report(one_stage, tmp_path, capsys):
 EXAMPLE = REPO_ROOT / "docs" / "examples" / "explain-cubic-stiffness"
 
 
+@pytest.mark.slow
 def test_the_worked_example_data_are_what_the_documented_command_writes(tmp_path, monkeypatch, capsys):
     page = (REPO_ROOT / "docs" / "data-loop.md").read_text().replace("\\\n", " ")
     command = re.search(r"^gearsym simulate .*$", page, re.M).group(0)

@@ -200,6 +200,7 @@ def test_campbell_orders_of_one_frequency_are_one_line_named_after_each():
     assert fc.unmatched_legend_entries(left) == []
 
 
+@pytest.mark.slow
 def test_campbell_panels_span_the_same_speeds_and_mark_every_crossing_in_both():
     diagram = spur_campbell()
     fig = plot_campbell(diagram, sweep=campbell_sweep(diagram), settings={"kZ": "1.27e8 N/m"})
@@ -310,6 +311,7 @@ def point():
     return spectrum, trajectory
 
 
+@pytest.mark.slow
 def test_a_long_title_is_wrapped_inside_the_figure(point):
     """`lyap --plot --coordinate x2` of a user model had its title cut off on both sides."""
     spectrum, trajectory = point
@@ -370,6 +372,7 @@ def test_a_lambda_map_uses_the_whole_colour_scale_on_each_side_of_zero():
     assert mesh.norm(0.0) == pytest.approx(0.5)
 
 
+@pytest.mark.slow
 def test_a_2d_sweep_names_its_zero_contour_and_maps_every_coordinate():
     r = map_sweep(lambda w, k: w - 1.5)
     fig = plot_sweep(r)

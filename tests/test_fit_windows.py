@@ -28,6 +28,7 @@ def case():
     return system, channels, (starts, t0, dt, samples, substeps, p)
 
 
+@pytest.mark.slow
 def test_compiled_and_in_process_windows_agree(case):
     system, channels, args = case
     compiled = Windows(system, channels, "compiled").run(*args)

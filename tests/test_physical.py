@@ -138,6 +138,7 @@ def test_a_simulation_of_the_physical_lagrange_equations_agrees_with_gearsym_car
     assert np.max(np.abs(got - expected_force)) < 1e-4 * np.max(np.abs(expected_force))
 
 
+@pytest.mark.slow
 def test_a_spectrum_is_carried_back_per_second_and_in_micrometres():
     s = scaling(pair_model())
     result = gearsym.lyapunov_spectrum(s.system(), options=Integration(periods=60, discard=40))

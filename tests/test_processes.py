@@ -134,6 +134,7 @@ def test_sweep_workers_die_with_a_killed_parent_and_the_sweep_resumes(tmp_path, 
     assert not lock_path(out).exists()
 
 
+@pytest.mark.slow
 @needs_fork
 def test_without_the_kernels_help_workers_still_die_with_their_parent(tmp_path, sweep_process):
     """The portable way (macOS): a thread in each worker waits for its parent's end of a pipe to close."""

@@ -318,6 +318,7 @@ def _energy(capsys, *argv) -> dict:
     return {g: float(v) for g, v in (part.split() for part in said.split(", "))}
 
 
+@pytest.mark.slow
 def test_a_healthy_pair_shows_no_sidebands_and_a_cracked_one_does(capsys):
     """one_stage with 20/53 teeth at omega = 1.5 answers with period 2 (half orders, no shaft order): over the
     default 212 mesh periods (10.6 pinion revolutions) the unwindowed fit gave the pinion 0.034 of sidebands, the

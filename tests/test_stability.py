@@ -46,6 +46,7 @@ def exact_omega(r: int, ka: float, curve, lo: float, hi: float) -> float:
     return brentq(lambda w: 4 / w**2 - curve(r, 2 * ka / w**2), lo, hi, xtol=1e-14)
 
 
+@pytest.mark.slow
 def test_the_undamped_one_stage_chart_has_mathieus_tongues_to_1e_6_in_omega(mathieu):
     rows = [0.35, 0.55, 0.75]  # (the third tongue is 0.0046 wide at k_a = 0.35: two grid steps)
     chart = static_chart(mathieu, {"omega": np.round(np.arange(0.6, 2.4, 0.002), 10), "k_a": rows})

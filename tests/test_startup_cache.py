@@ -102,6 +102,7 @@ def lyap_text(capsys, *argv: str) -> str:
     return capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_a_cached_physical_model_is_not_reduced_again_and_prints_the_same(model_copy, reductions, capsys):
     spur = str(model_copy("spur_pair"))
     first_text, first_json = lyap_text(capsys, spur), lyap(capsys, spur)

@@ -48,6 +48,7 @@ def run(w2: float, integrator: str = "auto", reorthonormalise: bool = True):
     return model, lyapunov_spectrum(model)
 
 
+@pytest.mark.slow
 def test_every_exponent_of_a_linear_chain_with_modes_30_times_apart_is_its_exact_decay_rate():
     model, result = run(30.0)
     assert model.integration.integrator == "rk4" and model.integration.steps_per_period == 800  # chosen, said
@@ -59,6 +60,7 @@ def test_every_exponent_of_a_linear_chain_with_modes_30_times_apart_is_its_exact
     np.testing.assert_allclose(result.exponents, exact, rtol=1e-3)
 
 
+@pytest.mark.slow
 def test_exponents_lost_in_round_off_are_not_reported_as_values():
     heavy = {"c2": 1.6 * 30.0}  # the fast mode's damping ratio 0.8: it decays by e^-150 over a period
     exact = exact_rates(chain(30.0).with_values(**heavy))

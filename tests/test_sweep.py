@@ -316,6 +316,7 @@ def test_missing_poincare_samples_are_not_silently_dropped(tmp_path, one_stage):
 
 
 # ------------------------------------------------------------------ command line
+@pytest.mark.slow
 def test_sweep_command(tmp_path, capsys):
     out = tmp_path / "s.csv"
     code = main(["sweep", "one_stage_resonant", "--param", "omega=1.3:1.4:0.05", "--direction", "both",
