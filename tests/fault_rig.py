@@ -21,7 +21,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.integrate import ode
 
 import rig
 
@@ -120,14 +119,7 @@ class Pair:
         t0 = transient * T
         tau = t0 + (T / samples_per_period) * np.arange(int(round(periods * samples_per_period)))
         # (max_step: no step strides over a fault's edges, 0.1 mesh periods wide)
-        solver = ode(self.rhs(omega)).set_integrator("dop853", rtol=1e-10, atol=1e-10, nsteps=10**6, max_step=T / 40)
-        solver.set_initial_value(y0, 0.0)
-        states = []
-        for t in tau:
-            states.append(solver.integrate(t))
-            if not solver.successful():
-                raise RuntimeError(f"DOP853 failed at tau = {t}")
-        x, v = np.array(states).T
+        x, v = rig.dop853_samples(self.rhs(omega), y0, tau, max_step=T / 40)
         return {"tau": tau, "x": x, "v": v}
 
 

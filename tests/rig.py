@@ -48,6 +48,20 @@ def acceleration(tau: float, x: float, v: float, omega: float, p: dict, extra: C
     return a + (extra(tau, x, v, omega) if extra else 0.0)
 
 
+
+def dop853_samples(rhs, y0, tau, **options) -> np.ndarray:
+    """The state at every time of ``tau`` (rows: the state's components), from ``y0`` at 0 by SciPy's DOP853
+    (Hairer's code, through scipy.integrate.ode: far less overhead per step than solve_ivp), rtol = atol = 1e-10;
+    ``options`` (max_step, ...) go to the integrator."""
+    solver = ode(rhs).set_integrator("dop853", rtol=1e-10, atol=1e-10, nsteps=10**6, **options)
+    solver.set_initial_value(y0, 0.0)
+    states = []
+    for t in tau:
+        states.append(solver.integrate(t))
+        if not solver.successful():
+            raise RuntimeError(f"DOP853 failed at tau = {t}")
+    return np.array(states).T
+
 def record(omega: float, *, extra: Callable | None = None, periods: float = 16.3, transient: int = 60,
            samples_per_period: float = 37.3, start: float = 0.7, **values) -> dict[str, np.ndarray]:
     """One run at ``omega``: tau, x, v and the exact acceleration x'' at the samples (no noise)."""
@@ -58,15 +72,7 @@ def record(omega: float, *, extra: Callable | None = None, periods: float = 16.3
 
     t0 = start + transient * T
     tau = t0 + (T / samples_per_period) * np.arange(int(periods * samples_per_period))
-    # SciPy's DOP853 (Hairer's code, through scipy.integrate.ode: far less overhead per step than solve_ivp)
-    solver = ode(rhs).set_integrator("dop853", rtol=1e-10, atol=1e-10, nsteps=10**6)
-    solver.set_initial_value((1.0, 0.0), 0.0)
-    states = []
-    for t in tau:
-        states.append(solver.integrate(t))
-        if not solver.successful():
-            raise RuntimeError(f"DOP853 failed at tau = {t}")
-    x, v = np.array(states).T
+    x, v = dop853_samples(rhs, (1.0, 0.0), tau)
     a = np.array([acceleration(t, xi, vi, omega, p, extra) for t, xi, vi in zip(tau, x, v)])
     return {"tau": tau, "x": x, "v": v, "x_ddot": a}
 
