@@ -266,6 +266,10 @@ class CacheSlot:
         """Whether a model compiled with ``options`` is kept here (a model in a file, compiled to a library)."""
         return self.name is not None and resolve_backend(options.backend) == "compiled"
 
+    def summary(self, full: Callable[[], object]) -> SystemSummary | None:
+        """The system's summary the slot holds (see :func:`read_summary`), or None."""
+        return read_summary(self.system, full)
+
 
 def cache_slot(ref, values: Mapping[str, object]) -> CacheSlot:
     """The slot of the model ``ref`` (a name or a file) with ``values``, and the summary it holds, read once."""
@@ -309,12 +313,23 @@ def keep_compiled(slot: CacheSlot, compiled, units: PointUnits | None) -> None:
                             "table_texts": list(compiled.table_texts)})
 
 
+def read_summary(system: Mapping | None, full: Callable[[], object]) -> SystemSummary | None:
+    """The :class:`SystemSummary` of a system's summary as read from the cache (``full``: the full system, loaded
+    only if a caller asks for its symbolic part), or None: no summary, or none that reads as one."""
+    try:
+        return SystemSummary.from_dict(system, full)
+    except (KeyError, TypeError, ValueError, AttributeError):
+        return None
+
+
 def _from_cache(system: Mapping | None, build_file: Path, options: Integration, full: Callable[[], object]):
     """The compiled model of a system's summary as read (``system``) and the build summary in ``build_file``, or
     None."""
     build = read_json(build_file)
+    summary = read_summary(system, full)
+    if summary is None:
+        return None
     try:
-        summary = SystemSummary.from_dict(system, full)
         digest, library, timed = str(build["hash"]), Path(build["library"]), frozenset(build["timed_parameters"])
         texts = tuple(str(t) for t in build["table_texts"])
     except (KeyError, TypeError, ValueError, AttributeError):

@@ -19,7 +19,7 @@ from functools import cached_property
 import gearsym  # the face: its verbs load on first use, so a cached model's run never loads the generator
 
 from . import stability  # (its modules load on first use: the linearisation's only when it is derived)
-from .cached import SystemSummary, cache_slot, cached_compiled, keep_compiled, load_linearisation, load_static_recipe
+from .cached import cache_slot, cached_compiled, keep_compiled, load_linearisation, load_static_recipe
 from .options import Integration
 from .physical.point import CachedScaling
 
@@ -98,12 +98,8 @@ class OpenModel:
         """What a run checks its request against (names, parameters, cycles): the cache's summary of the system
         when it has one (:class:`~gearsym.cached.SystemSummary`, which loads the full system only if asked for its
         symbolic part), else :attr:`system`."""
-        if self.slot.system is not None:
-            try:
-                return SystemSummary.from_dict(self.slot.system, lambda: self.system)
-            except (KeyError, TypeError, ValueError, AttributeError):
-                pass
-        return self.system
+        summary = self.slot.summary(lambda: self.system)
+        return self.system if summary is None else summary
 
     def compiled(self, options: Integration | None = None, *, over: Mapping | None = None,
                  before: Callable[[object], object] | None = None):
