@@ -5,7 +5,6 @@ model's default) lie. Cheap (a few thousand monodromy matrices, one period each)
 keeps numbers that another CPU reproduces to rounding, and the tests compare them with tolerances."""
 from __future__ import annotations
 
-
 import numpy as np
 
 from ..checks import json_safe
