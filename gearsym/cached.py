@@ -10,7 +10,7 @@ given ``--set`` values writes two small files into the cache (``$GEARSYM_CACHE/m
   a key that hashes the model's file, the other model files it may import, gearsym's own source and the
   values: any change to one of them is another key, never a stale summary;
 * ``<model>-<key>-<loops>.json``: for one structure of the loops (steps per period, crossings located), the
-  code hash and the compiled library.
+  code hash and the compiled library (:class:`BuildSummary`).
 
 Later runs build the :class:`~gearsym.codegen.compiled.CompiledModel` from them, with a
 :class:`SystemSummary` as its system, which loads (and reduces) the model only if something asks for what
@@ -167,7 +167,6 @@ def _watches(stored) -> tuple | None:
     return tuple((str(n), str(c), *(v if isinstance(v, str) else float(v) for v in (b, o))) for n, c, b, o in stored)
 
 
-
 @dataclass(frozen=True)
 class BuildSummary:
     """What the cache keeps of one build of a model (``<model>-<key>-<loops>.json``): its code hash, the compiled
@@ -196,6 +195,7 @@ class BuildSummary:
     def in_own_cache(self) -> bool:
         """Whether the library is one of the cache's own (no other is loaded)."""
         return self.library.parent == cache_dir("lib") and not self.library.name.startswith(".")
+
 
 @lru_cache(maxsize=None)
 def _source_digest(folder: Path) -> str:

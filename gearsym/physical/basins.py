@@ -3,10 +3,10 @@
 
 A grid given in physical units is checked and put in SI units once (:class:`PhysicalGrid`), and turned into the
 engine's nondimensional starts at each forcing frequency (a rate's unit, L omega omega_n per second, moves with the
-speed: :func:`engine_grid`); the results come back through
-the same numbers (:class:`~gearsym.physical.point.PointUnits`: the length unit L, omega_n, the speed's ratio).
-:class:`ShownBasinMap` and :class:`ShownFractions` are the results in those units, which the files
-(:mod:`.files`), the command's text and the figures (:mod:`gearsym.figures.basins`) take.
+speed: :func:`engine_grid`); the results come back through the same numbers
+(:class:`~gearsym.physical.point.PointUnits`: the length unit L, omega_n, the speed's ratio). :class:`ShownBasinMap`
+and :class:`ShownFractions` are the results in those units, which the files (:mod:`.files`), the command's text
+and the figures (:mod:`gearsym.figures.basins`) take.
 """
 from __future__ import annotations
 
@@ -237,7 +237,7 @@ class PhysicalGrid(StartGrid):
 
     def __init__(self, units: PointUnits, axes: Sequence[Axis]):
         super().__init__({a.name: a.values for a in axes}, [a.spec for a in axes])
-        self.units, self.axes, self.si = units, tuple(axes), grid_in_si(units, axes)
+        self.units, self.axes, self.si_grid = units, tuple(axes), grid_in_si(units, axes)
 
     def at(self, point):
-        return engine_grid(self.units, self.si, point.get("omega", 1.0))
+        return engine_grid(self.units, self.si_grid, point.get("omega", 1.0))
