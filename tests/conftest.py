@@ -12,6 +12,7 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import functools
+import os
 import sys
 
 import numpy as np
@@ -199,7 +200,6 @@ def _private_library_cache(tmp_path_factory, pytestconfig):
     they caused themselves, never a stale library from an earlier checkout. The workers of a parallel run
     (pytest -n) share it, as a user's processes share theirs: each model is compiled once, and two workers
     compiling the same one meanwhile is a case the cache handles (its libraries land whole, by rename)."""
-    import os
 
     old = os.environ.get("GEARSYM_CACHE")
     if not hasattr(pytestconfig, "workerinput"):  # (what pytest-xdist gives its workers)
@@ -313,6 +313,13 @@ def _group(item) -> str:
 
 def pytest_configure(config):
     """xdist's --dist loadgroup hands out the groups largest first by their number of tests; the order
-    pytest_collection_modifyitems gives (by their time) is the better one."""
+    pytest_collection_modifyitems gives (by their time) is the better one.
+
+    The gearsym processes the tests start run as an installed gearsym does, with its bytecode kept: an environment
+    that says PYTHONDONTWRITEBYTECODE (this machine's does) would have each of them compile gearsym's ~140 modules
+    from source again (about a second of CPU each; ``pip install`` writes the bytecode of a user's gearsym once).
+    Set here, before xdist starts its workers, so that they and every process they start inherit it."""
     if hasattr(config.option, "loadscopereorder"):
         config.option.loadscopereorder = False
+    os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
+    sys.dont_write_bytecode = False
