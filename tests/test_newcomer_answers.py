@@ -3,10 +3,8 @@ a model file of one's own."""
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import subprocess
-import sys
 import warnings
 
 import numpy as np
@@ -160,17 +158,16 @@ def repository_state() -> str:
 
 
 @pytest.mark.slow
-def test_a_user_model_writes_docs_and_c_beside_the_user_not_into_the_installed_tree(tmp_path):
+def test_a_user_model_writes_docs_and_c_beside_the_user_not_into_the_installed_tree(tmp_path, monkeypatch, capsys):
     models, work = tmp_path / "mymodels", tmp_path / "work"
     models.mkdir()
     work.mkdir()
     (models / "m.py").write_text(USER_MODEL)
     before = repository_state()
+    monkeypatch.chdir(work)
     try:
         for command in (["docs", "../mymodels/m.py"], ["compile", "../mymodels/m.py", "--no-compile"]):
-            proc = subprocess.run([sys.executable, "-m", "gearsym.cli", *command], cwd=work, capture_output=True,
-                                  text=True, env={**os.environ, "PYTHONPATH": str(REPO_ROOT)})
-            assert proc.returncode == 0, proc.stderr
+            assert main(command) == 0, capsys.readouterr().err
         assert (work / "docs" / "derivations" / "my_oscillator.md").is_file()
         assert (work / "generated" / "my_oscillator" / "my_oscillator.c").is_file()
         assert repository_state() == before
@@ -180,12 +177,12 @@ def test_a_user_model_writes_docs_and_c_beside_the_user_not_into_the_installed_t
 
 
 @pytest.mark.slow
-def test_shipped_models_run_from_a_scratch_folder_write_into_it_not_into_the_installed_tree(tmp_path):
+def test_shipped_models_run_from_a_scratch_folder_write_into_it_not_into_the_installed_tree(tmp_path, monkeypatch,
+                                                                                           capsys):
     before = repository_state()
+    monkeypatch.chdir(tmp_path)  # (the commands run here: the session's reductions of the models serve them)
     for command in (["docs", "flexible_shaft"], ["compile", "one_stage", "lorenz", "--no-compile"]):
-        proc = subprocess.run([sys.executable, "-m", "gearsym.cli", *command], cwd=tmp_path, capture_output=True,
-                              text=True, env={**os.environ, "PYTHONPATH": str(REPO_ROOT)})
-        assert proc.returncode == 0, proc.stderr
+        assert main(command) == 0, capsys.readouterr().err
     assert (tmp_path / "docs" / "derivations" / "flexible_shaft.md").read_bytes() == \
         (REPO_ROOT / "docs" / "derivations" / "flexible_shaft.md").read_bytes()  # (the committed page, here)
     for name in ("one_stage", "lorenz"):

@@ -139,40 +139,36 @@ def test_a_command_on_a_cached_model_imports_neither_sympy_nor_pint(model_copy, 
     argv = [str(model_file), *(s.format(tmp=tmp_path) for s in settings), *ARGS]
     unplotted = [a for i, a in enumerate(argv) if "--plot" not in argv[max(i - 1, 0):i + 1]]
 
-    def command(argv):  # a user's command: a process of its own, as the first run (which fills the cache) was
+    def command(argv):  # a user's command on the cached model: a process of its own, whose imports are its own
         script = ("import sys; from gearsym.cli import main; "
                   f"main(['lyap', *{argv!r}]); "
                   "print(sorted(m for m in ('sympy', 'pint') if m in sys.modules), file=sys.stderr)")
         return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO_ROOT,
                               env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120)
 
-    first = command(unplotted)  # (the cache is filled by the run without its figure: the figure is drawn once)
-    assert first.returncode == 0, first.stderr
+    first = lyap(capsys, *unplotted[:-len(ARGS)])  # (fills the cache, in this process: without the figure, drawn once)
     run = command(argv)
     assert run.returncode == 0, run.stderr
     assert run.stderr.strip().splitlines()[-1] == "[]", run.stderr[-3000:]
     if unplotted != argv:
         assert (tmp_path / "point.png").read_bytes()[:4] == b"\x89PNG"
-    assert json.loads(run.stdout) == json.loads(first.stdout) == lyap(capsys, *unplotted[:-len(ARGS)])
+    assert json.loads(run.stdout) == first
 
 
 @pytest.mark.slow
-def test_an_orbit_of_a_cached_model_imports_neither_sympy_nor_pint(model_copy):
+def test_an_orbit_of_a_cached_model_imports_neither_sympy_nor_pint(model_copy, capsys):
     """Its contact regime is read on the meshes the summary names (the reduction's couplings are not loaded)."""
+    argv = ["orbits", str(model_copy("one_stage")), "--set", "omega=1.2"]
+    assert main(argv) == 0  # (fills the cache, in this process)
+    first = capsys.readouterr().out
     script = ("import sys; from gearsym.cli import main; "
-              f"main(['orbits', {str(model_copy('one_stage'))!r}, '--set', 'omega=1.2']); "
+              f"main({argv!r}); "
               "print(sorted(m for m in ('sympy', 'pint') if m in sys.modules), file=sys.stderr)")
-
-    def command():
-        return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO_ROOT,
-                              env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120)
-
-    first = command()
-    assert first.returncode == 0, first.stderr
-    run = command()
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO_ROOT,
+                         env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120)
     assert run.returncode == 0, run.stderr
     assert run.stderr.strip().splitlines()[-1] == "[]", run.stderr[-3000:]
-    assert run.stdout == first.stdout
+    assert run.stdout == first
     assert "contact of mesh: single-sided impact" in run.stdout
 
 
