@@ -20,6 +20,8 @@ import gearsym  # the face: its verbs load on first use, so a cached model's run
 
 from . import stability  # (its modules load on first use: the linearisation's only when it is derived)
 from .cached import cache_slot, cached_compiled, keep_compiled, load_linearisation, load_static_recipe
+from .codegen.mode_rates import chosen_by_compiled
+from .codegen.step_choice import choices_from
 from .options import Integration
 from .physical.point import CachedScaling
 
@@ -108,7 +110,11 @@ class OpenModel:
         before the compiler's seconds), compiled and kept in the cache. ``over``: the engine's axes (name ->
         values) a sweep or a continuation runs over; the step is chosen for its fastest point (their ends
         decide; an integrator asked is kept), so that the model is compiled once."""
-        options = self.chosen_over(options or self.request.options, over or {})
+        options = options or self.request.options
+        found = self._cached_over(options, over or {})
+        if found is not None:
+            return found
+        options = self.chosen_over(options, over or {})
         found = cached_compiled(self.slot, options, lambda: self.system)
         if found is not None:
             return found
@@ -125,9 +131,21 @@ class OpenModel:
         """``options`` with the step chosen for every point of the engine's ``axes`` (see :meth:`compiled`)."""
         if options.integrator != "auto" or not axes:
             return options
-        ends = [{name: float(v) for name, v in zip(axes, point)}
-                for point in itertools.product(*[(min(v), max(v)) for v in axes.values()])]
-        return gearsym.chosen_integration(options, self.system, ends)
+        return gearsym.chosen_integration(options, self.system, _ends(axes))
+
+    def _cached_over(self, options: Integration, axes: Mapping):
+        """The compiled model of a sweep over ``axes`` from the cache alone, or None: the step chosen as
+        :meth:`chosen_over` chooses it, from the Jacobian and period of the library the cache holds for the
+        model's own values (the same functions whatever the loops: no SymPy, no reduction)."""
+        summary = self.slot.summary(lambda: self.system)
+        if options.integrator != "auto" or not axes or summary is None or not self.slot.keeps(options):
+            return None
+        # (any library of the model will do: the one of its own values, or one a sweep over faster points chose)
+        libraries = (cached_compiled(self.slot, o, lambda: self.system)
+                     for o in choices_from(options, summary.fastest, summary.cycle))
+        some = next((compiled for compiled in libraries if compiled is not None), None)
+        chosen = None if some is None else chosen_by_compiled(options, some, _ends(axes))
+        return None if chosen is None else cached_compiled(self.slot, chosen, lambda: self.system)
 
     def linearised(self, before: Callable[[object], object] | None = None):
         """The compiled linearisation about the model's static state (a chart's): from the cache, else the model
@@ -149,6 +167,12 @@ class OpenModel:
         derived from the loaded model."""
         return load_static_recipe(self.request.model, self.request.settings,
                                   derive=lambda: stability.static_recipe(self.system))
+
+
+def _ends(axes: Mapping) -> list[dict[str, float]]:
+    """The corners of the engine's ``axes`` (name -> values): each axis at its least and its largest value."""
+    return [{name: float(v) for name, v in zip(axes, point)}
+            for point in itertools.product(*[(min(v), max(v)) for v in axes.values()])]
 
 
 def open_model(request: ModelRequest) -> OpenModel:

@@ -186,6 +186,21 @@ def test_a_single_spectrum_loads_no_other_analysis():
     assert unused.isdisjoint(loaded), sorted(unused & loaded)
 
 
+def test_a_sweep_of_a_cached_model_chooses_its_step_without_reducing_it_again(model_file, reductions, tmp_path,
+                                                                            capsys):
+    """Its fastest end (omega = 0.1: 250 steps, the model's own values 200) is read from the cached library."""
+    def sweep(out: str) -> str:  # (the line that says the step and why)
+        assert main(["sweep", str(model_file), "--param", "omega=0.1:0.3:0.2", "--periods", "14", "--discard", "2",
+                     "--out", str(tmp_path / out)]) == 0
+        return next(line for line in capsys.readouterr().err.splitlines() if line.startswith("gearsym: step:"))
+
+    first = sweep("first.csv")
+    assert len(reductions) == 1 and "250 per forcing period" in first and "at omega=0.1:" in first
+    assert sweep("again.csv") == first
+    assert len(reductions) == 1
+    assert (tmp_path / "again.csv").read_text() == (tmp_path / "first.csv").read_text()
+
+
 @pytest.mark.slow
 def test_a_formula_spelt_another_way_is_the_same_cached_model(model_file, reductions, capsys):
     first = lyap(capsys, str(model_file), *FORMULA)

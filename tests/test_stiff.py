@@ -15,11 +15,12 @@ import pytest
 import sympy as sp
 
 import gearsym
-from conftest import system
+from conftest import compiled, system
 from gearsym import FirstOrderSystem, Integration, compile_model, lyapunov_spectrum, phase_trajectory
 from gearsym.codegen.rosenbrock import rosenbrock_state
 from gearsym.codegen.fastest_mode import fastest_rate
-from gearsym.codegen.step_choice import RK4_RESOLVED, chosen, round_steps
+from gearsym.codegen.mode_rates import chosen_by_compiled
+from gearsym.codegen.step_choice import RK4_RESOLVED, choices_from, chosen, round_steps
 
 
 # ------------------------------------------------------------------ a linear damped chain, modes far apart
@@ -91,6 +92,24 @@ def test_the_step_choice_rounds_up_and_keeps_what_is_asked():
     assert [round_steps(x) for x in (200, 201, 377, 1257, 0.3)] == [200, 250, 400, 1500, 1]
     asked = Integration(integrator="rk4", steps_per_period=100)
     assert chosen(asked, rho=1e6, cycle=1.0) is asked  # an integrator given is taken as given
+
+
+def test_a_sweeps_step_resolves_its_fastest_end_alike_from_the_model_and_from_its_compiled_library():
+    """The one-stage model's own values need 200 steps, omega = 0.1 (its fastest point) 250; a cached model's sweep
+    reads the rates from its library's Jacobian and period (no SymPy) and chooses the same, note and all."""
+    ends = [{"omega": 0.1}, {"omega": 2.0}]
+    from_model = gearsym.chosen_integration(Integration(), system("one_stage"), ends)
+    assert compiled("one_stage").integration.steps_per_period == 200
+    assert from_model.steps_per_period == 250 and "at omega=0.1:" in from_model.choice
+    assert chosen_by_compiled(Integration(), compiled("one_stage"), ends) == from_model
+
+
+def test_the_choices_a_faster_point_can_make_are_all_listed():
+    """A sweep finds a library of its model among them (the model's own values are its slowest point at best)."""
+    listed = [(o.integrator, o.steps_per_period) for o in choices_from(Integration(), 10.0, 2 * math.pi)]
+    for rho in np.geomspace(10.0, 1e4, 200):
+        made = chosen(Integration(), rho, 2 * math.pi)
+        assert (made.integrator, made.steps_per_period) in listed
 
 
 # ------------------------------------------------------------------ the step itself: 4th order, tangent too

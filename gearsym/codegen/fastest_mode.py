@@ -7,6 +7,7 @@ import numpy as np
 from ..options import Integration
 from ..system import FirstOrderSystem
 from .casadi_symbols import SystemSymbols
+from .mode_rates import fastest_of, largest_rate
 from .step_choice import chosen
 
 
@@ -18,14 +19,7 @@ def fastest_rate(system: FirstOrderSystem, values=None) -> float:
                                                                                           symbols.y))])
     merged = system.parameter_values(values)
     p = [merged[name] for name in system.parameters]
-    cycle = system.cycle_at(values)
-    rho = 0.0
-    for y in (system.initial_vector, [0.0] * system.dimension):
-        for k in range(8):
-            J = np.array(jacobian(cycle * k / 8, y, p), dtype=float)
-            if np.all(np.isfinite(J)):
-                rho = max(rho, float(np.max(np.abs(np.linalg.eigvals(J)))))
-    return rho
+    return largest_rate(lambda t, y: np.array(jacobian(t, y, p), dtype=float), system, system.cycle_at(values))
 
 
 def chosen_for(options: Integration, system: FirstOrderSystem) -> Integration:
@@ -41,11 +35,5 @@ def chosen_integration(options: Integration, system: FirstOrderSystem, points=()
     every point at a step that resolves its fastest mode."""
     if options.integrator != "auto":
         return options
-    own = system.parameters.get("omega")
-    rates = [(fastest_rate(system), own)] + [(fastest_rate(system, values), values.get("omega", own))
-                                             for values in points]
-    rho, omega = max(rates, key=lambda r: r[0])
-    # (a rate per unit time is per unit of tau: where omega differs from the model's, the note says at which, so
-    # that its frequency is converted there)
-    where = f" at omega={omega!r}" if omega is not None and omega != own else ""
-    return chosen(options, rho, system.cycle_at(), where)
+    rates = [fastest_rate(system)] + [fastest_rate(system, values) for values in points]
+    return fastest_of(options, rates, system, system.cycle_at(), points)

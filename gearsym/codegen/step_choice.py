@@ -65,6 +65,21 @@ def chosen(options: Integration, rho: float, cycle: float, unit: str = "") -> In
                           f"{needed} steps per forcing period to resolve it)")
 
 
+def choices_from(options: Integration, rho: float, cycle: float) -> list[Integration]:
+    """Every choice :func:`chosen` makes for ``options`` at a rate of ``rho`` or more (a sweep's fastest point is
+    at least as fast as the model's own values), the fewest steps first."""
+    if options.integrator != "auto":
+        return [options]
+    first, asked = chosen(options, rho, cycle), options.steps_per_period
+    if first.integrator == "stiff":
+        return [first]
+    steps, more = [first.steps_per_period], first.steps_per_period
+    while (more := round_steps(more + 1)) <= STIFF_COST * asked:
+        steps.append(more)
+    return ([replace(options, integrator="rk4", steps_per_period=n) for n in steps]
+            + [replace(options, integrator="stiff")])
+
+
 def explicit(options: Integration, rho: float, cycle: float) -> Integration:
     """``options`` with RK4 at the steps that resolve ``rho`` (at least those asked): what a consumer with only the
     explicit step takes (an FMU's co-simulation step)."""

@@ -20,8 +20,7 @@ from ..fit.selection import Candidate, Explanation, explain, record_label
 from ..fit.tooth_forms import standing_out, tooth_values
 from ..fit.tooth_scan import from_record_start
 from ..system import FirstOrderSystem
-from .layout import fit_texts
-from .save import pyplot, save_figure
+from .save import finish, pyplot, save_figure
 
 
 def explain_files(paths, system, fit, *, out=None, time_scale=None, held_out: float = 0.25, candidates=None,
@@ -54,8 +53,8 @@ def write_report(ex: Explanation, system: FirstOrderSystem, out: str | Path, sou
     with written_together(out, names, PARTIAL_MARKER, "the report") as stage:
         data = json_safe(ex.as_dict())
         write_atomically(stage / "report.json", json.dumps(data, indent=1, allow_nan=False) + "\n")
-        save_figure(residual_figure(ex, system), stage / "residuals.png", dpi=100)
-        save_figure(prediction_figure(ex, system.name), stage / "prediction.png", dpi=100)
+        residual_figure(ex, system, stage / "residuals.png")  # (fitted once, as they are written)
+        prediction_figure(ex, system.name, stage / "prediction.png")
         if teeth is not None:
             save_figure(tooth_figure(ex, teeth, system.name, sources), stage / TEETH_FIGURE, dpi=100)
         effects = [ex.library[e] for e in ex.effects]
@@ -130,9 +129,9 @@ def tooth_figure(ex: Explanation, c: Candidate, system_name: str = "", sources=(
     return fig
 
 
-def residual_figure(ex: Explanation, system: FirstOrderSystem):
+def residual_figure(ex: Explanation, system: FirstOrderSystem, path: str | Path | None = None):
     """Where the held-out residual lives (against the mesh phase, the coordinate and its rate) and its spectrum:
-    the model as declared always, and after when effects were added."""
+    the model as declared always, and after when effects were added; written to ``path`` if given."""
     plt = pyplot()
     fig, axs = plt.subplots(1, 4, figsize=(17, 3.8), constrained_layout=True)
     shown = [(ex.base, "0.6", "as declared")]
@@ -166,8 +165,7 @@ def residual_figure(ex: Explanation, system: FirstOrderSystem):
     axs[3].set_title("held-out residual's spectrum (numbers: orders tried)", fontsize=10)
     axs[3].legend(fontsize=8)
     fig.suptitle(f"{system.name}: the held-out residual of {channel}, {_which(ex.base.prediction)}", fontsize=10)
-    fit_texts(fig)
-    return fig
+    return finish(fig, path, dpi=100)
 
 
 def _which(prediction) -> str:
@@ -177,9 +175,9 @@ def _which(prediction) -> str:
             else f"every held-out window ({prediction.pairs})")
 
 
-def prediction_figure(ex: Explanation, system_name: str = ""):
+def prediction_figure(ex: Explanation, system_name: str = "", path: str | Path | None = None):
     """The measurement and the predictions of the first three held-out windows of the first record (the
-    title says which)."""
+    title says which); written to ``path`` if given."""
     plt = pyplot()
     p0, p1 = ex.base.prediction, ex.final.prediction
     channel = next(iter(p0.measured))
@@ -197,8 +195,7 @@ def prediction_figure(ex: Explanation, system_name: str = ""):
     ax.set_title(f"{system_name + ': ' if system_name else ''}one-period-ahead prediction of {channel} on the "
                  f"held-out data: {shown}", fontsize=10)
     ax.legend(fontsize=8)
-    fit_texts(fig)
-    return fig
+    return finish(fig, path, dpi=100)
 
 
 __all__ = ["explain_files", "prediction_figure", "residual_figure", "tooth_figure", "write_report"]
