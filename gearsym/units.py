@@ -8,8 +8,10 @@ own tokenizer and evaluator and never calls Python's ``eval``. No quantity strin
 What crosses into the model is a :class:`Measure`: the value in SI base units (kg, m, s; angles in
 radians), the exponents of mass, length and time it is made of, and the unit it was given in (to show it
 back in the user's units). The conversions back (``from_si``) are pint's own factors, applied at the
-other edge (``gearsym.physical``). pint and its registry (most of a second) load on first use only: the
-grammar, :func:`looks_like_quantity` and :func:`shown` need neither.
+other edge (``gearsym.physical``). pint and its registry (over a second of CPU) load on first use only: the
+grammar, :func:`looks_like_quantity` and :func:`shown` need neither, and a unit text pint has read once (in any
+process) is read again from what pint said it means, kept in the user's cache (:class:`UnitMeaning`): the commands
+of a model with units import no pint once they have met its units.
 
 Frequencies: pint's ``Hz`` is ``1/s``, so ``3000 rpm`` would convert to 314 Hz (radians per second under
 another name). Here ``Hz`` is one revolution (cycle) per second, so rpm, Hz and rad/s convert as a
@@ -17,13 +19,17 @@ drivetrain engineer expects: 3000 rpm = 50 Hz = 314.16 rad/s.
 """
 from __future__ import annotations
 
+import hashlib
+import importlib.util
 import math
 import re
 import warnings
 from dataclasses import dataclass
 from functools import lru_cache
+from pathlib import Path
 
 from .errors import GearsymError
+from .files.memo import keep, recall
 
 #: how long a quantity string may be (a unit expression is a few names, not a program)
 MAX_LENGTH = 120
@@ -42,6 +48,8 @@ BASE = ("[mass]", "[length]", "[time]")
 #: (min^-1 is how ISO 6336 and drive makers write a shaft speed: revolutions per minute)
 ALIASES = {"rev/min": "rpm", "rev/s": "revolution/second", "1/min": "rpm", "min^-1": "rpm", "min**-1": "rpm",
            "rpms": None, "rad/sec": "rad/s"}
+#: what gearsym adds to pint's registry (a kept unit's meaning depends on it: see :class:`UnitMeaning`)
+DEFINITIONS = ("hertz = revolution / second = Hz",)
 
 
 def looks_like_quantity(text: str) -> bool:
@@ -72,7 +80,8 @@ def registry():
     ureg = pint.UnitRegistry(on_redefinition="ignore")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        ureg.define("hertz = revolution / second = Hz")
+        for definition in DEFINITIONS:
+            ureg.define(definition)
     ureg.formatter.default_sort_func = None  # units in the order written: N·m, not pint's alphabetical m·N
     return ureg
 
@@ -91,6 +100,28 @@ def __getattr__(name: str):
 # ----------------------------------------------------------------------------------------- reading
 def parse_quantity(text: str, where: str):
     """The pint quantity ``text`` stands for, or a one-line error naming ``where``."""
+    number, unit_text, quoted = _split(text, where)
+    if not unit_text:
+        return Quantity(number)
+    q = Quantity(number, unit(unit_text, where, quoted))
+    try:
+        magnitude = q.to_base_units().magnitude
+    except (OverflowError, ZeroDivisionError):  # (pint's factor of rpm**-1e9 overflows before any check)
+        magnitude = math.inf
+    _check_range(magnitude, where, quoted)
+    return q
+
+
+def check_quantity(text: str, where: str) -> None:
+    """The one-line error :func:`parse_quantity` would give for ``text``, if any (without pint when the unit's
+    meaning is kept: :class:`UnitMeaning`)."""
+    if _measured(text, where) is None:
+        parse_quantity(text, where)
+
+
+def _split(text: str, where: str) -> tuple[float, str, str]:
+    """The number and the unit text of a quantity string (checked against the grammar), and the string quoted
+    for a message."""
     quoted = repr(text if len(text) <= 60 else text[:57] + "...")
     if len(text) > MAX_LENGTH:
         raise GearsymError(f"{where}: {quoted} is longer than the {MAX_LENGTH} characters a quantity may have; {GRAMMAR}")
@@ -106,17 +137,13 @@ def parse_quantity(text: str, where: str):
         raise GearsymError(f"{where}: {quoted} raises a power to a power; {GRAMMAR}")
     if unit_text.count("(") != unit_text.count(")"):
         raise GearsymError(f"{where}: {quoted} has unbalanced parentheses; {GRAMMAR}")
-    if not unit_text:
-        return Quantity(number)
-    q = Quantity(number, unit(unit_text, where, quoted))
-    try:
-        magnitude = q.to_base_units().magnitude
-    except (OverflowError, ZeroDivisionError):  # (pint's factor of rpm**-1e9 overflows before any check)
-        magnitude = math.inf
+    return number, unit_text, quoted
+
+
+def _check_range(magnitude: float, where: str, quoted: str) -> None:
     if not (math.isfinite(magnitude) and (magnitude == 0 or 1e-300 < abs(magnitude) < 1e300)):
         raise GearsymError(f"{where}: {quoted} is {magnitude:g} in SI units, out of the range of a number; "
                            "give a value with an ordinary unit")
-    return q
 
 
 @lru_cache(maxsize=256)
@@ -128,10 +155,7 @@ def unit(text: str, where: str, quoted: str | None = None):
     """The pint unit of a unit expression (already checked against the grammar by the caller)."""
     import pint
 
-    alias = ALIASES.get(text.replace(" ", ""), text)
-    if alias is None:
-        raise GearsymError(f"{where}: unknown unit {text!r} in {quoted or repr(text)}; did you mean 'rpm'? "
-                           "Units are pint's (N, m, mm, um, kg, s, rpm, Hz, rad, ...)")
+    alias = _alias(text, where, quoted)
     try:
         units = _units(alias)
     except pint.UndefinedUnitError as exc:
@@ -141,6 +165,15 @@ def unit(text: str, where: str, quoted: str | None = None):
     except Exception as exc:  # pint's own syntax errors: a unit expression it cannot read
         raise GearsymError(f"{where}: cannot read the unit of {quoted or repr(text)} ({exc}); {GRAMMAR}") from None
     return units
+
+
+def _alias(text: str, where: str, quoted: str | None = None) -> str:
+    """The unit text pint is given for ``text`` (:data:`ALIASES`), or a one-line error for a known misspelling."""
+    alias = ALIASES.get(text.replace(" ", ""), text)
+    if alias is None:
+        raise GearsymError(f"{where}: unknown unit {text!r} in {quoted or repr(text)}; did you mean 'rpm'? "
+                           "Units are pint's (N, m, mm, um, kg, s, rpm, Hz, rad, ...)")
+    return alias
 
 
 def as_quantity(value, where: str):
@@ -214,6 +247,12 @@ def measure(value, where: str) -> Measure:
     finite quantity made of mass, length and time."""
     if isinstance(value, Measure):
         return value
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value):
+        return Measure(float(value), (0.0, 0.0, 0.0), float(value))
+    if isinstance(value, str):
+        known = _measured(value, where)
+        if known is not None:
+            return known
     q = as_quantity(value, where)
     base = q.to_base_units()
     dims = dict(q.dimensionality)
@@ -228,11 +267,164 @@ def measure(value, where: str) -> Measure:
     return Measure(si, tuple(float(dims.get(d, 0)) for d in BASE), float(q.magnitude), unit_text)
 
 
-@lru_cache(maxsize=256)
+def measure_in(value: float, unit_text: str, where: str) -> Measure:
+    """``value`` in ``unit_text`` (as pint reads it, no alias) in SI, as :func:`measure` gives it for
+    ``Quantity(value, unit_text)``: without pint when the unit's meaning is kept."""
+    meaning = _meaning(unit_text) if unit_text else None
+    if (meaning is not None and isinstance(value, (int, float)) and not isinstance(value, bool)
+            and math.isfinite(si := float(value) * meaning.factor)):
+        return Measure(si, meaning.dims, float(value), meaning.name)
+    return measure(Quantity(value, unit_text) if unit_text else value, where)
+
+
+def _measured(text: str, where: str) -> Measure | None:
+    """A quantity string in SI without pint when its unit's meaning is kept (else learnt from pint and kept);
+    None if the unit is not plain (:class:`UnitMeaning`): pint reads it as a quantity."""
+    number, unit_text, quoted = _split(text, where)
+    if not unit_text:
+        return Measure(number, (0.0, 0.0, 0.0), number)
+    alias = _alias(unit_text, where, quoted)
+    meaning = _recalled(alias) or _learnt(alias, unit(unit_text, where, quoted))
+    if meaning is None:
+        return None
+    si = number * meaning.factor  # (pint's conversion of a multiplicative unit: the number times its factor)
+    _check_range(si, where, quoted)
+    return Measure(si, meaning.dims, number, meaning.name)
+
+
+# ----------------------------------------------------------------------------------------- kept meanings
+@dataclass(frozen=True)
+class UnitMeaning:
+    """What pint says a unit text means, as plain data: kept in the user's cache (:mod:`gearsym.files.memo`),
+    so that a later process meeting the same text reads it there and imports no pint (pint's import and its
+    registry cost over a second of CPU a process). pint stays the one parser: a meaning is what pint answered,
+    under a name that hashes the text, pint's version and definitions and :data:`DEFINITIONS`. Only a plain
+    unit is kept: multiplicative (no offset, not logarithmic) and made of mass, length and time."""
+
+    name: str  # the unit as pint names it (``str(units)``): what a Measure keeps
+    factor: float  # SI base units per one
+    dims: tuple[float, float, float]  # the exponents of mass, length and time
+    symbol: str  # pint's short form (``~P``)
+
+    @classmethod
+    def from_pint(cls, units) -> "UnitMeaning | None":
+        """The meaning of a pint unit, or None if it is not plain."""
+        try:
+            dims = dict(Quantity(1.0, units).dimensionality)
+            if set(dims) - set(BASE):
+                return None
+            zero, one, three = (Quantity(x, units).to_base_units().magnitude for x in (0.0, 1.0, 3.0))
+            if zero != 0 or three != 3.0 * one or not math.isfinite(one) or one == 0:
+                return None  # (an offset or logarithmic unit: its conversion is not a product)
+            name = str(units)  # (a Measure keeps no unit for pint's 'dimensionless')
+            return cls("" if name == "dimensionless" else name, float(one), tuple(float(dims.get(d, 0)) for d in BASE),
+                       f"{units:~P}")
+        except Exception:  # (pint could not convert it: it is read by pint, as before)
+            return None
+
+
+_MEANINGS: dict[str, UnitMeaning] = {}  # this process's: unit text -> meaning
+_WHAT = "kept meaning of a unit"
+
+
+def _recalled(text: str) -> UnitMeaning | None:
+    """The meaning of ``text`` (as pint reads it) kept by this or an earlier process, or None."""
+    if text not in _MEANINGS and (identity := _pint_identity()) is not None:
+        kept = recall("units", text, identity, _WHAT)
+        try:
+            meaning = kept and UnitMeaning(str(kept["name"]), float(kept["factor"]),
+                                           tuple(float(d) for d in kept["dims"]), str(kept["symbol"]))
+        except (KeyError, TypeError, ValueError):
+            meaning = None
+        if meaning and len(meaning.dims) == len(BASE) and math.isfinite(meaning.factor) and meaning.factor:
+            _MEANINGS[text] = meaning
+    return _MEANINGS.get(text)
+
+
+def _learnt(text: str, units) -> UnitMeaning | None:
+    """The meaning of the pint unit ``units`` read from ``text``, kept for later processes (and the meaning of
+    its name, which a Measure keeps and shows); None if it is not plain."""
+    meaning = UnitMeaning.from_pint(units)
+    identity = _pint_identity()
+    if meaning is None or identity is None:
+        return meaning
+    for said, meant in ((text, meaning), (meaning.name, None)):
+        if not said or said in _MEANINGS:
+            continue
+        if meant is None:
+            try:
+                meant = UnitMeaning.from_pint(_units(said))
+            except Exception:  # (a name pint does not read back: not kept)
+                continue
+        if meant is not None:
+            _MEANINGS[said] = meant
+            keep("units", said, identity, {"name": meant.name, "factor": meant.factor, "dims": list(meant.dims),
+                                           "symbol": meant.symbol})
+    return meaning
+
+
+def _meaning(unit_text: str) -> UnitMeaning | None:
+    """The meaning of a unit text as pint reads it (no alias), kept or learnt; None if it is not plain or pint
+    cannot read it (the caller asks pint, which says why)."""
+    meaning = _recalled(unit_text)
+    if meaning is None:
+        try:
+            meaning = _learnt(unit_text, _units(unit_text))
+        except Exception:
+            return None
+    return meaning
+
+
+@lru_cache(maxsize=None)
+def _pint_identity() -> str | None:
+    """What a pint answer depends on, found without importing pint: its version (the name of its installed
+    metadata), a hash of its definitions files, and :data:`DEFINITIONS`; None if there is no pint."""
+    try:
+        spec = importlib.util.find_spec("pint")
+    except (ImportError, ValueError):
+        return None
+    if spec is None or not spec.origin:
+        return None
+    folder = Path(spec.origin).parent
+    digest = hashlib.sha256()
+    for name in sorted(folder.glob("*.txt")):  # (default_en.txt, constants_en.txt: the units pint knows)
+        try:
+            digest.update(name.name.encode() + b"\0" + name.read_bytes())
+        except OSError:
+            return None
+    versions = sorted(p.name for p in folder.parent.glob("*.dist-info") if p.name.lower().startswith("pint-"))
+    return f"{' '.join(versions) or 'pint'} {digest.hexdigest()[:32]} {' ; '.join(DEFINITIONS)}"
+
+
+def conversion_factor(source: str, target: str) -> float:
+    """How many ``target`` one ``source`` is (pint's factor, ``Quantity(1.0, source).to(target)``: not the ratio
+    of the two SI factors, which may differ in the last bit), kept as a unit's meaning is."""
+    question = f"{source} -> {target}"
+    if question not in _FACTORS:
+        identity = _pint_identity()
+        kept = recall("unit-conversions", question, identity, _WHAT) if identity is not None else None
+        factor = kept.get("factor") if kept else None
+        if not (isinstance(factor, float) and math.isfinite(factor)):
+            factor = float(Quantity(1.0, source).to(target).magnitude)
+            if identity is not None and math.isfinite(factor):
+                keep("unit-conversions", question, identity, {"factor": factor})
+        _FACTORS[question] = factor
+    return _FACTORS[question]
+
+
+_FACTORS: dict[str, float] = {}  # this process's: 'source -> target' -> factor
+
+
 def si_factor(unit_text: str) -> float:
     """SI base units per one ``unit_text`` (1e-6 for 'um', 0.10472 for 'rpm')."""
     if not unit_text:
         return 1.0
+    meaning = _meaning(unit_text)
+    return meaning.factor if meaning is not None else _pint_factor(unit_text)
+
+
+@lru_cache(maxsize=256)
+def _pint_factor(unit_text: str) -> float:
     return float(Quantity(1.0, unit_text).to_base_units().magnitude)
 
 
@@ -252,14 +444,20 @@ def to_si(number, unit_text: str):
     return number * si_factor(unit_text)
 
 
-@lru_cache(maxsize=256)
 def symbol(unit_text: str) -> str:
     """The short symbol of a unit, as pint prints it ('µm' for 'micrometer', 'N·m' for 'newton * meter')."""
     if not unit_text:
         return ""
+    meaning = _meaning(unit_text)
+    return meaning.symbol if meaning is not None else _pint_symbol(unit_text)
+
+
+@lru_cache(maxsize=256)
+def _pint_symbol(unit_text: str) -> str:
     return f"{Quantity(1, unit_text).units:~P}"
 
 
-__all__ = ["BASE", "GRAMMAR", "MAX_LENGTH", "Measure", "QUANTITY", "Quantity", "as_quantity", "dimension_text",
-           "from_si", "is_quantity", "looks_like_quantity", "measure", "parse_quantity", "registry", "shown",
-           "si_factor", "symbol", "to_si", "unit", "unit_dims"]
+__all__ = ["BASE", "GRAMMAR", "MAX_LENGTH", "Measure", "QUANTITY", "Quantity", "UnitMeaning", "as_quantity",
+           "check_quantity", "conversion_factor", "dimension_text", "from_si", "is_quantity", "looks_like_quantity",
+           "measure", "measure_in", "parse_quantity", "registry", "shown", "si_factor", "symbol", "to_si", "unit",
+           "unit_dims"]

@@ -130,9 +130,11 @@ def test_a_changed_physical_value_is_carried_back_with_the_new_value(model_copy,
 FORMULA = ("--set", "k=1+0.2*cos(tau)")
 
 
-@pytest.mark.parametrize("name, settings", [("one_stage", ()), ("spur_pair", ()), ("one_stage", FORMULA),
+@pytest.mark.parametrize("name, settings", [("one_stage", ()), ("spur_pair", ("--set", "speed=9100 rpm")),
+                                            ("one_stage", FORMULA),
                                             ("spur_pair", (*FORMULA, "--plot", "{tmp}/point.png"))],
-                         ids=["one_stage", "spur_pair", "a stiffness formula", "a formula and its figure in units"])
+                         ids=["one_stage", "spur_pair at a speed in rpm (its unit read without pint)",
+                              "a stiffness formula", "a formula and its figure in units"])
 @pytest.mark.slow
 def test_a_command_on_a_cached_model_imports_neither_sympy_nor_pint(model_copy, tmp_path, name, settings, capsys):
     model_file = model_copy(name)

@@ -16,6 +16,7 @@ from ..files.atomic import write_atomically
 from ..figures import plot_point
 from ..files.outputs import check_figure
 from ..opening import open_model
+from ..physical.point import loads_trajectory
 from ..physical.text import parameters_line
 from .arguments.integration import add_integration_arguments, integration_from, model_request, step_line
 from .arguments.settings import add_set_argument, parse_state
@@ -48,9 +49,10 @@ def run(args: argparse.Namespace) -> int:
     result = lyapunov_spectrum(compiled, y0=y0)
     if result.divergence is not None:
         raise GearsymError(diverged_message(compiled, result))
-    # (the mesh forces and shaft torques from a trajectory at the point, as in Python: physical/point.py)
-    physical = scaling.to_physical(result, model=compiled) if scaling is not None else None
     units = scaling.point_units() if scaling is not None else None  # (the figure's, the JSON's and the text's)
+    # (the mesh forces and shaft torques from a trajectory at the point, as in Python: physical/point.py; carried
+    # back by the numbers the start-up cache keeps, so a first run shows what a cached one does, without pint)
+    physical = units.point(result, loads_trajectory(compiled, result)) if units is not None else None
     if args.plot:
         shown = min(30, result.periods - result.discard)
         trajectory = phase_trajectory(compiled, options=compiled.integration.run(discard=result.periods - shown),

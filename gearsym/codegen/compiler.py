@@ -48,6 +48,7 @@ from pathlib import Path
 
 from ..errors import GearsymError, warn
 from ..files.atomic import no_room, write_error
+from ..files.cache import configured_cache
 from ..files.private import CACHE_ADVICE, NotPrivate, private_folder
 from .trust import record, trusted
 
@@ -75,15 +76,6 @@ int gearsym_call(gearsym_entry f, const double** arg, double** res, long long* i
 
 class CompilerError(GearsymError):
     """No usable C compiler, or the compiler failed."""
-
-
-def configured_cache() -> Path:
-    """Where the cache is asked to be: ``$GEARSYM_CACHE``, else ``$XDG_CACHE_HOME/gearsym`` or ``~/.cache/gearsym``."""
-    root = os.environ.get("GEARSYM_CACHE")
-    if root:
-        return Path(root)
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "gearsym"
 
 
 def cache_dir(*levels: str) -> Path:

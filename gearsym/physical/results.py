@@ -22,7 +22,7 @@ from ..scales.dimensions import evaluate
 from ..scales.map import Scaling
 from ..sweep.grid import Axis
 from ..model.symbols import parameter_symbol, phi, tau
-from ..units import Quantity, from_si, symbol
+from ..units import Quantity, conversion_factor, from_si, symbol
 from .point import (ANGLE, ANGULAR_VELOCITY, LENGTH, LENGTH_UNIT, VELOCITY, VELOCITY_UNIT, Measured,
                     MeshUnits, PhysicalPoint, PointUnits, ShaftUnits, Unit, loads_trajectory)
 
@@ -98,19 +98,16 @@ def _quantities(value):
 
 def point_units(scaling: Scaling, length_unit: str = LENGTH_UNIT) -> PointUnits:
     """The numbers that carry a run of ``scaling`` to physical units (what the start-up cache keeps)."""
-    def factor(source: str, target: str) -> float:
-        return float(Quantity(1.0, source).to(target).magnitude)
-
     def text(unit: str) -> Unit:
         return Unit(unit, symbol(unit))
 
     speed_unit = scaling.speed_unit
     return PointUnits(
-        scaling.name, scaling.speed, text(speed_unit), factor("rad/s", speed_unit), scaling.omega_n_si,
+        scaling.name, scaling.speed, text(speed_unit), conversion_factor("rad/s", speed_unit), scaling.omega_n_si,
         scaling.omega_n_si / (2 * np.pi), float(scaling.forcing_ratio) if scaling.speed else float("nan"),
-        float(scaling.reference_mesh.order), factor("rad/s", "Hz"), scaling.length_si,
-        float(from_si(scaling.length_si, length_unit)), length_unit, text(length_unit), factor("m", length_unit),
-        text(VELOCITY_UNIT), factor("m/s", VELOCITY_UNIT), text("1/s"), text("N"), text("Hz"), text("rad"),
+        float(scaling.reference_mesh.order), conversion_factor("rad/s", "Hz"), scaling.length_si,
+        float(from_si(scaling.length_si, length_unit)), length_unit, text(length_unit), conversion_factor("m", length_unit),
+        text(VELOCITY_UNIT), conversion_factor("m/s", VELOCITY_UNIT), text("1/s"), text("N"), text("Hz"), text("rad"),
         text("rad/s"), text("N*m"), kinds(scaling), _per_unit(scaling), tuple(_mesh_units(scaling)),
         tuple(_shaft_units(scaling)), {n: q.text() for n, q in scaling.inputs.items()})
 

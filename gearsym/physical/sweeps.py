@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 from ..errors import GearsymError
 from ..sweep.grid import Axis, axes_from
-from ..units import Quantity, as_quantity, is_quantity, symbol
+from ..units import Quantity, as_quantity, is_quantity, measure_in, symbol
 
 if TYPE_CHECKING:  # (the type only: a sweep of a cached model reads this module without SymPy)
     from ..scales.map import Scaling
@@ -37,7 +37,7 @@ def nondimensional_axis(scaling: Scaling, axis: Axis, where: str | None = None) 
                                f"{scaling.unitless(name, axis.values[0], _spelled(axis, unit, where))}")
     unit = axis.unit
     base = scaling.values
-    columns = [scaling.values_at(**{name: Quantity(v, unit)}) for v in axis.values]
+    columns = [scaling.values_at(**{name: measure_in(v, unit, where)}) for v in axis.values]
     moved = sorted({k for row in columns for k in row if row[k] != base[k]} or {scaling.parameter_moved_by(name)})
     if len(moved) != 1:
         raise GearsymError(f"{where}: {name} moves {', '.join(moved)} of the nondimensional model "

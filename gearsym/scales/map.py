@@ -33,7 +33,7 @@ from ..model.resolved_components import ResolvedCoupling
 from ..reduction import NondimensionalModel
 from ..reduction.statics import StaticState, static_state, torque_imbalance
 from ..model.symbols import parameter_symbol
-from ..units import Measure, Quantity, dimension_text, measure, symbol
+from ..units import Measure, Quantity, conversion_factor, dimension_text, measure, symbol
 from .dimensions import evaluate, same_dimension
 from .roles import SPEED, fields, parameter_roles, physical_parameters
 from .settings import maybe_number
@@ -401,9 +401,13 @@ class Scaling:
 
     def mesh_frequency(self, speed=None, mesh: str | None = None):
         """The tooth-passing frequency of a mesh (default the first) at a speed, in Hz."""
+        return Quantity(self._mesh_frequency_hz(speed, mesh), "Hz")
+
+    def _mesh_frequency_hz(self, speed=None, mesh: str | None = None) -> float:
+        """:meth:`mesh_frequency`'s number (pint's conversion from rad/s, without pint when it is kept)."""
         rc = self.reference_mesh if mesh is None else self.model._mesh(
             next(f for f in self.model.functions if f.mesh == mesh))
-        return Quantity(self.speed_si(speed) * self.mesh_frequency_ratio(rc), "rad/s").to("Hz")
+        return self.speed_si(speed) * self.mesh_frequency_ratio(rc) * conversion_factor("rad/s", "Hz")
 
     def omega(self, speed=None) -> float:
         """The nondimensional forcing frequency at a speed: forcing frequency / omega_n."""
@@ -513,7 +517,7 @@ class Scaling:
             "values": self.values,
         }
         if self.speed and self.speed.parameter in self.inputs:
-            out["mesh_frequency"] = f"{self.mesh_frequency().magnitude:.6g} Hz"
+            out["mesh_frequency"] = f"{self._mesh_frequency_hz():.6g} Hz"
         return out
 
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from decimal import Decimal, InvalidOperation
 
 from ..errors import GearsymError
-from ..units import QUANTITY, parse_quantity
+from ..units import QUANTITY, check_quantity, parse_quantity
 
 MODES = ("continuation", "independent")
 DIRECTIONS = ("up", "down", "both")
@@ -83,9 +83,15 @@ def _numbers_and_unit(text: str, parts: list[str], option: str = "--param") -> t
     unit = next(u for u in units if u)
     numbers = []
     for part, own in zip(parts, units):
-        q = parse_quantity(part if own else f"{part} {unit}", f"{option} {text!r}")
+        quantity, where = part if own else f"{part} {unit}", f"{option} {text!r}"
+        if own in ("", unit):  # (already in the unit: only checked, without pint when the unit's meaning is kept)
+            check_quantity(quantity, where)
+            number = QUANTITY.fullmatch(part)["number"]
+            numbers.append(number if own else repr(float(number)))  # (what pint's conversion to the unit gave)
+            continue
+        q = parse_quantity(quantity, where)
         try:
-            numbers.append(repr(q.to(unit).magnitude) if own != unit else QUANTITY.fullmatch(part)["number"])
+            numbers.append(repr(q.to(unit).magnitude))
         except Exception:
             raise GearsymError(f"{option} {text!r}: {part.strip()} cannot be converted to {unit}") from None
     return numbers, unit
