@@ -75,9 +75,10 @@ class NativeFunction:
         work.restype, work.argtypes = ctypes.c_int, [ctypes.POINTER(_int)] * 4
         counts = [_int() for _ in range(4)]
         work(*(ctypes.byref(c) for c in counts))
-        # (as CasADi counts them: at least a pointer per input and output)
-        arg, res, iw, w = max(counts[0].value, self.n_in), max(counts[1].value, self.n_out), counts[2].value, \
-            counts[3].value
+        # (as casadi.external counts them, so that the arrays sit where they always did: a pointer per input and
+        # output of its own, then the function's work)
+        arg, res, iw, w = (self.n_in + counts[0].value, self.n_out + counts[1].value, counts[2].value,
+                           counts[3].value)
         sizes = [8 * max(n, 1) for n in (arg, res, iw, w)]
         offsets, total = work_layout(sizes)
         self._block = np.zeros(total + PAGE, dtype=np.uint8)
