@@ -2,6 +2,7 @@
 nothing else (values, units and reductions are the caller's: :mod:`gearsym.loading`)."""
 from __future__ import annotations
 
+import ast
 import importlib
 import importlib.util
 import sys
@@ -41,8 +42,30 @@ def pregenerated_models(what: str = "code") -> list[str]:
     page of formulas would be a megabyte)."""
     if what not in ("code", "page"):
         raise ValueError(f"what is 'code' or 'page', not {what!r}")
-    flags = {name: getattr(_module(name), "PREGENERATED", True) for name in available_models()}
+    flags = {name: _pregenerated_flag(models_dir() / f"{name}.py") for name in available_models()}
     return [name for name, flag in flags.items() if flag is True or flag == what]
+
+
+def _pregenerated_flag(path: Path) -> bool | str:
+    """A model file's ``PREGENERATED`` (True when it sets none), read from its text: listing the committed models
+    does not run every model file (each builds its model, some their gears' stiffness, when it runs)."""
+    try:
+        body = ast.parse(path.read_bytes(), filename=str(path)).body
+    except SyntaxError as exc:
+        raise GearsymError(f"{exc.filename}, line {exc.lineno}: {type(exc).__name__}: {exc.msg}") from None
+    for node in body:
+        targets = node.targets if isinstance(node, ast.Assign) else [node.target] if isinstance(node, ast.AnnAssign) \
+            else []
+        if any(isinstance(t, ast.Name) and t.id == "PREGENERATED" for t in targets) and node.value is not None:
+            try:
+                flag = ast.literal_eval(node.value)
+            except ValueError:
+                flag = None
+            if not (isinstance(flag, bool) or flag == "code"):
+                raise GearsymError(f"{path}, line {node.lineno}: PREGENERATED is True, False or \"code\", written as "
+                                   "such (the file is read, not run, to list the committed models)")
+            return flag
+    return True
 
 
 def model_path(ref: str) -> Path | None:

@@ -9,7 +9,7 @@ import sys
 import pytest
 
 import gearsym.derivation
-from gearsym import available_models
+from gearsym import GearsymError, available_models
 from gearsym.registry import pregenerated_models
 from gearsym.cli import COMMANDS, main
 from gearsym.derivation import derive
@@ -183,13 +183,24 @@ def test_a_model_whose_code_alone_is_pre_generated_is_left_out_of_the_pages():
     assert set(pregenerated_models("page")) == set(available_models()) - {"planetary_translational"}
 
 
-def test_a_model_that_is_not_pre_generated_is_listed_but_left_out_of_every_all(monkeypatch):
-    import types
+def test_a_model_that_is_not_pre_generated_is_listed_but_left_out_of_every_all(monkeypatch, tmp_path):
+    models = tmp_path / "models"  # (the working directory's models/ is the one gearsym lists)
+    models.mkdir()
+    (models / "__init__.py").write_text("")
+    (models / "derived_on_use.py").write_text("PREGENERATED = False\nraise SystemExit('listing runs no model file')\n")
+    (models / "code_only.py").write_text("PREGENERATED: str = 'code'\nraise SystemExit('listing runs no model file')\n")
+    (models / "committed.py").write_text("raise SystemExit('listing runs no model file')\n")
+    monkeypatch.chdir(tmp_path)
+    assert available_models() == ["code_only", "committed", "derived_on_use"]
+    assert pregenerated_models() == ["code_only", "committed"] and pregenerated_models("page") == ["committed"]
 
-    import gearsym.registry as registry
 
-    shipped = registry._module
-    monkeypatch.setattr(registry, "_module", lambda name: types.SimpleNamespace(PREGENERATED=False)
-                        if name == "duffing" else shipped(name))
-    assert "duffing" in available_models()
-    assert "duffing" not in pregenerated_models() and "duffing" not in pregenerated_models("page")
+@pytest.mark.parametrize("line", ["PREGENERATED = 1", "PREGENERATED = 'page'", "PREGENERATED = bool(1)"])
+def test_a_pre_generated_flag_that_is_not_written_as_true_false_or_code_is_said_with_its_line(monkeypatch, tmp_path,
+                                                                                                line):
+    (tmp_path / "models").mkdir()
+    (tmp_path / "models" / "__init__.py").write_text("")
+    (tmp_path / "models" / "odd.py").write_text(f"# a model\n{line}\n")
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(GearsymError, match=r"odd.py, line 2: PREGENERATED is True, False or \"code\""):
+        pregenerated_models()
