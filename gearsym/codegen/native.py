@@ -10,7 +10,7 @@ functions keep no state (``checkout`` returns 0), so each ``NativeFunction``
 owns its work arrays and distinct objects may run in different threads.
 What CasADi would tell of a function (its inputs and outputs, their sparsity, its work sizes) is read from the
 entry points the generated C exports beside it (``<f>_n_in``, ``<f>_sparsity_in``, ``<f>_work`` ...): a run on a
-cached model never imports CasADi (about a fifth of its start-up).
+cached model never imports CasADi (its import was about a tenth of that start-up).
 
 Where those arrays and the stack sit decided the speed of a step while CasADi's
 loops called each step through them: every step stored pointers into the argument
