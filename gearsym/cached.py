@@ -10,7 +10,7 @@ given ``--set`` values writes two small files into the cache (``$GEARSYM_CACHE/m
   a key that hashes the model's file, the other model files it may import, gearsym's own source and the
   values: any change to one of them is another key, never a stale summary;
 * ``<model>-<key>-<loops>.json``: for one structure of the loops (steps per period, crossings located), the
-  code hash and the compiled library.
+  code hash and the compiled library (:class:`BuildSummary`).
 
 Later runs build the :class:`~gearsym.codegen.compiled.CompiledModel` from them, with a
 :class:`SystemSummary` as its system, which loads (and reduces) the model only if something asks for what
@@ -35,13 +35,10 @@ from dataclasses import asdict, dataclass, field, replace
 from functools import lru_cache
 from pathlib import Path
 
-from .codegen.compiled import CompiledModel
 from .codegen.compiler import binary_key, cache_dir, compile_flags
-from .codegen.library import library_describes, library_functions, model_key, resolve_backend
-from .codegen.loaded import keep, loaded
+from .codegen.library import library_describes, library_model, resolve_backend
 from .codegen.loops import LoopOptions
 from .codegen.step_choice import chosen
-from .codegen.native import load_native
 from .codegen.trust import check, differences
 from .options import Integration
 from .parameters import Constraint, ParameterChecks
@@ -168,6 +165,36 @@ def _watches(stored) -> tuple | None:
     if stored is None:
         return None
     return tuple((str(n), str(c), *(v if isinstance(v, str) else float(v) for v in (b, o))) for n, c, b, o in stored)
+
+
+@dataclass(frozen=True)
+class BuildSummary:
+    """What the cache keeps of one build of a model (``<model>-<key>-<loops>.json``): its code hash, the compiled
+    library, the parameters in its tables of time, and those tables as text."""
+
+    hash: str
+    library: Path
+    timed_parameters: frozenset[str]
+    table_texts: tuple[str, ...]
+
+    @classmethod
+    def of(cls, compiled) -> "BuildSummary":
+        return cls(compiled.hash, Path(compiled.library), frozenset(compiled.timed_parameters),
+                   tuple(compiled.table_texts))
+
+    def as_dict(self) -> dict:
+        return {"hash": self.hash, "library": str(self.library), "timed_parameters": sorted(self.timed_parameters),
+                "table_texts": list(self.table_texts)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "BuildSummary":
+        return cls(str(d["hash"]), Path(d["library"]), frozenset(d["timed_parameters"]),
+                   tuple(str(t) for t in d["table_texts"]))
+
+    @property
+    def in_own_cache(self) -> bool:
+        """Whether the library is one of the cache's own (no other is loaded)."""
+        return self.library.parent == cache_dir("lib") and not self.library.name.startswith(".")
 
 
 @lru_cache(maxsize=None)
@@ -308,9 +335,7 @@ def keep_compiled(slot: CacheSlot, compiled, units: PointUnits | None) -> None:
     build_file = summary_path(slot.name, f"{slot.key}-{loops_key(LoopOptions.of(compiled.integration))}")
     summary = SystemSummary.of(compiled.system, units is not None, compiled.fastest)
     write_json(system_file, {"system": summary.as_dict(), "physical": units and units.as_dict()})
-    write_json(build_file, {"hash": compiled.hash, "library": str(compiled.library),
-                            "timed_parameters": sorted(compiled.timed_parameters),
-                            "table_texts": list(compiled.table_texts)})
+    write_json(build_file, BuildSummary.of(compiled).as_dict())
 
 
 def read_summary(system: Mapping | None, full: Callable[[], object]) -> SystemSummary | None:
@@ -322,40 +347,35 @@ def read_summary(system: Mapping | None, full: Callable[[], object]) -> SystemSu
         return None
 
 
-def _from_cache(system: Mapping | None, build_file: Path, options: Integration, full: Callable[[], object]):
-    """The compiled model of a system's summary as read (``system``) and the build summary in ``build_file``, or
-    None."""
-    build = read_json(build_file)
-    summary = read_summary(system, full)
-    if summary is None:
-        return None
+def read_build(path: Path) -> BuildSummary | None:
+    """The :class:`BuildSummary` in ``path``, or None: none, or none that reads as one."""
     try:
-        digest, library, timed = str(build["hash"]), Path(build["library"]), frozenset(build["timed_parameters"])
-        texts = tuple(str(t) for t in build["table_texts"])
+        return BuildSummary.from_dict(read_json(path))
     except (KeyError, TypeError, ValueError, AttributeError):
         return None
-    if library.parent != cache_dir("lib") or library.name.startswith("."):
-        return None  # (only a library of our own cache is loaded)
-    if not set(timed) <= set(summary.parameters):
-        distrust(build_file, "it names parameters its model does not have", _WHAT)
+
+
+def _from_cache(system: Mapping | None, build_file: Path, options: Integration, full: Callable[[], object]):
+    """The compiled model of a system's summary as read (``system``) and the build summary in ``build_file``, or
+    None: either missing or unreadable, a library not of our own cache or not as compiled (compile_model says so
+    and makes it again), or summaries that do not describe the library they point at (edited: said here)."""
+    summary = read_summary(system, full)
+    build = read_build(build_file)
+    if summary is None or build is None or not build.in_own_cache or summary.cycles < 1:
         return None
-    verdict = check(library)  # (a library not as compiled is said and made again by compile_model)
-    if verdict.data is None:
-        return None
-    why = differences(verdict.describes, library_describes(summary, digest))
-    if why is not None:  # (the summaries do not describe the library they point at: edited)
-        distrust(build_file, f"{library.name}, the library it points at, does not match it: {why}", _WHAT)
-        return None
-    key = model_key(digest, "compiled")
-    found = loaded(key)
-    if found is not None:  # (loaded in this process already: its functions with work arrays of their own)
-        return replace(found.clone(), system=summary, integration=options)
-    if summary.cycles < 1:
-        return None
-    loops = LoopOptions.of(options, summary.cycles)  # (the key's loops count steps per forcing period)
-    functions = library_functions(library)
-    return keep(key, CompiledModel(summary, loops, digest, functions, "compiled", library, {},
-                                   load_native(library, functions), options, timed, texts, summary.fastest))
+    if not build.timed_parameters <= set(summary.parameters):
+        why = "it names parameters its model does not have"
+    else:
+        verdict = check(build.library)  # (a library not as compiled is said and made again by compile_model)
+        if verdict.data is None:
+            return None
+        why = differences(verdict.describes, library_describes(summary, build.hash))
+        if why is None:  # (the summaries describe the library they point at)
+            return library_model(summary, build.hash, build.library, options, build.timed_parameters,
+                                 build.table_texts, summary.fastest)
+        why = f"{build.library.name}, the library it points at, does not match it: {why}"
+    distrust(build_file, why, _WHAT)  # (edited: said once, and the summaries are written again)
+    return None
 
 
 def load_linearisation(ref: str, values: Mapping[str, object], options: Integration, *,
@@ -389,9 +409,7 @@ def load_linearisation(ref: str, values: Mapping[str, object], options: Integrat
                              "linearisation": {"static": lin.recipe.as_dict(), "anchors": list(lin.anchors),
                                                "base": lin.base, "parameters": dict(lin.base_parameters),
                                                "physical": lin.physical}})
-    write_json(build_file, {"hash": lin.model.hash, "library": str(lin.model.library),
-                            "timed_parameters": sorted(lin.model.timed_parameters),
-                            "table_texts": list(lin.model.table_texts)})
+    write_json(build_file, BuildSummary.of(lin.model).as_dict())
     return lin
 
 

@@ -12,7 +12,7 @@ from ..figures.basins import plot_basin_fractions, plot_basin_map
 from ..files.outputs import check_figure, check_file
 from ..opening import open_model
 from ..options import Execution
-from ..physical.basins import PhysicalGrid, ShownBasinMap, ShownFractions, check_grid_units, engine_grid, shown_in
+from ..physical.basins import PhysicalGrid, ShownBasinMap, ShownFractions, shown_in
 from ..physical.files import write_basin_fractions, write_basin_map
 from ..physical.sweeps import nondimensional_axes
 from ..sweep.basin_continuation import MATCH_DISTANCE, StartGrid, continue_basins
@@ -74,23 +74,22 @@ def run(args: argparse.Namespace) -> int:
     model = open_model(request)
     scaling = model.scaling
     units = scaling.point_units() if scaling is not None else None
+    shown_as = shown_in(units, request.settings)
     if units is None:
         unit = next((a for a in [*grid_axes, *([axis] if axis else [])] if a.unit), None)
         if unit:
             raise GearsymError(f"{unit.spec!r} has a unit, but the model has no physical values; give the model's own "
                                "numbers")
-    if units is not None:
-        check_grid_units(units, grid_axes)  # (before the model is compiled)
-    if axis is not None and units is not None:
-        axis = nondimensional_axes(scaling.full, [axis])[0]
-    compiled = model.compiled()
+    # (a grid in physical units is checked here, once, before the model is compiled)
+    physical_grid = PhysicalGrid(units, grid_axes) if units is not None else None
     if axis is not None:
-        return _continuation(args, compiled, grid_axes, axis, units, y0)
+        return _continuation(args, model, grid_axes, physical_grid, axis, shown_as, y0)
+    compiled = model.compiled()
     omega = compiled.parameter_vector()[compiled.parameter_names.index("omega")] \
         if "omega" in compiled.parameter_names else 1.0
-    grid = engine_grid(units, grid_axes, omega) if units is not None else {a.name: a.values for a in grid_axes}
-    result = basin_map(compiled, grid, y0=y0, execution=_execution(args))
-    shown = ShownBasinMap(result, shown_in(units, request.settings), tuple(grid_axes))
+    starts = physical_grid.at({"omega": omega}) if physical_grid else {a.name: a.values for a in grid_axes}
+    result = basin_map(compiled, starts, y0=y0, execution=_execution(args))
+    shown = ShownBasinMap(result, shown_as, tuple(grid_axes))
     if args.out:
         written = write_basin_map(shown, args.out)
         print(f"gearsym: wrote {' and '.join(map(str, written))}", file=sys.stderr)
@@ -105,9 +104,15 @@ def _execution(args: argparse.Namespace) -> Execution:
     return Execution(args.jobs, lanes=not args.no_lanes, progress=not args.quiet)
 
 
-def _continuation(args, compiled, grid_axes: list[Axis], axis: Axis, units, y0) -> int:
-    grid = PhysicalGrid(units, grid_axes) if units is not None else \
-        StartGrid({a.name: a.values for a in grid_axes}, [a.spec for a in grid_axes])
+def _continuation(args, model, grid_axes: list[Axis], physical_grid: PhysicalGrid | None, axis: Axis, shown_as,
+                  y0) -> int:
+    """The basin fractions along --param (``physical_grid``: the grid in physical units, None for a model without
+    physical values)."""
+    physical = physical_grid is not None
+    if physical:  # (the parameter in the engine's numbers, before the model is compiled)
+        axis = nondimensional_axes(model.scaling.full, [axis])[0]
+    grid = physical_grid or StartGrid({a.name: a.values for a in grid_axes}, [a.spec for a in grid_axes])
+    compiled = model.compiled()
     try:
         result = continue_basins(compiled, grid, axis.name, axis.values, y0=y0, out=args.out,
                                  overwrite=args.overwrite, execution=_execution(args),
@@ -116,8 +121,8 @@ def _continuation(args, compiled, grid_axes: list[Axis], axis: Axis, units, y0) 
         print(f"gearsym: interrupted; the values finished are in {args.out}: run the same command again to resume",
               file=sys.stderr)
         return 130
-    shown = ShownFractions(result, shown_in(units))
-    if units is not None:
+    shown = ShownFractions(result, shown_as)
+    if physical:
         path = write_basin_fractions(shown, sidecar(args.out, ".physical.csv"))
         print(f"gearsym: wrote {path} (the fractions in the model's units)", file=sys.stderr)
     if args.plot:

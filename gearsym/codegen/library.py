@@ -8,10 +8,16 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Iterator, Mapping
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ..options import Integration
+from .compiled import CompiledModel
 from .compiler import FALLBACK_NOTE, compilers_looked_for, find_compiler
+from .loaded import keep, loaded
+from .loops import LoopOptions
+from .native import load_native
 
 if TYPE_CHECKING:
     import casadi as ca
@@ -74,3 +80,18 @@ def library_describes(system, digest: str) -> dict:
     (``system``: a FirstOrderSystem or the start-up cache's summary of one)."""
     return {"model": system.name, "code": digest, "states": list(system.state_names),
             "parameters": list(system.parameters)}
+
+
+def library_model(system, digest: str, library: Path, options: Integration, timed: frozenset[str],
+                  table_texts: tuple[str, ...], fastest: float = 0.0) -> CompiledModel:
+    """The compiled model of ``system`` whose ``library`` (compiled and checked before) holds the code ``digest``:
+    the one this process loaded already, with its functions' work arrays of its own, else the library loaded here
+    and kept (:mod:`.loaded`)."""
+    key = model_key(digest, "compiled")
+    found = loaded(key)
+    if found is not None:
+        return replace(found.clone(), system=system, integration=options)
+    loops = LoopOptions.of(options, system.cycles)  # (the key's loops count steps per forcing period)
+    functions = library_functions(library)
+    return keep(key, CompiledModel(system, loops, digest, functions, "compiled", library, {},
+                                   load_native(library, functions), options, timed, table_texts, fastest))

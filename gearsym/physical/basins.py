@@ -1,15 +1,16 @@
 """Basin maps and basin fractions as they are shown: in a model's units when it has physical values (a grid in
 µm and mm/s, the speed in rpm), else in its own numbers.
 
-A grid given in physical units is turned into the engine's nondimensional starts at each forcing frequency (a
-rate's unit, L omega omega_n per second, moves with the speed: :func:`engine_grid`); the results come back through
-the same numbers (:class:`~gearsym.physical.point.PointUnits`: the length unit L, omega_n, the speed's ratio).
-:class:`ShownBasinMap` and :class:`ShownFractions` are the results in those units, which the files
-(:mod:`.files`), the command's text and the figures (:mod:`gearsym.figures.basins`) take.
+A grid given in physical units is checked and put in SI units once (:class:`PhysicalGrid`), and turned into the
+engine's nondimensional starts at each forcing frequency (a rate's unit, L omega omega_n per second, moves with the
+speed: :func:`engine_grid`); the results come back through the same numbers
+(:class:`~gearsym.physical.point.PointUnits`: the length unit L, omega_n, the speed's ratio). :class:`ShownBasinMap`
+and :class:`ShownFractions` are the results in those units, which the files (:mod:`.files`), the command's text
+and the figures (:mod:`gearsym.figures.basins`) take.
 """
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -106,14 +107,19 @@ _DIMENSIONS = {LENGTH: ((0.0, 1.0, 0.0), "-20um:20um:1um"), VELOCITY: ((0.0, 1.0
                ANGULAR_VELOCITY: ((0.0, 0.0, -1.0), "-10rad/s:10rad/s:1rad/s")}
 
 
-def check_grid_units(units: PointUnits, axes: Sequence[Axis]) -> None:
-    """Every grid axis of a state with a physical kind has a unit of that kind's dimension (a length, a rate)."""
+def grid_in_si(units: PointUnits, axes: Sequence[Axis]) -> dict[str, np.ndarray]:
+    """The values of grid ``axes`` in SI units (an axis of a state without a physical kind: the model's own
+    numbers), each axis of a state with a physical kind checked to have a unit of that kind's dimension (a
+    length, a rate)."""
+    grid = {}
     for axis in axes:
+        values = np.asarray(axis.values, dtype=float)
         kind = units.kinds.get(axis.name)
         if kind is None:  # a state without a physical kind: the model's own numbers
+            grid[axis.name] = values
             continue
-        expected, grid = _DIMENSIONS[kind]
-        example = f"{axis.name}={grid}"
+        expected, example = _DIMENSIONS[kind]
+        example = f"{axis.name}={example}"
         if not axis.unit:
             raise GearsymError(f"--grid {axis.spec!r}: {axis.name} is a {kind} of {units.name}, which has physical "
                                f"values: give the grid with its unit, e.g. {example}")
@@ -122,6 +128,8 @@ def check_grid_units(units: PointUnits, axes: Sequence[Axis]) -> None:
             raise GearsymError(f"--grid {axis.spec!r}: {axis.name} is a {kind} of {units.name} "
                                f"({dimension_text(expected)}), but {axis.unit} is {dimension_text(got)}; give it in "
                                f"a unit of a {kind}, e.g. {example}")
+        grid[axis.name] = to_si(values, axis.unit)
+    return grid
 
 
 def shown_in(units: PointUnits | None, given: dict | None = None) -> OwnNumbers:
@@ -215,27 +223,21 @@ class ShownFractions:
         return self.units.parameters(values)
 
 
-def engine_grid(units: PointUnits, axes: Sequence[Axis], omega: float) -> dict[str, np.ndarray]:
-    """The engine's values of grid ``axes`` given in physical units, at the forcing frequency ``omega``."""
-    check_grid_units(units, axes)
-    grid = {}
-    for axis in axes:
-        kind = units.kinds.get(axis.name)
-        if kind is None:  # a state without a physical kind: the model's own numbers
-            grid[axis.name] = np.asarray(axis.values, dtype=float)
-            continue
-        per_engine_unit = float(units.state(axis.name, 1.0, omega, si=True))
-        grid[axis.name] = to_si(np.asarray(axis.values, dtype=float), axis.unit) / per_engine_unit
-    return grid
+def engine_grid(units: PointUnits, si_grid: Mapping[str, np.ndarray], omega: float) -> dict[str, np.ndarray]:
+    """The engine's values of a grid in SI units (:func:`grid_in_si`) at the forcing frequency ``omega`` (a rate's
+    engine unit moves with the speed)."""
+    return {name: values if units.kinds.get(name) is None else values / float(units.state(name, 1.0, omega, si=True))
+            for name, values in si_grid.items()}
 
 
 class PhysicalGrid(StartGrid):
-    """A continuation's grid of starts given in physical units: its engine values at each forcing frequency (a
-    rate's unit moves with the speed), and the grid as given in the record."""
+    """A grid of starts given in physical units, checked and in SI units when it is made (:func:`grid_in_si`): its
+    engine values at each forcing frequency (a rate's unit moves with the speed), and the grid as given in the
+    record."""
 
     def __init__(self, units: PointUnits, axes: Sequence[Axis]):
         super().__init__({a.name: a.values for a in axes}, [a.spec for a in axes])
-        self.units, self.axes = units, tuple(axes)
+        self.units, self.axes, self.si_grid = units, tuple(axes), grid_in_si(units, axes)
 
     def at(self, point):
-        return engine_grid(self.units, self.axes, point.get("omega", 1.0))
+        return engine_grid(self.units, self.si_grid, point.get("omega", 1.0))
