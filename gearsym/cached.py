@@ -49,7 +49,7 @@ from .stability.recipe import CompiledLinearisation
 from .stability.recipe import StaticRecipe
 
 #: bump when what a summary holds changes
-SUMMARY_FORMAT = 5
+SUMMARY_FORMAT = 6
 
 
 @dataclass(frozen=True, eq=False)

@@ -22,6 +22,7 @@ from gearsym import FirstOrderSystem, GearsymError, Integration, ModelError, Unk
 from gearsym.model.backlash import G, g, g_slope
 from gearsym.codegen import CompilerError
 from gearsym.codegen.generated import generate_model
+from gearsym.codegen.native import load_native
 from gearsym.codegen.on_arrays import evaluate_on_samples, numpy_program
 from gearsym.codegen.time_tables import split_rhs
 from gearsym.codegen.translate import to_casadi
@@ -304,6 +305,45 @@ def test_every_load_places_the_work_arrays_and_the_stack_the_same_way():
         g._aligned = None
     direct = cm.tangent_run(None, 60, inputs)
     assert np.array_equal(anchored.log_stretch, direct.log_stretch) and np.array_equal(anchored.Q, direct.Q)
+
+
+def test_a_library_tells_its_functions_sizes_as_casadi_reads_them():
+    """The native calls read each function's inputs, outputs and work sizes from the library's own exports (no
+    CasADi at a cached start-up): what casadi.external reads from the same library."""
+    for name in ("one_stage", "flexible_shaft"):
+        cm = compile_model(system(name))
+        for fname, f in cm.native.items():
+            g = cm.functions[fname]
+            assert (f.n_in, f.n_out) == (g.n_in(), g.n_out()), fname
+            assert f.shapes_in == [g.size_in(i) for i in range(g.n_in())], fname
+            assert f.shapes_out == [g.size_out(i) for i in range(g.n_out())], fname
+            assert f.dense_out == [g.sparsity_out(i).is_dense() for i in range(g.n_out())], fname
+            sizes = [ctypes.sizeof(f._arg) // 8, ctypes.sizeof(f._res) // 8, f._iw.size, f._w.size]
+            assert sizes == [max(n, 1) for n in (g.sz_arg(), g.sz_res(), g.sz_iw(), g.sz_w())], fname
+
+
+def test_a_sparse_pattern_is_read_from_a_library_as_casadi_has_it(tmp_path):
+    """CasADi's C gives a dense pattern as (rows, columns, 1) and a sparse one with its column offsets: a sparse
+    output is said as such (its native call is not used for a dense array), a sparse input is refused."""
+    x, y = ca.SX.sym("x", 3), ca.SX.sym("y", 2)
+    diagonal = ca.SX(ca.Sparsity.diag(3))
+    for i in range(3):
+        diagonal[i, i] = x[i] * x[i]
+    functions = [ca.Function("diagonal", [x], [diagonal, ca.vertcat(x, 1)]),
+                 ca.Function("sparse_in", [ca.SX.sym("s", ca.Sparsity.diag(2)), y], [y])]
+    source = tmp_path / "patterns.c"
+    generator = ca.CodeGenerator(source.name)
+    for f in functions:
+        generator.add(f)
+    generator.generate(str(tmp_path) + os.sep)
+    library = tmp_path / "patterns.so"
+    subprocess.run([compiler.find_compiler() or "cc", "-shared", "-fPIC", "-O0", "-o", str(library), str(source)],
+                   check=True)
+    f = load_native(library, ["diagonal"])["diagonal"]
+    assert (f.n_in, f.n_out, f.shapes_in, f.shapes_out, f.dense_out) == (1, 2, [(3, 1)], [(3, 3), (4, 1)],
+                                                                         [False, True])
+    with pytest.raises(GearsymError, match="sparse_in: input 0 is sparse"):
+        load_native(library, ["sparse_in"])
 
 
 def test_inputs_prepared_for_another_model_are_refused():

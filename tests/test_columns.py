@@ -73,7 +73,7 @@ def test_the_printed_loops_over_the_columns_give_the_bits_of_casadis_loops(monke
     assert "for (j = 0; j < 6; ++j) gs_tangent_mode_vector(A1 + 6*j, J, A2, A3, R1 + 6*j);" in text
     assert "static GEARSYM_NOINLINE void gs_tangent_step(" in text  # (one copy of the step in the span)
     path = str(compile_library(code.source, system.name, flags=NO_FMA).path)
-    native = load_native(path, {f: ca.external(f, path) for f in TANGENT_LOOPS})
+    native = load_native(path, TANGENT_LOOPS)
     for loop, args in _inputs(system, mf.functions).items():
         expected = [np.array(v) for v in mf.functions[loop].call(list(args))]
         got = native[loop](*[np.array(a) for a in args])

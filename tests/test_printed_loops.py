@@ -28,7 +28,7 @@ def _library(name: str, options: LoopOptions, tmp_path):
     mf = build_functions(system, options)
     code = write_code(mf, tmp_path / name, code_hash(system, options))
     path = str(compile_library(code.source, name, flags=NO_FMA).path)
-    return system, mf, load_native(path, {f: ca.external(f, path) for f in LOOP_NAMES})
+    return system, mf, load_native(path, LOOP_NAMES)
 
 
 @needs_cc

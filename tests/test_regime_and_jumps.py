@@ -6,6 +6,7 @@ import pytest
 
 from conftest import compiled
 from gearsym import Integration, lyapunov_spectrum
+from gearsym.analysis.divergence import own_rate
 from gearsym.analysis.jumps import find_jumps, hysteresis_intervals
 from gearsym.analysis.regime import classify_regime
 from gearsym.errors import GearsymError
@@ -115,3 +116,18 @@ def test_a_smooth_decay_from_the_first_point_is_not_a_jump():
     alone = np.where(speed > 800, 6.9, 9.0)
     (jump,) = find_jumps(speed, alone)
     assert (jump.start, jump.end) == (800.0, 850.0)
+
+
+def test_the_fastest_own_motion_is_looked_for_only_until_it_is_fast_enough(monkeypatch):
+    """A run long next to the model's fastest own motion needs only one Jacobian whose rate reaches the bound (a
+    cached spectrum's start-up solved 16 eigenvalue problems to learn that); below it, all are looked at."""
+    model = compiled("one_stage")
+    p = model.parameter_vector(omega=1.5)
+    y, period = np.array([0.3, 0.1]), model.prepare(p).period
+    full = own_rate(model, y, p, period)
+    calls = []
+    jacobian = model.jacobian
+    monkeypatch.setattr(model, "jacobian", lambda *args: calls.append(1) or jacobian(*args))
+    assert own_rate(model, y, p, period, enough=full / 2) >= full / 2 and len(calls) < 16
+    calls.clear()
+    assert own_rate(model, y, p, period, enough=2 * full) == full and len(calls) == 16

@@ -137,8 +137,10 @@ FORMULA = ("--set", "k=1+0.2*cos(tau)")
                          ids=["one_stage", "spur_pair at a speed in rpm (its unit read without pint)",
                               "a stiffness formula", "a formula and its figure in units"])
 @pytest.mark.slow
-def test_a_command_on_a_cached_model_imports_neither_sympy_nor_pint(model_copy, tmp_path, name, settings, capsys,
-                                                                   monkeypatch):
+def test_a_command_on_a_cached_model_imports_neither_sympy_pint_nor_casadi(model_copy, tmp_path, name, settings,
+                                                                           capsys, monkeypatch):
+    """The library is called through ctypes (its functions' sizes read from its own exports), the Jacobian for the
+    resolution too, and a mesh's k(tau) is the summary's NumPy program: CasADi is for generating, not running."""
     model_file = model_copy(name)
     argv = [str(model_file), *(s.format(tmp=tmp_path) for s in settings), *ARGS]
     unplotted = [a for i, a in enumerate(argv) if "--plot" not in argv[max(i - 1, 0):i + 1]]
@@ -146,7 +148,7 @@ def test_a_command_on_a_cached_model_imports_neither_sympy_nor_pint(model_copy, 
     def command(argv):  # a user's command on the cached model: a process of its own, whose imports are its own
         script = ("import sys; from gearsym.cli import main; "
                   f"main(['lyap', *{argv!r}]); "
-                  "print(sorted(m for m in ('sympy', 'pint') if m in sys.modules), file=sys.stderr)")
+                  "print(sorted(m for m in ('sympy', 'pint', 'casadi') if m in sys.modules), file=sys.stderr)")
         return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO_ROOT,
                               env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120)
 
@@ -181,7 +183,8 @@ def test_an_orbit_of_a_cached_model_imports_neither_sympy_nor_pint(model_copy, c
 
 def test_a_single_spectrum_loads_no_other_analysis():
     """What `gearsym lyap` imports (its command and the start-up cache) leaves out the runs from many starts, the
-    lanes, the orders and their figures: each module is start-up time of every cached run (issue 39)."""
+    lanes, the orders and their figures, and CasADi (the library is called through ctypes): each module is start-up
+    time of every cached run (issue 39)."""
     script = "import sys, gearsym.cli.lyap, gearsym.cached; print(' '.join(sorted(sys.modules)))"
     loaded = set(subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO_ROOT,
                                 env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120, check=True).stdout.split())
@@ -189,7 +192,7 @@ def test_a_single_spectrum_loads_no_other_analysis():
     unused = {"gearsym.analysis.attractors", "gearsym.analysis.basins", "gearsym.analysis.jumps",
               "gearsym.analysis.orders", "gearsym.analysis.order_run", "gearsym.analysis.lane_spectra",
               "gearsym.codegen.lane_runs", "gearsym.figures.poincare", "concurrent.futures", "sympy", "pint",
-              "matplotlib"}
+              "matplotlib", "casadi"}
     assert unused.isdisjoint(loaded), sorted(unused & loaded)
 
 

@@ -119,15 +119,20 @@ def find_divergence(strobe: np.ndarray, low: np.ndarray, high: np.ndarray, state
 RK4_LIMIT = 2.78
 
 
-def own_rate(model, y: np.ndarray, p: np.ndarray, period: float, samples: int = 16) -> float:
+def own_rate(model, y: np.ndarray, p: np.ndarray, period: float, samples: int = 16,
+             enough: float = np.inf) -> float:
     """The largest |eigenvalue| of the Jacobian at the state ``y`` over one forcing period: the rate of the model's
-    fastest own motion there (inf where the Jacobian is not finite: a parameter value overflows the equations)."""
+    fastest own motion there (inf where the Jacobian is not finite: a parameter value overflows the equations).
+    ``enough``: a caller that asks only whether the rate reaches it gets the first sample's rate that does (the
+    other eigenvalue problems, most of a cached spectrum's own time after its run, are not solved)."""
     largest = 0.0
     for t in np.linspace(0.0, period, samples, endpoint=False):
         J = np.asarray(model.jacobian(t, y, p), dtype=float)
         if not np.all(np.isfinite(J)):
             return np.inf
         largest = max(largest, float(np.max(np.abs(np.linalg.eigvals(J)))))
+        if largest >= enough:
+            break
     return largest
 
 

@@ -32,7 +32,7 @@ from .divergence import Divergence, counted_coordinates, find_divergence, own_ra
 from .pairs import merge_pairs
 from .resolution import Resolution, resolution
 from .regime import DIVERGED, EQUILIBRIUM, UNDETERMINED, classify_regimes, periods_to_decide, zero_band
-from .settling import Settling, brief_run, poincare_settling
+from .settling import Settling, brief_run, long_run_rate, poincare_settling
 from .statistics import batch_means_stderr
 
 #: a run rests on a fixed point when, over the measured periods, the state moves by no more than this and
@@ -251,7 +251,8 @@ def summarise_runs(model: CompiledModel, runs: TangentRuns, p: np.ndarray, perio
         exps = classify_regimes(exponents[live], stderr[live], measured_time[live], autonomous)
         for i, r in zip(live, exps):
             if r == "quasi-periodic" and not autonomous and eigenvalues[i] is None:
-                settlings[i] = brief_run(own_rate(model, runs.strobe[i, -1], p[i], period[i]), measured_time[i]) \
+                rate = own_rate(model, runs.strobe[i, -1], p[i], period[i], enough=long_run_rate(measured_time[i]))
+                settlings[i] = brief_run(rate, measured_time[i]) \
                     or poincare_settling(runs.strobe[i, discard:], period[i])
         regimes_live = classify_regimes(exponents[live], stderr[live], measured_time[live], autonomous,
                                         [settlings[i] for i in live])

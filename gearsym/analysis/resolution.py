@@ -62,8 +62,7 @@ class Resolution:
 
 def linearised_eigenvalues(model, state, p: np.ndarray, cycle: float) -> np.ndarray:
     """The eigenvalues of the Jacobian averaged over a forcing period ``cycle`` (8 times) at ``state``."""
-    jacobian = model.functions["jacobian"]
-    mean = sum(np.array(jacobian(cycle * k / 8, state, p), dtype=float) for k in range(8)) / 8
+    mean = sum(np.array(model.jacobian(cycle * k / 8, state, p), dtype=float) for k in range(8)) / 8
     return np.linalg.eigvals(mean) if np.all(np.isfinite(mean)) else np.full(len(state), np.nan)
 
 

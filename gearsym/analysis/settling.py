@@ -95,6 +95,12 @@ def brief_run(own_rate: float, measured_time: float) -> Settling | None:
     return Settling(BRIEF, 0, float(own_rate), 0.0, float(coverage)) if not coverage >= 1 else None
 
 
+def long_run_rate(measured_time: float) -> float:
+    """An own rate from which a run of ``measured_time`` is not brief (:func:`brief_run`), a hair above the bound
+    so that rounding cannot make one brief: where a search for the fastest own motion may stop."""
+    return 2 * np.pi / measured_time * (1 + 1e-9) if measured_time > 0 else np.inf
+
+
 def poincare_settling(strobe: np.ndarray, period: float) -> Settling | None:
     """The settling of the Poincare points ``strobe`` (measured periods x n) taken every ``period``; None with
     fewer than ``MIN_PERIODS`` points or non-finite ones."""

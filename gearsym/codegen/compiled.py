@@ -16,7 +16,6 @@ from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import casadi as ca
 import numpy as np
 
 from ..caller import option
@@ -28,7 +27,9 @@ from .loops import LoopOptions
 from .native import NativeFunction, load_native
 from .periodicity import NotPeriodicError
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # (CasADi is imported where the in-process backend calls it: a cached run never does)
+    import casadi as ca
+
     from ..system import FirstOrderSystem
 
 
@@ -45,10 +46,14 @@ class RunInputs:
 
     @cached_property
     def table_dm(self) -> ca.DM:  # for the in-process backend
+        import casadi as ca
+
         return ca.DM(self.table)
 
     @cached_property
     def constants_dm(self) -> ca.DM:
+        import casadi as ca
+
         return ca.DM(self.constants)
 
     @cached_property
@@ -169,7 +174,7 @@ class CompiledModel:
     def clone(self) -> "CompiledModel":
         """The same functions with work arrays of its own: one clone per thread runs in parallel
         (the native calls release the GIL; the generated functions keep no other state)."""
-        native = load_native(self.library, dict(self.functions)) if self.native else None
+        native = load_native(self.library, self.native) if self.native else None
         return replace(self, native=native, timings=dict(self.timings))
 
     # ---------------------------------------------------------------- names
@@ -496,6 +501,8 @@ class CompiledModel:
     def _casadi_loop(self, schedule, y, Q, inputs: RunInputs, rows: tuple[int, ...]):
         """The in-process twin of ``_native_loop``: the same chunks through CasADi's calls, outputs stacked
         per period (``rows``: their heights, for an empty run). ``Q`` None: no tangent vectors."""
+        import casadi as ca
+
         yd, Qd, parts = ca.DM(y), (None if Q is None else ca.DM(Q)), []
         for fname, count in schedule:
             f = self.functions[fname]
@@ -513,7 +520,9 @@ class CompiledModel:
     def shooting_pieces(self) -> int:
         """The pieces the generated code cuts a forcing period into for multiple shooting (4, or fewer
         when the steps per period do not divide by 4)."""
-        return self.steps_per_period // int(self.functions["monodromy_segment"].size_in(2)[1])
+        table = self.native["monodromy_segment"].shapes_in[2] if self.native \
+            else self.functions["monodromy_segment"].size_in(2)
+        return self.steps_per_period // int(table[1])
 
     def shoot(self, y0, inputs: RunInputs, pieces: int | None = None, first: int = 0) -> Shot:
         """The state and the exact Jacobian d state/d y0 after ``pieces`` pieces of a period (default one
@@ -559,6 +568,8 @@ class CompiledModel:
         return Shot(b.y[i].copy(), b.M[i].copy(), low, high)
 
     def _casadi_shot(self, y, inputs: RunInputs, first: int, end: int) -> Shot:
+        import casadi as ca
+
         m, width = len(self.observed), self.steps_per_period // self.shooting_pieces
         yd, Md = ca.DM(y), ca.DM.eye(self.dimension)
         low, high = np.full(m, np.inf), np.full(m, -np.inf)
@@ -599,6 +610,8 @@ class CompiledModel:
                 at = first + 8 * n * N * k
                 self.native["trajectory"].call((at, table, c), (at + 8 * n,))
         else:
+            import casadi as ca
+
             y = ca.DM(y)
             cols = [np.array(y)]
             for _ in range(periods):
@@ -618,11 +631,12 @@ class CompiledModel:
     def _at(self, name: str, t: float, y, p) -> np.ndarray:
         """The right-hand side or the Jacobian at (t, y, p): by the library's own call where the sizes are the
         function's (a tenth of CasADi's call and copy of the result), else CasADi's (which says what is wrong)."""
-        f = self.functions[name]
         args = [np.asarray(a, dtype=np.float64) for a in (t, y, p)]
-        if self.native and [a.size for a in args] == [f.nnz_in(i) for i in range(3)] and f.sparsity_out(0).is_dense():
-            return self.native[name](*args)[0]
-        return np.array(f(t, y, p))
+        if self.native:
+            f = self.native[name]
+            if [a.size for a in args] == [rows * cols for rows, cols in f.shapes_in] and f.dense_out[0]:
+                return f(*args)[0]
+        return np.array(self.functions[name](t, y, p))
 
     def check_finite(self, p: np.ndarray, *per_period: np.ndarray) -> None:
         """Raise the error of a run at the parameter vector ``p`` that became non-finite, if one of the

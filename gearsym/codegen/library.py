@@ -1,15 +1,16 @@
 """A model's library through CasADi and the backend a run asks for: what a cached start-up needs.
 
 The models this process loaded are kept in the one table of :mod:`.loaded`, under :func:`model_key`.
-Nothing here needs SymPy.
+Nothing here needs SymPy; CasADi is imported only when a function is asked of it (a run of the compiled backend
+calls the library directly, :mod:`.native`, and never does).
 """
 from __future__ import annotations
 
 import sys
+from collections.abc import Iterator, Mapping
 from dataclasses import replace
 from pathlib import Path
-
-import casadi as ca
+from typing import TYPE_CHECKING
 
 from ..options import Integration
 from .compiled import CompiledModel
@@ -17,6 +18,9 @@ from .compiler import FALLBACK_NOTE, compilers_looked_for, find_compiler
 from .loaded import keep, loaded
 from .loops import LoopOptions
 from .native import load_native
+
+if TYPE_CHECKING:
+    import casadi as ca
 
 #: every function the generated library exports
 FUNCTION_NAMES = ("rhs", "jacobian", "constants", "table", "lyapunov_chunk", "lyapunov_period",
@@ -42,9 +46,33 @@ def resolve_backend(asked: str) -> str:
     return "in-process"
 
 
-def library_functions(path: Path) -> dict[str, ca.Function]:
-    """The generated functions of the library at ``path``, through CasADi."""
-    return {name: ca.external(name, str(path)) for name in FUNCTION_NAMES}
+class LibraryFunctions(Mapping):
+    """The generated functions of the library at ``path`` through CasADi (``casadi.external``), each loaded when
+    first asked for: a run that calls the library directly never imports CasADi."""
+
+    def __init__(self, path: Path):
+        self.path = path
+        self._loaded: dict[str, ca.Function] = {}
+
+    def __getitem__(self, name: str) -> ca.Function:
+        if name not in FUNCTION_NAMES:
+            raise KeyError(name)
+        if name not in self._loaded:
+            import casadi as ca
+
+            self._loaded[name] = ca.external(name, str(self.path))
+        return self._loaded[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(FUNCTION_NAMES)
+
+    def __len__(self) -> int:
+        return len(FUNCTION_NAMES)
+
+
+def library_functions(path: Path) -> LibraryFunctions:
+    """The generated functions of the library at ``path``, through CasADi (loaded on first use)."""
+    return LibraryFunctions(path)
 
 
 def library_describes(system, digest: str) -> dict:

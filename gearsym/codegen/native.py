@@ -8,6 +8,9 @@ place (a run's outputs land directly in its result arrays; the next chunk
 reads its start state where the previous one wrote it). The generated
 functions keep no state (``checkout`` returns 0), so each ``NativeFunction``
 owns its work arrays and distinct objects may run in different threads.
+What CasADi would tell of a function (its inputs and outputs, their sparsity, its work sizes) is read from the
+entry points the generated C exports beside it (``<f>_n_in``, ``<f>_sparsity_in``, ``<f>_work`` ...): a run on a
+cached model never imports CasADi (its import was about a tenth of that start-up).
 
 Where those arrays and the stack sit decided the speed of a step while CasADi's
 loops called each step through them: every step stored pointers into the argument
@@ -29,15 +32,15 @@ memory the same way, and measured at the fast speed.
 from __future__ import annotations
 
 import ctypes
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
-import casadi as ca
 import numpy as np
 
 from ..errors import GearsymError
 from .loaded import open_library
 
 _ptr = ctypes.c_void_p
+_int = ctypes.c_longlong  # (the generated C's casadi_int)
 PAGE = 4096
 LINE = 64
 
@@ -54,17 +57,29 @@ def work_layout(sizes: Sequence[int]) -> tuple[list[int], int]:
 class NativeFunction:
     """One exported function of a generated library, called with raw pointers."""
 
-    def __init__(self, library: ctypes.CDLL, name: str, reference: ca.Function):
+    def __init__(self, library: ctypes.CDLL, name: str):
         self.name = name
         self._call = getattr(library, name)
         self._call.restype = ctypes.c_int
         self._call.argtypes = [_ptr, _ptr, _ptr, _ptr, ctypes.c_int]
-        self.n_in, self.n_out = reference.n_in(), reference.n_out()
-        for i in range(self.n_in):
-            if not reference.sparsity_in(i).is_dense():
+        self.n_in, self.n_out = _count(library, f"{name}_n_in"), _count(library, f"{name}_n_out")
+        sparsity_in = [_sparsity(library, f"{name}_sparsity_in", i) for i in range(self.n_in)]
+        sparsity_out = [_sparsity(library, f"{name}_sparsity_out", i) for i in range(self.n_out)]
+        for i, (_, _, dense) in enumerate(sparsity_in):
+            if not dense:
                 raise GearsymError(f"{name}: input {i} is sparse; the native call needs dense arrays")
-        self.shapes_out = [reference.size_out(i) for i in range(self.n_out)]
-        sizes = [8 * max(n, 1) for n in (reference.sz_arg(), reference.sz_res(), reference.sz_iw(), reference.sz_w())]
+        self.shapes_in = [(rows, cols) for rows, cols, _ in sparsity_in]
+        self.shapes_out = [(rows, cols) for rows, cols, _ in sparsity_out]
+        self.dense_out = [dense for _, _, dense in sparsity_out]
+        work = getattr(library, f"{name}_work")
+        work.restype, work.argtypes = ctypes.c_int, [ctypes.POINTER(_int)] * 4
+        counts = [_int() for _ in range(4)]
+        work(*(ctypes.byref(c) for c in counts))
+        # (as casadi.external counts them, so that the arrays sit where they always did: a pointer per input and
+        # output of its own, then the function's work)
+        arg, res, iw, w = (self.n_in + counts[0].value, self.n_out + counts[1].value, counts[2].value,
+                           counts[3].value)
+        sizes = [8 * max(n, 1) for n in (arg, res, iw, w)]
         offsets, total = work_layout(sizes)
         self._block = np.zeros(total + PAGE, dtype=np.uint8)
         self.base = -(-self._block.ctypes.data // PAGE) * PAGE  # (page-aligned: the layout is the same in every load)
@@ -107,6 +122,27 @@ def _stack_aligned_call(library: ctypes.CDLL):
     return call
 
 
-def load_native(path, functions: dict[str, ca.Function]) -> dict[str, NativeFunction]:
+def _count(library: ctypes.CDLL, entry: str) -> int:
+    """What the generated entry point ``entry`` (``<f>_n_in``, ``<f>_n_out``) returns."""
+    f = getattr(library, entry)
+    f.restype, f.argtypes = _int, []
+    return int(f())
+
+
+def _sparsity(library: ctypes.CDLL, entry: str, i: int) -> tuple[int, int, bool]:
+    """Rows, columns and whether it is dense, of the ``i``-th pattern ``entry`` (``<f>_sparsity_in``) gives, in
+    CasADi's compressed form: rows, columns, then 1 for a dense pattern, else the column offsets (from 0) and the
+    rows of the nonzeros."""
+    f = getattr(library, entry)
+    f.restype, f.argtypes = ctypes.POINTER(_int), [_int]
+    pattern = f(i)
+    rows, cols = int(pattern[0]), int(pattern[1])
+    if pattern[2] == 1:  # (the compressed form of a dense pattern; a sparse one starts its offsets with 0)
+        return rows, cols, True
+    return rows, cols, int(pattern[2 + cols]) == rows * cols
+
+
+def load_native(path, names: Iterable[str]) -> dict[str, NativeFunction]:
+    """The functions ``names`` of the library at ``path``, each with its own work arrays."""
     library = open_library(path)
-    return {name: NativeFunction(library, name, f) for name, f in functions.items()}
+    return {name: NativeFunction(library, name) for name in names}

@@ -3,7 +3,8 @@
 :func:`gearsym.physical.results.point_units` reads once, with pint, what carrying a
 :class:`~gearsym.analysis.lyapunov.LyapunovSpectrum` back to physical units takes (the time unit, the length unit,
 the unit conversions, each mesh's stiffness, damping, backlash and its variation k(tau) as a CasADi
-function, each shaft's stiffness and damping); :class:`PointUnits` keeps those numbers and does the carrying.
+function and as NumPy's instructions, each shaft's stiffness and damping); :class:`PointUnits` keeps those numbers
+and does the carrying.
 The mesh forces and shaft torques of a point come from a trajectory at that point (:func:`loads_trajectory`:
 ``FORCE_PERIODS`` forcing periods from the run's final state), whoever asks (the command line or Python). The start-up cache
 (gearsym/cached.py) stores them, so that ``gearsym lyap`` on a cached model with physical values imports
@@ -20,7 +21,7 @@ import numpy as np
 
 from ..analysis.lyapunov import LyapunovSpectrum
 from ..analysis.poincare import phase_trajectory
-from ..codegen.on_arrays import evaluate_on_samples
+from ..codegen.on_arrays import evaluate_on_samples, evaluate_program, stored_program
 from ..errors import GearsymError
 from ..scales.speeds import Speed
 from ..units import shown
@@ -162,12 +163,21 @@ class MeshUnits:
     damping: float  # N s/m
     eta: float  # m
     variation: str  # k(tau), a serialized CasADi function
+    program: tuple | None  # k(tau) as NumPy's instructions (codegen.on_arrays.numpy_program); None: one has none
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "MeshUnits":
+        return cls(**{**d, "program": None if d["program"] is None else stored_program(d["program"])})
 
     def variation_at(self, tau) -> np.ndarray:
-        """k(tau) at every sample of ``tau`` (all at once: :mod:`gearsym.codegen.on_arrays`)."""
+        """k(tau) at every sample of ``tau`` (all at once: :mod:`gearsym.codegen.on_arrays`; without CasADi when
+        NumPy has each of its instructions)."""
+        tau = np.atleast_1d(np.asarray(tau, dtype=float))
+        if self.program is not None:
+            return evaluate_program(self.program, tau)
         import casadi as ca
 
-        return evaluate_on_samples(ca.Function.deserialize(self.variation), np.atleast_1d(np.asarray(tau, dtype=float)))
+        return evaluate_on_samples(ca.Function.deserialize(self.variation), tau)
 
     def force(self, tau, x, v, k=None) -> np.ndarray:
         """The force in N along a trajectory (x in m, v in m/s; ``k``: :meth:`variation_at` ``tau``, if known)."""
@@ -248,7 +258,7 @@ class PointUnits:
         units = {k: Unit(str(d[k]["name"]), str(d[k]["text"]))
                  for k in ("speed_unit", "length_text", "velocity_text", "per_second", "newton", "hertz", "radian",
                            "radian_per_second", "newton_metre")}
-        meshes = tuple(MeshUnits(**m) for m in d["meshes"])
+        meshes = tuple(MeshUnits.from_dict(m) for m in d["meshes"])
         shafts = tuple(ShaftUnits(**m) for m in d["shafts"])
         speed = Speed(**d["speed"]) if d["speed"] else None
         return cls(**{**d, **units, "meshes": meshes, "shafts": shafts, "speed": speed,

@@ -16,6 +16,7 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 import sympy as sp
 
+from ..codegen.on_arrays import numpy_program
 from ..codegen.translate import to_casadi
 from ..errors import GearsymError
 from ..scales.dimensions import evaluate
@@ -136,7 +137,8 @@ def _mesh_units(scaling: Scaling):
         function = ca.Function("k", [angle], to_casadi([k_of_tau], {tau: angle}, where))
         coordinate = next(c for c in nd.coordinates if c.coupling.name == rc.name)
         yield MeshUnits(rc.name, coordinate.name, coordinate.velocity_name, evaluate(rc.stiffness, si, where).si,
-                        evaluate(rc.damping, si, where).si, evaluate(rc.backlash, si, where).si, function.serialize())
+                        evaluate(rc.damping, si, where).si, evaluate(rc.backlash, si, where).si, function.serialize(),
+                        numpy_program(function))
 
 
 def _shaft_units(scaling: Scaling):
