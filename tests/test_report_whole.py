@@ -57,10 +57,10 @@ def test_a_report_that_fails_while_it_is_written_leaves_the_previous_one_as_it_w
     for name, data in previous.items():
         (tmp_path / name).write_bytes(data)
 
-    def fails(*args, **kwargs):  # (the first figure: report.json is written by then)
+    def fails(*args, **kwargs):  # (the first figure, as its builder writes it: report.json is written by then)
         raise failure
 
-    monkeypatch.setattr(report_module, "save_figure", fails)
+    monkeypatch.setattr(report_module, "finish", fails)
     expected = GearsymError if isinstance(failure, OSError) else type(failure)
     with pytest.raises(expected) as raised:
         write_report(unexplained, system, tmp_path)
