@@ -13,7 +13,6 @@ Ctrl-C, 143 after SIGTERM (128 + the signal, as a shell reports either).
 from __future__ import annotations
 
 import argparse
-import errno
 import importlib
 import os
 import pkgutil

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 
 from ..errors import GearsymError
 from ..sweep.grid import Axis, axes_from
-from ..units import Quantity, as_quantity, is_quantity, measure_in, symbol
+from ..units import as_quantity, is_quantity, measure_in, symbol
 
 if TYPE_CHECKING:  # (the type only: a sweep of a cached model reads this module without SymPy)
     from ..scales.map import Scaling
