@@ -17,8 +17,8 @@ from .jacobian import Jacobian
 from .segment import Segment, substeps_for
 
 
-#: runs a problem keeps (:meth:`Problem.run_at`): Levenberg-Marquardt ends at an accepted step, after which at most a few
-#: refused trials are run
+#: runs a problem keeps (:meth:`Problem.run_at`): Levenberg-Marquardt ends at an accepted step, after which at most a
+#: few refused trials are run
 RECENT = 4
 
 

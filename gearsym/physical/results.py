@@ -107,10 +107,10 @@ def point_units(scaling: Scaling, length_unit: str = LENGTH_UNIT) -> PointUnits:
         scaling.name, scaling.speed, text(speed_unit), conversion_factor("rad/s", speed_unit), scaling.omega_n_si,
         scaling.omega_n_si / (2 * np.pi), float(scaling.forcing_ratio) if scaling.speed else float("nan"),
         float(scaling.reference_mesh.order), conversion_factor("rad/s", "Hz"), scaling.length_si,
-        float(from_si(scaling.length_si, length_unit)), length_unit, text(length_unit), conversion_factor("m", length_unit),
-        text(VELOCITY_UNIT), conversion_factor("m/s", VELOCITY_UNIT), text("1/s"), text("N"), text("Hz"), text("rad"),
-        text("rad/s"), text("N*m"), kinds(scaling), _per_unit(scaling), tuple(_mesh_units(scaling)),
-        tuple(_shaft_units(scaling)), {n: q.text() for n, q in scaling.inputs.items()})
+        float(from_si(scaling.length_si, length_unit)), length_unit, text(length_unit),
+        conversion_factor("m", length_unit), text(VELOCITY_UNIT), conversion_factor("m/s", VELOCITY_UNIT), text("1/s"),
+        text("N"), text("Hz"), text("rad"), text("rad/s"), text("N*m"), kinds(scaling), _per_unit(scaling),
+        tuple(_mesh_units(scaling)), tuple(_shaft_units(scaling)), {n: q.text() for n, q in scaling.inputs.items()})
 
 
 def _mesh_units(scaling: Scaling):
