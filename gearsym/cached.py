@@ -31,10 +31,11 @@ import json
 import os
 import sys
 from collections.abc import Callable, Mapping
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, field, replace
 from functools import lru_cache
 from pathlib import Path
 
+from .records import record_class
 from .codegen.compiler import binary_key, cache_dir, compile_flags
 from .codegen.library import library_describes, library_model, resolve_backend
 from .codegen.loops import LoopOptions
@@ -52,7 +53,7 @@ from .stability.recipe import StaticRecipe
 SUMMARY_FORMAT = 6
 
 
-@dataclass(frozen=True, eq=False)
+@record_class(eq=False)
 class SystemSummary(ParameterChecks):
     """The part of a :class:`~gearsym.system.FirstOrderSystem` a run reads, without SymPy; its symbolic part
     (equations, couplings, the period as an expression) comes from the full system (:attr:`full`), loaded on
@@ -167,7 +168,7 @@ def _watches(stored) -> tuple | None:
     return tuple((str(n), str(c), *(v if isinstance(v, str) else float(v) for v in (b, o))) for n, c, b, o in stored)
 
 
-@dataclass(frozen=True)
+@record_class
 class BuildSummary:
     """What the cache keeps of one build of a model (``<model>-<key>-<loops>.json``): its code hash, the compiled
     library, the parameters in its tables of time, and those tables as text."""
@@ -272,7 +273,7 @@ def write_json(path: Path, data: dict) -> None:
 _WHAT = "cached summary"
 
 
-@dataclass(frozen=True)
+@record_class
 class CacheSlot:
     """Where the start-up cache keeps the model ``ref`` with given values (its file's name and the key that hashes
     what its reduction depends on; ``name`` None for a model that is no file, which the cache does not keep), and

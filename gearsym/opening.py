@@ -13,11 +13,12 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from functools import cached_property
 
 import gearsym  # the face: its verbs load on first use, so a cached model's run never loads the generator
 
+from .records import record_class
 from . import stability  # (its modules load on first use: the linearisation's only when it is derived)
 from .cached import cache_slot, cached_compiled, keep_compiled, load_linearisation, load_static_recipe
 from .codegen.mode_rates import chosen_by_compiled
@@ -26,7 +27,7 @@ from .options import Integration
 from .physical.point import CachedScaling
 
 
-@dataclass(frozen=True)
+@record_class
 class ModelRequest:
     """What a run asks of its model, read once from the caller: ``model`` (a name or the path of a model file),
     ``settings`` (its values as ``gearsym.load`` takes them: numbers, quantities, a stiffness formula in tau, a

@@ -184,16 +184,24 @@ def test_an_orbit_of_a_cached_model_imports_neither_sympy_nor_pint(model_copy, c
 def test_a_single_spectrum_loads_no_other_analysis():
     """What `gearsym lyap` imports (its command and the start-up cache) leaves out the runs from many starts, the
     lanes, the orders and their figures, and CasADi (the library is called through ctypes): each module is start-up
-    time of every cached run (issue 39)."""
-    script = "import sys, gearsym.cli.lyap, gearsym.cached; print(' '.join(sorted(sys.modules)))"
-    loaded = set(subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO_ROOT,
-                                env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120, check=True).stdout.split())
+    time of every cached run (issue 39); and its classes are records, whose methods are not compiled when defined."""
+    script = ("import sys, gearsym.cli.lyap, gearsym.cached; print(' '.join(sorted(sys.modules))); "
+              "print(' '.join(sorted(f'{m}.{k}' for m, module in list(sys.modules.items()) if m.startswith('gearsym') "
+              "for k, v in vars(module).items() if isinstance(v, type) and v.__module__ == m "
+              "and getattr(getattr(v, '__init__', None), '__code__', None) is not None "
+              "and v.__init__.__code__.co_filename == '<string>')))")
+    loaded, generated = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO_ROOT,
+                                       env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120,
+                                       check=True).stdout.split("\n")[:2]
+    loaded = set(loaded.split())
     assert "gearsym.analysis.lyapunov" in loaded and "gearsym.physical.point" in loaded
     unused = {"gearsym.analysis.attractors", "gearsym.analysis.basins", "gearsym.analysis.jumps",
               "gearsym.analysis.orders", "gearsym.analysis.order_run", "gearsym.analysis.lane_spectra",
               "gearsym.codegen.lane_runs", "gearsym.figures.poincare", "concurrent.futures", "sympy", "pint",
               "matplotlib", "casadi"}
     assert unused.isdisjoint(loaded), sorted(unused & loaded)
+    # (a dataclass compiles its methods from text when defined, about a millisecond a class: these are records)
+    assert generated == "", f"dataclasses on the cached path (declare them with records.record_class): {generated}"
 
 
 def test_a_sweep_of_a_cached_model_chooses_its_step_without_reducing_it_again(model_file, reductions, tmp_path,
