@@ -6,7 +6,8 @@ a class, and the 32 classes a command on a cached model defines were a tenth of 
 :func:`record_class` makes the same class -- a dataclass (``dataclasses.fields``, ``replace`` and ``asdict`` work on
 it), frozen unless told otherwise, compared and hashed by its fields, printed and called as the dataclass is --
 with the functions below, which read the class's fields when they run. The modules a cached run imports
-declare their classes with it (tests/test_startup_cache.py); the rest keep ``@dataclass``.
+declare their classes with it (tests/test_startup_cache.py), but for codegen/loops.py, whose text is part of
+every generated library's hash; the rest keep ``@dataclass``.
 """
 from __future__ import annotations
 

@@ -200,8 +200,10 @@ def test_a_single_spectrum_loads_no_other_analysis():
               "gearsym.codegen.lane_runs", "gearsym.figures.poincare", "concurrent.futures", "sympy", "pint",
               "matplotlib", "casadi"}
     assert unused.isdisjoint(loaded), sorted(unused & loaded)
-    # (a dataclass compiles its methods from text when defined, about a millisecond a class: these are records)
-    assert generated == "", f"dataclasses on the cached path (declare them with records.record_class): {generated}"
+    # (a dataclass compiles its methods from text when defined, about a millisecond a class: these are records; but
+    # LoopOptions, whose module's text is hashed into every model's generated C, which a change would regenerate)
+    generated = set(generated.split()) - {"gearsym.codegen.loops.LoopOptions"}
+    assert not generated, f"dataclasses on the cached path (declare them with records.record_class): {generated}"
 
 
 def test_a_sweep_of_a_cached_model_chooses_its_step_without_reducing_it_again(model_file, reductions, tmp_path,

@@ -2,13 +2,13 @@
 cached is loaded with it alone."""
 from __future__ import annotations
 
+from dataclasses import dataclass
 
-from ..records import record_class
 from ..errors import ModelError
 from ..options import METHODS, STEPS_PER_PERIOD, Integration
 
 
-@record_class
+@dataclass(frozen=True)
 class LoopOptions:
     """Structure of the generated loops (part of the model hash; values of parameters are not)."""
 
