@@ -21,6 +21,9 @@ def record_class(cls=None, /, *, eq: bool = True, frozen: bool = True):
     """``@dataclass(frozen=frozen, eq=eq)`` without generated code: ``@record_class``, ``@record_class(eq=False)``."""
     if cls is None:
         return lambda c: record_class(c, eq=eq, frozen=frozen)
+    undocumented = not cls.__dict__.get("__doc__")
+    if undocumented:  # (else the dataclass writes one from the signature it finds before ours: object's)
+        cls.__doc__ = cls.__name__
     cls = dataclasses.dataclass(cls, init=False, repr=False, eq=False)
     every = dataclasses.fields(cls)
     arguments = tuple(f for f in every if f.init)
@@ -57,6 +60,8 @@ def record_class(cls=None, /, *, eq: bool = True, frozen: bool = True):
     cls.__signature__ = inspect.Signature([inspect.Parameter(f.name, inspect.Parameter.POSITIONAL_OR_KEYWORD,
                                                              default=_default(f), annotation=f.type)
                                            for f in arguments], return_annotation=None)
+    if undocumented:  # (as the dataclass's: its name and signature)
+        cls.__doc__ = cls.__name__ + str(cls.__signature__).replace(" -> None", "")
     cls.__repr__ = _repr_of(tuple(f.name for f in every if f.repr))
     if eq:
         cls.__eq__ = _eq_of(tuple(f.name for f in every if f.compare))

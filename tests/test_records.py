@@ -36,6 +36,9 @@ def frozen():
 def test_a_record_is_built_printed_compared_and_hashed_as_its_dataclass(frozen):
     ours, theirs = frozen
     assert str(inspect.signature(ours)) == str(inspect.signature(theirs))
+    undocumented = [decorate(type("Bare", (), {"__annotations__": {"x": "float"}}))
+                    for decorate in (record_class, dataclass(frozen=True))]
+    assert undocumented[0].__doc__ == undocumented[1].__doc__ == "Bare(x: 'float')"
     assert [f.name for f in fields(ours)] == [f.name for f in fields(theirs)]
     for args, kwargs in [((1.0,), {}), ((1.0, -3.0), {"tags": ("a",)}), ((), {"x": 0.5, "note": "n"})]:
         a, b = ours(*args, **kwargs), theirs(*args, **kwargs)
