@@ -1,6 +1,7 @@
 """A command on a model whose library is cached neither reduces it again nor imports SymPy (gearsym/cached.py)."""
 from __future__ import annotations
 
+import gc
 import json
 import os
 import re
@@ -241,3 +242,27 @@ def test_a_sweep_of_a_cached_physical_model_is_carried_to_physical_units(model_c
                          cwd=REPO_ROOT, env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120)
     assert run.returncode == 0, run.stderr[-2000:]
     assert out.with_suffix(".physical.csv").read_text().startswith("speed [rpm],")
+
+
+def test_the_face_leaves_numpy_to_the_command_which_imports_with_the_collector_paused(monkeypatch, capsys):
+    """``import gearsym`` (and the command line's module) imports no NumPy: the command imports it, with what it
+    needs, while the garbage collector is paused (its collections among the imports had nothing to free); the
+    objects then are set aside for good (gc.freeze) only in the command's own process, not in a caller's."""
+    script = "import sys, gearsym, gearsym.cli; print('numpy' in sys.modules)"
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO_ROOT,
+                         env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120, check=True)
+    assert run.stdout.split() == ["False"]
+    cli = sys.modules["gearsym.cli"]
+    seen, frozen = [], []
+    building = cli.build_parser
+
+    def build_parser(command=None):
+        seen.append(gc.isenabled())
+        return building(command)
+
+    monkeypatch.setattr(cli, "build_parser", build_parser)
+    monkeypatch.setattr(gc, "freeze", lambda: frozen.append(1))
+    assert main(["list"]) == 0 and seen == [False] and gc.isenabled() and not frozen
+    monkeypatch.setattr(sys, "argv", ["gearsym", "list"])
+    assert main() == 0 and seen == [False, False] and gc.isenabled() and frozen == [1]
+    capsys.readouterr()
