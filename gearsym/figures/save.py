@@ -35,6 +35,21 @@ def save_figure(fig, path: str | Path, dpi: int, keep_same: bool = False) -> Pat
     (:func:`same_picture`) is left as it is (a committed figure redrawn on another machine, whose rounding moved
     a line by a fraction of a pixel)."""
     path = Path(path)
+    image = _drawn(fig, path, dpi)
+    if keep_same and path.is_file() and same_picture(image, path):
+        return path
+    return write_atomically(path, image.getvalue())
+
+
+def figure_bytes(fig, path: str | Path, dpi: int) -> bytes:
+    """The bytes :func:`save_figure` writes to ``path`` for ``fig`` (closed): for a caller that writes them with
+    its other files."""
+    return _drawn(fig, Path(path), dpi).getvalue()
+
+
+def _drawn(fig, path: Path, dpi: int) -> io.BytesIO:
+    """``fig`` drawn in the format of ``path``'s suffix and closed, its titles wrapped to fit at ``dpi``; the
+    picture is read from its start."""
     fig.set_dpi(dpi)  # (laid out at the resolution it is written at: the layout made here is the one drawn)
     fit_texts(fig, again=True)
     engine = fig.get_layout_engine()
@@ -48,9 +63,7 @@ def save_figure(fig, path: str | Path, dpi: int, keep_same: bool = False) -> Pat
             fig.set_layout_engine(engine)
         pyplot().close(fig)
     image.seek(0)  # (the picture is read back from its start, without a copy of its bytes)
-    if keep_same and path.is_file() and same_picture(image, path):
-        return path
-    return write_atomically(path, image.getvalue())
+    return image
 
 
 def finish(fig, path: str | Path | None, dpi: int):
