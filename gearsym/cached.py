@@ -32,134 +32,19 @@ import json
 import os
 import sys
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from pathlib import Path
 
-from .codegen.kept import (SUMMARY_FORMAT, BuildSummary, build_path, found_build, found_over, kept_model, read_json,
-                           summary_path, write_json)
+from .codegen.kept import (SUMMARY_FORMAT, BuildSummary, build_path, found_build, found_over, keep_model, kept_model,
+                           read_json, summary_path, write_json)
+from .codegen.system_summary import SystemSummary, read_summary
 from .codegen.library import resolve_backend
 from .options import Integration
-from .parameters import Constraint, ParameterChecks
 from .physical.point import PointUnits
 from .registry import model_file, models_dir
 from .stability.recipe import CompiledLinearisation
 from .stability.recipe import StaticRecipe
-
-@dataclass(frozen=True, eq=False)
-class SystemSummary(ParameterChecks):
-    """The part of a :class:`~gearsym.system.FirstOrderSystem` a run reads, without SymPy; its symbolic part
-    (equations, couplings, the period as an expression) comes from the full system (:attr:`full`), loaded on
-    first use."""
-
-    name: str
-    title: str
-    time_name: str
-    state_names: tuple[str, ...]
-    parameters: Mapping[str, float]
-    initial: Mapping[str, float]
-    coordinates: tuple[str, ...]
-    descriptions: Mapping[str, str]
-    constraints: Mapping[str, Constraint]
-    autonomous: bool
-    physical: bool  # the model has physical values (its results are also given in its units)
-    load: Callable[[], object] = field(repr=False, default=None)  # the full system
-    cycles: int = 1  # forcing periods in one period (a gear's revolution with shaft-order terms)
-    fastest: float = 0.0  # the fastest linearised mode's rate and the forcing period at these values: the step's
-    cycle: float = 0.0  # choice (codegen/step_choice.py) without the model
-    #: the full system's contact_watches when each is numbers and parameters' names (what an orbit's contact is
-    #: read from, without the reduction); None: from the full system
-    watches: tuple[tuple[str, str, float | str, float | str], ...] | None = None
-
-    @property
-    def dimension(self) -> int:
-        return len(self.state_names)
-
-    @property
-    def observed(self) -> tuple[str, ...]:
-        return self.coordinates or self.state_names
-
-    @property
-    def initial_vector(self) -> tuple[float, ...]:
-        return tuple(float(self.initial.get(s, 0.0)) for s in self.state_names)
-
-    @property
-    def full(self):
-        """The full system (the model loaded and reduced: seconds, once)."""
-        if "_full" not in self.__dict__:
-            object.__setattr__(self, "_full", self.load())
-        return self.__dict__["_full"]
-
-    @property
-    def time(self):
-        """The time symbol (from the full system)."""
-        return self.full.time
-
-    @property
-    def states(self):
-        return self.full.states
-
-    @property
-    def rhs(self):
-        return self.full.rhs
-
-    @property
-    def period(self):
-        """The period as an expression (from the full system)."""
-        return self.full.period
-
-    @property
-    def contact_watches(self) -> tuple:
-        """The meshes an orbit's contact regime is read on (see the full system's ``contact_watches``)."""
-        return self.full.contact_watches if self.watches is None else self.watches
-
-    @property
-    def couplings(self):
-        """The meshes and shafts the reduction handed on (from the full system)."""
-        return self.full.couplings
-
-    def as_dict(self) -> dict:
-        return {"name": self.name, "title": self.title, "time_name": self.time_name,
-                "state_names": list(self.state_names), "parameters": dict(self.parameters),
-                "initial": dict(self.initial), "coordinates": list(self.coordinates),
-                "descriptions": dict(self.descriptions),
-                "constraints": {k: c.as_list() for k, c in self.constraints.items()},
-                "autonomous": self.autonomous, "physical": self.physical, "cycles": self.cycles,
-                "fastest": self.fastest, "cycle": self.cycle,
-                "watches": None if self.watches is None else [list(w) for w in self.watches]}
-
-    @classmethod
-    def from_dict(cls, d: dict, load: Callable[[], object]) -> "SystemSummary":
-        return cls(str(d["name"]), str(d["title"]), str(d["time_name"]), tuple(map(str, d["state_names"])),
-                   {str(k): float(v) for k, v in d["parameters"].items()},
-                   {str(k): float(v) for k, v in d["initial"].items()}, tuple(map(str, d["coordinates"])),
-                   {str(k): str(v) for k, v in d["descriptions"].items()},
-                   {str(k): Constraint.from_list(c) for k, c in d["constraints"].items()},
-                   bool(d["autonomous"]), bool(d["physical"]), load, int(d["cycles"]), float(d["fastest"]),
-                   float(d["cycle"]), _watches(d["watches"]))
-
-    @classmethod
-    def of(cls, system, physical: bool, fastest: float = 0.0) -> "SystemSummary":
-        """The summary of ``system`` (``fastest``: its fastest linearised mode's rate, for the step's choice)."""
-        return cls(system.name, system.title, system.time.name, system.state_names, dict(system.parameters),
-                   dict(system.initial), tuple(system.coordinates), dict(system.descriptions),
-                   dict(system.constraints), system.autonomous, physical, lambda: system, system.cycles,
-                   fastest, system.cycle_at(),
-                   system.watches if isinstance(system, SystemSummary) else _plain_watches(system.contact_watches))
-
-
-def _plain_watches(watches) -> tuple | None:
-    """``watches`` if each backlash and offset is a number or a parameter's name (what a summary can hold), else
-    None."""
-    plain = all(isinstance(v, (float, str)) for w in watches for v in w[2:])
-    return tuple(tuple(w) for w in watches) if plain else None
-
-
-def _watches(stored) -> tuple | None:
-    if stored is None:
-        return None
-    return tuple((str(n), str(c), *(v if isinstance(v, str) else float(v) for v in (b, o))) for n, c, b, o in stored)
-
 
 @lru_cache(maxsize=None)
 def _source_digest(folder: Path) -> str:
@@ -243,8 +128,8 @@ class CacheSlot:
         with ``integrator="auto"`` the step is chosen for the fastest of them: from the Jacobian and period of a
         library the slot keeps for the model (no SymPy, no reduction), else from the full system
         (``making.choose_over``)."""
-        summary = self.summary(making.load_system) if self.name is not None else None
         keeps = self.keeps(options)  # (the step's choice keeps the backend)
+        summary = read_summary(self.system, making.load_system) if self.name is not None else None
         auto = options.integrator == "auto" and bool(ends)
         found = found_over(self.name, self.key, summary, options, ends) if auto and summary is not None else None
         if found is None:
@@ -256,7 +141,7 @@ class CacheSlot:
                 making.before(system)
             found = making.compile_system(system, options)
             if keeps:
-                keep_compiled(self, found, making.kept_units())
+                keep_model(self.name, self.key, found, making.kept_units())
         return found
 
 
@@ -290,31 +175,12 @@ def cache_slot(ref, values: Mapping[str, object]) -> CacheSlot:
         return CacheSlot(path.stem, key)
 
 
-def keep_compiled(slot: CacheSlot, compiled, units: PointUnits | None) -> None:
-    """``compiled``'s summaries written into its slot (the build's under the loops it was compiled with), with
-    the ``units`` of a model with physical values."""
-    system_file = summary_path(slot.name, slot.key)
-    build_file = build_path(slot.name, slot.key, compiled.integration)
-    summary = SystemSummary.of(compiled.system, units is not None, compiled.fastest)
-    write_json(system_file, {"system": summary.as_dict(), "physical": units and units.as_dict()})
-    write_json(build_file, BuildSummary.of(compiled).as_dict())
-
-
-def read_summary(system: Mapping | None, full: Callable[[], object]) -> SystemSummary | None:
-    """The :class:`SystemSummary` of a system's summary as read from the cache (``full``: the full system, loaded
-    only if a caller asks for its symbolic part), or None: no summary, or none that reads as one."""
-    try:
-        return SystemSummary.from_dict(system, full)
-    except (KeyError, TypeError, ValueError, AttributeError):
-        return None
-
-
 def load_linearisation(ref: str, values: Mapping[str, object], options: Integration, *,
                        derive: Callable[[], CompiledLinearisation], verbose: bool = False) -> CompiledLinearisation:
     """The compiled linearisation about its static state of the model ``ref`` with ``values`` (a stability
-    chart's): from the cache as :func:`keep_compiled` keeps a model (its summaries beside the linear system's
-    library, with the static recipe and the model's own parameters), else ``derive()`` (the model loaded,
-    linearised and compiled) and the summaries written."""
+    chart's): from the cache as :func:`~gearsym.codegen.kept.keep_model` keeps a model (its summaries beside the
+    linear system's library, with the static recipe and the model's own parameters), else ``derive()`` (the model
+    loaded, linearised and compiled) and the summaries written."""
     path = model_file(ref) if isinstance(ref, str) else None
     if path is None or resolve_backend(options.backend) != "compiled":
         return derive()

@@ -25,6 +25,7 @@ from .library import library_describes, library_model, resolve_backend
 from .loops import LoopOptions
 from .mode_rates import chosen_by_compiled
 from .step_choice import choices_from, chosen
+from .system_summary import SystemSummary
 from .trust import check, differences
 
 #: bump when what a summary (the system's or a build's) holds changes
@@ -100,7 +101,7 @@ def found_over(name: str, key: str, summary, options: Integration, ends: list[di
     """The compiled model of a sweep over ``ends`` (the corners of its axes) from the cache alone, or None: the step
     chosen as the full system would choose it, from the Jacobian and period of any library the cache keeps for the
     model (the one of its own values, or one a sweep over faster points chose: the same functions whatever the
-    loops); ``summary``: the system's (:class:`~gearsym.cached.SystemSummary`)."""
+    loops); ``summary``: the system's (:class:`~.system_summary.SystemSummary`)."""
     libraries = (found_build(name, key, summary, o) for o in choices_from(options, summary.fastest, summary.cycle))
     some = next((compiled for compiled in libraries if compiled is not None), None)
     chosen_here = None if some is None else chosen_by_compiled(options, some, ends)
@@ -138,3 +139,12 @@ def kept_model(summary, build_file: Path, options: Integration):
         why = f"{build.library.name}, the library it points at, does not match it: {why}"
     distrust(build_file, why, WHAT)  # (edited: said once, and the summaries are written again)
     return None
+
+
+def keep_model(name: str, key: str, compiled, units=None) -> None:
+    """``compiled``'s summaries written into the cache under the model ``name`` with the values of ``key``: its
+    system's and its build's (under the loops it was compiled with), with the point units of a model with physical
+    values (``units``: an object with ``as_dict()``, else None)."""
+    summary = SystemSummary.of(compiled.system, units is not None, compiled.fastest)
+    write_json(summary_path(name, key), {"system": summary.as_dict(), "physical": units and units.as_dict()})
+    write_json(build_path(name, key, compiled.integration), BuildSummary.of(compiled).as_dict())
