@@ -85,13 +85,16 @@ def run(args: argparse.Namespace) -> int:
                                "numbers")
     # (a grid in physical units is checked here, once, before the model is compiled)
     physical_grid = PhysicalGrid(units, grid_axes) if units is not None else None
-    if axis is not None:
-        return _continuation(args, model, grid_axes, physical_grid, axis, units, request.settings, y0, execution)
+    if axis is not None and physical_grid is not None:  # (the parameter in the engine's numbers, also before)
+        axis = nondimensional_axes(model.scaling.full, [axis])[0]
     compiled = model.compiled()
-    shown_as = shown_in(units, request.settings)
+    if axis is not None:
+        return _continuation(args, compiled, grid_axes, physical_grid, axis, shown_in(units, request.settings), y0,
+                             execution)
     # (the engine's starts at the compiled model's speed: a rate's engine unit moves with it)
     starts = (physical_grid.at(dict(zip(compiled.parameter_names, compiled.parameter_vector()))) if physical_grid
               else {a.name: a.values for a in grid_axes})
+    shown_as = shown_in(units, request.settings)
     result = basin_map(compiled, starts, y0=y0, execution=execution)
     shown = ShownBasinMap(result, shown_as, tuple(grid_axes))
     write_map(shown, args.out, args.plot)
@@ -125,16 +128,12 @@ def write_fractions(shown: ShownFractions, physical: Path | None, plot: str | No
         print(f"gearsym: wrote {plot}", file=sys.stderr)
 
 
-def _continuation(args, model, grid_axes: list[Axis], physical_grid: PhysicalGrid | None, axis: Axis, units,
-                  given: dict, y0, execution: Execution) -> int:
-    """The basin fractions along --param (``physical_grid``: the grid in physical units, None for a model without
-    physical values; ``units``: the model's point units, None without; ``given``: the values the user set)."""
-    shown_as = shown_in(units, given)
+def _continuation(args, compiled, grid_axes: list[Axis], physical_grid: PhysicalGrid | None, axis: Axis, shown_as,
+                  y0, execution: Execution) -> int:
+    """The basin fractions along --param (``axis``: in the engine's numbers; ``physical_grid``: the grid in physical
+    units, None for a model without physical values)."""
     physical = physical_grid is not None
-    if physical:  # (the parameter in the engine's numbers, before the model is compiled)
-        axis = nondimensional_axes(model.scaling.full, [axis])[0]
     grid = physical_grid or StartGrid({a.name: a.values for a in grid_axes}, [a.spec for a in grid_axes])
-    compiled = model.compiled()
     try:
         result = continue_basins(compiled, grid, axis.name, axis.values, y0=y0, out=args.out,
                                  overwrite=args.overwrite, execution=execution,
