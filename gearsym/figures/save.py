@@ -30,10 +30,10 @@ SAME_MEAN, SAME_MOVED = 2e-3, 2e-4
 def save_figure(fig, path: str | Path, dpi: int, keep_same: bool = False) -> Path:
     """Write ``fig`` to ``path`` (folders made as needed) and close it, its titles wrapped to fit
     (:func:`~.layout.fit_texts`): laid out at ``dpi``, then drawn once, as laid out. No 'Software' entry, so the
-    bytes do not depend on the matplotlib version: committed figures are compared as files. Written whole or not at all (:func:`~gearsym.files.atomic.write_atomically`:
-    a full disk leaves no half a figure). ``keep_same``: a file already there that shows the same picture
-    (:func:`same_picture`) is left as it is (a committed figure redrawn on another machine, whose rounding moved
-    a line by a fraction of a pixel)."""
+    bytes do not depend on the matplotlib version: committed figures are compared as files. Written whole or not
+    at all (:func:`~gearsym.files.atomic.write_atomically`: a full disk leaves no half a figure). ``keep_same``: a
+    file already there that shows the same picture (:func:`same_picture`) is left as it is (a committed figure
+    redrawn on another machine, whose rounding moved a line by a fraction of a pixel)."""
     path = Path(path)
     fig.set_dpi(dpi)  # (laid out at the resolution it is written at: the layout made here is the one drawn)
     fit_texts(fig, again=True)
