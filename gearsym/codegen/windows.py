@@ -30,11 +30,12 @@ then read by every function of the step: before, each parameter's column compute
 at every step (a column 1000 operations, now 250; the 20/53 pair's library of docs/examples/explain-cracked-tooth:
 921 kB of C, now 529 kB, gcc 10.5 -> 6.3 s. A step, 40 windows of 76 samples, min of 5, the two codes back to back:
 9/13 library with three columns 4350 -> 2163 ns, every column 6307 -> 3181 ns, the state alone 2430 -> 1735 ns;
-20/53 library 3226 -> 2690, 6817 -> 4257, 2173 -> 1730 ns). A call that asks for many columns, or for columns that share a derivative of the
-state (a transmission error's or spacing errors' parameters each need the mesh force's derivative at the four
-stages), takes them all from ``fit_forcing`` instead: the driver compares the operations of the two ways (each
-function's count, written into the C) and takes the cheaper (a 9/13 pair's library: its eight spacing errors 2264
-operations a step one by one, 1626 all at once; the screen's 31 columns 7567 against 3719).
+20/53 library 3226 -> 2690, 6817 -> 4257, 2173 -> 1730 ns). A call that asks for many columns, or for columns
+that share a derivative of the state (a transmission error's or spacing errors' parameters each need the mesh
+force's derivative at the four stages), takes them all from ``fit_forcing`` instead: the driver compares the
+operations of the two ways (each function's count, written into the C) and takes the cheaper (a 9/13 pair's
+library: its eight spacing errors 2264 operations a step one by one, 1626 all at once; the screen's 31 columns 7567
+against 3719).
 The C is cached like the engine's (:mod:`.compiler`); without a compiler the same functions run in
 CasADi's virtual machine, mapped over the windows.
 """
