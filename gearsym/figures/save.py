@@ -40,8 +40,8 @@ def save_figure(fig, path: str | Path, dpi: int, keep_same: bool = False) -> Pat
     engine = fig.get_layout_engine()
     image = io.BytesIO()
     try:
-        if engine is not None:  # drawn as laid out above, not laid out once more
-            fig.set_layout_engine("none")
+        if engine is not None:  # drawn as laid out above: no engine, so savefig neither lays it out once more
+            without_layout(fig)  # nor draws it once without rendering before it draws it (matplotlib does for any)
         fig.savefig(image, format=path.suffix.lstrip(".").lower() or None, dpi=dpi, metadata={"Software": None})
     finally:
         if engine is not None:
@@ -51,6 +51,16 @@ def save_figure(fig, path: str | Path, dpi: int, keep_same: bool = False) -> Pat
     if keep_same and path.is_file() and same_picture(image, path):
         return path
     return write_atomically(path, image.getvalue())
+
+
+def without_layout(fig) -> None:
+    """``fig`` with no layout engine at all (``set_layout_engine("none")`` leaves a placeholder, and savefig draws a
+    figure with any engine once without rendering, a second draw of every text, before it draws it); a user's
+    matplotlibrc that asks for a layout does not put one back."""
+    import matplotlib
+
+    with matplotlib.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
+        fig.set_layout_engine(None)
 
 
 def finish(fig, path: str | Path | None, dpi: int):
