@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from gearsym.figures.poincare import REGIME_MARKERS
-from gearsym.figures.save import save_figure
 from gearsym.figures.sweep import plot_sweep
 from gearsym.reproduce import SCENARIOS
 from gearsym.reproduce import figures as paper_figures
@@ -459,19 +458,3 @@ def test_no_paper_figure_clips_a_text_or_covers_a_curve_with_a_legend(quick_repr
     for ax in fig.axes:
         assert fc.points_under_legend(ax) == 0, f"a legend covers data in {ax.get_title()!r}"
         assert fc.unmatched_legend_entries(ax) == [], ax.get_title()
-
-
-# ------------------------------------------------------------------ writing a figure
-def test_a_figure_is_drawn_once_when_it_is_saved_and_keeps_its_layout_engine(tmp_path):
-    """save_figure lays the figure out itself (its titles fitted), then matplotlib draws it: once, not a second
-    time without rendering first (which it does for a figure with any layout engine, a placeholder too)."""
-    fig, ax = plt.subplots(constrained_layout=True)
-    ax.plot([0, 1], [1, 0], label="a line")
-    ax.legend()
-    ax.set_title("a title")
-    engine = fig.get_layout_engine()
-    draws = []
-    fig.canvas.mpl_connect("draw_event", lambda event: draws.append(event))
-    save_figure(fig, tmp_path / "f.png", dpi=60)
-    assert len(draws) == 1
-    assert (tmp_path / "f.png").stat().st_size > 0 and fig.get_layout_engine() is engine
