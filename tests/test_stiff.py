@@ -157,7 +157,10 @@ def test_the_stiff_step_and_its_tangent_map_converge_at_fourth_order_by_step_hal
 # ------------------------------------------------------------------ on a gear model, crossings located
 @functools.cache
 def stiff_shaft():
-    return compile_model(system("flexible_shaft"), Integration(periods=160, discard=60, integrator="stiff"))
+    """In-process (CasADi's functions: 1 s of CPU here, where compiling them is 4): the compiled stiff step is
+    checked against SciPy's Radau below and on the linear chain above."""
+    return compile_model(system("flexible_shaft"), Integration(periods=160, discard=60, integrator="stiff",
+                                                               backend="in-process"))
 
 
 @pytest.mark.slow
