@@ -41,10 +41,12 @@ def exact_rates(s: FirstOrderSystem) -> np.ndarray:
 
 @functools.cache
 def run(w2: float, integrator: str = "auto", reorthonormalise: bool = True):
+    """The chain's model and spectrum, in-process (CasADi's functions: 0.25 s of CPU each, where compiling them is
+    1-2 s for a library no other test uses; the compiled stiff step is checked against SciPy's Radau below)."""
     s = chain(w2)
-    model = compile_model(s, Integration(periods=60, discard=10, integrator=integrator))
+    model = compile_model(s, Integration(periods=60, discard=10, integrator=integrator, backend="in-process"))
     if not reorthonormalise:  # (the sabotage check: Gram-Schmidt once per period)
-        model = compile_model(s, Integration.paper(periods=60, discard=10,
+        model = compile_model(s, Integration.paper(periods=60, discard=10, backend="in-process",
                                                    steps_per_period=model.integration.steps_per_period))
     return model, lyapunov_spectrum(model)
 
@@ -158,7 +160,7 @@ def test_the_stiff_step_and_its_tangent_map_converge_at_fourth_order_by_step_hal
 @functools.cache
 def stiff_shaft():
     """In-process (CasADi's functions: 1 s of CPU here, where compiling them is 4): the compiled stiff step is
-    checked against SciPy's Radau below and on the linear chain above."""
+    checked against SciPy's Radau below."""
     return compile_model(system("flexible_shaft"), Integration(periods=160, discard=60, integrator="stiff",
                                                                backend="in-process"))
 
