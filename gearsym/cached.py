@@ -36,7 +36,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from .codegen.compiler import binary_key, cache_dir, compile_flags
-from .codegen.library import library_describes, library_model, resolve_backend
+from .codegen.library import library_describes, library_from_code, library_model, resolve_backend
 from .codegen.loops import LoopOptions
 from .codegen.step_choice import chosen
 from .codegen.trust import check, differences
@@ -313,10 +313,10 @@ def cache_slot(ref, values: Mapping[str, object]) -> CacheSlot:
         return CacheSlot(path.stem, key)
 
 
-def cached_compiled(slot: CacheSlot, options: Integration, full: Callable[[], object]):
+def cached_compiled(slot: CacheSlot, options: Integration, full: Callable[[], object], verbose: bool = False):
     """The compiled model the slot's summaries and library give for ``options`` (``full``: the full system, loaded
     only if a caller asks for its symbolic part), or None: no summary, no library for these loops, a backend other
-    than the compiled one, or summaries not to trust."""
+    than the compiled one, or summaries not to trust. ``verbose``: say so when the library is compiled again."""
     if not slot.keeps(options):
         return None
     if options.integrator == "auto":  # (chosen from the model's fastest mode, which its summary keeps)
@@ -325,7 +325,7 @@ def cached_compiled(slot: CacheSlot, options: Integration, full: Callable[[], ob
         except (KeyError, TypeError, ValueError):
             return None
     build_file = summary_path(slot.name, f"{slot.key}-{loops_key(LoopOptions.of(options))}")
-    return _from_cache(slot.system, build_file, options, full)
+    return _from_cache(slot.system, build_file, options, full, verbose)
 
 
 def keep_compiled(slot: CacheSlot, compiled, units: PointUnits | None) -> None:
@@ -355,10 +355,13 @@ def read_build(path: Path) -> BuildSummary | None:
         return None
 
 
-def _from_cache(system: Mapping | None, build_file: Path, options: Integration, full: Callable[[], object]):
+def _from_cache(system: Mapping | None, build_file: Path, options: Integration, full: Callable[[], object],
+                verbose: bool = False):
     """The compiled model of a system's summary as read (``system``) and the build summary in ``build_file``, or
-    None: either missing or unreadable, a library not of our own cache or not as compiled (compile_model says so
-    and makes it again), or summaries that do not describe the library they point at (edited: said here)."""
+    None: either missing or unreadable, a library not of our own cache and no verified C to compile it from, or
+    summaries that do not describe the library they point at (edited: said here). A library gone or not as
+    compiled (damaged, a symlink: said by the compiler) is compiled again from the C that vouches for the same
+    code, states and parameters (:func:`~gearsym.codegen.library.library_from_code`), without the model."""
     summary = read_summary(system, full)
     build = read_build(build_file)
     if summary is None or build is None or not build.in_own_cache or summary.cycles < 1:
@@ -366,9 +369,9 @@ def _from_cache(system: Mapping | None, build_file: Path, options: Integration, 
     if not build.timed_parameters <= set(summary.parameters):
         why = "it names parameters its model does not have"
     else:
-        verdict = check(build.library)  # (a library not as compiled is said and made again by compile_model)
+        verdict = check(build.library)
         if verdict.data is None:
-            return None
+            return _compiled_again(summary, build, build_file, options, verbose)
         why = differences(verdict.describes, library_describes(summary, build.hash))
         if why is None:  # (the summaries describe the library they point at)
             return library_model(summary, build.hash, build.library, options, build.timed_parameters,
@@ -376,6 +379,21 @@ def _from_cache(system: Mapping | None, build_file: Path, options: Integration, 
         why = f"{build.library.name}, the library it points at, does not match it: {why}"
     distrust(build_file, why, _WHAT)  # (edited: said once, and the summaries are written again)
     return None
+
+
+def _compiled_again(summary: SystemSummary, build: BuildSummary, build_file: Path, options: Integration,
+                    verbose: bool):
+    """The compiled model of ``build`` with its library compiled again from its C (the compiler says why the one
+    in the cache is not used), the build summary written again if the library's name changed; or None: no C that
+    vouches for it (the model is loaded and its C generated)."""
+    announce = (lambda message: print(f"gearsym: {message}", file=sys.stderr, flush=True)) if verbose else None
+    library = library_from_code(summary, build.hash, announce)
+    if library is None:
+        return None
+    if library != build.library:
+        write_json(build_file, replace(build, library=library).as_dict())
+    return library_model(summary, build.hash, library, options, build.timed_parameters, build.table_texts,
+                         summary.fastest)
 
 
 def load_linearisation(ref: str, values: Mapping[str, object], options: Integration, *,
@@ -394,7 +412,7 @@ def load_linearisation(ref: str, values: Mapping[str, object], options: Integrat
     build_file = summary_path(name, f"{key}-{loops_key(loops)}")
     data = read_json(system_file)
     compiled = _from_cache(data.get("system") if data is not None else None, build_file, options,
-                           lambda: derive().model.system)
+                           lambda: derive().model.system, verbose)
     if compiled is not None:
         try:
             about = data["linearisation"]

@@ -115,7 +115,7 @@ class OpenModel:
         if found is not None:
             return found
         options = self.chosen_over(options, over or {})
-        found = cached_compiled(self.slot, options, lambda: self.system)
+        found = cached_compiled(self.slot, options, lambda: self.system, self.request.verbose)
         if found is not None:
             return found
         system = self.system
