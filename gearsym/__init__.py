@@ -31,7 +31,6 @@ import importlib
 from typing import TYPE_CHECKING
 
 from .errors import GearsymError, ModelError, UnknownParameterError
-from .options import Execution, Integration
 from .version import __version__
 
 
@@ -56,6 +55,8 @@ VERBS = {
 #: public name -> the module that defines it (imported when the name is first used: the declaring and
 #: reducing stages import SymPy, which a command on a cached model never needs)
 _LAZY = {
+    "Execution": "gearsym.options",
+    "Integration": "gearsym.options",
     "Bearing": "gearsym.model.components",
     "Disk": "gearsym.model.components",
     "Drivetrain": "gearsym.model.drivetrain",
@@ -114,7 +115,7 @@ _LAZY = {
     **dict.fromkeys(VERBS, "gearsym.verbs"),
 }
 
-__all__ = ["Execution", "GearsymError", "Integration", "ModelError", "UnknownParameterError", *_LAZY]
+__all__ = ["GearsymError", "ModelError", "UnknownParameterError", *_LAZY]
 
 
 def __getattr__(name: str):
@@ -132,6 +133,7 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # for editors and type checkers, which do not run __getattr__
     from .analysis.lyapunov import LyapunovSpectrum
+    from .options import Execution, Integration
     from .analysis.orders import order_spectrum
     from .analysis.regime import classify_regime
     from .codegen import CompiledModel

@@ -13,20 +13,19 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from functools import cached_property
 
 import gearsym  # the face: its verbs load on first use, so a cached model's run never loads the generator
 
+from .records import record_class
 from . import stability  # (its modules load on first use: the linearisation's only when it is derived)
-from .cached import cache_slot, cached_compiled, keep_compiled, load_linearisation, load_static_recipe
-from .codegen.mode_rates import chosen_by_compiled
-from .codegen.step_choice import choices_from
+from .cached import Making, cache_slot, load_linearisation, load_static_recipe
 from .options import Integration
 from .physical.point import CachedScaling
 
 
-@dataclass(frozen=True)
+@record_class
 class ModelRequest:
     """What a run asks of its model, read once from the caller: ``model`` (a name or the path of a model file),
     ``settings`` (its values as ``gearsym.load`` takes them: numbers, quantities, a stiffness formula in tau, a
@@ -98,8 +97,8 @@ class OpenModel:
     @cached_property
     def summary(self):
         """What a run checks its request against (names, parameters, cycles): the cache's summary of the system
-        when it has one (:class:`~gearsym.cached.SystemSummary`, which loads the full system only if asked for its
-        symbolic part), else :attr:`system`."""
+        when it has one (:class:`~gearsym.codegen.system_summary.SystemSummary`, which loads the full system only
+        if asked for its symbolic part), else :attr:`system`."""
         summary = self.slot.summary(lambda: self.system)
         return self.system if summary is None else summary
 
@@ -107,45 +106,17 @@ class OpenModel:
                  before: Callable[[object], object] | None = None):
         """The compiled model, with ``options`` (default: the request's): from the start-up cache when it has it,
         else the model loaded, ``before(system)`` (the run's checks of its request against the loaded system, made
-        before the compiler's seconds), compiled and kept in the cache. ``over``: the engine's axes (name ->
-        values) a sweep or a continuation runs over; the step is chosen for its fastest point (their ends
-        decide; an integrator asked is kept), so that the model is compiled once."""
-        options = options or self.request.options
-        found = self._cached_over(options, over or {})
-        if found is not None:
-            return found
-        options = self.chosen_over(options, over or {})
-        found = cached_compiled(self.slot, options, lambda: self.system, self.request.verbose)
-        if found is not None:
-            return found
-        system = self.system
-        if before is not None:
-            before(system)
-        compiled = gearsym.compile_model(system, options, verbose=self.request.verbose)
-        if self.slot.keeps(options):
-            scaling = self.scaling
-            keep_compiled(self.slot, compiled, None if scaling is None else scaling.point_units())
-        return compiled
-
-    def chosen_over(self, options: Integration, axes: Mapping) -> Integration:
-        """``options`` with the step chosen for every point of the engine's ``axes`` (see :meth:`compiled`)."""
-        if options.integrator != "auto" or not axes:
-            return options
-        return gearsym.chosen_integration(options, self.system, _ends(axes))
-
-    def _cached_over(self, options: Integration, axes: Mapping):
-        """The compiled model of a sweep over ``axes`` from the cache alone, or None: the step chosen as
-        :meth:`chosen_over` chooses it, from the Jacobian and period of the library the cache holds for the
-        model's own values (the same functions whatever the loops: no SymPy, no reduction)."""
-        summary = self.slot.summary(lambda: self.system)
-        if options.integrator != "auto" or not axes or summary is None or not self.slot.keeps(options):
-            return None
-        # (any library of the model will do: the one of its own values, or one a sweep over faster points chose)
-        libraries = (cached_compiled(self.slot, o, lambda: self.system)
-                     for o in choices_from(options, summary.fastest, summary.cycle))
-        some = next((compiled for compiled in libraries if compiled is not None), None)
-        chosen = None if some is None else chosen_by_compiled(options, some, _ends(axes))
-        return None if chosen is None else cached_compiled(self.slot, chosen, lambda: self.system)
+        before the compiler's seconds), compiled and kept in the cache
+        (:meth:`~gearsym.cached.CacheSlot.compiled_model`).
+        ``over``: the engine's axes (name -> values) a sweep or a continuation runs over; the step is chosen for its
+        fastest point (their ends decide; an integrator asked is kept), so that the model is compiled once."""
+        return self.slot.compiled_model(options or self.request.options, _ends(over) if over else [], Making(
+            load_system=lambda: self.system,
+            choose_over=lambda options, ends: gearsym.chosen_integration(options, self.system, ends),
+            compile_system=lambda system, options: gearsym.compile_model(system, options,
+                                                                         verbose=self.request.verbose),
+            kept_units=lambda: None if self.scaling is None else self.scaling.point_units(),
+            before=before))
 
     def linearised(self, before: Callable[[object], object] | None = None):
         """The compiled linearisation about the model's static state (a chart's): from the cache, else the model

@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 
+from .records import record_class
 from .caller import option
 from .checks import MAX_STEPS_PER_PERIOD, RUN_BYTES_PER_PERIOD, TABLE_BYTES_PER_STEP, whole_number
 from .errors import GearsymError
@@ -26,7 +27,7 @@ BACKENDS = ("auto", "compiled", "in-process")
 PARALLEL = ("auto", "processes", "threads")
 
 
-@dataclass(frozen=True)
+@record_class
 class Execution:
     """How a verb runs what it runs; the numbers are the same whatever this says.
 
@@ -79,7 +80,7 @@ METHODS = ("rk4", "stiff")
 INTEGRATORS = ("auto", *METHODS)
 
 
-@dataclass(frozen=True)
+@record_class
 class Integration:
     """Fixed-step RK4 over whole forcing periods.
 

@@ -7,8 +7,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, fields
+from dataclasses import fields
 
+from .records import record_class
 from .checks import sign_violation
 from .errors import GearsymError, ModelError, UnknownParameterError
 from .options import Integration
@@ -17,7 +18,7 @@ from .options import Integration
 _RUN_OPTIONS = tuple(f.name for f in fields(Integration))
 
 
-@dataclass(frozen=True)
+@record_class
 class Constraint:
     """What a parameter is physically, and so which values it may take: its sign; for a fraction of stiffness
     lost, ``below`` 1 (exclusive: at 1 the tooth pair carries nothing, beyond it pulls); for a tooth, a whole

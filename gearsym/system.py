@@ -220,8 +220,8 @@ class FirstOrderSystem(ParameterChecks, Model):
 
     @property
     def full(self) -> "FirstOrderSystem":
-        """The system itself (the start-up cache's summary of one, :class:`~gearsym.cached.SystemSummary`, loads
-        the full system here)."""
+        """The system itself (the start-up cache's summary of one,
+        :class:`~gearsym.codegen.system_summary.SystemSummary`, loads the full system here)."""
         return self
 
     @property

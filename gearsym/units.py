@@ -24,10 +24,10 @@ import importlib.util
 import math
 import re
 import warnings
-from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+from .records import record_class
 from .errors import GearsymError
 from .files.memo import keep, recall
 
@@ -215,7 +215,7 @@ def is_quantity(value) -> bool:
 
 
 # ----------------------------------------------------------------------------------------- SI numbers
-@dataclass(frozen=True)
+@record_class
 class Measure:
     """A physical value as it crosses into the model: ``si`` in kg, m, s (angles in rad) and the exponents of
     mass, length and time it is made of; ``given`` and ``unit`` are what the user wrote, to show it back."""
@@ -293,7 +293,7 @@ def _measured(text: str, where: str) -> Measure | None:
 
 
 # ----------------------------------------------------------------------------------------- kept meanings
-@dataclass(frozen=True)
+@record_class
 class UnitMeaning:
     """What pint says a unit text means, as plain data: kept in the user's cache (:mod:`gearsym.files.memo`),
     so that a later process meeting the same text reads it there and imports no pint (pint's import and its

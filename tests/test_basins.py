@@ -253,7 +253,12 @@ def test_a_physical_maps_title_gives_the_users_values_and_its_exponents_are_per_
     import gearsym.cli.basins as command
 
     drawn = []
-    monkeypatch.setattr(command, "plot_basin_map", lambda shown, path: drawn.append(plot_basin_map(shown, path)))
+
+    def draw(shown, path=None):
+        drawn.append(plot_basin_map(shown, path))
+        return drawn[-1]
+
+    monkeypatch.setattr(command, "plot_basin_map", draw)
     code, out, _ = run_cli(capsys, "basins", "spur_pair", "--set", "speed=5000 rpm", "--grid", "x=-20um:20um:20um",
                            "--grid", "v=-300mm/s:300mm/s:300mm/s", "--periods", "60", "--discard", "20",
                            "--plot", str(tmp_path / "map.png"))

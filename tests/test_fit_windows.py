@@ -13,8 +13,10 @@ from gearsym.fit import augment
 
 @pytest.fixture(scope="module")
 def case():
-    system = augment(conftest.system("one_stage"), ["cubic_stiffness", "torque_harmonic_3"],
-                     values={"k3": 0.01, "B_c3": 0.4, "B_s3": -0.2})
+    # (the transmission errors' four parameters share the mesh force's derivative: taken all at once, see below)
+    system = augment(conftest.system("one_stage"), ["cubic_stiffness", "torque_harmonic_3", "transmission_error_1",
+                                                    "transmission_error_2"],
+                     values={"k3": 0.01, "B_c3": 0.4, "B_s3": -0.2, "e_c1": 0.1, "e_s2": -0.05})
     x, v = system.states
     channels = [x, system.rhs[1], sp.cos(7 * system.time) * x]  # a state, the acceleration, a high harmonic
     K = 5

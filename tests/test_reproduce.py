@@ -3,6 +3,7 @@ record is what the engine computes, and a quick run writes every output."""
 from __future__ import annotations
 
 import dataclasses
+import io
 import json
 import re
 import sys
@@ -196,3 +197,32 @@ def test_a_figure_redrawn_with_a_line_moved_by_rounding_is_kept_and_a_changed_on
     assert save_figure(draw(2e-3), tmp_path / "g.png", dpi=80).read_bytes() != first  # other antialiasing
     assert save_figure(draw(2e-3), path, dpi=80, keep_same=True).read_bytes() == first
     assert save_figure(draw(0.3), path, dpi=80, keep_same=True).read_bytes() != first
+
+
+def test_a_saved_figure_is_drawn_once_and_is_the_picture_matplotlib_saves_of_its_layout(tmp_path, monkeypatch):
+    """save_figure lays a figure out at the resolution it writes, then draws it once: with matplotlib's 'none' layout
+    engine (a stand-in) savefig drew it twice, once without rendering. The PNG is byte for byte the one matplotlib's
+    own savefig writes of that layout, and the figure keeps its layout engine."""
+    from matplotlib.figure import Figure
+
+    from gearsym.figures.layout import fit_texts
+    from gearsym.figures.save import pyplot, save_figure
+
+    def draw():
+        fig, (a, b) = pyplot().subplots(1, 2, figsize=(5, 3), constrained_layout=True)
+        a.plot([0, 1, 2], [1, 3, 2])
+        b.set_title("the right panel")
+        fig.suptitle("a figure of two panels")
+        return fig
+
+    reference, image = draw(), io.BytesIO()
+    reference.set_dpi(80)
+    fit_texts(reference, again=True)
+    reference.set_layout_engine("none")
+    reference.savefig(image, format="png", dpi=80, metadata={"Software": None})
+    drawn, real = [], Figure.draw
+    monkeypatch.setattr(Figure, "draw", lambda fig, renderer: drawn.append(fig) or real(fig, renderer))
+    fig = draw()
+    engine = fig.get_layout_engine()
+    assert save_figure(fig, tmp_path / "f.png", dpi=80).read_bytes() == image.getvalue()
+    assert drawn == [fig] and fig.get_layout_engine() is engine

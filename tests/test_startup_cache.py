@@ -1,6 +1,7 @@
 """A command on a model whose library is cached neither reduces it again nor imports SymPy (gearsym/cached.py)."""
 from __future__ import annotations
 
+import gc
 import json
 import os
 import re
@@ -184,16 +185,26 @@ def test_an_orbit_of_a_cached_model_imports_neither_sympy_nor_pint(model_copy, c
 def test_a_single_spectrum_loads_no_other_analysis():
     """What `gearsym lyap` imports (its command and the start-up cache) leaves out the runs from many starts, the
     lanes, the orders and their figures, and CasADi (the library is called through ctypes): each module is start-up
-    time of every cached run (issue 39)."""
-    script = "import sys, gearsym.cli.lyap, gearsym.cached; print(' '.join(sorted(sys.modules)))"
-    loaded = set(subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO_ROOT,
-                                env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120, check=True).stdout.split())
+    time of every cached run (issue 39); and its classes are records, whose methods are not compiled when defined."""
+    script = ("import sys, gearsym.cli.lyap, gearsym.cached; print(' '.join(sorted(sys.modules))); "
+              "print(' '.join(sorted(f'{m}.{k}' for m, module in list(sys.modules.items()) if m.startswith('gearsym') "
+              "for k, v in vars(module).items() if isinstance(v, type) and v.__module__ == m "
+              "and getattr(getattr(v, '__init__', None), '__code__', None) is not None "
+              "and v.__init__.__code__.co_filename == '<string>')))")
+    loaded, generated = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO_ROOT,
+                                       env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120,
+                                       check=True).stdout.split("\n")[:2]
+    loaded = set(loaded.split())
     assert "gearsym.analysis.lyapunov" in loaded and "gearsym.physical.point" in loaded
     unused = {"gearsym.analysis.attractors", "gearsym.analysis.basins", "gearsym.analysis.jumps",
               "gearsym.analysis.orders", "gearsym.analysis.order_run", "gearsym.analysis.lane_spectra",
               "gearsym.codegen.lane_runs", "gearsym.figures.poincare", "concurrent.futures", "sympy", "pint",
               "matplotlib", "casadi"}
     assert unused.isdisjoint(loaded), sorted(unused & loaded)
+    # (a dataclass compiles its methods from text when defined, about a millisecond a class: these are records; but
+    # LoopOptions, whose module's text is hashed into every model's generated C, which a change would regenerate)
+    generated = set(generated.split()) - {"gearsym.codegen.loops.LoopOptions"}
+    assert not generated, f"dataclasses on the cached path (declare them with records.record_class): {generated}"
 
 
 def test_a_sweep_of_a_cached_model_chooses_its_step_without_reducing_it_again(model_file, reductions, tmp_path,
@@ -231,3 +242,45 @@ def test_a_sweep_of_a_cached_physical_model_is_carried_to_physical_units(model_c
                          cwd=REPO_ROOT, env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120)
     assert run.returncode == 0, run.stderr[-2000:]
     assert out.with_suffix(".physical.csv").read_text().startswith("speed [rpm],")
+
+
+def test_the_face_leaves_numpy_to_the_command_which_imports_with_the_collector_paused(monkeypatch, capsys):
+    """``import gearsym`` (and the command line's module) imports no NumPy: the command imports it, with what it
+    needs, while the garbage collector is paused (its collections among the imports had nothing to free); the
+    objects then are set aside for good (gc.freeze) only in the command's own process, not in a caller's."""
+    script = "import sys, gearsym, gearsym.cli; print('numpy' in sys.modules)"
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO_ROOT,
+                         env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120, check=True)
+    assert run.stdout.split() == ["False"]
+    cli = sys.modules["gearsym.cli"]
+    seen, frozen = [], []
+    building = cli.build_parser
+
+    def build_parser(command=None):
+        seen.append(gc.isenabled())
+        return building(command)
+
+    monkeypatch.setattr(cli, "build_parser", build_parser)
+    monkeypatch.setattr(gc, "freeze", lambda: frozen.append(1))
+    assert main(["list"]) == 0 and seen == [False] and gc.isenabled() and not frozen
+    monkeypatch.setattr(sys, "argv", ["gearsym", "list"])
+    assert main() == 0 and seen == [False, False] and gc.isenabled() and frozen == [1]
+    capsys.readouterr()
+
+
+@pytest.mark.parametrize("given", [{}, {"OMP_NUM_THREADS": "2"}, {"OPENBLAS_NUM_THREADS": "2"}])
+def test_the_command_runs_numpys_blas_on_one_thread_unless_told_otherwise(given):
+    """Set before NumPy is imported, in the command's own process only (its pool of threads was a tenth of a
+    cached model's start-up); a thread count the user set is kept."""
+    script = ("import os, sys; from gearsym.cli import main; sys.argv = ['gearsym', 'list']; "
+              "main(); print([os.environ.get(k) for k in ('OPENBLAS_NUM_THREADS', 'OMP_NUM_THREADS')])")
+    env = {k: v for k, v in os.environ.items() if not k.endswith("_NUM_THREADS")}
+    run = subprocess.run([sys.executable, "-c", script],
+                         capture_output=True, text=True, cwd=REPO_ROOT, timeout=120, check=True,
+                         env={**env, **given, "PYTHONPATH": str(REPO_ROOT)})
+    told = [given.get("OPENBLAS_NUM_THREADS", "1" if not given else None), given.get("OMP_NUM_THREADS")]
+    assert run.stdout.strip().splitlines()[-1] == repr(told)
+    in_a_caller = subprocess.run([sys.executable, "-c", "import os; from gearsym.cli import main; main(['list']); "
+                                  "print(os.environ.get('OPENBLAS_NUM_THREADS'))"], capture_output=True, text=True,
+                                 cwd=REPO_ROOT, timeout=120, check=True, env={**env, "PYTHONPATH": str(REPO_ROOT)})
+    assert in_a_caller.stdout.strip().splitlines()[-1] == "None"

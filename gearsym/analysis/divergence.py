@@ -22,10 +22,10 @@ grew, and, from the couplings' stiffness expressions, where a stiffness goes neg
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
+from ..records import record_class
 from ..errors import GearsymError
 
 #: a coordinate past this many times the run's scale has diverged
@@ -38,7 +38,7 @@ DRIFT = 100.0
 NON_FINITE, PAST_BOUND, GROWING = "non-finite", "past the bound", "growing without bound"
 
 
-@dataclass(frozen=True)
+@record_class
 class Divergence:
     """How a run diverged (see the module's rule)."""
 

@@ -20,10 +20,11 @@ exponent cannot be told from zero, the Poincare points decide between a torus an
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass, field
+from dataclasses import field
 
 import numpy as np
 
+from ..records import record_class
 from ..checks import json_safe
 from ..codegen import CompiledModel, TangentRuns, engine_verb
 from ..errors import warn
@@ -40,7 +41,7 @@ from .statistics import batch_means_stderr
 AT_REST = 1e-9
 
 
-@dataclass(frozen=True)
+@record_class
 class LyapunovSpectrum:
     """All n exponents at one point, with what the run saw along the way."""
 
@@ -198,7 +199,7 @@ def spectrum_resolution(model, exponents, p, state, period, divergence) -> Resol
     return resolution(model, exponents, p, state, period)
 
 
-@dataclass(frozen=True)
+@record_class
 class RunsSummary:
     """What the per-period records of several tangent runs of one model say, computed for all at once."""
 

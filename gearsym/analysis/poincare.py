@@ -1,15 +1,15 @@
 """Orbits at one parameter point: stroboscopic (Poincare) samples, amplitudes, phase trajectories."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 
+from ..records import record_class
 from ..codegen import CompiledModel, engine_verb
 from ..options import Integration
 
 
-@dataclass(frozen=True)
+@record_class
 class Orbit:
     """``strobe``: the state at t0 + k*period (the Poincare section t mod period = t0), k after the transient."""
 
@@ -21,7 +21,7 @@ class Orbit:
     period: float
 
 
-@dataclass(frozen=True)
+@record_class
 class Trajectory:
     """Every RK4 step: for phase portraits (x against v) with the Poincare points overlaid."""
 

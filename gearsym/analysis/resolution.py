@@ -18,10 +18,10 @@ the measured rate) or the linearisation's rate of its mode as an estimate (the s
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 
 import numpy as np
 
+from ..records import record_class
 from ..codegen.step_choice import RK4_RESOLVED, STIFF_RESOLVED
 
 #: ln of the spread between two re-orthonormalisations beyond which a tangent vector is lost in round-off
@@ -29,7 +29,7 @@ from ..codegen.step_choice import RK4_RESOLVED, STIFF_RESOLVED
 ROUND_OFF_SPREAD = 30.0
 
 
-@dataclass(frozen=True)
+@record_class
 class Resolution:
     """Per exponent (in the spectrum's descending order): whether the run resolved it, and if not why and what is
     known of it (``bound``: an upper bound for a round-off loss, ``estimate``: the linearised mode's rate)."""

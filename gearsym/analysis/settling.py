@@ -26,9 +26,9 @@ logarithm), and:
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
+
+from ..records import record_class
 
 #: lags (in forcing periods) compared, at most
 MAX_LAG = 16
@@ -49,7 +49,7 @@ SETTLED_STATE, STATIONARY_STATE, CONVERGING, SPREADING, IRREGULAR = (
 BRIEF = "brief"
 
 
-@dataclass(frozen=True)
+@record_class
 class Settling:
     """What the Poincare points did over the measured periods."""
 

@@ -5,15 +5,18 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from pathlib import Path
 
 from ..analysis.basins import RUN, basin_map
 from ..errors import GearsymError
-from ..figures.basins import plot_basin_fractions, plot_basin_map
+from ..figures.basins import BASINS_DPI, plot_basin_fractions, plot_basin_map
+from ..figures.save import figure_bytes
+from ..files.atomic import write_atomically
 from ..files.outputs import check_figure, check_file
 from ..opening import open_model
 from ..options import Execution
 from ..physical.basins import PhysicalGrid, ShownBasinMap, ShownFractions, shown_in
-from ..physical.files import write_basin_fractions, write_basin_map
+from ..physical.files import basin_fractions_text, basin_map_texts
 from ..physical.sweeps import nondimensional_axes
 from ..sweep.basin_continuation import MATCH_DISTANCE, StartGrid, continue_basins
 from ..sweep.grid import Axis, parse_axis
@@ -70,11 +73,11 @@ def run(args: argparse.Namespace) -> int:
     if len(grid_axes) != 2 or grid_axes[0].name == grid_axes[1].name:
         raise GearsymError(f"--grid: give two different states (e.g. --grid x=-5:5:0.1 --grid v=-5:5:0.1), got "
                            f"{', '.join(a.name for a in grid_axes) or 'none'}")
+    execution = Execution(args.jobs, lanes=not args.no_lanes, progress=not args.quiet)
     request = model_request(args, integration_from(args))
     model = open_model(request)
     scaling = model.scaling
     units = scaling.point_units() if scaling is not None else None
-    shown_as = shown_in(units, request.settings)
     if units is None:
         unit = next((a for a in [*grid_axes, *([axis] if axis else [])] if a.unit), None)
         if unit:
@@ -82,52 +85,65 @@ def run(args: argparse.Namespace) -> int:
                                "numbers")
     # (a grid in physical units is checked here, once, before the model is compiled)
     physical_grid = PhysicalGrid(units, grid_axes) if units is not None else None
-    if axis is not None:
-        return _continuation(args, model, grid_axes, physical_grid, axis, shown_as, y0)
+    if axis is not None and physical_grid is not None:  # (the parameter in the engine's numbers, also before)
+        axis = nondimensional_axes(model.scaling.full, [axis])[0]
     compiled = model.compiled()
-    omega = compiled.parameter_vector()[compiled.parameter_names.index("omega")] \
-        if "omega" in compiled.parameter_names else 1.0
-    starts = physical_grid.at({"omega": omega}) if physical_grid else {a.name: a.values for a in grid_axes}
-    result = basin_map(compiled, starts, y0=y0, execution=_execution(args))
+    if axis is not None:
+        return _continuation(args, compiled, grid_axes, physical_grid, axis, shown_in(units, request.settings), y0,
+                             execution)
+    # (the engine's starts at the compiled model's speed: a rate's engine unit moves with it)
+    starts = (physical_grid.at(dict(zip(compiled.parameter_names, compiled.parameter_vector()))) if physical_grid
+              else {a.name: a.values for a in grid_axes})
+    shown_as = shown_in(units, request.settings)
+    result = basin_map(compiled, starts, y0=y0, execution=execution)
     shown = ShownBasinMap(result, shown_as, tuple(grid_axes))
-    if args.out:
-        written = write_basin_map(shown, args.out)
-        print(f"gearsym: wrote {' and '.join(map(str, written))}", file=sys.stderr)
-    if args.plot:
-        plot_basin_map(shown, args.plot)
-        print(f"gearsym: wrote {args.plot}", file=sys.stderr)
+    write_map(shown, args.out, args.plot)
     print(json.dumps(shown.as_dict(), indent=2) if args.format == "json" else report(shown))
     return 0
 
 
-def _execution(args: argparse.Namespace) -> Execution:
-    return Execution(args.jobs, lanes=not args.no_lanes, progress=not args.quiet)
+def write_map(shown: ShownBasinMap, out: str | None, plot: str | None) -> None:
+    """The map's files, each written whole: ``out`` (one row per start) with its record beside it, and the
+    picture ``plot``; the picture is drawn before anything is written, so that a figure that fails leaves no
+    table without its picture."""
+    picture = figure_bytes(plot_basin_map(shown), plot, BASINS_DPI) if plot else None
+    if out:
+        written = [write_atomically(path, text) for path, text in basin_map_texts(shown, out).items()]
+        print(f"gearsym: wrote {' and '.join(map(str, written))}", file=sys.stderr)
+    if plot:
+        write_atomically(plot, picture)
+        print(f"gearsym: wrote {plot}", file=sys.stderr)
 
 
-def _continuation(args, model, grid_axes: list[Axis], physical_grid: PhysicalGrid | None, axis: Axis, shown_as,
-                  y0) -> int:
-    """The basin fractions along --param (``physical_grid``: the grid in physical units, None for a model without
-    physical values)."""
+def write_fractions(shown: ShownFractions, physical: Path | None, plot: str | None) -> None:
+    """A continuation's files beside its own (which it writes as it goes), each written whole: the fractions in
+    the model's units (``physical``, for a model with physical values) and the picture ``plot``, drawn before
+    anything is written."""
+    picture = figure_bytes(plot_basin_fractions(shown), plot, BASINS_DPI) if plot else None
+    if physical is not None:
+        write_atomically(physical, basin_fractions_text(shown))
+        print(f"gearsym: wrote {physical} (the fractions in the model's units)", file=sys.stderr)
+    if plot:
+        write_atomically(plot, picture)
+        print(f"gearsym: wrote {plot}", file=sys.stderr)
+
+
+def _continuation(args, compiled, grid_axes: list[Axis], physical_grid: PhysicalGrid | None, axis: Axis, shown_as,
+                  y0, execution: Execution) -> int:
+    """The basin fractions along --param (``axis``: in the engine's numbers; ``physical_grid``: the grid in physical
+    units, None for a model without physical values)."""
     physical = physical_grid is not None
-    if physical:  # (the parameter in the engine's numbers, before the model is compiled)
-        axis = nondimensional_axes(model.scaling.full, [axis])[0]
     grid = physical_grid or StartGrid({a.name: a.values for a in grid_axes}, [a.spec for a in grid_axes])
-    compiled = model.compiled()
     try:
         result = continue_basins(compiled, grid, axis.name, axis.values, y0=y0, out=args.out,
-                                 overwrite=args.overwrite, execution=_execution(args),
+                                 overwrite=args.overwrite, execution=execution,
                                  match_distance=args.match_distance)
     except KeyboardInterrupt:
         print(f"gearsym: interrupted; the values finished are in {args.out}: run the same command again to resume",
               file=sys.stderr)
         return 130
     shown = ShownFractions(result, shown_as)
-    if physical:
-        path = write_basin_fractions(shown, sidecar(args.out, ".physical.csv"))
-        print(f"gearsym: wrote {path} (the fractions in the model's units)", file=sys.stderr)
-    if args.plot:
-        plot_basin_fractions(shown, args.plot)
-        print(f"gearsym: wrote {args.plot}", file=sys.stderr)
+    write_fractions(shown, sidecar(args.out, ".physical.csv") if physical else None, args.plot)
     print(json.dumps(result.as_dict(), indent=2) if args.format == "json" else continuation_report(shown))
     return 0
 

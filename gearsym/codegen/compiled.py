@@ -11,13 +11,14 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..records import record_class
 from ..caller import option
 from ..checks import run_bytes_per_period, whole_number
 from ..errors import GearsymError, ModelError, warn
@@ -33,7 +34,7 @@ if TYPE_CHECKING:  # (CasADi is imported where the in-process backend calls it: 
     from ..system import FirstOrderSystem
 
 
-@dataclass(frozen=True)
+@record_class
 class RunInputs:
     """What the loops need for one parameter point, computed once: tables of time and constants."""
 
@@ -62,7 +63,7 @@ class RunInputs:
         return self.table.ctypes.data, self.constants.ctypes.data
 
 
-@dataclass(frozen=True)
+@record_class
 class TangentRun:
     """Raw output of ``periods`` forcing periods with tangent vectors."""
 
@@ -102,7 +103,7 @@ class TangentRuns:
         return [base + i * size for base, size in zip(self._bases, self._slot_bytes)]
 
 
-@dataclass(frozen=True)
+@record_class
 class Shot:
     """Where a shot from y0 lands, with the exact Jacobian of the landing point by y0."""
 
@@ -125,7 +126,7 @@ class _ShotBuffers:
         self.low_at, self.high_at = self.low.ctypes.data, self.high.ctypes.data
 
 
-@dataclass
+@record_class(frozen=False)
 class CompiledModel:
     """One model's generated functions, for any parameter values."""
 

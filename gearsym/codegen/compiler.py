@@ -42,10 +42,10 @@ import subprocess
 import tempfile
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+from ..records import record_class
 from ..errors import GearsymError, warn
 from ..files.atomic import no_room, write_error
 from ..files.cache import configured_cache
@@ -177,7 +177,7 @@ def binary_key(flags: tuple[str, ...]) -> str:
     return hashlib.sha256("\n".join(parts).encode()).hexdigest()[:12]
 
 
-@dataclass(frozen=True)
+@record_class
 class Library:
     path: Path
     compiled: bool  # False: found in the cache

@@ -17,10 +17,11 @@ from __future__ import annotations
 import hashlib
 import json
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 
 from ..errors import warn
+from ..records import record_class
 from ..files.private import NotPrivate, read_private, write_private
 
 #: bump when what a record holds changes
@@ -51,7 +52,7 @@ def trusted(path: Path, describes: Mapping[str, object] | None = None) -> bytes 
     return verdict.data
 
 
-@dataclass(frozen=True)
+@record_class
 class Verdict:
     """What :func:`check` found: the bytes if they are what gearsym recorded (else None, and why not: None if
     there is no file, or it has no record), and what the record says the file is."""

@@ -7,13 +7,15 @@ state and by the parameters. Here that is one C call for all windows:
 * ``fit_step`` (SX): one RK4 step (:func:`~gearsym.codegen.rk4.rk4_step`, the one RK4) of the
   state y and of its tangent Q = [dy/dy0 | dy/dp], as RK4 of the augmented system z = (y, p),
   z' = (f(tau, y, p), 0): the tangent is the exact derivative of the discrete flow;
-* ``fit_state_step``: the same step without the tangent;
+* ``fit_plain_step``: the same step without the tangent;
 * ``fit_output``: the observation channels h(tau, y, p) (a state, a derivative dv/dtau = f_v, a
   combination) and dh/d(y0, p) = dh/dy Q + [0 | dh/dp];
-* the same step by columns (:func:`column_functions`): ``fit_stages`` (the state's step, its stage states
-  and Jacobians), ``fit_column`` (a start state's column), ``fit_param_<j>`` (parameter j's), ``fit_channels``;
-  and for many columns at once ``fit_forcing`` (df/dp of every parameter at the four stages, its common
-  subexpressions computed once) with ``fit_column_forced`` (a column from its forcing);
+* the same step by columns (:func:`column_functions`), on what depends on time and the parameters alone computed
+  once per time point: ``fit_times`` (those values W, a shaft-order library's tooth windows and harmonics, and their
+  derivatives D by the parameters), ``fit_stages`` (the state's step, its stage states and Jacobians),
+  ``fit_state_step`` (the step alone), ``fit_column`` (a start state's column), ``fit_param_<j>`` (parameter j's),
+  ``fit_channels``; and for many columns at once ``fit_forcing`` (df/dp of every parameter at the four stages, its
+  common subexpressions computed once) with ``fit_column_forced`` (a column from its forcing);
 * ``gearsym_fit_windows`` (hand-written C around the column functions): every window from its start
   state, its samples ``substeps`` RK4 steps apart, the outputs and the derivatives by the start state and
   the parameters asked for written into the caller's arrays.
@@ -21,12 +23,19 @@ state and by the parameters. Here that is one C call for all windows:
 Every parameter has its column function, and a fit asks for the columns it estimates, so the library of
 candidate effects (all parameters at 0 but the tried ones) is compiled once for all candidates, and a fit
 of three parameters in a library of forty pays for three (the whole tangent step is what the in-process
-backend evaluates, mapped over the windows, and what the column functions are tested against). A call that
-asks for many columns, or for columns that share most of their work (a transmission error's or spacing errors'
-parameters each need the whole mesh force's derivative), takes them all from ``fit_forcing`` instead: the driver
-compares the operations of the two ways (each function's count, written into the C) and takes the cheaper
-(a 9/13 pair's library: its eight spacing errors 8064 operations a step one by one, 2065 all at once; the
-screen's forty columns 21600 against 2065).
+backend evaluates, mapped over the windows, and what the column functions are tested against). The time values
+are computed at two new times a step (t + h/2, and t + h, which is the next step's t: the last stage takes the
+time values of the next step's start as that step computes its time, which may differ from t + h in the last bit),
+then read by every function of the step: before, each parameter's column computed a 9/13 pair's tooth windows again
+at every step (a column 1000 operations, now 250; the 20/53 pair's library of docs/examples/explain-cracked-tooth:
+921 kB of C, now 529 kB, gcc 10.5 -> 6.3 s. A step, 40 windows of 76 samples, min of 5, the two codes back to back:
+9/13 library with three columns 4350 -> 2163 ns, every column 6307 -> 3181 ns, the state alone 2430 -> 1735 ns;
+20/53 library 3226 -> 2690, 6817 -> 4257, 2173 -> 1730 ns). A call that asks for many columns, or for columns
+that share a derivative of the state (a transmission error's or spacing errors' parameters each need the mesh
+force's derivative at the four stages), takes them all from ``fit_forcing`` instead: the driver compares the
+operations of the two ways (each function's count, written into the C) and takes the cheaper (a 9/13 pair's
+library: its eight spacing errors 2264 operations a step one by one, 1626 all at once; the screen's 31 columns 7567
+against 3719).
 The C is cached like the engine's (:mod:`.compiler`); without a compiler the same functions run in
 CasADi's virtual machine, mapped over the windows.
 """
@@ -57,7 +66,7 @@ from .translate import to_casadi
 from .trust import record, trusted
 
 #: bump when the generated window code changes for the same system and channels
-WINDOWS_VERSION = 3
+WINDOWS_VERSION = 4
 _OPTS = {"cse": True}
 #: RK4 steps in a call below which its windows run in one thread
 MIN_SHARED_STEPS = 20_000
@@ -103,7 +112,8 @@ def _harmonics_of_time(exprs: Sequence[sp.Expr], time: sp.Symbol, t: ca.SX) -> t
 
 
 def window_functions(system: FirstOrderSystem, channels: Sequence[sp.Expr]) -> dict[str, ca.Function]:
-    """``fit_step``, ``fit_state_step`` and ``fit_output`` of ``system`` (see the module docstring)."""
+    """``fit_step``, ``fit_plain_step`` and ``fit_output`` of ``system`` (the in-process backend's: see the module
+    docstring), then the compiled driver's functions (:func:`column_functions`)."""
     sym = SystemSymbols.of(system)
     n, m = system.dimension, sym.p.numel()
     exprs, waves = _harmonics_of_time(list(system.rhs) + list(channels), system.time, sym.t)
@@ -126,35 +136,57 @@ def window_functions(system: FirstOrderSystem, channels: Sequence[sp.Expr]) -> d
     z1, Qz1 = rk4_step(f_aug, J_aug, z, Qz, h, t, t + h / 2, t + h)
     step = ca.Function("fit_step", [y, Q, t, h, p], [z1[:n], Qz1[:n, :]], _OPTS)
     y1, _ = rk4_step(lambda x, time: rhs(time, x, p)[0], None, y, None, h, t, t + h / 2, t + h)
-    state_step = ca.Function("fit_state_step", [y, t, h, p], [y1], _OPTS)
+    plain_step = ca.Function("fit_plain_step", [y, t, h, p], [y1], _OPTS)
     out = ca.vertcat(*to_casadi(list(channels), mapping, f"{system.name}: observation channels"))
     dout = ca.mtimes(ca.jacobian(out, y), Q) + ca.horzcat(ca.SX(out.numel(), n), ca.jacobian(out, p))
     output = ca.Function("fit_output", [y, Q, t, p], [out, ca.densify(dout)], _OPTS)
-    return {"fit_step": step, "fit_state_step": state_step, "fit_output": output,
-            **column_functions(system, rhs, out, sym)}
+    return {"fit_step": step, "fit_plain_step": plain_step, "fit_output": output,
+            **column_functions(system, f, out, sym)}
 
 
-def column_functions(system: FirstOrderSystem, rhs: ca.Function, out: ca.SX, sym: SystemSymbols
-                     ) -> dict[str, ca.Function]:
-    """The same tangent step by columns, so that a fit pays only for the columns it estimates: ``fit_stages`` (the
-    state's step, its RK4 stage states and each stage's Jacobian dy), ``fit_column`` (a start state's column:
-    Q' = J Q at those stages), ``fit_param_<j>`` (parameter j's column, with df/dp_j at the stages: the augmented
-    system's RK4, as ``fit_step`` computes it), and ``fit_channels`` (the channels, dh/dy and dh/dp)."""
+def column_functions(system: FirstOrderSystem, f: ca.SX, out: ca.SX, sym: SystemSymbols) -> dict[str, ca.Function]:
+    """The same tangent step by columns, so that a fit pays only for the columns it asks for (see the module docstring).
+
+    What depends on time and the parameters alone (a library's tooth windows, shaft- and mesh-order harmonics: most
+    of a shaft-order library's operations, sines and tanh) is computed once per time point by ``fit_times`` (those
+    values W and their derivatives by the parameters D) and passed to the step's functions, which work on the rest:
+    ``fit_stages`` (the state's step, its RK4 stage states and each stage's Jacobian dy), ``fit_state_step`` (the
+    step alone), ``fit_column`` (a start state's column: Q' = J Q at those stages), ``fit_param_<j>`` (parameter j's
+    column, its forcing df/dp_j = dF/dp_j + dF/dW D_j at the stages: the augmented system's RK4, as ``fit_step``
+    computes it), ``fit_forcing`` (every parameter's forcing at the four stages at once) with
+    ``fit_column_forced`` (a column from its forcing), and ``fit_channels`` (the channels, dh/dy and dh/dp). The
+    stages' times are t, t + h/2, t + h: W and D come as three columns (blocks), one per time."""
     n, m = system.dimension, sym.p.numel()
     y, t, p, h = sym.y, sym.t, sym.p, ca.SX.sym("h")
-    f = lambda x, time: rhs(time, x, p)[0]  # noqa: E731
-    k1 = f(y, t)
+    rest, symbols, parametric = ca.extract_parametric(f, ca.vertcat(t, p), {})
+    w = ca.vertcat(*symbols) if symbols else ca.SX(0, 1)
+    values = ca.vertcat(*parametric) if parametric else ca.SX(0, 1)
+    nw = w.numel()
+    d_values = ca.jacobian(values, p)  # (sparse: each value depends on a few parameters)
+    times_fn = ca.Function("fit_times", [t, p], [ca.densify(values), d_values], _OPTS)
+    value_fn = ca.Function("fit_time_values", [t, p], [ca.densify(values)], _OPTS)
+    dense = ca.Function("F", [y, p, w], [rest, ca.jacobian(rest, y), ca.jacobian(rest, p), ca.jacobian(rest, w)])
+    W = ca.SX.sym("W", nw, 3)
+    D = ca.SX.sym("D", ca.horzcat(*[d_values.sparsity()] * 3))
+    Ds = [D[:, i * m:(i + 1) * m] for i in range(3)]
+    at = (0, 1, 1, 2)  # each RK4 stage's time: t, t + h/2, t + h/2, t + h
+
+    def rhs(x, i):
+        return dense(x, p, W[:, at[i]])[0]
+
+    k1 = rhs(y, 0)
     y2 = y + h / 2 * k1
-    k2 = f(y2, t + h / 2)
+    k2 = rhs(y2, 1)
     y3 = y + h / 2 * k2
-    k3 = f(y3, t + h / 2)
+    k3 = rhs(y3, 2)
     y4 = y + h * k3
-    k4 = f(y4, t + h)
+    k4 = rhs(y4, 3)
     y_next = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-    times = (t, t + h / 2, t + h / 2, t + h)
-    jac = [rhs(time, x, p)[1] for x, time in zip((y, y2, y3, y4), times)]
-    stages = ca.Function("fit_stages", [y, t, h, p], [ca.densify(y_next), ca.densify(ca.horzcat(y, y2, y3, y4)),
+    jac = [dense(x, p, W[:, at[i]])[1] for i, x in enumerate((y, y2, y3, y4))]
+    stages = ca.Function("fit_stages", [y, W, h, p], [ca.densify(y_next), ca.densify(ca.horzcat(y, y2, y3, y4)),
                                                       ca.densify(ca.horzcat(*jac))], _OPTS)  # (dense: C arrays)
+    y_alone, _ = rk4_step(lambda x, values: dense(x, p, values)[0], None, y, None, h, W[:, 0], W[:, 1], W[:, 2])
+    state_step = ca.Function("fit_state_step", [y, W, h, p], [ca.densify(y_alone)], _OPTS)  # (the one RK4)
     Y, J, q = ca.SX.sym("Y", n, 4), ca.SX.sym("J", n, 4 * n), ca.SX.sym("q", n)
 
     def column(forcing):
@@ -165,18 +197,20 @@ def column_functions(system: FirstOrderSystem, rhs: ca.Function, out: ca.SX, sym
         K4 = ca.mtimes(Js[3], q + h * K3) + forcing[3]
         return q + h / 6 * (K1 + 2 * K2 + 2 * K3 + K4)
 
+    def dfdp(i):  # df/dp at stage i: directly and through the time values
+        _, _, by_p, by_w = dense(Y[:, i], p, W[:, at[i]])
+        return by_p + ca.mtimes(by_w, Ds[at[i]])
+
     zero = [ca.SX(n, 1)] * 4
-    out_fns = {"fit_stages": stages,
+    out_fns = {"fit_times": times_fn, "fit_time_values": value_fn, "fit_stages": stages,
+               "fit_state_step": state_step,
                "fit_column": ca.Function("fit_column", [q, J, h], [ca.densify(column(zero))], _OPTS)}
-    fp = ca.jacobian(f(y, t), p)
-    dfdp = ca.Function("dfdp", [y, t, p], [fp])
+    forcings = [dfdp(i) for i in range(4)]
     for j in range(m):
-        forcing = [dfdp(Y[:, i], time, p)[:, j] for i, time in enumerate(times)]
-        out_fns[f"fit_param_{j}"] = ca.Function(f"fit_param_{j}", [q, J, Y, t, h, p], [ca.densify(column(forcing))],
-                                                _OPTS)
+        out_fns[f"fit_param_{j}"] = ca.Function(f"fit_param_{j}", [q, J, Y, W, D, h, p],
+                                                [ca.densify(column([fi[:, j] for fi in forcings]))], _OPTS)
     # every parameter's forcing at the four stages at once, (n, 4 m): stage i's df/dp in columns i m ... i m + m - 1
-    out_fns["fit_forcing"] = ca.Function("fit_forcing", [Y, t, h, p], [ca.densify(ca.horzcat(
-        *(dfdp(Y[:, i], time, p) for i, time in enumerate(times))))], _OPTS)
+    out_fns["fit_forcing"] = ca.Function("fit_forcing", [Y, W, D, h, p], [ca.densify(ca.horzcat(*forcings))], _OPTS)
     F = ca.SX.sym("F", n, 4)
     out_fns["fit_column_forced"] = ca.Function("fit_column_forced", [q, J, F, h],
                                                [ca.densify(column([F[:, i] for i in range(4)]))], _OPTS)
@@ -228,7 +262,9 @@ class Windows:
         works = ", ".join(f"fit_param_{j}_work" for j in range(self.parameters)) or "0"
         functions = self.functions
         costs = ", ".join(str(functions[f"fit_param_{j}"].n_instructions()) for j in range(self.parameters)) or "0"
+        times = functions["fit_times"]
         return gen.dump() + _DRIVER.format(n=self.n, p=self.parameters, c=len(self.channels), table=table,
+                                           nw=times.nnz_out(0), nd=times.nnz_out(1),
                                            works=works, p1=max(1, self.parameters), costs=costs,
                                            forcing=functions["fit_forcing"].n_instructions(),
                                            forced=functions["fit_column_forced"].n_instructions())
@@ -295,7 +331,7 @@ class Windows:
             y = starts[:, group]
             Q = np.tile(eye, (1, K))
             h = dt[group] / sub
-            step = f["fit_step"].map(K) if tangent else f["fit_state_step"].map(K)
+            step = f["fit_step"].map(K) if tangent else f["fit_plain_step"].map(K)
             output = f["fit_output"].map(K)
             for s in range(int(samples[group].max())):
                 if s:
@@ -345,7 +381,7 @@ def windows_hash(system: FirstOrderSystem, channels: Sequence[sp.Expr]) -> str:
 
 
 #: the whole tangent step and output of the in-process backend (the compiled driver goes column by column)
-_IN_PROCESS_ONLY = ("fit_step", "fit_output")
+_IN_PROCESS_ONLY = ("fit_step", "fit_plain_step", "fit_output")
 
 def compile_windows(system: FirstOrderSystem, channels: Sequence[sp.Expr], backend: str = "auto") -> Windows:
     """The window integrator of ``system`` observed through ``channels``: built once per process (found again by
@@ -364,6 +400,9 @@ _DRIVER = r"""
 #define GS_N {n}
 #define GS_P {p}
 #define GS_C {c}
+/* the time values W (and the nonzeros of their derivatives D by the parameters) at one time */
+#define GS_NW {nw}
+#define GS_ND {nd}
 
 typedef int (*gs_fn)(const casadi_real**, casadi_real**, casadi_int*, casadi_real*, int);
 typedef int (*gs_work_fn)(casadi_int*, casadi_int*, casadi_int*, casadi_int*);
@@ -383,12 +422,21 @@ static void gs_grow(gs_work_fn f, casadi_int* sz) {{
   sz[0] = gs_max(sz[0], a); sz[1] = gs_max(sz[1], r); sz[2] = gs_max(sz[2], i); sz[3] = gs_max(sz[3], w);
 }}
 
+/* the time values at one time (their derivatives too, with_d) */
+static int gs_times(casadi_real at, const casadi_real* pk, int with_d, casadi_real* W, casadi_real* D,
+                    const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* work) {{
+  arg[0] = &at; arg[1] = pk; res[0] = W; res[1] = D;
+  return with_d ? fit_times(arg, res, iw, work, 0) : fit_time_values(arg, res, iw, work, 0);
+}}
+
 CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int* samples,
     const casadi_int* substeps, const casadi_real* t0, const casadi_real* dt, const casadi_real* start,
     const casadi_real* p, casadi_int tangent, casadi_int ncols, const casadi_int* cols, casadi_real* states,
     casadi_real* outputs, casadi_real* derivatives) {{
   casadi_int sz[4] = {{0, 0, 0, 0}}, i, k, s, j, l, col = 0, width = GS_N + ncols, all = 0, one_by_one = 0;
-  casadi_real y[GS_N], y1[GS_N], Y[4 * GS_N], J[4 * GS_N * GS_N], q1[GS_N], Fj[4 * GS_N], t, h;
+  int with_d;
+  casadi_real y[GS_N], y1[GS_N], Y[4 * GS_N], J[4 * GS_N * GS_N], q1[GS_N], Fj[4 * GS_N], t, h, at;
+  casadi_real W[3 * GS_NW > 0 ? 3 * GS_NW : 1], D[3 * GS_ND > 0 ? 3 * GS_ND : 1];
   casadi_real* F = 0;
   casadi_real out[GS_C > 0 ? GS_C : 1], Hy[GS_C * GS_N > 0 ? GS_C * GS_N : 1], Hp[GS_C * GS_P > 0 ? GS_C * GS_P : 1];
   casadi_real* Q = 0;
@@ -397,7 +445,8 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
   casadi_int* iw;
   casadi_real* work;
   gs_grow(fit_state_step_work, sz); gs_grow(fit_stages_work, sz); gs_grow(fit_column_work, sz);
-  gs_grow(fit_channels_work, sz);
+  gs_grow(fit_channels_work, sz); gs_grow(fit_times_work, sz); gs_grow(fit_time_values_work, sz);
+  with_d = tangent && ncols > 0;
   for (j = 0; j < ncols; ++j) {{
     if (cols[j] < 0 || cols[j] >= GS_P) return 1;
     one_by_one += gs_param_cost[cols[j]];
@@ -427,11 +476,19 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
       if (s > 0) {{
         for (l = 0; l < substeps[k]; ++l) {{
           t = t0[k] + dt[k] * (casadi_real)(s - 1) + h * (casadi_real)l;
+          /* the time values at the stages' times, once each for every function of the step: at t (the step before
+             computed them, but for a window's first step), t + h/2 and t + h, which is the next step's t as it
+             computes it (the last bit may differ from t + h) */
+          if (s == 1 && l == 0 && gs_times(t, pk, with_d, W, D, arg, res, iw, work)) goto fail;
+          if (gs_times(t + h / 2, pk, with_d, W + GS_NW, D + GS_ND, arg, res, iw, work)) goto fail;
+          at = l + 1 < substeps[k] ? t0[k] + dt[k] * (casadi_real)(s - 1) + h * (casadi_real)(l + 1)
+                                   : t0[k] + dt[k] * (casadi_real)s;
+          if (gs_times(at, pk, with_d, W + 2 * GS_NW, D + 2 * GS_ND, arg, res, iw, work)) goto fail;
           if (tangent) {{
-            arg[0] = y; arg[1] = &t; arg[2] = &h; arg[3] = pk; res[0] = y1; res[1] = Y; res[2] = J;
+            arg[0] = y; arg[1] = W; arg[2] = &h; arg[3] = pk; res[0] = y1; res[1] = Y; res[2] = J;
             if (fit_stages(arg, res, iw, work, 0)) goto fail;
             if (all) {{
-              arg[0] = Y; arg[1] = &t; arg[2] = &h; arg[3] = pk; res[0] = F;
+              arg[0] = Y; arg[1] = W; arg[2] = D; arg[3] = &h; arg[4] = pk; res[0] = F;
               if (fit_forcing(arg, res, iw, work, 0)) goto fail;
             }}
             for (j = 0; j < width; ++j) {{
@@ -446,16 +503,18 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
                 arg[0] = qj; arg[1] = J; arg[2] = Fj; arg[3] = &h; res[0] = q1;
                 if (fit_column_forced(arg, res, iw, work, 0)) goto fail;
               }} else {{
-                arg[0] = qj; arg[1] = J; arg[2] = Y; arg[3] = &t; arg[4] = &h; arg[5] = pk; res[0] = q1;
+                arg[0] = qj; arg[1] = J; arg[2] = Y; arg[3] = W; arg[4] = D; arg[5] = &h; arg[6] = pk; res[0] = q1;
                 if (gs_param[cols[j - GS_N]](arg, res, iw, work, 0)) goto fail;
               }}
               memcpy(qj, q1, sizeof(q1));
             }}
           }} else {{
-            arg[0] = y; arg[1] = &t; arg[2] = &h; arg[3] = pk; res[0] = y1;
+            arg[0] = y; arg[1] = W; arg[2] = &h; arg[3] = pk; res[0] = y1;
             if (fit_state_step(arg, res, iw, work, 0)) goto fail;
           }}
           memcpy(y, y1, sizeof(y));
+          memcpy(W, W + 2 * GS_NW, sizeof(casadi_real) * GS_NW);  /* (the next step's t) */
+          memcpy(D, D + 2 * GS_ND, sizeof(casadi_real) * GS_ND);
         }}
       }}
       t = t0[k] + dt[k] * (casadi_real)s;

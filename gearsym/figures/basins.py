@@ -24,6 +24,8 @@ from ..physical.text import SYMBOLS
 from ..sweep.basin_continuation import BasinContinuation
 from .save import pyplot, save_figure
 
+#: the resolution the basins' figures are written at
+BASINS_DPI = 120
 #: colours of the attractors by number (or id), then of the two other classes
 COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#bcbd22", "#17becf",
           "#7f7f7f")
@@ -134,7 +136,7 @@ def plot_basin_map(shown: ShownBasinMap | BasinMap, path: str | Path | None = No
                                     "basin's ± is the binomial standard error of the fraction.", 150),
                       fontsize=7, color="0.35")
     if path is not None:
-        save_figure(fig, path, dpi=120)
+        save_figure(fig, path, dpi=BASINS_DPI)
     return fig
 
 
@@ -205,5 +207,5 @@ def plot_basin_fractions(shown: ShownFractions | BasinContinuation, path: str | 
              + ("crossings located" if record.get("locate_crossings") else "plain RK4"))
     fig.suptitle(textwrap.fill(title, 150), fontsize=8)
     if path is not None:
-        save_figure(fig, path, dpi=120)
+        save_figure(fig, path, dpi=BASINS_DPI)
     return fig

@@ -37,6 +37,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -116,8 +117,10 @@ class Solution:
     switched_to: int | None = None  # the index of the branch of twice the period started here
     curvature: np.ndarray | None = None  # d tangent / ds, from the step that reached this point
 
-    @property
+    @cached_property
     def u(self) -> np.ndarray:
+        """The point as the tracer's vector: the segments' states, then the parameter (made once: a step, its
+        events and their location read it many times; nobody writes into it)."""
         return np.append(self.ev.z.reshape(-1), self.ev.value)
 
     @property
@@ -168,6 +171,17 @@ class Tracer:
     def norm(self, v: np.ndarray) -> float:
         return float(np.sqrt(np.dot(self.weights * v, v)))
 
+    @staticmethod
+    def bordered(ev: Evaluation, last_row: np.ndarray) -> np.ndarray:
+        """The shooting Jacobian with the derivative by the parameter as its last column and ``last_row`` below
+        (the corrector's and the tangent's matrix), filled in place."""
+        size = len(last_row)
+        A = np.empty((size, size))
+        A[:-1, :-1] = ev.jacobian()
+        A[:-1, -1] = ev.d_parameter.reshape(-1)
+        A[-1] = last_row
+        return A
+
     def split(self, u: np.ndarray) -> tuple[np.ndarray, float]:
         return u[:-1].reshape(self.problem.shooting.count, self.problem.n), float(u[-1])
 
@@ -193,7 +207,7 @@ class Tracer:
                 return None
             if ev.error() <= TOLERANCE:
                 return Solution(ev, iteration, contraction=sizes[1] / sizes[0] if len(sizes) > 1 and sizes[0] else 0.0)
-            A = np.vstack([np.hstack([ev.jacobian(), ev.d_parameter.reshape(-1, 1)]), a[None, :]])
+            A = self.bordered(ev, a)
             try:
                 du = np.linalg.solve(A, -np.append(ev.residual, np.dot(a, u) - b))
             except np.linalg.LinAlgError:
@@ -207,8 +221,7 @@ class Tracer:
     def tangent(self, s: Solution, previous: np.ndarray) -> np.ndarray:
         """The unit tangent at ``s``, oriented along ``previous``."""
         ev = s.ev
-        A = np.vstack([np.hstack([ev.jacobian(), ev.d_parameter.reshape(-1)[:, None]]),
-                       (self.weights * previous)[None, :]])
+        A = self.bordered(ev, self.weights * previous)
         rhs = np.zeros(len(previous))
         rhs[-1] = 1.0
         try:

@@ -86,16 +86,19 @@ class Evaluation:
     high: np.ndarray
     d_parameter: np.ndarray | None = None  # (K, n): d phi_k / d parameter, when asked for
     _monodromy: np.ndarray | None = field(default=None, repr=False)
+    _residual: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def residual(self) -> np.ndarray:
-        """phi_k(z_k) - z_(k+1), flattened."""
-        r = self.landing - self.z[0]
-        r[:-1] = self.landing[:-1] - self.z[1:]
-        return r.reshape(-1)
+        """phi_k(z_k) - z_(k+1), flattened (made once: Newton and its tests read it several times)."""
+        if self._residual is None:
+            r = self.landing - self.z[0]
+            r[:-1] = self.landing[:-1] - self.z[1:]
+            self._residual = r.reshape(-1)
+        return self._residual
 
     def error(self) -> float:
-        return float(np.max(np.abs(self.residual)) / (1.0 + np.max(np.abs(self.z))))
+        return float(np.abs(self.residual).max() / (1.0 + np.abs(self.z).max()))
 
     def jacobian(self) -> np.ndarray:
         """d residual / d z: M_k on the diagonal blocks, -I on the next block (cyclically)."""

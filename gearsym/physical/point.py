@@ -15,10 +15,11 @@ from __future__ import annotations
 import math
 import textwrap
 from collections.abc import Callable, Mapping
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, field, replace
 
 import numpy as np
 
+from ..records import record_class
 from ..analysis.lyapunov import LyapunovSpectrum
 from ..analysis.poincare import phase_trajectory
 from ..codegen.on_arrays import evaluate_on_samples, evaluate_program, stored_program
@@ -36,7 +37,7 @@ SPEED_DIGITS = 12
 FORCE_PERIODS = 20
 
 
-@dataclass(frozen=True)
+@record_class
 class Unit:
     """A unit by its name for pint (``um``) and its short symbol (``µm``, what ``f"{quantity.units:~P}"`` prints)."""
 
@@ -50,7 +51,7 @@ class Unit:
         return self.text
 
 
-@dataclass(frozen=True)
+@record_class
 class Measured:
     """A number (or array) with its unit, shown as a pint Quantity is (:func:`~gearsym.units.shown`)."""
 
@@ -59,7 +60,7 @@ class Measured:
     dimensionless = False
 
 
-@dataclass(frozen=True)
+@record_class
 class PhysicalPoint:
     """One operating point of a spectrum run, in physical units (pint Quantities or :class:`Measured`)."""
 
@@ -151,7 +152,7 @@ def whole_period_mean(time, values, period: float) -> float:
     return float(np.trapezoid(values[keep], time[keep]) / (time[keep][-1] - time[0]))
 
 
-@dataclass(frozen=True)
+@record_class
 class MeshUnits:
     """A mesh's law in SI: force = stiffness k(tau) g(x, eta) + damping dx/dt, where k(tau) is the mesh's
     stiffness variation (declared, or the formula that replaced it) at the engine's time tau."""
@@ -185,7 +186,7 @@ class MeshUnits:
         return self.stiffness * k * contact(x, self.eta) + self.damping * v
 
 
-@dataclass(frozen=True)
+@record_class
 class ShaftUnits:
     """A shaft's law in SI: torque = stiffness twist + damping d(twist)/dt; a bearing's (``kind`` "bearing"): its
     force = stiffness deflection + damping d(deflection)/dt (N/m and N s/m, a deflection in m)."""
@@ -212,7 +213,7 @@ LENGTH, VELOCITY, ANGLE, ANGULAR_VELOCITY = "length", "velocity", "angle", "angu
 RATES = (VELOCITY, ANGULAR_VELOCITY)
 
 
-@dataclass(frozen=True)
+@record_class
 class PointUnits:
     """The numbers that carry a run of one scaling to physical units (see the module's docstring);
     factors are pint's own (``rad_s_to_hz``: 1 rad/s in Hz), applied as pint applies them.

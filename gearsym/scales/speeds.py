@@ -9,9 +9,9 @@ from __future__ import annotations
 import math
 from fractions import Fraction
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from ..records import record_class
 from ..errors import GearsymError, ModelError
 
 if TYPE_CHECKING:  # (types only: the start-up path reads Speed without SymPy)
@@ -22,7 +22,7 @@ if TYPE_CHECKING:  # (types only: the start-up path reads Speed without SymPy)
 RATIO_TOLERANCE = 1e-3
 
 
-@dataclass(frozen=True)
+@record_class
 class Speed:
     """The declared operating speed: the body it drives and the parameter that names it."""
 

@@ -4,8 +4,9 @@ needs neither the reduction nor the code generator."""
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 
+from ..records import record_class
 from ..codegen.compiled import CompiledModel
 
 #: the suffix of the parameters that carry the static state into the linearised system
@@ -17,7 +18,7 @@ def anchor_parameter(state: str) -> str:
     return f"{state}{STATIC_SUFFIX}"
 
 
-@dataclass(frozen=True)
+@record_class
 class StaticRecipe:
     """The static state of a model as a problem in numbers: ``unknowns`` (the states not at rest) solve
     residual(unknowns, parameters) = 0, the other states being 0 (rates at rest). The residual depends only on
@@ -42,7 +43,7 @@ class StaticRecipe:
                    tuple(map(str, d["meshes"])), str(d["function"]))
 
 
-@dataclass(frozen=True)
+@record_class
 class CompiledLinearisation:
     """A model's linearisation about its static state, compiled: the linear system's compiled model, the static
     recipe, the states its Jacobian depends on, and the model's own name and parameters (a chart's axes)."""
