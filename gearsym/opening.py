@@ -97,8 +97,8 @@ class OpenModel:
     @cached_property
     def summary(self):
         """What a run checks its request against (names, parameters, cycles): the cache's summary of the system
-        when it has one (:class:`~gearsym.codegen.system_summary.SystemSummary`, which loads the full system only if asked for its
-        symbolic part), else :attr:`system`."""
+        when it has one (:class:`~gearsym.codegen.system_summary.SystemSummary`, which loads the full system only
+        if asked for its symbolic part), else :attr:`system`."""
         summary = self.slot.summary(lambda: self.system)
         return self.system if summary is None else summary
 

@@ -209,7 +209,10 @@ class FirstOrderSystem(ParameterChecks, Model):
         for c in self.couplings:
             if c.kind != "mesh" or c.backlash == 0 or c.coordinate not in self.observed:
                 continue
-            offset = sp.simplify(c.contact - sp.Symbol(c.coordinate, real=True))
+            offset = c.contact - sp.Symbol(c.coordinate, real=True)
+            if _moves(offset, params):  # (seen in two numbers: simplify, seconds on a runout's terms, not needed)
+                continue
+            offset = sp.simplify(offset)
             if {s.name for s in offset.free_symbols} - params:
                 continue  # shifted by time or states: no extreme of the coordinate says where it is
             out.append((c.name, c.coordinate, _plain(c.backlash), _plain(offset)))
@@ -217,8 +220,8 @@ class FirstOrderSystem(ParameterChecks, Model):
 
     @property
     def full(self) -> "FirstOrderSystem":
-        """The system itself (the start-up cache's summary of one, :class:`~gearsym.codegen.system_summary.SystemSummary`, loads
-        the full system here)."""
+        """The system itself (the start-up cache's summary of one,
+        :class:`~gearsym.codegen.system_summary.SystemSummary`, loads the full system here)."""
         return self
 
     @property
@@ -255,6 +258,23 @@ class FirstOrderSystem(ParameterChecks, Model):
     def jacobian(self) -> sp.Matrix:
         """Exact Jacobian d rhs / d y."""
         return sp.Matrix(self.rhs).jacobian(sp.Matrix(self.states))
+
+
+def _moves(expr: sp.Expr, fixed: set[str]) -> bool:
+    """Whether ``expr`` is seen to change with a symbol whose name is not in ``fixed`` (time, a state): its values
+    at two points that differ in those symbols alone differ by far more than rounding. False when that is not
+    seen (no such symbol, values that are not finite numbers, equal values): then only simplifying can tell."""
+    symbols = sorted(expr.free_symbols, key=lambda s: s.name)
+    if all(s.name in fixed for s in symbols):
+        return False
+    here = {s: sp.Float(0.31 + 0.17 * i) for i, s in enumerate(symbols)}
+    there = {s: v if s.name in fixed else v + sp.Float(0.73) for s, v in here.items()}
+    try:
+        a, b = (complex(expr.xreplace(point).evalf()) for point in (here, there))
+    except (TypeError, ValueError, ZeroDivisionError):
+        return False
+    finite = all(math.isfinite(z.real) and math.isfinite(z.imag) for z in (a, b))
+    return finite and abs(a - b) > 1e-6 * max(1.0, abs(a), abs(b))
 
 
 def _plain(expr: sp.Expr) -> float | str | sp.Expr:

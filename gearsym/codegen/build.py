@@ -96,7 +96,7 @@ def _compiled_functions(system: FirstOrderSystem, loops: LoopOptions, digest: st
         timings["build"] = time.perf_counter() - t
         t = time.perf_counter()
         with writing(code_dir, CACHE_ADVICE):  # (the cache's disk full: said as such)
-            keep_generated(write_code(mf, code_dir, digest))
+            keep_generated(write_code(mf, code_dir, digest), system)
         timings["generate"] = time.perf_counter() - t
     lib = compile_library(source, system.name, announce=_to_stderr if verbose else None,
                           describes=library_describes(system, digest))
@@ -105,11 +105,13 @@ def _compiled_functions(system: FirstOrderSystem, loops: LoopOptions, digest: st
     return library_functions(lib.path), lib.path
 
 
-def keep_generated(code) -> None:
-    """Generated C just written into the cache (a :class:`~.generate.GeneratedCode`): made private and recorded."""
+def keep_generated(code, system) -> None:
+    """Generated C of ``system`` just written into the cache (a :class:`~.generate.GeneratedCode`): made private and
+    recorded, the model's C as the C of its library (its states and parameters too: a library damaged since is
+    compiled again from it without the model, :func:`~.library.library_from_code`)."""
     for path in (code.manifest, code.source, code.lanes):
         os.chmod(path, 0o600)  # (the files were made with the umask's mode)
-    record(code.source, code.source.read_bytes(), source_describes(code.source.stem, code.hash))
+    record(code.source, code.source.read_bytes(), library_describes(system, code.hash))
     record(code.lanes, code.lanes.read_bytes(), lanes_describes(code.source.stem, code.hash))
 
 

@@ -22,7 +22,7 @@ from ..records import record_class
 from ..files.sealed import distrust, read_sealed, write_sealed
 from ..options import Integration
 from .compiler import binary_key, cache_dir, compile_flags
-from .library import library_describes, library_model, resolve_backend
+from .library import library_describes, library_from_code, library_model, resolve_backend
 from .loops import LoopOptions
 from .mode_rates import chosen_by_compiled
 from .step_choice import choices_from, chosen
@@ -122,17 +122,19 @@ def found_build(name: str, key: str, summary, options: Integration):
 
 def kept_model(summary, build_file: Path, options: Integration):
     """The compiled model of a system's ``summary`` and the build summary in ``build_file``, or None: either
-    missing or unreadable, a library not of our own cache or not as compiled (compile_model says so and makes it
-    again), or a build that does not describe the library it points at (edited: said here)."""
+    missing or unreadable, a library not of our own cache, or a build that does not describe the library it points
+    at (edited: said here). A library gone or not as compiled (damaged, a symlink: said by the compiler) is
+    compiled again from the C that vouches for the same code, states and parameters
+    (:func:`~.library.library_from_code`), without the model; None when there is no such C."""
     build = read_build(build_file)
     if summary is None or build is None or not build.in_own_cache or summary.cycles < 1:
         return None
     if not build.timed_parameters <= set(summary.parameters):
         why = "it names parameters its model does not have"
     else:
-        verdict = check(build.library)  # (a library not as compiled is said and made again by compile_model)
-        if verdict.data is None:
-            return None
+        verdict = check(build.library)
+        if verdict.data is None:  # (gone or not as compiled: made again from its C, the compiler says why)
+            return _compiled_again(summary, build, build_file, options)
         why = differences(verdict.describes, library_describes(summary, build.hash))
         if why is None:  # (the summaries describe the library they point at)
             return library_model(summary, build.hash, build.library, options, build.timed_parameters,
@@ -140,6 +142,18 @@ def kept_model(summary, build_file: Path, options: Integration):
         why = f"{build.library.name}, the library it points at, does not match it: {why}"
     distrust(build_file, why, WHAT)  # (edited: said once, and the summaries are written again)
     return None
+
+
+def _compiled_again(summary, build: BuildSummary, build_file: Path, options: Integration):
+    """The compiled model of ``build`` with its library compiled again from its C (the build summary written again
+    if the library's name changed), or None: no C that vouches for it (the model is loaded, its C generated)."""
+    library = library_from_code(summary, build.hash)
+    if library is None:
+        return None
+    if library != build.library:
+        write_json(build_file, BuildSummary(build.hash, library, build.timed_parameters, build.table_texts).as_dict())
+    return library_model(summary, build.hash, library, options, build.timed_parameters, build.table_texts,
+                         summary.fastest)
 
 
 def keep_model(name: str, key: str, compiled, units=None) -> None:

@@ -14,10 +14,12 @@ from typing import TYPE_CHECKING
 
 from ..options import Integration
 from .compiled import CompiledModel
-from .compiler import FALLBACK_NOTE, compilers_looked_for, find_compiler
+from .code_files import code_directory, is_committed, read_manifest, source_file
+from .compiler import FALLBACK_NOTE, compile_library, compilers_looked_for, find_compiler
 from .loaded import keep, loaded
 from .loops import LoopOptions
 from .native import load_native
+from .trust import check, differences
 
 if TYPE_CHECKING:
     import casadi as ca
@@ -95,3 +97,24 @@ def library_model(system, digest: str, library: Path, options: Integration, time
     functions = library_functions(library)
     return keep(key, CompiledModel(system, loops, digest, functions, "compiled", library, {},
                                    load_native(library, functions), options, timed, table_texts, fastest))
+
+
+def library_from_code(system, digest: str, announce=None) -> Path | None:
+    """The library of the code ``digest`` of ``system`` (a start-up cache's summary) compiled from its C, without
+    the model (no SymPy, no reduction): the C of the committed ``generated/<model>/``, whose manifest names this
+    code, these states and parameters, or the cache's C, whose record says it is this library's C (its bytes as
+    gearsym wrote them). None when neither vouches for it: the caller loads the model and generates the C.
+    ``announce(message)`` is told before the compiler runs (seconds)."""
+    describes = library_describes(system, digest)
+    code_dir = code_directory(system.name, digest)
+    source = code_dir / source_file(system.name)
+    if is_committed(code_dir, system.name):
+        manifest = read_manifest(code_dir) or {}
+        said = {"model": manifest.get("model"), "code": manifest.get("hash"), "states": manifest.get("states"),
+                "parameters": manifest.get("parameters")}
+    else:
+        verdict = check(source)  # (silent: a C not to trust is said once, by the compile that makes it again)
+        said = verdict.describes if verdict.data is not None else None
+    if said is None or differences(said, describes) is not None:
+        return None
+    return compile_library(source, system.name, announce=announce, describes=describes).path

@@ -97,7 +97,7 @@ def ship(compiled: CompiledModel) -> ShippedModel:
     if not is_committed(code_dir, name) and trusted(source, source_describes(name, compiled.hash)) is None:
         # (the cache was cleaned since the library was built, or its C is not what gearsym wrote: generate it)
         with writing(code_dir, CACHE_ADVICE):
-            keep_generated(write_code(build_functions(system, compiled.options), code_dir, compiled.hash))
+            keep_generated(write_code(build_functions(system, compiled.options), code_dir, compiled.hash), system)
     library = trusted(compiled.library, library_describes(system, compiled.hash))
     if library is None:
         raise GearsymError(f"{compiled.library} changed since it was loaded; run again to compile it anew")

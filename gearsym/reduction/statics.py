@@ -34,20 +34,38 @@ MEAN_SAMPLES = 1024
 MAX_STEPS = 60
 
 
+#: numbers :func:`number` gave, by expression and the values of its parameters (a scaling probed value by value,
+#: as an FMU's frame is measured, solves the statics again for each probe: most of its expressions keep their values)
+_NUMBERS: dict[tuple, float] = {}
+_NUMBERS_KEPT = 8192
+
+
 def number(expr: sp.Expr, values: Mapping[str, float], what: str) -> float:
     """``expr`` at ``values``, or a one-line error naming what has no value."""
     expr = sp.sympify(expr, strict=True)
+    names = _parameters_of(expr)
+    key = (expr, tuple(repr(values.get(n)) for n in names))  # (repr: -0.0 is not 0.0, 1 not 1.0)
+    if key in _NUMBERS:
+        return _NUMBERS[key]
     # only the parameters ``expr`` has (a planetary set's scaling evaluates thousands of small expressions, each
     # against every value of the model: a Float made for each value was most of the time)
-    value = expr.xreplace({s: sp.Float(values[s.name]) for s in expr.free_symbols
-                           if s.name in values and s == parameter_symbol(s.name)})
+    value = expr.xreplace({parameter_symbol(n): sp.Float(values[n]) for n in names if n in values})
     if not value.is_number:
         missing = ", ".join(sorted(s.name for s in value.free_symbols))
         raise GearsymError(f"{what} needs a value for {missing}")
     result = float(value)
     if not math.isfinite(result):
         raise GearsymError(f"{what} is {result} at these values")
+    if len(_NUMBERS) >= _NUMBERS_KEPT:
+        _NUMBERS.clear()
+    _NUMBERS[key] = result
     return result
+
+
+@lru_cache(maxsize=4096)
+def _parameters_of(expr: sp.Expr) -> tuple[str, ...]:
+    """The names of the parameters in ``expr`` (its symbols that are parameters' own)."""
+    return tuple(sorted(s.name for s in expr.free_symbols if s == parameter_symbol(s.name)))
 
 
 def mean_over(expr: sp.Expr, variable: sp.Symbol, period: float, values: Mapping[str, float], what: str) -> float:
