@@ -16,7 +16,7 @@ from ..files.outputs import check_figure, check_file
 from ..opening import open_model
 from ..options import Execution
 from ..physical.basins import PhysicalGrid, ShownBasinMap, ShownFractions, shown_in
-from ..physical.files import basin_fractions_text, basin_map_texts
+from ..physical.files import write_basin_fractions, write_basin_map
 from ..physical.sweeps import nondimensional_axes
 from ..sweep.basin_continuation import MATCH_DISTANCE, StartGrid, continue_basins
 from ..sweep.grid import Axis, parse_axis
@@ -108,7 +108,7 @@ def write_map(shown: ShownBasinMap, out: str | None, plot: str | None) -> None:
     table without its picture."""
     picture = figure_bytes(plot_basin_map(shown), plot, BASINS_DPI) if plot else None
     if out:
-        written = [write_atomically(path, text) for path, text in basin_map_texts(shown, out).items()]
+        written = write_basin_map(shown, out)
         print(f"gearsym: wrote {' and '.join(map(str, written))}", file=sys.stderr)
     if plot:
         write_atomically(plot, picture)
@@ -121,7 +121,7 @@ def write_fractions(shown: ShownFractions, physical: Path | None, plot: str | No
     anything is written."""
     picture = figure_bytes(plot_basin_fractions(shown), plot, BASINS_DPI) if plot else None
     if physical is not None:
-        write_atomically(physical, basin_fractions_text(shown))
+        write_basin_fractions(shown, physical)
         print(f"gearsym: wrote {physical} (the fractions in the model's units)", file=sys.stderr)
     if plot:
         write_atomically(plot, picture)

@@ -46,11 +46,6 @@ def write_basin_map(shown: ShownBasinMap | BasinMap, path: str | Path) -> tuple[
     """A basin map (as shown, or in the model's own numbers): ``path``, one row per start (the grid's two states,
     headed by their units, and the class it reached), and its record beside it (``.json``, without the labels
     the rows hold). Returns the two paths."""
-    return tuple(write_atomically(p, text) for p, text in basin_map_texts(shown, path).items())
-
-
-def basin_map_texts(shown: ShownBasinMap | BasinMap, path: str | Path) -> dict[Path, str]:
-    """What :func:`write_basin_map` writes: ``path`` -> the rows, and the record's path beside it -> the record."""
     shown, path = ShownBasinMap.of(shown), Path(path)
     result = shown.result
     (x, xs), (y, ys) = result.axes
@@ -63,19 +58,17 @@ def basin_map_texts(shown: ShownBasinMap | BasinMap, path: str | Path) -> dict[P
         for i, xv in enumerate(sx):
             label = int(result.labels[j, i])
             writer.writerow([repr(float(xv)), repr(float(yv)), CLASSES.get(label, label)])
+    write_atomically(path, text.getvalue())
     data = shown.as_dict()
     data.pop("labels", None)
-    return {path: text.getvalue(), sidecar(path, ".json"): json.dumps(data, indent=2) + "\n"}
+    record = sidecar(path, ".json")
+    write_atomically(record, json.dumps(data, indent=2) + "\n")
+    return path, record
 
 
 def write_basin_fractions(shown: ShownFractions, path: str | Path) -> Path:
     """A basin continuation's rows as shown: the parameter (the speed, for a model with physical values) and the
     amplitudes in their units."""
-    return write_atomically(Path(path), basin_fractions_text(shown))
-
-
-def basin_fractions_text(shown: ShownFractions) -> str:
-    """What :func:`write_basin_fractions` writes."""
     name, values, unit = shown.parameter()
     result = shown.result
     speed = dict(zip(result.values, values))
@@ -90,7 +83,7 @@ def basin_fractions_text(shown: ShownFractions) -> str:
                      for k in coordinates]
         writer.writerow([repr(float(speed[r.value])), r.kind, "" if r.id is None else r.id, repr(r.fraction),
                          repr(r.stderr), "" if r.period is None else r.period, r.regime, *amplitude])
-    return text.getvalue()
+    return write_atomically(Path(path), text.getvalue())
 
 
 def _cell(value) -> str:
