@@ -14,8 +14,9 @@ from gearsym.fit import augment
 @pytest.fixture(scope="module")
 def case():
     # (the transmission errors' four parameters share the mesh force's derivative: taken all at once, see below)
+    # (Coulomb friction at 0, its default: its time values divide, and are skipped, see the test of skipping)
     system = augment(conftest.system("one_stage"), ["cubic_stiffness", "torque_harmonic_3", "transmission_error_1",
-                                                    "transmission_error_2"],
+                                                    "transmission_error_2", "coulomb_friction"],
                      values={"k3": 0.01, "B_c3": 0.4, "B_s3": -0.2, "e_c1": 0.1, "e_s2": -0.05})
     x, v = system.states
     channels = [x, system.rhs[1], sp.cos(7 * system.time) * x]  # a state, the acceleration, a high harmonic
@@ -38,6 +39,33 @@ def test_compiled_and_in_process_windows_agree(case):
     for a, b in zip((compiled.states, compiled.outputs, compiled.derivatives),
                     (inprocess.states, inprocess.outputs, inprocess.derivatives)):
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.slow
+def test_time_values_only_effects_at_zero_use_are_skipped_with_the_same_results(case):
+    """A window skips the time values that only matter while a parameter it has at 0, and whose column it does not ask
+    for, is not (gearsym/codegen/time_gates.py): Coulomb friction's (which divide: kept finite, not set to 0), a
+    transmission error's terms at 0, the cubic stiffness and the torque harmonic's pair in the windows that have them
+    at 0. Outputs and derivatives, a column asked for at 0 among them, are the in-process evaluation's, which computes
+    every time value at every step."""
+    system, channels, (starts, t0, dt, samples, substeps, p) = case
+    names = list(system.parameters)
+    some = [2, 4]  # (two windows that start in contact: the mesh's parameters act from the first step)
+    p = p[:, some].copy()
+    p[names.index("k3"), 0] = 0
+    p[names.index("B_c3"), 1] = p[names.index("B_s3"), 1] = 0
+    at_rest = starts[:, some].copy()
+    at_rest[1, 0] = 0  # (friction's 1 / sqrt(eps_c^2 + v^2) at v = 0: finite with its skipped eps_c^2 kept, not 0)
+    args = (at_rest, t0[some], dt[some], np.array([12, 9]), substeps[some], p)
+    compiled, inprocess = Windows(system, channels, "compiled"), Windows(system, channels, "in-process")
+    gates = {tuple(names[j] for j in gate) for group in inprocess.functions.groups for gate in group.gates}
+    assert {("mu_c",), ("e_c2",), ("k3",), ("B_c3", "B_s3")} <= gates, gates
+    asked = [names.index(c) for c in ("zeta", "e_c2", "k3")]  # (e_c2 at 0 everywhere)
+    for tangent in (True, False):
+        a, b = (w.run(*args, tangent=tangent, columns=asked) for w in (compiled, inprocess))
+        for x, y in zip((a.states, a.outputs, a.derivatives), (b.states, b.outputs, b.derivatives)):
+            assert (x is None and y is None) or (np.all(np.isfinite(x)) and np.allclose(x, y, rtol=1e-12, atol=1e-12))
+        assert not tangent or np.abs(a.derivatives[:, system.dimension + 1]).max() > 0.01  # (e_c2's: not 0)
 
 
 def test_window_derivatives_are_those_of_the_discrete_flow(case):

@@ -35,7 +35,10 @@ that share a derivative of the state (a transmission error's or spacing errors' 
 force's derivative at the four stages), takes them all from ``fit_forcing`` instead: the driver compares the
 operations of the two ways (each function's count, written into the C) and takes the cheaper (a 9/13 pair's
 library: its eight spacing errors 2264 operations a step one by one, 1626 all at once; the screen's 31 columns 7567
-against 3719).
+against 3719). The time values are computed by groups, and a window skips the groups that only matter while a
+parameter it has at 0 (and does not ask the column of) is not (:mod:`.time_gates`): a fit or a tooth scan in a
+library of candidates pays for the time values of the effects it tries (the 20/53 library's worked example: its
+fits' and scans' window runs 15 -> 7.5 s of CPU, the same bits).
 The C is cached like the engine's (:mod:`.compiler`); without a compiler the same functions run in
 CasADi's virtual machine, mapped over the windows.
 """
@@ -61,12 +64,13 @@ from .compiler import WINDOW_FLAGS, cache_dir, compile_flags, compile_library, f
 from .loaded import load_once, open_library
 from .casadi_symbols import SystemSymbols
 from .rk4 import rk4_step
+from .time_gates import TimeGroup, time_groups
 from .generate import generator_digest
 from .translate import to_casadi
 from .trust import record, trusted
 
 #: bump when the generated window code changes for the same system and channels
-WINDOWS_VERSION = 4
+WINDOWS_VERSION = 5
 _OPTS = {"cse": True}
 #: RK4 steps in a call below which its windows run in one thread
 MIN_SHARED_STEPS = 20_000
@@ -79,6 +83,14 @@ class WindowRun:
     states: np.ndarray  # (n, samples of all windows)
     outputs: np.ndarray  # (channels, samples)
     derivatives: np.ndarray | None  # (channels, n + parameters, samples): by [start state, parameters]
+
+
+class WindowFunctions(dict):
+    """The window functions by name, and the groups of time values they compute (:mod:`.time_gates`)."""
+
+    def __init__(self, functions: dict[str, ca.Function], groups: Sequence[TimeGroup]):
+        super().__init__(functions)
+        self.groups = tuple(groups)
 
 
 def _harmonics_of_time(exprs: Sequence[sp.Expr], time: sp.Symbol, t: ca.SX) -> tuple[list[sp.Expr], dict]:
@@ -111,7 +123,7 @@ def _harmonics_of_time(exprs: Sequence[sp.Expr], time: sp.Symbol, t: ca.SX) -> t
     return out, {d: (cos if kind == "cos" else sin)[n] for (kind, n), d in found.items()}
 
 
-def window_functions(system: FirstOrderSystem, channels: Sequence[sp.Expr]) -> dict[str, ca.Function]:
+def window_functions(system: FirstOrderSystem, channels: Sequence[sp.Expr]) -> WindowFunctions:
     """``fit_step``, ``fit_plain_step`` and ``fit_output`` of ``system`` (the in-process backend's: see the module
     docstring), then the compiled driver's functions (:func:`column_functions`)."""
     sym = SystemSymbols.of(system)
@@ -140,11 +152,12 @@ def window_functions(system: FirstOrderSystem, channels: Sequence[sp.Expr]) -> d
     out = ca.vertcat(*to_casadi(list(channels), mapping, f"{system.name}: observation channels"))
     dout = ca.mtimes(ca.jacobian(out, y), Q) + ca.horzcat(ca.SX(out.numel(), n), ca.jacobian(out, p))
     output = ca.Function("fit_output", [y, Q, t, p], [out, ca.densify(dout)], _OPTS)
-    return {"fit_step": step, "fit_plain_step": plain_step, "fit_output": output,
-            **column_functions(system, f, out, sym)}
+    columns = column_functions(system, f, out, sym)
+    return WindowFunctions({"fit_step": step, "fit_plain_step": plain_step, "fit_output": output, **columns},
+                           columns.groups)
 
 
-def column_functions(system: FirstOrderSystem, f: ca.SX, out: ca.SX, sym: SystemSymbols) -> dict[str, ca.Function]:
+def column_functions(system: FirstOrderSystem, f: ca.SX, out: ca.SX, sym: SystemSymbols) -> WindowFunctions:
     """The same tangent step by columns, so that a fit pays only for the columns it asks for (see the module docstring).
 
     What depends on time and the parameters alone (a library's tooth windows, shaft- and mesh-order harmonics: most
@@ -155,7 +168,9 @@ def column_functions(system: FirstOrderSystem, f: ca.SX, out: ca.SX, sym: System
     column, its forcing df/dp_j = dF/dp_j + dF/dW D_j at the stages: the augmented system's RK4, as ``fit_step``
     computes it), ``fit_forcing`` (every parameter's forcing at the four stages at once) with
     ``fit_column_forced`` (a column from its forcing), and ``fit_channels`` (the channels, dh/dy and dh/dp). The
-    stages' times are t, t + h/2, t + h: W and D come as three columns (blocks), one per time."""
+    stages' times are t, t + h/2, t + h: W and D come as three columns (blocks), one per time. The driver computes W
+    and D by groups (``fit_times_<g>``: a group's values and derivatives), skipping in a window the groups whose
+    parameters leave them unused there (:mod:`.time_gates`: a candidate effect at 0 costs no time values)."""
     n, m = system.dimension, sym.p.numel()
     y, t, p, h = sym.y, sym.t, sym.p, ca.SX.sym("h")
     rest, symbols, parametric = ca.extract_parametric(f, ca.vertcat(t, p), {})
@@ -165,6 +180,12 @@ def column_functions(system: FirstOrderSystem, f: ca.SX, out: ca.SX, sym: System
     d_values = ca.jacobian(values, p)  # (sparse: each value depends on a few parameters)
     times_fn = ca.Function("fit_times", [t, p], [ca.densify(values), d_values], _OPTS)
     value_fn = ca.Function("fit_time_values", [t, p], [ca.densify(values)], _OPTS)
+    groups = time_groups(rest, w, values, d_values, p)
+    by_group = {}
+    for g, group in enumerate(groups):
+        rows = list(group.rows)
+        by_group[f"fit_times_{g}"] = ca.Function(f"fit_times_{g}", [t, p], [ca.densify(values[rows]),
+                                                                           d_values[rows, :]], _OPTS)
     dense = ca.Function("F", [y, p, w], [rest, ca.jacobian(rest, y), ca.jacobian(rest, p), ca.jacobian(rest, w)])
     W = ca.SX.sym("W", nw, 3)
     D = ca.SX.sym("D", ca.horzcat(*[d_values.sparsity()] * 3))
@@ -202,7 +223,7 @@ def column_functions(system: FirstOrderSystem, f: ca.SX, out: ca.SX, sym: System
         return by_p + ca.mtimes(by_w, Ds[at[i]])
 
     zero = [ca.SX(n, 1)] * 4
-    out_fns = {"fit_times": times_fn, "fit_time_values": value_fn, "fit_stages": stages,
+    out_fns = {"fit_times": times_fn, "fit_time_values": value_fn, **by_group, "fit_stages": stages,
                "fit_state_step": state_step,
                "fit_column": ca.Function("fit_column", [q, J, h], [ca.densify(column(zero))], _OPTS)}
     forcings = [dfdp(i) for i in range(4)]
@@ -216,7 +237,7 @@ def column_functions(system: FirstOrderSystem, f: ca.SX, out: ca.SX, sym: System
                                                [ca.densify(column([F[:, i] for i in range(4)]))], _OPTS)
     out_fns["fit_channels"] = ca.Function("fit_channels", [y, t, p], [ca.densify(out), ca.densify(ca.jacobian(out, y)),
                                                                       ca.densify(ca.jacobian(out, p))], _OPTS)
-    return out_fns
+    return WindowFunctions(out_fns, groups)
 
 
 class Windows:
@@ -228,11 +249,11 @@ class Windows:
         self.digest = windows_hash(system, self.channels)
         compiled = backend == "compiled" or (backend == "auto" and find_compiler() is not None)
         self.backend = "compiled" if compiled else "in-process"
-        self._functions: dict[str, ca.Function] | None = None
+        self._functions: WindowFunctions | None = None
         self._library = self._compile() if compiled else None
 
     @property
-    def functions(self) -> dict[str, ca.Function]:
+    def functions(self) -> WindowFunctions:
         if self._functions is None:
             self._functions = window_functions(self.system, self.channels)
         return self._functions
@@ -267,7 +288,8 @@ class Windows:
                                            nw=times.nnz_out(0), nd=times.nnz_out(1),
                                            works=works, p1=max(1, self.parameters), costs=costs,
                                            forcing=functions["fit_forcing"].n_instructions(),
-                                           forced=functions["fit_column_forced"].n_instructions())
+                                           forced=functions["fit_column_forced"].n_instructions(),
+                                           **_group_tables(functions))
 
     def run(self, starts: np.ndarray, t0: Sequence[float], dt: Sequence[float], samples: Sequence[int],
             substeps: Sequence[int], parameters: np.ndarray, tangent: bool = True,
@@ -367,8 +389,10 @@ def windows_hash(system: FirstOrderSystem, channels: Sequence[sp.Expr]) -> str:
     """What determines the window code: the equations, names, channels, this module and the versions."""
     description = {
         "version": WINDOWS_VERSION,
-        # this module and the step's own generator (translate, functions, ...): an edit to either changes the C
-        "generator": hashlib.sha256(Path(__file__).read_bytes()).hexdigest() + generator_digest(),
+        # this module, its time values' groups and the step's own generator (translate, functions, ...): an edit to
+        # any changes the C
+        "generator": hashlib.sha256(Path(__file__).read_bytes()).hexdigest() + generator_digest()
+        + hashlib.sha256((Path(__file__).parent / "time_gates.py").read_bytes()).hexdigest(),
         "casadi": ca.__version__,
         "name": system.name,
         "time": system.time.name,
@@ -380,8 +404,38 @@ def windows_hash(system: FirstOrderSystem, channels: Sequence[sp.Expr]) -> str:
     return hashlib.sha256(json.dumps(description, sort_keys=True).encode()).hexdigest()
 
 
-#: the whole tangent step and output of the in-process backend (the compiled driver goes column by column)
-_IN_PROCESS_ONLY = ("fit_step", "fit_plain_step", "fit_output")
+def _group_tables(functions: WindowFunctions) -> dict[str, str]:
+    """The driver's tables of the time values' groups: their functions, where each group's values and derivatives go
+    in W and D (D's nonzeros in column order), and the sets of parameters that gate each (see :mod:`.time_gates`)."""
+    d_rows, d_cols = functions["fit_times"].sparsity_out(1).get_triplet()
+    nonzero = {(r, c): i for i, (r, c) in enumerate(zip(d_rows, d_cols))}
+    w_index, d_index, w_start, d_start, gate_start, set_start, set_params = [], [], [0], [0], [0], [0], []
+    for g, group in enumerate(functions.groups):
+        rows, cols = functions[f"fit_times_{g}"].sparsity_out(1).get_triplet()
+        w_index += group.rows
+        d_index += [nonzero[group.rows[r], c] for r, c in zip(rows, cols)]
+        w_start.append(len(w_index))
+        d_start.append(len(d_index))
+        for gate in group.gates:
+            set_params += gate
+            set_start.append(len(set_params))
+        gate_start.append(len(set_start) - 1)
+    count = len(functions.groups)
+
+    def listed(values) -> str:
+        return ", ".join(map(str, values)) or "0"
+
+    return {"g": count, "g1": max(1, count),
+            "times": listed(f"fit_times_{g}" for g in range(count)),
+            "times_work": listed(f"fit_times_{g}_work" for g in range(count)),
+            "w_start": listed(w_start), "w_index": listed(w_index), "d_start": listed(d_start),
+            "d_index": listed(d_index), "gate_start": listed(gate_start), "set_start": listed(set_start),
+            "set_params": listed(set_params)}
+
+
+#: the whole tangent step and output of the in-process backend (the compiled driver goes column by column), and all
+#: time values at once (the driver computes them by groups)
+_IN_PROCESS_ONLY = ("fit_step", "fit_plain_step", "fit_output", "fit_times", "fit_time_values")
 
 def compile_windows(system: FirstOrderSystem, channels: Sequence[sp.Expr], backend: str = "auto") -> Windows:
     """The window integrator of ``system`` observed through ``channels``: built once per process (found again by
@@ -403,11 +457,22 @@ _DRIVER = r"""
 /* the time values W (and the nonzeros of their derivatives D by the parameters) at one time */
 #define GS_NW {nw}
 #define GS_ND {nd}
+/* ... computed by groups: a group's values go to W[gs_w_index[gs_w_start[g] ...]], its derivatives' nonzeros to
+   D[gs_d_index[gs_d_start[g] ...]]; it is skipped in a window where every parameter of one of its gate sets (sets
+   gs_gate_start[g] ... of the parameters gs_set_params[gs_set_start[s] ...]) is 0 and not asked for, as nothing
+   depends on it there (gearsym/codegen/time_gates.py) */
+#define GS_G {g}
 
 typedef int (*gs_fn)(const casadi_real**, casadi_real**, casadi_int*, casadi_real*, int);
 typedef int (*gs_work_fn)(casadi_int*, casadi_int*, casadi_int*, casadi_int*);
 static const gs_fn gs_param[{p1}] = {{{table}}};
 static const gs_work_fn gs_param_work[{p1}] = {{{works}}};
+static const gs_fn gs_group_times[{g1}] = {{{times}}};
+static const gs_work_fn gs_group_times_work[{g1}] = {{{times_work}}};
+static const casadi_int gs_w_start[] = {{{w_start}}}, gs_w_index[] = {{{w_index}}};
+static const casadi_int gs_d_start[] = {{{d_start}}}, gs_d_index[] = {{{d_index}}};
+static const casadi_int gs_gate_start[] = {{{gate_start}}}, gs_set_start[] = {{{set_start}}};
+static const casadi_int gs_set_params[] = {{{set_params}}};
 /* operations a step: each parameter's column function's, and every forcing at once with a column from its forcing */
 static const casadi_int gs_param_cost[{p1}] = {{{costs}}};
 #define GS_FORCING_COST {forcing}
@@ -422,11 +487,33 @@ static void gs_grow(gs_work_fn f, casadi_int* sz) {{
   sz[0] = gs_max(sz[0], a); sz[1] = gs_max(sz[1], r); sz[2] = gs_max(sz[2], i); sz[3] = gs_max(sz[3], w);
 }}
 
-/* the time values at one time (their derivatives too, with_d) */
-static int gs_times(casadi_real at, const casadi_real* pk, int with_d, casadi_real* W, casadi_real* D,
+/* whether group g's time values are needed with the parameters pk, the parameters asked[j] != 0 asked for */
+static int gs_group_on(casadi_int g, const casadi_real* pk, const char* asked) {{
+  casadi_int s, i;
+  for (s = gs_gate_start[g]; s < gs_gate_start[g + 1]; ++s) {{
+    int off = 1;
+    for (i = gs_set_start[s]; i < gs_set_start[s + 1] && off; ++i)
+      if (pk[gs_set_params[i]] != 0 || asked[gs_set_params[i]]) off = 0;
+    if (off) return 0;
+  }}
+  return 1;
+}}
+
+/* the time values of the groups on[g] and their derivatives at one time (the others' stay as they are; a group's
+   derivatives come with its values, one function a group: a few operations more where a run needs no derivatives,
+   half the functions to compile) */
+static int gs_times(casadi_real at, const casadi_real* pk, const char* on, casadi_real* W, casadi_real* D,
                     const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* work) {{
-  arg[0] = &at; arg[1] = pk; res[0] = W; res[1] = D;
-  return with_d ? fit_times(arg, res, iw, work, 0) : fit_time_values(arg, res, iw, work, 0);
+  casadi_real wg[GS_NW > 0 ? GS_NW : 1], dg[GS_ND > 0 ? GS_ND : 1];
+  casadi_int g, i;
+  for (g = 0; g < GS_G; ++g) {{
+    if (!on[g]) continue;
+    arg[0] = &at; arg[1] = pk; res[0] = wg; res[1] = dg;
+    if (gs_group_times[g](arg, res, iw, work, 0)) return 1;
+    for (i = gs_w_start[g]; i < gs_w_start[g + 1]; ++i) W[gs_w_index[i]] = wg[i - gs_w_start[g]];
+    for (i = gs_d_start[g]; i < gs_d_start[g + 1]; ++i) D[gs_d_index[i]] = dg[i - gs_d_start[g]];
+  }}
+  return 0;
 }}
 
 CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int* samples,
@@ -434,7 +521,6 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
     const casadi_real* p, casadi_int tangent, casadi_int ncols, const casadi_int* cols, casadi_real* states,
     casadi_real* outputs, casadi_real* derivatives) {{
   casadi_int sz[4] = {{0, 0, 0, 0}}, i, k, s, j, l, col = 0, width = GS_N + ncols, all = 0, one_by_one = 0;
-  int with_d;
   casadi_real y[GS_N], y1[GS_N], Y[4 * GS_N], J[4 * GS_N * GS_N], q1[GS_N], Fj[4 * GS_N], t, h, at;
   casadi_real W[3 * GS_NW > 0 ? 3 * GS_NW : 1], D[3 * GS_ND > 0 ? 3 * GS_ND : 1];
   casadi_real* F = 0;
@@ -444,12 +530,16 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
   casadi_real** res;
   casadi_int* iw;
   casadi_real* work;
+  char asked[GS_P > 0 ? GS_P : 1], on[GS_G > 0 ? GS_G : 1], every[GS_G > 0 ? GS_G : 1];
   gs_grow(fit_state_step_work, sz); gs_grow(fit_stages_work, sz); gs_grow(fit_column_work, sz);
-  gs_grow(fit_channels_work, sz); gs_grow(fit_times_work, sz); gs_grow(fit_time_values_work, sz);
-  with_d = tangent && ncols > 0;
+  gs_grow(fit_channels_work, sz);
+  for (i = 0; i < GS_G; ++i) gs_grow(gs_group_times_work[i], sz);
+  memset(asked, 0, sizeof(asked));
+  memset(every, 1, sizeof(every));
   for (j = 0; j < ncols; ++j) {{
     if (cols[j] < 0 || cols[j] >= GS_P) return 1;
     one_by_one += gs_param_cost[cols[j]];
+    if (tangent) asked[cols[j]] = 1;
   }}
   /* the parameters' columns from every forcing at once where that is fewer operations than one by one */
   all = tangent && ncols > 0 && GS_FORCING_COST + ncols * GS_FORCED_COST < one_by_one;
@@ -469,6 +559,14 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
   for (k = 0; k < count; ++k) {{
     const casadi_real* pk = p + k * GS_P;
     memcpy(y, start + k * GS_N, sizeof(y));
+    /* every group's values at the window's start, at all three times: a group skipped in this window keeps them
+       (finite where it enters multiplied by 0: not 0, which could meet a division) */
+    if (gs_times(t0[k], pk, every, W, D, arg, res, iw, work)) goto fail;
+    for (i = 1; i < 3; ++i) {{
+      memcpy(W + i * GS_NW, W, sizeof(casadi_real) * GS_NW);
+      memcpy(D + i * GS_ND, D, sizeof(casadi_real) * GS_ND);
+    }}
+    for (i = 0; i < GS_G; ++i) on[i] = (char)gs_group_on(i, pk, asked);
     memset(Q, 0, sizeof(casadi_real) * (size_t)(GS_N * width));
     for (j = 0; j < GS_N; ++j) Q[j * GS_N + j] = 1;
     h = dt[k] / (casadi_real)substeps[k];
@@ -479,11 +577,11 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
           /* the time values at the stages' times, once each for every function of the step: at t (the step before
              computed them, but for a window's first step), t + h/2 and t + h, which is the next step's t as it
              computes it (the last bit may differ from t + h) */
-          if (s == 1 && l == 0 && gs_times(t, pk, with_d, W, D, arg, res, iw, work)) goto fail;
-          if (gs_times(t + h / 2, pk, with_d, W + GS_NW, D + GS_ND, arg, res, iw, work)) goto fail;
+          if (s == 1 && l == 0 && gs_times(t, pk, on, W, D, arg, res, iw, work)) goto fail;
+          if (gs_times(t + h / 2, pk, on, W + GS_NW, D + GS_ND, arg, res, iw, work)) goto fail;
           at = l + 1 < substeps[k] ? t0[k] + dt[k] * (casadi_real)(s - 1) + h * (casadi_real)(l + 1)
                                    : t0[k] + dt[k] * (casadi_real)s;
-          if (gs_times(at, pk, with_d, W + 2 * GS_NW, D + 2 * GS_ND, arg, res, iw, work)) goto fail;
+          if (gs_times(at, pk, on, W + 2 * GS_NW, D + 2 * GS_ND, arg, res, iw, work)) goto fail;
           if (tangent) {{
             arg[0] = y; arg[1] = W; arg[2] = &h; arg[3] = pk; res[0] = y1; res[1] = Y; res[2] = J;
             if (fit_stages(arg, res, iw, work, 0)) goto fail;
