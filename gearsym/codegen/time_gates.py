@@ -35,17 +35,21 @@ def time_groups(rest: ca.SX, w: ca.SX, values: ca.SX, d_values: ca.SX, p: ca.SX)
     that does, or else the fewest of those the value depends on that do together (a harmonic's cosine and sine
     amplitudes), in order of first value."""
     nw, m = w.numel(), p.numel()
+    symbols = [e.element_hash() for e in w.nonzeros()]
+    d_rows, d_cols = d_values.sparsity().get_triplet()
 
     def unused(zeroed: list[int]) -> set[int]:
         """The values nothing depends on while the parameters ``zeroed`` are 0."""
         at = ca.vertcat(*(p[j] for j in zeroed))
-        at_zero = ca.substitute(values, at, ca.SX.zeros(len(zeroed)))
-        others = ca.substitute(d_values, at, ca.SX.zeros(len(zeroed)))
-        vanish = [k for k in range(nw) if at_zero[k].is_zero()
-                  and all(others[k, i].is_zero() for i in range(m) if i not in zeroed)]
+        zeros = ca.SX.zeros(len(zeroed))
+        zero = [e.is_zero() for e in ca.substitute(values, at, zeros).nonzeros()]
+        for k, i, e in zip(d_rows, d_cols, ca.substitute(d_values, at, zeros).nonzeros()):
+            if i not in zeroed and not e.is_zero():  # (a derivative by another parameter is left)
+                zero[k] = False
+        vanish = [k for k in range(nw) if zero[k]]
         kept = ca.substitute(rest, ca.vertcat(at, *(w[k] for k in vanish)), ca.SX.zeros(len(zeroed) + len(vanish)))
-        left = {ca.SX(s).element_hash() for s in ca.symvar(kept)}
-        return set(vanish) | {k for k in range(nw) if w[k].element_hash() not in left}
+        left = {e.element_hash() for e in ca.symvar(kept)}
+        return set(vanish) | {k for k in range(nw) if symbols[k] not in left}
 
     gates: list[list[tuple[int, ...]]] = [[] for _ in range(nw)]
     for j in range(m):
