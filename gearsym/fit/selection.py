@@ -374,8 +374,10 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
         here = placed(seg_train, current.placements, library)
         gains = linearised_gains(superset, here, current.fit, library, [n for n in open_ if not library[n].scan],
                                  bias, options)
-        for name in (n for n in open_ if library[n].scan):  # a tooth fault: its tooth scanned in every record
-            scanned[name] = scan_teeth(superset, here, current.fit, library[name], bias, options)
+        # a tooth fault: its tooth scanned in every record
+        scanned.update(scan_teeth(superset, here, current.fit, [library[n] for n in open_ if library[n].scan], bias,
+                                  options))
+        for name in (n for n in open_ if library[n].scan):
             gains[name] = (scanned[name].gain, scanned[name].why)
         names = _round(library, current, current_spectrum, superset, {k: g for k, (g, _) in gains.items()}, refits)
         screened.append({"after": list(current.effects), "gains": {k: g for k, (g, _) in gains.items()},

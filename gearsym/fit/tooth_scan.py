@@ -13,7 +13,7 @@ windows only: the whole scan costs about three runs of the record's windows, not
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -41,27 +41,35 @@ class Placement:
     why: str = ""  # why the effect cannot act (0 gain)
 
 
-def scan_teeth(system: FirstOrderSystem, segments: Sequence[Segment], fit: Fit, e: Effect, bias: Sequence[str],
-               options: Integration) -> Placement:
-    """Place the tooth fault ``e`` in every record of ``segments`` at the fit ``fit`` (see the module docstring)."""
+def scan_teeth(system: FirstOrderSystem, segments: Sequence[Segment], fit: Fit, effects: Sequence[Effect],
+               bias: Sequence[str], options: Integration) -> dict[str, Placement]:
+    """Place each tooth fault of ``effects`` in every record of ``segments`` at the fit ``fit`` (see the module
+    docstring), by name. The residual, its Jacobian by what the fit estimates and their projection are the same for
+    every fault (its severity is 0 at the fit, its own column computed tooth by tooth): computed once for them all."""
+    if not effects:
+        return {}
     fitted = list(fit.estimates)
-    q = e.fitted[0]
-    problem = Problem(system, segments, fitted + [q], list(bias), 2 * np.pi, options)
-    theta = np.array([fit.estimates[p] for p in fitted] + [0.0])
+    problem = Problem(system, segments, fitted, list(bias), 2 * np.pi, options)
+    theta = np.array([fit.estimates[p] for p in fitted])
     b = np.array([fit.bias[c] for c in problem.bias])
     starts = fit.starts
-    u = np.concatenate([theta, b, starts.reshape(-1, order="F")])
-    r, J = problem(u)
-    m = len(fitted)
-    nuisance = replace(J, P=np.delete(J.P, m, axis=1))
+    r, nuisance = problem(np.concatenate([theta, b, starts.reshape(-1, order="F")]))
     y = nuisance.project_out(-r[:, None])[:, 0]
     total = float(y @ y) or 1.0
-    order = float(next(c.order for c in system.couplings if c.coordinate == e.coordinate) or 1)
-    index_q, index_n = problem.names.index(q), problem.names.index(e.scan)
-    P = problem.parameters(theta)
+    projection = RecordProjection.of(nuisance, y)
     records = list(dict.fromkeys(seg.key[0] if seg.key else k for k, seg in enumerate(segments)))
     of_record = np.array([records.index(seg.key[0] if seg.key else k) for k, seg in enumerate(segments)])
-    projection = RecordProjection.of(nuisance, y)
+    return {e.name: _placement(problem, nuisance, projection, y, total, records, of_record, starts,
+                               problem.parameters(theta), e) for e in effects}
+
+
+def _placement(problem: Problem, J, projection: "RecordProjection", y: np.ndarray, total: float, records: list,
+               of_record: np.ndarray, starts: np.ndarray, P: np.ndarray, e: Effect) -> Placement:
+    """The tooth fault ``e`` placed in every record: each record's tooth of largest gain, and their gain together."""
+    order = float(next(c.order for c in problem.system.couplings if c.coordinate == e.coordinate) or 1)
+    index_q, index_n = problem.names.index(e.fitted[0]), problem.names.index(e.scan)
+    P = P.copy()
+    P[index_q, :] = 0.0  # (the fault's severity at the fit: 0)
     teeth, gains = {}, {}
     raw, along = np.zeros_like(y), np.zeros(projection.fitted.shape[1])  # the chosen columns' sum: own rows, along P
     for ri, record in enumerate(records):
