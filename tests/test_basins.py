@@ -14,6 +14,7 @@ from gearsym import Execution, FirstOrderSystem, Integration
 from gearsym.analysis.basins import DIVERGED, UNDETERMINED, basin_map
 from gearsym.cli import main
 from gearsym.figures.basins import plot_basin_map
+from gearsym.physical.basins import GridAxis
 from gearsym.sweep.basin_continuation import APPEARS, VANISHES, continue_basins
 
 import conftest
@@ -232,6 +233,23 @@ def test_cli_errors_are_one_line_messages(capsys, argv, message):
     *before, last = err.strip().splitlines()
     assert code == 2 and message in last and last.startswith("gearsym: error:") and "Traceback" not in err
     assert all(line.startswith("gearsym: compiling") for line in before)  # (at most the note of a first compile)
+
+
+@pytest.mark.parametrize("model, grid, message", [
+    ("spur_pair", "x=-1mm/s:1mm/s:1mm/s", "x is a length of spur_pair ([length]), but mm/s is [length] / [time]"),
+    ("spur_pair", "x=-1A:1A:1A", "A: a drivetrain value is made of mass, length and time"),
+    ("one_stage", "x=-1A:1A:1A", "has a unit, but the model has no physical values"),  # (its unit read, not said)
+])
+def test_a_grid_in_a_unit_of_another_kind_is_refused_before_the_model_is_compiled(capsys, model, grid, message):
+    code, _, err = run_cli(capsys, "basins", model, "--grid", grid, "--grid", "v=0,1")
+    assert code == 2 and message in err and "compiling" not in err
+
+
+def test_a_grid_axis_is_read_into_si_units_once_when_it_is_parsed():
+    axis = GridAxis.read("x=-20um:20um:20um")
+    assert axis.values == (-20.0, 0.0, 20.0) and axis.unit == "um" and axis.dims == (0.0, 1.0, 0.0)
+    assert axis.si_values == pytest.approx((-2e-5, 0.0, 2e-5), rel=1e-15)
+    assert GridAxis.read("v=-1,1").dims is None and GridAxis.read("v=-1,1").si_values == ()
 
 
 @pytest.mark.slow
