@@ -17,9 +17,9 @@ from ..opening import open_model
 from ..options import Execution
 from ..physical.basins import GridAxis, PhysicalGrid, ShownBasinMap, ShownFractions, shown_in
 from ..physical.files import write_basin_fractions, write_basin_map
-from ..physical.sweeps import nondimensional_axes
+from ..physical.sweeps import MeasuredAxis, engine_axis
 from ..sweep.basin_continuation import MATCH_DISTANCE, StartGrid, continue_basins
-from ..sweep.grid import Axis, parse_axis
+from ..sweep.grid import Axis
 from ..sweep.store import sidecar
 from .arguments.integration import add_integration_arguments, integration_from, model_request
 from .arguments.settings import add_set_argument, parse_state
@@ -37,7 +37,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "v=-500mm/s:500mm/s:25mm/s)")
     parser.add_argument("--y0", type=parse_state, metavar="x1=0,v1=0",
                         help="where the states off the grid start (default: the model's)")
-    parser.add_argument("--param", type=parse_axis, metavar="NAME=START:STOP:STEP",
+    parser.add_argument("--param", type=MeasuredAxis.read, metavar="NAME=START:STOP:STEP",
                         help="the basin fractions along this parameter, each attractor followed by its Poincare "
                              "set (needs --out; resumable: the same command continues an interrupted run)")
     add_integration_arguments(parser, **RUN)
@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
     # (a grid in physical units is checked here, once, before the model is compiled)
     physical_grid = PhysicalGrid(units, grid_axes) if units is not None else None
     if axis is not None and physical_grid is not None:  # (the parameter in the engine's numbers, also before)
-        axis = nondimensional_axes(model.scaling.full, [axis])[0]
+        axis = engine_axis(model.scaling.full, axis)
     compiled = model.compiled()
     if axis is not None:
         return _continuation(args, compiled, grid_axes, physical_grid, axis, shown_as, y0, execution)
