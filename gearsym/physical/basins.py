@@ -3,10 +3,10 @@
 
 A grid given in physical units is read into SI units once, when it is parsed (:class:`GridAxis`), checked against
 the model's states once (:class:`PhysicalGrid`), and turned into the engine's nondimensional starts at each forcing
-frequency (a rate's unit, L omega omega_n per second, moves with the speed: :func:`engine_grid`); the results come back through the same numbers
-(:class:`~gearsym.physical.point.PointUnits`: the length unit L, omega_n, the speed's ratio). :class:`ShownBasinMap`
-and :class:`ShownFractions` are the results in those units, which the files (:mod:`.files`), the command's text
-and the figures (:mod:`gearsym.figures.basins`) take.
+frequency (a rate's unit, L omega omega_n per second, moves with the speed: :func:`engine_grid`); the results come
+back through the same numbers (:class:`~gearsym.physical.point.PointUnits`: the length unit L, omega_n, the speed's
+ratio). :class:`ShownBasinMap` and :class:`ShownFractions` are the results in those units, which the files
+(:mod:`.files`), the command's text and the figures (:mod:`gearsym.figures.basins`) take.
 """
 from __future__ import annotations
 
