@@ -147,7 +147,8 @@ def kept_model(summary, build_file: Path, options: Integration):
 
 def _compiled_again(summary, build: BuildSummary, build_file: Path, options: Integration):
     """The compiled model of ``build`` with its library compiled again from its C (the build summary written again
-    if the library's name changed, once it has loaded), or None: no C that vouches for it (the model is loaded, its C generated)."""
+    if the library's name changed, once it has loaded), or None: no C that vouches for it (the model is loaded, its
+    C generated)."""
     library = library_from_code(summary, build.hash)
     if library is None:
         return None
