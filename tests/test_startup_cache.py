@@ -269,10 +269,13 @@ def test_the_face_leaves_numpy_to_the_command_which_imports_with_the_collector_p
 
 
 @pytest.mark.parametrize("given", [{}, {"OMP_NUM_THREADS": "2"}, {"OPENBLAS_NUM_THREADS": "2"}])
-def test_the_command_runs_numpys_blas_on_one_thread_unless_told_otherwise(given):
+def test_the_command_runs_numpys_blas_on_one_thread_unless_told_otherwise(given, capsys):
     """Set before NumPy is imported, in the command's own process only (its pool of threads was a tenth of a cached
-    model's start-up); a thread count the user set is kept. (A caller's process: the test after this one.)"""
-    script = ("import os, sys; from gearsym.cli import main; sys.argv = ['gearsym', 'list']; "
+    model's start-up); a thread count the user set is kept. (A caller's process: the test after this one.) The
+    command: a spectrum of a cached model (cached here first), which runs NumPy's linear algebra."""
+    lyap(capsys, "one_stage")
+    script = ("import os, sys; from gearsym.cli import main; "
+              f"sys.argv = ['gearsym', 'lyap', 'one_stage', *{ARGS!r}]; "
               "main(); print([os.environ.get(k) for k in ('OPENBLAS_NUM_THREADS', 'OMP_NUM_THREADS')])")
     env = {k: v for k, v in os.environ.items() if not k.endswith("_NUM_THREADS")}
     run = subprocess.run([sys.executable, "-c", script],
