@@ -62,7 +62,7 @@ class Problem:
             self.scale[name] = float(np.std(values)) or 1.0
         self.samples = np.array([len(s.tau) for s in segments], dtype=np.int64)
         self.t0 = np.array([float(s.tau[0]) for s in segments])
-        self.dt = np.array([float(np.median(np.diff(s.tau))) for s in segments])
+        self.dt = _sample_steps(segments)
         self.substeps = np.array([substeps_for(dt, period, options) for dt in self.dt], dtype=np.int64)
         self.base = np.array([[s.parameters[n] for n in self.names] for s in segments], dtype=float).T
         # per slot (across the forms' gears): its parameter's row, and per window the position in theta of its tooth's
@@ -172,3 +172,17 @@ class Problem:
             if self.bias else np.zeros((r.size, 0))
         return r, Jacobian(np.hstack([self._parameter_columns(D[:, self.n:]), offsets]), D[:, :self.n], self.window,
                            self.row_offsets)
+
+
+def _sample_steps(segments: Sequence[Segment]) -> np.ndarray:
+    """Each window's median step between samples: the windows of one length at once (one median call per length,
+    not per window, which was most of a problem's set-up: the same numbers)."""
+    lengths = np.array([len(s.tau) for s in segments], dtype=np.int64)
+    out = np.empty(len(segments))
+    for length in np.unique(lengths):
+        which = np.nonzero(lengths == length)[0]
+        if length < 2:  # (no step: what the median of none is)
+            out[which] = [float(np.median(np.diff(segments[k].tau))) for k in which]
+        else:
+            out[which] = np.median(np.diff(np.array([segments[k].tau for k in which], dtype=float), axis=1), axis=1)
+    return out
