@@ -230,6 +230,26 @@ def test_a_sweep_of_a_cached_model_chooses_its_step_without_reducing_it_again(mo
     assert (tmp_path / "again.csv").read_text() == (tmp_path / "first.csv").read_text()
 
 
+def test_a_chart_of_a_cached_model_runs_no_model_file_to_look_for_its_options(model_file, reductions, capsys,
+                                                                              monkeypatch):
+    """Its axes are parameters of the cached system, so neither is a model option (planets, dof): the model file is
+    not run (SymPy not loaded) to say so, and the chart is the same."""
+    argv = ["stability", str(model_file), "--param", "omega=0.5,1.5", "--param", "k_a=0.1", "--about", "orbit",
+            "--format", "json", "--quiet"]
+    def chart() -> dict:  # (but its timings)
+        assert main(argv) == 0
+        return {k: v for k, v in json.loads(capsys.readouterr().out).items() if k != "timings"}
+
+    first = chart()
+    assert len(reductions) == 1 and first["points"]
+
+    def run_the_file(model):
+        raise AssertionError(f"the model file {model} was run to read its options")
+
+    monkeypatch.setattr(sys.modules["gearsym.cli.stability"], "model_options", run_the_file)
+    assert chart() == first and len(reductions) == 1
+
+
 @pytest.mark.slow
 def test_a_formula_spelt_another_way_is_the_same_cached_model(model_file, reductions, capsys):
     first = lyap(capsys, str(model_file), *FORMULA)
