@@ -31,8 +31,17 @@ def record_class(cls=None, /, *, eq: bool = True, frozen: bool = True):
     # (name, default, factory) of each field, in order: what __init__ sets
     setting = tuple((f.name, f.default, f.default_factory, f.init) for f in every)
     post_init = getattr(cls, "__post_init__", None) is not None
+    # every field given in order, none outside __init__ to default, none a descriptor of the class: the values go
+    # straight into the instance's dict
+    every_given_in_order = len(arguments) == len(every) and not any(
+        hasattr(getattr(cls, n, None), "__set__") for n in names) and "__slots__" not in cls.__dict__
 
     def __init__(self, *args, **kwargs):
+        if not kwargs and len(args) == len(names) and every_given_in_order:  # (a record made in a loop: a shot)
+            self.__dict__.update(zip(names, args))
+            if post_init:
+                self.__post_init__()
+            return
         if len(args) > len(names):
             raise TypeError(f"{cls.__qualname__}.__init__() takes {len(names) + 1} positional arguments but "
                             f"{len(args) + 1} were given")

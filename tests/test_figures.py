@@ -7,7 +7,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
-from gearsym.figures.poincare import REGIME_MARKERS
+from gearsym.figures.poincare import REGIME_MARKERS, _place_labels
 from gearsym.figures.sweep import plot_sweep
 from gearsym.reproduce import SCENARIOS
 from gearsym.reproduce import figures as paper_figures
@@ -458,3 +458,27 @@ def test_no_paper_figure_clips_a_text_or_covers_a_curve_with_a_legend(quick_repr
     for ax in fig.axes:
         assert fc.points_under_legend(ax) == 0, f"a legend covers data in {ax.get_title()!r}"
         assert fc.unmatched_legend_entries(ax) == [], ax.get_title()
+
+
+def test_each_attractors_mark_keeps_clear_of_every_point_and_of_the_other_marks():
+    """A chaotic cloud over the lower half of the axes and two periodic orbits above it: each mark's text box (half
+    0.065 x 0.035 of the axes) covers no plotted point and no mark placed before it, though most spots near the
+    cloud would."""
+    rng = np.random.default_rng(3)
+    cloud = rng.uniform(0, 1, 3000), rng.uniform(0, 0.55, 3000)
+    drawn = [(SimpleNamespace(paper_label="2", regime="chaotic", period=0), *cloud, "C0"),
+             (SimpleNamespace(paper_label="1", regime="periodic", period=1), [0.3], [0.8], "C1"),
+             (SimpleNamespace(paper_label="1", regime="periodic", period=2), [0.7, 0.8], [0.75, 0.9], "C2")]
+    fig, ax = plt.subplots()
+    ax.set_xlim(0, 1)
+    ax.set_ylim(0, 1)
+    _place_labels(ax, drawn)
+    spots = [np.array(mark.xyann) for mark in ax.texts]
+    points = np.vstack([np.column_stack([np.asarray(x, float), np.asarray(y, float)]) for _, x, y, _ in drawn])
+    half = np.array([0.065, 0.035])
+    plt.close(fig)
+    assert len(spots) == 3
+    for k, spot in enumerate(spots):
+        assert (np.abs(points - spot) / half).max(axis=1).min() >= 1.0, f"mark {k} at {spot} covers a point"
+        for other in spots[:k]:
+            assert (np.abs(other - spot) / half).max() >= 2.0, f"mark {k} at {spot} covers the mark at {other}"

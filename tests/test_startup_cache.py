@@ -209,17 +209,45 @@ def test_a_single_spectrum_loads_no_other_analysis():
 
 def test_a_sweep_of_a_cached_model_chooses_its_step_without_reducing_it_again(model_file, reductions, tmp_path,
                                                                             capsys):
-    """Its fastest end (omega = 0.1: 250 steps, the model's own values 200) is read from the cached library."""
-    def sweep(out: str) -> str:  # (the line that says the step and why)
-        assert main(["sweep", str(model_file), "--param", "omega=0.1:0.3:0.2", "--periods", "14", "--discard", "2",
-                     "--out", str(tmp_path / out)]) == 0
-        return next(line for line in capsys.readouterr().err.splitlines() if line.startswith("gearsym: step:"))
+    """Its fastest end (omega = 0.1: 250 steps, the model's own values 200) is read from the cached library; the
+    second sweep, a process of its own as a user's, imports neither SymPy nor CasADi (the Dask side, which ships
+    models, loads the code generator only when a sweep runs there)."""
+    argv = ["sweep", str(model_file), "--param", "omega=0.1:0.3:0.2", "--periods", "14", "--discard", "2", "--out"]
 
-    first = sweep("first.csv")
+    def step(err: str) -> str:  # (the line that says the step and why)
+        return next(line for line in err.splitlines() if line.startswith("gearsym: step:"))
+
+    assert main([*argv, str(tmp_path / "first.csv")]) == 0
+    first = step(capsys.readouterr().err)
     assert len(reductions) == 1 and "250 per forcing period" in first and "at omega=0.1:" in first
-    assert sweep("again.csv") == first
-    assert len(reductions) == 1
+    script = ("import sys; from gearsym.cli import main; "
+              f"status = main({[*argv, str(tmp_path / 'again.csv')]!r}); "
+              "print(status, sorted(m for m in ('sympy', 'pint', 'casadi') if m in sys.modules), file=sys.stderr)")
+    again = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=REPO_ROOT,
+                           env={**os.environ, "PYTHONPATH": str(REPO_ROOT)}, timeout=120)
+    assert again.stderr.strip().splitlines()[-1] == "0 []", again.stderr[-3000:]
+    assert step(again.stderr) == first
     assert (tmp_path / "again.csv").read_text() == (tmp_path / "first.csv").read_text()
+
+
+def test_a_chart_of_a_cached_model_runs_no_model_file_to_look_for_its_options(model_file, reductions, capsys,
+                                                                              monkeypatch):
+    """Its axes are parameters of the cached system, so neither is a model option (planets, dof): the model file is
+    not run (SymPy not loaded) to say so, and the chart is the same."""
+    argv = ["stability", str(model_file), "--param", "omega=0.5,1.5", "--param", "k_a=0.1", "--about", "orbit",
+            "--format", "json", "--quiet"]
+    def chart() -> dict:  # (but its timings)
+        assert main(argv) == 0
+        return {k: v for k, v in json.loads(capsys.readouterr().out).items() if k != "timings"}
+
+    first = chart()
+    assert len(reductions) == 1 and first["points"]
+
+    def run_the_file(model):
+        raise AssertionError(f"the model file {model} was run to read its options")
+
+    monkeypatch.setattr(sys.modules["gearsym.cli.stability"], "model_options", run_the_file)
+    assert chart() == first and len(reductions) == 1
 
 
 @pytest.mark.slow

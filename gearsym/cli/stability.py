@@ -77,7 +77,6 @@ def run(args: argparse.Namespace) -> int:
     if len(given) != 2:
         raise GearsymError(f"give two --param axes (got {len(given)}); for a line give the second one value, e.g. "
                            "--param k_a=0.2")
-    _refuse_model_options(args.model, given)
     options = integration_from(args)
     user = _formula_axes(args, given)
     tolerance_of = lambda axes: tuple(args.tolerance * (max(a.values) - min(a.values) or max(1.0, abs(a.values[0])))
@@ -86,6 +85,7 @@ def run(args: argparse.Namespace) -> int:
     execution = Execution(args.jobs, lanes=not args.no_lanes, progress=progress or False)
     request = model_request(args, options)  # (after the formula's placeholders: the model is loaded with them)
     model = open_model(request)
+    _refuse_model_options(args.model, given, model.slot.system)
     start = time.perf_counter()
     common = dict(refine=not args.no_refine, execution=execution)
 
@@ -130,9 +130,13 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _refuse_model_options(model: str, given) -> None:
+def _refuse_model_options(model: str, given, cached: dict | None = None) -> None:
     """An axis that names a model option (planets, dof: another model built, another set of equations) cannot be
-    charted: refused from the model file's options (a second), before the model is reduced and compiled."""
+    charted: refused from the model file's options (a second: the file runs, SymPy loads), before the model is
+    reduced and compiled. Where the start-up cache's summary of the model (``cached``) has every axis among its
+    parameters, none is an option (an option builds the model: it is no parameter of the system built)."""
+    if cached is not None and all(a.name in cached.get("parameters", ()) for a in given):
+        return
     options = model_options(model)
     for a in given:
         if a.name in options:

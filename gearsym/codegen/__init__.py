@@ -18,10 +18,11 @@ from .verbs import engine_verb
 
 #: the code generator's own names, imported on first use (SymPy): a model whose library is cached never needs them
 _GENERATOR = {"build_functions": "gearsym.codegen.functions", "code_hash": "gearsym.codegen.generate",
-              "compile_model": "gearsym.codegen.build", "write_code": "gearsym.codegen.generate"}
+              "compile_model": "gearsym.codegen.build", "write_code": "gearsym.codegen.generate",
+              "load_shipped": "gearsym.codegen.portable", "ship": "gearsym.codegen.portable"}
 
 __all__ = ["CompiledModel", "CompilerError", "LoopOptions", "RunInputs", "TangentRun", "TangentRuns", "build_functions",
-           "cache_dir", "code_hash", "compile_model", "engine_verb", "write_code"]
+           "cache_dir", "code_hash", "compile_model", "engine_verb", "load_shipped", "ship", "write_code"]
 
 
 def __getattr__(name: str):
@@ -36,3 +37,4 @@ if TYPE_CHECKING:
     from .build import compile_model
     from .functions import build_functions
     from .generate import code_hash, write_code
+    from .portable import load_shipped, ship

@@ -40,7 +40,8 @@ def compiled_rate(compiled, values: Mapping[str, float] | None = None) -> tuple[
     """The fastest rate (:func:`largest_rate`) and the forcing period at ``values``, from a compiled model's own
     Jacobian and period, or None where the period is not a positive number (the full system's error says why)."""
     p = compiled.parameter_vector(values)
-    period = float(np.asarray(compiled.functions["constants"](p)[1]).reshape(-1)[0])
+    functions = compiled.native or compiled.functions  # (the library's own call where it has one: no CasADi loaded)
+    period = float(np.asarray(functions["constants"](p)[1]).reshape(-1)[0])
     if not (math.isfinite(period) and period > 0):
         return None
     cycle = period / compiled.cycles

@@ -176,8 +176,10 @@ def _place_labels(ax, drawn) -> None:
         if not inside.any():
             inside[:] = True
         obstacles = np.vstack([everything, *placed]) if placed else everything
-        # box distance in units of the text's half size: below 1 the text covers the obstacle
-        clearance = (np.abs(spots[:, None, :] - obstacles[None, :, :]) / half).max(axis=2).min(axis=1)
+        # box distance in units of the text's half size: below 1 the text covers the obstacle (the two coordinates'
+        # distances compared elementwise: a maximum over an axis of two is numpy's slowest reduction)
+        clearance = np.maximum(np.abs(spots[:, 0, None] - obstacles[None, :, 0]) / half[0],
+                               np.abs(spots[:, 1, None] - obstacles[None, :, 1]) / half[1]).min(axis=1)
         best = int(np.argmax(np.where(inside, clearance, -1.0)))
         anchor = anchors[best // len(steps)]
         spot = spots[best]

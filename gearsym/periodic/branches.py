@@ -98,12 +98,13 @@ class Continuation:
         rows = []
         for br in self.branches:
             moduli = np.abs(br.multipliers)
+            amplitude, stable = br.amplitude, br.stable  # (made once a branch, not once a row)
             located = set(br.events.tolist())
             for i in range(len(br)):
                 row = {"branch": br.index, "period_multiple": br.period_multiple, self.parameter: br.values[i]}
-                row.update({f"A_{c}": br.amplitude[i, j] for j, c in enumerate(self.observed)})
+                row.update({f"A_{c}": amplitude[i, j] for j, c in enumerate(self.observed)})
                 row.update({f"mu_abs_{j + 1}": moduli[i, j] for j in range(moduli.shape[1])})
-                row["stable"] = bool(br.stable[i])
+                row["stable"] = bool(stable[i])
                 row.update({f"contact_{m}": br.contact[i, j] for j, m in enumerate(self.meshes)})
                 row.update({f"min_{c}": br.low[i, j] for j, c in enumerate(self.observed)})
                 row.update({f"max_{c}": br.high[i, j] for j, c in enumerate(self.observed)})

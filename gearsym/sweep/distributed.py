@@ -30,13 +30,17 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .. import codegen
 from ..codegen import CompiledModel
-from ..codegen.portable import ShippedModel, load_shipped, ship
 from ..errors import GearsymError
 from .grid import INDEPENDENT, Point
+
+if TYPE_CHECKING:  # (the type only: the code generator and SymPy load when a model is shipped, on Dask alone)
+    from ..codegen.portable import ShippedModel
 
 #: the optional dependency, as the error says it
 EXTRA = 'pip install "gearsym[distributed]"'
@@ -141,7 +145,7 @@ def execute_dask(run, tasks: list[tuple[list[Point], np.ndarray]], client,
         info.update(workers=len(client.nthreads()), threads=threads)
     outstanding = set()  # a finished task is let go once its rows are yielded: the cluster frees them
     try:
-        model, shared = client.scatter([ship(run.compiled), run], broadcast=True, hash=False)
+        model, shared = client.scatter([codegen.ship(run.compiled), run], broadcast=True, hash=False)
         outstanding |= {model, shared}
         for points, start in _pieces(tasks, threads):
             if points[0].direction == INDEPENDENT:
@@ -206,7 +210,7 @@ def worker_model(shipped: ShippedModel) -> CompiledModel:
     if clone is None:
         with _MODELS_LOCK:
             if key not in _MODELS:
-                _MODELS[key] = load_shipped(shipped)
+                _MODELS[key] = codegen.load_shipped(shipped)
             base = _MODELS[key]
         clone = clones[key] = base.clone()
     if clone.system is not shipped.system:  # the same code, another sweep's parameter defaults
