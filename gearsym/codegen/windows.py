@@ -427,7 +427,7 @@ typedef int (*gs_fn)(const casadi_real**, casadi_real**, casadi_int*, casadi_rea
 typedef int (*gs_work_fn)(casadi_int*, casadi_int*, casadi_int*, casadi_int*);
 static const gs_fn gs_param[{p1}] = {{{table}}};
 static const gs_work_fn gs_param_work[{p1}] = {{{works}}};
-/* operations a step: each parameter's column function's, and every forcing at once with a column from its forcing */
+/* operations a step: each parameter's column (its forcing, then a column from it), and every forcing at once */
 static const casadi_int gs_param_cost[{p1}] = {{{costs}}};
 /* each channel's value, dh/dy and dh/dp */
 static const gs_fn gs_channel[{c1}] = {{{channels}}};
