@@ -229,18 +229,18 @@ def _cores_for_two_workers():
 def quick_reproduction(tmp_path_factory):
     """``gearsym reproduce --quick`` run once for the session, as the user runs it (into a folder of its own):
     its folder, its record, each scenario's computed plan (by scenario name) and every figure it wrote (by file
-    name), as written: laid out at the resolution it was written at, on an Agg canvas that draws that layout
-    (the layout engine set aside, as when it was saved), so that a check reads what the PNG shows."""
+    name), as written: at the resolution it was written at, its artists where the file's drawing put them
+    (figure_checks.as_saved), so that a check reads what the PNG shows."""
     import gearsym.figures.save as save
     import gearsym.reproduce as reproduction
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from figure_checks import as_saved
 
-    computed, figures = {}, {}
+    computed, figures, resolution = {}, {}, {}
     written, drawn = save.save_figure, reproduction.draw_all
 
-    def kept(fig, path, *args, **kwargs):
-        figures[Path(path).name] = fig
-        return written(fig, path, *args, **kwargs)
+    def kept(fig, path, dpi, **kwargs):
+        figures[Path(path).name], resolution[Path(path).name] = fig, dpi
+        return written(fig, path, dpi, **kwargs)
 
     def recorded(c, out, suffix=""):
         computed[c.plan.scenario.name] = c
@@ -251,9 +251,8 @@ def quick_reproduction(tmp_path_factory):
         patch.setattr(reproduction, "draw_all", recorded)
         patch.setattr(sys.modules["gearsym.reproduce.figures"], "save_figure", kept)
         record = reproduction.reproduce(out / "figures", out / "reproduction.md", quick=True)
-    for fig in figures.values():
-        FigureCanvasAgg(fig)  # (the closed figure's canvas: drawn as saved, not laid out again)
-        fig.set_layout_engine("none")
+    for name, fig in figures.items():
+        as_saved(fig, resolution[name])  # (read as the file's drawing left it: not laid out or drawn again)
     return SimpleNamespace(out=out, record=record, computed=computed, figures=figures)
 
 

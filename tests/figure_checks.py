@@ -3,6 +3,7 @@ its legends name what is drawn. Read from the laid-out Figure (drawn once, as it
 from __future__ import annotations
 
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import to_rgba
 from matplotlib.text import Text
 
@@ -14,6 +15,19 @@ def laid_out(fig):
         fig.canvas.draw()
         fig._checks_drawn = fig.canvas
     return fig.canvas.get_renderer()
+
+
+def as_saved(fig, dpi: float):
+    """``fig`` as ``save_figure`` left it after drawing it into its file at ``dpi`` (closed, which puts it on a
+    plain canvas at the screen's resolution): back on an Agg canvas at ``dpi``, its layout engine set aside, and
+    taken as drawn. Its artists are where the file's drawing put them, so the checks read what the file shows
+    without drawing it again (a figure changed since is drawn again by :func:`laid_out`)."""
+    FigureCanvasAgg(fig)
+    fig.set_dpi(dpi)
+    fig.set_layout_engine("none")
+    fig._checks_drawn = fig.canvas
+    fig.stale = False  # (stale only from its closing and the steps above: nothing in it changed since it was drawn)
+    return fig
 
 
 def _undrawn_tick_labels(fig) -> set[int]:
@@ -35,7 +49,7 @@ def clipped_texts(fig) -> list[str]:
     renderer = laid_out(fig)
     edge = fig.bbox
     undrawn = _undrawn_tick_labels(fig)
-    out = []
+    out, stale = [], fig.stale
     for text in fig.findobj(Text):
         if not text.get_visible() or not text.get_text().strip() or id(text) in undrawn:
             continue
@@ -45,6 +59,7 @@ def clipped_texts(fig) -> list[str]:
         box = text.get_window_extent(renderer)
         if box.x0 < edge.x0 - 1 or box.x1 > edge.x1 + 1 or box.y0 < edge.y0 - 1 or box.y1 > edge.y1 + 1:
             out.append(text.get_text())
+    fig.stale = stale  # (an annotation measured places its arrow as the draw did: nothing changed)
     return out
 
 

@@ -14,6 +14,9 @@ from gearsym import Execution, FirstOrderSystem, Integration
 from gearsym.analysis.basins import DIVERGED, UNDETERMINED, basin_map
 from gearsym.cli import main
 from gearsym.figures.basins import plot_basin_map
+from gearsym.physical.basins import GridAxis
+from gearsym.physical.sweeps import MeasuredAxis
+from gearsym.sweep.grid import parse_axis
 from gearsym.sweep.basin_continuation import APPEARS, VANISHES, continue_basins
 
 import conftest
@@ -232,6 +235,42 @@ def test_cli_errors_are_one_line_messages(capsys, argv, message):
     *before, last = err.strip().splitlines()
     assert code == 2 and message in last and last.startswith("gearsym: error:") and "Traceback" not in err
     assert all(line.startswith("gearsym: compiling") for line in before)  # (at most the note of a first compile)
+
+
+@pytest.mark.parametrize("model, grid, message", [
+    ("spur_pair", "x=-1A:1A:1A", "A: a drivetrain value is made of mass, length and time"),
+    ("one_stage", "x=-1A:1A:1A", "has a unit, but the model has no physical values"),  # (its unit read, not said)
+])
+def test_a_grid_in_a_unit_of_another_kind_is_refused_before_the_model_is_compiled(capsys, model, grid, message):
+    code, _, err = run_cli(capsys, "basins", model, "--grid", grid, "--grid", "v=0,1")
+    assert code == 2 and message in err and "compiling" not in err
+
+
+def test_a_grid_axis_is_read_into_si_units_once_when_it_is_parsed():
+    axis = GridAxis.read("x=-20um:20um:20um")
+    assert axis.values == (-20.0, 0.0, 20.0) and axis.unit == "um" and axis.dims == (0.0, 1.0, 0.0)
+    assert axis.si_values == pytest.approx((-2e-5, 0.0, 2e-5), rel=1e-15)
+    assert GridAxis.read("v=-1,1").dims is None and GridAxis.read("v=-1,1").si_values == ()
+
+
+@pytest.mark.parametrize("model, param, message", [
+    ("spur_pair", "speed=1A,2A", "--param 'speed=1A,2A': a drivetrain value is made of mass, length and time"),
+    ("spur_pair", "speed=9000:11000:2000", "write speed=9000rpm:11000rpm:2000rpm"),
+    ("one_stage", "omega=1A,2A", "has a unit, but the model has no physical values"),  # (its unit read, not said)
+])
+def test_a_parameter_in_a_unit_of_another_kind_is_refused_before_the_model_is_compiled(capsys, tmp_path, model,
+                                                                                        param, message):
+    grid = ("x=-1um:1um:1um", "v=0mm/s,1mm/s") if model == "spur_pair" else ("x=-1:1:1", "v=0,1")
+    code, _, err = run_cli(capsys, "basins", model, "--grid", grid[0], "--grid", grid[1], "--param", param,
+                           "--out", str(tmp_path / "c.csv"))
+    assert code == 2 and message in err and "compiling" not in err and not list(tmp_path.iterdir())
+
+
+def test_a_parameter_axis_is_read_in_its_unit_once_when_it_is_parsed():
+    axis = MeasuredAxis.read("speed=9000rpm:11000rpm:2000rpm")
+    assert [m.si for m in axis.measures] == pytest.approx([9000 * math.pi / 30, 11000 * math.pi / 30], rel=1e-15)
+    assert {m.dims for m in axis.measures} == {(0.0, 0.0, -1.0)} and axis.plain == parse_axis(axis.spec)
+    assert MeasuredAxis.read("omega=1,2").measures == () and not MeasuredAxis.read("omega=1,2").refused
 
 
 @pytest.mark.slow

@@ -142,9 +142,16 @@ def at_200_steps():
             for locate in (False, True)}
 
 
+@pytest.fixture(scope="module")
+def dop853_at_1_5():
+    """DOP853's exponents of one_stage at omega = 1.5 over at_200_steps' 60 periods (20 discarded): 3 s of SciPy
+    calling Python, made once for the two tests that compare with them."""
+    return dop853_exponents(1.5, 60, 20)
+
+
 @pytest.mark.slow
-def test_agrees_with_dop853_where_plain_rk4_does_not(at_200_steps):
-    reference = dop853_exponents(1.5, 60, 20)
+def test_agrees_with_dop853_where_plain_rk4_does_not(at_200_steps, dop853_at_1_5):
+    reference = dop853_at_1_5
     located = np.abs(at_200_steps[True] - reference).max()
     plain = np.abs(at_200_steps[False] - reference).max()
     assert located <= 1e-6, located  # measured 4.5e-9
@@ -156,11 +163,11 @@ def test_sum_rule_holds_with_crossings_located(at_200_steps):
 
 
 @pytest.mark.slow
-def test_the_default_integration_locates_the_crossings(at_200_steps):
+def test_the_default_integration_locates_the_crossings(at_200_steps, dop853_at_1_5):
     """gearsym.lyapunov_spectrum with no scheme asked for: DOP853's exponents, not the paper's plain RK4's."""
     default = gearsym.lyapunov_spectrum(system("one_stage"), options=Integration(periods=60, discard=20),
                                         omega=1.5).exponents
-    assert np.abs(default - dop853_exponents(1.5, 60, 20)).max() <= 1e-7
+    assert np.abs(default - dop853_at_1_5).max() <= 1e-7
     assert np.abs(default - at_200_steps[False]).max() >= 1e-4  # plain RK4 is 1e-3 off
     assert Integration().locate_crossings and not Integration.paper().locate_crossings
 

@@ -73,9 +73,12 @@ def _records_equal(a, b) -> list[str]:
 
 @needs_cc
 @pytest.mark.parametrize("name, located, omega", [("one_stage", True, 1.5), ("one_stage", False, 1.0),
-                                                  ("lorenz", False, None)])
+                                                  ("lorenz", True, None)])
 @pytest.mark.slow
 def test_every_lane_gives_the_bits_of_the_scalar_loop_from_its_start(name, located, omega, tmp_path):
+    """one_stage with its backlash split and in plain blocks of steps; Lorenz (no switching surface: single steps,
+    as located) chaotic, where a differing bit grows. (Lorenz's scalar library is test_printed_loops.py's: the same
+    C and flags; its lanes' C of single steps compiles in 60 % of the time of the blocks' C.)"""
     model, lanes = _built(name, loop_options(located), tmp_path)
     assert lanes.width >= 2, "the portable build has lanes (cloned for AVX2 and the baseline on x86-64)"
     values = {"omega": omega} if omega else {}
@@ -89,7 +92,7 @@ def test_every_lane_gives_the_bits_of_the_scalar_loop_from_its_start(name, locat
         one = LaneRunner(model, 7, 30, lanes=False).orbits(starts, inputs, tangent=tangent)
         assert np.isfinite(one.strobe).all()
         assert _records_equal(wide, one) == [], (name, located, tangent)
-    if located:  # the lanes' split ran: some trajectory crossed the backlash surface x = 0
+    if located and name == "one_stage":  # the lanes' split ran: some trajectory crossed the backlash surface x = 0
         x = one.strobe[:, :, 0]
         assert ((x.min(axis=1) < 0) & (x.max(axis=1) > 0)).any()
 

@@ -269,10 +269,13 @@ def test_the_face_leaves_numpy_to_the_command_which_imports_with_the_collector_p
 
 
 @pytest.mark.parametrize("given", [{}, {"OMP_NUM_THREADS": "2"}, {"OPENBLAS_NUM_THREADS": "2"}])
-def test_the_command_runs_numpys_blas_on_one_thread_unless_told_otherwise(given):
-    """Set before NumPy is imported, in the command's own process only (its pool of threads was a tenth of a
-    cached model's start-up); a thread count the user set is kept."""
-    script = ("import os, sys; from gearsym.cli import main; sys.argv = ['gearsym', 'list']; "
+def test_the_command_runs_numpys_blas_on_one_thread_unless_told_otherwise(given, capsys):
+    """Set before NumPy is imported, in the command's own process only (its pool of threads was a tenth of a cached
+    model's start-up); a thread count the user set is kept. (A caller's process: the test after this one.) The
+    command: a spectrum of a cached model (cached here first), which runs NumPy's linear algebra."""
+    lyap(capsys, "one_stage")
+    script = ("import os, sys; from gearsym.cli import main; "
+              f"sys.argv = ['gearsym', 'lyap', 'one_stage', *{ARGS!r}]; "
               "main(); print([os.environ.get(k) for k in ('OPENBLAS_NUM_THREADS', 'OMP_NUM_THREADS')])")
     env = {k: v for k, v in os.environ.items() if not k.endswith("_NUM_THREADS")}
     run = subprocess.run([sys.executable, "-c", script],
@@ -280,7 +283,11 @@ def test_the_command_runs_numpys_blas_on_one_thread_unless_told_otherwise(given)
                          env={**env, **given, "PYTHONPATH": str(REPO_ROOT)})
     told = [given.get("OPENBLAS_NUM_THREADS", "1" if not given else None), given.get("OMP_NUM_THREADS")]
     assert run.stdout.strip().splitlines()[-1] == repr(told)
-    in_a_caller = subprocess.run([sys.executable, "-c", "import os; from gearsym.cli import main; main(['list']); "
-                                  "print(os.environ.get('OPENBLAS_NUM_THREADS'))"], capture_output=True, text=True,
-                                 cwd=REPO_ROOT, timeout=120, check=True, env={**env, "PYTHONPATH": str(REPO_ROOT)})
-    assert in_a_caller.stdout.strip().splitlines()[-1] == "None"
+
+
+def test_a_caller_of_main_keeps_its_blas_threads_as_they_were(monkeypatch, capsys):
+    """main(argv) called from a caller's process (a notebook, a script) leaves the caller's environment alone."""
+    for name in [k for k in os.environ if k.endswith("_NUM_THREADS")]:
+        monkeypatch.delenv(name)
+    assert lyap(capsys, "one_stage")["exponents"]
+    assert not [k for k in os.environ if k.endswith("_NUM_THREADS")]

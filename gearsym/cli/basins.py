@@ -15,11 +15,11 @@ from ..files.atomic import write_atomically
 from ..files.outputs import check_figure, check_file
 from ..opening import open_model
 from ..options import Execution
-from ..physical.basins import PhysicalGrid, ShownBasinMap, ShownFractions, shown_in
+from ..physical.basins import GridAxis, PhysicalGrid, ShownBasinMap, ShownFractions, shown_in
 from ..physical.files import write_basin_fractions, write_basin_map
-from ..physical.sweeps import nondimensional_axes
+from ..physical.sweeps import MeasuredAxis, engine_axis
 from ..sweep.basin_continuation import MATCH_DISTANCE, StartGrid, continue_basins
-from ..sweep.grid import Axis, parse_axis
+from ..sweep.grid import Axis
 from ..sweep.store import sidecar
 from .arguments.integration import add_integration_arguments, integration_from, model_request
 from .arguments.settings import add_set_argument, parse_state
@@ -28,21 +28,16 @@ NAME = "basins"
 HELP = "basins of attraction on a grid of starts (attractors by their Poincare sets), and their fractions along a parameter"
 
 
-def grid_axis(text: str) -> Axis:
-    """One --grid axis (its errors name --grid)."""
-    return parse_axis(text, "--grid")
-
-
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("model", help="a model name (see `gearsym list`) or the path of a model file")
     add_set_argument(parser)
-    parser.add_argument("--grid", type=grid_axis, action="append", required=True, metavar="STATE=START:STOP:STEP",
+    parser.add_argument("--grid", type=GridAxis.read, action="append", required=True, metavar="STATE=START:STOP:STEP",
                         help="the starts of one state (stop included; V1,V2,... also); give two states, the "
                              "others are held at --y0 (a model with physical values: with units, x=-20um:20um:1um, "
                              "v=-500mm/s:500mm/s:25mm/s)")
     parser.add_argument("--y0", type=parse_state, metavar="x1=0,v1=0",
                         help="where the states off the grid start (default: the model's)")
-    parser.add_argument("--param", type=parse_axis, metavar="NAME=START:STOP:STEP",
+    parser.add_argument("--param", type=MeasuredAxis.read, metavar="NAME=START:STOP:STEP",
                         help="the basin fractions along this parameter, each attractor followed by its Poincare "
                              "set (needs --out; resumable: the same command continues an interrupted run)")
     add_integration_arguments(parser, **RUN)
@@ -83,18 +78,17 @@ def run(args: argparse.Namespace) -> int:
         if unit:
             raise GearsymError(f"{unit.spec!r} has a unit, but the model has no physical values; give the model's own "
                                "numbers")
+    shown_as = shown_in(units, request.settings)
     # (a grid in physical units is checked here, once, before the model is compiled)
     physical_grid = PhysicalGrid(units, grid_axes) if units is not None else None
     if axis is not None and physical_grid is not None:  # (the parameter in the engine's numbers, also before)
-        axis = nondimensional_axes(model.scaling.full, [axis])[0]
+        axis = engine_axis(model.scaling.full, axis)
     compiled = model.compiled()
     if axis is not None:
-        return _continuation(args, compiled, grid_axes, physical_grid, axis, shown_in(units, request.settings), y0,
-                             execution)
+        return _continuation(args, compiled, grid_axes, physical_grid, axis, shown_as, y0, execution)
     # (the engine's starts at the compiled model's speed: a rate's engine unit moves with it)
     starts = (physical_grid.at(dict(zip(compiled.parameter_names, compiled.parameter_vector()))) if physical_grid
               else {a.name: a.values for a in grid_axes})
-    shown_as = shown_in(units, request.settings)
     result = basin_map(compiled, starts, y0=y0, execution=execution)
     shown = ShownBasinMap(result, shown_as, tuple(grid_axes))
     write_map(shown, args.out, args.plot)

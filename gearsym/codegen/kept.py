@@ -133,27 +133,30 @@ def kept_model(summary, build_file: Path, options: Integration):
         why = "it names parameters its model does not have"
     else:
         verdict = check(build.library)
-        if verdict.data is None:  # (gone or not as compiled: made again from its C, the compiler says why)
+        if verdict.data is not None:  # (as recorded: it is loaded if it is the library its summaries describe)
+            why = differences(verdict.describes, library_describes(summary, build.hash))
+            if why is None:
+                return library_model(summary, build.hash, build.library, options, build.timed_parameters,
+                                     build.table_texts, summary.fastest)
+            why = f"{build.library.name}, the library it points at, does not match it: {why}"
+        else:  # (gone or not as compiled: made again from its C, the compiler says why)
             return _compiled_again(summary, build, build_file, options)
-        why = differences(verdict.describes, library_describes(summary, build.hash))
-        if why is None:  # (the summaries describe the library they point at)
-            return library_model(summary, build.hash, build.library, options, build.timed_parameters,
-                                 build.table_texts, summary.fastest)
-        why = f"{build.library.name}, the library it points at, does not match it: {why}"
     distrust(build_file, why, WHAT)  # (edited: said once, and the summaries are written again)
     return None
 
 
 def _compiled_again(summary, build: BuildSummary, build_file: Path, options: Integration):
     """The compiled model of ``build`` with its library compiled again from its C (the build summary written again
-    if the library's name changed), or None: no C that vouches for it (the model is loaded, its C generated)."""
+    if the library's name changed, once it has loaded), or None: no C that vouches for it (the model is loaded, its
+    C generated)."""
     library = library_from_code(summary, build.hash)
     if library is None:
         return None
-    if library != build.library:
+    compiled = library_model(summary, build.hash, library, options, build.timed_parameters, build.table_texts,
+                             summary.fastest)
+    if library != build.library:  # (once it has loaded: a summary never points at a library that did not)
         write_json(build_file, BuildSummary(build.hash, library, build.timed_parameters, build.table_texts).as_dict())
-    return library_model(summary, build.hash, library, options, build.timed_parameters, build.table_texts,
-                         summary.fastest)
+    return compiled
 
 
 def keep_model(name: str, key: str, compiled, units=None) -> None:

@@ -1,17 +1,17 @@
 """Basin maps and basin fractions as they are shown: in a model's units when it has physical values (a grid in
 µm and mm/s, the speed in rpm), else in its own numbers.
 
-A grid given in physical units is checked and put in SI units once (:class:`PhysicalGrid`), and turned into the
-engine's nondimensional starts at each forcing frequency (a rate's unit, L omega omega_n per second, moves with the
-speed: :func:`engine_grid`); the results come back through the same numbers
-(:class:`~gearsym.physical.point.PointUnits`: the length unit L, omega_n, the speed's ratio). :class:`ShownBasinMap`
-and :class:`ShownFractions` are the results in those units, which the files (:mod:`.files`), the command's text
-and the figures (:mod:`gearsym.figures.basins`) take.
+A grid given in physical units is read into SI units once, when it is parsed (:class:`GridAxis`), checked against
+the model's states once (:class:`PhysicalGrid`), and turned into the engine's nondimensional starts at each forcing
+frequency (a rate's unit, L omega omega_n per second, moves with the speed: :func:`engine_grid`); the results come
+back through the same numbers (:class:`~gearsym.physical.point.PointUnits`: the length unit L, omega_n, the speed's
+ratio). :class:`ShownBasinMap` and :class:`ShownFractions` are the results in those units, which the files
+(:mod:`.files`), the command's text and the figures (:mod:`gearsym.figures.basins`) take.
 """
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -19,7 +19,7 @@ from ..analysis.basins import BasinMap
 from ..checks import json_safe
 from ..errors import GearsymError
 from ..sweep.basin_continuation import BasinContinuation, StartGrid
-from ..sweep.grid import Axis
+from ..sweep.grid import Axis, parse_axis
 from ..units import dimension_text, to_si, unit_dims
 from .point import ANGLE, ANGULAR_VELOCITY, LENGTH, VELOCITY, PointUnits
 from .text import parameter_text
@@ -107,7 +107,32 @@ _DIMENSIONS = {LENGTH: ((0.0, 1.0, 0.0), "-20um:20um:1um"), VELOCITY: ((0.0, 1.0
                ANGULAR_VELOCITY: ((0.0, 0.0, -1.0), "-10rad/s:10rad/s:1rad/s")}
 
 
-def grid_in_si(units: PointUnits, axes: Sequence[Axis]) -> dict[str, np.ndarray]:
+@dataclass(frozen=True)
+class GridAxis(Axis):
+    """One ``--grid`` axis as given, its unit read once when it is parsed (:meth:`read`): its values in SI units and
+    the unit's dimension (exponents of mass, length and time), or why the unit is no drivetrain's (``refused``: a
+    model with physical values says it, one without says that it takes no unit)."""
+
+    si_values: tuple[float, ...] = ()
+    dims: tuple[float, float, float] | None = None
+    refused: str = ""
+
+    @classmethod
+    def read(cls, text: str) -> "GridAxis":
+        """``STATE=START:STOP:STEP`` (or a list, or one value), with or without a unit (its errors name --grid)."""
+        axis = parse_axis(text, "--grid")
+        plain = {f.name: getattr(axis, f.name) for f in fields(Axis)}
+        if not axis.unit:
+            return cls(**plain)
+        try:
+            dims = unit_dims(axis.unit)
+        except GearsymError as exc:
+            return cls(**plain, refused=str(exc))
+        values = to_si(np.asarray(axis.values, dtype=float), axis.unit)
+        return cls(**plain, si_values=tuple(float(v) for v in values), dims=dims)
+
+
+def grid_in_si(units: PointUnits, axes: Sequence[GridAxis]) -> dict[str, np.ndarray]:
     """The values of grid ``axes`` in SI units (an axis of a state without a physical kind: the model's own
     numbers), each axis of a state with a physical kind checked to have a unit of that kind's dimension (a
     length, a rate)."""
@@ -123,12 +148,13 @@ def grid_in_si(units: PointUnits, axes: Sequence[Axis]) -> dict[str, np.ndarray]
         if not axis.unit:
             raise GearsymError(f"--grid {axis.spec!r}: {axis.name} is a {kind} of {units.name}, which has physical "
                                f"values: give the grid with its unit, e.g. {example}")
-        got = unit_dims(axis.unit)
-        if got != expected:
+        if axis.dims is None:
+            raise GearsymError(axis.refused)
+        if axis.dims != expected:
             raise GearsymError(f"--grid {axis.spec!r}: {axis.name} is a {kind} of {units.name} "
-                               f"({dimension_text(expected)}), but {axis.unit} is {dimension_text(got)}; give it in "
-                               f"a unit of a {kind}, e.g. {example}")
-        grid[axis.name] = to_si(values, axis.unit)
+                               f"({dimension_text(expected)}), but {axis.unit} is {dimension_text(axis.dims)}; give it "
+                               f"in a unit of a {kind}, e.g. {example}")
+        grid[axis.name] = np.asarray(axis.si_values, dtype=float)
     return grid
 
 
@@ -235,7 +261,7 @@ class PhysicalGrid(StartGrid):
     engine values at each forcing frequency (a rate's unit moves with the speed), and the grid as given in the
     record."""
 
-    def __init__(self, units: PointUnits, axes: Sequence[Axis]):
+    def __init__(self, units: PointUnits, axes: Sequence[GridAxis]):
         super().__init__({a.name: a.values for a in axes}, [a.spec for a in axes])
         self.units, self.axes, self.si_grid = units, tuple(axes), grid_in_si(units, axes)
 

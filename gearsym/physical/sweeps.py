@@ -6,11 +6,12 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING
 
 from ..errors import GearsymError
-from ..sweep.grid import Axis, axes_from
-from ..units import as_quantity, is_quantity, measure_in, symbol
+from ..sweep.grid import Axis, axes_from, parse_axis
+from ..units import Measure, as_quantity, is_quantity, measure_in, symbol
 
 if TYPE_CHECKING:  # (the type only: a sweep of a cached model reads this module without SymPy)
     from ..scales.map import Scaling
@@ -19,25 +20,70 @@ if TYPE_CHECKING:  # (the type only: a sweep of a cached model reads this module
 _PLAIN_UNIT = re.compile(r"[A-Za-zµμ]+")
 
 
+@dataclass(frozen=True)
+class MeasuredAxis(Axis):
+    """An axis whose values carry a unit, read once (:meth:`of`; :meth:`read` for a ``--param`` as written): each
+    value as a :class:`~gearsym.units.Measure` (in SI, its dimension, as given), or why they cannot be read
+    (``refused``: said where they are used, after the checks that come before it)."""
+
+    measures: tuple[Measure, ...] = ()
+    refused: str = ""
+
+    @classmethod
+    def of(cls, axis: Axis, where: str | None = None) -> "MeasuredAxis":
+        """``axis`` with its values read in its unit (none without one); ``where`` names it in errors (default the
+        ``--param`` it was written as)."""
+        if isinstance(axis, cls):
+            return axis
+        plain = _fields(axis)
+        if not axis.unit:
+            return cls(**plain)
+        where = where or f"--param {axis.spec!r}"
+        try:
+            return cls(**plain, measures=tuple(measure_in(v, axis.unit, where) for v in axis.values))
+        except GearsymError as exc:
+            return cls(**plain, refused=str(exc))
+
+    @classmethod
+    def read(cls, text: str) -> "MeasuredAxis":
+        """A ``--param`` axis (``NAME=START:STOP:STEP``, a list or one value, with or without a unit)."""
+        return cls.of(parse_axis(text))
+
+    @property
+    def plain(self) -> Axis:
+        """The axis as it was given (its values in their unit)."""
+        return Axis(**_fields(self))
+
+
+def _fields(axis: Axis) -> dict:
+    return {f.name: getattr(axis, f.name) for f in fields(Axis)}
+
+
 def nondimensional_axis(scaling: Scaling, axis: Axis, where: str | None = None) -> Axis:
     """The engine's axis for ``axis``: a physical value swept (with a unit) becomes the one nondimensional
     parameter it changes; other axes pass as they are. ``where`` names the entry in errors (default the
     ``--param`` it was written as)."""
+    return engine_axis(scaling, MeasuredAxis.of(axis, where), where)
+
+
+def engine_axis(scaling: Scaling, axis: MeasuredAxis, where: str | None = None) -> Axis:
+    """:func:`nondimensional_axis` of an axis whose values were read in their unit already."""
     where = where or f"--param {axis.spec!r}"
     name = axis.name
     if name not in scaling.inputs and not (scaling.speed and name == scaling.speed.parameter):
         if axis.unit:
             raise GearsymError(f"{where}: {name} is not a physical value of {scaling.name}, so it takes no unit; "
                                f"physical values: {', '.join(scaling.roles)}")
-        return axis
+        return axis.plain
     if not axis.unit:
         unit = scaling.unit_needed(name)
         if unit:
             raise GearsymError(f"{where}: {name}: "
                                f"{scaling.unitless(name, axis.values[0], _spelled(axis, unit, where))}")
-    unit = axis.unit
+    if axis.refused:
+        raise GearsymError(axis.refused)
     base = scaling.values
-    columns = [scaling.values_at(**{name: measure_in(v, unit, where)}) for v in axis.values]
+    columns = [scaling.values_at(**{name: value}) for value in axis.measures]
     moved = sorted({k for row in columns for k in row if row[k] != base[k]} or {scaling.parameter_moved_by(name)})
     if len(moved) != 1:
         raise GearsymError(f"{where}: {name} moves {', '.join(moved)} of the nondimensional model "
