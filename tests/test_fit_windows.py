@@ -9,6 +9,7 @@ import sympy as sp
 import conftest
 from gearsym.codegen.windows import Windows
 from gearsym.fit import augment
+from gearsym.fit.observed import observed_windows
 
 
 @pytest.fixture(scope="module")
@@ -39,6 +40,26 @@ def test_compiled_and_in_process_windows_agree(case):
     for a, b in zip((compiled.states, compiled.outputs, compiled.derivatives),
                     (inprocess.states, inprocess.outputs, inprocess.derivatives)):
         np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-12)
+    some = Windows(system, channels, "compiled").run(*args, channels=[2, 0])  # a call computes the channels it asks
+    assert np.array_equal(some.outputs, compiled.outputs[[2, 0]])
+    assert np.array_equal(some.derivatives, compiled.derivatives[[2, 0]])
+
+
+def test_a_displacement_and_an_accelerometer_in_seconds_are_read_from_one_library(case):
+    """x and 62500 x_ddot (an accelerometer in seconds, tau = 250 t) come from the model's one library of its states
+    and rates: x the same bits as a library of its own gives, x_ddot its rate times the scale; a channel with the
+    time in it has a library of its own."""
+    system, _, (starts, t0, dt, samples, substeps, p) = case
+    x, x_ddot = system.states[0], sp.Symbol("x_ddot", real=True)
+    shown = observed_windows(system, [x], "in-process")
+    felt = observed_windows(system, [62500.0 * x_ddot], "in-process")
+    assert shown.windows is felt.windows
+    own = Windows(system, [x, system.rhs[1]], "in-process").run(starts, t0, dt, samples, substeps, p, columns=[1, 3])
+    a, b = (w.run(starts, t0, dt, samples, substeps, p, columns=[1, 3]) for w in (shown, felt))
+    assert np.array_equal(a.outputs, own.outputs[:1]) and np.array_equal(a.derivatives, own.derivatives[:1])
+    assert np.array_equal(b.outputs, 62500.0 * own.outputs[1:]) and np.array_equal(b.derivatives,
+                                                                                   62500.0 * own.derivatives[1:])
+    assert isinstance(observed_windows(system, [sp.cos(7 * system.time) * x], "in-process"), Windows)
 
 
 @pytest.mark.slow
@@ -104,8 +125,9 @@ def test_every_column_at_once_is_each_column_asked_for_alone(case):
     system, channels, args = case
     windows = Windows(system, channels, "compiled")
     f = windows.functions
-    one_by_one = sum(f[f"fit_param_{j}"].n_instructions() for j in range(windows.parameters))
-    assert f["fit_forcing"].n_instructions() + windows.parameters * f["fit_column_forced"].n_instructions() < one_by_one
+    forced = f["fit_column_forced"].n_instructions()  # (a column from its forcing: each parameter's own, or all)
+    one_by_one = sum(f[f"fit_param_{j}"].n_instructions() + forced for j in range(windows.parameters))
+    assert f["fit_forcing"].n_instructions() + windows.parameters * forced < one_by_one
     every = windows.run(*args).derivatives
     n = system.dimension
     for j in range(windows.parameters):

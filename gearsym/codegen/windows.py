@@ -13,9 +13,10 @@ state and by the parameters. Here that is one C call for all windows:
 * the same step by columns (:func:`column_functions`), on what depends on time and the parameters alone computed
   once per time point: ``fit_times`` (those values W, a shaft-order library's tooth windows and harmonics, and their
   derivatives D by the parameters), ``fit_stages`` (the state's step, its stage states and Jacobians),
-  ``fit_state_step`` (the step alone), ``fit_column`` (a start state's column), ``fit_param_<j>`` (parameter j's),
-  ``fit_channels``; and for many columns at once ``fit_forcing`` (df/dp of every parameter at the four stages, its
-  common subexpressions computed once) with ``fit_column_forced`` (a column from its forcing);
+  ``fit_state_step`` (the step alone), ``fit_column`` (a start state's column), ``fit_param_<j>`` (parameter j's
+  forcing, df/dp_j at the four stages), ``fit_column_forced`` (a column from its forcing), ``fit_channel_<k>``; and for
+  many columns at once ``fit_forcing`` (df/dp of every parameter at the four stages, its common subexpressions
+  computed once);
 * ``gearsym_fit_windows`` (hand-written C around the column functions): every window from its start
   state, its samples ``substeps`` RK4 steps apart, the outputs and the derivatives by the start state and
   the parameters asked for written into the caller's arrays.
@@ -70,7 +71,7 @@ from .translate import to_casadi
 from .trust import record, trusted
 
 #: bump when the generated window code changes for the same system and channels
-WINDOWS_VERSION = 5
+WINDOWS_VERSION = 7
 _OPTS = {"cse": True}
 #: RK4 steps in a call below which its windows run in one thread
 MIN_SHARED_STEPS = 20_000
@@ -165,12 +166,15 @@ def column_functions(system: FirstOrderSystem, f: ca.SX, out: ca.SX, sym: System
     values W and their derivatives by the parameters D) and passed to the step's functions, which work on the rest:
     ``fit_stages`` (the state's step, its RK4 stage states and each stage's Jacobian dy), ``fit_state_step`` (the
     step alone), ``fit_column`` (a start state's column: Q' = J Q at those stages), ``fit_param_<j>`` (parameter j's
-    column, its forcing df/dp_j = dF/dp_j + dF/dW D_j at the stages: the augmented system's RK4, as ``fit_step``
-    computes it), ``fit_forcing`` (every parameter's forcing at the four stages at once) with
-    ``fit_column_forced`` (a column from its forcing), and ``fit_channels`` (the channels, dh/dy and dh/dp). The
-    stages' times are t, t + h/2, t + h: W and D come as three columns (blocks), one per time. The driver computes W
-    and D by groups (``fit_times_<g>``: a group's values and derivatives), skipping in a window the groups whose
-    parameters leave them unused there (:mod:`.time_gates`: a candidate effect at 0 costs no time values)."""
+    forcing df/dp_j = dF/dp_j + dF/dW D_j at the four stages), ``fit_forcing`` (every parameter's forcing at once),
+    ``fit_column_forced`` (a parameter's column from its forcing: the augmented system's RK4, as ``fit_step``
+    computes it), and ``fit_channel_<k>`` (channel k, dh/dy and dh/dp). The stages' times are t, t + h/2, t + h: W
+    and D come as three columns (blocks), one per time. (A parameter's function is its forcing alone, the column's
+    RK4 written once for all in ``fit_column_forced``: the same operations as a whole column per parameter, a fifth
+    less C to compile: the one-stage model's library of every candidate 347 -> 287 kB, gcc 4.3 -> 3.4 s.) The
+    driver computes W and D by groups (``fit_times_<g>``: a group's values and derivatives), skipping in a window
+    the groups whose parameters leave them unused there (:mod:`.time_gates`: a candidate effect at 0 costs no time
+    values)."""
     n, m = system.dimension, sym.p.numel()
     y, t, p, h = sym.y, sym.t, sym.p, ca.SX.sym("h")
     rest, symbols, parametric = ca.extract_parametric(f, ca.vertcat(t, p), {})
@@ -227,16 +231,18 @@ def column_functions(system: FirstOrderSystem, f: ca.SX, out: ca.SX, sym: System
                "fit_state_step": state_step,
                "fit_column": ca.Function("fit_column", [q, J, h], [ca.densify(column(zero))], _OPTS)}
     forcings = [dfdp(i) for i in range(4)]
-    for j in range(m):
-        out_fns[f"fit_param_{j}"] = ca.Function(f"fit_param_{j}", [q, J, Y, W, D, h, p],
-                                                [ca.densify(column([fi[:, j] for fi in forcings]))], _OPTS)
+    for j in range(m):  # parameter j's forcing at the four stages, (n, 4): its column is fit_column_forced's
+        out_fns[f"fit_param_{j}"] = ca.Function(f"fit_param_{j}", [Y, W, D, p],
+                                                [ca.densify(ca.horzcat(*[fi[:, j] for fi in forcings]))], _OPTS)
     # every parameter's forcing at the four stages at once, (n, 4 m): stage i's df/dp in columns i m ... i m + m - 1
     out_fns["fit_forcing"] = ca.Function("fit_forcing", [Y, W, D, h, p], [ca.densify(ca.horzcat(*forcings))], _OPTS)
     F = ca.SX.sym("F", n, 4)
     out_fns["fit_column_forced"] = ca.Function("fit_column_forced", [q, J, F, h],
                                                [ca.densify(column([F[:, i] for i in range(4)]))], _OPTS)
-    out_fns["fit_channels"] = ca.Function("fit_channels", [y, t, p], [ca.densify(out), ca.densify(ca.jacobian(out, y)),
-                                                                      ca.densify(ca.jacobian(out, p))], _OPTS)
+    for k in range(out.numel()):  # (one function a channel: a call computes only the channels it asks for)
+        h_k = out[k]
+        out_fns[f"fit_channel_{k}"] = ca.Function(f"fit_channel_{k}", [y, t, p], [
+            ca.densify(h_k), ca.densify(ca.jacobian(h_k, y)), ca.densify(ca.jacobian(h_k, p))], _OPTS)
     return WindowFunctions(out_fns, groups)
 
 
@@ -271,7 +277,7 @@ class Windows:
         call = lib.gearsym_fit_windows
         call.restype = ctypes.c_int
         call.argtypes = ([ctypes.c_longlong] + [ctypes.c_void_p] * 6 + [ctypes.c_longlong] * 2
-                         + [ctypes.c_void_p] * 4)
+                         + [ctypes.c_void_p, ctypes.c_longlong] + [ctypes.c_void_p] * 4)
         return call
 
     def _source(self) -> str:
@@ -282,22 +288,28 @@ class Windows:
         table = ", ".join(f"fit_param_{j}" for j in range(self.parameters)) or "0"
         works = ", ".join(f"fit_param_{j}_work" for j in range(self.parameters)) or "0"
         functions = self.functions
-        costs = ", ".join(str(functions[f"fit_param_{j}"].n_instructions()) for j in range(self.parameters)) or "0"
+        forced = functions["fit_column_forced"].n_instructions()
+        costs = ", ".join(str(functions[f"fit_param_{j}"].n_instructions() + forced)
+                          for j in range(self.parameters)) or "0"
+        channels = ", ".join(f"fit_channel_{k}" for k in range(len(self.channels))) or "0"
+        channel_works = ", ".join(f"fit_channel_{k}_work" for k in range(len(self.channels))) or "0"
         times = functions["fit_times"]
         return gen.dump() + _DRIVER.format(n=self.n, p=self.parameters, c=len(self.channels), table=table,
                                            nw=times.nnz_out(0), nd=times.nnz_out(1),
                                            works=works, p1=max(1, self.parameters), costs=costs,
+                                           channels=channels, channel_works=channel_works,
+                                           c1=max(1, len(self.channels)),
                                            forcing=functions["fit_forcing"].n_instructions(),
-                                           forced=functions["fit_column_forced"].n_instructions(),
-                                           **_group_tables(functions))
+                                           forced=forced, **_group_tables(functions))
 
     def run(self, starts: np.ndarray, t0: Sequence[float], dt: Sequence[float], samples: Sequence[int],
             substeps: Sequence[int], parameters: np.ndarray, tangent: bool = True,
-            columns: Sequence[int] | None = None) -> WindowRun:
+            columns: Sequence[int] | None = None, channels: Sequence[int] | None = None) -> WindowRun:
         """Every window k from ``starts[:, k]`` at time ``t0[k]``: ``samples[k]`` samples ``dt[k]`` apart,
         ``substeps[k]`` RK4 steps between samples, parameter vector ``parameters[:, k]``. With ``tangent``, the
         derivatives by the start state and by the parameters ``columns`` (their indices; default every one), in
-        that order: a fit pays only for the columns it asks for."""
+        that order: a fit pays only for the columns it asks for, and for the ``channels`` (indices into
+        ``self.channels``; default every one), which are the outputs' rows in that order."""
         starts = np.asfortranarray(starts, dtype=float)
         parameters = np.asfortranarray(parameters, dtype=float)
         samples = np.ascontiguousarray(samples, dtype=np.int64)
@@ -307,12 +319,16 @@ class Windows:
         if chosen.size and (chosen.min() < 0 or chosen.max() >= self.parameters):
             raise GearsymError(f"parameter columns {chosen.tolist()} out of range (0 ... {self.parameters - 1})")
         chosen = np.ascontiguousarray(chosen, dtype=np.int64)
-        total, c, width = int(samples.sum()), len(self.channels), self.n + chosen.size
+        observed = np.arange(len(self.channels)) if channels is None else np.asarray(channels, np.int64).reshape(-1)
+        if observed.size and (observed.min() < 0 or observed.max() >= len(self.channels)):
+            raise GearsymError(f"channels {observed.tolist()} out of range (0 ... {len(self.channels) - 1})")
+        observed = np.ascontiguousarray(observed, dtype=np.int64)
+        total, c, width = int(samples.sum()), observed.size, self.n + chosen.size
         states = np.zeros((self.n, total), order="F")
         outputs = np.zeros((c, total), order="F")
         derivatives = np.zeros((c, width, total), order="F") if tangent else None
         if self._library is not None:
-            arrays = (samples, substeps, t0, dt, starts, parameters, chosen, states, outputs, derivatives)
+            arrays = (samples, substeps, t0, dt, starts, parameters, chosen, observed, states, outputs, derivatives)
             pieces = _pieces(samples, substeps)
             if len(pieces) == 1:
                 status = [self._call(*arrays, *pieces[0], tangent)]
@@ -322,13 +338,15 @@ class Windows:
             if any(status):
                 raise GearsymError("the compiled window integrator reported an error")
         else:
-            full = np.zeros((c, self.n + self.parameters, total), order="F") if tangent else None
-            self._run_in_process(starts, t0, dt, samples, substeps, parameters, tangent, states, outputs, full)
+            every = np.zeros((len(self.channels), total), order="F")
+            full = np.zeros((len(self.channels), self.n + self.parameters, total), order="F") if tangent else None
+            self._run_in_process(starts, t0, dt, samples, substeps, parameters, tangent, states, every, full)
+            outputs[...] = every[observed]
             if tangent:
-                derivatives[...] = full[:, np.concatenate([np.arange(self.n), self.n + chosen]), :]
+                derivatives[...] = full[observed][:, np.concatenate([np.arange(self.n), self.n + chosen]), :]
         return WindowRun(states, outputs, derivatives)
 
-    def _call(self, samples, substeps, t0, dt, starts, parameters, chosen, states, outputs, derivatives,
+    def _call(self, samples, substeps, t0, dt, starts, parameters, chosen, observed, states, outputs, derivatives,
               first: int, last: int, column: int, tangent: bool) -> int:
         """The compiled integrator on windows ``first`` ... ``last - 1``, whose samples start at ``column``."""
         f8, i8 = 8, 8  # (float64 and int64 arrays, Fortran order: window k's column is k times its height)
@@ -337,9 +355,10 @@ class Windows:
                              t0.ctypes.data + f8 * first, dt.ctypes.data + f8 * first,
                              starts.ctypes.data + f8 * self.n * first,
                              parameters.ctypes.data + f8 * self.parameters * first, int(tangent), chosen.size,
-                             chosen.ctypes.data, states.ctypes.data + f8 * self.n * column,
-                             outputs.ctypes.data + f8 * len(self.channels) * column,
-                             derivatives.ctypes.data + f8 * len(self.channels) * width * column if tangent else None)
+                             chosen.ctypes.data, observed.size, observed.ctypes.data,
+                             states.ctypes.data + f8 * self.n * column,
+                             outputs.ctypes.data + f8 * observed.size * column,
+                             derivatives.ctypes.data + f8 * observed.size * width * column if tangent else None)
 
     def _run_in_process(self, starts, t0, dt, samples, substeps, parameters, tangent, states, outputs, derivatives):
         """The same steps in CasADi's virtual machine, each group of windows with equal substeps mapped."""
@@ -473,8 +492,11 @@ static const casadi_int gs_w_start[] = {{{w_start}}}, gs_w_index[] = {{{w_index}
 static const casadi_int gs_d_start[] = {{{d_start}}}, gs_d_index[] = {{{d_index}}};
 static const casadi_int gs_gate_start[] = {{{gate_start}}}, gs_set_start[] = {{{set_start}}};
 static const casadi_int gs_set_params[] = {{{set_params}}};
-/* operations a step: each parameter's column function's, and every forcing at once with a column from its forcing */
+/* operations a step: each parameter's column (its forcing, then a column from it), and every forcing at once */
 static const casadi_int gs_param_cost[{p1}] = {{{costs}}};
+/* each channel's value, dh/dy and dh/dp */
+static const gs_fn gs_channel[{c1}] = {{{channels}}};
+static const gs_work_fn gs_channel_work[{c1}] = {{{channel_works}}};
 #define GS_FORCING_COST {forcing}
 #define GS_FORCED_COST {forced}
 
@@ -518,13 +540,13 @@ static int gs_times(casadi_real at, const casadi_real* pk, const char* on, casad
 
 CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int* samples,
     const casadi_int* substeps, const casadi_real* t0, const casadi_real* dt, const casadi_real* start,
-    const casadi_real* p, casadi_int tangent, casadi_int ncols, const casadi_int* cols, casadi_real* states,
-    casadi_real* outputs, casadi_real* derivatives) {{
+    const casadi_real* p, casadi_int tangent, casadi_int ncols, const casadi_int* cols, casadi_int nchans,
+    const casadi_int* chans, casadi_real* states, casadi_real* outputs, casadi_real* derivatives) {{
   casadi_int sz[4] = {{0, 0, 0, 0}}, i, k, s, j, l, col = 0, width = GS_N + ncols, all = 0, one_by_one = 0;
   casadi_real y[GS_N], y1[GS_N], Y[4 * GS_N], J[4 * GS_N * GS_N], q1[GS_N], Fj[4 * GS_N], t, h, at;
   casadi_real W[3 * GS_NW > 0 ? 3 * GS_NW : 1], D[3 * GS_ND > 0 ? 3 * GS_ND : 1];
   casadi_real* F = 0;
-  casadi_real out[GS_C > 0 ? GS_C : 1], Hy[GS_C * GS_N > 0 ? GS_C * GS_N : 1], Hp[GS_C * GS_P > 0 ? GS_C * GS_P : 1];
+  casadi_real out, Hy[GS_N], Hp[GS_P > 0 ? GS_P : 1];
   casadi_real* Q = 0;
   const casadi_real** arg;
   casadi_real** res;
@@ -532,8 +554,11 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
   casadi_real* work;
   char asked[GS_P > 0 ? GS_P : 1], on[GS_G > 0 ? GS_G : 1], every[GS_G > 0 ? GS_G : 1];
   gs_grow(fit_state_step_work, sz); gs_grow(fit_stages_work, sz); gs_grow(fit_column_work, sz);
-  gs_grow(fit_channels_work, sz);
   for (i = 0; i < GS_G; ++i) gs_grow(gs_group_times_work[i], sz);
+  for (i = 0; i < nchans; ++i) {{
+    if (chans[i] < 0 || chans[i] >= GS_C) return 1;
+    gs_grow(gs_channel_work[chans[i]], sz);
+  }}
   memset(asked, 0, sizeof(asked));
   memset(every, 1, sizeof(every));
   for (j = 0; j < ncols; ++j) {{
@@ -549,6 +574,7 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
     if (!F) return 1;
   }} else {{
     for (j = 0; j < ncols; ++j) gs_grow(gs_param_work[cols[j]], sz);
+    if (ncols > 0) gs_grow(fit_column_forced_work, sz);
   }}
   arg = (const casadi_real**)malloc(sizeof(casadi_real*) * (size_t)gs_max(sz[0], 1));
   res = (casadi_real**)malloc(sizeof(casadi_real*) * (size_t)gs_max(sz[1], 1));
@@ -600,9 +626,11 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
                   for (r = 0; r < GS_N; ++r) Fj[stage * GS_N + r] = F[(stage * GS_P + cols[j - GS_N]) * GS_N + r];
                 arg[0] = qj; arg[1] = J; arg[2] = Fj; arg[3] = &h; res[0] = q1;
                 if (fit_column_forced(arg, res, iw, work, 0)) goto fail;
-              }} else {{
-                arg[0] = qj; arg[1] = J; arg[2] = Y; arg[3] = W; arg[4] = D; arg[5] = &h; arg[6] = pk; res[0] = q1;
+              }} else {{  /* (parameter j's forcing alone, then its column as above) */
+                arg[0] = Y; arg[1] = W; arg[2] = D; arg[3] = pk; res[0] = Fj;
                 if (gs_param[cols[j - GS_N]](arg, res, iw, work, 0)) goto fail;
+                arg[0] = qj; arg[1] = J; arg[2] = Fj; arg[3] = &h; res[0] = q1;
+                if (fit_column_forced(arg, res, iw, work, 0)) goto fail;
               }}
               memcpy(qj, q1, sizeof(q1));
             }}
@@ -617,17 +645,17 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
       }}
       t = t0[k] + dt[k] * (casadi_real)s;
       memcpy(states + col * GS_N, y, sizeof(y));
-      arg[0] = y; arg[1] = &t; arg[2] = pk; res[0] = out; res[1] = Hy; res[2] = Hp;
-      if (fit_channels(arg, res, iw, work, 0)) goto fail;
-      for (i = 0; i < GS_C; ++i) outputs[col * GS_C + i] = out[i];
-      if (tangent) {{
-        casadi_real* d = derivatives + col * GS_C * width;
-        for (j = 0; j < width; ++j) {{
-          for (i = 0; i < GS_C; ++i) {{
-            casadi_real sum = j < GS_N ? 0 : Hp[cols[j - GS_N] * GS_C + i];
+      for (i = 0; i < nchans; ++i) {{  /* (the channels asked for, in their order) */
+        arg[0] = y; arg[1] = &t; arg[2] = pk; res[0] = &out; res[1] = Hy; res[2] = Hp;
+        if (gs_channel[chans[i]](arg, res, iw, work, 0)) goto fail;
+        outputs[col * nchans + i] = out;
+        if (tangent) {{
+          casadi_real* d = derivatives + col * nchans * width;
+          for (j = 0; j < width; ++j) {{
+            casadi_real sum = j < GS_N ? 0 : Hp[cols[j - GS_N]];
             casadi_int r;
-            for (r = 0; r < GS_N; ++r) sum += Hy[r * GS_C + i] * Q[j * GS_N + r];
-            d[j * GS_C + i] = sum;
+            for (r = 0; r < GS_N; ++r) sum += Hy[r] * Q[j * GS_N + r];
+            d[j * nchans + i] = sum;
           }}
         }}
       }}

@@ -7,13 +7,13 @@ from collections.abc import Sequence
 import numpy as np
 import sympy as sp
 
-from ..codegen.windows import Windows, compile_windows
-from ..data.channels import channel_expression
+from ..codegen.windows import Windows
 from ..errors import GearsymError
 from ..options import Integration
 from ..system import FirstOrderSystem
 from .integrated import from_rate
 from .jacobian import Jacobian
+from .observed import ObservedWindows, observed_windows
 from .segment import Segment, substeps_for
 
 
@@ -54,8 +54,7 @@ class Problem:
         if twice:
             raise GearsymError(f"bias of {twice[0]}: the channel measures different things in different files (a "
                                "t file and a tau file?); one offset cannot serve both")
-        self.engine: Windows = compile_windows(system, [channel_expression(e, system) for _, e in keys],
-                                               options.backend)
+        self.engine: Windows | ObservedWindows = observed_windows(system, [e for _, e in keys], options.backend)
         self.scale = {}
         for name in dict.fromkeys(self.channel_names):
             values = np.concatenate([s.observed[name] for s in segments if name in s.observed])
