@@ -183,7 +183,6 @@ def column_functions(system: FirstOrderSystem, f: ca.SX, out: ca.SX, sym: System
     nw = w.numel()
     d_values = ca.jacobian(values, p)  # (sparse: each value depends on a few parameters)
     times_fn = ca.Function("fit_times", [t, p], [ca.densify(values), d_values], _OPTS)
-    value_fn = ca.Function("fit_time_values", [t, p], [ca.densify(values)], _OPTS)
     groups = time_groups(rest, w, values, d_values, p)
     by_group = {}
     for g, group in enumerate(groups):
@@ -227,7 +226,7 @@ def column_functions(system: FirstOrderSystem, f: ca.SX, out: ca.SX, sym: System
         return by_p + ca.mtimes(by_w, Ds[at[i]])
 
     zero = [ca.SX(n, 1)] * 4
-    out_fns = {"fit_times": times_fn, "fit_time_values": value_fn, **by_group, "fit_stages": stages,
+    out_fns = {"fit_times": times_fn, **by_group, "fit_stages": stages,
                "fit_state_step": state_step,
                "fit_column": ca.Function("fit_column", [q, J, h], [ca.densify(column(zero))], _OPTS)}
     forcings = [dfdp(i) for i in range(4)]
@@ -454,7 +453,7 @@ def _group_tables(functions: WindowFunctions) -> dict[str, str]:
 
 #: the whole tangent step and output of the in-process backend (the compiled driver goes column by column), and all
 #: time values at once (the driver computes them by groups)
-_IN_PROCESS_ONLY = ("fit_step", "fit_plain_step", "fit_output", "fit_times", "fit_time_values")
+_IN_PROCESS_ONLY = ("fit_step", "fit_plain_step", "fit_output", "fit_times")
 
 def compile_windows(system: FirstOrderSystem, channels: Sequence[sp.Expr], backend: str = "auto") -> Windows:
     """The window integrator of ``system`` observed through ``channels``: built once per process (found again by
