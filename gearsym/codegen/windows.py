@@ -600,9 +600,8 @@ CASADI_SYMBOL_EXPORT int gearsym_fit_windows(casadi_int count, const casadi_int*
         for (l = 0; l < substeps[k]; ++l) {{
           t = t0[k] + dt[k] * (casadi_real)(s - 1) + h * (casadi_real)l;
           /* the time values at the stages' times, once each for every function of the step: at t (the step before
-             computed them, but for a window's first step), t + h/2 and t + h, which is the next step's t as it
-             computes it (the last bit may differ from t + h) */
-          if (s == 1 && l == 0 && gs_times(t, pk, on, W, D, arg, res, iw, work)) goto fail;
+             computed them, or the window's start, which computed every group at t0), t + h/2 and t + h, which is the
+             next step's t as it computes it (the last bit may differ from t + h) */
           if (gs_times(t + h / 2, pk, on, W + GS_NW, D + GS_ND, arg, res, iw, work)) goto fail;
           at = l + 1 < substeps[k] ? t0[k] + dt[k] * (casadi_real)(s - 1) + h * (casadi_real)(l + 1)
                                    : t0[k] + dt[k] * (casadi_real)s;
