@@ -284,14 +284,13 @@ class Windows:
         for name, f in self.functions.items():
             if name not in _IN_PROCESS_ONLY:
                 gen.add(f)
-        table = ", ".join(f"fit_param_{j}" for j in range(self.parameters)) or "0"
-        works = ", ".join(f"fit_param_{j}_work" for j in range(self.parameters)) or "0"
         functions = self.functions
         forced = functions["fit_column_forced"].n_instructions()
-        costs = ", ".join(str(functions[f"fit_param_{j}"].n_instructions() + forced)
-                          for j in range(self.parameters)) or "0"
-        channels = ", ".join(f"fit_channel_{k}" for k in range(len(self.channels))) or "0"
-        channel_works = ", ".join(f"fit_channel_{k}_work" for k in range(len(self.channels))) or "0"
+        params, chans = range(self.parameters), range(len(self.channels))
+        table, works = _listed(f"fit_param_{j}" for j in params), _listed(f"fit_param_{j}_work" for j in params)
+        costs = _listed(functions[f"fit_param_{j}"].n_instructions() + forced for j in params)
+        channels = _listed(f"fit_channel_{k}" for k in chans)
+        channel_works = _listed(f"fit_channel_{k}_work" for k in chans)
         times = functions["fit_times"]
         return gen.dump() + _DRIVER.format(n=self.n, p=self.parameters, c=len(self.channels), table=table,
                                            nw=times.nnz_out(0), nd=times.nnz_out(1),
@@ -439,16 +438,17 @@ def _group_tables(functions: WindowFunctions) -> dict[str, str]:
             set_start.append(len(set_params))
         gate_start.append(len(set_start) - 1)
     count = len(functions.groups)
-
-    def listed(values) -> str:
-        return ", ".join(map(str, values)) or "0"
-
     return {"g": count, "g1": max(1, count),
-            "times": listed(f"fit_times_{g}" for g in range(count)),
-            "times_work": listed(f"fit_times_{g}_work" for g in range(count)),
-            "w_start": listed(w_start), "w_index": listed(w_index), "d_start": listed(d_start),
-            "d_index": listed(d_index), "gate_start": listed(gate_start), "set_start": listed(set_start),
-            "set_params": listed(set_params)}
+            "times": _listed(f"fit_times_{g}" for g in range(count)),
+            "times_work": _listed(f"fit_times_{g}_work" for g in range(count)),
+            "w_start": _listed(w_start), "w_index": _listed(w_index), "d_start": _listed(d_start),
+            "d_index": _listed(d_index), "gate_start": _listed(gate_start), "set_start": _listed(set_start),
+            "set_params": _listed(set_params)}
+
+
+def _listed(values) -> str:
+    """A C initialiser's list (an empty one as ``0``: C has no empty array)."""
+    return ", ".join(map(str, values)) or "0"
 
 
 #: the whole tangent step and output of the in-process backend (the compiled driver goes column by column), and all
