@@ -375,10 +375,10 @@ def explain(system: FirstOrderSystem, measurements: Measurements, fit: Sequence[
         gains = linearised_gains(superset, here, current.fit, library, [n for n in open_ if not library[n].scan],
                                  bias, options)
         # a tooth fault: its tooth scanned in every record
-        scanned.update(scan_teeth(superset, here, current.fit, [library[n] for n in open_ if library[n].scan], bias,
-                                  options))
-        for name in (n for n in open_ if library[n].scan):
-            gains[name] = (scanned[name].gain, scanned[name].why)
+        for name, placement in scan_teeth(superset, here, current.fit, [library[n] for n in open_ if library[n].scan],
+                                          bias, options).items():
+            scanned[name] = placement
+            gains[name] = (placement.gain, placement.why)
         names = _round(library, current, current_spectrum, superset, {k: g for k, (g, _) in gains.items()}, refits)
         screened.append({"after": list(current.effects), "gains": {k: g for k, (g, _) in gains.items()},
                          "why_not": {k: why for k, (_, why) in gains.items() if why}, "refitted": names})
