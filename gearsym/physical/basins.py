@@ -11,7 +11,7 @@ ratio). :class:`ShownBasinMap` and :class:`ShownFractions` are the results in th
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -19,7 +19,7 @@ from ..analysis.basins import BasinMap
 from ..checks import json_safe
 from ..errors import GearsymError
 from ..sweep.basin_continuation import BasinContinuation, StartGrid
-from ..sweep.grid import Axis, parse_axis
+from ..sweep.grid import Axis, axis_fields, parse_axis
 from ..units import dimension_text, to_si, unit_dims
 from .point import ANGLE, ANGULAR_VELOCITY, LENGTH, VELOCITY, PointUnits
 from .text import parameter_text
@@ -121,7 +121,7 @@ class GridAxis(Axis):
     def read(cls, text: str) -> "GridAxis":
         """``STATE=START:STOP:STEP`` (or a list, or one value), with or without a unit (its errors name --grid)."""
         axis = parse_axis(text, "--grid")
-        plain = {f.name: getattr(axis, f.name) for f in fields(Axis)}
+        plain = axis_fields(axis)
         if not axis.unit:
             return cls(**plain)
         try:

@@ -6,11 +6,11 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ..errors import GearsymError
-from ..sweep.grid import Axis, axes_from, parse_axis
+from ..sweep.grid import Axis, axes_from, axis_fields, parse_axis
 from ..units import Measure, as_quantity, is_quantity, measure_in, symbol
 
 if TYPE_CHECKING:  # (the type only: a sweep of a cached model reads this module without SymPy)
@@ -35,7 +35,7 @@ class MeasuredAxis(Axis):
         ``--param`` it was written as)."""
         if isinstance(axis, cls):
             return axis
-        plain = _fields(axis)
+        plain = axis_fields(axis)
         if not axis.unit:
             return cls(**plain)
         where = where or f"--param {axis.spec!r}"
@@ -52,11 +52,7 @@ class MeasuredAxis(Axis):
     @property
     def plain(self) -> Axis:
         """The axis as it was given (its values in their unit)."""
-        return Axis(**_fields(self))
-
-
-def _fields(axis: Axis) -> dict:
-    return {f.name: getattr(axis, f.name) for f in fields(Axis)}
+        return Axis(**axis_fields(self))
 
 
 def nondimensional_axis(scaling: Scaling, axis: Axis, where: str | None = None) -> Axis:

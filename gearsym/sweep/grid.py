@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from decimal import Decimal, InvalidOperation
 
 from ..errors import GearsymError
@@ -45,6 +45,11 @@ class Axis:
             raise GearsymError(f"{self.option} {self.spec!r}: no values")
         if len(set(self.values)) != len(self.values):
             raise GearsymError(f"{self.option} {self.spec!r}: values repeat")
+
+
+def axis_fields(axis: Axis) -> dict:
+    """``axis``'s fields as an :class:`Axis` has them (a subclass's own left out): what makes it again as given."""
+    return {f.name: getattr(axis, f.name) for f in fields(Axis)}
 
 
 def parse_axis(text: str, option: str = "--param") -> Axis:
