@@ -14,10 +14,8 @@ from collections.abc import Callable
 from dataclasses import field, replace
 
 from .records import record_class
-from .caller import option
-from .checks import MAX_STEPS_PER_PERIOD, RUN_BYTES_PER_PERIOD, TABLE_BYTES_PER_STEP, whole_number
-from .errors import GearsymError
-from .memory import check_fits
+from .errors import GearsymError, option
+from .checks import MAX_STEPS_PER_PERIOD, RUN_BYTES_PER_PERIOD, TABLE_BYTES_PER_STEP, check_fits, whole_number
 
 #: RK4 steps per forcing period (the paper's 200): the one definition of the default
 STEPS_PER_PERIOD = 200

@@ -20,7 +20,7 @@ BENCH = ROOT.parent / "bench"
 
 #: the stages from the bottom up (docs/architecture.md): a module may import its own stage and those below
 LAYERS = [
-    {"errors", "version", "files", "units", "checks", "options", "parameters", "caller", "memory", "records"},
+    {"errors", "version", "files", "units", "checks", "options", "parameters", "records"},
     {"geometry"},
     {"model"},
     {"system", "registry"},

@@ -4,7 +4,7 @@ the message says the option as the caller writes it (``--time-scale`` on the com
 Python).
 
 Memory limits depend on the machine, so the tests that need one give the machine a known amount
-(``gearsym.memory.available``) instead of asking for more than any machine has.
+(``gearsym.checks.available``) instead of asking for more than any machine has.
 """
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ import conftest
 import gearsym
 import gearsym.data.csvtext as csvtext
 import gearsym.data.grouping as grouping
-import gearsym.memory
+import gearsym.checks
 import gearsym.sweep.workers
 from gearsym.sweep.workers import Workers
 from gearsym import Execution, Integration, explain, find_attractors, load_measurements, run_sweep, simulate_measurements
@@ -39,7 +39,7 @@ GIB = 2**30
 @pytest.fixture
 def one_gib(monkeypatch):
     """A machine with 1 GiB of memory available."""
-    monkeypatch.setattr(gearsym.memory, "available", lambda: GIB)
+    monkeypatch.setattr(gearsym.checks, "available", lambda: GIB)
 
 
 @pytest.fixture(scope="module")
@@ -60,13 +60,13 @@ def measurement_file(tmp_path, records=2, per_period=20, periods=3, name="m.csv"
 
 # --------------------------------------------------------------------------- sizes: checked before memory
 def test_a_request_is_refused_exactly_where_it_stops_fitting(monkeypatch):
-    monkeypatch.setattr(gearsym.memory, "available", lambda: 10 * GIB)
+    monkeypatch.setattr(gearsym.checks, "available", lambda: 10 * GIB)
     per_item = 1000
     allowed = 10 * GIB // per_item
-    gearsym.memory.check_fits(allowed, per_item, asked="n", item="item", what="test")
+    gearsym.checks.check_fits(allowed, per_item, asked="n", item="item", what="test")
     with pytest.raises(GearsymError, match=rf"^n needs 10 GiB of memory \(test: 1000 B per item\), more than the "
                                            rf"10 GiB available: at most {allowed} items fit$"):
-        gearsym.memory.check_fits(allowed + 1, per_item, asked="n", item="item", what="test")
+        gearsym.checks.check_fits(allowed + 1, per_item, asked="n", item="item", what="test")
 
 
 @pytest.mark.parametrize("argv,said", [

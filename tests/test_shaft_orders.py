@@ -18,7 +18,7 @@ import conftest
 import fault_rig
 import gearsym
 import gearsym.cli.spectrum
-import gearsym.memory
+import gearsym.checks
 import rig
 from gearsym import Drivetrain, Gear, Harmonic, Integration, Mesh, Torque
 from gearsym.cli import main
@@ -340,7 +340,7 @@ def test_a_healthy_pair_shows_no_sidebands_and_a_cracked_one_does(capsys):
                                                "of the larger gear, 4000000000 mesh periods, after the transient) needs"),
 ])
 def test_a_spectrum_that_cannot_show_sidebands_is_refused_before_the_run(capsys, monkeypatch, argv, said):
-    monkeypatch.setattr(gearsym.memory, "available", lambda: 2**30)  # (a machine of 1 GiB: the same on any)
+    monkeypatch.setattr(gearsym.checks, "available", lambda: 2**30)  # (a machine of 1 GiB: the same on any)
     monkeypatch.setattr(gearsym.cli.spectrum, "simulated_order_spectrum", lambda *a, **k: pytest.fail("ran"))
     assert main(["spectrum", *argv]) == 2
     err = capsys.readouterr().err

@@ -31,12 +31,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..caller import option
-from ..checks import json_safe, whole_number
+from ..errors import GearsymError, option, suggest
+from ..checks import check_fits, json_safe, whole_number
 from ..codegen import CompiledModel, engine_verb
 from ..options import Integration
-from ..errors import GearsymError, suggest
-from ..memory import check_fits
 from .lane_spectra import lyapunov_spectra
 from .lyapunov import LyapunovSpectrum
 from .regime import classify_regime

@@ -26,9 +26,8 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from types import ModuleType
 
-from ..caller import command_line
+from ..errors import GearsymError, GearsymWarning, command_line
 from ..version import __version__
-from ..errors import GearsymError, GearsymWarning
 from ..files.atomic import NO_ROOM
 
 #: the commands whose module is named otherwise (a module named ``list`` would hide the builtin in this package)

@@ -16,13 +16,12 @@ import gearsym  # the face: the code generator loads on first use
 
 from ..analysis.order_run import SAMPLES_PER_CYCLE, mesh_gears, simulated_order_spectrum
 from ..analysis.orders import MESH_HARMONICS, MIN_REVOLUTIONS, SIDEBANDS, check_length, most_sidebands, order_spectrum
-from ..checks import check_run, json_safe
+from ..checks import check_fits, check_run, json_safe
 from ..data.measurements import load_measurements
 from ..errors import GearsymError
 from ..files.atomic import write_atomically
 from ..figures.orders import plot_order_spectra
 from ..loading import declared, split_options
-from ..memory import check_fits
 from ..opening import OpenModel, open_model
 from ..options import STEPS_PER_PERIOD, Integration
 from ..files.outputs import check_figure, check_file

@@ -19,10 +19,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..records import record_class
-from ..caller import option
-from ..checks import run_bytes_per_period, whole_number
-from ..errors import GearsymError, ModelError, warn
-from ..memory import check_fits
+from ..errors import GearsymError, ModelError, option, warn
+from ..checks import check_fits, run_bytes_per_period, whole_number
 from ..options import Integration
 from .loops import LoopOptions
 from .native import NativeFunction, load_native

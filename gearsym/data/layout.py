@@ -8,8 +8,7 @@ from pathlib import Path
 
 import sympy as sp
 
-from ..caller import option
-from ..errors import suggest
+from ..errors import option, suggest
 from ..system import FirstOrderSystem
 from .channels import CHANNELS_HELP, channel_symbols, in_file_units
 from .columns import PHYSICAL_TIME, RECORD

@@ -7,8 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..caller import option
-from ..errors import GearsymError
+from ..errors import GearsymError, option
 from ..system import FirstOrderSystem
 from .columns import PHYSICAL_TIME, RECORD
 from .errors import DataError

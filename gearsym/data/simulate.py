@@ -27,13 +27,11 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.poincare import phase_trajectory
-from ..caller import name as caller_name, option
-from ..checks import MAX_STEPS_PER_PERIOD, whole_number
+from ..errors import GearsymError, option, option_name as caller_name
+from ..checks import MAX_STEPS_PER_PERIOD, check_fits, whole_number
 from ..codegen import CompiledModel, engine_verb
 from ..options import STEPS_PER_PERIOD, Integration
-from ..errors import GearsymError
 from ..files.atomic import write_atomically
-from ..memory import check_fits
 from .columns import RECORD
 
 #: the run of each record when no options are given: 40 periods recorded after a transient of 100

@@ -37,10 +37,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..caller import name as caller_name, on_command_line, option
+from ..errors import GearsymError, on_command_line, option, option_name as caller_name, suggest
 from ..checks import whole_number
 from ..data.dataset import Measurements
-from ..errors import GearsymError, suggest
 from ..options import Execution, Integration
 from ..system import FirstOrderSystem
 from .canonical import amplitude_phase, canonical

@@ -19,7 +19,7 @@ import numpy as np
 from ..codegen.compiled import CompiledModel
 from ..codegen.lane_runs import LaneLibrary, chunked, lanes_of, threaded
 from ..errors import GearsymError
-from ..memory import check_fits
+from ..checks import check_fits
 
 #: points per native call (and per task of a threaded run)
 CALL_POINTS = 1024

@@ -14,8 +14,7 @@ import threading
 
 import numpy as np
 
-from .. import caller
-from ..errors import GearsymError
+from ..errors import GearsymError, on_command_line
 from .grid import Point
 from .point_runs import PointRuns
 
@@ -99,8 +98,8 @@ def _check_alive(procs: list) -> None:
     dead = next((p for p in procs if p.exitcode not in (None, 0)), None)
     if dead is not None:
         raise GearsymError(f"a sweep worker process died (exit code {dead.exitcode}); the points finished so far "
-                           f"are kept: repeat the {'command' if caller.on_command_line() else 'call'} with "
-                           + ("--parallel threads" if caller.on_command_line()
+                           f"are kept: repeat the {'command' if on_command_line() else 'call'} with "
+                           + ("--parallel threads" if on_command_line()
                               else 'execution=Execution(parallel="threads")')
                            + " to resume")
 

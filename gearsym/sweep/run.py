@@ -16,11 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import caller
-from ..checks import run_bytes_per_period, whole_number
+from ..checks import check_fits, run_bytes_per_period, whole_number
 from ..codegen import CompiledModel, engine_verb
-from ..errors import GearsymError, UnknownParameterError
-from ..memory import check_fits
+from ..errors import GearsymError, UnknownParameterError, option
 from ..options import Execution, Integration
 from ..version import __version__
 from .distributed import execute_on_dask
@@ -83,7 +81,7 @@ def run_sweep(
     at_once = 1 if workers.scheduler is not None else min(workers.count, len(plan.points))
     if at_once > 1:  # each worker holds the records of a point
         check_fits(options.periods, at_once * run_bytes_per_period(model.dimension, len(model.observed)),
-                   asked=caller.option("periods", options.periods), item="period",
+                   asked=option("periods", options.periods), item="period",
                    what=f"{at_once} workers' states, stretches and extremes of each period")
     store = SweepStore(out, plan.columns, plan.strobe_columns, [*plan.names, "direction"], plan.record) \
         if out else None
@@ -137,9 +135,9 @@ def poincare_samples_of(poincare: int, options: Integration) -> int:
     (the default: as many as they measure, up to POINCARE_SAMPLES)."""
     poincare = whole_number(poincare, "poincare samples")
     if poincare > options.measured and poincare != POINCARE_SAMPLES:  # (the default fits what a run measures)
-        raise GearsymError(f"{caller.option('poincare', poincare)}: a point has one Poincare sample per measured "
-                           f"period, {options.measured} here ({caller.option('periods', options.periods)} minus "
-                           f"{caller.option('discard', options.discard)}): give at most {options.measured}, or "
+        raise GearsymError(f"{option('poincare', poincare)}: a point has one Poincare sample per measured "
+                           f"period, {options.measured} here ({option('periods', options.periods)} minus "
+                           f"{option('discard', options.discard)}): give at most {options.measured}, or "
                            "more periods")
     return min(poincare, options.measured)
 

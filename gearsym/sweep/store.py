@@ -34,8 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import caller
-from ..errors import GearsymError, warn
+from ..errors import GearsymError, on_command_line, option, option_name, warn
 from ..files.atomic import write_atomically
 from ..files.lock import release_lock, take_lock
 
@@ -45,12 +44,12 @@ RECORD_ROOM = 2048
 
 def overwrite_option() -> str:
     """The option that starts a sweep's files again, as the caller writes it (--overwrite, overwrite=True)."""
-    return caller.option("overwrite", True)
+    return option("overwrite", True)
 
 
 def start_again() -> str:
     """The advice 'pass --overwrite or choose another --out', as the caller writes it."""
-    return f"pass {overwrite_option()} or choose another {caller.name('out')}"
+    return f"pass {overwrite_option()} or choose another {option_name('out')}"
 
 
 def number(x: float) -> str:
@@ -194,7 +193,7 @@ class SweepStore:
             return None
         detail = "; ".join(f"{k}: {_short(old.get(k))} before, {_short(new.get(k))} now" for k in differ)
         return (f"{self.path} was written by a different sweep ({detail}). To resume it, repeat "
-                f"the {'command' if caller.on_command_line() else 'call'} it came from; to start again {start_again()}")
+                f"the {'command' if on_command_line() else 'call'} it came from; to start again {start_again()}")
 
     def _read(self, path: Path, columns: list[str]) -> dict[tuple, dict]:
         rows = {}

@@ -6,9 +6,8 @@ import multiprocessing
 import os
 from dataclasses import dataclass
 
-from .. import caller
 from ..checks import whole_number
-from ..errors import GearsymError, warn
+from ..errors import GearsymError, option, warn
 from ..options import PARALLEL, Execution
 from .distributed import check_scheduler
 
@@ -44,7 +43,7 @@ class Workers:
             check_scheduler(self.scheduler, self.jobs)  # no Dask, a bad address: said before any work
         here = cores()
         if jobs > here and self.scheduler in (None, "local"):  # (a cluster elsewhere has cores of its own)
-            warn(f"{caller.option('jobs', jobs)}: this machine has {here} core{'s' if here > 1 else ''}; running "
+            warn(f"{option('jobs', jobs)}: this machine has {here} core{'s' if here > 1 else ''}; running "
                  f"{here} worker{'s' if here > 1 else ''} (more would only share them)")
             object.__setattr__(self, "jobs", here)
 
