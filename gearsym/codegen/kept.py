@@ -2,7 +2,8 @@
 
 Beside the system's summary (:mod:`gearsym.cached`), the cache keeps one small file per structure of the loops a
 model was compiled with (``<model>-<key>-<loops>.json``): the code hash, the compiled library, the parameters in
-its tables of time and those tables as text (:class:`BuildSummary`). A build is found for the options a run asks
+its tables of time and those tables as text (:class:`BuildSummary`). A model's builds are read once, with its
+system's summary (:func:`read_builds`, by the start-up cache's slot). A build is found for the options a run asks
 (the step chosen from the fastest linearised mode the system's summary keeps, or for a sweep's fastest point from a
 library of the model kept already) and trusted no more than its library: the summary is a sealed private file
 (:func:`~gearsym.files.sealed.read_sealed`), and the library's record (:mod:`.trust`) must name the same model, code
