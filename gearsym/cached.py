@@ -32,13 +32,13 @@ import json
 import os
 import sys
 from collections.abc import Callable, Mapping
-from dataclasses import replace
+from dataclasses import field, replace
 from functools import lru_cache
 from pathlib import Path
 
 from .records import record_class
 from .codegen.kept import (SUMMARY_FORMAT, BuildSummary, build_path, found_build, found_over, keep_model, kept_model,
-                           read_json, summary_path, write_json)
+                           read_build, read_builds, read_json, summary_path, write_json)
 from .codegen.system_summary import SystemSummary, read_summary
 from .codegen.library import resolve_backend
 from .options import Integration
@@ -102,13 +102,16 @@ def system_key(path: Path, values: Mapping[str, object]) -> str:
 class CacheSlot:
     """Where the start-up cache keeps the model ``ref`` with given values (its file's name and the key that hashes
     what its reduction depends on; ``name`` None for a model that is no file, which the cache does not keep), and
-    what the slot holds: the system's summary as read (``system``: None when there is none, or none to trust) and,
-    for a model with physical values, its :class:`~gearsym.physical.point.PointUnits`. Read once per run."""
+    what the slot holds: the system's summary as read (``system``: None when there is none, or none to trust),
+    for a model with physical values its :class:`~gearsym.physical.point.PointUnits`, and the builds kept of it
+    (``builds``: each :class:`~gearsym.codegen.kept.BuildSummary` by its file, or why the file is not to be
+    trusted; one this process keeps is added). Read once per run."""
 
     name: str | None = None
     key: str = ""
     system: Mapping | None = None
     units: PointUnits | None = None
+    builds: dict[Path, BuildSummary | str] = field(default_factory=dict)
 
     @property
     def physical(self) -> bool | None:
@@ -132,17 +135,18 @@ class CacheSlot:
         keeps = self.keeps(options)  # (the step's choice keeps the backend)
         summary = read_summary(self.system, making.load_system) if self.name is not None else None
         auto = options.integrator == "auto" and bool(ends)
-        found = found_over(self.name, self.key, summary, options, ends) if auto and summary is not None else None
+        found = (found_over(self.name, self.key, summary, self.builds, options, ends) if auto and summary is not None
+                 else None)
         if found is None:
             options = making.choose_over(options, ends) if auto else options
-            found = found_build(self.name, self.key, summary, options) if summary is not None else None
+            found = found_build(self.name, self.key, summary, self.builds, options) if summary is not None else None
         if found is None:
             system = making.load_system()
             if making.before is not None:
                 making.before(system)
             found = making.compile_system(system, options)
             if keeps:
-                keep_model(self.name, self.key, found, making.kept_units())
+                self.builds.update(keep_model(self.name, self.key, found, making.kept_units()))
         return found
 
 
@@ -171,9 +175,10 @@ def cache_slot(ref, values: Mapping[str, object]) -> CacheSlot:
     try:
         system = data["system"]
         physical = data["physical"] if system["physical"] else None
-        return CacheSlot(path.stem, key, system, PointUnits.from_dict(physical) if physical else None)
+        units = PointUnits.from_dict(physical) if physical else None
     except (KeyError, TypeError, ValueError, AttributeError):
         return CacheSlot(path.stem, key)
+    return CacheSlot(path.stem, key, system, units, read_builds(path.stem, key))
 
 
 def load_linearisation(ref: str, values: Mapping[str, object], options: Integration, *,
@@ -192,7 +197,7 @@ def load_linearisation(ref: str, values: Mapping[str, object], options: Integrat
     build_file = build_path(name, key, options)
     data = read_json(system_file)
     compiled = kept_model(read_summary(data.get("system") if data is not None else None,
-                                       lambda: derive().model.system), build_file, options)
+                                       lambda: derive().model.system), read_build(build_file), build_file, options)
     if compiled is not None:
         try:
             about = data["linearisation"]

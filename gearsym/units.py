@@ -29,7 +29,7 @@ from pathlib import Path
 
 from .records import record_class
 from .errors import GearsymError
-from .files.memo import keep, recall
+from .files.memo import keep, recall_all
 
 #: how long a quantity string may be (a unit expression is a few names, not a program)
 MAX_LENGTH = 120
@@ -323,22 +323,45 @@ class UnitMeaning:
             return None
 
 
-_MEANINGS: dict[str, UnitMeaning] = {}  # this process's: unit text -> meaning
 _WHAT = "kept meaning of a unit"
+#: this process's answers of each kind ("units": unit text -> UnitMeaning, "unit-conversions": "source -> target" ->
+#: factor): those earlier processes kept, read once on the kind's first question, and those learnt since
+_KNOWN: dict[str, dict] = {}
+
+
+def _known(kind: str) -> dict:
+    """This process's answers of ``kind`` (see :data:`_KNOWN`)."""
+    if kind not in _KNOWN:
+        identity = _pint_identity()
+        kept = recall_all(kind, identity, _WHAT) if identity is not None else {}
+        read = _READ_KEPT[kind]
+        _KNOWN[kind] = {question: answer for question, kept_answer in kept.items()
+                        if (answer := read(kept_answer)) is not None}
+    return _KNOWN[kind]
+
+
+def _meaning_kept(kept: dict) -> UnitMeaning | None:
+    """A unit's meaning as kept, or None if it does not read as one."""
+    try:
+        meaning = UnitMeaning(str(kept["name"]), float(kept["factor"]), tuple(float(d) for d in kept["dims"]),
+                              str(kept["symbol"]))
+    except (KeyError, TypeError, ValueError):
+        return None
+    return meaning if len(meaning.dims) == len(BASE) and math.isfinite(meaning.factor) and meaning.factor else None
+
+
+def _factor_kept(kept: dict) -> float | None:
+    """A conversion factor as kept, or None if it is not a finite number."""
+    factor = kept.get("factor")
+    return factor if isinstance(factor, float) and math.isfinite(factor) else None
+
+
+_READ_KEPT = {"units": _meaning_kept, "unit-conversions": _factor_kept}
 
 
 def _recalled(text: str) -> UnitMeaning | None:
     """The meaning of ``text`` (as pint reads it) kept by this or an earlier process, or None."""
-    if text not in _MEANINGS and (identity := _pint_identity()) is not None:
-        kept = recall("units", text, identity, _WHAT)
-        try:
-            meaning = kept and UnitMeaning(str(kept["name"]), float(kept["factor"]),
-                                           tuple(float(d) for d in kept["dims"]), str(kept["symbol"]))
-        except (KeyError, TypeError, ValueError):
-            meaning = None
-        if meaning and len(meaning.dims) == len(BASE) and math.isfinite(meaning.factor) and meaning.factor:
-            _MEANINGS[text] = meaning
-    return _MEANINGS.get(text)
+    return _known("units").get(text)
 
 
 def _learnt(text: str, units) -> UnitMeaning | None:
@@ -348,8 +371,9 @@ def _learnt(text: str, units) -> UnitMeaning | None:
     identity = _pint_identity()
     if meaning is None or identity is None:
         return meaning
+    known = _known("units")
     for said, meant in ((text, meaning), (meaning.name, None)):
-        if not said or said in _MEANINGS:
+        if not said or said in known:
             continue
         if meant is None:
             try:
@@ -357,7 +381,7 @@ def _learnt(text: str, units) -> UnitMeaning | None:
             except Exception:  # (a name pint does not read back: not kept)
                 continue
         if meant is not None:
-            _MEANINGS[said] = meant
+            known[said] = meant
             keep("units", said, identity, {"name": meant.name, "factor": meant.factor, "dims": list(meant.dims),
                                            "symbol": meant.symbol})
     return meaning
@@ -400,19 +424,14 @@ def conversion_factor(source: str, target: str) -> float:
     """How many ``target`` one ``source`` is (pint's factor, ``Quantity(1.0, source).to(target)``: not the ratio
     of the two SI factors, which may differ in the last bit), kept as a unit's meaning is."""
     question = f"{source} -> {target}"
-    if question not in _FACTORS:
+    known = _known("unit-conversions")
+    if question not in known:
+        factor = float(Quantity(1.0, source).to(target).magnitude)
         identity = _pint_identity()
-        kept = recall("unit-conversions", question, identity, _WHAT) if identity is not None else None
-        factor = kept.get("factor") if kept else None
-        if not (isinstance(factor, float) and math.isfinite(factor)):
-            factor = float(Quantity(1.0, source).to(target).magnitude)
-            if identity is not None and math.isfinite(factor):
-                keep("unit-conversions", question, identity, {"factor": factor})
-        _FACTORS[question] = factor
-    return _FACTORS[question]
-
-
-_FACTORS: dict[str, float] = {}  # this process's: 'source -> target' -> factor
+        if identity is not None and math.isfinite(factor):
+            keep("unit-conversions", question, identity, {"factor": factor})
+        known[question] = factor
+    return known[question]
 
 
 def si_factor(unit_text: str) -> float:

@@ -337,6 +337,21 @@ def test_an_edited_summary_is_found_and_written_again(cache, clean, edit):
 
 
 @pytest.mark.slow
+def test_an_edited_build_summary_is_said_when_a_run_asks_for_its_build_and_not_before(cache, clean):
+    """The builds of a model are read together when it is opened (gearsym/codegen/kept.py read_builds); an edited one
+    is said, and written again, only by the run that asks for its options."""
+    system, build = summaries(cache)
+    build.write_text(json.dumps({**json.loads(build.read_text()), "table_texts": []}, indent=1))  # (its seal as it was)
+    other = gearsym(cache, "lyap", "one_stage", *ARGS, *STEPS_150)  # (other loops: another build)
+    assert other.returncode == 0 and "the cached summary" not in other.stderr, other.stderr
+    run = gearsym(cache, "lyap", "one_stage", *ARGS)
+    assert run.returncode == 0, run.stderr
+    assert "edited" in one_line_warning(run.stderr, "the cached summary") and str(build) in run.stderr
+    assert run.stdout == clean["one_stage"]
+    assert json.loads(build.read_text())["table_texts"]  # (written again)
+
+
+@pytest.mark.slow
 def test_summaries_edited_with_their_seal_made_again_are_checked_against_the_library(cache, clean):
     system, _ = summaries(cache)
     reseal(system, swap_states(json.loads(system.read_text())))

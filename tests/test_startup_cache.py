@@ -155,7 +155,7 @@ def test_a_command_on_a_cached_model_imports_neither_sympy_pint_nor_casadi(model
 
     # (fills the cache, in this process: without the figure, drawn once; the units this worker met earlier were kept
     # in other tests' caches, so it learns them again, as the user's first process does)
-    monkeypatch.setattr(gearsym.units, "_MEANINGS", {})
+    monkeypatch.setattr(gearsym.units, "_KNOWN", {})
     first = lyap(capsys, *unplotted[:-len(ARGS)])
     run = command(argv)
     assert run.returncode == 0, run.stderr

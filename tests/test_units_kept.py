@@ -12,6 +12,7 @@ import pytest
 
 from gearsym import units
 from gearsym.errors import GearsymWarning
+from gearsym.files import sealed
 from gearsym.files.memo import keep
 from gearsym.files.paths import REPO_ROOT
 
@@ -71,8 +72,7 @@ def test_a_second_process_reads_the_units_the_first_met_without_pint_and_means_w
 def cache(tmp_path, monkeypatch):
     """A cache of this test's own, and this process's kept meanings forgotten (as in a new process)."""
     monkeypatch.setenv("GEARSYM_CACHE", str(tmp_path / "cache"))
-    monkeypatch.setattr(units, "_MEANINGS", {})
-    monkeypatch.setattr(units, "_FACTORS", {})
+    monkeypatch.setattr(units, "_KNOWN", {})
     return tmp_path / "cache"
 
 
@@ -87,7 +87,7 @@ def test_an_edited_meaning_is_not_trusted_but_said_and_written_again(cache, monk
     path, record = kept(cache, "rpm")
     record["answer"]["factor"] *= 2  # (twice the speed: a planted answer, its seal left as it was)
     path.write_text(json.dumps(record))
-    monkeypatch.setattr(units, "_MEANINGS", {})
+    monkeypatch.setattr(units, "_KNOWN", {})
     with pytest.warns(GearsymWarning, match=rf"kept meaning of a unit {path} is not used: its content is not what"):
         assert units.measure("9100 rpm", "speed") == right
     assert kept(cache, "rpm")[1]["answer"]["factor"] == units.registry().Quantity(1.0, "rpm").to_base_units().magnitude
@@ -106,7 +106,7 @@ def test_a_meaning_someone_else_could_have_written_is_not_read(cache, monkeypatc
         planted = tmp_path / "planted.json"
         path.rename(planted)
         path.symlink_to(planted)
-    monkeypatch.setattr(units, "_MEANINGS", {})
+    monkeypatch.setattr(units, "_KNOWN", {})
     with pytest.warns(GearsymWarning, match=rf"kept meaning of a unit {path} is not used: .*"
                                             rf"{'writable by others' if plant != 'a symlink' else 'is a symlink'}"):
         assert units.measure("50 um", "eta") == right
@@ -120,3 +120,18 @@ def test_a_cache_someone_else_could_write_keeps_no_meaning_and_says_nothing(cach
         warnings.simplefilter("error")
         assert units.measure("2e8 N/m", "kZ").si == 2e8
     assert not (cache / "units").exists()
+
+
+def test_an_edited_meaning_of_a_unit_not_asked_for_is_said_once_not_in_every_process(cache, monkeypatch):
+    units.measure("50 um", "eta")
+    path, record = kept(cache, "um")
+    record["answer"]["factor"] = 1e-3  # (its seal left as it was)
+    path.write_text(json.dumps(record))
+    monkeypatch.setattr(units, "_KNOWN", {})
+    with pytest.warns(GearsymWarning, match=rf"kept meaning of a unit {path} is not used"):
+        assert units.measure("9100 rpm", "speed").si == pytest.approx(9100 * 2 * 3.141592653589793 / 60)
+    monkeypatch.setattr(units, "_KNOWN", {})  # (a later process, which does not ask for um either)
+    monkeypatch.setattr(sealed, "_DISTRUSTED", set())
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert units.measure("9100 rpm", "speed").si == pytest.approx(9100 * 2 * 3.141592653589793 / 60)

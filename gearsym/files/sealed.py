@@ -19,18 +19,27 @@ from .private import NotPrivate, read_private, write_private
 def read_sealed(path: Path, format: int, what: str = "record") -> dict | None:
     """The record at ``path`` of this ``format``, or None (missing, partial, corrupt, of another format; or not
     private, or changed since it was written: said in a warning that names it as ``what``)."""
+    record = unsealed(path, format)
+    if isinstance(record, str):
+        distrust(path, record, what)
+        return None
+    return record
+
+
+def unsealed(path: Path, format: int) -> dict | str | None:
+    """The record at ``path`` of this ``format``; None if there is none (missing, partial, corrupt, of another
+    format); or, for one not to be trusted (not private, changed since it was written), why not: for a caller
+    that reads records before it knows which it uses, and says why (:func:`distrust`) of the one it uses."""
     try:
         data = json.loads(read_private(path))
     except NotPrivate as exc:
-        distrust(path, str(exc), what)
-        return None
+        return str(exc)
     except (OSError, ValueError):
         return None
     if not (isinstance(data, dict) and data.get("format") == format):
         return None
     if data.pop("seal", None) != _seal(path, data):
-        distrust(path, "its content is not what gearsym wrote (edited?)", what)
-        return None
+        return "its content is not what gearsym wrote (edited?)"
     return data
 
 
