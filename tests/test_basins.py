@@ -289,7 +289,7 @@ def test_a_model_with_physical_values_is_mapped_and_answered_in_its_units(capsys
 
 def test_a_physical_maps_title_gives_the_users_values_and_its_exponents_are_per_second(capsys, tmp_path,
                                                                                           monkeypatch):
-    import gearsym.cli.basins as command
+    import gearsym.figures.basins as figures
 
     drawn = []
 
@@ -297,7 +297,7 @@ def test_a_physical_maps_title_gives_the_users_values_and_its_exponents_are_per_
         drawn.append(plot_basin_map(shown, path))
         return drawn[-1]
 
-    monkeypatch.setattr(command, "plot_basin_map", draw)
+    monkeypatch.setattr(figures, "plot_basin_map", draw)
     code, out, _ = run_cli(capsys, "basins", "spur_pair", "--set", "speed=5000 rpm", "--grid", "x=-20um:20um:20um",
                            "--grid", "v=-300mm/s:300mm/s:300mm/s", "--periods", "60", "--discard", "20",
                            "--plot", str(tmp_path / "map.png"))

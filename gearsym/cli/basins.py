@@ -5,21 +5,16 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from pathlib import Path
 
 from ..analysis.basins import RUN, basin_map
 from ..errors import GearsymError
-from ..figures.basins import BASINS_DPI, plot_basin_fractions, plot_basin_map
-from ..figures.save import figure_bytes
-from ..files.atomic import write_atomically
+from ..figures.basins import save_basin_fractions, save_basin_map
 from ..files.outputs import check_figure, check_file
 from ..opening import open_model
 from ..options import Execution
-from ..physical.basins import GridAxis, PhysicalGrid, ShownBasinMap, ShownFractions, shown_in
-from ..physical.files import write_basin_fractions, write_basin_map
+from ..physical.basins import GivenGrid, GridAxis, ShownBasinMap, ShownFractions, shown_in
 from ..physical.sweeps import MeasuredAxis, engine_axis
-from ..sweep.basin_continuation import MATCH_DISTANCE, StartGrid, continue_basins
-from ..sweep.grid import Axis
+from ..sweep.basin_continuation import MATCH_DISTANCE, continue_basins
 from ..sweep.store import sidecar
 from .arguments.integration import add_integration_arguments, integration_from, model_request
 from .arguments.settings import add_set_argument, parse_state
@@ -64,7 +59,7 @@ def run(args: argparse.Namespace) -> int:
         raise GearsymError("--param follows the basins along a parameter into files: give --out FILE.csv")
     if args.jobs < 0:
         raise GearsymError(f"--jobs must be 0 (every core) or more, got {args.jobs}")
-    grid_axes, y0, axis = args.grid, args.y0, args.param
+    grid_axes, axis = args.grid, args.param
     if len(grid_axes) != 2 or grid_axes[0].name == grid_axes[1].name:
         raise GearsymError(f"--grid: give two different states (e.g. --grid x=-5:5:0.1 --grid v=-5:5:0.1), got "
                            f"{', '.join(a.name for a in grid_axes) or 'none'}")
@@ -79,67 +74,40 @@ def run(args: argparse.Namespace) -> int:
             raise GearsymError(f"{unit.spec!r} has a unit, but the model has no physical values; give the model's own "
                                "numbers")
     shown_as = shown_in(units, request.settings)
-    # (a grid in physical units is checked here, once, before the model is compiled)
-    physical_grid = PhysicalGrid(units, grid_axes) if units is not None else None
-    if axis is not None and physical_grid is not None:  # (the parameter in the engine's numbers, also before)
+    # (the starts, made once for the map or every value of the continuation: a grid in physical units is checked
+    # here, once, before the model is compiled, and its engine values are taken where the starts are made)
+    grid = GivenGrid(units, grid_axes)
+    if axis is not None and units is not None:  # (the parameter in the engine's numbers, also before)
         axis = engine_axis(model.scaling.full, axis)
     compiled = model.compiled()
-    if axis is not None:
-        return _continuation(args, compiled, grid_axes, physical_grid, axis, shown_as, y0, execution)
-    # (the engine's starts at the compiled model's speed: a rate's engine unit moves with it)
-    starts = (physical_grid.at(dict(zip(compiled.parameter_names, compiled.parameter_vector()))) if physical_grid
-              else {a.name: a.values for a in grid_axes})
-    result = basin_map(compiled, starts, y0=y0, execution=execution)
-    shown = ShownBasinMap(result, shown_as, tuple(grid_axes))
-    write_map(shown, args.out, args.plot)
-    print(json.dumps(shown.as_dict(), indent=2) if args.format == "json" else report(shown))
-    return 0
-
-
-def write_map(shown: ShownBasinMap, out: str | None, plot: str | None) -> None:
-    """The map's files, each written whole: ``out`` (one row per start) with its record beside it, and the
-    picture ``plot``; the picture is drawn before anything is written, so that a figure that fails leaves no
-    table without its picture."""
-    picture = figure_bytes(plot_basin_map(shown), plot, BASINS_DPI) if plot else None
-    if out:
-        written = write_basin_map(shown, out)
-        print(f"gearsym: wrote {' and '.join(map(str, written))}", file=sys.stderr)
-    if plot:
-        write_atomically(plot, picture)
-        print(f"gearsym: wrote {plot}", file=sys.stderr)
-
-
-def write_fractions(shown: ShownFractions, physical: Path | None, plot: str | None) -> None:
-    """A continuation's files beside its own (which it writes as it goes), each written whole: the fractions in
-    the model's units (``physical``, for a model with physical values) and the picture ``plot``, drawn before
-    anything is written."""
-    picture = figure_bytes(plot_basin_fractions(shown), plot, BASINS_DPI) if plot else None
-    if physical is not None:
-        write_basin_fractions(shown, physical)
-        print(f"gearsym: wrote {physical} (the fractions in the model's units)", file=sys.stderr)
-    if plot:
-        write_atomically(plot, picture)
-        print(f"gearsym: wrote {plot}", file=sys.stderr)
-
-
-def _continuation(args, compiled, grid_axes: list[Axis], physical_grid: PhysicalGrid | None, axis: Axis, shown_as,
-                  y0, execution: Execution) -> int:
-    """The basin fractions along --param (``axis``: in the engine's numbers; ``physical_grid``: the grid in physical
-    units, None for a model without physical values)."""
-    physical = physical_grid is not None
-    grid = physical_grid or StartGrid({a.name: a.values for a in grid_axes}, [a.spec for a in grid_axes])
+    if axis is None:
+        shown = ShownBasinMap(basin_map(compiled, grid, y0=args.y0, execution=execution), shown_as, tuple(grid_axes))
+        written = save_basin_map(shown, args.out, args.plot)
+        if args.out:
+            print(f"gearsym: wrote {written[0]} and {written[1]}", file=sys.stderr)
+        _said_plot(args.plot)
+        print(json.dumps(shown.as_dict(), indent=2) if args.format == "json" else report(shown))
+        return 0
     try:
-        result = continue_basins(compiled, grid, axis.name, axis.values, y0=y0, out=args.out,
-                                 overwrite=args.overwrite, execution=execution,
-                                 match_distance=args.match_distance)
+        result = continue_basins(compiled, grid, axis.name, axis.values, y0=args.y0, out=args.out,
+                                 overwrite=args.overwrite, execution=execution, match_distance=args.match_distance)
     except KeyboardInterrupt:
         print(f"gearsym: interrupted; the values finished are in {args.out}: run the same command again to resume",
               file=sys.stderr)
         return 130
     shown = ShownFractions(result, shown_as)
-    write_fractions(shown, sidecar(args.out, ".physical.csv") if physical else None, args.plot)
+    physical = sidecar(args.out, ".physical.csv") if units is not None else None
+    save_basin_fractions(shown, physical, args.plot)
+    if physical is not None:
+        print(f"gearsym: wrote {physical} (the fractions in the model's units)", file=sys.stderr)
+    _said_plot(args.plot)
     print(json.dumps(result.as_dict(), indent=2) if args.format == "json" else continuation_report(shown))
     return 0
+
+
+def _said_plot(plot: str | None) -> None:
+    if plot:
+        print(f"gearsym: wrote {plot}", file=sys.stderr)
 
 
 def report(shown: ShownBasinMap) -> str:

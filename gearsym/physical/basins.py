@@ -2,7 +2,7 @@
 µm and mm/s, the speed in rpm), else in its own numbers.
 
 A grid given in physical units is read into SI units once, when it is parsed (:class:`GridAxis`), checked against
-the model's states once (:class:`PhysicalGrid`), and turned into the engine's nondimensional starts at each forcing
+the model's states once (:class:`GivenGrid`), and turned into the engine's nondimensional starts at each forcing
 frequency (a rate's unit, L omega omega_n per second, moves with the speed: :func:`engine_grid`); the results come
 back through the same numbers (:class:`~gearsym.physical.point.PointUnits`: the length unit L, omega_n, the speed's
 ratio). :class:`ShownBasinMap` and :class:`ShownFractions` are the results in those units, which the files
@@ -15,10 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.basins import BasinMap
+from ..analysis.basins import BasinMap, StartGrid
 from ..checks import json_safe
 from ..errors import GearsymError
-from ..sweep.basin_continuation import BasinContinuation, StartGrid
+from ..sweep.basin_continuation import BasinContinuation
 from ..sweep.grid import Axis, axis_fields, parse_axis
 from ..units import dimension_text, to_si, unit_dims
 from .point import ANGLE, ANGULAR_VELOCITY, LENGTH, VELOCITY, PointUnits
@@ -256,14 +256,18 @@ def engine_grid(units: PointUnits, si_grid: Mapping[str, np.ndarray], omega: flo
             for name, values in si_grid.items()}
 
 
-class PhysicalGrid(StartGrid):
-    """A grid of starts given in physical units, checked and in SI units when it is made (:func:`grid_in_si`): its
-    engine values at each forcing frequency (a rate's unit moves with the speed), and the grid as given in the
-    record."""
+class GivenGrid(StartGrid):
+    """The starts of a grid as given (``axes``: :class:`GridAxis`, with the record's specs): in the model's own
+    numbers (``units`` None: a model without physical values), or in physical units, checked and in SI units
+    when it is made (:func:`grid_in_si`), its engine values at each forcing frequency (a rate's unit moves with
+    the speed)."""
 
-    def __init__(self, units: PointUnits, axes: Sequence[GridAxis]):
+    def __init__(self, units: PointUnits | None, axes: Sequence[GridAxis]):
         super().__init__({a.name: a.values for a in axes}, [a.spec for a in axes])
-        self.units, self.axes, self.si_grid = units, tuple(axes), grid_in_si(units, axes)
+        self.units, self.axes = units, tuple(axes)
+        self.si_grid = grid_in_si(units, axes) if units is not None else None
 
     def at(self, point):
+        if self.units is None:
+            return self.values
         return engine_grid(self.units, self.si_grid, point.get("omega", 1.0))
