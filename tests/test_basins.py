@@ -14,7 +14,8 @@ from gearsym import Execution, FirstOrderSystem, Integration
 from gearsym.analysis.basins import DIVERGED, UNDETERMINED, basin_map
 from gearsym.cli import main
 from gearsym.figures.basins import plot_basin_map
-from gearsym.physical.basins import GridAxis
+from gearsym.opening import ModelRequest, open_model
+from gearsym.physical.basins import GivenGrid, GridAxis
 from gearsym.physical.sweeps import MeasuredAxis
 from gearsym.sweep.grid import parse_axis
 from gearsym.sweep.basin_continuation import APPEARS, VANISHES, continue_basins
@@ -309,3 +310,23 @@ def test_a_physical_maps_title_gives_the_users_values_and_its_exponents_are_per_
     legend = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert any("λ₁ = " in t and t.endswith("1/s") for t in legend)
     assert "the rest as the model declares them" in out
+
+
+def test_a_continuation_maps_each_value_of_a_grid_in_physical_units_as_the_basin_map_at_that_value():
+    """Along a parameter other than omega, the grid's rates (mm/s) are turned into the engine's numbers at the
+    model's own speed, as the map at that value turns them (a rate's engine unit moves with omega)."""
+    model = open_model(ModelRequest("spur_pair", {"speed": gearsym.units.measure("5000 rpm", "speed")},
+                                    Integration(periods=30, discard=10)))
+    grid = GivenGrid(model.scaling.point_units(), [GridAxis.read("x=-20um:20um:20um"),
+                                                     GridAxis.read("v=-300mm/s:300mm/s:300mm/s")])
+    compiled = model.compiled()
+    omega = dict(zip(compiled.parameter_names, compiled.parameter_vector()))["omega"]
+    assert not math.isclose(omega, 1.0)
+    at_speed = grid.at({"omega": omega})
+    assert not np.allclose(at_speed["v"], grid.at({"omega": 1.0})["v"])  # (the rates' engine values move with omega)
+    found = []
+    continue_basins(compiled, grid, "zeta", [0.05], on_value=found.append)
+    alone = basin_map(compiled, grid, zeta=0.05)
+    for mapped in (found[0], alone):
+        assert [(n, v.tolist()) for n, v in mapped.axes] == [(n, np.asarray(v).tolist()) for n, v in at_speed.items()]
+    assert found[0].labels.tolist() == alone.labels.tolist()
