@@ -214,11 +214,12 @@ class StartGrid:
         """The grid at the parameter values ``point``."""
         return self.values
 
-    def record(self, point: Mapping[str, float]) -> list | dict:
-        """How the grid stands in the continuation's record (at the first value ``point``)."""
+    @property
+    def record(self) -> list | dict:
+        """How the grid stands in a record (a continuation's): as it was given, else its values."""
         if self.given:
             return list(self.given)
-        return {k: np.asarray(v, dtype=float).tolist() for k, v in self.at(point).items()}
+        return {k: np.asarray(v, dtype=float).tolist() for k, v in self.values.items()}
 
 
 # ------------------------------------------------------------------------------------------ entry point

@@ -131,7 +131,7 @@ def continue_basins(model: CompiledModel, grid: Mapping[str, Sequence[float]] | 
         raise GearsymError(f"match_distance must be a positive number, got {match_distance!r}")
     record = {"model": model.name, "model_hash": model.hash, "backend": model.backend, "parameter": parameter,
               "values": list(values), "settings": {k: float(v) for k, v in fixed.items()},
-              "grid": grid.record({**fixed, parameter: values[0]}), "initial_state": dict(zip(
+              "grid": grid.record, "initial_state": dict(zip(
                   model.state_names, map(float, model.initial_state(y0)))), "periods": options.periods,
               "discard": options.discard, "steps_per_period": model.steps_per_period,
               "locate_crossings": model.options.locate_crossings, "match_distance": float(match_distance),
