@@ -78,10 +78,10 @@ def run(args: argparse.Namespace) -> int:
     # here, once, before the model is compiled, and its engine values are taken where the starts are made)
     grid = GivenGrid(units, grid_axes)
     if axis is not None and units is not None:  # (the parameter in the engine's numbers, also before)
-        axis = engine_axis(model.scaling.full, axis)
+        axis = engine_axis(scaling.full, axis)
     compiled = model.compiled()
     if axis is None:
-        shown = ShownBasinMap(basin_map(compiled, grid, y0=args.y0, execution=execution), shown_as, tuple(grid_axes))
+        shown = ShownBasinMap(basin_map(compiled, grid, y0=args.y0, execution=execution), shown_as, grid.axes)
         written = save_basin_map(shown, args.out, args.plot)
         if args.out:
             print(f"gearsym: wrote {written[0]} and {written[1]}", file=sys.stderr)
