@@ -11,7 +11,9 @@ from scipy.integrate import solve_ivp
 
 import gearsym
 from gearsym import Execution, FirstOrderSystem, Integration
+import gearsym.basin_jobs as basin_jobs
 from gearsym.analysis.basins import DIVERGED, UNDETERMINED, basin_map
+from gearsym.basin_jobs import BasinMapJob
 from gearsym.cli import main
 from gearsym.figures.basins import plot_basin_map
 from gearsym.opening import ModelRequest, open_model
@@ -223,6 +225,42 @@ def test_cli_text_and_the_continuation_figure(capsys, tmp_path):
     assert code == 0
     assert "basin fractions at 2 values of omega" in out and "omega=1.2:" in out
     assert (tmp_path / "c.png").stat().st_size > 10_000 and (tmp_path / "c.attractors.csv").is_file()
+
+
+def test_a_python_caller_runs_the_commands_map_job_to_the_same_files_and_report(capsys, tmp_path):
+    code, out, _ = run_cli(capsys, "basins", "duffing", "--grid", "x=-4:4:4", "--grid", "v=-4:4:4", "--periods", "150",
+                           "--discard", "100", "--format", "json", "--out", str(tmp_path / "cli.csv"), "--quiet")
+    assert code == 0
+    job = BasinMapJob(grid=(GridAxis.read("x=-4:4:4"), GridAxis.read("v=-4:4:4")), out=tmp_path / "job.csv")
+    done = job.run(open_model(ModelRequest("duffing", options=Integration(periods=150, discard=100))))
+    assert done.report("json") + "\n" == out
+    assert done.written == (f"wrote {tmp_path / 'job.csv'} and {tmp_path / 'job.json'}",)
+    for suffix in (".csv", ".json"):
+        assert (tmp_path / f"job{suffix}").read_bytes() == (tmp_path / f"cli{suffix}").read_bytes(), suffix
+
+
+def test_ctrl_c_during_the_fractions_says_where_the_values_finished_are_and_during_a_map_only_that(capsys, tmp_path,
+                                                                                                   monkeypatch):
+    def first_value_only(*args, **kwargs):
+        def stop(found):
+            raise KeyboardInterrupt
+        return continue_basins(*args, on_value=stop, **kwargs)
+
+    monkeypatch.setattr(basin_jobs, "continue_basins", first_value_only)
+    out = tmp_path / "c.csv"
+    code, _, err = run_cli(capsys, "basins", "duffing", "--grid", "x=-4:4:4", "--grid", "v=-4:4:4", "--param",
+                           "omega=1.2:1.3:0.1", "--periods", "150", "--discard", "100", "--out", str(out), "--quiet")
+    assert code == 130 and json.loads((tmp_path / "c.json").read_text())["values"]["done"] == 1
+    assert err.strip().splitlines()[-1] == (f"gearsym: interrupted; the values finished are in {out}: run the same "
+                                            "command again to resume")
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(basin_jobs, "basin_map", interrupted)
+    code, _, err = run_cli(capsys, "basins", "duffing", "--grid", "x=-4:4:4", "--grid", "v=-4:4:4", "--periods",
+                           "150", "--discard", "100", "--out", str(tmp_path / "m.csv"), "--quiet")
+    assert code == 130 and err.strip().splitlines()[-1] == "gearsym: interrupted"  # (nothing kept to say where)
 
 
 @pytest.mark.parametrize("argv, message", [
