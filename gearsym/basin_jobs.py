@@ -72,7 +72,7 @@ class BasinsJob:
     plot: str | Path | None = None
 
     def plotted(self) -> tuple[str, ...]:
-        """What the picture's writing says."""
+        """The line that says the picture was written (none without a picture)."""
         return (f"wrote {self.plot}",) if self.plot else ()
 
 
