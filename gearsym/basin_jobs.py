@@ -63,13 +63,18 @@ def checked_starts(model: OpenModel, grid: Sequence[GridAxis],
 class BasinsJob:
     """What both jobs are given: the ``grid`` of starts as given (two :class:`~gearsym.physical.basins.GridAxis`,
     in physical units for a model with physical values), where the other states start (``y0``: the model's
-    initial state by default), the runs' threads, lanes and progress (``execution``) and the picture (``plot``).
-    Each job's ``run(model)`` (an :class:`~gearsym.opening.OpenModel`) returns what it found (:class:`Done`)."""
+    initial state by default), the runs' threads, lanes and progress (``execution``) and the picture (``plot``)."""
 
     grid: Sequence[GridAxis]
     y0: Mapping[str, float] | None = None
     execution: Execution = field(default_factory=Execution)
     plot: str | Path | None = None
+
+    def run(self, model: OpenModel) -> Done:  # pragma: no cover (each job has its own)
+        """The job on ``model`` (an :class:`~gearsym.opening.OpenModel`): what it was given checked against the
+        model, the model compiled, the job run and its files written; what it found, as shown, and what it
+        wrote."""
+        raise NotImplementedError
 
     def plotted(self) -> tuple[str, ...]:
         """The line that says the picture was written (none without a picture)."""
