@@ -11,10 +11,13 @@ from scipy.integrate import solve_ivp
 
 import gearsym
 from gearsym import Execution, FirstOrderSystem, Integration
+import gearsym.basin_jobs as basin_jobs
 from gearsym.analysis.basins import DIVERGED, UNDETERMINED, basin_map
+from gearsym.basin_jobs import BasinMapJob
 from gearsym.cli import main
 from gearsym.figures.basins import plot_basin_map
-from gearsym.physical.basins import GridAxis
+from gearsym.opening import ModelRequest, open_model
+from gearsym.physical.basins import GivenGrid, GridAxis
 from gearsym.physical.sweeps import MeasuredAxis
 from gearsym.sweep.grid import parse_axis
 from gearsym.sweep.basin_continuation import APPEARS, VANISHES, continue_basins
@@ -224,6 +227,42 @@ def test_cli_text_and_the_continuation_figure(capsys, tmp_path):
     assert (tmp_path / "c.png").stat().st_size > 10_000 and (tmp_path / "c.attractors.csv").is_file()
 
 
+def test_a_python_caller_runs_the_commands_map_job_to_the_same_files_and_report(capsys, tmp_path):
+    code, out, _ = run_cli(capsys, "basins", "duffing", "--grid", "x=-4:4:4", "--grid", "v=-4:4:4", "--periods", "150",
+                           "--discard", "100", "--format", "json", "--out", str(tmp_path / "cli.csv"), "--quiet")
+    assert code == 0
+    job = BasinMapJob(grid=(GridAxis.read("x=-4:4:4"), GridAxis.read("v=-4:4:4")), out=tmp_path / "job.csv")
+    done = job.run(open_model(ModelRequest("duffing", options=Integration(periods=150, discard=100))))
+    assert done.report("json") + "\n" == out
+    assert done.written == (f"wrote {tmp_path / 'job.csv'} and {tmp_path / 'job.json'}",)
+    for suffix in (".csv", ".json"):
+        assert (tmp_path / f"job{suffix}").read_bytes() == (tmp_path / f"cli{suffix}").read_bytes(), suffix
+
+
+def test_ctrl_c_during_the_fractions_says_where_the_values_finished_are_and_during_a_map_only_that(capsys, tmp_path,
+                                                                                                   monkeypatch):
+    def first_value_only(*args, **kwargs):
+        def stop(found):
+            raise KeyboardInterrupt
+        return continue_basins(*args, on_value=stop, **kwargs)
+
+    monkeypatch.setattr(basin_jobs, "continue_basins", first_value_only)
+    out = tmp_path / "c.csv"
+    code, _, err = run_cli(capsys, "basins", "duffing", "--grid", "x=-4:4:4", "--grid", "v=-4:4:4", "--param",
+                           "omega=1.2:1.3:0.1", "--periods", "150", "--discard", "100", "--out", str(out), "--quiet")
+    assert code == 130 and json.loads((tmp_path / "c.json").read_text())["values"]["done"] == 1
+    assert err.strip().splitlines()[-1] == (f"gearsym: interrupted; the values finished are in {out}: run the same "
+                                            "command again to resume")
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(basin_jobs, "basin_map", interrupted)
+    code, _, err = run_cli(capsys, "basins", "duffing", "--grid", "x=-4:4:4", "--grid", "v=-4:4:4", "--periods",
+                           "150", "--discard", "100", "--out", str(tmp_path / "m.csv"), "--quiet")
+    assert code == 130 and err.strip().splitlines()[-1] == "gearsym: interrupted"  # (nothing kept to say where)
+
+
 @pytest.mark.parametrize("argv, message", [
     (("--grid", "x=-1:1:1"), "give two different states"),
     (("--grid", "x=-1:1:1", "--grid", "q=0,1"), "--grid q: not a state of one_stage"),
@@ -289,7 +328,7 @@ def test_a_model_with_physical_values_is_mapped_and_answered_in_its_units(capsys
 
 def test_a_physical_maps_title_gives_the_users_values_and_its_exponents_are_per_second(capsys, tmp_path,
                                                                                           monkeypatch):
-    import gearsym.cli.basins as command
+    import gearsym.figures.basins as figures
 
     drawn = []
 
@@ -297,7 +336,7 @@ def test_a_physical_maps_title_gives_the_users_values_and_its_exponents_are_per_
         drawn.append(plot_basin_map(shown, path))
         return drawn[-1]
 
-    monkeypatch.setattr(command, "plot_basin_map", draw)
+    monkeypatch.setattr(figures, "plot_basin_map", draw)
     code, out, _ = run_cli(capsys, "basins", "spur_pair", "--set", "speed=5000 rpm", "--grid", "x=-20um:20um:20um",
                            "--grid", "v=-300mm/s:300mm/s:300mm/s", "--periods", "60", "--discard", "20",
                            "--plot", str(tmp_path / "map.png"))
@@ -309,3 +348,23 @@ def test_a_physical_maps_title_gives_the_users_values_and_its_exponents_are_per_
     legend = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert any("λ₁ = " in t and t.endswith("1/s") for t in legend)
     assert "the rest as the model declares them" in out
+
+
+def test_a_continuation_maps_each_value_of_a_grid_in_physical_units_as_the_basin_map_at_that_value():
+    """Along a parameter other than omega, the grid's rates (mm/s) are turned into the engine's numbers at the
+    model's own speed, as the map at that value turns them (a rate's engine unit moves with omega)."""
+    model = open_model(ModelRequest("spur_pair", {"speed": gearsym.units.measure("5000 rpm", "speed")},
+                                    Integration(periods=30, discard=10)))
+    grid = GivenGrid(model.scaling.point_units(), [GridAxis.read("x=-20um:20um:20um"),
+                                                     GridAxis.read("v=-300mm/s:300mm/s:300mm/s")])
+    compiled = model.compiled()
+    omega = dict(zip(compiled.parameter_names, compiled.parameter_vector()))["omega"]
+    assert not math.isclose(omega, 1.0)
+    at_speed = grid.at({"omega": omega})
+    assert not np.allclose(at_speed["v"], grid.at({"omega": 1.0})["v"])  # (the rates' engine values move with omega)
+    found = []
+    continue_basins(compiled, grid, "zeta", [0.05], on_value=found.append)
+    alone = basin_map(compiled, grid, zeta=0.05)
+    for mapped in (found[0], alone):
+        assert [(n, v.tolist()) for n, v in mapped.axes] == [(n, np.asarray(v).tolist()) for n, v in at_speed.items()]
+    assert found[0].labels.tolist() == alone.labels.tolist()

@@ -200,12 +200,36 @@ class BasinMap:
                    dict(data["method"]))
 
 
+class StartGrid:
+    """The starts of basin maps: ``values`` ({state: values} for two states) at any parameter values, and how they
+    were ``given`` (for the record: e.g. the command line's ``x=-5:5:0.1``; by default the values themselves). A
+    grid whose engine values move with the parameters (a grid in physical units, whose rates' unit moves with the
+    speed: :class:`~gearsym.physical.basins.GivenGrid`) is a subclass that overrides :meth:`at`, which
+    :func:`basin_map` asks where it makes the starts, at the parameter values of its run."""
+
+    def __init__(self, values: Mapping[str, Sequence[float]], given: Sequence[str] = ()):
+        self.values, self.given = values, tuple(given)
+
+    def at(self, point: Mapping[str, float]) -> Mapping[str, Sequence[float]]:
+        """The grid at the parameter values ``point``."""
+        return self.values
+
+    @property
+    def record(self) -> list | dict:
+        """How the grid stands in a record (a continuation's): as it was given, else its values."""
+        if self.given:
+            return list(self.given)
+        return {k: np.asarray(v, dtype=float).tolist() for k, v in self.values.items()}
+
+
 # ------------------------------------------------------------------------------------------ entry point
 @engine_verb(default=Integration(**RUN))
-def basin_map(model: CompiledModel, grid: Mapping[str, Sequence[float]], *, options: Integration | None = None,
-              y0=None, execution: Execution | None = None, **values: float) -> BasinMap:
-    """The basin map of ``model`` on ``grid`` ({state: values} for two states, e.g. ``{"x": xs, "v": vs}``; the
-    other states start where ``y0`` says, default the model's initial state) at the parameter ``values``.
+def basin_map(model: CompiledModel, grid: Mapping[str, Sequence[float]] | StartGrid, *,
+              options: Integration | None = None, y0=None, execution: Execution | None = None,
+              **values: float) -> BasinMap:
+    """The basin map of ``model`` on ``grid`` ({state: values} for two states, e.g. ``{"x": xs, "v": vs}``, or a
+    :class:`StartGrid`, whose values are taken at this run's parameters; the other states start where ``y0`` says,
+    default the model's initial state) at the parameter ``values``.
 
     Every start runs ``options.discard`` periods and is classified from the ``options.measured`` after them
     (module docstring); ``execution``: its ``jobs`` threads run the lanes (0: one per core); ``lanes=False`` runs
@@ -214,7 +238,8 @@ def basin_map(model: CompiledModel, grid: Mapping[str, Sequence[float]], *, opti
     options = model.run_options(options)
     execution = execution or Execution()
     p = model.parameter_vector(values)  # names and values checked before any run
-    axes, held, starts = grid_starts(model, grid, y0)
+    point = dict(zip(model.parameter_names, map(float, p)))
+    axes, held, starts = grid_starts(model, grid.at(point) if isinstance(grid, StartGrid) else grid, y0)
     inputs = model.prepare(p)
     runner = LaneRunner(model, options.discard, options.measured, lanes=execution.with_lanes(True),
                         verbose=execution.verbose)
@@ -222,12 +247,11 @@ def basin_map(model: CompiledModel, grid: Mapping[str, Sequence[float]], *, opti
     summary = Summary.join(list(threaded(lambda rows: Summary.of(runner.orbits(starts[rows], inputs)), chunks,
                                          execution.jobs)))
     labels, groups, scale = classify(summary, starts)
-    values = dict(zip(model.parameter_names, map(float, p)))
-    attractors = _attractors(model, options, values, summary, starts, labels, groups)
+    attractors = _attractors(model, options, point, summary, starts, labels, groups)
     shape = (len(axes[1][1]), len(axes[0][1]))
     counts = {k: int(np.sum(labels == k)) for k in (DIVERGED, UNDETERMINED)}
     return BasinMap(
-        model=model.name, parameters=values, state_names=model.state_names, axes=axes, held=held,
+        model=model.name, parameters=point, state_names=model.state_names, axes=axes, held=held,
         labels=_renumbered(labels, attractors).reshape(shape), attractors=tuple(a for a, _ in attractors),
         diverged=Fraction(counts[DIVERGED], len(starts)), undetermined=Fraction(counts[UNDETERMINED], len(starts)),
         scale=scale, periods=options.periods, discard=options.discard, steps_per_period=model.steps_per_period,

@@ -3,24 +3,17 @@ their fractions along a parameter (``--param omega=1.3:1.8:0.01``, resumable).""
 from __future__ import annotations
 
 import argparse
-import json
 import sys
-from pathlib import Path
 
-from ..analysis.basins import RUN, basin_map
+from ..analysis.basins import RUN
+from ..basin_jobs import BasinFractionsJob, BasinMapJob, BasinsJob, FractionsInterrupted
 from ..errors import GearsymError
-from ..figures.basins import BASINS_DPI, plot_basin_fractions, plot_basin_map
-from ..figures.save import figure_bytes
-from ..files.atomic import write_atomically
 from ..files.outputs import check_figure, check_file
 from ..opening import open_model
 from ..options import Execution
-from ..physical.basins import GridAxis, PhysicalGrid, ShownBasinMap, ShownFractions, shown_in
-from ..physical.files import write_basin_fractions, write_basin_map
-from ..physical.sweeps import MeasuredAxis, engine_axis
-from ..sweep.basin_continuation import MATCH_DISTANCE, StartGrid, continue_basins
-from ..sweep.grid import Axis
-from ..sweep.store import sidecar
+from ..physical.basins import GridAxis
+from ..physical.sweeps import MeasuredAxis
+from ..sweep.basin_continuation import MATCH_DISTANCE
 from .arguments.integration import add_integration_arguments, integration_from, model_request
 from .arguments.settings import add_set_argument, parse_state
 
@@ -64,128 +57,29 @@ def run(args: argparse.Namespace) -> int:
         raise GearsymError("--param follows the basins along a parameter into files: give --out FILE.csv")
     if args.jobs < 0:
         raise GearsymError(f"--jobs must be 0 (every core) or more, got {args.jobs}")
-    grid_axes, y0, axis = args.grid, args.y0, args.param
-    if len(grid_axes) != 2 or grid_axes[0].name == grid_axes[1].name:
+    if len(args.grid) != 2 or args.grid[0].name == args.grid[1].name:
         raise GearsymError(f"--grid: give two different states (e.g. --grid x=-5:5:0.1 --grid v=-5:5:0.1), got "
-                           f"{', '.join(a.name for a in grid_axes) or 'none'}")
-    execution = Execution(args.jobs, lanes=not args.no_lanes, progress=not args.quiet)
+                           f"{', '.join(a.name for a in args.grid) or 'none'}")
+    job = job_from(args)
     request = model_request(args, integration_from(args))
     model = open_model(request)
-    scaling = model.scaling
-    units = scaling.point_units() if scaling is not None else None
-    if units is None:
-        unit = next((a for a in [*grid_axes, *([axis] if axis else [])] if a.unit), None)
-        if unit:
-            raise GearsymError(f"{unit.spec!r} has a unit, but the model has no physical values; give the model's own "
-                               "numbers")
-    shown_as = shown_in(units, request.settings)
-    # (a grid in physical units is checked here, once, before the model is compiled)
-    physical_grid = PhysicalGrid(units, grid_axes) if units is not None else None
-    if axis is not None and physical_grid is not None:  # (the parameter in the engine's numbers, also before)
-        axis = engine_axis(model.scaling.full, axis)
-    compiled = model.compiled()
-    if axis is not None:
-        return _continuation(args, compiled, grid_axes, physical_grid, axis, shown_as, y0, execution)
-    # (the engine's starts at the compiled model's speed: a rate's engine unit moves with it)
-    starts = (physical_grid.at(dict(zip(compiled.parameter_names, compiled.parameter_vector()))) if physical_grid
-              else {a.name: a.values for a in grid_axes})
-    result = basin_map(compiled, starts, y0=y0, execution=execution)
-    shown = ShownBasinMap(result, shown_as, tuple(grid_axes))
-    write_map(shown, args.out, args.plot)
-    print(json.dumps(shown.as_dict(), indent=2) if args.format == "json" else report(shown))
-    return 0
-
-
-def write_map(shown: ShownBasinMap, out: str | None, plot: str | None) -> None:
-    """The map's files, each written whole: ``out`` (one row per start) with its record beside it, and the
-    picture ``plot``; the picture is drawn before anything is written, so that a figure that fails leaves no
-    table without its picture."""
-    picture = figure_bytes(plot_basin_map(shown), plot, BASINS_DPI) if plot else None
-    if out:
-        written = write_basin_map(shown, out)
-        print(f"gearsym: wrote {' and '.join(map(str, written))}", file=sys.stderr)
-    if plot:
-        write_atomically(plot, picture)
-        print(f"gearsym: wrote {plot}", file=sys.stderr)
-
-
-def write_fractions(shown: ShownFractions, physical: Path | None, plot: str | None) -> None:
-    """A continuation's files beside its own (which it writes as it goes), each written whole: the fractions in
-    the model's units (``physical``, for a model with physical values) and the picture ``plot``, drawn before
-    anything is written."""
-    picture = figure_bytes(plot_basin_fractions(shown), plot, BASINS_DPI) if plot else None
-    if physical is not None:
-        write_basin_fractions(shown, physical)
-        print(f"gearsym: wrote {physical} (the fractions in the model's units)", file=sys.stderr)
-    if plot:
-        write_atomically(plot, picture)
-        print(f"gearsym: wrote {plot}", file=sys.stderr)
-
-
-def _continuation(args, compiled, grid_axes: list[Axis], physical_grid: PhysicalGrid | None, axis: Axis, shown_as,
-                  y0, execution: Execution) -> int:
-    """The basin fractions along --param (``axis``: in the engine's numbers; ``physical_grid``: the grid in physical
-    units, None for a model without physical values)."""
-    physical = physical_grid is not None
-    grid = physical_grid or StartGrid({a.name: a.values for a in grid_axes}, [a.spec for a in grid_axes])
     try:
-        result = continue_basins(compiled, grid, axis.name, axis.values, y0=y0, out=args.out,
-                                 overwrite=args.overwrite, execution=execution,
-                                 match_distance=args.match_distance)
-    except KeyboardInterrupt:
+        done = job.run(model)
+    except FractionsInterrupted:
         print(f"gearsym: interrupted; the values finished are in {args.out}: run the same command again to resume",
               file=sys.stderr)
         return 130
-    shown = ShownFractions(result, shown_as)
-    write_fractions(shown, sidecar(args.out, ".physical.csv") if physical else None, args.plot)
-    print(json.dumps(result.as_dict(), indent=2) if args.format == "json" else continuation_report(shown))
+    for line in done.written:
+        print(f"gearsym: {line}", file=sys.stderr)
+    print(done.report(args.format))
     return 0
 
 
-def report(shown: ShownBasinMap) -> str:
-    """The text output: the run, each attractor, the other classes."""
-    result = shown.result
-    (x, xs), (y, ys) = result.axes
-    sx, ux = shown.state(x, xs)
-    sy, uy = shown.state(y, ys)
-    held = ", ".join("{}={:g}{}".format(k, *shown.number(k, v)) for k, v in result.held.items())
-    lines = [
-        f"{result.model}: {result.starts} starts, {x} in [{sx.min():g}, {sx.max():g}]{ux} ({xs.size}) x {y} in "
-        f"[{sy.min():g}, {sy.max():g}]{uy} ({ys.size})" + (f", held {held}" if held else ""),
-        f"parameters: {shown.parameters_text().replace('$', '')}",  # (no figure mathtext in text)
-        f"{result.periods} periods per start ({result.discard} discarded), {result.steps_per_period} RK4 steps/period, "
-        f"{'crossings located' if result.locate_crossings else 'plain RK4'}, {result.backend}, "
-        f"{result.lanes} trajectories per call",
-        f"{len(result.attractors)} attractor{'s' if len(result.attractors) != 1 else ''} (fraction of starts ± "
-        "binomial standard error; exponents from one tangent run on each):",
-    ]
-    for a in result.attractors:
-        amplitude = ", ".join("A_{} = {:.6g}{}".format(k, *_spaced(shown.number(k, v)))
-                              for k, v in a.amplitude.items())
-        lines += [f"  {a.number}: {a.description}: {a.fraction:.4f} ± {a.stderr:.4f} ({a.basin.starts} starts)",
-                  f"     {amplitude}; lambda = " + ", ".join(f"{v:+.5f}" for v in a.exponents)]
-    for name, share in (("diverged", result.diverged), ("undetermined", result.undetermined)):
-        lines.append(f"  {name}: {share.fraction:.4f} ± {share.stderr:.4f} ({share.starts} starts)")
-    return "\n".join(lines)
-
-
-def _spaced(number: tuple[float, str]) -> tuple[float, str]:
-    value, unit = number
-    return value, f" {unit}" if unit else ""
-
-
-def continuation_report(shown: ShownFractions) -> str:
-    result = shown.result
-    name, values, unit = shown.parameter()
-    lines = [f"{result.model}: basin fractions at {len(values)} values of {name} ({values[0]:g} to {values[-1]:g}"
-             f"{' ' + unit if unit else ''}) -> {result.path}"]
-    where = dict(zip(result.values, values))
-    for v in result.values:
-        parts = [f"{r.id}: {r.fraction:.3f} ({r.period and f'period {r.period}' or r.regime})"
-                 for r in result.at(v) if r.kind == "attractor"]
-        other = [f"{r.kind} {r.fraction:.3f}" for r in result.at(v) if r.kind != "attractor" and r.starts]
-        lines.append(f"  {name}={where[v]:g}: " + "; ".join(parts + other))
-    for e in result.events:
-        what = f"attractor {e['attractor']} {e['event']}" + (f" into {e['into']}" if e["into"] else "")
-        lines.append(f"  at {name}={where[e['value']]:g}: {what}")
-    return "\n".join(lines)
+def job_from(args: argparse.Namespace) -> BasinsJob:
+    """The job the arguments ask for: the fractions along --param, else a map."""
+    given = {"grid": tuple(args.grid), "y0": args.y0, "plot": args.plot, "out": args.out,
+             "execution": Execution(args.jobs, lanes=not args.no_lanes, progress=not args.quiet)}
+    if args.param is None:
+        return BasinMapJob(**given)
+    return BasinFractionsJob(**given, parameter=args.param, overwrite=args.overwrite,
+                             match_distance=args.match_distance)

@@ -7,6 +7,9 @@ is (period, regime, amplitude) and how much of the grid its basin covers. :func:
 fraction of every attractor (by its id along the parameter) with its standard error, and its amplitude, against
 the parameter, with the appearances, merges and vanishings marked.
 
+:func:`save_basin_map` and :func:`save_basin_fractions` write a result's files as the command writes them: its
+tables (:mod:`gearsym.physical.files`) and its picture, each whole.
+
 Each takes the result it draws as it is shown (:class:`~gearsym.physical.basins.ShownBasinMap`,
 :class:`~gearsym.physical.basins.ShownFractions`: a model with physical values in µm, mm/s, rpm), or the engine's
 result, drawn in the model's own numbers.
@@ -19,10 +22,12 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.basins import BasinMap
+from ..files.atomic import write_atomically
 from ..physical.basins import ShownBasinMap, ShownFractions
+from ..physical.files import write_basin_fractions, write_basin_map
 from ..physical.text import SYMBOLS
 from ..sweep.basin_continuation import BasinContinuation
-from .save import pyplot, save_figure
+from .save import figure_bytes, pyplot, save_figure
 
 #: the resolution the basins' figures are written at
 BASINS_DPI = 120
@@ -209,3 +214,26 @@ def plot_basin_fractions(shown: ShownFractions | BasinContinuation, path: str | 
     if path is not None:
         save_figure(fig, path, dpi=BASINS_DPI)
     return fig
+
+
+def save_basin_map(shown: ShownBasinMap | BasinMap, out: str | Path | None = None,
+                   plot: str | Path | None = None) -> list[Path]:
+    """A basin map's files, each written whole: ``out`` (one row per start) with its record beside it
+    (:func:`~gearsym.physical.files.write_basin_map`), and the picture ``plot``; the picture is drawn before
+    anything is written, so that a figure that fails leaves no table without its picture. Returns the paths
+    written, in that order."""
+    shown = ShownBasinMap.of(shown)
+    picture = figure_bytes(plot_basin_map(shown), plot, BASINS_DPI) if plot else None
+    written = list(write_basin_map(shown, out)) if out else []
+    return written + ([write_atomically(plot, picture)] if plot else [])
+
+
+def save_basin_fractions(shown: ShownFractions | BasinContinuation, physical: str | Path | None = None,
+                         plot: str | Path | None = None) -> list[Path]:
+    """A continuation's files beside its own (which it writes as it goes), each written whole: the fractions in
+    the model's units (``physical``: :func:`~gearsym.physical.files.write_basin_fractions`) and the picture
+    ``plot``, drawn before anything is written. Returns the paths written, in that order."""
+    shown = ShownFractions.of(shown)
+    picture = figure_bytes(plot_basin_fractions(shown), plot, BASINS_DPI) if plot else None
+    written = [write_basin_fractions(shown, physical)] if physical is not None else []
+    return written + ([write_atomically(plot, picture)] if plot else [])

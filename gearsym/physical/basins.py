@@ -2,11 +2,12 @@
 µm and mm/s, the speed in rpm), else in its own numbers.
 
 A grid given in physical units is read into SI units once, when it is parsed (:class:`GridAxis`), checked against
-the model's states once (:class:`PhysicalGrid`), and turned into the engine's nondimensional starts at each forcing
+the model's states once (:class:`GivenGrid`), and turned into the engine's nondimensional starts at each forcing
 frequency (a rate's unit, L omega omega_n per second, moves with the speed: :func:`engine_grid`); the results come
 back through the same numbers (:class:`~gearsym.physical.point.PointUnits`: the length unit L, omega_n, the speed's
-ratio). :class:`ShownBasinMap` and :class:`ShownFractions` are the results in those units, which the files
-(:mod:`.files`), the command's text and the figures (:mod:`gearsym.figures.basins`) take.
+ratio). :class:`ShownBasinMap` and :class:`ShownFractions` are the results in those units, which say themselves
+as text and as a record (``text``, ``as_dict``: the command's output), and which the files (:mod:`.files`) and
+the figures (:mod:`gearsym.figures.basins`) take.
 """
 from __future__ import annotations
 
@@ -15,10 +16,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.basins import BasinMap
+from ..analysis.basins import BasinMap, StartGrid
 from ..checks import json_safe
 from ..errors import GearsymError
-from ..sweep.basin_continuation import BasinContinuation, StartGrid
+from ..sweep.basin_continuation import BasinContinuation
 from ..sweep.grid import Axis, axis_fields, parse_axis
 from ..units import dimension_text, to_si, unit_dims
 from .point import ANGLE, ANGULAR_VELOCITY, LENGTH, VELOCITY, PointUnits
@@ -219,6 +220,37 @@ class ShownBasinMap:
             data["speed"] = {"value": float(units.speed(self.omega)), "unit": units.units.speed_unit.text}
         return data
 
+    def text(self) -> str:
+        """The map as the command's text says it: the run, each attractor, the other classes."""
+        result = self.result
+        (x, xs), (y, ys) = result.axes
+        sx, ux = self.state(x, xs)
+        sy, uy = self.state(y, ys)
+        held = ", ".join("{}={:g}{}".format(k, *self.number(k, v)) for k, v in result.held.items())
+        lines = [
+            f"{result.model}: {result.starts} starts, {x} in [{sx.min():g}, {sx.max():g}]{ux} ({xs.size}) x {y} in "
+            f"[{sy.min():g}, {sy.max():g}]{uy} ({ys.size})" + (f", held {held}" if held else ""),
+            f"parameters: {self.parameters_text().replace('$', '')}",  # (no figure mathtext in text)
+            f"{result.periods} periods per start ({result.discard} discarded), {result.steps_per_period} RK4 "
+            f"steps/period, {'crossings located' if result.locate_crossings else 'plain RK4'}, {result.backend}, "
+            f"{result.lanes} trajectories per call",
+            f"{len(result.attractors)} attractor{'s' if len(result.attractors) != 1 else ''} (fraction of starts ± "
+            "binomial standard error; exponents from one tangent run on each):",
+        ]
+        for a in result.attractors:
+            amplitude = ", ".join("A_{} = {:.6g}{}".format(k, *_spaced(self.number(k, v)))
+                                  for k, v in a.amplitude.items())
+            lines += [f"  {a.number}: {a.description}: {a.fraction:.4f} ± {a.stderr:.4f} ({a.basin.starts} starts)",
+                      f"     {amplitude}; lambda = " + ", ".join(f"{v:+.5f}" for v in a.exponents)]
+        for name, share in (("diverged", result.diverged), ("undetermined", result.undetermined)):
+            lines.append(f"  {name}: {share.fraction:.4f} ± {share.stderr:.4f} ({share.starts} starts)")
+        return "\n".join(lines)
+
+
+def _spaced(number: tuple[float, str]) -> tuple[float, str]:
+    value, unit = number
+    return value, f" {unit}" if unit else ""
+
 
 @dataclass(frozen=True)
 class ShownFractions:
@@ -248,6 +280,30 @@ class ShownFractions:
     def parameters_text(self, values: dict) -> str:
         return self.units.parameters(values)
 
+    def as_dict(self) -> dict:
+        """The continuation's record, in the engine's numbers as its own files hold them (the fractions in the
+        model's units: :func:`~gearsym.physical.files.write_basin_fractions`)."""
+        return self.result.as_dict()
+
+    def text(self) -> str:
+        """The fractions as the command's text says them: at each value of the parameter (the speed for a model
+        with physical values), each attractor's share and what it is, then where attractors appear, vanish or
+        merge."""
+        result = self.result
+        name, values, unit = self.parameter()
+        lines = [f"{result.model}: basin fractions at {len(values)} values of {name} ({values[0]:g} to "
+                 f"{values[-1]:g}{' ' + unit if unit else ''}) -> {result.path}"]
+        where = dict(zip(result.values, values))
+        for v in result.values:
+            parts = [f"{r.id}: {r.fraction:.3f} ({r.period and f'period {r.period}' or r.regime})"
+                     for r in result.at(v) if r.kind == "attractor"]
+            other = [f"{r.kind} {r.fraction:.3f}" for r in result.at(v) if r.kind != "attractor" and r.starts]
+            lines.append(f"  {name}={where[v]:g}: " + "; ".join(parts + other))
+        for e in result.events:
+            what = f"attractor {e['attractor']} {e['event']}" + (f" into {e['into']}" if e["into"] else "")
+            lines.append(f"  at {name}={where[e['value']]:g}: {what}")
+        return "\n".join(lines)
+
 
 def engine_grid(units: PointUnits, si_grid: Mapping[str, np.ndarray], omega: float) -> dict[str, np.ndarray]:
     """The engine's values of a grid in SI units (:func:`grid_in_si`) at the forcing frequency ``omega`` (a rate's
@@ -256,14 +312,18 @@ def engine_grid(units: PointUnits, si_grid: Mapping[str, np.ndarray], omega: flo
             for name, values in si_grid.items()}
 
 
-class PhysicalGrid(StartGrid):
-    """A grid of starts given in physical units, checked and in SI units when it is made (:func:`grid_in_si`): its
-    engine values at each forcing frequency (a rate's unit moves with the speed), and the grid as given in the
-    record."""
+class GivenGrid(StartGrid):
+    """The starts of a grid as given (``axes``: :class:`GridAxis`, with the record's specs): in the model's own
+    numbers (``units`` None: a model without physical values), or in physical units, checked and in SI units
+    when it is made (:func:`grid_in_si`), its engine values at each forcing frequency (a rate's unit moves with
+    the speed)."""
 
-    def __init__(self, units: PointUnits, axes: Sequence[GridAxis]):
+    def __init__(self, units: PointUnits | None, axes: Sequence[GridAxis]):
         super().__init__({a.name: a.values for a in axes}, [a.spec for a in axes])
-        self.units, self.axes, self.si_grid = units, tuple(axes), grid_in_si(units, axes)
+        self.units, self.axes = units, tuple(axes)
+        self.si_grid = grid_in_si(units, axes) if units is not None else None
 
     def at(self, point):
+        if self.units is None:
+            return self.values
         return engine_grid(self.units, self.si_grid, point.get("omega", 1.0))

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.attractors import cloud_distance
-from ..analysis.basins import RUN, BasinMap, basin_map, method
+from ..analysis.basins import RUN, BasinMap, StartGrid, basin_map, method
 from ..checks import json_safe
 from ..codegen import CompiledModel, engine_verb
 from ..errors import GearsymError, UnknownParameterError
@@ -41,26 +41,6 @@ from .store import number, read_rows, sidecar
 MATCH_DISTANCE = 0.5
 #: what happens to an attractor at a value
 CONTINUES, APPEARS, MERGES, VANISHES = "continues", "appears", "merges", "vanishes"
-
-
-class StartGrid:
-    """The starts of a continuation's basin maps: ``values`` ({state: values} for two states) at every value of
-    the parameter, and how they were ``given`` (for the record: e.g. the command line's ``x=-5:5:0.1``; by
-    default the values themselves). A grid whose engine values move with the parameter (a grid in physical
-    units, whose rates' unit moves with the speed) is a subclass that overrides :meth:`at`."""
-
-    def __init__(self, values: Mapping[str, Sequence[float]], given: Sequence[str] = ()):
-        self.values, self.given = values, tuple(given)
-
-    def at(self, point: Mapping[str, float]) -> Mapping[str, Sequence[float]]:
-        """The grid at the parameter values ``point``."""
-        return self.values
-
-    def record(self, point: Mapping[str, float]) -> list | dict:
-        """How the grid stands in the continuation's record (at the first value ``point``)."""
-        if self.given:
-            return list(self.given)
-        return {k: np.asarray(v, dtype=float).tolist() for k, v in self.at(point).items()}
 
 
 @dataclass(frozen=True)
@@ -151,7 +131,7 @@ def continue_basins(model: CompiledModel, grid: Mapping[str, Sequence[float]] | 
         raise GearsymError(f"match_distance must be a positive number, got {match_distance!r}")
     record = {"model": model.name, "model_hash": model.hash, "backend": model.backend, "parameter": parameter,
               "values": list(values), "settings": {k: float(v) for k, v in fixed.items()},
-              "grid": grid.record({**fixed, parameter: values[0]}), "initial_state": dict(zip(
+              "grid": grid.record, "initial_state": dict(zip(
                   model.state_names, map(float, model.initial_state(y0)))), "periods": options.periods,
               "discard": options.discard, "steps_per_period": model.steps_per_period,
               "locate_crossings": model.options.locate_crossings, "match_distance": float(match_distance),
@@ -167,7 +147,7 @@ def continue_basins(model: CompiledModel, grid: Mapping[str, Sequence[float]] | 
                 continue
             execution.say(f"basins at {parameter}={value:g}")
             point = {**fixed, parameter: value}
-            found = basin_map(model, grid.at(point), options=options, y0=y0,
+            found = basin_map(model, grid, options=options, y0=y0,
                               execution=replace(execution, progress=False), **point)
             tracked = track(found, value, previous, match_distance, _next_id(rows))
             rows += tracked
