@@ -31,7 +31,7 @@ LAYERS = [
     {"sweep", "periodic", "stability"},
     {"fit", "physical"},
     {"figures"},
-    {"verbs", "loading", "cached", "opening", "basin_jobs", "fmu"},
+    {"verbs", "loading", "cached", "opening", "jobs", "fmu"},
     {"reproduce"},
     {"cli", "__init__"},
 ]

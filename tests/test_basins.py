@@ -11,9 +11,9 @@ from scipy.integrate import solve_ivp
 
 import gearsym
 from gearsym import Execution, FirstOrderSystem, Integration
-import gearsym.basin_jobs as basin_jobs
+import gearsym.jobs.basins as basin_jobs
 from gearsym.analysis.basins import DIVERGED, UNDETERMINED, basin_map
-from gearsym.basin_jobs import BasinMapJob
+from gearsym.jobs.basins import BasinMapJob
 from gearsym.cli import main
 from gearsym.figures.basins import plot_basin_map
 from gearsym.opening import ModelRequest, open_model

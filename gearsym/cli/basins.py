@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from ..analysis.basins import RUN
-from ..basin_jobs import BasinFractionsJob, BasinMapJob, BasinsJob, FractionsInterrupted
+from ..jobs.basins import BasinFractionsJob, BasinMapJob, BasinsJob, FractionsInterrupted
 from ..errors import GearsymError
 from ..files.outputs import check_figure, check_file
 from ..opening import open_model

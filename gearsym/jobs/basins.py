@@ -18,16 +18,16 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .analysis.basins import basin_map
-from .errors import GearsymError
-from .figures.basins import save_basin_fractions, save_basin_map
-from .opening import OpenModel
-from .options import Execution
-from .physical.basins import GivenGrid, GridAxis, OwnNumbers, ShownBasinMap, ShownFractions, shown_in
-from .physical.sweeps import MeasuredAxis, engine_axis
-from .sweep.basin_continuation import MATCH_DISTANCE, continue_basins
-from .sweep.grid import Axis
-from .sweep.store import sidecar
+from ..analysis.basins import basin_map
+from ..errors import GearsymError
+from ..figures.basins import save_basin_fractions, save_basin_map
+from ..opening import OpenModel
+from ..options import Execution
+from ..physical.basins import GivenGrid, GridAxis, OwnNumbers, ShownBasinMap, ShownFractions, shown_in
+from ..physical.sweeps import MeasuredAxis, engine_axis
+from ..sweep.basin_continuation import MATCH_DISTANCE, continue_basins
+from ..sweep.grid import Axis
+from ..sweep.store import sidecar
 
 
 @dataclass(frozen=True)
