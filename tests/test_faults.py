@@ -26,13 +26,15 @@ from same_numbers import differences, measured_differences, wrong_models_held
 import gearsym
 import gearsym.cli.spectrum
 import gearsym.figures.fit_report
-from gearsym import explain, load_measurements
+from gearsym import Integration, explain, load_measurements
 from gearsym.cli import main
 from gearsym.errors import GearsymError
 from gearsym.figures.fit_report import tooth_figure, write_report
 from gearsym.figures.save import pyplot
 from gearsym.fit.report import TEETH_FIGURE
-from gearsym.fit.selection import candidate_library
+from gearsym.fit import augment
+from gearsym.fit.selection import candidate_library, segments_of
+from gearsym.fit.tooth_scan import scan_teeth
 from gearsym.files.paths import REPO_ROOT
 
 TEETH = (9, 13)
@@ -181,6 +183,24 @@ def test_a_crack_that_softens_the_whole_mesh_is_found_tooth_by_tooth(whole, clea
     assert all(teeth == {"gear1": [], "gear2": [counted]} for teeth in found["standing_out_by_record"].values())
     value, stderr = found["refitted"]["gear2"][tooth]
     assert value == pytest.approx(q, rel=0.05) and 0 < stderr < 0.01
+
+
+@pytest.mark.slow
+def test_tooth_faults_scanned_together_are_placed_as_each_alone(whole, geared):
+    """A scan's tooth faults share their compiled runs (every severity is 0 at the fit, each fault asks for its own
+    column with its own tooth): each fault is placed, with the same gains to the last bit, as when it is scanned alone
+    (here on the whole-mesh crack's records, at the declared model's fit: the wheel's tooth fault gains most, on the
+    rig's tooth)."""
+    ex, measured = whole
+    library = candidate_library(geared, LIBRARY, HARMONICS)
+    superset = augment(geared, list(library.values()), name=f"{geared.name}_candidates")
+    segments, _ = segments_of(superset, measured.split(0.25)[0])
+    faults = [e for e in library.values() if e.scan]
+    together = scan_teeth(superset, segments, ex.base.fit, faults, (), Integration())
+    alone = {e.name: scan_teeth(superset, segments, ex.base.fit, [e], (), Integration())[e.name] for e in faults}
+    assert [e.name for e in faults] == ["tooth_fault_gear1", "tooth_fault_gear2"] and together == alone
+    wheel, pinion = together["tooth_fault_gear2"], together["tooth_fault_gear1"]
+    assert wheel.gain > pinion.gain > 0 and set(wheel.teeth.values()) == {WHOLE[1]}  # (counted from tau = 0)
 
 
 @pytest.mark.slow
