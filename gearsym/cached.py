@@ -39,6 +39,7 @@ from pathlib import Path
 from .records import record_class
 from .codegen.kept import (SUMMARY_FORMAT, BuildSummary, build_path, found_build, found_over, keep_model, kept_model,
                            read_json, summary_path, write_json)
+from .codegen.derived_summary import derived_entry, plain_values
 from .codegen.system_summary import SystemSummary, read_summary
 from .codegen.library import resolve_backend
 from .options import Integration
@@ -168,6 +169,9 @@ def cache_slot(ref, values: Mapping[str, object]) -> CacheSlot:
         return CacheSlot()
     key = system_key(path, values)
     data = read_json(summary_path(path.stem, key))
+    if data is None and (plain := plain_values(values)):  # (new plain values: from the entry without them)
+        data = derived_entry(path.stem, system_key(path, {k: v for k, v in values.items() if k not in plain}), key,
+                             plain)
     try:
         system = data["system"]
         physical = data["physical"] if system["physical"] else None
