@@ -84,7 +84,7 @@ def test_a_changed_model_file_or_formula_is_reduced_again_and_a_new_plain_value_
     new_value = lyap(capsys, str(model_file), "--set", "omega=1.2")
     assert len(reductions) == 1
     assert new_value["parameters"]["omega"] == 1.2 and new_value["exponents"] != own["exponents"]
-    lyap(capsys, str(model_file), "--set", "k=1+0.1*cos(tau)")
+    lyap(capsys, str(model_file), "--set", "k=1+0.2*cos(tau)")
     assert len(reductions) == 2
     model_file.write_text(model_file.read_text().replace("omega=1.5", "omega=1.25"))
     changed = lyap(capsys, str(model_file))
