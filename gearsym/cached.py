@@ -13,6 +13,10 @@ given ``--set`` values writes two small files into the cache (``$GEARSYM_CACHE/m
   code hash and the compiled library (:class:`~gearsym.codegen.kept.BuildSummary`: kept, found again for a run's
   options and trusted by :mod:`gearsym.codegen.kept`).
 
+A run with new plain numbers for some of the system's parameters (``--set omega=0.82``) finds its entry made from
+the entry of the same model without them (:mod:`gearsym.codegen.derived_summary`: the values replaced, the step's
+choice recomputed from the model's library), where there is one.
+
 Later runs build the :class:`~gearsym.codegen.compiled.CompiledModel` from them, with a
 :class:`SystemSummary` as its system, which loads (and reduces) the model only if something asks for what
 it does not keep (a SymPy expression). A summary that is missing, unreadable, not ours or pointing at a
