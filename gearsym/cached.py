@@ -174,8 +174,7 @@ def cache_slot(ref, values: Mapping[str, object]) -> CacheSlot:
     key = system_key(path, values)
     data = read_json(summary_path(path.stem, key))
     if data is None and (plain := plain_values(values)):  # (new plain values: from the entry without them)
-        data = derived_entry(path.stem, system_key(path, {k: v for k, v in values.items() if k not in plain}), key,
-                             plain)
+        data = derived_entry(path, system_key(path, {k: v for k, v in values.items() if k not in plain}), key, plain)
     try:
         system = data["system"]
         physical = data["physical"] if system["physical"] else None

@@ -127,6 +127,15 @@ def test_a_derived_entry_for_new_plain_values_is_the_entry_a_fresh_reduction_wri
     assert lyap(capsys, str(path), *settings) == derived
 
 
+def test_no_entry_is_derived_for_a_model_file_with_options(model_file, capsys):
+    """A model option goes to the file's build, which may change the model (here it takes the name of a parameter,
+    zeta, and leaves the model as it is): the model is loaded, as the option asks, not derived from its entry."""
+    model_file.write_text(model_file.read_text() + "\nOPTIONS = {'zeta': 0.05}\n\n\ndef build(zeta=0.05):\n"
+                          "    return model\n")
+    own = lyap(capsys, str(model_file))
+    assert lyap(capsys, str(model_file), "--set", "zeta=0.2")["parameters"] == own["parameters"]
+
+
 def test_no_entry_is_derived_for_a_value_out_of_bounds_or_for_a_name_that_is_no_parameter(model_file, reductions,
                                                                                           capsys):
     """The model is loaded as before, whose error says what is wrong."""

@@ -12,7 +12,8 @@ model file and reducing (about a second) are saved.
 An entry is derived only where that reasoning holds, else the model is loaded as before (which also says what is
 wrong with a bad value): the new values are plain finite numbers of parameters the base entry's system has, each
 within its constraint; the base entry is of a model without physical values (a physical model's values enter its
-scaling); and a library of the base entry is found and trusted (:func:`~.kept.kept_model`).
+scaling) whose file declares no model options (an option is given to the file's ``build`` and may change the
+model); and a library of the base entry is found and trusted (:func:`~.kept.kept_model`).
 """
 from __future__ import annotations
 
@@ -35,10 +36,14 @@ def plain_values(values: Mapping[str, object]) -> dict[str, float]:
             if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)}
 
 
-def derived_entry(name: str, base_key: str, key: str, plain: Mapping[str, float]) -> dict | None:
-    """The system's summary (as the cache keeps it: ``{"system": ..., "physical": None}``) of the model ``name``
-    with the values of ``key``, which are those of ``base_key`` and the plain numbers ``plain``, derived from the
-    base entry and written under ``key`` with the base entry's builds; None where none is derived (see above)."""
+def derived_entry(path: Path, base_key: str, key: str, plain: Mapping[str, float]) -> dict | None:
+    """The system's summary (as the cache keeps it: ``{"system": ..., "physical": None}``) of the model in the file
+    ``path`` with the values of ``key``, which are those of ``base_key`` and the plain numbers ``plain``, derived
+    from the base entry and written under ``key`` with the base entry's builds; None where none is derived (see
+    above)."""
+    if _may_declare_options(path):
+        return None
+    name = path.stem
     base = read_json(summary_path(name, base_key))
     summary = read_summary(base.get("system") if base is not None else None, _never)
     if summary is None or summary.physical or not plain or base.get("physical") is not None:
@@ -63,6 +68,15 @@ def derived_entry(name: str, base_key: str, key: str, plain: Mapping[str, float]
             write_json(summary_path(name, f"{key}-{loops}"), build.as_dict())
     write_json(summary_path(name, key), entry)
     return entry
+
+
+def _may_declare_options(path: Path) -> bool:
+    """Whether the model file may declare model options (``OPTIONS``, given to its ``build``: ``--set planets=4``
+    changes the model, and an option may share a parameter's name): told from its text, without running it."""
+    try:
+        return b"OPTIONS" in path.read_bytes()
+    except OSError:
+        return True
 
 
 def _rate(summary, name: str, base_key: str, build_file: Path, build, plain: Mapping[str, float]):
