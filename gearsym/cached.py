@@ -13,6 +13,10 @@ given ``--set`` values writes two small files into the cache (``$GEARSYM_CACHE/m
   code hash and the compiled library (:class:`~gearsym.codegen.kept.BuildSummary`: kept, found again for a run's
   options and trusted by :mod:`gearsym.codegen.kept`).
 
+A run with new plain numbers for some of the system's parameters (``--set omega=0.82``) finds its entry made from
+the entry of the same model without them (:mod:`gearsym.codegen.derived_summary`: the values replaced, the step's
+choice recomputed from the model's library), where there is one.
+
 Later runs build the :class:`~gearsym.codegen.compiled.CompiledModel` from them, with a
 :class:`SystemSummary` as its system, which loads (and reduces) the model only if something asks for what
 it does not keep (a SymPy expression). A summary that is missing, unreadable, not ours or pointing at a
@@ -39,6 +43,7 @@ from pathlib import Path
 from .records import record_class
 from .codegen.kept import (SUMMARY_FORMAT, BuildSummary, build_path, found_build, found_over, keep_model, kept_model,
                            read_build, read_builds, read_json, summary_path, write_json)
+from .codegen.derived_summary import derived_entry, plain_values
 from .codegen.system_summary import SystemSummary, read_summary
 from .codegen.library import resolve_backend
 from .options import Integration
@@ -172,6 +177,8 @@ def cache_slot(ref, values: Mapping[str, object]) -> CacheSlot:
         return CacheSlot()
     key = system_key(path, values)
     data = read_json(summary_path(path.stem, key))
+    if data is None and (plain := plain_values(values)):  # (new plain values: from the entry without them)
+        data = derived_entry(path, system_key(path, {k: v for k, v in values.items() if k not in plain}), key, plain)
     try:
         system = data["system"]
         physical = data["physical"] if system["physical"] else None

@@ -76,14 +76,77 @@ def test_a_cached_model_is_not_reduced_again_and_gives_the_same_results(model_fi
     assert again == first
 
 
-def test_a_changed_model_file_or_value_is_reduced_again(model_file, reductions, capsys):
-    lyap(capsys, str(model_file))
-    lyap(capsys, str(model_file), "--set", "omega=1.2")
+def test_a_changed_model_file_or_formula_is_reduced_again_and_a_new_plain_value_is_run_at_its_value(
+        model_file, reductions, capsys):
+    """A new plain value needs no reduction (its entry is derived from the model's own: test_a_derived_entry_...),
+    but is run at that value; a formula or an edited model file is reduced again."""
+    own = lyap(capsys, str(model_file))
+    new_value = lyap(capsys, str(model_file), "--set", "omega=1.2")
+    assert len(reductions) == 1
+    assert new_value["parameters"]["omega"] == 1.2 and new_value["exponents"] != own["exponents"]
+    lyap(capsys, str(model_file), "--set", "k=1+0.2*cos(tau)")
     assert len(reductions) == 2
     model_file.write_text(model_file.read_text().replace("omega=1.5", "omega=1.25"))
     changed = lyap(capsys, str(model_file))
     assert len(reductions) == 3
     assert changed["parameters"]["omega"] == 1.25
+
+
+@pytest.mark.parametrize("name, values", [("one_stage", {"omega": 0.8}), ("one_stage", {"omega": 2.5, "zeta": 0.0}),
+                                          ("flexible_shaft", {"omega": 1.3, "kS": 0.4}), ("duffing", {"omega": 1.7})])
+def test_a_derived_entry_for_new_plain_values_is_the_entry_a_fresh_reduction_writes(model_copy, reductions, capsys,
+                                                                                    tmp_path, monkeypatch, name,
+                                                                                    values):
+    """The summary derived from the model's own entry (gearsym/codegen/derived_summary.py) holds what the model
+    loaded and reduced at the new values gives (its values, names, constraints, watches; the fastest mode and the
+    period recomputed, to the rounding of the library's arithmetic), and the run prints what a run of a cache without
+    the model's own entry prints."""
+    from gearsym.codegen.fastest_mode import fastest_rate
+    from gearsym.codegen.system_summary import SystemSummary
+
+    import gearsym.cached as cached
+
+    made, derive = [], cached.derived_entry
+    monkeypatch.setattr(cached, "derived_entry", lambda *args: made.append(derive(*args)) or made[-1])
+    path = model_copy(name)
+    lyap(capsys, str(path))
+    settings = [a for k, v in values.items() for a in ("--set", f"{k}={v}")]
+    derived = lyap(capsys, str(path), *settings)
+    assert len(made) == 1 and made[0] is not None and len(reductions) <= 1  # (duffing: a first-order system)
+    entry = cached.cache_slot(str(path), values).system
+    system = gearsym.load(str(path), **values)
+    fresh = SystemSummary.of(system, False, fastest_rate(system)).as_dict()
+    for key in ("fastest", "cycle"):
+        assert entry.pop(key) == pytest.approx(fresh.pop(key), rel=1e-12, abs=0), key
+    assert entry == fresh
+    own_cache = tmp_path / "fresh-cache"  # (the libraries shared: the fresh run reduces, finds the library)
+    own_cache.mkdir()
+    for folder in ("lib", "code"):
+        (own_cache / folder).symlink_to(cache_dir() / folder)
+    monkeypatch.setenv("GEARSYM_CACHE", str(own_cache))
+    assert lyap(capsys, str(path), *settings) == derived
+
+
+def test_no_entry_is_derived_for_a_model_file_with_options(model_file, capsys):
+    """A model option goes to the file's build, which may change the model (here it takes the name of a parameter,
+    zeta, and leaves the model as it is): the model is loaded, as the option asks, not derived from its entry."""
+    model_file.write_text(model_file.read_text() + "\nOPTIONS = {'zeta': 0.05}\n\n\ndef build(zeta=0.05):\n"
+                          "    return model\n")
+    own = lyap(capsys, str(model_file))
+    assert lyap(capsys, str(model_file), "--set", "zeta=0.2")["parameters"] == own["parameters"]
+
+
+def test_no_entry_is_derived_for_a_value_out_of_bounds_or_for_a_name_that_is_no_parameter(model_file, reductions,
+                                                                                          capsys):
+    """The model is loaded as before, whose error says what is wrong."""
+    from gearsym.cached import cache_slot
+
+    lyap(capsys, str(model_file))
+    assert cache_slot(str(model_file), {"omega": 1.1}).system is not None
+    for values in ({"zeta": -1.0}, {"omega": 1.1, "no_such_parameter": 2.0}):
+        assert cache_slot(str(model_file), values).system is None, values
+    assert main(["lyap", str(model_file), "--set", "zeta=-1", *ARGS]) == 2
+    assert "zeta" in capsys.readouterr().err
 
 
 def test_a_corrupt_summary_is_ignored_and_written_again(model_file, reductions, capsys):
