@@ -12,6 +12,7 @@ from scipy.integrate import solve_ivp
 import gearsym
 from gearsym import Execution, FirstOrderSystem, Integration
 import gearsym.jobs.basins as basin_jobs
+import gearsym.sweep.basin_continuation as basin_continuation
 from gearsym.analysis.basins import DIVERGED, UNDETERMINED, basin_map
 from gearsym.jobs.basins import BasinMapJob
 from gearsym.cli import main
@@ -188,10 +189,46 @@ def test_an_interrupted_basin_continuation_resumes_to_the_same_files(duffing, tm
     assert len(seen) == 4  # two values computed before the interruption, two after it
     for suffix in (".csv", ".attractors.csv", ".json"):
         assert (tmp_path / f"whole{suffix}").read_bytes() == (tmp_path / f"cut{suffix}").read_bytes(), suffix
-    assert resumed.as_dict()["rows"] == whole.as_dict()["rows"]
+    assert resumed.as_dict()["rows"] == whole.as_dict()["rows"] and resumed.events == whole.events
     # the window's second attractor appears at 1.2 and the first vanishes past it: a period-1 orbit each
     assert [(e["value"], e["event"]) for e in whole.events] == [(1.2, APPEARS), (1.4, VANISHES)]
     assert [len(whole.at(w)) - 2 for w in omegas] == [1, 2, 2, 1]
+
+
+def test_a_continuation_killed_before_a_values_record_computes_that_value_again_and_a_finished_one_writes_nothing(
+        duffing, tmp_path, monkeypatch):
+    """A value is finished once the record (written last) counts it: killed after the second value's rows and
+    before its record, the run resumes at the second value, to the files of a run never interrupted; run once more,
+    the finished continuation is read and no file is written."""
+    grid = {"x": np.linspace(-4, 4, 5), "v": np.linspace(-4, 4, 5)}
+    omegas = [1.1, 1.2, 1.4]
+    whole = continue_basins(duffing, grid, "omega", omegas, options=RUN, out=tmp_path / "whole.csv")
+    write = basin_continuation.write_atomically
+
+    def killed_at_the_second_record(path, data):
+        if path.suffix == ".json" and json.loads(data)["values"]["done"] == 2:
+            raise KeyboardInterrupt
+        return write(path, data)
+
+    cut = tmp_path / "cut.csv"
+    with monkeypatch.context() as m:
+        m.setattr(basin_continuation, "write_atomically", killed_at_the_second_record)
+        with pytest.raises(KeyboardInterrupt):
+            continue_basins(duffing, grid, "omega", omegas, options=RUN, out=cut)
+    assert "\n1.2," in cut.read_text() and json.loads((tmp_path / "cut.json").read_text())["values"]["done"] == 1
+    seen = []
+    resumed = continue_basins(duffing, grid, "omega", omegas, options=RUN, out=cut, on_value=seen.append)
+    assert [found.parameters["omega"] for found in seen] == [1.2, 1.4]
+    for suffix in (".csv", ".attractors.csv", ".json"):
+        assert (tmp_path / f"whole{suffix}").read_bytes() == (tmp_path / f"cut{suffix}").read_bytes(), suffix
+    assert resumed.as_dict() == whole.as_dict() and whole.events
+
+    def no_write(path, data):
+        raise AssertionError(f"a finished continuation wrote {path}")
+
+    monkeypatch.setattr(basin_continuation, "write_atomically", no_write)
+    again = continue_basins(duffing, grid, "omega", omegas, options=RUN, out=cut, on_value=seen.append)
+    assert again.as_dict() == whole.as_dict() and len(seen) == 2
 
 
 def run_cli(capsys, *argv: str) -> tuple[int, str, str]:

@@ -9,10 +9,15 @@ a previous one left without a partner ``vanishes``, unless it lies within ``matc
 new attractors, into which it then ``merges`` (two basins became one). This is the global continuation of
 Attractors.jl (matching by the distance of attractors' sets) on Poincare sets.
 
-With ``out`` the rows are written after each value (``FILE.csv``: one row per class and value;
-``FILE.attractors.csv``: every attractor's Poincare points; ``FILE.json``: how it was made and what happened),
-whole files each time; the same call again resumes after the last value finished and gives the same files as a
-run that was never interrupted (nothing in them depends on when or how fast it ran).
+What happened (an attractor appeared, merged or vanished: :attr:`BasinContinuation.events`) is said once,
+by :func:`track`, where each value's attractors are matched.
+
+With ``out`` the files are written after each value (``FILE.attractors.csv``: every attractor's Poincare points;
+``FILE.csv``: one row per class and value; ``FILE.json``: how it was made and what happened), whole files each
+time and in that order: a value is finished once the record counts it. The same call again resumes after the
+last value finished (its rows from the CSV, what happened from the record) and gives the same files as a run
+that was never interrupted (nothing in them depends on when or how fast it ran); a finished continuation is read
+and nothing is written.
 """
 from __future__ import annotations
 
@@ -21,6 +26,7 @@ import io
 import json
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
+from itertools import takewhile
 from pathlib import Path
 
 import numpy as np
@@ -138,39 +144,28 @@ def continue_basins(model: CompiledModel, grid: Mapping[str, Sequence[float]] | 
               "method": method()}
     store = _Store(Path(out), model.state_names, model.observed, model.dimension, parameter) if out else None
     try:
-        rows, done = store.open(record, overwrite) if store else ([], [])
-        # (a rerun of a finished continuation reads its files and writes nothing)
-        finished = bool(store) and len(done) == len(values) and store.status() == "complete"
+        # the values finished (a prefix of values), their rows in order and what happened along them
+        rows, done, happened = store.open(record, overwrite) if store else ([], [], [])
         previous = _last(rows, done)
-        for value in values:
-            if value in done:
-                continue
+        for value in values[len(done):]:
             execution.say(f"basins at {parameter}={value:g}")
             point = {**fixed, parameter: value}
             found = basin_map(model, grid, options=options, y0=y0,
                               execution=replace(execution, progress=False), **point)
-            tracked = track(found, value, previous, match_distance, _next_id(rows))
+            tracked, news = track(found, value, previous, match_distance, _next_id(rows))
             rows += tracked
             done.append(value)
+            happened += news
             previous = (tracked, found.scale)
             if store:
-                store.write(rows, done, record, complete=len(done) == len(values))
+                store.write(rows, done, happened, record)
             if on_value:
                 on_value(found)
-        order = {v: i for i, v in enumerate(values)}
-        rows.sort(key=lambda r: (order[r.value], _class_order(r)))
-        result = BasinContinuation(model.name, parameter, values, model.state_names, tuple(rows),
-                                   tuple(events(rows, values)), record, store.path if store else None)
-        if store and not finished:
-            store.write(rows, done, record, complete=True)
-        return result
+        return BasinContinuation(model.name, parameter, values, model.state_names, tuple(rows), tuple(happened),
+                                 record, store.path if store else None)
     finally:
         if store:
             store.release()
-
-
-def _class_order(r: Tracked) -> tuple:
-    return (0, r.id) if r.kind == "attractor" else (1 if r.kind == "diverged" else 2, 0)
 
 
 def _next_id(rows: list[Tracked]) -> int:
@@ -185,65 +180,60 @@ def _last(rows: list[Tracked], done: list[float]):
     return last, np.array(last[0].scale)
 
 
-def track(found: BasinMap, value: float, previous, match_distance: float, next_id: int) -> list[Tracked]:
+def track(found: BasinMap, value: float, previous, match_distance: float,
+          next_id: int) -> tuple[list[Tracked], list[dict]]:
     """The classes of ``found`` at ``value``, its attractors matched with ``previous`` (the last value's classes
-    and scale, or None)."""
-    attractors = list(found.attractors)
-    ids: dict[int, int] = {}
-    events: dict[int, list[str]] = {}
+    and scale, or None), and what happened there ({"value", "event", "attractor", "into"}: after a value with
+    attractors, each that appears, each of the last value's that merges into one of these, then each that
+    vanishes)."""
+    attractors = sorted(found.attractors, key=lambda a: a.number)
+    ids: dict[int, int] = {}  # the map's number of an attractor -> its id
+    merged: dict[int, list[int]] = {}  # the map's number -> the ids of the last value's attractors merged into it
+    before_ids: set[int] = set()  # the last value's attractors
+    kept: set[int] = set()  # those that continue here, or merge into one here
     if previous is not None:
         before, scale_before = previous
         old = [r for r in before if r.kind == "attractor"]
+        before_ids = {r.id for r in old}
         scale = (found.scale + scale_before) / 2 if scale_before is not None else found.scale
         pairs = sorted((cloud_distance(r.points / scale[:, None], a.points / scale[:, None]), r.id, a.number)
                        for r in old for a in attractors)
-        used_old, used_new = set(), set()
+        used_new = set()
         for d, old_id, new in pairs:
-            if d <= match_distance and old_id not in used_old and new not in used_new:
-                ids[new], used_old, used_new = old_id, used_old | {old_id}, used_new | {new}
+            if d <= match_distance and old_id not in kept and new not in used_new:
+                ids[new] = old_id
+                kept.add(old_id)
+                used_new.add(new)
         for d, old_id, new in pairs:  # an old attractor left alone, near a new one: their basins merged
-            if old_id not in used_old and d <= match_distance:
-                events.setdefault(new, []).append(f"{MERGES} {old_id}")
-                used_old.add(old_id)
-    rows, scale_of = [], tuple(map(float, found.scale))
-    for a in sorted(attractors, key=lambda a: a.number):
-        if a.number in ids:
-            aid, event = ids[a.number], CONTINUES
-        else:
-            aid, event, next_id = next_id, APPEARS, next_id + 1
-        event = " ".join([event, *events.get(a.number, [])]) if previous is not None else APPEARS
+            if old_id not in kept and d <= match_distance:
+                merged.setdefault(new, []).append(old_id)
+                kept.add(old_id)
+    appeared = [a.number for a in attractors if a.number not in ids]  # new ids in the map's order
+    ids.update({number: next_id + k for k, number in enumerate(appeared)})
+    rows, news, scale_of = [], [], tuple(map(float, found.scale))
+    for a in sorted(attractors, key=lambda a: ids[a.number]):
+        aid, into_it = ids[a.number], merged.get(a.number, [])
+        if a.number in appeared and before_ids:  # (an appearance is news after a value with attractors)
+            news.append(_event(value, APPEARS, aid))
+        news += [_event(value, MERGES, k, aid) for k in into_it]
+        event = APPEARS if previous is None else " ".join(
+            [APPEARS if a.number in appeared else CONTINUES, *(f"{MERGES} {k}" for k in into_it)])
         rows.append(Tracked(value, "attractor", aid, a.fraction, a.stderr, a.basin.starts, a.period, a.regime,
                             dict(a.amplitude), tuple(map(float, a.exponents)), event, a.points, scale_of))
-    rows.sort(key=lambda r: r.id)
+    news += [_event(value, VANISHES, k) for k in sorted(before_ids - kept)]
     for kind, share in (("diverged", found.diverged), ("undetermined", found.undetermined)):
         rows.append(Tracked(value, kind, None, share.fraction, share.stderr, share.starts, None, kind, {}, (), "",
                             np.zeros((len(found.state_names), 0)), scale_of))
-    return rows
+    return rows, news
 
 
-def events(rows: Sequence[Tracked], values: Sequence[float]) -> list[dict]:
-    """What happened, value by value: appearances, merges and vanishings (from the rows' events)."""
-    out, alive = [], set()
-    for v in values:
-        here = [r for r in rows if r.value == v and r.kind == "attractor"]
-        merged = set()
-        for r in here:
-            words = r.event.split()
-            if words and words[0] == APPEARS and alive:
-                out.append({"value": v, "event": APPEARS, "attractor": r.id, "into": None})
-            for i, w in enumerate(words):
-                if w == MERGES:
-                    merged.add(int(words[i + 1]))
-                    out.append({"value": v, "event": MERGES, "attractor": int(words[i + 1]), "into": r.id})
-        now = {r.id for r in here}
-        out += [{"value": v, "event": VANISHES, "attractor": k, "into": None} for k in sorted(alive - now - merged)]
-        alive = now
-    return out
+def _event(value: float, event: str, attractor: int, into: int | None = None) -> dict:
+    return {"value": value, "event": event, "attractor": attractor, "into": into}
 
 
 class _Store:
-    """``FILE.csv``, ``FILE.attractors.csv`` and ``FILE.json`` of one continuation, locked against a second writer
-    and written whole after each value."""
+    """``FILE.attractors.csv``, ``FILE.csv`` and ``FILE.json`` of one continuation, locked against a second writer
+    and written whole after each value, in that order: a value is finished once the record counts it."""
 
     def __init__(self, path: Path, states: Sequence[str], observed: Sequence[str], n: int, parameter: str):
         if path.suffix.lower() != ".csv":
@@ -257,38 +247,52 @@ class _Store:
         self.point_columns = [parameter, "attractor", "point", *states]
         self._lock: int | None = None
 
-    def open(self, record: dict, overwrite: bool | str) -> tuple[list[Tracked], list[float]]:
-        """The rows of the values already done, and those values in order (none: a fresh start).
-        ``overwrite="stale"``: start again files another continuation (or another model) wrote, resume this one's
-        (how the reproduction keeps its data)."""
+    def open(self, record: dict, overwrite: bool | str) -> tuple[list[Tracked], list[float], list[dict]]:
+        """The rows of the values finished (those the record counts, from the first, whose rows are there), those
+        values in order and what happened along them (none: a fresh start). ``overwrite="stale"``: start again
+        files another continuation (or another model) wrote, resume this one's (how the reproduction keeps its
+        data)."""
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._lock = take_lock(self.path)
+        said = self._said()
         if overwrite == "stale":
-            overwrite = self.path.exists() and self._differs(record) is not None
+            overwrite = self.path.exists() and self._differs(record, said) is not None
         if overwrite:
             for p in (self.path, self.points_path, self.meta_path):
                 p.unlink(missing_ok=True)
         if not self.path.exists():
-            return [], []
-        why = self._differs(record)
+            return [], [], []
+        why = self._differs(record, said)
         if why:
             raise GearsymError(why)
+        table = read_rows(self.path, self.columns)
+        there = {float(row[self.parameter]) for row in table}
+        done = list(takewhile(lambda v: v in there, record["values"][:said["values"]["done"]]))
         points: dict[tuple[float, int], list] = {}
         for row in read_rows(self.points_path, self.point_columns) if self.points_path.exists() else []:
             key = (float(row[self.parameter]), int(row["attractor"]))
             points.setdefault(key, []).append([float(row[s]) for s in self.states])
-        rows = [self._tracked(row, points) for row in read_rows(self.path, self.columns)]
-        done = list(dict.fromkeys(r.value for r in rows))
-        return rows, done
+        rows = [self._tracked(row, points) for row in table if float(row[self.parameter]) in done]
+        return rows, done, [e for e in said["events"] if e["value"] in done]
 
-    def _differs(self, record: dict) -> str | None:
-        """Why the files cannot be resumed with ``record`` (another continuation's, or damaged), or None."""
+    def _said(self) -> dict | None:
+        """The record in ``FILE.json``, or None: missing, or damaged (without how the continuation was made, how
+        many values are finished or what happened along them)."""
         try:
-            old = json.loads(self.meta_path.read_text())["basins"]
+            said = json.loads(self.meta_path.read_text())
+            whole = (isinstance(said["basins"], dict) and isinstance(said["values"]["done"], int)
+                     and said["values"]["done"] >= 0 and all(isinstance(e["value"], float) for e in said["events"]))
         except (OSError, ValueError, KeyError, TypeError):
+            return None
+        return said if whole else None
+
+    def _differs(self, record: dict, said: dict | None) -> str | None:
+        """Why the files cannot be resumed with ``record`` (another continuation's, or ``said``, their record,
+        missing or damaged), or None."""
+        if said is None:
             return (f"{self.path} exists but {self.meta_path.name} (the record of how it was made) is missing or "
                     "damaged, so it cannot be resumed: pass --overwrite or choose another --out")
-        new = json.loads(json.dumps(record))
+        old, new = said["basins"], json.loads(json.dumps(record))
         differ = sorted(k for k in set(old) | set(new) if old.get(k) != new.get(k))
         if differ:
             return (f"{self.path} was written by another basin continuation ({', '.join(differ)} differ); repeat "
@@ -309,9 +313,9 @@ class _Store:
                        tuple(float(x) for x in lambdas if x), row["event"], pts,
                        tuple(float(row[f"scale_{s}"]) for s in self.states))
 
-    def write(self, rows: Sequence[Tracked], done: Sequence[float], record: dict, complete: bool) -> None:
-        """Every file whole: the points first, then the rows (a value counts as done once its rows are there),
-        then the record."""
+    def write(self, rows: Sequence[Tracked], done: Sequence[float], happened: Sequence[dict], record: dict) -> None:
+        """Every file whole, after a value: the points, the rows, then the record (that counts the value
+        finished) with what happened."""
         text = io.StringIO()
         writer = csv.writer(text, lineterminator="\n")
         writer.writerow(self.point_columns)
@@ -329,17 +333,11 @@ class _Store:
                              number(r.stderr), r.starts, "" if r.period is None else r.period, r.regime, *amplitude,
                              *lambdas, r.event, *map(number, r.scale)])
         write_atomically(self.path, text.getvalue())
-        meta = {"basins": record, "status": "complete" if complete else "running",
-                "values": {"planned": len(record["values"]), "done": len(done)},
-                "events": json_safe(events(rows, done)), "gearsym": __version__}
+        planned = len(record["values"])
+        meta = {"basins": record, "status": "complete" if len(done) == planned else "running",
+                "values": {"planned": planned, "done": len(done)}, "events": json_safe(list(happened)),
+                "gearsym": __version__}
         write_atomically(self.meta_path, json.dumps(meta, indent=2) + "\n")
-
-    def status(self) -> str | None:
-        """What the record says of the continuation: running, complete (None: no record)."""
-        try:
-            return json.loads(self.meta_path.read_text()).get("status")
-        except (OSError, ValueError, AttributeError):
-            return None
 
     def release(self) -> None:
         if self._lock is not None:
