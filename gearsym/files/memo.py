@@ -4,12 +4,12 @@ read without importing pint: :mod:`gearsym.units`).
 An answer is a sealed private record (:mod:`.sealed`) in ``<cache>/<kind>/``, under a name that hashes its question
 and what the answer depends on (the answering library's version and data): another version is another name,
 never a stale answer. A process reads the answers of a kind once, all together (:func:`recall_all`), and looks
-its questions up in what it read. They are read only from a cache that is private (:func:`~.private.private_folder`: a cache
-someone else could write, or reached through their symlink, is not read: the question is asked again), only if the
-record is as it was written (a record changed since, or not private, is said once in a warning and written again)
-and only if it answers the question it is kept under (a record not to be trusted is removed: its question is asked
-again). Keeping one is best effort: a cache that cannot be written leaves the
-answer unkept, in silence (the next process asks again).
+its questions up in what it read. They are read only from a cache that is private
+(:func:`~.private.private_folder`: a cache someone else could write, or reached through their symlink, is not read:
+the question is asked again), only if the record is as it was written (a record changed since, or not private, is
+said once in a warning and written again) and only if it answers the question it is kept under (a record not to be
+trusted is removed: its question is asked again). Keeping one is best effort: a cache that cannot be written leaves
+the answer unkept, in silence (the next process asks again).
 """
 from __future__ import annotations
 
