@@ -96,11 +96,16 @@ def _kind(path: Path) -> str:
 def system_key(path: Path, values: Mapping[str, object]) -> str:
     """What the reduction of the model in ``path`` with ``values`` depends on, hashed: the model file, the
     model files beside it and in the models folder (a model imports another), gearsym's source, the values."""
+    return system_keys(path, values)[0]
+
+
+def system_keys(path: Path, *values: Mapping[str, object]) -> tuple[str, ...]:
+    """:func:`system_key` of the model in ``path`` with each of ``values``, its files read and hashed once."""
     files = _model_files(tuple(sorted({path.parent, models_dir().resolve()})))
-    description = {"format": SUMMARY_FORMAT, "model": str(path), "files": files,
-                   "gearsym": _source_digest(Path(__file__).resolve().parent),
-                   "python": sys.version, "values": {k: repr(v) for k, v in sorted(values.items())}}
-    return hashlib.sha256(json.dumps(description, sort_keys=True).encode()).hexdigest()[:24]
+    described = {"format": SUMMARY_FORMAT, "model": str(path), "files": files,
+                 "gearsym": _source_digest(Path(__file__).resolve().parent), "python": sys.version}
+    return tuple(hashlib.sha256(json.dumps({**described, "values": {k: repr(v) for k, v in sorted(each.items())}},
+                                           sort_keys=True).encode()).hexdigest()[:24] for each in values)
 
 
 @record_class
@@ -175,10 +180,11 @@ def cache_slot(ref, values: Mapping[str, object]) -> CacheSlot:
     path = model_file(ref) if isinstance(ref, str) else None
     if path is None:
         return CacheSlot()
-    key = system_key(path, values)
+    plain = plain_values(values)  # (new plain values: the entry is derived from the one without them)
+    key, base_key = system_keys(path, values, {k: v for k, v in values.items() if k not in plain})
     data = read_json(summary_path(path.stem, key))
-    if data is None and (plain := plain_values(values)):  # (new plain values: from the entry without them)
-        data = derived_entry(path, system_key(path, {k: v for k, v in values.items() if k not in plain}), key, plain)
+    if data is None and plain:
+        data = derived_entry(path, base_key, key, plain)
     try:
         system = data["system"]
         physical = data["physical"] if system["physical"] else None
