@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import sys
 from collections.abc import Callable, Mapping
@@ -43,7 +44,7 @@ from pathlib import Path
 from .records import record_class
 from .codegen.kept import (SUMMARY_FORMAT, BuildSummary, build_path, found_build, found_over, keep_model, kept_model,
                            read_build, read_builds, read_json, summary_path, write_json)
-from .codegen.derived_summary import derived_entry, plain_values
+from .codegen.derived_summary import derived_entry
 from .codegen.system_summary import SystemSummary, read_summary
 from .codegen.library import resolve_backend
 from .options import Integration
@@ -173,6 +174,12 @@ class Making:
     compile_system: Callable[[object, Integration], object]
     kept_units: Callable[[], PointUnits | None]
     before: Callable[[object], object] | None = None
+
+
+def plain_values(values: Mapping[str, object]) -> dict[str, float]:
+    """The values of ``values`` that are plain finite numbers (what a derived entry may differ by)."""
+    return {name: float(v) for name, v in values.items()
+            if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)}
 
 
 def cache_slot(ref, values: Mapping[str, object]) -> CacheSlot:

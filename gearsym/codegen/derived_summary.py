@@ -17,7 +17,6 @@ model); and a library of the base entry is found and trusted (:func:`~.kept.kept
 """
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
@@ -28,12 +27,6 @@ from .code_files import code_directory, read_manifest
 from .kept import BuildSummary, build_path, kept_model, read_builds, read_json, summary_path, write_json
 from .mode_rates import compiled_rate
 from .system_summary import read_summary
-
-
-def plain_values(values: Mapping[str, object]) -> dict[str, float]:
-    """The values of ``values`` that are plain finite numbers (what a derived entry may differ by)."""
-    return {name: float(v) for name, v in values.items()
-            if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)}
 
 
 def derived_entry(path: Path, base_key: str, key: str, plain: Mapping[str, float]) -> dict | None:
