@@ -188,7 +188,8 @@ def cache_slot(ref, values: Mapping[str, object]) -> CacheSlot:
     if path is None:
         return CacheSlot()
     plain = plain_values(values)  # (new plain values: the entry is derived from the one without them)
-    key, base_key = system_keys(path, values, {k: v for k, v in values.items() if k not in plain})
+    without = {k: v for k, v in values.items() if k not in plain}
+    key, base_key = system_keys(path, values, without) if plain else (system_key(path, values), None)
     data = read_json(summary_path(path.stem, key))
     if data is None and plain:
         data = derived_entry(path, base_key, key, plain)
