@@ -43,8 +43,8 @@ fits' and scans' window runs 15 -> 7.5 s of CPU, the same bits). The driver clea
 halves before each window, step and sample's calls (``GS_CLEAN_UPPER``): the compiler copies the time values with
 512-bit moves and, at the windows' -O1, does not clear them itself (gcc's vzeroupper pass runs from -O2), and with
 them dirty every call into the maths library (pow, fmin) cost about ten times as much (the one-stage model's default
-library, 40 windows of 76 samples: a step with three columns 6327 -> 800 ns, the state alone 3788 -> 700 ns, the
-same bits).
+library, 40 windows of 76 samples: a step with three columns 6327 -> 577-871 ns, the state alone 3788 -> 377-700 ns,
+the same bits).
 The C is cached like the engine's (:mod:`.compiler`); without a compiler the same functions run in
 CasADi's virtual machine, mapped over the windows.
 """
@@ -477,8 +477,8 @@ _DRIVER = r"""
 /* the upper halves of the vector registers cleared before the generated functions and the maths library run: the
    compiler copies W and D (fixed sizes) with 512-bit moves and leaves those halves dirty (at -O1 gcc inserts no
    vzeroupper of its own: that pass needs -fexpensive-optimizations, on from -O2), and every call into libm (pow,
-   fmin) then ran about ten times slower (a candidate library's step 6300 -> 900 ns on a Xeon with AVX-512: the same
-   instructions, the same bits) */
+   fmin) then ran about ten times slower (a candidate library's step with three columns 6300 -> 600-900 ns on a Xeon
+   with AVX-512: the same instructions, the same bits) */
 #if defined(__AVX__)
 #include <immintrin.h>
 #define GS_CLEAN_UPPER() _mm256_zeroupper()

@@ -324,6 +324,6 @@ class GivenGrid(StartGrid):
         self.si_grid = grid_in_si(units, axes) if units is not None else None
 
     def at(self, point):
-        if self.units is None:
-            return self.values
+        if self.units is None:  # (the model's own numbers: the same at every point)
+            return super().at(point)
         return engine_grid(self.units, self.si_grid, point.get("omega", 1.0))
