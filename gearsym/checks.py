@@ -1,4 +1,5 @@
-"""Small argument checks shared by the engine and the analyses, and what a request needs in memory against what
+"""Small argument checks shared by the engine and the analyses (a command line's checks of its own flags are
+the command line's: :mod:`gearsym.cli.arguments.integration`), and what a request needs in memory against what
 this machine has.
 
 A size is checked where it enters (the options, a verb's own counts), before the memory is taken: a size that
@@ -13,12 +14,8 @@ import os
 
 import numpy as np
 
-from .errors import GearsymError, suggest, warn
+from .errors import GearsymError, suggest
 
-#: RK4 steps per forcing period: fewer than MIN do not resolve the forcing at all (refused); fewer than FEW
-#: leave the paper's models' exponents and amplitudes off by a per cent or more (one_stage at 8 steps: 3 %)
-MIN_STEPS_PER_PERIOD = 8
-FEW_STEPS_PER_PERIOD = 20
 #: at most this many RK4 steps per forcing period: 200 steps for each natural period 5000 times shorter than the
 #: forcing's. The compiled time tables hold every step: building them takes some KiB and tenths of a millisecond a
 #: step (one_stage at 10^6 steps: 3 GB and 100 s), so 10^8 steps ran out of memory after minutes
@@ -36,10 +33,6 @@ def run_bytes_per_period(dimension: int, observed: int) -> int:
 
 #: the least memory a run takes per forcing period (one state, observed)
 RUN_BYTES_PER_PERIOD = run_bytes_per_period(1, 1)
-#: measured periods (after the transient): the standard error comes from 10 batches of at least one period
-#: each (refused below), and an exponent within 5/(measured time) of zero counts as zero (warned below FEW)
-MIN_MEASURED_PERIODS = 10
-FEW_MEASURED_PERIODS = 50
 
 
 def whole_number(value, what: str, minimum: int = 0) -> int:
@@ -53,31 +46,6 @@ def whole_number(value, what: str, minimum: int = 0) -> int:
     if count < minimum:
         raise GearsymError(f"{what} must be at least {minimum}, got {count}")
     return count
-
-
-def check_run(*, steps_per_period: int | None = None, measured: int | None = None, discard: int | None = None,
-              measured_is: str = "--periods minus --discard") -> None:
-    """Refuse a run too coarse or too short to mean anything, and warn (one line) in the grey zone below
-    the usual values; ``measured_is`` says how the measured periods came about, for the message."""
-    if steps_per_period is not None:
-        steps = whole_number(steps_per_period, "steps per period", -2**63)  # (below the minimum: the message below)
-        if steps < MIN_STEPS_PER_PERIOD:
-            raise GearsymError(f"{steps} RK4 steps per forcing period (--steps-per-period) cannot resolve the "
-                               f"forcing: give at least {MIN_STEPS_PER_PERIOD} (200 is the default)")
-        if steps < FEW_STEPS_PER_PERIOD:
-            warn(f"{steps} RK4 steps per forcing period are coarse: exponents and amplitudes may be off by a per "
-                 f"cent or more ({FEW_STEPS_PER_PERIOD} or more are safer, 200 is the default)")
-    if measured is not None:
-        if measured < 1:
-            raise GearsymError(f"no measured periods ({measured_is} is {measured}): need discard < periods")
-        if measured < MIN_MEASURED_PERIODS:
-            raise GearsymError(f"{measured} measured periods ({measured_is}) are too few: exponents need at least "
-                               f"{MIN_MEASURED_PERIODS} for a standard error (the defaults measure 300)")
-        if measured < FEW_MEASURED_PERIODS:
-            warn(f"only {measured} measured periods ({measured_is}): an exponent within 5/(measured time) of zero "
-                 f"counts as zero, so the regime is uncertain ({FEW_MEASURED_PERIODS} or more are safer)")
-    if discard == 0:
-        warn("no transient discarded (--discard 0): the exponents and amplitudes include the start")
 
 
 def json_safe(x):

@@ -157,7 +157,7 @@ def test_a_run_too_coarse_or_too_short_to_mean_anything_is_refused(capsys, no_wo
 
 
 def test_a_coarse_or_short_run_is_warned_in_one_line_each():
-    from gearsym.checks import check_run
+    from gearsym.cli.arguments.integration import check_run
 
     with pytest.warns(GearsymWarning) as seen:
         check_run(steps_per_period=12, measured=20, discard=0)

@@ -16,7 +16,7 @@ import gearsym  # the face: the code generator loads on first use
 
 from ..analysis.order_run import SAMPLES_PER_CYCLE, mesh_gears, simulated_order_spectrum
 from ..analysis.orders import MESH_HARMONICS, MIN_REVOLUTIONS, SIDEBANDS, check_length, most_sidebands, order_spectrum
-from ..checks import check_fits, check_run, json_safe
+from ..checks import check_fits, json_safe
 from ..data.measurements import load_measurements
 from ..errors import GearsymError
 from ..files.atomic import write_atomically
@@ -26,7 +26,7 @@ from ..opening import OpenModel, open_model
 from ..options import STEPS_PER_PERIOD, Integration
 from ..files.outputs import check_figure, check_file
 from ..physical.point import LENGTH
-from .arguments.integration import add_integration_arguments, model_request
+from .arguments.integration import add_integration_arguments, check_run, model_request
 from .arguments.settings import add_set_argument, model_settings
 from .simulate import with_effects
 

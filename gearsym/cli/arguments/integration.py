@@ -1,15 +1,53 @@
 """The options every integrating command shares, declared once: the command-line face of
-:class:`~gearsym.options.Integration`, and what a command asks of its MODEL (:func:`model_request`), read once
+:class:`~gearsym.options.Integration`, the command line's checks of a run's length and steps (:func:`check_run`:
+their messages name the flags), and what a command asks of its MODEL (:func:`model_request`), read once
 into a :class:`~gearsym.opening.ModelRequest` that :func:`~gearsym.opening.open_model` opens."""
 from __future__ import annotations
 
 import argparse
 import re
 
-from ...checks import check_run
+from ...errors import GearsymError, warn
 from ...opening import ModelRequest
 from ...options import BACKENDS, INTEGRATORS, STEPS_PER_PERIOD, Integration
 from .settings import model_settings
+
+
+#: RK4 steps per forcing period: fewer than MIN do not resolve the forcing at all (refused); fewer than FEW
+#: leave the paper's models' exponents and amplitudes off by a per cent or more (one_stage at 8 steps: 3 %)
+MIN_STEPS_PER_PERIOD = 8
+FEW_STEPS_PER_PERIOD = 20
+
+#: measured periods (after the transient): the standard error comes from 10 batches of at least one period
+#: each (refused below), and an exponent within 5/(measured time) of zero counts as zero (warned below FEW)
+MIN_MEASURED_PERIODS = 10
+FEW_MEASURED_PERIODS = 50
+
+
+def check_run(*, steps_per_period: int | None = None, measured: int | None = None, discard: int | None = None,
+              measured_is: str = "--periods minus --discard") -> None:
+    """Refuse a run too coarse or too short to mean anything, and warn (one line) in the grey zone below
+    the usual values; ``measured_is`` says how the measured periods came about, for the message."""
+    if steps_per_period is not None:
+        steps = steps_per_period  # (a whole number: argparse's, or the command's own choice)
+        if steps < MIN_STEPS_PER_PERIOD:
+            raise GearsymError(f"{steps} RK4 steps per forcing period (--steps-per-period) cannot resolve the "
+                               f"forcing: give at least {MIN_STEPS_PER_PERIOD} (200 is the default)")
+        if steps < FEW_STEPS_PER_PERIOD:
+            warn(f"{steps} RK4 steps per forcing period are coarse: exponents and amplitudes may be off by a per "
+                 f"cent or more ({FEW_STEPS_PER_PERIOD} or more are safer, 200 is the default)")
+    if measured is not None:
+        if measured < 1:
+            raise GearsymError(f"no measured periods ({measured_is} is {measured}): need discard < periods")
+        if measured < MIN_MEASURED_PERIODS:
+            raise GearsymError(f"{measured} measured periods ({measured_is}) are too few: exponents need at least "
+                               f"{MIN_MEASURED_PERIODS} for a standard error (the defaults measure 300)")
+        if measured < FEW_MEASURED_PERIODS:
+            warn(f"only {measured} measured periods ({measured_is}): an exponent within 5/(measured time) of zero "
+                 f"counts as zero, so the regime is uncertain ({FEW_MEASURED_PERIODS} or more are safer)")
+    if discard == 0:
+        warn("no transient discarded (--discard 0): the exponents and amplitudes include the start")
+
 
 
 def add_integration_arguments(parser: argparse.ArgumentParser, *, periods: int | None = 400, discard: int = 100,
