@@ -314,7 +314,7 @@ def test_cli_errors_are_one_line_messages(capsys, argv, message):
 
 
 @pytest.mark.parametrize("model, grid, message", [
-    ("spur_pair", "x=-1A:1A:1A", "A: a drivetrain value is made of mass, length and time"),
+    ("spur_pair", "x=-1A:1A:1A", "--grid 'x=-1A:1A:1A': a drivetrain value is made of mass, length and time"),
     ("one_stage", "x=-1A:1A:1A", "has a unit, but the model has no physical values"),  # (its unit read, not said)
 ])
 def test_a_grid_in_a_unit_of_another_kind_is_refused_before_the_model_is_compiled(capsys, model, grid, message):

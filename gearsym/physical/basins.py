@@ -20,9 +20,10 @@ from ..analysis.basins import BasinMap, StartGrid
 from ..checks import json_safe
 from ..errors import GearsymError
 from ..sweep.basin_continuation import BasinContinuation
-from ..sweep.grid import Axis, axis_fields, parse_axis
-from ..units import dimension_text, to_si, unit_dims
+from ..sweep.grid import Axis, parse_axis
+from ..units import dimension_text
 from .point import ANGLE, ANGULAR_VELOCITY, LENGTH, VELOCITY, PointUnits
+from .sweeps import MeasuredAxis
 from .text import parameter_text
 
 
@@ -109,28 +110,27 @@ _DIMENSIONS = {LENGTH: ((0.0, 1.0, 0.0), "-20um:20um:1um"), VELOCITY: ((0.0, 1.0
 
 
 @dataclass(frozen=True)
-class GridAxis(Axis):
-    """One ``--grid`` axis as given, its unit read once when it is parsed (:meth:`read`): its values in SI units and
-    the unit's dimension (exponents of mass, length and time), or why the unit is no drivetrain's (``refused``: a
-    model with physical values says it, one without says that it takes no unit)."""
-
-    si_values: tuple[float, ...] = ()
-    dims: tuple[float, float, float] | None = None
-    refused: str = ""
+class GridAxis(MeasuredAxis):
+    """One ``--grid`` axis as given, its unit read once when it is parsed (:meth:`read`), as any axis with a unit
+    is (:class:`~gearsym.physical.sweeps.MeasuredAxis`): its values in SI units and the unit's dimension
+    (exponents of mass, length and time), or why the unit is no drivetrain's (``refused``: a model with physical
+    values says it, one without says that it takes no unit)."""
 
     @classmethod
     def read(cls, text: str) -> "GridAxis":
         """``STATE=START:STOP:STEP`` (or a list, or one value), with or without a unit (its errors name --grid)."""
         axis = parse_axis(text, "--grid")
-        plain = axis_fields(axis)
-        if not axis.unit:
-            return cls(**plain)
-        try:
-            dims = unit_dims(axis.unit)
-        except GearsymError as exc:
-            return cls(**plain, refused=str(exc))
-        values = to_si(np.asarray(axis.values, dtype=float), axis.unit)
-        return cls(**plain, si_values=tuple(float(v) for v in values), dims=dims)
+        return cls.of(axis, f"--grid {axis.spec!r}")
+
+    @property
+    def si_values(self) -> tuple[float, ...]:
+        """The values in SI units (none without a unit, or with one refused)."""
+        return tuple(m.si for m in self.measures)
+
+    @property
+    def dims(self) -> tuple[float, float, float] | None:
+        """The unit's dimension (None without a unit, or with one refused)."""
+        return self.measures[0].dims if self.measures else None
 
 
 def grid_in_si(units: PointUnits, axes: Sequence[GridAxis]) -> dict[str, np.ndarray]:
