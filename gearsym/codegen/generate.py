@@ -92,6 +92,17 @@ class GeneratedCode:
     lanes: Path | None = None  # the lanes' C (:mod:`.lanes`), compiled only when lanes are asked for
 
 
+def casadi_source(file_name: str, functions) -> str:
+    """The C file ``file_name`` CasADi's code generator writes for ``functions`` (deterministic; without a header,
+    no prefix), as text: generated into a private temporary folder by the generator's own prefix (the working
+    directory is left alone, which another thread may be using) and read back."""
+    gen = ca.CodeGenerator(file_name, {"with_header": False, "verbose": False, "prefix": ""})
+    for f in functions:
+        gen.add(f)
+    with tempfile.TemporaryDirectory() as tmp:
+        return Path(gen.generate(tmp + os.sep)).read_text()
+
+
 def write_code(mf: ModelFunctions, directory: Path, digest: str) -> GeneratedCode:
     """Write ``<model>.c``, ``<model>_lanes.c`` and ``manifest.json`` into ``directory`` (atomically: no
     half-written files): CasADi's C, with the integration loops printed by :mod:`.printed`, and the lanes printed
@@ -100,17 +111,9 @@ def write_code(mf: ModelFunctions, directory: Path, digest: str) -> GeneratedCod
     directory.mkdir(parents=True, exist_ok=True)
     name = mf.system.name
     with tempfile.TemporaryDirectory(dir=directory) as tmp:
-        gen = ca.CodeGenerator(source_file(name), {"with_header": False, "verbose": False, "prefix": ""})
-        for fname, f in mf.functions.items():
-            gen.add(stand_in(f, pieces(mf, fname)) if fname in LOOP_NAMES else f)
-        cwd = os.getcwd()
-        try:  # CasADi writes into the working directory
-            os.chdir(tmp)
-            gen.generate()
-        finally:
-            os.chdir(cwd)
+        text = casadi_source(source_file(name), [stand_in(f, pieces(mf, fname)) if fname in LOOP_NAMES else f
+                                                 for fname, f in mf.functions.items()])
         source, lanes = Path(tmp) / source_file(name), Path(tmp) / lanes_file(name)
-        text = source.read_text()
         lanes.write_text(lanes_source(mf))
         source.write_text(print_loops(text, mf))
         os.replace(lanes, directory / lanes.name)

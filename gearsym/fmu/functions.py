@@ -9,9 +9,7 @@ backlash, each shaft's twist), all in the engine's units, from the system's coup
 """
 from __future__ import annotations
 
-import os
 import re
-import tempfile
 from pathlib import Path
 
 import casadi as ca
@@ -19,6 +17,7 @@ import sympy as sp
 
 from ..model.backlash import g
 from ..codegen.casadi_symbols import SystemSymbols
+from ..codegen.generate import casadi_source
 from ..codegen.time_tables import SplitRHS
 from ..codegen.translate import to_casadi
 from ..errors import ModelError
@@ -90,21 +89,10 @@ def _mapping(system: FirstOrderSystem, sym: SystemSymbols, exprs) -> dict:
 
 def write_functions(functions: list[ca.Function], directory: Path) -> Path:
     """The C of ``functions`` as ``directory/`` :data:`SOURCE` (CasADi's code generator: deterministic)."""
-    directory = Path(directory)
-    with tempfile.TemporaryDirectory() as tmp:
-        gen = ca.CodeGenerator(SOURCE, {"with_header": False, "verbose": False, "prefix": ""})
-        for f in functions:
-            gen.add(f)
-        cwd = os.getcwd()
-        try:  # CasADi writes into the working directory
-            os.chdir(tmp)
-            gen.generate()
-        finally:
-            os.chdir(cwd)
-        text = (Path(tmp) / SOURCE).read_text()
+    text = casadi_source(SOURCE, functions)
     # CasADi's exported helpers (_casadi_version, ...) have the same names in the engine's C beside it: renamed here
     helpers = sorted(set(re.findall(r"^CASADI_SYMBOL_EXPORT [\w ]+?\b(_casadi_\w+)\(", text, re.M)))
     text = "".join(f"#define {name} gearsym_fmu{name}\n" for name in helpers) + text
-    target = directory / SOURCE
+    target = Path(directory) / SOURCE
     target.write_text(text)
     return target
