@@ -76,7 +76,8 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     reference = args.reference or subprocess.run(["git", "merge-base", "HEAD", "main"], cwd=REPO, capture_output=True,
                                                  text=True, check=True).stdout.strip()
-    results = {"command": " ".join(["python -m bench.fit", *(sys.argv[1:] if argv is None else argv)]), "date": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+    command = " ".join(["python -m bench.fit", *(sys.argv[1:] if argv is None else argv)])
+    results = {"command": command, "date": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
                "reference": reference, "now": subprocess.run(["git", "rev-parse", "HEAD"], cwd=REPO,
                                                              capture_output=True, text=True).stdout.strip(),
                "loadavg_at_start": list(os.getloadavg()), "cases": {}}
