@@ -49,7 +49,6 @@ def check_run(*, steps_per_period: int | None = None, measured: int | None = Non
         warn("no transient discarded (--discard 0): the exponents and amplitudes include the start")
 
 
-
 def add_integration_arguments(parser: argparse.ArgumentParser, *, periods: int | None = 400, discard: int = 100,
                               steps_help: str = (f"steps per forcing period (a mesh period of the first mesh; default at "
                                                  f"least {STEPS_PER_PERIOD}, more if the fastest mode needs them)")) -> None:
