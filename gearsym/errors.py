@@ -95,6 +95,6 @@ def option(keyword: str, value: object = _ANY, *, flag: str | None = None) -> st
     """
     shown = "..." if value is _ANY else f"{value:g}" if isinstance(value, float) else value
     if on_command_line():
-        name = flag or "--" + keyword.replace("_", "-")
+        name = option_name(keyword, flag=flag)
         return name if value is True else f"{name} {shown}"
     return f"{keyword}={shown!r}" if isinstance(value, str) else f"{keyword}={shown}"
