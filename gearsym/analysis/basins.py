@@ -210,6 +210,11 @@ class StartGrid:
     def __init__(self, values: Mapping[str, Sequence[float]], given: Sequence[str] = ()):
         self.values, self.given = values, tuple(given)
 
+    @classmethod
+    def of(cls, grid: "Mapping[str, Sequence[float]] | StartGrid") -> "StartGrid":
+        """``grid`` as a :class:`StartGrid` (a mapping of values: the same at every point, given as those values)."""
+        return grid if isinstance(grid, StartGrid) else cls(grid)
+
     def at(self, point: Mapping[str, float]) -> Mapping[str, Sequence[float]]:
         """The grid at the parameter values ``point``."""
         return self.values
@@ -239,7 +244,7 @@ def basin_map(model: CompiledModel, grid: Mapping[str, Sequence[float]] | StartG
     execution = execution or Execution()
     p = model.parameter_vector(values)  # names and values checked before any run
     point = dict(zip(model.parameter_names, map(float, p)))
-    axes, held, starts = grid_starts(model, grid.at(point) if isinstance(grid, StartGrid) else grid, y0)
+    axes, held, starts = grid_starts(model, StartGrid.of(grid).at(point), y0)
     inputs = model.prepare(p)
     runner = LaneRunner(model, options.discard, options.measured, lanes=execution.with_lanes(True),
                         verbose=execution.verbose)

@@ -123,7 +123,7 @@ def continue_basins(model: CompiledModel, grid: Mapping[str, Sequence[float]] | 
     with ``progress`` a line per value. ``on_value(map)`` is called after each value is stored."""
     options = model.run_options(options)
     execution = execution or Execution()
-    grid = grid if isinstance(grid, StartGrid) else StartGrid(grid)
+    grid = StartGrid.of(grid)
     if parameter not in model.parameter_names:
         raise UnknownParameterError(parameter, model.parameter_names, f"{model.name}: --param")
     if parameter in fixed:
