@@ -86,6 +86,7 @@ def sign_violation(number: float, allow_zero: bool) -> str | None:
         return "must not be negative" if allow_zero else "must be positive"
     return None
 
+
 #: requests below this size are not checked (they fit anywhere gearsym runs, and reading the memory costs a call)
 SMALL = 1 << 26
 
